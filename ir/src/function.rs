@@ -1,0 +1,364 @@
+//! Functions and modules: value arena, body order, outputs, and the builder API used by front
+//! ends and passes.
+
+use std::collections::HashMap;
+
+use crate::entities::Value;
+use crate::span::Span;
+use crate::syntax::{Def, Expr, OpKind, Operand, Output, Phase, ValueData};
+
+/// One Robotran function in SSA form (`dirdyna`, `invdyna`, `sensor_3`, …).
+///
+/// Values live in an arena indexed by [`Value`]. `inputs` lists the input values; `body` lists
+/// every other value in definition (topological) order. Names are unique within the function.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Function {
+    /// Function name without `@` (`dirdyna`, `sensor_2`).
+    pub name: String,
+    /// Which definition forms are allowed.
+    pub phase: Phase,
+    /// Number of equations of the source (SPEC §1: assignments except trig initial variables),
+    /// carried through passes for reports; `None` when unknown.
+    pub equations: Option<u32>,
+    /// Value arena: index = `Value::index()`.
+    pub values: Vec<ValueData>,
+    /// Input values, in first-use order.
+    pub inputs: Vec<Value>,
+    /// Defined values (trig, ops, expressions), in definition order.
+    pub body: Vec<Value>,
+    /// Outputs in source order.
+    pub outputs: Vec<Output>,
+    /// Span of the whole function in its source.
+    pub span: Span,
+    names: HashMap<String, Value>,
+}
+
+/// A set of functions from one input file.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Module {
+    /// Functions in source order; names are unique.
+    pub functions: Vec<Function>,
+}
+
+impl Module {
+    /// The function called `name`, if any.
+    pub fn function(&self, name: &str) -> Option<&Function> {
+        self.functions.iter().find(|f| f.name == name)
+    }
+}
+
+/// Counts of operations by kind (SPEC §7 `stats.ops`), units: ops.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct OpCounts {
+    /// `add` ops.
+    pub add: u64,
+    /// `sub` ops.
+    pub sub: u64,
+    /// `mul` ops.
+    pub mul: u64,
+    /// `div` ops.
+    pub div: u64,
+    /// `call` ops.
+    pub call: u64,
+    /// Sum of the above.
+    pub total: u64,
+}
+
+impl OpCounts {
+    /// Counts one op of `kind`.
+    pub fn bump(&mut self, kind: OpKind) {
+        match kind {
+            OpKind::Add => self.add += 1,
+            OpKind::Sub => self.sub += 1,
+            OpKind::Mul => self.mul += 1,
+            OpKind::Div => self.div += 1,
+            OpKind::Call => self.call += 1,
+        }
+        self.total += 1;
+    }
+}
+
+impl Function {
+    /// An empty function in `phase`.
+    pub fn new(name: impl Into<String>, phase: Phase) -> Function {
+        Function {
+            name: name.into(),
+            phase,
+            equations: None,
+            values: Vec::new(),
+            inputs: Vec::new(),
+            body: Vec::new(),
+            outputs: Vec::new(),
+            span: Span::DUMMY,
+            names: HashMap::new(),
+        }
+    }
+
+    /// The data of `v`. Panics if `v` is not a value of this function (a verified function only
+    /// holds its own values).
+    pub fn value(&self, v: Value) -> &ValueData {
+        &self.values[v.index()]
+    }
+
+    /// Mutable data of `v`; the name must not be changed through it (use [`Function::rename`]).
+    pub fn value_mut(&mut self, v: Value) -> &mut ValueData {
+        &mut self.values[v.index()]
+    }
+
+    /// The value named `name` (without `%`).
+    pub fn lookup(&self, name: &str) -> Option<Value> {
+        self.names.get(name).copied()
+    }
+
+    /// The name of `v` (without `%`).
+    pub fn name_of(&self, v: Value) -> &str {
+        &self.values[v.index()].name
+    }
+
+    /// A name not yet used in this function: `base` itself if free, else `base.1`, `base.2`, …
+    pub fn fresh_name(&self, base: &str) -> String {
+        if !self.names.contains_key(base) {
+            return base.to_string();
+        }
+        (1..)
+            .map(|k| format!("{base}.{k}"))
+            .find(|n| !self.names.contains_key(n))
+            .expect("unbounded counter")
+    }
+
+    fn push_value(&mut self, name: String, def: Def, span: Span) -> Result<Value, Value> {
+        if let Some(&old) = self.names.get(&name) {
+            return Err(old);
+        }
+        let v = Value::with_number(self.values.len() as u32);
+        self.names.insert(name.clone(), v);
+        self.values.push(ValueData { name, def, timing: None, span });
+        Ok(v)
+    }
+
+    /// Adds an input named `name`.
+    ///
+    /// # Errors
+    /// `Err(existing)` when the name is already taken; nothing is added.
+    pub fn add_input(&mut self, name: impl Into<String>, span: Span) -> Result<Value, Value> {
+        let v = self.push_value(name.into(), Def::Input, span)?;
+        self.inputs.push(v);
+        Ok(v)
+    }
+
+    /// Appends a definition to the body.
+    ///
+    /// # Errors
+    /// `Err(existing)` when the name is already taken; nothing is added.
+    pub fn define(&mut self, name: impl Into<String>, def: Def, span: Span) -> Result<Value, Value> {
+        let v = self.push_value(name.into(), def, span)?;
+        self.body.push(v);
+        Ok(v)
+    }
+
+    /// Appends a definition under a fresh name derived from `base` (see [`Function::fresh_name`]).
+    pub fn define_fresh(&mut self, base: &str, def: Def, span: Span) -> Value {
+        let name = self.fresh_name(base);
+        self.define(name, def, span).expect("fresh name is free")
+    }
+
+    /// Sets output `name` to `value`, replacing an earlier output of that name (read-modify-write).
+    pub fn set_output(&mut self, name: impl Into<String>, value: Operand, span: Span) {
+        let name = name.into();
+        if let Some(o) = self.outputs.iter_mut().find(|o| o.name == name) {
+            o.value = value;
+            o.span = span;
+        } else {
+            self.outputs.push(Output { name, value, span });
+        }
+    }
+
+    /// The operation kind of `v`'s definition, or `None` for inputs, trig variables and
+    /// (parsed-phase) expressions.
+    pub fn op_kind(&self, v: Value) -> Option<OpKind> {
+        self.value(v).def.op_kind()
+    }
+
+    /// Counts the operations of the function; expressions count as SPEC §3 atomises them.
+    pub fn op_counts(&self) -> OpCounts {
+        let mut c = OpCounts::default();
+        for &v in &self.body {
+            match &self.value(v).def {
+                Def::Expr(e) => crate::count::count_expr(e, &mut c),
+                d => {
+                    if let Some(k) = d.op_kind() {
+                        c.bump(k)
+                    }
+                }
+            }
+        }
+        c
+    }
+
+    /// Removes every schedule attribute (call after a change that invalidates them).
+    pub fn clear_timing(&mut self) {
+        for d in &mut self.values {
+            d.timing = None;
+        }
+    }
+
+    /// Rebuilds the name index; for code that edits `values` directly.
+    pub fn reindex_names(&mut self) {
+        self.names = self.values.iter().enumerate().map(|(i, d)| (d.name.clone(), Value::with_number(i as u32))).collect();
+    }
+
+    /// Keeps only the body values for which `keep` is true, renumbering values densely and
+    /// rewriting every reference. Inputs are kept when `keep_input` says so.
+    ///
+    /// The caller guarantees that no kept value refers to a dropped one.
+    pub fn retain(&mut self, mut keep: impl FnMut(&Function, Value) -> bool) {
+        let n = self.values.len();
+        let mut map: Vec<Option<Value>> = vec![None; n];
+        let mut new_values = Vec::new();
+        let order: Vec<Value> = self.inputs.iter().chain(self.body.iter()).copied().collect();
+        let mut new_inputs = Vec::new();
+        let mut new_body = Vec::new();
+        for v in order {
+            if !keep(self, v) {
+                continue;
+            }
+            let nv = Value::with_number(new_values.len() as u32);
+            map[v.index()] = Some(nv);
+            new_values.push(self.values[v.index()].clone());
+            if matches!(self.values[v.index()].def, Def::Input) {
+                new_inputs.push(nv);
+            } else {
+                new_body.push(nv);
+            }
+        }
+        let remap = |v: Value| map[v.index()].expect("kept value refers to a dropped value");
+        for d in &mut new_values {
+            d.def.map_values(&remap);
+        }
+        for o in &mut self.outputs {
+            if let Operand::Value(v) = o.value {
+                o.value = Operand::Value(remap(v));
+            }
+        }
+        self.values = new_values;
+        self.inputs = new_inputs;
+        self.body = new_body;
+        self.reindex_names();
+    }
+}
+
+impl Def {
+    /// The operation kind of this definition (`None` for inputs, trig and expressions).
+    pub fn op_kind(&self) -> Option<OpKind> {
+        match self {
+            Def::Binary(op, _, _) => Some(op.kind()),
+            Def::Call(..) => Some(OpKind::Call),
+            Def::Input | Def::Trig(..) | Def::Expr(_) => None,
+        }
+    }
+
+    /// Calls `f` on every value this definition reads, in operand order.
+    pub fn for_each_value(&self, mut f: impl FnMut(Value)) {
+        match self {
+            Def::Input => {}
+            Def::Trig(_, v) => f(*v),
+            Def::Binary(_, a, b) => {
+                for o in [a, b] {
+                    if let Operand::Value(v) = o {
+                        f(*v)
+                    }
+                }
+            }
+            Def::Call(_, args) => args.iter().for_each(|o| {
+                if let Operand::Value(v) = o {
+                    f(*v)
+                }
+            }),
+            Def::Expr(e) => e.for_each_value(&mut f),
+        }
+    }
+
+    /// Rewrites every value this definition reads through `m`.
+    pub fn map_values(&mut self, m: &impl Fn(Value) -> Value) {
+        let op = |o: &mut Operand| {
+            if let Operand::Value(v) = o {
+                *v = m(*v)
+            }
+        };
+        match self {
+            Def::Input => {}
+            Def::Trig(_, v) => *v = m(*v),
+            Def::Binary(_, a, b) => {
+                op(a);
+                op(b)
+            }
+            Def::Call(_, args) => args.iter_mut().for_each(op),
+            Def::Expr(e) => e.map_values(m),
+        }
+    }
+}
+
+impl Expr {
+    /// Calls `f` on every value the expression reads, left to right.
+    pub fn for_each_value(&self, f: &mut impl FnMut(Value)) {
+        match self {
+            Expr::Operand(Operand::Value(v)) => f(*v),
+            Expr::Operand(Operand::Const(_)) => {}
+            Expr::Neg(e) => e.for_each_value(f),
+            Expr::Binary(_, a, b) => {
+                a.for_each_value(f);
+                b.for_each_value(f)
+            }
+            Expr::Call(_, args) => args.iter().for_each(|a| a.for_each_value(f)),
+        }
+    }
+
+    /// Rewrites every value the expression reads through `m`.
+    pub fn map_values(&mut self, m: &impl Fn(Value) -> Value) {
+        match self {
+            Expr::Operand(Operand::Value(v)) => *v = m(*v),
+            Expr::Operand(Operand::Const(_)) => {}
+            Expr::Neg(e) => e.map_values(m),
+            Expr::Binary(_, a, b) => {
+                a.map_values(m);
+                b.map_values(m)
+            }
+            Expr::Call(_, args) => args.iter_mut().for_each(|a| a.map_values(m)),
+        }
+    }
+}
+
+impl crate::syntax::BinOp {
+    /// The op kind counted for this operator.
+    pub fn kind(self) -> OpKind {
+        use crate::syntax::BinOp::*;
+        match self {
+            Add => OpKind::Add,
+            Sub => OpKind::Sub,
+            Mul => OpKind::Mul,
+            Div => OpKind::Div,
+        }
+    }
+
+    /// The text mnemonic (`add`, `sub`, `mul`, `div`).
+    pub fn mnemonic(self) -> &'static str {
+        use crate::syntax::BinOp::*;
+        match self {
+            Add => "add",
+            Sub => "sub",
+            Mul => "mul",
+            Div => "div",
+        }
+    }
+
+    /// The infix symbol (`+ - * /`).
+    pub fn symbol(self) -> char {
+        use crate::syntax::BinOp::*;
+        match self {
+            Add => '+',
+            Sub => '-',
+            Mul => '*',
+            Div => '/',
+        }
+    }
+}

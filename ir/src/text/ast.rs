@@ -1,0 +1,120 @@
+//! The parse tree of `.rvir` text: names unresolved, spans kept. [`super::parser`] resolves
+//! names into a [`crate::Module`].
+
+use crate::span::Span;
+use crate::syntax::{BinOp, Callee, Phase, Timing, TrigFn};
+
+/// One `func @name { … }`.
+#[derive(Debug)]
+pub struct FuncAst<'a> {
+    /// Function name.
+    pub name: &'a str,
+    /// `phase …` line, default [`Phase::Parsed`].
+    pub phase: Option<Phase>,
+    /// `equations N` line.
+    pub equations: Option<u32>,
+    /// Body lines in order.
+    pub items: Vec<ItemAst<'a>>,
+    /// The whole function.
+    pub span: Span,
+}
+
+/// One line of a function body.
+#[derive(Debug)]
+pub enum ItemAst<'a> {
+    /// `input %name`
+    Input(&'a str, Span),
+    /// `%name = rhs {timing}`
+    Def {
+        /// Defined name.
+        name: &'a str,
+        /// Span of `%name`.
+        name_span: Span,
+        /// Right-hand side.
+        rhs: RhsAst<'a>,
+        /// Schedule attributes.
+        timing: Option<Timing>,
+    },
+    /// `output NAME = operand`
+    Output(&'a str, OperandAst<'a>, Span),
+}
+
+/// A right-hand side.
+#[derive(Debug)]
+pub enum RhsAst<'a> {
+    /// `add a, b` …
+    Bin(BinOp, OperandAst<'a>, OperandAst<'a>),
+    /// `cos %q[4]`
+    Trig(TrigFn, OperandAst<'a>),
+    /// `call @f(a, b)`
+    Call(Callee, Vec<OperandAst<'a>>),
+    /// An infix expression.
+    Expr(ExprAst<'a>),
+}
+
+/// An operand: `%name` or a constant.
+#[derive(Debug)]
+pub enum OperandAst<'a> {
+    /// A value name and its span.
+    Value(&'a str, Span),
+    /// A constant (may be negative in operation form).
+    Const(f64, Span),
+}
+
+/// An infix expression.
+#[derive(Debug)]
+pub enum ExprAst<'a> {
+    /// Leaf.
+    Operand(OperandAst<'a>),
+    /// `-x`
+    Neg(Box<ExprAst<'a>>),
+    /// `a op b`
+    Bin(BinOp, Box<ExprAst<'a>>, Box<ExprAst<'a>>),
+    /// `@f(args)`
+    Call(Callee, Vec<ExprAst<'a>>),
+}
+
+/// Splits `user_ExtForces.1[3]` into callee name and element.
+pub fn callee(text: &str) -> Callee {
+    if let Some(open) = text.rfind('[') {
+        if text.ends_with(']') {
+            if let Ok(e) = text[open + 1..text.len() - 1].parse::<u32>() {
+                return Callee { name: text[..open].to_string(), elem: Some(e) };
+            }
+        }
+    }
+    Callee { name: text.to_string(), elem: None }
+}
+
+/// Builds [`Timing`] from `{asap=…, alap=…, asap_cycle=…, alap_cycle=…, mobility=…}`.
+///
+/// # Errors
+/// A missing, repeated or unknown key, or a mobility that is not `alap - asap`.
+pub fn timing<'a>(
+    kv: Vec<(&'a str, u32)>,
+    start: usize,
+    end: usize,
+) -> Result<Timing, lalrpop_util::ParseError<usize, super::lexer::Tok<'a>, super::error::GrammarError>> {
+    let err = |msg: String| lalrpop_util::ParseError::User {
+        error: super::error::GrammarError::BadTiming { start, end, message: msg },
+    };
+    const KEYS: [&str; 5] = ["asap", "alap", "asap_cycle", "alap_cycle", "mobility"];
+    let mut got: [Option<u32>; 5] = [None; 5];
+    for (k, v) in kv {
+        let Some(i) = KEYS.iter().position(|x| *x == k) else {
+            return Err(err(format!("unknown timing key `{k}`; expected one of {}", KEYS.join(", "))));
+        };
+        if got[i].replace(v).is_some() {
+            return Err(err(format!("timing key `{k}` given twice")));
+        }
+    }
+    let mut vals = [0u32; 5];
+    for (i, g) in got.iter().enumerate() {
+        vals[i] = g.ok_or_else(|| err(format!("timing key `{}` missing", KEYS[i])))?;
+    }
+    let [asap, alap, asap_cycle, alap_cycle, mobility] = vals;
+    if alap < asap || mobility != alap - asap {
+        return Err(err(format!("mobility must equal alap - asap ({alap} - {asap}), found {mobility}")));
+    }
+    Ok(Timing { asap, alap, asap_cycle, alap_cycle, mobility })
+}

@@ -1,0 +1,122 @@
+//! Lexer of the `.rvir` text form (logos), adapted to lalrpop's external-lexer interface.
+
+use logos::Logos;
+
+/// A token of the `.rvir` text form. Whitespace and `;` comments are skipped.
+#[derive(Logos, Clone, Copy, Debug, PartialEq)]
+#[logos(skip r"[ \t\r\n\f]+")]
+#[logos(skip(r";[^\n]*", allow_greedy = true))]
+pub enum Tok<'a> {
+    /// `func`
+    #[token("func")]
+    Func,
+    /// `phase`
+    #[token("phase")]
+    Phase,
+    /// `parsed`
+    #[token("parsed")]
+    Parsed,
+    /// `atomised`
+    #[token("atomised")]
+    Atomised,
+    /// `equations`
+    #[token("equations")]
+    Equations,
+    /// `input`
+    #[token("input")]
+    Input,
+    /// `output`
+    #[token("output")]
+    Output,
+    /// `add`
+    #[token("add")]
+    Add,
+    /// `sub`
+    #[token("sub")]
+    Sub,
+    /// `mul`
+    #[token("mul")]
+    Mul,
+    /// `div`
+    #[token("div")]
+    Div,
+    /// `call`
+    #[token("call")]
+    Call,
+    /// `sin`
+    #[token("sin")]
+    Sin,
+    /// `cos`
+    #[token("cos")]
+    Cos,
+    /// `{`
+    #[token("{")]
+    LBrace,
+    /// `}`
+    #[token("}")]
+    RBrace,
+    /// `(`
+    #[token("(")]
+    LParen,
+    /// `)`
+    #[token(")")]
+    RParen,
+    /// `,`
+    #[token(",")]
+    Comma,
+    /// `=`
+    #[token("=")]
+    Eq,
+    /// `+`
+    #[token("+")]
+    Plus,
+    /// `-`
+    #[token("-")]
+    Minus,
+    /// `*`
+    #[token("*")]
+    Star,
+    /// `/`
+    #[token("/")]
+    Slash,
+    /// A value name after `%` (`%AlF15` → `AlF15`, `%frc[2][11].1`).
+    #[regex(r"%[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+|\[[0-9]+\])*", |lex| &lex.slice()[1..])]
+    Local(&'a str),
+    /// A function or callee name after `@` (`@dirdyna`, `@user_ExtForces.1[3]`).
+    #[regex(r"@[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+|\[[0-9]+\])*", |lex| &lex.slice()[1..])]
+    Global(&'a str),
+    /// A bare name: output names (`M[1][2]`, `sens.P[1]`) and attribute keys.
+    #[regex(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+|\[[0-9]+\])*")]
+    Name(&'a str),
+    /// An unsigned number as written (`2.0`, `12`, `1e-7`); parsed by the grammar.
+    #[regex(r"[0-9]+(\.[0-9]*)?([eE][+-]?[0-9]+)?")]
+    Number(&'a str),
+}
+
+impl std::fmt::Display for Tok<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Tok::Local(s) => write!(f, "%{s}"),
+            Tok::Global(s) => write!(f, "@{s}"),
+            Tok::Name(s) | Tok::Number(s) => write!(f, "{s}"),
+            other => write!(f, "{}", format!("{other:?}").to_lowercase()),
+        }
+    }
+}
+
+/// A character sequence that starts no token, at byte offsets `start..end`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LexError {
+    /// First byte of the bad text.
+    pub start: usize,
+    /// One past its last byte.
+    pub end: usize,
+}
+
+/// Spanned tokens of `src` in the form lalrpop's generated parser consumes.
+pub fn tokens(src: &str) -> impl Iterator<Item = Result<(usize, Tok<'_>, usize), LexError>> {
+    Tok::lexer(src).spanned().map(|(t, r)| match t {
+        Ok(t) => Ok((r.start, t, r.end)),
+        Err(()) => Err(LexError { start: r.start, end: r.end }),
+    })
+}

@@ -1,0 +1,24 @@
+//! The `.rvir` text form: logos lexer, lalrpop grammar, name resolution, printer.
+//!
+//! ```text
+//! func @invdyna {
+//!   phase atomised
+//!   equations 2
+//!   input %q[2]
+//!   input %g[3]
+//!   %S2 = sin %q[2]
+//!   %AF12 = mul %g[3], %S2 {asap=1, alap=1, asap_cycle=7, alap_cycle=7, mobility=0}
+//!   output Qq[1] = %AF12
+//! }
+//! ```
+//! Parsed-phase definitions are infix expressions: `%x = -%a*%b + (%c - 2.0)`; a unary minus
+//! stands at the start of a sum and covers the product term after it (SPEC §3).
+
+pub mod ast;
+pub mod error;
+pub mod lexer;
+pub mod parser;
+pub mod printer;
+
+pub use error::ParseError;
+pub use parser::parse;

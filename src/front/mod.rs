@@ -1,0 +1,1 @@
+//! Front ends: Robotran C, Matlab and Python outputs → IR modules (parsed phase).
