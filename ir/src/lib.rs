@@ -1,4 +1,33 @@
-//! robovec's SSA IR (placeholder doc, completed below).
+//! robovec's SSA IR for Robotran equations of motion.
+//!
+//! # Model
+//! A [`Module`] holds the [`Function`]s read from one file (one per Robotran function:
+//! `dirdyna`, `invdyna`, `cons_hJ`, `sensor_3`, …). A function has:
+//! - **inputs**: values known before the equations run — joint coordinates `q[i] qd[i] qdd[i]`,
+//!   model parameters `dpt[k][j] l[k][b] m[b] In[k][b] g[k] frc[k][b] …`, `tsim` (SPEC §1–§2);
+//! - a **body** of definitions in order: trig initial variables (`%C4 = cos %q[4]`, not
+//!   operations), binary operations (`add sub mul div`), calls (`sqrt`, opaque user callbacks),
+//!   and — in the parsed phase only — nested expressions (one Robotran equation each);
+//! - **outputs**: named results (`M[1][2]`, `c[3]`, `Qq[1]`, `sens.P[1]`), each a value or a
+//!   constant.
+//!
+//! # SSA rules
+//! Every value has one definition and a name unique in its function (Robotran names are kept;
+//! values made by passes get names derived from the value they serve, `AF24.1`). A value is
+//! read only after its definition; the body order is a topological order. There is no control
+//! flow: a function is one straight-line block.
+//!
+//! # Phases ([`Phase`])
+//! - `parsed`: any definition form, including nested expressions (`%x = -%a*%b + %c`).
+//! - `atomised`: every body value is `sin`/`cos` of an input, one binary op or one call on
+//!   operands (inputs, constants, earlier values) — the seed's eq. 2.2 form (seed §2.1).
+//!
+//! The [`verifier`] checks these rules; [`text`] reads and writes the `.rvir` form;
+//! [`interp`] evaluates any function in `f64` or `f32`; [`analysis`] holds the dependence
+//! graph and ASAP/ALAP timing.
+#![deny(missing_docs)]
+
+pub mod analysis;
 pub mod count;
 pub mod entities;
 pub mod function;
@@ -6,6 +35,7 @@ pub mod interp;
 pub mod span;
 pub mod syntax;
 pub mod text;
+pub mod verifier;
 
 pub use entities::Value;
 pub use function::{Function, Module, OpCounts};

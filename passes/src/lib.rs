@@ -1,1 +1,165 @@
-//! Passes.
+//! robovec's passes and the pass manager.
+//!
+//! Every pass is registered once in [`PASSES`] (name, parameters, doc, constructor); that
+//! table feeds `-passes=` parsing, `--print-passes` and the error that lists valid names (as
+//! rustc's `declare_passes!` and Cranelift's `timing.rs` do). A pass only transforms; the
+//! [`manager`] does printing, dumping, verifying and timing.
+#![deny(missing_docs)]
+
+pub mod asap_alap;
+pub mod atomise;
+pub mod dce;
+pub mod manager;
+pub mod params;
+pub mod pipeline;
+
+use robovec_ir::analysis::Latencies;
+use robovec_ir::{Module, Phase};
+
+pub use manager::{Instrumentation, PassManager, PassRecord, PrintSelector};
+pub use params::{ParamInfo, Params};
+pub use pipeline::{parse_pipeline, PassSpec};
+
+/// What a pass may fail with.
+#[derive(Debug, thiserror::Error)]
+pub enum PassError {
+    /// The pipeline text names an unknown pass; lists the valid names.
+    #[error("unknown pass `{name}`; valid passes: {valid}")]
+    UnknownPass {
+        /// The unknown name.
+        name: String,
+        /// Comma-separated valid names.
+        valid: String,
+    },
+    /// A parameter is unknown, repeated or malformed.
+    #[error("pass `{pass}`: {message}")]
+    BadParameter {
+        /// Pass name.
+        pass: String,
+        /// What is wrong, with the valid parameters.
+        message: String,
+    },
+    /// The pipeline text does not parse.
+    #[error("bad pipeline `{pipeline}`: {message}")]
+    BadPipeline {
+        /// The pipeline text.
+        pipeline: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The module is in the wrong phase for the pass.
+    #[error("pass `{pass}` needs phase {needs:?} but function @{function} is {found:?} (run `atomise` first)")]
+    WrongPhase {
+        /// Pass name.
+        pass: String,
+        /// Function name.
+        function: String,
+        /// Phase required.
+        needs: Phase,
+        /// Phase found.
+        found: Phase,
+    },
+    /// Any other failure of a pass on the given input.
+    #[error("pass `{pass}`: {message}")]
+    Failed {
+        /// Pass name.
+        pass: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// The verifier rejected the module after a pass (names the pass).
+    #[error("verifier failed after pass `{pass}`:\n{errors}")]
+    Verify {
+        /// The pass after which the module no longer verifies (`input` before any pass).
+        pass: String,
+        /// The errors, one per line.
+        errors: String,
+    },
+    /// Writing a dump failed.
+    #[error("cannot write dump {path}: {source}")]
+    Io {
+        /// File path.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+}
+
+/// State that passes share across one pipeline run.
+#[derive(Clone, Debug, Default)]
+pub struct PassContext {
+    /// Latencies of the last `asap-alap` run (defaults otherwise); used for the report's stats.
+    pub latencies: Latencies,
+}
+
+/// A transformation or analysis over a whole module.
+pub trait Pass {
+    /// The registered (kebab-case) name.
+    fn name(&self) -> &'static str;
+    /// Runs the pass on every function of `m`.
+    ///
+    /// # Errors
+    /// [`PassError`] when the input is not what the pass accepts.
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError>;
+    /// The phase every function must be in, if any.
+    fn requires(&self) -> Option<Phase> {
+        None
+    }
+    /// True when the pass keeps existing timing attributes valid (analyses that only read, or
+    /// write timing themselves); otherwise the manager clears them after the pass.
+    fn preserves_timing(&self) -> bool {
+        false
+    }
+}
+
+/// One entry of the pass registry.
+pub struct PassInfo {
+    /// Name used in `-passes=`.
+    pub name: &'static str,
+    /// One-line description.
+    pub doc: &'static str,
+    /// Accepted parameters.
+    pub params: &'static [ParamInfo],
+    /// Builds the pass from checked parameters.
+    pub build: fn(&Params) -> Result<Box<dyn Pass>, PassError>,
+}
+
+/// The registry: every pass robovec knows, in `--print-passes` order.
+pub const PASSES: &[PassInfo] = &[atomise::INFO, dce::INFO, asap_alap::INFO];
+
+/// Looks up a registered pass.
+pub fn pass_info(name: &str) -> Option<&'static PassInfo> {
+    PASSES.iter().find(|p| p.name == name)
+}
+
+/// Comma-separated names of all registered passes.
+pub fn pass_names() -> String {
+    PASSES.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
+}
+
+/// Builds the pass of a parsed pipeline element, checking its parameters.
+///
+/// # Errors
+/// [`PassError::UnknownPass`] or [`PassError::BadParameter`].
+pub fn build_pass(spec: &PassSpec) -> Result<Box<dyn Pass>, PassError> {
+    let info = pass_info(&spec.name)
+        .ok_or_else(|| PassError::UnknownPass { name: spec.name.clone(), valid: pass_names() })?;
+    let params = Params::check(info, &spec.params)?;
+    (info.build)(&params)
+}
+
+/// Checks that every function of `m` is in `phase`.
+///
+/// # Errors
+/// [`PassError::WrongPhase`] naming the first function that is not.
+pub fn require_phase(pass: &str, m: &Module, phase: Phase) -> Result<(), PassError> {
+    match m.functions.iter().find(|f| f.phase != phase) {
+        Some(f) => Err(PassError::WrongPhase {
+            pass: pass.to_string(),
+            function: f.name.clone(),
+            needs: phase,
+            found: f.phase,
+        }),
+        None => Ok(()),
+    }
+}

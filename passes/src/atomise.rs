@@ -1,0 +1,157 @@
+//! `atomise`: equations → binary operations (seed §2.1, eq. 2.2; SPEC §3).
+//!
+//! Phase: parsed → atomised. Every nested expression becomes a sequence of single operations:
+//! - sums and products cascade left to right in source order, as the tree is written:
+//!   `a+b-c` → `(a+b)-c`, `a*b*c` → `(a*b)*c`;
+//! - a unary minus becomes `0 - t` **after** its term `t` is computed (`-g3*S4` →
+//!   `t = g3*S4; r = 0 - t`), except on a literal or on a product whose first factor is a
+//!   literal, where the literal is negated instead (`-(2.0)*x*y` → `((-2.0)*x)*y`,
+//!   `-(1.0)` → the constant −1.0);
+//! - a plain copy (`M[1][1] = FM41_15;`) or a lone constant is 0 ops: uses are rewritten to the
+//!   copied operand and the value disappears;
+//! - calls stay calls, on atomised arguments.
+//!
+//! The root operation of an equation keeps the equation's name; intermediate operations are
+//! named `NAME.1`, `NAME.2`, … in emission order (left operand first). Already-atomic
+//! definitions are copied. Numerics: identical to the parsed form in every precision except the
+//! sign of a zero produced by `0 - t` where C computes `-t` (see `robovec_ir::interp`).
+//!
+//! Contract: idempotent (an atomised function is copied unchanged); never changes an output's
+//! value; the op counts equal `robovec_ir::count::count_expr` of the source expressions.
+//! Cost: O(expression nodes).
+
+use robovec_ir::count::neg_folds;
+use robovec_ir::{BinOp, Def, Expr, Function, Module, Operand, Phase, Span};
+
+use crate::{Pass, PassContext, PassError, PassInfo, Params};
+
+/// Registry entry.
+pub const INFO: PassInfo = PassInfo {
+    name: "atomise",
+    doc: "split equations into binary operations (SPEC §3: left-to-right cascades, 0 - t, literal folding)",
+    params: &[],
+    build: |_: &Params| Ok(Box::new(Atomise)),
+};
+
+/// The `atomise` pass.
+pub struct Atomise;
+
+impl Pass for Atomise {
+    fn name(&self) -> &'static str {
+        "atomise"
+    }
+
+    fn run(&self, m: &mut Module, _cx: &mut PassContext) -> Result<(), PassError> {
+        for f in &mut m.functions {
+            *f = atomise_function(f);
+        }
+        Ok(())
+    }
+}
+
+/// Returns the atomised form of `f` (which must verify).
+pub fn atomise_function(f: &Function) -> Function {
+    let mut out = Function::new(f.name.clone(), Phase::Atomised);
+    out.equations = f.equations;
+    out.span = f.span;
+    let mut map: Vec<Operand> = vec![Operand::Const(f64::NAN); f.values.len()];
+    for &v in &f.inputs {
+        let d = f.value(v);
+        let nv = out.add_input(d.name.clone(), d.span).expect("input names are unique");
+        map[v.index()] = Operand::Value(nv);
+    }
+    for &v in &f.body {
+        let d = f.value(v);
+        let m = |o: &Operand| match o {
+            Operand::Value(x) => map[x.index()],
+            c => *c,
+        };
+        let result = match &d.def {
+            Def::Input => unreachable!("inputs are not in the body"),
+            Def::Trig(t, a) => {
+                let Operand::Value(a) = map[a.index()] else { unreachable!("inputs map to inputs") };
+                Operand::Value(out.define(d.name.clone(), Def::Trig(*t, a), d.span).expect("unique name"))
+            }
+            Def::Binary(op, a, b) => {
+                let def = Def::Binary(*op, m(a), m(b));
+                Operand::Value(out.define(d.name.clone(), def, d.span).expect("unique name"))
+            }
+            Def::Call(c, args) => {
+                let def = Def::Call(c.clone(), args.iter().map(m).collect());
+                Operand::Value(out.define(d.name.clone(), def, d.span).expect("unique name"))
+            }
+            Def::Expr(e) => {
+                let mut em = Emitter { out: &mut out, root: &d.name, span: d.span, next: 1, map: &map };
+                em.emit(e, true)
+            }
+        };
+        map[v.index()] = result;
+    }
+    for o in &f.outputs {
+        let value = match o.value {
+            Operand::Value(x) => map[x.index()],
+            c => c,
+        };
+        out.set_output(o.name.clone(), value, o.span);
+    }
+    out
+}
+
+struct Emitter<'a> {
+    out: &'a mut Function,
+    root: &'a str,
+    span: Span,
+    next: u32,
+    map: &'a [Operand],
+}
+
+impl Emitter<'_> {
+    fn define(&mut self, top: bool, def: Def) -> Operand {
+        let name = if top {
+            self.root.to_string()
+        } else {
+            loop {
+                let n = format!("{}.{}", self.root, self.next);
+                self.next += 1;
+                if self.out.lookup(&n).is_none() {
+                    break n;
+                }
+            }
+        };
+        // The root name is free: sources and passes keep names unique per function.
+        let name = if self.out.lookup(&name).is_some() { self.out.fresh_name(&name) } else { name };
+        Operand::Value(self.out.define(name, def, self.span).expect("name is free"))
+    }
+
+    fn emit(&mut self, e: &Expr, top: bool) -> Operand {
+        match e {
+            Expr::Operand(Operand::Value(x)) => self.map[x.index()],
+            Expr::Operand(c) => *c,
+            Expr::Neg(x) if neg_folds(x) => self.emit(&negate_first_literal(x), top),
+            Expr::Neg(x) => {
+                let t = self.emit(x, false);
+                self.define(top, Def::Binary(BinOp::Sub, Operand::Const(0.0), t))
+            }
+            Expr::Binary(op, a, b) => {
+                let a = self.emit(a, false);
+                let b = self.emit(b, false);
+                self.define(top, Def::Binary(*op, a, b))
+            }
+            Expr::Call(c, args) => {
+                let args = args.iter().map(|a| self.emit(a, false)).collect();
+                self.define(top, Def::Call(c.clone(), args))
+            }
+        }
+    }
+}
+
+/// `x` with the literal that a unary minus folds into negated (see [`neg_folds`]).
+fn negate_first_literal(x: &Expr) -> Expr {
+    match x {
+        Expr::Operand(Operand::Const(c)) => Expr::Operand(Operand::Const(-c)),
+        Expr::Binary(op @ (BinOp::Mul | BinOp::Div), a, b) => {
+            Expr::Binary(*op, Box::new(negate_first_literal(a)), b.clone())
+        }
+        _ => unreachable!("called only when neg_folds holds"),
+    }
+}

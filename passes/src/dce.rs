@@ -1,0 +1,78 @@
+//! `dce<outputs=…>`: dead-code elimination. Keeps the listed outputs (all when `outputs` is
+//! not given) and every value they need; drops the rest, unused inputs included.
+//!
+//! `outputs` is a comma-separated list; an entry names one output (`Qq[1]`) or a whole output
+//! array (`c` keeps `c[1]`, `c[2]`, …). An entry that matches no output of any function is an
+//! error. Works in both phases; clears timing attributes. Cost: O(values + operands).
+
+use robovec_ir::{Module, Operand};
+
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+
+/// Registry entry.
+pub const INFO: PassInfo = PassInfo {
+    name: "dce",
+    doc: "drop everything the kept outputs do not need",
+    params: &[ParamInfo {
+        name: "outputs",
+        default: "all",
+        doc: "outputs to keep: names (`Qq[1],Qq[2]`) or arrays (`c`), comma-separated",
+    }],
+    build: |p: &Params| {
+        let keep = p.get("outputs").map(|s| s.split(',').map(|x| x.trim().to_string()).filter(|x| !x.is_empty()).collect());
+        if matches!(&keep, Some(k) if Vec::is_empty(k)) {
+            return Err(PassError::BadParameter { pass: "dce".into(), message: "`outputs` is empty".into() });
+        }
+        Ok(Box::new(Dce { keep }))
+    },
+};
+
+/// The `dce` pass.
+pub struct Dce {
+    /// Output names or arrays to keep; `None` keeps all.
+    pub keep: Option<Vec<String>>,
+}
+
+fn matches(entry: &str, output: &str) -> bool {
+    output == entry || (output.starts_with(entry) && output[entry.len()..].starts_with('['))
+}
+
+impl Pass for Dce {
+    fn name(&self) -> &'static str {
+        "dce"
+    }
+
+    fn run(&self, m: &mut Module, _cx: &mut PassContext) -> Result<(), PassError> {
+        if let Some(keep) = &self.keep {
+            for e in keep {
+                if !m.functions.iter().any(|f| f.outputs.iter().any(|o| matches(e, &o.name))) {
+                    let mut names: Vec<&str> = m.functions.iter().flat_map(|f| f.outputs.iter().map(|o| o.name.as_str())).collect();
+                    names.truncate(12);
+                    return Err(PassError::BadParameter {
+                        pass: "dce".into(),
+                        message: format!("no output matches `{e}` (outputs are like: {})", names.join(", ")),
+                    });
+                }
+            }
+        }
+        for f in &mut m.functions {
+            if let Some(keep) = &self.keep {
+                f.outputs.retain(|o| keep.iter().any(|e| matches(e, &o.name)));
+            }
+            let mut live = vec![false; f.values.len()];
+            for o in &f.outputs {
+                if let Operand::Value(v) = o.value {
+                    live[v.index()] = true;
+                }
+            }
+            for &v in f.body.iter().rev() {
+                if live[v.index()] {
+                    f.value(v).def.for_each_value(|a| live[a.index()] = true);
+                }
+            }
+            f.retain(|_, v| live[v.index()]);
+            f.clear_timing();
+        }
+        Ok(())
+    }
+}

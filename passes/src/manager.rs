@@ -1,0 +1,189 @@
+//! The pass manager: runs a pipeline and owns the cross-cutting work — IR printing before and
+//! after passes, dump files, verification after each pass, timing (LLVM's pass
+//! instrumentation; rustc's `run_passes_inner`). Passes never print or verify by themselves.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use robovec_ir::{verifier, Module};
+
+use crate::{build_pass, parse_pipeline, Pass, PassContext, PassError, PassSpec};
+
+/// Which passes to print the IR before/after.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum PrintSelector {
+    /// None.
+    #[default]
+    None,
+    /// Every pass (`-print-after-all`).
+    All,
+    /// Passes with these names (`-print-after=atomise`).
+    Passes(Vec<String>),
+}
+
+impl PrintSelector {
+    fn selects(&self, name: &str) -> bool {
+        match self {
+            PrintSelector::None => false,
+            PrintSelector::All => true,
+            PrintSelector::Passes(p) => p.iter().any(|x| x == name),
+        }
+    }
+}
+
+/// Instrumentation settings (command-line flags of SPEC §7).
+#[derive(Clone, Debug)]
+pub struct Instrumentation {
+    /// `-print-before[-all]`.
+    pub print_before: PrintSelector,
+    /// `-print-after[-all]`.
+    pub print_after: PrintSelector,
+    /// `-dump-dir=DIR`: writes `DIR/NNN-<pass>.before.rvir` and `.after.rvir` (NNN from 001).
+    pub dump_dir: Option<PathBuf>,
+    /// `-verify-each` (default on): verify the input and the IR after every pass.
+    pub verify_each: bool,
+    /// `-time-passes`: print a timing table after the run.
+    pub time_passes: bool,
+}
+
+impl Default for Instrumentation {
+    fn default() -> Self {
+        Instrumentation {
+            print_before: PrintSelector::None,
+            print_after: PrintSelector::None,
+            dump_dir: None,
+            verify_each: true,
+            time_passes: false,
+        }
+    }
+}
+
+/// What one pass did (the report's `passes` entries, SPEC §7).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PassRecord {
+    /// Pass name as written in the pipeline (parameters included).
+    pub name: String,
+    /// Wall time of the pass alone, milliseconds (printing and verifying excluded).
+    pub wall_ms: f64,
+    /// Ops of the module before (SPEC §1; expressions counted as atomised).
+    pub ops_before: u64,
+    /// Ops after.
+    pub ops_after: u64,
+}
+
+/// A parsed and checked pipeline with its instrumentation.
+pub struct PassManager {
+    passes: Vec<(PassSpec, Box<dyn Pass>)>,
+    instr: Instrumentation,
+}
+
+/// Total ops of a module.
+pub fn module_ops(m: &Module) -> u64 {
+    m.functions.iter().map(|f| f.op_counts().total).sum()
+}
+
+impl PassManager {
+    /// Parses `pipeline` and builds every pass (all names and parameters checked up front).
+    ///
+    /// # Errors
+    /// [`PassError::BadPipeline`], [`PassError::UnknownPass`], [`PassError::BadParameter`].
+    pub fn new(pipeline: &str, instr: Instrumentation) -> Result<PassManager, PassError> {
+        let specs = if pipeline.trim().is_empty() { Vec::new() } else { parse_pipeline(pipeline)? };
+        let passes = specs
+            .into_iter()
+            .map(|s| build_pass(&s).map(|p| (s, p)))
+            .collect::<Result<Vec<_>, _>>()?;
+        if let PrintSelector::Passes(names) = instr.print_before.clone() {
+            check_names(&names)?;
+        }
+        if let PrintSelector::Passes(names) = instr.print_after.clone() {
+            check_names(&names)?;
+        }
+        Ok(PassManager { passes, instr })
+    }
+
+    /// The normalised pipeline text (round-trips through [`PassManager::new`]).
+    pub fn pipeline_text(&self) -> String {
+        self.passes.iter().map(|(s, _)| s.to_string()).collect::<Vec<_>>().join(",")
+    }
+
+    /// Runs the pipeline on `m`; IR dumps and the timing table go to `log`.
+    ///
+    /// # Errors
+    /// The first pass error, a verifier failure naming the pass after which it happened, or a
+    /// dump that cannot be written.
+    pub fn run(&self, m: &mut Module, cx: &mut PassContext, log: &mut dyn Write) -> Result<Vec<PassRecord>, PassError> {
+        if self.instr.verify_each {
+            verify_named(m, "input")?;
+        }
+        if let Some(d) = &self.instr.dump_dir {
+            std::fs::create_dir_all(d).map_err(|e| PassError::Io { path: d.display().to_string(), source: e })?;
+        }
+        let mut records = Vec::new();
+        for (i, (spec, pass)) in self.passes.iter().enumerate() {
+            let name = pass.name();
+            if self.instr.print_before.selects(name) {
+                let _ = write!(log, "*** IR Dump Before {spec} ***\n{m}");
+            }
+            if let Some(d) = &self.instr.dump_dir {
+                write_dump(d, &format!("{:03}-{name}.before.rvir", i + 1), m)?;
+            }
+            let ops_before = module_ops(m);
+            let t0 = Instant::now();
+            pass.run(m, cx)?;
+            let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+            if !pass.preserves_timing() {
+                m.functions.iter_mut().for_each(|f| f.clear_timing());
+            }
+            records.push(PassRecord { name: spec.to_string(), wall_ms, ops_before, ops_after: module_ops(m) });
+            if self.instr.print_after.selects(name) {
+                let _ = write!(log, "*** IR Dump After {spec} ***\n{m}");
+            }
+            if let Some(d) = &self.instr.dump_dir {
+                write_dump(d, &format!("{:03}-{name}.after.rvir", i + 1), m)?;
+            }
+            if self.instr.verify_each {
+                verify_named(m, name)?;
+            }
+        }
+        if self.instr.time_passes {
+            let total: f64 = records.iter().map(|r| r.wall_ms).sum();
+            let _ = writeln!(log, "===-------------------------------------------------------------------------===");
+            let _ = writeln!(log, "                          Pass execution timing report");
+            let _ = writeln!(log, "===-------------------------------------------------------------------------===");
+            let _ = writeln!(log, "  {:>12}  {:>6}  {:>10}  {:>10}  Name", "Wall (ms)", "%", "ops before", "ops after");
+            for r in &records {
+                let pct = if total > 0.0 { 100.0 * r.wall_ms / total } else { 0.0 };
+                let _ = writeln!(log, "  {:>12.3}  {:>5.1}%  {:>10}  {:>10}  {}", r.wall_ms, pct, r.ops_before, r.ops_after, r.name);
+            }
+            let _ = writeln!(log, "  {total:>12.3}  100.0%  {:>10}  {:>10}  Total", "", "");
+        }
+        Ok(records)
+    }
+}
+
+fn check_names(names: &[String]) -> Result<(), PassError> {
+    for n in names {
+        if crate::pass_info(n).is_none() {
+            return Err(PassError::UnknownPass { name: n.clone(), valid: crate::pass_names() });
+        }
+    }
+    Ok(())
+}
+
+fn verify_named(m: &Module, pass: &str) -> Result<(), PassError> {
+    verifier::verify(m).map_err(|errs| PassError::Verify {
+        pass: pass.to_string(),
+        errors: errs.iter().map(|e| format!("  {e}")).collect::<Vec<_>>().join("\n"),
+    })
+}
+
+/// Writes `m` to `dir/name` atomically (temporary file, then rename).
+fn write_dump(dir: &Path, name: &str, m: &Module) -> Result<(), PassError> {
+    let path = dir.join(name);
+    let tmp = dir.join(format!(".{name}.tmp"));
+    let io = |e| PassError::Io { path: path.display().to_string(), source: e };
+    std::fs::write(&tmp, m.to_string()).map_err(io)?;
+    std::fs::rename(&tmp, &path).map_err(io)
+}
