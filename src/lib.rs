@@ -1,6 +1,11 @@
-//! robovec: the driver library behind `robovec-opt` (front ends, command line, reports).
+//! robovec: the driver library behind `robovec-opt` — front ends, command line, reports.
 //!
 //! The IR lives in `robovec-ir`, the passes in `robovec-passes`; this crate reads Robotran
-//! files (C, Matlab, Python) into IR modules and runs pipelines on them.
+//! files (C, Matlab, Python) into IR modules ([`front`]), runs pipelines on them
+//! ([`driver::run`]) and writes reports ([`report`]).
 
+pub mod cli;
+pub mod diagnostics;
+pub mod driver;
 pub mod front;
+pub mod report;

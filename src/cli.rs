@@ -1,0 +1,135 @@
+//! The command line of `robovec-opt` (SPEC §7), LLVM `opt` style.
+//!
+//! clap parses `--flag=value`; LLVM's single-dash spellings (`-passes=…`, `-print-after-all`)
+//! are mapped onto them first, so both `-flag` and `--flag` work. `-o` and `-p` stay short.
+
+use std::path::PathBuf;
+
+use clap::{ArgAction, Parser};
+use robovec_passes::{Instrumentation, PrintSelector, PASSES};
+
+use crate::driver::Options;
+
+/// `robovec-opt INPUT -passes=PIPELINE [options]`
+#[derive(Parser, Debug)]
+#[command(
+    name = "robovec-opt",
+    version,
+    about = "Run a pipeline of passes over Robotran equations (C, Matlab, Python) or robovec IR (.rvir)",
+    after_help = "Single-dash spellings (-passes=…, -print-after-all) are accepted as in LLVM's opt.\n\
+                  Exit status: 0 success, 1 bad input, 2 bad usage."
+)]
+pub struct Cli {
+    /// Input: a Robotran file (.c, .m, .py) or robovec IR (.rvir); `-` reads IR from stdin.
+    pub input: Option<String>,
+    /// Pipeline, LLVM syntax: `atomise,dce<outputs=c>,asap-alap<lat-add=12>`.
+    #[arg(long = "passes", short = 'p', value_name = "PIPELINE", default_value = "")]
+    pub passes: String,
+    /// Write the final IR to FILE (default: stdout, unless -eval prints there).
+    #[arg(short = 'o', value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Print the IR (stderr) after every pass.
+    #[arg(long)]
+    pub print_after_all: bool,
+    /// Print the IR (stderr) before every pass.
+    #[arg(long)]
+    pub print_before_all: bool,
+    /// Print the IR (stderr) after the named passes (comma-separated).
+    #[arg(long, value_delimiter = ',', value_name = "PASS")]
+    pub print_after: Vec<String>,
+    /// Print the IR (stderr) before the named passes (comma-separated).
+    #[arg(long, value_delimiter = ',', value_name = "PASS")]
+    pub print_before: Vec<String>,
+    /// Write `NNN-<pass>.before.rvir` / `.after.rvir` for every pass into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub dump_dir: Option<PathBuf>,
+    /// Print a pass timing table to stderr.
+    #[arg(long)]
+    pub time_passes: bool,
+    /// Verify the IR after each pass (default true; `-verify-each=false` turns it off).
+    #[arg(long, action = ArgAction::Set, num_args = 0..=1, default_value_t = true, default_missing_value = "true")]
+    pub verify_each: bool,
+    /// Write the JSON report (SPEC §7) to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+    /// Evaluate the final IR in f64 on the inputs in FILE (JSON object name → number); print
+    /// inputs and outputs as JSON on stdout.
+    #[arg(long, value_name = "FILE")]
+    pub eval: Option<PathBuf>,
+    /// The function that -report and -eval describe (e.g. `sensor_2`).
+    #[arg(long, value_name = "NAME")]
+    pub function: Option<String>,
+    /// Print the stats of the final IR (ops, critical path, Y) to stderr.
+    #[arg(long)]
+    pub stats: bool,
+    /// List the registered passes with their parameters and exit.
+    #[arg(long)]
+    pub print_passes: bool,
+}
+
+/// Maps LLVM single-dash long flags (`-passes=x`) to clap's `--passes=x`.
+pub fn normalise_args(args: impl IntoIterator<Item = String>) -> Vec<String> {
+    args.into_iter()
+        .enumerate()
+        .map(|(i, a)| {
+            let long_single_dash = i > 0
+                && a.starts_with('-')
+                && !a.starts_with("--")
+                && a.len() > 2
+                && a.as_bytes()[1].is_ascii_alphabetic()
+                && !(a.starts_with("-o") && !a.starts_with("-output"));
+            if long_single_dash {
+                format!("-{a}")
+            } else {
+                a
+            }
+        })
+        .collect()
+}
+
+/// The `--print-passes` listing.
+pub fn print_passes() -> String {
+    let mut s = String::from("Passes (use -passes=a,b<k=v;k2=v2>,c):\n");
+    for p in PASSES {
+        s += &format!("  {:<12} {}\n", p.name, p.doc);
+        for q in p.params {
+            s += &format!("      {:<10} (default {}) {}\n", q.name, q.default, q.doc);
+        }
+    }
+    s
+}
+
+impl Cli {
+    /// The driver options.
+    ///
+    /// # Errors
+    /// A usage message when no input is given.
+    pub fn options(self) -> Result<Options, String> {
+        let input = self.input.ok_or("error: no input file (use `-` for IR on stdin)")?;
+        let sel = |all: bool, names: Vec<String>| {
+            if all {
+                PrintSelector::All
+            } else if names.is_empty() {
+                PrintSelector::None
+            } else {
+                PrintSelector::Passes(names)
+            }
+        };
+        Ok(Options {
+            input,
+            passes: self.passes,
+            output: self.output,
+            instr: Instrumentation {
+                print_before: sel(self.print_before_all, self.print_before),
+                print_after: sel(self.print_after_all, self.print_after),
+                dump_dir: self.dump_dir,
+                verify_each: self.verify_each,
+                time_passes: self.time_passes,
+            },
+            report: self.report,
+            eval: self.eval,
+            function: self.function,
+            stats: self.stats,
+        })
+    }
+}

@@ -1,0 +1,94 @@
+//! The JSON report (`-report=FILE`, SPEC §7) and the `-eval` output.
+
+use std::collections::BTreeMap;
+
+use robovec_ir::analysis::{compute_timing, Latencies};
+use robovec_ir::{interp, Def, Function, OpCounts, Phase};
+use robovec_passes::atomise::atomise_function;
+use robovec_passes::PassRecord;
+use serde::Serialize;
+
+/// `stats` of SPEC §7: the IR at the end of the pipeline.
+#[derive(Clone, Debug, Serialize)]
+pub struct Stats {
+    /// Equations of the source function (SPEC §1), `null` when unknown.
+    pub equations: Option<u32>,
+    /// Ops by kind (SPEC §1, §3).
+    pub ops: OpCounts,
+    /// Initial variables: inputs plus trig variables (SPEC §1).
+    pub inputs: u64,
+    /// Of which trig initial variables (`sin`/`cos` of a joint coordinate).
+    pub trig: u64,
+    /// Outputs.
+    pub outputs: u64,
+    /// Critical path in unit steps (largest ASAP).
+    pub asap: u32,
+    /// Critical path in cycles (largest ASAPCycle) under `latencies`.
+    pub asap_cycle: u32,
+    /// Number Y = ops / asap_cycle (seed §3.2); 0 when there is no op.
+    pub y: f64,
+    /// Latencies used for `asap_cycle`, cycles.
+    pub latencies: Latencies,
+}
+
+/// Computes the stats of `f`. A parsed-phase function is measured on its atomised form (SPEC
+/// §3), so the figures are the same before and after `atomise`.
+pub fn stats(f: &Function, lat: &Latencies) -> Stats {
+    let atomised;
+    let g = if f.phase == Phase::Parsed {
+        atomised = atomise_function(f);
+        &atomised
+    } else {
+        f
+    };
+    let ops = g.op_counts();
+    let (_, t) = compute_timing(g, lat);
+    let trig = g.body.iter().filter(|&&v| matches!(g.value(v).def, Def::Trig(..))).count() as u64;
+    Stats {
+        equations: f.equations,
+        ops,
+        inputs: g.inputs.len() as u64 + trig,
+        trig,
+        outputs: g.outputs.len() as u64,
+        asap: t.asap,
+        asap_cycle: t.asap_cycle,
+        y: if t.asap_cycle == 0 { 0.0 } else { ops.total as f64 / t.asap_cycle as f64 },
+        latencies: *lat,
+    }
+}
+
+/// The report of SPEC §7 (fields not produced by this pipeline are omitted).
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Input path.
+    pub input: String,
+    /// Function described.
+    pub function: String,
+    /// Normalised pipeline text.
+    pub pipeline: String,
+    /// One record per pass run.
+    pub passes: Vec<PassRecord>,
+    /// Figures of the final IR.
+    pub stats: Stats,
+}
+
+/// `-eval` output: every input used and every output, in f64.
+#[derive(Clone, Debug, Serialize)]
+pub struct EvalResult {
+    /// Input name → value used.
+    pub inputs: BTreeMap<String, f64>,
+    /// Output name → value.
+    pub outputs: BTreeMap<String, f64>,
+}
+
+/// Evaluates `f` in f64 on `given` inputs; inputs not given get deterministic pseudo-random
+/// values in [-1, 1] (`robovec_ir::interp::pseudo_random_input` with seed 0).
+pub fn evaluate(f: &Function, given: &BTreeMap<String, f64>) -> EvalResult {
+    let mut inputs = BTreeMap::new();
+    let outputs = interp::eval::<f64>(f, |name| {
+        let x = given.get(name).copied().unwrap_or_else(|| interp::pseudo_random_input(name, 0));
+        inputs.insert(name.to_string(), x);
+        x
+    });
+    EvalResult { inputs, outputs: outputs.into_iter().collect() }
+}

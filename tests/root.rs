@@ -1,0 +1,14 @@
+//! The single integration-test binary (naga's `tests/root.rs` layout).
+//!
+//! Tests that need the Robotran corpus read it from `../shared/corpus/robotran` and fail — not
+//! skip — when it is missing.
+
+mod common;
+
+mod cli;
+mod corpus;
+mod diagnostics;
+mod example;
+mod filetests;
+mod props;
+mod roundtrip;
