@@ -63,3 +63,42 @@ impl Pass for AsapAlap {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use robovec_ir::text::parse;
+
+    #[test]
+    fn hand_computed_timing() {
+        // x = a*b (mul), y = x + c (add), z = y*x (mul), w = a*c (mul, off the critical path).
+        // ASAP: x 1, y 2, z 3, w 1.  ASAPCycle: x 7, y 19, z 26, w 7.  Critical path 3 / 26.
+        // ALAP: z 3, y 2, x min(2-1, 3-1) = 1, w (no op user) 3.
+        // ALAPCycle: z 26, y 26-7 = 19, x min(19-12, 26-7) = 7, w 26.
+        let mut m = parse(
+            "func @f { phase atomised input %a input %b input %c %x = mul %a, %b %y = add %x, %c %z = mul %y, %x %w = mul %a, %c output o = %z output p = %w }",
+        )
+        .unwrap();
+        AsapAlap { lat: Latencies::default() }.run(&mut m, &mut PassContext::default()).unwrap();
+        let f = &m.functions[0];
+        let t = |n: &str| f.value(f.lookup(n).unwrap()).timing.unwrap();
+        let row = |n: &str| {
+            let t = t(n);
+            (t.asap, t.alap, t.asap_cycle, t.alap_cycle, t.mobility)
+        };
+        assert_eq!(row("x"), (1, 1, 7, 7, 0));
+        assert_eq!(row("y"), (2, 2, 19, 19, 0));
+        assert_eq!(row("z"), (3, 3, 26, 26, 0));
+        assert_eq!(row("w"), (1, 3, 7, 26, 2));
+        // Printed and re-read unchanged.
+        let again = parse(&m.to_string()).unwrap();
+        assert_eq!(again.to_string(), m.to_string());
+    }
+
+    #[test]
+    fn parsed_input_is_rejected() {
+        let mut m = parse("func @f { input %a %x = %a*%a output o = %x }").unwrap();
+        let e = AsapAlap { lat: Latencies::default() }.run(&mut m, &mut PassContext::default()).unwrap_err();
+        assert!(e.to_string().contains("run `atomise` first"), "{e}");
+    }
+}

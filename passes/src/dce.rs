@@ -76,3 +76,36 @@ impl Pass for Dce {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use robovec_ir::text::parse;
+
+    const SRC: &str = "func @f { input %a input %b input %c %x = %a*%b %y = %x + %c %z = %b*%b output c[1] = %x output c[2] = %y output Qq[1] = %z }";
+
+    fn run(keep: Option<&str>) -> Result<Module, PassError> {
+        let mut m = parse(SRC).unwrap();
+        let keep = keep.map(|k| k.split(',').map(String::from).collect());
+        Dce { keep }.run(&mut m, &mut PassContext::default()).map(|_| m)
+    }
+
+    #[test]
+    fn keeps_what_the_outputs_need() {
+        let m = run(Some("Qq[1]")).unwrap();
+        let f = &m.functions[0];
+        assert_eq!(f.outputs.len(), 1);
+        assert_eq!(f.inputs.len(), 1, "only %b is needed");
+        assert_eq!(f.body.len(), 1);
+        assert!(robovec_ir::verifier::verify_function(f).is_empty());
+        let m = run(Some("c")).unwrap();
+        assert_eq!(m.functions[0].outputs.len(), 2);
+        assert!(m.functions[0].lookup("z").is_none());
+        assert_eq!(run(None).unwrap().functions[0].body.len(), 3);
+    }
+
+    #[test]
+    fn unknown_output_is_an_error() {
+        assert!(matches!(run(Some("M")), Err(PassError::BadParameter { .. })));
+    }
+}

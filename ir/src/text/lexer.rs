@@ -99,6 +99,16 @@ impl std::fmt::Display for Tok<'_> {
             Tok::Local(s) => write!(f, "%{s}"),
             Tok::Global(s) => write!(f, "@{s}"),
             Tok::Name(s) | Tok::Number(s) => write!(f, "{s}"),
+            Tok::LBrace => f.write_str("{"),
+            Tok::RBrace => f.write_str("}"),
+            Tok::LParen => f.write_str("("),
+            Tok::RParen => f.write_str(")"),
+            Tok::Comma => f.write_str(","),
+            Tok::Eq => f.write_str("="),
+            Tok::Plus => f.write_str("+"),
+            Tok::Minus => f.write_str("-"),
+            Tok::Star => f.write_str("*"),
+            Tok::Slash => f.write_str("/"),
             other => write!(f, "{}", format!("{other:?}").to_lowercase()),
         }
     }

@@ -115,3 +115,70 @@ fn expr(func: &Function, e: ExprAst<'_>, errors: &mut Vec<ParseError>) -> Expr {
         ExprAst::Call(c, args) => Expr::Call(c, args.into_iter().map(|a| expr(func, a, errors)).collect()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SRC: &str = "; a comment
+func @f {
+  phase parsed
+  equations 3
+  input %q[1]
+  input %g[3]
+  %S1 = sin %q[1]
+  %A = -%g[3]*%S1 + (-%q[1]) - (%S1 - 2.0)*(-(%g[3]))
+  %B = %A/%q[1] - (-(%A + 1.0))
+  %C = @user_ExtForces.1[3](%A, %B*%A) + @sqrt(%A)
+  output Qq[1] = %C
+  output Qq[2] = -1.5
+}
+";
+
+    #[test]
+    fn expressions_round_trip() {
+        let m = parse(SRC).unwrap_or_else(|e| panic!("{e:?}"));
+        let printed = m.to_string();
+        let m2 = parse(&printed).unwrap();
+        assert_eq!(printed, m2.to_string());
+        // Same structure; spans differ, so compare the printed form and the defs.
+        let (f, g) = (&m.functions[0], &m2.functions[0]);
+        for (a, b) in f.values.iter().zip(&g.values) {
+            assert_eq!((&a.name, &a.def), (&b.name, &b.def));
+        }
+        assert_eq!(f.outputs.len(), 2);
+        assert_eq!(f.equations, Some(3));
+    }
+
+    #[test]
+    fn unary_minus_covers_the_product_term() {
+        let m = parse("func @f { input %a input %b %x = -%a*%b + %a }").unwrap();
+        let f = &m.functions[0];
+        let x = f.lookup("x").unwrap();
+        let Def::Expr(Expr::Binary(crate::BinOp::Add, l, _)) = &f.value(x).def else { panic!() };
+        assert!(matches!(**l, Expr::Neg(ref p) if matches!(**p, Expr::Binary(crate::BinOp::Mul, _, _))));
+    }
+
+    #[test]
+    fn resolution_errors_are_collected() {
+        let e = parse("func @f { input %a %x = add %a, %y %x = mul %a, %a output o = %z }").unwrap_err();
+        let msgs: Vec<&str> = e.iter().map(|e| e.message.as_str()).collect();
+        assert_eq!(msgs, ["use of undefined value `%y`", "value `%x` defined twice", "use of undefined value `%z`"]);
+    }
+
+    #[test]
+    fn bad_numbers_and_tokens() {
+        assert_eq!(parse("func @f { %x = add 1e999, 1.0 }").unwrap_err()[0].message, "number does not parse");
+        assert_eq!(parse("func @f { %x = add 1.0, 1.0 } $").unwrap_err()[0].message, "invalid character");
+        assert_eq!(parse("func @f {").unwrap_err()[0].message, "unexpected end of input");
+    }
+
+    #[test]
+    fn timing_attributes_round_trip_and_are_checked() {
+        let src = "func @f {\n  phase atomised\n  input %a\n  %x = mul %a, %a {asap=1, alap=2, asap_cycle=7, alap_cycle=19, mobility=1}\n  output o = %x\n}\n";
+        let m = parse(src).unwrap();
+        assert_eq!(m.to_string(), src);
+        let bad = src.replace("mobility=1", "mobility=3");
+        assert!(parse(&bad).unwrap_err()[0].message.starts_with("mobility must equal"));
+    }
+}
