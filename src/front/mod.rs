@@ -1,1 +1,111 @@
 //! Front ends: Robotran C, Matlab and Python outputs → IR modules (parsed phase).
+//!
+//! Pipeline (naga style): the bytes are made text by [`source_text`] (every byte offset kept),
+//! lexed once by the shared logos lexer ([`lexer`]), grouped into functions and logical
+//! statements by the file scanner of the language ([`c`], [`matlab`], [`python`]), each
+//! statement parsed by the shared lalrpop grammar (`expr.lalrpop`, glue in [`stmt`]) into the
+//! language-agnostic [`ast`], and lowered to IR by [`lower`] (whose module doc states the
+//! lowering rules).
+//!
+//! # Encoding
+//! Input is bytes. Valid UTF-8 is kept; each byte of an invalid UTF-8 sequence (a Latin-1
+//! `é` in a banner) becomes one `?`, so every span is a byte offset into the original bytes
+//! *and* into the text. Render diagnostics over [`source_text`] of the same bytes (or any
+//! conversion with the same property), not over `String::from_utf8_lossy`, whose U+FFFD
+//! replacement is 3 bytes long. CRLF line ends are accepted everywhere (a CR is a blank).
+
+pub mod ast;
+pub mod c;
+pub mod error;
+pub mod lexer;
+pub mod lower;
+pub mod matlab;
+pub mod python;
+pub mod scan;
+pub mod sensor;
+pub mod stmt;
+
+use std::path::Path;
+
+pub use error::FrontError;
+
+/// A Robotran output language.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Language {
+    /// C (`.c`, companion `.h`).
+    C,
+    /// Matlab (`.m`).
+    Matlab,
+    /// Python (`.py`).
+    Python,
+}
+
+/// The language of a file from its extension: `.c`/`.h` → C, `.m` → Matlab, `.py` → Python.
+pub fn language_of(path: &Path) -> Option<Language> {
+    match path.extension()?.to_str()? {
+        "c" | "h" => Some(Language::C),
+        "m" => Some(Language::Matlab),
+        "py" => Some(Language::Python),
+        _ => None,
+    }
+}
+
+/// The bytes as text with every byte offset kept: each byte of an invalid UTF-8 sequence
+/// becomes `?` (see the module doc).
+pub fn source_text(bytes: &[u8]) -> String {
+    let mut out = String::with_capacity(bytes.len());
+    let mut rest = bytes;
+    loop {
+        match std::str::from_utf8(rest) {
+            Ok(s) => {
+                out.push_str(s);
+                return out;
+            }
+            Err(e) => {
+                let (good, bad) = rest.split_at(e.valid_up_to());
+                out.push_str(std::str::from_utf8(good).unwrap_or_default());
+                let n = e.error_len().unwrap_or(bad.len()).max(1).min(bad.len());
+                out.extend(std::iter::repeat_n('?', n));
+                rest = &bad[n..];
+            }
+        }
+    }
+}
+
+/// Most errors reported for one file (the rest are dropped: the first ones tell the story).
+pub const MAX_ERRORS: usize = 100;
+
+/// Parses a Robotran file into an IR module in `Phase::Parsed`.
+///
+/// `header` is the companion `.h` text of a C file (optional; its `double NAME;` lines are
+/// declarations and only matter for `double *X;` pointers). Spans in errors are byte offsets
+/// into `src`.
+///
+/// # Errors
+/// Every problem found (up to [`MAX_ERRORS`]); no module is returned when there is one.
+pub fn parse_str(lang: Language, src: &[u8], header: Option<&[u8]>) -> Result<robovec_ir::Module, Vec<FrontError>> {
+    let text = source_text(src);
+    let toks = lexer::lex(&text);
+    let mut errors = Vec::new();
+    let funcs = match lang {
+        Language::C => {
+            let header = header.map(source_text);
+            c::scan(&text, &toks, header.as_deref(), &mut errors)
+        }
+        Language::Matlab => matlab::scan(&text, &toks, &mut errors),
+        Language::Python => python::scan(&text, &toks, &mut errors),
+    };
+    if funcs.is_empty() && errors.is_empty() {
+        errors.push(scan::no_function(lang, text.len()));
+    }
+    let module = lower::lower_module(&text, lang, &funcs, &mut errors);
+    if errors.is_empty() {
+        Ok(module)
+    } else {
+        errors.truncate(MAX_ERRORS);
+        Err(errors)
+    }
+}
+
+#[cfg(test)]
+mod corpus_tests;
