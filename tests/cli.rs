@@ -1,1 +1,163 @@
-//! (to be written)
+//! `robovec-opt` end to end: SPEC §7 flags, report, eval, dumps, exit statuses.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use crate::common::corpus_dir;
+
+fn opt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_robovec-opt")).args(args).output().expect("robovec-opt runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn segway() -> String {
+    corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c").display().to_string()
+}
+
+#[test]
+fn print_passes_lists_every_pass_and_parameter() {
+    let o = opt(&["--print-passes"]);
+    assert!(o.status.success());
+    let s = String::from_utf8_lossy(&o.stdout);
+    for needle in ["atomise", "dce", "outputs", "asap-alap", "lat-add", "lat-mul", "lat-div", "lat-call"] {
+        assert!(s.contains(needle), "missing {needle} in\n{s}");
+    }
+}
+
+#[test]
+fn unknown_passes_and_parameters_are_usage_errors_listing_valid_ones() {
+    let o = opt(&[&segway(), "-passes=atomise,frobnicate"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("unknown pass `frobnicate`; valid passes: atomise, dce, asap-alap"), "{}", stderr(&o));
+    let o = opt(&[&segway(), "--passes=atomise,asap-alap<lat-foo=3>"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("valid: lat-add, lat-mul, lat-div, lat-call"), "{}", stderr(&o));
+    let o = opt(&[&segway(), "-passes=asap-alap<lat-add=x>"]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn report_has_the_spec_fields_and_the_segway_figures() {
+    let d = tmp("report");
+    let r = d.join("r.json");
+    let o = opt(&[&segway(), "-passes=atomise,asap-alap", &format!("-report={}", r.display()), "-o", d.join("out.rvir").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&r).unwrap()).unwrap();
+    assert_eq!(j["function"], "dirdyna");
+    assert_eq!(j["pipeline"], "atomise,asap-alap");
+    assert_eq!(j["passes"][0]["name"], "atomise");
+    assert_eq!(j["passes"][0]["ops_before"], 4261);
+    assert_eq!(j["passes"][0]["ops_after"], 4261);
+    assert!(j["passes"][1]["wall_ms"].is_number());
+    let s = &j["stats"];
+    assert_eq!(s["equations"], 924);
+    assert_eq!(s["ops"]["total"], 4261);
+    assert_eq!(s["ops"]["add"], 954);
+    assert_eq!(s["ops"]["sub"], 923);
+    assert_eq!(s["ops"]["mul"], 2384);
+    assert_eq!(s["asap"], 65);
+    assert_eq!(s["asap_cycle"], 720);
+    assert!((s["y"].as_f64().unwrap() - 4261.0 / 720.0).abs() < 1e-12);
+    assert!(s["inputs"].as_u64().unwrap() > 0 && s["outputs"].as_u64().unwrap() > 0);
+    // The written IR re-reads and carries the timing attributes.
+    let o = opt(&[d.join("out.rvir").to_str().unwrap(), "-passes=", "-stats"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("asap_cycle="));
+    assert!(stderr(&o).contains("critical path 65 ops / 720 cycles"), "{}", stderr(&o));
+}
+
+#[test]
+fn dumps_and_prints_are_real_ir() {
+    let d = tmp("dumps");
+    let dump = d.join("dump");
+    let o = opt(&[&segway(), "-passes=atomise,dce<outputs=c>,asap-alap", "-print-after-all", &format!("-dump-dir={}", dump.display()), "-time-passes", "-o", d.join("o.rvir").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("*** IR Dump After atomise ***") && e.contains("*** IR Dump After asap-alap ***"));
+    assert!(e.contains("Pass execution timing report"));
+    let mut names: Vec<String> = std::fs::read_dir(&dump).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, ["001-atomise.after.rvir", "001-atomise.before.rvir", "002-dce.after.rvir", "002-dce.before.rvir", "003-asap-alap.after.rvir", "003-asap-alap.before.rvir"]);
+    for n in names {
+        let o = opt(&[dump.join(&n).to_str().unwrap(), "-passes=", "-o", d.join("x.rvir").to_str().unwrap()]);
+        assert!(o.status.success(), "{n}: {}", stderr(&o));
+    }
+    // dce<outputs=c> dropped the mass matrix.
+    let after = std::fs::read_to_string(dump.join("002-dce.after.rvir")).unwrap();
+    assert!(!after.contains("output M[") && after.contains("output c[1]"));
+}
+
+#[test]
+fn eval_uses_given_inputs_and_reports_all_outputs() {
+    let d = tmp("eval");
+    let inputs = d.join("in.json");
+    std::fs::write(&inputs, r#"{"q[1]": 0.25, "m[5]": 3.5}"#).unwrap();
+    let o = opt(&[&segway(), "-passes=atomise", &format!("-eval={}", inputs.display())]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["inputs"]["q[1]"], 0.25);
+    assert_eq!(j["inputs"]["m[5]"], 3.5);
+    assert!(j["outputs"]["M[1][1]"].is_number() && j["outputs"]["c[17]"].is_number());
+    // Same numbers before atomise (the parsed IR is evaluated as written).
+    let o2 = opt(&[&segway(), "-passes=", &format!("-eval={}", inputs.display())]);
+    assert_eq!(o.stdout, o2.stdout);
+}
+
+#[test]
+fn bad_input_exits_1_and_leaves_no_output_file() {
+    let d = tmp("bad");
+    let bad = d.join("bad.c");
+    std::fs::write(&bad, "void mbs_invdyna(double *Qq,\nMbsData *s, double tsim)\n{\n  x = tan(q[1]);\n}\n").unwrap();
+    let out = d.join("out.rvir");
+    let o = opt(&[bad.to_str().unwrap(), "-passes=atomise", "-o", out.to_str().unwrap(), &format!("-report={}", d.join("r.json").display())]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("bad.c:4:"), "names file and line: {}", stderr(&o));
+    assert!(!out.exists() && !d.join("r.json").exists());
+    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1, "no temporary file left behind");
+}
+
+#[test]
+fn modules_with_several_functions_need_function_for_reports() {
+    let d = tmp("sensor");
+    let sensor = corpus_dir().join("c/m454__mbs_sensor_m454_project.c");
+    let r = d.join("r.json");
+    let o = opt(&[sensor.to_str().unwrap(), "-passes=atomise", &format!("-report={}", r.display()), "-o", d.join("o.rvir").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("-function=NAME"), "{}", stderr(&o));
+    let o = opt(&[sensor.to_str().unwrap(), "-passes=atomise", &format!("-report={}", r.display()), "-function=sensor_1", "-o", d.join("o.rvir").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn ir_from_stdin_and_verifier_errors_on_input() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_robovec-opt"))
+        .args(["-", "-passes=atomise,asap-alap"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write;
+    child.stdin.take().unwrap().write_all(b"func @f { input %a %x = -%a*%a output o = %x }").unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("%x = sub 0.0, %x.1 {asap=2"));
+
+    let d = tmp("verify");
+    let p = d.join("bad.rvir");
+    std::fs::write(&p, "func @f {\n  phase atomised\n  input %a\n  %x = %a*%a\n  output o = %x\n}\n").unwrap();
+    let o = opt(&[p.to_str().unwrap(), "-passes=asap-alap"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("nested expression in an atomised function") && stderr(&o).contains("bad.rvir:4:"), "{}", stderr(&o));
+}
+
