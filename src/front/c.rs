@@ -62,11 +62,12 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                 match toks.get(body_open).map(|t| t.1) {
                     Some(Tok::Semi) => i = body_open + 1, // a prototype
                     Some(Tok::LBrace) => {
-                        let Some(body_close) = matching(&toks, body_open) else {
+                        let body_close = matching(&toks, body_open).unwrap_or_else(|| {
                             errors.push(FrontError::new(Span::new(toks[body_open].0, toks[body_open].2), "unclosed `{`", "function body opened here").note("expected `}` closing the function body"));
-                            break;
-                        };
-                        let mut f = FuncAst::new(name, Span::new(toks[start].0, toks[body_close].2));
+                            toks.len()
+                        });
+                        let end = toks.get(body_close).map_or(src.len(), |t| t.0);
+                        let mut f = FuncAst::new(name, Span::new(toks[start].0, toks.get(body_close).map_or(src.len(), |t| t.2)));
                         for (p, stars, ty) in scan::params(&toks[open + 1..close]) {
                             f.params.push(p.to_string());
                             if stars > 0 && ty == "double" {
@@ -75,7 +76,7 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                         }
                         f.defines = defines.clone();
                         f.pointers = header_pointers.clone();
-                        body(src, &toks[body_open + 1..body_close], toks[body_close].0, &mut f, errors);
+                        body(src, &toks[body_open + 1..body_close], end, &mut f, errors);
                         funcs.push(f);
                         i = body_close + 1;
                     }

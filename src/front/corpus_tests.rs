@@ -45,6 +45,19 @@ fn straight_line_files_parse_and_loop_files_are_rejected() {
         match (parse_file(&p), is_loop_file(&p)) {
             (Ok(m), false) => {
                 assert!(!m.functions.is_empty(), "{name}: no function");
+                if let Err(errs) = robovec_ir::verifier::verify(&m) {
+                    failures.push(format!("{name}: verifier: {:?}", errs.iter().take(3).map(|e| e.message.clone()).collect::<Vec<_>>()));
+                }
+                let text = m.to_string();
+                match robovec_ir::text::parse(&text) {
+                    Ok(back) => {
+                        for (a, b) in m.functions.iter().zip(&back.functions) {
+                            assert_eq!(a.op_counts(), b.op_counts(), "{name}: .rvir round trip changes {}", a.name);
+                            assert_eq!(a.outputs.len(), b.outputs.len(), "{name}: .rvir round trip changes {}", a.name);
+                        }
+                    }
+                    Err(errs) => failures.push(format!("{name}: printed IR does not parse back: {:?}", errs.first())),
+                }
                 for f in &m.functions {
                     let stats = f.op_counts();
                     println!("{name}: {} equations={} ops={} (add {} sub {} mul {} div {} call {}) inputs={} outputs={}",

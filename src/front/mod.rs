@@ -102,6 +102,7 @@ pub fn parse_str(lang: Language, src: &[u8], header: Option<&[u8]>) -> Result<ro
     if errors.is_empty() {
         Ok(module)
     } else {
+        errors.sort_by_key(|e| (e.span.start, e.span.end));
         errors.truncate(MAX_ERRORS);
         Err(errors)
     }
@@ -109,3 +110,7 @@ pub fn parse_str(lang: Language, src: &[u8], header: Option<&[u8]>) -> Result<ro
 
 #[cfg(test)]
 mod corpus_tests;
+#[cfg(test)]
+mod error_tests;
+#[cfg(test)]
+mod snippet_tests;
