@@ -101,16 +101,23 @@ fn dumps_and_prints_are_real_ir() {
 fn eval_uses_given_inputs_and_reports_all_outputs() {
     let d = tmp("eval");
     let inputs = d.join("in.json");
-    std::fs::write(&inputs, r#"{"q[1]": 0.25, "m[5]": 3.5}"#).unwrap();
+    std::fs::write(&inputs, r#"{"q[4]": 0.25, "dpt[3][2]": 3.5}"#).unwrap();
     let o = opt(&[&segway(), "-passes=atomise", &format!("-eval={}", inputs.display())]);
     assert!(o.status.success(), "{}", stderr(&o));
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(j["inputs"]["q[1]"], 0.25);
-    assert_eq!(j["inputs"]["m[5]"], 3.5);
+    assert_eq!(j["inputs"]["q[4]"], 0.25);
+    assert_eq!(j["inputs"]["dpt[3][2]"], 3.5);
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
     assert!(j["outputs"]["M[1][1]"].is_number() && j["outputs"]["c[17]"].is_number());
-    // Same numbers before atomise (the parsed IR is evaluated as written).
+    // Same numbers before atomise (the parsed IR is evaluated as written); JSON numbers compare
+    // as f64, so a zero whose sign `0 - t` changed still compares equal.
     let o2 = opt(&[&segway(), "-passes=", &format!("-eval={}", inputs.display())]);
-    assert_eq!(o.stdout, o2.stdout);
+    let j2: serde_json::Value = serde_json::from_slice(&o2.stdout).unwrap();
+    assert_eq!(j, j2);
+    // An unknown input name is reported, not silently used.
+    std::fs::write(&inputs, r#"{"q[99]": 1.0}"#).unwrap();
+    let o = opt(&[&segway(), "-passes=atomise", &format!("-eval={}", inputs.display())]);
+    assert!(o.status.success() && stderr(&o).contains("`q[99]` is not an input of @dirdyna"));
 }
 
 #[test]

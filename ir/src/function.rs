@@ -208,7 +208,8 @@ impl Function {
     }
 
     /// Keeps only the body values for which `keep` is true, renumbering values densely and
-    /// rewriting every reference. Inputs are kept when `keep_input` says so.
+    /// rewriting every reference; `keep` is asked about inputs too. `retain(|_, _| true)`
+    /// renumbers into the canonical order (inputs, then body) that the text reader produces.
     ///
     /// The caller guarantees that no kept value refers to a dropped one.
     pub fn retain(&mut self, mut keep: impl FnMut(&Function, Value) -> bool) {
