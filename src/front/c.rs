@@ -76,8 +76,14 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                         }
                         f.defines = defines.clone();
                         f.pointers = header_pointers.clone();
-                        body(src, &toks[body_open + 1..body_close], end, &mut f, errors);
-                        funcs.push(f);
+                        let mark = errors.len();
+                        if body(src, &toks[body_open + 1..body_close], end, &mut f, errors) {
+                            funcs.push(f);
+                        } else if let Some(fatal) = errors.pop() {
+                            // Control flow: the loop diagnostic alone tells why the file is rejected.
+                            errors.truncate(mark);
+                            errors.push(fatal);
+                        }
                         i = body_close + 1;
                     }
                     _ => {
@@ -176,7 +182,9 @@ enum Target {
     Suffix,
 }
 
-fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &mut Vec<FrontError>) {
+/// Scans a function body into `f`; false after a fatal (control-flow or structure) error,
+/// which is then the last error pushed.
+fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &mut Vec<FrontError>) -> bool {
     let mut i = 0;
     let mut target = Target::Prefix;
     let mut cases: Option<Vec<Case>> = None;
@@ -222,7 +230,7 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
                         switch_close = matching(toks, c + 1);
                         if switch_close.is_none() {
                             errors.push(FrontError::new(Span::new(t.0, t.2), "unclosed `switch`", "this switch").note("expected `}` closing the switch"));
-                            return;
+                            return false;
                         }
                         cases = Some(Vec::new());
                         target = Target::Dead;
@@ -230,7 +238,7 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
                     }
                     _ => {
                         errors.push(FrontError::new(Span::new(t.0, t.2), "malformed `switch`", "this switch").note("expected `switch (isens) { case 1: … }`"));
-                        return;
+                        return false;
                     }
                 }
             }
@@ -241,7 +249,7 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
                 };
                 let Some(label) = label else {
                     errors.push(FrontError::new(Span::new(t.0, t.2), "malformed `case` label", "this case").note("expected `case N:` with an integer N"));
-                    return;
+                    return false;
                 };
                 let span = Span::new(t.0, toks[i + 2].2);
                 let cs = cases.get_or_insert_with(Vec::new);
@@ -267,15 +275,15 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
             }
             (_, Some("return")) => {
                 errors.push(scan::control_error(src, "`return` with a value", Span::new(t.0, t.2)));
-                return;
+                return false;
             }
             (_, Some(w)) if scan::control_kind(w).is_some() => {
                 errors.push(scan::control_error(src, scan::control_kind(w).unwrap_or(w), Span::new(t.0, t.2)));
-                return;
+                return false;
             }
             (Tok::LBrace | Tok::RBrace, _) => {
                 errors.push(scan::unexpected(&t, "a statement; nested blocks are not supported"));
-                return;
+                return false;
             }
             _ => {
                 // A statement: tokens up to `;`.
@@ -305,4 +313,5 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
         }
     }
     f.cases = cases;
+    true
 }

@@ -145,6 +145,21 @@ fn absurd_nesting_and_length_are_diagnosed() {
     assert_eq!(first(Language::C, &c_fn(&deeper)).message, "expression nests deeper than 256 parentheses");
     let long = format!("  X = q[1]{};\n", "+q[1]".repeat(100_000));
     assert!(first(Language::C, &c_fn(&long)).message.starts_with("statement has more than"));
+    // The largest accepted statement goes through lowering, counting, printing and verifying.
+    let big = format!("  X = -(q[1]{})*{}q[2]{};\n  M[1][1] = X;\n", "+q[1]*q[2]/q[3]".repeat(600), "(".repeat(250), ")".repeat(250));
+    let m = std::thread::Builder::new()
+        .stack_size(2 << 20)
+        .spawn(move || {
+            let m = super::snippet_tests::parse(Language::C, &c_fn(&big));
+            let f = &m.functions[0];
+            assert_eq!(f.op_counts().total, 1800 + 1 + 1);
+            robovec_ir::verifier::verify(&m).expect("verifies");
+            m.to_string().len()
+        })
+        .expect("thread")
+        .join()
+        .expect("no stack overflow on a 1800-operator statement");
+    assert!(m > 0);
     let py = format!("def dirdyna(M, c, s, tsim):\n    X = {}1\n", "(".repeat(1000));
     assert!(first(Language::Python, &py).message.contains("256"));
 }

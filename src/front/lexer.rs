@@ -101,7 +101,9 @@ pub enum Tok<'a> {
 impl std::fmt::Display for Tok<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let s = match self {
-            Tok::SlashComment | Tok::BlockComment | Tok::PercentComment => "comment",
+            Tok::SlashComment => "//",
+            Tok::BlockComment => "/*",
+            Tok::PercentComment => "%",
             Tok::Hash(s) | Tok::Ident(s) | Tok::Number(s) | Tok::Str(s) => s,
             Tok::Ellipsis => "...",
             Tok::Backslash => "\\",

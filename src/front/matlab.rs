@@ -29,12 +29,14 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
     let mut ended = false;
     let mut outside_reported = false;
     let mut dropped = false;
+    let mut mark = errors.len();
     for line in scan::lines(&flat) {
         let first = line[0];
         let word = if let Tok::Ident(w) = first.1 { Some(w) } else { None };
         match word {
             Some("function") => {
                 dropped = false;
+                mark = errors.len();
                 if let Some(f) = signature(line, errors) {
                     funcs.push(f);
                     ended = false;
@@ -48,7 +50,11 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
             Some("return") if line.len() == 1 || (line.len() == 2 && line[1].1 == Tok::Semi) => continue,
             Some(w) if scan::control_kind(w).is_some() || w == "return" => {
                 let what = scan::control_kind(w).unwrap_or("`return`");
-                errors.push(scan::control_error(src, what, Span::new(first.0, first.2)));
+                if !dropped {
+                    // The loop diagnostic alone tells why the file is rejected.
+                    errors.truncate(mark);
+                    errors.push(scan::control_error(src, what, Span::new(first.0, first.2)));
+                }
                 // Drop the function: nothing after a loop can be trusted.
                 if !dropped && !ended {
                     funcs.pop();

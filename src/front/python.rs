@@ -27,6 +27,7 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
     let mut funcs: Vec<FuncAst> = Vec::new();
     let mut outside_reported = false;
     let mut dropped = false;
+    let mut mark = errors.len();
     for line in scan::lines(&flat) {
         let first = line[0];
         let word = if let Tok::Ident(w) = first.1 { Some(w) } else { None };
@@ -34,6 +35,7 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
             Some("import" | "from") => continue,
             Some("def") => {
                 dropped = false;
+                mark = errors.len();
                 if let Some(f) = signature(line, errors) {
                     funcs.push(f);
                 }
@@ -43,7 +45,11 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
             Some("return") if line.len() == 1 => continue,
             Some(w) if scan::control_kind(w).is_some() || w == "return" => {
                 let what = scan::control_kind(w).unwrap_or("`return` with a value");
-                errors.push(scan::control_error(src, what, Span::new(first.0, first.2)));
+                if !dropped {
+                    // The loop diagnostic alone tells why the file is rejected.
+                    errors.truncate(mark);
+                    errors.push(scan::control_error(src, what, Span::new(first.0, first.2)));
+                }
                 if !dropped {
                     funcs.pop();
                 }
