@@ -305,7 +305,7 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
                     errors.push(FrontError::new(scan::span_of(stmt, t.0), "unreachable statement after `return;`", "after return").note(format!("`return;` at line {line} ends the function")));
                 }
                 match scan::statement(stmt, errors) {
-                    Parsed::Stmt(s) => push(s, &target, f, &mut cases, errors),
+                    Parsed::Stmt(s) => push(*s, &target, f, &mut cases, errors),
                     Parsed::Ignored | Parsed::Failed => {}
                 }
                 i = stop + 1;

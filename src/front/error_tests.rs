@@ -167,14 +167,11 @@ fn absurd_nesting_and_length_are_diagnosed() {
 #[test]
 fn diagnostics_render_with_codespan() {
     use codespan_reporting::files::SimpleFile;
-    use codespan_reporting::term::{self, Config};
+    use codespan_reporting::term::{emit_into_string, Config};
     let src = c_fn("  X = tan(q[1]);\n");
     let e = first(Language::C, &src);
     let file = SimpleFile::new("x.c", src.as_str());
-    let mut out = String::new();
-    let mut w = codespan_reporting::term::termcolor::NoColor::new(Vec::new());
-    term::emit(&mut w, &Config::default(), &file, &e.to_diagnostic(())).expect("renders");
-    out.push_str(&String::from_utf8_lossy(&w.into_inner()));
+    let out = emit_into_string(&Config::default(), &file, &e.to_diagnostic(())).expect("renders");
     assert!(out.contains("x.c:5:7"), "{out}");
     assert!(out.contains("unknown function `tan`"), "{out}");
 }

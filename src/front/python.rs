@@ -73,7 +73,7 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
             _ => line,
         };
         if let Parsed::Stmt(s) = scan::statement(stmt, errors) {
-            f.prefix.push(s);
+            f.prefix.push(*s);
         }
         f.span = f.span.to(Span::new(line[0].0, line[line.len() - 1].2));
     }

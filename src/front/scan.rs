@@ -69,7 +69,7 @@ pub fn span_of(toks: &[Spanned<'_>], at: usize) -> Span {
 /// What one statement's tokens turned out to be.
 pub enum Parsed {
     /// An assignment.
-    Stmt(Stmt),
+    Stmt(Box<Stmt>),
     /// `mbs_msg("…")`: a runtime message, ignored (it computes nothing).
     Ignored,
     /// An error was pushed.
@@ -96,7 +96,7 @@ pub fn statement(toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Parsed {
         return Parsed::Failed;
     }
     match parse_stmt(toks, span.end as usize) {
-        Ok(s) => Parsed::Stmt(s),
+        Ok(s) => Parsed::Stmt(Box::new(s)),
         Err(e) => {
             errors.push(e);
             Parsed::Failed
