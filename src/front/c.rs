@@ -46,6 +46,11 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                     errors.push(scan::unexpected(&toks[toks.len() - 1], "a function definition"));
                     break;
                 };
+                if matches!(toks[open].1, Tok::Semi | Tok::LBracket | Tok::Comma) {
+                    // A file-level declaration (`double    C4;` in a companion header): ignored.
+                    i = skip_item(&toks, open);
+                    continue;
+                }
                 let name = match (toks[open].1, open.checked_sub(1).map(|k| toks[k].1)) {
                     (Tok::LParen, Some(Tok::Ident(n))) if open - 1 > start => n,
                     _ => {

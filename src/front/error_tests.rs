@@ -128,6 +128,11 @@ fn empty_and_garbage_files() {
         assert!(e[0].notes[0].starts_with("expected"));
         let e = errs(lang, b"// just a comment\n% another\n# and one\n");
         assert!(!e.is_empty());
+        let e = errs(Language::C, b"double    C4;\r\ndouble    S4;\r\n");
+        assert_eq!(e.len(), 1);
+        assert_eq!(e[0].message, "no Robotran function found");
+        let e = errs(lang, b"\n\n   \n");
+        assert!(!e.is_empty());
         let e = errs(lang, b"\x00\x01\xff\xfe garbage \x80 @@ \xc3");
         assert!(!e.is_empty());
         for err in &e {
