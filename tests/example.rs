@@ -69,10 +69,7 @@ fn lagrange(x: &HashMap<&'static str, f64>) -> [f64; 2] {
     let h = m2 * d * l2 * s2;
     let g1 = -g3 * (m1 * l1 * c1 + m2 * (d * c1 + l2 * c12));
     let g2 = -g3 * m2 * l2 * c12;
-    [
-        m11 * qdd1 + m12 * qdd2 - h * (2.0 * qd1 * qd2 + qd2 * qd2) + g1,
-        m12 * qdd1 + m22 * qdd2 + h * qd1 * qd1 + g2,
-    ]
+    [m11 * qdd1 + m12 * qdd2 - h * (2.0 * qd1 * qd2 + qd2 * qd2) + g1, m12 * qdd1 + m22 * qdd2 + h * qd1 * qd1 + g2]
 }
 
 fn outputs(f: &Function, x: &HashMap<&'static str, f64>) -> HashMap<String, f64> {
@@ -97,8 +94,20 @@ fn example_loads_with_expected_inputs_and_ops() {
     let mut inputs: Vec<&str> = f.inputs.iter().map(|&v| f.name_of(v)).collect();
     inputs.sort_unstable();
     let mut want = vec![
-        "In[1][1]", "In[1][2]", "dpt[2][2]", "g[3]", "l[2][1]", "l[2][2]", "m[1]", "m[2]", "q[1]", "q[2]", "qd[1]",
-        "qd[2]", "qdd[1]", "qdd[2]",
+        "In[1][1]",
+        "In[1][2]",
+        "dpt[2][2]",
+        "g[3]",
+        "l[2][1]",
+        "l[2][2]",
+        "m[1]",
+        "m[2]",
+        "q[1]",
+        "q[2]",
+        "qd[1]",
+        "qd[2]",
+        "qdd[1]",
+        "qdd[2]",
     ];
     want.sort_unstable();
     assert_eq!(inputs, want);
