@@ -108,6 +108,9 @@ fn syntax_errors_and_unterminated_statements() {
     assert_eq!(at(&src, &e), "X = q[1]+q[2]");
     let e = first(Language::C, "void mbs_invdyna(double *Qq, MbsData *s, double tsim)\n{\n  Qq[1] = q[1];\n");
     assert_eq!(e.message, "unclosed `{`");
+    let all = errs(Language::C, b"void mbs_invdyna(double *Qq, MbsData *s, double tsim)\n{\n  Qq[1] = q[1]");
+    let msgs: Vec<&str> = all.iter().map(|e| e.message.as_str()).collect();
+    assert_eq!(msgs, ["unclosed `{`", "statement is not terminated by `;`"]);
     let e = first(Language::Matlab, "function [c] = dirdyna(s,tsim,usrfun)\n  c(1) = q(1)+...\n");
     assert_eq!(e.message, "unexpected end of statement");
     let e = first(Language::Python, "def dirdyna(M, c, s, tsim):\n    c[1] = q[1]* \\\n");

@@ -3,14 +3,14 @@
 //! Comments of every language are tokens, not skipped: each file scanner keeps the ones of
 //! its language as comments and rejects the others (`%` in a C file is an error, `#` is a
 //! preprocessor line in C and a comment in Python). Newlines are tokens too (they end Matlab
-//! and Python statements; C ignores them). A character that starts no token becomes
+//! and Python statements; C ignores them). Blanks, CRs and a byte-order mark are skipped. A character that starts no token becomes
 //! [`Tok::Error`] so that a scanner can report it in context instead of aborting.
 
 use logos::Logos;
 
 /// A token of a Robotran file.
 #[derive(Logos, Clone, Copy, Debug, PartialEq, Eq)]
-#[logos(skip r"[ \t\f\r\x0b]+")]
+#[logos(skip r"[ \t\f\r\x0b\u{FEFF}]+")]
 pub enum Tok<'a> {
     /// `// …` to the end of the line (C comment).
     #[regex(r"//[^\n]*", allow_greedy = true)]

@@ -126,6 +126,9 @@ fn crlf_and_latin1_bytes_are_accepted_with_offsets_kept() {
     let at = bad.windows(10).position(|w| w == b"Undefined1").unwrap();
     assert_eq!(errs[0].span.range(), at..at + 10);
     assert_eq!(super::source_text(&bad).len(), bad.len());
+    // A UTF-8 byte-order mark is a blank.
+    let bom = parse(Language::C, &format!("\u{FEFF}{C_DIRDYNA}"));
+    assert_eq!(bom.to_string(), lf.to_string());
 }
 
 #[test]

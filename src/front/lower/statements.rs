@@ -66,10 +66,8 @@ impl Lower<'_> {
                 true
             }
             // `Qq = phi`
-            (None, []) if self.fa.params.contains(&r.name.text) && !self.current.contains_key(&r.name.text) => {
-                if self.outputs.contains(&r.name.text) {
-                    self.outputs.insert(x.to_string());
-                }
+            (None, []) if self.fa.params.contains(&r.name.text) && self.outputs.contains(&r.name.text) => {
+                self.outputs.insert(x.to_string());
                 true
             }
             // `M = zeros(55,55);`
