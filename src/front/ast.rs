@@ -120,6 +120,8 @@ pub struct FuncAst {
     pub cases: Option<Vec<Case>>,
     /// Statements after the `switch` (run after every case).
     pub suffix: Vec<Stmt>,
+    /// Names assigned by statements that failed to parse (their uses are not reported again).
+    pub poisoned: Vec<String>,
 }
 
 impl FuncAst {
@@ -135,6 +137,7 @@ impl FuncAst {
             prefix: Vec::new(),
             cases: None,
             suffix: Vec::new(),
+            poisoned: Vec::new(),
         }
     }
 }

@@ -311,7 +311,8 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
                 }
                 match scan::statement(stmt, errors) {
                     Parsed::Stmt(s) => push(*s, &target, f, &mut cases, errors),
-                    Parsed::Ignored | Parsed::Failed => {}
+                    Parsed::Failed(Some(name)) => f.poisoned.push(name),
+                    Parsed::Ignored | Parsed::Failed(None) => {}
                 }
                 i = stop + 1;
             }

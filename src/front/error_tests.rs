@@ -55,6 +55,8 @@ fn use_before_definition_and_redefinition() {
     // A failed statement does not cascade into more errors.
     let all = errs(Language::C, c_fn("  X = tan(q[1]);\n  Y = X*X;\n  M[1][1] = Y;\n").as_bytes());
     assert_eq!(all.len(), 1, "{all:?}");
+    let all = errs(Language::Python, b"def invdyna(phi,s,tsim):\n  Qq = phi\n  A = q[1]*(2.0.1)\n  Qq[1] = A\n");
+    assert_eq!(all.len(), 1, "a statement that does not parse poisons its name: {all:?}");
 }
 
 #[test]

@@ -132,7 +132,7 @@ impl<'a> Lower<'a> {
             s_arrays: fa.defines.iter().cloned().collect(),
             arrays: HashMap::new(),
             vectors: HashMap::new(),
-            failed: HashSet::new(),
+            failed: fa.poisoned.iter().map(|n| n.strip_prefix("s.").unwrap_or(n).to_string()).collect(),
             equations: 0,
         }
     }

@@ -6,7 +6,7 @@ use robovec_ir::Span;
 use super::ast::FuncAst;
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
-use super::scan::{self, Parsed};
+use super::scan;
 
 /// Scans a Matlab file.
 pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
@@ -73,9 +73,7 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
             continue;
         };
         for stmt in line.split(|t| t.1 == Tok::Semi).filter(|s| !s.is_empty()) {
-            if let Parsed::Stmt(s) = scan::statement(stmt, errors) {
-                f.prefix.push(*s);
-            }
+            scan::file_statement(stmt, f, errors);
         }
         f.span = f.span.to(Span::new(line[0].0, line[line.len() - 1].2));
     }

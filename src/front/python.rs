@@ -7,7 +7,7 @@ use robovec_ir::Span;
 use super::ast::FuncAst;
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
-use super::scan::{self, Parsed};
+use super::scan;
 
 /// Parameters that are never outputs.
 const NOT_OUTPUTS: &[&str] = &["s", "tsim", "usrfun", "self", "isens", "sens"];
@@ -72,9 +72,7 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
             [rest @ .., (_, Tok::Semi, _)] => rest,
             _ => line,
         };
-        if let Parsed::Stmt(s) = scan::statement(stmt, errors) {
-            f.prefix.push(*s);
-        }
+        scan::file_statement(stmt, f, errors);
         f.span = f.span.to(Span::new(line[0].0, line[line.len() - 1].2));
     }
     funcs

@@ -3,7 +3,7 @@
 
 use robovec_ir::Span;
 
-use super::ast::Stmt;
+use super::ast::{FuncAst, Stmt};
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
 use super::stmt::parse_stmt;
@@ -72,8 +72,19 @@ pub enum Parsed {
     Stmt(Box<Stmt>),
     /// `mbs_msg("…")`: a runtime message, ignored (it computes nothing).
     Ignored,
-    /// An error was pushed.
-    Failed,
+    /// An error was pushed; the name assigned, when it can be told, is poisoned so that its
+    /// later uses do not cascade into more errors.
+    Failed(Option<String>),
+}
+
+/// Parses the tokens of one statement (terminator excluded) and files it in `f`.
+/// Statement-position calls are rejected, except `mbs_msg(…)` which is ignored.
+pub fn file_statement(toks: &[Spanned<'_>], f: &mut FuncAst, errors: &mut Vec<FrontError>) {
+    match statement(toks, errors) {
+        Parsed::Stmt(s) => f.prefix.push(*s),
+        Parsed::Failed(Some(name)) => f.poisoned.push(name),
+        Parsed::Failed(None) | Parsed::Ignored => {}
+    }
 }
 
 /// Parses the tokens of one statement (terminator excluded). Statement-position calls are
@@ -90,16 +101,21 @@ pub fn statement(toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Parsed {
                 FrontError::new(span, format!("call statement `{name}(…)` is not supported"), "call without a result")
                     .note("expected an assignment `name = expression`; robovec cannot see what a call without a result changes (only `mbs_msg(…)` is ignored)"),
             );
-            return Parsed::Failed;
+            return Parsed::Failed(None);
         }
         errors.push(FrontError::new(span, "expected an assignment", "not an assignment").note("expected `name = expression`"));
-        return Parsed::Failed;
+        return Parsed::Failed(None);
     }
     match parse_stmt(toks, span.end as usize) {
         Ok(s) => Parsed::Stmt(Box::new(s)),
         Err(e) => {
             errors.push(e);
-            Parsed::Failed
+            let lhs = match toks {
+                [(_, Tok::Ident(obj), _), (_, Tok::Arrow | Tok::Dot, _), (_, Tok::Ident(name), _), ..] => format!("{obj}.{name}"),
+                [(_, Tok::Ident(name), _), ..] => name.to_string(),
+                _ => return Parsed::Failed(None),
+            };
+            Parsed::Failed(Some(lhs))
         }
     }
 }
