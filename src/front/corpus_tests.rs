@@ -86,3 +86,52 @@ fn frank_segway_dirdyna_matches_spec() {
     let c = f.op_counts();
     assert_eq!((c.add, c.sub, c.mul, c.div, c.call, c.total), (954, 923, 2384, 0, 0, 4261));
 }
+
+/// Long mutation run over the corpus (`cargo test -p robovec --lib front -- --ignored`):
+/// slices of real files with random edits; nothing may panic.
+#[test]
+#[ignore = "long fuzz run; run on demand"]
+fn corpus_mutations_never_panic() {
+    let files = corpus_files();
+    let mut x: u64 = 0x2545_F491_4F6C_DD1D;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let rounds: usize = std::env::var("FRONT_FUZZ_ROUNDS").ok().and_then(|s| s.parse().ok()).unwrap_or(20_000);
+    for _ in 0..rounds {
+        let p = &files[(next() as usize) % files.len()];
+        let src = std::fs::read(p).expect("readable");
+        let start = (next() as usize) % src.len();
+        let len = 1 + (next() as usize) % 4000;
+        let mut buf = src[start..(start + len).min(src.len())].to_vec();
+        if next() % 2 == 0 {
+            // keep the signature so that bodies get exercised
+            buf = [&src[..src.len().min(2000)], &buf[..]].concat();
+        }
+        for _ in 0..(next() % 8) {
+            let pos = (next() as usize) % (buf.len() + 1);
+            let alphabet = b"()[];=+-*/,.\n\\%#{}-> \r0123456789swhileforcase:";
+            let byte = alphabet[(next() as usize) % alphabet.len()];
+            match next() % 3 {
+                0 if pos < buf.len() => {
+                    buf.remove(pos);
+                }
+                1 => buf.insert(pos, byte),
+                _ if pos < buf.len() => buf[pos] = (next() & 0xff) as u8,
+                _ => {}
+            }
+        }
+        let lang = language_of(p).expect("known");
+        match parse_str(lang, &buf, None) {
+            Err(errs) => assert!(errs.iter().all(|e| e.span.end as usize <= buf.len().max(1))),
+            Ok(m) => {
+                if let Err(e) = robovec_ir::verifier::verify(&m) {
+                    panic!("front output does not verify: {:?}\n{}", e.first().map(|e| &e.message), String::from_utf8_lossy(&buf));
+                }
+            }
+        }
+    }
+}
