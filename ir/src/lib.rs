@@ -29,6 +29,7 @@
 
 pub mod analysis;
 pub mod count;
+pub mod diagnostic;
 pub mod entities;
 pub mod function;
 pub mod interp;
@@ -37,6 +38,7 @@ pub mod syntax;
 pub mod text;
 pub mod verifier;
 
+pub use diagnostic::SourceError;
 pub use entities::Value;
 pub use function::{Function, Module, OpCounts};
 pub use span::Span;

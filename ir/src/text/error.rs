@@ -1,7 +1,5 @@
 //! Errors of the `.rvir` reader, rendered with codespan-reporting.
 
-use codespan_reporting::diagnostic::{Diagnostic, Label};
-
 use crate::span::Span;
 
 /// Errors raised inside grammar actions and by the lexer adapter (byte offsets).
@@ -35,39 +33,7 @@ pub enum GrammarError {
 }
 
 /// An error reading `.rvir` text: where, what, and what was expected.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{message}")]
-pub struct ParseError {
-    /// The offending text.
-    pub span: Span,
-    /// Lower-case message stating the broken rule.
-    pub message: String,
-    /// Label on the offending text.
-    pub label: String,
-    /// Extra lines (`expected one of …`).
-    pub notes: Vec<String>,
-}
-
-impl ParseError {
-    /// An error with one label.
-    pub fn new(span: Span, message: impl Into<String>, label: impl Into<String>) -> ParseError {
-        ParseError { span, message: message.into(), label: label.into(), notes: Vec::new() }
-    }
-
-    /// Adds a note line.
-    pub fn with_note(mut self, note: impl Into<String>) -> ParseError {
-        self.notes.push(note.into());
-        self
-    }
-
-    /// The codespan diagnostic for file `file`.
-    pub fn to_diagnostic<F: Copy>(&self, file: F) -> Diagnostic<F> {
-        Diagnostic::error()
-            .with_message(&self.message)
-            .with_labels(vec![Label::primary(file, self.span.range()).with_message(&self.label)])
-            .with_notes(self.notes.clone())
-    }
-}
+pub use crate::diagnostic::SourceError as ParseError;
 
 fn expected_note(expected: &[String]) -> String {
     let shown: Vec<&str> = expected.iter().map(|s| s.trim_matches('"')).collect();
@@ -88,11 +54,11 @@ impl ParseError {
             P::UnrecognizedEof { location, expected } => {
                 let at = location.min(src_len);
                 ParseError::new(Span::new(at, at), "unexpected end of input", "input ends here")
-                    .with_note(expected_note(&expected))
+                    .note(expected_note(&expected))
             }
             P::UnrecognizedToken { token: (l, t, r), expected } => {
                 ParseError::new(Span::new(l, r), format!("unexpected `{t}`"), "not expected here")
-                    .with_note(expected_note(&expected))
+                    .note(expected_note(&expected))
             }
             P::ExtraToken { token: (l, t, r) } => {
                 ParseError::new(Span::new(l, r), format!("extra token `{t}`"), "not expected here")

@@ -62,7 +62,7 @@ fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
                         Operand::Value(v) => Def::Trig(t, v),
                         Operand::Const(_) => {
                             errors.push(ParseError::new(name_span, "trig initial variable of a constant", "here")
-                                .with_note("`sin`/`cos` take an input value, e.g. `cos %q[4]`"));
+                                .note("`sin`/`cos` take an input value, e.g. `cos %q[4]`"));
                             continue;
                         }
                     },
@@ -88,7 +88,7 @@ fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
 
 fn redefined(name: &str, span: Span) -> ParseError {
     ParseError::new(span, format!("value `%{name}` defined twice"), "redefinition")
-        .with_note("SSA: every value has exactly one definition")
+        .note("SSA: every value has exactly one definition")
 }
 
 fn operand(func: &Function, o: OperandAst<'_>, errors: &mut Vec<ParseError>) -> Operand {
@@ -99,7 +99,7 @@ fn operand(func: &Function, o: OperandAst<'_>, errors: &mut Vec<ParseError>) -> 
             None => {
                 errors.push(
                     ParseError::new(span, format!("use of undefined value `%{name}`"), "not defined before this use")
-                        .with_note("define the value or declare it with `input` before reading it"),
+                        .note("define the value or declare it with `input` before reading it"),
                 );
                 Operand::Const(0.0)
             }
