@@ -77,7 +77,8 @@ pub fn normalise_args(args: impl IntoIterator<Item = String>) -> Vec<String> {
                 && !a.starts_with("--")
                 && a.len() > 2
                 && a.as_bytes()[1].is_ascii_alphabetic()
-                && !(a.starts_with("-o") && !a.starts_with("-output"));
+                // `-o FILE` and `-oFILE` are the short option.
+                && !a.starts_with("-o");
             if long_single_dash {
                 format!("-{a}")
             } else {

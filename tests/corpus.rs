@@ -20,7 +20,7 @@ fn tree_critical_path(f: &Function, lat: &Latencies) -> (u32, u32) {
     let mut t = vec![(0u32, 0u32); f.values.len()];
     let mut best = (0, 0);
     fn walk(e: &Expr, t: &[(u32, u32)], lat: &Latencies, best: &mut (u32, u32)) -> (u32, u32) {
-        let mut op = |k: OpKind, parts: &[(u32, u32)], best: &mut (u32, u32)| {
+        let op = |k: OpKind, parts: &[(u32, u32)], best: &mut (u32, u32)| {
             let a = 1 + parts.iter().map(|p| p.0).max().unwrap_or(0);
             let c = lat.of(k) + parts.iter().map(|p| p.1).max().unwrap_or(0);
             best.0 = best.0.max(a);

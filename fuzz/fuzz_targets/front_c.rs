@@ -3,9 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use robovec::front::{parse_str, Language};
-use robovec_ir::verifier;
-use robovec_passes::atomise::atomise_function;
+use robovec::front::{check_accepted, parse_str, Language};
 
 fuzz_target!(|data: &[u8]| {
     // A NUL byte (never in a Robotran file) splits the input into the .c text and the
@@ -15,12 +13,7 @@ fuzz_target!(|data: &[u8]| {
         None => (data, None),
     };
     let Ok(m) = parse_str(Language::C, src, header) else { return };
-    if let Err(e) = verifier::verify(&m) {
-        panic!("front end returned a module that does not verify: {e:?}");
-    }
-    for f in &m.functions {
-        let a = atomise_function(f);
-        let errs = verifier::verify_function(&a);
-        assert!(errs.is_empty(), "atomised @{} does not verify: {errs:?}", f.name);
+    if let Err(e) = check_accepted(&m) {
+        panic!("{e}");
     }
 });

@@ -114,3 +114,20 @@ mod corpus_tests;
 mod error_tests;
 #[cfg(test)]
 mod snippet_tests;
+
+/// The contract every front end keeps, checked by the fuzz targets and property tests: a
+/// module it returns verifies, atomises, and its atomised form verifies.
+///
+/// # Errors
+/// A description of the first broken invariant.
+pub fn check_accepted(m: &robovec_ir::Module) -> Result<(), String> {
+    robovec_ir::verifier::verify(m).map_err(|e| format!("front end returned a module that does not verify: {e:?}"))?;
+    for f in &m.functions {
+        let a = robovec_passes::atomise::atomise_function(f);
+        let errs = robovec_ir::verifier::verify_function(&a);
+        if !errs.is_empty() {
+            return Err(format!("atomised @{} does not verify: {errs:?}", f.name));
+        }
+    }
+    Ok(())
+}
