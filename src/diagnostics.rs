@@ -26,7 +26,10 @@ impl SourceFile {
         let config = Config::default();
         diags
             .iter()
-            .map(|d| emit_into_string(&config, &file, d).unwrap_or_else(|e| format!("error: {}\n(could not render: {e})\n", d.message)))
+            .map(|d| {
+                emit_into_string(&config, &file, d)
+                    .unwrap_or_else(|e| format!("error: {}\n(could not render: {e})\n", d.message))
+            })
             .collect()
     }
 }

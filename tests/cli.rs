@@ -50,7 +50,13 @@ fn unknown_passes_and_parameters_are_usage_errors_listing_valid_ones() {
 fn report_has_the_spec_fields_and_the_segway_figures() {
     let d = tmp("report");
     let r = d.join("r.json");
-    let o = opt(&[&segway(), "-passes=atomise,asap-alap", &format!("-report={}", r.display()), "-o", d.join("out.rvir").to_str().unwrap()]);
+    let o = opt(&[
+        &segway(),
+        "-passes=atomise,asap-alap",
+        &format!("-report={}", r.display()),
+        "-o",
+        d.join("out.rvir").to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&r).unwrap()).unwrap();
     assert_eq!(j["function"], "dirdyna");
@@ -80,14 +86,33 @@ fn report_has_the_spec_fields_and_the_segway_figures() {
 fn dumps_and_prints_are_real_ir() {
     let d = tmp("dumps");
     let dump = d.join("dump");
-    let o = opt(&[&segway(), "-passes=atomise,dce<outputs=c>,asap-alap", "-print-after-all", &format!("-dump-dir={}", dump.display()), "-time-passes", "-o", d.join("o.rvir").to_str().unwrap()]);
+    let o = opt(&[
+        &segway(),
+        "-passes=atomise,dce<outputs=c>,asap-alap",
+        "-print-after-all",
+        &format!("-dump-dir={}", dump.display()),
+        "-time-passes",
+        "-o",
+        d.join("o.rvir").to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let e = stderr(&o);
     assert!(e.contains("*** IR Dump After atomise ***") && e.contains("*** IR Dump After asap-alap ***"));
     assert!(e.contains("Pass execution timing report"));
-    let mut names: Vec<String> = std::fs::read_dir(&dump).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let mut names: Vec<String> =
+        std::fs::read_dir(&dump).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
-    assert_eq!(names, ["001-atomise.after.rvir", "001-atomise.before.rvir", "002-dce.after.rvir", "002-dce.before.rvir", "003-asap-alap.after.rvir", "003-asap-alap.before.rvir"]);
+    assert_eq!(
+        names,
+        [
+            "001-atomise.after.rvir",
+            "001-atomise.before.rvir",
+            "002-dce.after.rvir",
+            "002-dce.before.rvir",
+            "003-asap-alap.after.rvir",
+            "003-asap-alap.before.rvir"
+        ]
+    );
     for n in names {
         let o = opt(&[dump.join(&n).to_str().unwrap(), "-passes=", "-o", d.join("x.rvir").to_str().unwrap()]);
         assert!(o.status.success(), "{n}: {}", stderr(&o));
@@ -126,7 +151,13 @@ fn bad_input_exits_1_and_leaves_no_output_file() {
     let bad = d.join("bad.c");
     std::fs::write(&bad, "void mbs_invdyna(double *Qq,\nMbsData *s, double tsim)\n{\n  x = tan(q[1]);\n}\n").unwrap();
     let out = d.join("out.rvir");
-    let o = opt(&[bad.to_str().unwrap(), "-passes=atomise", "-o", out.to_str().unwrap(), &format!("-report={}", d.join("r.json").display())]);
+    let o = opt(&[
+        bad.to_str().unwrap(),
+        "-passes=atomise",
+        "-o",
+        out.to_str().unwrap(),
+        &format!("-report={}", d.join("r.json").display()),
+    ]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("bad.c:4:"), "names file and line: {}", stderr(&o));
     assert!(!out.exists() && !d.join("r.json").exists());
@@ -138,10 +169,23 @@ fn modules_with_several_functions_need_function_for_reports() {
     let d = tmp("sensor");
     let sensor = corpus_dir().join("c/m454__mbs_sensor_m454_project.c");
     let r = d.join("r.json");
-    let o = opt(&[sensor.to_str().unwrap(), "-passes=atomise", &format!("-report={}", r.display()), "-o", d.join("o.rvir").to_str().unwrap()]);
+    let o = opt(&[
+        sensor.to_str().unwrap(),
+        "-passes=atomise",
+        &format!("-report={}", r.display()),
+        "-o",
+        d.join("o.rvir").to_str().unwrap(),
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("-function=NAME"), "{}", stderr(&o));
-    let o = opt(&[sensor.to_str().unwrap(), "-passes=atomise", &format!("-report={}", r.display()), "-function=sensor_1", "-o", d.join("o.rvir").to_str().unwrap()]);
+    let o = opt(&[
+        sensor.to_str().unwrap(),
+        "-passes=atomise",
+        &format!("-report={}", r.display()),
+        "-function=sensor_1",
+        "-o",
+        d.join("o.rvir").to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
@@ -165,6 +209,9 @@ fn ir_from_stdin_and_verifier_errors_on_input() {
     std::fs::write(&p, "func @f {\n  phase atomised\n  input %a\n  %x = %a*%a\n  output o = %x\n}\n").unwrap();
     let o = opt(&[p.to_str().unwrap(), "-passes=asap-alap"]);
     assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("nested expression in an atomised function") && stderr(&o).contains("bad.rvir:4:"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("nested expression in an atomised function") && stderr(&o).contains("bad.rvir:4:"),
+        "{}",
+        stderr(&o)
+    );
 }
-

@@ -66,21 +66,36 @@ fn straight_line_files_lower_verify_atomise_and_evaluate() {
         assert!(!m.functions.is_empty(), "{}: no function", p.display());
         for f in &m.functions {
             let a = atomise_function(f);
-            assert!(verifier::verify_function(&a).is_empty(), "{} @{}: atomised IR does not verify", p.display(), f.name);
+            assert!(
+                verifier::verify_function(&a).is_empty(),
+                "{} @{}: atomised IR does not verify",
+                p.display(),
+                f.name
+            );
             assert_eq!(a.op_counts(), f.op_counts(), "{} @{}: op counts", p.display(), f.name);
             assert!(a.body.iter().all(|&v| !matches!(a.value(v).def, Def::Expr(_))));
             let (_, cp) = compute_timing(&a, &lat);
-            assert_eq!((cp.asap, cp.asap_cycle), tree_critical_path(f, &lat), "{} @{}: critical path", p.display(), f.name);
+            assert_eq!(
+                (cp.asap, cp.asap_cycle),
+                tree_critical_path(f, &lat),
+                "{} @{}: critical path",
+                p.display(),
+                f.name
+            );
             for seed in 1..=4u64 {
                 let input = |n: &str| pseudo_random_input(n, seed);
                 let (x, y) = (eval::<f64>(f, input), eval::<f64>(&a, input));
                 assert_eq!(x.len(), y.len());
                 for ((n, u), (_, w)) in x.iter().zip(&y) {
-                    signed_zeros += same_bits(u.to_bits(), w.to_bits(), *u == 0.0 && *w == 0.0, || format!("{} @{} {n} seed {seed}: {u:e} vs {w:e}", p.display(), f.name));
+                    signed_zeros += same_bits(u.to_bits(), w.to_bits(), *u == 0.0 && *w == 0.0, || {
+                        format!("{} @{} {n} seed {seed}: {u:e} vs {w:e}", p.display(), f.name)
+                    });
                 }
                 let (x, y) = (eval::<f32>(f, input), eval::<f32>(&a, input));
                 for ((n, u), (_, w)) in x.iter().zip(&y) {
-                    signed_zeros += same_bits(u.to_bits() as u64, w.to_bits() as u64, *u == 0.0 && *w == 0.0, || format!("{} @{} f32 {n} seed {seed}", p.display(), f.name));
+                    signed_zeros += same_bits(u.to_bits() as u64, w.to_bits() as u64, *u == 0.0 && *w == 0.0, || {
+                        format!("{} @{} f32 {n} seed {seed}", p.display(), f.name)
+                    });
                 }
             }
         }

@@ -120,10 +120,7 @@ impl Function {
         if !self.names.contains_key(base) {
             return base.to_string();
         }
-        (1..)
-            .map(|k| format!("{base}.{k}"))
-            .find(|n| !self.names.contains_key(n))
-            .expect("unbounded counter")
+        (1..).map(|k| format!("{base}.{k}")).find(|n| !self.names.contains_key(n)).expect("unbounded counter")
     }
 
     fn push_value(&mut self, name: String, def: Def, span: Span) -> Result<Value, Value> {
@@ -204,7 +201,8 @@ impl Function {
 
     /// Rebuilds the name index; for code that edits `values` directly.
     pub fn reindex_names(&mut self) {
-        self.names = self.values.iter().enumerate().map(|(i, d)| (d.name.clone(), Value::with_number(i as u32))).collect();
+        self.names =
+            self.values.iter().enumerate().map(|(i, d)| (d.name.clone(), Value::with_number(i as u32))).collect();
     }
 
     /// Keeps only the body values for which `keep` is true, renumbering values densely and

@@ -23,7 +23,7 @@
 use robovec_ir::count::neg_folds;
 use robovec_ir::{BinOp, Def, Expr, Function, Module, Operand, Phase, Span};
 
-use crate::{Pass, PassContext, PassError, PassInfo, Params};
+use crate::{Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -168,7 +168,11 @@ mod tests {
 
     fn line_of(f: &Function, name: &str) -> String {
         let text = f.to_string();
-        text.lines().find(|l| l.trim_start().starts_with(&format!("%{name} ="))).unwrap_or_else(|| panic!("no %{name} in\n{text}")).trim().to_string()
+        text.lines()
+            .find(|l| l.trim_start().starts_with(&format!("%{name} =")))
+            .unwrap_or_else(|| panic!("no %{name} in\n{text}"))
+            .trim()
+            .to_string()
     }
 
     #[test]

@@ -19,7 +19,8 @@ pub const INFO: PassInfo = PassInfo {
         doc: "outputs to keep: names (`Qq[1],Qq[2]`) or arrays (`c`), comma-separated",
     }],
     build: |p: &Params| {
-        let keep = p.get("outputs").map(|s| s.split(',').map(|x| x.trim().to_string()).filter(|x| !x.is_empty()).collect());
+        let keep =
+            p.get("outputs").map(|s| s.split(',').map(|x| x.trim().to_string()).filter(|x| !x.is_empty()).collect());
         if matches!(&keep, Some(k) if Vec::is_empty(k)) {
             return Err(PassError::BadParameter { pass: "dce".into(), message: "`outputs` is empty".into() });
         }
@@ -46,7 +47,8 @@ impl Pass for Dce {
         if let Some(keep) = &self.keep {
             for e in keep {
                 if !m.functions.iter().any(|f| f.outputs.iter().any(|o| matches(e, &o.name))) {
-                    let mut names: Vec<&str> = m.functions.iter().flat_map(|f| f.outputs.iter().map(|o| o.name.as_str())).collect();
+                    let mut names: Vec<&str> =
+                        m.functions.iter().flat_map(|f| f.outputs.iter().map(|o| o.name.as_str())).collect();
                     names.truncate(12);
                     return Err(PassError::BadParameter {
                         pass: "dce".into(),

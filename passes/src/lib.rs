@@ -142,8 +142,8 @@ pub fn pass_names() -> String {
 /// # Errors
 /// [`PassError::UnknownPass`] or [`PassError::BadParameter`].
 pub fn build_pass(spec: &PassSpec) -> Result<Box<dyn Pass>, PassError> {
-    let info = pass_info(&spec.name)
-        .ok_or_else(|| PassError::UnknownPass { name: spec.name.clone(), valid: pass_names() })?;
+    let info =
+        pass_info(&spec.name).ok_or_else(|| PassError::UnknownPass { name: spec.name.clone(), valid: pass_names() })?;
     let params = Params::check(info, &spec.params)?;
     (info.build)(&params)
 }

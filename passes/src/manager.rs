@@ -90,10 +90,7 @@ impl PassManager {
     /// [`PassError::BadPipeline`], [`PassError::UnknownPass`], [`PassError::BadParameter`].
     pub fn new(pipeline: &str, instr: Instrumentation) -> Result<PassManager, PassError> {
         let specs = if pipeline.trim().is_empty() { Vec::new() } else { parse_pipeline(pipeline)? };
-        let passes = specs
-            .into_iter()
-            .map(|s| build_pass(&s).map(|p| (s, p)))
-            .collect::<Result<Vec<_>, _>>()?;
+        let passes = specs.into_iter().map(|s| build_pass(&s).map(|p| (s, p))).collect::<Result<Vec<_>, _>>()?;
         if let PrintSelector::Passes(names) = instr.print_before.clone() {
             check_names(&names)?;
         }
@@ -155,7 +152,11 @@ impl PassManager {
             let _ = writeln!(log, "  {:>12}  {:>6}  {:>10}  {:>10}  Name", "Wall (ms)", "%", "ops before", "ops after");
             for r in &records {
                 let pct = if total > 0.0 { 100.0 * r.wall_ms / total } else { 0.0 };
-                let _ = writeln!(log, "  {:>12.3}  {:>5.1}%  {:>10}  {:>10}  {}", r.wall_ms, pct, r.ops_before, r.ops_after, r.name);
+                let _ = writeln!(
+                    log,
+                    "  {:>12.3}  {:>5.1}%  {:>10}  {:>10}  {}",
+                    r.wall_ms, pct, r.ops_before, r.ops_after, r.name
+                );
             }
             let _ = writeln!(log, "  {total:>12.3}  100.0%  {:>10}  {:>10}  Total", "", "");
         }

@@ -43,7 +43,10 @@ impl Params {
                 });
             }
             if values.iter().any(|(x, _)| x == k) {
-                return Err(PassError::BadParameter { pass: info.name.into(), message: format!("parameter `{k}` given twice") });
+                return Err(PassError::BadParameter {
+                    pass: info.name.into(),
+                    message: format!("parameter `{k}` given twice"),
+                });
             }
             let Some(v) = v else {
                 return Err(PassError::BadParameter {

@@ -16,11 +16,8 @@ const TYPES: &[&str] =
 /// Scans a C file. `header` is the companion `.h` text: its declarations are only used for
 /// `double *X;` pointers.
 pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
-    let toks: Vec<Spanned<'_>> = toks
-        .iter()
-        .copied()
-        .filter(|t| !matches!(t.1, Tok::SlashComment | Tok::BlockComment | Tok::Newline))
-        .collect();
+    let toks: Vec<Spanned<'_>> =
+        toks.iter().copied().filter(|t| !matches!(t.1, Tok::SlashComment | Tok::BlockComment | Tok::Newline)).collect();
     let mut header_pointers = Vec::new();
     if let Some(h) = header {
         let htoks: Vec<_> = super::lexer::lex(h).into_iter().filter(|t| t.1 != Tok::Newline).collect();
@@ -60,7 +57,10 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                     }
                 };
                 let Some(close) = matching(&toks, open) else {
-                    errors.push(FrontError::new(Span::new(toks[open].0, toks[open].2), "unclosed `(`", "opened here").note("expected `)` closing the parameter list"));
+                    errors.push(
+                        FrontError::new(Span::new(toks[open].0, toks[open].2), "unclosed `(`", "opened here")
+                            .note("expected `)` closing the parameter list"),
+                    );
                     break;
                 };
                 let body_open = close + 1;
@@ -68,11 +68,21 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                     Some(Tok::Semi) => i = body_open + 1, // a prototype
                     Some(Tok::LBrace) => {
                         let body_close = matching(&toks, body_open).unwrap_or_else(|| {
-                            errors.push(FrontError::new(Span::new(toks[body_open].0, toks[body_open].2), "unclosed `{`", "function body opened here").note("expected `}` closing the function body"));
+                            errors.push(
+                                FrontError::new(
+                                    Span::new(toks[body_open].0, toks[body_open].2),
+                                    "unclosed `{`",
+                                    "function body opened here",
+                                )
+                                .note("expected `}` closing the function body"),
+                            );
                             toks.len()
                         });
                         let end = toks.get(body_close).map_or(src.len(), |t| t.0);
-                        let mut f = FuncAst::new(name, Span::new(toks[start].0, toks.get(body_close).map_or(src.len(), |t| t.2)));
+                        let mut f = FuncAst::new(
+                            name,
+                            Span::new(toks[start].0, toks.get(body_close).map_or(src.len(), |t| t.2)),
+                        );
                         for (p, stars, ty) in scan::params(&toks[open + 1..close]) {
                             f.params.push(p.to_string());
                             if stars > 0 && ty == "double" {
@@ -154,7 +164,8 @@ fn directive(text: &str, span: Span, defines: &mut Vec<String>, errors: &mut Vec
                 .note("expected only `#define X s->X` aliases such as `#define q s->q`"),
         ),
         _ => errors.push(
-            FrontError::new(span, "unsupported preprocessor line", "this line").note("expected `#include` or `#define X s->X`"),
+            FrontError::new(span, "unsupported preprocessor line", "this line")
+                .note("expected `#include` or `#define X s->X`"),
         ),
     }
 }
@@ -195,18 +206,22 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
     let mut cases: Option<Vec<Case>> = None;
     let mut switch_close: Option<usize> = None;
     let mut returned: Option<Span> = None;
-    let push = |s: Stmt, target: &Target, f: &mut FuncAst, cases: &mut Option<Vec<Case>>, errors: &mut Vec<FrontError>| match target {
-        Target::Prefix => f.prefix.push(s),
-        Target::Suffix => f.suffix.push(s),
-        Target::Case => {
-            if let Some(c) = cases.as_mut().and_then(|c| c.last_mut()) {
-                c.body.push(s)
+    let push =
+        |s: Stmt, target: &Target, f: &mut FuncAst, cases: &mut Option<Vec<Case>>, errors: &mut Vec<FrontError>| {
+            match target {
+                Target::Prefix => f.prefix.push(s),
+                Target::Suffix => f.suffix.push(s),
+                Target::Case => {
+                    if let Some(c) = cases.as_mut().and_then(|c| c.last_mut()) {
+                        c.body.push(s)
+                    }
+                }
+                Target::Dead => errors.push(
+                    FrontError::new(s.span, "unreachable statement in a `switch`", "after `break;` or `default:`")
+                        .note("expected `case N:` before statements"),
+                ),
             }
-        }
-        Target::Dead => errors.push(
-            FrontError::new(s.span, "unreachable statement in a `switch`", "after `break;` or `default:`").note("expected `case N:` before statements"),
-        ),
-    };
+        };
     while i < toks.len() {
         let t = toks[i];
         if Some(i) == switch_close {
@@ -234,7 +249,10 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
                     Some((c, Some(Tok::LBrace))) => {
                         switch_close = matching(toks, c + 1);
                         if switch_close.is_none() {
-                            errors.push(FrontError::new(Span::new(t.0, t.2), "unclosed `switch`", "this switch").note("expected `}` closing the switch"));
+                            errors.push(
+                                FrontError::new(Span::new(t.0, t.2), "unclosed `switch`", "this switch")
+                                    .note("expected `}` closing the switch"),
+                            );
                             return false;
                         }
                         cases = Some(Vec::new());
@@ -242,7 +260,10 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
                         i = c + 2;
                     }
                     _ => {
-                        errors.push(FrontError::new(Span::new(t.0, t.2), "malformed `switch`", "this switch").note("expected `switch (isens) { case 1: … }`"));
+                        errors.push(
+                            FrontError::new(Span::new(t.0, t.2), "malformed `switch`", "this switch")
+                                .note("expected `switch (isens) { case 1: … }`"),
+                        );
                         return false;
                     }
                 }
@@ -253,14 +274,20 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
                     _ => None,
                 };
                 let Some(label) = label else {
-                    errors.push(FrontError::new(Span::new(t.0, t.2), "malformed `case` label", "this case").note("expected `case N:` with an integer N"));
+                    errors.push(
+                        FrontError::new(Span::new(t.0, t.2), "malformed `case` label", "this case")
+                            .note("expected `case N:` with an integer N"),
+                    );
                     return false;
                 };
                 let span = Span::new(t.0, toks[i + 2].2);
                 let cs = cases.get_or_insert_with(Vec::new);
                 if let Some(prev) = cs.iter().find(|c| c.label == label) {
                     let line = scan::line_of(src, prev.span.start as usize);
-                    errors.push(FrontError::new(span, format!("`case {label}` appears twice"), "second case").note(format!("first `case {label}:` at line {line}")));
+                    errors.push(
+                        FrontError::new(span, format!("`case {label}` appears twice"), "second case")
+                            .note(format!("first `case {label}:` at line {line}")),
+                    );
                 }
                 cs.push(Case { label, body: Vec::new(), span });
                 target = Target::Case;
@@ -293,21 +320,35 @@ fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &m
             _ => {
                 // A statement: tokens up to `;`.
                 let stop = (i..toks.len())
-                    .find(|&k| matches!(toks[k].1, Tok::Semi | Tok::LBrace | Tok::RBrace | Tok::Hash(_)) || Some(k) == switch_close)
+                    .find(|&k| {
+                        matches!(toks[k].1, Tok::Semi | Tok::LBrace | Tok::RBrace | Tok::Hash(_))
+                            || Some(k) == switch_close
+                    })
                     .unwrap_or(toks.len());
                 let stmt = &toks[i..stop];
                 if stop >= toks.len() || toks[stop].1 != Tok::Semi {
                     let at = toks.get(stop).map_or(end, |t| t.0);
                     errors.push(
-                        FrontError::new(scan::span_of(stmt, at), "statement is not terminated by `;`", "this statement")
-                            .note("expected `;` at the end of the statement"),
+                        FrontError::new(
+                            scan::span_of(stmt, at),
+                            "statement is not terminated by `;`",
+                            "this statement",
+                        )
+                        .note("expected `;` at the end of the statement"),
                     );
                     i = stop;
                     continue;
                 }
                 if let Some(r) = returned {
                     let line = scan::line_of(src, r.start as usize);
-                    errors.push(FrontError::new(scan::span_of(stmt, t.0), "unreachable statement after `return;`", "after return").note(format!("`return;` at line {line} ends the function")));
+                    errors.push(
+                        FrontError::new(
+                            scan::span_of(stmt, t.0),
+                            "unreachable statement after `return;`",
+                            "after return",
+                        )
+                        .note(format!("`return;` at line {line} ends the function")),
+                    );
                 }
                 match scan::statement(stmt, errors) {
                     Parsed::Stmt(s) => push(*s, &target, f, &mut cases, errors),

@@ -46,7 +46,10 @@ fn straight_line_files_parse_and_loop_files_are_rejected() {
             (Ok(m), false) => {
                 assert!(!m.functions.is_empty(), "{name}: no function");
                 if let Err(errs) = robovec_ir::verifier::verify(&m) {
-                    failures.push(format!("{name}: verifier: {:?}", errs.iter().take(3).map(|e| e.message.clone()).collect::<Vec<_>>()));
+                    failures.push(format!(
+                        "{name}: verifier: {:?}",
+                        errs.iter().take(3).map(|e| e.message.clone()).collect::<Vec<_>>()
+                    ));
                 }
                 let text = m.to_string();
                 match robovec_ir::text::parse(&text) {
@@ -60,15 +63,32 @@ fn straight_line_files_parse_and_loop_files_are_rejected() {
                 }
                 for f in &m.functions {
                     let stats = f.op_counts();
-                    println!("{name}: {} equations={} ops={} (add {} sub {} mul {} div {} call {}) inputs={} outputs={}",
-                        f.name, f.equations.unwrap_or(0), stats.total, stats.add, stats.sub, stats.mul, stats.div, stats.call, f.inputs.len(), f.outputs.len());
+                    println!(
+                        "{name}: {} equations={} ops={} (add {} sub {} mul {} div {} call {}) inputs={} outputs={}",
+                        f.name,
+                        f.equations.unwrap_or(0),
+                        stats.total,
+                        stats.add,
+                        stats.sub,
+                        stats.mul,
+                        stats.div,
+                        stats.call,
+                        f.inputs.len(),
+                        f.outputs.len()
+                    );
                 }
             }
-            (Err(errs), false) => failures.push(format!("{name}: {}", errs.iter().take(5).map(|e| e.to_string()).collect::<Vec<_>>().join("\n    "))),
+            (Err(errs), false) => failures.push(format!(
+                "{name}: {}",
+                errs.iter().take(5).map(|e| e.to_string()).collect::<Vec<_>>().join("\n    ")
+            )),
             (Ok(_), true) => failures.push(format!("{name}: loop file accepted")),
             (Err(errs), true) => {
                 if !errs.iter().any(|e| e.message.contains("loop at line") && e.message.contains("straight-line")) {
-                    failures.push(format!("{name}: no loop diagnostic: {:?}", errs.iter().map(|e| &e.message).collect::<Vec<_>>()));
+                    failures.push(format!(
+                        "{name}: no loop diagnostic: {:?}",
+                        errs.iter().map(|e| &e.message).collect::<Vec<_>>()
+                    ));
                 }
             }
         }
@@ -129,7 +149,11 @@ fn corpus_mutations_never_panic() {
             Err(errs) => assert!(errs.iter().all(|e| e.span.end as usize <= buf.len().max(1))),
             Ok(m) => {
                 if let Err(e) = robovec_ir::verifier::verify(&m) {
-                    panic!("front output does not verify: {:?}\n{}", e.first().map(|e| &e.message), String::from_utf8_lossy(&buf));
+                    panic!(
+                        "front output does not verify: {:?}\n{}",
+                        e.first().map(|e| &e.message),
+                        String::from_utf8_lossy(&buf)
+                    );
                 }
             }
         }

@@ -65,7 +65,12 @@ fn loops_and_branches_are_rejected_with_their_line() {
     let e = first(Language::C, &src);
     assert!(e.message.starts_with("`while` loop at line 6: robovec handles straight-line"), "{}", e.message);
     assert_eq!(at(&src, &e), "while");
-    for (kw, what) in [("for(i=1;i<=3;i++)", "`for` loop"), ("if (X)", "`if` branch"), ("goto end;", "`goto`"), ("do { X = q[2]; } while (X);", "`do` loop")] {
+    for (kw, what) in [
+        ("for(i=1;i<=3;i++)", "`for` loop"),
+        ("if (X)", "`if` branch"),
+        ("goto end;", "`goto`"),
+        ("do { X = q[2]; } while (X);", "`do` loop"),
+    ] {
         let e = first(Language::C, &c_fn(&format!("  X = q[1];\n  {kw}\n")));
         assert!(e.message.starts_with(&format!("{what} at line 6")), "{}", e.message);
     }
@@ -74,7 +79,10 @@ fn loops_and_branches_are_rejected_with_their_line() {
     // A helper with a loop rejects the file even when the main function is straight-line.
     let src = format!("void reset_frctrq(MBSdataStruct *s) \n{{ \n\tint i,j; \n\tfor(i=1;i<=s->nbody;i++) \n\t{{\n\t\ts->frc[1][i]=0; \n\t}}\n}}\n{}", c_fn("  c[1] = q[1];\n"));
     assert!(first(Language::C, &src).message.starts_with("`for` loop at line 4"));
-    let e = first(Language::Matlab, "function [c] = dirdyna(s,tsim,usrfun)\n  X = q(1);\n  for i = 1:3\n  X = q(2);\n  end\n");
+    let e = first(
+        Language::Matlab,
+        "function [c] = dirdyna(s,tsim,usrfun)\n  X = q(1);\n  for i = 1:3\n  X = q(2);\n  end\n",
+    );
     assert!(e.message.starts_with("`for` loop at line 3"), "{}", e.message);
     let e = first(Language::Python, "def dirdyna(M, c, s, tsim):\n    X = q[1]\n    while X:\n        X = q[2]\n");
     assert!(e.message.starts_with("`while` loop at line 3"), "{}", e.message);
@@ -156,7 +164,12 @@ fn absurd_nesting_and_length_are_diagnosed() {
     let long = format!("  X = q[1]{};\n", "+q[1]".repeat(100_000));
     assert!(first(Language::C, &c_fn(&long)).message.starts_with("statement has more than"));
     // The largest accepted statement goes through lowering, counting, printing and verifying.
-    let big = format!("  X = -(q[1]{})*{}q[2]{};\n  M[1][1] = X;\n", "+q[1]*q[2]/q[3]".repeat(600), "(".repeat(250), ")".repeat(250));
+    let big = format!(
+        "  X = -(q[1]{})*{}q[2]{};\n  M[1][1] = X;\n",
+        "+q[1]*q[2]/q[3]".repeat(600),
+        "(".repeat(250),
+        ")".repeat(250)
+    );
     let m = std::thread::Builder::new()
         .stack_size(2 << 20)
         .spawn(move || {
@@ -220,7 +233,11 @@ fn no_panic_on_mutated_or_random_input() {
         for lang in [Language::C, Language::Matlab, Language::Python] {
             if let Err(errs) = parse_str(lang, &buf, None) {
                 for e in errs {
-                    assert!(e.span.end as usize <= buf.len().max(1), "span out of range for {:?}", String::from_utf8_lossy(&buf));
+                    assert!(
+                        e.span.end as usize <= buf.len().max(1),
+                        "span out of range for {:?}",
+                        String::from_utf8_lossy(&buf)
+                    );
                 }
             }
         }

@@ -136,10 +136,7 @@ pub type Spanned<'a> = (usize, Tok<'a>, usize);
 
 /// Every token of `src`, including comments and newlines; unlexable text becomes [`Tok::Error`].
 pub fn lex(src: &str) -> Vec<Spanned<'_>> {
-    Tok::lexer(src)
-        .spanned()
-        .map(|(t, r)| (r.start, t.unwrap_or(Tok::Error), r.end))
-        .collect()
+    Tok::lexer(src).spanned().map(|(t, r)| (r.start, t.unwrap_or(Tok::Error), r.end)).collect()
 }
 
 #[cfg(test)]
@@ -174,7 +171,10 @@ mod tests {
             ]
         );
         assert_eq!(kinds("2.0.1"), vec![Tok::Number("2.0.1")]);
-        assert_eq!(kinds("a*...\r\n b"), vec![Tok::Ident("a"), Tok::Star, Tok::Ellipsis, Tok::Newline, Tok::Ident("b")]);
+        assert_eq!(
+            kinds("a*...\r\n b"),
+            vec![Tok::Ident("a"), Tok::Star, Tok::Ellipsis, Tok::Newline, Tok::Ident("b")]
+        );
         assert_eq!(kinds("a \\\n"), vec![Tok::Ident("a"), Tok::Backslash, Tok::Newline]);
         assert_eq!(kinds("\u{1}"), vec![Tok::Error]);
     }

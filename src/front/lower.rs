@@ -170,20 +170,33 @@ impl<'a> Lower<'a> {
         for s in suffix {
             let (Suffix::Bracket(args, span) | Suffix::Paren(args, span)) = s;
             if args.is_empty() {
-                self.err(FrontError::new(*span, "empty index", "no index here").note("expected a positive integer literal such as `q[4]`"));
+                self.err(
+                    FrontError::new(*span, "empty index", "no index here")
+                        .note("expected a positive integer literal such as `q[4]`"),
+                );
                 ok = false;
             }
             for a in args {
                 match a {
                     Expr::Num { value, int: true, span } => match u32::try_from(*value as u64) {
                         Ok(0) | Err(_) => {
-                            self.err(FrontError::new(*span, format!("index `{value}` is out of range"), "bad index").note("expected a 1-based index between 1 and 4294967295"));
+                            self.err(
+                                FrontError::new(*span, format!("index `{value}` is out of range"), "bad index")
+                                    .note("expected a 1-based index between 1 and 4294967295"),
+                            );
                             ok = false;
                         }
                         Ok(i) => out.push(i),
                     },
                     other => {
-                        self.err(FrontError::new(other.span(), "index must be a positive integer literal", "not an integer literal").note("expected an index such as `q[4]` or `s->dpt[2][4]`"));
+                        self.err(
+                            FrontError::new(
+                                other.span(),
+                                "index must be a positive integer literal",
+                                "not an integer literal",
+                            )
+                            .note("expected an index such as `q[4]` or `s->dpt[2][4]`"),
+                        );
                         ok = false;
                     }
                 }
@@ -237,7 +250,10 @@ impl<'a> Lower<'a> {
                 "np" | "math" if call_like => self.call(r),
                 other => {
                     let msg = format!("unknown structure `{other}`");
-                    self.err(FrontError::new(o.span, msg, "not a Robotran structure").note("expected `s->x`, `s.x`, `sens->x`, `np.cos`, `usrfun.f(…)`"));
+                    self.err(
+                        FrontError::new(o.span, msg, "not a Robotran structure")
+                            .note("expected `s->x`, `s.x`, `sens->x`, `np.cos`, `usrfun.f(…)`"),
+                    );
                     Err(())
                 }
             };
@@ -258,7 +274,9 @@ impl<'a> Lower<'a> {
             }
             if self.arrays.contains_key(name) || self.vectors.contains_key(name) {
                 let msg = format!("array `{name}` used as a number");
-                self.err(FrontError::new(r.span, msg, "a whole array").note("expected an element such as `PxF1[1]`; a whole local array may only be passed to a user callback"));
+                self.err(FrontError::new(r.span, msg, "a whole array").note(
+                    "expected an element such as `PxF1[1]`; a whole local array may only be passed to a user callback",
+                ));
                 return Err(());
             }
             return self.undefined(name, r.span);
@@ -306,13 +324,22 @@ impl<'a> Lower<'a> {
                 let e = self.expr(a)?;
                 return Ok(IrExpr::Call(Callee { name: "sqrt".into(), elem: None }, vec![e]));
             }
-            self.err(FrontError::new(r.span, "`sqrt` takes one argument", "wrong number of arguments").note("expected `sqrt(x)`"));
+            self.err(
+                FrontError::new(r.span, "`sqrt` takes one argument", "wrong number of arguments")
+                    .note("expected `sqrt(x)`"),
+            );
             return Err(());
         }
         let (msg, note) = if is_trig(name).is_some() {
-            (format!("`{name}` is accepted only as a whole right-hand side"), "expected a trig initial variable such as `C4 = cos(q[4])`".to_string())
+            (
+                format!("`{name}` is accepted only as a whole right-hand side"),
+                "expected a trig initial variable such as `C4 = cos(q[4])`".to_string(),
+            )
         } else if name == "zeros" {
-            ("`zeros` is accepted only in a pre-allocation line".to_string(), "expected `M = zeros(55,55);`".to_string())
+            (
+                "`zeros` is accepted only in a pre-allocation line".to_string(),
+                "expected `M = zeros(55,55);`".to_string(),
+            )
         } else {
             (format!("unknown function `{name}`"), ACCEPTED.to_string())
         };
@@ -358,7 +385,10 @@ impl<'a> Lower<'a> {
         match e {
             Expr::Num { value, .. } => Ok(IrExpr::Operand(Operand::Const(*value))),
             Expr::Str(span) => {
-                self.err(FrontError::new(*span, "string literal in an expression", "a string").note("expected a number or a name"));
+                self.err(
+                    FrontError::new(*span, "string literal in an expression", "a string")
+                        .note("expected a number or a name"),
+                );
                 Err(())
             }
             Expr::Ref(r) => self.read(r),

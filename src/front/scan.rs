@@ -51,7 +51,9 @@ pub fn control_error(src: &str, what: &str, span: Span) -> FrontError {
 /// The diagnostic for a file without any function.
 pub fn no_function(lang: Language, len: usize) -> FrontError {
     let expected = match lang {
-        Language::C => "expected a C function such as `void mbs_dirdyna(double **M,double *c, MbsData *s, double tsim) { … }`",
+        Language::C => {
+            "expected a C function such as `void mbs_dirdyna(double **M,double *c, MbsData *s, double tsim) { … }`"
+        }
         Language::Matlab => "expected a Matlab function such as `function [M,c] = dirdyna(s,tsim,usrfun)`",
         Language::Python => "expected a Python function such as `def dirdyna(M, c, s, tsim):`",
     };
@@ -103,7 +105,9 @@ pub fn statement(toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Parsed {
             );
             return Parsed::Failed(None);
         }
-        errors.push(FrontError::new(span, "expected an assignment", "not an assignment").note("expected `name = expression`"));
+        errors.push(
+            FrontError::new(span, "expected an assignment", "not an assignment").note("expected `name = expression`"),
+        );
         return Parsed::Failed(None);
     }
     match parse_stmt(toks, span.end as usize) {
@@ -111,7 +115,9 @@ pub fn statement(toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Parsed {
         Err(e) => {
             errors.push(e);
             let lhs = match toks {
-                [(_, Tok::Ident(obj), _), (_, Tok::Arrow | Tok::Dot, _), (_, Tok::Ident(name), _), ..] => format!("{obj}.{name}"),
+                [(_, Tok::Ident(obj), _), (_, Tok::Arrow | Tok::Dot, _), (_, Tok::Ident(name), _), ..] => {
+                    format!("{obj}.{name}")
+                }
                 [(_, Tok::Ident(name), _), ..] => name.to_string(),
                 _ => return Parsed::Failed(None),
             };

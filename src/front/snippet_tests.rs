@@ -84,10 +84,7 @@ fn c_expressions_unary_minus_literals_and_outputs() {
     // `-a*b+c` is Add(Neg(Mul(a,b)), c)
     assert_eq!(expr(f, "A"), &bin(Add, neg(bin(Mul, val(f, "g[3]"), val(f, "S4"))), val(f, "C4")));
     // unary minus right after `(`
-    assert_eq!(
-        expr(f, "B"),
-        &bin(Mul, val(f, "C4"), bin(Sub, neg(bin(Mul, val(f, "A"), val(f, "S4"))), val(f, "C4")))
-    );
+    assert_eq!(expr(f, "B"), &bin(Mul, val(f, "C4"), bin(Sub, neg(bin(Mul, val(f, "A"), val(f, "S4"))), val(f, "C4"))));
     assert_eq!(expr(f, "D"), &neg(val(f, "A")));
     // a literal stays a non-negative constant under the minus
     assert_eq!(expr(f, "E"), &neg(bin(Mul, bin(Mul, k(2.0), val(f, "A")), val(f, "S4"))));
@@ -176,11 +173,17 @@ fn c_callbacks_vectors_and_local_arrays() {
     assert_eq!(expr(f, "SWr1[3]"), &call(3));
     assert_eq!(expr(f, "SWr1[1]"), &call(1));
     assert!(f.lookup("SWr1[2]").is_none(), "only used elements are defined");
-    assert_eq!(expr(f, "x"), &bin(BinOp::Add, bin(BinOp::Mul, val(f, "SWr1[3]"), val(f, "SWr1[1]")), val(f, "SWr1[3]")));
+    assert_eq!(
+        expr(f, "x"),
+        &bin(BinOp::Add, bin(BinOp::Mul, val(f, "SWr1[3]"), val(f, "SWr1[1]")), val(f, "SWr1[3]"))
+    );
     assert_eq!(expr(f, "Z1"), &Expr::Call(Callee { name: "sqrt".into(), elem: None }, vec![val(f, "x")]));
     assert_eq!(
         expr(f, "F1"),
-        &Expr::Call(Callee { name: "user_LinkForces.2".into(), elem: None }, vec![val(f, "Z1"), val(f, "x"), val(f, "tsim")])
+        &Expr::Call(
+            Callee { name: "user_LinkForces.2".into(), elem: None },
+            vec![val(f, "Z1"), val(f, "x"), val(f, "tsim")]
+        )
     );
     // 3 array elements + x + Z1 + F1 + frc output; the SWr1 binding is not an equation.
     assert_eq!(f.equations, Some(7));
@@ -230,11 +233,18 @@ fn matlab_function_aliases_continuations_and_callbacks() {
     use BinOp::*;
     assert_eq!(
         expr(f, "A"),
-        &bin(Sub, bin(Add, bin(Mul, val(f, "dpt[2][4]"), val(f, "C2")), val(f, "m[3]")), bin(Mul, k(0.5), val(f, "q[2]")))
+        &bin(
+            Sub,
+            bin(Add, bin(Mul, val(f, "dpt[2][4]"), val(f, "C2")), val(f, "m[3]")),
+            bin(Mul, k(0.5), val(f, "q[2]"))
+        )
     );
     assert_eq!(
         expr(f, "Flink1"),
-        &Expr::Call(Callee { name: "usrfun.flink.1".into(), elem: None }, vec![val(f, "A"), val(f, "C2"), val(f, "tsim")])
+        &Expr::Call(
+            Callee { name: "usrfun.flink.1".into(), elem: None },
+            vec![val(f, "A"), val(f, "C2"), val(f, "tsim")]
+        )
     );
     assert_eq!(expr(f, "frc[2][1].2"), &bin(Add, val(f, "frc[2][1].1"), val(f, "A")));
     assert_eq!(output(f, "frc[2][1]"), Operand::Value(f.lookup("frc[2][1].2").unwrap()));
@@ -263,7 +273,11 @@ fn python_aliases_continuations_and_zero_outputs() {
         use BinOp::*;
         assert_eq!(
             expr(f, "A"),
-            &bin(Add, bin(Mul, val(f, "dpt[2][1]"), val(f, "S4")), bin(Mul, val(f, "In[1][22]"), bin(Add, neg(val(f, "C4")), val(f, "frc[1][3]"))))
+            &bin(
+                Add,
+                bin(Mul, val(f, "dpt[2][1]"), val(f, "S4")),
+                bin(Mul, val(f, "In[1][22]"), bin(Add, neg(val(f, "C4")), val(f, "frc[1][3]")))
+            )
         );
         assert_eq!(expr(f, "B"), &neg(bin(Mul, val(f, "A"), k(2.0))));
         assert_eq!(output(f, "Qq[1]"), Operand::Value(f.lookup("A").unwrap()));
@@ -276,7 +290,10 @@ fn python_aliases_continuations_and_zero_outputs() {
 
 #[test]
 fn python_outputs_are_parameters() {
-    let m = parse(Language::Python, "def cons_hJ(h, Jac, s):\n    q = s.q\n    h[1] = q[1]\n    Jac[1,1] = 0\n    Jac[1,2] = (1.0)\n");
+    let m = parse(
+        Language::Python,
+        "def cons_hJ(h, Jac, s):\n    q = s.q\n    h[1] = q[1]\n    Jac[1,1] = 0\n    Jac[1,2] = (1.0)\n",
+    );
     let f = &m.functions[0];
     assert_eq!(f.name, "cons_hJ");
     assert_eq!(output(f, "Jac[1][2]"), Operand::Const(1.0));

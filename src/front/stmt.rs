@@ -92,8 +92,20 @@ fn expected_note(expected: &[String]) -> String {
         return "expected nothing more in this statement".to_string();
     }
     let list: Vec<&str> = expected.iter().map(|s| s.trim_matches('"')).collect();
-    let list: Vec<String> =
-        list.iter().map(|s| if *s == "IDENT" { "a name".to_string() } else if *s == "NUMBER" { "a number".to_string() } else if *s == "STRING" { "a string".to_string() } else { format!("`{s}`") }).collect();
+    let list: Vec<String> = list
+        .iter()
+        .map(|s| {
+            if *s == "IDENT" {
+                "a name".to_string()
+            } else if *s == "NUMBER" {
+                "a number".to_string()
+            } else if *s == "STRING" {
+                "a string".to_string()
+            } else {
+                format!("`{s}`")
+            }
+        })
+        .collect();
     format!("expected one of {}", list.join(", "))
 }
 
@@ -118,11 +130,9 @@ fn from_lalrpop(e: ParseError<usize, Tok<'_>, GrammarError>, end: usize) -> Fron
         ParseError::ExtraToken { token: (l, t, r) } => {
             FrontError::new(Span::new(l, r), format!("extra `{t}` after the statement"), "not expected here")
         }
-        ParseError::User { error: GrammarError::BadNumber { start, end, text } } => FrontError::new(
-            Span::new(start, end),
-            format!("number `{text}` does not parse"),
-            "not a number",
-        )
-        .note("expected digits with an optional fraction, such as `2` or `2.0`"),
+        ParseError::User { error: GrammarError::BadNumber { start, end, text } } => {
+            FrontError::new(Span::new(start, end), format!("number `{text}` does not parse"), "not a number")
+                .note("expected digits with an optional fraction, such as `2` or `2.0`")
+        }
     }
 }

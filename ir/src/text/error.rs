@@ -67,11 +67,9 @@ impl ParseError {
                 GrammarError::Lex { start, end } => {
                     ParseError::new(Span::new(start, end), "invalid character", "no token starts here")
                 }
-                GrammarError::BadNumber { start, end, what } => ParseError::new(
-                    Span::new(start, end),
-                    "number does not parse",
-                    format!("expected {what}"),
-                ),
+                GrammarError::BadNumber { start, end, what } => {
+                    ParseError::new(Span::new(start, end), "number does not parse", format!("expected {what}"))
+                }
                 GrammarError::BadTiming { start, end, message } => {
                     ParseError::new(Span::new(start, end), message, "in this timing attribute")
                 }

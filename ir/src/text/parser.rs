@@ -24,9 +24,7 @@ lalrpop_util::lalrpop_mod!(
 /// The first syntax error, or every name-resolution error, each with its span.
 pub fn parse(src: &str) -> Result<Module, Vec<ParseError>> {
     let toks = lexer::tokens(src).map(|r| r.map_err(|e| GrammarError::Lex { start: e.start, end: e.end }));
-    let funcs = grammar::ModuleParser::new()
-        .parse(toks)
-        .map_err(|e| vec![ParseError::from_lalrpop(e, src.len())])?;
+    let funcs = grammar::ModuleParser::new().parse(toks).map_err(|e| vec![ParseError::from_lalrpop(e, src.len())])?;
     let mut errors = Vec::new();
     let mut module = Module::default();
     let mut seen = HashSet::new();
@@ -61,12 +59,16 @@ fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
                     RhsAst::Trig(t, a) => match operand(&func, a, errors) {
                         Operand::Value(v) => Def::Trig(t, v),
                         Operand::Const(_) => {
-                            errors.push(ParseError::new(name_span, "trig initial variable of a constant", "here")
-                                .note("`sin`/`cos` take an input value, e.g. `cos %q[4]`"));
+                            errors.push(
+                                ParseError::new(name_span, "trig initial variable of a constant", "here")
+                                    .note("`sin`/`cos` take an input value, e.g. `cos %q[4]`"),
+                            );
                             continue;
                         }
                     },
-                    RhsAst::Call(c, args) => Def::Call(c, args.into_iter().map(|a| operand(&func, a, errors)).collect()),
+                    RhsAst::Call(c, args) => {
+                        Def::Call(c, args.into_iter().map(|a| operand(&func, a, errors)).collect())
+                    }
                     RhsAst::Expr(e) => Def::Expr(expr(&func, e, errors)),
                 };
                 match func.define(name, def, name_span) {

@@ -17,7 +17,10 @@ impl Lower<'_> {
                 "sens" => "sens.",
                 other => {
                     let msg = format!("unknown structure `{other}`");
-                    self.err(FrontError::new(o.span, msg, "not a Robotran structure").note("expected `s->x`, `s.x` or `sens->x` on a left-hand side"));
+                    self.err(
+                        FrontError::new(o.span, msg, "not a Robotran structure")
+                            .note("expected `s->x`, `s.x` or `sens->x` on a left-hand side"),
+                    );
                     return;
                 }
             };
@@ -39,7 +42,10 @@ impl Lower<'_> {
             return;
         }
         if self.lang != Language::Matlab && lhs.suffix.iter().any(|s| matches!(s, Suffix::Paren(..))) {
-            self.err(FrontError::new(lhs.span, "a call cannot be assigned to", "not a location").note("expected a name or an element such as `M[1][2]`"));
+            self.err(
+                FrontError::new(lhs.span, "a call cannot be assigned to", "not a location")
+                    .note("expected a name or an element such as `M[1][2]`"),
+            );
             return;
         }
         let Ok(idx) = self.indices(&lhs.suffix) else {
@@ -73,7 +79,8 @@ impl Lower<'_> {
             // `M = zeros(55,55);`
             (None, [Suffix::Paren(..)]) if r.name.text == "zeros" => true,
             (obj, [Suffix::Paren(args, _)])
-                if is_trig(&r.name.text).is_some() && obj.as_ref().is_none_or(|(o, _)| o.text == "np" || o.text == "math") =>
+                if is_trig(&r.name.text).is_some()
+                    && obj.as_ref().is_none_or(|(o, _)| o.text == "np" || o.text == "math") =>
             {
                 self.trig(x, r, args, s.span);
                 true
@@ -109,8 +116,12 @@ impl Lower<'_> {
             _ => {
                 let name = &r.name.text;
                 self.err(
-                    FrontError::new(r.span, format!("argument of `{name}` must be a joint coordinate"), "not a joint coordinate")
-                        .note(format!("expected a trig initial variable such as `C4 = {name}(q[4])`")),
+                    FrontError::new(
+                        r.span,
+                        format!("argument of `{name}` must be a joint coordinate"),
+                        "not a joint coordinate",
+                    )
+                    .note(format!("expected a trig initial variable such as `C4 = {name}(q[4])`")),
                 );
                 self.failed.insert(x.to_string());
                 return;
@@ -132,7 +143,11 @@ impl Lower<'_> {
             None => None,
         };
         let Some(first) = first else { return true };
-        let mut e = FrontError::new(label_span.to(Span::new(span.start as usize, span.start as usize)), format!("value `{name}` defined twice"), "second definition");
+        let mut e = FrontError::new(
+            label_span.to(Span::new(span.start as usize, span.start as usize)),
+            format!("value `{name}` defined twice"),
+            "second definition",
+        );
         e = if first == Span::DUMMY {
             e.note("first defined earlier in this function")
         } else {
