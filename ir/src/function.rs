@@ -30,6 +30,8 @@ pub struct Function {
     pub outputs: Vec<Output>,
     /// Span of the whole function in its source.
     pub span: Span,
+    /// The placement on the PE architecture, when `place` made one (or the text had one).
+    pub placement: Option<crate::placement::Placement>,
     names: HashMap<String, Value>,
 }
 
@@ -90,6 +92,7 @@ impl Function {
             body: Vec::new(),
             outputs: Vec::new(),
             span: Span::DUMMY,
+            placement: None,
             names: HashMap::new(),
         }
     }
@@ -192,11 +195,13 @@ impl Function {
         c
     }
 
-    /// Removes every schedule attribute (call after a change that invalidates them).
+    /// Removes every schedule attribute and the placement (call after a change that
+    /// invalidates them).
     pub fn clear_timing(&mut self) {
         for d in &mut self.values {
             d.timing = None;
         }
+        self.placement = None;
     }
 
     /// Rebuilds the name index; for code that edits `values` directly.

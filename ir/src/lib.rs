@@ -33,6 +33,7 @@ pub mod diagnostic;
 pub mod entities;
 pub mod function;
 pub mod interp;
+pub mod placement;
 pub mod span;
 pub mod syntax;
 pub mod text;
