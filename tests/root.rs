@@ -8,6 +8,7 @@ mod common;
 mod cli;
 mod corpus;
 mod diagnostics;
+mod exact_gap;
 mod example;
 mod filetests;
 mod props;

@@ -1,0 +1,1 @@
+//! (to be written: list scheduler vs exact optimum on random small DAGs)
