@@ -11,5 +11,6 @@ mod diagnostics;
 mod exact_gap;
 mod example;
 mod filetests;
+mod placement;
 mod props;
 mod roundtrip;

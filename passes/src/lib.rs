@@ -12,6 +12,7 @@ pub mod dce;
 pub mod manager;
 pub mod params;
 pub mod pipeline;
+pub mod place;
 
 use robovec_ir::analysis::Latencies;
 use robovec_ir::{Module, Phase};
@@ -125,7 +126,7 @@ pub struct PassInfo {
 }
 
 /// The registry: every pass robovec knows, in `--print-passes` order.
-pub const PASSES: &[PassInfo] = &[atomise::INFO, dce::INFO, asap_alap::INFO];
+pub const PASSES: &[PassInfo] = &[atomise::INFO, dce::INFO, asap_alap::INFO, place::INFO];
 
 /// Looks up a registered pass.
 pub fn pass_info(name: &str) -> Option<&'static PassInfo> {

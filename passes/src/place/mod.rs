@@ -1,0 +1,215 @@
+//! `place<pe=N;priority=classical;select=preferential;…>`: list scheduling onto N ADD + N MULTI
+//! pipelined PEs with per-PE memories, buffers and a crossbar (seed ch. 1, §2.3; SPEC §4–§5).
+//!
+//! Phase: atomised → atomised with a [`Placement`] attached (printed in the IR, re-read by the
+//! parser, executed by `sim`). The machine model is documented in `robovec_ir::placement`.
+//!
+//! Algorithm ([`schedule`]): cycle by cycle, ready ops (every operand op arrived) sorted by
+//! priority — **classical**: ALAPCycle, then ASAPCycle; **mobility**: ALAPCycle − ASAPCycle,
+//! then ALAPCycle (seed §2.3.1, with latency-weighted attributes) — are assigned to a free PE of
+//! their type where both operands can be in its memory: **naive** selection takes the first such
+//! PE, **preferential** the one with the best operand-location pair of seed Table 2.1 (PE/PE = 1
+//! … Indirect/Indirect = 9). Then [`memory`] assigns addresses and sizes.
+//!
+//! Contract: never changes the function; every placement it returns passes `sim`. Cost:
+//! O(n log n + n·N) for n ops and N PEs per type.
+
+pub mod memory;
+pub mod schedule;
+
+use robovec_ir::analysis::{compute_timing, Latencies};
+use robovec_ir::placement::{Arch, Placement};
+use robovec_ir::{Function, Module, OpKind, Phase};
+
+use crate::{require_phase, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+
+/// Priority of ready ops (seed §2.3.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Priority {
+    /// ALAPCycle, then ASAPCycle.
+    Classical,
+    /// Mobility (ALAPCycle − ASAPCycle), then ALAPCycle.
+    Mobility,
+}
+
+/// How a PE is chosen among the free ones (seed §2.3, Table 2.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Select {
+    /// First free PE of the right type that can receive the operands.
+    Naive,
+    /// Best operand-location preference (Table 2.1), then lowest index.
+    Preferential,
+}
+
+/// Options of one placement.
+#[derive(Clone, Copy, Debug)]
+pub struct PlaceOptions {
+    /// Target architecture.
+    pub arch: Arch,
+    /// Ready-list priority.
+    pub priority: Priority,
+    /// PE selection.
+    pub select: Select,
+}
+
+impl PlaceOptions {
+    /// N ADD + N MULTI PEs, default latencies, 2 write ports, buffers on, classical,
+    /// preferential.
+    pub fn with_pes(n: u32) -> PlaceOptions {
+        PlaceOptions {
+            arch: Arch { n_add: n, n_mul: n, lat: Latencies::default(), writes: 2, buffer: true },
+            priority: Priority::Classical,
+            select: Select::Preferential,
+        }
+    }
+}
+
+/// Places `f` (atomised, verified).
+///
+/// # Errors
+/// Only with `buffer = false`: an operand that can no longer reach any PE memory of its type.
+pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement, String> {
+    let s = schedule::schedule(f, &opts.arch, opts.priority, opts.select)?;
+    Ok(memory::build(f, &opts.arch, &s))
+}
+
+/// Places `f` (atomised, verified) on an architecture with buffers.
+///
+/// # Panics
+/// If `opts.arch.buffer` is false and the placement gets stuck (use [`try_place_function`]).
+pub fn place_function(f: &Function, opts: &PlaceOptions) -> Placement {
+    try_place_function(f, opts).expect("with buffers a placement always exists")
+}
+
+/// Cycles of a placement (SPEC §4): the largest arrival, 0 without ops.
+pub fn cycles(f: &Function, p: &Placement) -> u32 {
+    f.body
+        .iter()
+        .filter_map(|&v| Some(p.issue[v.index()]?.cycle + p.latency(f.op_kind(v)?)))
+        .max()
+        .unwrap_or(0)
+}
+
+/// Ops that run on the ADD side (add, sub, div, call) and on the MULTI side.
+pub fn ops_per_side(f: &Function) -> (u64, u64) {
+    let c = f.op_counts();
+    (c.add + c.sub + c.div + c.call, c.mul)
+}
+
+/// The lower bound LB of SPEC §4: max(ASAPCycle critical path, ⌈n_add_side/N_add⌉ − 1 + lat_add,
+/// ⌈n_mul/N_mul⌉ − 1 + lat_mul), in cycles. No valid placement has fewer cycles.
+pub fn lower_bound(f: &Function, arch: &Arch) -> u32 {
+    let (_, cp) = compute_timing(f, &arch.lat);
+    let (na, nm) = ops_per_side(f);
+    let side = |n: u64, pes: u32, lat: u32| if n == 0 { 0 } else { (n.div_ceil(pes as u64) - 1) as u32 + lat };
+    cp.asap_cycle.max(side(na, arch.n_add, arch.lat.add)).max(side(nm, arch.n_mul, arch.lat.mul))
+}
+
+/// Ops issued per cycle on each side: `(add_side, mul_side)`, one entry per cycle `0..cycles`.
+pub fn issues_per_cycle(f: &Function, p: &Placement) -> (Vec<u32>, Vec<u32>) {
+    let n = cycles(f, p) as usize;
+    let (mut a, mut m) = (vec![0; n], vec![0; n]);
+    for &v in &f.body {
+        if let (Some(i), Some(k)) = (p.issue[v.index()], f.op_kind(v)) {
+            let side = if k == OpKind::Mul { &mut m } else { &mut a };
+            side[i.cycle as usize] += 1;
+        }
+    }
+    (a, m)
+}
+
+/// Occupation rate of one PE type (SPEC §4, seed §3.6): issued ops / N per cycle, rolling mean
+/// over a window of `window` cycles ending at each cycle.
+pub fn occupation(issued: &[u32], n: u32, window: usize) -> Vec<f64> {
+    let mut out = Vec::with_capacity(issued.len());
+    let mut sum = 0u64;
+    for i in 0..issued.len() {
+        sum += issued[i] as u64;
+        if i >= window {
+            sum -= issued[i - window] as u64;
+        }
+        let w = (i + 1).min(window) as f64;
+        out.push(sum as f64 / (w * n as f64));
+    }
+    out
+}
+
+/// Registry entry.
+pub const INFO: PassInfo = PassInfo {
+    name: "place",
+    doc: "list-schedule ops onto N ADD + N MULTI PEs with PE memories, buffers and a crossbar",
+    params: &[
+        ParamInfo { name: "pe", default: "4", doc: "N: N ADD PEs and N MULTI PEs" },
+        ParamInfo { name: "add", default: "pe", doc: "ADD PEs (overrides pe)" },
+        ParamInfo { name: "mul", default: "pe", doc: "MULTI PEs (overrides pe)" },
+        ParamInfo { name: "priority", default: "classical", doc: "classical (ALAP, ASAP) | mobility (mobility, ALAP)" },
+        ParamInfo { name: "select", default: "preferential", doc: "naive (first free PE) | preferential (Table 2.1)" },
+        ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency, cycles" },
+        ParamInfo { name: "lat-mul", default: "7", doc: "mul latency, cycles" },
+        ParamInfo { name: "lat-div", default: "12", doc: "div latency, cycles (ADD side)" },
+        ParamInfo { name: "lat-call", default: "12", doc: "call latency, cycles (ADD side)" },
+        ParamInfo { name: "writes", default: "2", doc: "write ports per PE memory per cycle" },
+        ParamInfo { name: "buffer", default: "on", doc: "on | off: results may wait in buffer memories" },
+    ],
+    build: |p: &Params| {
+        let d = Latencies::default();
+        let n = p.u32_in("pe", 4, 1, 4096)?;
+        let enum_param = |key: &str, options: &[&str], default: usize| -> Result<usize, PassError> {
+            match p.get(key) {
+                None => Ok(default),
+                Some(v) => options.iter().position(|o| *o == v).ok_or_else(|| PassError::BadParameter {
+                    pass: "place".into(),
+                    message: format!("parameter `{key}` must be one of {}, found `{v}`", options.join(" | ")),
+                }),
+            }
+        };
+        let opts = PlaceOptions {
+            arch: Arch {
+                n_add: p.u32_in("add", n, 1, 4096)?,
+                n_mul: p.u32_in("mul", n, 1, 4096)?,
+                lat: Latencies {
+                    add: p.u32_in("lat-add", d.add, 1, 10_000)?,
+                    mul: p.u32_in("lat-mul", d.mul, 1, 10_000)?,
+                    div: p.u32_in("lat-div", d.div, 1, 10_000)?,
+                    call: p.u32_in("lat-call", d.call, 1, 10_000)?,
+                },
+                writes: p.u32_in("writes", 2, 1, 64)?,
+                buffer: enum_param("buffer", &["off", "on"], 1)? == 1,
+            },
+            priority: [Priority::Classical, Priority::Mobility][enum_param("priority", &["classical", "mobility"], 0)?],
+            select: [Select::Naive, Select::Preferential][enum_param("select", &["naive", "preferential"], 1)?],
+        };
+        Ok(Box::new(Place { opts }))
+    },
+};
+
+/// The `place` pass.
+pub struct Place {
+    /// Options.
+    pub opts: PlaceOptions,
+}
+
+impl Pass for Place {
+    fn name(&self) -> &'static str {
+        "place"
+    }
+
+    fn requires(&self) -> Option<Phase> {
+        Some(Phase::Atomised)
+    }
+
+    fn preserves_timing(&self) -> bool {
+        true
+    }
+
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        require_phase(self.name(), m, Phase::Atomised)?;
+        for f in &mut m.functions {
+            let p = try_place_function(f, &self.opts)
+                .map_err(|e| PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) })?;
+            f.placement = Some(p);
+        }
+        cx.latencies = self.opts.arch.lat;
+        Ok(())
+    }
+}

@@ -1,0 +1,350 @@
+//! List scheduling with operand routing (seed §2.3; SPEC §5): cycle by cycle, ready ops in
+//! priority order are assigned to a free PE of their type on which both operands can be in the
+//! PE memory at the issue cycle — already there, written directly at the operand's arrival, or
+//! written later from the producer's buffer.
+//!
+//! Ready rule: an op is ready at cycle `t` when every operand op has arrived (`issue + latency
+//! ≤ t`). Writes are booked when the consumer is placed, at the producer's arrival cycle `a`
+//! (direct) or at the earliest cycle `b ∈ [a, t]` at which the producer's buffer can be read
+//! and the target memory has a free write port (indirect) — the seed's "placed on hold until we
+//! find a cycle where we have an empty writing slot". Bookings are decided at compile time, so a
+//! booking in a past cycle is legal as long as that cycle's ports are still free.
+//!
+//! Cost: each op enters and leaves a binary heap once (plus rare deferrals), and each placement
+//! tries at most the free PEs of its type: O(n log n + n·N) for n ops and N PEs per type; idle
+//! cycles are skipped.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use robovec_ir::analysis::{compute_timing, DepGraph};
+use robovec_ir::placement::{Arch, Pe};
+use robovec_ir::{Function, OpKind, Operand, Value};
+
+use super::{Priority, Select};
+
+/// How an operand reaches the PE memory that reads it (seed §2.3, Table 2.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Route {
+    /// Already in the memory (initial data, or written for an earlier consumer).
+    Pe,
+    /// Written directly at the producer's arrival cycle.
+    Direct,
+    /// Written from the producer's buffer at the given cycle.
+    Indirect(u32),
+}
+
+/// Preference of seed Table 2.1 (1 best … 9 worst) for the routes of the left and right operand.
+pub fn preference(left: Route, right: Route) -> u32 {
+    let r = |x: Route| match x {
+        Route::Pe => 0,
+        Route::Direct => 1,
+        Route::Indirect(_) => 2,
+    };
+    const TABLE: [[u32; 3]; 3] = [[1, 2, 5], [3, 4, 7], [6, 8, 9]];
+    TABLE[r(left)][r(right)]
+}
+
+/// A booked write of an op's result into a PE memory.
+#[derive(Clone, Copy, Debug)]
+pub struct Booking {
+    /// Producer op (value).
+    pub value: Value,
+    /// Target memory (PE slot).
+    pub target: usize,
+    /// Write cycle.
+    pub cycle: u32,
+    /// True when it goes through the producer's buffer.
+    pub indirect: bool,
+}
+
+/// The schedule: issues and bookings (addresses come later, see `memory.rs`).
+pub struct Schedule {
+    /// `(pe slot, issue cycle)` per value index, `None` for non-ops.
+    pub issue: Vec<Option<(usize, u32)>>,
+    /// Arrival cycle per value index (0 for non-ops).
+    pub arrival: Vec<u32>,
+    /// Every write booked, in booking order.
+    pub bookings: Vec<Booking>,
+}
+
+/// Per-cycle port usage, grown on demand.
+struct Ports {
+    /// `writes[slot][cycle]`: writes booked into that PE memory in that cycle.
+    writes: Vec<Vec<u8>>,
+    /// `buffer_read[slot][cycle]`: value index + 1 read from that PE's buffer in that cycle (0 = free).
+    buffer_read: Vec<Vec<u32>>,
+}
+
+impl Ports {
+    fn writes_at(&self, slot: usize, c: u32) -> u8 {
+        self.writes[slot].get(c as usize).copied().unwrap_or(0)
+    }
+    fn buffer_at(&self, slot: usize, c: u32) -> u32 {
+        self.buffer_read[slot].get(c as usize).copied().unwrap_or(0)
+    }
+    fn add_write(&mut self, slot: usize, c: u32) {
+        let v = &mut self.writes[slot];
+        if v.len() <= c as usize {
+            v.resize(c as usize + 1, 0);
+        }
+        v[c as usize] += 1;
+    }
+    fn set_buffer(&mut self, slot: usize, c: u32, value: Value) {
+        let v = &mut self.buffer_read[slot];
+        if v.len() <= c as usize {
+            v.resize(c as usize + 1, 0);
+        }
+        v[c as usize] = value.index() as u32 + 1;
+    }
+}
+
+struct Ctx<'a> {
+    arch: &'a Arch,
+    issue: Vec<Option<(usize, u32)>>,
+    arrival: Vec<u32>,
+    /// Memories (PE slots) a value has been written into.
+    located: Vec<Vec<usize>>,
+    ports: Ports,
+    bookings: Vec<Booking>,
+}
+
+/// Writes and buffer reads that earlier operands of the same op plan, not yet booked.
+#[derive(Default)]
+struct Planned {
+    /// Write cycles into the target memory.
+    writes: Vec<u32>,
+    /// `(producer slot, cycle, value)` buffer reads.
+    reads: Vec<(usize, u32, Value)>,
+}
+
+impl Ctx<'_> {
+    /// Route of op operand `v` into memory `q` for an issue at `t`, on top of `planned`.
+    fn route(&self, v: Value, q: usize, t: u32, planned: &Planned) -> Option<Route> {
+        if self.located[v.index()].contains(&q) {
+            return Some(Route::Pe);
+        }
+        let a = self.arrival[v.index()];
+        let used = |c: u32| self.ports.writes_at(q, c) as u32 + planned.writes.iter().filter(|&&x| x == c).count() as u32;
+        if used(a) < self.arch.writes {
+            return Some(Route::Direct);
+        }
+        if !self.arch.buffer {
+            return None;
+        }
+        let (p, _) = self.issue[v.index()].expect("operand op was issued");
+        let tag = v.index() as u32 + 1;
+        let buffer_free = |b: u32| {
+            let booked = self.ports.buffer_at(p, b);
+            (booked == 0 || booked == tag) && planned.reads.iter().all(|&(pp, bb, w)| pp != p || bb != b || w == v)
+        };
+        (a..=t).find(|&b| used(b) < self.arch.writes && buffer_free(b)).map(Route::Indirect)
+    }
+
+    /// Routes of the op operands `ops` of one op into `q` at `t` (`None` if one cannot get there).
+    fn routes(&self, ops: &[Option<Value>], q: usize, t: u32) -> Option<Vec<Route>> {
+        let mut out = Vec::with_capacity(ops.len());
+        let mut planned = Planned::default();
+        for (i, &o) in ops.iter().enumerate() {
+            let Some(v) = o.filter(|v| !ops[..i].contains(&Some(*v))) else {
+                out.push(Route::Pe); // initial data (loaded), or the same value as an earlier operand
+                continue;
+            };
+            let r = self.route(v, q, t, &planned)?;
+            match r {
+                Route::Direct => planned.writes.push(self.arrival[v.index()]),
+                Route::Indirect(b) => {
+                    planned.writes.push(b);
+                    planned.reads.push((self.issue[v.index()].expect("issued").0, b, v));
+                }
+                Route::Pe => {}
+            }
+            out.push(r);
+        }
+        Some(out)
+    }
+
+    fn commit(&mut self, ops: &[Option<Value>], routes: &[Route], q: usize) {
+        for (&o, &r) in ops.iter().zip(routes) {
+            let Some(v) = o else { continue };
+            let (cycle, indirect) = match r {
+                Route::Pe => continue,
+                Route::Direct => (self.arrival[v.index()], false),
+                Route::Indirect(b) => (b, true),
+            };
+            if self.located[v.index()].contains(&q) {
+                continue; // the same value twice in one op
+            }
+            self.ports.add_write(q, cycle);
+            if indirect {
+                let (p, _) = self.issue[v.index()].expect("issued");
+                self.ports.set_buffer(p, cycle, v);
+            }
+            self.located[v.index()].push(q);
+            self.bookings.push(Booking { value: v, target: q, cycle, indirect });
+        }
+    }
+}
+
+/// Schedules every op of `f` (atomised, verified) on `arch`.
+///
+/// # Errors
+/// Only without buffers: an op whose operand can no longer reach any PE memory of its type.
+pub fn schedule(f: &Function, arch: &Arch, priority: Priority, select: Select) -> Result<Schedule, String> {
+    let n = f.values.len();
+    let (timing, _) = compute_timing(f, &arch.lat);
+    let graph = DepGraph::build(f);
+    let ops: Vec<Value> = f.body.iter().copied().filter(|&v| f.op_kind(v).is_some()).collect();
+    let kind = |v: Value| f.op_kind(v).expect("op");
+    let key = |v: Value| {
+        let t = timing[v.index()].expect("ops have timing");
+        match priority {
+            Priority::Classical => (t.alap_cycle, t.asap_cycle, v.index() as u32),
+            Priority::Mobility => (t.alap_cycle - t.asap_cycle, t.alap_cycle, v.index() as u32),
+        }
+    };
+    // Per operand position: the producing op, or `None` for initial data (inputs, trig, constants).
+    let mut op_operands: Vec<Vec<Option<Value>>> = vec![Vec::new(); n];
+    let mut pending = vec![0u32; n];
+    for &v in &ops {
+        let list: Vec<Option<Value>> = match &f.value(v).def {
+            robovec_ir::Def::Binary(_, a, b) => vec![*a, *b],
+            robovec_ir::Def::Call(_, args) => args.clone(),
+            _ => Vec::new(),
+        }
+        .into_iter()
+        .map(|o| match o {
+            Operand::Value(x) if f.op_kind(x).is_some() => Some(x),
+            _ => None,
+        })
+        .collect();
+        let mut distinct: Vec<Value> = list.iter().flatten().copied().collect();
+        distinct.sort();
+        distinct.dedup();
+        pending[v.index()] = distinct.len() as u32;
+        op_operands[v.index()] = list;
+    }
+    let mut ctx = Ctx {
+        arch,
+        issue: vec![None; n],
+        arrival: vec![0; n],
+        located: vec![Vec::new(); n],
+        ports: Ports { writes: vec![Vec::new(); arch.n_pe()], buffer_read: vec![Vec::new(); arch.n_pe()] },
+        bookings: Vec::new(),
+    };
+    let is_mul = |v: Value| kind(v) == OpKind::Mul;
+    let mut ready: [BinaryHeap<Reverse<((u32, u32, u32), Value)>>; 2] = [BinaryHeap::new(), BinaryHeap::new()];
+    for &v in &ops {
+        if pending[v.index()] == 0 {
+            ready[is_mul(v) as usize].push(Reverse((key(v), v)));
+        }
+    }
+    let mut arrivals: BinaryHeap<Reverse<(u32, Value)>> = BinaryHeap::new();
+    let pes_of = |mul: bool| -> Vec<usize> {
+        if mul {
+            (0..arch.n_mul).map(|i| Pe::Mul(i).slot(arch.n_add)).collect()
+        } else {
+            (0..arch.n_add).map(|i| Pe::Add(i).slot(arch.n_add)).collect()
+        }
+    };
+    let pes = [pes_of(false), pes_of(true)];
+    let mut placed = 0usize;
+    let mut t: u32 = 0;
+    let mut stalled_since: Option<u32> = None;
+    while placed < ops.len() {
+        while let Some(&Reverse((c, v))) = arrivals.peek() {
+            if c > t {
+                break;
+            }
+            arrivals.pop();
+            let mut users: Vec<Value> = graph.users(v).collect();
+            users.sort();
+            users.dedup();
+            for u in users {
+                pending[u.index()] -= 1;
+                if pending[u.index()] == 0 {
+                    ready[is_mul(u) as usize].push(Reverse((key(u), u)));
+                }
+            }
+        }
+        let mut progress = false;
+        for ty in 0..2 {
+            if pes[ty].is_empty() {
+                continue;
+            }
+            let mut free: Vec<usize> = pes[ty].clone();
+            let mut deferred = Vec::new();
+            while !free.is_empty() {
+                let Some(Reverse((k, v))) = ready[ty].pop() else { break };
+                let operands = &op_operands[v.index()];
+                let mut best: Option<(u32, usize, Vec<Route>)> = None;
+                for (i, &q) in free.iter().enumerate() {
+                    let Some(routes) = ctx.routes(operands, q, t) else { continue };
+                    let score = match select {
+                        Select::Naive => 0,
+                        Select::Preferential => {
+                            let at = |j: usize| routes.get(j).copied().unwrap_or(Route::Pe);
+                            preference(at(0), at(1)) + routes.iter().skip(2).filter(|r| **r != Route::Pe).count() as u32
+                        }
+                    };
+                    if best.as_ref().is_none_or(|(s, _, _)| score < *s) {
+                        best = Some((score, i, routes));
+                        if score <= 1 && select == Select::Preferential || select == Select::Naive {
+                            break;
+                        }
+                    }
+                }
+                match best {
+                    Some((_, i, routes)) => {
+                        let q = free.swap_remove(i);
+                        ctx.commit(operands, &routes, q);
+                        let lat = arch.lat.of(kind(v));
+                        ctx.issue[v.index()] = Some((q, t));
+                        ctx.arrival[v.index()] = t + lat;
+                        arrivals.push(Reverse((t + lat, v)));
+                        placed += 1;
+                        progress = true;
+                        free.sort_unstable();
+                    }
+                    None => deferred.push(Reverse((k, v))),
+                }
+            }
+            ready[ty].extend(deferred);
+        }
+        if progress {
+            stalled_since = None;
+        } else if arrivals.is_empty() && stalled_since.is_none() {
+            stalled_since = Some(t);
+        }
+        if let Some(s) = stalled_since {
+            if t > s + 1 {
+                return Err("no PE memory can receive an operand any more (without buffers a result can only be \
+                            written at its arrival); use buffer=on or more write ports"
+                    .into());
+            }
+        }
+        // Next cycle; skip idle stretches when nothing is ready.
+        t += 1;
+        if ready[0].is_empty() && ready[1].is_empty() {
+            if let Some(&Reverse((c, _))) = arrivals.peek() {
+                t = t.max(c);
+            }
+        }
+    }
+    Ok(Schedule { issue: ctx.issue, arrival: ctx.arrival, bookings: ctx.bookings })
+}
+
+/// Constant or value read by an op, for load bookkeeping.
+pub fn initial_operands(f: &Function, v: Value) -> Vec<Operand> {
+    let mut out = Vec::new();
+    match &f.value(v).def {
+        robovec_ir::Def::Binary(_, a, b) => out.extend([*a, *b]),
+        robovec_ir::Def::Call(_, args) => out.extend(args.iter().copied()),
+        _ => {}
+    }
+    out.retain(|o| match o {
+        Operand::Const(_) => true,
+        Operand::Value(x) => f.op_kind(*x).is_none(),
+    });
+    out
+}
