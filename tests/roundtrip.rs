@@ -1,5 +1,5 @@
-//! `parse(print(m)) == m` for every corpus module, before and after `atomise` and with timing
-//! attributes (Cranelift's `test cat`).
+//! `parse(print(m)) == m` for every corpus module, before and after `atomise`, with timing
+//! attributes and with a placement (Cranelift's `test cat`).
 
 use robovec_ir::text::parse;
 use robovec_ir::Module;
@@ -17,6 +17,7 @@ fn assert_same(a: &Module, b: &Module, what: &str) {
         }
         let outs = |f: &robovec_ir::Function| f.outputs.iter().map(|o| (o.name.clone(), o.value)).collect::<Vec<_>>();
         assert_eq!(outs(f), outs(g), "{what} @{}", f.name);
+        assert_eq!(f.placement, g.placement, "{what} @{}: placement", f.name);
     }
 }
 
@@ -24,7 +25,7 @@ fn assert_same(a: &Module, b: &Module, what: &str) {
 fn corpus_modules_round_trip_in_every_phase() {
     for p in corpus_files().into_iter().filter(|p| !is_loop_file(p)) {
         let (mut m, _) = robovec::driver::load(p.to_str().unwrap()).unwrap_or_else(|f| panic!("{}", f.message()));
-        for pipeline in ["", "atomise", "asap-alap"] {
+        for pipeline in ["", "atomise", "asap-alap", "place<pe=3;select=naive>"] {
             let pm = PassManager::new(pipeline, Instrumentation::default()).unwrap();
             pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink()).unwrap();
             // Front ends number values in first-use order; the reader numbers inputs first.

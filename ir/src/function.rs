@@ -244,6 +244,30 @@ impl Function {
                 o.value = Operand::Value(remap(v));
             }
         }
+        if let Some(p) = &mut self.placement {
+            // Renumbering keeps a placement valid only if every value it names is kept.
+            let kept = |v: Value| map[v.index()].is_some();
+            let names_kept = p.writes.iter().all(|w| kept(w.value))
+                && p.loads.iter().all(|l| !matches!(l.operand, Operand::Value(v) if !kept(v)))
+                && p.issue.iter().enumerate().all(|(i, x)| x.is_none() || map[i].is_some());
+            if names_kept {
+                let mut issue = vec![None; new_values.len()];
+                for (i, x) in p.issue.iter().enumerate() {
+                    if let (Some(x), Some(nv)) = (x, map[i]) {
+                        issue[nv.index()] = Some(*x);
+                    }
+                }
+                p.issue = issue;
+                p.writes.iter_mut().for_each(|w| w.value = remap(w.value));
+                for l in &mut p.loads {
+                    if let Operand::Value(v) = l.operand {
+                        l.operand = Operand::Value(remap(v));
+                    }
+                }
+            } else {
+                self.placement = None;
+            }
+        }
         self.values = new_values;
         self.inputs = new_inputs;
         self.body = new_body;

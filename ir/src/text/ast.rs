@@ -15,8 +15,68 @@ pub struct FuncAst<'a> {
     pub equations: Option<u32>,
     /// Body lines in order.
     pub items: Vec<ItemAst<'a>>,
+    /// The placement block, if any.
+    pub placement: Option<PlacementAst<'a>>,
     /// The whole function.
     pub span: Span,
+}
+
+/// A `placement key=value… { words … buffers … lines }` block.
+#[derive(Debug)]
+pub struct PlacementAst<'a> {
+    /// Architecture keys (`n_add`, `n_mul`, `lat_add`, `lat_mul`, `lat_div`, `lat_call`,
+    /// `writes`, `buffer`).
+    pub arch: Vec<(&'a str, u32, Span)>,
+    /// Words per PE memory (`add0=5`).
+    pub words: Vec<(&'a str, u32, Span)>,
+    /// Words per buffer.
+    pub buffers: Vec<(&'a str, u32, Span)>,
+    /// Issue, load and write lines.
+    pub lines: Vec<PlacementLineAst<'a>>,
+    /// The whole block.
+    pub span: Span,
+}
+
+/// One line of a placement block.
+#[derive(Debug)]
+pub enum PlacementLineAst<'a> {
+    /// `issue %v PE CYCLE`
+    Issue {
+        /// Op name.
+        value: &'a str,
+        /// PE name (`add0`).
+        pe: &'a str,
+        /// Issue cycle.
+        cycle: u32,
+        /// Line span.
+        span: Span,
+    },
+    /// `load PE ADDR OPERAND`
+    Load {
+        /// PE name.
+        pe: &'a str,
+        /// Address.
+        addr: u32,
+        /// Input, trig value or constant.
+        operand: OperandAst<'a>,
+        /// Line span.
+        span: Span,
+    },
+    /// `write %v PE ADDR CYCLE [buffer BADDR]`
+    Write {
+        /// Op name.
+        value: &'a str,
+        /// Target PE memory.
+        pe: &'a str,
+        /// Address.
+        addr: u32,
+        /// Write cycle.
+        cycle: u32,
+        /// `buffer BADDR` for an indirect write.
+        via: Option<(&'a str, u32)>,
+        /// Line span.
+        span: Span,
+    },
 }
 
 /// One line of a function body.

@@ -49,6 +49,24 @@ pub enum Tok<'a> {
     /// `cos`
     #[token("cos")]
     Cos,
+    /// `placement`
+    #[token("placement")]
+    Placement,
+    /// `issue`
+    #[token("issue")]
+    Issue,
+    /// `load`
+    #[token("load")]
+    Load,
+    /// `write`
+    #[token("write")]
+    Write,
+    /// `words`
+    #[token("words")]
+    Words,
+    /// `buffers`
+    #[token("buffers")]
+    Buffers,
     /// `{`
     #[token("{")]
     LBrace,

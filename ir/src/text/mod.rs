@@ -18,6 +18,7 @@ pub mod ast;
 pub mod error;
 pub mod lexer;
 pub mod parser;
+pub mod placement;
 pub mod printer;
 
 pub use error::ParseError;

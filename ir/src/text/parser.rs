@@ -85,6 +85,9 @@ fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
             }
         }
     }
+    if let Some(p) = f.placement {
+        func.placement = super::placement::resolve(&func, p, errors);
+    }
     func
 }
 

@@ -140,6 +140,9 @@ pub fn write_function(out: &mut impl Write, f: &Function) -> fmt::Result {
         write_operand(out, f, &o.value)?;
         out.write_char('\n')?;
     }
+    if let Some(p) = &f.placement {
+        super::placement::write(out, f, p)?;
+    }
     writeln!(out, "}}")
 }
 
