@@ -12,7 +12,7 @@ use robovec_passes::{Instrumentation, PassContext, PassManager};
 
 use crate::diagnostics::SourceFile;
 use crate::front;
-use crate::report::{evaluate, stats, Report};
+use crate::report::{evaluate, placement_report, stats, Report};
 
 /// What the command line asked for.
 #[derive(Clone, Debug, Default)]
@@ -176,6 +176,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 pipeline: pm.pipeline_text(),
                 passes: records.clone(),
                 stats: stats(f, &cx.latencies),
+                placement: placement_report(f),
             };
             Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
         }
@@ -217,6 +218,25 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 s.asap_cycle,
                 s.y
             );
+            if let Some(p) = placement_report(f) {
+                let max = |v: &[u32]| v.iter().copied().max().unwrap_or(0);
+                let _ = writeln!(
+                    stderr,
+                    "@{}: placed on {} ADD + {} MULTI PEs: {} cycles, lower bound {} (x{:.3}), parallelisation rate {:.3}, \
+                     PE memory up to {} words, buffer up to {} words, writes {} direct / {} indirect",
+                    f.name,
+                    p.n_add,
+                    p.n_mul,
+                    p.cycles,
+                    p.lower_bound,
+                    p.cycles_over_lower_bound,
+                    p.parallelisation_rate,
+                    max(&p.pe_memory_words),
+                    max(&p.buffer_words),
+                    p.writes_direct,
+                    p.writes_indirect
+                );
+            }
         }
     }
     let ir = module.to_string();
