@@ -8,7 +8,9 @@
 
 pub mod asap_alap;
 pub mod atomise;
+pub mod dag_gen;
 pub mod dce;
+pub mod exact;
 pub mod manager;
 pub mod params;
 pub mod pipeline;

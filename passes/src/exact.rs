@@ -1,0 +1,1 @@
+//! Exact scheduler (in progress).
