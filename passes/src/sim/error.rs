@@ -1,0 +1,128 @@
+//! What the simulator rejects: one [`SimError`] naming when, where and which value.
+
+use robovec_ir::placement::Pe;
+
+/// When an error happened in the simulated run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum When {
+    /// While loading initial data, before cycle 0.
+    Load,
+    /// In this cycle.
+    Cycle(u32),
+    /// After the last cycle (outputs).
+    End,
+}
+
+impl std::fmt::Display for When {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            When::Load => write!(f, "before cycle 0"),
+            When::Cycle(c) => write!(f, "cycle {c}"),
+            When::End => write!(f, "at the end"),
+        }
+    }
+}
+
+/// The rule a placement breaks (one per check of the simulator).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SimErrorKind {
+    /// The function or placement cannot be simulated at all (vector sizes, unknown values,
+    /// a zero latency, parsed-phase expressions).
+    Malformed,
+    /// `verify_placement` on a function without a placement.
+    NoPlacement,
+    /// A PE index beyond the architecture's `n_add`/`n_mul`.
+    NoSuchPe,
+    /// An op issued on a PE of the wrong type (`mul` on an ADD PE…).
+    WrongPeType,
+    /// Two ops issued on one PE in one cycle.
+    PeBusy,
+    /// An op of the function has no issue.
+    MissingIssue,
+    /// An issue or a result write of a value that is not an op.
+    NotAnOp,
+    /// A load of a value that is not initial data (an op result).
+    BadLoad,
+    /// An op reads a value its PE memory does not hold in that cycle (never written, written
+    /// later, or overwritten).
+    ReadMissing,
+    /// An op issued before one of its operands arrives.
+    BeforeArrival,
+    /// More than `arch.writes` writes into one PE memory in one cycle.
+    WritePorts,
+    /// More than one distinct buffer read of one buffer in one cycle.
+    BufferReads,
+    /// One value entering its producer's buffer at two addresses.
+    BufferEntries,
+    /// An indirect write on an architecture without buffers.
+    NoBuffer,
+    /// A direct write in a cycle other than the value's arrival.
+    DirectWriteCycle,
+    /// A buffer read before the value arrives in the buffer.
+    BufferReadBeforeArrival,
+    /// A memory or buffer address at or beyond the reported `pe_words`/`buffer_words`.
+    AddressOutOfRange,
+    /// An address written while the value it holds still has a read in this or a later cycle,
+    /// or written twice in one cycle.
+    AddressReused,
+    /// An output whose value was never computed.
+    OutputUnavailable,
+    /// A simulated output differs from the interpreter (`verify_placement`).
+    Mismatch,
+}
+
+/// A placement the simulator rejects: the first broken rule, with the cycle, the PE and the
+/// value involved when there are such. Displays as `cycle 7, add0, %x: message`.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{}", self.render())]
+pub struct SimError {
+    /// The broken rule.
+    pub kind: SimErrorKind,
+    /// When, if the error has a time.
+    pub when: Option<When>,
+    /// The PE (memory, buffer or issuing PE) involved.
+    pub pe: Option<Pe>,
+    /// The value involved, as printed (`%AF24`, a constant `2.0`, or an output name).
+    pub value: Option<String>,
+    /// What is wrong, lower case.
+    pub message: String,
+}
+
+impl SimError {
+    pub(crate) fn new(kind: SimErrorKind, message: impl Into<String>) -> SimError {
+        SimError { kind, when: None, pe: None, value: None, message: message.into() }
+    }
+
+    pub(crate) fn at(mut self, when: When) -> SimError {
+        self.when = Some(when);
+        self
+    }
+
+    pub(crate) fn on(mut self, pe: Pe) -> SimError {
+        self.pe = Some(pe);
+        self
+    }
+
+    pub(crate) fn of(mut self, value: impl Into<String>) -> SimError {
+        self.value = Some(value.into());
+        self
+    }
+
+    fn render(&self) -> String {
+        let mut parts: Vec<String> = Vec::new();
+        if let Some(w) = self.when {
+            parts.push(w.to_string());
+        }
+        if let Some(p) = self.pe {
+            parts.push(p.to_string());
+        }
+        if let Some(v) = &self.value {
+            parts.push(v.clone());
+        }
+        if parts.is_empty() {
+            self.message.clone()
+        } else {
+            format!("{}: {}", parts.join(", "), self.message)
+        }
+    }
+}

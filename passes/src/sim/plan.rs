@@ -1,0 +1,353 @@
+//! The plan: everything the simulator derives from a [`Placement`] before running it — arrival
+//! cycles, every PE memory write (loads and `Write`s) with the reads that use it, every buffer
+//! entry with its reads, and the events of each cycle.
+
+use std::collections::{BTreeMap, HashMap};
+
+use robovec_ir::placement::{Issue, Pe, Placement};
+use robovec_ir::syntax::{Def, OpKind, Operand};
+use robovec_ir::{Function, Value};
+
+use super::error::{SimError, SimErrorKind as K, When};
+
+/// Longest run the simulator accepts, cycles (guards the per-cycle counters).
+const MAX_CYCLES: u32 = 50_000_000;
+
+/// What a memory word holds: a value of the function or a constant (by its `f64` bits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(super) enum Key {
+    Value(Value),
+    Const(u64),
+}
+
+pub(super) fn key_of(o: &Operand) -> Key {
+    match o {
+        Operand::Value(v) => Key::Value(*v),
+        Operand::Const(c) => Key::Const(c.to_bits()),
+    }
+}
+
+/// One write into a PE memory word (a load, time −1, or a `Write`, time = its cycle).
+pub(super) struct MemEvent {
+    pub slot: usize,
+    pub pe: Pe,
+    pub addr: u32,
+    pub time: i64,
+    pub key: Key,
+    /// Latest cycle an op reads this word (reads resolved statically, see `resolve`).
+    pub last_read: Option<i64>,
+}
+
+/// A value entering its producer's buffer at arrival and read back by indirect writes.
+pub(super) struct BufEvent {
+    pub slot: usize,
+    pub pe: Pe,
+    pub addr: u32,
+    pub value: Value,
+    pub arrival: u32,
+    pub last_read: u32,
+}
+
+/// Events of one cycle, in the order they happen.
+#[derive(Default)]
+pub(super) struct Bucket {
+    /// Buffer entries (`BufEvent` indices) of results arriving now.
+    pub entries: Vec<usize>,
+    /// `Placement::writes` indices written into PE memories now.
+    pub writes: Vec<usize>,
+    /// Ops issued now, in body order.
+    pub issues: Vec<Value>,
+}
+
+/// A read of an operand: the memory event it reads, or the first cycle the value is written
+/// into that memory later (`None`: never).
+pub(super) type Read = Result<usize, Option<i64>>;
+
+pub(super) struct Run<'a> {
+    pub f: &'a Function,
+    pub p: &'a Placement,
+}
+
+impl Run<'_> {
+    pub fn name(&self, k: Key) -> String {
+        match k {
+            Key::Value(v) => format!("%{}", self.f.name_of(v)),
+            Key::Const(b) => format!("{:?}", f64::from_bits(b)),
+        }
+    }
+
+    pub fn vname(&self, v: Value) -> String {
+        self.name(Key::Value(v))
+    }
+
+    fn pe_exists(&self, pe: Pe) -> bool {
+        match pe {
+            Pe::Add(i) => i < self.p.arch.n_add,
+            Pe::Mul(i) => i < self.p.arch.n_mul,
+        }
+    }
+
+    pub fn slot(&self, pe: Pe) -> usize {
+        pe.slot(self.p.arch.n_add)
+    }
+
+    pub fn value_ok(&self, v: Value, what: &str) -> Result<(), SimError> {
+        if v.index() < self.f.values.len() {
+            Ok(())
+        } else {
+            Err(SimError::new(K::Malformed, format!("{what} refers to {v}, which the function does not have")))
+        }
+    }
+
+    fn no_pe(&self, pe: Pe, when: When, what: &str) -> SimError {
+        let a = self.p.arch;
+        SimError::new(
+            K::NoSuchPe,
+            format!("{what} uses PE {pe}, which does not exist ({} ADD and {} MULTI PEs)", a.n_add, a.n_mul),
+        )
+        .at(when)
+        .on(pe)
+    }
+
+    /// Checks everything that has no time order: sizes, value and PE references, issues of
+    /// non-ops, missing issues, loads of non-initial data, writes of non-ops.
+    fn check_structure(&self) -> Result<(), SimError> {
+        let (f, p) = (self.f, self.p);
+        let n_pe = p.arch.n_pe();
+        if p.pe_words.len() != n_pe || p.buffer_words.len() != n_pe {
+            return Err(SimError::new(
+                K::Malformed,
+                format!(
+                    "placement lists {} PE memory and {} buffer sizes for {n_pe} PEs",
+                    p.pe_words.len(),
+                    p.buffer_words.len()
+                ),
+            ));
+        }
+        for k in [OpKind::Add, OpKind::Mul, OpKind::Div, OpKind::Call] {
+            if p.latency(k) == 0 {
+                return Err(SimError::new(K::Malformed, format!("latency of {k:?} is 0; latencies must be ≥ 1")));
+            }
+        }
+        if let Some(i) = p.issue.iter().skip(f.values.len()).position(Option::is_some) {
+            let v = Value::with_number((f.values.len() + i) as u32);
+            return Err(SimError::new(K::Malformed, format!("issue of {v}, which the function does not have")));
+        }
+        for &v in &f.body {
+            if matches!(f.value(v).def, Def::Expr(_)) {
+                return Err(
+                    SimError::new(K::Malformed, "is a nested expression; run `atomise` before `sim`").of(self.vname(v))
+                );
+            }
+        }
+        for (i, is) in p.issue.iter().enumerate() {
+            let Some(is) = is else { continue };
+            let v = Value::with_number(i as u32);
+            if f.op_kind(v).is_none() {
+                return Err(SimError::new(K::NotAnOp, "is issued but is not an op")
+                    .at(When::Cycle(is.cycle))
+                    .on(is.pe)
+                    .of(self.vname(v)));
+            }
+            if !self.pe_exists(is.pe) {
+                return Err(self.no_pe(is.pe, When::Cycle(is.cycle), "issue").of(self.vname(v)));
+            }
+        }
+        for &v in &f.body {
+            if f.op_kind(v).is_some() && p.issue.get(v.index()).copied().flatten().is_none() {
+                return Err(SimError::new(K::MissingIssue, "op is never issued").of(self.vname(v)));
+            }
+        }
+        for l in &p.loads {
+            if !self.pe_exists(l.pe) {
+                return Err(self.no_pe(l.pe, When::Load, "load").of(self.name(key_of(&l.operand))));
+            }
+            if let Operand::Value(v) = l.operand {
+                self.value_ok(v, "a load")?;
+                if !matches!(f.value(v).def, Def::Input | Def::Trig(..)) {
+                    return Err(SimError::new(K::BadLoad, "loaded, but it is an op result, not initial data")
+                        .at(When::Load)
+                        .on(l.pe)
+                        .of(self.vname(v)));
+                }
+            }
+        }
+        for w in &p.writes {
+            self.value_ok(w.value, "a write")?;
+            if !self.pe_exists(w.pe) {
+                return Err(self.no_pe(w.pe, When::Cycle(w.cycle), "write").of(self.vname(w.value)));
+            }
+            if f.op_kind(w.value).is_none() {
+                return Err(SimError::new(K::NotAnOp, "written as a result, but it is not an op")
+                    .at(When::Cycle(w.cycle))
+                    .on(w.pe)
+                    .of(self.vname(w.value)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Operand keys an op reads, in operand order (a call reads all its arguments).
+    fn operands(&self, v: Value) -> Vec<Key> {
+        match &self.f.value(v).def {
+            Def::Binary(_, a, b) => vec![key_of(a), key_of(b)],
+            Def::Call(_, args) => args.iter().map(key_of).collect(),
+            _ => Vec::new(),
+        }
+    }
+}
+
+/// What [`derive`] finds; indices of `mem_ev` are loads (`0..n_loads`), then `Placement::writes`.
+pub(super) struct Plan {
+    /// Arrival cycle of every op, by value index.
+    pub arrival: Vec<Option<u32>>,
+    /// Largest arrival (0 without ops).
+    pub cycles: u32,
+    /// Number of loads.
+    pub n_loads: usize,
+    /// PE memory writes.
+    pub mem_ev: Vec<MemEvent>,
+    /// Each op's operand reads, by value index.
+    pub reads: Vec<Vec<(Key, Read)>>,
+    /// Buffer entries.
+    pub buf_ev: Vec<BufEvent>,
+    /// The buffer entry each indirect write reads.
+    pub buf_of_write: Vec<Option<usize>>,
+    /// Events per cycle.
+    pub buckets: BTreeMap<u32, Bucket>,
+}
+
+impl Run<'_> {
+    /// The issue of op `v` (checked to exist).
+    pub fn issue(&self, v: Value) -> Issue {
+        self.p.issue[v.index()].expect("checked: every op is issued")
+    }
+
+    /// Checks the structure and derives the plan.
+    pub fn derive(&self) -> Result<Plan, SimError> {
+        let r = self;
+        let (f, p) = (self.f, self.p);
+        r.check_structure()?;
+        let n = f.values.len();
+        let issue = |v: Value| r.issue(v);
+
+        // Arrivals.
+        let mut arrival: Vec<Option<u32>> = vec![None; n];
+        let mut cycles = 0u32;
+        for &v in &f.body {
+            let Some(kind) = f.op_kind(v) else { continue };
+            let is = issue(v);
+            let a = is.cycle.checked_add(p.latency(kind)).filter(|&a| a <= MAX_CYCLES).ok_or_else(|| {
+                SimError::new(K::Malformed, format!("arrives after cycle {MAX_CYCLES}, too late to simulate"))
+                    .at(When::Cycle(is.cycle))
+                    .on(is.pe)
+                    .of(r.vname(v))
+            })?;
+            arrival[v.index()] = Some(a);
+            cycles = cycles.max(a);
+        }
+
+        // PE memory writes: loads first, then `Write`s.
+        let n_loads = p.loads.len();
+        let mut mem_ev: Vec<MemEvent> = p
+            .loads
+            .iter()
+            .map(|l| MemEvent {
+                slot: r.slot(l.pe),
+                pe: l.pe,
+                addr: l.addr,
+                time: -1,
+                key: key_of(&l.operand),
+                last_read: None,
+            })
+            .chain(p.writes.iter().map(|w| MemEvent {
+                slot: r.slot(w.pe),
+                pe: w.pe,
+                addr: w.addr,
+                time: w.cycle as i64,
+                key: Key::Value(w.value),
+                last_read: None,
+            }))
+            .collect();
+        let mut by_key: HashMap<(usize, Key), Vec<usize>> = HashMap::new();
+        for (i, e) in mem_ev.iter().enumerate() {
+            by_key.entry((e.slot, e.key)).or_default().push(i);
+        }
+
+        // Reads: an op on PE p at cycle c reads each operand from the latest write of it into p at
+        // a cycle ≤ c (the first such write on a tie).
+        let mut reads: Vec<Vec<(Key, Read)>> = vec![Vec::new(); n];
+        for &v in &f.body {
+            if f.op_kind(v).is_none() {
+                continue;
+            }
+            let is = issue(v);
+            let (slot, c) = (r.slot(is.pe), is.cycle as i64);
+            for k in r.operands(v) {
+                let list = by_key.get(&(slot, k)).map(Vec::as_slice).unwrap_or(&[]);
+                let mut best: Option<usize> = None;
+                for &e in list {
+                    if mem_ev[e].time <= c && !matches!(best, Some(b) if mem_ev[b].time >= mem_ev[e].time) {
+                        best = Some(e);
+                    }
+                }
+                let res = match best {
+                    Some(e) => {
+                        let lr = &mut mem_ev[e].last_read;
+                        *lr = Some(lr.map_or(c, |x| x.max(c)));
+                        Ok(e)
+                    }
+                    None => Err(list.iter().map(|&e| mem_ev[e].time).min()),
+                };
+                reads[v.index()].push((k, res));
+            }
+        }
+
+        // Buffer entries: one per indirect-written value, at its producer's buffer, from arrival.
+        let mut buf_ev: Vec<BufEvent> = Vec::new();
+        let mut buf_of_value: HashMap<Value, usize> = HashMap::new();
+        let mut buf_of_write: Vec<Option<usize>> = vec![None; p.writes.len()];
+        for (i, w) in p.writes.iter().enumerate() {
+            let Some(addr) = w.buffer_addr else { continue };
+            let is = issue(w.value);
+            let arr = arrival[w.value.index()].expect("ops arrive");
+            let b = *buf_of_value.entry(w.value).or_insert_with(|| {
+                buf_ev.push(BufEvent {
+                    slot: r.slot(is.pe),
+                    pe: is.pe,
+                    addr,
+                    value: w.value,
+                    arrival: arr,
+                    last_read: 0,
+                });
+                buf_ev.len() - 1
+            });
+            if buf_ev[b].addr != addr {
+                return Err(SimError::new(
+                    K::BufferEntries,
+                    format!("enters the buffer of {} at two addresses ({} and {addr})", is.pe, buf_ev[b].addr),
+                )
+                .at(When::Cycle(arr))
+                .on(is.pe)
+                .of(r.vname(w.value)));
+            }
+            buf_ev[b].last_read = buf_ev[b].last_read.max(w.cycle);
+            buf_of_write[i] = Some(b);
+        }
+
+        // The schedule, cycle by cycle.
+        let mut buckets: BTreeMap<u32, Bucket> = BTreeMap::new();
+        for (i, b) in buf_ev.iter().enumerate() {
+            buckets.entry(b.arrival).or_default().entries.push(i);
+        }
+        for (i, w) in p.writes.iter().enumerate() {
+            buckets.entry(w.cycle).or_default().writes.push(i);
+        }
+        for &v in &f.body {
+            if f.op_kind(v).is_some() {
+                buckets.entry(issue(v).cycle).or_default().issues.push(v);
+            }
+        }
+        Ok(Plan { arrival, cycles, n_loads, mem_ev, reads, buf_ev, buf_of_write, buckets })
+    }
+}

@@ -1,0 +1,426 @@
+use super::*;
+use robovec_ir::analysis::Latencies;
+use robovec_ir::interp::pseudo_random_input;
+use robovec_ir::placement::{Arch, Issue, Load, Pe, Write};
+use robovec_ir::text::parse;
+use robovec_ir::{Operand, Value};
+
+use Pe::{Add, Mul};
+
+const SRC: &str = "func @f { phase atomised input %a input %b %x = mul %a, %b %y = add %x, %a output o = %y }";
+
+fn func(src: &str) -> Function {
+    parse(src).unwrap_or_else(|e| panic!("{e:?}")).functions.remove(0)
+}
+
+fn v(f: &Function, name: &str) -> Value {
+    f.lookup(name).unwrap_or_else(|| panic!("no %{name}"))
+}
+
+fn arch(n_add: u32, n_mul: u32) -> Arch {
+    Arch { n_add, n_mul, lat: Latencies::default(), writes: 2, buffer: true }
+}
+
+fn load(f: &Function, pe: Pe, addr: u32, name: &str) -> Load {
+    Load { pe, addr, operand: Operand::Value(v(f, name)) }
+}
+
+fn direct(f: &Function, name: &str, pe: Pe, addr: u32, cycle: u32) -> Write {
+    Write { value: v(f, name), pe, addr, cycle, buffer_addr: None }
+}
+
+fn indirect(f: &Function, name: &str, pe: Pe, addr: u32, cycle: u32, buffer_addr: u32) -> Write {
+    Write { value: v(f, name), pe, addr, cycle, buffer_addr: Some(buffer_addr) }
+}
+
+fn issue(f: &Function, list: &[(&str, Pe, u32)]) -> Vec<Option<Issue>> {
+    let mut is = vec![None; f.values.len()];
+    for &(name, pe, cycle) in list {
+        is[v(f, name).index()] = Some(Issue { pe, cycle });
+    }
+    is
+}
+
+/// The example: mul on mul0 at 0, add on add0 at 7, %x written directly into add0 at 7,
+/// %a loaded into mul0 and add0, %b into mul0.
+fn base(f: &Function) -> Placement {
+    Placement {
+        arch: arch(1, 1),
+        issue: issue(f, &[("x", Mul(0), 0), ("y", Add(0), 7)]),
+        loads: vec![load(f, Mul(0), 0, "a"), load(f, Mul(0), 1, "b"), load(f, Add(0), 0, "a")],
+        writes: vec![direct(f, "x", Add(0), 1, 7)],
+        pe_words: vec![2, 2],
+        buffer_words: vec![0, 0],
+    }
+}
+
+fn input(name: &str) -> f64 {
+    pseudo_random_input(name, 7)
+}
+
+fn fails(f: &Function, p: &Placement, kind: SimErrorKind, parts: &[&str]) -> SimError {
+    let e = simulate::<f64>(f, p, input).expect_err("placement should be rejected");
+    let text = e.to_string();
+    assert_eq!(e.kind, kind, "{text}");
+    for part in parts {
+        assert!(text.contains(part), "`{text}` should contain `{part}`");
+    }
+    e
+}
+
+#[test]
+fn valid_direct_placement() {
+    let f = func(SRC);
+    let p = base(&f);
+    let o = simulate::<f64>(&f, &p, input).unwrap();
+    assert_eq!(o.cycles, 19);
+    assert_eq!(o.outputs, robovec_ir::interp::eval::<f64>(&f, input));
+    let (a, b) = (input("a"), input("b"));
+    assert_eq!(o.outputs[0].1, a * b + a);
+    assert_eq!((o.writes_direct, o.writes_indirect), (1, 0));
+    assert_eq!(o.max_words_per_memory, vec![2, 2]);
+    assert_eq!(o.max_buffer_words, vec![0, 0]);
+    let mut add = vec![0; 19];
+    add[7] = 1;
+    let mut mul = vec![0; 19];
+    mul[0] = 1;
+    assert_eq!((o.issued_per_cycle_add, o.issued_per_cycle_mul), (add, mul));
+    let o32 = simulate::<f32>(&f, &p, input).unwrap();
+    assert_eq!(o32.outputs, robovec_ir::interp::eval::<f32>(&f, input));
+    let r = verify_with(&f, &p, &[0, 1, 2]).unwrap();
+    assert_eq!((r.cycles, r.outputs, r.seeds.len()), (19, 1, 3));
+}
+
+#[test]
+fn valid_indirect_write_with_fan_out() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.arch = arch(2, 1);
+    p.issue = issue(&f, &[("x", Mul(0), 0), ("y", Add(1), 9)]);
+    p.loads = vec![load(&f, Mul(0), 0, "a"), load(&f, Mul(0), 1, "b"), load(&f, Add(1), 0, "a")];
+    // %x waits in mul0's buffer from 7; one read at 9 fans out into add0 and add1.
+    p.writes = vec![indirect(&f, "x", Add(0), 0, 9, 0), indirect(&f, "x", Add(1), 1, 9, 0)];
+    p.pe_words = vec![1, 2, 2];
+    p.buffer_words = vec![0, 0, 1];
+    let o = simulate::<f64>(&f, &p, input).unwrap();
+    assert_eq!(o.cycles, 21);
+    assert_eq!(o.outputs, robovec_ir::interp::eval::<f64>(&f, input));
+    assert_eq!((o.writes_direct, o.writes_indirect), (0, 2));
+    assert_eq!(o.max_buffer_words, vec![0, 0, 1]);
+    assert_eq!(o.max_words_per_memory, vec![1, 2, 2]);
+    verify_with(&f, &p, &[3, 4]).unwrap();
+}
+
+#[test]
+fn constants_trig_and_calls_with_three_operands() {
+    let f = func(
+        "func @f { phase atomised input %q %s = sin %q %x = add %s, 2.0 %z = call @user_g(%x, %q, %s) \
+         output o = %z output c = -1.5 output t = %s }",
+    );
+    let p = Placement {
+        arch: arch(1, 0),
+        issue: issue(&f, &[("x", Add(0), 0), ("z", Add(0), 12)]),
+        loads: vec![
+            load(&f, Add(0), 0, "s"),
+            Load { pe: Add(0), addr: 1, operand: Operand::Const(2.0) },
+            load(&f, Add(0), 2, "q"),
+        ],
+        // 2.0 is dead after cycle 0: %x reuses its address.
+        writes: vec![direct(&f, "x", Add(0), 1, 12)],
+        pe_words: vec![3],
+        buffer_words: vec![0],
+    };
+    let r = verify_with(&f, &p, &[0, 1, 2]).unwrap();
+    assert_eq!(r.cycles, 24);
+    assert_eq!(r.max_words_per_memory, vec![3]);
+    // Without the constant in memory, the add cannot read it.
+    let mut q = p.clone();
+    q.loads.remove(1);
+    fails(&f, &q, SimErrorKind::ReadMissing, &["cycle 0", "add0", "2.0", "never written or loaded"]);
+    // A call reads all its operands: drop %q and the third read fails.
+    let mut q = p.clone();
+    q.loads.remove(2);
+    fails(&f, &q, SimErrorKind::ReadMissing, &["cycle 12", "add0", "%q"]);
+}
+
+#[test]
+fn op_on_wrong_pe_type() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.issue = issue(&f, &[("x", Add(0), 0), ("y", Add(0), 7)]);
+    fails(&f, &p, SimErrorKind::WrongPeType, &["cycle 0", "add0", "%x", "wrong type"]);
+}
+
+#[test]
+fn unknown_pe() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.issue = issue(&f, &[("x", Mul(1), 0), ("y", Add(0), 7)]);
+    fails(&f, &p, SimErrorKind::NoSuchPe, &["cycle 0", "mul1", "%x", "does not exist"]);
+}
+
+#[test]
+fn two_ops_on_one_pe_in_one_cycle() {
+    let f = func(
+        "func @f { phase atomised input %a input %b %x = add %a, %b %y = sub %a, %b output o = %x output p = %y }",
+    );
+    let p = Placement {
+        arch: arch(1, 0),
+        issue: issue(&f, &[("x", Add(0), 3), ("y", Add(0), 3)]),
+        loads: vec![load(&f, Add(0), 0, "a"), load(&f, Add(0), 1, "b")],
+        writes: vec![],
+        pe_words: vec![2],
+        buffer_words: vec![0],
+    };
+    fails(&f, &p, SimErrorKind::PeBusy, &["cycle 3", "add0", "%y", "same cycle as %x"]);
+}
+
+#[test]
+fn missing_issue_of_an_output_op() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.issue = issue(&f, &[("x", Mul(0), 0)]);
+    fails(&f, &p, SimErrorKind::MissingIssue, &["%y", "never issued"]);
+}
+
+#[test]
+fn issue_or_write_of_a_non_op() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.issue[v(&f, "a").index()] = Some(Issue { pe: Add(0), cycle: 1 });
+    fails(&f, &p, SimErrorKind::NotAnOp, &["cycle 1", "add0", "%a"]);
+    let mut p = base(&f);
+    p.writes.push(direct(&f, "b", Add(0), 1, 7));
+    fails(&f, &p, SimErrorKind::NotAnOp, &["cycle 7", "add0", "%b"]);
+}
+
+#[test]
+fn load_of_an_op_result_is_not_a_stale_copy() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.loads.push(load(&f, Add(0), 1, "x"));
+    fails(&f, &p, SimErrorKind::BadLoad, &["before cycle 0", "add0", "%x", "not initial data"]);
+}
+
+#[test]
+fn read_of_a_value_never_written() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.loads.pop(); // %a never reaches add0
+    fails(&f, &p, SimErrorKind::ReadMissing, &["cycle 7", "add0", "%a", "never written or loaded there"]);
+}
+
+#[test]
+fn read_of_a_value_written_later() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    // %x arrives at 7 and waits in the buffer until 9, but the add issues at 8.
+    p.issue = issue(&f, &[("x", Mul(0), 0), ("y", Add(0), 8)]);
+    p.writes = vec![indirect(&f, "x", Add(0), 1, 9, 0)];
+    p.buffer_words = vec![0, 1];
+    fails(&f, &p, SimErrorKind::ReadMissing, &["cycle 8", "add0", "%x", "written there only at cycle 9"]);
+}
+
+#[test]
+fn read_of_an_overwritten_value_is_address_reuse() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    // %x lands on %a's address of add0 in the cycle %a is read.
+    p.writes = vec![direct(&f, "x", Add(0), 0, 7)];
+    fails(
+        &f,
+        &p,
+        SimErrorKind::AddressReused,
+        &["cycle 7", "add0", "%x", "holds %a, which is read at cycle 7", "still needed"],
+    );
+}
+
+#[test]
+fn op_issued_before_its_operand_arrives() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.issue = issue(&f, &[("x", Mul(0), 0), ("y", Add(0), 6)]);
+    fails(&f, &p, SimErrorKind::BeforeArrival, &["cycle 6", "add0", "%x", "arrives only at cycle 7"]);
+}
+
+#[test]
+fn write_ports_over_subscribed() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.writes = vec![direct(&f, "x", Add(0), 1, 7), direct(&f, "x", Add(0), 2, 7), direct(&f, "x", Add(0), 3, 7)];
+    p.pe_words = vec![4, 2];
+    fails(&f, &p, SimErrorKind::WritePorts, &["cycle 7", "add0", "%x", "2 write ports"]);
+    p.arch.writes = 3;
+    simulate::<f64>(&f, &p, input).unwrap();
+}
+
+fn two_products() -> (Function, Placement) {
+    let f = func(
+        "func @f { phase atomised input %a input %b %x = mul %a, %b %z = mul %b, %b %y = add %x, %z output o = %y }",
+    );
+    let p = Placement {
+        arch: arch(1, 1),
+        issue: issue(&f, &[("x", Mul(0), 0), ("z", Mul(0), 1), ("y", Add(0), 10)]),
+        loads: vec![load(&f, Mul(0), 0, "a"), load(&f, Mul(0), 1, "b")],
+        writes: vec![indirect(&f, "x", Add(0), 0, 9, 0), indirect(&f, "z", Add(0), 1, 10, 1)],
+        pe_words: vec![2, 2],
+        buffer_words: vec![0, 2],
+    };
+    (f, p)
+}
+
+#[test]
+fn two_buffer_reads_in_one_cycle() {
+    let (f, mut p) = two_products();
+    verify_with(&f, &p, &[0]).unwrap();
+    p.writes[1].cycle = 9;
+    fails(&f, &p, SimErrorKind::BufferReads, &["cycle 9", "mul0", "%z", "read twice"]);
+}
+
+#[test]
+fn buffer_address_reused_while_needed() {
+    let (f, mut p) = two_products();
+    p.writes[1].buffer_addr = Some(0);
+    fails(&f, &p, SimErrorKind::AddressReused, &["cycle 8", "mul0", "%z", "holds %x, which is read at cycle 9"]);
+    // Once %x has been read out (cycle 7 arrival, read at 7), %z may take its word at 8.
+    p.writes[0].cycle = 7;
+    p.buffer_words = vec![0, 1];
+    let o = simulate::<f64>(&f, &p, input).unwrap();
+    assert_eq!(o.max_buffer_words, vec![0, 1]);
+}
+
+#[test]
+fn value_in_two_buffer_addresses() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.arch = arch(2, 1);
+    p.pe_words = vec![2, 2, 2];
+    p.buffer_words = vec![0, 0, 2];
+    p.writes =
+        vec![direct(&f, "x", Add(0), 1, 7), indirect(&f, "x", Add(1), 0, 8, 0), indirect(&f, "x", Add(1), 1, 9, 1)];
+    fails(&f, &p, SimErrorKind::BufferEntries, &["cycle 7", "mul0", "%x", "two addresses (0 and 1)"]);
+}
+
+#[test]
+fn indirect_write_without_buffers() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.arch.buffer = false;
+    p.writes = vec![indirect(&f, "x", Add(0), 1, 8, 0)];
+    p.issue = issue(&f, &[("x", Mul(0), 0), ("y", Add(0), 8)]);
+    p.buffer_words = vec![0, 1];
+    fails(&f, &p, SimErrorKind::NoBuffer, &["cycle 7", "mul0", "%x", "no buffers"]);
+}
+
+#[test]
+fn direct_write_off_arrival() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.writes[0].cycle = 8;
+    p.issue = issue(&f, &[("x", Mul(0), 0), ("y", Add(0), 8)]);
+    fails(&f, &p, SimErrorKind::DirectWriteCycle, &["cycle 8", "add0", "%x", "arrives at cycle 7"]);
+    p.writes[0].cycle = 5;
+    fails(&f, &p, SimErrorKind::DirectWriteCycle, &["cycle 5", "add0", "%x"]);
+}
+
+#[test]
+fn buffer_read_before_arrival() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.writes = vec![indirect(&f, "x", Add(0), 1, 5, 0)];
+    p.buffer_words = vec![0, 1];
+    fails(&f, &p, SimErrorKind::BufferReadBeforeArrival, &["cycle 5", "mul0", "%x", "before it arrives at cycle 7"]);
+}
+
+#[test]
+fn memory_larger_than_reported() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.pe_words = vec![1, 2];
+    fails(&f, &p, SimErrorKind::AddressOutOfRange, &["cycle 7", "add0", "%x", "memory larger than reported"]);
+    let mut p = base(&f);
+    p.pe_words = vec![2, 1];
+    fails(&f, &p, SimErrorKind::AddressOutOfRange, &["before cycle 0", "mul0", "%b", "memory larger than reported"]);
+    let mut p = base(&f);
+    p.writes = vec![indirect(&f, "x", Add(0), 1, 7, 1)];
+    p.buffer_words = vec![0, 1];
+    fails(&f, &p, SimErrorKind::AddressOutOfRange, &["cycle 7", "mul0", "%x", "buffer", "memory larger than reported"]);
+}
+
+#[test]
+fn address_written_twice_in_one_cycle() {
+    let (f, mut p) = two_products();
+    p.issue = issue(&f, &[("x", Mul(0), 0), ("z", Mul(1), 0), ("y", Add(0), 7)]);
+    p.arch = arch(1, 2);
+    p.loads = vec![load(&f, Mul(0), 0, "a"), load(&f, Mul(0), 1, "b"), load(&f, Mul(1), 0, "b")];
+    p.writes = vec![direct(&f, "x", Add(0), 0, 7), direct(&f, "z", Add(0), 0, 7)];
+    p.pe_words = vec![2, 2, 1];
+    p.buffer_words = vec![0, 0, 0];
+    fails(&f, &p, SimErrorKind::AddressReused, &["cycle 7", "add0", "%z", "written twice in one cycle (%x, then %z)"]);
+    p.writes[1].addr = 1;
+    verify_with(&f, &p, &[0]).unwrap();
+}
+
+#[test]
+fn malformed_placements() {
+    let f = func(SRC);
+    let mut p = base(&f);
+    p.pe_words.pop();
+    fails(&f, &p, SimErrorKind::Malformed, &["1 PE memory and 2 buffer sizes for 2 PEs"]);
+    let mut p = base(&f);
+    p.arch.lat.add = 0;
+    fails(&f, &p, SimErrorKind::Malformed, &["latency"]);
+    let g = func("func @f { input %a %x = %a*%a output o = %x }");
+    let p = Placement {
+        arch: arch(1, 1),
+        issue: vec![],
+        loads: vec![],
+        writes: vec![],
+        pe_words: vec![0, 0],
+        buffer_words: vec![0, 0],
+    };
+    fails(&g, &p, SimErrorKind::Malformed, &["%x", "atomise"]);
+}
+
+#[test]
+fn outputs_of_inputs_and_no_ops() {
+    let f = func("func @f { phase atomised input %a output o = %a output c = 3.0 }");
+    let p = Placement {
+        arch: arch(1, 1),
+        issue: vec![],
+        loads: vec![],
+        writes: vec![],
+        pe_words: vec![0, 0],
+        buffer_words: vec![0, 0],
+    };
+    let o = simulate::<f32>(&f, &p, input).unwrap();
+    assert_eq!(o.cycles, 0);
+    assert_eq!(o.outputs, vec![("o".to_string(), input("a") as f32), ("c".to_string(), 3.0)]);
+    assert!(o.issued_per_cycle_add.is_empty());
+}
+
+#[test]
+fn error_display_names_cycle_pe_and_value() {
+    let e = SimError::new(SimErrorKind::ReadMissing, "not there").at(When::Cycle(7)).on(Add(3)).of("%AF24");
+    assert_eq!(e.to_string(), "cycle 7, add3, %AF24: not there");
+}
+
+#[test]
+fn pass_needs_placements_and_checks_them() {
+    let mut m = parse(SRC).unwrap();
+    let pass = (INFO.build)(&Params::default()).unwrap();
+    assert!(pass.preserves_timing());
+    let e = pass.run(&mut m, &mut PassContext::default()).unwrap_err().to_string();
+    assert!(e.contains("run `place` first"), "{e}");
+    let p = base(&m.functions[0]);
+    m.functions[0].placement = Some(p.clone());
+    pass.run(&mut m, &mut PassContext::default()).unwrap();
+    assert_eq!(verify_placement(&m.functions[0], &[5]).unwrap().cycles, 19);
+    let mut bad = p;
+    bad.pe_words = vec![1, 2];
+    m.functions[0].placement = Some(bad);
+    let e = pass.run(&mut m, &mut PassContext::default()).unwrap_err().to_string();
+    assert!(e.starts_with("pass `sim`: @f: cycle 7, add0, %x:"), "{e}");
+    assert_eq!(INFO.name, "sim");
+    assert_eq!(INFO.params[0].name, "seeds");
+}
