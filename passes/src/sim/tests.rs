@@ -424,3 +424,118 @@ fn pass_needs_placements_and_checks_them() {
     assert_eq!(INFO.name, "sim");
     assert_eq!(INFO.params[0].name, "seeds");
 }
+
+/// A naive placer written here (independent of `place`): 1 ADD + 1 MULTI PE, ops in body
+/// order, each as soon as its PE is free and its operands arrived; every operand loaded or
+/// written directly into the memory that reads it; addresses reused greedily.
+fn naive_placement(f: &Function) -> Placement {
+    use std::collections::BTreeMap;
+    let a = arch(1, 1);
+    let pe_of = |v: Value| if f.op_kind(v) == Some(robovec_ir::OpKind::Mul) { Mul(0) } else { Add(0) };
+    let mut issue = vec![None; f.values.len()];
+    let mut arrival = vec![0u32; f.values.len()];
+    let mut free = [0u32; 2];
+    // (pe slot, operand) → (start: -1 for loads, last read)
+    let mut words: BTreeMap<(usize, u64, usize), (i64, i64)> = BTreeMap::new();
+    for &v in &f.body {
+        let Some(kind) = f.op_kind(v) else { continue };
+        let pe = pe_of(v);
+        let s = pe.slot(1);
+        let mut c = free[s];
+        f.value(v).def.for_each_value(|u| {
+            if f.op_kind(u).is_some() {
+                c = c.max(arrival[u.index()]);
+            }
+        });
+        free[s] = c + 1;
+        issue[v.index()] = Some(Issue { pe, cycle: c });
+        arrival[v.index()] = c + a.lat.of(kind);
+        let ops: Vec<Operand> = match &f.value(v).def {
+            robovec_ir::Def::Binary(_, x, y) => vec![*x, *y],
+            robovec_ir::Def::Call(_, args) => args.clone(),
+            _ => unreachable!(),
+        };
+        for o in ops {
+            let (tag, id, start) = match o {
+                Operand::Const(k) => (1, k.to_bits() as usize, -1),
+                Operand::Value(u) if f.op_kind(u).is_some() => (0, u.index(), arrival[u.index()] as i64),
+                Operand::Value(u) => (0, u.index(), -1),
+            };
+            let e = words.entry((s, tag, id)).or_insert((start, c as i64));
+            e.1 = e.1.max(c as i64);
+        }
+    }
+    // Greedy address allocation by start time, per memory.
+    let mut by_start: Vec<_> = words.into_iter().collect();
+    by_start.sort_by_key(|&((s, _, _), (start, _))| (s, start));
+    let (mut loads, mut writes, mut pe_words) = (Vec::new(), Vec::new(), vec![0u32; 2]);
+    let mut ends: Vec<Vec<i64>> = vec![Vec::new(); 2];
+    for ((s, tag, id), (start, end)) in by_start {
+        let addr = match ends[s].iter().position(|&e| e < start) {
+            Some(i) => i,
+            None => {
+                ends[s].push(0);
+                ends[s].len() - 1
+            }
+        };
+        ends[s][addr] = end;
+        pe_words[s] = ends[s].len() as u32;
+        let pe = if s == 0 { Add(0) } else { Mul(0) };
+        let operand = if tag == 1 {
+            Operand::Const(f64::from_bits(id as u64))
+        } else {
+            Operand::Value(Value::with_number(id as u32))
+        };
+        match operand {
+            Operand::Value(u) if f.op_kind(u).is_some() => {
+                writes.push(Write { value: u, pe, addr: addr as u32, cycle: start as u32, buffer_addr: None })
+            }
+            _ => loads.push(Load { pe, addr: addr as u32, operand }),
+        }
+    }
+    Placement { arch: a, issue, loads, writes, pe_words, buffer_words: vec![0, 0] }
+}
+
+const MIXED: &str = "func @f { phase atomised input %q input %m %s = sin %q %c = cos %q \
+    %x = mul %s, %m %y = div %x, 3.0 %z = call @sqrt(%m) %w = sub %y, %z %u = call @user_h.2[1](%w, %c, %x, 3.0) \
+    %k = add %u, %u %r = mul %k, %c output a = %r output b = %w output c = %q }";
+
+#[test]
+fn naive_placements_verify_and_peaks_match_sizes() {
+    let mut fs = vec![func(MIXED)];
+    fs.extend((1..4).map(|seed| crate::dag_gen::generate(300, seed)));
+    for f in &fs {
+        let p = naive_placement(f);
+        let r = verify_with(f, &p, &[0, 1, 2]).unwrap_or_else(|e| panic!("@{}: {e}", f.name));
+        assert_eq!(r.max_words_per_memory, p.pe_words, "@{}", f.name);
+        assert_eq!(r.writes_direct as usize, p.writes.len());
+        let ops = f.body.iter().filter(|&&v| f.op_kind(v).is_some()).count() as u32;
+        let issued: u32 = r.issued_per_cycle_add.iter().chain(&r.issued_per_cycle_mul).sum();
+        assert_eq!(issued, ops);
+    }
+}
+
+#[test]
+fn mutants_are_rejected_or_still_exact_and_never_panic() {
+    let f = crate::dag_gen::generate(200, 7);
+    let p0 = naive_placement(&f);
+    let mut rng = crate::dag_gen::SplitMix64::new(3);
+    let ops: Vec<usize> = (0..p0.issue.len()).filter(|&i| p0.issue[i].is_some()).collect();
+    let mut rejected = 0;
+    for _ in 0..600 {
+        let mut p = p0.clone();
+        let pick = |rng: &mut crate::dag_gen::SplitMix64, n: usize| rng.below(n as u64) as usize;
+        match pick(&mut rng, 6) {
+            0 => p.issue[ops[pick(&mut rng, ops.len())]].as_mut().unwrap().cycle ^= 1,
+            1 => drop(p.loads.remove(pick(&mut rng, p0.loads.len()))),
+            2 => drop(p.writes.remove(pick(&mut rng, p0.writes.len()))),
+            3 => p.writes[pick(&mut rng, p0.writes.len())].addr = pick(&mut rng, 4) as u32,
+            4 => p.writes[pick(&mut rng, p0.writes.len())].cycle += 1,
+            _ => p.loads[pick(&mut rng, p0.loads.len())].addr = pick(&mut rng, 4) as u32,
+        }
+        if verify_with(&f, &p, &[0]).is_err() {
+            rejected += 1;
+        }
+    }
+    assert!(rejected > 400, "only {rejected} of 600 mutants rejected");
+}
