@@ -62,6 +62,9 @@ pub struct Cli {
     /// Print the stats of the final IR (ops, critical path, Y) to stderr.
     #[arg(long)]
     pub stats: bool,
+    /// Write the rows of `sweep` passes to FILE as CSV.
+    #[arg(long, value_name = "FILE")]
+    pub sweep_csv: Option<PathBuf>,
     /// List the registered passes with their parameters and exit.
     #[arg(long)]
     pub print_passes: bool,
@@ -131,6 +134,7 @@ impl Cli {
             eval: self.eval,
             function: self.function,
             stats: self.stats,
+            sweep_csv: self.sweep_csv,
         })
     }
 }

@@ -33,6 +33,8 @@ pub struct Options {
     pub function: Option<String>,
     /// `-stats`: print the stats of the final IR to stderr.
     pub stats: bool,
+    /// `-sweep-csv=FILE`: the rows of `sweep` runs as CSV.
+    pub sweep_csv: Option<PathBuf>,
 }
 
 /// Why a run failed; the text is ready for stderr.
@@ -177,6 +179,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 passes: records.clone(),
                 stats: stats(f, &cx.latencies),
                 placement: placement_report(f),
+                sweep: cx.sweep.iter().filter(|r| r.function == f.name).cloned().collect(),
             };
             Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
         }
@@ -239,9 +242,18 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             }
         }
     }
+    if !cx.sweep.is_empty() {
+        let _ = write!(stderr, "{}", robovec_passes::sweep::to_table(&cx.sweep));
+    }
     let ir = module.to_string();
 
     // Then write.
+    if let Some(path) = &opts.sweep_csv {
+        if cx.sweep.is_empty() {
+            return Err(Failure::Usage("error: -sweep-csv needs a `sweep` pass in the pipeline\n".into()));
+        }
+        write_atomically(path, robovec_passes::sweep::to_csv(&cx.sweep).as_bytes())?;
+    }
     if let (Some(path), Some(r)) = (&opts.report, &report) {
         write_atomically(path, r.as_bytes())?;
     }

@@ -141,6 +141,9 @@ pub struct Report {
     /// Figures of the placement, when the pipeline placed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub placement: Option<PlacementReport>,
+    /// Rows of `sweep` runs for this function, when the pipeline swept.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sweep: Vec<robovec_passes::sweep::SweepRow>,
 }
 
 /// `-eval` output: every input used and every output, in f64.

@@ -1,24 +1,83 @@
-//! Placement of corpus files: cycles against the SPEC §4 lower bound.
+//! Placement of every straight-line corpus file at N ∈ {1, 2, 4, 8, 16, 32, 64}: each placement
+//! is executed by the cycle-accurate simulator in f32 and f64 (bit for bit against the
+//! interpreter), and its cycles are compared with the SPEC §4 lower bound and the tighter
+//! head-body-tail bound (`tight_lower_bound`).
+//!
+//! Measured (release, 490 placements): all but 6 within 1.05 × the tight bound; the 6 are the
+//! `cons_hJ` Jacobians and the Segway `extforces` at N ≤ 4 (worst 1.17), where both PE types are
+//! saturated and neither list scheduling forward nor backward packs them closer — the gap is
+//! either the heuristic's or the bound's; issue 3's note says what is next.
 
+use robovec_ir::Function;
 use robovec_passes::atomise::atomise_function;
-use robovec_passes::place::{cycles, lower_bound, place_function, PlaceOptions, Priority, Select};
+use robovec_passes::place::{cycles, lower_bound, place_function, tight_lower_bound, PlaceOptions, Priority, Select};
+use robovec_passes::sim::verify_placement;
 
-use crate::common::corpus_dir;
+use crate::common::{corpus_files, is_loop_file};
+
+/// The placed function, its cycles, the SPEC §4 lower bound and the tight lower bound.
+fn placed(f: &Function, n: u32, priority: Priority, select: Select) -> (Function, u32, u32, u32) {
+    let mut o = PlaceOptions::with_pes(n);
+    o.priority = priority;
+    o.select = select;
+    let mut g = f.clone();
+    g.placement = Some(place_function(f, &o));
+    let c = cycles(&g, g.placement.as_ref().unwrap());
+    (g, c, lower_bound(f, &o.arch), tight_lower_bound(f, &o.arch))
+}
 
 #[test]
-fn segway_cycles_against_lower_bound() {
-    let (m, _) = robovec::driver::load(corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c").to_str().unwrap())
-        .unwrap_or_else(|f| panic!("{}", f.message()));
-    let f = atomise_function(&m.functions[0]);
-    for n in [1, 2, 4, 8, 16, 32, 64] {
-        for (priority, select) in [(Priority::Classical, Select::Preferential), (Priority::Mobility, Select::Naive)] {
-            let mut o = PlaceOptions::with_pes(n);
-            o.priority = priority;
-            o.select = select;
-            let p = place_function(&f, &o);
-            let (c, lb) = (cycles(&f, &p), lower_bound(&f, &o.arch));
-            println!("N={n:>2} {priority:?}/{select:?}: cycles {c}, LB {lb}, ratio {:.3}, pe words max {}, buffer max {}", c as f64 / lb as f64, p.pe_words.iter().max().unwrap(), p.buffer_words.iter().max().unwrap());
-            assert!(c >= lb);
+fn corpus_placements_simulate_and_stay_near_the_lower_bound() {
+    let mut worst = (1.0f64, String::new());
+    let mut worst_spec = (1.0f64, String::new());
+    let mut over_spec = 0;
+    let mut above = Vec::new();
+    let mut runs = 0;
+    let (mut words_pref, mut words_naive, mut buf_pref, mut buf_naive) = (0u64, 0u64, 0u64, 0u64);
+    for p in corpus_files().into_iter().filter(|p| !is_loop_file(p)) {
+        let (m, _) = robovec::driver::load(p.to_str().unwrap()).unwrap_or_else(|f| panic!("{}", f.message()));
+        for f in m.functions.iter().map(atomise_function) {
+            if f.op_counts().total == 0 {
+                continue;
+            }
+            for n in [1, 2, 4, 8, 16, 32, 64] {
+                let (g, c, lb, tight) = placed(&f, n, Priority::Classical, Select::Preferential);
+                verify_placement(&g, &[1]).unwrap_or_else(|e| panic!("{} @{} N={n}: {e}", p.display(), f.name));
+                assert!(c >= tight && tight >= lb, "bounds are bounds");
+                let name = format!("{} @{} N={n}", p.file_name().unwrap().to_string_lossy(), f.name);
+                let ratio = c as f64 / tight as f64;
+                if ratio > 1.05 {
+                    above.push(format!("{name}: {c} cycles, tight LB {tight}, SPEC LB {lb}"));
+                }
+                if ratio > worst.0 {
+                    worst = (ratio, name.clone());
+                }
+                let spec_ratio = c as f64 / lb as f64;
+                if spec_ratio > 1.05 {
+                    over_spec += 1;
+                }
+                if spec_ratio > worst_spec.0 {
+                    worst_spec = (spec_ratio, name);
+                }
+                let (h, _, _, _) = placed(&f, n, Priority::Classical, Select::Naive);
+                verify_placement(&h, &[2]).unwrap_or_else(|e| panic!("{} @{} N={n} naive: {e}", p.display(), f.name));
+                let sum = |g: &Function, buf: bool| {
+                    let p = g.placement.as_ref().unwrap();
+                    (if buf { &p.buffer_words } else { &p.pe_words }).iter().map(|&w| w as u64).sum::<u64>()
+                };
+                words_pref += sum(&g, false);
+                words_naive += sum(&h, false);
+                buf_pref += sum(&g, true);
+                buf_naive += sum(&h, true);
+                runs += 1;
+            }
         }
     }
+    println!("{runs} placements simulated; worst cycles / tight LB {:.4} ({})", worst.0, worst.1);
+    println!("worst cycles / SPEC LB {:.4} ({}); {over_spec} runs above 1.05 x SPEC LB", worst_spec.0, worst_spec.1);
+    println!("total PE memory words: preferential {words_pref}, naive {words_naive}; buffer words: preferential {buf_pref}, naive {buf_naive}");
+    assert!(runs > 400);
+    println!("above 1.05 x tight lower bound:\n{}", above.join("\n"));
+    assert!(above.len() * 50 <= runs, "more than 2% of placements above 1.05 x tight LB:\n{}", above.join("\n"));
+    assert!(worst.0 <= 1.20, "worst cycles / tight LB {:.3} ({})", worst.0, worst.1);
 }

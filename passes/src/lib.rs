@@ -15,6 +15,8 @@ pub mod manager;
 pub mod params;
 pub mod pipeline;
 pub mod place;
+pub mod sim;
+pub mod sweep;
 
 use robovec_ir::analysis::Latencies;
 use robovec_ir::{Module, Phase};
@@ -91,8 +93,11 @@ pub enum PassError {
 /// State that passes share across one pipeline run.
 #[derive(Clone, Debug, Default)]
 pub struct PassContext {
-    /// Latencies of the last `asap-alap` run (defaults otherwise); used for the report's stats.
+    /// Latencies of the last `asap-alap` or `place` run (defaults otherwise); used for the
+    /// report's stats and by `sweep`.
     pub latencies: Latencies,
+    /// Rows of every `sweep` run.
+    pub sweep: Vec<sweep::SweepRow>,
 }
 
 /// A transformation or analysis over a whole module.
@@ -128,7 +133,7 @@ pub struct PassInfo {
 }
 
 /// The registry: every pass robovec knows, in `--print-passes` order.
-pub const PASSES: &[PassInfo] = &[atomise::INFO, dce::INFO, asap_alap::INFO, place::INFO];
+pub const PASSES: &[PassInfo] = &[atomise::INFO, dce::INFO, asap_alap::INFO, place::INFO, sim::INFO, sweep::INFO];
 
 /// Looks up a registered pass.
 pub fn pass_info(name: &str) -> Option<&'static PassInfo> {

@@ -9,7 +9,11 @@
 //! then ALAPCycle (seed §2.3.1, with latency-weighted attributes) — are assigned to a free PE of
 //! their type where both operands can be in its memory: **naive** selection takes the first such
 //! PE, **preferential** the one with the best operand-location pair of seed Table 2.1 (PE/PE = 1
-//! … Indirect/Indirect = 9). Then [`memory`] assigns addresses and sizes.
+//! … Indirect/Indirect = 9). Then `improve` rounds of forward-backward improvement re-run the
+//! list scheduler with the start times of a backward (right-justified) schedule as priorities,
+//! keeping the best result (Tormos & Lova 2001; Valls et al. 2005): it recovers the idle cycles
+//! that ALAP order leaves when both PE types are saturated. Then [`memory`] assigns addresses
+//! and sizes.
 //!
 //! Contract: never changes the function; every placement it returns passes `sim`. Cost:
 //! O(n log n + n·N) for n ops and N PEs per type.
@@ -50,6 +54,9 @@ pub struct PlaceOptions {
     pub priority: Priority,
     /// PE selection.
     pub select: Select,
+    /// Rounds of forward-backward improvement after the seed's list schedule (0 = the seed's
+    /// algorithm alone); the best schedule is kept.
+    pub improve: u32,
 }
 
 impl PlaceOptions {
@@ -60,6 +67,7 @@ impl PlaceOptions {
             arch: Arch { n_add: n, n_mul: n, lat: Latencies::default(), writes: 2, buffer: true },
             priority: Priority::Classical,
             select: Select::Preferential,
+            improve: 2,
         }
     }
 }
@@ -69,8 +77,26 @@ impl PlaceOptions {
 /// # Errors
 /// Only with `buffer = false`: an operand that can no longer reach any PE memory of its type.
 pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement, String> {
-    let s = schedule::schedule(f, &opts.arch, opts.priority, opts.select)?;
-    Ok(memory::build(f, &opts.arch, &s))
+    let a = &opts.arch;
+    let seed = schedule::seed_keys(f, a, opts.priority);
+    let mut best = schedule::schedule(f, a, &seed, opts.select)?;
+    let end = |s: &schedule::Schedule| s.arrival.iter().copied().max().unwrap_or(0);
+    for _ in 0..opts.improve {
+        // Backward pass: ops that arrived last go first in reverse time; then forward again in
+        // order of the backward (justified) start times.
+        let t = end(&best);
+        let back: Vec<schedule::Key> =
+            (0..f.values.len()).map(|i| (t - best.arrival[i], seed[i].0, i as u32)).collect();
+        let r = schedule::backward_starts(f, a.n_add, a.n_mul, &a.lat, &back);
+        let r_max = r.iter().copied().max().unwrap_or(0);
+        let fwd: Vec<schedule::Key> = (0..f.values.len()).map(|i| (r_max - r[i], seed[i].0, i as u32)).collect();
+        let s = schedule::schedule(f, a, &fwd, opts.select)?;
+        if end(&s) >= end(&best) {
+            break;
+        }
+        best = s;
+    }
+    Ok(memory::build(f, a, &best))
 }
 
 /// Places `f` (atomised, verified) on an architecture with buffers.
@@ -83,11 +109,7 @@ pub fn place_function(f: &Function, opts: &PlaceOptions) -> Placement {
 
 /// Cycles of a placement (SPEC §4): the largest arrival, 0 without ops.
 pub fn cycles(f: &Function, p: &Placement) -> u32 {
-    f.body
-        .iter()
-        .filter_map(|&v| Some(p.issue[v.index()]?.cycle + p.latency(f.op_kind(v)?)))
-        .max()
-        .unwrap_or(0)
+    f.body.iter().filter_map(|&v| Some(p.issue[v.index()]?.cycle + p.latency(f.op_kind(v)?))).max().unwrap_or(0)
 }
 
 /// Ops that run on the ADD side (add, sub, div, call) and on the MULTI side.
@@ -103,6 +125,55 @@ pub fn lower_bound(f: &Function, arch: &Arch) -> u32 {
     let (na, nm) = ops_per_side(f);
     let side = |n: u64, pes: u32, lat: u32| if n == 0 { 0 } else { (n.div_ceil(pes as u64) - 1) as u32 + lat };
     cp.asap_cycle.max(side(na, arch.n_add, arch.lat.add)).max(side(nm, arch.n_mul, arch.lat.mul))
+}
+
+/// A lower bound at least as tight as [`lower_bound`] that also accounts for when ops of each
+/// type can start and how much of the critical path must follow them (a head-body-tail bound,
+/// as in single-machine scheduling with release dates and tails).
+///
+/// For a PE type with N PEs and any set S of its ops: the last op of S to issue issues no
+/// earlier than `min_{o∈S} r(o) + ⌈|S|/N⌉ − 1`, where `r(o) = ASAPCycle(o) − lat(o)` is the
+/// earliest issue; it then takes its latency and at least `min_{o∈S} q(o)` more cycles, where
+/// `q(o) = critical path − ALAPCycle(o)` is the longest path after its result. The bound is the
+/// maximum over the sets `{o : r(o) ≥ h}` and `{o : q(o) ≥ k}` for all thresholds, and over
+/// [`lower_bound`]. Cost: O(n log n).
+pub fn tight_lower_bound(f: &Function, arch: &Arch) -> u32 {
+    let (timing, cp) = compute_timing(f, &arch.lat);
+    let mut best = lower_bound(f, arch);
+    for mul_side in [false, true] {
+        let n_pe = if mul_side { arch.n_mul } else { arch.n_add } as u64;
+        // (release r, tail q, latency) of every op of this type.
+        let mut ops: Vec<(u32, u32, u32)> = f
+            .body
+            .iter()
+            .filter_map(|&v| {
+                let k = f.op_kind(v)?;
+                if (k == OpKind::Mul) != mul_side {
+                    return None;
+                }
+                let t = timing[v.index()]?;
+                let lat = arch.lat.of(k);
+                Some((t.asap_cycle - lat, cp.asap_cycle - t.alap_cycle, lat))
+            })
+            .collect();
+        if ops.is_empty() {
+            continue;
+        }
+        for by_tail in [false, true] {
+            // Sort by decreasing threshold key; the suffix sets {key ≥ h} are prefixes here.
+            ops.sort_by_key(|&(r, q, _)| std::cmp::Reverse(if by_tail { q } else { r }));
+            let (mut min_r, mut min_q, mut min_lat) = (u32::MAX, u32::MAX, u32::MAX);
+            for (i, &(r, q, lat)) in ops.iter().enumerate() {
+                min_r = min_r.min(r);
+                min_q = min_q.min(q);
+                min_lat = min_lat.min(lat);
+                let count = i as u64 + 1;
+                let bound = min_r as u64 + count.div_ceil(n_pe) - 1 + min_lat as u64 + min_q as u64;
+                best = best.max(bound.min(u32::MAX as u64) as u32);
+            }
+        }
+    }
+    best
 }
 
 /// Ops issued per cycle on each side: `(add_side, mul_side)`, one entry per cycle `0..cycles`.
@@ -144,6 +215,11 @@ pub const INFO: PassInfo = PassInfo {
         ParamInfo { name: "mul", default: "pe", doc: "MULTI PEs (overrides pe)" },
         ParamInfo { name: "priority", default: "classical", doc: "classical (ALAP, ASAP) | mobility (mobility, ALAP)" },
         ParamInfo { name: "select", default: "preferential", doc: "naive (first free PE) | preferential (Table 2.1)" },
+        ParamInfo {
+            name: "improve",
+            default: "2",
+            doc: "rounds of forward-backward improvement after the seed's list schedule (0 = seed only)",
+        },
         ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency, cycles" },
         ParamInfo { name: "lat-mul", default: "7", doc: "mul latency, cycles" },
         ParamInfo { name: "lat-div", default: "12", doc: "div latency, cycles (ADD side)" },
@@ -178,6 +254,7 @@ pub const INFO: PassInfo = PassInfo {
             },
             priority: [Priority::Classical, Priority::Mobility][enum_param("priority", &["classical", "mobility"], 0)?],
             select: [Select::Naive, Select::Preferential][enum_param("select", &["naive", "preferential"], 1)?],
+            improve: p.u32_in("improve", 2, 0, 16)?,
         };
         Ok(Box::new(Place { opts }))
     },

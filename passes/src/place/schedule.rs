@@ -22,6 +22,7 @@ use robovec_ir::placement::{Arch, Pe};
 use robovec_ir::{Function, OpKind, Operand, Value};
 
 use super::{Priority, Select};
+use robovec_ir::analysis::Latencies;
 
 /// How an operand reaches the PE memory that reads it (seed §2.3, Table 2.1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -125,7 +126,8 @@ impl Ctx<'_> {
             return Some(Route::Pe);
         }
         let a = self.arrival[v.index()];
-        let used = |c: u32| self.ports.writes_at(q, c) as u32 + planned.writes.iter().filter(|&&x| x == c).count() as u32;
+        let used =
+            |c: u32| self.ports.writes_at(q, c) as u32 + planned.writes.iter().filter(|&&x| x == c).count() as u32;
         if used(a) < self.arch.writes {
             return Some(Route::Direct);
         }
@@ -186,23 +188,34 @@ impl Ctx<'_> {
     }
 }
 
-/// Schedules every op of `f` (atomised, verified) on `arch`.
+/// Priority keys of the seed's orders (smaller = scheduled first), indexed by value index.
+pub fn seed_keys(f: &Function, arch: &Arch, priority: Priority) -> Vec<Key> {
+    let (timing, _) = compute_timing(f, &arch.lat);
+    (0..f.values.len())
+        .map(|i| match timing[i] {
+            Some(t) => match priority {
+                Priority::Classical => (t.alap_cycle, t.asap_cycle, i as u32),
+                Priority::Mobility => (t.alap_cycle - t.asap_cycle, t.alap_cycle, i as u32),
+            },
+            None => (0, 0, i as u32),
+        })
+        .collect()
+}
+
+/// A priority key: smaller is scheduled first.
+pub type Key = (u32, u32, u32);
+
+/// Schedules every op of `f` (atomised, verified) on `arch`, ready ops taken in increasing
+/// `keys` order (indexed by value index).
 ///
 /// # Errors
 /// Only without buffers: an op whose operand can no longer reach any PE memory of its type.
-pub fn schedule(f: &Function, arch: &Arch, priority: Priority, select: Select) -> Result<Schedule, String> {
+pub fn schedule(f: &Function, arch: &Arch, keys: &[Key], select: Select) -> Result<Schedule, String> {
     let n = f.values.len();
-    let (timing, _) = compute_timing(f, &arch.lat);
     let graph = DepGraph::build(f);
     let ops: Vec<Value> = f.body.iter().copied().filter(|&v| f.op_kind(v).is_some()).collect();
     let kind = |v: Value| f.op_kind(v).expect("op");
-    let key = |v: Value| {
-        let t = timing[v.index()].expect("ops have timing");
-        match priority {
-            Priority::Classical => (t.alap_cycle, t.asap_cycle, v.index() as u32),
-            Priority::Mobility => (t.alap_cycle - t.asap_cycle, t.alap_cycle, v.index() as u32),
-        }
-    };
+    let key = |v: Value| keys[v.index()];
     // Per operand position: the producing op, or `None` for initial data (inputs, trig, constants).
     let mut op_operands: Vec<Vec<Option<Value>>> = vec![Vec::new(); n];
     let mut pending = vec![0u32; n];
@@ -233,7 +246,7 @@ pub fn schedule(f: &Function, arch: &Arch, priority: Priority, select: Select) -
         bookings: Vec::new(),
     };
     let is_mul = |v: Value| kind(v) == OpKind::Mul;
-    let mut ready: [BinaryHeap<Reverse<((u32, u32, u32), Value)>>; 2] = [BinaryHeap::new(), BinaryHeap::new()];
+    let mut ready: [BinaryHeap<Reverse<(Key, Value)>>; 2] = [BinaryHeap::new(), BinaryHeap::new()];
     for &v in &ops {
         if pending[v.index()] == 0 {
             ready[is_mul(v) as usize].push(Reverse((key(v), v)));
@@ -347,4 +360,78 @@ pub fn initial_operands(f: &Function, v: Value) -> Vec<Operand> {
         Operand::Value(x) => f.op_kind(*x).is_none(),
     });
     out
+}
+
+/// Backward ("right-justified") list schedule in the pure resource model of SPEC §5 (PEs and
+/// latencies, no memories): ops are issued in reverse time, an op as soon as all its users are,
+/// taken in increasing `keys` order. Returns each op's reverse issue cycle `r` (`s = T − r` is a
+/// forward start of a schedule that ends together for every sink), indexed by value index.
+///
+/// Used by forward-backward improvement (Tormos & Lova 2001; "justification", Valls et al.
+/// 2005): scheduling forward again in decreasing `r` order packs the resources better than
+/// ALAP order when both PE types are saturated. Cost: O(n log n).
+pub fn backward_starts(f: &Function, n_add: u32, n_mul: u32, lat: &Latencies, keys: &[Key]) -> Vec<u32> {
+    let n = f.values.len();
+    let graph = DepGraph::build(f);
+    let ops: Vec<Value> = f.body.iter().copied().filter(|&v| f.op_kind(v).is_some()).collect();
+    let mut pending = vec![0u32; n];
+    let mut users: Vec<Vec<Value>> = vec![Vec::new(); n];
+    for &v in &ops {
+        let mut u: Vec<Value> = graph.users(v).collect();
+        u.sort();
+        u.dedup();
+        pending[v.index()] = u.len() as u32;
+        users[v.index()] = u;
+    }
+    let mut earliest = vec![0u32; n]; // reverse ready time before the op's own latency
+    let mut r = vec![0u32; n];
+    let mut waiting: BinaryHeap<Reverse<(u32, Value)>> = BinaryHeap::new();
+    for &v in &ops {
+        if pending[v.index()] == 0 {
+            waiting.push(Reverse((lat.of(f.op_kind(v).expect("op")), v)));
+        }
+    }
+    let mut ready: [BinaryHeap<Reverse<(Key, Value)>>; 2] = [BinaryHeap::new(), BinaryHeap::new()];
+    let caps = [n_add as usize, n_mul as usize];
+    let mut done = 0;
+    let mut t = 0u32;
+    while done < ops.len() {
+        while let Some(&Reverse((c, v))) = waiting.peek() {
+            if c > t {
+                break;
+            }
+            waiting.pop();
+            let ty = usize::from(f.op_kind(v) == Some(OpKind::Mul));
+            ready[ty].push(Reverse((keys[v.index()], v)));
+        }
+        for ty in 0..2 {
+            for _ in 0..caps[ty] {
+                let Some(Reverse((_, v))) = ready[ty].pop() else { break };
+                r[v.index()] = t;
+                done += 1;
+                // Operands: ready in reverse time once every user is placed, after their latency.
+                let mut operands = Vec::new();
+                f.value(v).def.for_each_value(|a| {
+                    if f.op_kind(a).is_some() && !operands.contains(&a) {
+                        operands.push(a);
+                    }
+                });
+                for a in operands {
+                    earliest[a.index()] = earliest[a.index()].max(t + 1);
+                    pending[a.index()] -= 1;
+                    if pending[a.index()] == 0 {
+                        let k = f.op_kind(a).expect("op");
+                        waiting.push(Reverse((earliest[a.index()] + lat.of(k) - 1, a)));
+                    }
+                }
+            }
+        }
+        t += 1;
+        if ready[0].is_empty() && ready[1].is_empty() {
+            if let Some(&Reverse((c, _))) = waiting.peek() {
+                t = t.max(c);
+            }
+        }
+    }
+    r
 }
