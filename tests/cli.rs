@@ -215,3 +215,40 @@ fn ir_from_stdin_and_verifier_errors_on_input() {
         stderr(&o)
     );
 }
+
+#[test]
+fn place_sim_and_sweep_end_to_end() {
+    let d = tmp("place");
+    let placed = d.join("placed.rvir");
+    let r = d.join("r.json");
+    let o = opt(&[&segway(), "-passes=atomise,place<pe=2>,sim", "-o", placed.to_str().unwrap(), &format!("-report={}", r.display())]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&r).unwrap()).unwrap();
+    let p = &j["placement"];
+    assert_eq!((p["n_add"].as_u64(), p["n_mul"].as_u64()), (Some(2), Some(2)));
+    let (c, lb) = (p["cycles"].as_f64().unwrap(), p["lower_bound"].as_f64().unwrap());
+    assert!(c >= lb && c <= 1.05 * lb, "{c} vs {lb}");
+    assert!((p["parallelisation_rate"].as_f64().unwrap() - 4261.0 / (c * 4.0)).abs() < 1e-12);
+    assert_eq!(p["pe_memory_words"].as_array().unwrap().len(), 4);
+    assert_eq!(p["occupation"]["add"].as_array().unwrap().len() as f64, c);
+    // The placed IR re-reads and simulates again without re-placing.
+    let o = opt(&[placed.to_str().unwrap(), "-passes=sim<seeds=2>", "-o", d.join("again.rvir").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&placed).unwrap(), std::fs::read_to_string(d.join("again.rvir")).unwrap());
+    // A corrupted placement is caught by the simulator, naming cycle, PE and value.
+    let text = std::fs::read_to_string(&placed).unwrap();
+    let line = text.lines().find(|l| l.trim_start().starts_with("write ")).unwrap().to_string();
+    let bad = text.replacen(&line, "", 1);
+    std::fs::write(d.join("bad.rvir"), bad).unwrap();
+    let o = opt(&[d.join("bad.rvir").to_str().unwrap(), "-passes=sim"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("cycle") && stderr(&o).contains('%'), "{}", stderr(&o));
+    // Sweep: a table on stderr and CSV rows for each N and configuration.
+    let csv = d.join("s.csv");
+    let o = opt(&[&segway(), "-passes=atomise,sweep<pe=1,4>", &format!("-sweep-csv={}", csv.display()), "-o", d.join("s.rvir").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("classical+fbi"));
+    let rows = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(rows.lines().count(), 1 + 2 * 4);
+    assert!(rows.lines().nth(1).unwrap().starts_with("dirdyna,1,classical,preferential,"));
+}
