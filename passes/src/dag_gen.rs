@@ -215,7 +215,13 @@ impl Gen {
         let mut acc: Option<Src> = None;
         'eq: for _ in 0..terms {
             let r = self.rng.below(100);
-            let mut factors = if r < 35 { 1 } else if r < 83 { 2 } else { 3 };
+            let mut factors = if r < 35 {
+                1
+            } else if r < 83 {
+                2
+            } else {
+                3
+            };
             if terms == 1 && factors == 1 {
                 factors = 2;
             }
@@ -259,7 +265,7 @@ pub fn generate(n_ops: usize, seed: u64) -> Function {
     let gap = ((n_ops as f64).sqrt() * 0.75).round().max(1.0) as usize;
     let eqs_per_body = (n_ops / 5 / dof as usize).max(1);
     let mut g = Gen {
-        rng: SplitMix64::new(seed ^ 0x5EED_0F_D0F5),
+        rng: SplitMix64::new(seed ^ 0x005E_ED0F_D0F5),
         leaves: Leaves { dof },
         ops: Vec::with_capacity(n_ops),
         roots: Vec::with_capacity(n_ops / 3 + 1),
