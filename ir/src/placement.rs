@@ -51,7 +51,10 @@ impl Pe {
 
     /// True when ops of `kind` run on this PE's type.
     pub fn accepts(self, kind: OpKind) -> bool {
-        matches!((self, kind), (Pe::Mul(_), OpKind::Mul) | (Pe::Add(_), OpKind::Add | OpKind::Sub | OpKind::Div | OpKind::Call))
+        matches!(
+            (self, kind),
+            (Pe::Mul(_), OpKind::Mul) | (Pe::Add(_), OpKind::Add | OpKind::Sub | OpKind::Div | OpKind::Call)
+        )
     }
 
     /// Dense index over all PEs: ADD PEs `0..n_add`, then MULTI PEs.

@@ -36,21 +36,23 @@ fn pe_name(text: &str, arch: &Arch) -> Option<Pe> {
 /// Resolves a placement block against its function.
 pub fn resolve(f: &Function, p: PlacementAst<'_>, errors: &mut Vec<ParseError>) -> Option<Placement> {
     let before = errors.len();
-    let key = |k: &str, default: Option<u32>, errors: &mut Vec<ParseError>| {
-        match (p.arch.iter().find(|(n, _, _)| *n == k), default) {
-            (Some(&(_, v, _)), _) => v,
-            (None, Some(d)) => d,
-            (None, None) => {
-                errors.push(ParseError::new(p.span, format!("placement: missing `{k}=…`"), "in this placement"));
-                0
-            }
+    let key = |k: &str, default: Option<u32>, errors: &mut Vec<ParseError>| match (
+        p.arch.iter().find(|(n, _, _)| *n == k),
+        default,
+    ) {
+        (Some(&(_, v, _)), _) => v,
+        (None, Some(d)) => d,
+        (None, None) => {
+            errors.push(ParseError::new(p.span, format!("placement: missing `{k}=…`"), "in this placement"));
+            0
         }
     };
     const KEYS: [&str; 8] = ["n_add", "n_mul", "lat_add", "lat_mul", "lat_div", "lat_call", "writes", "buffer"];
     for (k, _, span) in &p.arch {
         if !KEYS.contains(k) {
             errors.push(
-                ParseError::new(*span, format!("placement: unknown key `{k}`"), "here").note(format!("expected one of {}", KEYS.join(", "))),
+                ParseError::new(*span, format!("placement: unknown key `{k}`"), "here")
+                    .note(format!("expected one of {}", KEYS.join(", "))),
             );
         }
     }
@@ -68,17 +70,23 @@ pub fn resolve(f: &Function, p: PlacementAst<'_>, errors: &mut Vec<ParseError>) 
         buffer: key("buffer", Some(1), errors) != 0,
     };
     if arch.n_add == 0 || arch.n_mul == 0 || arch.n_pe() > 1 << 16 {
-        errors.push(ParseError::new(p.span, "placement: `n_add` and `n_mul` must be in 1..=32768", "in this placement"));
+        errors.push(ParseError::new(
+            p.span,
+            "placement: `n_add` and `n_mul` must be in 1..=32768",
+            "in this placement",
+        ));
         return None;
     }
     let pe = |text: &str, span: Span, errors: &mut Vec<ParseError>| {
         let r = pe_name(text, &arch);
         if r.is_none() {
-            errors.push(ParseError::new(span, format!("no PE `{text}` on this architecture"), "unknown PE").note(format!(
-                "expected add0…add{} or mul0…mul{}",
-                arch.n_add - 1,
-                arch.n_mul - 1
-            )));
+            errors.push(
+                ParseError::new(span, format!("no PE `{text}` on this architecture"), "unknown PE").note(format!(
+                    "expected add0…add{} or mul0…mul{}",
+                    arch.n_add - 1,
+                    arch.n_mul - 1
+                )),
+            );
         }
         r
     };
@@ -123,7 +131,11 @@ pub fn resolve(f: &Function, p: PlacementAst<'_>, errors: &mut Vec<ParseError>) 
                     OperandAst::Value(n, s) => match f.lookup(n).filter(|&v| f.op_kind(v).is_none()) {
                         Some(v) => Some(Operand::Value(v)),
                         None => {
-                            errors.push(ParseError::new(s, format!("`%{n}` is not initial data of @{}", f.name), "here"));
+                            errors.push(ParseError::new(
+                                s,
+                                format!("`%{n}` is not initial data of @{}", f.name),
+                                "here",
+                            ));
                             None
                         }
                     },
@@ -137,7 +149,10 @@ pub fn resolve(f: &Function, p: PlacementAst<'_>, errors: &mut Vec<ParseError>) 
                     None => None,
                     Some(("buffer", b)) => Some(b),
                     Some((other, _)) => {
-                        errors.push(ParseError::new(span, format!("unexpected `{other}`"), "here").note("expected `buffer ADDR`"));
+                        errors.push(
+                            ParseError::new(span, format!("unexpected `{other}`"), "here")
+                                .note("expected `buffer ADDR`"),
+                        );
                         None
                     }
                 };
