@@ -81,3 +81,37 @@ fn corpus_placements_simulate_and_stay_near_the_lower_bound() {
     assert!(above.len() * 50 <= runs, "more than 2% of placements above 1.05 x tight LB:\n{}", above.join("\n"));
     assert!(worst.0 <= 1.20, "worst cycles / tight LB {:.3} ({})", worst.0, worst.1);
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 48, ..Default::default() })]
+
+    /// Random Robotran-like DAGs, random architectures and options: every placement verifies in
+    /// the simulator (f32 and f64 equal to the interpreter bit for bit) and respects the bounds.
+    #[test]
+    fn random_dags_place_validly(
+        n_ops in 1usize..400,
+        seed in 0u64..1_000_000,
+        n_add in 1u32..6,
+        n_mul in 1u32..6,
+        writes in 1u32..4,
+        mobility in proptest::bool::ANY,
+        naive in proptest::bool::ANY,
+        improve in 0u32..3,
+    ) {
+        let f = robovec_passes::dag_gen::generate(n_ops, seed);
+        let mut o = PlaceOptions::with_pes(1);
+        o.arch.n_add = n_add;
+        o.arch.n_mul = n_mul;
+        o.arch.writes = writes;
+        o.priority = if mobility { Priority::Mobility } else { Priority::Classical };
+        o.select = if naive { Select::Naive } else { Select::Preferential };
+        o.improve = improve;
+        let mut g = f.clone();
+        g.placement = Some(place_function(&f, &o));
+        let c = cycles(&g, g.placement.as_ref().unwrap());
+        proptest::prop_assert!(c >= tight_lower_bound(&f, &o.arch));
+        if let Err(e) = verify_placement(&g, &[seed]) {
+            proptest::prop_assert!(false, "{e}");
+        }
+    }
+}
