@@ -8,7 +8,7 @@
 use robovec_ir::analysis::{compute_timing, Latencies};
 use robovec_ir::{Module, Phase};
 
-use crate::{require_phase, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -20,16 +20,7 @@ pub const INFO: PassInfo = PassInfo {
         ParamInfo { name: "lat-div", default: "12", doc: "div latency, cycles" },
         ParamInfo { name: "lat-call", default: "12", doc: "call (sqrt, callbacks) latency, cycles" },
     ],
-    build: |p: &Params| {
-        let d = Latencies::default();
-        let lat = Latencies {
-            add: p.u32_in("lat-add", d.add, 1, 10_000)?,
-            mul: p.u32_in("lat-mul", d.mul, 1, 10_000)?,
-            div: p.u32_in("lat-div", d.div, 1, 10_000)?,
-            call: p.u32_in("lat-call", d.call, 1, 10_000)?,
-        };
-        Ok(Box::new(AsapAlap { lat }))
-    },
+    build: |p: &Params| Ok(Box::new(AsapAlap { lat: p.latencies()? })),
 };
 
 /// The `asap-alap` pass.
@@ -52,7 +43,6 @@ impl Pass for AsapAlap {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        require_phase(self.name(), m, Phase::Atomised)?;
         for f in &mut m.functions {
             let (t, _) = compute_timing(f, &self.lat);
             for (d, t) in f.values.iter_mut().zip(t) {
@@ -96,9 +86,10 @@ mod tests {
     }
 
     #[test]
-    fn parsed_input_is_rejected() {
+    fn parsed_input_is_rejected_by_the_manager() {
         let mut m = parse("func @f { input %a %x = %a*%a output o = %x }").unwrap();
-        let e = AsapAlap { lat: Latencies::default() }.run(&mut m, &mut PassContext::default()).unwrap_err();
+        let pm = crate::PassManager::new("asap-alap", crate::Instrumentation::default()).unwrap();
+        let e = pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink()).unwrap_err();
         assert!(e.to_string().contains("run `atomise` first"), "{e}");
     }
 }

@@ -109,7 +109,7 @@ pub trait Pass {
     /// # Errors
     /// [`PassError`] when the input is not what the pass accepts.
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError>;
-    /// The phase every function must be in, if any.
+    /// The phase every function must be in, if any; the manager checks it before `run`.
     fn requires(&self) -> Option<Phase> {
         None
     }

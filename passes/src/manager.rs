@@ -126,6 +126,9 @@ impl PassManager {
             if let Some(d) = &self.instr.dump_dir {
                 write_dump(d, &format!("{:03}-{name}.before.rvir", i + 1), m)?;
             }
+            if let Some(phase) = pass.requires() {
+                crate::require_phase(name, m, phase)?;
+            }
             let ops_before = module_ops(m);
             let t0 = Instant::now();
             pass.run(m, cx)?;

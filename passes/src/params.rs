@@ -64,6 +64,21 @@ impl Params {
         self.values.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
     }
 
+    /// The latencies `lat-add`, `lat-mul`, `lat-div`, `lat-call` (cycles, 1..=10000), each
+    /// defaulting to SPEC §1's value.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when one is not such an integer.
+    pub fn latencies(&self) -> Result<robovec_ir::analysis::Latencies, PassError> {
+        let d = robovec_ir::analysis::Latencies::default();
+        Ok(robovec_ir::analysis::Latencies {
+            add: self.u32_in("lat-add", d.add, 1, 10_000)?,
+            mul: self.u32_in("lat-mul", d.mul, 1, 10_000)?,
+            div: self.u32_in("lat-div", d.div, 1, 10_000)?,
+            call: self.u32_in("lat-call", d.call, 1, 10_000)?,
+        })
+    }
+
     /// `key` as a `u32` in `min..=max`, or `default`.
     ///
     /// # Errors

@@ -13,7 +13,7 @@ use robovec_ir::analysis::compute_timing;
 use robovec_ir::{Module, Phase};
 
 use crate::place::{cycles, lower_bound, ops_per_side, try_place_function, PlaceOptions, Priority, Select};
-use crate::{require_phase, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// min / mean / max of words over the PEs of one type.
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
@@ -114,7 +114,6 @@ impl Pass for Sweep {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        require_phase(self.name(), m, Phase::Atomised)?;
         // The seed's algorithm alone (improve = 0) for the Table 2.2 / Fig. 2.4–2.7 comparisons,
         // then robovec's default (forward-backward improvement).
         let configs = [

@@ -25,7 +25,7 @@ use robovec_ir::analysis::{compute_timing, Latencies};
 use robovec_ir::placement::{Arch, Placement};
 use robovec_ir::{Function, Module, OpKind, Phase};
 
-use crate::{require_phase, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Priority of ready ops (seed §2.3.1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -228,7 +228,6 @@ pub const INFO: PassInfo = PassInfo {
         ParamInfo { name: "buffer", default: "on", doc: "on | off: results may wait in buffer memories" },
     ],
     build: |p: &Params| {
-        let d = Latencies::default();
         let n = p.u32_in("pe", 4, 1, 4096)?;
         let enum_param = |key: &str, options: &[&str], default: usize| -> Result<usize, PassError> {
             match p.get(key) {
@@ -243,12 +242,7 @@ pub const INFO: PassInfo = PassInfo {
             arch: Arch {
                 n_add: p.u32_in("add", n, 1, 4096)?,
                 n_mul: p.u32_in("mul", n, 1, 4096)?,
-                lat: Latencies {
-                    add: p.u32_in("lat-add", d.add, 1, 10_000)?,
-                    mul: p.u32_in("lat-mul", d.mul, 1, 10_000)?,
-                    div: p.u32_in("lat-div", d.div, 1, 10_000)?,
-                    call: p.u32_in("lat-call", d.call, 1, 10_000)?,
-                },
+                lat: p.latencies()?,
                 writes: p.u32_in("writes", 2, 1, 64)?,
                 buffer: enum_param("buffer", &["off", "on"], 1)? == 1,
             },
@@ -280,7 +274,6 @@ impl Pass for Place {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        require_phase(self.name(), m, Phase::Atomised)?;
         for f in &mut m.functions {
             let p = try_place_function(f, &self.opts)
                 .map_err(|e| PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) })?;
