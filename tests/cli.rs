@@ -221,7 +221,13 @@ fn place_sim_and_sweep_end_to_end() {
     let d = tmp("place");
     let placed = d.join("placed.rvir");
     let r = d.join("r.json");
-    let o = opt(&[&segway(), "-passes=atomise,place<pe=2>,sim", "-o", placed.to_str().unwrap(), &format!("-report={}", r.display())]);
+    let o = opt(&[
+        &segway(),
+        "-passes=atomise,place<pe=2>,sim",
+        "-o",
+        placed.to_str().unwrap(),
+        &format!("-report={}", r.display()),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&r).unwrap()).unwrap();
     let p = &j["placement"];
@@ -245,7 +251,13 @@ fn place_sim_and_sweep_end_to_end() {
     assert!(stderr(&o).contains("cycle") && stderr(&o).contains('%'), "{}", stderr(&o));
     // Sweep: a table on stderr and CSV rows for each N and configuration.
     let csv = d.join("s.csv");
-    let o = opt(&[&segway(), "-passes=atomise,sweep<pe=1,4>", &format!("-sweep-csv={}", csv.display()), "-o", d.join("s.rvir").to_str().unwrap()]);
+    let o = opt(&[
+        &segway(),
+        "-passes=atomise,sweep<pe=1,4>",
+        &format!("-sweep-csv={}", csv.display()),
+        "-o",
+        d.join("s.rvir").to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("classical+fbi"));
     let rows = std::fs::read_to_string(&csv).unwrap();
