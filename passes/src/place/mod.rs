@@ -18,12 +18,15 @@
 //! Contract: never changes the function; every placement it returns passes `sim`. Cost:
 //! O(n log n + n·N) for n ops and N PEs per type.
 
+pub mod bound;
 pub mod memory;
 pub mod schedule;
 
-use robovec_ir::analysis::{compute_timing, Latencies};
+use robovec_ir::analysis::Latencies;
 use robovec_ir::placement::{Arch, Placement};
 use robovec_ir::{Function, Module, OpKind, Phase};
+
+pub use bound::{lower_bound, ops_per_side, tight_lower_bound};
 
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
@@ -110,70 +113,6 @@ pub fn place_function(f: &Function, opts: &PlaceOptions) -> Placement {
 /// Cycles of a placement (SPEC §4): the largest arrival, 0 without ops.
 pub fn cycles(f: &Function, p: &Placement) -> u32 {
     f.body.iter().filter_map(|&v| Some(p.issue[v.index()]?.cycle + p.latency(f.op_kind(v)?))).max().unwrap_or(0)
-}
-
-/// Ops that run on the ADD side (add, sub, div, call) and on the MULTI side.
-pub fn ops_per_side(f: &Function) -> (u64, u64) {
-    let c = f.op_counts();
-    (c.add + c.sub + c.div + c.call, c.mul)
-}
-
-/// The lower bound LB of SPEC §4: max(ASAPCycle critical path, ⌈n_add_side/N_add⌉ − 1 + lat_add,
-/// ⌈n_mul/N_mul⌉ − 1 + lat_mul), in cycles. No valid placement has fewer cycles.
-pub fn lower_bound(f: &Function, arch: &Arch) -> u32 {
-    let (_, cp) = compute_timing(f, &arch.lat);
-    let (na, nm) = ops_per_side(f);
-    let side = |n: u64, pes: u32, lat: u32| if n == 0 { 0 } else { (n.div_ceil(pes as u64) - 1) as u32 + lat };
-    cp.asap_cycle.max(side(na, arch.n_add, arch.lat.add)).max(side(nm, arch.n_mul, arch.lat.mul))
-}
-
-/// A lower bound at least as tight as [`lower_bound`] that also accounts for when ops of each
-/// type can start and how much of the critical path must follow them (a head-body-tail bound,
-/// as in single-machine scheduling with release dates and tails).
-///
-/// For a PE type with N PEs and any set S of its ops: the last op of S to issue issues no
-/// earlier than `min_{o∈S} r(o) + ⌈|S|/N⌉ − 1`, where `r(o) = ASAPCycle(o) − lat(o)` is the
-/// earliest issue; it then takes its latency and at least `min_{o∈S} q(o)` more cycles, where
-/// `q(o) = critical path − ALAPCycle(o)` is the longest path after its result. The bound is the
-/// maximum over the sets `{o : r(o) ≥ h}` and `{o : q(o) ≥ k}` for all thresholds, and over
-/// [`lower_bound`]. Cost: O(n log n).
-pub fn tight_lower_bound(f: &Function, arch: &Arch) -> u32 {
-    let (timing, cp) = compute_timing(f, &arch.lat);
-    let mut best = lower_bound(f, arch);
-    for mul_side in [false, true] {
-        let n_pe = if mul_side { arch.n_mul } else { arch.n_add } as u64;
-        // (release r, tail q, latency) of every op of this type.
-        let mut ops: Vec<(u32, u32, u32)> = f
-            .body
-            .iter()
-            .filter_map(|&v| {
-                let k = f.op_kind(v)?;
-                if (k == OpKind::Mul) != mul_side {
-                    return None;
-                }
-                let t = timing[v.index()]?;
-                let lat = arch.lat.of(k);
-                Some((t.asap_cycle - lat, cp.asap_cycle - t.alap_cycle, lat))
-            })
-            .collect();
-        if ops.is_empty() {
-            continue;
-        }
-        for by_tail in [false, true] {
-            // Sort by decreasing threshold key; the suffix sets {key ≥ h} are prefixes here.
-            ops.sort_by_key(|&(r, q, _)| std::cmp::Reverse(if by_tail { q } else { r }));
-            let (mut min_r, mut min_q, mut min_lat) = (u32::MAX, u32::MAX, u32::MAX);
-            for (i, &(r, q, lat)) in ops.iter().enumerate() {
-                min_r = min_r.min(r);
-                min_q = min_q.min(q);
-                min_lat = min_lat.min(lat);
-                let count = i as u64 + 1;
-                let bound = min_r as u64 + count.div_ceil(n_pe) - 1 + min_lat as u64 + min_q as u64;
-                best = best.max(bound.min(u32::MAX as u64) as u32);
-            }
-        }
-    }
-    best
 }
 
 /// Ops issued per cycle on each side: `(add_side, mul_side)`, one entry per cycle `0..cycles`.
