@@ -55,5 +55,8 @@ fn main() {
         }
     }
     println!("{runs} runs; above 1.05 x SPEC LB: {over_spec}; above 1.05 x tight LB: {over_tight_105}; above 1.02 x tight LB: {over_tight_102}");
-    println!("worst / SPEC LB {:.4} ({}); worst / tight LB {:.4} ({})", worst_spec.0, worst_spec.1, worst_tight.0, worst_tight.1);
+    println!(
+        "worst / SPEC LB {:.4} ({}); worst / tight LB {:.4} ({})",
+        worst_spec.0, worst_spec.1, worst_tight.0, worst_tight.1
+    );
 }

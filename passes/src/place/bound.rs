@@ -104,9 +104,9 @@ impl Dag {
     }
 }
 
-/// Ancestor visits allowed for head/tail tightening per call (about 10 ms of work): beyond it
+/// Ancestor visits allowed for head/tail tightening per call (a few tens of ms at most): beyond it
 /// the remaining ops keep their untightened (still valid) heads and tails.
-const TIGHTEN_BUDGET: u64 = 4_000_000;
+const TIGHTEN_BUDGET: u64 = 1_000_000;
 
 /// Tightens `head[j]` (a lower bound on node j's issue cycle) for every node, in topological
 /// order `order`: the ancestors of each PE type must all have delivered into j, so j's issue is

@@ -11,7 +11,7 @@ use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
 
 use robovec_ir::placement::{Arch, Issue, Load, Pe, Placement, Write};
-use robovec_ir::{Function, Operand, Value};
+use robovec_ir::{Function, Operand};
 
 use super::schedule::{initial_operands, Schedule};
 
@@ -69,26 +69,43 @@ fn allocate(items: &[(u32, u32)]) -> (Vec<u32>, u32) {
 /// Builds the placement of `f` from its schedule.
 pub fn build(f: &Function, arch: &Arch, s: &Schedule) -> Placement {
     let n_pe = arch.n_pe();
-    // Last read cycle of each item on each PE.
-    let mut last: HashMap<(usize, Key), u32> = HashMap::new();
+    let n = f.values.len();
+    // Bookings of each value (compressed rows), to find the one an op reads on its PE.
+    let mut at = vec![0u32; n + 1];
+    for b in &s.bookings {
+        at[b.value.index() + 1] += 1;
+    }
+    for i in 0..n {
+        at[i + 1] += at[i];
+    }
+    let mut fill = at.clone();
+    let mut by_value = vec![0u32; s.bookings.len()];
+    for (i, b) in s.bookings.iter().enumerate() {
+        by_value[fill[b.value.index()] as usize] = i as u32;
+        fill[b.value.index()] += 1;
+    }
+    // Last read cycle of each booking, and of each initial item loaded into each PE memory.
+    let mut last_booking = vec![0u32; s.bookings.len()];
     let mut loads_wanted: Vec<Vec<Operand>> = vec![Vec::new(); n_pe];
+    let mut load_index: Vec<HashMap<Key, usize>> = vec![HashMap::new(); n_pe];
+    let mut last_load: Vec<Vec<u32>> = vec![Vec::new(); n_pe];
     for &v in &f.body {
         let Some((q, t)) = s.issue[v.index()] else { continue };
-        let mut operands = Vec::new();
-        f.value(v).def.for_each_value(|a| operands.push(Operand::Value(a)));
-        if let robovec_ir::Def::Binary(_, a, b) = &f.value(v).def {
-            operands.extend([a, b].into_iter().filter(|o| matches!(o, Operand::Const(_))).copied());
-        } else if let robovec_ir::Def::Call(_, args) = &f.value(v).def {
-            operands.extend(args.iter().filter(|o| matches!(o, Operand::Const(_))).copied());
-        }
-        for o in &operands {
-            let e = last.entry((q, key(o))).or_insert(t);
-            *e = (*e).max(t);
-        }
-        for o in initial_operands(f, v) {
-            if !loads_wanted[q].iter().any(|x| key(x) == key(&o)) {
-                loads_wanted[q].push(o);
+        f.value(v).def.for_each_value(|a| {
+            if let Some(&i) = by_value[at[a.index()] as usize..at[a.index() + 1] as usize]
+                .iter()
+                .find(|&&i| s.bookings[i as usize].target == q)
+            {
+                last_booking[i as usize] = last_booking[i as usize].max(t);
             }
+        });
+        for o in initial_operands(f, v) {
+            let i = *load_index[q].entry(key(&o)).or_insert_with(|| {
+                loads_wanted[q].push(o);
+                last_load[q].push(0);
+                loads_wanted[q].len() - 1
+            });
+            last_load[q][i] = last_load[q][i].max(t);
         }
     }
     let mut loads = Vec::new();
@@ -98,40 +115,33 @@ pub fn build(f: &Function, arch: &Arch, s: &Schedule) -> Placement {
     for (i, b) in s.bookings.iter().enumerate() {
         per_memory[b.target].push(i);
     }
-    let mut buffer_addr: HashMap<u32, u32> = HashMap::new();
-    let mut buffer_words = vec![0; n_pe];
-    // Buffers: one item per value that is read from its producer's buffer.
-    let mut buffer_items: Vec<Vec<(Value, u32, u32)>> = vec![Vec::new(); n_pe];
-    {
-        let mut span: HashMap<u32, (usize, u32, u32)> = HashMap::new();
-        for b in s.bookings.iter().filter(|b| b.indirect) {
-            let (p, _) = s.issue[b.value.index()].expect("issued");
-            let e = span.entry(b.value.index() as u32).or_insert((p, s.arrival[b.value.index()], b.cycle));
-            e.2 = e.2.max(b.cycle);
-        }
-        let mut vals: Vec<_> = span.into_iter().collect();
-        vals.sort_by_key(|(v, _)| *v);
-        for (v, (p, start, end)) in vals {
-            buffer_items[p].push((Value::with_number(v), start, end));
+    // Buffers: one item per value that is read from its producer's buffer, from its arrival
+    // to its last buffer read.
+    let mut buffer_end: Vec<Option<u32>> = vec![None; n];
+    for b in s.bookings.iter().filter(|b| b.indirect) {
+        let e = buffer_end[b.value.index()].get_or_insert(b.cycle);
+        *e = (*e).max(b.cycle);
+    }
+    let mut buffer_items: Vec<Vec<(usize, u32, u32)>> = vec![Vec::new(); n_pe];
+    for (v, end) in buffer_end.iter().enumerate() {
+        if let Some(end) = *end {
+            let (p, _) = s.issue[v].expect("issued");
+            buffer_items[p].push((v, s.arrival[v], end));
         }
     }
+    let mut buffer_addr = vec![0u32; n];
+    let mut buffer_words = vec![0; n_pe];
     for (p, items) in buffer_items.iter().enumerate() {
         let spans: Vec<(u32, u32)> = items.iter().map(|&(_, a, b)| (a, b)).collect();
         let (addrs, words) = allocate(&spans);
         buffer_words[p] = words;
         for (&(v, _, _), a) in items.iter().zip(addrs) {
-            buffer_addr.insert(v.index() as u32, a);
+            buffer_addr[v] = a;
         }
     }
     for q in 0..n_pe {
-        let mut spans = Vec::new();
-        for o in &loads_wanted[q] {
-            spans.push((0, last[&(q, key(o))]));
-        }
-        for &i in &per_memory[q] {
-            let b = &s.bookings[i];
-            spans.push((b.cycle, last[&(q, Key::Value(b.value.index() as u32))]));
-        }
+        let mut spans: Vec<(u32, u32)> = last_load[q].iter().map(|&e| (0, e)).collect();
+        spans.extend(per_memory[q].iter().map(|&i| (s.bookings[i].cycle, last_booking[i])));
         let (addrs, words) = allocate(&spans);
         pe_words[q] = words;
         let pe = pe_of(arch, q);
@@ -140,11 +150,11 @@ pub fn build(f: &Function, arch: &Arch, s: &Schedule) -> Placement {
         }
         for (&i, &addr) in per_memory[q].iter().zip(&addrs[loads_wanted[q].len()..]) {
             let b = &s.bookings[i];
-            let buffer_addr = b.indirect.then(|| buffer_addr[&(b.value.index() as u32)]);
+            let buffer_addr = b.indirect.then(|| buffer_addr[b.value.index()]);
             writes.push(Write { value: b.value, pe, addr, cycle: b.cycle, buffer_addr });
         }
     }
-    writes.sort_by_key(|w| (w.cycle, w.pe, w.addr));
+    writes.sort_unstable_by_key(|w| (w.cycle, w.pe, w.addr));
     let issue = s.issue.iter().map(|x| x.map(|(q, cycle)| Issue { pe: pe_of(arch, q), cycle })).collect();
     Placement { arch: *arch, issue, loads, writes, pe_words, buffer_words }
 }

@@ -81,8 +81,9 @@ impl PlaceOptions {
 /// Only with `buffer = false`: an operand that can no longer reach any PE memory of its type.
 pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement, String> {
     let a = &opts.arch;
+    let dag = schedule::OpDag::new(f);
     let seed = schedule::seed_keys(f, a, opts.priority);
-    let mut best = schedule::schedule(f, a, &seed, opts.select)?;
+    let mut best = schedule::schedule(f, &dag, a, &seed, opts.select)?;
     let end = |s: &schedule::Schedule| s.arrival.iter().copied().max().unwrap_or(0);
     for _ in 0..opts.improve {
         // Backward pass: ops that arrived last go first in reverse time; then forward again in
@@ -90,10 +91,10 @@ pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement
         let t = end(&best);
         let back: Vec<schedule::Key> =
             (0..f.values.len()).map(|i| (t - best.arrival[i], seed[i].0, i as u32)).collect();
-        let r = schedule::backward_starts(f, a.n_add, a.n_mul, &a.lat, &back);
+        let r = schedule::backward_starts(f, &dag, a.n_add, a.n_mul, &a.lat, &back);
         let r_max = r.iter().copied().max().unwrap_or(0);
         let fwd: Vec<schedule::Key> = (0..f.values.len()).map(|i| (r_max - r[i], seed[i].0, i as u32)).collect();
-        let s = schedule::schedule(f, a, &fwd, opts.select)?;
+        let s = schedule::schedule(f, &dag, a, &fwd, opts.select)?;
         if end(&s) >= end(&best) {
             break;
         }

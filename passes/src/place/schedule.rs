@@ -17,7 +17,7 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use robovec_ir::analysis::{compute_timing, DepGraph};
+use robovec_ir::analysis::compute_timing;
 use robovec_ir::placement::{Arch, Pe};
 use robovec_ir::{Function, OpKind, Operand, Value};
 
@@ -143,16 +143,18 @@ impl Ctx<'_> {
         (a..=t).find(|&b| used(b) < self.arch.writes && buffer_free(b)).map(Route::Indirect)
     }
 
-    /// Routes of the op operands `ops` of one op into `q` at `t` (`None` if one cannot get there).
-    fn routes(&self, ops: &[Option<Value>], q: usize, t: u32) -> Option<Vec<Route>> {
-        let mut out = Vec::with_capacity(ops.len());
-        let mut planned = Planned::default();
+    /// Routes of the op operands `ops` of one op into `q` at `t`, written into `out`; false if
+    /// one cannot get there. `planned` is scratch space.
+    fn routes(&self, ops: &[Option<Value>], q: usize, t: u32, planned: &mut Planned, out: &mut Vec<Route>) -> bool {
+        out.clear();
+        planned.writes.clear();
+        planned.reads.clear();
         for (i, &o) in ops.iter().enumerate() {
             let Some(v) = o.filter(|v| !ops[..i].contains(&Some(*v))) else {
                 out.push(Route::Pe); // initial data (loaded), or the same value as an earlier operand
                 continue;
             };
-            let r = self.route(v, q, t, &planned)?;
+            let Some(r) = self.route(v, q, t, planned) else { return false };
             match r {
                 Route::Direct => planned.writes.push(self.arrival[v.index()]),
                 Route::Indirect(b) => {
@@ -163,7 +165,7 @@ impl Ctx<'_> {
             }
             out.push(r);
         }
-        Some(out)
+        true
     }
 
     fn commit(&mut self, ops: &[Option<Value>], routes: &[Route], q: usize) {
@@ -185,6 +187,105 @@ impl Ctx<'_> {
             self.located[v.index()].push(q);
             self.bookings.push(Booking { value: v, target: q, cycle, indirect });
         }
+    }
+}
+
+/// The dependence structure the list schedulers need, built once per placement and shared by
+/// every forward and backward pass (compressed rows, no per-op allocation). Indexed by value
+/// index.
+pub struct OpDag {
+    /// Ops in body (topological) order.
+    pub ops: Vec<Value>,
+    /// True for ops of the MULTI side.
+    mul: Vec<bool>,
+    /// `operands[operand_at[i]..operand_at[i + 1]]`: op operands of value i by position, `None`
+    /// for initial data (inputs, trig variables, constants).
+    operand_at: Vec<u32>,
+    operands: Vec<Option<Value>>,
+    /// `users[user_at[i]..user_at[i + 1]]`: distinct op users of value i.
+    user_at: Vec<u32>,
+    users: Vec<Value>,
+    /// Distinct op operands per value.
+    n_distinct: Vec<u32>,
+}
+
+impl OpDag {
+    /// Builds the structure of `f` (atomised, verified). Cost: O(values + operands).
+    pub fn new(f: &Function) -> OpDag {
+        let n = f.values.len();
+        let is_op = |o: &Operand| match o {
+            Operand::Value(x) if f.op_kind(*x).is_some() => Some(*x),
+            _ => None,
+        };
+        let mut dag = OpDag {
+            ops: Vec::new(),
+            mul: vec![false; n],
+            operand_at: Vec::with_capacity(n + 1),
+            operands: Vec::new(),
+            user_at: Vec::new(),
+            users: Vec::new(),
+            n_distinct: vec![0; n],
+        };
+        let mut n_users = vec![0u32; n + 1];
+        for (i, val) in f.values.iter().enumerate() {
+            dag.operand_at.push(dag.operands.len() as u32);
+            let v = Value::with_number(i as u32);
+            let Some(k) = f.op_kind(v) else { continue };
+            dag.mul[i] = k == OpKind::Mul;
+            let start = dag.operands.len();
+            match &val.def {
+                robovec_ir::Def::Binary(_, a, b) => dag.operands.extend([is_op(a), is_op(b)]),
+                robovec_ir::Def::Call(_, args) => dag.operands.extend(args.iter().map(is_op)),
+                _ => {}
+            }
+            for j in start..dag.operands.len() {
+                if let Some(a) = dag.operands[j] {
+                    if !dag.operands[start..j].contains(&Some(a)) {
+                        dag.n_distinct[i] += 1;
+                        n_users[a.index()] += 1;
+                    }
+                }
+            }
+        }
+        dag.operand_at.push(dag.operands.len() as u32);
+        dag.ops = f.body.iter().copied().filter(|&v| f.op_kind(v).is_some()).collect();
+        // Users: prefix sums, then fill in body order (so each row is in topological order).
+        let mut at = 0u32;
+        for c in &mut n_users {
+            let x = *c;
+            *c = at;
+            at += x;
+        }
+        dag.user_at = n_users.clone();
+        let mut users = vec![Value::with_number(0); at as usize];
+        for &v in &dag.ops {
+            let row = dag.operands_of(v);
+            for (j, &o) in row.iter().enumerate() {
+                if let Some(a) = o {
+                    if !row[..j].contains(&Some(a)) {
+                        users[n_users[a.index()] as usize] = v;
+                        n_users[a.index()] += 1;
+                    }
+                }
+            }
+        }
+        dag.users = users;
+        dag
+    }
+
+    /// Op operands of `v` by position (`None` for initial data).
+    pub fn operands_of(&self, v: Value) -> &[Option<Value>] {
+        &self.operands[self.operand_at[v.index()] as usize..self.operand_at[v.index() + 1] as usize]
+    }
+
+    /// Distinct op users of `v`.
+    pub fn users_of(&self, v: Value) -> &[Value] {
+        &self.users[self.user_at[v.index()] as usize..self.user_at[v.index() + 1] as usize]
+    }
+
+    /// True for an op of the MULTI side.
+    pub fn is_mul(&self, v: Value) -> bool {
+        self.mul[v.index()]
     }
 }
 
@@ -210,33 +311,11 @@ pub type Key = (u32, u32, u32);
 ///
 /// # Errors
 /// Only without buffers: an op whose operand can no longer reach any PE memory of its type.
-pub fn schedule(f: &Function, arch: &Arch, keys: &[Key], select: Select) -> Result<Schedule, String> {
+pub fn schedule(f: &Function, dag: &OpDag, arch: &Arch, keys: &[Key], select: Select) -> Result<Schedule, String> {
     let n = f.values.len();
-    let graph = DepGraph::build(f);
-    let ops: Vec<Value> = f.body.iter().copied().filter(|&v| f.op_kind(v).is_some()).collect();
     let kind = |v: Value| f.op_kind(v).expect("op");
     let key = |v: Value| keys[v.index()];
-    // Per operand position: the producing op, or `None` for initial data (inputs, trig, constants).
-    let mut op_operands: Vec<Vec<Option<Value>>> = vec![Vec::new(); n];
-    let mut pending = vec![0u32; n];
-    for &v in &ops {
-        let list: Vec<Option<Value>> = match &f.value(v).def {
-            robovec_ir::Def::Binary(_, a, b) => vec![*a, *b],
-            robovec_ir::Def::Call(_, args) => args.clone(),
-            _ => Vec::new(),
-        }
-        .into_iter()
-        .map(|o| match o {
-            Operand::Value(x) if f.op_kind(x).is_some() => Some(x),
-            _ => None,
-        })
-        .collect();
-        let mut distinct: Vec<Value> = list.iter().flatten().copied().collect();
-        distinct.sort();
-        distinct.dedup();
-        pending[v.index()] = distinct.len() as u32;
-        op_operands[v.index()] = list;
-    }
+    let mut pending = dag.n_distinct.clone();
     let mut ctx = Ctx {
         arch,
         issue: vec![None; n],
@@ -245,11 +324,10 @@ pub fn schedule(f: &Function, arch: &Arch, keys: &[Key], select: Select) -> Resu
         ports: Ports { writes: vec![Vec::new(); arch.n_pe()], buffer_read: vec![Vec::new(); arch.n_pe()] },
         bookings: Vec::new(),
     };
-    let is_mul = |v: Value| kind(v) == OpKind::Mul;
     let mut ready: [BinaryHeap<Reverse<(Key, Value)>>; 2] = [BinaryHeap::new(), BinaryHeap::new()];
-    for &v in &ops {
+    for &v in &dag.ops {
         if pending[v.index()] == 0 {
-            ready[is_mul(v) as usize].push(Reverse((key(v), v)));
+            ready[dag.is_mul(v) as usize].push(Reverse((key(v), v)));
         }
     }
     let mut arrivals: BinaryHeap<Reverse<(u32, Value)>> = BinaryHeap::new();
@@ -261,22 +339,22 @@ pub fn schedule(f: &Function, arch: &Arch, keys: &[Key], select: Select) -> Resu
         }
     };
     let pes = [pes_of(false), pes_of(true)];
+    let (mut planned, mut routes, mut best_routes) = (Planned::default(), Vec::new(), Vec::new());
+    let mut free: Vec<usize> = Vec::new();
+    let mut deferred = Vec::new();
     let mut placed = 0usize;
     let mut t: u32 = 0;
     let mut stalled_since: Option<u32> = None;
-    while placed < ops.len() {
+    while placed < dag.ops.len() {
         while let Some(&Reverse((c, v))) = arrivals.peek() {
             if c > t {
                 break;
             }
             arrivals.pop();
-            let mut users: Vec<Value> = graph.users(v).collect();
-            users.sort();
-            users.dedup();
-            for u in users {
+            for &u in dag.users_of(v) {
                 pending[u.index()] -= 1;
                 if pending[u.index()] == 0 {
-                    ready[is_mul(u) as usize].push(Reverse((key(u), u)));
+                    ready[dag.is_mul(u) as usize].push(Reverse((key(u), u)));
                 }
             }
         }
@@ -285,14 +363,17 @@ pub fn schedule(f: &Function, arch: &Arch, keys: &[Key], select: Select) -> Resu
             if pes[ty].is_empty() {
                 continue;
             }
-            let mut free: Vec<usize> = pes[ty].clone();
-            let mut deferred = Vec::new();
+            free.clear();
+            free.extend_from_slice(&pes[ty]);
+            deferred.clear();
             while !free.is_empty() {
                 let Some(Reverse((k, v))) = ready[ty].pop() else { break };
-                let operands = &op_operands[v.index()];
-                let mut best: Option<(u32, usize, Vec<Route>)> = None;
+                let operands = dag.operands_of(v);
+                let mut best: Option<(u32, usize)> = None;
                 for (i, &q) in free.iter().enumerate() {
-                    let Some(routes) = ctx.routes(operands, q, t) else { continue };
+                    if !ctx.routes(operands, q, t, &mut planned, &mut routes) {
+                        continue;
+                    }
                     let score = match select {
                         Select::Naive => 0,
                         Select::Preferential => {
@@ -300,17 +381,18 @@ pub fn schedule(f: &Function, arch: &Arch, keys: &[Key], select: Select) -> Resu
                             preference(at(0), at(1)) + routes.iter().skip(2).filter(|r| **r != Route::Pe).count() as u32
                         }
                     };
-                    if best.as_ref().is_none_or(|(s, _, _)| score < *s) {
-                        best = Some((score, i, routes));
+                    if best.is_none_or(|(s, _)| score < s) {
+                        best = Some((score, i));
+                        std::mem::swap(&mut routes, &mut best_routes);
                         if score <= 1 && select == Select::Preferential || select == Select::Naive {
                             break;
                         }
                     }
                 }
                 match best {
-                    Some((_, i, routes)) => {
+                    Some((_, i)) => {
                         let q = free.swap_remove(i);
-                        ctx.commit(operands, &routes, q);
+                        ctx.commit(operands, &best_routes, q);
                         let lat = arch.lat.of(kind(v));
                         ctx.issue[v.index()] = Some((q, t));
                         ctx.arrival[v.index()] = t + lat;
@@ -322,7 +404,7 @@ pub fn schedule(f: &Function, arch: &Arch, keys: &[Key], select: Select) -> Resu
                     None => deferred.push(Reverse((k, v))),
                 }
             }
-            ready[ty].extend(deferred);
+            ready[ty].extend(deferred.drain(..));
         }
         if progress {
             stalled_since = None;
@@ -370,23 +452,13 @@ pub fn initial_operands(f: &Function, v: Value) -> Vec<Operand> {
 /// Used by forward-backward improvement (Tormos & Lova 2001; "justification", Valls et al.
 /// 2005): scheduling forward again in decreasing `r` order packs the resources better than
 /// ALAP order when both PE types are saturated. Cost: O(n log n).
-pub fn backward_starts(f: &Function, n_add: u32, n_mul: u32, lat: &Latencies, keys: &[Key]) -> Vec<u32> {
+pub fn backward_starts(f: &Function, dag: &OpDag, n_add: u32, n_mul: u32, lat: &Latencies, keys: &[Key]) -> Vec<u32> {
     let n = f.values.len();
-    let graph = DepGraph::build(f);
-    let ops: Vec<Value> = f.body.iter().copied().filter(|&v| f.op_kind(v).is_some()).collect();
-    let mut pending = vec![0u32; n];
-    let mut users: Vec<Vec<Value>> = vec![Vec::new(); n];
-    for &v in &ops {
-        let mut u: Vec<Value> = graph.users(v).collect();
-        u.sort();
-        u.dedup();
-        pending[v.index()] = u.len() as u32;
-        users[v.index()] = u;
-    }
+    let mut pending: Vec<u32> = (0..n).map(|i| dag.user_at[i + 1] - dag.user_at[i]).collect();
     let mut earliest = vec![0u32; n]; // reverse ready time before the op's own latency
     let mut r = vec![0u32; n];
     let mut waiting: BinaryHeap<Reverse<(u32, Value)>> = BinaryHeap::new();
-    for &v in &ops {
+    for &v in &dag.ops {
         if pending[v.index()] == 0 {
             waiting.push(Reverse((lat.of(f.op_kind(v).expect("op")), v)));
         }
@@ -395,14 +467,13 @@ pub fn backward_starts(f: &Function, n_add: u32, n_mul: u32, lat: &Latencies, ke
     let caps = [n_add as usize, n_mul as usize];
     let mut done = 0;
     let mut t = 0u32;
-    while done < ops.len() {
+    while done < dag.ops.len() {
         while let Some(&Reverse((c, v))) = waiting.peek() {
             if c > t {
                 break;
             }
             waiting.pop();
-            let ty = usize::from(f.op_kind(v) == Some(OpKind::Mul));
-            ready[ty].push(Reverse((keys[v.index()], v)));
+            ready[dag.is_mul(v) as usize].push(Reverse((keys[v.index()], v)));
         }
         for ty in 0..2 {
             for _ in 0..caps[ty] {
@@ -410,13 +481,12 @@ pub fn backward_starts(f: &Function, n_add: u32, n_mul: u32, lat: &Latencies, ke
                 r[v.index()] = t;
                 done += 1;
                 // Operands: ready in reverse time once every user is placed, after their latency.
-                let mut operands = Vec::new();
-                f.value(v).def.for_each_value(|a| {
-                    if f.op_kind(a).is_some() && !operands.contains(&a) {
-                        operands.push(a);
+                let row = dag.operands_of(v);
+                for (j, &o) in row.iter().enumerate() {
+                    let Some(a) = o else { continue };
+                    if row[..j].contains(&Some(a)) {
+                        continue;
                     }
-                });
-                for a in operands {
                     earliest[a.index()] = earliest[a.index()].max(t + 1);
                     pending[a.index()] -= 1;
                     if pending[a.index()] == 0 {
