@@ -74,6 +74,9 @@ pub struct PlacementReport {
     pub lower_bound: u32,
     /// cycles / LB (1 is optimal).
     pub cycles_over_lower_bound: f64,
+    /// A tighter lower bound (`place::tight_lower_bound`: per PE type, the exact one-type
+    /// relaxation with heads and tails tightened through both types), cycles; extra key.
+    pub tight_lower_bound: u32,
     /// ops / (cycles × (n_add + n_mul)) (seed §3.4).
     pub parallelisation_rate: f64,
     /// Words of each PE memory: ADD PEs, then MULTI PEs.
@@ -100,7 +103,7 @@ pub struct Occupation {
 
 /// The placement figures of `f`, if it is placed.
 pub fn placement_report(f: &Function) -> Option<PlacementReport> {
-    use robovec_passes::place::{cycles, issues_per_cycle, lower_bound, occupation};
+    use robovec_passes::place::{cycles, issues_per_cycle, lower_bound, occupation, tight_lower_bound};
     let p = f.placement.as_ref()?;
     let a = &p.arch;
     let c = cycles(f, p);
@@ -116,6 +119,7 @@ pub fn placement_report(f: &Function) -> Option<PlacementReport> {
         cycles: c,
         lower_bound: lb,
         cycles_over_lower_bound: if lb == 0 { 1.0 } else { c as f64 / lb as f64 },
+        tight_lower_bound: tight_lower_bound(f, a),
         parallelisation_rate: if c == 0 { 0.0 } else { ops / (c as f64 * (a.n_add + a.n_mul) as f64) },
         pe_memory_words: p.pe_words.clone(),
         buffer_words: p.buffer_words.clone(),

@@ -1,12 +1,15 @@
 //! Placement of every straight-line corpus file at N ∈ {1, 2, 4, 8, 16, 32, 64}: each placement
 //! is executed by the cycle-accurate simulator in f32 and f64 (bit for bit against the
 //! interpreter), and its cycles are compared with the SPEC §4 lower bound and the tighter
-//! head-body-tail bound (`tight_lower_bound`).
+//! bound `tight_lower_bound` (per PE type, the exact one-type relaxation with heads and tails
+//! tightened through both types).
 //!
-//! Measured (release, 490 placements): all but 6 within 1.05 × the tight bound; the 6 are the
-//! `cons_hJ` Jacobians and the Segway `extforces` at N ≤ 4 (worst 1.17), where both PE types are
-//! saturated and neither list scheduling forward nor backward packs them closer — the gap is
-//! either the heuristic's or the bound's; issue 3's note says what is next.
+//! Measured (release, 490 placements; `cargo run --release --example placement_quality`):
+//! 13 runs above 1.05 × SPEC LB, of which the tight bound proves 8 cannot be placed within
+//! 1.05 × SPEC LB by any placement (e.g. Mazda `invdyna` N=2: tight LB 1493 = 1.19 × SPEC LB
+//! 1253; we place it in 1495). 5 runs are above 1.05 × the tight bound, all `cons_hJ`
+//! Jacobians at N ≤ 4 (worst 1.165, Mazda N=2), where the ADD PEs starve early while the MULTI
+//! PEs are saturated: the gap is either the heuristic's or the bound's.
 
 use robovec_ir::Function;
 use robovec_passes::atomise::atomise_function;

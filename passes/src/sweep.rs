@@ -12,7 +12,9 @@
 use robovec_ir::analysis::compute_timing;
 use robovec_ir::{Module, Phase};
 
-use crate::place::{cycles, lower_bound, ops_per_side, try_place_function, PlaceOptions, Priority, Select};
+use crate::place::{
+    cycles, lower_bound, ops_per_side, tight_lower_bound, try_place_function, PlaceOptions, Priority, Select,
+};
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// min / mean / max of words over the PEs of one type.
@@ -53,6 +55,9 @@ pub struct SweepRow {
     pub cycles: u32,
     /// SPEC §4 lower bound, cycles.
     pub lower_bound: u32,
+    /// The tighter bound of [`crate::place::tight_lower_bound`] (no placement beats it either),
+    /// cycles.
+    pub tight_lower_bound: u32,
     /// First lower-bound curve of seed §3.3 (100% parallelisation): max over the PE types of
     /// ⌈ops of the type / N⌉ − 1 + latency, cycles.
     pub resource_bound: u32,
@@ -153,6 +158,7 @@ impl Pass for Sweep {
                         select: sname,
                         cycles: c,
                         lower_bound: lower_bound(f, &o.arch),
+                        tight_lower_bound: tight_lower_bound(f, &o.arch),
                         resource_bound: side(n_add_side, o.arch.lat.add).max(side(n_mul, o.arch.lat.mul)),
                         critical_path: cp.asap_cycle,
                         y: if cp.asap_cycle == 0 { 0.0 } else { ops as f64 / cp.asap_cycle as f64 },
@@ -177,12 +183,12 @@ pub fn to_csv(rows: &[SweepRow]) -> String {
         "function,n,priority,select,cycles,lower_bound,resource_bound,critical_path,y,parallelisation_rate,\
          pe_words_add_min,pe_words_add_mean,pe_words_add_max,pe_words_mul_min,pe_words_mul_mean,pe_words_mul_max,\
          buffer_words_add_min,buffer_words_add_mean,buffer_words_add_max,buffer_words_mul_min,buffer_words_mul_mean,\
-         buffer_words_mul_max,writes_direct,writes_indirect\n",
+         buffer_words_mul_max,writes_direct,writes_indirect,tight_lower_bound\n",
     );
     for r in rows {
         let w = |x: &WordStats| format!("{},{:.2},{}", x.min, x.mean, x.max);
         s += &format!(
-            "{},{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{},{},{},{}\n",
             r.function,
             r.n,
             r.priority,
@@ -198,7 +204,8 @@ pub fn to_csv(rows: &[SweepRow]) -> String {
             w(&r.buffer_words_add),
             w(&r.buffer_words_mul),
             r.writes_direct,
-            r.writes_indirect
+            r.writes_indirect,
+            r.tight_lower_bound
         );
     }
     s
@@ -207,7 +214,7 @@ pub fn to_csv(rows: &[SweepRow]) -> String {
 /// The rows as a text table (Table 2.2 style: one line per N and configuration).
 pub fn to_table(rows: &[SweepRow]) -> String {
     let mut s = format!(
-        "{:<10} {:>4} {:<13} {:<12} {:>8} {:>8} {:>7} {:>8} {:>8} {:>6} {:>15} {:>15} {:>13} {:>13}\n",
+        "{:<10} {:>4} {:<13} {:<12} {:>8} {:>8} {:>7} {:>8} {:>7} {:>8} {:>8} {:>6} {:>15} {:>15} {:>13} {:>13}\n",
         "function",
         "N",
         "priority",
@@ -215,6 +222,8 @@ pub fn to_table(rows: &[SweepRow]) -> String {
         "cycles",
         "LB",
         "c/LB",
+        "tightLB",
+        "c/tLB",
         "res.bnd",
         "crit.p",
         "par.",
@@ -226,7 +235,7 @@ pub fn to_table(rows: &[SweepRow]) -> String {
     for r in rows {
         let w = |x: &WordStats| format!("{}/{:.0}/{}", x.min, x.mean, x.max);
         s += &format!(
-            "{:<10} {:>4} {:<13} {:<12} {:>8} {:>8} {:>7.3} {:>8} {:>8} {:>6.3} {:>15} {:>15} {:>13} {:>13}\n",
+            "{:<10} {:>4} {:<13} {:<12} {:>8} {:>8} {:>7.3} {:>8} {:>7.3} {:>8} {:>8} {:>6.3} {:>15} {:>15} {:>13} {:>13}\n",
             r.function,
             r.n,
             r.priority,
@@ -234,6 +243,8 @@ pub fn to_table(rows: &[SweepRow]) -> String {
             r.cycles,
             r.lower_bound,
             r.cycles as f64 / r.lower_bound.max(1) as f64,
+            r.tight_lower_bound,
+            r.cycles as f64 / r.tight_lower_bound.max(1) as f64,
             r.resource_bound,
             r.critical_path,
             r.parallelisation_rate,
