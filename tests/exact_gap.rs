@@ -117,6 +117,8 @@ fn list_scheduling_vs_optimum() {
                     priority: *priority,
                     select: Select::Preferential,
                     improve: *improve,
+                    // improve = 0 is the seed's algorithm alone: no restarts either.
+                    restarts: if *improve == 0 { 0 } else { PlaceOptions::with_pes(*tn).restarts },
                     ..PlaceOptions::with_pes(*tn)
                 };
                 let p = place_function(f, &opts);
