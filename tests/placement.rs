@@ -5,11 +5,11 @@
 //! tightened through both types).
 //!
 //! Measured (release, 490 placements; `cargo run --release --example placement_quality`):
-//! 13 runs above 1.05 × SPEC LB, of which the tight bound proves 8 cannot be placed within
+//! 12 runs above 1.05 × SPEC LB, of which the tight bound proves 8 cannot be placed within
 //! 1.05 × SPEC LB by any placement (e.g. Mazda `invdyna` N=2: tight LB 1493 = 1.19 × SPEC LB
-//! 1253; we place it in 1495). 5 runs are above 1.05 × the tight bound, all `cons_hJ`
-//! Jacobians at N ≤ 4 (worst 1.165, Mazda N=2), where the ADD PEs starve early while the MULTI
-//! PEs are saturated: the gap is either the heuristic's or the bound's.
+//! 1253; we place it in 1495). 3 runs are above 1.05 × the tight bound, the Mazda `cons_hJ`
+//! Jacobian at N = 1, 2, 4 (worst 1.147), where the ADD PEs starve early while the MULTI PEs
+//! are saturated: the gap is either the heuristic's or the bound's.
 
 use robovec_ir::Function;
 use robovec_passes::atomise::atomise_function;
