@@ -5,10 +5,10 @@
 //! tightened through both types).
 //!
 //! Measured (release, 490 placements; `cargo run --release --example placement_quality`):
-//! 12 runs above 1.05 × SPEC LB, of which the tight bound proves 8 cannot be placed within
+//! 11 runs above 1.05 × SPEC LB, of which the tight bound proves 6 cannot be placed within
 //! 1.05 × SPEC LB by any placement (e.g. Mazda `invdyna` N=2: tight LB 1493 = 1.19 × SPEC LB
 //! 1253; we place it in 1495). 3 runs are above 1.05 × the tight bound, the Mazda `cons_hJ`
-//! Jacobian at N = 1, 2, 4 (worst 1.147), where the ADD PEs starve early while the MULTI PEs
+//! Jacobian at N = 1, 2, 4 (worst 1.133), where the ADD PEs starve early while the MULTI PEs
 //! are saturated: the gap is either the heuristic's or the bound's.
 
 use robovec_ir::Function;
