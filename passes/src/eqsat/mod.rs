@@ -78,7 +78,7 @@ pub const INFO: PassInfo = PassInfo {
         };
         Ok(Box::new(Eqsat {
             opts: EqsatOptions {
-                window: p.u32_in("window", 8, 2, 64)? as usize,
+                window: p.u32_in("window", 6, 2, 64)? as usize,
                 budget: p.u32_in("budget", 0, 0, 10_000)?,
                 iters: p.u32_in("iters", 30, 1, 10_000)? as usize,
                 nodes: p.u32_in("nodes", 10_000, 10, 10_000_000)? as usize,
@@ -115,7 +115,7 @@ pub struct EqsatOptions {
 impl Default for EqsatOptions {
     fn default() -> Self {
         EqsatOptions {
-            window: 8,
+            window: 6,
             budget: 0,
             iters: 30,
             nodes: 10_000,
