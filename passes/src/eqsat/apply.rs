@@ -213,7 +213,7 @@ fn rebuild(f: &mut Function, windows: &[Window], plans: &[Option<RecExpr<Arith>>
             let (w, plan) = (&windows[i], plans[i].as_ref().expect("planned"));
             let base = f.name_of(v).to_string();
             let mut made: Vec<Operand> = Vec::with_capacity(plan.as_ref().len());
-            let mut memo: HashMap<(BinOp, (bool, u64), (bool, u64)), Operand> = HashMap::new();
+            let mut memo: HashMap<OpKey, Operand> = HashMap::new();
             let last = plan.as_ref().len() - 1;
             for (k, node) in plan.as_ref().iter().enumerate() {
                 let get = |id: &Id| made[usize::from(*id)];
@@ -270,6 +270,9 @@ fn rebuild(f: &mut Function, windows: &[Window], plans: &[Option<RecExpr<Arith>>
     let keep: std::collections::HashSet<Value> = f.body.iter().chain(&f.inputs).copied().collect();
     f.retain(|_, v| keep.contains(&v));
 }
+
+/// A hashable key of one binary op on two operands (dedups the ops of a materialised window).
+type OpKey = (BinOp, (bool, u64), (bool, u64));
 
 /// A hashable key of an operand: (is a constant, value index or constant bits).
 fn operand_key(o: Operand) -> (bool, u64) {

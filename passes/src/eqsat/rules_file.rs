@@ -114,7 +114,7 @@ impl<'a> LineParser<'a> {
                 }
                 parts.push(self.pattern(bind)?);
             }
-            if !self.peek().is_some_and(|t| t.text == ")") {
+            if self.peek().is_none_or(|t| t.text != ")") {
                 return Err(self.err_here(&format!("`{}` takes {arity} operand(s)", op.text), "`)`"));
             }
             self.pos += 1;
