@@ -99,7 +99,7 @@ impl Analysis<Arith> for ConstantFold {
     }
 
     fn merge(&mut self, to: &mut Option<Const>, from: Option<Const>) -> DidMerge {
-        merge_option(to, from, |_, _| DidMerge(false, true))
+        merge_option(to, from, |a, b| DidMerge(false, *a != b))
     }
 
     fn modify(egraph: &mut EGraph, id: Id) {
