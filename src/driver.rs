@@ -242,6 +242,11 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             }
         }
     }
+    if opts.stats {
+        for e in cx.eqsat.iter().filter(|e| opts.function.as_ref().is_none_or(|n| n == &e.function)) {
+            let _ = writeln!(stderr, "{e}");
+        }
+    }
     if !cx.sweep.is_empty() {
         let _ = write!(stderr, "{}", robovec_passes::sweep::to_table(&cx.sweep));
     }

@@ -8,6 +8,7 @@ mod common;
 mod cli;
 mod corpus;
 mod diagnostics;
+mod eqsat;
 mod exact_gap;
 mod example;
 mod filetests;

@@ -10,6 +10,7 @@ pub mod asap_alap;
 pub mod atomise;
 pub mod dag_gen;
 pub mod dce;
+pub mod eqsat;
 pub mod exact;
 pub mod manager;
 pub mod params;
@@ -98,6 +99,8 @@ pub struct PassContext {
     pub latencies: Latencies,
     /// Rows of every `sweep` run.
     pub sweep: Vec<sweep::SweepRow>,
+    /// What every `eqsat` run did, one entry per function (printed by `-stats`).
+    pub eqsat: Vec<eqsat::EqsatStats>,
 }
 
 /// A transformation or analysis over a whole module.
@@ -133,7 +136,8 @@ pub struct PassInfo {
 }
 
 /// The registry: every pass robovec knows, in `--print-passes` order.
-pub const PASSES: &[PassInfo] = &[atomise::INFO, dce::INFO, asap_alap::INFO, place::INFO, sim::INFO, sweep::INFO];
+pub const PASSES: &[PassInfo] =
+    &[atomise::INFO, dce::INFO, asap_alap::INFO, place::INFO, sim::INFO, sweep::INFO, eqsat::INFO];
 
 /// Looks up a registered pass.
 pub fn pass_info(name: &str) -> Option<&'static PassInfo> {

@@ -1,0 +1,283 @@
+//! Running `eqsat` on one function: windows in topological order, saturation, extraction,
+//! the replacement decision, and the rebuilt body.
+
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
+
+use egg::{Extractor, Id, RecExpr, Runner, StopReason};
+use robovec_ir::analysis::compute_timing;
+use robovec_ir::{BinOp, Def, Function, Operand, Span, Value};
+
+use super::extract::{count_ops, pareto_extract, ReadyCost};
+use super::lang::{leaf_index, Arith, ConstantFold, Rewrite};
+use super::window::{find_windows, Window};
+use super::EqsatOptions;
+
+/// How the egg runs of a function stopped (egg `StopReason`), in windows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct StopCounts {
+    /// No rule could add anything.
+    pub saturated: u32,
+    /// `iters` reached.
+    pub iteration_limit: u32,
+    /// `nodes` reached.
+    pub node_limit: u32,
+    /// `time-ms` reached.
+    pub time_limit: u32,
+    /// Any other reason.
+    pub other: u32,
+}
+
+/// What `eqsat` did to one function (printed by `-stats`).
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct EqsatStats {
+    /// Function name.
+    pub function: String,
+    /// Windows saturated, windows.
+    pub windows_tried: u32,
+    /// Windows replaced by their extracted form, windows.
+    pub windows_replaced: u32,
+    /// Windows where egg's lexicographic extraction was over the op budget and the Pareto
+    /// extraction within the budget was used, windows.
+    pub budget_fallbacks: u32,
+    /// Stop reasons of the runs.
+    pub stops: StopCounts,
+    /// Total wall time of saturation + extraction, milliseconds.
+    pub total_ms: f64,
+    /// Mean wall time per window, milliseconds.
+    pub mean_ms: f64,
+    /// Largest wall time of one window, milliseconds.
+    pub max_ms: f64,
+    /// Largest e-graph of a window, e-nodes.
+    pub max_enodes: usize,
+    /// Ops before / after, ops.
+    pub ops_before: u64,
+    /// Ops after, ops.
+    pub ops_after: u64,
+    /// Critical path (largest ASAPCycle, SPEC §4) before, cycles.
+    pub cp_before: u32,
+    /// Critical path after, cycles.
+    pub cp_after: u32,
+}
+
+impl std::fmt::Display for EqsatStats {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let s = &self.stops;
+        write!(
+            f,
+            "@{}: eqsat: windows {} tried, {} replaced ({} within budget by Pareto extraction); stop reasons: \
+             saturated {}, iteration limit {}, node limit {}, time limit {}, other {}; time {:.1} ms total, \
+             {:.3} ms mean / {:.3} ms max per window; largest e-graph {} e-nodes; ops {} -> {}; critical path \
+             {} -> {} cycles",
+            self.function,
+            self.windows_tried,
+            self.windows_replaced,
+            self.budget_fallbacks,
+            s.saturated,
+            s.iteration_limit,
+            s.node_limit,
+            s.time_limit,
+            s.other,
+            self.total_ms,
+            self.mean_ms,
+            self.max_ms,
+            self.max_enodes,
+            self.ops_before,
+            self.ops_after,
+            self.cp_before,
+            self.cp_after
+        )
+    }
+}
+
+/// Rewrites `f` (atomised, verified) window by window; see the module doc of `eqsat`.
+pub fn eqsat_function(f: &mut Function, o: &EqsatOptions, rules: &[Rewrite]) -> EqsatStats {
+    let mut st = EqsatStats {
+        function: f.name.clone(),
+        ops_before: f.op_counts().total,
+        cp_before: compute_timing(f, &o.lat).1.asap_cycle,
+        ..EqsatStats::default()
+    };
+    let windows = find_windows(f, o.window);
+    let n = f.values.len();
+    let mut at_root: Vec<Option<usize>> = vec![None; n];
+    let mut inside = vec![false; n];
+    for (i, w) in windows.iter().enumerate() {
+        at_root[w.root.index()] = Some(i);
+        w.interior.iter().for_each(|v| inside[v.index()] = true);
+    }
+    let mut ready = vec![0u32; n];
+    let mut plans: Vec<Option<RecExpr<Arith>>> = vec![None; windows.len()];
+    for &v in &f.body {
+        if inside[v.index()] {
+            continue; // computed with its window's root
+        }
+        if let Some(i) = at_root[v.index()] {
+            let w = &windows[i];
+            let leaf_ready: Vec<u32> = w.leaves.iter().map(|l| ready[l.index()]).collect();
+            let t0 = Instant::now();
+            let (r, plan) = saturate(w, &leaf_ready, o, rules, &mut st);
+            let dt = t0.elapsed().as_secs_f64() * 1e3;
+            st.windows_tried += 1;
+            st.total_ms += dt;
+            st.max_ms = st.max_ms.max(dt);
+            ready[v.index()] = r;
+            if plan.is_some() {
+                st.windows_replaced += 1;
+            }
+            plans[i] = plan;
+            continue;
+        }
+        let Some(kind) = f.op_kind(v) else { continue };
+        let mut r = 0;
+        f.value(v).def.for_each_value(|p| r = r.max(ready[p.index()]));
+        ready[v.index()] = r + o.lat.of(kind);
+    }
+    st.mean_ms = if st.windows_tried > 0 { st.total_ms / st.windows_tried as f64 } else { 0.0 };
+    rebuild(f, &windows, &plans);
+    st.ops_after = f.op_counts().total;
+    st.cp_after = compute_timing(f, &o.lat).1.asap_cycle;
+    st
+}
+
+/// Saturates one window; returns the root's ready time (cycles) and the replacement, if any.
+fn saturate(
+    w: &Window,
+    leaf_ready: &[u32],
+    o: &EqsatOptions,
+    rules: &[Rewrite],
+    st: &mut EqsatStats,
+) -> (u32, Option<RecExpr<Arith>>) {
+    let cf = ReadyCost { leaf_ready, lat_add: o.lat.add, lat_mul: o.lat.mul };
+    let (orig_ready, _) = cf.expr_cost(&w.expr);
+    let runner: Runner<Arith, ConstantFold> = Runner::default()
+        .with_iter_limit(o.iters)
+        .with_node_limit(o.nodes)
+        .with_time_limit(Duration::from_millis(o.time_ms))
+        .with_expr(&w.expr)
+        .run(rules);
+    match &runner.stop_reason {
+        Some(StopReason::Saturated) => st.stops.saturated += 1,
+        Some(StopReason::IterationLimit(_)) => st.stops.iteration_limit += 1,
+        Some(StopReason::NodeLimit(_)) => st.stops.node_limit += 1,
+        Some(StopReason::TimeLimit(_)) => st.stops.time_limit += 1,
+        Some(StopReason::Other(_)) | None => st.stops.other += 1,
+    }
+    st.max_enodes = st.max_enodes.max(runner.egraph.total_number_of_nodes());
+    let root: Id = runner.roots[0];
+    let limit = w.ops + o.budget;
+    let (_, mut best) = Extractor::new(&runner.egraph, cf.clone()).find_best(root);
+    if count_ops(&best) > limit {
+        match pareto_extract(&runner.egraph, root, &cf, limit, 64) {
+            Some((_, e)) => {
+                st.budget_fallbacks += 1;
+                best = e
+            }
+            None => return (orig_ready, None),
+        }
+    }
+    let (new_ready, _) = cf.expr_cost(&best);
+    let new_ops = count_ops(&best);
+    let better = new_ready < orig_ready || new_ops < w.ops;
+    if new_ready <= orig_ready && new_ops <= limit && better {
+        (new_ready, Some(best))
+    } else {
+        (orig_ready, None)
+    }
+}
+
+/// Replaces every planned window: new ops go just before the root (all leaves precede it),
+/// interior values disappear, and a root whose new form is a leaf or a constant is replaced by
+/// it in every use.
+fn rebuild(f: &mut Function, windows: &[Window], plans: &[Option<RecExpr<Arith>>]) {
+    let n = f.values.len();
+    let mut dropped = vec![false; n];
+    let mut plan_at: Vec<Option<usize>> = vec![None; n];
+    for (i, w) in windows.iter().enumerate() {
+        if plans[i].is_some() {
+            w.interior.iter().for_each(|v| dropped[v.index()] = true);
+            plan_at[w.root.index()] = Some(i);
+        }
+    }
+    let mut subst: Vec<Option<Operand>> = vec![None; n];
+    let sub = |subst: &[Option<Operand>], o: Operand| match o {
+        Operand::Value(v) => subst[v.index()].unwrap_or(o),
+        c => c,
+    };
+    let old = std::mem::take(&mut f.body);
+    for v in old {
+        if dropped[v.index()] {
+            continue;
+        }
+        if let Some(i) = plan_at[v.index()] {
+            let (w, plan) = (&windows[i], plans[i].as_ref().expect("planned"));
+            let base = f.name_of(v).to_string();
+            let mut made: Vec<Operand> = Vec::with_capacity(plan.as_ref().len());
+            let mut memo: HashMap<OpKey, Operand> = HashMap::new();
+            let last = plan.as_ref().len() - 1;
+            for (k, node) in plan.as_ref().iter().enumerate() {
+                let get = |id: &Id| made[usize::from(*id)];
+                let (op, a, b) = match node {
+                    Arith::Leaf(s) => {
+                        made.push(sub(&subst, Operand::Value(w.leaves[leaf_index(*s).expect("window leaf")])));
+                        continue;
+                    }
+                    Arith::Num(c) => {
+                        made.push(Operand::Const(c.get()));
+                        continue;
+                    }
+                    Arith::Add([a, b]) => (BinOp::Add, get(a), get(b)),
+                    Arith::Sub([a, b]) => (BinOp::Sub, get(a), get(b)),
+                    Arith::Mul([a, b]) => (BinOp::Mul, get(a), get(b)),
+                    Arith::Neg(a) => (BinOp::Sub, Operand::Const(0.0), get(a)),
+                };
+                let key = (op, operand_key(a), operand_key(b));
+                if k != last {
+                    if let Some(&x) = memo.get(&key) {
+                        made.push(x);
+                        continue;
+                    }
+                    let x = Operand::Value(f.define_fresh(&base, Def::Binary(op, a, b), Span::DUMMY));
+                    memo.insert(key, x);
+                    made.push(x);
+                } else {
+                    f.value_mut(v).def = Def::Binary(op, a, b);
+                    f.body.push(v);
+                    made.push(Operand::Value(v));
+                }
+            }
+            let top = *made.last().expect("non-empty plan");
+            if top != Operand::Value(v) {
+                subst[v.index()] = Some(top);
+            }
+            continue;
+        }
+        let mut def = f.value(v).def.clone();
+        match &mut def {
+            Def::Binary(_, a, b) => {
+                *a = sub(&subst, *a);
+                *b = sub(&subst, *b);
+            }
+            Def::Call(_, args) => args.iter_mut().for_each(|a| *a = sub(&subst, *a)),
+            _ => {}
+        }
+        f.value_mut(v).def = def;
+        f.body.push(v);
+    }
+    for o in &mut f.outputs {
+        o.value = sub(&subst, o.value);
+    }
+    let keep: std::collections::HashSet<Value> = f.body.iter().chain(&f.inputs).copied().collect();
+    f.retain(|_, v| keep.contains(&v));
+}
+
+/// A hashable key of one binary op on two operands (dedups the ops of a materialised window).
+type OpKey = (BinOp, (bool, u64), (bool, u64));
+
+/// A hashable key of an operand: (is a constant, value index or constant bits).
+fn operand_key(o: Operand) -> (bool, u64) {
+    match o {
+        Operand::Value(v) => (false, v.index() as u64),
+        Operand::Const(c) => (true, c.to_bits()),
+    }
+}
