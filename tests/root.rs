@@ -14,3 +14,4 @@ mod filetests;
 mod placement;
 mod props;
 mod roundtrip;
+mod thr;

@@ -160,11 +160,16 @@ impl Engine<'_> {
 
     /// `0 − w` for the original value `v` (made once).
     fn flip_of(&mut self, v: Value) -> Operand {
+        self.flip_named(v, v)
+    }
+
+    /// `0 − w` for the original value `v` (made once), named after `name` when it is free.
+    fn flip_named(&mut self, v: Value, name: Value) -> Operand {
         if let Some(o) = self.flip[v.index()] {
             return o;
         }
         let w = self.rep(v).op;
-        let name = self.f.name_of(v);
+        let name = self.f.name_of(name);
         let name = if self.out.lookup(name).is_none() { name.to_string() } else { format!("{name}.neg") };
         let span = self.f.value(v).span;
         let n = Operand::Value(self.emit(&name, Def::Binary(BinOp::Sub, Operand::Const(0.0), w), span));
@@ -354,7 +359,8 @@ impl Engine<'_> {
                 let (i, mut p) = plans.swap_remove(k);
                 if p.cost > 0 {
                     let src = p.terms[i].src.expect("value term");
-                    let o = self.flip_of(src);
+                    // With one term the root makes no op: its name is free for the flip.
+                    let o = self.flip_named(src, if p.tree.len() == 1 { root } else { src });
                     p.terms[i].op = o;
                     p.terms[i].ready = self.ready_of(o);
                 }

@@ -186,6 +186,6 @@ mod tests {
         assert_eq!(root_time(&cascade, &ready, 12), 86);
         let s = swap(&cascade, &ready);
         assert_eq!(root_time(&s, &ready, 12), 62);
-        assert_eq!(s[6], BNode::Term(0));
+        assert_eq!(s[5], BNode::Term(0), "the late term is the root's right operand");
     }
 }
