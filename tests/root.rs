@@ -15,3 +15,4 @@ mod placement;
 mod props;
 mod roundtrip;
 mod thr;
+mod thr_passes;

@@ -305,7 +305,7 @@ fn reassociation_stays_within_the_rounding_error_bound() {
         if c.div + c.call > 0 {
             continue; // the bound below covers + − × only
         }
-        for pipeline in ["zero-removal,swap", "balance"] {
+        for pipeline in ["zero-removal,swap", "balance", "inline<max-uses=3>,balance"] {
             let g = run(pipeline, &f);
             for seed in [1, 2] {
                 // Inputs exactly representable in binary32, so both evaluations start equal.

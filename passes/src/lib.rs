@@ -147,6 +147,8 @@ pub const PASSES: &[PassInfo] = &[
     thr::zero_removal::INFO,
     thr::swap::INFO,
     thr::balance::INFO,
+    thr::inline::INFO,
+    thr::specialize::INFO,
 ];
 
 /// Looks up a registered pass.

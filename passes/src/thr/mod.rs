@@ -23,9 +23,11 @@
 
 pub mod balance;
 pub mod cluster;
+pub mod inline;
 pub mod rebuild;
 pub mod shape;
 pub mod sign;
+pub mod specialize;
 pub mod swap;
 pub mod zero_removal;
 
