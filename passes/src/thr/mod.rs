@@ -34,7 +34,7 @@ pub mod zero_removal;
 #[cfg(test)]
 mod tests;
 
-use robovec_ir::analysis::{compute_timing, Latencies};
+use robovec_ir::analysis::Latencies;
 use robovec_ir::Function;
 
 pub use rebuild::RebuildStats;
@@ -57,10 +57,11 @@ pub struct Outcome {
 /// keeping the contract above.
 pub fn rewrite(f: &Function, shape: Shape, lat: &Latencies) -> (Function, Outcome) {
     let ops = f.op_counts().total;
-    let cp = compute_timing(f, lat).1.asap_cycle;
+    let orig = rebuild::ready_times(f, lat);
+    let cp = f.body.iter().filter(|&&v| f.op_kind(v).is_some()).map(|&v| orig[v.index()]).max().unwrap_or(0);
     for (fallback, trust) in [(0u8, true), (1, false)] {
-        let (g, stats) = rebuild::rebuild(f, shape, lat, trust);
-        let (g_ops, g_cp) = (g.op_counts().total, compute_timing(&g, lat).1.asap_cycle);
+        let (g, stats, g_cp) = rebuild::rebuild(f, shape, lat, &orig, trust);
+        let g_ops = g.op_counts().total;
         if g_ops <= ops && g_cp <= cp {
             return (g, Outcome { stats, ops: (ops, g_ops), asap_cycle: (cp, g_cp), fallback });
         }

@@ -30,7 +30,7 @@
 //! Cost: O(n log k) for n values and clusters of up to k terms (each cluster is built a few
 //! times when it has negative terms to choose from).
 
-use robovec_ir::analysis::{compute_timing, Latencies};
+use robovec_ir::analysis::Latencies;
 use robovec_ir::{BinOp, Def, Function, Operand, Phase, Value};
 
 use super::cluster::{Class, Clusters, TreeLeaf, TreeNode};
@@ -69,11 +69,18 @@ struct Term {
 /// Rebuilds `f` with `shape`. The result verifies, computes the same outputs up to
 /// reassociation (`Keep`: bit for bit, up to the sign of zero) and is never ready later than
 /// `f` op by op when the sign analysis holds (callers check the whole function).
-pub fn rebuild(f: &Function, shape: Shape, lat: &Latencies, trust_absorbs: bool) -> (Function, RebuildStats) {
+///
+/// `orig` is the ASAPCycle of every value of `f` under `lat` ([`ready_times`]). Returns the new
+/// function, what was done, and its critical path (`asap_cycle`, cycles).
+pub fn rebuild(
+    f: &Function,
+    shape: Shape,
+    lat: &Latencies,
+    orig: &[u32],
+    trust_absorbs: bool,
+) -> (Function, RebuildStats, u32) {
     let cl = Clusters::new(f);
     let absorb = if trust_absorbs { absorbs(f, &cl) } else { vec![false; f.values.len()] };
-    let (timing, _) = compute_timing(f, lat);
-    let orig: Vec<u32> = timing.iter().map(|t| t.map_or(0, |t| t.asap_cycle)).collect();
     let mut out = Function::new(f.name.clone(), Phase::Atomised);
     out.equations = f.equations;
     out.span = f.span;
@@ -81,7 +88,7 @@ pub fn rebuild(f: &Function, shape: Shape, lat: &Latencies, trust_absorbs: bool)
         f,
         cl: &cl,
         absorb: &absorb,
-        orig: &orig,
+        orig,
         shape,
         lat: *lat,
         out,
@@ -106,7 +113,23 @@ pub fn rebuild(f: &Function, shape: Shape, lat: &Latencies, trust_absorbs: bool)
         };
         e.out.set_output(o.name.clone(), value, o.span);
     }
-    (e.out, e.stats)
+    // Ready times of ops are their ASAPCycles, so the critical path is the latest of them.
+    let cp = e.out.body.iter().filter(|&&v| e.out.op_kind(v).is_some()).map(|&v| e.ready[v.index()]).max().unwrap_or(0);
+    (e.out, e.stats, cp)
+}
+
+/// ASAPCycle of every value of `f` (atomised) under `lat`: inputs, trig variables and
+/// constants 0, an op its latency after its latest operand (SPEC §4). O(values + operands).
+pub fn ready_times(f: &Function, lat: &Latencies) -> Vec<u32> {
+    let mut t = vec![0u32; f.values.len()];
+    for &v in &f.body {
+        if let Some(k) = f.op_kind(v) {
+            let mut r = 0;
+            f.value(v).def.for_each_value(|a| r = r.max(t[a.index()]));
+            t[v.index()] = r + lat.of(k);
+        }
+    }
+    t
 }
 
 struct Engine<'a> {
@@ -152,8 +175,10 @@ impl Engine<'_> {
         if let Some(k) = def.op_kind() {
             r += self.lat.of(k);
         }
-        let name = if self.out.lookup(name).is_some() { self.out.fresh_name(name) } else { name.to_string() };
-        let v = self.out.define(name, def, span).expect("name is free");
+        let v = match self.out.define(name, def.clone(), span) {
+            Ok(v) => v,
+            Err(_) => self.out.define_fresh(name, def, span),
+        };
         self.ready.push(r);
         v
     }

@@ -79,6 +79,11 @@ impl Pass for Specialize {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let params = read_params(&self.path)?;
+        let unused: Vec<&str> = params
+            .keys()
+            .filter(|k| !m.functions.iter().any(|f| f.lookup(k).is_some_and(|v| matches!(f.value(v).def, Def::Input))))
+            .map(String::as_str)
+            .collect();
         let mut parts = Vec::new();
         for f in &mut m.functions {
             let before = f.op_counts().total;
@@ -90,14 +95,9 @@ impl Pass for Specialize {
         for ((name, before, known), f) in parts.into_iter().zip(&m.functions) {
             line.push(format!("@{name}: {known} inputs known, ops {before} -> {}", f.op_counts().total));
         }
-        let unused: Vec<&str> = params
-            .keys()
-            .filter(|k| !m.functions.iter().any(|f| f.lookup(k).is_some_and(|v| matches!(f.value(v).def, Def::Input))))
-            .map(String::as_str)
-            .collect();
         let mut note = format!("specialize<params={}>: {}", self.path, line.join("; "));
         if !unused.is_empty() {
-            note += &format!("; {} names are not (or no longer) inputs: {}", unused.len(), unused.join(", "));
+            note += &format!("; {} given names are not inputs: {}", unused.len(), unused.join(", "));
         }
         cx.notes.push(note);
         Ok(())
