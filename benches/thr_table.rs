@@ -27,6 +27,8 @@ const PIPELINES: &[&str] = &[
     "atomise,inline<max-uses=3>,balance",
     "atomise,inline<max-uses=8>,balance",
     "atomise,inline<max-uses=64>,balance",
+    "atomise,inline<max-uses=8>,distribute,balance",
+    "atomise,inline<max-uses=64>,distribute<rounds=30>,balance",
 ];
 
 fn corpus() -> Vec<PathBuf> {

@@ -148,6 +148,7 @@ pub const PASSES: &[PassInfo] = &[
     thr::swap::INFO,
     thr::balance::INFO,
     thr::inline::INFO,
+    thr::distribute::INFO,
     thr::specialize::INFO,
 ];
 

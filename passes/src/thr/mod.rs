@@ -23,6 +23,7 @@
 
 pub mod balance;
 pub mod cluster;
+pub mod distribute;
 pub mod inline;
 pub mod rebuild;
 pub mod shape;
