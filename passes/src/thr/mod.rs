@@ -7,11 +7,12 @@
 //! | `swap` | [`swap`] | reorders each cluster's terms, latest nearest the root (seed §2.4.2) |
 //! | `balance` | [`balance`] | rebuilds each cluster as the two-earliest-first tree (seed §2.4.3) |
 //! | `inline<max-uses=K>` | [`inline`] | duplicates values used ≤ K times into their consumers' clusters |
+//! | `distribute` | [`distribute`] | opt-in: distributes critical products over sums, within an ops budget |
 //! | `specialize<params=FILE>` | [`specialize`] | folds known model parameters, then drops dead code |
 //!
 //! The first three share [`cluster`] (maximal associative clusters), [`sign`] (where a sign
 //! can go for free), [`shape`] (the tree of one cluster) and [`rebuild`] (the rewriter that
-//! carries signs). All run on the atomised phase and keep it.
+//! carries signs; its `emit` half writes the ops). All run on the atomised phase and keep it.
 //!
 //! # Contract of the cluster rewrites
 //! For every function: the op count never increases, the critical path (`asap_cycle` under
@@ -24,6 +25,7 @@
 pub mod balance;
 pub mod cluster;
 pub mod distribute;
+mod emit;
 pub mod inline;
 pub mod rebuild;
 pub mod shape;
