@@ -183,6 +183,15 @@ fn cli_reports_what_the_rewrites_did_and_rejects_bad_parameter_files() {
     let o = opt(&[ex, "-passes=atomise,specialize", "-o", "-"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("needs `params=FILE.json`"));
-    let o = opt(&[ex, "-passes=atomise,inline<max-uses=0>", "-o", "-"]);
-    assert_eq!(o.status.code(), Some(2));
+    for bad in ["inline<max-uses=0>", "distribute<max-growth=0.5>", "balance<lat-add=0>", "swap<pe=3>"] {
+        let o = opt(&[ex, &format!("-passes=atomise,{bad}"), "-o", "-"]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+    }
+    let o = opt(&["--print-passes"]);
+    let listed = String::from_utf8_lossy(&o.stdout);
+    for pass in
+        ["zero-removal", "swap", "balance", "inline", "max-uses", "distribute", "max-growth", "specialize", "params"]
+    {
+        assert!(listed.contains(pass), "--print-passes lacks {pass}:\n{listed}");
+    }
 }

@@ -7,8 +7,10 @@
 //! `sub` (or swaps its operands: the positive term comes forward), two `−` terms are added and
 //! carry the sign up, a product carries it to its consumers (`(0 − x)·y` → `−(x·y)`), a
 //! constant factor takes it. Where a sign reaches an output or a call argument and nothing on
-//! the way can take it, one `0 − x` stays, as close to the output as the critical path allows
-//! (documented choice: the output keeps its true sign; robovec has no negated outputs).
+//! the way can take it, one `0 − x` stays (documented choice: an output keeps its true sign;
+//! robovec has no negated outputs): on the output's value itself, or on one negative term of
+//! its cluster when that makes the output ready earlier (`−a − b·c` → `(0 − a) − b·c`, ready at
+//! 24 cycles, rather than `0 − (a + b·c)` at 31).
 //!
 //! Contract: never adds an op, never lengthens the critical path (`asap_cycle` under the given
 //! latencies; checked, see [`super::rewrite`]), and the outputs are bit for bit those of the
