@@ -125,6 +125,9 @@ fn zero_removal_is_exact_never_longer_and_leaves_no_removable_zero() {
             assert_eq!(removable_zeros(&g), Vec::<String>::new(), "{name} {pipeline}: removable zeros remain");
         }
         let g = run("zero-removal", &f);
+        for lat in &lats {
+            assert!(cp(&g, lat) <= cp(&f, lat), "{name}: zero-removal (default latencies) is longer under {lat:?}");
+        }
         zeros_before += count_zeros(&f);
         zeros_after += count_zeros(&g);
         ops_before += f.op_counts().total;
