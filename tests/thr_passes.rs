@@ -180,9 +180,14 @@ fn cli_reports_what_the_rewrites_did_and_rejects_bad_parameter_files() {
         assert!(err.contains("specialize") && err.contains(needle), "{err}");
         assert!(!err.contains("panicked"), "{err}");
     }
-    let o = opt(&[ex, "-passes=atomise,specialize", "-o", "-"]);
+    let o = opt(&[ex, "-passes=atomise,specialize<params=>", "-o", "-"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("needs `params=FILE.json`"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("`params` needs a file name"));
+    let o = opt(&[ex, "-passes=atomise,specialize", "-stats", "-o", "-"]);
+    assert!(o.status.success(), "without parameters only constants fold (and dead code goes)");
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("specialize<params=none>: @invdyna: 0 inputs known, ops 48 -> 45")
+    );
     for bad in ["inline<max-uses=0>", "distribute<max-growth=0.5>", "balance<lat-add=0>", "swap<pe=3>"] {
         let o = opt(&[ex, &format!("-passes=atomise,{bad}"), "-o", "-"]);
         assert_eq!(o.status.code(), Some(2), "{bad}");

@@ -1,5 +1,5 @@
 //! `specialize<params=FILE.json>`: folds model parameters whose values are known, then drops
-//! dead code.
+//! dead code. Without `params`, only what is already constant folds.
 //!
 //! Phase: atomised → atomised. `FILE.json` is an object of canonical input name → number, the
 //! names and format of `-eval` (SPEC §2, §7: `{"dpt[3][5]": 0, "m[2]": 1.5}`). Every input it
@@ -34,22 +34,22 @@ pub const INFO: PassInfo = PassInfo {
     doc: "fold model parameters of known value (JSON file, -eval format), simplify x*0, x*1, x+0, then dce",
     params: &[ParamInfo {
         name: "params",
-        default: "(required)",
-        doc: "JSON file: object of canonical input name -> number, e.g. {\"dpt[3][5]\": 0}",
+        default: "none",
+        doc: "JSON file: object of canonical input name -> number, e.g. {\"dpt[3][5]\": 0}; without it only constants fold",
     }],
     build: |p: &Params| match p.get("params") {
-        Some(path) if !path.is_empty() => Ok(Box::new(Specialize { path: path.to_string() })),
-        _ => Err(PassError::BadParameter {
+        Some("") => Err(PassError::BadParameter {
             pass: "specialize".into(),
-            message: "needs `params=FILE.json` (an object of input name -> number)".into(),
+            message: "`params` needs a file name (`params=FILE.json`, an object of input name -> number)".into(),
         }),
+        path => Ok(Box::new(Specialize { path: path.map(String::from) })),
     },
 };
 
 /// The `specialize` pass.
 pub struct Specialize {
-    /// Path of the JSON parameter file.
-    pub path: String,
+    /// Path of the JSON parameter file; `None`: no known parameter (constants still fold).
+    pub path: Option<String>,
 }
 
 /// Reads a parameter file: JSON object of input name → number.
@@ -78,7 +78,10 @@ impl Pass for Specialize {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let params = read_params(&self.path)?;
+        let params = match &self.path {
+            Some(path) => read_params(path)?,
+            None => BTreeMap::new(),
+        };
         let unused: Vec<&str> = params
             .keys()
             .filter(|k| !m.functions.iter().any(|f| f.lookup(k).is_some_and(|v| matches!(f.value(v).def, Def::Input))))
@@ -95,7 +98,7 @@ impl Pass for Specialize {
         for ((name, before, known), f) in parts.into_iter().zip(&m.functions) {
             line.push(format!("@{name}: {known} inputs known, ops {before} -> {}", f.op_counts().total));
         }
-        let mut note = format!("specialize<params={}>: {}", self.path, line.join("; "));
+        let mut note = format!("specialize<params={}>: {}", self.path.as_deref().unwrap_or("none"), line.join("; "));
         if !unused.is_empty() {
             note += &format!("; {} given names are not inputs: {}", unused.len(), unused.join(", "));
         }
