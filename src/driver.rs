@@ -198,6 +198,9 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         None => None,
     };
     if opts.stats {
+        for note in &cx.notes {
+            let _ = writeln!(stderr, "{note}");
+        }
         for f in &module.functions {
             if opts.function.as_ref().is_some_and(|n| n != &f.name) {
                 continue;

@@ -15,3 +15,5 @@ mod filetests;
 mod placement;
 mod props;
 mod roundtrip;
+mod thr;
+mod thr_passes;

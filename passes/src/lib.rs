@@ -18,6 +18,7 @@ pub mod pipeline;
 pub mod place;
 pub mod sim;
 pub mod sweep;
+pub mod thr;
 
 use robovec_ir::analysis::Latencies;
 use robovec_ir::{Module, Phase};
@@ -101,6 +102,9 @@ pub struct PassContext {
     pub sweep: Vec<sweep::SweepRow>,
     /// What every `eqsat` run did, one entry per function (printed by `-stats`).
     pub eqsat: Vec<eqsat::EqsatStats>,
+    /// One line per run of a rewriting pass saying what it changed (ops added or removed,
+    /// critical path before and after); the driver prints them with `-stats`.
+    pub notes: Vec<String>,
 }
 
 /// A transformation or analysis over a whole module.
@@ -136,8 +140,21 @@ pub struct PassInfo {
 }
 
 /// The registry: every pass robovec knows, in `--print-passes` order.
-pub const PASSES: &[PassInfo] =
-    &[atomise::INFO, dce::INFO, asap_alap::INFO, place::INFO, sim::INFO, sweep::INFO, eqsat::INFO];
+pub const PASSES: &[PassInfo] = &[
+    atomise::INFO,
+    dce::INFO,
+    asap_alap::INFO,
+    place::INFO,
+    sim::INFO,
+    sweep::INFO,
+    thr::zero_removal::INFO,
+    thr::swap::INFO,
+    thr::balance::INFO,
+    thr::inline::INFO,
+    thr::distribute::INFO,
+    thr::specialize::INFO,
+    eqsat::INFO,
+];
 
 /// Looks up a registered pass.
 pub fn pass_info(name: &str) -> Option<&'static PassInfo> {

@@ -1,0 +1,73 @@
+//! `zero-removal<lat-add;lat-mul;lat-div;lat-call>`: removes the `0 − x` ops that `atomise`
+//! inserts for a unary minus (SPEC §3) by moving signs (seed §2.4.1; SPEC §6).
+//!
+//! Phase: atomised → atomised. Every cluster keeps its tree ([`Shape::Keep`]) minus its
+//! additive zero terms (and ±1 factors); the sign a removed `0 − x` leaves is carried as
+//! [`super::rebuild`] describes: a `−` term next to a `+` one turns the parent's `add` into a
+//! `sub` (or swaps its operands: the positive term comes forward), two `−` terms are added and
+//! carry the sign up, a product carries it to its consumers (`(0 − x)·y` → `−(x·y)`), a
+//! constant factor takes it. Where a sign reaches an output or a call argument and nothing on
+//! the way can take it, one `0 − x` stays (documented choice: an output keeps its true sign;
+//! robovec has no negated outputs): on the output's value itself, or on one negative term of
+//! its cluster when that makes the output ready earlier (`−a − b·c` → `(0 − a) − b·c`, ready at
+//! 24 cycles, rather than `0 − (a + b·c)` at 31).
+//!
+//! Contract: never adds an op, never lengthens the critical path (`asap_cycle` under the given
+//! latencies; enforced, see [`super::rewrite`]; under other latencies too on every corpus file
+//! and on random DAGs, as the tests check, because the tree keeps its shape and a remaining zero
+//! sits where the original had one or on the output), and the outputs are bit for bit those of the
+//! input (negation and exchanging `a + (−b)` for `a − b` are exact in IEEE 754) except the
+//! sign of an exact zero. Idempotent. Cost: O(values + operands) plus O(k log k) per cluster
+//! with negative terms.
+
+use robovec_ir::{Module, Phase};
+
+use super::{rewrite, summary, Shape};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+
+/// The latency parameters the cluster rewrites take (cycles; SPEC §1 defaults).
+pub const LATENCY_PARAMS: &[ParamInfo] = &[
+    ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency, cycles" },
+    ParamInfo { name: "lat-mul", default: "7", doc: "mul latency, cycles" },
+    ParamInfo { name: "lat-div", default: "12", doc: "div latency, cycles" },
+    ParamInfo { name: "lat-call", default: "12", doc: "call latency, cycles" },
+];
+
+/// Registry entry.
+pub const INFO: PassInfo = PassInfo {
+    name: "zero-removal",
+    doc: "remove the `0 - x` ops of atomise by moving signs into parents and consumers (seed §2.4.1)",
+    params: LATENCY_PARAMS,
+    build: |p: &Params| Ok(Box::new(ClusterRewrite { name: "zero-removal", shape: Shape::Keep, lat: p.latencies()? })),
+};
+
+/// A pass that rebuilds every cluster with one [`Shape`] (`zero-removal`, `swap`, `balance`).
+pub struct ClusterRewrite {
+    /// Registered name.
+    pub name: &'static str,
+    /// Tree of each cluster.
+    pub shape: Shape,
+    /// Latencies the ready times (and the critical-path check) use, cycles.
+    pub lat: robovec_ir::analysis::Latencies,
+}
+
+impl Pass for ClusterRewrite {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn requires(&self) -> Option<Phase> {
+        Some(Phase::Atomised)
+    }
+
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        let mut outcomes = Vec::new();
+        for f in &mut m.functions {
+            let (g, o) = rewrite(f, self.shape, &self.lat);
+            *f = g;
+            outcomes.push((f.name.clone(), o));
+        }
+        cx.notes.push(summary(self.name, &outcomes));
+        Ok(())
+    }
+}
