@@ -156,6 +156,18 @@ fn read_eval_inputs(path: &Path) -> Result<BTreeMap<String, f64>, Failure> {
     })
 }
 
+/// Writes the `worst-K.json` files of every `accuracy<worst=DIR>` measurement.
+fn write_worst_points(reports: &[robovec_passes::accuracy::AccuracyReport], prefix: bool) -> Result<(), Failure> {
+    for r in reports {
+        let Some(dir) = &r.worst_dir else { continue };
+        std::fs::create_dir_all(dir).map_err(|e| Failure::Input(format!("error: cannot create `{dir}`: {e}\n")))?;
+        for (name, json) in robovec_passes::accuracy::report::worst_files(r, prefix) {
+            write_atomically(&Path::new(dir).join(name), json.as_bytes())?;
+        }
+    }
+    Ok(())
+}
+
 /// Runs one `robovec-opt` invocation. `stdout` receives the IR (or `-eval` JSON); `stderr`
 /// receives dumps, timing and stats.
 ///
@@ -180,6 +192,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 stats: stats(f, &cx.latencies),
                 placement: placement_report(f),
                 sweep: cx.sweep.iter().filter(|r| r.function == f.name).cloned().collect(),
+                accuracy: cx.accuracy.iter().rev().find(|r| r.function == f.name).cloned(),
             };
             Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
         }
@@ -245,9 +258,13 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     if !cx.sweep.is_empty() {
         let _ = write!(stderr, "{}", robovec_passes::sweep::to_table(&cx.sweep));
     }
+    if !cx.accuracy.is_empty() {
+        let _ = write!(stderr, "{}", robovec_passes::accuracy::report::to_text(&cx.accuracy, opts.stats));
+    }
     let ir = module.to_string();
 
     // Then write.
+    write_worst_points(&cx.accuracy, module.functions.len() > 1)?;
     if let Some(path) = &opts.sweep_csv {
         if cx.sweep.is_empty() {
             return Err(Failure::Usage("error: -sweep-csv needs a `sweep` pass in the pipeline\n".into()));

@@ -6,6 +6,7 @@
 //! [`manager`] does printing, dumping, verifying and timing.
 #![deny(missing_docs)]
 
+pub mod accuracy;
 pub mod asap_alap;
 pub mod atomise;
 pub mod dag_gen;
@@ -98,6 +99,8 @@ pub struct PassContext {
     pub latencies: Latencies,
     /// Rows of every `sweep` run.
     pub sweep: Vec<sweep::SweepRow>,
+    /// One report per function of every `accuracy` run.
+    pub accuracy: Vec<accuracy::AccuracyReport>,
 }
 
 /// A transformation or analysis over a whole module.
@@ -133,7 +136,8 @@ pub struct PassInfo {
 }
 
 /// The registry: every pass robovec knows, in `--print-passes` order.
-pub const PASSES: &[PassInfo] = &[atomise::INFO, dce::INFO, asap_alap::INFO, place::INFO, sim::INFO, sweep::INFO];
+pub const PASSES: &[PassInfo] =
+    &[atomise::INFO, dce::INFO, asap_alap::INFO, place::INFO, sim::INFO, sweep::INFO, accuracy::INFO];
 
 /// Looks up a registered pass.
 pub fn pass_info(name: &str) -> Option<&'static PassInfo> {
