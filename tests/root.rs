@@ -11,6 +11,7 @@ mod diagnostics;
 mod exact_gap;
 mod example;
 mod filetests;
+mod numerics;
 mod placement;
 mod props;
 mod roundtrip;

@@ -10,6 +10,7 @@
 //!   value, certified by a running error bound; double-double first, 256 then 1024 bits where
 //!   the bound does not prove the double-double rounding right.
 //! - [`bits`]: bits of error, `log2(1 + ordinal distance)` (Herbie).
+//! - [`budget`]: the rigorous `γ_K·M` error budget of `+ − ×` functions (Higham ch. 3).
 //!
 //! "Exact" means: the real-number value of the IR's expression on the given `f64` inputs, with
 //! `sin`/`cos`/`sqrt` exact and user callbacks replaced by the interpreter's stand-in (a linear
@@ -17,6 +18,7 @@
 
 pub mod big;
 pub mod bits;
+pub mod budget;
 pub mod dd;
 pub mod reference;
 pub mod tape;
