@@ -35,6 +35,12 @@ pub struct Options {
     pub stats: bool,
     /// `-sweep-csv=FILE`: the rows of `sweep` runs as CSV.
     pub sweep_csv: Option<PathBuf>,
+    /// `-pareto=A;B;…`: pipelines to compare (speed against error, [`crate::pareto`]).
+    pub pareto: Option<String>,
+    /// `-pareto-samples=N`: samples of each pipeline's accuracy measurement.
+    pub pareto_samples: u32,
+    /// `-pareto-seed=S`: seed of those measurements.
+    pub pareto_seed: u64,
 }
 
 /// Why a run failed; the text is ready for stderr.
@@ -177,6 +183,15 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     let pm = PassManager::new(&opts.passes, opts.instr.clone()).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
     let (mut module, _src) = load(&opts.input)?;
+    let pareto = match &opts.pareto {
+        Some(text) => {
+            let name = select(&module, &opts.function, "-pareto")?.name.clone();
+            let rows = crate::pareto::run(&module, &name, text, opts.pareto_samples, opts.pareto_seed)?;
+            let _ = write!(stderr, "{}", crate::pareto::to_table(&name, &rows));
+            rows
+        }
+        None => Vec::new(),
+    };
     let mut cx = PassContext::default();
     let records = pm.run(&mut module, &mut cx, stderr).map_err(|e| Failure::Input(format!("error: {e}\n")))?;
 
@@ -193,6 +208,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 placement: placement_report(f),
                 sweep: cx.sweep.iter().filter(|r| r.function == f.name).cloned().collect(),
                 accuracy: cx.accuracy.iter().rev().find(|r| r.function == f.name).cloned(),
+                pareto: pareto.clone(),
             };
             Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
         }

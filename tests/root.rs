@@ -5,6 +5,7 @@
 
 mod common;
 
+mod accuracy;
 mod cli;
 mod corpus;
 mod diagnostics;
