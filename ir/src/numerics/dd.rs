@@ -32,23 +32,27 @@ pub struct DD {
     pub lo: f64,
 }
 
+#[inline]
 fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     let bb = s - a;
     (s, (a - (s - bb)) + (b - bb))
 }
 
+#[inline]
 fn fast_two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     (s, b - (s - a))
 }
 
+#[inline]
 fn split(a: f64) -> (f64, f64) {
     let c = 134_217_729.0 * a; // 2^27 + 1
     let hi = c - (c - a);
     (hi, a - hi)
 }
 
+#[inline]
 fn two_prod(a: f64, b: f64) -> (f64, f64) {
     let p = a * b;
     let (ah, al) = split(a);
@@ -222,6 +226,7 @@ fn cos_series(r: DD) -> DD {
 
 impl std::ops::Neg for DD {
     type Output = DD;
+    #[inline]
     fn neg(self) -> DD {
         DD { hi: -self.hi, lo: -self.lo }
     }
@@ -230,6 +235,7 @@ impl std::ops::Neg for DD {
 impl std::ops::Add for DD {
     type Output = DD;
     /// Joldeș–Muller–Popescu Alg. 6 (AccurateDWPlusDW).
+    #[inline]
     fn add(self, y: DD) -> DD {
         let (sh, sl) = two_sum(self.hi, y.hi);
         let (th, tl) = two_sum(self.lo, y.lo);
@@ -245,6 +251,7 @@ impl std::ops::Add for DD {
 
 impl std::ops::Sub for DD {
     type Output = DD;
+    #[inline]
     fn sub(self, y: DD) -> DD {
         self + -y
     }
@@ -253,6 +260,7 @@ impl std::ops::Sub for DD {
 impl std::ops::Mul for DD {
     type Output = DD;
     /// Joldeș–Muller–Popescu Alg. 10 (DWTimesDW1) with Dekker's TwoProduct.
+    #[inline]
     fn mul(self, y: DD) -> DD {
         let (ch, cl1) = two_prod(self.hi, y.hi);
         let tl = self.hi * y.lo + self.lo * y.hi;

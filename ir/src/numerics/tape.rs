@@ -211,7 +211,16 @@ impl Tape {
         slots.extend(self.consts.iter().map(|&x| T::from_f64(x)));
         for s in &self.steps {
             let r = match *s {
-                Step::Bin(op, a, b) => crate::interp::eval_binop(op, slots[a as usize], slots[b as usize]),
+                Step::Bin(op, a, b) => {
+                    // What `interp::eval_binop` does, inlined: this loop is the hot path.
+                    let (a, b) = (slots[a as usize], slots[b as usize]);
+                    match op {
+                        BinOp::Add => a + b,
+                        BinOp::Sub => a - b,
+                        BinOp::Mul => a * b,
+                        BinOp::Div => a / b,
+                    }
+                }
                 Step::Neg(a) => -slots[a as usize],
                 Step::Trig(TrigFn::Sin, a) => slots[a as usize].sin(),
                 Step::Trig(TrigFn::Cos, a) => slots[a as usize].cos(),

@@ -83,6 +83,9 @@ pub struct AccuracyReport {
     pub f64: BitsSummary,
     /// Per output.
     pub outputs: OutputsMap,
+    /// `f32` and `f64` over the outputs that are not [`AccuracyReport::structural_zeros`]
+    /// (their ~30/62-bit errors against an exact 0 otherwise set every `max_bits`).
+    pub excluding_structural_zeros: OutputAccuracy,
     /// Reference paths.
     pub reference: ReferenceCounts,
     /// Outputs whose reference stayed an uncertified interval around zero on the probe
@@ -110,6 +113,7 @@ pub fn build(
     let n_out = tape.outputs.len();
     let mut all32 = Vec::with_capacity(errs.len() * n_out);
     let mut all64 = Vec::with_capacity(errs.len() * n_out);
+    let (mut nz32, mut nz64) = (Vec::new(), Vec::new());
     let mut reference = ReferenceCounts::default();
     let mut outputs = Vec::with_capacity(n_out);
     for (k, (name, _)) in tape.outputs.iter().enumerate() {
@@ -117,6 +121,10 @@ pub fn build(
         let mut e64: Vec<f64> = errs.iter().map(|e| e.f64[k]).collect();
         all32.extend_from_slice(&e32);
         all64.extend_from_slice(&e64);
+        if !skip[k] {
+            nz32.extend_from_slice(&e32);
+            nz64.extend_from_slice(&e64);
+        }
         outputs.push((name.clone(), OutputAccuracy { f32: summarise(&mut e32), f64: summarise(&mut e64) }));
     }
     for e in errs {
@@ -151,6 +159,7 @@ pub fn build(
         evaluations,
         f32: summarise(&mut all32),
         f64: summarise(&mut all64),
+        excluding_structural_zeros: OutputAccuracy { f32: summarise(&mut nz32), f64: summarise(&mut nz64) },
         outputs: OutputsMap(outputs),
         reference,
         structural_zeros: tape.outputs.iter().zip(skip).filter(|(_, &z)| z).map(|(o, _)| o.0.clone()).collect(),
@@ -181,11 +190,15 @@ pub fn to_text(reports: &[AccuracyReport], per_output: bool) -> String {
             rc.uncertified
         );
         if !r.structural_zeros.is_empty() {
+            let x = &r.excluding_structural_zeros;
             s += &format!(
-                "@{}: {} structural zero output(s) (exact value 0 through inexact steps): {}\n",
+                "@{}: {} structural zero output(s) (exact value 0 through inexact steps): {}; without them \
+                 f32 {} f64 {}\n",
                 r.function,
                 r.structural_zeros.len(),
-                r.structural_zeros.join(", ")
+                r.structural_zeros.join(", "),
+                b(&x.f32),
+                b(&x.f64)
             );
         }
         if let Some(w) = r.worst.first() {
