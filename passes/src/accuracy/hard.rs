@@ -91,3 +91,27 @@ pub fn climb(
     }
     starts.len() as u64 * o.climb_rounds as u64 * NEIGHBOURS as u64
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::accuracy::{measure_function, Mode, Options};
+    use crate::expr_gen;
+
+    #[test]
+    fn climbing_is_deterministic_and_never_loses_the_worst_point() {
+        for seed in [1, 2, 3] {
+            let f = expr_gen::generate(seed);
+            let o = Options { samples: 64, mode: Mode::Hard, climb_rounds: 0, ..Options::default() };
+            let flat = measure_function(&f, &o);
+            let o = Options { climb_rounds: 4, ..o };
+            let a = measure_function(&f, &o);
+            let b = measure_function(&f, &o);
+            assert_eq!(
+                a.worst.iter().map(|w| &w.inputs).collect::<Vec<_>>(),
+                b.worst.iter().map(|w| &w.inputs).collect::<Vec<_>>()
+            );
+            assert_eq!(a.evaluations, 64 + 8 * 4 * 8);
+            assert!(a.worst[0].max_f32_bits >= flat.worst[0].max_f32_bits, "seed {seed}");
+        }
+    }
+}

@@ -90,8 +90,9 @@ pub struct AccuracyReport {
     pub reference: ReferenceCounts,
     /// Outputs whose reference stayed an uncertified interval around zero on the probe
     /// samples even at 256 bits: exact zeros reached through inexact steps (structural zeros
-    /// such as `m·(cos²q + sin²q) − m`). Their bits of error measure the computed value against
-    /// zero: any nonzero result is many bits away (Herbie's metric has no absolute floor).
+    /// such as `m·(cos²q + sin²q) − m`; in hard mode also outputs that vanish at the singular
+    /// poses drawn). Their bits of error measure the computed value against zero: any nonzero
+    /// result is many bits away (Herbie's metric has no absolute floor).
     pub structural_zeros: Vec<String>,
     /// The worst points, worst first.
     pub worst: Vec<WorstPoint>,
