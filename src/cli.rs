@@ -65,6 +65,17 @@ pub struct Cli {
     /// Write the rows of `sweep` passes to FILE as CSV.
     #[arg(long, value_name = "FILE")]
     pub sweep_csv: Option<PathBuf>,
+    /// Speed against error: run each `;`-separated pipeline on the input and print one table
+    /// (ops, critical path, placed cycles, bits of error in f32/f64; Pareto-optimal rows
+    /// marked); with -report, also its `pareto` array.
+    #[arg(long, value_name = "PIPELINE;PIPELINE;…")]
+    pub pareto: Option<String>,
+    /// Samples of -pareto's accuracy measurement (same for every pipeline).
+    #[arg(long, value_name = "N", default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=10_000_000))]
+    pub pareto_samples: u32,
+    /// Seed of -pareto's accuracy measurement.
+    #[arg(long, value_name = "SEED", default_value_t = 1)]
+    pub pareto_seed: u64,
     /// List the registered passes with their parameters and exit.
     #[arg(long)]
     pub print_passes: bool,
@@ -135,6 +146,9 @@ impl Cli {
             function: self.function,
             stats: self.stats,
             sweep_csv: self.sweep_csv,
+            pareto: self.pareto,
+            pareto_samples: self.pareto_samples,
+            pareto_seed: self.pareto_seed,
         })
     }
 }

@@ -35,6 +35,12 @@ pub struct Options {
     pub stats: bool,
     /// `-sweep-csv=FILE`: the rows of `sweep` runs as CSV.
     pub sweep_csv: Option<PathBuf>,
+    /// `-pareto=A;B;…`: pipelines to compare (speed against error, [`crate::pareto`]).
+    pub pareto: Option<String>,
+    /// `-pareto-samples=N`: samples of each pipeline's accuracy measurement.
+    pub pareto_samples: u32,
+    /// `-pareto-seed=S`: seed of those measurements.
+    pub pareto_seed: u64,
 }
 
 /// Why a run failed; the text is ready for stderr.
@@ -156,6 +162,18 @@ fn read_eval_inputs(path: &Path) -> Result<BTreeMap<String, f64>, Failure> {
     })
 }
 
+/// Writes the `worst-K.json` files of every `accuracy<worst=DIR>` measurement.
+fn write_worst_points(reports: &[robovec_passes::accuracy::AccuracyReport], prefix: bool) -> Result<(), Failure> {
+    for r in reports {
+        let Some(dir) = &r.worst_dir else { continue };
+        std::fs::create_dir_all(dir).map_err(|e| Failure::Input(format!("error: cannot create `{dir}`: {e}\n")))?;
+        for (name, json) in robovec_passes::accuracy::report::worst_files(r, prefix) {
+            write_atomically(&Path::new(dir).join(name), json.as_bytes())?;
+        }
+    }
+    Ok(())
+}
+
 /// Runs one `robovec-opt` invocation. `stdout` receives the IR (or `-eval` JSON); `stderr`
 /// receives dumps, timing and stats.
 ///
@@ -165,6 +183,15 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     let pm = PassManager::new(&opts.passes, opts.instr.clone()).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
     let (mut module, _src) = load(&opts.input)?;
+    let pareto = match &opts.pareto {
+        Some(text) => {
+            let name = select(&module, &opts.function, "-pareto")?.name.clone();
+            let rows = crate::pareto::run(&module, &name, text, opts.pareto_samples, opts.pareto_seed)?;
+            let _ = write!(stderr, "{}", crate::pareto::to_table(&name, &rows));
+            rows
+        }
+        None => Vec::new(),
+    };
     let mut cx = PassContext::default();
     let records = pm.run(&mut module, &mut cx, stderr).map_err(|e| Failure::Input(format!("error: {e}\n")))?;
 
@@ -180,6 +207,8 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 stats: stats(f, &cx.latencies),
                 placement: placement_report(f),
                 sweep: cx.sweep.iter().filter(|r| r.function == f.name).cloned().collect(),
+                accuracy: cx.accuracy.iter().rev().find(|r| r.function == f.name).cloned(),
+                pareto: pareto.clone(),
             };
             Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
         }
@@ -253,9 +282,13 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     if !cx.sweep.is_empty() {
         let _ = write!(stderr, "{}", robovec_passes::sweep::to_table(&cx.sweep));
     }
+    if !cx.accuracy.is_empty() {
+        let _ = write!(stderr, "{}", robovec_passes::accuracy::report::to_text(&cx.accuracy, opts.stats));
+    }
     let ir = module.to_string();
 
     // Then write.
+    write_worst_points(&cx.accuracy, module.functions.len() > 1)?;
     if let Some(path) = &opts.sweep_csv {
         if cx.sweep.is_empty() {
             return Err(Failure::Usage("error: -sweep-csv needs a `sweep` pass in the pipeline\n".into()));

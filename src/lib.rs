@@ -8,4 +8,5 @@ pub mod cli;
 pub mod diagnostics;
 pub mod driver;
 pub mod front;
+pub mod pareto;
 pub mod report;

@@ -148,6 +148,12 @@ pub struct Report {
     /// Rows of `sweep` runs for this function, when the pipeline swept.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub sweep: Vec<robovec_passes::sweep::SweepRow>,
+    /// The last `accuracy` measurement of this function, when the pipeline measured (SPEC §7).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<robovec_passes::accuracy::AccuracyReport>,
+    /// The rows of `-pareto`, when given (speed against error, `crate::pareto`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pareto: Vec<crate::pareto::ParetoRow>,
 }
 
 /// `-eval` output: every input used and every output, in f64.

@@ -5,6 +5,7 @@
 
 mod common;
 
+mod accuracy;
 mod cli;
 mod corpus;
 mod diagnostics;
@@ -12,6 +13,7 @@ mod eqsat;
 mod exact_gap;
 mod example;
 mod filetests;
+mod numerics;
 mod placement;
 mod props;
 mod roundtrip;

@@ -24,7 +24,8 @@
 //!
 //! The [`verifier`] checks these rules; [`text`] reads and writes the `.rvir` form;
 //! [`interp`] evaluates any function in `f64` or `f32`; [`analysis`] holds the dependence
-//! graph and ASAP/ALAP timing.
+//! graph and ASAP/ALAP timing; [`numerics`] holds the extended-precision reference and the
+//! bits-of-error metric (SPEC §6).
 #![deny(missing_docs)]
 
 pub mod analysis;
@@ -33,6 +34,7 @@ pub mod diagnostic;
 pub mod entities;
 pub mod function;
 pub mod interp;
+pub mod numerics;
 pub mod placement;
 pub mod span;
 pub mod syntax;

@@ -6,13 +6,16 @@
 //! [`manager`] does printing, dumping, verifying and timing.
 #![deny(missing_docs)]
 
+pub mod accuracy;
 pub mod asap_alap;
 pub mod atomise;
 pub mod dag_gen;
 pub mod dce;
 pub mod eqsat;
 pub mod exact;
+pub mod expr_gen;
 pub mod manager;
+pub mod numeric_check;
 pub mod params;
 pub mod pipeline;
 pub mod place;
@@ -105,6 +108,8 @@ pub struct PassContext {
     /// One line per run of a rewriting pass saying what it changed (ops added or removed,
     /// critical path before and after); the driver prints them with `-stats`.
     pub notes: Vec<String>,
+    /// One report per function of every `accuracy` run.
+    pub accuracy: Vec<accuracy::AccuracyReport>,
 }
 
 /// A transformation or analysis over a whole module.
@@ -147,6 +152,7 @@ pub const PASSES: &[PassInfo] = &[
     place::INFO,
     sim::INFO,
     sweep::INFO,
+    accuracy::INFO,
     thr::zero_removal::INFO,
     thr::swap::INFO,
     thr::balance::INFO,

@@ -1,0 +1,234 @@
+//! What `accuracy` reports: SPEC §7's `accuracy` object (`samples`, `f32`, `f64`, `outputs`)
+//! plus how the reference was obtained and the worst points; a text summary for stderr; the
+//! `worst-K.json` files.
+
+use std::collections::BTreeMap;
+
+use robovec_ir::numerics::Tape;
+use robovec_ir::Function;
+use serde::ser::{Serialize, SerializeMap, Serializer};
+
+use super::hard::worst_indices;
+use super::measure::{summarise, BitsSummary, PointErrors};
+use super::Options;
+
+/// Errors of one output over the points.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct OutputAccuracy {
+    /// binary32, bits.
+    pub f32: BitsSummary,
+    /// binary64, bits.
+    pub f64: BitsSummary,
+}
+
+/// Outputs in the function's output order, serialised as a JSON object.
+#[derive(Clone, Debug, Default)]
+pub struct OutputsMap(pub Vec<(String, OutputAccuracy)>);
+
+impl Serialize for OutputsMap {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(self.0.len()))?;
+        for (k, v) in &self.0 {
+            m.serialize_entry(k, v)?;
+        }
+        m.end()
+    }
+}
+
+/// How many (output, point) reference values each path produced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ReferenceCounts {
+    /// Certified by double-double (≈ 106 bits).
+    pub double_double: u64,
+    /// Certified at 256 bits.
+    pub bits_256: u64,
+    /// Certified at 1024 bits.
+    pub bits_1024: u64,
+    /// Not certified (the 1024-bit value is used; typically an exact zero reached by inexact
+    /// cancellation, e.g. `sin(a) − sin(a)`).
+    pub uncertified: u64,
+}
+
+/// One of the worst points found.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct WorstPoint {
+    /// Largest binary32 error over the outputs, bits.
+    pub max_f32_bits: f64,
+    /// Mean binary32 error over the outputs, bits.
+    pub mean_f32_bits: f64,
+    /// Largest binary64 error over the outputs, bits.
+    pub max_f64_bits: f64,
+    /// The output with the largest binary32 error.
+    pub output: String,
+    /// Every input's value (canonical name → value; `-eval`'s input format).
+    pub inputs: BTreeMap<String, f64>,
+}
+
+/// The measurement of one function (SPEC §7 `accuracy`, extra keys allowed).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct AccuracyReport {
+    /// Function measured.
+    pub function: String,
+    /// `sampled` or `hard`.
+    pub mode: &'static str,
+    /// Points summarised, samples.
+    pub samples: u64,
+    /// Seed of the draws.
+    pub seed: u64,
+    /// Points evaluated, including hill-climbing neighbours.
+    pub evaluations: u64,
+    /// Over every (output, point) pair, binary32, bits.
+    pub f32: BitsSummary,
+    /// Over every (output, point) pair, binary64, bits.
+    pub f64: BitsSummary,
+    /// Per output.
+    pub outputs: OutputsMap,
+    /// `f32` and `f64` over the outputs that are not [`AccuracyReport::structural_zeros`]
+    /// (their ~30/62-bit errors against an exact 0 otherwise set every `max_bits`).
+    pub excluding_structural_zeros: OutputAccuracy,
+    /// Reference paths.
+    pub reference: ReferenceCounts,
+    /// Outputs whose reference stayed an uncertified interval around zero on the probe
+    /// samples even at 256 bits: exact zeros reached through inexact steps (structural zeros
+    /// such as `m·(cos²q + sin²q) − m`; in hard mode also outputs that vanish at the singular
+    /// poses drawn). Their bits of error measure the computed value against zero: any nonzero
+    /// result is many bits away (Herbie's metric has no absolute floor).
+    pub structural_zeros: Vec<String>,
+    /// The worst points, worst first.
+    pub worst: Vec<WorstPoint>,
+    /// `worst=DIR` of the pass, where the driver writes `worst-K.json`.
+    #[serde(skip)]
+    pub worst_dir: Option<String>,
+}
+
+/// Summarises the errors at `points`.
+pub fn build(
+    f: &Function,
+    tape: &Tape,
+    o: &Options,
+    points: &[Vec<f64>],
+    errs: &[PointErrors],
+    evaluations: u64,
+    skip: &[bool],
+) -> AccuracyReport {
+    let n_out = tape.outputs.len();
+    let mut all32 = Vec::with_capacity(errs.len() * n_out);
+    let mut all64 = Vec::with_capacity(errs.len() * n_out);
+    let (mut nz32, mut nz64) = (Vec::new(), Vec::new());
+    let mut reference = ReferenceCounts::default();
+    let mut outputs = Vec::with_capacity(n_out);
+    for (k, (name, _)) in tape.outputs.iter().enumerate() {
+        let mut e32: Vec<f64> = errs.iter().map(|e| e.f32[k]).collect();
+        let mut e64: Vec<f64> = errs.iter().map(|e| e.f64[k]).collect();
+        all32.extend_from_slice(&e32);
+        all64.extend_from_slice(&e64);
+        if !skip[k] {
+            nz32.extend_from_slice(&e32);
+            nz64.extend_from_slice(&e64);
+        }
+        outputs.push((name.clone(), OutputAccuracy { f32: summarise(&mut e32), f64: summarise(&mut e64) }));
+    }
+    for e in errs {
+        for &(bits, ok, _) in &e.reference {
+            match (bits, ok) {
+                (_, false) => reference.uncertified += 1,
+                (106, true) => reference.double_double += 1,
+                (256, true) => reference.bits_256 += 1,
+                (_, true) => reference.bits_1024 += 1,
+            }
+        }
+    }
+    let worst = worst_indices(errs, o.worst_count as usize)
+        .into_iter()
+        .map(|i| {
+            let e = &errs[i];
+            let k = (0..n_out).max_by(|&a, &b| e.f32[a].total_cmp(&e.f32[b]).then(b.cmp(&a))).unwrap_or(0);
+            WorstPoint {
+                max_f32_bits: e.max_f32(),
+                mean_f32_bits: e.mean_f32(),
+                max_f64_bits: e.f64.iter().copied().fold(0.0, f64::max),
+                output: tape.outputs.get(k).map(|o| o.0.clone()).unwrap_or_default(),
+                inputs: tape.inputs.iter().cloned().zip(points[i].iter().copied()).collect(),
+            }
+        })
+        .collect();
+    AccuracyReport {
+        function: f.name.clone(),
+        mode: o.mode.name(),
+        samples: points.len() as u64,
+        seed: o.seed,
+        evaluations,
+        f32: summarise(&mut all32),
+        f64: summarise(&mut all64),
+        excluding_structural_zeros: OutputAccuracy { f32: summarise(&mut nz32), f64: summarise(&mut nz64) },
+        outputs: OutputsMap(outputs),
+        reference,
+        structural_zeros: tape.outputs.iter().zip(skip).filter(|(_, &z)| z).map(|(o, _)| o.0.clone()).collect(),
+        worst,
+        worst_dir: o.worst_dir.clone(),
+    }
+}
+
+/// A readable summary: one line per function, then (with `per_output`) one per output.
+pub fn to_text(reports: &[AccuracyReport], per_output: bool) -> String {
+    let b = |s: &BitsSummary| format!("{:.2}/{:.2}/{:.2}", s.mean_bits, s.p95_bits, s.max_bits);
+    let mut s = String::new();
+    for r in reports {
+        let rc = &r.reference;
+        s += &format!(
+            "@{}: accuracy ({} inputs, {} samples, seed {}, {} evaluations): bits of error mean/p95/max \
+             f32 {} f64 {}; reference: {} double-double, {} at 256 bits, {} at 1024 bits, {} uncertified\n",
+            r.function,
+            r.mode,
+            r.samples,
+            r.seed,
+            r.evaluations,
+            b(&r.f32),
+            b(&r.f64),
+            rc.double_double,
+            rc.bits_256,
+            rc.bits_1024,
+            rc.uncertified
+        );
+        if !r.structural_zeros.is_empty() {
+            let x = &r.excluding_structural_zeros;
+            s += &format!(
+                "@{}: {} structural zero output(s) (exact value 0 through inexact steps): {}; without them \
+                 f32 {} f64 {}\n",
+                r.function,
+                r.structural_zeros.len(),
+                r.structural_zeros.join(", "),
+                b(&x.f32),
+                b(&x.f64)
+            );
+        }
+        if let Some(w) = r.worst.first() {
+            s += &format!(
+                "@{}: worst point: {:.2} bits (f32) on {}, {:.2} bits (f64)\n",
+                r.function, w.max_f32_bits, w.output, w.max_f64_bits
+            );
+        }
+        if per_output {
+            s += &format!("  {:<16} {:>20} {:>20}\n", "output", "f32 mean/p95/max", "f64 mean/p95/max");
+            for (name, o) in &r.outputs.0 {
+                s += &format!("  {:<16} {:>20} {:>20}\n", name, b(&o.f32), b(&o.f64));
+            }
+        }
+    }
+    s
+}
+
+/// The `worst-K.json` files of `r` (K from 1, worst first): file name and contents (a JSON
+/// object of input name → value that `-eval` reads). With `prefix`, names are
+/// `<function>-worst-K.json` (modules of several functions).
+pub fn worst_files(r: &AccuracyReport, prefix: bool) -> Vec<(String, String)> {
+    r.worst
+        .iter()
+        .enumerate()
+        .map(|(k, w)| {
+            let name =
+                if prefix { format!("{}-worst-{}.json", r.function, k + 1) } else { format!("worst-{}.json", k + 1) };
+            (name, serde_json::to_string_pretty(&w.inputs).expect("numbers serialise") + "\n")
+        })
+        .collect()
+}

@@ -1,0 +1,179 @@
+//! The numeric property every pipeline must keep (shared by the proptest suite and the
+//! cargo-fuzz target `pipeline_numerics`): run a pipeline on a `+ − ×` function, then
+//! - the module verifies after every pass (the manager's `verify-each`);
+//! - every output of the result stays within the error budget of `robovec_ir::numerics::budget`
+//!   around the exact value of the **original** function, in binary32 and binary64:
+//!   `|fl(after) − exact(before)| ≤ γ_K(after)·M(after) + γ_K(before)(2⁻¹⁰⁰)·M(before) + slack`,
+//!   the second term covering the double-double reference (so an algebraically different
+//!   rewrite fails, a reassociation within its rounding passes);
+//! - pipelines made only of passes in [`BIT_EXACT`] reproduce the original bit for bit, except
+//!   the sign of an exact zero (`atomise` writes `−t` as `0 − t`, README "Unary minus
+//!   semantics").
+//!
+//! Points whose `M` comes within a factor 4 of the format's largest value are not checked in
+//! that format (the budget assumes no overflow).
+
+use robovec_ir::numerics::budget::{allowed, gamma, terms, U32, U64};
+use robovec_ir::numerics::{Tape, DD};
+use robovec_ir::{Function, Module, Phase};
+
+use crate::{Instrumentation, PassContext, PassManager, PASSES};
+
+/// Passes that never change a computed value (no reassociation, no rewriting of arithmetic):
+/// a pipeline of these is checked bit for bit. Any other registered pass gets the budget check.
+pub const BIT_EXACT: &[&str] = &["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy"];
+
+/// Registered passes the property cannot build from default parameters because they need a
+/// file (none today: `accuracy`'s `params` file is optional).
+pub const NEEDS_FILE: &[&str] = &[];
+
+/// Every registered pass the property exercises (all of `PASSES` but [`NEEDS_FILE`]).
+pub fn checked_passes() -> Vec<&'static str> {
+    PASSES.iter().map(|p| p.name).filter(|n| !NEEDS_FILE.contains(n)).collect()
+}
+
+/// Passes that need another pass right before them, beyond the phase (`Pass::requires`):
+/// `sim` executes the placement that `place` attaches (any other pass in between may drop it).
+pub const NEEDS_BEFORE: &[(&str, &str)] = &[("sim", "place")];
+
+/// The pipeline text for `names` with default parameters: `atomise` inserted before the first
+/// pass that needs the atomised phase (the manager would reject it on parsed input), and the
+/// [`NEEDS_BEFORE`] prerequisites right before the passes that need them.
+pub fn pipeline_text(names: &[&str]) -> String {
+    let mut out: Vec<&str> = Vec::new();
+    let mut atomised = false;
+    let mut push = |n: &'static str, out: &mut Vec<&'static str>| {
+        let p = crate::pass_info(n).expect("registered pass");
+        let needs = (p.build)(&Default::default()).ok().and_then(|b| b.requires());
+        if needs == Some(Phase::Atomised) && !atomised {
+            out.push("atomise");
+            atomised = true;
+        }
+        atomised |= n == "atomise";
+        out.push(n);
+    };
+    for &n in names {
+        let n = checked_passes().into_iter().find(|&x| x == n).expect("registered pass");
+        if let Some(&(_, pre)) = NEEDS_BEFORE.iter().find(|(p, _)| *p == n) {
+            if out.last() != Some(&pre) {
+                push(pre, &mut out);
+            }
+        }
+        push(n, &mut out);
+    }
+    out.join(",")
+}
+
+fn same_bits<T: Copy + PartialEq + Into<f64>>(a: T, b: T, bits: impl Fn(T) -> u64) -> bool {
+    bits(a) == bits(b) || (a.into() == 0.0 && b.into() == 0.0)
+}
+
+/// Runs `pipeline` on `before` (a verified `+ − ×` function) and checks the property at every
+/// point (input values in `before`'s input order). Returns the function after the pipeline.
+///
+/// # Errors
+/// A message naming the pipeline, the output, the point and the figures.
+pub fn check(before: &Function, pipeline: &str, points: &[Vec<f64>]) -> Result<Function, String> {
+    let pm = PassManager::new(pipeline, Instrumentation::default()).map_err(|e| format!("{pipeline}: {e}"))?;
+    let mut m = Module { functions: vec![before.clone()] };
+    pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink()).map_err(|e| format!("{pipeline}: {e}"))?;
+    let after = m.functions.pop().ok_or_else(|| format!("{pipeline}: the function disappeared"))?;
+    let (t0, t1) = (Tape::new(before), Tape::new(&after));
+    let bit_exact = pipeline.split(',').all(|p| BIT_EXACT.contains(&p.split('<').next().unwrap_or("").trim()));
+    // Where each output and input of `after` sits in `before`.
+    let out_at: Vec<usize> = t1
+        .outputs
+        .iter()
+        .map(|(n, _)| t0.outputs.iter().position(|(m, _)| m == n).ok_or_else(|| format!("{pipeline}: new output {n}")))
+        .collect::<Result<_, _>>()?;
+    let in_at: Vec<usize> = t1
+        .inputs
+        .iter()
+        .map(|n| t0.inputs.iter().position(|m| m == n).ok_or_else(|| format!("{pipeline}: new input {n}")))
+        .collect::<Result<_, _>>()?;
+    for x in points {
+        let x1: Vec<f64> = in_at.iter().map(|&i| x[i]).collect();
+        let exact = t0.eval::<DD>(x);
+        let (Some(b0), Some(b1)) = (terms(&t0, x), terms(&t1, &x1)) else {
+            return Err(format!("{pipeline}: only + - * functions have a budget"));
+        };
+        let (y32, y64) = (t1.eval::<f32>(&x1), t1.eval::<f64>(&x1));
+        let (z32, z64) = (t0.eval::<f32>(x), t0.eval::<f64>(x));
+        for (k, &o) in out_at.iter().enumerate() {
+            let name = &t1.outputs[k].0;
+            if bit_exact
+                && !(same_bits(y32[k], z32[o], |v: f32| v.to_bits() as u64) && same_bits(y64[k], z64[o], f64::to_bits))
+            {
+                return Err(format!(
+                    "{pipeline}: {name} changed: f32 {:e} → {:e}, f64 {:e} → {:e} at {x:?}",
+                    z32[o], y32[k], z64[o], y64[k]
+                ));
+            }
+            let (k1, m1) = b1.outputs[k];
+            let (k0, m0) = b0.outputs[o];
+            let ref_err = gamma(k0, robovec_ir::numerics::dd::DD_UNIT) * m0;
+            for (got, u, max) in [(y32[k] as f64, U32, f32::MAX as f64), (y64[k], U64, f64::MAX)] {
+                if b1.max_m.max(b0.max_m) >= max / 4.0 {
+                    continue;
+                }
+                let err = (DD::from_f64(got) - exact[o]).abs().round_f64();
+                let budget = allowed(k1, m1, u, t1.steps.len()) + ref_err;
+                if !(err <= budget) {
+                    return Err(format!(
+                        "{pipeline}: {name} in {} is {err:e} from the exact value {:e}, above the budget \
+                         {budget:e} (K = {k1}, M = {m1:e}) at {x:?}",
+                        if u == U32 { "f32" } else { "f64" },
+                        exact[o].round_f64()
+                    ));
+                }
+            }
+        }
+    }
+    Ok(after)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use robovec_ir::text;
+
+    #[test]
+    fn pipeline_text_inserts_atomise_once() {
+        assert_eq!(pipeline_text(&["dce", "place", "sim"]), "dce,atomise,place,sim");
+        assert_eq!(pipeline_text(&["sim", "dce", "sim"]), "atomise,place,sim,dce,place,sim");
+        assert_eq!(pipeline_text(&["atomise", "asap-alap"]), "atomise,asap-alap");
+        assert_eq!(pipeline_text(&["accuracy"]), "accuracy");
+    }
+
+    #[test]
+    fn a_wrong_rewrite_is_caught_and_a_reassociation_is_not() {
+        // Reassociating (a + b) + c into a + (b + c) stays within budget; changing a constant
+        // does not. The "pipelines" here are empty; the functions stand for their results.
+        let before =
+            "func @f {\n  phase parsed\n  input %a\n  input %b\n  input %c\n  %y = %a + %b + %c\n  output y = %y\n}\n";
+        let f0 = text::parse(before).unwrap().functions.remove(0);
+        let points = vec![vec![1.0, 1e-8, -1.0], vec![3.0, 0.1f32 as f64, 1e-3f32 as f64]];
+        check(&f0, "dce", &points).unwrap();
+        let reassoc = before.replace("%a + %b + %c", "%a + (%b + %c)");
+        let f1 = text::parse(&reassoc).unwrap().functions.remove(0);
+        assert!(same_outputs_within_budget(&f0, &f1, &points).is_ok());
+        let wrong = before.replace("%a + %b + %c", "%a + %b + %c*1.5");
+        let f2 = text::parse(&wrong).unwrap().functions.remove(0);
+        assert!(same_outputs_within_budget(&f0, &f2, &points).is_err());
+    }
+
+    /// The budget part of [`check`] applied to two given functions (for the test above).
+    fn same_outputs_within_budget(f0: &Function, f1: &Function, points: &[Vec<f64>]) -> Result<(), String> {
+        let (t0, t1) = (Tape::new(f0), Tape::new(f1));
+        for x in points {
+            let exact = t0.eval::<DD>(x)[0];
+            let (k, m) = terms(&t1, x).unwrap().outputs[0];
+            let got = t1.eval::<f32>(x)[0] as f64;
+            let err = (DD::from_f64(got) - exact).abs().round_f64();
+            if err > allowed(k, m, U32, t1.steps.len()) + 1e-30 {
+                return Err(format!("{err:e}"));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,198 @@
+//! `-pareto="PIPELINE_A;PIPELINE_B;…"`: speed against error. Runs each pipeline on the same
+//! input, measures the final IR's speed (ops, critical path, placed cycles when the pipeline
+//! places) and its accuracy (the `accuracy` measurement with the same samples and seed for
+//! every pipeline), and marks the Pareto-optimal rows.
+//!
+//! **Dominance** (two objectives, both minimised): *time* = placed cycles when the pipeline
+//! placed, else the critical path `asap_cycle` (SPEC §4), and *error* = mean binary32 bits of
+//! error (Herbie's score, over every output and sample). A row is Pareto-optimal when no other
+//! row is at least as good in both and strictly better in one (Herbie's `pareto.rkt` frontier).
+//!
+//! Pipelines are separated by `;` outside `<…>` (parameters also use `;`); any registered pass
+//! works. A pipeline that does not parse or names an unknown pass is bad usage (exit 2); a
+//! pipeline that fails on the input is bad input (exit 1).
+
+use robovec_ir::{Function, Module};
+use robovec_passes::accuracy::{measure_function, BitsSummary, Options as AccuracyOptions};
+use robovec_passes::{Instrumentation, PassContext, PassManager};
+use serde::Serialize;
+
+use crate::driver::Failure;
+use crate::report::stats;
+
+/// One pipeline's figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct ParetoRow {
+    /// The pipeline as given (normalised).
+    pub pipeline: String,
+    /// Ops of the final IR (SPEC §1).
+    pub ops: u64,
+    /// Critical path in unit steps.
+    pub asap: u32,
+    /// Critical path in cycles (`asap_cycle`, with the pipeline's latencies).
+    pub asap_cycle: u32,
+    /// N (ADD PEs = MULTI PEs) of the placement, when the pipeline placed.
+    pub n: Option<u32>,
+    /// Cycles of the placement (SPEC §4), when the pipeline placed.
+    pub placed_cycles: Option<u32>,
+    /// The time objective: `placed_cycles`, else `asap_cycle`, cycles.
+    pub time_cycles: u32,
+    /// Samples of the accuracy measurement.
+    pub samples: u64,
+    /// binary32 bits of error (mean / 95th percentile / max).
+    pub f32: BitsSummary,
+    /// binary64 bits of error.
+    pub f64: BitsSummary,
+    /// True when no other row dominates this one.
+    pub pareto_optimal: bool,
+}
+
+/// Splits `-pareto`'s text into pipelines at `;` outside `<…>`.
+///
+/// # Errors
+/// A message for an empty list or an empty pipeline.
+pub fn split_pipelines(text: &str) -> Result<Vec<String>, String> {
+    let mut out = Vec::new();
+    let (mut depth, mut start) = (0i32, 0);
+    for (i, c) in text.char_indices() {
+        match c {
+            '<' => depth += 1,
+            '>' => depth -= 1,
+            ';' if depth == 0 => {
+                out.push(text[start..i].trim().to_string());
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    out.push(text[start..].trim().to_string());
+    if out.iter().any(String::is_empty) {
+        return Err(format!("error: -pareto: empty pipeline in `{text}` (pipelines are separated by `;`)\n"));
+    }
+    Ok(out)
+}
+
+/// Marks the rows no other row dominates (see the module doc).
+pub fn mark_front(rows: &mut [ParetoRow]) {
+    let key: Vec<(u32, f64)> = rows.iter().map(|r| (r.time_cycles, r.f32.mean_bits)).collect();
+    for (i, r) in rows.iter_mut().enumerate() {
+        let (t, e) = key[i];
+        r.pareto_optimal = !key.iter().any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e));
+    }
+}
+
+/// Runs every pipeline of `text` on a copy of `module` and measures function `function`.
+///
+/// # Errors
+/// [`Failure::Usage`] for a bad pipeline, [`Failure::Input`] when a pipeline fails.
+pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64) -> Result<Vec<ParetoRow>, Failure> {
+    let pipelines = split_pipelines(text).map_err(Failure::Usage)?;
+    let managers = pipelines
+        .iter()
+        .map(|p| {
+            PassManager::new(p, Instrumentation::default())
+                .map_err(|e| Failure::Usage(format!("error: -pareto pipeline `{p}`: {e}\n")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let opts = AccuracyOptions { samples, seed, ..AccuracyOptions::default() };
+    let mut rows = Vec::new();
+    for (p, pm) in pipelines.iter().zip(&managers) {
+        let mut m = module.clone();
+        let mut cx = PassContext::default();
+        pm.run(&mut m, &mut cx, &mut std::io::sink())
+            .map_err(|e| Failure::Input(format!("error: -pareto pipeline `{p}`: {e}\n")))?;
+        let f: &Function = m
+            .function(function)
+            .ok_or_else(|| Failure::Input(format!("error: -pareto pipeline `{p}` removed function @{function}\n")))?;
+        let s = stats(f, &cx.latencies);
+        let placed = f.placement.as_ref().map(|pl| (pl.arch.n_add, robovec_passes::place::cycles(f, pl)));
+        let acc = measure_function(f, &opts);
+        rows.push(ParetoRow {
+            pipeline: pm.pipeline_text(),
+            ops: s.ops.total,
+            asap: s.asap,
+            asap_cycle: s.asap_cycle,
+            n: placed.map(|x| x.0),
+            placed_cycles: placed.map(|x| x.1),
+            time_cycles: placed.map_or(s.asap_cycle, |x| x.1),
+            samples: acc.samples,
+            f32: acc.f32,
+            f64: acc.f64,
+            pareto_optimal: false,
+        });
+    }
+    mark_front(&mut rows);
+    Ok(rows)
+}
+
+/// The table printed on stderr (`*` marks Pareto-optimal rows).
+pub fn to_table(function: &str, rows: &[ParetoRow]) -> String {
+    let b = |s: &BitsSummary| format!("{:.2}/{:.2}/{:.2}", s.mean_bits, s.p95_bits, s.max_bits);
+    let w = rows.iter().map(|r| r.pipeline.len()).max().unwrap_or(8).max(8);
+    let mut s = format!(
+        "@{function}: speed against error ({} samples; * = Pareto-optimal in time (placed cycles, else critical \
+         path) and mean f32 bits)\n",
+        rows.first().map_or(0, |r| r.samples)
+    );
+    s += &format!(
+        "  {:<w$} {:>8} {:>11} {:>4} {:>8} {:>20} {:>20}\n",
+        "pipeline", "ops", "crit.path", "N", "placed", "f32 mean/p95/max", "f64 mean/p95/max"
+    );
+    for r in rows {
+        let opt = |x: Option<u32>| x.map_or(String::new(), |v| v.to_string());
+        s += &format!(
+            "{} {:<w$} {:>8} {:>11} {:>4} {:>8} {:>20} {:>20}\n",
+            if r.pareto_optimal { "*" } else { " " },
+            r.pipeline,
+            r.ops,
+            r.asap_cycle,
+            opt(r.n),
+            opt(r.placed_cycles),
+            b(&r.f32),
+            b(&r.f64)
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(time: u32, err: f64) -> ParetoRow {
+        let bits = BitsSummary { mean_bits: err, p95_bits: err, max_bits: err };
+        ParetoRow {
+            pipeline: format!("{time}/{err}"),
+            ops: 0,
+            asap: 0,
+            asap_cycle: time,
+            n: None,
+            placed_cycles: None,
+            time_cycles: time,
+            samples: 1,
+            f32: bits,
+            f64: bits,
+            pareto_optimal: false,
+        }
+    }
+
+    #[test]
+    fn front_by_hand() {
+        let mut rows = vec![row(100, 2.0), row(80, 3.0), row(80, 2.5), row(120, 1.0), row(130, 1.0), row(100, 2.0)];
+        mark_front(&mut rows);
+        let front: Vec<bool> = rows.iter().map(|r| r.pareto_optimal).collect();
+        // (80, 2.5) dominates (80, 3.0); (120, 1.0) dominates (130, 1.0); equal rows do not
+        // dominate each other.
+        assert_eq!(front, [true, false, true, true, false, true]);
+    }
+
+    #[test]
+    fn pipelines_split_outside_brackets() {
+        assert_eq!(
+            split_pipelines("atomise; atomise,place<pe=4;improve=0>;atomise,dce").unwrap(),
+            ["atomise", "atomise,place<pe=4;improve=0>", "atomise,dce"]
+        );
+        assert!(split_pipelines("atomise;;dce").is_err());
+        assert!(split_pipelines("").is_err());
+    }
+}
