@@ -81,6 +81,26 @@ impl OpCounts {
 }
 
 impl Function {
+    /// Values that an output or one of `roots` needs, transitively (indexed by
+    /// `Value::index()`): the liveness that dead-code removal keeps. Cost: O(values + operands).
+    pub fn live_values(&self, roots: &[Value]) -> Vec<bool> {
+        let mut live = vec![false; self.values.len()];
+        for v in roots {
+            live[v.index()] = true;
+        }
+        for o in &self.outputs {
+            if let Operand::Value(v) = o.value {
+                live[v.index()] = true;
+            }
+        }
+        for &v in self.body.iter().rev() {
+            if live[v.index()] {
+                self.value(v).def.for_each_value(|a| live[a.index()] = true);
+            }
+        }
+        live
+    }
+
     /// An empty function in `phase`.
     pub fn new(name: impl Into<String>, phase: Phase) -> Function {
         Function {

@@ -5,7 +5,7 @@
 //! array (`c` keeps `c[1]`, `c[2]`, …). An entry that matches no output of any function is an
 //! error. Works in both phases; clears timing attributes. Cost: O(values + operands).
 
-use robovec_ir::{Module, Operand};
+use robovec_ir::Module;
 
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
@@ -61,17 +61,7 @@ impl Pass for Dce {
             if let Some(keep) = &self.keep {
                 f.outputs.retain(|o| keep.iter().any(|e| matches(e, &o.name)));
             }
-            let mut live = vec![false; f.values.len()];
-            for o in &f.outputs {
-                if let Operand::Value(v) = o.value {
-                    live[v.index()] = true;
-                }
-            }
-            for &v in f.body.iter().rev() {
-                if live[v.index()] {
-                    f.value(v).def.for_each_value(|a| live[a.index()] = true);
-                }
-            }
+            let live = f.live_values(&[]);
             f.retain(|_, v| live[v.index()]);
             f.clear_timing();
         }

@@ -130,7 +130,7 @@ impl Tape {
     /// # Panics
     /// If `f` does not verify (a value read before its definition) or has 2³⁰ slots or more.
     pub fn new(f: &Function) -> Tape {
-        let live = live_values(f);
+        let live = f.live_values(&[]);
         let tape = Tape {
             inputs: f.inputs.iter().map(|&v| f.name_of(v).to_string()).collect(),
             consts: Vec::new(),
@@ -274,22 +274,6 @@ impl Tape {
         self.eval_into(inputs, &mut slots, &mut scratch);
         self.outputs.iter().map(|&(_, s)| slots[s as usize]).collect()
     }
-}
-
-/// Values some output needs (transitively), indexed by `Value::index()`.
-fn live_values(f: &Function) -> Vec<bool> {
-    let mut live = vec![false; f.values.len()];
-    for o in &f.outputs {
-        if let Operand::Value(v) = o.value {
-            live[v.index()] = true;
-        }
-    }
-    for &v in f.body.iter().rev() {
-        if live[v.index()] {
-            f.value(v).def.for_each_value(|x| live[x.index()] = true);
-        }
-    }
-    live
 }
 
 #[cfg(test)]

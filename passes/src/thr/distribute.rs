@@ -312,24 +312,16 @@ fn apply(f: &Function, picks: &[Pick]) -> Function {
         out.set_output(o.name.clone(), m(o.value, &map), o.span);
     }
     // Drop what distribution left without uses (the input's own dead code stays).
-    let mut live = vec![false; out.values.len()];
-    for &v in &f.body {
-        if cl.uses[v.index()] == 0 {
-            if let Operand::Value(x) = map[v.index()] {
-                live[x.index()] = true;
-            }
-        }
-    }
-    for o in &out.outputs {
-        if let Operand::Value(v) = o.value {
-            live[v.index()] = true;
-        }
-    }
-    for &v in out.body.iter().rev() {
-        if live[v.index()] {
-            out.value(v).def.for_each_value(|a| live[a.index()] = true);
-        }
-    }
+    let roots: Vec<Value> = f
+        .body
+        .iter()
+        .filter(|v| cl.uses[v.index()] == 0)
+        .filter_map(|v| match map[v.index()] {
+            Operand::Value(x) => Some(x),
+            Operand::Const(_) => None,
+        })
+        .collect();
+    let live = out.live_values(&roots);
     out.retain(|g, v| live[v.index()] || matches!(g.value(v).def, Def::Input));
     out
 }

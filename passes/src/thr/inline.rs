@@ -192,20 +192,7 @@ fn map_operands(def: Def, map: &[Operand]) -> Def {
 
 /// Removes values that neither an output nor a value of `keep` needs.
 fn drop_dead(f: &mut Function, keep: &[Value]) {
-    let mut live = vec![false; f.values.len()];
-    for v in keep {
-        live[v.index()] = true;
-    }
-    for o in &f.outputs {
-        if let Operand::Value(v) = o.value {
-            live[v.index()] = true;
-        }
-    }
-    for &v in f.body.iter().rev() {
-        if live[v.index()] {
-            f.value(v).def.for_each_value(|a| live[a.index()] = true);
-        }
-    }
+    let live = f.live_values(keep);
     // Inputs stay: inlining does not change which inputs a function reads.
     f.retain(|g, v| live[v.index()] || matches!(g.value(v).def, Def::Input));
 }
