@@ -201,7 +201,7 @@ fn pareto_table_and_report() {
         assert_eq!(rows[1]["pareto_optimal"], false);
         // The placed N = 4 run cannot beat the critical path: both are on the front only if equal.
         let front: Vec<bool> = rows.iter().map(|r| r["pareto_optimal"].as_bool().unwrap()).collect();
-        assert_eq!(front[0], true);
+        assert!(front[0]);
         assert_eq!(front[2], rows[2]["time_cycles"] == rows[0]["time_cycles"]);
     }
     let o = opt(&[PENDULUM, "-pareto=atomise;frobnicate"]);
