@@ -201,7 +201,7 @@ fn pareto_table_and_report() {
         assert_eq!(rows[1]["pareto_optimal"], false);
         // The placed N = 4 run cannot beat the critical path: both are on the front only if equal.
         let front: Vec<bool> = rows.iter().map(|r| r["pareto_optimal"].as_bool().unwrap()).collect();
-        assert_eq!(front[0], true);
+        assert!(front[0]);
         assert_eq!(front[2], rows[2]["time_cycles"] == rows[0]["time_cycles"]);
     }
     let o = opt(&[PENDULUM, "-pareto=atomise;frobnicate"]);
@@ -211,4 +211,23 @@ fn pareto_table_and_report() {
     assert_eq!(o.status.code(), Some(2));
     let o = opt(&[PENDULUM, "-pareto=place"]);
     assert_eq!(o.status.code(), Some(1), "place on parsed input fails: {}", stderr(&o));
+}
+
+#[test]
+fn modules_of_several_functions_get_one_worst_file_per_function() {
+    let d = tmp("sensors");
+    let dir = d.join("w");
+    let sensor = corpus_dir().join("c/m454__mbs_sensor_m454_project.c").display().to_string();
+    let passes = format!("-passes=accuracy<samples=20;worst={};worst-count=1>", dir.display());
+    let o = opt(&[&sensor, &passes, "-o", d.join("o.rvir").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["sensor_1-worst-1.json", "sensor_2-worst-1.json", "sensor_3-worst-1.json", "sensor_4-worst-1.json"]
+    );
+    let o = opt(&[&sensor, "-passes=", "-function=sensor_3", &format!("-eval={}", dir.join(&names[2]).display())]);
+    assert!(o.status.success() && !stderr(&o).contains("warning"), "{}", stderr(&o));
 }

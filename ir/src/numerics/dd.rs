@@ -174,7 +174,7 @@ fn next_down_f32(x: f32) -> f32 {
 
 /// π/2 as a sum of three binary64 values (fdlibm's `pio2_1`, `pio2_2`, `pio2_3` with full
 /// 53-bit parts).
-const PIO2: [f64; 3] = [1.5707963267948966, 6.123233995736766e-17, -1.4973849048591698e-33];
+const PIO2: [f64; 3] = [std::f64::consts::FRAC_PI_2, 6.123233995736766e-17, -1.4973849048591698e-33];
 
 /// `x = k·π/2 + r` with `|r| ≤ π/4` (approximately), for `|x| ≤ 2²⁰`.
 fn reduce(x: DD) -> Option<(i64, DD)> {
@@ -207,7 +207,7 @@ fn series(r2: DD, off: usize) -> DD {
     let mut acc = DD::from_f64(0.0);
     let mut n = (31 - off) / 2;
     loop {
-        let term = if n % 2 == 0 { c[2 * n + off] } else { -c[2 * n + off] };
+        let term = if n & 1 == 0 { c[2 * n + off] } else { -c[2 * n + off] };
         acc = acc * r2 + term;
         if n == 0 {
             return acc;
@@ -348,7 +348,7 @@ mod tests {
     #[test]
     fn trig_matches_known_values() {
         // sin(π/6) = 1/2 up to the error of π/6 in binary64: use exact identities instead.
-        for x in [0.1, 0.5, 1.0, 2.0, 3.0, -3.14159, 10.0, 1000.0] {
+        for x in [0.1, 0.5, 1.0, 2.0, 3.0, -3.1, 10.0, 1000.0] {
             let (s, c) = (DD::from_f64(x).sin(), DD::from_f64(x).cos());
             let one = s * s + c * c - DD::from_f64(1.0);
             assert!(one.round_f64().abs() < 1e-30, "sin²+cos²−1 = {:e} at {x}", one.round_f64());

@@ -165,7 +165,8 @@ impl Reference {
             let (v, e) = (self.dd[s as usize], self.err[s as usize]);
             let certified = dd_certified(v, e);
             let near_zero = e > 0.0 && v.hi.abs() <= e;
-            if !certified && !(near_zero && skip_big.is_some_and(|m| m[k])) {
+            let skip = near_zero && skip_big.is_some_and(|m| m[k]);
+            if !certified && !skip {
                 redo.push(k);
             }
             out.push(RefValue { f64: v.round_f64(), f32: v.round_f32(), certified, bits: 106, near_zero });
