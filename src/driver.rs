@@ -209,6 +209,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 sweep: cx.sweep.iter().filter(|r| r.function == f.name).cloned().collect(),
                 accuracy: cx.accuracy.iter().rev().find(|r| r.function == f.name).cloned(),
                 pareto: pareto.clone(),
+                eqsat: cx.eqsat.iter().filter(|e| e.function == f.name).cloned().collect(),
             };
             Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
         }

@@ -154,6 +154,10 @@ pub struct Report {
     /// The rows of `-pareto`, when given (speed against error, `crate::pareto`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pareto: Vec<crate::pareto::ParetoRow>,
+    /// What every `eqsat` run did to this function (windows, stop reasons, time per window),
+    /// when the pipeline ran `eqsat`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub eqsat: Vec<robovec_passes::eqsat::EqsatStats>,
 }
 
 /// `-eval` output: every input used and every output, in f64.

@@ -198,6 +198,28 @@ fn cli_runs_the_example_rules_and_prints_eqsat_stats() {
 }
 
 #[test]
+fn report_carries_eqsat_windows_and_stop_reasons() {
+    let dir = std::env::temp_dir().join(format!("robovec-eqsat-report-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let report = dir.join("report.json");
+    let o = opt(&[
+        "tests/ir/eqsat/late_leaf.rvir",
+        "-passes=eqsat",
+        &format!("-report={}", report.display()),
+        "-o",
+        dir.join("out.rvir").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let e = &r["eqsat"][0];
+    assert_eq!(e["function"], "f");
+    assert_eq!(e["windows_tried"], 2, "{e}");
+    assert_eq!(e["stops"]["saturated"], 2, "{e}");
+    assert_eq!((e["cp_before"].as_u64(), e["cp_after"].as_u64()), (Some(57), Some(36)), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn cli_bad_rules_file_is_an_input_error_with_a_located_diagnostic() {
     let d = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("eqsat-rules");
     std::fs::create_dir_all(&d).unwrap();
