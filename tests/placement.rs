@@ -5,15 +5,18 @@
 //! tightened through both types).
 //!
 //! Measured (release, 490 placements; `cargo run --release --example placement_quality`):
-//! 11 runs above 1.05 × SPEC LB, of which the tight bound proves 6 cannot be placed within
+//! 8 runs above 1.05 × SPEC LB, of which the tight bound proves 6 cannot be placed within
 //! 1.05 × SPEC LB by any placement (e.g. Mazda `invdyna` N=2: tight LB 1493 = 1.19 × SPEC LB
-//! 1253; we place it in 1495). 3 runs are above 1.05 × the tight bound, the Mazda `cons_hJ`
-//! Jacobian at N = 1, 2, 4 (worst 1.133), where the ADD PEs starve early while the MULTI PEs
-//! are saturated: the gap is either the heuristic's or the bound's.
+//! 1253; we place it in 1495). The other 2: tricycle `cons_hJ` N=2 (194 cycles, tight LB 190)
+//! and Mazda `cons_hJ` N=4 (155 cycles, tight LB 143 = its critical path), the only run above
+//! 1.05 × the tight bound. Feeding restarts (`schedule::Feed`) brought Mazda `cons_hJ` from
+//! 574/298/162 to within 1.02 × the tight bound at N=1 and 275/155 at N=2/4.
 
 use robovec_ir::Function;
 use robovec_passes::atomise::atomise_function;
-use robovec_passes::place::{cycles, lower_bound, place_function, tight_lower_bound, PlaceOptions, Priority, Select};
+use robovec_passes::place::{
+    cycles, lower_bound, memory, place_function, schedule, tight_lower_bound, PlaceOptions, Priority, Select,
+};
 use robovec_passes::sim::verify_placement;
 
 use crate::common::{corpus_files, is_loop_file};
@@ -81,8 +84,9 @@ fn corpus_placements_simulate_and_stay_near_the_lower_bound() {
     println!("total PE memory words: preferential {words_pref}, naive {words_naive}; buffer words: preferential {buf_pref}, naive {buf_naive}");
     assert!(runs > 400);
     println!("above 1.05 x tight lower bound:\n{}", above.join("\n"));
-    assert!(above.len() * 50 <= runs, "more than 2% of placements above 1.05 x tight LB:\n{}", above.join("\n"));
-    assert!(worst.0 <= 1.20, "worst cycles / tight LB {:.3} ({})", worst.0, worst.1);
+    assert!(above.len() <= 2, "more than 2 placements above 1.05 x tight LB:\n{}", above.join("\n"));
+    assert!(worst.0 <= 1.10, "worst cycles / tight LB {:.3} ({})", worst.0, worst.1);
+    assert!(over_spec <= 10, "{over_spec} runs above 1.05 x SPEC LB");
 }
 
 proptest::proptest! {
@@ -116,5 +120,47 @@ proptest::proptest! {
         if let Err(e) = verify_placement(&g, &[seed]) {
             proptest::prop_assert!(false, "{e}");
         }
+    }
+
+    /// The list scheduler with a feeding bonus (restarts use 8–64 cycles) places validly too.
+    #[test]
+    fn feeding_schedules_place_validly(n_ops in 1usize..300, seed in 0u64..1_000_000, n in 1u32..4, feed in 0u32..80) {
+        let f = robovec_passes::dag_gen::generate(n_ops, seed);
+        let o = PlaceOptions::with_pes(n);
+        let dag = schedule::OpDag::new(&f);
+        let keys = schedule::seed_keys(&f, &o.arch, Priority::Classical);
+        let s = schedule::schedule(&f, &dag, &o.arch, &keys, Select::Preferential, feed).expect("buffers on");
+        let mut g = f.clone();
+        g.placement = Some(memory::build(&f, &o.arch, &s));
+        proptest::prop_assert!(cycles(&g, g.placement.as_ref().unwrap()) >= tight_lower_bound(&f, &o.arch));
+        if let Err(e) = verify_placement(&g, &[seed]) {
+            proptest::prop_assert!(false, "{e}");
+        }
+    }
+}
+
+/// Feeding (`schedule::Feed`) on the Jacobian where both PE types are saturated: Mazda
+/// `cons_hJ` at N=1 has 505 ADD-side ops and 508 products, and the seed's ALAP order starves
+/// the ADD PE. One list schedule with a 16-cycle feeding bonus beats the seed's order by more
+/// than 5%, and the default placement (whose restarts try the bonuses) is within 1.05 × the
+/// SPEC §4 bound at N = 1 and 2.
+#[test]
+fn feeding_keeps_both_pe_types_busy_on_mazda_cons_hj() {
+    let p = crate::common::corpus_dir().join("python/mazda_mx5__mbs_cons_hJ_Robotran_Mazda_MX5.py");
+    let (m, _) = robovec::driver::load(p.to_str().unwrap()).unwrap_or_else(|e| panic!("{}", e.message()));
+    let f = atomise_function(&m.functions[0]);
+    let o = PlaceOptions::with_pes(1);
+    let dag = schedule::OpDag::new(&f);
+    let keys = schedule::seed_keys(&f, &o.arch, Priority::Classical);
+    let end = |feed| {
+        let s = schedule::schedule(&f, &dag, &o.arch, &keys, Select::Preferential, feed).expect("buffers on");
+        s.arrival.iter().copied().max().unwrap()
+    };
+    let (seed_order, fed) = (end(0), end(16));
+    assert!(fed * 100 < seed_order * 95, "feeding {fed} cycles vs the seed's order {seed_order}");
+    for n in [1, 2] {
+        let (g, c, lb, _) = placed(&f, n, Priority::Classical, Select::Preferential);
+        assert!(c * 100 <= lb * 105, "N={n}: {c} cycles, SPEC LB {lb}");
+        verify_placement(&g, &[7]).unwrap();
     }
 }

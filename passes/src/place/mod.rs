@@ -60,8 +60,10 @@ pub struct PlaceOptions {
     /// Rounds of forward-backward improvement after the seed's list schedule (0 = the seed's
     /// algorithm alone); the best schedule is kept.
     pub improve: u32,
-    /// Restarts with other priorities (the other seed priority, then ALAP keys with
-    /// deterministic random jitter of 8–32 cycles), each improved as above, tried only while
+    /// Restarts with other priorities (the other seed priority, then the seed keys with
+    /// feeding bonuses of 8–64 cycles — see `schedule::schedule` — then ALAP keys with
+    /// deterministic random jitter of 8–32 cycles, cycling through the bonuses), each improved
+    /// as above, tried only while
     /// the best schedule is more than 2% above [`tight_lower_bound`] or 5% above
     /// [`lower_bound`] (when the tight bound allows it); at most about 10⁶ op schedulings in
     /// all. 0 = none.
@@ -90,7 +92,7 @@ pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement
     let a = &opts.arch;
     let dag = schedule::OpDag::new(f);
     let seed = schedule::seed_keys(f, a, opts.priority);
-    let mut best = improved(f, &dag, opts, &seed)?;
+    let mut best = improved(f, &dag, opts, &seed, 0)?;
     let spec = lower_bound(f, a) as u64;
     // Within 2% of SPEC §4's bound (hence of the tight bound too): nothing to restart for, and
     // the tight bound (O(n log n) but not free) is not computed.
@@ -111,11 +113,17 @@ pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement
             if end(&best) as u64 <= target {
                 break;
             }
+            // Restart plan: the other seed priority; the seed keys with each feeding bonus;
+            // then jittered seed keys, cycling through the bonuses (0 = none).
+            const FEEDS: [u32; 5] = [0, 8, 16, 32, 64];
+            let feed = FEEDS[r as usize % FEEDS.len()];
             let keys = if r == 0 {
                 let other = if opts.priority == Priority::Classical { Priority::Mobility } else { Priority::Classical };
                 schedule::seed_keys(f, a, other)
+            } else if r < FEEDS.len() as u64 {
+                seed.clone()
             } else {
-                let amplitude = [8u64, 16, 32][r as usize % 3];
+                let amplitude = [8u64, 16, 32][(r as usize / FEEDS.len()) % 3];
                 seed.iter()
                     .map(|&(k0, k1, _)| {
                         rng ^= rng << 13;
@@ -125,7 +133,7 @@ pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement
                     })
                     .collect()
             };
-            let s = improved(f, &dag, opts, &keys)?;
+            let s = improved(f, &dag, opts, &keys, feed)?;
             if end(&s) < end(&best) {
                 best = s;
             }
@@ -149,9 +157,10 @@ fn improved(
     dag: &schedule::OpDag,
     opts: &PlaceOptions,
     keys: &[schedule::Key],
+    feed: u32,
 ) -> Result<schedule::Schedule, String> {
     let a = &opts.arch;
-    let mut best = schedule::schedule(f, dag, a, keys, opts.select)?;
+    let mut best = schedule::schedule(f, dag, a, keys, opts.select, feed)?;
     for _ in 0..opts.improve {
         // Backward pass: ops that arrived last go first in reverse time; then forward again in
         // order of the backward (justified) start times.
@@ -161,7 +170,7 @@ fn improved(
         let r = schedule::backward_starts(f, dag, a.n_add, a.n_mul, &a.lat, &back);
         let r_max = r.iter().copied().max().unwrap_or(0);
         let fwd: Vec<schedule::Key> = (0..f.values.len()).map(|i| (r_max - r[i], keys[i].0, i as u32)).collect();
-        let s = schedule::schedule(f, dag, a, &fwd, opts.select)?;
+        let s = schedule::schedule(f, dag, a, &fwd, opts.select, feed)?;
         if end(&s) >= end(&best) {
             break;
         }

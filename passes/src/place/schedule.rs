@@ -306,15 +306,88 @@ pub fn seed_keys(f: &Function, arch: &Arch, priority: Priority) -> Vec<Key> {
 /// A priority key: smaller is scheduled first.
 pub type Key = (u32, u32, u32);
 
+/// Feeding priority: an op that is the last unissued op operand of an op of the *other* PE
+/// type has its priority key lowered by `bonus` cycles, since issuing it makes work for the
+/// other PE type after one latency. When both PE types are saturated (Jacobians such as
+/// Mazda `cons_hJ`, with about one add per product), the seed's ALAP order issues the
+/// products of long chains first and starves the ADD PEs for tens of cycles; feeding keeps
+/// both types busy (issue 3's measurements: 574 → 531 cycles at N=1).
+struct Feed {
+    /// Cycles subtracted from the first key component (0 = off: the seed's static order).
+    bonus: u32,
+    /// Current key per value index (lowered at most once per user that it completes).
+    key: Vec<Key>,
+    /// Distinct op operands not yet issued, per value index.
+    unissued: Vec<u32>,
+}
+
+impl Feed {
+    fn new(dag: &OpDag, keys: &[Key], bonus: u32) -> Feed {
+        let mut feed = Feed { bonus, key: keys.to_vec(), unissued: dag.n_distinct.clone() };
+        if bonus > 0 {
+            for &w in &dag.ops {
+                if feed.unissued[w.index()] == 1 {
+                    let u = dag.operands_of(w).iter().flatten().next().copied().expect("one op operand");
+                    feed.lower(dag, u, w);
+                }
+            }
+        }
+        feed
+    }
+
+    /// Lowers the key of `u` (an unissued operand of `w`) if the two are of different types;
+    /// returns the new key when it changed.
+    fn lower(&mut self, dag: &OpDag, u: Value, w: Value) -> Option<Key> {
+        if dag.is_mul(u) == dag.is_mul(w) {
+            return None;
+        }
+        let c = &mut self.key[u.index()];
+        let lowered = (c.0.saturating_sub(self.bonus), c.1, c.2);
+        (lowered < *c).then(|| {
+            *c = lowered;
+            lowered
+        })
+    }
+
+    /// After `v` is issued: the ops whose last unissued operand is now known, with their new
+    /// keys (pushed to `out`).
+    fn issued(&mut self, dag: &OpDag, issue: &[Option<(usize, u32)>], v: Value, out: &mut Vec<(Key, Value)>) {
+        if self.bonus == 0 {
+            return;
+        }
+        for &w in dag.users_of(v) {
+            self.unissued[w.index()] -= 1;
+            if self.unissued[w.index()] != 1 {
+                continue;
+            }
+            let last = dag.operands_of(w).iter().flatten().copied().find(|u| issue[u.index()].is_none());
+            if let Some(u) = last {
+                if let Some(k) = self.lower(dag, u, w) {
+                    out.push((k, u));
+                }
+            }
+        }
+    }
+}
+
 /// Schedules every op of `f` (atomised, verified) on `arch`, ready ops taken in increasing
-/// `keys` order (indexed by value index).
+/// `keys` order (indexed by value index), with the feeding bonus `feed` in cycles (see
+/// [`Feed`]; 0 = the seed's static order).
 ///
 /// # Errors
 /// Only without buffers: an op whose operand can no longer reach any PE memory of its type.
-pub fn schedule(f: &Function, dag: &OpDag, arch: &Arch, keys: &[Key], select: Select) -> Result<Schedule, String> {
+pub fn schedule(
+    f: &Function,
+    dag: &OpDag,
+    arch: &Arch,
+    keys: &[Key],
+    select: Select,
+    feed: u32,
+) -> Result<Schedule, String> {
     let n = f.values.len();
     let kind = |v: Value| f.op_kind(v).expect("op");
-    let key = |v: Value| keys[v.index()];
+    let mut feed = Feed::new(dag, keys, feed);
+    let mut lowered = Vec::new();
     let mut pending = dag.n_distinct.clone();
     let mut ctx = Ctx {
         arch,
@@ -327,7 +400,7 @@ pub fn schedule(f: &Function, dag: &OpDag, arch: &Arch, keys: &[Key], select: Se
     let mut ready: [BinaryHeap<Reverse<(Key, Value)>>; 2] = [BinaryHeap::new(), BinaryHeap::new()];
     for &v in &dag.ops {
         if pending[v.index()] == 0 {
-            ready[dag.is_mul(v) as usize].push(Reverse((key(v), v)));
+            ready[dag.is_mul(v) as usize].push(Reverse((feed.key[v.index()], v)));
         }
     }
     let mut arrivals: BinaryHeap<Reverse<(u32, Value)>> = BinaryHeap::new();
@@ -354,7 +427,7 @@ pub fn schedule(f: &Function, dag: &OpDag, arch: &Arch, keys: &[Key], select: Se
             for &u in dag.users_of(v) {
                 pending[u.index()] -= 1;
                 if pending[u.index()] == 0 {
-                    ready[dag.is_mul(u) as usize].push(Reverse((key(u), u)));
+                    ready[dag.is_mul(u) as usize].push(Reverse((feed.key[u.index()], u)));
                 }
             }
         }
@@ -368,6 +441,9 @@ pub fn schedule(f: &Function, dag: &OpDag, arch: &Arch, keys: &[Key], select: Se
             deferred.clear();
             while !free.is_empty() {
                 let Some(Reverse((k, v))) = ready[ty].pop() else { break };
+                if k != feed.key[v.index()] || ctx.issue[v.index()].is_some() {
+                    continue; // stale entry (the key was lowered since)
+                }
                 let operands = dag.operands_of(v);
                 let mut best: Option<(u32, usize)> = None;
                 for (i, &q) in free.iter().enumerate() {
@@ -399,6 +475,12 @@ pub fn schedule(f: &Function, dag: &OpDag, arch: &Arch, keys: &[Key], select: Se
                         arrivals.push(Reverse((t + lat, v)));
                         placed += 1;
                         progress = true;
+                        feed.issued(dag, &ctx.issue, v, &mut lowered);
+                        for (k, u) in lowered.drain(..) {
+                            if pending[u.index()] == 0 {
+                                ready[dag.is_mul(u) as usize].push(Reverse((k, u)));
+                            }
+                        }
                         free.sort_unstable();
                     }
                     None => deferred.push(Reverse((k, v))),
