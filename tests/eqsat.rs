@@ -18,9 +18,9 @@
 //! depth (constants folded by the pass are counted as roundings of the original's depth). Leaves
 //! are inputs, constants and trig values (computed identically in both forms). Outputs that
 //! depend on a `div` or a call (5 files) use a first-order running error bound instead:
-//! E(a±b) = Ea + Eb + u|r|, E(a·b) = |a|Eb + |b|Ea + EaEb + u|r|, E(a/b) = (Ea + |r|Eb)/(|b| − Eb)
-//! + u|r|, E(√a) = min(√Ea, Ea/√a) + u|r|, and a callback's stand-in Σ wₖaₖ (|wₖ| ≤ 1):
-//! ΣEₖ + γ₂ₙ·Σ|aₖ|.
+//! E(a±b) = Ea + Eb + u|r|, E(a·b) = |a|Eb + |b|Ea + EaEb + u|r|,
+//! E(a/b) = (Ea + |r|Eb)/(|b| − Eb) + u|r|, E(√a) = min(√Ea, Ea/√a) + u|r|, and a callback's
+//! stand-in Σ wₖaₖ (|wₖ| ≤ 1): ΣEₖ + γ₂ₙ·Σ|aₖ|.
 
 use robovec_ir::analysis::{compute_timing, Latencies};
 use robovec_ir::interp::{eval_values, pseudo_random_input};

@@ -8,9 +8,9 @@
 //! 8 runs above 1.05 × SPEC LB, of which the tight bound proves 6 cannot be placed within
 //! 1.05 × SPEC LB by any placement (e.g. Mazda `invdyna` N=2: tight LB 1493 = 1.19 × SPEC LB
 //! 1253; we place it in 1495). The other 2: tricycle `cons_hJ` N=2 (194 cycles, tight LB 190)
-//! and Mazda `cons_hJ` N=4 (155 cycles, tight LB 143 = its critical path), the only run above
+//! and Mazda `cons_hJ` N=4 (152 cycles, tight LB 143 = its critical path), the only run above
 //! 1.05 × the tight bound. Feeding restarts (`schedule::Feed`) brought Mazda `cons_hJ` from
-//! 574/298/162 to within 1.02 × the tight bound at N=1 and 275/155 at N=2/4.
+//! 574/298/162 cycles at N=1/2/4 to 516 (= the tight bound: optimal)/271/152.
 
 use robovec_ir::Function;
 use robovec_passes::atomise::atomise_function;

@@ -61,7 +61,7 @@ pub struct PlaceOptions {
     /// algorithm alone); the best schedule is kept.
     pub improve: u32,
     /// Restarts with other priorities (the other seed priority, then the seed keys with
-    /// feeding bonuses of 8–64 cycles — see `schedule::schedule` — then ALAP keys with
+    /// feeding bonuses of 8–1000 cycles — see `schedule::schedule` — then ALAP keys with
     /// deterministic random jitter of 8–32 cycles, cycling through the bonuses), each improved
     /// as above, tried only while
     /// the best schedule is more than 2% above [`tight_lower_bound`] or 5% above
@@ -113,9 +113,9 @@ pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement
             if end(&best) as u64 <= target {
                 break;
             }
-            // Restart plan: the other seed priority; the seed keys with each feeding bonus;
-            // then jittered seed keys, cycling through the bonuses (0 = none).
-            const FEEDS: [u32; 5] = [0, 8, 16, 32, 64];
+            // Restart plan: the other seed priority; the seed keys with each feeding bonus (1000
+            // = feed first); then jittered seed keys, cycling through the bonuses (0 = none).
+            const FEEDS: [u32; 7] = [0, 8, 16, 32, 64, 128, 1000];
             let feed = FEEDS[r as usize % FEEDS.len()];
             let keys = if r == 0 {
                 let other = if opts.priority == Priority::Classical { Priority::Mobility } else { Priority::Classical };
@@ -167,7 +167,7 @@ fn improved(
         let t = end(&best);
         let back: Vec<schedule::Key> =
             (0..f.values.len()).map(|i| (t - best.arrival[i], keys[i].0, i as u32)).collect();
-        let r = schedule::backward_starts(f, dag, a.n_add, a.n_mul, &a.lat, &back);
+        let r = schedule::backward_starts(f, dag, a.n_add, a.n_mul, &a.lat, &back, feed);
         let r_max = r.iter().copied().max().unwrap_or(0);
         let fwd: Vec<schedule::Key> = (0..f.values.len()).map(|i| (r_max - r[i], keys[i].0, i as u32)).collect();
         let s = schedule::schedule(f, dag, a, &fwd, opts.select, feed)?;

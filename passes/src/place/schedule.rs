@@ -283,6 +283,12 @@ impl OpDag {
         &self.users[self.user_at[v.index()] as usize..self.user_at[v.index() + 1] as usize]
     }
 
+    /// Distinct op operands of `v`, in operand order.
+    pub fn distinct_operands(&self, v: Value) -> Vec<Value> {
+        let row = self.operands_of(v);
+        row.iter().enumerate().filter_map(|(j, &o)| o.filter(|a| !row[..j].contains(&Some(*a)))).collect()
+    }
+
     /// True for an op of the MULTI side.
     pub fn is_mul(&self, v: Value) -> bool {
         self.mul[v.index()]
@@ -311,23 +317,32 @@ pub type Key = (u32, u32, u32);
 /// other PE type after one latency. When both PE types are saturated (Jacobians such as
 /// Mazda `cons_hJ`, with about one add per product), the seed's ALAP order issues the
 /// products of long chains first and starves the ADD PEs for tens of cycles; feeding keeps
-/// both types busy (issue 3's measurements: 574 → 531 cycles at N=1).
+/// both types busy (issue 3's measurements, with restarts: 574 → 516 cycles at N=1, which is the
+/// tight lower bound, hence optimal; 162 → 152 at N=4). The
+/// backward schedule of forward-backward improvement feeds in reverse time the same way.
 struct Feed {
     /// Cycles subtracted from the first key component (0 = off: the seed's static order).
     bonus: u32,
-    /// Current key per value index (lowered at most once per user that it completes).
+    /// True in a backward (reverse-time) schedule: "operand" and "user" swap roles.
+    backward: bool,
+    /// Current key per value index (lowered at most once per op that it completes).
     key: Vec<Key>,
-    /// Distinct op operands not yet issued, per value index.
+    /// Distinct op predecessors (operands; users when backward) not yet issued, per value index.
     unissued: Vec<u32>,
 }
 
 impl Feed {
-    fn new(dag: &OpDag, keys: &[Key], bonus: u32) -> Feed {
-        let mut feed = Feed { bonus, key: keys.to_vec(), unissued: dag.n_distinct.clone() };
+    fn new(dag: &OpDag, keys: &[Key], bonus: u32, backward: bool) -> Feed {
+        let unissued = if backward {
+            (0..keys.len()).map(|i| dag.user_at[i + 1] - dag.user_at[i]).collect()
+        } else {
+            dag.n_distinct.clone()
+        };
+        let mut feed = Feed { bonus, backward, key: keys.to_vec(), unissued };
         if bonus > 0 {
             for &w in &dag.ops {
                 if feed.unissued[w.index()] == 1 {
-                    let u = dag.operands_of(w).iter().flatten().next().copied().expect("one op operand");
+                    let u = feed.preds(dag, w)[0];
                     feed.lower(dag, u, w);
                 }
             }
@@ -335,8 +350,27 @@ impl Feed {
         feed
     }
 
-    /// Lowers the key of `u` (an unissued operand of `w`) if the two are of different types;
-    /// returns the new key when it changed.
+    /// Distinct op predecessors of `w` in the schedule's direction (operands forward, users
+    /// backward).
+    fn preds(&self, dag: &OpDag, w: Value) -> Vec<Value> {
+        if self.backward {
+            dag.users_of(w).to_vec()
+        } else {
+            dag.distinct_operands(w)
+        }
+    }
+
+    /// Distinct op successors of `v` in the schedule's direction.
+    fn succs(&self, dag: &OpDag, v: Value) -> Vec<Value> {
+        if self.backward {
+            dag.distinct_operands(v)
+        } else {
+            dag.users_of(v).to_vec()
+        }
+    }
+
+    /// Lowers the key of `u` (an unissued predecessor of `w`) if the two are of different
+    /// types; returns the new key when it changed.
     fn lower(&mut self, dag: &OpDag, u: Value, w: Value) -> Option<Key> {
         if dag.is_mul(u) == dag.is_mul(w) {
             return None;
@@ -349,18 +383,18 @@ impl Feed {
         })
     }
 
-    /// After `v` is issued: the ops whose last unissued operand is now known, with their new
-    /// keys (pushed to `out`).
-    fn issued(&mut self, dag: &OpDag, issue: &[Option<(usize, u32)>], v: Value, out: &mut Vec<(Key, Value)>) {
+    /// After `v` is issued (`done(u)`: whether `u` is issued): the ops whose last unissued
+    /// predecessor is now known, with their new keys (pushed to `out`).
+    fn issued(&mut self, dag: &OpDag, done: impl Fn(Value) -> bool, v: Value, out: &mut Vec<(Key, Value)>) {
         if self.bonus == 0 {
             return;
         }
-        for &w in dag.users_of(v) {
+        for w in self.succs(dag, v) {
             self.unissued[w.index()] -= 1;
             if self.unissued[w.index()] != 1 {
                 continue;
             }
-            let last = dag.operands_of(w).iter().flatten().copied().find(|u| issue[u.index()].is_none());
+            let last = self.preds(dag, w).into_iter().find(|&u| !done(u));
             if let Some(u) = last {
                 if let Some(k) = self.lower(dag, u, w) {
                     out.push((k, u));
@@ -386,7 +420,7 @@ pub fn schedule(
 ) -> Result<Schedule, String> {
     let n = f.values.len();
     let kind = |v: Value| f.op_kind(v).expect("op");
-    let mut feed = Feed::new(dag, keys, feed);
+    let mut feed = Feed::new(dag, keys, feed, false);
     let mut lowered = Vec::new();
     let mut pending = dag.n_distinct.clone();
     let mut ctx = Ctx {
@@ -475,7 +509,7 @@ pub fn schedule(
                         arrivals.push(Reverse((t + lat, v)));
                         placed += 1;
                         progress = true;
-                        feed.issued(dag, &ctx.issue, v, &mut lowered);
+                        feed.issued(dag, |u| ctx.issue[u.index()].is_some(), v, &mut lowered);
                         for (k, u) in lowered.drain(..) {
                             if pending[u.index()] == 0 {
                                 ready[dag.is_mul(u) as usize].push(Reverse((k, u)));
@@ -533,9 +567,21 @@ pub fn initial_operands(f: &Function, v: Value) -> Vec<Operand> {
 ///
 /// Used by forward-backward improvement (Tormos & Lova 2001; "justification", Valls et al.
 /// 2005): scheduling forward again in decreasing `r` order packs the resources better than
-/// ALAP order when both PE types are saturated. Cost: O(n log n).
-pub fn backward_starts(f: &Function, dag: &OpDag, n_add: u32, n_mul: u32, lat: &Latencies, keys: &[Key]) -> Vec<u32> {
+/// ALAP order when both PE types are saturated. `feed` is the feeding bonus in cycles (see
+/// [`Feed`]), applied in reverse time: an op that is the last unissued user of an op of the
+/// other type goes earlier. Cost: O(n log n).
+pub fn backward_starts(
+    f: &Function,
+    dag: &OpDag,
+    n_add: u32,
+    n_mul: u32,
+    lat: &Latencies,
+    keys: &[Key],
+    feed: u32,
+) -> Vec<u32> {
     let n = f.values.len();
+    let mut feed = Feed::new(dag, keys, feed, true);
+    let (mut lowered, mut in_ready, mut placed) = (Vec::new(), vec![false; n], vec![false; n]);
     let mut pending: Vec<u32> = (0..n).map(|i| dag.user_at[i + 1] - dag.user_at[i]).collect();
     let mut earliest = vec![0u32; n]; // reverse ready time before the op's own latency
     let mut r = vec![0u32; n];
@@ -555,13 +601,26 @@ pub fn backward_starts(f: &Function, dag: &OpDag, n_add: u32, n_mul: u32, lat: &
                 break;
             }
             waiting.pop();
-            ready[dag.is_mul(v) as usize].push(Reverse((keys[v.index()], v)));
+            in_ready[v.index()] = true;
+            ready[dag.is_mul(v) as usize].push(Reverse((feed.key[v.index()], v)));
         }
         for ty in 0..2 {
-            for _ in 0..caps[ty] {
-                let Some(Reverse((_, v))) = ready[ty].pop() else { break };
+            let mut issued = 0;
+            while issued < caps[ty] {
+                let Some(Reverse((k, v))) = ready[ty].pop() else { break };
+                if k != feed.key[v.index()] || placed[v.index()] {
+                    continue; // stale entry (the key was lowered since)
+                }
+                issued += 1;
                 r[v.index()] = t;
+                placed[v.index()] = true;
                 done += 1;
+                feed.issued(dag, |u| placed[u.index()], v, &mut lowered);
+                for (k, u) in lowered.drain(..) {
+                    if in_ready[u.index()] {
+                        ready[dag.is_mul(u) as usize].push(Reverse((k, u)));
+                    }
+                }
                 // Operands: ready in reverse time once every user is placed, after their latency.
                 let row = dag.operands_of(v);
                 for (j, &o) in row.iter().enumerate() {
