@@ -185,7 +185,7 @@ fn tighten(
 ///
 /// Valid: in any placement, an op issues no earlier than its head, and at least its tail
 /// remains after its issue; the relaxation drops only constraints. Cost: O(n log n) plus the
-/// bounded tightening (at most [`TIGHTEN_BUDGET`] ancestor visits).
+/// bounded tightening (at most `TIGHTEN_BUDGET` = 10⁶ ancestor visits).
 pub fn tight_lower_bound(f: &Function, arch: &Arch) -> u32 {
     let Some((dag, head, rhead)) = heads_and_tails(f, arch) else { return 0 };
     let mut best = lower_bound(f, arch);

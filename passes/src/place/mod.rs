@@ -19,6 +19,7 @@
 //! O(n log n + n·N) for n ops and N PEs per type.
 
 pub mod bound;
+pub mod feed;
 pub mod memory;
 pub mod schedule;
 
@@ -150,8 +151,8 @@ fn end(s: &schedule::Schedule) -> u32 {
     s.arrival.iter().copied().max().unwrap_or(0)
 }
 
-/// The list schedule for `keys`, then up to `opts.improve` rounds of forward-backward
-/// improvement (kept while they shorten it).
+/// The list schedule for `keys` with feeding bonus `feed` (cycles, see [`feed::Feed`]), then up
+/// to `opts.improve` rounds of forward-backward improvement (kept while they shorten it).
 fn improved(
     f: &Function,
     dag: &schedule::OpDag,

@@ -21,6 +21,7 @@ use robovec_ir::analysis::compute_timing;
 use robovec_ir::placement::{Arch, Pe};
 use robovec_ir::{Function, OpKind, Operand, Value};
 
+use super::feed::Feed;
 use super::{Priority, Select};
 use robovec_ir::analysis::Latencies;
 
@@ -203,10 +204,10 @@ pub struct OpDag {
     operand_at: Vec<u32>,
     operands: Vec<Option<Value>>,
     /// `users[user_at[i]..user_at[i + 1]]`: distinct op users of value i.
-    user_at: Vec<u32>,
+    pub(crate) user_at: Vec<u32>,
     users: Vec<Value>,
     /// Distinct op operands per value.
-    n_distinct: Vec<u32>,
+    pub(crate) n_distinct: Vec<u32>,
 }
 
 impl OpDag {
@@ -311,98 +312,6 @@ pub fn seed_keys(f: &Function, arch: &Arch, priority: Priority) -> Vec<Key> {
 
 /// A priority key: smaller is scheduled first.
 pub type Key = (u32, u32, u32);
-
-/// Feeding priority: an op that is the last unissued op operand of an op of the *other* PE
-/// type has its priority key lowered by `bonus` cycles, since issuing it makes work for the
-/// other PE type after one latency. When both PE types are saturated (Jacobians such as
-/// Mazda `cons_hJ`, with about one add per product), the seed's ALAP order issues the
-/// products of long chains first and starves the ADD PEs for tens of cycles; feeding keeps
-/// both types busy (issue 3's measurements, with restarts: 574 → 516 cycles at N=1, which is the
-/// tight lower bound, hence optimal; 162 → 152 at N=4). The
-/// backward schedule of forward-backward improvement feeds in reverse time the same way.
-struct Feed {
-    /// Cycles subtracted from the first key component (0 = off: the seed's static order).
-    bonus: u32,
-    /// True in a backward (reverse-time) schedule: "operand" and "user" swap roles.
-    backward: bool,
-    /// Current key per value index (lowered at most once per op that it completes).
-    key: Vec<Key>,
-    /// Distinct op predecessors (operands; users when backward) not yet issued, per value index.
-    unissued: Vec<u32>,
-}
-
-impl Feed {
-    fn new(dag: &OpDag, keys: &[Key], bonus: u32, backward: bool) -> Feed {
-        let unissued = if backward {
-            (0..keys.len()).map(|i| dag.user_at[i + 1] - dag.user_at[i]).collect()
-        } else {
-            dag.n_distinct.clone()
-        };
-        let mut feed = Feed { bonus, backward, key: keys.to_vec(), unissued };
-        if bonus > 0 {
-            for &w in &dag.ops {
-                if feed.unissued[w.index()] == 1 {
-                    let u = feed.preds(dag, w)[0];
-                    feed.lower(dag, u, w);
-                }
-            }
-        }
-        feed
-    }
-
-    /// Distinct op predecessors of `w` in the schedule's direction (operands forward, users
-    /// backward).
-    fn preds(&self, dag: &OpDag, w: Value) -> Vec<Value> {
-        if self.backward {
-            dag.users_of(w).to_vec()
-        } else {
-            dag.distinct_operands(w)
-        }
-    }
-
-    /// Distinct op successors of `v` in the schedule's direction.
-    fn succs(&self, dag: &OpDag, v: Value) -> Vec<Value> {
-        if self.backward {
-            dag.distinct_operands(v)
-        } else {
-            dag.users_of(v).to_vec()
-        }
-    }
-
-    /// Lowers the key of `u` (an unissued predecessor of `w`) if the two are of different
-    /// types; returns the new key when it changed.
-    fn lower(&mut self, dag: &OpDag, u: Value, w: Value) -> Option<Key> {
-        if dag.is_mul(u) == dag.is_mul(w) {
-            return None;
-        }
-        let c = &mut self.key[u.index()];
-        let lowered = (c.0.saturating_sub(self.bonus), c.1, c.2);
-        (lowered < *c).then(|| {
-            *c = lowered;
-            lowered
-        })
-    }
-
-    /// After `v` is issued (`done(u)`: whether `u` is issued): the ops whose last unissued
-    /// predecessor is now known, with their new keys (pushed to `out`).
-    fn issued(&mut self, dag: &OpDag, done: impl Fn(Value) -> bool, v: Value, out: &mut Vec<(Key, Value)>) {
-        if self.bonus == 0 {
-            return;
-        }
-        for w in self.succs(dag, v) {
-            self.unissued[w.index()] -= 1;
-            if self.unissued[w.index()] != 1 {
-                continue;
-            }
-            let last = self.preds(dag, w).into_iter().find(|&u| !done(u));
-            if let Some(u) = last {
-                if let Some(k) = self.lower(dag, u, w) {
-                    out.push((k, u));
-                }
-            }
-        }
-    }
-}
 
 /// Schedules every op of `f` (atomised, verified) on `arch`, ready ops taken in increasing
 /// `keys` order (indexed by value index), with the feeding bonus `feed` in cycles (see
