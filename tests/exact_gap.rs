@@ -117,8 +117,9 @@ fn list_scheduling_vs_optimum() {
                     priority: *priority,
                     select: Select::Preferential,
                     improve: *improve,
-                    // improve = 0 is the seed's algorithm alone: no restarts either.
+                    // improve = 0 is the seed's algorithm alone: no restarts or search either.
                     restarts: if *improve == 0 { 0 } else { PlaceOptions::with_pes(*tn).restarts },
+                    search: if *improve == 0 { 0 } else { PlaceOptions::with_pes(*tn).search },
                     ..PlaceOptions::with_pes(*tn)
                 };
                 let p = place_function(f, &opts);

@@ -5,12 +5,13 @@
 //! tightened through both types).
 //!
 //! Measured (release, 490 placements; `cargo run --release --example placement_quality`):
-//! 8 runs above 1.05 × SPEC LB, of which the tight bound proves 6 cannot be placed within
-//! 1.05 × SPEC LB by any placement (e.g. Mazda `invdyna` N=2: tight LB 1493 = 1.19 × SPEC LB
-//! 1253; we place it in 1495). The other 2: tricycle `cons_hJ` N=2 (194 cycles, tight LB 190)
-//! and Mazda `cons_hJ` N=4 (152 cycles, tight LB 143 = its critical path), the only run above
-//! 1.05 × the tight bound. Feeding restarts (`schedule::Feed`) brought Mazda `cons_hJ` from
-//! 574/298/162 cycles at N=1/2/4 to 516 (= the tight bound: optimal)/271/152.
+//! every placement is within 1.05 × the tight bound (worst: Mazda `cons_hJ` N=4, 150 cycles
+//! against 143). 7 runs are above 1.05 × SPEC LB, and the tight bound proves that 6 of them
+//! cannot be placed within 1.05 × SPEC LB by any placement (e.g. Mazda `invdyna` N=2: tight LB
+//! 1493 = 1.19 × SPEC LB 1253; we place it in 1495). The last one is tricycle `cons_hJ` N=2:
+//! 192 cycles, SPEC LB 181, tight LB 190. Feeding restarts (`feed::Feed`) and the key-mutation
+//! search (`search`) brought Mazda `cons_hJ` from 574/298/162 cycles at N=1/2/4 to 516 (= the
+//! tight bound: optimal)/271/150.
 
 use robovec_ir::Function;
 use robovec_passes::atomise::atomise_function;
@@ -84,9 +85,8 @@ fn corpus_placements_simulate_and_stay_near_the_lower_bound() {
     println!("total PE memory words: preferential {words_pref}, naive {words_naive}; buffer words: preferential {buf_pref}, naive {buf_naive}");
     assert!(runs > 400);
     println!("above 1.05 x tight lower bound:\n{}", above.join("\n"));
-    assert!(above.len() <= 2, "more than 2 placements above 1.05 x tight LB:\n{}", above.join("\n"));
-    assert!(worst.0 <= 1.10, "worst cycles / tight LB {:.3} ({})", worst.0, worst.1);
-    assert!(over_spec <= 10, "{over_spec} runs above 1.05 x SPEC LB");
+    assert!(above.is_empty(), "placements above 1.05 x tight LB:\n{}", above.join("\n"));
+    assert!(over_spec <= 8, "{over_spec} runs above 1.05 x SPEC LB");
 }
 
 proptest::proptest! {
@@ -122,7 +122,7 @@ proptest::proptest! {
         }
     }
 
-    /// The list scheduler with a feeding bonus (restarts use 8–64 cycles) places validly too.
+    /// The list scheduler with a feeding bonus (restarts use 8–1000 cycles) places validly too.
     #[test]
     fn feeding_schedules_place_validly(n_ops in 1usize..300, seed in 0u64..1_000_000, n in 1u32..4, feed in 0u32..80) {
         let f = robovec_passes::dag_gen::generate(n_ops, seed);
@@ -142,8 +142,8 @@ proptest::proptest! {
 /// Feeding (`schedule::Feed`) on the Jacobian where both PE types are saturated: Mazda
 /// `cons_hJ` at N=1 has 505 ADD-side ops and 508 products, and the seed's ALAP order starves
 /// the ADD PE. One list schedule with a 16-cycle feeding bonus beats the seed's order by more
-/// than 5%, and the default placement (whose restarts try the bonuses) is within 1.05 × the
-/// SPEC §4 bound at N = 1 and 2.
+/// than 5%, and the default placement (whose restarts try the bonuses, then the key-mutation
+/// search) is within 1.05 × the SPEC §4 bound at N = 1, 2 and 4.
 #[test]
 fn feeding_keeps_both_pe_types_busy_on_mazda_cons_hj() {
     let p = crate::common::corpus_dir().join("python/mazda_mx5__mbs_cons_hJ_Robotran_Mazda_MX5.py");
@@ -158,7 +158,7 @@ fn feeding_keeps_both_pe_types_busy_on_mazda_cons_hj() {
     };
     let (seed_order, fed) = (end(0), end(16));
     assert!(fed * 100 < seed_order * 95, "feeding {fed} cycles vs the seed's order {seed_order}");
-    for n in [1, 2] {
+    for n in [1, 2, 4] {
         let (g, c, lb, _) = placed(&f, n, Priority::Classical, Select::Preferential);
         assert!(c * 100 <= lb * 105, "N={n}: {c} cycles, SPEC LB {lb}");
         verify_placement(&g, &[7]).unwrap();

@@ -137,6 +137,10 @@ impl Pass for Sweep {
                     o.priority = priority;
                     o.select = select;
                     o.improve = improve;
+                    if improve == 0 {
+                        // The seed's algorithm alone: no restarts or search either.
+                        (o.restarts, o.search) = (0, 0);
+                    }
                     let p = try_place_function(f, &o)
                         .map_err(|e| PassError::Failed { pass: "sweep".into(), message: e })?;
                     let mut placed = f.clone();

@@ -22,6 +22,7 @@ pub mod bound;
 pub mod feed;
 pub mod memory;
 pub mod schedule;
+pub mod search;
 
 use robovec_ir::analysis::Latencies;
 use robovec_ir::placement::{Arch, Placement};
@@ -62,13 +63,15 @@ pub struct PlaceOptions {
     /// algorithm alone); the best schedule is kept.
     pub improve: u32,
     /// Restarts with other priorities (the other seed priority, then the seed keys with
-    /// feeding bonuses of 8–1000 cycles — see `schedule::schedule` — then ALAP keys with
+    /// feeding bonuses of 8–1000 cycles — see [`feed::Feed`] — then ALAP keys with
     /// deterministic random jitter of 8–32 cycles, cycling through the bonuses), each improved
-    /// as above, tried only while
-    /// the best schedule is more than 2% above [`tight_lower_bound`] or 5% above
-    /// [`lower_bound`] (when the tight bound allows it); at most about 10⁶ op schedulings in
-    /// all. 0 = none.
+    /// as above, tried only while the best schedule is more than 2% above
+    /// [`tight_lower_bound`] or 5% above [`lower_bound`] (when the tight bound allows it); at
+    /// most about 10⁶ op schedulings in all. 0 = none. See [`search`].
     pub restarts: u32,
+    /// Iterations of key-mutation search after the restarts, under the same condition (see
+    /// [`search`]); at most about 4·10⁶ op schedulings in all. 0 = none.
+    pub search: u32,
 }
 
 impl PlaceOptions {
@@ -81,6 +84,7 @@ impl PlaceOptions {
             select: Select::Preferential,
             improve: 2,
             restarts: 64,
+            search: 1000,
         }
     }
 }
@@ -93,67 +97,25 @@ pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement
     let a = &opts.arch;
     let dag = schedule::OpDag::new(f);
     let seed = schedule::seed_keys(f, a, opts.priority);
-    let mut best = improved(f, &dag, opts, &seed, 0)?;
+    let best = improved(f, &dag, opts, &seed, 0)?;
     let spec = lower_bound(f, a) as u64;
-    // Within 2% of SPEC §4's bound (hence of the tight bound too): nothing to restart for, and
+    // Within 2% of SPEC §4's bound (hence of the tight bound too): nothing to search for, and
     // the tight bound (O(n log n) but not free) is not computed.
-    if opts.restarts > 0 && end(&best) as u64 * 100 > spec * 102 {
-        // Restarts only where the schedule is measurably above the bounds (small N on
-        // resource-bound functions): until within 2% of the tight bound and, where the tight
-        // bound allows it, within 5% of SPEC §4's bound (issue 3's quality bar). About
-        // `RESTART_WORK` op schedulings in all, so large functions get few restarts.
-        let tight = tight_lower_bound(f, a) as u64;
-        let mut target = tight * 102 / 100;
-        if tight * 100 <= spec * 105 {
-            target = target.min(spec * 105 / 100);
-        }
-        let per_restart = dag.ops.len().max(1) as u64 * (1 + opts.improve as u64);
-        let restarts = (opts.restarts as u64).min((RESTART_WORK / per_restart).max(1));
-        let mut rng = 0x9E37_79B9_7F4A_7C15u64;
-        for r in 0..restarts {
-            if end(&best) as u64 <= target {
-                break;
-            }
-            // Restart plan: the other seed priority; the seed keys with each feeding bonus (1000
-            // = feed first); then jittered seed keys, cycling through the bonuses (0 = none).
-            const FEEDS: [u32; 7] = [0, 8, 16, 32, 64, 128, 1000];
-            let feed = FEEDS[r as usize % FEEDS.len()];
-            let keys = if r == 0 {
-                let other = if opts.priority == Priority::Classical { Priority::Mobility } else { Priority::Classical };
-                schedule::seed_keys(f, a, other)
-            } else if r < FEEDS.len() as u64 {
-                seed.clone()
-            } else {
-                let amplitude = [8u64, 16, 32][(r as usize / FEEDS.len()) % 3];
-                seed.iter()
-                    .map(|&(k0, k1, _)| {
-                        rng ^= rng << 13;
-                        rng ^= rng >> 7;
-                        rng ^= rng << 17;
-                        (k0.saturating_add((rng % amplitude) as u32), k1, (rng >> 40) as u32)
-                    })
-                    .collect()
-            };
-            let s = improved(f, &dag, opts, &keys, feed)?;
-            if end(&s) < end(&best) {
-                best = s;
-            }
-        }
+    if (opts.restarts > 0 || opts.search > 0) && end(&best) as u64 * 100 > spec * 102 {
+        let best = search::restarts_and_search(f, &dag, opts, seed, best)?;
+        return Ok(memory::build(f, a, &best));
     }
     Ok(memory::build(f, a, &best))
 }
 
-/// Op schedulings allowed for restarts per placement (about a second of work).
-const RESTART_WORK: u64 = 1_000_000;
-
 /// Cycles of a schedule: the largest arrival.
-fn end(s: &schedule::Schedule) -> u32 {
+pub(crate) fn end(s: &schedule::Schedule) -> u32 {
     s.arrival.iter().copied().max().unwrap_or(0)
 }
 
 /// The list schedule for `keys` with feeding bonus `feed` (cycles, see [`feed::Feed`]), then up
 /// to `opts.improve` rounds of forward-backward improvement (kept while they shorten it).
-fn improved(
+pub(crate) fn improved(
     f: &Function,
     dag: &schedule::OpDag,
     opts: &PlaceOptions,
@@ -242,6 +204,11 @@ pub const INFO: PassInfo = PassInfo {
             default: "64",
             doc: "restarts with other priorities while >2% above the tight bound or >5% above SPEC's (0 = none)",
         },
+        ParamInfo {
+            name: "search",
+            default: "1000",
+            doc: "key-mutation search iterations after the restarts, same condition (0 = none)",
+        },
         ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency, cycles" },
         ParamInfo { name: "lat-mul", default: "7", doc: "mul latency, cycles" },
         ParamInfo { name: "lat-div", default: "12", doc: "div latency, cycles (ADD side)" },
@@ -272,6 +239,7 @@ pub const INFO: PassInfo = PassInfo {
             select: [Select::Naive, Select::Preferential][enum_param("select", &["naive", "preferential"], 1)?],
             improve: p.u32_in("improve", 2, 0, 16)?,
             restarts: p.u32_in("restarts", 64, 0, 10_000)?,
+            search: p.u32_in("search", 1000, 0, 1_000_000)?,
         };
         Ok(Box::new(Place { opts }))
     },
