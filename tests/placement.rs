@@ -9,7 +9,7 @@
 //! against 143). 7 runs are above 1.05 × SPEC LB, and the tight bound proves that 6 of them
 //! cannot be placed within 1.05 × SPEC LB by any placement (e.g. Mazda `invdyna` N=2: tight LB
 //! 1493 = 1.19 × SPEC LB 1253; we place it in 1495). The last one is tricycle `cons_hJ` N=2:
-//! 192 cycles, SPEC LB 181, tight LB 190. Feeding restarts (`feed::Feed`) and the key-mutation
+//! 191 cycles, SPEC LB 181, tight LB 190. Feeding restarts (`feed::Feed`) and the key-mutation
 //! search (`search`) brought Mazda `cons_hJ` from 574/298/162 cycles at N=1/2/4 to 516 (= the
 //! tight bound: optimal)/271/150.
 
