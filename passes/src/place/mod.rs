@@ -70,7 +70,7 @@ pub struct PlaceOptions {
     /// most about 10⁶ op schedulings in all. 0 = none. See [`search`].
     pub restarts: u32,
     /// Iterations of key-mutation search after the restarts, under the same condition (see
-    /// [`search`]); at most about 4·10⁶ op schedulings in all. 0 = none.
+    /// [`search`]); at most about 1.2·10⁷ op schedulings in all. 0 = none.
     pub search: u32,
 }
 
@@ -84,7 +84,7 @@ impl PlaceOptions {
             select: Select::Preferential,
             improve: 2,
             restarts: 64,
-            search: 1000,
+            search: 5000,
         }
     }
 }
@@ -206,7 +206,7 @@ pub const INFO: PassInfo = PassInfo {
         },
         ParamInfo {
             name: "search",
-            default: "1000",
+            default: "5000",
             doc: "key-mutation search iterations after the restarts, same condition (0 = none)",
         },
         ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency, cycles" },
@@ -239,7 +239,7 @@ pub const INFO: PassInfo = PassInfo {
             select: [Select::Naive, Select::Preferential][enum_param("select", &["naive", "preferential"], 1)?],
             improve: p.u32_in("improve", 2, 0, 16)?,
             restarts: p.u32_in("restarts", 64, 0, 10_000)?,
-            search: p.u32_in("search", 1000, 0, 1_000_000)?,
+            search: p.u32_in("search", 5000, 0, 1_000_000)?,
         };
         Ok(Box::new(Place { opts }))
     },
