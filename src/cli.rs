@@ -108,7 +108,7 @@ pub fn print_passes() -> String {
     for p in PASSES {
         s += &format!("  {:<12} {}\n", p.name, p.doc);
         for q in p.params {
-            s += &format!("      {:<10} (default {}) {}\n", q.name, q.default, q.doc);
+            s += &format!("      {:<12} (default {}; {}) {}\n", q.name, q.default_text(), q.range_text(), q.doc);
         }
     }
     s

@@ -174,6 +174,25 @@ fn write_worst_points(reports: &[robovec_passes::accuracy::AccuracyReport], pref
     Ok(())
 }
 
+/// Renders a pipeline failure; errors located in the input (verifier errors, placement lines
+/// named by `sim`, a function in the wrong phase) show `file:line:col` and the line.
+fn pass_failure(e: robovec_passes::PassError, src: &SourceFile) -> Failure {
+    use codespan_reporting::diagnostic::{Diagnostic, Label};
+    if let robovec_passes::PassError::Verify { pass, list, .. } = &e {
+        if !list.is_empty() {
+            let when = if pass == "input" { "on input".to_string() } else { format!("after pass `{pass}`") };
+            let diags: Vec<_> = list.iter().map(|v| v.to_diagnostic((), &when)).collect();
+            return Failure::Input(src.render(&diags));
+        }
+    }
+    match e.span() {
+        Some(span) if span.range().end <= src.text.len() => Failure::Input(src.render(&[Diagnostic::error()
+            .with_message(e.to_string())
+            .with_labels(vec![Label::primary((), span.range()).with_message("here")])])),
+        _ => Failure::Input(format!("error: {e}\n")),
+    }
+}
+
 /// Runs one `robovec-opt` invocation. `stdout` receives the IR (or `-eval` JSON); `stderr`
 /// receives dumps, timing and stats.
 ///
@@ -182,7 +201,7 @@ fn write_worst_points(reports: &[robovec_passes::accuracy::AccuracyReport], pref
 pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
     let pm = PassManager::new(&opts.passes, opts.instr.clone()).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
-    let (mut module, _src) = load(&opts.input)?;
+    let (mut module, src) = load(&opts.input)?;
     let pareto = match &opts.pareto {
         Some(text) => {
             let name = select(&module, &opts.function, "-pareto")?.name.clone();
@@ -193,7 +212,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         None => Vec::new(),
     };
     let mut cx = PassContext::default();
-    let records = pm.run(&mut module, &mut cx, stderr).map_err(|e| Failure::Input(format!("error: {e}\n")))?;
+    let records = pm.run(&mut module, &mut cx, stderr).map_err(|e| pass_failure(e, &src))?;
 
     // Build every output in memory first.
     let report = match &opts.report {
@@ -210,6 +229,11 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 accuracy: cx.accuracy.iter().rev().find(|r| r.function == f.name).cloned(),
                 pareto: pareto.clone(),
                 eqsat: cx.eqsat.iter().filter(|e| e.function == f.name).cloned().collect(),
+                sim: cx.sim.last().map(|s| {
+                    let mut s = s.clone();
+                    s.functions.retain(|x| x.function == f.name);
+                    s
+                }),
             };
             Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
         }
@@ -278,6 +302,9 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     if opts.stats {
         for e in cx.eqsat.iter().filter(|e| opts.function.as_ref().is_none_or(|n| n == &e.function)) {
             let _ = writeln!(stderr, "{e}");
+        }
+        for s in &cx.sim {
+            let _ = writeln!(stderr, "{s}");
         }
     }
     if !cx.sweep.is_empty() {

@@ -154,6 +154,10 @@ pub struct Report {
     /// The rows of `-pareto`, when given (speed against error, `crate::pareto`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pareto: Vec<crate::pareto::ParetoRow>,
+    /// What the last `sim` run checked (its `functions` restricted to this function), when
+    /// the pipeline simulated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sim: Option<robovec_passes::sim::SimStats>,
     /// What every `eqsat` run did to this function (windows, stop reasons, time per window),
     /// when the pipeline ran `eqsat`.
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -15,6 +15,7 @@ mod example;
 mod filetests;
 mod numerics;
 mod placement;
+mod placement_verify;
 mod props;
 mod roundtrip;
 mod thr;

@@ -278,6 +278,15 @@ impl Function {
                     }
                 }
                 p.issue = issue;
+                if !p.spans.issue.is_empty() {
+                    let mut spans = vec![crate::span::Span::DUMMY; new_values.len()];
+                    for (i, s) in p.spans.issue.iter().enumerate() {
+                        if let Some(nv) = map.get(i).copied().flatten() {
+                            spans[nv.index()] = *s;
+                        }
+                    }
+                    p.spans.issue = spans;
+                }
                 p.writes.iter_mut().for_each(|w| w.value = remap(w.value));
                 for l in &mut p.loads {
                     if let Operand::Value(v) = l.operand {

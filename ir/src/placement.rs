@@ -29,6 +29,7 @@
 
 use crate::analysis::Latencies;
 use crate::entities::Value;
+use crate::span::Span;
 use crate::syntax::{OpKind, Operand};
 
 /// A processing element: its type and index within the type (`add0`, `mul3`).
@@ -138,8 +139,41 @@ pub struct Write {
     pub buffer_addr: Option<u32>,
 }
 
+/// Source spans of a placement's lines when it was read from text (all empty when a pass made
+/// it). Diagnostics only: they take no part in equality.
+#[derive(Clone, Debug, Default)]
+pub struct PlacementSpans {
+    /// The whole `placement … { … }` block.
+    pub block: Span,
+    /// The `issue` line of each op, indexed by `Value::index()`.
+    pub issue: Vec<Span>,
+    /// The line of each load, in `Placement::loads` order.
+    pub loads: Vec<Span>,
+    /// The line of each write, in `Placement::writes` order.
+    pub writes: Vec<Span>,
+}
+
+impl PlacementSpans {
+    /// The span of `v`'s `issue` line (`Span::DUMMY` when unknown).
+    pub fn issue(&self, v: Value) -> Span {
+        self.issue.get(v.index()).copied().unwrap_or(Span::DUMMY)
+    }
+
+    /// The span of load `i` (`Span::DUMMY` when unknown).
+    pub fn load(&self, i: usize) -> Span {
+        self.loads.get(i).copied().unwrap_or(Span::DUMMY)
+    }
+
+    /// The span of write `i` (`Span::DUMMY` when unknown).
+    pub fn write(&self, i: usize) -> Span {
+        self.writes.get(i).copied().unwrap_or(Span::DUMMY)
+    }
+}
+
 /// A complete placement of one function.
-#[derive(Clone, Debug, PartialEq)]
+///
+/// Equality compares the placement itself, never its [`PlacementSpans`].
+#[derive(Clone, Debug)]
 pub struct Placement {
     /// Target architecture.
     pub arch: Arch,
@@ -153,6 +187,19 @@ pub struct Placement {
     pub pe_words: Vec<u32>,
     /// Words used by each PE's buffer, indexed by [`Pe::slot`].
     pub buffer_words: Vec<u32>,
+    /// Where each line was read from, for diagnostics (default when made by a pass).
+    pub spans: PlacementSpans,
+}
+
+impl PartialEq for Placement {
+    fn eq(&self, o: &Placement) -> bool {
+        self.arch == o.arch
+            && self.issue == o.issue
+            && self.loads == o.loads
+            && self.writes == o.writes
+            && self.pe_words == o.pe_words
+            && self.buffer_words == o.buffer_words
+    }
 }
 
 impl Placement {

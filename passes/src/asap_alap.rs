@@ -8,22 +8,18 @@
 use robovec_ir::analysis::{compute_timing, Latencies};
 use robovec_ir::{Module, Phase};
 
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
     name: "asap-alap",
     doc: "annotate ops with ASAP/ALAP (unit) and ASAPCycle/ALAPCycle (latency) and mobility",
-    params: &[
-        ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency, cycles (10 pipeline + 2 write)" },
-        ParamInfo { name: "lat-mul", default: "7", doc: "mul latency, cycles (5 pipeline + 2 write)" },
-        ParamInfo { name: "lat-div", default: "12", doc: "div latency, cycles" },
-        ParamInfo { name: "lat-call", default: "12", doc: "call (sqrt, callbacks) latency, cycles" },
-    ],
+    params: crate::params::LATENCY_PARAMS,
     build: |p: &Params| Ok(Box::new(AsapAlap { lat: p.latencies()? })),
 };
 
 /// The `asap-alap` pass.
+#[derive(Debug)]
 pub struct AsapAlap {
     /// Latencies in cycles.
     pub lat: Latencies,

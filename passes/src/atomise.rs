@@ -34,6 +34,7 @@ pub const INFO: PassInfo = PassInfo {
 };
 
 /// The `atomise` pass.
+#[derive(Debug)]
 pub struct Atomise;
 
 impl Pass for Atomise {

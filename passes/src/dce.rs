@@ -7,6 +7,7 @@
 
 use robovec_ir::Module;
 
+use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
@@ -15,20 +16,14 @@ pub const INFO: PassInfo = PassInfo {
     doc: "drop everything the kept outputs do not need",
     params: &[ParamInfo {
         name: "outputs",
-        default: "all",
+        kind: ParamKind::Names,
         doc: "outputs to keep: names (`Qq[1],Qq[2]`) or arrays (`c`), comma-separated",
     }],
-    build: |p: &Params| {
-        let keep =
-            p.get("outputs").map(|s| s.split(',').map(|x| x.trim().to_string()).filter(|x| !x.is_empty()).collect());
-        if matches!(&keep, Some(k) if Vec::is_empty(k)) {
-            return Err(PassError::BadParameter { pass: "dce".into(), message: "`outputs` is empty".into() });
-        }
-        Ok(Box::new(Dce { keep }))
-    },
+    build: |p: &Params| Ok(Box::new(Dce { keep: p.names("outputs")? })),
 };
 
 /// The `dce` pass.
+#[derive(Debug)]
 pub struct Dce {
     /// Output names or arrays to keep; `None` keeps all.
     pub keep: Option<Vec<String>>,

@@ -24,7 +24,8 @@ pub mod sweep;
 pub mod thr;
 
 use robovec_ir::analysis::Latencies;
-use robovec_ir::{Module, Phase};
+use robovec_ir::verifier::VerifierError;
+use robovec_ir::{Module, Phase, Span};
 
 pub use manager::{Instrumentation, PassManager, PassRecord, PrintSelector};
 pub use params::{ParamInfo, Params};
@@ -68,6 +69,8 @@ pub enum PassError {
         needs: Phase,
         /// Phase found.
         found: Phase,
+        /// The function's source span (`Span::DUMMY` when a front end or pass made it).
+        span: Span,
     },
     /// Any other failure of a pass on the given input.
     #[error("pass `{pass}`: {message}")]
@@ -84,6 +87,16 @@ pub enum PassError {
         pass: String,
         /// The errors, one per line.
         errors: String,
+        /// The same errors with their source spans, for rendering against the input.
+        list: Vec<VerifierError>,
+    },
+    /// An error located at a line of the input (a `.rvir` placement line, a definition…).
+    #[error("{error}")]
+    At {
+        /// The offending source text.
+        span: Span,
+        /// The error.
+        error: Box<PassError>,
     },
     /// Writing a dump failed.
     #[error("cannot write dump {path}: {source}")]
@@ -93,6 +106,26 @@ pub enum PassError {
         /// The I/O error.
         source: std::io::Error,
     },
+}
+
+impl PassError {
+    /// Attaches the source span of the offending input line; a `Span::DUMMY` leaves `self`
+    /// unchanged.
+    pub fn at(self, span: Span) -> PassError {
+        if span == Span::DUMMY {
+            self
+        } else {
+            PassError::At { span, error: Box::new(self) }
+        }
+    }
+
+    /// The source span the error points at, if any (`WrongPhase`: the function).
+    pub fn span(&self) -> Option<Span> {
+        match self {
+            PassError::At { span, .. } | PassError::WrongPhase { span, .. } => Some(*span).filter(|s| *s != Span::DUMMY),
+            _ => None,
+        }
+    }
 }
 
 /// State that passes share across one pipeline run.
@@ -110,10 +143,12 @@ pub struct PassContext {
     pub notes: Vec<String>,
     /// One report per function of every `accuracy` run.
     pub accuracy: Vec<accuracy::AccuracyReport>,
+    /// What every `sim` run checked, one entry per run (printed by `-stats`, reported).
+    pub sim: Vec<sim::SimStats>,
 }
 
-/// A transformation or analysis over a whole module.
-pub trait Pass {
+/// A transformation or analysis over a whole module (`Debug` shows its options).
+pub trait Pass: std::fmt::Debug {
     /// The registered (kebab-case) name.
     fn name(&self) -> &'static str;
     /// Runs the pass on every function of `m`.
@@ -194,6 +229,7 @@ pub fn require_phase(pass: &str, m: &Module, phase: Phase) -> Result<(), PassErr
             function: f.name.clone(),
             needs: phase,
             found: f.phase,
+            span: f.span,
         }),
         None => Ok(()),
     }

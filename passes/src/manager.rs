@@ -180,6 +180,7 @@ fn verify_named(m: &Module, pass: &str) -> Result<(), PassError> {
     verifier::verify(m).map_err(|errs| PassError::Verify {
         pass: pass.to_string(),
         errors: errs.iter().map(|e| format!("  {e}")).collect::<Vec<_>>().join("\n"),
+        list: errs,
     })
 }
 

@@ -1,23 +1,194 @@
 //! Pass parameters: `pass<k=v;flag;no-flag>` (LLVM `PassBuilder` syntax), declared per pass
 //! and checked before the pass is built.
+//!
+//! Each parameter is declared once, as a [`ParamInfo`] whose [`ParamKind`] holds its type,
+//! default and range (issue 10 item 5). The typed getters of [`Params`] (`u32`, `f64`,
+//! `choice`, `flag`…) take only the key and read default and range from that declaration, and
+//! `--print-passes` prints them from it, so the parser, the defaults and the listing cannot
+//! disagree.
+
+use robovec_ir::analysis::Latencies;
 
 use crate::{PassError, PassInfo};
 
-/// A declared parameter of a pass.
+/// The type, default and accepted range of a parameter.
+#[derive(Clone, Copy, Debug)]
+pub enum ParamKind {
+    /// An integer in `min..=max`.
+    U32 {
+        /// Value when the parameter is not given.
+        default: u32,
+        /// Smallest accepted value.
+        min: u32,
+        /// Largest accepted value.
+        max: u32,
+    },
+    /// An integer in `min..=max` whose default is the value of parameter `fallback` (a `U32`).
+    U32Or {
+        /// The parameter whose value is the default.
+        fallback: &'static str,
+        /// Smallest accepted value.
+        min: u32,
+        /// Largest accepted value.
+        max: u32,
+    },
+    /// A 64-bit integer in `min..=max`.
+    U64 {
+        /// Value when the parameter is not given.
+        default: u64,
+        /// Smallest accepted value.
+        min: u64,
+        /// Largest accepted value.
+        max: u64,
+    },
+    /// A finite number in `min..=max`.
+    F64 {
+        /// Value when the parameter is not given.
+        default: f64,
+        /// Smallest accepted value.
+        min: f64,
+        /// Largest accepted value.
+        max: f64,
+    },
+    /// One word of `choices`.
+    Choice {
+        /// The accepted words.
+        choices: &'static [&'static str],
+        /// The word used when the parameter is not given (one of `choices`).
+        default: &'static str,
+    },
+    /// `on` or `off` (also `true`/`false`, `1`/`0`).
+    Flag {
+        /// Value when the parameter is not given.
+        default: bool,
+    },
+    /// A file or folder path; nothing when not given.
+    Path,
+    /// A comma-separated, non-empty list of integers, each in `min..=max`.
+    U32List {
+        /// The list used when the parameter is not given (comma-separated).
+        default: &'static str,
+        /// Smallest accepted element.
+        min: u32,
+        /// Largest accepted element.
+        max: u32,
+    },
+    /// A comma-separated, non-empty list of names; `all` (nothing selected) when not given.
+    Names,
+}
+
+/// A declared parameter of a pass: name, type with default and range, and doc.
 #[derive(Clone, Copy, Debug)]
 pub struct ParamInfo {
     /// Name (`lat-add`).
     pub name: &'static str,
-    /// Default value as text (`12`), shown by `--print-passes`.
-    pub default: &'static str,
+    /// Type, default and range.
+    pub kind: ParamKind,
     /// What it means, with its unit.
     pub doc: &'static str,
 }
+
+impl ParamInfo {
+    /// The default as `--print-passes` shows it: a value accepted by the parameter when it
+    /// has a literal default (`6`, `on`, `1,2,4`), else a word in words (`none`, `all`, the
+    /// name of the parameter it defaults to).
+    pub fn default_text(&self) -> String {
+        match self.kind {
+            ParamKind::U32 { default, .. } => default.to_string(),
+            ParamKind::U32Or { fallback, .. } => format!("`{fallback}`"),
+            ParamKind::U64 { default, .. } => default.to_string(),
+            ParamKind::F64 { default, .. } => format!("{default}"),
+            ParamKind::Choice { default, .. } => default.to_string(),
+            ParamKind::Flag { default } => if default { "on" } else { "off" }.to_string(),
+            ParamKind::Path => "none".to_string(),
+            ParamKind::U32List { default, .. } => default.to_string(),
+            ParamKind::Names => "all".to_string(),
+        }
+    }
+
+    /// True when [`ParamInfo::default_text`] is a value the parameter accepts (giving it
+    /// explicitly changes nothing).
+    pub fn default_is_literal(&self) -> bool {
+        !matches!(self.kind, ParamKind::U32Or { .. } | ParamKind::Path | ParamKind::Names)
+    }
+
+    /// The accepted values, as `--print-passes` shows them (`2..=64`, `on|off`).
+    pub fn range_text(&self) -> String {
+        match self.kind {
+            ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => format!("{min}..={max}"),
+            ParamKind::U64 { min, max, .. } => format!("{min}..={max}"),
+            ParamKind::F64 { min, max, .. } => format!("{min}..={max}"),
+            ParamKind::Choice { choices, .. } => choices.join("|"),
+            ParamKind::Flag { .. } => "on|off".to_string(),
+            ParamKind::Path => "path".to_string(),
+            ParamKind::U32List { min, max, .. } => format!("list of {min}..={max}"),
+            ParamKind::Names => "list of names".to_string(),
+        }
+    }
+
+    /// The smallest and largest accepted value of a numeric parameter, as text.
+    pub fn bounds(&self) -> Option<(String, String)> {
+        match self.kind {
+            ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => {
+                Some((min.to_string(), max.to_string()))
+            }
+            ParamKind::U64 { min, max, .. } => Some((min.to_string(), max.to_string())),
+            ParamKind::F64 { min, max, .. } => Some((format!("{min}"), format!("{max}"))),
+            _ => None,
+        }
+    }
+
+    /// Values just outside the range (`min − 1`, `max + 1`) where they are representable.
+    pub fn out_of_bounds(&self) -> Vec<String> {
+        match self.kind {
+            ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => {
+                let mut v: Vec<String> = min.checked_sub(1).map(|x| x.to_string()).into_iter().collect();
+                v.push((max as u64 + 1).to_string());
+                v
+            }
+            ParamKind::U64 { min, max, .. } => {
+                let mut v: Vec<String> = min.checked_sub(1).map(|x| x.to_string()).into_iter().collect();
+                v.push((max as u128 + 1).to_string());
+                v
+            }
+            ParamKind::F64 { min, max, .. } => vec![format!("{}", min - 1.0), format!("{}", max + 1.0)],
+            _ => Vec::new(),
+        }
+    }
+}
+
+/// The add/sub latency parameter (SPEC §1), cycles.
+pub const LAT_ADD: ParamInfo = ParamInfo {
+    name: "lat-add",
+    kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
+    doc: "add/sub latency, cycles (10 pipeline + 2 write)",
+};
+/// The mul latency parameter (SPEC §1), cycles.
+pub const LAT_MUL: ParamInfo = ParamInfo {
+    name: "lat-mul",
+    kind: ParamKind::U32 { default: 7, min: 1, max: 10_000 },
+    doc: "mul latency, cycles (5 pipeline + 2 write)",
+};
+/// The div latency parameter (SPEC §1), cycles.
+pub const LAT_DIV: ParamInfo = ParamInfo {
+    name: "lat-div",
+    kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
+    doc: "div latency, cycles (ADD side)",
+};
+/// The call latency parameter (SPEC §1), cycles.
+pub const LAT_CALL: ParamInfo = ParamInfo {
+    name: "lat-call",
+    kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
+    doc: "call (sqrt, callbacks) latency, cycles (ADD side)",
+};
+/// The four latency parameters, for passes that take only them.
+pub const LATENCY_PARAMS: &[ParamInfo] = &[LAT_ADD, LAT_MUL, LAT_DIV, LAT_CALL];
 
 /// Checked parameters of one pipeline element: `(name, value)` pairs, each name declared.
 #[derive(Clone, Debug, Default)]
 pub struct Params {
     pass: &'static str,
+    decls: &'static [ParamInfo],
     values: Vec<(String, String)>,
 }
 
@@ -26,7 +197,7 @@ impl Params {
     ///
     /// # Errors
     /// [`PassError::BadParameter`] listing the valid parameters.
-    pub fn check(info: &PassInfo, raw: &[(String, Option<String>)]) -> Result<Params, PassError> {
+    pub fn check(info: &'static PassInfo, raw: &[(String, Option<String>)]) -> Result<Params, PassError> {
         let valid = || {
             if info.params.is_empty() {
                 "it takes no parameters".to_string()
@@ -56,7 +227,12 @@ impl Params {
             };
             values.push((k.clone(), v.clone()));
         }
-        Ok(Params { pass: info.name, values })
+        Ok(Params { pass: info.name, decls: info.params, values })
+    }
+
+    /// No parameter given: every getter returns the declared default.
+    pub fn defaults(info: &'static PassInfo) -> Params {
+        Params { pass: info.name, decls: info.params, values: Vec::new() }
     }
 
     /// The raw value of `key`, if given.
@@ -64,35 +240,176 @@ impl Params {
         self.values.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
     }
 
-    /// The latencies `lat-add`, `lat-mul`, `lat-div`, `lat-call` (cycles, 1..=10000), each
-    /// defaulting to SPEC §1's value.
+    /// The declaration of `key`; a getter asking for an undeclared key is a bug of the pass.
+    fn decl(&self, key: &str) -> ParamKind {
+        match self.decls.iter().find(|d| d.name == key) {
+            Some(d) => d.kind,
+            None => panic!("pass `{}` reads undeclared parameter `{key}`", self.pass),
+        }
+    }
+
+    fn bad(&self, key: &str, expected: String, found: &str) -> PassError {
+        PassError::BadParameter {
+            pass: self.pass.into(),
+            message: format!("parameter `{key}` must be {expected}, found `{found}`"),
+        }
+    }
+
+    /// The latencies `lat-add`, `lat-mul`, `lat-div`, `lat-call` (cycles), each from its
+    /// declaration ([`LAT_ADD`]…); an undeclared one takes SPEC §1's value.
     ///
     /// # Errors
-    /// [`PassError::BadParameter`] when one is not such an integer.
-    pub fn latencies(&self) -> Result<robovec_ir::analysis::Latencies, PassError> {
-        let d = robovec_ir::analysis::Latencies::default();
-        Ok(robovec_ir::analysis::Latencies {
-            add: self.u32_in("lat-add", d.add, 1, 10_000)?,
-            mul: self.u32_in("lat-mul", d.mul, 1, 10_000)?,
-            div: self.u32_in("lat-div", d.div, 1, 10_000)?,
-            call: self.u32_in("lat-call", d.call, 1, 10_000)?,
+    /// [`PassError::BadParameter`] when one is out of range.
+    pub fn latencies(&self) -> Result<Latencies, PassError> {
+        let d = Latencies::default();
+        let get = |key: &str, default: u32| {
+            if self.decls.iter().any(|p| p.name == key) {
+                self.u32(key)
+            } else {
+                Ok(default)
+            }
+        };
+        Ok(Latencies {
+            add: get("lat-add", d.add)?,
+            mul: get("lat-mul", d.mul)?,
+            div: get("lat-div", d.div)?,
+            call: get("lat-call", d.call)?,
         })
     }
 
-    /// `key` as a `u32` in `min..=max`, or `default`.
+    /// A `U32` (or `U32Or`) parameter: its value, or its declared default.
     ///
     /// # Errors
-    /// [`PassError::BadParameter`] when the value is not such an integer.
-    pub fn u32_in(&self, key: &str, default: u32, min: u32, max: u32) -> Result<u32, PassError> {
+    /// [`PassError::BadParameter`] when the value is not an integer in the declared range.
+    pub fn u32(&self, key: &str) -> Result<u32, PassError> {
+        let (default, min, max) = match self.decl(key) {
+            ParamKind::U32 { default, min, max } => (default, min, max),
+            ParamKind::U32Or { fallback, min, max } => (self.u32(fallback)?, min, max),
+            k => panic!("parameter `{key}` of `{}` is {k:?}, not an integer", self.pass),
+        };
         match self.get(key) {
             None => Ok(default),
             Some(v) => match v.parse::<u32>() {
                 Ok(x) if (min..=max).contains(&x) => Ok(x),
-                _ => Err(PassError::BadParameter {
-                    pass: self.pass.into(),
-                    message: format!("parameter `{key}` must be an integer in {min}..={max}, found `{v}`"),
-                }),
+                _ => Err(self.bad(key, format!("an integer in {min}..={max}"), v)),
             },
+        }
+    }
+
+    /// A `U64` parameter: its value, or its declared default.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when the value is not an integer in the declared range.
+    pub fn u64(&self, key: &str) -> Result<u64, PassError> {
+        let ParamKind::U64 { default, min, max } = self.decl(key) else {
+            panic!("parameter `{key}` of `{}` is not a u64", self.pass)
+        };
+        match self.get(key) {
+            None => Ok(default),
+            Some(v) => match v.parse::<u64>() {
+                Ok(x) if (min..=max).contains(&x) => Ok(x),
+                _ => Err(self.bad(key, format!("an integer in {min}..={max}"), v)),
+            },
+        }
+    }
+
+    /// An `F64` parameter: its value, or its declared default.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when the value is not a number in the declared range.
+    pub fn f64(&self, key: &str) -> Result<f64, PassError> {
+        let ParamKind::F64 { default, min, max } = self.decl(key) else {
+            panic!("parameter `{key}` of `{}` is not a number", self.pass)
+        };
+        match self.get(key) {
+            None => Ok(default),
+            Some(v) => match v.parse::<f64>() {
+                Ok(x) if (min..=max).contains(&x) => Ok(x),
+                _ => Err(self.bad(key, format!("a number in {min}..={max}"), v)),
+            },
+        }
+    }
+
+    /// A `Choice` parameter: the word given, or the declared default.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when the word is not one of the choices.
+    pub fn choice(&self, key: &str) -> Result<&'static str, PassError> {
+        let ParamKind::Choice { choices, default } = self.decl(key) else {
+            panic!("parameter `{key}` of `{}` is not a choice", self.pass)
+        };
+        match self.get(key) {
+            None => Ok(default),
+            Some(v) => choices
+                .iter()
+                .find(|c| **c == v)
+                .copied()
+                .ok_or_else(|| self.bad(key, format!("one of {}", choices.join(" | ")), v)),
+        }
+    }
+
+    /// A `Flag` parameter: `on`/`true`/`1` or `off`/`false`/`0`, or the declared default.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] for any other word.
+    pub fn flag(&self, key: &str) -> Result<bool, PassError> {
+        let ParamKind::Flag { default } = self.decl(key) else {
+            panic!("parameter `{key}` of `{}` is not a flag", self.pass)
+        };
+        match self.get(key) {
+            None => Ok(default),
+            Some("on" | "true" | "1") => Ok(true),
+            Some("off" | "false" | "0") => Ok(false),
+            Some(v) => Err(self.bad(key, "`on` or `off`".into(), v)),
+        }
+    }
+
+    /// A `Path` parameter: the path given, if any.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when it is empty.
+    pub fn path(&self, key: &str) -> Result<Option<String>, PassError> {
+        let ParamKind::Path = self.decl(key) else { panic!("parameter `{key}` of `{}` is not a path", self.pass) };
+        match self.get(key) {
+            None => Ok(None),
+            Some("") => Err(self.bad(key, format!("a file name (`{key}=PATH`)"), "")),
+            Some(v) => Ok(Some(v.to_string())),
+        }
+    }
+
+    /// A `U32List` parameter: the integers given, or the declared default list.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when the list is empty or an element is out of range.
+    pub fn u32_list(&self, key: &str) -> Result<Vec<u32>, PassError> {
+        let ParamKind::U32List { default, min, max } = self.decl(key) else {
+            panic!("parameter `{key}` of `{}` is not a list of integers", self.pass)
+        };
+        let text = self.get(key).unwrap_or(default);
+        let ns: Result<Vec<u32>, _> = text.split(',').map(|x| x.trim().parse::<u32>()).collect();
+        match ns {
+            Ok(ns) if !ns.is_empty() && ns.iter().all(|n| (min..=max).contains(n)) => Ok(ns),
+            _ => Err(self.bad(key, format!("a comma-separated list of integers in {min}..={max}"), text)),
+        }
+    }
+
+    /// A `Names` parameter: the names given (trimmed, empty ones dropped), or `None` (all).
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when no name is left.
+    pub fn names(&self, key: &str) -> Result<Option<Vec<String>>, PassError> {
+        let ParamKind::Names = self.decl(key) else { panic!("parameter `{key}` of `{}` is not a name list", self.pass) };
+        match self.get(key) {
+            None => Ok(None),
+            Some(v) => {
+                let names: Vec<String> =
+                    v.split(',').map(|x| x.trim().to_string()).filter(|x| !x.is_empty()).collect();
+                if names.is_empty() {
+                    Err(self.bad(key, "a comma-separated list of names".into(), v))
+                } else {
+                    Ok(Some(names))
+                }
+            }
         }
     }
 }

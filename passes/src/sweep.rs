@@ -15,6 +15,7 @@ use robovec_ir::{Module, Phase};
 use crate::place::{
     cycles, lower_bound, ops_per_side, tight_lower_bound, try_place_function, PlaceOptions, Priority, Select,
 };
+use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// min / mean / max of words over the PEs of one type.
@@ -85,21 +86,16 @@ pub struct SweepRow {
 pub const INFO: PassInfo = PassInfo {
     name: "sweep",
     doc: "place at several N (classical/mobility, naive/preferential), simulate each, tabulate the seed's study",
-    params: &[ParamInfo { name: "pe", default: "1,2,4,8,16,32,64", doc: "values of N, comma-separated" }],
-    build: |p: &Params| {
-        let list = p.get("pe").unwrap_or("1,2,4,8,16,32,64");
-        let ns: Result<Vec<u32>, _> = list.split(',').map(|x| x.trim().parse::<u32>()).collect();
-        match ns {
-            Ok(ns) if !ns.is_empty() && ns.iter().all(|&n| (1..=4096).contains(&n)) => Ok(Box::new(Sweep { ns })),
-            _ => Err(PassError::BadParameter {
-                pass: "sweep".into(),
-                message: format!("`pe` must be a comma-separated list of integers in 1..=4096, found `{list}`"),
-            }),
-        }
-    },
+    params: &[ParamInfo {
+        name: "pe",
+        kind: ParamKind::U32List { default: "1,2,4,8,16,32,64", min: 1, max: 4096 },
+        doc: "values of N, comma-separated",
+    }],
+    build: |p: &Params| Ok(Box::new(Sweep { ns: p.u32_list("pe")? })),
 };
 
 /// The `sweep` pass.
+#[derive(Debug)]
 pub struct Sweep {
     /// Values of N.
     pub ns: Vec<u32>,

@@ -20,7 +20,7 @@ use super::ast::{OperandAst, PlacementAst, PlacementLineAst};
 use super::error::ParseError;
 use crate::analysis::Latencies;
 use crate::function::Function;
-use crate::placement::{Arch, Issue, Load, Pe, Placement, Write};
+use crate::placement::{Arch, Issue, Load, Pe, Placement, PlacementSpans, Write};
 use crate::span::Span;
 use crate::syntax::Operand;
 
@@ -116,6 +116,7 @@ pub fn resolve(f: &Function, p: PlacementAst<'_>, errors: &mut Vec<ParseError>) 
     let mut issue = vec![None; f.values.len()];
     let mut loads = Vec::new();
     let mut writes = Vec::new();
+    let mut spans = PlacementSpans { block: p.span, issue: vec![Span::DUMMY; f.values.len()], ..Default::default() };
     for line in p.lines {
         match line {
             PlacementLineAst::Issue { value: v, pe: q, cycle, span } => {
@@ -123,6 +124,7 @@ pub fn resolve(f: &Function, p: PlacementAst<'_>, errors: &mut Vec<ParseError>) 
                     if issue[v.index()].replace(Issue { pe: q, cycle }).is_some() {
                         errors.push(ParseError::new(span, format!("`%{}` issued twice", f.name_of(v)), "second issue"));
                     }
+                    spans.issue[v.index()] = span;
                 }
             }
             PlacementLineAst::Load { pe: q, addr, operand, span } => {
@@ -142,6 +144,7 @@ pub fn resolve(f: &Function, p: PlacementAst<'_>, errors: &mut Vec<ParseError>) 
                 };
                 if let (Some(q), Some(operand)) = (pe(q, span, errors), operand) {
                     loads.push(Load { pe: q, addr, operand });
+                    spans.loads.push(span);
                 }
             }
             PlacementLineAst::Write { value: v, pe: q, addr, cycle, via, span } => {
@@ -158,11 +161,12 @@ pub fn resolve(f: &Function, p: PlacementAst<'_>, errors: &mut Vec<ParseError>) 
                 };
                 if let (Some(v), Some(q)) = (value(v, span, errors), pe(q, span, errors)) {
                     writes.push(Write { value: v, pe: q, addr, cycle, buffer_addr });
+                    spans.writes.push(span);
                 }
             }
         }
     }
-    (errors.len() == before).then_some(Placement { arch, issue, loads, writes, pe_words, buffer_words })
+    (errors.len() == before).then_some(Placement { arch, issue, loads, writes, pe_words, buffer_words, spans })
 }
 
 /// Writes the placement block of `f` (two-space indented, inside the function).

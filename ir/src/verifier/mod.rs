@@ -24,7 +24,13 @@
 //! - timing attributes, when present, have `alap ≥ asap`, `mobility = alap − asap` and
 //!   `alap_cycle ≥ asap_cycle`.
 //!
+//! Placement (when the function has one; see [`placement`] for the list): phase, every op
+//! issued once on an existing PE of its type, one op per PE per cycle, write cycles, ports and
+//! buffer reads, operands present at issue, addresses within the reported memory sizes.
+//!
 //! TODO: types beyond `f64` scalars do not exist yet; nothing to check there.
+
+pub mod placement;
 
 use std::collections::HashSet;
 
@@ -44,6 +50,8 @@ pub enum Location {
     Value(Value),
     /// Output `i` (index into `Function::outputs`).
     Output(usize),
+    /// The placement block (an `issue`, `load` or `write` line, or the block itself).
+    Placement,
 }
 
 /// One broken invariant.
@@ -226,6 +234,9 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
             }
             _ => {}
         }
+    }
+    if errs.is_empty() {
+        errs.extend(placement::verify_placement(f));
     }
     errs
 }

@@ -31,6 +31,7 @@ use rayon::prelude::*;
 use robovec_ir::numerics::Tape;
 use robovec_ir::{Function, Module};
 
+use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 pub use measure::{BitsSummary, PointErrors};
 pub use report::{AccuracyReport, OutputAccuracy, ReferenceCounts, WorstPoint};
@@ -78,18 +79,9 @@ pub struct Options {
 }
 
 impl Default for Options {
+    /// The defaults declared in [`INFO`].
     fn default() -> Options {
-        Options {
-            samples: 1000,
-            seed: 1,
-            mode: Mode::Sampled,
-            params: None,
-            known: BTreeMap::new(),
-            worst_dir: None,
-            worst_count: 5,
-            climb_rounds: 4,
-            climb_points: 8,
-        }
+        options_from(&Params::defaults(&INFO)).expect("declared defaults are valid")
     }
 }
 
@@ -98,59 +90,66 @@ pub const INFO: PassInfo = PassInfo {
     name: "accuracy",
     doc: "bits of error (Herbie) of every output in f32 and f64 against a certified extended-precision reference",
     params: &[
-        ParamInfo { name: "samples", default: "1000", doc: "input points measured, 1..=10000000" },
-        ParamInfo { name: "seed", default: "1", doc: "seed of the deterministic draws (u64)" },
+        ParamInfo {
+            name: "samples",
+            kind: ParamKind::U32 { default: 1000, min: 1, max: 10_000_000 },
+            doc: "input points measured",
+        },
+        ParamInfo {
+            name: "seed",
+            kind: ParamKind::U64 { default: 1, min: 0, max: u64::MAX },
+            doc: "seed of the deterministic draws",
+        },
         ParamInfo {
             name: "mode",
-            default: "sampled",
+            kind: ParamKind::Choice { choices: &["sampled", "hard"], default: "sampled" },
             doc: "`sampled` (physical ranges) or `hard` (singular poses, extreme scales, hill climbing)",
         },
         ParamInfo {
             name: "params",
-            default: "none",
+            kind: ParamKind::Path,
             doc: "JSON file of known input values ({\"m[2]\": 1.5}); the rest is drawn",
         },
         ParamInfo {
             name: "worst",
-            default: "none",
+            kind: ParamKind::Path,
             doc: "folder for worst-K.json, the worst points in -eval's input format",
         },
-        ParamInfo { name: "worst-count", default: "5", doc: "worst points listed (and written), 0..=1000" },
-        ParamInfo { name: "climb", default: "4", doc: "hill-climbing rounds in hard mode, 0..=100" },
-        ParamInfo { name: "climb-points", default: "8", doc: "worst points hill climbing starts from, 1..=1000" },
+        ParamInfo {
+            name: "worst-count",
+            kind: ParamKind::U32 { default: 5, min: 0, max: 1000 },
+            doc: "worst points listed (and written)",
+        },
+        ParamInfo {
+            name: "climb",
+            kind: ParamKind::U32 { default: 4, min: 0, max: 100 },
+            doc: "hill-climbing rounds in hard mode",
+        },
+        ParamInfo {
+            name: "climb-points",
+            kind: ParamKind::U32 { default: 8, min: 1, max: 1000 },
+            doc: "worst points hill climbing starts from",
+        },
     ],
     build: |p: &Params| Ok(Box::new(Accuracy { opts: options_from(p)? })),
 };
 
 fn options_from(p: &Params) -> Result<Options, PassError> {
-    let bad = |m: String| PassError::BadParameter { pass: "accuracy".into(), message: m };
-    let d = Options::default();
-    let seed = match p.get("seed") {
-        None => d.seed,
-        Some(s) => s
-            .parse::<u64>()
-            .map_err(|_| bad(format!("parameter `seed` must be an integer in 0..=2^64-1, found `{s}`")))?,
-    };
-    let mode = match p.get("mode") {
-        None | Some("sampled") => Mode::Sampled,
-        Some("hard") => Mode::Hard,
-        Some(m) => return Err(bad(format!("parameter `mode` must be `sampled` or `hard`, found `{m}`"))),
-    };
-    let path = |k: &str| p.get(k).filter(|s| !s.is_empty()).map(str::to_string);
     Ok(Options {
-        samples: p.u32_in("samples", d.samples, 1, 10_000_000)?,
-        seed,
-        mode,
-        params: path("params"),
+        samples: p.u32("samples")?,
+        seed: p.u64("seed")?,
+        mode: if p.choice("mode")? == "hard" { Mode::Hard } else { Mode::Sampled },
+        params: p.path("params")?,
         known: BTreeMap::new(),
-        worst_dir: path("worst"),
-        worst_count: p.u32_in("worst-count", d.worst_count, 0, 1000)?,
-        climb_rounds: p.u32_in("climb", d.climb_rounds, 0, 100)?,
-        climb_points: p.u32_in("climb-points", d.climb_points, 1, 1000)?,
+        worst_dir: p.path("worst")?,
+        worst_count: p.u32("worst-count")?,
+        climb_rounds: p.u32("climb")?,
+        climb_points: p.u32("climb-points")?,
     })
 }
 
 /// The `accuracy` pass.
+#[derive(Debug)]
 pub struct Accuracy {
     /// Options (the `params` file is read when the pass runs).
     pub opts: Options,

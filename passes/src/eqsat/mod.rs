@@ -38,6 +38,7 @@ use std::path::PathBuf;
 use robovec_ir::analysis::Latencies;
 use robovec_ir::{Module, Phase};
 
+use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 pub use apply::{eqsat_function, EqsatStats, StopCounts};
@@ -49,46 +50,39 @@ pub const INFO: PassInfo = PassInfo {
     params: &[
         ParamInfo {
             name: "window",
-            default: "8",
-            doc: "max leaf occurrences per window, leaves (2..=64; ops ≤ window − 1)",
+            kind: ParamKind::U32 { default: 6, min: 2, max: 64 },
+            doc: "max leaf occurrences per window, leaves (ops ≤ window − 1)",
         },
         ParamInfo {
             name: "budget",
-            default: "0",
+            kind: ParamKind::U32 { default: 0, min: 0, max: 10_000 },
             doc: "max extra ops per window, ops (0: never more ops than the window had)",
         },
-        ParamInfo { name: "iters", default: "30", doc: "egg runner iteration limit per window, iterations" },
-        ParamInfo { name: "nodes", default: "10000", doc: "egg runner e-node limit per window, e-nodes" },
-        ParamInfo { name: "time-ms", default: "100", doc: "egg runner time limit per window, milliseconds" },
-        ParamInfo { name: "distribute", default: "on", doc: "distributivity/factoring rules: on or off" },
-        ParamInfo { name: "rules", default: "none", doc: "file of extra rules (docs/eqsat-rules.md)" },
-        ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency for extraction, cycles" },
-        ParamInfo { name: "lat-mul", default: "7", doc: "mul latency for extraction, cycles" },
+        ParamInfo {
+            name: "iters",
+            kind: ParamKind::U32 { default: 30, min: 1, max: 10_000 },
+            doc: "egg runner iteration limit per window, iterations",
+        },
+        ParamInfo {
+            name: "nodes",
+            kind: ParamKind::U32 { default: 10_000, min: 10, max: 10_000_000 },
+            doc: "egg runner e-node limit per window, e-nodes",
+        },
+        ParamInfo {
+            name: "time-ms",
+            kind: ParamKind::U32 { default: 100, min: 1, max: 600_000 },
+            doc: "egg runner time limit per window, milliseconds",
+        },
+        ParamInfo {
+            name: "distribute",
+            kind: ParamKind::Flag { default: true },
+            doc: "distributivity/factoring rules: on or off",
+        },
+        ParamInfo { name: "rules", kind: ParamKind::Path, doc: "file of extra rules (docs/eqsat-rules.md)" },
+        ParamInfo { doc: "add/sub latency for extraction, cycles", ..crate::params::LAT_ADD },
+        ParamInfo { doc: "mul latency for extraction, cycles", ..crate::params::LAT_MUL },
     ],
-    build: |p: &Params| {
-        let distribute = match p.get("distribute") {
-            None | Some("on" | "true" | "1") => true,
-            Some("off" | "false" | "0") => false,
-            Some(v) => {
-                return Err(PassError::BadParameter {
-                    pass: "eqsat".into(),
-                    message: format!("parameter `distribute` must be `on` or `off`, found `{v}`"),
-                })
-            }
-        };
-        Ok(Box::new(Eqsat {
-            opts: EqsatOptions {
-                window: p.u32_in("window", 6, 2, 64)? as usize,
-                budget: p.u32_in("budget", 0, 0, 10_000)?,
-                iters: p.u32_in("iters", 30, 1, 10_000)? as usize,
-                nodes: p.u32_in("nodes", 10_000, 10, 10_000_000)? as usize,
-                time_ms: p.u32_in("time-ms", 100, 1, 600_000)? as u64,
-                distribute,
-                rules_file: p.get("rules").map(PathBuf::from),
-                lat: p.latencies()?,
-            },
-        }))
-    },
+    build: |p: &Params| Ok(Box::new(Eqsat { opts: options_from(p)? })),
 };
 
 /// Options of the `eqsat` pass (see [`INFO`] for the parameters they come from).
@@ -112,22 +106,29 @@ pub struct EqsatOptions {
     pub lat: Latencies,
 }
 
+/// The options of checked parameters `p` (defaults and ranges from [`INFO`]).
+fn options_from(p: &Params) -> Result<EqsatOptions, PassError> {
+    Ok(EqsatOptions {
+        window: p.u32("window")? as usize,
+        budget: p.u32("budget")?,
+        iters: p.u32("iters")? as usize,
+        nodes: p.u32("nodes")? as usize,
+        time_ms: p.u32("time-ms")? as u64,
+        distribute: p.flag("distribute")?,
+        rules_file: p.path("rules")?.map(PathBuf::from),
+        lat: p.latencies()?,
+    })
+}
+
 impl Default for EqsatOptions {
+    /// The defaults declared in [`INFO`].
     fn default() -> Self {
-        EqsatOptions {
-            window: 6,
-            budget: 0,
-            iters: 30,
-            nodes: 10_000,
-            time_ms: 100,
-            distribute: true,
-            rules_file: None,
-            lat: Latencies::default(),
-        }
+        options_from(&Params::defaults(&INFO)).expect("declared defaults are valid")
     }
 }
 
 /// The `eqsat` pass.
+#[derive(Debug)]
 pub struct Eqsat {
     /// Options.
     pub opts: EqsatOptions,

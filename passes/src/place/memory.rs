@@ -156,7 +156,7 @@ pub fn build(f: &Function, arch: &Arch, s: &Schedule) -> Placement {
     }
     writes.sort_unstable_by_key(|w| (w.cycle, w.pe, w.addr));
     let issue = s.issue.iter().map(|x| x.map(|(q, cycle)| Issue { pe: pe_of(arch, q), cycle })).collect();
-    Placement { arch: *arch, issue, loads, writes, pe_words, buffer_words }
+    Placement { arch: *arch, issue, loads, writes, pe_words, buffer_words, spans: Default::default() }
 }
 
 #[cfg(test)]

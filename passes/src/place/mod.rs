@@ -24,12 +24,12 @@ pub mod memory;
 pub mod schedule;
 pub mod search;
 
-use robovec_ir::analysis::Latencies;
 use robovec_ir::placement::{Arch, Placement};
 use robovec_ir::{Function, Module, OpKind, Phase};
 
 pub use bound::{lower_bound, ops_per_side, tight_lower_bound};
 
+use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Priority of ready ops (seed §2.3.1).
@@ -78,15 +78,29 @@ impl PlaceOptions {
     /// N ADD + N MULTI PEs, default latencies, 2 write ports, buffers on, classical,
     /// preferential.
     pub fn with_pes(n: u32) -> PlaceOptions {
-        PlaceOptions {
-            arch: Arch { n_add: n, n_mul: n, lat: Latencies::default(), writes: 2, buffer: true },
-            priority: Priority::Classical,
-            select: Select::Preferential,
-            improve: 2,
-            restarts: 64,
-            search: 5000,
-        }
+        let mut o = options_from(&Params::defaults(&INFO)).expect("declared defaults are valid");
+        o.arch.n_add = n;
+        o.arch.n_mul = n;
+        o
     }
+}
+
+/// The options of checked parameters `p` (defaults and ranges from [`INFO`]).
+fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
+    Ok(PlaceOptions {
+        arch: Arch {
+            n_add: p.u32("add")?,
+            n_mul: p.u32("mul")?,
+            lat: p.latencies()?,
+            writes: p.u32("writes")?,
+            buffer: p.flag("buffer")?,
+        },
+        priority: if p.choice("priority")? == "mobility" { Priority::Mobility } else { Priority::Classical },
+        select: if p.choice("select")? == "naive" { Select::Naive } else { Select::Preferential },
+        improve: p.u32("improve")?,
+        restarts: p.u32("restarts")?,
+        search: p.u32("search")?,
+    })
 }
 
 /// Places `f` (atomised, verified).
@@ -189,63 +203,66 @@ pub const INFO: PassInfo = PassInfo {
     name: "place",
     doc: "list-schedule ops onto N ADD + N MULTI PEs with PE memories, buffers and a crossbar",
     params: &[
-        ParamInfo { name: "pe", default: "4", doc: "N: N ADD PEs and N MULTI PEs" },
-        ParamInfo { name: "add", default: "pe", doc: "ADD PEs (overrides pe)" },
-        ParamInfo { name: "mul", default: "pe", doc: "MULTI PEs (overrides pe)" },
-        ParamInfo { name: "priority", default: "classical", doc: "classical (ALAP, ASAP) | mobility (mobility, ALAP)" },
-        ParamInfo { name: "select", default: "preferential", doc: "naive (first free PE) | preferential (Table 2.1)" },
+        ParamInfo {
+            name: "pe",
+            kind: ParamKind::U32 { default: 4, min: 1, max: 4096 },
+            doc: "N: N ADD PEs and N MULTI PEs",
+        },
+        ParamInfo {
+            name: "add",
+            kind: ParamKind::U32Or { fallback: "pe", min: 1, max: 4096 },
+            doc: "ADD PEs (overrides pe)",
+        },
+        ParamInfo {
+            name: "mul",
+            kind: ParamKind::U32Or { fallback: "pe", min: 1, max: 4096 },
+            doc: "MULTI PEs (overrides pe)",
+        },
+        ParamInfo {
+            name: "priority",
+            kind: ParamKind::Choice { choices: &["classical", "mobility"], default: "classical" },
+            doc: "classical (ALAP, ASAP) | mobility (mobility, ALAP)",
+        },
+        ParamInfo {
+            name: "select",
+            kind: ParamKind::Choice { choices: &["naive", "preferential"], default: "preferential" },
+            doc: "naive (first free PE) | preferential (Table 2.1)",
+        },
         ParamInfo {
             name: "improve",
-            default: "2",
+            kind: ParamKind::U32 { default: 2, min: 0, max: 16 },
             doc: "rounds of forward-backward improvement after the seed's list schedule (0 = seed only)",
         },
         ParamInfo {
             name: "restarts",
-            default: "64",
+            kind: ParamKind::U32 { default: 64, min: 0, max: 10_000 },
             doc: "restarts with other priorities while >2% above the tight bound or >5% above SPEC's (0 = none)",
         },
         ParamInfo {
             name: "search",
-            default: "5000",
+            kind: ParamKind::U32 { default: 5000, min: 0, max: 1_000_000 },
             doc: "key-mutation search iterations after the restarts, same condition (0 = none)",
         },
-        ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency, cycles" },
-        ParamInfo { name: "lat-mul", default: "7", doc: "mul latency, cycles" },
-        ParamInfo { name: "lat-div", default: "12", doc: "div latency, cycles (ADD side)" },
-        ParamInfo { name: "lat-call", default: "12", doc: "call latency, cycles (ADD side)" },
-        ParamInfo { name: "writes", default: "2", doc: "write ports per PE memory per cycle" },
-        ParamInfo { name: "buffer", default: "on", doc: "on | off: results may wait in buffer memories" },
+        crate::params::LAT_ADD,
+        crate::params::LAT_MUL,
+        crate::params::LAT_DIV,
+        crate::params::LAT_CALL,
+        ParamInfo {
+            name: "writes",
+            kind: ParamKind::U32 { default: 2, min: 1, max: 64 },
+            doc: "write ports per PE memory per cycle",
+        },
+        ParamInfo {
+            name: "buffer",
+            kind: ParamKind::Flag { default: true },
+            doc: "on | off: results may wait in buffer memories",
+        },
     ],
-    build: |p: &Params| {
-        let n = p.u32_in("pe", 4, 1, 4096)?;
-        let enum_param = |key: &str, options: &[&str], default: usize| -> Result<usize, PassError> {
-            match p.get(key) {
-                None => Ok(default),
-                Some(v) => options.iter().position(|o| *o == v).ok_or_else(|| PassError::BadParameter {
-                    pass: "place".into(),
-                    message: format!("parameter `{key}` must be one of {}, found `{v}`", options.join(" | ")),
-                }),
-            }
-        };
-        let opts = PlaceOptions {
-            arch: Arch {
-                n_add: p.u32_in("add", n, 1, 4096)?,
-                n_mul: p.u32_in("mul", n, 1, 4096)?,
-                lat: p.latencies()?,
-                writes: p.u32_in("writes", 2, 1, 64)?,
-                buffer: enum_param("buffer", &["off", "on"], 1)? == 1,
-            },
-            priority: [Priority::Classical, Priority::Mobility][enum_param("priority", &["classical", "mobility"], 0)?],
-            select: [Select::Naive, Select::Preferential][enum_param("select", &["naive", "preferential"], 1)?],
-            improve: p.u32_in("improve", 2, 0, 16)?,
-            restarts: p.u32_in("restarts", 64, 0, 10_000)?,
-            search: p.u32_in("search", 5000, 0, 1_000_000)?,
-        };
-        Ok(Box::new(Place { opts }))
-    },
+    build: |p: &Params| Ok(Box::new(Place { opts: options_from(p)? })),
 };
 
 /// The `place` pass.
+#[derive(Debug)]
 pub struct Place {
     /// Options.
     pub opts: PlaceOptions,

@@ -1,6 +1,7 @@
 //! What the simulator rejects: one [`SimError`] naming when, where and which value.
 
 use robovec_ir::placement::Pe;
+use robovec_ir::Span;
 
 /// When an error happened in the simulated run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,11 +87,14 @@ pub struct SimError {
     pub value: Option<String>,
     /// What is wrong, lower case.
     pub message: String,
+    /// The offending `.rvir` line (an `issue`, `load` or `write` line, a definition or an
+    /// output) when the placement was read from text; `Span::DUMMY` otherwise.
+    pub span: Span,
 }
 
 impl SimError {
     pub(crate) fn new(kind: SimErrorKind, message: impl Into<String>) -> SimError {
-        SimError { kind, when: None, pe: None, value: None, message: message.into() }
+        SimError { kind, when: None, pe: None, value: None, message: message.into(), span: Span::DUMMY }
     }
 
     pub(crate) fn at(mut self, when: When) -> SimError {
@@ -105,6 +109,11 @@ impl SimError {
 
     pub(crate) fn of(mut self, value: impl Into<String>) -> SimError {
         self.value = Some(value.into());
+        self
+    }
+
+    pub(crate) fn src(mut self, span: Span) -> SimError {
+        self.span = span;
         self
     }
 

@@ -106,6 +106,8 @@ pub(super) fn run<T: Float>(
     let mut issued_add = vec![0u32; cycles as usize];
     let mut issued_mul = vec![0u32; cycles as usize];
 
+    // The placement line of memory event `e` (a load, then the writes).
+    let mem_span = |e: usize| if e < n_loads { p.spans.load(e) } else { p.spans.write(e - n_loads) };
     // Writes one PE memory word: bounds, reuse.
     let store = |mem: &mut HashMap<(usize, u32), usize>, e: usize, now: i64, when: When| -> Result<(), SimError> {
         let ev = &mem_ev[e];
@@ -120,10 +122,11 @@ pub(super) fn run<T: Float>(
             )
             .at(when)
             .on(ev.pe)
-            .of(r.name(ev.key)));
+            .of(r.name(ev.key))
+            .src(mem_span(e)));
         }
         occupy(mem, (ev.slot, ev.addr), e, now, |x| mem_ev[x].time, |x| mem_ev[x].last_read).map_err(|(old, read)| {
-            reuse_error("memory", ev.addr, r.name(mem_ev[old].key), r.name(ev.key), read).at(when).on(ev.pe)
+            reuse_error("memory", ev.addr, r.name(mem_ev[old].key), r.name(ev.key), read).at(when).on(ev.pe).src(mem_span(e))
         })
     };
 
@@ -145,7 +148,8 @@ pub(super) fn run<T: Float>(
                 return Err(SimError::new(K::NoBuffer, "written indirectly, but the architecture has no buffers")
                     .at(now)
                     .on(ev.pe)
-                    .of(r.vname(ev.value)));
+                    .of(r.vname(ev.value))
+                    .src(p.spans.write(ev.write)));
             }
             let words = p.buffer_words[ev.slot];
             if ev.addr >= words {
@@ -158,7 +162,8 @@ pub(super) fn run<T: Float>(
                 )
                 .at(now)
                 .on(ev.pe)
-                .of(r.vname(ev.value)));
+                .of(r.vname(ev.value))
+                .src(p.spans.write(ev.write)));
             }
             occupy(
                 &mut buf,
@@ -169,7 +174,7 @@ pub(super) fn run<T: Float>(
                 |x| Some(buf_ev[x].last_read as i64),
             )
             .map_err(|(old, read)| {
-                reuse_error("buffer", ev.addr, r.vname(buf_ev[old].value), r.vname(ev.value), read).at(now).on(ev.pe)
+                reuse_error("buffer", ev.addr, r.vname(buf_ev[old].value), r.vname(ev.value), read).at(now).on(ev.pe).src(p.spans.write(ev.write))
             })?;
             buf_data[b] = Some(result[ev.value.index()].expect("issued before arrival"));
         }
@@ -190,7 +195,8 @@ pub(super) fn run<T: Float>(
                         )
                         .at(now)
                         .on(w.pe)
-                        .of(r.vname(v)));
+                        .of(r.vname(v))
+                        .src(p.spans.write(wi)));
                     }
                     result[v.index()].expect("issued before arrival")
                 }
@@ -203,7 +209,8 @@ pub(super) fn run<T: Float>(
                         )
                         .at(now)
                         .on(ev.pe)
-                        .of(r.vname(v)));
+                        .of(r.vname(v))
+                        .src(p.spans.write(wi)));
                     }
                     if c < arr {
                         return Err(SimError::new(
@@ -212,7 +219,8 @@ pub(super) fn run<T: Float>(
                         )
                         .at(now)
                         .on(ev.pe)
-                        .of(r.vname(v)));
+                        .of(r.vname(v))
+                        .src(p.spans.write(wi)));
                     }
                     if let Some(&other) = buf_reads.get(&ev.slot) {
                         let o = &buf_ev[other];
@@ -231,7 +239,8 @@ pub(super) fn run<T: Float>(
                             )
                             .at(now)
                             .on(ev.pe)
-                            .of(r.vname(v)));
+                            .of(r.vname(v))
+                        .src(p.spans.write(wi)));
                         }
                     }
                     buf_reads.insert(ev.slot, b);
@@ -242,7 +251,8 @@ pub(super) fn run<T: Float>(
                         )
                         .at(now)
                         .on(ev.pe)
-                        .of(r.vname(v)));
+                        .of(r.vname(v))
+                        .src(p.spans.write(wi)));
                     }
                     buf_data[b].expect("entered at arrival")
                 }
@@ -261,7 +271,8 @@ pub(super) fn run<T: Float>(
                 )
                 .at(now)
                 .on(w.pe)
-                .of(r.vname(v)));
+                .of(r.vname(v))
+                .src(p.spans.issue(v)));
             }
             store(&mut mem, e, c as i64, now)?;
             mem_data[e] = Some(data);
@@ -279,7 +290,8 @@ pub(super) fn run<T: Float>(
                 )
                 .at(now)
                 .on(is.pe)
-                .of(r.vname(v)));
+                .of(r.vname(v))
+                .src(p.spans.issue(v)));
             }
             if let Some(&other) = busy.get(&r.slot(is.pe)) {
                 return Err(SimError::new(
@@ -288,7 +300,8 @@ pub(super) fn run<T: Float>(
                 )
                 .at(now)
                 .on(is.pe)
-                .of(r.vname(v)));
+                .of(r.vname(v))
+                .src(p.spans.issue(v)));
             }
             busy.insert(r.slot(is.pe), v);
             let mut args: Vec<T> = Vec::new();
@@ -305,7 +318,8 @@ pub(super) fn run<T: Float>(
                         )
                         .at(now)
                         .on(is.pe)
-                        .of(r.name(k)));
+                        .of(r.name(k))
+                        .src(p.spans.issue(v)));
                     }
                 }
                 let missing = |why: String| {
@@ -316,6 +330,7 @@ pub(super) fn run<T: Float>(
                     .at(now)
                     .on(is.pe)
                     .of(r.name(k))
+                    .src(p.spans.issue(v))
                 };
                 match res {
                     Err(None) => return Err(missing("never written or loaded there".into())),
@@ -354,7 +369,8 @@ pub(super) fn run<T: Float>(
                             format!("output `{}` was never computed", o.name),
                         )
                         .at(When::End)
-                        .of(r.vname(v)))
+                        .of(r.vname(v))
+                        .src(o.span))
                     }
                 }
             }

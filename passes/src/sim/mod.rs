@@ -58,6 +58,7 @@ use robovec_ir::{Function, Module};
 
 pub use error::{SimError, SimErrorKind, When};
 
+use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// What one simulated run computed and measured.
@@ -103,6 +104,52 @@ pub struct SimReport {
     pub seeds: Vec<u64>,
     /// Outputs compared per run.
     pub outputs: usize,
+}
+
+/// What one run of the `sim` pass checked: printed by `-stats` and written as the report's
+/// `sim` object (issue 10 item 5).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SimStats {
+    /// Placements (one per function) simulated.
+    pub placements: usize,
+    /// Input sets (seeds `0..seeds`), each simulated in every precision.
+    pub seeds: u32,
+    /// Precisions simulated and compared with the interpreter.
+    pub precisions: Vec<&'static str>,
+    /// True: every output equalled the interpreter's bit for bit (a mismatch fails the pass).
+    pub bit_exact: bool,
+    /// One entry per function simulated.
+    pub functions: Vec<SimFunctionStats>,
+}
+
+/// The machine figures `sim` measured on one function's placement.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SimFunctionStats {
+    /// Function name.
+    pub function: String,
+    /// Largest arrival cycle, cycles.
+    pub cycles: u32,
+    /// Outputs compared per run.
+    pub outputs: usize,
+    /// Direct writes.
+    pub writes_direct: u32,
+    /// Indirect writes.
+    pub writes_indirect: u32,
+}
+
+impl std::fmt::Display for SimStats {
+    /// `sim: simulated N placements bit-exact in f32 and f64 (S seeds)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let plural = |n: usize, w: &str| if n == 1 { format!("{n} {w}") } else { format!("{n} {w}s") };
+        write!(
+            f,
+            "sim: simulated {} {} in {} ({})",
+            plural(self.placements, "placement"),
+            if self.bit_exact { "bit-exact" } else { "with mismatches" },
+            self.precisions.join(" and "),
+            plural(self.seeds as usize, "seed")
+        )
+    }
 }
 
 /// Simulates placement `p` of `f` cycle by cycle in precision `T`; `input(name)` gives each
@@ -161,7 +208,7 @@ fn compare<T: Float>(f: &Function, p: &Placement, seed: u64, precision: &str) ->
     let input = |n: &str| pseudo_random_input(n, seed);
     let sim = simulate::<T>(f, p, input)?;
     let reference = eval::<T>(f, input);
-    for ((name, s), (_, e)) in sim.outputs.iter().zip(&reference) {
+    for (((name, s), (_, e)), o) in sim.outputs.iter().zip(&reference).zip(&f.outputs) {
         let (s, e) = (s.to_f64(), e.to_f64());
         if s.to_bits() != e.to_bits() && !(s.is_nan() && e.is_nan()) {
             return Err(SimError::new(
@@ -169,7 +216,8 @@ fn compare<T: Float>(f: &Function, p: &Placement, seed: u64, precision: &str) ->
                 format!("simulated {s:?} but the interpreter gives {e:?} ({precision}, seed {seed})"),
             )
             .at(When::End)
-            .of(format!("output `{name}`")));
+            .of(format!("output `{name}`"))
+            .src(o.span));
         }
     }
     Ok(sim)
@@ -181,13 +229,14 @@ pub const INFO: PassInfo = PassInfo {
     doc: "simulate each placement cycle by cycle and check its outputs against the interpreter (f32 and f64)",
     params: &[ParamInfo {
         name: "seeds",
-        default: "3",
+        kind: ParamKind::U32 { default: 3, min: 1, max: 10_000 },
         doc: "number of pseudo-random input sets (seeds 0..n), each simulated in f32 and f64",
     }],
-    build: |p: &Params| Ok(Box::new(Sim { seeds: p.u32_in("seeds", 3, 1, 10_000)? })),
+    build: |p: &Params| Ok(Box::new(Sim { seeds: p.u32("seeds")? })),
 };
 
 /// The `sim` pass: checks, never changes, the module.
+#[derive(Debug)]
 pub struct Sim {
     /// Number of input sets (seeds `0..seeds`).
     pub seeds: u32,
@@ -202,19 +251,37 @@ impl Pass for Sim {
         true
     }
 
-    fn run(&self, m: &mut Module, _cx: &mut PassContext) -> Result<(), PassError> {
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let seeds: Vec<u64> = (0..self.seeds as u64).collect();
+        let mut functions = Vec::new();
         for f in &m.functions {
             let fail = |message: String| PassError::Failed { pass: "sim".into(), message };
             let p = f
                 .placement
                 .as_ref()
                 .ok_or_else(|| fail(format!("function @{} has no placement; run `place` first", f.name)))?;
-            verify_with(f, p, &seeds).map_err(|e| fail(format!("@{}: {e}", f.name)))?;
+            let r = verify_with(f, p, &seeds).map_err(|e| fail(format!("@{}: {e}", f.name)).at(e.span))?;
+            functions.push(SimFunctionStats {
+                function: f.name.clone(),
+                cycles: r.cycles,
+                outputs: r.outputs,
+                writes_direct: r.writes_direct,
+                writes_indirect: r.writes_indirect,
+            });
         }
+        cx.sim.push(SimStats {
+            placements: functions.len(),
+            seeds: self.seeds,
+            precisions: vec!["f32", "f64"],
+            bit_exact: true,
+            functions,
+        });
         Ok(())
     }
 }
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod agree;

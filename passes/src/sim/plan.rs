@@ -46,6 +46,8 @@ pub(super) struct BufEvent {
     pub value: Value,
     pub arrival: u32,
     pub last_read: u32,
+    /// The first indirect write reading it (`Placement::writes` index), for diagnostics.
+    pub write: usize,
 }
 
 /// Events of one cycle, in the order they happen.
@@ -136,7 +138,9 @@ impl Run<'_> {
         for &v in &f.body {
             if matches!(f.value(v).def, Def::Expr(_)) {
                 return Err(
-                    SimError::new(K::Malformed, "is a nested expression; run `atomise` before `sim`").of(self.vname(v))
+                    SimError::new(K::Malformed, "is a nested expression; run `atomise` before `sim`")
+                        .of(self.vname(v))
+                        .src(f.value(v).span)
                 );
             }
         }
@@ -147,20 +151,21 @@ impl Run<'_> {
                 return Err(SimError::new(K::NotAnOp, "is issued but is not an op")
                     .at(When::Cycle(is.cycle))
                     .on(is.pe)
-                    .of(self.vname(v)));
+                    .of(self.vname(v))
+                    .src(p.spans.issue(v)));
             }
             if !self.pe_exists(is.pe) {
-                return Err(self.no_pe(is.pe, When::Cycle(is.cycle), "issue").of(self.vname(v)));
+                return Err(self.no_pe(is.pe, When::Cycle(is.cycle), "issue").of(self.vname(v)).src(p.spans.issue(v)));
             }
         }
         for &v in &f.body {
             if f.op_kind(v).is_some() && p.issue.get(v.index()).copied().flatten().is_none() {
-                return Err(SimError::new(K::MissingIssue, "op is never issued").of(self.vname(v)));
+                return Err(SimError::new(K::MissingIssue, "op is never issued").of(self.vname(v)).src(f.value(v).span));
             }
         }
-        for l in &p.loads {
+        for (i, l) in p.loads.iter().enumerate() {
             if !self.pe_exists(l.pe) {
-                return Err(self.no_pe(l.pe, When::Load, "load").of(self.name(key_of(&l.operand))));
+                return Err(self.no_pe(l.pe, When::Load, "load").of(self.name(key_of(&l.operand))).src(p.spans.load(i)));
             }
             if let Operand::Value(v) = l.operand {
                 self.value_ok(v, "a load")?;
@@ -168,20 +173,22 @@ impl Run<'_> {
                     return Err(SimError::new(K::BadLoad, "loaded, but it is an op result, not initial data")
                         .at(When::Load)
                         .on(l.pe)
-                        .of(self.vname(v)));
+                        .of(self.vname(v))
+                        .src(p.spans.load(i)));
                 }
             }
         }
-        for w in &p.writes {
+        for (i, w) in p.writes.iter().enumerate() {
             self.value_ok(w.value, "a write")?;
             if !self.pe_exists(w.pe) {
-                return Err(self.no_pe(w.pe, When::Cycle(w.cycle), "write").of(self.vname(w.value)));
+                return Err(self.no_pe(w.pe, When::Cycle(w.cycle), "write").of(self.vname(w.value)).src(p.spans.write(i)));
             }
             if f.op_kind(w.value).is_none() {
                 return Err(SimError::new(K::NotAnOp, "written as a result, but it is not an op")
                     .at(When::Cycle(w.cycle))
                     .on(w.pe)
-                    .of(self.vname(w.value)));
+                    .of(self.vname(w.value))
+                    .src(p.spans.write(i)));
             }
         }
         Ok(())
@@ -242,6 +249,7 @@ impl Run<'_> {
                     .at(When::Cycle(is.cycle))
                     .on(is.pe)
                     .of(r.vname(v))
+                    .src(p.spans.issue(v))
             })?;
             arrival[v.index()] = Some(a);
             cycles = cycles.max(a);
@@ -319,6 +327,7 @@ impl Run<'_> {
                     value: w.value,
                     arrival: arr,
                     last_read: 0,
+                    write: i,
                 });
                 buf_ev.len() - 1
             });
@@ -329,7 +338,8 @@ impl Run<'_> {
                 )
                 .at(When::Cycle(arr))
                 .on(is.pe)
-                .of(r.vname(w.value)));
+                .of(r.vname(w.value))
+                .src(p.spans.write(i)));
             }
             buf_ev[b].last_read = buf_ev[b].last_read.max(w.cycle);
             buf_of_write[i] = Some(b);

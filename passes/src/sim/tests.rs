@@ -51,6 +51,7 @@ fn base(f: &Function) -> Placement {
         writes: vec![direct(f, "x", Add(0), 1, 7)],
         pe_words: vec![2, 2],
         buffer_words: vec![0, 0],
+        spans: Default::default(),
     }
 }
 
@@ -171,6 +172,7 @@ fn two_ops_on_one_pe_in_one_cycle() {
         writes: vec![],
         pe_words: vec![2],
         buffer_words: vec![0],
+        spans: Default::default(),
     };
     fails(&f, &p, SimErrorKind::PeBusy, &["cycle 3", "add0", "%y", "same cycle as %x"]);
 }
@@ -265,6 +267,7 @@ fn two_products() -> (Function, Placement) {
         writes: vec![indirect(&f, "x", Add(0), 0, 9, 0), indirect(&f, "z", Add(0), 1, 10, 1)],
         pe_words: vec![2, 2],
         buffer_words: vec![0, 2],
+        spans: Default::default(),
     };
     (f, p)
 }
@@ -378,6 +381,7 @@ fn malformed_placements() {
         writes: vec![],
         pe_words: vec![0, 0],
         buffer_words: vec![0, 0],
+        spans: Default::default(),
     };
     fails(&g, &p, SimErrorKind::Malformed, &["%x", "atomise"]);
 }
@@ -392,6 +396,7 @@ fn outputs_of_inputs_and_no_ops() {
         writes: vec![],
         pe_words: vec![0, 0],
         buffer_words: vec![0, 0],
+        spans: Default::default(),
     };
     let o = simulate::<f32>(&f, &p, input).unwrap();
     assert_eq!(o.cycles, 0);
@@ -493,7 +498,7 @@ fn naive_placement(f: &Function) -> Placement {
             _ => loads.push(Load { pe, addr: addr as u32, operand }),
         }
     }
-    Placement { arch: a, issue, loads, writes, pe_words, buffer_words: vec![0, 0] }
+    Placement { arch: a, issue, loads, writes, pe_words, buffer_words: vec![0, 0], spans: Default::default() }
 }
 
 const MIXED: &str = "func @f { phase atomised input %q input %m %s = sin %q %c = cos %q \

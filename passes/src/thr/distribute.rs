@@ -23,6 +23,7 @@ use robovec_ir::{BinOp, Def, Function, Module, Operand, Phase, Value};
 
 use super::cluster::{Class, Clusters};
 use super::{rewrite, Shape};
+use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
@@ -30,41 +31,38 @@ pub const INFO: PassInfo = PassInfo {
     name: "distribute",
     doc: "distribute critical products over the sums they multiply, within an ops budget (run balance after)",
     params: &[
-        ParamInfo { name: "rounds", default: "8", doc: "rounds of (balance, pick critical products, distribute)" },
-        ParamInfo { name: "max-growth", default: "1.5", doc: "largest ops / input ops" },
+        ParamInfo {
+            name: "rounds",
+            kind: ParamKind::U32 { default: 8, min: 0, max: 1000 },
+            doc: "rounds of (balance, pick critical products, distribute)",
+        },
+        ParamInfo {
+            name: "max-growth",
+            kind: ParamKind::F64 { default: 1.5, min: 1.0, max: 100.0 },
+            doc: "largest ops / input ops",
+        },
         ParamInfo {
             name: "slack",
-            default: "0",
+            kind: ParamKind::U32 { default: 0, min: 0, max: 1_000_000 },
             doc: "distribute products with at most this slack after balance, cycles",
         },
-        ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency, cycles" },
-        ParamInfo { name: "lat-mul", default: "7", doc: "mul latency, cycles" },
-        ParamInfo { name: "lat-div", default: "12", doc: "div latency, cycles" },
-        ParamInfo { name: "lat-call", default: "12", doc: "call latency, cycles" },
+        crate::params::LAT_ADD,
+        crate::params::LAT_MUL,
+        crate::params::LAT_DIV,
+        crate::params::LAT_CALL,
     ],
     build: |p: &Params| {
-        let growth = match p.get("max-growth") {
-            None => 1.5,
-            Some(v) => match v.parse::<f64>() {
-                Ok(x) if (1.0..=100.0).contains(&x) => x,
-                _ => {
-                    return Err(PassError::BadParameter {
-                        pass: "distribute".into(),
-                        message: format!("parameter `max-growth` must be a number in 1..=100, found `{v}`"),
-                    })
-                }
-            },
-        };
         Ok(Box::new(Distribute {
-            rounds: p.u32_in("rounds", 8, 0, 1000)?,
-            max_growth: growth,
-            slack: p.u32_in("slack", 0, 0, 1_000_000)?,
+            rounds: p.u32("rounds")?,
+            max_growth: p.f64("max-growth")?,
+            slack: p.u32("slack")?,
             lat: p.latencies()?,
         }))
     },
 };
 
 /// The `distribute` pass.
+#[derive(Debug)]
 pub struct Distribute {
     /// Rounds at most.
     pub rounds: u32,

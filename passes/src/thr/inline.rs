@@ -22,6 +22,7 @@ use std::collections::HashMap;
 use robovec_ir::{Def, Function, Module, Operand, Phase, Value};
 
 use super::cluster::{Class, Clusters};
+use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
@@ -29,18 +30,22 @@ pub const INFO: PassInfo = PassInfo {
     name: "inline",
     doc: "duplicate sums/products used at most K times into same-kind consumers, so clusters cross equations",
     params: &[
-        ParamInfo { name: "max-uses", default: "2", doc: "K: inline values with 2..=K uses (1 = no change)" },
-        ParamInfo { name: "max-size", default: "64", doc: "largest cluster tree copied, ops" },
+        ParamInfo {
+            name: "max-uses",
+            kind: ParamKind::U32 { default: 2, min: 1, max: 1_000_000 },
+            doc: "K: inline values with 2..=K uses (1 = no change)",
+        },
+        ParamInfo {
+            name: "max-size",
+            kind: ParamKind::U32 { default: 64, min: 1, max: 1 << 30 },
+            doc: "largest cluster tree copied, ops",
+        },
     ],
-    build: |p: &Params| {
-        Ok(Box::new(Inline {
-            max_uses: p.u32_in("max-uses", 2, 1, 1_000_000)?,
-            max_size: p.u32_in("max-size", 64, 1, 1 << 30)?,
-        }))
-    },
+    build: |p: &Params| Ok(Box::new(Inline { max_uses: p.u32("max-uses")?, max_size: p.u32("max-size")? })),
 };
 
 /// The `inline` pass.
+#[derive(Debug)]
 pub struct Inline {
     /// K: values with 2..=K uses are inlined.
     pub max_uses: u32,

@@ -26,6 +26,7 @@ use std::collections::BTreeMap;
 use robovec_ir::{BinOp, Def, Function, Module, Operand, Phase, TrigFn};
 
 use crate::dce::Dce;
+use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
@@ -34,19 +35,14 @@ pub const INFO: PassInfo = PassInfo {
     doc: "fold model parameters of known value (JSON file, -eval format), simplify x*0, x*1, x+0, then dce",
     params: &[ParamInfo {
         name: "params",
-        default: "none",
+        kind: ParamKind::Path,
         doc: "JSON file: object of canonical input name -> number, e.g. {\"dpt[3][5]\": 0}; without it only constants fold",
     }],
-    build: |p: &Params| match p.get("params") {
-        Some("") => Err(PassError::BadParameter {
-            pass: "specialize".into(),
-            message: "`params` needs a file name (`params=FILE.json`, an object of input name -> number)".into(),
-        }),
-        path => Ok(Box::new(Specialize { path: path.map(String::from) })),
-    },
+    build: |p: &Params| Ok(Box::new(Specialize { path: p.path("params")? })),
 };
 
 /// The `specialize` pass.
+#[derive(Debug)]
 pub struct Specialize {
     /// Path of the JSON parameter file; `None`: no known parameter (constants still fold).
     pub path: Option<String>,

@@ -26,12 +26,7 @@ use super::{rewrite, summary, Shape};
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// The latency parameters the cluster rewrites take (cycles; SPEC §1 defaults).
-pub const LATENCY_PARAMS: &[ParamInfo] = &[
-    ParamInfo { name: "lat-add", default: "12", doc: "add/sub latency, cycles" },
-    ParamInfo { name: "lat-mul", default: "7", doc: "mul latency, cycles" },
-    ParamInfo { name: "lat-div", default: "12", doc: "div latency, cycles" },
-    ParamInfo { name: "lat-call", default: "12", doc: "call latency, cycles" },
-];
+pub const LATENCY_PARAMS: &[ParamInfo] = crate::params::LATENCY_PARAMS;
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -42,6 +37,7 @@ pub const INFO: PassInfo = PassInfo {
 };
 
 /// A pass that rebuilds every cluster with one [`Shape`] (`zero-removal`, `swap`, `balance`).
+#[derive(Debug)]
 pub struct ClusterRewrite {
     /// Registered name.
     pub name: &'static str,
