@@ -14,6 +14,7 @@ mod exact_gap;
 mod example;
 mod filetests;
 mod numerics;
+mod params;
 mod placement;
 mod placement_verify;
 mod props;

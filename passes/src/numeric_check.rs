@@ -44,7 +44,7 @@ pub fn pipeline_text(names: &[&str]) -> String {
     let mut atomised = false;
     let mut push = |n: &'static str, out: &mut Vec<&'static str>| {
         let p = crate::pass_info(n).expect("registered pass");
-        let needs = (p.build)(&Default::default()).ok().and_then(|b| b.requires());
+        let needs = (p.build)(&crate::Params::defaults(p)).ok().and_then(|b| b.requires());
         if needs == Some(Phase::Atomised) && !atomised {
             out.push("atomise");
             atomised = true;

@@ -185,7 +185,7 @@ pub const LAT_CALL: ParamInfo = ParamInfo {
 pub const LATENCY_PARAMS: &[ParamInfo] = &[LAT_ADD, LAT_MUL, LAT_DIV, LAT_CALL];
 
 /// Checked parameters of one pipeline element: `(name, value)` pairs, each name declared.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Params {
     pass: &'static str,
     decls: &'static [ParamInfo],
@@ -344,7 +344,14 @@ impl Params {
                 .iter()
                 .find(|c| **c == v)
                 .copied()
-                .ok_or_else(|| self.bad(key, format!("one of {}", choices.join(" | ")), v)),
+                .ok_or_else(|| {
+                    let quoted: Vec<String> = choices.iter().map(|c| format!("`{c}`")).collect();
+                    let expected = match quoted.as_slice() {
+                        [a, b] => format!("{a} or {b}"),
+                        q => format!("one of {}", q.join(", ")),
+                    };
+                    self.bad(key, expected, v)
+                }),
         }
     }
 
@@ -372,7 +379,10 @@ impl Params {
         let ParamKind::Path = self.decl(key) else { panic!("parameter `{key}` of `{}` is not a path", self.pass) };
         match self.get(key) {
             None => Ok(None),
-            Some("") => Err(self.bad(key, format!("a file name (`{key}=PATH`)"), "")),
+            Some("") => Err(PassError::BadParameter {
+                pass: self.pass.into(),
+                message: format!("parameter `{key}` needs a file name (`{key}=PATH`)"),
+            }),
             Some(v) => Ok(Some(v.to_string())),
         }
     }
@@ -411,5 +421,85 @@ impl Params {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::PASSES;
+
+    fn build(info: &'static PassInfo, raw: &[(&str, String)]) -> Result<String, PassError> {
+        let raw: Vec<(String, Option<String>)> = raw.iter().map(|(k, v)| (k.to_string(), Some(v.clone()))).collect();
+        let p = Params::check(info, &raw)?;
+        Ok(format!("{:?}", (info.build)(&p)?))
+    }
+
+    #[test]
+    fn every_declared_default_is_the_default_and_every_range_is_enforced() {
+        for info in PASSES {
+            let none = build(info, &[]).unwrap_or_else(|e| panic!("{}: {e}", info.name));
+            let given: Vec<(&str, String)> =
+                info.params.iter().filter(|p| p.default_is_literal()).map(|p| (p.name, p.default_text())).collect();
+            let all = build(info, &given).unwrap_or_else(|e| panic!("{}: {e}", info.name));
+            assert_eq!(none, all, "{}: no parameters vs every printed default", info.name);
+            for p in info.params {
+                let ok = |v: &str| build(info, &[(p.name, v.to_string())]);
+                if let Some((lo, hi)) = p.bounds() {
+                    for v in [&lo, &hi] {
+                        ok(v).unwrap_or_else(|e| panic!("{} {}={v}: {e}", info.name, p.name));
+                    }
+                    for v in p.out_of_bounds() {
+                        assert!(
+                            matches!(ok(&v), Err(PassError::BadParameter { .. })),
+                            "{} {}={v} accepted",
+                            info.name,
+                            p.name
+                        );
+                    }
+                }
+                match p.kind {
+                    ParamKind::Choice { choices, .. } => {
+                        for c in choices {
+                            ok(c).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, p.name));
+                        }
+                    }
+                    ParamKind::Flag { .. } => {
+                        for c in ["on", "off"] {
+                            ok(c).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, p.name));
+                        }
+                    }
+                    _ => {}
+                }
+                if !matches!(p.kind, ParamKind::Path | ParamKind::Names) {
+                    assert!(ok("x").is_err(), "{} {}=x accepted", info.name, p.name);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn option_defaults_come_from_the_declarations() {
+        // Window 6 is what eqsat uses; `--print-passes` printed 8 before the declarations.
+        let eqsat = crate::pass_info("eqsat").unwrap();
+        let window = eqsat.params.iter().find(|p| p.name == "window").unwrap();
+        assert_eq!(window.default_text(), crate::eqsat::EqsatOptions::default().window.to_string());
+        assert_eq!(
+            build(eqsat, &[]).unwrap(),
+            format!("{:?}", crate::eqsat::Eqsat { opts: crate::eqsat::EqsatOptions::default() })
+        );
+        let place = crate::pass_info("place").unwrap();
+        assert_eq!(
+            build(place, &[]).unwrap(),
+            format!("{:?}", crate::place::Place { opts: crate::place::PlaceOptions::with_pes(4) })
+        );
+        let accuracy = crate::pass_info("accuracy").unwrap();
+        assert_eq!(
+            build(accuracy, &[]).unwrap(),
+            format!("{:?}", crate::accuracy::Accuracy { opts: crate::accuracy::Options::default() })
+        );
+        let d = Latencies::default();
+        let lat: Vec<String> = LATENCY_PARAMS.iter().map(ParamInfo::default_text).collect();
+        assert_eq!(lat, [d.add, d.mul, d.div, d.call].map(|x| x.to_string()));
     }
 }

@@ -18,7 +18,7 @@ fn placed(n_ops: usize, seed: u64, buffer: bool) -> Function {
     o.restarts = 0;
     o.search = 0;
     o.arch.buffer = buffer;
-    o.arch.writes = 1 + (seed % 2) as u32;
+    o.arch.writes = if buffer { 1 + (seed % 2) as u32 } else { 2 };
     f.placement = Some(place_function(&f, &o));
     f
 }
@@ -51,10 +51,11 @@ fn mutate(rng: &mut SplitMix64, p: &mut Placement) {
         0 | 1 => {
             let ops: Vec<usize> = (0..p.issue.len()).filter(|&i| p.issue[i].is_some()).collect();
             if let Some(k) = pick(rng, &ops) {
+                let q = other_pe(rng, p);
                 let is = p.issue[ops[k]].as_mut().unwrap();
                 match rng.below(3) {
                     0 => is.cycle = jiggle(rng, is.cycle),
-                    1 => is.pe = other_pe(rng, &p.clone()),
+                    1 => is.pe = q,
                     _ => p.issue[ops[k]] = None,
                 }
             }
@@ -78,9 +79,10 @@ fn mutate(rng: &mut SplitMix64, p: &mut Placement) {
         }
         4 | 5 => {
             if let Some(k) = pick(rng, &p.loads) {
+                let q = other_pe(rng, p);
                 match rng.below(3) {
                     0 => p.loads[k].addr = jiggle(rng, p.loads[k].addr),
-                    1 => p.loads[k].pe = other_pe(rng, &p.clone()),
+                    1 => p.loads[k].pe = q,
                     _ => {
                         p.loads.remove(k);
                     }

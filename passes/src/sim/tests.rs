@@ -130,6 +130,7 @@ fn constants_trig_and_calls_with_three_operands() {
         writes: vec![direct(&f, "x", Add(0), 1, 12)],
         pe_words: vec![3],
         buffer_words: vec![0],
+        spans: Default::default(),
     };
     let r = verify_with(&f, &p, &[0, 1, 2]).unwrap();
     assert_eq!(r.cycles, 24);
@@ -413,7 +414,7 @@ fn error_display_names_cycle_pe_and_value() {
 #[test]
 fn pass_needs_placements_and_checks_them() {
     let mut m = parse(SRC).unwrap();
-    let pass = (INFO.build)(&Params::default()).unwrap();
+    let pass = (INFO.build)(&Params::defaults(&INFO)).unwrap();
     assert!(pass.preserves_timing());
     let e = pass.run(&mut m, &mut PassContext::default()).unwrap_err().to_string();
     assert!(e.contains("run `place` first"), "{e}");
