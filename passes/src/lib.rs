@@ -26,7 +26,7 @@ pub mod thr;
 use robovec_ir::analysis::Latencies;
 use robovec_ir::{Module, Phase};
 
-pub use manager::{Instrumentation, PassManager, PassRecord, PrintSelector};
+pub use manager::{DumpSink, Instrumentation, PassManager, PassRecord, PrintSelector};
 pub use params::{ParamInfo, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
 
@@ -93,6 +93,15 @@ pub enum PassError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// The [`DumpSink`] refused a dump (the message names the file).
+    #[error("{message}")]
+    Output {
+        /// One line, ready for stderr.
+        message: String,
+    },
+    /// Writing IR prints or the timing table to the log (stderr) failed.
+    #[error("cannot write to the log: {0}")]
+    Log(std::io::Error),
 }
 
 /// State that passes share across one pipeline run.
