@@ -124,7 +124,9 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
         let message = if is_ir { "expected at least one `func`" } else { "expected at least one function" };
         let d = codespan_reporting::diagnostic::Diagnostic::error()
             .with_message(format!("{message}: the input has no function"))
-            .with_labels(vec![codespan_reporting::diagnostic::Label::primary((), 0..0).with_message("no function in this input")]);
+            .with_labels(vec![
+                codespan_reporting::diagnostic::Label::primary((), 0..0).with_message("no function in this input")
+            ]);
         return Err(Failure::Input(src.render(&[d])));
     }
     if let Err(errs) = verifier::verify(&module) {
@@ -252,6 +254,17 @@ fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     for d in opts.instr.dump_dir.iter().cloned().chain(worst_dirs.map(PathBuf::from)) {
         output::check_folder(&d).map_err(output_failure)?;
     }
+    // Files a pass reads when it runs (`accuracy<params=…>`, `specialize<params=…>`): readable
+    // now, so a typo fails before any work; their content is checked by the pass.
+    for spec in pm.specs() {
+        for (_, file) in spec.params.iter().filter(|(k, v)| k == "params" && v.as_ref().is_some_and(|v| !v.is_empty()))
+        {
+            let file = file.as_deref().unwrap_or_default();
+            std::fs::File::open(file).map_err(|e| {
+                Failure::Input(format!("error: cannot read `{file}` (parameter `params` of `{}`): {e}\n", spec.name))
+            })?;
+        }
+    }
     Ok(())
 }
 
@@ -261,7 +274,8 @@ fn check_functions(opts: &Options, module: &Module) -> Result<(), Failure> {
     if opts.function.is_some() {
         select(module, &opts.function, "-function")?;
     }
-    for (given, what) in [(opts.report.is_some(), "-report"), (opts.eval.is_some(), "-eval"), (opts.pareto.is_some(), "-pareto")]
+    for (given, what) in
+        [(opts.report.is_some(), "-report"), (opts.eval.is_some(), "-eval"), (opts.pareto.is_some(), "-pareto")]
     {
         if given {
             select(module, &opts.function, what)?;
@@ -395,7 +409,8 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         write!(stderr, "{}", robovec_passes::sweep::to_table(&cx.sweep)).map_err(stderr_failure)?;
     }
     if !cx.accuracy.is_empty() {
-        write!(stderr, "{}", robovec_passes::accuracy::report::to_text(&cx.accuracy, opts.stats)).map_err(stderr_failure)?;
+        write!(stderr, "{}", robovec_passes::accuracy::report::to_text(&cx.accuracy, opts.stats))
+            .map_err(stderr_failure)?;
     }
     let ir = module.to_string();
 
@@ -432,7 +447,9 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             let names: Vec<String> = written.iter().map(|p| format!("`{}`", p.display())).collect();
             format!("; files already written: {}", names.join(", "))
         };
-        Failure::Output(format!("error: cannot write to stdout: {e}{already}
-"))
+        Failure::Output(format!(
+            "error: cannot write to stdout: {e}{already}
+"
+        ))
     })
 }

@@ -63,7 +63,9 @@ fn classify(path: &Path) -> Result<Kind, String> {
         }
         Ok(m) => match special_kind(&m) {
             Special::Writable => Ok(Kind::Direct),
-            Special::Refused(what) => Err(fail(format!("it is a {what}; robovec writes only files, character devices and FIFOs"))),
+            Special::Refused(what) => {
+                Err(fail(format!("it is a {what}; robovec writes only files, character devices and FIFOs")))
+            }
         },
         Err(e) if e.kind() == io::ErrorKind::NotFound => {
             let target = dangling_target(path).map_err(fail)?;
@@ -273,7 +275,12 @@ impl OutputSet {
                 let tmp = dir.join(format!(".{name}.{}.{}.robovec-tmp", std::process::id(), self.counter));
                 let mut file = OpenOptions::new().write(true).create_new(true).open(&tmp).map_err(fail)?;
                 // From here on the temporary file exists: record it so a failure removes it.
-                self.staged.push(Staged { shown: path.into(), final_path: Some(final_path), tmp: Some(tmp), data: Vec::new() });
+                self.staged.push(Staged {
+                    shown: path.into(),
+                    final_path: Some(final_path),
+                    tmp: Some(tmp),
+                    data: Vec::new(),
+                });
                 if let Some(m) = &existing {
                     copy_owner_and_mode(&file, m).map_err(fail)?;
                 }
@@ -313,7 +320,10 @@ impl OutputSet {
             done.push(s.shown.clone());
         }
         for s in &directs {
-            let r = OpenOptions::new().write(true).open(&s.shown).and_then(|mut f| f.write_all(&s.data).and_then(|()| f.flush()));
+            let r = OpenOptions::new()
+                .write(true)
+                .open(&s.shown)
+                .and_then(|mut f| f.write_all(&s.data).and_then(|()| f.flush()));
             if let Err(e) = r {
                 return Err(format!("error: cannot write `{}`: {e}{}", s.shown.display(), already(&done)));
             }

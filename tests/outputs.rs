@@ -41,7 +41,8 @@ fn s(p: &Path) -> &str {
 
 /// Sorted names in `d`.
 fn entries(d: &Path) -> Vec<String> {
-    let mut v: Vec<String> = fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let mut v: Vec<String> =
+        fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     v.sort();
     v
 }
@@ -90,7 +91,8 @@ fn a_symlink_is_followed_and_stays_a_link() {
         &format!("-sweep-csv={}", d.join("csv-link").display()),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    for (link, to) in [("link.rvir", "real.rvir"), ("report-link.json", "sub/report.json"), ("csv-link", "sub/new.csv")] {
+    for (link, to) in [("link.rvir", "real.rvir"), ("report-link.json", "sub/report.json"), ("csv-link", "sub/new.csv")]
+    {
         let p = d.join(link);
         assert!(fs::symlink_metadata(&p).unwrap().file_type().is_symlink(), "{link} is no longer a link");
         assert_eq!(fs::read_link(&p).unwrap(), Path::new(to), "{link} points elsewhere");
@@ -158,7 +160,8 @@ fn a_fifo_is_written_directly() {
 /// already exited; returns (exit status, stderr).
 fn into_closed_pipe(d: &Path, cmd: &str) -> (Option<i32>, String) {
     let script = format!("{{ sleep 0.5; {cmd} 2>\"$D/err\"; echo $? > \"$D/status\"; }} | true");
-    let st = Command::new("sh").arg("-c").arg(script).env("BIN", BIN).env("IN", pendulum()).env("D", d).status().unwrap();
+    let st =
+        Command::new("sh").arg("-c").arg(script).env("BIN", BIN).env("IN", pendulum()).env("D", d).status().unwrap();
     assert!(st.success());
     let code = fs::read_to_string(d.join("status")).unwrap().trim().parse().ok();
     (code, fs::read_to_string(d.join("err")).unwrap())
@@ -247,12 +250,18 @@ fn usage_errors_come_before_any_work() {
     let dumps = d.join("dumps");
     let dump = format!("-dump-dir={}", dumps.display());
     let out = d.join("out.rvir");
-    let cases: [(&[&str], i32, &str); 5] = [
+    let cases: [(&[&str], i32, &str); 6] = [
         (&["-passes=atomise", &format!("-sweep-csv={}", d.join("s.csv").display())], 2, "needs a `sweep` pass"),
-        (&["-passes=atomise", "-function=nope", &format!("-report={}", d.join("r.json").display())], 2, "no function `nope`"),
+        (
+            &["-passes=atomise", "-function=nope", &format!("-report={}", d.join("r.json").display())],
+            2,
+            "no function `nope`",
+        ),
         (&["-passes=atomise", "-function=nope", "-stats"], 2, "no function `nope`"),
         (&["-passes=atomise", &format!("-report={}", out.display())], 2, "are the same file"),
         (&["-passes=atomise", &format!("-report={}", d.join("missing/r.json").display())], 1, "missing"),
+        // A file a pass would read only when it runs must exist before any work.
+        (&["-passes=atomise,specialize<params=missing.json>"], 1, "cannot read `missing.json`"),
     ];
     for (extra, code, needle) in cases {
         let mut args = vec![pendulum(), dump.clone(), "-o".into(), out.display().to_string()];
@@ -268,10 +277,12 @@ fn usage_errors_come_before_any_work() {
     let o = opt(&[&pendulum(), "-passes=atomise", &dump, "-o", s(&d.join("adir"))]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("folder") && !dumps.exists(), "{}", stderr(&o));
-    let o = opt(&[&pendulum(), "-passes=atomise", "-o", s(&out), &format!("-dump-dir={}", d.join("adir/x/y").display())]);
+    let o =
+        opt(&[&pendulum(), "-passes=atomise", "-o", s(&out), &format!("-dump-dir={}", d.join("adir/x/y").display())]);
     assert!(o.status.success(), "{}", stderr(&o));
     fs::write(d.join("afile"), "").unwrap();
-    let o = opt(&[&pendulum(), "-passes=atomise", "-o", s(&out), &format!("-dump-dir={}", d.join("afile/x").display())]);
+    let o =
+        opt(&[&pendulum(), "-passes=atomise", "-o", s(&out), &format!("-dump-dir={}", d.join("afile/x").display())]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("is not a folder"), "{}", stderr(&o));
 }

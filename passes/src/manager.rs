@@ -193,17 +193,21 @@ impl PassManager {
         }
         if self.instr.time_passes {
             let total: f64 = records.iter().map(|r| r.wall_ms).sum();
-            writeln!(log, "===-------------------------------------------------------------------------===").map_err(PassError::Log)?;
+            writeln!(log, "===-------------------------------------------------------------------------===")
+                .map_err(PassError::Log)?;
             writeln!(log, "                          Pass execution timing report").map_err(PassError::Log)?;
-            writeln!(log, "===-------------------------------------------------------------------------===").map_err(PassError::Log)?;
-            writeln!(log, "  {:>12}  {:>6}  {:>10}  {:>10}  Name", "Wall (ms)", "%", "ops before", "ops after").map_err(PassError::Log)?;
+            writeln!(log, "===-------------------------------------------------------------------------===")
+                .map_err(PassError::Log)?;
+            writeln!(log, "  {:>12}  {:>6}  {:>10}  {:>10}  Name", "Wall (ms)", "%", "ops before", "ops after")
+                .map_err(PassError::Log)?;
             for r in &records {
                 let pct = if total > 0.0 { 100.0 * r.wall_ms / total } else { 0.0 };
                 writeln!(
                     log,
                     "  {:>12.3}  {:>5.1}%  {:>10}  {:>10}  {}",
                     r.wall_ms, pct, r.ops_before, r.ops_after, r.name
-                ).map_err(PassError::Log)?;
+                )
+                .map_err(PassError::Log)?;
             }
             writeln!(log, "  {total:>12.3}  100.0%  {:>10}  {:>10}  Total", "", "").map_err(PassError::Log)?;
         }
