@@ -254,15 +254,17 @@ fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     for d in opts.instr.dump_dir.iter().cloned().chain(worst_dirs.map(PathBuf::from)) {
         output::check_folder(&d).map_err(output_failure)?;
     }
-    // Files a pass reads when it runs (`accuracy<params=…>`, `specialize<params=…>`): readable
-    // now, so a typo fails before any work; their content is checked by the pass.
+    // Files a pass reads when it runs (`accuracy<params=…>`, `specialize<params=…>`,
+    // `eqsat<rules=…>`): readable now, so a typo fails before any work; the pass checks content.
+    const READ_BY_PASSES: [(&str, &str); 3] = [("accuracy", "params"), ("specialize", "params"), ("eqsat", "rules")];
     for spec in pm.specs() {
-        for (_, file) in spec.params.iter().filter(|(k, v)| k == "params" && v.as_ref().is_some_and(|v| !v.is_empty()))
-        {
-            let file = file.as_deref().unwrap_or_default();
-            std::fs::File::open(file).map_err(|e| {
-                Failure::Input(format!("error: cannot read `{file}` (parameter `params` of `{}`): {e}\n", spec.name))
-            })?;
+        for (key, file) in &spec.params {
+            let Some(file) = file.as_deref().filter(|f| !f.is_empty()) else { continue };
+            if READ_BY_PASSES.contains(&(spec.name.as_str(), key.as_str())) {
+                std::fs::File::open(file).map_err(|e| {
+                    Failure::Input(format!("error: pass `{}`: cannot read {key} file `{file}`: {e}\n", spec.name))
+                })?;
+            }
         }
     }
     Ok(())

@@ -173,9 +173,27 @@ fn a_closed_pipe_is_exit_1_with_one_line() {
     let (code, err) = into_closed_pipe(&d, "\"$BIN\" --print-passes");
     assert_one_line_exit_1(code, &err, "--print-passes | (closed)");
     assert!(err.contains("stdout"), "{err}");
-    let (code, err) = into_closed_pipe(&d, "\"$BIN\" \"$IN\" -passes=atomise");
+    // The report is put in place before stdout is written: the diagnostic names it.
+    let (code, err) = into_closed_pipe(&d, "\"$BIN\" \"$IN\" -passes=atomise -report=\"$D/r.json\"");
     assert_one_line_exit_1(code, &err, "IR | (closed)");
-    assert!(err.contains("stdout"), "{err}");
+    assert!(err.contains("stdout") && err.contains("already written") && err.contains("r.json"), "{err}");
+}
+
+#[test]
+fn a_failure_while_putting_files_in_place_names_the_files_already_written() {
+    let d = tmp("commit");
+    // A full disk of our own (`/dev/full`'s numbers): devices are written after the renames.
+    let full = d.join("full");
+    let made = Command::new("mknod").args([s(&full), "c", "1", "7"]).status().expect("mknod runs");
+    assert!(made.success(), "mknod failed: this test needs root (as in CI)");
+    let r = d.join("r.json");
+    let o = opt(&[&pendulum(), "-passes=atomise", &format!("-report={}", r.display()), "-o", s(&full)]);
+    let err = stderr(&o);
+    assert_one_line_exit_1(o.status.code(), &err, "-o full device");
+    assert!(err.contains("No space left") && err.contains("already written") && err.contains("r.json"), "{err}");
+    assert!(fs::read_to_string(&r).unwrap().contains("\"function\": \"invdyna\""));
+    assert!(fs::symlink_metadata(&full).unwrap().file_type().is_char_device());
+    assert_eq!(entries(&d), ["full", "r.json"]);
 }
 
 #[test]
@@ -261,7 +279,7 @@ fn usage_errors_come_before_any_work() {
         (&["-passes=atomise", &format!("-report={}", out.display())], 2, "are the same file"),
         (&["-passes=atomise", &format!("-report={}", d.join("missing/r.json").display())], 1, "missing"),
         // A file a pass would read only when it runs must exist before any work.
-        (&["-passes=atomise,specialize<params=missing.json>"], 1, "cannot read `missing.json`"),
+        (&["-passes=atomise,specialize<params=missing.json>"], 1, "cannot read params file `missing.json`"),
     ];
     for (extra, code, needle) in cases {
         let mut args = vec![pendulum(), dump.clone(), "-o".into(), out.display().to_string()];
