@@ -1,7 +1,8 @@
 //! `robovec-opt`'s work: read the input, run the pipeline, write IR, report and evaluation.
 //!
-//! Order of work: every option is checked before any work (pipeline, `-sweep-csv` against it,
-//! every output path and folder under the output policy of [`crate::output`], `-eval` inputs);
+//! Order of work: every option is checked before any work ([`crate::preflight`]: pipeline,
+//! `-sweep-csv` against it, every output path and folder under the output policy of
+//! [`crate::output`], files passes will read; then the `-eval` inputs);
 //! the input is read and `-function` checked against it before any pass runs; the passes run
 //! with their dumps staged; the other outputs are staged; then [`OutputSet::commit`] puts every
 //! file in place at once, and stdout is written last. A failure before the commit leaves
@@ -19,7 +20,7 @@ use robovec_passes::{DumpSink, Instrumentation, PassContext, PassError, PassMana
 
 use crate::diagnostics::SourceFile;
 use crate::front;
-use crate::output::{self, OutputSet};
+use crate::output::OutputSet;
 use crate::report::{evaluate, placement_report, stats, Report};
 
 /// What the command line asked for.
@@ -136,7 +137,7 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
     Ok((module, src))
 }
 
-fn select<'m>(m: &'m Module, want: &Option<String>, what: &str) -> Result<&'m Function, Failure> {
+pub(crate) fn select<'m>(m: &'m Module, want: &Option<String>, what: &str) -> Result<&'m Function, Failure> {
     match want {
         Some(name) => m.function(name).ok_or_else(|| {
             let names: Vec<&str> = m.functions.iter().map(|f| f.name.as_str()).collect();
@@ -186,7 +187,7 @@ fn stage_worst_points(
 }
 
 /// A refused or failed output (one line from [`crate::output`]).
-fn output_failure(message: String) -> Failure {
+pub(crate) fn output_failure(message: String) -> Failure {
     Failure::Output(message + "\n")
 }
 
@@ -212,80 +213,6 @@ impl DumpSink for StagedDumps<'_> {
     }
 }
 
-/// Checks every option against the pipeline and every output path and folder under the output
-/// policy, before any work.
-///
-/// # Errors
-/// [`Failure::Usage`] for options that contradict each other or the pipeline;
-/// [`Failure::Output`] for a path the policy refuses.
-fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
-    if opts.sweep_csv.is_some() && !pm.specs().any(|s| s.name == "sweep") {
-        return Err(Failure::Usage("error: -sweep-csv needs a `sweep` pass in the pipeline\n".into()));
-    }
-    let files: Vec<(&str, &Path)> = [
-        ("-o", opts.output.as_deref().filter(|p| p.as_os_str() != "-")),
-        ("-report", opts.report.as_deref()),
-        ("-sweep-csv", opts.sweep_csv.as_deref()),
-    ]
-    .into_iter()
-    .filter_map(|(flag, p)| p.map(|p| (flag, p)))
-    .collect();
-    for (_, p) in &files {
-        output::check_file(p).map_err(output_failure)?;
-    }
-    for (i, (flag_a, a)) in files.iter().enumerate() {
-        for (flag_b, b) in &files[i + 1..] {
-            if let (Some(x), Some(y)) = (output::identity(a), output::identity(b)) {
-                if x == y {
-                    return Err(Failure::Usage(format!(
-                        "error: {flag_a} `{}` and {flag_b} `{}` are the same file\n",
-                        a.display(),
-                        b.display()
-                    )));
-                }
-            }
-        }
-    }
-    let worst_dirs = pm
-        .specs()
-        .filter(|s| s.name == "accuracy")
-        .filter_map(|s| s.params.iter().find(|(k, _)| k == "worst").and_then(|(_, v)| v.clone()))
-        .filter(|v| !v.is_empty());
-    for d in opts.instr.dump_dir.iter().cloned().chain(worst_dirs.map(PathBuf::from)) {
-        output::check_folder(&d).map_err(output_failure)?;
-    }
-    // Files a pass reads when it runs (`accuracy<params=…>`, `specialize<params=…>`,
-    // `eqsat<rules=…>`): readable now, so a typo fails before any work; the pass checks content.
-    const READ_BY_PASSES: [(&str, &str); 3] = [("accuracy", "params"), ("specialize", "params"), ("eqsat", "rules")];
-    for spec in pm.specs() {
-        for (key, file) in &spec.params {
-            let Some(file) = file.as_deref().filter(|f| !f.is_empty()) else { continue };
-            if READ_BY_PASSES.contains(&(spec.name.as_str(), key.as_str())) {
-                std::fs::File::open(file).map_err(|e| {
-                    Failure::Input(format!("error: pass `{}`: cannot read {key} file `{file}`: {e}\n", spec.name))
-                })?;
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Checks `-function` and the one-function needs of `-report`, `-eval` and `-pareto` against
-/// the input, before any pass runs.
-fn check_functions(opts: &Options, module: &Module) -> Result<(), Failure> {
-    if opts.function.is_some() {
-        select(module, &opts.function, "-function")?;
-    }
-    for (given, what) in
-        [(opts.report.is_some(), "-report"), (opts.eval.is_some(), "-eval"), (opts.pareto.is_some(), "-pareto")]
-    {
-        if given {
-            select(module, &opts.function, what)?;
-        }
-    }
-    Ok(())
-}
-
 /// Runs one `robovec-opt` invocation. `stdout` receives the IR (or `-eval` JSON); `stderr`
 /// receives dumps, timing and stats.
 ///
@@ -293,10 +220,10 @@ fn check_functions(opts: &Options, module: &Module) -> Result<(), Failure> {
 /// [`Failure`] with its exit status.
 pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
     let pm = PassManager::new(&opts.passes, opts.instr.clone()).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
-    check_options(opts, &pm)?;
+    crate::preflight::check_options(opts, &pm)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
     let (mut module, _src) = load(&opts.input)?;
-    check_functions(opts, &module)?;
+    crate::preflight::check_functions(opts, &module)?;
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
     // removes what it staged.
     let mut out = OutputSet::new();

@@ -10,4 +10,5 @@ pub mod driver;
 pub mod front;
 pub mod output;
 pub mod pareto;
+pub mod preflight;
 pub mod report;
