@@ -1,17 +1,26 @@
 //! `robovec-opt`'s work: read the input, run the pipeline, write IR, report and evaluation.
 //!
-//! Nothing is written before everything succeeded: outputs are built in memory and files are
-//! written through a temporary file and a rename, so a failure never leaves a half-written file.
+//! Order of work: every option is checked before any work ([`crate::preflight`]: pipeline,
+//! `-sweep-csv` against it, every output path and folder under the output policy of
+//! [`crate::output`], files passes will read; then the `-eval` inputs);
+//! the input is read and `-function` checked against it before any pass runs; the passes run
+//! with their dumps staged; the other outputs are staged; then [`OutputSet::commit`] puts every
+//! file in place at once, and stdout is written last. A failure before the commit leaves
+//! nothing of this run behind (see [`crate::output`] for the policy and its limits).
+//!
+//! Every write to stdout and stderr is checked: a failed write (closed pipe, full disk) ends the
+//! run with [`Failure::Output`] (exit status 1, one line on stderr unless stderr is what failed).
 
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use robovec_ir::{text, verifier, Function, Module};
-use robovec_passes::{Instrumentation, PassContext, PassManager};
+use robovec_passes::{DumpSink, Instrumentation, PassContext, PassError, PassManager};
 
 use crate::diagnostics::SourceFile;
 use crate::front;
+use crate::output::OutputSet;
 use crate::report::{evaluate, placement_report, stats, Report};
 
 /// What the command line asked for.
@@ -50,13 +59,17 @@ pub enum Failure {
     Input(String),
     /// Bad usage (exit status 2).
     Usage(String),
+    /// An output could not be written — a file under the output policy ([`crate::output`]),
+    /// stdout or stderr (exit status 1). The message is one line, empty when stderr itself
+    /// failed (nothing more can be said).
+    Output(String),
 }
 
 impl Failure {
     /// Exit status: 1 for bad input, 2 for bad usage (SPEC §7).
     pub fn exit_code(&self) -> i32 {
         match self {
-            Failure::Input(_) => 1,
+            Failure::Input(_) | Failure::Output(_) => 1,
             Failure::Usage(_) => 2,
         }
     }
@@ -64,7 +77,7 @@ impl Failure {
     /// The message.
     pub fn message(&self) -> &str {
         match self {
-            Failure::Input(s) | Failure::Usage(s) => s,
+            Failure::Input(s) | Failure::Usage(s) | Failure::Output(s) => s,
         }
     }
 }
@@ -106,6 +119,17 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
             })?
         }
     };
+    if module.functions.is_empty() {
+        // An empty or comment-only file is bad input, not a module to describe (issue 10).
+        let is_ir = front::language_of(path).is_none() || input == "-";
+        let message = if is_ir { "expected at least one `func`" } else { "expected at least one function" };
+        let d = codespan_reporting::diagnostic::Diagnostic::error()
+            .with_message(format!("{message}: the input has no function"))
+            .with_labels(vec![
+                codespan_reporting::diagnostic::Label::primary((), 0..0).with_message("no function in this input")
+            ]);
+        return Err(Failure::Input(src.render(&[d])));
+    }
     if let Err(errs) = verifier::verify(&module) {
         let diags: Vec<_> = errs.iter().map(|e| e.to_diagnostic((), "on input")).collect();
         return Err(Failure::Input(src.render(&diags)));
@@ -113,7 +137,7 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
     Ok((module, src))
 }
 
-fn select<'m>(m: &'m Module, want: &Option<String>, what: &str) -> Result<&'m Function, Failure> {
+pub(crate) fn select<'m>(m: &'m Module, want: &Option<String>, what: &str) -> Result<&'m Function, Failure> {
     match want {
         Some(name) => m.function(name).ok_or_else(|| {
             let names: Vec<&str> = m.functions.iter().map(|f| f.name.as_str()).collect();
@@ -133,22 +157,6 @@ fn select<'m>(m: &'m Module, want: &Option<String>, what: &str) -> Result<&'m Fu
     }
 }
 
-/// Writes `data` to `path` through a temporary file in the same folder and a rename.
-///
-/// # Errors
-/// [`Failure::Input`] naming the file.
-pub fn write_atomically(path: &Path, data: &[u8]) -> Result<(), Failure> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let fname = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{fname}.{}.tmp", std::process::id()));
-    let fail = |e: std::io::Error| Failure::Input(format!("error: cannot write `{}`: {e}\n", path.display()));
-    std::fs::write(&tmp, data).map_err(fail)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        fail(e)
-    })
-}
-
 fn read_eval_inputs(path: &Path) -> Result<BTreeMap<String, f64>, Failure> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| Failure::Input(format!("error: cannot read `{}`: {e}\n", path.display())))?;
@@ -162,13 +170,17 @@ fn read_eval_inputs(path: &Path) -> Result<BTreeMap<String, f64>, Failure> {
     })
 }
 
-/// Writes the `worst-K.json` files of every `accuracy<worst=DIR>` measurement.
-fn write_worst_points(reports: &[robovec_passes::accuracy::AccuracyReport], prefix: bool) -> Result<(), Failure> {
+/// Stages the `worst-K.json` files of every `accuracy<worst=DIR>` measurement.
+fn stage_worst_points(
+    out: &mut OutputSet,
+    reports: &[robovec_passes::accuracy::AccuracyReport],
+    prefix: bool,
+) -> Result<(), Failure> {
     for r in reports {
         let Some(dir) = &r.worst_dir else { continue };
-        std::fs::create_dir_all(dir).map_err(|e| Failure::Input(format!("error: cannot create `{dir}`: {e}\n")))?;
+        out.ensure_folder(Path::new(dir)).map_err(output_failure)?;
         for (name, json) in robovec_passes::accuracy::report::worst_files(r, prefix) {
-            write_atomically(&Path::new(dir).join(name), json.as_bytes())?;
+            out.stage(&Path::new(dir).join(name), json.as_bytes()).map_err(output_failure)?;
         }
     }
     Ok(())
@@ -193,6 +205,33 @@ fn pass_failure(e: robovec_passes::PassError, src: &SourceFile) -> Failure {
     }
 }
 
+/// A refused or failed output (one line from [`crate::output`]).
+pub(crate) fn output_failure(message: String) -> Failure {
+    Failure::Output(message + "\n")
+}
+
+/// A failed write to stderr: exit 1 with nothing more to say.
+fn stderr_failure(_: std::io::Error) -> Failure {
+    Failure::Output(String::new())
+}
+
+/// Dumps of `-dump-dir` staged into the run's [`OutputSet`] as the passes run.
+struct StagedDumps<'a> {
+    dir: PathBuf,
+    out: &'a mut OutputSet,
+    created: bool,
+}
+
+impl DumpSink for StagedDumps<'_> {
+    fn dump(&mut self, name: &str, text: &str) -> Result<(), String> {
+        if !self.created {
+            self.out.ensure_folder(&self.dir)?;
+            self.created = true;
+        }
+        self.out.stage(&self.dir.join(name), text.as_bytes())
+    }
+}
+
 /// Runs one `robovec-opt` invocation. `stdout` receives the IR (or `-eval` JSON); `stderr`
 /// receives dumps, timing and stats.
 ///
@@ -200,20 +239,32 @@ fn pass_failure(e: robovec_passes::PassError, src: &SourceFile) -> Failure {
 /// [`Failure`] with its exit status.
 pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
     let pm = PassManager::new(&opts.passes, opts.instr.clone()).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
+    crate::preflight::check_options(opts, &pm)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
     let (mut module, src) = load(&opts.input)?;
+    crate::preflight::check_functions(opts, &module)?;
+    // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
+    // removes what it staged.
+    let mut out = OutputSet::new();
     let pareto = match &opts.pareto {
         Some(text) => {
             let name = select(&module, &opts.function, "-pareto")?.name.clone();
             let rows = crate::pareto::run(&module, &name, text, opts.pareto_samples, opts.pareto_seed)?;
-            let _ = write!(stderr, "{}", crate::pareto::to_table(&name, &rows));
+            write!(stderr, "{}", crate::pareto::to_table(&name, &rows)).map_err(stderr_failure)?;
             rows
         }
         None => Vec::new(),
     };
     let mut cx = PassContext::default();
-    let records = pm.run(&mut module, &mut cx, stderr).map_err(|e| pass_failure(e, &src))?;
-
+    let records = {
+        let dir = opts.instr.dump_dir.clone().unwrap_or_default();
+        let mut dumps = StagedDumps { dir, out: &mut out, created: false };
+        pm.run_with_dumps(&mut module, &mut cx, stderr, &mut dumps).map_err(|e| match e {
+            PassError::Output { message } => output_failure(message),
+            PassError::Log(e) => stderr_failure(e),
+            e => pass_failure(e, &src),
+        })?
+    };
     // Build every output in memory first.
     let report = match &opts.report {
         Some(_) => {
@@ -244,7 +295,8 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             let f = select(&module, &opts.function, "-eval")?;
             for name in given.keys() {
                 if !f.inputs.iter().any(|&v| f.name_of(v) == name) {
-                    let _ = writeln!(stderr, "warning: `{name}` is not an input of @{}; ignored", f.name);
+                    writeln!(stderr, "warning: `{name}` is not an input of @{}; ignored", f.name)
+                        .map_err(stderr_failure)?;
                 }
             }
             Some(serde_json::to_string_pretty(&evaluate(f, given)).expect("eval serialises") + "\n")
@@ -253,14 +305,14 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     };
     if opts.stats {
         for note in &cx.notes {
-            let _ = writeln!(stderr, "{note}");
+            writeln!(stderr, "{note}").map_err(stderr_failure)?;
         }
         for f in &module.functions {
             if opts.function.as_ref().is_some_and(|n| n != &f.name) {
                 continue;
             }
             let s = stats(f, &cx.latencies);
-            let _ = writeln!(
+            writeln!(
                 stderr,
                 "@{}: equations {}, ops {} (add {}, sub {}, mul {}, div {}, call {}), inputs {}, outputs {}, \
                  critical path {} ops / {} cycles, Y = {:.2}",
@@ -277,10 +329,11 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 s.asap,
                 s.asap_cycle,
                 s.y
-            );
+            )
+            .map_err(stderr_failure)?;
             if let Some(p) = placement_report(f) {
                 let max = |v: &[u32]| v.iter().copied().max().unwrap_or(0);
-                let _ = writeln!(
+                writeln!(
                     stderr,
                     "@{}: placed on {} ADD + {} MULTI PEs: {} cycles, lower bound {} (x{:.3}), parallelisation rate {:.3}, \
                      PE memory up to {} words, buffer up to {} words, writes {} direct / {} indirect",
@@ -295,49 +348,64 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                     max(&p.buffer_words),
                     p.writes_direct,
                     p.writes_indirect
-                );
+                )
+                .map_err(stderr_failure)?;
             }
         }
     }
     if opts.stats {
         for e in cx.eqsat.iter().filter(|e| opts.function.as_ref().is_none_or(|n| n == &e.function)) {
-            let _ = writeln!(stderr, "{e}");
+            writeln!(stderr, "{e}").map_err(stderr_failure)?;
         }
         for s in &cx.sim {
-            let _ = writeln!(stderr, "{s}");
+            writeln!(stderr, "{s}").map_err(stderr_failure)?;
         }
     }
     if !cx.sweep.is_empty() {
-        let _ = write!(stderr, "{}", robovec_passes::sweep::to_table(&cx.sweep));
+        write!(stderr, "{}", robovec_passes::sweep::to_table(&cx.sweep)).map_err(stderr_failure)?;
     }
     if !cx.accuracy.is_empty() {
-        let _ = write!(stderr, "{}", robovec_passes::accuracy::report::to_text(&cx.accuracy, opts.stats));
+        write!(stderr, "{}", robovec_passes::accuracy::report::to_text(&cx.accuracy, opts.stats))
+            .map_err(stderr_failure)?;
     }
     let ir = module.to_string();
 
-    // Then write.
-    write_worst_points(&cx.accuracy, module.functions.len() > 1)?;
+    // Then put every file in place at once, and write stdout last.
+    stage_worst_points(&mut out, &cx.accuracy, module.functions.len() > 1)?;
     if let Some(path) = &opts.sweep_csv {
-        if cx.sweep.is_empty() {
-            return Err(Failure::Usage("error: -sweep-csv needs a `sweep` pass in the pipeline\n".into()));
-        }
-        write_atomically(path, robovec_passes::sweep::to_csv(&cx.sweep).as_bytes())?;
+        out.stage(path, robovec_passes::sweep::to_csv(&cx.sweep).as_bytes()).map_err(output_failure)?;
     }
     if let (Some(path), Some(r)) = (&opts.report, &report) {
-        write_atomically(path, r.as_bytes())?;
+        out.stage(path, r.as_bytes()).map_err(output_failure)?;
     }
-    match &opts.output {
-        Some(p) if p.as_os_str() == "-" => {
-            let _ = stdout.write_all(ir.as_bytes());
+    let ir_to_stdout = match &opts.output {
+        Some(p) if p.as_os_str() == "-" => true,
+        Some(p) => {
+            out.stage(p, ir.as_bytes()).map_err(output_failure)?;
+            false
         }
-        Some(p) => write_atomically(p, ir.as_bytes())?,
-        None if eval.is_none() => {
-            let _ = stdout.write_all(ir.as_bytes());
+        None => eval.is_none(),
+    };
+    let written = out.commit().map_err(output_failure)?;
+    let mut put = || -> std::io::Result<()> {
+        if ir_to_stdout {
+            stdout.write_all(ir.as_bytes())?;
         }
-        None => {}
-    }
-    if let Some(e) = eval {
-        let _ = stdout.write_all(e.as_bytes());
-    }
-    Ok(())
+        if let Some(e) = &eval {
+            stdout.write_all(e.as_bytes())?;
+        }
+        stdout.flush()
+    };
+    put().map_err(|e| {
+        let already = if written.is_empty() {
+            String::new()
+        } else {
+            let names: Vec<String> = written.iter().map(|p| format!("`{}`", p.display())).collect();
+            format!("; files already written: {}", names.join(", "))
+        };
+        Failure::Output(format!(
+            "error: cannot write to stdout: {e}{already}
+"
+        ))
+    })
 }

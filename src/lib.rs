@@ -8,5 +8,7 @@ pub mod cli;
 pub mod diagnostics;
 pub mod driver;
 pub mod front;
+pub mod output;
 pub mod pareto;
+pub mod preflight;
 pub mod report;

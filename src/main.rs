@@ -1,25 +1,66 @@
 //! `robovec-opt`: argument parsing → [`robovec::driver::run`] → exit status. No logic here.
+//!
+//! Every write to stdout and stderr is checked: a failed one (closed pipe, full disk) ends with
+//! exit status 1 and one line on stderr (nothing when stderr itself failed), never a panic.
+
+use std::io::Write;
 
 use clap::Parser;
 use robovec::cli::{normalise_args, print_passes, Cli};
 
 fn main() {
-    let cli = Cli::parse_from(normalise_args(std::env::args()));
+    std::process::exit(run());
+}
+
+/// Writes `text` to stdout and flushes; on failure says so on stderr. Returns the exit status.
+fn to_stdout(text: &str, ok: i32) -> i32 {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => ok,
+        Err(e) => {
+            to_stderr(&format!("error: cannot write to stdout: {e}\n"));
+            1
+        }
+    }
+}
+
+/// Writes `text` to stderr; if that fails there is nowhere left to say so.
+fn to_stderr(text: &str) {
+    let mut err = std::io::stderr().lock();
+    let _ = err.write_all(text.as_bytes()).and_then(|()| err.flush());
+}
+
+fn run() -> i32 {
+    let cli = match Cli::try_parse_from(normalise_args(std::env::args())) {
+        Ok(c) => c,
+        Err(e) => {
+            let text = e.render().to_string();
+            if e.use_stderr() {
+                to_stderr(&text);
+                return e.exit_code();
+            }
+            // --help and --version.
+            return to_stdout(&text, e.exit_code());
+        }
+    };
     if cli.print_passes {
-        print!("{}", print_passes());
-        return;
+        return to_stdout(&print_passes(), 0);
     }
     let opts = match cli.options() {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("{e}");
-            std::process::exit(2);
+            to_stderr(&format!("{e}\n"));
+            return 2;
         }
     };
     let mut stdout = std::io::stdout().lock();
     let mut stderr = std::io::stderr().lock();
-    if let Err(f) = robovec::driver::run(&opts, &mut stdout, &mut stderr) {
-        eprint!("{}", f.message());
-        std::process::exit(f.exit_code());
+    match robovec::driver::run(&opts, &mut stdout, &mut stderr) {
+        Ok(()) => 0,
+        Err(f) => {
+            drop(stderr);
+            to_stderr(f.message());
+            f.exit_code()
+        }
     }
 }

@@ -14,6 +14,8 @@ mod exact_gap;
 mod example;
 mod filetests;
 mod numerics;
+#[cfg(unix)]
+mod outputs;
 mod params;
 mod placement;
 mod placement_verify;

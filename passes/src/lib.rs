@@ -27,7 +27,7 @@ use robovec_ir::analysis::Latencies;
 use robovec_ir::verifier::VerifierError;
 use robovec_ir::{Module, Phase, Span};
 
-pub use manager::{Instrumentation, PassManager, PassRecord, PrintSelector};
+pub use manager::{DumpSink, Instrumentation, PassManager, PassRecord, PrintSelector};
 pub use params::{ParamInfo, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
 
@@ -106,6 +106,15 @@ pub enum PassError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// The [`DumpSink`] refused a dump (the message names the file).
+    #[error("{message}")]
+    Output {
+        /// One line, ready for stderr.
+        message: String,
+    },
+    /// Writing IR prints or the timing table to the log (stderr) failed.
+    #[error("cannot write to the log: {0}")]
+    Log(std::io::Error),
 }
 
 impl PassError {

@@ -1,9 +1,13 @@
 //! The pass manager: runs a pipeline and owns the cross-cutting work — IR printing before and
 //! after passes, dump files, verification after each pass, timing (LLVM's pass
 //! instrumentation; rustc's `run_passes_inner`). Passes never print or verify by themselves.
+//!
+//! Dump files (`-dump-dir`) are handed to a [`DumpSink`] as the passes run: the manager decides
+//! what to dump and names each file, the sink (`robovec-opt`'s output policy) decides how files
+//! are written, so a failed run leaves none of them.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use robovec_ir::{verifier, Module};
@@ -39,7 +43,8 @@ pub struct Instrumentation {
     pub print_before: PrintSelector,
     /// `-print-after[-all]`.
     pub print_after: PrintSelector,
-    /// `-dump-dir=DIR`: writes `DIR/NNN-<pass>.before.rvir` and `.after.rvir` (NNN from 001).
+    /// `-dump-dir=DIR`: dumps `NNN-<pass>.before.rvir` and `.after.rvir` (NNN from 001) for every
+    /// pass; the files go through the [`DumpSink`] given to [`PassManager::run_with_dumps`].
     pub dump_dir: Option<PathBuf>,
     /// `-verify-each` (default on): verify the input and the IR after every pass.
     pub verify_each: bool,
@@ -70,6 +75,26 @@ pub struct PassRecord {
     pub ops_before: u64,
     /// Ops after.
     pub ops_after: u64,
+}
+
+/// Receives the dumps of `-dump-dir` while the pipeline runs.
+pub trait DumpSink {
+    /// Takes one dump: its file name inside the dump folder (`001-atomise.before.rvir`) and its
+    /// text.
+    ///
+    /// # Errors
+    /// A one-line message naming the file; the manager stops the pipeline with
+    /// [`PassError::Output`].
+    fn dump(&mut self, name: &str, text: &str) -> Result<(), String>;
+}
+
+/// The sink of [`PassManager::run`]: dumps need a real sink, so this one refuses them.
+struct NoDumps;
+
+impl DumpSink for NoDumps {
+    fn dump(&mut self, name: &str, _: &str) -> Result<(), String> {
+        Err(format!("cannot write dump {name}: dumps need PassManager::run_with_dumps and a DumpSink"))
+    }
 }
 
 /// A parsed and checked pipeline with its instrumentation.
@@ -105,27 +130,48 @@ impl PassManager {
         self.passes.iter().map(|(s, _)| s.to_string()).collect::<Vec<_>>().join(",")
     }
 
-    /// Runs the pipeline on `m`; IR dumps and the timing table go to `log`.
+    /// The elements of the pipeline, in order (names and raw parameters), for checking
+    /// options against it before any work.
+    pub fn specs(&self) -> impl Iterator<Item = &PassSpec> {
+        self.passes.iter().map(|(s, _)| s)
+    }
+
+    /// Runs the pipeline on `m`; IR prints and the timing table go to `log`. With `dump_dir`
+    /// set, use [`PassManager::run_with_dumps`] (this one fails at the first dump).
     ///
     /// # Errors
-    /// The first pass error, a verifier failure naming the pass after which it happened, or a
-    /// dump that cannot be written.
+    /// As [`PassManager::run_with_dumps`].
     pub fn run(&self, m: &mut Module, cx: &mut PassContext, log: &mut dyn Write) -> Result<Vec<PassRecord>, PassError> {
+        self.run_with_dumps(m, cx, log, &mut NoDumps)
+    }
+
+    /// Runs the pipeline on `m`; IR prints and the timing table go to `log`, dumps (when
+    /// `dump_dir` is set) to `dumps`.
+    ///
+    /// # Errors
+    /// The first pass error, a verifier failure naming the pass after which it happened, a dump
+    /// the sink refuses ([`PassError::Output`]) or a failed write to `log` ([`PassError::Log`]).
+    pub fn run_with_dumps(
+        &self,
+        m: &mut Module,
+        cx: &mut PassContext,
+        log: &mut dyn Write,
+        dumps: &mut dyn DumpSink,
+    ) -> Result<Vec<PassRecord>, PassError> {
         if self.instr.verify_each {
             verify_named(m, "input")?;
         }
-        if let Some(d) = &self.instr.dump_dir {
-            std::fs::create_dir_all(d).map_err(|e| PassError::Io { path: d.display().to_string(), source: e })?;
-        }
+        let mut dump = |name: String, m: &Module| match &self.instr.dump_dir {
+            Some(_) => dumps.dump(&name, &m.to_string()).map_err(|message| PassError::Output { message }),
+            None => Ok(()),
+        };
         let mut records = Vec::new();
         for (i, (spec, pass)) in self.passes.iter().enumerate() {
             let name = pass.name();
             if self.instr.print_before.selects(name) {
-                let _ = write!(log, "*** IR Dump Before {spec} ***\n{m}");
+                write!(log, "*** IR Dump Before {spec} ***\n{m}").map_err(PassError::Log)?;
             }
-            if let Some(d) = &self.instr.dump_dir {
-                write_dump(d, &format!("{:03}-{name}.before.rvir", i + 1), m)?;
-            }
+            dump(format!("{:03}-{name}.before.rvir", i + 1), m)?;
             if let Some(phase) = pass.requires() {
                 crate::require_phase(name, m, phase)?;
             }
@@ -138,30 +184,32 @@ impl PassManager {
             }
             records.push(PassRecord { name: spec.to_string(), wall_ms, ops_before, ops_after: module_ops(m) });
             if self.instr.print_after.selects(name) {
-                let _ = write!(log, "*** IR Dump After {spec} ***\n{m}");
+                write!(log, "*** IR Dump After {spec} ***\n{m}").map_err(PassError::Log)?;
             }
-            if let Some(d) = &self.instr.dump_dir {
-                write_dump(d, &format!("{:03}-{name}.after.rvir", i + 1), m)?;
-            }
+            dump(format!("{:03}-{name}.after.rvir", i + 1), m)?;
             if self.instr.verify_each {
                 verify_named(m, name)?;
             }
         }
         if self.instr.time_passes {
             let total: f64 = records.iter().map(|r| r.wall_ms).sum();
-            let _ = writeln!(log, "===-------------------------------------------------------------------------===");
-            let _ = writeln!(log, "                          Pass execution timing report");
-            let _ = writeln!(log, "===-------------------------------------------------------------------------===");
-            let _ = writeln!(log, "  {:>12}  {:>6}  {:>10}  {:>10}  Name", "Wall (ms)", "%", "ops before", "ops after");
+            writeln!(log, "===-------------------------------------------------------------------------===")
+                .map_err(PassError::Log)?;
+            writeln!(log, "                          Pass execution timing report").map_err(PassError::Log)?;
+            writeln!(log, "===-------------------------------------------------------------------------===")
+                .map_err(PassError::Log)?;
+            writeln!(log, "  {:>12}  {:>6}  {:>10}  {:>10}  Name", "Wall (ms)", "%", "ops before", "ops after")
+                .map_err(PassError::Log)?;
             for r in &records {
                 let pct = if total > 0.0 { 100.0 * r.wall_ms / total } else { 0.0 };
-                let _ = writeln!(
+                writeln!(
                     log,
                     "  {:>12.3}  {:>5.1}%  {:>10}  {:>10}  {}",
                     r.wall_ms, pct, r.ops_before, r.ops_after, r.name
-                );
+                )
+                .map_err(PassError::Log)?;
             }
-            let _ = writeln!(log, "  {total:>12.3}  100.0%  {:>10}  {:>10}  Total", "", "");
+            writeln!(log, "  {total:>12.3}  100.0%  {:>10}  {:>10}  Total", "", "").map_err(PassError::Log)?;
         }
         Ok(records)
     }
@@ -182,13 +230,4 @@ fn verify_named(m: &Module, pass: &str) -> Result<(), PassError> {
         errors: errs.iter().map(|e| format!("  {e}")).collect::<Vec<_>>().join("\n"),
         list: errs,
     })
-}
-
-/// Writes `m` to `dir/name` atomically (temporary file, then rename).
-fn write_dump(dir: &Path, name: &str, m: &Module) -> Result<(), PassError> {
-    let path = dir.join(name);
-    let tmp = dir.join(format!(".{name}.tmp"));
-    let io = |e| PassError::Io { path: path.display().to_string(), source: e };
-    std::fs::write(&tmp, m.to_string()).map_err(io)?;
-    std::fs::rename(&tmp, &path).map_err(io)
 }

@@ -1,0 +1,351 @@
+//! The output-file policy of `robovec-opt`, in one place (issue 10, item 1): outputs never
+//! damage what is at their path, and a run leaves all of its output files or none.
+//!
+//! **What is at the path decides how it is written.**
+//! - *Nothing yet, or a regular file*: the bytes go to a temporary file in the same folder as
+//!   the final file (`.NAME.PID.K.robovec-tmp`, created exclusively), are flushed to disk
+//!   (`fsync`) and the temporary file is renamed over the path, so a reader sees the old file or
+//!   the new one, never half of one. An existing file keeps its permission bits and, where the
+//!   process may set them (root), its owner and group. A hard-linked file is replaced at this
+//!   name only (its other names keep the old content), as editors that save by rename do.
+//! - *A symbolic link* is followed (whole chain): the file it points to is what gets replaced,
+//!   the link stays a link. A dangling link creates the file it names.
+//! - *A read-only regular file* (no write permission bit at all) is refused with exit 1 before
+//!   any work: robovec does not replace a file its owner protected (run as root, a rename would
+//!   otherwise succeed silently). Make it writable or choose another path.
+//! - *A character device or a FIFO* (`/dev/null`, `/dev/stdout` on a pipe, `mkfifo`) is opened
+//!   for writing as it is — no temporary file, no rename, no truncation — and written directly.
+//! - *A folder, a block device or a socket* is refused with exit 1 before any work (writing IR
+//!   over a disk is never what was meant).
+//!
+//! **All or nothing.** [`OutputSet`] stages every output of a run (`-o`, `-report`,
+//! `-sweep-csv`, `accuracy<worst=…>` files and `-dump-dir` dumps): phase 1 writes each
+//! temporary file (dumps as the passes run, so a large model's dumps are on disk, not in
+//! memory); [`OutputSet::commit`] renames them all into place (phase 2) and only then writes
+//! the devices and FIFOs (phase 3, which cannot be undone). When anything fails before the
+//! commit — a pass, the verifier, a write to stderr — dropping the set removes every temporary
+//! file and every folder this run created (when empty), so nothing of the run is left. When a
+//! rename or a direct write fails during the commit, the diagnostic names each file already
+//! written. A run killed by a signal can leave `.robovec-tmp` files behind; no other file is
+//! ever touched before the commit.
+
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+/// How a path is written (see the module doc).
+#[derive(Debug)]
+enum Kind {
+    /// Temporary file in `final_path`'s folder, then rename; `meta` of the file replaced.
+    Replace { final_path: PathBuf, existing: Option<fs::Metadata> },
+    /// Opened and written as it is (character device, FIFO).
+    Direct,
+}
+
+/// Classifies `path` and checks it can be written under the policy, without touching it.
+///
+/// # Errors
+/// A one-line message (`error: cannot write `X`: …`) when `path` is a folder, a block device, a
+/// socket, a read-only file, a link loop, or its folder does not exist.
+fn classify(path: &Path) -> Result<Kind, String> {
+    let fail = |why: String| format!("error: cannot write `{}`: {why}", path.display());
+    match fs::metadata(path) {
+        Ok(m) if m.is_dir() => Err(fail("it is a folder".into())),
+        Ok(m) if m.is_file() => {
+            if m.permissions().readonly() {
+                return Err(fail(format!(
+                    "it is read-only (mode {:04o}); robovec does not replace a read-only file: make it writable or choose another path",
+                    mode_of(&m)
+                )));
+            }
+            let final_path = fs::canonicalize(path).map_err(|e| fail(e.to_string()))?;
+            Ok(Kind::Replace { final_path, existing: Some(m) })
+        }
+        Ok(m) => match special_kind(&m) {
+            Special::Writable => Ok(Kind::Direct),
+            Special::Refused(what) => {
+                Err(fail(format!("it is a {what}; robovec writes only files, character devices and FIFOs")))
+            }
+        },
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            let target = dangling_target(path).map_err(fail)?;
+            let name = target.file_name().ok_or_else(|| fail("not a file name".into()))?.to_owned();
+            let dir = target.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            match fs::metadata(dir) {
+                Ok(d) if d.is_dir() => {}
+                Ok(_) => return Err(fail(format!("`{}` is not a folder", dir.display()))),
+                Err(e) => return Err(fail(format!("folder `{}`: {e}", dir.display()))),
+            }
+            let dir = fs::canonicalize(dir).map_err(|e| fail(format!("folder `{}`: {e}", dir.display())))?;
+            Ok(Kind::Replace { final_path: dir.join(name), existing: None })
+        }
+        Err(e) => Err(fail(e.to_string())),
+    }
+}
+
+/// For a path that does not resolve: the path itself, or the missing file a (chain of)
+/// dangling symbolic link(s) names.
+fn dangling_target(path: &Path) -> Result<PathBuf, String> {
+    let mut p = path.to_path_buf();
+    for _ in 0..40 {
+        match fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let to = fs::read_link(&p).map_err(|e| e.to_string())?;
+                p = p.parent().unwrap_or(Path::new("")).join(to);
+            }
+            Ok(_) => return Err(format!("`{}` changed while being checked", p.display())),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(p),
+            Err(e) => return Err(e.to_string()),
+        }
+    }
+    Err("too many levels of symbolic links".into())
+}
+
+/// Checks that `path` is usable as an output file (same rules as [`OutputSet::stage`]) without
+/// creating or changing anything; for validating options before any work.
+///
+/// # Errors
+/// The one-line message of the refusal.
+pub fn check_file(path: &Path) -> Result<(), String> {
+    classify(path).map(|_| ())
+}
+
+/// Checks that `dir` is a folder or can be created as one (its nearest existing ancestor is a
+/// folder), without creating anything.
+///
+/// # Errors
+/// A one-line message naming the obstacle.
+pub fn check_folder(dir: &Path) -> Result<(), String> {
+    missing_folders(dir).map(|_| ())
+}
+
+/// The folders to create for `dir` to exist, outermost last.
+fn missing_folders(dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let fail = |why: String| format!("error: cannot create folder `{}`: {why}", dir.display());
+    let mut missing = Vec::new();
+    // The first error that is not "missing" (e.g. no permission), reported if no ancestor
+    // explains it better.
+    let mut other: Option<io::Error> = None;
+    let mut p = dir;
+    loop {
+        match fs::metadata(p) {
+            Ok(m) if m.is_dir() => return other.map_or(Ok(missing), |e| Err(fail(e.to_string()))),
+            Ok(_) => return Err(fail(format!("`{}` is not a folder", p.display()))),
+            Err(e) => {
+                if e.kind() != io::ErrorKind::NotFound && other.is_none() {
+                    other = Some(e);
+                }
+                missing.push(p.to_path_buf());
+                match p.parent() {
+                    Some(q) if !q.as_os_str().is_empty() => p = q,
+                    _ => return other.map_or(Ok(missing), |e| Err(fail(e.to_string()))),
+                }
+            }
+        }
+    }
+}
+
+/// The path a regular output would finally be written to (symlinks and the folder resolved),
+/// for telling whether two options name the same file; `None` for devices, FIFOs and paths
+/// that are refused anyway.
+pub fn identity(path: &Path) -> Option<PathBuf> {
+    match classify(path) {
+        Ok(Kind::Replace { final_path, .. }) => Some(final_path),
+        _ => None,
+    }
+}
+
+enum Special {
+    Writable,
+    Refused(&'static str),
+}
+
+#[cfg(unix)]
+fn special_kind(m: &fs::Metadata) -> Special {
+    use std::os::unix::fs::FileTypeExt;
+    let t = m.file_type();
+    if t.is_char_device() || t.is_fifo() {
+        Special::Writable
+    } else if t.is_block_device() {
+        Special::Refused("block device")
+    } else if t.is_socket() {
+        Special::Refused("socket")
+    } else {
+        Special::Refused("special file")
+    }
+}
+
+#[cfg(not(unix))]
+fn special_kind(_: &fs::Metadata) -> Special {
+    Special::Writable
+}
+
+#[cfg(unix)]
+fn mode_of(m: &fs::Metadata) -> u32 {
+    use std::os::unix::fs::PermissionsExt;
+    m.permissions().mode() & 0o7777
+}
+
+#[cfg(not(unix))]
+fn mode_of(_: &fs::Metadata) -> u32 {
+    0o444
+}
+
+/// Gives the temporary file the owner (when permitted) and permissions of the file it replaces.
+fn copy_owner_and_mode(file: &File, existing: &fs::Metadata) -> io::Result<()> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        // Only root may give a file away; for anyone else the new file is theirs, as with any
+        // editor's save.
+        let _ = std::os::unix::fs::fchown(file, Some(existing.uid()), Some(existing.gid()));
+    }
+    file.set_permissions(existing.permissions())
+}
+
+/// One staged output waiting for the commit.
+#[derive(Debug)]
+struct Staged {
+    /// The path as the user gave it (for messages).
+    shown: PathBuf,
+    /// Where the file ends up (rename target), or `None` for a direct write.
+    final_path: Option<PathBuf>,
+    /// The temporary file (rename targets).
+    tmp: Option<PathBuf>,
+    /// The bytes of a direct write.
+    data: Vec<u8>,
+}
+
+/// Every output file of one run, staged until [`OutputSet::commit`]; dropping an uncommitted
+/// set removes its temporary files and the folders it created (see the module doc).
+#[derive(Debug, Default)]
+pub struct OutputSet {
+    staged: Vec<Staged>,
+    created_dirs: Vec<PathBuf>,
+    counter: u32,
+    committed: bool,
+}
+
+impl OutputSet {
+    /// An empty set.
+    pub fn new() -> OutputSet {
+        OutputSet::default()
+    }
+
+    /// Creates `dir` and its missing ancestors, remembering the ones this run created (removed
+    /// again if the run fails).
+    ///
+    /// # Errors
+    /// A one-line message naming the folder.
+    pub fn ensure_folder(&mut self, dir: &Path) -> Result<(), String> {
+        let missing = missing_folders(dir)?;
+        for d in missing.into_iter().rev() {
+            match fs::create_dir(&d) {
+                Ok(()) => self.created_dirs.push(d),
+                Err(e) if e.kind() == io::ErrorKind::AlreadyExists && d.is_dir() => {}
+                Err(e) => return Err(format!("error: cannot create folder `{}`: {e}", d.display())),
+            }
+        }
+        Ok(())
+    }
+
+    /// Stages `data` for `path`: a file or a path to create gets its temporary file written now
+    /// (phase 1); a device or FIFO keeps the bytes for the commit. Staging the same file again
+    /// replaces the earlier bytes (the last write wins).
+    ///
+    /// # Errors
+    /// A one-line message naming the file (refused kind of file, missing folder, I/O error).
+    pub fn stage(&mut self, path: &Path, data: &[u8]) -> Result<(), String> {
+        let fail = |e: io::Error| format!("error: cannot write `{}`: {e}", path.display());
+        match classify(path)? {
+            Kind::Direct => {
+                self.staged.push(Staged { shown: path.into(), final_path: None, tmp: None, data: data.to_vec() });
+                Ok(())
+            }
+            Kind::Replace { final_path, existing } => {
+                if let Some(i) = self.staged.iter().position(|s| s.final_path.as_ref() == Some(&final_path)) {
+                    let old = self.staged.remove(i);
+                    if let Some(t) = old.tmp {
+                        let _ = fs::remove_file(t);
+                    }
+                }
+                let dir = final_path.parent().unwrap_or(Path::new("."));
+                let name = final_path.file_name().unwrap_or_default().to_string_lossy().into_owned();
+                self.counter += 1;
+                let tmp = dir.join(format!(".{name}.{}.{}.robovec-tmp", std::process::id(), self.counter));
+                let mut file = OpenOptions::new().write(true).create_new(true).open(&tmp).map_err(fail)?;
+                // From here on the temporary file exists: record it so a failure removes it.
+                self.staged.push(Staged {
+                    shown: path.into(),
+                    final_path: Some(final_path),
+                    tmp: Some(tmp),
+                    data: Vec::new(),
+                });
+                if let Some(m) = &existing {
+                    copy_owner_and_mode(&file, m).map_err(fail)?;
+                }
+                file.write_all(data).and_then(|()| file.sync_all()).map_err(fail)
+            }
+        }
+    }
+
+    /// Puts every staged output in place: renames all temporary files (phase 2), then writes
+    /// the devices and FIFOs (phase 3). Returns the paths written, in order.
+    ///
+    /// # Errors
+    /// A one-line message naming the file that failed and each file already written.
+    pub fn commit(mut self) -> Result<Vec<PathBuf>, String> {
+        self.committed = true;
+        let staged = std::mem::take(&mut self.staged);
+        let (renames, directs): (Vec<Staged>, Vec<Staged>) = staged.into_iter().partition(|s| s.tmp.is_some());
+        let mut done: Vec<PathBuf> = Vec::new();
+        let already = |done: &[PathBuf]| {
+            if done.is_empty() {
+                "; no file was written".to_string()
+            } else {
+                let names: Vec<String> = done.iter().map(|p| format!("`{}`", p.display())).collect();
+                format!("; already written: {}", names.join(", "))
+            }
+        };
+        for (i, s) in renames.iter().enumerate() {
+            let (Some(tmp), Some(fin)) = (&s.tmp, &s.final_path) else { continue };
+            if let Err(e) = fs::rename(tmp, fin) {
+                for rest in &renames[i..] {
+                    if let Some(t) = &rest.tmp {
+                        let _ = fs::remove_file(t);
+                    }
+                }
+                return Err(format!("error: cannot write `{}`: {e}{}", s.shown.display(), already(&done)));
+            }
+            done.push(s.shown.clone());
+        }
+        for s in &directs {
+            let r = OpenOptions::new()
+                .write(true)
+                .open(&s.shown)
+                .and_then(|mut f| f.write_all(&s.data).and_then(|()| f.flush()));
+            if let Err(e) = r {
+                return Err(format!("error: cannot write `{}`: {e}{}", s.shown.display(), already(&done)));
+            }
+            done.push(s.shown.clone());
+        }
+        Ok(done)
+    }
+}
+
+impl Drop for OutputSet {
+    fn drop(&mut self) {
+        if self.committed {
+            return;
+        }
+        for s in &self.staged {
+            if let Some(t) = &s.tmp {
+                let _ = fs::remove_file(t);
+            }
+        }
+        // Innermost first; `remove_dir` leaves a folder that is not empty.
+        for d in self.created_dirs.iter().rev() {
+            let _ = fs::remove_dir(d);
+        }
+    }
+}

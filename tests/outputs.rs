@@ -1,0 +1,320 @@
+//! Issue 10 item 1: output files never damage what is at their path, a run leaves all of its
+//! outputs or none, stdout/stderr failures are exit 1 with one line, and options are checked
+//! before any work. Also item 5's empty `.rvir` (bad input, exit 1).
+//!
+//! The character device and FIFO tests need `mknod`/`mkfifo` and root (as in CI); when they
+//! cannot be made the tests fail, they do not skip.
+
+use std::fs;
+use std::os::unix::fs::{FileTypeExt, PermissionsExt};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_robovec-opt");
+
+fn opt(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().expect("robovec-opt runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("outputs").join(name);
+    let _ = fs::remove_dir_all(&d);
+    fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn pendulum() -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/double_pendulum/mbs_invdyna_double_pendulum.c")
+        .display()
+        .to_string()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Sorted names in `d`.
+fn entries(d: &Path) -> Vec<String> {
+    let mut v: Vec<String> =
+        fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    v.sort();
+    v
+}
+
+fn mode(p: &Path) -> u32 {
+    fs::metadata(p).unwrap().permissions().mode() & 0o7777
+}
+
+/// Asserts exit status 1 and exactly one line on stderr, with no panic text.
+fn assert_one_line_exit_1(code: Option<i32>, err: &str, what: &str) {
+    assert_eq!(code, Some(1), "{what}: exit status; stderr: {err}");
+    assert_eq!(err.lines().count(), 1, "{what}: one line on stderr, got: {err:?}");
+    assert!(!err.contains("panicked"), "{what}: {err}");
+}
+
+#[test]
+fn a_character_device_stays_a_device() {
+    let d = tmp("chardev");
+    let null = d.join("null");
+    let made = Command::new("mknod").args([s(&null), "c", "1", "3"]).status().expect("mknod runs");
+    assert!(made.success(), "mknod failed: this test needs root (as in CI)");
+    let o = opt(&[&pendulum(), "-passes=atomise,asap-alap", "-o", s(&null), &format!("-report={}", null.display())]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = fs::symlink_metadata(&null).unwrap().file_type();
+    assert!(t.is_char_device(), "{} is no longer a character device: {t:?}", null.display());
+    assert_eq!(entries(&d), ["null"], "no temporary or other file beside the device");
+}
+
+#[test]
+fn a_symlink_is_followed_and_stays_a_link() {
+    let d = tmp("symlink");
+    fs::create_dir(d.join("sub")).unwrap();
+    fs::write(d.join("real.rvir"), "old").unwrap();
+    fs::write(d.join("sub/report.json"), "old").unwrap();
+    std::os::unix::fs::symlink("real.rvir", d.join("link.rvir")).unwrap();
+    // A link into another folder: the temporary file must go beside the target, not the link.
+    std::os::unix::fs::symlink("sub/report.json", d.join("report-link.json")).unwrap();
+    // A dangling link creates the file it names.
+    std::os::unix::fs::symlink("sub/new.csv", d.join("csv-link")).unwrap();
+    let o = opt(&[
+        &pendulum(),
+        "-passes=atomise,sweep<pe=1>",
+        "-o",
+        s(&d.join("link.rvir")),
+        &format!("-report={}", d.join("report-link.json").display()),
+        &format!("-sweep-csv={}", d.join("csv-link").display()),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for (link, to) in [("link.rvir", "real.rvir"), ("report-link.json", "sub/report.json"), ("csv-link", "sub/new.csv")]
+    {
+        let p = d.join(link);
+        assert!(fs::symlink_metadata(&p).unwrap().file_type().is_symlink(), "{link} is no longer a link");
+        assert_eq!(fs::read_link(&p).unwrap(), Path::new(to), "{link} points elsewhere");
+    }
+    assert!(fs::read_to_string(d.join("real.rvir")).unwrap().contains("func @invdyna"));
+    let j: serde_json::Value = serde_json::from_str(&fs::read_to_string(d.join("sub/report.json")).unwrap()).unwrap();
+    assert_eq!(j["function"], "invdyna");
+    assert!(fs::read_to_string(d.join("sub/new.csv")).unwrap().starts_with("function,"));
+    assert_eq!(entries(&d), ["csv-link", "link.rvir", "real.rvir", "report-link.json", "sub"]);
+    assert_eq!(entries(&d.join("sub")), ["new.csv", "report.json"]);
+}
+
+#[test]
+fn file_modes_are_kept_and_read_only_files_refused_before_any_work() {
+    let d = tmp("modes");
+    let private = d.join("private.rvir");
+    fs::write(&private, "old").unwrap();
+    fs::set_permissions(&private, fs::Permissions::from_mode(0o600)).unwrap();
+    let o = opt(&[&pendulum(), "-passes=atomise", "-o", s(&private)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(fs::read_to_string(&private).unwrap().contains("func @invdyna"));
+    assert_eq!(mode(&private), 0o600, "the file keeps its mode");
+
+    let ro = d.join("ro.rvir");
+    fs::write(&ro, "keep").unwrap();
+    fs::set_permissions(&ro, fs::Permissions::from_mode(0o444)).unwrap();
+    let dumps = d.join("dumps");
+    let o = opt(&[&pendulum(), "-passes=atomise", "-o", s(&ro), &format!("-dump-dir={}", dumps.display())]);
+    assert_one_line_exit_1(o.status.code(), &stderr(&o), "read-only -o");
+    assert!(stderr(&o).contains("ro.rvir") && stderr(&o).contains("read-only"), "{}", stderr(&o));
+    assert_eq!(fs::read_to_string(&ro).unwrap(), "keep");
+    assert_eq!(mode(&ro), 0o444);
+    assert!(!dumps.exists(), "refused before any pass ran");
+    assert_eq!(entries(&d), ["private.rvir", "ro.rvir"]);
+}
+
+#[test]
+fn a_fifo_is_written_directly() {
+    let d = tmp("fifo");
+    let fifo = d.join("fifo");
+    let made = Command::new("mkfifo").arg(s(&fifo)).status().expect("mkfifo runs");
+    assert!(made.success(), "mkfifo failed");
+    let got = d.join("got");
+    let mut reader =
+        Command::new("cat").arg(s(&fifo)).stdout(fs::File::create(&got).unwrap()).spawn().expect("cat runs");
+    let o = opt(&[&pendulum(), "-passes=atomise", "-o", s(&fifo)]);
+    // If the FIFO was replaced, `cat` still waits on the old one: stop it rather than hang.
+    let t0 = Instant::now();
+    while reader.try_wait().unwrap().is_none() && t0.elapsed() < Duration::from_secs(10) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let finished = reader.try_wait().unwrap().is_some();
+    if !finished {
+        let _ = reader.kill();
+        let _ = reader.wait();
+    }
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(finished, "the reader of the FIFO never got an end of file");
+    assert!(fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo(), "still a FIFO");
+    assert!(fs::read_to_string(&got).unwrap().contains("func @invdyna"));
+    assert_eq!(entries(&d), ["fifo", "got"]);
+}
+
+/// Runs `cmd` (a shell command using `$BIN`, `$IN`) with stdout into a pipe whose reader has
+/// already exited; returns (exit status, stderr).
+fn into_closed_pipe(d: &Path, cmd: &str) -> (Option<i32>, String) {
+    let script = format!("{{ sleep 0.5; {cmd} 2>\"$D/err\"; echo $? > \"$D/status\"; }} | true");
+    let st =
+        Command::new("sh").arg("-c").arg(script).env("BIN", BIN).env("IN", pendulum()).env("D", d).status().unwrap();
+    assert!(st.success());
+    let code = fs::read_to_string(d.join("status")).unwrap().trim().parse().ok();
+    (code, fs::read_to_string(d.join("err")).unwrap())
+}
+
+#[test]
+fn a_closed_pipe_is_exit_1_with_one_line() {
+    let d = tmp("pipe");
+    let (code, err) = into_closed_pipe(&d, "\"$BIN\" --print-passes");
+    assert_one_line_exit_1(code, &err, "--print-passes | (closed)");
+    assert!(err.contains("stdout"), "{err}");
+    // The report is put in place before stdout is written: the diagnostic names it.
+    let (code, err) = into_closed_pipe(&d, "\"$BIN\" \"$IN\" -passes=atomise -report=\"$D/r.json\"");
+    assert_one_line_exit_1(code, &err, "IR | (closed)");
+    assert!(err.contains("stdout") && err.contains("already written") && err.contains("r.json"), "{err}");
+}
+
+#[test]
+fn a_failure_while_putting_files_in_place_names_the_files_already_written() {
+    let d = tmp("commit");
+    // A full disk of our own (`/dev/full`'s numbers): devices are written after the renames.
+    let full = d.join("full");
+    let made = Command::new("mknod").args([s(&full), "c", "1", "7"]).status().expect("mknod runs");
+    assert!(made.success(), "mknod failed: this test needs root (as in CI)");
+    let r = d.join("r.json");
+    let o = opt(&[&pendulum(), "-passes=atomise", &format!("-report={}", r.display()), "-o", s(&full)]);
+    let err = stderr(&o);
+    assert_one_line_exit_1(o.status.code(), &err, "-o full device");
+    assert!(err.contains("No space left") && err.contains("already written") && err.contains("r.json"), "{err}");
+    assert!(fs::read_to_string(&r).unwrap().contains("\"function\": \"invdyna\""));
+    assert!(fs::symlink_metadata(&full).unwrap().file_type().is_char_device());
+    assert_eq!(entries(&d), ["full", "r.json"]);
+}
+
+#[test]
+fn a_full_disk_is_exit_1_with_one_line() {
+    let full = || fs::OpenOptions::new().write(true).open("/dev/full").expect("/dev/full");
+    for args in [vec!["--print-passes".to_string()], vec![pendulum(), "-passes=atomise".into()]] {
+        let o = Command::new(BIN).args(&args).stdout(Stdio::from(full())).output().unwrap();
+        assert_one_line_exit_1(o.status.code(), &stderr(&o), &format!("{args:?} > /dev/full"));
+        assert!(stderr(&o).contains("No space left"), "{}", stderr(&o));
+    }
+    // stderr on a full disk: exit 1 (nothing can be said) and no output file.
+    let d = tmp("full");
+    let out = d.join("out.rvir");
+    let o = Command::new(BIN)
+        .args([&pendulum(), "-passes=atomise", "-stats", "-o", s(&out)])
+        .stderr(Stdio::from(full()))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(entries(&d), Vec::<String>::new(), "a run whose stderr failed leaves no file");
+}
+
+#[test]
+fn a_failing_run_leaves_none_of_its_outputs() {
+    let d = tmp("failing");
+    // The second pass fails (no such output) after the first one's dumps were written.
+    let args = |d: &Path| {
+        vec![
+            pendulum(),
+            "-passes=atomise,dce<outputs=nope>,sweep<pe=1>".to_string(),
+            "-o".into(),
+            d.join("out.rvir").display().to_string(),
+            format!("-report={}", d.join("r.json").display()),
+            format!("-sweep-csv={}", d.join("s.csv").display()),
+            format!("-dump-dir={}", d.join("dumps/deeper").display()),
+        ]
+    };
+    let o = Command::new(BIN).args(args(&d)).output().unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no output matches `nope`"), "{}", stderr(&o));
+    assert_eq!(entries(&d), Vec::<String>::new(), "nothing of the run is left, not even the dump folders");
+
+    // Existing files of an earlier run are left exactly as they were.
+    fs::create_dir_all(d.join("dumps/deeper")).unwrap();
+    for f in ["out.rvir", "r.json", "s.csv", "dumps/deeper/001-atomise.after.rvir"] {
+        fs::write(d.join(f), "old").unwrap();
+    }
+    let o = Command::new(BIN).args(args(&d)).output().unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    for f in ["out.rvir", "r.json", "s.csv", "dumps/deeper/001-atomise.after.rvir"] {
+        assert_eq!(fs::read_to_string(d.join(f)).unwrap(), "old", "{f}");
+    }
+    assert_eq!(entries(&d), ["dumps", "out.rvir", "r.json", "s.csv"]);
+    assert_eq!(entries(&d.join("dumps/deeper")), ["001-atomise.after.rvir"]);
+
+    // The same run without the failing pass writes everything.
+    let mut ok = args(&d);
+    ok[1] = "-passes=atomise,sweep<pe=1>".into();
+    let o = Command::new(BIN).args(&ok).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        entries(&d.join("dumps/deeper")),
+        ["001-atomise.after.rvir", "001-atomise.before.rvir", "002-sweep.after.rvir", "002-sweep.before.rvir"]
+    );
+    assert!(fs::read_to_string(d.join("dumps/deeper/001-atomise.after.rvir")).unwrap().contains("func @invdyna"));
+    assert!(fs::read_to_string(d.join("s.csv")).unwrap().starts_with("function,"));
+}
+
+#[test]
+fn usage_errors_come_before_any_work() {
+    let d = tmp("usage");
+    let dumps = d.join("dumps");
+    let dump = format!("-dump-dir={}", dumps.display());
+    let out = d.join("out.rvir");
+    let cases: [(&[&str], i32, &str); 6] = [
+        (&["-passes=atomise", &format!("-sweep-csv={}", d.join("s.csv").display())], 2, "needs a `sweep` pass"),
+        (
+            &["-passes=atomise", "-function=nope", &format!("-report={}", d.join("r.json").display())],
+            2,
+            "no function `nope`",
+        ),
+        (&["-passes=atomise", "-function=nope", "-stats"], 2, "no function `nope`"),
+        (&["-passes=atomise", &format!("-report={}", out.display())], 2, "are the same file"),
+        (&["-passes=atomise", &format!("-report={}", d.join("missing/r.json").display())], 1, "missing"),
+        // A file a pass would read only when it runs must exist before any work.
+        (&["-passes=atomise,specialize<params=missing.json>"], 1, "cannot read params file `missing.json`"),
+    ];
+    for (extra, code, needle) in cases {
+        let mut args = vec![pendulum(), dump.clone(), "-o".into(), out.display().to_string()];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        let o = Command::new(BIN).args(&args).output().unwrap();
+        assert_eq!(o.status.code(), Some(code), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(needle), "{extra:?}: {}", stderr(&o));
+        assert!(!dumps.exists(), "{extra:?}: no pass ran, no dump was written");
+        assert_eq!(entries(&d), Vec::<String>::new(), "{extra:?}: no file written");
+    }
+    // A folder given as an output file, and a dump folder that is a file.
+    fs::create_dir(d.join("adir")).unwrap();
+    let o = opt(&[&pendulum(), "-passes=atomise", &dump, "-o", s(&d.join("adir"))]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("folder") && !dumps.exists(), "{}", stderr(&o));
+    let o =
+        opt(&[&pendulum(), "-passes=atomise", "-o", s(&out), &format!("-dump-dir={}", d.join("adir/x/y").display())]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    fs::write(d.join("afile"), "").unwrap();
+    let o =
+        opt(&[&pendulum(), "-passes=atomise", "-o", s(&out), &format!("-dump-dir={}", d.join("afile/x").display())]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("is not a folder"), "{}", stderr(&o));
+}
+
+#[test]
+fn an_empty_or_comment_only_rvir_is_bad_input() {
+    let d = tmp("empty");
+    for (name, text) in [("empty.rvir", ""), ("comments.rvir", "; only a comment\n\n; and another\n")] {
+        let p = d.join(name);
+        fs::write(&p, text).unwrap();
+        let o = opt(&[s(&p), "-passes=atomise", &format!("-report={}", d.join("r.json").display())]);
+        assert_eq!(o.status.code(), Some(1), "{name}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("expected at least one `func`") && e.contains(&format!("{name}:1:1")), "{name}: {e}");
+        assert!(!d.join("r.json").exists());
+    }
+}
