@@ -66,7 +66,8 @@ pub enum Failure {
 }
 
 impl Failure {
-    /// Exit status: 1 for bad input, 2 for bad usage (SPEC §7).
+    /// Exit status: 1 for bad input or an output that cannot be written, 2 for bad usage
+    /// (SPEC §7).
     pub fn exit_code(&self) -> i32 {
         match self {
             Failure::Input(_) | Failure::Output(_) => 1,
@@ -155,6 +156,17 @@ pub(crate) fn select<'m>(m: &'m Module, want: &Option<String>, what: &str) -> Re
             }
         },
     }
+}
+
+/// Writes one file under the output policy ([`crate::output`]) on its own. Inside a run, stage
+/// files in the run's [`OutputSet`] instead, so that they are put in place together.
+///
+/// # Errors
+/// [`Failure::Output`] naming the file.
+pub fn write_atomically(path: &Path, data: &[u8]) -> Result<(), Failure> {
+    let mut out = OutputSet::new();
+    out.stage(path, data).map_err(output_failure)?;
+    out.commit().map(|_| ()).map_err(output_failure)
 }
 
 fn read_eval_inputs(path: &Path) -> Result<BTreeMap<String, f64>, Failure> {
