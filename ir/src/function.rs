@@ -33,6 +33,28 @@ pub struct Function {
     /// The placement on the PE architecture, when `place` made one (or the text had one).
     pub placement: Option<crate::placement::Placement>,
     names: HashMap<String, Value>,
+    outputs_by_name: OutputIndex,
+}
+
+/// Position of every output by name, so that [`Function::set_output`] does not scan the
+/// outputs (which made building a function with n outputs O(n²)). `outputs` is public and
+/// may be edited directly: the index is checked before use and rebuilt when it does not match
+/// (the number of outputs differs, the last output is not where the index says, or the entry
+/// found names another output; code that renames outputs in place without changing their
+/// number calls [`Function::reindex_names`]). Ignored by `==`.
+#[derive(Clone, Debug, Default)]
+struct OutputIndex {
+    pos: HashMap<String, usize>,
+    /// Outputs compared by name while locating outputs (one per lookup when the index is
+    /// current; a rebuild counts every output): the work counter behind
+    /// [`Function::output_probes`].
+    probes: u64,
+}
+
+impl PartialEq for OutputIndex {
+    fn eq(&self, _: &OutputIndex) -> bool {
+        true
+    }
 }
 
 /// A set of functions from one input file.
@@ -114,6 +136,7 @@ impl Function {
             span: Span::DUMMY,
             placement: None,
             names: HashMap::new(),
+            outputs_by_name: OutputIndex::default(),
         }
     }
 
@@ -183,14 +206,50 @@ impl Function {
     }
 
     /// Sets output `name` to `value`, replacing an earlier output of that name (read-modify-write).
+    /// Cost: O(1) expected (a hash lookup; see [`Function::output_probes`]).
     pub fn set_output(&mut self, name: impl Into<String>, value: Operand, span: Span) {
         let name = name.into();
-        if let Some(o) = self.outputs.iter_mut().find(|o| o.name == name) {
+        if let Some(i) = self.output_position(&name) {
+            let o = &mut self.outputs[i];
             o.value = value;
             o.span = span;
         } else {
+            self.outputs_by_name.pos.insert(name.clone(), self.outputs.len());
             self.outputs.push(Output { name, value, span });
         }
+    }
+
+    /// The index in `outputs` of the output called `name`. Cost: O(1) expected; O(outputs)
+    /// once after `outputs` was edited directly (the name index is rebuilt).
+    pub fn output_position(&mut self, name: &str) -> Option<usize> {
+        let idx = &mut self.outputs_by_name;
+        let n = self.outputs.len();
+        let last_ok = self.outputs.last().is_none_or(|o| idx.pos.get(&o.name) == Some(&(n - 1)));
+        if idx.pos.len() != n || !last_ok {
+            idx.probes += self.outputs.len() as u64;
+            idx.pos = self.outputs.iter().enumerate().map(|(i, o)| (o.name.clone(), i)).collect();
+        }
+        match idx.pos.get(name) {
+            Some(&i) => {
+                idx.probes += 1;
+                if self.outputs.get(i).is_some_and(|o| o.name == name) {
+                    return Some(i);
+                }
+                // Stale (an output renamed or reordered in place): rebuild and look again.
+                idx.probes += self.outputs.len() as u64;
+                idx.pos = self.outputs.iter().enumerate().map(|(i, o)| (o.name.clone(), i)).collect();
+                idx.pos.get(name).copied()
+            }
+            None => None,
+        }
+    }
+
+    /// Work counter of output lookups by name: outputs compared by name so far by
+    /// [`Function::set_output`] and [`Function::output_position`] (units: comparisons). Linear
+    /// in the number of lookups when outputs are only added through `set_output`; tests use it
+    /// to check that building a function with n outputs is O(n), not O(n²).
+    pub fn output_probes(&self) -> u64 {
+        self.outputs_by_name.probes
     }
 
     /// The operation kind of `v`'s definition, or `None` for inputs, trig variables and
@@ -224,8 +283,10 @@ impl Function {
         self.placement = None;
     }
 
-    /// Rebuilds the name index; for code that edits `values` directly.
+    /// Rebuilds the name indexes (values and outputs); for code that edits `values` or renames
+    /// `outputs` directly.
     pub fn reindex_names(&mut self) {
+        self.outputs_by_name.pos = self.outputs.iter().enumerate().map(|(i, o)| (o.name.clone(), i)).collect();
         self.names =
             self.values.iter().enumerate().map(|(i, d)| (d.name.clone(), Value::with_number(i as u32))).collect();
     }

@@ -154,6 +154,70 @@ pub struct PassContext {
     pub accuracy: Vec<accuracy::AccuracyReport>,
     /// What every `sim` run checked, one entry per run (printed by `-stats`, reported).
     pub sim: Vec<sim::SimStats>,
+    /// `-time-limit=SECONDS`: the instant by which the pipeline should end, with the limit it
+    /// came from. Passes with long loops (eqsat's windows, place's restarts and search, sweep's
+    /// configurations) check [`PassContext::out_of_time`] between steps, stop early with a valid
+    /// result, and say so (see [`PassContext::note_stop`]).
+    pub deadline: Option<Deadline>,
+    /// One line per early stop of a pass (time limit or work budget reached), such as
+    /// `eqsat stopped after 12 of 345 windows of @dirdyna: time limit of 1 s reached`; the
+    /// driver prints each on stderr as a `note:` line (with or without `-stats`) and lists them
+    /// in the report's `stopped_early`.
+    pub stopped: Vec<String>,
+}
+
+/// A wall-clock limit on a pipeline run (`-time-limit=SECONDS`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Deadline {
+    /// When the limit is reached.
+    pub at: std::time::Instant,
+    /// The limit as given, seconds.
+    pub seconds: f64,
+}
+
+impl Deadline {
+    /// A limit of `seconds` from now.
+    pub fn after_seconds(seconds: f64) -> Deadline {
+        let d = std::time::Duration::try_from_secs_f64(seconds.max(0.0)).unwrap_or(std::time::Duration::MAX);
+        let at = std::time::Instant::now().checked_add(d).unwrap_or_else(|| {
+            // Beyond what the clock can represent: about a century is "no limit".
+            std::time::Instant::now() + std::time::Duration::from_secs(100 * 365 * 86_400)
+        });
+        Deadline { at, seconds }
+    }
+
+    /// Time left before the limit (zero once reached).
+    pub fn time_left(&self) -> std::time::Duration {
+        self.at.saturating_duration_since(std::time::Instant::now())
+    }
+
+    /// True once the limit is reached.
+    pub fn reached(&self) -> bool {
+        std::time::Instant::now() >= self.at
+    }
+
+    /// Why a pass stopped: `time limit of 5 s reached`.
+    pub fn reason(&self) -> String {
+        format!("time limit of {} s reached", self.seconds)
+    }
+}
+
+impl PassContext {
+    /// Time left before `-time-limit` is reached (`None`: no limit).
+    pub fn time_left(&self) -> Option<std::time::Duration> {
+        self.deadline.map(|d| d.time_left())
+    }
+
+    /// True when `-time-limit` is given and reached: a pass stops starting new work.
+    pub fn out_of_time(&self) -> bool {
+        self.deadline.is_some_and(|d| d.reached())
+    }
+
+    /// Records that `pass` stopped early: `what` says where and why (`after 12 of 345 windows
+    /// of @dirdyna: time limit of 1 s reached`); see [`PassContext::stopped`].
+    pub fn note_stop(&mut self, pass: &str, what: &str) {
+        self.stopped.push(format!("{pass} stopped {what}"));
+    }
 }
 
 /// A transformation or analysis over a whole module (`Debug` shows its options).

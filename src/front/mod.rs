@@ -24,6 +24,7 @@ pub mod python;
 pub mod scan;
 pub mod sensor;
 pub mod stmt;
+pub mod synth;
 
 use std::path::Path;
 

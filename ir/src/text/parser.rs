@@ -77,7 +77,7 @@ fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
                 }
             }
             ItemAst::Output(name, v, span) => {
-                if func.outputs.iter().any(|o| o.name == name) {
+                if func.output_position(name).is_some() {
                     errors.push(ParseError::new(span, format!("output `{name}` defined twice"), "second definition"));
                 }
                 let v = operand(&func, v, errors);
