@@ -23,6 +23,7 @@
 //! [`MAX_ERRORS`] violations of a function are listed, then a count of the rest.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use super::{Location, VerifierError};
 use crate::function::Function;
@@ -33,6 +34,40 @@ use crate::Value;
 
 /// Largest number of placement violations listed per function.
 pub const MAX_ERRORS: usize = 20;
+
+/// A multiply-rotate hasher (the Fx hash of rustc) for the small integer keys of these maps:
+/// the default SipHash costs more than the checks themselves on 600k-op placements.
+#[derive(Default, Clone, Copy)]
+struct Fx(u64);
+
+impl Hasher for Fx {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u8(&mut self, x: u8) {
+        self.write_u64(x as u64)
+    }
+    fn write_u32(&mut self, x: u32) {
+        self.write_u64(x as u64)
+    }
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64)
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+type Map<K, V> = HashMap<K, V, BuildHasherDefault<Fx>>;
+
+fn map<K, V>(capacity: usize) -> Map<K, V> {
+    Map::with_capacity_and_hasher(capacity, Default::default())
+}
 
 /// What a memory word holds: a value or a constant (by its `f64` bits, as `sim` matches them).
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
@@ -131,7 +166,7 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
 
     // Issues: every op exactly once (a `Vec<Option<Issue>>` cannot hold two), nothing else.
     let mut arrival: Vec<Option<u64>> = vec![None; n];
-    let mut busy: HashMap<(usize, u32), Value> = HashMap::new();
+    let mut busy: Map<(usize, u32), Value> = map(p.issue.len());
     for (i, is) in p.issue.iter().enumerate() {
         let Some(is) = is else { continue };
         let v = Value::with_number(i as u32);
@@ -168,7 +203,7 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
     }
 
     // Loads and writes: first cycle each key is in each PE memory (loads: −1).
-    let mut present: HashMap<(usize, Key), i64> = HashMap::new();
+    let mut present: Map<(usize, Key), i64> = map(p.loads.len() + p.writes.len());
     for (i, l) in p.loads.iter().enumerate() {
         let span = p.spans.load(i);
         let k = key_of(&l.operand);
@@ -197,9 +232,9 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
         }
         present.insert((slot, k), -1);
     }
-    let mut ports: HashMap<(usize, u32), u32> = HashMap::new();
-    let mut buf_addr: HashMap<Value, u32> = HashMap::new();
-    let mut buf_read: HashMap<(usize, u32), (u32, Value)> = HashMap::new();
+    let mut ports: Map<(usize, u32), u32> = map(p.writes.len());
+    let mut buf_addr: Map<Value, u32> = map(0);
+    let mut buf_read: Map<(usize, u32), (u32, Value)> = map(0);
     for (i, w) in p.writes.iter().enumerate() {
         let span = p.spans.write(i);
         let v = w.value;

@@ -1,0 +1,67 @@
+//! Verifier cost on placed IR (issue 10 item 4: the placement checks run whenever a placed
+//! `.rvir` is read and after every pass under `-verify-each`, so they must stay O(ops)).
+//!
+//! Workloads, each placed at N = 16 without restarts or search (the placement's shape, not its
+//! quality, matters here):
+//! - `walkman`: the largest corpus file (`../shared/corpus/robotran/matlab/
+//!   walkman__mbs_dirdyna_walkman_robotran.m`, 37.6k ops after `atomise`);
+//! - `synthetic_600k`: `dag_gen::generate(600_000, 1)`, the size of the largest seed system.
+//!
+//! Prints, per workload, the median of 7 runs of the whole verifier
+//! (`robovec_ir::verifier::verify_function`) and of its placement checks alone
+//! (`verifier::placement::verify_placement`), and the time per op. Run with
+//! `cargo bench --bench verify`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use robovec_ir::verifier::{placement::verify_placement, verify_function};
+use robovec_ir::Function;
+use robovec_passes::atomise::atomise_function;
+use robovec_passes::dag_gen::generate;
+use robovec_passes::place::{place_function, PlaceOptions};
+
+const FILE: &str = "../shared/corpus/robotran/matlab/walkman__mbs_dirdyna_walkman_robotran.m";
+
+fn walkman() -> Function {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(FILE);
+    let (m, _) = robovec::driver::load(&p.to_string_lossy())
+        .unwrap_or_else(|e| panic!("cannot load {} (the corpus must sit at ../shared): {}", p.display(), e.message()));
+    atomise_function(&m.functions[0])
+}
+
+fn placed(mut f: Function) -> Function {
+    let mut o = PlaceOptions::with_pes(16);
+    o.restarts = 0;
+    o.search = 0;
+    f.placement = Some(place_function(&f, &o));
+    f
+}
+
+fn median_ms(mut run: impl FnMut()) -> f64 {
+    let mut t: Vec<f64> = (0..7)
+        .map(|_| {
+            let t0 = Instant::now();
+            run();
+            t0.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[3]
+}
+
+fn main() {
+    for (name, f) in [("walkman", placed(walkman())), ("synthetic_600k", placed(generate(600_000, 1)))] {
+        let ops = f.op_counts().total;
+        assert!(verify_function(&f).is_empty(), "{name}: the placer's placement verifies");
+        let all = median_ms(|| assert!(verify_function(&f).is_empty()));
+        let place = median_ms(|| assert!(verify_placement(&f).is_empty()));
+        println!(
+            "{name:>15}: {ops} ops, {} writes, {} loads: verifier {all:.1} ms, of which placement checks {place:.1} ms \
+             ({:.0} ns/op)",
+            f.placement.as_ref().unwrap().writes.len(),
+            f.placement.as_ref().unwrap().loads.len(),
+            place * 1e6 / ops as f64
+        );
+    }
+}
