@@ -110,6 +110,10 @@ pub struct PassContext {
     pub notes: Vec<String>,
     /// One report per function of every `accuracy` run.
     pub accuracy: Vec<accuracy::AccuracyReport>,
+    /// The module as it entered the pipeline: the reference `accuracy` measures errors
+    /// against (issue 10). The manager sets it when a pass asks for it
+    /// ([`Pass::needs_original`]) and it is not set yet (`-pareto` presets it).
+    pub original: Option<robovec_ir::Module>,
 }
 
 /// A transformation or analysis over a whole module.
@@ -128,6 +132,11 @@ pub trait Pass {
     /// True when the pass keeps existing timing attributes valid (analyses that only read, or
     /// write timing themselves); otherwise the manager clears them after the pass.
     fn preserves_timing(&self) -> bool {
+        false
+    }
+    /// True when the pass reads [`PassContext::original`] (the manager then keeps a copy of
+    /// the module as it entered the pipeline).
+    fn needs_original(&self) -> bool {
         false
     }
 }

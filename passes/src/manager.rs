@@ -117,6 +117,9 @@ impl PassManager {
         if let Some(d) = &self.instr.dump_dir {
             std::fs::create_dir_all(d).map_err(|e| PassError::Io { path: d.display().to_string(), source: e })?;
         }
+        if cx.original.is_none() && self.passes.iter().any(|(_, p)| p.needs_original()) {
+            cx.original = Some(m.clone());
+        }
         let mut records = Vec::new();
         for (i, (spec, pass)) in self.passes.iter().enumerate() {
             let name = pass.name();
