@@ -23,6 +23,7 @@
 //! ([`stream`]: memory independent of `samples`); cost is O(samples × ops) plus the rare
 //! 256-bit re-evaluations, bounded by the work budget `max-work`.
 
+pub mod check;
 pub mod hard;
 pub mod inputs;
 pub mod measure;
