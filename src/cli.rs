@@ -76,6 +76,21 @@ pub struct Cli {
     /// Seed of -pareto's accuracy measurement.
     #[arg(long, value_name = "SEED", default_value_t = 1)]
     pub pareto_seed: u64,
+    /// Evaluation precision of -eval: `f64` (default) or `f32` (inputs rounded to binary32,
+    /// every operation in binary32 in the IR's order, as the FPGA computes).
+    #[arg(long, value_name = "f32|f64", default_value = "f64", value_parser = ["f32", "f64"])]
+    pub eval_precision: String,
+    /// After the pipeline, check that every output stays within the rigorous error budget of
+    /// the input's exact value (bit for bit for bit-exact pipelines); exit 1 naming the first
+    /// output that does not.
+    #[arg(long)]
+    pub check: bool,
+    /// Points of -check.
+    #[arg(long, value_name = "N", default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..=10_000_000))]
+    pub check_samples: u32,
+    /// Seed of -check's points (point i is `accuracy<seed=S>`'s point i).
+    #[arg(long, value_name = "SEED", default_value_t = 1)]
+    pub check_seed: u64,
     /// List the registered passes with their parameters and exit.
     #[arg(long)]
     pub print_passes: bool,
@@ -149,6 +164,8 @@ impl Cli {
             pareto: self.pareto,
             pareto_samples: self.pareto_samples,
             pareto_seed: self.pareto_seed,
+            eval_f32: self.eval_precision == "f32",
+            check: self.check.then_some((self.check_samples, self.check_seed)),
         })
     }
 }

@@ -50,6 +50,10 @@ pub struct Options {
     pub pareto_samples: u32,
     /// `-pareto-seed=S`: seed of those measurements.
     pub pareto_seed: u64,
+    /// `-eval-precision=f32`: evaluate in binary32.
+    pub eval_f32: bool,
+    /// `-check` with its samples and seed.
+    pub check: Option<(u32, u64)>,
 }
 
 /// Why a run failed; the text is ready for stderr.
@@ -267,7 +271,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         }
         None => Vec::new(),
     };
-    let mut cx = PassContext::default();
+    let mut cx = PassContext { original: opts.check.map(|_| module.clone()), ..PassContext::default() };
     let records = {
         let dir = opts.instr.dump_dir.clone().unwrap_or_default();
         let mut dumps = StagedDumps { dir, out: &mut out, created: false };
@@ -277,6 +281,10 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             e => pass_failure(e, &src),
         })?
     };
+    if let (Some((samples, seed)), Some(original)) = (opts.check, &cx.original) {
+        crate::check::run(&module, original, &pm.pipeline_text(), &opts.function, samples, seed, stderr)?;
+    }
+
     // Build every output in memory first.
     let report = match &opts.report {
         Some(_) => {
@@ -311,7 +319,17 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                         .map_err(stderr_failure)?;
                 }
             }
-            Some(serde_json::to_string_pretty(&evaluate(f, given)).expect("eval serialises") + "\n")
+            let r = evaluate(f, given, opts.eval_f32);
+            for c in &r.callback_standins {
+                writeln!(
+                    stderr,
+                    "warning: @{} calls user callback `{c}`; evaluated with the stand-in (a linear form of its \
+                     arguments, robovec_ir::interp::callback_standin)",
+                    f.name
+                )
+                .map_err(stderr_failure)?;
+            }
+            Some(serde_json::to_string_pretty(&r).expect("eval serialises") + "\n")
         }
         None => None,
     };

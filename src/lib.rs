@@ -4,6 +4,7 @@
 //! files (C, Matlab, Python) into IR modules ([`front`]), runs pipelines on them
 //! ([`driver::run`]) and writes reports ([`report`]).
 
+pub mod check;
 pub mod cli;
 pub mod diagnostics;
 pub mod driver;

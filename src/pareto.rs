@@ -1,19 +1,28 @@
 //! `-pareto="PIPELINE_A;PIPELINE_B;…"`: speed against error. Runs each pipeline on the same
 //! input, measures the final IR's speed (ops, critical path, placed cycles when the pipeline
 //! places) and its accuracy (the `accuracy` measurement with the same samples and seed for
-//! every pipeline), and marks the Pareto-optimal rows.
+//! every pipeline, **against the exact value of the loaded module**, not of the pipeline's own
+//! result), checks it against the error budget (`accuracy::check`, same points), and marks the
+//! Pareto-optimal rows.
 //!
 //! **Dominance** (two objectives, both minimised): *time* = placed cycles when the pipeline
 //! placed, else the critical path `asap_cycle` (SPEC §4), and *error* = mean binary32 bits of
-//! error (Herbie's score, over every output and sample). A row is Pareto-optimal when no other
-//! row is at least as good in both and strictly better in one (Herbie's `pareto.rkt` frontier).
+//! error (Herbie's score, over every output and sample) with its 95% confidence interval
+//! `mean ± h`, `h = 1.96·s/√n` over the per-sample means. Row B is *better* on error than A
+//! when the intervals do not overlap (`B.mean + B.h < A.mean − A.h`), *worse* when
+//! `B.mean − B.h > A.mean + A.h`, and *tied* otherwise (the difference is within the sampling
+//! noise). B dominates A when B's time is ≤ A's, B is not worse on error, and B is strictly
+//! faster or better on error (Herbie's `pareto.rkt` frontier, with noise-aware ties). A row
+//! whose result breaks the error budget of the original (`sound: false`: a rewrite that
+//! changed the mathematics) is never Pareto-optimal and dominates nothing.
 //!
 //! Pipelines are separated by `;` outside `<…>` (parameters also use `;`); any registered pass
 //! works. A pipeline that does not parse or names an unknown pass is bad usage (exit 2); a
 //! pipeline that fails on the input is bad input (exit 1).
 
 use robovec_ir::{Function, Module};
-use robovec_passes::accuracy::{measure_function, BitsSummary, Options as AccuracyOptions};
+use robovec_passes::accuracy::check::{check_function, pipeline_is_bit_exact};
+use robovec_passes::accuracy::{measure_against, BitsSummary, Options as AccuracyOptions};
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 use serde::Serialize;
 
@@ -39,11 +48,21 @@ pub struct ParetoRow {
     pub time_cycles: u32,
     /// Samples of the accuracy measurement.
     pub samples: u64,
-    /// binary32 bits of error (mean / 95th percentile / max).
+    /// binary32 bits of error (mean / 95th percentile / max), against the loaded module.
     pub f32: BitsSummary,
+    /// Half-width of the 95% confidence interval of `f32.mean_bits`, bits.
+    pub f32_mean_ci95_bits: f64,
     /// binary64 bits of error.
     pub f64: BitsSummary,
-    /// True when no other row dominates this one.
+    /// True when every output stays within the error budget of the loaded module at the
+    /// measured points (`-check`'s property); false for a rewrite that changed the values
+    /// beyond its rounding.
+    pub sound: bool,
+    /// The first output outside its budget, when not sound.
+    pub violation: Option<String>,
+    /// User callbacks evaluated with the interpreter's stand-in.
+    pub callback_standins: Vec<String>,
+    /// True when no other row dominates this one (never for a row that is not sound).
     pub pareto_optimal: bool,
 }
 
@@ -72,12 +91,29 @@ pub fn split_pipelines(text: &str) -> Result<Vec<String>, String> {
     Ok(out)
 }
 
+/// -1 when error `b` is better (lower) than `a` beyond the noise, 1 when worse, 0 when tied:
+/// `(mean, ci95 half-width)` intervals that overlap are tied (see the module doc).
+pub fn compare_error(b: (f64, f64), a: (f64, f64)) -> i32 {
+    if b.0 + b.1 < a.0 - a.1 {
+        -1
+    } else if b.0 - b.1 > a.0 + a.1 {
+        1
+    } else {
+        0
+    }
+}
+
 /// Marks the rows no other row dominates (see the module doc).
 pub fn mark_front(rows: &mut [ParetoRow]) {
-    let key: Vec<(u32, f64)> = rows.iter().map(|r| (r.time_cycles, r.f32.mean_bits)).collect();
+    let key: Vec<(u32, (f64, f64), bool)> =
+        rows.iter().map(|r| (r.time_cycles, (r.f32.mean_bits, r.f32_mean_ci95_bits), r.sound)).collect();
     for (i, r) in rows.iter_mut().enumerate() {
-        let (t, e) = key[i];
-        r.pareto_optimal = !key.iter().any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e));
+        let (t, e, _) = key[i];
+        let dominated = key.iter().any(|&(t2, e2, sound2)| {
+            let c = compare_error(e2, e);
+            sound2 && t2 <= t && c <= 0 && (t2 < t || c < 0)
+        });
+        r.pareto_optimal = r.sound && !dominated;
     }
 }
 
@@ -86,6 +122,7 @@ pub fn mark_front(rows: &mut [ParetoRow]) {
 /// # Errors
 /// [`Failure::Usage`] for a bad pipeline, [`Failure::Input`] when a pipeline fails.
 pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64) -> Result<Vec<ParetoRow>, Failure> {
+    let original = module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
     let pipelines = split_pipelines(text).map_err(Failure::Usage)?;
     let managers = pipelines
         .iter()
@@ -98,7 +135,7 @@ pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64)
     let mut rows = Vec::new();
     for (p, pm) in pipelines.iter().zip(&managers) {
         let mut m = module.clone();
-        let mut cx = PassContext::default();
+        let mut cx = PassContext { original: Some(module.clone()), ..PassContext::default() };
         pm.run(&mut m, &mut cx, &mut std::io::sink())
             .map_err(|e| Failure::Input(format!("error: -pareto pipeline `{p}`: {e}\n")))?;
         let f: &Function = m
@@ -106,7 +143,9 @@ pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64)
             .ok_or_else(|| Failure::Input(format!("error: -pareto pipeline `{p}` removed function @{function}\n")))?;
         let s = stats(f, &cx.latencies);
         let placed = f.placement.as_ref().map(|pl| (pl.arch.n_add, robovec_passes::place::cycles(f, pl)));
-        let acc = measure_function(f, &opts);
+        let fail = |e: String| Failure::Input(format!("error: -pareto pipeline `{p}`: {e}\n"));
+        let acc = measure_against(f, Some(original), &opts).map_err(fail)?;
+        let check = check_function(f, original, pipeline_is_bit_exact(p), samples, seed).map_err(fail)?;
         rows.push(ParetoRow {
             pipeline: pm.pipeline_text(),
             ops: s.ops.total,
@@ -117,7 +156,11 @@ pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64)
             time_cycles: placed.map_or(s.asap_cycle, |x| x.1),
             samples: acc.samples,
             f32: acc.f32,
+            f32_mean_ci95_bits: acc.f32_mean_ci95_bits,
             f64: acc.f64,
+            sound: check.violation.is_none(),
+            violation: check.violation.map(|v| v.to_string()),
+            callback_standins: acc.callback_standins,
             pareto_optimal: false,
         });
     }
@@ -130,27 +173,46 @@ pub fn to_table(function: &str, rows: &[ParetoRow]) -> String {
     let b = |s: &BitsSummary| format!("{:.2}/{:.2}/{:.2}", s.mean_bits, s.p95_bits, s.max_bits);
     let w = rows.iter().map(|r| r.pipeline.len()).max().unwrap_or(8).max(8);
     let mut s = format!(
-        "@{function}: speed against error ({} samples; * = Pareto-optimal in time (placed cycles, else critical \
-         path) and mean f32 bits)\n",
+        "@{function}: speed against error ({} samples, errors against the input of the pipelines; * = \
+         Pareto-optimal in time (placed cycles, else critical path) and mean f32 bits, ties within the 95% \
+         confidence interval; ! = outside the error budget of the input, never optimal)\n",
         rows.first().map_or(0, |r| r.samples)
     );
     s += &format!(
-        "  {:<w$} {:>8} {:>11} {:>4} {:>8} {:>20} {:>20}\n",
-        "pipeline", "ops", "crit.path", "N", "placed", "f32 mean/p95/max", "f64 mean/p95/max"
+        "  {:<w$} {:>8} {:>11} {:>4} {:>8} {:>20} {:>8} {:>20}\n",
+        "pipeline", "ops", "crit.path", "N", "placed", "f32 mean/p95/max", "±95%", "f64 mean/p95/max"
     );
     for r in rows {
         let opt = |x: Option<u32>| x.map_or(String::new(), |v| v.to_string());
         s += &format!(
-            "{} {:<w$} {:>8} {:>11} {:>4} {:>8} {:>20} {:>20}\n",
-            if r.pareto_optimal { "*" } else { " " },
+            "{} {:<w$} {:>8} {:>11} {:>4} {:>8} {:>20} {:>8} {:>20}\n",
+            if r.pareto_optimal {
+                "*"
+            } else if r.sound {
+                " "
+            } else {
+                "!"
+            },
             r.pipeline,
             r.ops,
             r.asap_cycle,
             opt(r.n),
             opt(r.placed_cycles),
             b(&r.f32),
+            format!("{:.3}", r.f32_mean_ci95_bits),
             b(&r.f64)
         );
+    }
+    for r in rows {
+        if let Some(v) = &r.violation {
+            s += &format!("! {}: {v}\n", r.pipeline);
+        }
+        for c in &r.callback_standins {
+            s += &format!(
+                "warning: @{function} calls user callback `{c}`; evaluated with the stand-in (pipeline {})\n",
+                r.pipeline
+            );
+        }
     }
     s
 }
@@ -160,6 +222,10 @@ mod tests {
     use super::*;
 
     fn row(time: u32, err: f64) -> ParetoRow {
+        row_ci(time, err, 0.0, true)
+    }
+
+    fn row_ci(time: u32, err: f64, ci: f64, sound: bool) -> ParetoRow {
         let bits = BitsSummary { mean_bits: err, p95_bits: err, max_bits: err };
         ParetoRow {
             pipeline: format!("{time}/{err}"),
@@ -171,7 +237,11 @@ mod tests {
             time_cycles: time,
             samples: 1,
             f32: bits,
+            f32_mean_ci95_bits: ci,
             f64: bits,
+            sound,
+            violation: None,
+            callback_standins: Vec::new(),
             pareto_optimal: false,
         }
     }
@@ -184,6 +254,25 @@ mod tests {
         // (80, 2.5) dominates (80, 3.0); (120, 1.0) dominates (130, 1.0); equal rows do not
         // dominate each other.
         assert_eq!(front, [true, false, true, true, false, true]);
+    }
+
+    #[test]
+    fn front_ties_errors_within_the_noise_and_drops_unsound_rows() {
+        // (100, 2.00 ± 0.05) and (100, 2.08 ± 0.05) overlap: tied, both optimal. (100, 2.30 ± 0.05)
+        // is worse beyond the noise: dominated. (90, 2.2 ± 0.5) is faster and tied on error with
+        // the first two: it dominates them. An unsound row (50, 40 bits) is never optimal and
+        // dominates nothing, even though it is the fastest.
+        let mut rows = vec![row_ci(100, 2.0, 0.05, true), row_ci(100, 2.08, 0.05, true), row_ci(100, 2.3, 0.05, true)];
+        mark_front(&mut rows);
+        assert_eq!(rows.iter().map(|r| r.pareto_optimal).collect::<Vec<_>>(), [true, true, false]);
+        rows.push(row_ci(90, 2.2, 0.5, true));
+        rows.push(row_ci(50, 40.0, 0.5, false));
+        rows.push(row_ci(80, 9.0, 0.5, true));
+        mark_front(&mut rows);
+        assert_eq!(rows.iter().map(|r| r.pareto_optimal).collect::<Vec<_>>(), [false, false, false, true, false, true]);
+        assert_eq!(compare_error((1.0, 0.1), (1.15, 0.1)), 0);
+        assert_eq!(compare_error((1.0, 0.1), (1.25, 0.1)), -1);
+        assert_eq!(compare_error((1.25, 0.1), (1.0, 0.1)), 1);
     }
 
     #[test]

@@ -164,6 +164,10 @@ pub struct PassContext {
     /// driver prints each on stderr as a `note:` line (with or without `-stats`) and lists them
     /// in the report's `stopped_early`.
     pub stopped: Vec<String>,
+    /// The module as it entered the pipeline: the reference `accuracy` measures errors
+    /// against (issue 10). The manager sets it when a pass asks for it
+    /// ([`Pass::needs_original`]) and it is not set yet (`-pareto` presets it).
+    pub original: Option<robovec_ir::Module>,
 }
 
 /// A wall-clock limit on a pipeline run (`-time-limit=SECONDS`).
@@ -236,6 +240,11 @@ pub trait Pass: std::fmt::Debug {
     /// True when the pass keeps existing timing attributes valid (analyses that only read, or
     /// write timing themselves); otherwise the manager clears them after the pass.
     fn preserves_timing(&self) -> bool {
+        false
+    }
+    /// True when the pass reads [`PassContext::original`] (the manager then keeps a copy of
+    /// the module as it entered the pipeline).
+    fn needs_original(&self) -> bool {
         false
     }
 }

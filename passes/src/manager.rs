@@ -165,6 +165,9 @@ impl PassManager {
             Some(_) => dumps.dump(&name, &m.to_string()).map_err(|message| PassError::Output { message }),
             None => Ok(()),
         };
+        if cx.original.is_none() && self.passes.iter().any(|(_, p)| p.needs_original()) {
+            cx.original = Some(m.clone());
+        }
         let mut records = Vec::new();
         for (i, (spec, pass)) in self.passes.iter().enumerate() {
             let name = pass.name();

@@ -72,6 +72,8 @@ enum Known<'a> {
     DoubleDouble(&'a [DD]),
     /// astro-float: values whose inexact flag is clear.
     Big(&'a [bool]),
+    /// Nothing: every step rounds (a binary32/binary64 evaluation).
+    Nothing,
 }
 
 /// Fills `err` with the running error bound of every slot (see the module doc); `val` holds
@@ -79,6 +81,12 @@ enum Known<'a> {
 fn propagate(tape: &Tape, val: &[f64], known: Known, u: f64, trig_abs: f64, err: &mut Vec<f64>) {
     err.clear();
     err.resize(tape.inputs.len() + tape.consts.len(), 0.0);
+    propagate_from(tape, val, known, u, trig_abs, 0.0, err)
+}
+
+/// [`propagate`] from given leaf errors (`err` holds one per input and constant), adding
+/// `floor` (an absolute underflow allowance) to every rounded step.
+fn propagate_from(tape: &Tape, val: &[f64], known: Known, u: f64, trig_abs: f64, floor: f64, err: &mut Vec<f64>) {
     for s in &tape.steps {
         let slot = err.len();
         let r = val[slot];
@@ -89,6 +97,7 @@ fn propagate(tape: &Tape, val: &[f64], known: Known, u: f64, trig_abs: f64, err:
                 matches!(*s, Step::Bin(BinOp::Add | BinOp::Sub | BinOp::Mul, a, b) if plain(a) && plain(b))
             }
             Known::Big(exact) => exact[slot],
+            Known::Nothing => false,
         };
         let e = match *s {
             _ if exact => 0.0,
@@ -127,12 +136,12 @@ fn propagate(tape: &Tape, val: &[f64], known: Known, u: f64, trig_abs: f64, err:
                 }
             }
         };
-        let e = if e == 0.0 {
+        let e = if e == 0.0 && floor == 0.0 {
             0.0
         } else if e.is_nan() || !r.is_finite() {
             f64::INFINITY
         } else {
-            e * INFLATE
+            e * INFLATE + floor
         };
         err.push(e);
     }
@@ -183,6 +192,36 @@ impl Reference {
             redo.retain(|&k| !out[k].certified && !out[k].near_zero);
         }
     }
+}
+
+/// The double-double value of every output of `tape` at `inputs` and a bound on its distance
+/// from the exact value (infinite when unbounded): the reference of the error budget check.
+pub fn dd_bounded(tape: &Tape, inputs: &[f64]) -> Vec<(DD, f64)> {
+    let (mut dd, mut scratch, mut err) = (Vec::new(), Vec::new(), Vec::new());
+    tape.eval_into::<DD>(inputs, &mut dd, &mut scratch);
+    let val: Vec<f64> = dd.iter().map(|x| x.hi).collect();
+    propagate(tape, &val, Known::DoubleDouble(&dd), DD_UNIT, DD_TRIG_ABS, &mut err);
+    tape.outputs.iter().map(|&(_, s)| (dd[s as usize], err[s as usize])).collect()
+}
+
+/// A rigorous bound on |computed − exact| for every output of `tape` evaluated in binary32
+/// (`single`) or binary64 at `inputs`, from the computed slots (`slots[i]` as `f64`; Wilkinson's
+/// running error analysis, Higham §3.3, as in the module doc): inputs and constants start with
+/// their own rounding to the format; each step adds `u'·|r|` with `u' = u·(1 + 2⁻²⁰)` (unit
+/// roundoff, widened for the computed `r`), trig results `2⁻²²` (binary32) or `2⁻⁵¹`
+/// (binary64) absolute (two ulps of 1: libm's sin/cos are within one), and `2⁻¹⁴⁹` or
+/// `2⁻¹⁰⁷⁴` for underflow. Infinite where a divisor's interval reaches zero or a value
+/// overflows.
+pub fn float_bound(tape: &Tape, inputs: &[f64], slots: &[f64], single: bool) -> Vec<f64> {
+    let (u, trig, floor) = if single {
+        (2f64.powi(-24), 2f64.powi(-22), 2f64.powi(-149))
+    } else {
+        (2f64.powi(-53), 2f64.powi(-51), 2f64.powi(-1074))
+    };
+    let round = |x: f64| if single { x as f32 as f64 } else { x };
+    let mut err: Vec<f64> = inputs.iter().chain(&tape.consts).map(|&x| (x - round(x)).abs() * INFLATE).collect();
+    propagate_from(tape, slots, Known::Nothing, u * (1.0 + 2f64.powi(-20)), trig, floor, &mut err);
+    tape.outputs.iter().map(|&(_, s)| err[s as usize]).collect()
 }
 
 fn dd_certified(v: DD, e: f64) -> bool {

@@ -268,6 +268,30 @@ impl Tape {
         mask
     }
 
+    /// The user callbacks the outputs depend on (every callee but the square root, see
+    /// [`super::is_sqrt`]): robovec cannot see them and evaluates them with the interpreter's
+    /// stand-in ([`crate::interp::callback_standin`]). Distinct names (`name` or `name[elem]`),
+    /// sorted.
+    pub fn standin_callees(&self) -> Vec<String> {
+        let mut out: Vec<String> = self
+            .steps
+            .iter()
+            .filter_map(|s| match *s {
+                Step::Call(c, _, len) if !super::is_sqrt(&self.callees[c as usize], len as usize) => {
+                    let c = &self.callees[c as usize];
+                    Some(match c.elem {
+                        Some(e) => format!("{}[{e}]", c.name),
+                        None => c.name.clone(),
+                    })
+                }
+                _ => None,
+            })
+            .collect();
+        out.sort();
+        out.dedup();
+        out
+    }
+
     /// Outputs in precision `T`, in output order (allocates; see [`Tape::eval_into`]).
     pub fn eval<T: Float>(&self, inputs: &[f64]) -> Vec<T> {
         let (mut slots, mut scratch) = (Vec::new(), Vec::new());
@@ -308,5 +332,6 @@ mod tests {
             );
         }
         assert_eq!(t.outputs.iter().map(|o| o.0.as_str()).collect::<Vec<_>>(), ["Qq[1]", "Qq[2]", "c"]);
+        assert_eq!(t.standin_callees(), ["user_F.1[2]"], "sqrt is not a stand-in");
     }
 }

@@ -9,13 +9,13 @@
 //! never move. Every point has its own generator, so the result does not depend on threads.
 
 use rayon::prelude::*;
-use robovec_ir::numerics::Tape;
 
 use super::inputs::{draw_hard, rng_for, unit, Family, Range};
-use super::measure::{errors_at, PointErrors, Workspace};
+use super::measure::{errors_at, PointErrors, Subject, Workspace};
+use super::stream::{Acc, Kept};
 use super::Options;
 
-const NEIGHBOURS: u32 = 8;
+const NEIGHBOURS: u64 = 8;
 
 fn objective(e: &PointErrors) -> (f64, f64) {
     (e.max_f32(), e.mean_f32())
@@ -25,38 +25,34 @@ fn better(a: &PointErrors, b: &PointErrors) -> bool {
     objective(a).partial_cmp(&objective(b)) == Some(std::cmp::Ordering::Greater)
 }
 
-/// Indices of the `n` worst points (largest objective first; ties by lower index).
-pub fn worst_indices(errs: &[PointErrors], n: usize) -> Vec<usize> {
-    let mut idx: Vec<usize> = (0..errs.len()).collect();
-    idx.sort_by(|&a, &b| {
-        let (oa, ob) = (objective(&errs[a]), objective(&errs[b]));
-        ob.0.total_cmp(&oa.0).then(ob.1.total_cmp(&oa.1)).then(a.cmp(&b))
-    });
-    idx.truncate(n);
-    idx
-}
-
-/// Climbs from the worst points, replacing them in `points`/`errs` by what it found; returns
-/// the number of extra evaluations.
+/// Climbs from the `climb-points` worst points of `acc`, replacing them (in the worst list
+/// and in the statistics) by what it found. At most `budget` evaluations: the rounds are cut
+/// to what it pays for. Returns the number of evaluations and, when rounds were cut, a note.
 pub fn climb(
-    tape: &Tape,
+    sub: &Subject,
     ranges: &[Range],
     o: &Options,
     skip: &[bool],
-    points: &mut [Vec<f64>],
-    errs: &mut [PointErrors],
-) -> u64 {
-    let free: Vec<usize> = (0..ranges.len()).filter(|&i| !o.known.contains_key(&tape.inputs[i])).collect();
-    if o.climb_rounds == 0 || free.is_empty() {
-        return 0;
+    acc: &mut Acc,
+    budget: u64,
+) -> (u64, Option<String>) {
+    let free: Vec<usize> = (0..ranges.len()).filter(|&i| !o.known.contains_key(&sub.names[i])).collect();
+    let n_starts = (o.climb_points as usize).min(acc.worst.len());
+    if o.climb_rounds == 0 || free.is_empty() || n_starts == 0 {
+        return (0, None);
     }
-    let starts = worst_indices(errs, o.climb_points as usize);
-    let found: Vec<(usize, Vec<f64>, PointErrors)> = starts
+    let per_round = n_starts as u64 * NEIGHBOURS;
+    let rounds = (o.climb_rounds as u64).min(budget / per_round);
+    let note = (rounds < o.climb_rounds as u64).then(|| {
+        format!("work budget: {rounds} of {} hill-climbing rounds (max-work = {} op evaluations)", o.climb_rounds, o.max_work)
+    });
+    let starts: Vec<Kept> = acc.worst[..n_starts].to_vec();
+    let found: Vec<Kept> = starts
         .par_iter()
-        .map_init(Workspace::default, |ws, &i| {
-            let mut rng = rng_for(o.seed, 2, i as u64);
-            let (mut x, mut e) = (points[i].clone(), errs[i].clone());
-            for _ in 0..o.climb_rounds {
+        .map_init(Workspace::default, |ws, k| {
+            let mut rng = rng_for(o.seed, 2, k.index);
+            let (mut x, mut e) = (k.point.clone(), k.errs.clone());
+            for _ in 0..rounds {
                 let mut best: Option<(Vec<f64>, PointErrors)> = None;
                 for _ in 0..NEIGHBOURS {
                     let mut y = x.clone();
@@ -71,7 +67,7 @@ pub fn climb(
                             y[k] * (1.0 + sign * 2f64.powf(-(1.0 + 23.0 * unit(&mut rng))))
                         } as f32 as f64;
                     }
-                    let ey = errors_at(tape, &y, ws, Some(skip));
+                    let ey = errors_at(sub, &y, ws, Some(skip));
                     if best.as_ref().is_none_or(|(_, b)| better(&ey, b)) {
                         best = Some((y, ey));
                     }
@@ -82,14 +78,16 @@ pub fn climb(
                     }
                 }
             }
-            (i, x, e)
+            Kept { index: k.index, point: x, errs: e }
         })
         .collect();
-    for (i, x, e) in found {
-        points[i] = x;
-        errs[i] = e;
+    for (j, (s, f)) in starts.iter().zip(found).enumerate() {
+        acc.remove(&s.errs);
+        acc.add_stats(&f.errs);
+        acc.worst[j] = f;
     }
-    starts.len() as u64 * o.climb_rounds as u64 * NEIGHBOURS as u64
+    acc.sort_worst();
+    (per_round * rounds, note)
 }
 
 #[cfg(test)]

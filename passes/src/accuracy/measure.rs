@@ -1,8 +1,73 @@
 //! Bits of error of one function at many input points: binary32 and binary64 evaluations in the
-//! IR's own operation order against the certified reference (`robovec_ir::numerics`), and
-//! their statistics.
+//! IR's own operation order against the certified reference (`robovec_ir::numerics`) of the
+//! function as it entered the pipeline, and their statistics.
 
 use robovec_ir::numerics::{bits_f32, bits_f64, RefValue, Reference, Tape};
+use robovec_ir::Function;
+
+/// What is measured: the tape of the function after the pipeline (evaluated in binary32 and
+/// binary64) and the tape of the reference function (the same function as it entered the
+/// pipeline, whose exact value is the reference), with outputs matched by name and inputs by
+/// name over the union of both input lists.
+#[derive(Clone, Debug)]
+pub struct Subject {
+    /// The measured function's tape.
+    pub tape: Tape,
+    /// The reference function's tape, restricted to the measured outputs in the measured
+    /// order (output `k` of both tapes is the same name).
+    pub reference: Tape,
+    /// Coordinates of a sample point: the reference's inputs, then inputs only the measured
+    /// function has.
+    pub names: Vec<String>,
+    /// For each input of [`Subject::tape`], its coordinate in [`Subject::names`].
+    tape_at: Vec<usize>,
+    /// For each input of [`Subject::reference`], its coordinate.
+    ref_at: Vec<usize>,
+}
+
+impl Subject {
+    /// Measures `f` against `original` (the same function as it entered the pipeline), or
+    /// against itself when `None`.
+    ///
+    /// # Errors
+    /// A message when an output of `f` is not an output of `original`.
+    pub fn new(f: &Function, original: Option<&Function>) -> Result<Subject, String> {
+        let tape = Tape::new(f);
+        let reference = match original {
+            None => tape.clone(),
+            Some(g) => {
+                let mut g = g.clone();
+                let mut outs = Vec::with_capacity(f.outputs.len());
+                for o in &f.outputs {
+                    let Some(x) = g.outputs.iter().find(|x| x.name == o.name) else {
+                        return Err(format!(
+                            "output `{}` of @{} is not an output of the function as it entered the pipeline \
+                             (the error reference)",
+                            o.name, f.name
+                        ));
+                    };
+                    outs.push(x.clone());
+                }
+                g.outputs = outs;
+                Tape::new(&g)
+            }
+        };
+        let mut names = reference.inputs.clone();
+        for n in &tape.inputs {
+            if !names.contains(n) {
+                names.push(n.clone());
+            }
+        }
+        let at = |t: &Tape| t.inputs.iter().map(|n| names.iter().position(|m| m == n).expect("union")).collect();
+        let (tape_at, ref_at) = (at(&tape), at(&reference));
+        Ok(Subject { tape, reference, names, tape_at, ref_at })
+    }
+
+    /// Number of outputs measured.
+    pub fn n_outputs(&self) -> usize {
+        self.tape.outputs.len()
+    }
+}
 
 /// Per-thread buffers: no allocation per point once warm.
 #[derive(Default)]
@@ -13,6 +78,8 @@ pub struct Workspace {
     x64: Vec<f64>,
     reference: Reference,
     refs: Vec<RefValue>,
+    xt: Vec<f64>,
+    xr: Vec<f64>,
 }
 
 /// The errors at one point.
@@ -43,12 +110,18 @@ impl PointErrors {
     }
 }
 
-/// Evaluates `tape` at `inputs` in binary32, binary64 and the reference (`skip_big`: see
+/// Evaluates the measured tape at `point` (one value per [`Subject::names`]) in binary32 and
+/// binary64, and the reference tape at the same point (`skip_big`: see
 /// `Reference::eval_with`).
-pub fn errors_at(tape: &Tape, inputs: &[f64], ws: &mut Workspace, skip_big: Option<&[bool]>) -> PointErrors {
-    tape.eval_into::<f32>(inputs, &mut ws.s32, &mut ws.x32);
-    tape.eval_into::<f64>(inputs, &mut ws.s64, &mut ws.x64);
-    ws.reference.eval_with(tape, inputs, &mut ws.refs, skip_big);
+pub fn errors_at(sub: &Subject, point: &[f64], ws: &mut Workspace, skip_big: Option<&[bool]>) -> PointErrors {
+    let tape = &sub.tape;
+    ws.xt.clear();
+    ws.xt.extend(sub.tape_at.iter().map(|&i| point[i]));
+    ws.xr.clear();
+    ws.xr.extend(sub.ref_at.iter().map(|&i| point[i]));
+    tape.eval_into::<f32>(&ws.xt, &mut ws.s32, &mut ws.x32);
+    tape.eval_into::<f64>(&ws.xt, &mut ws.s64, &mut ws.x64);
+    ws.reference.eval_with(&sub.reference, &ws.xr, &mut ws.refs, skip_big);
     let mut e = PointErrors::default();
     for (&(_, s), r) in tape.outputs.iter().zip(&ws.refs) {
         e.f32.push(bits_f32(ws.s32[s as usize], r.f32));

@@ -8,7 +8,9 @@
 //! 2. at each point evaluate the function in binary32 and binary64 (the interpreter's
 //!    semantics, through `robovec_ir::numerics::Tape`) and compute the certified reference
 //!    (double-double with a running error bound, 256/1024-bit astro-float where the bound does
-//!    not certify; `robovec_ir::numerics::reference`);
+//!    not certify; `robovec_ir::numerics::reference`) **of the function as it entered the
+//!    pipeline** (`PassContext::original`: the parsed equations or the input `.rvir`; outputs
+//!    and inputs matched by name, so a rewrite that changes the mathematics shows as error);
 //! 3. bits of error per output and point (Herbie: log2(1 + floats between the computed and the
 //!    correctly rounded exact value); `robovec_ir::numerics::bits`);
 //! 4. `mode=hard` then hill-climbs from the worst points ([`hard`]);
@@ -17,24 +19,26 @@
 //!
 //! Results go to `PassContext::accuracy`; the driver writes them into the report (SPEC §7
 //! `accuracy`) and on stderr, and `worst=DIR` makes it write `DIR/worst-K.json` (the `-eval`
-//! input format) for each listed point. Points are measured in parallel (rayon); cost is
-//! O(samples × ops) plus the rare 256-bit re-evaluations.
+//! input format) for each listed point. Points are measured in parallel (rayon) and streamed
+//! ([`stream`]: memory independent of `samples`); cost is O(samples × ops) plus the rare
+//! 256-bit re-evaluations, bounded by the work budget `max-work`.
 
+pub mod check;
 pub mod hard;
 pub mod inputs;
 pub mod measure;
 pub mod report;
+pub mod stats;
+pub mod stream;
 
 use std::collections::BTreeMap;
 
-use rayon::prelude::*;
-use robovec_ir::numerics::Tape;
 use robovec_ir::{Function, Module};
 
 use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
-pub use measure::{BitsSummary, PointErrors};
-pub use report::{AccuracyReport, OutputAccuracy, ReferenceCounts, WorstPoint};
+pub use measure::{BitsSummary, PointErrors, Subject};
+pub use report::{AccuracyReport, OutputAccuracy, ReferenceCounts, ReferenceInfo, WorstPoint};
 
 /// Sampled (physical ranges) or hard (near-singular poses, extreme scales, search) inputs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,7 +80,15 @@ pub struct Options {
     pub climb_rounds: u32,
     /// Points hill-climbing starts from (the worst ones; `mode=hard`).
     pub climb_points: u32,
+    /// Work budget, op evaluations (samples × ops of the measured and reference tapes, plus
+    /// hill-climbing neighbours × ops); see [`stream`].
+    pub max_work: u64,
+    /// Stop (and say so) when this instant passes; checked once per chunk of samples.
+    pub deadline: Option<std::time::Instant>,
 }
+
+/// Default work budget, op evaluations (about 10 minutes on two cores).
+pub const DEFAULT_MAX_WORK: u64 = 20_000_000_000;
 
 impl Default for Options {
     /// The defaults declared in [`INFO`].
@@ -130,6 +142,11 @@ pub const INFO: PassInfo = PassInfo {
             kind: ParamKind::U32 { default: 8, min: 1, max: 1000 },
             doc: "worst points hill climbing starts from",
         },
+        ParamInfo {
+            name: "max-work",
+            kind: ParamKind::U64 { default: DEFAULT_MAX_WORK, min: 1, max: u64::MAX },
+            doc: "work budget in op evaluations (samples x ops, plus hill climbing); stops early and says so",
+        },
     ],
     build: |p: &Params| Ok(Box::new(Accuracy { opts: options_from(p)? })),
 };
@@ -145,6 +162,8 @@ fn options_from(p: &Params) -> Result<Options, PassError> {
         worst_count: p.u32("worst-count")?,
         climb_rounds: p.u32("climb")?,
         climb_points: p.u32("climb-points")?,
+        max_work: p.u64("max-work")?,
+        deadline: None,
     })
 }
 
@@ -170,7 +189,8 @@ impl Pass for Accuracy {
             o.known =
                 inputs::read_params(path).map_err(|message| PassError::Failed { pass: "accuracy".into(), message })?;
             for name in o.known.keys() {
-                let used = m.functions.iter().any(|f| f.inputs.iter().any(|&v| f.name_of(v) == name));
+                let has = |m: &Module| m.functions.iter().any(|f| f.inputs.iter().any(|&v| f.name_of(v) == name));
+                let used = has(m) || cx.original.as_ref().is_some_and(has);
                 if !used {
                     return Err(PassError::Failed {
                         pass: "accuracy".into(),
@@ -179,35 +199,43 @@ impl Pass for Accuracy {
                 }
             }
         }
+        let fail = |message: String| PassError::Failed { pass: "accuracy".into(), message };
         for f in &m.functions {
-            cx.accuracy.push(measure_function(f, &o));
+            let original = match &cx.original {
+                None => None,
+                Some(om) => Some(om.function(&f.name).ok_or_else(|| {
+                    fail(format!("function @{} is not in the module as it entered the pipeline (the error reference)", f.name))
+                })?),
+            };
+            cx.accuracy.push(measure_against(f, original, &o).map_err(fail)?);
         }
         Ok(())
     }
+
+    fn needs_original(&self) -> bool {
+        true
+    }
 }
 
-/// Measures `f` (any phase, verified) under `o` (with `o.known` already read).
+/// What `against` says when the reference is the pipeline's input.
+pub const AGAINST_INPUT: &str = "input of the pipeline (the function of the same name as parsed or read)";
+/// What `against` says when no original was available.
+pub const AGAINST_SELF: &str = "the measured IR itself";
+
+/// Measures `f` (any phase, verified) under `o` (with `o.known` already read) against its own
+/// exact value.
 pub fn measure_function(f: &Function, o: &Options) -> AccuracyReport {
-    let tape = Tape::new(f);
-    let ranges: Vec<inputs::Range> = tape.inputs.iter().map(|n| inputs::range_of(n)).collect();
-    let hard = o.mode == Mode::Hard;
-    let stream = hard as u64;
-    let mut points: Vec<Vec<f64>> = (0..o.samples as u64)
-        .map(|i| inputs::point(&tape.inputs, &ranges, &o.known, &mut inputs::rng_for(o.seed, stream, i), hard))
-        .collect();
-    let probes = points.len().min(measure::PROBES);
-    let measure = |points: &[Vec<f64>], skip: Option<&[bool]>| -> Vec<PointErrors> {
-        points
-            .par_iter()
-            .map_init(measure::Workspace::default, |ws, p| measure::errors_at(&tape, p, ws, skip))
-            .collect()
-    };
-    let mut errs = measure(&points[..probes], None);
-    let skip = measure::skip_after_probes(&errs, tape.outputs.len());
-    errs.extend(measure(&points[probes..], Some(&skip)));
-    let mut evaluations = points.len() as u64;
-    if hard {
-        evaluations += hard::climb(&tape, &ranges, o, &skip, &mut points, &mut errs);
-    }
-    report::build(f, &tape, o, &points, &errs, evaluations, &skip)
+    measure_against(f, None, o).expect("a function is its own reference")
+}
+
+/// Measures `f` under `o` against the exact value of `original` (the same function as it
+/// entered the pipeline; `None`: `f` itself).
+///
+/// # Errors
+/// A message when an output of `f` is not an output of `original`.
+pub fn measure_against(f: &Function, original: Option<&Function>, o: &Options) -> Result<AccuracyReport, String> {
+    let sub = Subject::new(f, original)?;
+    let run = stream::run(&sub, o);
+    let against = if original.is_some() { AGAINST_INPUT } else { AGAINST_SELF };
+    Ok(report::build(&f.name, &sub, o, run, against))
 }

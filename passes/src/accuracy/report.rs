@@ -4,12 +4,11 @@
 
 use std::collections::BTreeMap;
 
-use robovec_ir::numerics::Tape;
-use robovec_ir::Function;
 use serde::ser::{Serialize, SerializeMap, Serializer};
 
-use super::hard::worst_indices;
-use super::measure::{summarise, BitsSummary, PointErrors};
+use super::measure::{BitsSummary, Subject};
+use super::stats::Stream;
+use super::stream::Run;
 use super::Options;
 
 /// Errors of one output over the points.
@@ -49,6 +48,18 @@ pub struct ReferenceCounts {
     pub uncertified: u64,
 }
 
+/// Which reference the errors were measured against, and how its values were obtained.
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ReferenceInfo {
+    /// What the exact values are those of: `input of the pipeline` (the function of the same
+    /// name as it entered the pipeline: the parsed equations or the input `.rvir`; outputs and
+    /// inputs matched by name) or `the measured IR itself` (no original available).
+    pub against: String,
+    /// How many (output, point) values each path produced.
+    #[serde(flatten)]
+    pub counts: ReferenceCounts,
+}
+
 /// One of the worst points found.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct WorstPoint {
@@ -81,13 +92,23 @@ pub struct AccuracyReport {
     pub f32: BitsSummary,
     /// Over every (output, point) pair, binary64, bits.
     pub f64: BitsSummary,
+    /// Half-width of the 95% confidence interval of `f32.mean_bits`: 1.96·s/√n over the
+    /// per-point means (every point has the same outputs), bits.
+    pub f32_mean_ci95_bits: f64,
     /// Per output.
     pub outputs: OutputsMap,
     /// `f32` and `f64` over the outputs that are not [`AccuracyReport::structural_zeros`]
     /// (their ~30/62-bit errors against an exact 0 otherwise set every `max_bits`).
     pub excluding_structural_zeros: OutputAccuracy,
-    /// Reference paths.
-    pub reference: ReferenceCounts,
+    /// The reference and its paths.
+    pub reference: ReferenceInfo,
+    /// User callbacks evaluated with the interpreter's stand-in (a linear form of the
+    /// arguments; `robovec_ir::interp::callback_standin`), in the measured IR or the reference:
+    /// their error figures are those of the stand-in, not of the real callback.
+    pub callback_standins: Vec<String>,
+    /// Why fewer samples or hill-climbing rounds than asked were measured (the work budget
+    /// `max-work` or the time limit), or `null` when the run is complete.
+    pub stopped_early: Option<String>,
     /// Outputs whose reference stayed an uncertified interval around zero on the probe
     /// samples even at 256 bits: exact zeros reached through inexact steps (structural zeros
     /// such as `m·(cos²q + sin²q) − m`; in hard mode also outputs that vanish at the singular
@@ -101,69 +122,58 @@ pub struct AccuracyReport {
     pub worst_dir: Option<String>,
 }
 
-/// Summarises the errors at `points`.
-pub fn build(
-    f: &Function,
-    tape: &Tape,
-    o: &Options,
-    points: &[Vec<f64>],
-    errs: &[PointErrors],
-    evaluations: u64,
-    skip: &[bool],
-) -> AccuracyReport {
-    let n_out = tape.outputs.len();
-    let mut all32 = Vec::with_capacity(errs.len() * n_out);
-    let mut all64 = Vec::with_capacity(errs.len() * n_out);
-    let (mut nz32, mut nz64) = (Vec::new(), Vec::new());
-    let mut reference = ReferenceCounts::default();
-    let mut outputs = Vec::with_capacity(n_out);
-    for (k, (name, _)) in tape.outputs.iter().enumerate() {
-        let mut e32: Vec<f64> = errs.iter().map(|e| e.f32[k]).collect();
-        let mut e64: Vec<f64> = errs.iter().map(|e| e.f64[k]).collect();
-        all32.extend_from_slice(&e32);
-        all64.extend_from_slice(&e64);
-        if !skip[k] {
-            nz32.extend_from_slice(&e32);
-            nz64.extend_from_slice(&e64);
-        }
-        outputs.push((name.clone(), OutputAccuracy { f32: summarise(&mut e32), f64: summarise(&mut e64) }));
-    }
-    for e in errs {
-        for &(bits, ok, _) in &e.reference {
-            match (bits, ok) {
-                (_, false) => reference.uncertified += 1,
-                (106, true) => reference.double_double += 1,
-                (256, true) => reference.bits_256 += 1,
-                (_, true) => reference.bits_1024 += 1,
-            }
-        }
-    }
-    let worst = worst_indices(errs, o.worst_count as usize)
-        .into_iter()
-        .map(|i| {
-            let e = &errs[i];
+fn merged<'a>(xs: impl Iterator<Item = &'a Stream>) -> BitsSummary {
+    let mut all = Stream::default();
+    xs.for_each(|x| all.merge(x));
+    all.summary()
+}
+
+/// Summarises a streamed run of `sub` (function `function`, reference described by `against`).
+pub fn build(function: &str, sub: &Subject, o: &Options, run: Run, against: &str) -> AccuracyReport {
+    let Run { acc, skip, evaluations, stopped_early } = run;
+    let outputs = sub
+        .tape
+        .outputs
+        .iter()
+        .enumerate()
+        .map(|(k, (name, _))| (name.clone(), OutputAccuracy { f32: acc.f32[k].summary(), f64: acc.f64[k].summary() }))
+        .collect();
+    let kept = |v: &[Stream]| -> BitsSummary { merged(v.iter().zip(&skip).filter(|(_, &z)| !z).map(|(s, _)| s)) };
+    let worst = acc
+        .worst
+        .iter()
+        .map(|w| {
+            let e = &w.errs;
+            let n_out = e.f32.len();
             let k = (0..n_out).max_by(|&a, &b| e.f32[a].total_cmp(&e.f32[b]).then(b.cmp(&a))).unwrap_or(0);
             WorstPoint {
                 max_f32_bits: e.max_f32(),
                 mean_f32_bits: e.mean_f32(),
                 max_f64_bits: e.f64.iter().copied().fold(0.0, f64::max),
-                output: tape.outputs.get(k).map(|o| o.0.clone()).unwrap_or_default(),
-                inputs: tape.inputs.iter().cloned().zip(points[i].iter().copied()).collect(),
+                output: sub.tape.outputs.get(k).map(|o| o.0.clone()).unwrap_or_default(),
+                inputs: sub.names.iter().cloned().zip(w.point.iter().copied()).collect(),
             }
         })
         .collect();
+    let mut standins = sub.tape.standin_callees();
+    standins.extend(sub.reference.standin_callees());
+    standins.sort();
+    standins.dedup();
     AccuracyReport {
-        function: f.name.clone(),
+        function: function.to_string(),
         mode: o.mode.name(),
-        samples: points.len() as u64,
+        samples: acc.samples(),
         seed: o.seed,
         evaluations,
-        f32: summarise(&mut all32),
-        f64: summarise(&mut all64),
-        excluding_structural_zeros: OutputAccuracy { f32: summarise(&mut nz32), f64: summarise(&mut nz64) },
+        f32: merged(acc.f32.iter()),
+        f64: merged(acc.f64.iter()),
+        f32_mean_ci95_bits: acc.point_means.ci95(),
+        excluding_structural_zeros: OutputAccuracy { f32: kept(&acc.f32), f64: kept(&acc.f64) },
         outputs: OutputsMap(outputs),
-        reference,
-        structural_zeros: tape.outputs.iter().zip(skip).filter(|(_, &z)| z).map(|(o, _)| o.0.clone()).collect(),
+        reference: ReferenceInfo { against: against.to_string(), counts: acc.reference },
+        callback_standins: standins,
+        stopped_early,
+        structural_zeros: sub.tape.outputs.iter().zip(&skip).filter(|(_, &z)| z).map(|(o, _)| o.0.clone()).collect(),
         worst,
         worst_dir: o.worst_dir.clone(),
     }
@@ -174,10 +184,10 @@ pub fn to_text(reports: &[AccuracyReport], per_output: bool) -> String {
     let b = |s: &BitsSummary| format!("{:.2}/{:.2}/{:.2}", s.mean_bits, s.p95_bits, s.max_bits);
     let mut s = String::new();
     for r in reports {
-        let rc = &r.reference;
+        let rc = &r.reference.counts;
         s += &format!(
             "@{}: accuracy ({} inputs, {} samples, seed {}, {} evaluations): bits of error mean/p95/max \
-             f32 {} f64 {}; reference: {} double-double, {} at 256 bits, {} at 1024 bits, {} uncertified\n",
+             f32 {} f64 {}; reference ({}): {} double-double, {} at 256 bits, {} at 1024 bits, {} uncertified\n",
             r.function,
             r.mode,
             r.samples,
@@ -185,11 +195,22 @@ pub fn to_text(reports: &[AccuracyReport], per_output: bool) -> String {
             r.evaluations,
             b(&r.f32),
             b(&r.f64),
+            r.reference.against,
             rc.double_double,
             rc.bits_256,
             rc.bits_1024,
             rc.uncertified
         );
+        for c in &r.callback_standins {
+            s += &format!(
+                "warning: @{} calls user callback `{c}`; evaluated with the stand-in (a linear form of its \
+                 arguments, robovec_ir::interp::callback_standin): its figures are not the real callback's\n",
+                r.function
+            );
+        }
+        if let Some(why) = &r.stopped_early {
+            s += &format!("@{}: accuracy stopped early: {why}\n", r.function);
+        }
         if !r.structural_zeros.is_empty() {
             let x = &r.excluding_structural_zeros;
             s += &format!(

@@ -1,0 +1,233 @@
+//! The measurement, streamed: samples are drawn, measured and folded into running statistics
+//! chunk by chunk, so memory does not grow with `samples` (only the `worst-count` /
+//! `climb-points` worst points are kept with their inputs and errors).
+//!
+//! Every statistic merges in an order-independent way (counts, exact fixed-point sums, maxima,
+//! histograms; worst points ordered by objective then index), so results are deterministic
+//! and independent of the number of threads and of the chunking.
+//!
+//! # Work budget
+//! One sample costs `ops` = steps of the measured tape + steps of the reference tape (each
+//! evaluated in binary32, binary64 and double-double). A run may spend at most
+//! `max-work` = [`super::Options::max_work`] op evaluations (default 2·10¹⁰, ~10 minutes on
+//! two cores): the samples measured are `min(samples, max(32, max-work / ops))`, and hill
+//! climbing runs only the rounds the rest of the budget pays for. Either cut is reported
+//! (`stopped_early` in the report, a line on stderr). A deadline (the driver's time limit) is
+//! checked once per chunk; stopping there is also reported.
+
+use std::cmp::Ordering;
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::inputs::{self, range_of, rng_for};
+use super::measure::{errors_at, skip_after_probes, PointErrors, Subject, Workspace, PROBES};
+use super::report::ReferenceCounts;
+use super::stats::{Moments, Stream};
+use super::{Mode, Options};
+
+/// A point kept among the worst.
+#[derive(Clone, Debug)]
+pub struct Kept {
+    /// Sample index.
+    pub index: u64,
+    /// Value of every coordinate ([`Subject::names`]).
+    pub point: Vec<f64>,
+    /// Its errors.
+    pub errs: PointErrors,
+}
+
+/// Worst first: larger (max f32 bits, mean f32 bits), then lower index.
+fn order(a: &Kept, b: &Kept) -> Ordering {
+    let (oa, ob) = ((a.errs.max_f32(), a.errs.mean_f32()), (b.errs.max_f32(), b.errs.mean_f32()));
+    ob.0.total_cmp(&oa.0).then(ob.1.total_cmp(&oa.1)).then(a.index.cmp(&b.index))
+}
+
+/// Running statistics of a set of points.
+#[derive(Clone, Debug, Default)]
+pub struct Acc {
+    /// Per output, binary32 bits.
+    pub f32: Vec<Stream>,
+    /// Per output, binary64 bits.
+    pub f64: Vec<Stream>,
+    /// Reference paths over every (output, point).
+    pub reference: ReferenceCounts,
+    /// The mean binary32 bits of each point (its confidence interval).
+    pub point_means: Moments,
+    /// The worst points, worst first (at most `keep`).
+    pub worst: Vec<Kept>,
+    keep: usize,
+}
+
+fn count_reference(r: &mut ReferenceCounts, e: &PointErrors, sign: i64) {
+    for &(bits, ok, _) in &e.reference {
+        let c = match (bits, ok) {
+            (_, false) => &mut r.uncertified,
+            (106, true) => &mut r.double_double,
+            (256, true) => &mut r.bits_256,
+            (_, true) => &mut r.bits_1024,
+        };
+        *c = c.wrapping_add_signed(sign);
+    }
+}
+
+impl Acc {
+    /// Empty statistics for `n` outputs, keeping the `keep` worst points.
+    pub fn new(n: usize, keep: usize) -> Acc {
+        Acc { f32: vec![Stream::default(); n], f64: vec![Stream::default(); n], keep, ..Acc::default() }
+    }
+
+    /// Adds point `index` (`point` is called only when the point is kept).
+    pub fn add(&mut self, index: u64, point: impl FnOnce() -> Vec<f64>, errs: PointErrors) {
+        self.add_stats(&errs);
+        self.keep_point(Kept { index, point: Vec::new(), errs }, point);
+    }
+
+    /// Adds the errors of a point to the counts, sums, maxima and histograms only.
+    pub fn add_stats(&mut self, errs: &PointErrors) {
+        for (k, (&a, &b)) in errs.f32.iter().zip(&errs.f64).enumerate() {
+            self.f32[k].add(a);
+            self.f64[k].add(b);
+        }
+        count_reference(&mut self.reference, errs, 1);
+        self.point_means.add(errs.mean_f32(), 1);
+    }
+
+    /// Re-sorts the worst points (after the hill climbing changed some).
+    pub fn sort_worst(&mut self) {
+        self.worst.sort_by(order);
+    }
+
+    fn keep_point(&mut self, mut k: Kept, point: impl FnOnce() -> Vec<f64>) {
+        if self.keep == 0 {
+            return;
+        }
+        if self.worst.len() == self.keep && order(&k, self.worst.last().expect("full")) != Ordering::Less {
+            return;
+        }
+        if k.point.is_empty() {
+            k.point = point();
+        }
+        let at = self.worst.partition_point(|w| order(w, &k) == Ordering::Less);
+        self.worst.insert(at, k);
+        self.worst.truncate(self.keep);
+    }
+
+    /// Takes the errors of a point out of the counts, sums and histograms (not the maxima).
+    pub fn remove(&mut self, errs: &PointErrors) {
+        for (k, (&a, &b)) in errs.f32.iter().zip(&errs.f64).enumerate() {
+            self.f32[k].remove(a);
+            self.f64[k].remove(b);
+        }
+        count_reference(&mut self.reference, errs, -1);
+        self.point_means.add(errs.mean_f32(), -1);
+    }
+
+    /// Both sets of points.
+    pub fn merge(mut self, o: Acc) -> Acc {
+        for (a, b) in self.f32.iter_mut().zip(&o.f32) {
+            a.merge(b);
+        }
+        for (a, b) in self.f64.iter_mut().zip(&o.f64) {
+            a.merge(b);
+        }
+        let r = &mut self.reference;
+        r.double_double += o.reference.double_double;
+        r.bits_256 += o.reference.bits_256;
+        r.bits_1024 += o.reference.bits_1024;
+        r.uncertified += o.reference.uncertified;
+        self.point_means.merge(&o.point_means);
+        for k in o.worst {
+            self.keep_point(k, Vec::new);
+        }
+        self
+    }
+
+    /// Points summarised.
+    pub fn samples(&self) -> u64 {
+        self.f32.first().map_or(0, |s| s.count)
+    }
+}
+
+/// What a streamed run produced.
+pub struct Run {
+    /// The statistics.
+    pub acc: Acc,
+    /// Structural zeros (per output; see [`skip_after_probes`]).
+    pub skip: Vec<bool>,
+    /// Points evaluated, hill-climbing neighbours included.
+    pub evaluations: u64,
+    /// Why the run measured less than asked, if it did.
+    pub stopped_early: Option<String>,
+}
+
+/// Samples per chunk: about 2²² op evaluations, 64 to 16384 samples.
+fn chunk_len(ops: u64) -> u64 {
+    ((1u64 << 22) / ops.max(1)).clamp(64, 16384)
+}
+
+/// Measures `sub` under `o` (see the module doc).
+pub fn run(sub: &Subject, o: &Options) -> Run {
+    let n_out = sub.n_outputs();
+    let ranges: Vec<inputs::Range> = sub.names.iter().map(|n| range_of(n)).collect();
+    let hard = o.mode == Mode::Hard;
+    let stream = hard as u64;
+    let keep = o.worst_count.max(if hard { o.climb_points } else { 0 }) as usize;
+    let draw = |i: u64| inputs::point(&sub.names, &ranges, &o.known, &mut rng_for(o.seed, stream, i), hard);
+    let ops = (sub.tape.steps.len() + sub.reference.steps.len()).max(1) as u64;
+    let mut stopped_early = None;
+    let mut n = o.samples as u64;
+    let affordable = (o.max_work / ops).max(PROBES as u64);
+    if affordable < n {
+        stopped_early = Some(format!(
+            "work budget: measured {affordable} of {n} samples (max-work = {} op evaluations, {ops} ops per sample)",
+            o.max_work
+        ));
+        n = affordable;
+    }
+    let probes = n.min(PROBES as u64);
+    let probe_errs: Vec<PointErrors> = (0..probes)
+        .into_par_iter()
+        .map_init(Workspace::default, |ws, i| errors_at(sub, &draw(i), ws, None))
+        .collect();
+    let skip = skip_after_probes(&probe_errs, n_out);
+    let mut acc = Acc::new(n_out, keep);
+    for (i, e) in probe_errs.into_iter().enumerate() {
+        acc.add(i as u64, || draw(i as u64), e);
+    }
+    let chunk = chunk_len(ops);
+    let mut start = probes;
+    while start < n {
+        if o.deadline.is_some_and(|d| Instant::now() >= d) {
+            stopped_early = Some(format!("time limit: measured {start} of {} samples", o.samples));
+            n = start;
+            break;
+        }
+        let end = (start + chunk).min(n);
+        let part = (start..end)
+            .into_par_iter()
+            .fold(
+                || (Workspace::default(), Acc::new(n_out, keep)),
+                |(mut ws, mut a), i| {
+                    let e = errors_at(sub, &draw(i), &mut ws, Some(&skip));
+                    a.add(i, || draw(i), e);
+                    (ws, a)
+                },
+            )
+            .map(|(_, a)| a)
+            .reduce(|| Acc::new(n_out, keep), Acc::merge);
+        acc = acc.merge(part);
+        start = end;
+    }
+    let mut evaluations = n;
+    if hard {
+        let left = o.max_work.saturating_sub(n * ops) / ops;
+        let (extra, note) = super::hard::climb(sub, &ranges, o, &skip, &mut acc, left);
+        evaluations += extra;
+        if let Some(note) = note {
+            stopped_early = Some(stopped_early.map_or(note.clone(), |s| format!("{s}; {note}")));
+        }
+    }
+    acc.worst.truncate(o.worst_count as usize);
+    Run { acc, skip, evaluations, stopped_early }
+}
