@@ -185,6 +185,8 @@ impl Pass for Accuracy {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let mut o = self.opts.clone();
+        // `-time-limit`: accuracy checks it once per chunk of samples.
+        o.deadline = cx.deadline.map(|d| d.at);
         if let Some(path) = &o.params {
             o.known =
                 inputs::read_params(path).map_err(|message| PassError::Failed { pass: "accuracy".into(), message })?;
@@ -207,7 +209,11 @@ impl Pass for Accuracy {
                     fail(format!("function @{} is not in the module as it entered the pipeline (the error reference)", f.name))
                 })?),
             };
-            cx.accuracy.push(measure_against(f, original, &o).map_err(fail)?);
+            let r = measure_against(f, original, &o).map_err(fail)?;
+            if let Some(why) = &r.stopped_early {
+                cx.note_stop("accuracy", &format!("on @{}: {why}", f.name));
+            }
+            cx.accuracy.push(r);
         }
         Ok(())
     }
