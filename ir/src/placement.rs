@@ -23,6 +23,10 @@
 //!   its last read; it may be written again only in a later cycle than that last read.
 //! - **cycles** = the largest arrival cycle (0 without ops); a lone add takes 12 cycles.
 //!
+//! The verifier checks every rule above except word lifetimes (address reuse) whenever a
+//! placement is read or left by a pass ([`crate::verifier::placement`]); the simulator `sim`
+//! checks them all.
+//!
 //! Memory sizes (`pe_words`, `buffer_words`) are the number of addresses each memory uses
 //! (addresses are `0..words`), which the placer keeps equal to the largest number of words the
 //! memory holds at once.
