@@ -10,6 +10,7 @@ mod cli;
 mod corpus;
 mod diagnostics;
 mod eqsat;
+mod error_reference;
 mod exact_gap;
 mod example;
 mod filetests;

@@ -35,6 +35,9 @@ use robovec_ir::Function;
 use super::inputs::{point, range_of, rng_for, Range};
 use super::measure::Subject;
 
+/// Inputs a violation's message lists (all are in [`Violation::inputs`]).
+const SHOWN: usize = 12;
+
 /// Default number of points of `-check`.
 pub const DEFAULT_SAMPLES: u32 = 200;
 
@@ -79,8 +82,10 @@ impl fmt::Display for Violation {
                 self.function, self.output, self.format, self.error, self.exact, self.budget, self.computed
             )?;
         }
-        let inputs: Vec<String> = self.inputs.iter().map(|(k, v)| format!("{k} = {v:e}")).collect();
-        write!(f, " at sample {} ({})", self.sample, inputs.join(", "))
+        let inputs: Vec<String> = self.inputs.iter().take(SHOWN).map(|(k, v)| format!("{k} = {v:e}")).collect();
+        let more = self.inputs.len().saturating_sub(SHOWN);
+        let more = if more > 0 { format!(", … {more} more inputs") } else { String::new() };
+        write!(f, " at sample {} ({}{more})", self.sample, inputs.join(", "))
     }
 }
 

@@ -168,6 +168,12 @@ fn chunk_len(ops: u64) -> u64 {
 
 /// Measures `sub` under `o` (see the module doc).
 pub fn run(sub: &Subject, o: &Options) -> Run {
+    let ops = (sub.tape.steps.len() + sub.reference.steps.len()).max(1) as u64;
+    run_chunked(sub, o, chunk_len(ops))
+}
+
+/// [`run`] with `chunk` samples per chunk (the results do not depend on it).
+pub fn run_chunked(sub: &Subject, o: &Options, chunk: u64) -> Run {
     let n_out = sub.n_outputs();
     let ranges: Vec<inputs::Range> = sub.names.iter().map(|n| range_of(n)).collect();
     let hard = o.mode == Mode::Hard;
@@ -195,7 +201,6 @@ pub fn run(sub: &Subject, o: &Options) -> Run {
     for (i, e) in probe_errs.into_iter().enumerate() {
         acc.add(i as u64, || draw(i as u64), e);
     }
-    let chunk = chunk_len(ops);
     let mut start = probes;
     while start < n {
         if o.deadline.is_some_and(|d| Instant::now() >= d) {
@@ -230,4 +235,55 @@ pub fn run(sub: &Subject, o: &Options) -> Run {
     }
     acc.worst.truncate(o.worst_count as usize);
     Run { acc, skip, evaluations, stopped_early }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accuracy::measure::summarise;
+    use crate::accuracy::stats::BIN_WIDTH_BITS;
+    use crate::accuracy::{measure_function, Options};
+    use crate::expr_gen;
+
+    #[test]
+    fn streamed_run_equals_a_batch_computation_and_ignores_chunking() {
+        for seed in [1, 4] {
+            let f = expr_gen::generate(seed);
+            let o = Options { samples: 700, seed: 3, ..Options::default() };
+            let r = measure_function(&f, &o);
+            // Batch, independently: every point kept, sorted summaries (the former code path).
+            let sub = Subject::new(&f, None).unwrap();
+            let ranges: Vec<inputs::Range> = sub.names.iter().map(|n| range_of(n)).collect();
+            let mut ws = Workspace::default();
+            let errs: Vec<PointErrors> = (0..700)
+                .map(|i| {
+                    let p = inputs::point(&sub.names, &ranges, &o.known, &mut rng_for(3, 0, i), false);
+                    errors_at(&sub, &p, &mut ws, None)
+                })
+                .collect();
+            let mut all32: Vec<f64> = errs.iter().flat_map(|e| e.f32.iter().copied()).collect();
+            let mut all64: Vec<f64> = errs.iter().flat_map(|e| e.f64.iter().copied()).collect();
+            for (got, want) in [(r.f32, summarise(&mut all32)), (r.f64, summarise(&mut all64))] {
+                assert!((got.mean_bits - want.mean_bits).abs() < 1e-12, "{got:?} {want:?}");
+                assert_eq!(got.max_bits, want.max_bits);
+                assert!(got.p95_bits >= want.p95_bits && got.p95_bits - want.p95_bits <= BIN_WIDTH_BITS);
+            }
+            let total: u64 = errs.iter().map(|e| e.f32.len() as u64).sum();
+            let rc = r.reference.counts;
+            assert_eq!(rc.double_double + rc.bits_256 + rc.bits_1024 + rc.uncertified, total);
+            // The worst point is the batch's worst.
+            let worst = errs.iter().map(|e| e.max_f32()).fold(0.0, f64::max);
+            assert_eq!(r.worst[0].max_f32_bits, worst);
+            // Another chunking and one thread: the same statistics and worst points.
+            let a = run(&sub, &o);
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+            let b = pool.install(|| run_chunked(&sub, &o, 7));
+            assert_eq!((&a.acc.f32, &a.acc.f64, a.acc.reference), (&b.acc.f32, &b.acc.f64, b.acc.reference));
+            assert_eq!(a.acc.point_means, b.acc.point_means);
+            let idx = |r: &Run| r.acc.worst.iter().map(|k| k.index).collect::<Vec<_>>();
+            assert_eq!(idx(&a), idx(&b));
+            assert_eq!(chunk_len(1), 16384);
+            assert_eq!(chunk_len(1 << 30), 64);
+        }
+    }
 }
