@@ -41,6 +41,8 @@ pub struct Options {
     pub pareto_samples: u32,
     /// `-pareto-seed=S`: seed of those measurements.
     pub pareto_seed: u64,
+    /// `-time-limit=SECONDS`: wall-clock limit of the run (see `PassContext::deadline`).
+    pub time_limit: Option<f64>,
 }
 
 /// Why a run failed; the text is ready for stderr.
@@ -180,6 +182,7 @@ fn write_worst_points(reports: &[robovec_passes::accuracy::AccuracyReport], pref
 /// # Errors
 /// [`Failure`] with its exit status.
 pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
+    let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
     let pm = PassManager::new(&opts.passes, opts.instr.clone()).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
     let (mut module, _src) = load(&opts.input)?;
@@ -192,8 +195,11 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         }
         None => Vec::new(),
     };
-    let mut cx = PassContext::default();
+    let mut cx = PassContext { deadline, ..PassContext::default() };
     let records = pm.run(&mut module, &mut cx, stderr).map_err(|e| Failure::Input(format!("error: {e}\n")))?;
+    for s in &cx.stopped {
+        let _ = writeln!(stderr, "note: {s}");
+    }
 
     // Build every output in memory first.
     let report = match &opts.report {
@@ -210,6 +216,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                 accuracy: cx.accuracy.iter().rev().find(|r| r.function == f.name).cloned(),
                 pareto: pareto.clone(),
                 eqsat: cx.eqsat.iter().filter(|e| e.function == f.name).cloned().collect(),
+                stopped_early: cx.stopped.clone(),
             };
             Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
         }
