@@ -94,6 +94,19 @@ pub struct Cli {
     /// List the registered passes with their parameters and exit.
     #[arg(long)]
     pub print_passes: bool,
+    /// Wall-clock limit of the whole run, seconds (> 0): passes with long searches (eqsat,
+    /// place, sweep) stop early once it is reached, keep a valid result and say so on stderr
+    /// (`note: … stopped …`) and in the report (`stopped_early`).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_time_limit)]
+    pub time_limit: Option<f64>,
+}
+
+/// `-time-limit=SECONDS`: a positive, finite number of seconds (`5`, `0.5`).
+fn parse_time_limit(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 && x <= 1e9 => Ok(x),
+        _ => Err(format!("expected a number of seconds greater than 0 (such as `5` or `0.5`), found `{s}`")),
+    }
 }
 
 /// Maps LLVM single-dash long flags (`-passes=x`) to clap's `--passes=x`.
@@ -166,6 +179,7 @@ impl Cli {
             pareto_seed: self.pareto_seed,
             eval_f32: self.eval_precision == "f32",
             check: self.check.then_some((self.check_samples, self.check_seed)),
+            time_limit: self.time_limit,
         })
     }
 }

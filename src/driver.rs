@@ -54,6 +54,8 @@ pub struct Options {
     pub eval_f32: bool,
     /// `-check` with its samples and seed.
     pub check: Option<(u32, u64)>,
+    /// `-time-limit=SECONDS`: wall-clock limit of the run (see `PassContext::deadline`).
+    pub time_limit: Option<f64>,
 }
 
 /// Why a run failed; the text is ready for stderr.
@@ -254,6 +256,7 @@ impl DumpSink for StagedDumps<'_> {
 /// # Errors
 /// [`Failure`] with its exit status.
 pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
+    let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
     let pm = PassManager::new(&opts.passes, opts.instr.clone()).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     crate::preflight::check_options(opts, &pm)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
@@ -271,7 +274,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         }
         None => Vec::new(),
     };
-    let mut cx = PassContext { original: opts.check.map(|_| module.clone()), ..PassContext::default() };
+    let mut cx = PassContext { original: opts.check.map(|_| module.clone()), deadline, ..PassContext::default() };
     let records = {
         let dir = opts.instr.dump_dir.clone().unwrap_or_default();
         let mut dumps = StagedDumps { dir, out: &mut out, created: false };
@@ -281,6 +284,9 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             e => pass_failure(e, &src),
         })?
     };
+    for s in &cx.stopped {
+        writeln!(stderr, "note: {s}").map_err(stderr_failure)?;
+    }
     if let (Some((samples, seed)), Some(original)) = (opts.check, &cx.original) {
         crate::check::run(&module, original, &pm.pipeline_text(), &opts.function, samples, seed, stderr)?;
     }
@@ -305,6 +311,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
                     s.functions.retain(|x| x.function == f.name);
                     s
                 }),
+                stopped_early: cx.stopped.clone(),
             };
             Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
         }

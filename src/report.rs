@@ -162,6 +162,10 @@ pub struct Report {
     /// when the pipeline ran `eqsat`.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub eqsat: Vec<robovec_passes::eqsat::EqsatStats>,
+    /// Passes that stopped early (`-time-limit` or a work budget reached), one line each, as
+    /// printed on stderr after `note: `.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stopped_early: Vec<String>,
 }
 
 /// `-eval` output: every input used and every output, in the evaluation precision.

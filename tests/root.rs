@@ -6,6 +6,7 @@
 mod common;
 
 mod accuracy;
+mod bounds;
 mod cli;
 mod corpus;
 mod diagnostics;

@@ -123,12 +123,20 @@ impl Pass for Sweep {
             (Priority::Classical, Select::Naive, 0, "classical", "naive"),
             (Priority::Classical, Select::Preferential, 2, "classical+fbi", "preferential"),
         ];
+        let total = m.functions.len() * self.ns.len() * configs.len();
+        let mut done = 0usize;
         for f in &m.functions {
             let ops = f.op_counts().total;
             let (n_add_side, n_mul) = ops_per_side(f);
             for &n in &self.ns {
                 for (priority, select, improve, pname, sname) in configs {
+                    if let Some(d) = cx.deadline.filter(|d| d.reached()) {
+                        cx.note_stop("sweep", &format!("after {done} of {total} configurations: {}", d.reason()));
+                        return Ok(());
+                    }
+                    done += 1;
                     let mut o = PlaceOptions::with_pes(n);
+                    o.deadline = cx.deadline;
                     o.arch.lat = cx.latencies;
                     o.priority = priority;
                     o.select = select;

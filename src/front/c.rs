@@ -16,8 +16,14 @@ const TYPES: &[&str] =
 /// Scans a C file. `header` is the companion `.h` text: its declarations are only used for
 /// `double *X;` pointers.
 pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
-    let toks: Vec<Spanned<'_>> =
-        toks.iter().copied().filter(|t| !matches!(t.1, Tok::SlashComment | Tok::BlockComment | Tok::Newline)).collect();
+    // Without comments and newlines (already so when lexed by `parse_str`: no copy then).
+    let filtered: Vec<Spanned<'_>>;
+    let toks = if toks.iter().any(|t| ignored(&t.1)) {
+        filtered = toks.iter().copied().filter(|t| !ignored(&t.1)).collect();
+        &filtered[..]
+    } else {
+        toks
+    };
     let mut header_pointers = Vec::new();
     if let Some(h) = header {
         let htoks: Vec<_> = super::lexer::lex(h).into_iter().filter(|t| t.1 != Tok::Newline).collect();
@@ -118,6 +124,11 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
         }
     }
     funcs
+}
+
+/// Tokens the C scanner skips: comments and newlines.
+pub fn ignored(t: &Tok<'_>) -> bool {
+    matches!(t, Tok::SlashComment | Tok::BlockComment | Tok::Newline)
 }
 
 /// Index of the bracket closing the one at `open`.

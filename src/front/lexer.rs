@@ -136,7 +136,13 @@ pub type Spanned<'a> = (usize, Tok<'a>, usize);
 
 /// Every token of `src`, including comments and newlines; unlexable text becomes [`Tok::Error`].
 pub fn lex(src: &str) -> Vec<Spanned<'_>> {
-    Tok::lexer(src).spanned().map(|(t, r)| (r.start, t.unwrap_or(Tok::Error), r.end)).collect()
+    lex_where(src, |_| true)
+}
+
+/// The tokens of `src` for which `keep` holds (the C scanner drops comments and newlines while
+/// lexing: the token vector is the largest structure of a parse, 40 bytes per token).
+pub fn lex_where(src: &str, keep: impl Fn(&Tok<'_>) -> bool) -> Vec<Spanned<'_>> {
+    Tok::lexer(src).spanned().map(|(t, r)| (r.start, t.unwrap_or(Tok::Error), r.end)).filter(|t| keep(&t.1)).collect()
 }
 
 #[cfg(test)]

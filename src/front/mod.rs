@@ -86,15 +86,16 @@ pub const MAX_ERRORS: usize = 100;
 /// Every problem found (up to [`MAX_ERRORS`]); no module is returned when there is one.
 pub fn parse_str(lang: Language, src: &[u8], header: Option<&[u8]>) -> Result<robovec_ir::Module, Vec<FrontError>> {
     let text = source_text(src);
-    let toks = lexer::lex(&text);
     let mut errors = Vec::new();
+    // The tokens live only while scanning: the statements own their text.
     let funcs = match lang {
         Language::C => {
             let header = header.map(source_text);
+            let toks = lexer::lex_where(&text, |t| !c::ignored(t));
             c::scan(&text, &toks, header.as_deref(), &mut errors)
         }
-        Language::Matlab => matlab::scan(&text, &toks, &mut errors),
-        Language::Python => python::scan(&text, &toks, &mut errors),
+        Language::Matlab => matlab::scan(&text, &lexer::lex(&text), &mut errors),
+        Language::Python => python::scan(&text, &lexer::lex(&text), &mut errors),
     };
     if funcs.is_empty() && errors.is_empty() {
         errors.push(scan::no_function(lang, text.len()));

@@ -12,6 +12,21 @@ use super::extract::{count_ops, pareto_extract, ReadyCost};
 use super::lang::{leaf_index, Arith, ConstantFold, Rewrite};
 use super::window::{find_windows, Window};
 use super::EqsatOptions;
+use crate::Deadline;
+
+/// Work budget of one function, e-nodes (`EqsatOptions::work_enodes` of the pass): the
+/// e-graphs of all its windows together hold at most about this many e-nodes (each window's runner gets `min(nodes, what is left)` as its node limit).
+/// When less than [`MIN_WINDOW_WORK`] is left, the remaining windows are kept as they are and
+/// the run says so (`stopped_early`). Saturation and extraction cost about 5–10 µs per e-node
+/// (measured on the corpus), so the budget bounds a function's eqsat work to about 15–30 s
+/// whatever the parameters. The defaults stay far below it on every corpus file (WALK-MAN
+/// `dirdyna`, the largest: 4.9·10⁵ e-nodes; COMAN `dirdyna`: 4.6·10⁵); `window=64;nodes=1000000`
+/// takes Segway `dirdyna` to 8.8·10⁵ (about 6 s) and COMAN `dirdyna` to the budget (today's main
+/// ran it for 170 s).
+pub const WORK_ENODES: u64 = 3_000_000;
+
+/// Least budget left for another window to be saturated, e-nodes.
+pub const MIN_WINDOW_WORK: u64 = 1_000;
 
 /// How the egg runs of a function stopped (egg `StopReason`), in windows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -58,6 +73,16 @@ pub struct EqsatStats {
     pub cp_before: u32,
     /// Critical path after, cycles.
     pub cp_after: u32,
+    /// Windows found in the function, windows (`windows_tried` is smaller when the run
+    /// stopped early).
+    pub windows_total: u32,
+    /// E-nodes of all the windows' e-graphs together, e-nodes (about at most the work budget,
+    /// [`WORK_ENODES`] by default: egg checks its node limit between rules).
+    pub enodes_total: u64,
+    /// Why the run stopped before trying every window (the `-time-limit` or the work budget
+    /// reached); the windows not tried are kept unchanged.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped_early: Option<String>,
 }
 
 impl std::fmt::Display for EqsatStats {
@@ -86,12 +111,29 @@ impl std::fmt::Display for EqsatStats {
             self.ops_after,
             self.cp_before,
             self.cp_after
-        )
+        )?;
+        if let Some(why) = &self.stopped_early {
+            write!(f, "; stopped after {} of {} windows: {why}", self.windows_tried, self.windows_total)?;
+        }
+        Ok(())
     }
 }
 
 /// Rewrites `f` (atomised, verified) window by window; see the module doc of `eqsat`.
 pub fn eqsat_function(f: &mut Function, o: &EqsatOptions, rules: &[Rewrite]) -> EqsatStats {
+    eqsat_function_within(f, o, rules, None)
+}
+
+/// [`eqsat_function`] that stops saturating windows once `deadline` is reached or the work
+/// budget `o.work_enodes` ([`WORK_ENODES`] by default) is spent (each runner's time limit is also cut to the time left).
+/// Windows not tried keep their form, so the result verifies either way; `stopped_early` says
+/// why the run stopped.
+pub fn eqsat_function_within(
+    f: &mut Function,
+    o: &EqsatOptions,
+    rules: &[Rewrite],
+    deadline: Option<Deadline>,
+) -> EqsatStats {
     let mut st = EqsatStats {
         function: f.name.clone(),
         ops_before: f.op_counts().total,
@@ -99,6 +141,7 @@ pub fn eqsat_function(f: &mut Function, o: &EqsatOptions, rules: &[Rewrite]) -> 
         ..EqsatStats::default()
     };
     let windows = find_windows(f, o.window);
+    st.windows_total = windows.len() as u32;
     let n = f.values.len();
     let mut at_root: Vec<Option<usize>> = vec![None; n];
     let mut inside = vec![false; n];
@@ -115,8 +158,27 @@ pub fn eqsat_function(f: &mut Function, o: &EqsatOptions, rules: &[Rewrite]) -> 
         if let Some(i) = at_root[v.index()] {
             let w = &windows[i];
             let leaf_ready: Vec<u32> = w.leaves.iter().map(|l| ready[l.index()]).collect();
+            if st.stopped_early.is_none() {
+                if let Some(d) = deadline.filter(|d| d.reached()) {
+                    st.stopped_early = Some(d.reason());
+                } else if o.work_enodes.saturating_sub(st.enodes_total) < MIN_WINDOW_WORK {
+                    let b = o.work_enodes;
+                    st.stopped_early = Some(format!("work budget of {b} e-nodes per function reached"));
+                }
+            }
+            if st.stopped_early.is_some() {
+                // Kept as it is: its ready time from the leaves, as written.
+                let cf = ReadyCost { leaf_ready: &leaf_ready, lat_add: o.lat.add, lat_mul: o.lat.mul };
+                ready[v.index()] = cf.expr_cost(&w.expr).0;
+                continue;
+            }
+            let limits = Limits {
+                nodes: (o.nodes as u64).min(o.work_enodes.saturating_sub(st.enodes_total)) as usize,
+                time: deadline
+                    .map_or(Duration::from_millis(o.time_ms), |d| d.time_left().min(Duration::from_millis(o.time_ms))),
+            };
             let t0 = Instant::now();
-            let (r, plan) = saturate(w, &leaf_ready, o, rules, &mut st);
+            let (r, plan) = saturate(w, &leaf_ready, o, limits, rules, &mut st);
             let dt = t0.elapsed().as_secs_f64() * 1e3;
             st.windows_tried += 1;
             st.total_ms += dt;
@@ -140,11 +202,19 @@ pub fn eqsat_function(f: &mut Function, o: &EqsatOptions, rules: &[Rewrite]) -> 
     st
 }
 
+/// The runner limits of one window: `nodes` and `time-ms` cut to the budget and time left.
+#[derive(Clone, Copy)]
+struct Limits {
+    nodes: usize,
+    time: Duration,
+}
+
 /// Saturates one window; returns the root's ready time (cycles) and the replacement, if any.
 fn saturate(
     w: &Window,
     leaf_ready: &[u32],
     o: &EqsatOptions,
+    limits: Limits,
     rules: &[Rewrite],
     st: &mut EqsatStats,
 ) -> (u32, Option<RecExpr<Arith>>) {
@@ -152,10 +222,11 @@ fn saturate(
     let (orig_ready, _) = cf.expr_cost(&w.expr);
     let runner: Runner<Arith, ConstantFold> = Runner::default()
         .with_iter_limit(o.iters)
-        .with_node_limit(o.nodes)
-        .with_time_limit(Duration::from_millis(o.time_ms))
+        .with_node_limit(limits.nodes)
+        .with_time_limit(limits.time)
         .with_expr(&w.expr)
         .run(rules);
+    st.enodes_total += runner.egraph.total_number_of_nodes() as u64;
     match &runner.stop_reason {
         Some(StopReason::Saturated) => st.stops.saturated += 1,
         Some(StopReason::IterationLimit(_)) => st.stops.iteration_limit += 1,

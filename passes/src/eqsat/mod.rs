@@ -21,7 +21,11 @@
 //!
 //! Contracts: never lengthens the critical path (each root is ready no later, by induction in
 //! topological order); never adds more than `budget` ops per window; idempotent up to the
-//! e-graph limits. Cost: per window, bounded by the runner limits (`nodes` e-nodes, `time-ms`).
+//! e-graph limits. Cost: per window, bounded by the runner limits (`nodes` e-nodes, `time-ms`);
+//! per function, bounded by the work budget [`WORK_ENODES`] (the e-nodes of all windows
+//! together) and by `-time-limit` ([`crate::PassContext::deadline`]). When either stops the
+//! run, the windows not yet tried keep their form (the IR stays valid), the stats say
+//! `stopped after K of N windows: …` and the pass adds a note to the context.
 
 pub mod extract;
 pub mod lang;
@@ -41,7 +45,7 @@ use robovec_ir::{Module, Phase};
 use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
-pub use apply::{eqsat_function, EqsatStats, StopCounts};
+pub use apply::{eqsat_function, eqsat_function_within, EqsatStats, StopCounts, MIN_WINDOW_WORK, WORK_ENODES};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -104,6 +108,9 @@ pub struct EqsatOptions {
     pub rules_file: Option<PathBuf>,
     /// Latencies for extraction (cycles); `add` and `mul` are used.
     pub lat: Latencies,
+    /// Work budget of one function, e-nodes over all its windows ([`WORK_ENODES`] in the
+    /// pass; smaller in tests).
+    pub work_enodes: u64,
 }
 
 /// The options of checked parameters `p` (defaults and ranges from [`INFO`]).
@@ -117,6 +124,7 @@ fn options_from(p: &Params) -> Result<EqsatOptions, PassError> {
         distribute: p.flag("distribute")?,
         rules_file: p.path("rules")?.map(PathBuf::from),
         lat: p.latencies()?,
+        work_enodes: WORK_ENODES,
     })
 }
 
@@ -151,7 +159,11 @@ impl Pass for Eqsat {
             rules.extend(extra);
         }
         for f in &mut m.functions {
-            let stats = eqsat_function(f, &self.opts, &rules);
+            let stats = eqsat_function_within(f, &self.opts, &rules, cx.deadline);
+            if let Some(why) = &stats.stopped_early {
+                let what = format!("after {} of {} windows of @{}: {why}", stats.windows_tried, stats.windows_total, f.name);
+                cx.note_stop("eqsat", &what);
+            }
             cx.eqsat.push(stats);
         }
         Ok(())

@@ -284,3 +284,50 @@ fn long_cascades_split_into_bounded_windows() {
     assert_eq!((s.cp_before, s.cp_after), (228, 72));
     assert_eq!(s.ops_after, 19);
 }
+
+/// A chain of `n` adds of products: many windows, each saturating to a few hundred e-nodes.
+fn chain(n: usize) -> String {
+    let mut src = String::from("func @chain { phase atomised");
+    for i in 0..=n {
+        src += &format!(" input %x{i}");
+    }
+    src += " %s0 = mul %x0, %x1";
+    for i in 1..=n {
+        src += &format!(" %p{i} = mul %x{i}, %x{} %s{i} = add %s{}, %p{i}", (i + 3) % (n + 1), i - 1);
+    }
+    src + &format!(" output o = %s{n} }}")
+}
+
+#[test]
+fn the_work_budget_stops_the_run_between_windows_and_says_so() {
+    let unlimited = run(&mut func(&chain(200)), &EqsatOptions { window: 8, ..EqsatOptions::default() });
+    assert!(unlimited.stopped_early.is_none());
+    assert_eq!(unlimited.windows_tried, unlimited.windows_total);
+    assert!(unlimited.windows_total >= 4 && unlimited.enodes_total > 3_000, "{unlimited}");
+    // Half of what the whole run needs: some windows are tried, not all.
+    let work = unlimited.enodes_total / 2;
+    assert!(work > 2 * super::MIN_WINDOW_WORK, "{unlimited}");
+    let mut m = func(&chain(200));
+    let s = run(&mut m, &EqsatOptions { window: 8, work_enodes: work, ..EqsatOptions::default() });
+    let why = s.stopped_early.clone().expect("stopped by the budget");
+    assert_eq!(why, format!("work budget of {work} e-nodes per function reached"));
+    assert!(s.windows_tried >= 1 && s.windows_tried < s.windows_total, "{s}");
+    assert!(s.enodes_total <= work + 10_000, "{s}");
+    assert!(s.to_string().contains(&format!("stopped after {} of {} windows", s.windows_tried, s.windows_total)));
+    // The windows not tried keep their ops: the critical path is no longer than before.
+    assert!(s.cp_after <= s.cp_before && s.ops_after <= s.ops_before, "{s}");
+}
+
+#[test]
+fn a_reached_deadline_tries_no_window_and_keeps_the_function() {
+    let mut m = func(&chain(40));
+    let before = m.to_string();
+    let r = rules(true);
+    let past = crate::Deadline::after_seconds(1e-9);
+    std::thread::sleep(std::time::Duration::from_millis(2));
+    let s = super::eqsat_function_within(&mut m.functions[0], &EqsatOptions::default(), &r, Some(past));
+    assert_eq!(s.windows_tried, 0, "{s}");
+    assert_eq!(s.stopped_early.as_deref(), Some("time limit of 0.000000001 s reached"));
+    assert!(robovec_ir::verifier::verify_function(&m.functions[0]).is_empty());
+    assert_eq!(m.to_string(), before, "no window tried, nothing rewritten");
+}

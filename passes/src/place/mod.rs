@@ -72,6 +72,9 @@ pub struct PlaceOptions {
     /// Iterations of key-mutation search after the restarts, under the same condition (see
     /// [`search`]); at most about 1.2·10⁷ op schedulings in all. 0 = none.
     pub search: u32,
+    /// `-time-limit`: restarts and search stop once it is reached, keeping the best schedule
+    /// so far (`None`: no limit; the work caps above still apply).
+    pub deadline: Option<crate::Deadline>,
 }
 
 impl PlaceOptions {
@@ -100,6 +103,7 @@ fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
         improve: p.u32("improve")?,
         restarts: p.u32("restarts")?,
         search: p.u32("search")?,
+        deadline: None,
     })
 }
 
@@ -108,6 +112,15 @@ fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
 /// # Errors
 /// Only with `buffer = false`: an operand that can no longer reach any PE memory of its type.
 pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement, String> {
+    try_place_function_within(f, opts).map(|(p, _)| p)
+}
+
+/// [`try_place_function`] that also says whether restarts or search stopped at
+/// `opts.deadline` (`true`: the placement is the best found by then).
+///
+/// # Errors
+/// As [`try_place_function`].
+pub fn try_place_function_within(f: &Function, opts: &PlaceOptions) -> Result<(Placement, bool), String> {
     let a = &opts.arch;
     let dag = schedule::OpDag::new(f);
     let seed = schedule::seed_keys(f, a, opts.priority);
@@ -116,10 +129,10 @@ pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement
     // Within 2% of SPEC §4's bound (hence of the tight bound too): nothing to search for, and
     // the tight bound (O(n log n) but not free) is not computed.
     if (opts.restarts > 0 || opts.search > 0) && end(&best) as u64 * 100 > spec * 102 {
-        let best = search::restarts_and_search(f, &dag, opts, seed, best)?;
-        return Ok(memory::build(f, a, &best));
+        let (best, stopped) = search::restarts_and_search(f, &dag, opts, seed, best)?;
+        return Ok((memory::build(f, a, &best), stopped));
     }
-    Ok(memory::build(f, a, &best))
+    Ok((memory::build(f, a, &best), false))
 }
 
 /// Cycles of a schedule: the largest arrival.
@@ -282,9 +295,14 @@ impl Pass for Place {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        let opts = PlaceOptions { deadline: cx.deadline, ..self.opts };
         for f in &mut m.functions {
-            let p = try_place_function(f, &self.opts)
+            let (p, stopped) = try_place_function_within(f, &opts)
                 .map_err(|e| PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) })?;
+            if let (true, Some(d)) = (stopped, cx.deadline) {
+                let what = format!("searching @{} early (best schedule so far kept): {}", f.name, d.reason());
+                cx.note_stop("place", &what);
+            }
             f.placement = Some(p);
         }
         cx.latencies = self.opts.arch.lat;

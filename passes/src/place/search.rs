@@ -53,7 +53,8 @@ impl Rng {
 }
 
 /// Restarts, then key-mutation search, from the seed `keys` and their (improved) schedule
-/// `best`; returns the shortest schedule found.
+/// `best`; returns the shortest schedule found, and `true` when `opts.deadline` stopped the
+/// work early (the schedule is then the best found by that time).
 ///
 /// # Errors
 /// Only with `buffer = false` (see [`super::try_place_function`]).
@@ -63,7 +64,8 @@ pub fn restarts_and_search(
     opts: &PlaceOptions,
     seed: Vec<Key>,
     mut best: Schedule,
-) -> Result<Schedule, String> {
+) -> Result<(Schedule, bool), String> {
+    let out_of_time = || opts.deadline.is_some_and(|d| d.reached());
     let a = &opts.arch;
     let (spec, tight) = (lower_bound(f, a) as u64, tight_lower_bound(f, a) as u64);
     let mut target = tight * 102 / 100;
@@ -78,7 +80,10 @@ pub fn restarts_and_search(
     let restarts = (opts.restarts as u64).min((RESTART_WORK / per_run).max(1));
     for r in 0..restarts {
         if done(&best) {
-            return Ok(best);
+            return Ok((best, false));
+        }
+        if out_of_time() {
+            return Ok((best, true));
         }
         let feed = FEEDS[r as usize % FEEDS.len()];
         let keys = if r == 0 {
@@ -107,6 +112,9 @@ pub fn restarts_and_search(
         if done(&best) {
             break;
         }
+        if out_of_time() {
+            return Ok((best, true));
+        }
         let mut keys = plan.0.clone();
         for k in keys.iter_mut() {
             let x = rng.next();
@@ -121,5 +129,5 @@ pub fn restarts_and_search(
             plan.0 = keys;
         }
     }
-    Ok(best)
+    Ok((best, false))
 }

@@ -1,0 +1,112 @@
+//! Issue 10 §3, resources stay bounded: building the IR is linear in the number of outputs,
+//! an over-long statement's diagnostic stays short, and `-time-limit` / eqsat's work budget
+//! stop heavy but valid runs with a valid result and a note.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use robovec::front::synth::{straight_line_c, Shape};
+use robovec::front::{parse_str, Language};
+
+use crate::common::corpus_dir;
+
+fn opt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_robovec-opt")).args(args).output().expect("robovec-opt runs")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bounds").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Outputs compared by name while building the parsed and the atomised function of a
+/// generated file with about `outputs` outputs; also the outputs counted by the generator.
+fn output_work(outputs: u64) -> (u64, u64, u64) {
+    // ~48 bytes per temporary + output with one op per temporary.
+    let shape = Shape { bytes: outputs as usize * 48, joints: 8, temps_per_output: 1, ops_per_temp: 1 };
+    let g = straight_line_c(shape);
+    let m = parse_str(Language::C, g.text.as_bytes(), None).unwrap_or_else(|e| panic!("{:?}", &e[..1]));
+    let f = &m.functions[0];
+    assert_eq!(f.outputs.len() as u64, g.outputs, "one output per generated output");
+    let a = robovec_passes::atomise::atomise_function(f);
+    assert_eq!(a.outputs.len() as u64, g.outputs);
+    (f.output_probes(), a.output_probes(), g.outputs)
+}
+
+/// Today's main located each new output by scanning all the earlier ones (`set_output`):
+/// 20k outputs cost 2·10⁸ name comparisons, 40k four times as many. Now each `set_output`
+/// compares one name, so doubling the outputs doubles the work.
+#[test]
+fn building_n_outputs_compares_o_n_names_in_the_front_end_and_atomise() {
+    let (p1, a1, n1) = output_work(20_000);
+    let (p2, a2, n2) = output_work(40_000);
+    assert!(n1 >= 18_000 && n2 as f64 >= 1.9 * n1 as f64, "generator: {n1}, {n2} outputs");
+    for (what, w1, w2) in [("front end", p1, p2), ("atomise", a1, a2)] {
+        assert!(w1 <= 2 * n1 && w2 <= 2 * n2, "{what}: {w1} comparisons for {n1} outputs, {w2} for {n2}");
+        assert!(w2 as f64 <= 2.5 * w1 as f64, "{what}: {w1} → {w2} comparisons when the outputs double");
+    }
+}
+
+#[test]
+fn an_over_long_statement_is_quoted_in_a_few_hundred_bytes_with_line_and_column() {
+    let d = tmp("long");
+    let names: Vec<String> = (0..1500).map(|i| format!("LongTemporaryName_{i:05}_abcdefghijklmnopqrstuvwxyz_0123456789")).collect();
+    let stmt = format!("  T1 = {} $ q[1];", names.join("+"));
+    assert!(stmt.len() > 90_000);
+    let src = format!("void mbs_f(double *c, MbsData *s, double tsim)\n{{\n  x = q[2];\n{stmt}\n  c[1] = T1;\n}}\n");
+    let path = d.join("long.c");
+    std::fs::write(&path, &src).unwrap();
+    let o = opt(&[path.to_str().unwrap(), "-passes=atomise"]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    // The `$` is on line 4, column (its byte offset in the line) + 1.
+    let col = stmt.find('$').unwrap() + 1;
+    assert!(err.contains(&format!("long.c:4:{col}")), "{err}");
+    assert!(err.len() < 1000, "{} bytes of diagnostic:\n{err}", err.len());
+    assert!(err.contains("unexpected character") && err.contains("4 │ …") && err.contains("$ q[1];"), "{err}");
+}
+
+/// `-time-limit=1` stops eqsat between windows: exit 0, a valid IR, a note on stderr and in
+/// the report. (Without the limit this run takes about 10 s in release, longer in debug.)
+#[test]
+fn time_limit_stops_a_heavy_eqsat_with_a_valid_ir_and_a_note() {
+    let d = tmp("time_limit");
+    let input = corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c");
+    let (out, report) = (d.join("out.rvir"), d.join("report.json"));
+    let o = opt(&[
+        input.to_str().unwrap(),
+        "-passes=atomise,eqsat<window=64;nodes=1000000>",
+        "-time-limit=1",
+        "-o",
+        out.to_str().unwrap(),
+        &format!("-report={}", report.display()),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let note = err.lines().find(|l| l.starts_with("note: eqsat stopped after ")).unwrap_or_else(|| panic!("{err}"));
+    assert!(note.ends_with("windows of @dirdyna: time limit of 1 s reached"), "{note}");
+    let ir = std::fs::read_to_string(&out).unwrap();
+    let m = robovec_ir::text::parse(&ir).unwrap_or_else(|e| panic!("{e:?}"));
+    robovec_ir::verifier::verify(&m).unwrap_or_else(|e| panic!("{e:?}"));
+    assert_eq!(m.functions[0].outputs.len(), 192, "every output kept (the issue counts 192)");
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["stopped_early"][0].as_str(), Some(note.trim_start_matches("note: ")));
+    let e = &r["eqsat"][0];
+    assert_eq!(e["stopped_early"].as_str(), Some("time limit of 1 s reached"));
+    assert!(e["windows_tried"].as_u64().unwrap() < e["windows_total"].as_u64().unwrap(), "{e}");
+}
+
+#[test]
+fn a_bad_time_limit_is_a_usage_error() {
+    let input = corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c");
+    for bad in ["0", "-1", "abc", "inf", "NaN", ""] {
+        let o = opt(&[input.to_str().unwrap(), "-passes=atomise", &format!("-time-limit={bad}")]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "-time-limit={bad}: {err}");
+        assert!(err.contains("time-limit"), "{err}");
+    }
+    let o = opt(&[input.to_str().unwrap(), "-passes=atomise", "-time-limit=30", "-o", "-"]);
+    assert!(o.status.success() && String::from_utf8_lossy(&o.stderr).is_empty());
+}
