@@ -226,7 +226,7 @@ impl Pass for Accuracy {
 }
 
 /// What `against` says when the reference is the pipeline's input.
-pub const AGAINST_INPUT: &str = "input of the pipeline (the function of the same name as parsed or read)";
+pub const AGAINST_INPUT: &str = "input of the pipeline: the function of the same name as parsed or read";
 /// What `against` says when no original was available.
 pub const AGAINST_SELF: &str = "the measured IR itself";
 
