@@ -212,7 +212,10 @@ impl Pass for Accuracy {
             let original = match &cx.original {
                 None => None,
                 Some(om) => Some(om.function(&f.name).ok_or_else(|| {
-                    fail(format!("function @{} is not in the module as it entered the pipeline (the error reference)", f.name))
+                    fail(format!(
+                        "function @{} is not in the module as it entered the pipeline (the error reference)",
+                        f.name
+                    ))
                 })?),
             };
             cx.accuracy.push(measure_against(f, original, &o).map_err(fail)?);

@@ -192,10 +192,8 @@ pub fn run_chunked(sub: &Subject, o: &Options, chunk: u64) -> Run {
         n = affordable;
     }
     let probes = n.min(PROBES as u64);
-    let probe_errs: Vec<PointErrors> = (0..probes)
-        .into_par_iter()
-        .map_init(Workspace::default, |ws, i| errors_at(sub, &draw(i), ws, None))
-        .collect();
+    let probe_errs: Vec<PointErrors> =
+        (0..probes).into_par_iter().map_init(Workspace::default, |ws, i| errors_at(sub, &draw(i), ws, None)).collect();
     let skip = skip_after_probes(&probe_errs, n_out);
     let mut acc = Acc::new(n_out, keep);
     for (i, e) in probe_errs.into_iter().enumerate() {
