@@ -45,7 +45,11 @@ pub fn run(
             r.outputs,
             r.samples,
             if bit_exact { ", bit for bit" } else { "" },
-            if r.undecided > 0 { format!(" ({} values undecided: unbounded budget)", r.undecided) } else { String::new() }
+            if r.undecided > 0 {
+                format!(" ({} values undecided: unbounded budget)", r.undecided)
+            } else {
+                String::new()
+            }
         );
     }
     Ok(())

@@ -52,8 +52,8 @@ pub struct Cli {
     /// Write the JSON report (SPEC §7) to FILE.
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
-    /// Evaluate the final IR in f64 on the inputs in FILE (JSON object name → number); print
-    /// inputs and outputs as JSON on stdout.
+    /// Evaluate the final IR (in f64, or f32 with -eval-precision=f32) on the inputs in FILE
+    /// (JSON object name → number); print inputs and outputs as JSON on stdout.
     #[arg(long, value_name = "FILE")]
     pub eval: Option<PathBuf>,
     /// The function that -report and -eval describe (e.g. `sensor_2`).
@@ -66,8 +66,9 @@ pub struct Cli {
     #[arg(long, value_name = "FILE")]
     pub sweep_csv: Option<PathBuf>,
     /// Speed against error: run each `;`-separated pipeline on the input and print one table
-    /// (ops, critical path, placed cycles, bits of error in f32/f64; Pareto-optimal rows
-    /// marked); with -report, also its `pareto` array.
+    /// (ops, critical path, placed cycles, bits of error in f32/f64 against the input with the
+    /// 95% confidence interval; Pareto-optimal rows marked, rows outside the error budget of
+    /// the input flagged); with -report, also its `pareto` array.
     #[arg(long, value_name = "PIPELINE;PIPELINE;…")]
     pub pareto: Option<String>,
     /// Samples of -pareto's accuracy measurement (same for every pipeline).

@@ -122,7 +122,8 @@ pub fn mark_front(rows: &mut [ParetoRow]) {
 /// # Errors
 /// [`Failure::Usage`] for a bad pipeline, [`Failure::Input`] when a pipeline fails.
 pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64) -> Result<Vec<ParetoRow>, Failure> {
-    let original = module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
+    let original =
+        module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
     let pipelines = split_pipelines(text).map_err(Failure::Usage)?;
     let managers = pipelines
         .iter()

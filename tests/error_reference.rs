@@ -60,10 +60,8 @@ fn accuracy_after_an_unsound_rule_shows_tens_of_bits() {
     assert!(o.status.success(), "{}", err(&o));
     let acc = &json(&r)["accuracy"];
     let fig = |p: &str, k: &str| format!("{:.2}", acc[p][k].as_f64().unwrap());
-    let figs: Vec<String> = ["f32", "f64"]
-        .iter()
-        .flat_map(|p| ["mean_bits", "p95_bits", "max_bits"].map(|k| fig(p, k)))
-        .collect();
+    let figs: Vec<String> =
+        ["f32", "f64"].iter().flat_map(|p| ["mean_bits", "p95_bits", "max_bits"].map(|k| fig(p, k))).collect();
     assert_eq!(figs, ["0.88", "2.58", "8.85", "0.79", "2.32", "9.77"]);
 }
 
@@ -124,7 +122,8 @@ fn check_fails_naming_the_output_for_an_unsound_rule_and_passes_for_balance() {
     assert!(e.contains("above the error budget") && e.contains("q[1] = ") && e.contains("sample 0"), "{e}");
     // Nothing is written when the check fails.
     let out = d.join("out.rvir");
-    let o = opt(&[PENDULUM, &format!("-passes=atomise,eqsat<rules={}>", rules(&d)), "-check", "-o", out.to_str().unwrap()]);
+    let o =
+        opt(&[PENDULUM, &format!("-passes=atomise,eqsat<rules={}>", rules(&d)), "-check", "-o", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     assert!(!out.exists());
     for p in ["atomise,balance", "atomise,eqsat"] {
@@ -193,7 +192,13 @@ fn callback_standins_are_named_on_stderr_and_in_the_report() {
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["callback_standins"], serde_json::json!(["user_F.1[2]"]));
     let r = d.join("r.json");
-    let o = opt(&[f.to_str().unwrap(), "-passes=accuracy<samples=20>", &format!("-report={}", r.display()), "-o", "/dev/null"]);
+    let o = opt(&[
+        f.to_str().unwrap(),
+        "-passes=accuracy<samples=20>",
+        &format!("-report={}", r.display()),
+        "-o",
+        "/dev/null",
+    ]);
     assert!(o.status.success() && err(&o).contains(warn), "{}", err(&o));
     assert_eq!(json(&r)["accuracy"]["callback_standins"], serde_json::json!(["user_F.1[2]"]));
     let o = opt(&[f.to_str().unwrap(), "-pareto=atomise;atomise,balance", "-pareto-samples=20", "-o", "/dev/null"]);
@@ -208,7 +213,8 @@ fn callback_standins_are_named_on_stderr_and_in_the_report() {
 fn heavy_parameters_stop_at_the_work_budget_and_say_so() {
     let d = tmp("budget");
     let r = d.join("r.json");
-    let o = opt(&[PENDULUM, "-passes=atomise,accuracy<samples=1000;max-work=9600>", &format!("-report={}", r.display())]);
+    let o =
+        opt(&[PENDULUM, "-passes=atomise,accuracy<samples=1000;max-work=9600>", &format!("-report={}", r.display())]);
     assert!(o.status.success(), "{}", err(&o));
     let acc = &json(&r)["accuracy"];
     let why = acc["stopped_early"].as_str().unwrap();
@@ -230,14 +236,37 @@ fn heavy_parameters_stop_at_the_work_budget_and_say_so() {
     let rounds = (30000 - 100 * ops) / ops / 64;
     assert!(rounds >= 1);
     assert_eq!(acc["evaluations"].as_u64(), Some(100 + rounds * 64), "{acc}");
-    assert!(
-        acc["stopped_early"].as_str().unwrap().contains(&format!("{rounds} of 100 hill-climbing rounds")),
-        "{acc}"
-    );
+    assert!(acc["stopped_early"].as_str().unwrap().contains(&format!("{rounds} of 100 hill-climbing rounds")), "{acc}");
     // A complete run says null.
     let o = opt(&[PENDULUM, "-passes=atomise,accuracy<samples=50>", &format!("-report={}", r.display())]);
     assert!(o.status.success());
     assert!(json(&r)["accuracy"]["stopped_early"].is_null());
     let o = opt(&[PENDULUM, "-passes=accuracy<max-work=0>"]);
     assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+}
+
+#[test]
+fn inputs_folded_by_specialize_are_drawn_for_the_reference_unless_params_fix_them() {
+    let d = tmp("specialize");
+    let params = d.join("p.json");
+    std::fs::write(&params, r#"{"m[1]": 2.0, "m[2]": 1.5}"#).unwrap();
+    let p = params.display().to_string();
+    let r = d.join("r.json");
+    let run = |acc: &str| {
+        let o = opt(&[
+            PENDULUM,
+            &format!("-passes=atomise,specialize<params={p}>,{acc}"),
+            &format!("-report={}", r.display()),
+        ]);
+        assert!(o.status.success(), "{}", err(&o));
+        (err(&o), json(&r)["accuracy"].clone())
+    };
+    let (e, acc) = run("accuracy<samples=100>");
+    assert!(e.contains("warning: @invdyna: 2 input(s) of the function as it entered the pipeline"), "{e}");
+    assert_eq!(acc["drawn_reference_inputs"], serde_json::json!(["m[2]", "m[1]"]), "input order of the original");
+    assert!(acc["f64"]["mean_bits"].as_f64().unwrap() > 20.0, "other masses: another function");
+    let (e, acc) = run(&format!("accuracy<samples=100;params={p}>"));
+    assert!(!e.contains("warning"), "{e}");
+    assert_eq!(acc["drawn_reference_inputs"], serde_json::json!([]));
+    assert!(acc["f64"]["mean_bits"].as_f64().unwrap() < 3.0, "{acc}");
 }

@@ -44,7 +44,10 @@ pub fn climb(
     let per_round = n_starts as u64 * NEIGHBOURS;
     let rounds = (o.climb_rounds as u64).min(budget / per_round);
     let note = (rounds < o.climb_rounds as u64).then(|| {
-        format!("work budget: {rounds} of {} hill-climbing rounds (max-work = {} op evaluations)", o.climb_rounds, o.max_work)
+        format!(
+            "work budget: {rounds} of {} hill-climbing rounds (max-work = {} op evaluations)",
+            o.climb_rounds, o.max_work
+        )
     });
     let starts: Vec<Kept> = acc.worst[..n_starts].to_vec();
     let found: Vec<Kept> = starts

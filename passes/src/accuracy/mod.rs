@@ -206,7 +206,10 @@ impl Pass for Accuracy {
             let original = match &cx.original {
                 None => None,
                 Some(om) => Some(om.function(&f.name).ok_or_else(|| {
-                    fail(format!("function @{} is not in the module as it entered the pipeline (the error reference)", f.name))
+                    fail(format!(
+                        "function @{} is not in the module as it entered the pipeline (the error reference)",
+                        f.name
+                    ))
                 })?),
             };
             let r = measure_against(f, original, &o).map_err(fail)?;
@@ -224,7 +227,7 @@ impl Pass for Accuracy {
 }
 
 /// What `against` says when the reference is the pipeline's input.
-pub const AGAINST_INPUT: &str = "input of the pipeline (the function of the same name as parsed or read)";
+pub const AGAINST_INPUT: &str = "input of the pipeline: the function of the same name as parsed or read";
 /// What `against` says when no original was available.
 pub const AGAINST_SELF: &str = "the measured IR itself";
 

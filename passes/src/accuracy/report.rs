@@ -106,6 +106,11 @@ pub struct AccuracyReport {
     /// arguments; `robovec_ir::interp::callback_standin`), in the measured IR or the reference:
     /// their error figures are those of the stand-in, not of the real callback.
     pub callback_standins: Vec<String>,
+    /// Inputs of the reference (the function as it entered the pipeline) that the measured IR
+    /// no longer reads (e.g. folded by `specialize`) and that `params` does not fix: they are
+    /// drawn like any input, so the reference may differ from what the pipeline assumed; give
+    /// their values with `accuracy<params=FILE>`.
+    pub drawn_reference_inputs: Vec<String>,
     /// Why fewer samples or hill-climbing rounds than asked were measured (the work budget
     /// `max-work` or the time limit), or `null` when the run is complete.
     pub stopped_early: Option<String>,
@@ -172,6 +177,13 @@ pub fn build(function: &str, sub: &Subject, o: &Options, run: Run, against: &str
         outputs: OutputsMap(outputs),
         reference: ReferenceInfo { against: against.to_string(), counts: acc.reference },
         callback_standins: standins,
+        drawn_reference_inputs: sub
+            .reference
+            .inputs
+            .iter()
+            .filter(|n| !sub.tape.inputs.contains(n) && !o.known.contains_key(*n))
+            .cloned()
+            .collect(),
         stopped_early,
         structural_zeros: sub.tape.outputs.iter().zip(&skip).filter(|(_, &z)| z).map(|(o, _)| o.0.clone()).collect(),
         worst,
@@ -206,6 +218,15 @@ pub fn to_text(reports: &[AccuracyReport], per_output: bool) -> String {
                 "warning: @{} calls user callback `{c}`; evaluated with the stand-in (a linear form of its \
                  arguments, robovec_ir::interp::callback_standin): its figures are not the real callback's\n",
                 r.function
+            );
+        }
+        if !r.drawn_reference_inputs.is_empty() {
+            s += &format!(
+                "warning: @{}: {} input(s) of the function as it entered the pipeline are not read by the measured IR \
+                 and are drawn for the reference (give their values with accuracy<params=FILE>): {}\n",
+                r.function,
+                r.drawn_reference_inputs.len(),
+                r.drawn_reference_inputs.join(", ")
             );
         }
         if let Some(why) = &r.stopped_early {
