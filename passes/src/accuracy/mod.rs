@@ -212,11 +212,9 @@ impl Pass for Accuracy {
                     ))
                 })?),
             };
-            let r = measure_against(f, original, &o).map_err(fail)?;
-            if let Some(why) = &r.stopped_early {
-                cx.note_stop("accuracy", &format!("on @{}: {why}", f.name));
-            }
-            cx.accuracy.push(r);
+            // An early stop (work budget or `-time-limit`) is in the report's
+            // `accuracy.stopped_early` and printed with the accuracy summary.
+            cx.accuracy.push(measure_against(f, original, &o).map_err(fail)?);
         }
         Ok(())
     }
