@@ -117,6 +117,22 @@ pub fn mark_front(rows: &mut [ParetoRow]) {
     }
 }
 
+/// Splits `-pareto`'s text and builds each pipeline's pass manager (every name and parameter
+/// checked); the driver's preflight calls it before any work, [`run`] again to run them.
+///
+/// # Errors
+/// [`Failure::Usage`] for an empty list, an empty pipeline, an unknown pass or a bad parameter.
+pub fn managers(text: &str) -> Result<Vec<(String, PassManager)>, Failure> {
+    split_pipelines(text)
+        .map_err(Failure::Usage)?
+        .into_iter()
+        .map(|p| match PassManager::new(&p, Instrumentation::default()) {
+            Ok(pm) => Ok((p, pm)),
+            Err(e) => Err(Failure::Usage(format!("error: -pareto pipeline `{p}`: {e}\n"))),
+        })
+        .collect()
+}
+
 /// Runs every pipeline of `text` on a copy of `module` and measures function `function`.
 ///
 /// # Errors
@@ -124,14 +140,7 @@ pub fn mark_front(rows: &mut [ParetoRow]) {
 pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64) -> Result<Vec<ParetoRow>, Failure> {
     let original =
         module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
-    let pipelines = split_pipelines(text).map_err(Failure::Usage)?;
-    let managers = pipelines
-        .iter()
-        .map(|p| {
-            PassManager::new(p, Instrumentation::default())
-                .map_err(|e| Failure::Usage(format!("error: -pareto pipeline `{p}`: {e}\n")))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let (pipelines, managers): (Vec<String>, Vec<PassManager>) = managers(text)?.into_iter().unzip();
     let opts = AccuracyOptions { samples, seed, ..AccuracyOptions::default() };
     let mut rows = Vec::new();
     for (p, pm) in pipelines.iter().zip(&managers) {

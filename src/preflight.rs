@@ -53,8 +53,23 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     for d in opts.instr.dump_dir.iter().cloned().chain(worst_dirs.map(PathBuf::from)) {
         output::check_folder(&d).map_err(output_failure)?;
     }
-    // Files a pass reads when it runs (`accuracy<params=…>`, `specialize<params=…>`,
-    // `eqsat<rules=…>`): readable now, so a typo fails before any work; the pass checks content.
+    check_pass_files(pm)?;
+    // `-pareto`'s pipelines: every name, parameter and file they read, before any work too.
+    if let Some(text) = &opts.pareto {
+        for (_, other) in crate::pareto::managers(text)? {
+            check_pass_files(&other)?;
+        }
+    }
+    Ok(())
+}
+
+/// Files a pass reads when it runs (`accuracy<params=…>`, `specialize<params=…>`,
+/// `eqsat<rules=…>`) must be readable before any work, so a typo fails at once; the pass
+/// checks their content when it runs.
+///
+/// # Errors
+/// [`Failure::Input`] naming the pass, the parameter and the file.
+fn check_pass_files(pm: &PassManager) -> Result<(), Failure> {
     const READ_BY_PASSES: [(&str, &str); 3] = [("accuracy", "params"), ("specialize", "params"), ("eqsat", "rules")];
     for spec in pm.specs() {
         for (key, file) in &spec.params {

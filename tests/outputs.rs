@@ -268,7 +268,7 @@ fn usage_errors_come_before_any_work() {
     let dumps = d.join("dumps");
     let dump = format!("-dump-dir={}", dumps.display());
     let out = d.join("out.rvir");
-    let cases: [(&[&str], i32, &str); 6] = [
+    let cases: [(&[&str], i32, &str); 7] = [
         (&["-passes=atomise", &format!("-sweep-csv={}", d.join("s.csv").display())], 2, "needs a `sweep` pass"),
         (
             &["-passes=atomise", "-function=nope", &format!("-report={}", d.join("r.json").display())],
@@ -280,6 +280,12 @@ fn usage_errors_come_before_any_work() {
         (&["-passes=atomise", &format!("-report={}", d.join("missing/r.json").display())], 1, "missing"),
         // A file a pass would read only when it runs must exist before any work.
         (&["-passes=atomise,specialize<params=missing.json>"], 1, "cannot read params file `missing.json`"),
+        // Likewise for the pipelines of `-pareto`: checked before the first of them runs.
+        (
+            &["-passes=atomise", "-pareto=atomise;atomise,eqsat<rules=missing.rules>"],
+            1,
+            "pass `eqsat`: cannot read rules file `missing.rules`",
+        ),
     ];
     for (extra, code, needle) in cases {
         let mut args = vec![pendulum(), dump.clone(), "-o".into(), out.display().to_string()];
