@@ -280,9 +280,10 @@ fn usage_errors_come_before_any_work() {
         (&["-passes=atomise", &format!("-report={}", d.join("missing/r.json").display())], 1, "missing"),
         // A file a pass would read only when it runs must exist before any work.
         (&["-passes=atomise,specialize<params=missing.json>"], 1, "cannot read params file `missing.json`"),
-        // Likewise for the pipelines of `-pareto`: checked before the first of them runs.
+        // Likewise for the pipelines of `-pareto`: checked before the first of them runs (which
+        // would fail on its own, naming `nope`, if it ran first).
         (
-            &["-passes=atomise", "-pareto=atomise;atomise,eqsat<rules=missing.rules>"],
+            &["-passes=atomise", "-pareto=atomise,dce<outputs=nope>;atomise,eqsat<rules=missing.rules>"],
             1,
             "pass `eqsat`: cannot read rules file `missing.rules`",
         ),
