@@ -273,7 +273,7 @@ mod tests {
     fn short_lines_render_as_before() {
         let src = SourceFile { name: "f.c".into(), text: "a\nb = 1 $;\n".into() };
         let d = Diagnostic::error().with_message("bad").with_labels(vec![Label::primary((), 8..9).with_message("here")]);
-        let out = src.render(&[d.clone()]);
+        let out = src.render(std::slice::from_ref(&d));
         let plain = emit_into_string(&Config::default(), &SimpleFile::new("f.c", src.text.as_str()), &d).unwrap();
         assert_eq!(out, plain);
         assert!(out.contains("f.c:2:7"), "{out}");

@@ -480,3 +480,41 @@ impl crate::syntax::BinOp {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn out(f: &Function) -> Vec<(String, Operand)> {
+        f.outputs.iter().map(|o| (o.name.clone(), o.value)).collect()
+    }
+
+    #[test]
+    fn set_output_replaces_by_name_even_after_direct_edits_of_outputs() {
+        let mut f = Function::new("f", Phase::Parsed);
+        for i in 0..100 {
+            f.set_output(format!("y[{i}]"), Operand::Const(i as f64), Span::DUMMY);
+        }
+        f.set_output("y[7]", Operand::Const(-7.0), Span::DUMMY);
+        assert_eq!(f.outputs.len(), 100);
+        assert_eq!(f.outputs[7].value, Operand::Const(-7.0));
+        // 101 lookups, one name compared each (plus none for the new names).
+        assert!(f.output_probes() <= 101, "{}", f.output_probes());
+        // Removed behind the index's back (as `dce` does), then set again.
+        f.outputs.retain(|o| o.name != "y[3]" && o.name != "y[50]");
+        f.set_output("y[51]", Operand::Const(51.5), Span::DUMMY);
+        f.set_output("y[3]", Operand::Const(3.5), Span::DUMMY);
+        let o = out(&f);
+        assert_eq!(o.len(), 99);
+        assert_eq!(o.iter().filter(|(n, _)| n == "y[51]").count(), 1);
+        assert_eq!(o.iter().find(|(n, _)| n == "y[51]").unwrap().1, Operand::Const(51.5));
+        assert_eq!(o.last().unwrap(), &("y[3]".to_string(), Operand::Const(3.5)));
+        // Reordered behind its back: still found, never duplicated.
+        f.outputs.reverse();
+        f.set_output("y[0]", Operand::Const(0.5), Span::DUMMY);
+        assert_eq!(f.outputs.len(), 99);
+        assert_eq!(f.outputs.iter().find(|o| o.name == "y[0]").unwrap().value, Operand::Const(0.5));
+        assert_eq!(f.output_position("y[99]"), f.outputs.iter().position(|o| o.name == "y[99]"));
+        assert_eq!(f.output_position("nope"), None);
+    }
+}

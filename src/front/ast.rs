@@ -59,7 +59,7 @@ pub enum Expr {
     /// A string literal (only legal as an `mbs_msg` argument).
     Str(Span),
     /// A name, index or call.
-    Ref(Ref),
+    Ref(Box<Ref>),
     /// Unary minus on the product term that follows.
     Neg(Box<Expr>, Span),
     /// `a op b`.

@@ -51,18 +51,18 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                 };
                 if matches!(toks[open].1, Tok::Semi | Tok::LBracket | Tok::Comma) {
                     // A file-level declaration (`double    C4;` in a companion header): ignored.
-                    i = skip_item(&toks, open);
+                    i = skip_item(toks, open);
                     continue;
                 }
                 let name = match (toks[open].1, open.checked_sub(1).map(|k| toks[k].1)) {
                     (Tok::LParen, Some(Tok::Ident(n))) if open - 1 > start => n,
                     _ => {
                         errors.push(scan::unexpected(&toks[open], "a function definition `void NAME(…) { … }`"));
-                        i = skip_item(&toks, open);
+                        i = skip_item(toks, open);
                         continue;
                     }
                 };
-                let Some(close) = matching(&toks, open) else {
+                let Some(close) = matching(toks, open) else {
                     errors.push(
                         FrontError::new(Span::new(toks[open].0, toks[open].2), "unclosed `(`", "opened here")
                             .note("expected `)` closing the parameter list"),
@@ -73,7 +73,7 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                 match toks.get(body_open).map(|t| t.1) {
                     Some(Tok::Semi) => i = body_open + 1, // a prototype
                     Some(Tok::LBrace) => {
-                        let body_close = matching(&toks, body_open).unwrap_or_else(|| {
+                        let body_close = matching(toks, body_open).unwrap_or_else(|| {
                             errors.push(
                                 FrontError::new(
                                     Span::new(toks[body_open].0, toks[body_open].2),
@@ -110,7 +110,7 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                     _ => {
                         let t = toks.get(body_open).copied().unwrap_or((toks[close].2, Tok::Semi, toks[close].2));
                         errors.push(scan::unexpected(&t, "`{` opening the function body"));
-                        i = skip_item(&toks, body_open);
+                        i = skip_item(toks, body_open);
                     }
                 }
             }

@@ -103,7 +103,7 @@ pub fn straight_line_c(shape: Shape) -> Generated {
         }
         g.ops += ops;
         t.push_str(";\n");
-        if k % shape.temps_per_output.max(1) as u64 == 0 {
+        if k.is_multiple_of(shape.temps_per_output.max(1) as u64) {
             if rng.below(4) == 0 {
                 c_outputs += 1;
                 let _ = writeln!(t, "  c[{c_outputs}] = T{k}*C{}-(2.0);", 1 + rng.below(joints));
