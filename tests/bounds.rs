@@ -134,3 +134,30 @@ fn time_limit_stops_place_search_and_sweep_with_notes() {
     assert!(o.status.success(), "{err}");
     assert!(err.contains("note: sweep stopped after 0 of 8 configurations: time limit of 0.000001 s reached"), "{err}");
 }
+
+/// `accuracy` reads `-time-limit` too (once per chunk of samples): ten million samples of the
+/// double pendulum (far more than a second's work) stop with the figures of the samples
+/// measured, and say so in the report and on stderr.
+#[test]
+fn time_limit_stops_accuracy_with_its_figures_and_a_note() {
+    let d = tmp("accuracy");
+    let report = d.join("r.json");
+    let example = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/double_pendulum/mbs_invdyna_double_pendulum.c");
+    let o = opt(&[
+        example.to_str().unwrap(),
+        "-passes=atomise,accuracy<samples=10000000>",
+        "-time-limit=1",
+        &format!("-report={}", report.display()),
+        "-o",
+        d.join("out.rvir").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("@invdyna: accuracy stopped early: time limit"), "{err}");
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let why = r["accuracy"]["stopped_early"].as_str().expect("stopped_early set");
+    assert!(why.starts_with("time limit"), "{why}");
+    let samples = r["accuracy"]["samples"].as_u64().unwrap();
+    assert!((1..10_000_000).contains(&samples), "{samples} samples measured");
+    assert!(r["accuracy"]["f32"]["mean_bits"].as_f64().unwrap().is_finite());
+}
