@@ -229,7 +229,8 @@ impl<'a> Files<'a> for Windowed<'_> {
     }
 
     fn line_number(&'a self, (): (), line_index: usize) -> Result<usize, FilesError> {
-        let l = self.lines.get(line_index).ok_or(FilesError::LineTooLarge { given: line_index, max: self.lines.len() })?;
+        let l =
+            self.lines.get(line_index).ok_or(FilesError::LineTooLarge { given: line_index, max: self.lines.len() })?;
         Ok(l.orig.map_or(0, |i| i + 1))
     }
 
@@ -245,7 +246,8 @@ impl<'a> Files<'a> for Windowed<'_> {
     }
 
     fn line_range(&'a self, (): (), line_index: usize) -> Result<Range<usize>, FilesError> {
-        let l = self.lines.get(line_index).ok_or(FilesError::LineTooLarge { given: line_index, max: self.lines.len() })?;
+        let l =
+            self.lines.get(line_index).ok_or(FilesError::LineTooLarge { given: line_index, max: self.lines.len() })?;
         Ok(l.view.start..(l.view.end + 1).min(self.text.len()))
     }
 }
@@ -261,7 +263,9 @@ mod tests {
         let text = format!("first line\n{long}\nlast\n");
         let src = SourceFile { name: "f.c".into(), text: text.clone() };
         let at = 11 + 4 + 3 * 49_000; // line 2, column 4 + 3·49000 + 1
-        let d = Diagnostic::error().with_message("bad").with_labels(vec![Label::primary((), at..at + 2).with_message("here")]);
+        let d = Diagnostic::error()
+            .with_message("bad")
+            .with_labels(vec![Label::primary((), at..at + 2).with_message("here")]);
         let out = src.render(&[d]);
         assert!(out.len() < 1000, "{} bytes:\n{out}", out.len());
         assert!(out.contains(&format!("f.c:2:{}", 4 + 3 * 49_000 + 1)), "{out}");
@@ -272,7 +276,8 @@ mod tests {
     #[test]
     fn short_lines_render_as_before() {
         let src = SourceFile { name: "f.c".into(), text: "a\nb = 1 $;\n".into() };
-        let d = Diagnostic::error().with_message("bad").with_labels(vec![Label::primary((), 8..9).with_message("here")]);
+        let d =
+            Diagnostic::error().with_message("bad").with_labels(vec![Label::primary((), 8..9).with_message("here")]);
         let out = src.render(std::slice::from_ref(&d));
         let plain = emit_into_string(&Config::default(), &SimpleFile::new("f.c", src.text.as_str()), &d).unwrap();
         assert_eq!(out, plain);

@@ -216,9 +216,13 @@ fn pass_failure(e: robovec_passes::PassError, src: &SourceFile) -> Failure {
         }
     }
     match e.span() {
-        Some(span) if span.range().end <= src.text.len() => Failure::Input(src.render(&[Diagnostic::error()
-            .with_message(e.to_string())
-            .with_labels(vec![Label::primary((), span.range()).with_message("here")])])),
+        Some(span) if span.range().end <= src.text.len() => Failure::Input(
+            src.render(&[Diagnostic::error().with_message(e.to_string()).with_labels(vec![Label::primary(
+                (),
+                span.range(),
+            )
+            .with_message("here")])]),
+        ),
         _ => Failure::Input(format!("error: {e}\n")),
     }
 }

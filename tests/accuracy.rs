@@ -2,35 +2,13 @@
 //! points re-checked by an independent route (interpreter + 1024-bit reference) and replayed
 //! with `-eval`, `params` files, diagnostics, and the speed-against-error table.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
 use robovec_ir::interp;
 use robovec_ir::numerics::reference::eval_big;
 use robovec_ir::numerics::{bits_f32, bits_f64, Tape};
 
-use crate::common::corpus_dir;
+use crate::common::{corpus_dir, opt, stderr, tmp};
 
 const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";
-
-fn opt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robovec-opt"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("robovec-opt runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("accuracy").join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn report(d: &std::path::Path, input: &str, passes: &str, extra: &[&str]) -> serde_json::Value {
     let r = d.join("r.json");

@@ -3,23 +3,11 @@
 //! stop heavy but valid runs with a valid result and a note.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
 use robovec::front::synth::{straight_line_c, Shape};
 use robovec::front::{parse_str, Language};
 
-use crate::common::corpus_dir;
-
-fn opt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robovec-opt")).args(args).output().expect("robovec-opt runs")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bounds").join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use crate::common::{corpus_dir, opt, tmp};
 
 /// Outputs compared by name while building the parsed and the atomised function of a
 /// generated file with about `outputs` outputs; also the outputs counted by the generator.
@@ -52,7 +40,8 @@ fn building_n_outputs_compares_o_n_names_in_the_front_end_and_atomise() {
 #[test]
 fn an_over_long_statement_is_quoted_in_a_few_hundred_bytes_with_line_and_column() {
     let d = tmp("long");
-    let names: Vec<String> = (0..1500).map(|i| format!("LongTemporaryName_{i:05}_abcdefghijklmnopqrstuvwxyz_0123456789")).collect();
+    let names: Vec<String> =
+        (0..1500).map(|i| format!("LongTemporaryName_{i:05}_abcdefghijklmnopqrstuvwxyz_0123456789")).collect();
     let stmt = format!("  T1 = {} $ q[1];", names.join("+"));
     assert!(stmt.len() > 90_000);
     let src = format!("void mbs_f(double *c, MbsData *s, double tsim)\n{{\n  x = q[2];\n{stmt}\n  c[1] = T1;\n}}\n");
@@ -119,7 +108,13 @@ fn time_limit_stops_place_search_and_sweep_with_notes() {
     let input = corpus_dir().join("c/tricycle__mbs_cons_hJ_tricycle.c");
     let out = d.join("out.rvir");
     // Tricycle `cons_hJ` on 2 + 2 PEs is far enough above its bounds that place searches.
-    let o = opt(&[input.to_str().unwrap(), "-passes=atomise,place<add=2;mul=2>", "-time-limit=0.000001", "-o", out.to_str().unwrap()]);
+    let o = opt(&[
+        input.to_str().unwrap(),
+        "-passes=atomise,place<add=2;mul=2>",
+        "-time-limit=0.000001",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(
@@ -129,7 +124,13 @@ fn time_limit_stops_place_search_and_sweep_with_notes() {
     let m = robovec_ir::text::parse(&std::fs::read_to_string(&out).unwrap()).unwrap_or_else(|e| panic!("{e:?}"));
     robovec_ir::verifier::verify(&m).unwrap_or_else(|e| panic!("{e:?}"));
     assert!(m.functions[0].placement.is_some());
-    let o = opt(&[input.to_str().unwrap(), "-passes=atomise,sweep<pe=1,2>", "-time-limit=0.000001", "-o", out.to_str().unwrap()]);
+    let o = opt(&[
+        input.to_str().unwrap(),
+        "-passes=atomise,sweep<pe=1,2>",
+        "-time-limit=0.000001",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("note: sweep stopped after 0 of 8 configurations: time limit of 0.000001 s reached"), "{err}");
@@ -142,7 +143,8 @@ fn time_limit_stops_place_search_and_sweep_with_notes() {
 fn time_limit_stops_accuracy_with_its_figures_and_a_note() {
     let d = tmp("accuracy");
     let report = d.join("r.json");
-    let example = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/double_pendulum/mbs_invdyna_double_pendulum.c");
+    let example =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/double_pendulum/mbs_invdyna_double_pendulum.c");
     let o = opt(&[
         example.to_str().unwrap(),
         "-passes=atomise,accuracy<samples=10000000>",

@@ -1,24 +1,8 @@
 //! `robovec-opt` end to end: SPEC §7 flags, report, eval, dumps, exit statuses.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Command;
 
-use crate::common::corpus_dir;
-
-fn opt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robovec-opt")).args(args).output().expect("robovec-opt runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli").join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use crate::common::{corpus_dir, opt, stderr, tmp};
 
 fn segway() -> String {
     corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c").display().to_string()

@@ -31,3 +31,28 @@ pub fn is_loop_file(p: &std::path::Path) -> bool {
     let n = p.file_name().unwrap().to_string_lossy();
     n.contains("accelred") || n.contains("invdynared")
 }
+
+/// Runs `robovec-opt` with `args` from the package root (so `examples/…` paths resolve).
+pub fn opt(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_robovec-opt"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("robovec-opt runs")
+}
+
+/// The stderr of a run, as text.
+pub fn stderr(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A fresh, empty folder `CARGO_TARGET_TMPDIR/<calling test file>/<name>` (removed first).
+#[track_caller]
+pub fn tmp(name: &str) -> PathBuf {
+    let caller = std::path::Path::new(std::panic::Location::caller().file());
+    let group = caller.file_stem().map_or_else(|| "tests".into(), |s| s.to_string_lossy().into_owned());
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(group).join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}

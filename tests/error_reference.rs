@@ -2,33 +2,13 @@
 //! `accuracy`, `-pareto` and `-check` on an unsound rewrite rule, `-eval-precision`, callback
 //! stand-in warnings and the work budget.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
-use crate::common::corpus_dir;
+use crate::common::{corpus_dir, opt, stderr, tmp};
 
 const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";
 /// Keeps only the first factor of every product: changes the mathematics.
 const DROP_FACTOR: &str = "drop-factor: (* ?a ?b) => ?a\n";
-
-fn opt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robovec-opt"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("robovec-opt runs")
-}
-
-fn err(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("error_reference").join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn rules(d: &Path) -> String {
     let p = d.join("drop.rules");
@@ -46,18 +26,18 @@ fn accuracy_after_an_unsound_rule_shows_tens_of_bits() {
     let r = d.join("r.json");
     let pipeline = format!("atomise,eqsat<rules={}>,accuracy<samples=200>", rules(&d));
     let o = opt(&[PENDULUM, &format!("-passes={pipeline}"), &format!("-report={}", r.display()), "-o", "/dev/null"]);
-    assert!(o.status.success(), "{}", err(&o));
+    assert!(o.status.success(), "{}", stderr(&o));
     let acc = &json(&r)["accuracy"];
     // Against its own IR this pipeline looked perfect (< 1 bit); against the input it is off
     // by tens of bits in both formats.
     assert!(acc["f32"]["mean_bits"].as_f64().unwrap() > 20.0, "{acc}");
     assert!(acc["f64"]["mean_bits"].as_f64().unwrap() > 40.0, "{acc}");
     assert!(acc["reference"]["against"].as_str().unwrap().starts_with("input of the pipeline"), "{acc}");
-    assert!(err(&o).contains("reference (input of the pipeline"), "{}", err(&o));
+    assert!(stderr(&o).contains("reference (input of the pipeline"), "{}", stderr(&o));
     // The unchanged pipeline measures the same as the function against itself: the original
     // is bit for bit the same computation (figures of the README table).
     let o = opt(&[PENDULUM, "-passes=atomise,accuracy<samples=1000;seed=1>", &format!("-report={}", r.display())]);
-    assert!(o.status.success(), "{}", err(&o));
+    assert!(o.status.success(), "{}", stderr(&o));
     let acc = &json(&r)["accuracy"];
     let fig = |p: &str, k: &str| format!("{:.2}", acc[p][k].as_f64().unwrap());
     let figs: Vec<String> =
@@ -75,8 +55,8 @@ fn pareto_rows(input: &str, d: &Path, samples: &str) -> Vec<serde_json::Value> {
         &format!("-pareto-samples={samples}"),
         &format!("-pareto=atomise;atomise,balance;atomise,eqsat<rules={}>", rules(d)),
     ]);
-    assert!(o.status.success(), "{}", err(&o));
-    assert!(err(&o).contains("! atomise,eqsat<rules="), "the unsound row is flagged: {}", err(&o));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("! atomise,eqsat<rules="), "the unsound row is flagged: {}", stderr(&o));
     json(&r)["pareto"].as_array().unwrap().clone()
 }
 
@@ -116,8 +96,8 @@ fn pareto_on_the_segway_dirdyna_with_the_unsound_rule() {
 fn check_fails_naming_the_output_for_an_unsound_rule_and_passes_for_balance() {
     let d = tmp("check");
     let o = opt(&[PENDULUM, &format!("-passes=atomise,eqsat<rules={}>", rules(&d)), "-check", "-o", "/dev/null"]);
-    assert_eq!(o.status.code(), Some(1), "{}", err(&o));
-    let e = err(&o);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
     assert!(e.starts_with("error: -check: @invdyna: output Qq[1] in f32"), "{e}");
     assert!(e.contains("above the error budget") && e.contains("q[1] = ") && e.contains("sample 0"), "{e}");
     // Nothing is written when the check fails.
@@ -128,11 +108,11 @@ fn check_fails_naming_the_output_for_an_unsound_rule_and_passes_for_balance() {
     assert!(!out.exists());
     for p in ["atomise,balance", "atomise,eqsat"] {
         let o = opt(&[PENDULUM, &format!("-passes={p}"), "-check", "-check-samples=300", "-o", "/dev/null"]);
-        assert!(o.status.success(), "{p}: {}", err(&o));
-        assert!(err(&o).contains("@invdyna: check passed: 2 outputs at 300 samples"), "{}", err(&o));
+        assert!(o.status.success(), "{p}: {}", stderr(&o));
+        assert!(stderr(&o).contains("@invdyna: check passed: 2 outputs at 300 samples"), "{}", stderr(&o));
     }
     let o = opt(&[PENDULUM, "-passes=atomise", "-check", "-o", "/dev/null"]);
-    assert!(err(&o).contains("bit for bit"), "{}", err(&o));
+    assert!(stderr(&o).contains("bit for bit"), "{}", stderr(&o));
     let o = opt(&[PENDULUM, "-passes=atomise", "-check", "-check-samples=0"]);
     assert_eq!(o.status.code(), Some(2), "bad usage");
 }
@@ -149,7 +129,7 @@ fn eval_precision_f32_computes_in_binary32_in_the_ir_order() {
     std::fs::write(&inputs, r#"{"a": 0.1, "b": 3.3}"#).unwrap();
     let run = |p: &str, file: &str| {
         let o = opt(&[file, &format!("-eval={}", inputs.display()), &format!("-eval-precision={p}")]);
-        assert!(o.status.success(), "{}", err(&o));
+        assert!(o.status.success(), "{}", stderr(&o));
         serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
     };
     let j = run("f32", f.to_str().unwrap());
@@ -188,7 +168,7 @@ fn callback_standins_are_named_on_stderr_and_in_the_report() {
     std::fs::write(&inputs, "{}").unwrap();
     let warn = "warning: @f calls user callback `user_F.1[2]`; evaluated with the stand-in";
     let o = opt(&[f.to_str().unwrap(), &format!("-eval={}", inputs.display())]);
-    assert!(o.status.success() && err(&o).contains(warn), "{}", err(&o));
+    assert!(o.status.success() && stderr(&o).contains(warn), "{}", stderr(&o));
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["callback_standins"], serde_json::json!(["user_F.1[2]"]));
     let r = d.join("r.json");
@@ -199,13 +179,13 @@ fn callback_standins_are_named_on_stderr_and_in_the_report() {
         "-o",
         "/dev/null",
     ]);
-    assert!(o.status.success() && err(&o).contains(warn), "{}", err(&o));
+    assert!(o.status.success() && stderr(&o).contains(warn), "{}", stderr(&o));
     assert_eq!(json(&r)["accuracy"]["callback_standins"], serde_json::json!(["user_F.1[2]"]));
     let o = opt(&[f.to_str().unwrap(), "-pareto=atomise;atomise,balance", "-pareto-samples=20", "-o", "/dev/null"]);
-    assert!(o.status.success() && err(&o).contains(warn), "{}", err(&o));
+    assert!(o.status.success() && stderr(&o).contains(warn), "{}", stderr(&o));
     // Without a callback: no warning, no field in -eval.
     let o = opt(&[PENDULUM, &format!("-eval={}", inputs.display())]);
-    assert!(!err(&o).contains("warning"), "{}", err(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
     assert!(serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap().get("callback_standins").is_none());
 }
 
@@ -215,7 +195,7 @@ fn heavy_parameters_stop_at_the_work_budget_and_say_so() {
     let r = d.join("r.json");
     let o =
         opt(&[PENDULUM, "-passes=atomise,accuracy<samples=1000;max-work=9600>", &format!("-report={}", r.display())]);
-    assert!(o.status.success(), "{}", err(&o));
+    assert!(o.status.success(), "{}", stderr(&o));
     let acc = &json(&r)["accuracy"];
     let why = acc["stopped_early"].as_str().unwrap();
     // "work budget: measured N of 1000 samples (max-work = 9600 op evaluations, K ops per sample)"
@@ -223,7 +203,7 @@ fn heavy_parameters_stop_at_the_work_budget_and_say_so() {
     assert!((90..110).contains(&ops), "the atomised 48 ops plus the parsed reference: {why}");
     assert_eq!(acc["samples"], 9600 / ops);
     assert!(why.contains(&format!("measured {} of 1000 samples", 9600 / ops)), "{why}");
-    assert!(err(&o).contains("@invdyna: accuracy stopped early: work budget"), "{}", err(&o));
+    assert!(stderr(&o).contains("@invdyna: accuracy stopped early: work budget"), "{}", stderr(&o));
     // Hill climbing: 100 rounds asked; what is left after the samples pays for a few rounds
     // of 8 starting points × 8 neighbours.
     let o = opt(&[
@@ -231,7 +211,7 @@ fn heavy_parameters_stop_at_the_work_budget_and_say_so() {
         "-passes=atomise,accuracy<samples=100;mode=hard;climb=100;max-work=30000>",
         &format!("-report={}", r.display()),
     ]);
-    assert!(o.status.success(), "{}", err(&o));
+    assert!(o.status.success(), "{}", stderr(&o));
     let acc = &json(&r)["accuracy"];
     let rounds = (30000 - 100 * ops) / ops / 64;
     assert!(rounds >= 1);
@@ -242,7 +222,7 @@ fn heavy_parameters_stop_at_the_work_budget_and_say_so() {
     assert!(o.status.success());
     assert!(json(&r)["accuracy"]["stopped_early"].is_null());
     let o = opt(&[PENDULUM, "-passes=accuracy<max-work=0>"]);
-    assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
 #[test]
@@ -258,8 +238,8 @@ fn inputs_folded_by_specialize_are_drawn_for_the_reference_unless_params_fix_the
             &format!("-passes=atomise,specialize<params={p}>,{acc}"),
             &format!("-report={}", r.display()),
         ]);
-        assert!(o.status.success(), "{}", err(&o));
-        (err(&o), json(&r)["accuracy"].clone())
+        assert!(o.status.success(), "{}", stderr(&o));
+        (stderr(&o), json(&r)["accuracy"].clone())
     };
     let (e, acc) = run("accuracy<samples=100>");
     assert!(e.contains("warning: @invdyna: 2 input(s) of the function as it entered the pipeline"), "{e}");

@@ -11,21 +11,12 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::common::{stderr, tmp};
+
 const BIN: &str = env!("CARGO_BIN_EXE_robovec-opt");
 
 fn opt(args: &[&str]) -> Output {
     Command::new(BIN).args(args).output().expect("robovec-opt runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("outputs").join(name);
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
 }
 
 fn pendulum() -> String {

@@ -4,22 +4,8 @@
 //! `-stats` line and report object.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn opt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robovec-opt")).args(args).output().expect("robovec-opt runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("placement_verify").join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use crate::common::{opt, stderr, tmp};
 
 /// A correct placement, computed by hand (cycles: %d issues at 13 on add0, +12 → 25).
 const GOOD: &str = "func @f {
@@ -153,7 +139,12 @@ fn an_operand_never_written_is_rejected() {
 
 #[test]
 fn an_address_beyond_the_reported_memory_is_rejected() {
-    rejected("address", "write %b add0 1 13", "write %b add0 3 13", "address 3 of the memory of add0, which reports 3 words");
+    rejected(
+        "address",
+        "write %b add0 1 13",
+        "write %b add0 3 13",
+        "address 3 of the memory of add0, which reports 3 words",
+    );
 }
 
 #[test]
@@ -206,7 +197,8 @@ fn sim_errors_name_the_offending_line() {
 fn a_pass_in_the_wrong_phase_names_the_function_line() {
     let d = tmp("wrong_phase");
     let path = d.join("parsed.rvir");
-    std::fs::write(&path, "; a parsed function\nfunc @g {\n  input %x\n  %y = mul %x, 2.0\n  output o = %y\n}\n").unwrap();
+    std::fs::write(&path, "; a parsed function\nfunc @g {\n  input %x\n  %y = mul %x, 2.0\n  output o = %y\n}\n")
+        .unwrap();
     let o = opt(&[path.to_str().unwrap(), "-passes=asap-alap", "-o", "-"]);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{e}");
@@ -223,10 +215,7 @@ fn a_broken_double_pendulum_placement_is_rejected() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let text = std::fs::read_to_string(&placed).unwrap();
     // Move the first `mul` op onto an ADD PE.
-    let mul = text
-        .lines()
-        .find_map(|l| l.trim().split_once(" = mul ").map(|(v, _)| v.to_string()))
-        .expect("a mul op");
+    let mul = text.lines().find_map(|l| l.trim().split_once(" = mul ").map(|(v, _)| v.to_string())).expect("a mul op");
     let lines: Vec<&str> = text.lines().collect();
     let i = lines.iter().position(|l| l.trim_start().starts_with(&format!("issue {mul} "))).unwrap();
     let mut out: Vec<String> = lines.iter().map(|s| s.to_string()).collect();

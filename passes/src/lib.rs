@@ -131,7 +131,9 @@ impl PassError {
     /// The source span the error points at, if any (`WrongPhase`: the function).
     pub fn span(&self) -> Option<Span> {
         match self {
-            PassError::At { span, .. } | PassError::WrongPhase { span, .. } => Some(*span).filter(|s| *s != Span::DUMMY),
+            PassError::At { span, .. } | PassError::WrongPhase { span, .. } => {
+                Some(*span).filter(|s| *s != Span::DUMMY)
+            }
             _ => None,
         }
     }

@@ -340,18 +340,14 @@ impl Params {
         };
         match self.get(key) {
             None => Ok(default),
-            Some(v) => choices
-                .iter()
-                .find(|c| **c == v)
-                .copied()
-                .ok_or_else(|| {
-                    let quoted: Vec<String> = choices.iter().map(|c| format!("`{c}`")).collect();
-                    let expected = match quoted.as_slice() {
-                        [a, b] => format!("{a} or {b}"),
-                        q => format!("one of {}", q.join(", ")),
-                    };
-                    self.bad(key, expected, v)
-                }),
+            Some(v) => choices.iter().find(|c| **c == v).copied().ok_or_else(|| {
+                let quoted: Vec<String> = choices.iter().map(|c| format!("`{c}`")).collect();
+                let expected = match quoted.as_slice() {
+                    [a, b] => format!("{a} or {b}"),
+                    q => format!("one of {}", q.join(", ")),
+                };
+                self.bad(key, expected, v)
+            }),
         }
     }
 
@@ -408,12 +404,13 @@ impl Params {
     /// # Errors
     /// [`PassError::BadParameter`] when no name is left.
     pub fn names(&self, key: &str) -> Result<Option<Vec<String>>, PassError> {
-        let ParamKind::Names = self.decl(key) else { panic!("parameter `{key}` of `{}` is not a name list", self.pass) };
+        let ParamKind::Names = self.decl(key) else {
+            panic!("parameter `{key}` of `{}` is not a name list", self.pass)
+        };
         match self.get(key) {
             None => Ok(None),
             Some(v) => {
-                let names: Vec<String> =
-                    v.split(',').map(|x| x.trim().to_string()).filter(|x| !x.is_empty()).collect();
+                let names: Vec<String> = v.split(',').map(|x| x.trim().to_string()).filter(|x| !x.is_empty()).collect();
                 if names.is_empty() {
                     Err(self.bad(key, "a comma-separated list of names".into(), v))
                 } else {

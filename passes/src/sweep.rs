@@ -12,10 +12,10 @@
 use robovec_ir::analysis::compute_timing;
 use robovec_ir::{Module, Phase};
 
+use crate::params::ParamKind;
 use crate::place::{
     cycles, lower_bound, ops_per_side, tight_lower_bound, try_place_function, PlaceOptions, Priority, Select,
 };
-use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// min / mean / max of words over the PEs of one type.

@@ -92,8 +92,17 @@ struct Sink<'f> {
 impl Sink<'_> {
     fn push(&mut self, span: Span, message: String) {
         if self.errs.len() < MAX_ERRORS {
-            let span = if span == Span::DUMMY { self.f.placement.as_ref().map_or(Span::DUMMY, |p| p.spans.block) } else { span };
-            self.errs.push(VerifierError { function: self.f.name.clone(), location: Location::Placement, message, span });
+            let span = if span == Span::DUMMY {
+                self.f.placement.as_ref().map_or(Span::DUMMY, |p| p.spans.block)
+            } else {
+                span
+            };
+            self.errs.push(VerifierError {
+                function: self.f.name.clone(),
+                location: Location::Placement,
+                message,
+                span,
+            });
         } else {
             self.more += 1;
         }
@@ -253,7 +262,12 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
         match w.buffer_addr {
             None if w.cycle as u64 != arr => s.push(
                 span,
-                format!("direct write of {} into {} at cycle {}, but it arrives at cycle {arr}", name(v), w.pe, w.cycle),
+                format!(
+                    "direct write of {} into {} at cycle {}, but it arrives at cycle {arr}",
+                    name(v),
+                    w.pe,
+                    w.cycle
+                ),
             ),
             None => {}
             Some(b) => {
@@ -283,7 +297,10 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
                 }
                 if let Some(&first) = buf_addr.get(&v) {
                     if first != b {
-                        s.push(span, format!("{} enters the buffer of {producer} at two addresses ({first} and {b})", name(v)));
+                        s.push(
+                            span,
+                            format!("{} enters the buffer of {producer} at two addresses ({first} and {b})", name(v)),
+                        );
                     }
                 } else {
                     buf_addr.insert(v, b);

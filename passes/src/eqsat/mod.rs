@@ -161,7 +161,8 @@ impl Pass for Eqsat {
         for f in &mut m.functions {
             let stats = eqsat_function_within(f, &self.opts, &rules, cx.deadline);
             if let Some(why) = &stats.stopped_early {
-                let what = format!("after {} of {} windows of @{}: {why}", stats.windows_tried, stats.windows_total, f.name);
+                let what =
+                    format!("after {} of {} windows of @{}: {why}", stats.windows_tried, stats.windows_total, f.name);
                 cx.note_stop("eqsat", &what);
             }
             cx.eqsat.push(stats);

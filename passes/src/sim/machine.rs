@@ -126,7 +126,10 @@ pub(super) fn run<T: Float>(
             .src(mem_span(e)));
         }
         occupy(mem, (ev.slot, ev.addr), e, now, |x| mem_ev[x].time, |x| mem_ev[x].last_read).map_err(|(old, read)| {
-            reuse_error("memory", ev.addr, r.name(mem_ev[old].key), r.name(ev.key), read).at(when).on(ev.pe).src(mem_span(e))
+            reuse_error("memory", ev.addr, r.name(mem_ev[old].key), r.name(ev.key), read)
+                .at(when)
+                .on(ev.pe)
+                .src(mem_span(e))
         })
     };
 
@@ -174,7 +177,10 @@ pub(super) fn run<T: Float>(
                 |x| Some(buf_ev[x].last_read as i64),
             )
             .map_err(|(old, read)| {
-                reuse_error("buffer", ev.addr, r.vname(buf_ev[old].value), r.vname(ev.value), read).at(now).on(ev.pe).src(p.spans.write(ev.write))
+                reuse_error("buffer", ev.addr, r.vname(buf_ev[old].value), r.vname(ev.value), read)
+                    .at(now)
+                    .on(ev.pe)
+                    .src(p.spans.write(ev.write))
             })?;
             buf_data[b] = Some(result[ev.value.index()].expect("issued before arrival"));
         }
@@ -240,7 +246,7 @@ pub(super) fn run<T: Float>(
                             .at(now)
                             .on(ev.pe)
                             .of(r.vname(v))
-                        .src(p.spans.write(wi)));
+                            .src(p.spans.write(wi)));
                         }
                     }
                     buf_reads.insert(ev.slot, b);

@@ -137,11 +137,9 @@ impl Run<'_> {
         }
         for &v in &f.body {
             if matches!(f.value(v).def, Def::Expr(_)) {
-                return Err(
-                    SimError::new(K::Malformed, "is a nested expression; run `atomise` before `sim`")
-                        .of(self.vname(v))
-                        .src(f.value(v).span)
-                );
+                return Err(SimError::new(K::Malformed, "is a nested expression; run `atomise` before `sim`")
+                    .of(self.vname(v))
+                    .src(f.value(v).span));
             }
         }
         for (i, is) in p.issue.iter().enumerate() {
@@ -160,12 +158,17 @@ impl Run<'_> {
         }
         for &v in &f.body {
             if f.op_kind(v).is_some() && p.issue.get(v.index()).copied().flatten().is_none() {
-                return Err(SimError::new(K::MissingIssue, "op is never issued").of(self.vname(v)).src(f.value(v).span));
+                return Err(SimError::new(K::MissingIssue, "op is never issued")
+                    .of(self.vname(v))
+                    .src(f.value(v).span));
             }
         }
         for (i, l) in p.loads.iter().enumerate() {
             if !self.pe_exists(l.pe) {
-                return Err(self.no_pe(l.pe, When::Load, "load").of(self.name(key_of(&l.operand))).src(p.spans.load(i)));
+                return Err(self
+                    .no_pe(l.pe, When::Load, "load")
+                    .of(self.name(key_of(&l.operand)))
+                    .src(p.spans.load(i)));
             }
             if let Operand::Value(v) = l.operand {
                 self.value_ok(v, "a load")?;
@@ -181,7 +184,10 @@ impl Run<'_> {
         for (i, w) in p.writes.iter().enumerate() {
             self.value_ok(w.value, "a write")?;
             if !self.pe_exists(w.pe) {
-                return Err(self.no_pe(w.pe, When::Cycle(w.cycle), "write").of(self.vname(w.value)).src(p.spans.write(i)));
+                return Err(self
+                    .no_pe(w.pe, When::Cycle(w.cycle), "write")
+                    .of(self.vname(w.value))
+                    .src(p.spans.write(i)));
             }
             if f.op_kind(w.value).is_none() {
                 return Err(SimError::new(K::NotAnOp, "written as a result, but it is not an op")
