@@ -345,62 +345,8 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         None => None,
     };
     if opts.stats {
-        for note in &cx.notes {
-            writeln!(stderr, "{note}").map_err(stderr_failure)?;
-        }
-        for f in &module.functions {
-            if opts.function.as_ref().is_some_and(|n| n != &f.name) {
-                continue;
-            }
-            let s = stats(f, &cx.latencies);
-            writeln!(
-                stderr,
-                "@{}: equations {}, ops {} (add {}, sub {}, mul {}, div {}, call {}), inputs {}, outputs {}, \
-                 critical path {} ops / {} cycles, Y = {:.2}",
-                f.name,
-                s.equations.map_or("?".to_string(), |e| e.to_string()),
-                s.ops.total,
-                s.ops.add,
-                s.ops.sub,
-                s.ops.mul,
-                s.ops.div,
-                s.ops.call,
-                s.inputs,
-                s.outputs,
-                s.asap,
-                s.asap_cycle,
-                s.y
-            )
+        write!(stderr, "{}", crate::report::stats_text(&module, &cx, opts.function.as_deref()))
             .map_err(stderr_failure)?;
-            if let Some(p) = placement_report(f) {
-                let max = |v: &[u32]| v.iter().copied().max().unwrap_or(0);
-                writeln!(
-                    stderr,
-                    "@{}: placed on {} ADD + {} MULTI PEs: {} cycles, lower bound {} (x{:.3}), parallelisation rate {:.3}, \
-                     PE memory up to {} words, buffer up to {} words, writes {} direct / {} indirect",
-                    f.name,
-                    p.n_add,
-                    p.n_mul,
-                    p.cycles,
-                    p.lower_bound,
-                    p.cycles_over_lower_bound,
-                    p.parallelisation_rate,
-                    max(&p.pe_memory_words),
-                    max(&p.buffer_words),
-                    p.writes_direct,
-                    p.writes_indirect
-                )
-                .map_err(stderr_failure)?;
-            }
-        }
-    }
-    if opts.stats {
-        for e in cx.eqsat.iter().filter(|e| opts.function.as_ref().is_none_or(|n| n == &e.function)) {
-            writeln!(stderr, "{e}").map_err(stderr_failure)?;
-        }
-        for s in &cx.sim {
-            writeln!(stderr, "{s}").map_err(stderr_failure)?;
-        }
     }
     if !cx.sweep.is_empty() {
         write!(stderr, "{}", robovec_passes::sweep::to_table(&cx.sweep)).map_err(stderr_failure)?;

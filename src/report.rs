@@ -214,3 +214,63 @@ pub fn evaluate(f: &Function, given: &BTreeMap<String, f64>, single: bool) -> Ev
         callback_standins: robovec_ir::numerics::Tape::new(f).standin_callees(),
     }
 }
+
+/// The `-stats` lines on stderr: each rewriting pass's note, then per function (only
+/// `function` when given) its figures (equations, ops by kind, inputs, outputs, critical path in
+/// ops and cycles, number Y) and, when placed, its placement's (cycles, lower bound, rate, PE
+/// memory and buffer words, direct/indirect writes), then every `eqsat` run's and every `sim`
+/// run's line.
+pub fn stats_text(module: &robovec_ir::Module, cx: &robovec_passes::PassContext, function: Option<&str>) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    for note in &cx.notes {
+        let _ = writeln!(out, "{note}");
+    }
+    for f in module.functions.iter().filter(|f| function.is_none_or(|n| n == f.name)) {
+        let s = stats(f, &cx.latencies);
+        let _ = writeln!(
+            out,
+            "@{}: equations {}, ops {} (add {}, sub {}, mul {}, div {}, call {}), inputs {}, outputs {}, \
+             critical path {} ops / {} cycles, Y = {:.2}",
+            f.name,
+            s.equations.map_or("?".to_string(), |e| e.to_string()),
+            s.ops.total,
+            s.ops.add,
+            s.ops.sub,
+            s.ops.mul,
+            s.ops.div,
+            s.ops.call,
+            s.inputs,
+            s.outputs,
+            s.asap,
+            s.asap_cycle,
+            s.y
+        );
+        if let Some(p) = placement_report(f) {
+            let max = |v: &[u32]| v.iter().copied().max().unwrap_or(0);
+            let _ = writeln!(
+                out,
+                "@{}: placed on {} ADD + {} MULTI PEs: {} cycles, lower bound {} (x{:.3}), parallelisation rate {:.3}, \
+                 PE memory up to {} words, buffer up to {} words, writes {} direct / {} indirect",
+                f.name,
+                p.n_add,
+                p.n_mul,
+                p.cycles,
+                p.lower_bound,
+                p.cycles_over_lower_bound,
+                p.parallelisation_rate,
+                max(&p.pe_memory_words),
+                max(&p.buffer_words),
+                p.writes_direct,
+                p.writes_indirect
+            );
+        }
+    }
+    for e in cx.eqsat.iter().filter(|e| function.is_none_or(|n| n == e.function)) {
+        let _ = writeln!(out, "{e}");
+    }
+    for s in &cx.sim {
+        let _ = writeln!(out, "{s}");
+    }
+    out
+}
