@@ -1,7 +1,7 @@
 //! Functions and modules: value arena, body order, outputs, and the builder API used by front
 //! ends and passes.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 use crate::entities::Value;
 use crate::span::Span;
@@ -135,7 +135,7 @@ impl Function {
             outputs: Vec::new(),
             span: Span::DUMMY,
             placement: None,
-            names: HashMap::new(),
+            names: HashMap::default(),
             outputs_by_name: OutputIndex::default(),
         }
     }
