@@ -32,8 +32,54 @@ pub struct Function {
     pub span: Span,
     /// The placement on the PE architecture, when `place` made one (or the text had one).
     pub placement: Option<crate::placement::Placement>,
-    names: HashMap<String, Value>,
+    names: NameIndex,
     outputs_by_name: OutputIndex,
+}
+
+/// Every value by name, holding only the [`Value`]s (the names stay in `values`: one `String`
+/// per value, not two — issue 10 §3, memory of large functions). Derived from `values`, so
+/// ignored by `==`.
+#[derive(Clone, Debug, Default)]
+struct NameIndex(hashbrown::HashTable<Value>);
+
+impl PartialEq for NameIndex {
+    fn eq(&self, _: &NameIndex) -> bool {
+        true
+    }
+}
+
+fn name_hash(name: &str) -> u64 {
+    use std::hash::{BuildHasher, BuildHasherDefault};
+    BuildHasherDefault::<rustc_hash::FxHasher>::default().hash_one(name)
+}
+
+fn name_is(values: &[ValueData], v: Value, name: &str) -> bool {
+    values.get(v.index()).is_some_and(|d| d.name == name)
+}
+
+impl NameIndex {
+    fn get(&self, values: &[ValueData], name: &str) -> Option<Value> {
+        self.0.find(name_hash(name), |&v| name_is(values, v, name)).copied()
+    }
+
+    /// Indexes `v` under its name in `values` (the caller checked it is free).
+    fn insert(&mut self, values: &[ValueData], v: Value) {
+        let h = name_hash(&values[v.index()].name);
+        self.0.insert_unique(h, v, |&x| values.get(x.index()).map_or(0, |d| name_hash(&d.name)));
+    }
+
+    fn build(values: &[ValueData]) -> NameIndex {
+        let mut ix = NameIndex(hashbrown::HashTable::with_capacity(values.len()));
+        // As a map built by inserting every value in order: the last of equal names wins.
+        for (i, d) in values.iter().enumerate() {
+            let v = Value::with_number(i as u32);
+            match ix.0.find_mut(name_hash(&d.name), |&x| name_is(values, x, &d.name)) {
+                Some(slot) => *slot = v,
+                None => ix.insert(values, v),
+            }
+        }
+        ix
+    }
 }
 
 /// Position of every output by name, so that [`Function::set_output`] does not scan the
@@ -135,7 +181,7 @@ impl Function {
             outputs: Vec::new(),
             span: Span::DUMMY,
             placement: None,
-            names: HashMap::default(),
+            names: NameIndex::default(),
             outputs_by_name: OutputIndex::default(),
         }
     }
@@ -153,7 +199,7 @@ impl Function {
 
     /// The value named `name` (without `%`).
     pub fn lookup(&self, name: &str) -> Option<Value> {
-        self.names.get(name).copied()
+        self.names.get(&self.values, name)
     }
 
     /// The name of `v` (without `%`).
@@ -163,19 +209,19 @@ impl Function {
 
     /// A name not yet used in this function: `base` itself if free, else `base.1`, `base.2`, …
     pub fn fresh_name(&self, base: &str) -> String {
-        if !self.names.contains_key(base) {
+        if self.lookup(base).is_none() {
             return base.to_string();
         }
-        (1..).map(|k| format!("{base}.{k}")).find(|n| !self.names.contains_key(n)).expect("unbounded counter")
+        (1..).map(|k| format!("{base}.{k}")).find(|n| self.lookup(n).is_none()).expect("unbounded counter")
     }
 
     fn push_value(&mut self, name: String, def: Def, span: Span) -> Result<Value, Value> {
-        if let Some(&old) = self.names.get(&name) {
+        if let Some(old) = self.lookup(&name) {
             return Err(old);
         }
         let v = Value::with_number(self.values.len() as u32);
-        self.names.insert(name.clone(), v);
         self.values.push(ValueData { name, def, timing: None, span });
+        self.names.insert(&self.values, v);
         Ok(v)
     }
 
@@ -287,8 +333,7 @@ impl Function {
     /// `outputs` directly.
     pub fn reindex_names(&mut self) {
         self.outputs_by_name.pos = self.outputs.iter().enumerate().map(|(i, o)| (o.name.clone(), i)).collect();
-        self.names =
-            self.values.iter().enumerate().map(|(i, d)| (d.name.clone(), Value::with_number(i as u32))).collect();
+        self.names = NameIndex::build(&self.values);
     }
 
     /// Keeps only the body values for which `keep` is true, renumbering values densely and
