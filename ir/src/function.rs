@@ -535,6 +535,30 @@ mod tests {
     }
 
     #[test]
+    fn name_index_finds_values_and_the_verifier_tells_a_stale_index_from_a_duplicate_name() {
+        let mut f = Function::new("f", Phase::Parsed);
+        let a = f.add_input("a", Span::DUMMY).unwrap();
+        let b = f.add_input("b", Span::DUMMY).unwrap();
+        assert_eq!((f.lookup("a"), f.lookup("b"), f.lookup("c")), (Some(a), Some(b), None));
+        assert_eq!(f.add_input("a", Span::DUMMY), Err(a));
+        assert_eq!(f.fresh_name("a"), "a.1");
+        assert!(crate::verifier::verify_function(&f).is_empty());
+        // `b` renamed to `a` behind the index: a duplicate name.
+        f.value_mut(b).name = "a".into();
+        let msgs =
+            |f: &Function| crate::verifier::verify_function(f).into_iter().map(|e| e.message).collect::<Vec<_>>();
+        assert_eq!(msgs(&f), ["value name `%a` is used twice"]);
+        // Rebuilt, the last of equal names wins (as a map filled in order): `a`'s entry is stale.
+        f.reindex_names();
+        assert_eq!(f.lookup("a"), Some(b));
+        assert_eq!(msgs(&f), ["name index out of date for `%a`", "value name `%a` is used twice"]);
+        // Renamed back and reindexed: verifies again.
+        f.value_mut(b).name = "b".into();
+        f.reindex_names();
+        assert!(crate::verifier::verify_function(&f).is_empty());
+    }
+
+    #[test]
     fn set_output_replaces_by_name_even_after_direct_edits_of_outputs() {
         let mut f = Function::new("f", Phase::Parsed);
         for i in 0..100 {

@@ -9,8 +9,8 @@ use super::ast::{Case, FuncAst, Stmt};
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
 use super::lower::Lower;
-use super::Language;
 use super::scan::{self, Parsed};
+use super::Language;
 
 const TYPES: &[&str] =
     &["void", "int", "double", "float", "long", "unsigned", "static", "const", "MbsData", "MBSdataStruct", "MbsSensor"];

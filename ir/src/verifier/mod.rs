@@ -129,8 +129,12 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
             err(Location::Value(v), f.value(v).span, format!("`%{}` is in no list", f.name_of(v)));
         }
     }
-    let mut seen_names = HashSet::with_capacity_and_hasher(f.values.len(), Default::default());
-    for (i, d) in f.values.iter().enumerate() {
+    // A current index maps every name to its own value, so no two values share a name: the
+    // set of names seen is only needed (to tell which error) when the index is not current.
+    let index_current =
+        f.values.iter().enumerate().all(|(i, d)| f.lookup(&d.name) == Some(Value::with_number(i as u32)));
+    let mut seen_names = HashSet::default();
+    for (i, d) in f.values.iter().enumerate().filter(|_| !index_current) {
         let v = Value::with_number(i as u32);
         if !seen_names.insert(d.name.as_str()) {
             err(Location::Value(v), d.span, format!("value name `%{}` is used twice", d.name));
