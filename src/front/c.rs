@@ -58,8 +58,8 @@ pub fn scan_and_lower(src: &str, toks: &[Spanned<'_>], header: Option<&str>) -> 
     Some(m)
 }
 
-fn scan_impl<'s>(
-    src: &'s str,
+fn scan_impl(
+    src: &str,
     toks: &[Spanned<'_>],
     header: Option<&str>,
     errors: &mut Vec<FrontError>,
