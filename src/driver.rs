@@ -355,7 +355,9 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         write!(stderr, "{}", robovec_passes::accuracy::report::to_text(&cx.accuracy, opts.stats))
             .map_err(stderr_failure)?;
     }
-    let ir = module.to_string();
+    // The IR is printed straight into its file or stdout (never held as one string: at 7× the
+    // size of a Robotran input it would be the largest allocation of a run).
+    let mut print_ir = |w: &mut dyn Write| write!(w, "{module}");
 
     // Then put every file in place at once, and write stdout last.
     stage_worst_points(&mut out, &cx.accuracy, module.functions.len() > 1)?;
@@ -368,7 +370,7 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     let ir_to_stdout = match &opts.output {
         Some(p) if p.as_os_str() == "-" => true,
         Some(p) => {
-            out.stage(p, ir.as_bytes()).map_err(output_failure)?;
+            out.stage_with(p, &mut print_ir).map_err(output_failure)?;
             false
         }
         None => eval.is_none(),
@@ -376,7 +378,9 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     let written = out.commit().map_err(output_failure)?;
     let mut put = || -> std::io::Result<()> {
         if ir_to_stdout {
-            stdout.write_all(ir.as_bytes())?;
+            let mut buf = std::io::BufWriter::with_capacity(1 << 16, &mut *stdout);
+            print_ir(&mut buf)?;
+            buf.flush()?;
         }
         if let Some(e) = &eval {
             stdout.write_all(e.as_bytes())?;

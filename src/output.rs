@@ -256,10 +256,27 @@ impl OutputSet {
     /// # Errors
     /// A one-line message naming the file (refused kind of file, missing folder, I/O error).
     pub fn stage(&mut self, path: &Path, data: &[u8]) -> Result<(), String> {
+        self.stage_with(path, &mut |w| w.write_all(data))
+    }
+
+    /// Like [`OutputSet::stage`], with the bytes produced by `write` into the temporary file
+    /// through a buffer, so a large output (the printed IR) is never held in memory whole.
+    /// A device or FIFO still collects the bytes for the commit (nothing may reach it before).
+    ///
+    /// # Errors
+    /// A one-line message naming the file (refused kind of file, missing folder, I/O error,
+    /// or an error returned by `write`).
+    pub fn stage_with(
+        &mut self,
+        path: &Path,
+        write: &mut dyn FnMut(&mut dyn Write) -> io::Result<()>,
+    ) -> Result<(), String> {
         let fail = |e: io::Error| format!("error: cannot write `{}`: {e}", path.display());
         match classify(path)? {
             Kind::Direct => {
-                self.staged.push(Staged { shown: path.into(), final_path: None, tmp: None, data: data.to_vec() });
+                let mut data = Vec::new();
+                write(&mut data).map_err(fail)?;
+                self.staged.push(Staged { shown: path.into(), final_path: None, tmp: None, data });
                 Ok(())
             }
             Kind::Replace { final_path, existing } => {
@@ -273,7 +290,7 @@ impl OutputSet {
                 let name = final_path.file_name().unwrap_or_default().to_string_lossy().into_owned();
                 self.counter += 1;
                 let tmp = dir.join(format!(".{name}.{}.{}.robovec-tmp", std::process::id(), self.counter));
-                let mut file = OpenOptions::new().write(true).create_new(true).open(&tmp).map_err(fail)?;
+                let file = OpenOptions::new().write(true).create_new(true).open(&tmp).map_err(fail)?;
                 // From here on the temporary file exists: record it so a failure removes it.
                 self.staged.push(Staged {
                     shown: path.into(),
@@ -284,7 +301,10 @@ impl OutputSet {
                 if let Some(m) = &existing {
                     copy_owner_and_mode(&file, m).map_err(fail)?;
                 }
-                file.write_all(data).and_then(|()| file.sync_all()).map_err(fail)
+                let mut buf = io::BufWriter::with_capacity(1 << 16, file);
+                write(&mut buf).map_err(fail)?;
+                let file = buf.into_inner().map_err(|e| fail(e.into_error()))?;
+                file.sync_all().map_err(fail)
             }
         }
     }

@@ -1,7 +1,7 @@
 //! Functions and modules: value arena, body order, outputs, and the builder API used by front
 //! ends and passes.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 use crate::entities::Value;
 use crate::span::Span;
@@ -32,8 +32,54 @@ pub struct Function {
     pub span: Span,
     /// The placement on the PE architecture, when `place` made one (or the text had one).
     pub placement: Option<crate::placement::Placement>,
-    names: HashMap<String, Value>,
+    names: NameIndex,
     outputs_by_name: OutputIndex,
+}
+
+/// Every value by name, holding only the [`Value`]s (the names stay in `values`: one `String`
+/// per value, not two — issue 10 §3, memory of large functions). Derived from `values`, so
+/// ignored by `==`.
+#[derive(Clone, Debug, Default)]
+struct NameIndex(hashbrown::HashTable<Value>);
+
+impl PartialEq for NameIndex {
+    fn eq(&self, _: &NameIndex) -> bool {
+        true
+    }
+}
+
+fn name_hash(name: &str) -> u64 {
+    use std::hash::{BuildHasher, BuildHasherDefault};
+    BuildHasherDefault::<rustc_hash::FxHasher>::default().hash_one(name)
+}
+
+fn name_is(values: &[ValueData], v: Value, name: &str) -> bool {
+    values.get(v.index()).is_some_and(|d| d.name == name)
+}
+
+impl NameIndex {
+    fn get(&self, values: &[ValueData], name: &str) -> Option<Value> {
+        self.0.find(name_hash(name), |&v| name_is(values, v, name)).copied()
+    }
+
+    /// Indexes `v` under its name in `values` (the caller checked it is free).
+    fn insert(&mut self, values: &[ValueData], v: Value) {
+        let h = name_hash(&values[v.index()].name);
+        self.0.insert_unique(h, v, |&x| values.get(x.index()).map_or(0, |d| name_hash(&d.name)));
+    }
+
+    fn build(values: &[ValueData]) -> NameIndex {
+        let mut ix = NameIndex(hashbrown::HashTable::with_capacity(values.len()));
+        // As a map built by inserting every value in order: the last of equal names wins.
+        for (i, d) in values.iter().enumerate() {
+            let v = Value::with_number(i as u32);
+            match ix.0.find_mut(name_hash(&d.name), |&x| name_is(values, x, &d.name)) {
+                Some(slot) => *slot = v,
+                None => ix.insert(values, v),
+            }
+        }
+        ix
+    }
 }
 
 /// Position of every output by name, so that [`Function::set_output`] does not scan the
@@ -135,7 +181,7 @@ impl Function {
             outputs: Vec::new(),
             span: Span::DUMMY,
             placement: None,
-            names: HashMap::new(),
+            names: NameIndex::default(),
             outputs_by_name: OutputIndex::default(),
         }
     }
@@ -153,7 +199,7 @@ impl Function {
 
     /// The value named `name` (without `%`).
     pub fn lookup(&self, name: &str) -> Option<Value> {
-        self.names.get(name).copied()
+        self.names.get(&self.values, name)
     }
 
     /// The name of `v` (without `%`).
@@ -163,19 +209,19 @@ impl Function {
 
     /// A name not yet used in this function: `base` itself if free, else `base.1`, `base.2`, …
     pub fn fresh_name(&self, base: &str) -> String {
-        if !self.names.contains_key(base) {
+        if self.lookup(base).is_none() {
             return base.to_string();
         }
-        (1..).map(|k| format!("{base}.{k}")).find(|n| !self.names.contains_key(n)).expect("unbounded counter")
+        (1..).map(|k| format!("{base}.{k}")).find(|n| self.lookup(n).is_none()).expect("unbounded counter")
     }
 
     fn push_value(&mut self, name: String, def: Def, span: Span) -> Result<Value, Value> {
-        if let Some(&old) = self.names.get(&name) {
+        if let Some(old) = self.lookup(&name) {
             return Err(old);
         }
         let v = Value::with_number(self.values.len() as u32);
-        self.names.insert(name.clone(), v);
         self.values.push(ValueData { name, def, timing: None, span });
+        self.names.insert(&self.values, v);
         Ok(v)
     }
 
@@ -287,8 +333,7 @@ impl Function {
     /// `outputs` directly.
     pub fn reindex_names(&mut self) {
         self.outputs_by_name.pos = self.outputs.iter().enumerate().map(|(i, o)| (o.name.clone(), i)).collect();
-        self.names =
-            self.values.iter().enumerate().map(|(i, d)| (d.name.clone(), Value::with_number(i as u32))).collect();
+        self.names = NameIndex::build(&self.values);
     }
 
     /// Keeps only the body values for which `keep` is true, renumbering values densely and
@@ -487,6 +532,30 @@ mod tests {
 
     fn out(f: &Function) -> Vec<(String, Operand)> {
         f.outputs.iter().map(|o| (o.name.clone(), o.value)).collect()
+    }
+
+    #[test]
+    fn name_index_finds_values_and_the_verifier_tells_a_stale_index_from_a_duplicate_name() {
+        let mut f = Function::new("f", Phase::Parsed);
+        let a = f.add_input("a", Span::DUMMY).unwrap();
+        let b = f.add_input("b", Span::DUMMY).unwrap();
+        assert_eq!((f.lookup("a"), f.lookup("b"), f.lookup("c")), (Some(a), Some(b), None));
+        assert_eq!(f.add_input("a", Span::DUMMY), Err(a));
+        assert_eq!(f.fresh_name("a"), "a.1");
+        assert!(crate::verifier::verify_function(&f).is_empty());
+        // `b` renamed to `a` behind the index: a duplicate name.
+        f.value_mut(b).name = "a".into();
+        let msgs =
+            |f: &Function| crate::verifier::verify_function(f).into_iter().map(|e| e.message).collect::<Vec<_>>();
+        assert_eq!(msgs(&f), ["value name `%a` is used twice"]);
+        // Rebuilt, the last of equal names wins (as a map filled in order): `a`'s entry is stale.
+        f.reindex_names();
+        assert_eq!(f.lookup("a"), Some(b));
+        assert_eq!(msgs(&f), ["name index out of date for `%a`", "value name `%a` is used twice"]);
+        // Renamed back and reindexed: verifies again.
+        f.value_mut(b).name = "b".into();
+        f.reindex_names();
+        assert!(crate::verifier::verify_function(&f).is_empty());
     }
 
     #[test]

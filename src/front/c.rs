@@ -8,7 +8,9 @@ use robovec_ir::Span;
 use super::ast::{Case, FuncAst, Stmt};
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
+use super::lower::Lower;
 use super::scan::{self, Parsed};
+use super::Language;
 
 const TYPES: &[&str] =
     &["void", "int", "double", "float", "long", "unsigned", "static", "const", "MbsData", "MBSdataStruct", "MbsSensor"];
@@ -16,6 +18,53 @@ const TYPES: &[&str] =
 /// Scans a C file. `header` is the companion `.h` text: its declarations are only used for
 /// `double *X;` pointers.
 pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
+    scan_impl(src, toks, header, errors, None)
+}
+
+/// Functions lowered while their body is scanned, each statement as soon as it is parsed (the
+/// whole file's statement trees are never held at once: they took ~30× the input's size).
+#[derive(Default)]
+struct Streamed {
+    functions: Vec<robovec_ir::Function>,
+    /// A case the streaming path does not cover (a `switch`, a `#define` or pointer declared
+    /// after the first statement, a poisoned statement): the batch path decides.
+    broken: bool,
+}
+
+/// One function's lowering in progress.
+struct Stream<'s> {
+    lower: Option<Lower<'s>>,
+    /// `#define`s and pointers known when lowering started.
+    at: (usize, usize),
+}
+
+/// The streaming path of [`super::parse_str`]: scans and lowers `src` in one go. `None` when
+/// the file has any error or a form the streaming path leaves to the batch path
+/// ([`scan`] then [`super::lower::lower_module`]), whose diagnostics are the reference.
+pub fn scan_and_lower(src: &str, toks: &[Spanned<'_>], header: Option<&str>) -> Option<robovec_ir::Module> {
+    let mut errors = Vec::new();
+    let mut streamed = Streamed::default();
+    let funcs = scan_impl(src, toks, header, &mut errors, Some(&mut streamed));
+    if !errors.is_empty() || streamed.broken || funcs.is_empty() || funcs.len() != streamed.functions.len() {
+        return None;
+    }
+    let mut m = robovec_ir::Module::default();
+    for f in streamed.functions {
+        if m.function(&f.name).is_some() {
+            return None;
+        }
+        m.functions.push(f);
+    }
+    Some(m)
+}
+
+fn scan_impl(
+    src: &str,
+    toks: &[Spanned<'_>],
+    header: Option<&str>,
+    errors: &mut Vec<FrontError>,
+    mut streamed: Option<&mut Streamed>,
+) -> Vec<FuncAst> {
     // Without comments and newlines (already so when lexed by `parse_str`: no copy then).
     let filtered: Vec<Spanned<'_>>;
     let toks = if toks.iter().any(|t| ignored(&t.1)) {
@@ -98,7 +147,15 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut 
                         f.defines = defines.clone();
                         f.pointers = header_pointers.clone();
                         let mark = errors.len();
-                        if body(src, &toks[body_open + 1..body_close], end, &mut f, errors) {
+                        let mut stream = streamed.as_ref().map(|_| Stream { lower: None, at: (0, 0) });
+                        if body(src, &toks[body_open + 1..body_close], end, &mut f, errors, stream.as_mut()) {
+                            if let (Some(st), Some(stream)) = (streamed.as_deref_mut(), stream) {
+                                st.broken |= f.cases.is_some()
+                                    || !f.poisoned.is_empty()
+                                    || (stream.lower.is_some() && stream.at != (f.defines.len(), f.pointers.len()));
+                                let lower = stream.lower.unwrap_or_else(|| Lower::new(src, Language::C, &f));
+                                st.functions.push(lower.finish(f.name.clone(), errors));
+                            }
                             funcs.push(f);
                         } else if let Some(fatal) = errors.pop() {
                             // Control flow: the loop diagnostic alone tells why the file is rejected.
@@ -211,15 +268,35 @@ enum Target {
 
 /// Scans a function body into `f`; false after a fatal (control-flow or structure) error,
 /// which is then the last error pushed.
-fn body(src: &str, toks: &[Spanned<'_>], end: usize, f: &mut FuncAst, errors: &mut Vec<FrontError>) -> bool {
+fn body<'s>(
+    src: &'s str,
+    toks: &[Spanned<'_>],
+    end: usize,
+    f: &mut FuncAst,
+    errors: &mut Vec<FrontError>,
+    mut stream: Option<&mut Stream<'s>>,
+) -> bool {
     let mut i = 0;
     let mut target = Target::Prefix;
     let mut cases: Option<Vec<Case>> = None;
     let mut switch_close: Option<usize> = None;
     let mut returned: Option<Span> = None;
-    let push =
+    let mut push =
         |s: Stmt, target: &Target, f: &mut FuncAst, cases: &mut Option<Vec<Case>>, errors: &mut Vec<FrontError>| {
             match target {
+                // Without a `switch` (else the batch path decides), the statements lower in
+                // source order: prefix then suffix.
+                Target::Prefix | Target::Suffix if stream.is_some() => {
+                    if let Some(st) = stream.as_deref_mut() {
+                        if st.lower.is_none() {
+                            st.at = (f.defines.len(), f.pointers.len());
+                            st.lower = Some(Lower::new(src, Language::C, f));
+                        }
+                        if let Some(lower) = st.lower.as_mut() {
+                            lower.stmt(&s);
+                        }
+                    }
+                }
                 Target::Prefix => f.prefix.push(s),
                 Target::Suffix => f.suffix.push(s),
                 Target::Case => {

@@ -37,7 +37,9 @@
 //!   redefinition. A statement whose lowering failed poisons its left-hand side so that its
 //!   later uses do not cascade into more errors.
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::BTreeMap;
+
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 use robovec_ir::{Callee, Def, Expr as IrExpr, Function, Module, Operand, Phase, Span, TrigFn};
 
@@ -65,14 +67,15 @@ pub fn lower_module(src: &str, lang: Language, funcs: &[FuncAst], errors: &mut V
         match &fa.cases {
             None => {
                 let stmts: Vec<&Stmt> = fa.prefix.iter().chain(&fa.suffix).collect();
-                add(Lower::new(src, lang, fa, errors).run(fa.name.clone(), &stmts), fa.span, errors);
+                let f = Lower::new(src, lang, fa).run(fa.name.clone(), &stmts, errors);
+                add(f, fa.span, errors);
             }
             Some(cases) => {
                 for c in cases {
                     let tail: Vec<&Stmt> = c.body.iter().chain(&fa.suffix).collect();
                     let mut stmts = sensor::needed_prefix(&fa.prefix, &tail, &fa.outputs);
                     stmts.extend(tail);
-                    let f = Lower::new(src, lang, fa, errors).run(format!("{}_{}", fa.name, c.label), &stmts);
+                    let f = Lower::new(src, lang, fa).run(format!("{}_{}", fa.name, c.label), &stmts, errors);
                     add(f, c.span, errors);
                 }
             }
@@ -100,12 +103,22 @@ fn is_trig(name: &str) -> Option<TrigFn> {
     }
 }
 
-struct Lower<'a> {
+/// The parts of a [`FuncAst`] that lowering reads (not its statements).
+struct Header {
+    span: Span,
+    params: Vec<String>,
+    pointers: Vec<String>,
+}
+
+/// Lowers the statements of one function, one at a time ([`Lower::stmt`]).
+pub(crate) struct Lower<'a> {
     src: &'a str,
     lang: Language,
-    fa: &'a FuncAst,
+    fa: Header,
     f: Function,
-    errors: &'a mut Vec<FrontError>,
+    /// Errors of this function's statements, appended to the file's by [`Lower::run`] /
+    /// [`Lower::finish`] (same order as when pushed directly).
+    errors: Vec<FrontError>,
     /// Latest value of every location written or read (temporaries, elements, outputs, inputs).
     current: HashMap<String, Operand>,
     outputs: HashSet<String>,
@@ -118,32 +131,40 @@ struct Lower<'a> {
 }
 
 impl<'a> Lower<'a> {
-    fn new(src: &'a str, lang: Language, fa: &'a FuncAst, errors: &'a mut Vec<FrontError>) -> Lower<'a> {
+    /// A lowering of `fa`'s statements with its header (parameters, outputs, pointers,
+    /// defines, poisoned names) as it is now.
+    pub(crate) fn new(src: &'a str, lang: Language, fa: &FuncAst) -> Lower<'a> {
         let aliases = fa.defines.iter().map(|d| (d.clone(), d.clone())).collect();
         Lower {
             src,
             lang,
-            fa,
+            fa: Header { span: fa.span, params: fa.params.clone(), pointers: fa.pointers.clone() },
             f: Function::new(String::new(), Phase::Parsed),
-            errors,
-            current: HashMap::new(),
+            errors: Vec::new(),
+            current: HashMap::default(),
             outputs: fa.outputs.iter().cloned().collect(),
             aliases,
             s_arrays: fa.defines.iter().cloned().collect(),
-            arrays: HashMap::new(),
-            vectors: HashMap::new(),
+            arrays: HashMap::default(),
+            vectors: HashMap::default(),
             failed: fa.poisoned.iter().map(|n| n.strip_prefix("s.").unwrap_or(n).to_string()).collect(),
             equations: 0,
         }
     }
 
-    fn run(mut self, name: String, stmts: &[&Stmt]) -> Function {
-        self.f.name = name;
-        self.f.span = self.fa.span;
+    fn run(mut self, name: String, stmts: &[&Stmt], errors: &mut Vec<FrontError>) -> Function {
         for s in stmts {
             self.stmt(s);
         }
+        self.finish(name, errors)
+    }
+
+    /// The lowered function, named `name`; its errors are appended to `errors`.
+    pub(crate) fn finish(mut self, name: String, errors: &mut Vec<FrontError>) -> Function {
+        self.f.name = name;
+        self.f.span = self.fa.span;
         self.f.equations = Some(self.equations);
+        errors.append(&mut self.errors);
         self.f
     }
 

@@ -92,6 +92,11 @@ pub fn parse_str(lang: Language, src: &[u8], header: Option<&[u8]>) -> Result<ro
         Language::C => {
             let header = header.map(source_text);
             let toks = lexer::lex_where(&text, |t| !c::ignored(t));
+            // Statements lowered as soon as they are parsed; on any error (or a form it leaves
+            // out) the batch path below runs from the start and gives the diagnostics.
+            if let Some(module) = c::scan_and_lower(&text, &toks, header.as_deref()) {
+                return Ok(module);
+            }
             c::scan(&text, &toks, header.as_deref(), &mut errors)
         }
         Language::Matlab => matlab::scan(&text, &lexer::lex(&text), &mut errors),
@@ -116,6 +121,8 @@ mod corpus_tests;
 mod error_tests;
 #[cfg(test)]
 mod snippet_tests;
+#[cfg(test)]
+mod stream_tests;
 
 /// The contract every front end keeps, checked by the fuzz targets and property tests: a
 /// module it returns verifies, atomises, and its atomised form verifies.

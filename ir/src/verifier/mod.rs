@@ -32,7 +32,7 @@
 
 pub mod placement;
 
-use std::collections::HashSet;
+use rustc_hash::FxHashSet as HashSet;
 
 use codespan_reporting::diagnostic::{Diagnostic, Label};
 
@@ -86,7 +86,7 @@ impl VerifierError {
 /// All violations found, in function order.
 pub fn verify(m: &Module) -> Result<(), Vec<VerifierError>> {
     let mut errs = Vec::new();
-    let mut names = HashSet::new();
+    let mut names = HashSet::default();
     for f in &m.functions {
         if !names.insert(f.name.as_str()) {
             errs.push(VerifierError {
@@ -129,8 +129,12 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
             err(Location::Value(v), f.value(v).span, format!("`%{}` is in no list", f.name_of(v)));
         }
     }
-    let mut seen_names = HashSet::new();
-    for (i, d) in f.values.iter().enumerate() {
+    // A current index maps every name to its own value, so no two values share a name: the
+    // set of names seen is only needed (to tell which error) when the index is not current.
+    let index_current =
+        f.values.iter().enumerate().all(|(i, d)| f.lookup(&d.name) == Some(Value::with_number(i as u32)));
+    let mut seen_names = HashSet::default();
+    for (i, d) in f.values.iter().enumerate().filter(|_| !index_current) {
         let v = Value::with_number(i as u32);
         if !seen_names.insert(d.name.as_str()) {
             err(Location::Value(v), d.span, format!("value name `%{}` is used twice", d.name));
@@ -220,7 +224,7 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
         }
         defined[v.index()] = true;
     }
-    let mut out_names = HashSet::new();
+    let mut out_names = HashSet::with_capacity_and_hasher(f.outputs.len(), Default::default());
     for (i, o) in f.outputs.iter().enumerate() {
         if !out_names.insert(o.name.as_str()) {
             err(Location::Output(i), o.span, format!("output `{}` is defined twice", o.name));

@@ -9,7 +9,8 @@ use crate::front::error::FrontError;
 use crate::front::Language;
 
 impl Lower<'_> {
-    pub(super) fn stmt(&mut self, s: &Stmt) {
+    /// Lowers one statement (errors kept until [`Lower::finish`]).
+    pub(crate) fn stmt(&mut self, s: &Stmt) {
         let lhs = &s.lhs;
         if let Some((o, _)) = &lhs.obj {
             let prefix = match o.text.as_str() {
