@@ -16,25 +16,16 @@
 //! `log n / log 10k`. Run with `cargo bench --bench place` (about a minute and a half).
 
 use std::hint::black_box;
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use robovec_ir::Function;
-use robovec_passes::atomise::atomise_function;
 use robovec_passes::dag_gen::generate;
 use robovec_passes::place::{cycles, place_function, PlaceOptions};
 
-const FILE: &str = "../shared/corpus/robotran/matlab/walkman__mbs_dirdyna_walkman_robotran.m";
-
-/// The atomised WALK-MAN direct dynamics.
-fn walkman() -> Function {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(FILE);
-    let (m, _) = robovec::driver::load(&p.to_string_lossy())
-        .unwrap_or_else(|e| panic!("cannot load {} (the corpus must sit at ../shared): {}", p.display(), e.message()));
-    assert_eq!(m.functions.len(), 1, "{FILE} holds one function");
-    atomise_function(&m.functions[0])
-}
+#[path = "common.rs"]
+mod common;
+use common::walkman;
 
 fn ops(f: &Function) -> u64 {
     f.op_counts().total

@@ -14,24 +14,17 @@
 //! `cargo bench --bench rewrite`.
 
 use std::hint::black_box;
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use robovec_ir::analysis::Latencies;
 use robovec_ir::Function;
-use robovec_passes::atomise::atomise_function;
 use robovec_passes::dag_gen::generate;
 use robovec_passes::thr::{rewrite, Shape};
 
-const FILE: &str = "../shared/corpus/robotran/matlab/walkman__mbs_dirdyna_walkman_robotran.m";
-
-fn walkman() -> Function {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(FILE);
-    let (m, _) = robovec::driver::load(&p.to_string_lossy())
-        .unwrap_or_else(|e| panic!("cannot load {} (the corpus must sit at ../shared): {}", p.display(), e.message()));
-    atomise_function(&m.functions[0])
-}
+#[path = "common.rs"]
+mod common;
+use common::walkman;
 
 fn bench(c: &mut Criterion) {
     let lat = Latencies::default();

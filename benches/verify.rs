@@ -12,23 +12,16 @@
 //! (`verifier::placement::verify_placement`), and the time per op. Run with
 //! `cargo bench --bench verify`.
 
-use std::path::PathBuf;
 use std::time::Instant;
 
 use robovec_ir::verifier::{placement::verify_placement, verify_function};
 use robovec_ir::Function;
-use robovec_passes::atomise::atomise_function;
 use robovec_passes::dag_gen::generate;
 use robovec_passes::place::{place_function, PlaceOptions};
 
-const FILE: &str = "../shared/corpus/robotran/matlab/walkman__mbs_dirdyna_walkman_robotran.m";
-
-fn walkman() -> Function {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(FILE);
-    let (m, _) = robovec::driver::load(&p.to_string_lossy())
-        .unwrap_or_else(|e| panic!("cannot load {} (the corpus must sit at ../shared): {}", p.display(), e.message()));
-    atomise_function(&m.functions[0])
-}
+#[path = "common.rs"]
+mod common;
+use common::walkman;
 
 fn placed(mut f: Function) -> Function {
     let mut o = PlaceOptions::with_pes(16);
