@@ -169,6 +169,7 @@ impl Cli {
                 dump_dir: self.dump_dir,
                 verify_each: self.verify_each,
                 time_passes: self.time_passes,
+                ..Instrumentation::default()
             },
             report: self.report,
             eval: self.eval,

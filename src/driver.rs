@@ -261,7 +261,9 @@ impl DumpSink for StagedDumps<'_> {
 /// [`Failure`] with its exit status.
 pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
     let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
-    let pm = PassManager::new(&opts.passes, opts.instr.clone()).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
+    // `load` verifies the input (always, whatever `-verify-each` says): the manager need not.
+    let instr = Instrumentation { input_verified: true, ..opts.instr.clone() };
+    let pm = PassManager::new(&opts.passes, instr).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     crate::preflight::check_options(opts, &pm)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
     let (mut module, src) = load(&opts.input)?;

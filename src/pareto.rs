@@ -126,7 +126,8 @@ pub fn managers(text: &str) -> Result<Vec<(String, PassManager)>, Failure> {
     split_pipelines(text)
         .map_err(Failure::Usage)?
         .into_iter()
-        .map(|p| match PassManager::new(&p, Instrumentation::default()) {
+        // They run on the driver's loaded module, which `load` verified.
+        .map(|p| match PassManager::new(&p, Instrumentation { input_verified: true, ..Instrumentation::default() }) {
             Ok(pm) => Ok((p, pm)),
             Err(e) => Err(Failure::Usage(format!("error: -pareto pipeline `{p}`: {e}\n"))),
         })
@@ -134,6 +135,7 @@ pub fn managers(text: &str) -> Result<Vec<(String, PassManager)>, Failure> {
 }
 
 /// Runs every pipeline of `text` on a copy of `module` and measures function `function`.
+/// `module` must be verified (the driver's `load` does it): the pipelines do not check it again.
 ///
 /// # Errors
 /// [`Failure::Usage`] for a bad pipeline, [`Failure::Input`] when a pipeline fails.

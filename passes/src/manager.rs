@@ -50,6 +50,10 @@ pub struct Instrumentation {
     pub verify_each: bool,
     /// `-time-passes`: print a timing table after the run.
     pub time_passes: bool,
+    /// The caller verified the module before handing it over (the driver's `load` always does),
+    /// so the manager skips its own check of the input; the IR after each pass is still
+    /// verified under `verify_each`.
+    pub input_verified: bool,
 }
 
 impl Default for Instrumentation {
@@ -60,6 +64,7 @@ impl Default for Instrumentation {
             dump_dir: None,
             verify_each: true,
             time_passes: false,
+            input_verified: false,
         }
     }
 }
@@ -158,7 +163,7 @@ impl PassManager {
         log: &mut dyn Write,
         dumps: &mut dyn DumpSink,
     ) -> Result<Vec<PassRecord>, PassError> {
-        if self.instr.verify_each {
+        if self.instr.verify_each && !self.instr.input_verified {
             verify_named(m, "input")?;
         }
         let mut dump = |name: String, m: &Module| match &self.instr.dump_dir {
