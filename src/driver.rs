@@ -16,12 +16,14 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use robovec_ir::{text, verifier, Function, Module};
-use robovec_passes::{DumpSink, Instrumentation, PassContext, PassError, PassManager};
+use robovec_passes::{
+    study, DumpSink, GeneratedCode, Instrumentation, PassContext, PassError, PassManager, PassRecord,
+};
 
 use crate::diagnostics::SourceFile;
 use crate::front;
 use crate::output::OutputSet;
-use crate::report::{evaluate, placement_report, stats, Report};
+use crate::report::evaluate;
 
 /// What the command line asked for.
 #[derive(Clone, Debug, Default)]
@@ -188,22 +190,6 @@ fn read_eval_inputs(path: &Path) -> Result<BTreeMap<String, f64>, Failure> {
     })
 }
 
-/// Stages the `worst-K.json` files of every `accuracy<worst=DIR>` measurement.
-fn stage_worst_points(
-    out: &mut OutputSet,
-    reports: &[robovec_passes::accuracy::AccuracyReport],
-    prefix: bool,
-) -> Result<(), Failure> {
-    for r in reports {
-        let Some(dir) = &r.worst_dir else { continue };
-        out.ensure_folder(Path::new(dir)).map_err(output_failure)?;
-        for (name, json) in robovec_passes::accuracy::report::worst_files(r, prefix) {
-            out.stage(&Path::new(dir).join(name), json.as_bytes()).map_err(output_failure)?;
-        }
-    }
-    Ok(())
-}
-
 /// Renders a pipeline failure; errors located in the input (verifier errors, placement lines
 /// named by `sim`, a function in the wrong phase) show `file:line:col` and the line.
 fn pass_failure(e: robovec_passes::PassError, src: &SourceFile) -> Failure {
@@ -254,13 +240,21 @@ impl DumpSink for StagedDumps<'_> {
     }
 }
 
-/// Runs one `robovec-opt` invocation. `stdout` receives the IR (or `-eval` JSON); `stderr`
-/// receives dumps, timing and stats.
+/// What a run hands to the writing step: the passes' records and context, with everything
+/// rendered in memory.
+struct Ran {
+    records: Vec<PassRecord>,
+    cx: PassContext,
+}
+
+/// Runs one `robovec-opt` invocation: check options → load → run passes (and the studies
+/// `-pareto` and `-check`) → render every output in memory → put every file in place at once →
+/// stdout. `stdout` receives the IR, the generated code or the `-eval` JSON; `stderr` receives
+/// dumps, timing, notes, stats and the artifacts' tables.
 ///
 /// # Errors
 /// [`Failure`] with its exit status.
 pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
-    let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
     // `load` verifies the input (always, whatever `-verify-each` says): the manager need not.
     let instr = Instrumentation { input_verified: true, ..opts.instr.clone() };
     let pm = PassManager::new(&opts.passes, instr).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
@@ -271,117 +265,184 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
     // removes what it staged.
     let mut out = OutputSet::new();
-    let pareto = match &opts.pareto {
-        Some(text) => {
-            let name = select(&module, &opts.function, "-pareto")?.name.clone();
-            let rows = crate::pareto::run(&module, &name, text, opts.pareto_samples, opts.pareto_seed)?;
-            write!(stderr, "{}", crate::pareto::to_table(&name, &rows)).map_err(stderr_failure)?;
-            rows
-        }
-        None => Vec::new(),
-    };
+    let ran = run_passes(opts, &pm, &mut module, &src, &mut out, stderr)?;
+    write_outputs(opts, &pm, &module, &ran, eval_inputs.as_ref(), out, stdout, stderr)
+}
+
+/// Runs `-pareto` (before the pipeline, on the input), the pipeline with its dumps staged in
+/// `out`, then `-check`; prints the early-stop notes.
+fn run_passes(
+    opts: &Options,
+    pm: &PassManager,
+    module: &mut Module,
+    src: &SourceFile,
+    out: &mut OutputSet,
+    stderr: &mut dyn Write,
+) -> Result<Ran, Failure> {
+    let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
     let mut cx = PassContext { original: opts.check.map(|_| module.clone()), deadline, ..PassContext::default() };
+    if let Some(text) = &opts.pareto {
+        let name = select(module, &opts.function, "-pareto")?.name.clone();
+        let study =
+            study::pareto::study(module, &name, text, opts.pareto_samples, opts.pareto_seed).map_err(study_failure)?;
+        cx.emit(study);
+    }
     let records = {
         let dir = opts.instr.dump_dir.clone().unwrap_or_default();
-        let mut dumps = StagedDumps { dir, out: &mut out, created: false };
-        pm.run_with_dumps(&mut module, &mut cx, stderr, &mut dumps).map_err(|e| match e {
+        let mut dumps = StagedDumps { dir, out, created: false };
+        pm.run_with_dumps(module, &mut cx, stderr, &mut dumps).map_err(|e| match e {
             PassError::Output { message } => output_failure(message),
             PassError::Log(e) => stderr_failure(e),
-            e => pass_failure(e, &src),
+            e => pass_failure(e, src),
         })?
     };
     for s in &cx.stopped {
         writeln!(stderr, "note: {s}").map_err(stderr_failure)?;
     }
     if let (Some((samples, seed)), Some(original)) = (opts.check, &cx.original) {
-        crate::check::run(&module, original, &pm.pipeline_text(), &opts.function, samples, seed, stderr)?;
+        study::check::run(module, original, &pm.pipeline_text(), &opts.function, samples, seed, stderr)
+            .map_err(study_failure)?;
     }
+    Ok(Ran { records, cx })
+}
 
-    // Build every output in memory first.
-    let report = match &opts.report {
-        Some(_) => {
-            let f = select(&module, &opts.function, "-report")?;
-            let r = Report {
-                input: opts.input.clone(),
-                function: f.name.clone(),
-                pipeline: pm.pipeline_text(),
-                passes: records.clone(),
-                stats: stats(f, &cx.latencies),
-                placement: placement_report(f),
-                sweep: cx.sweep.iter().filter(|r| r.function == f.name).cloned().collect(),
-                accuracy: cx.accuracy.iter().rev().find(|r| r.function == f.name).cloned(),
-                pareto: pareto.clone(),
-                eqsat: cx.eqsat.iter().filter(|e| e.function == f.name).cloned().collect(),
-                sim: cx.sim.last().map(|s| {
-                    let mut s = s.clone();
-                    s.functions.retain(|x| x.function == f.name);
-                    s
-                }),
-                stopped_early: cx.stopped.clone(),
-            };
-            Some(serde_json::to_string_pretty(&r).expect("report serialises") + "\n")
+fn study_failure(f: study::Failure) -> Failure {
+    match f {
+        study::Failure::Usage(s) => Failure::Usage(s),
+        study::Failure::Input(s) => Failure::Input(s),
+    }
+}
+
+/// The report (SPEC §7) of the function `-report` describes: the run's own fields, the figures
+/// of the final IR, then each artifact's entry (merged by key), then the early stops.
+fn report_json(opts: &Options, pm: &PassManager, module: &Module, ran: &Ran) -> Result<String, Failure> {
+    let f = select(module, &opts.function, "-report")?;
+    let mut r = serde_json::Map::new();
+    r.insert("input".into(), opts.input.clone().into());
+    r.insert("function".into(), f.name.clone().into());
+    r.insert("pipeline".into(), pm.pipeline_text().into());
+    r.insert("passes".into(), serde_json::to_value(&ran.records).expect("records serialise"));
+    let entries = robovec_passes::figures::report_entries(f, &ran.cx)
+        .into_iter()
+        .chain(robovec_passes::artifact::report_entries(ran.cx.artifacts(), &f.name));
+    for (key, value) in entries {
+        r.insert(key.into(), value);
+    }
+    if !ran.cx.stopped.is_empty() {
+        r.insert("stopped_early".into(), ran.cx.stopped.clone().into());
+    }
+    Ok(serde_json::to_string_pretty(&serde_json::Value::Object(r)).expect("report serialises") + "\n")
+}
+
+/// `-eval`'s JSON, with a warning on stderr for each input given that the function does not
+/// have and each user callback replaced by the interpreter's stand-in.
+fn eval_json(
+    opts: &Options,
+    module: &Module,
+    given: &BTreeMap<String, f64>,
+    stderr: &mut dyn Write,
+) -> Result<String, Failure> {
+    let f = select(module, &opts.function, "-eval")?;
+    for name in given.keys() {
+        if !f.inputs.iter().any(|&v| f.name_of(v) == name) {
+            writeln!(stderr, "warning: `{name}` is not an input of @{}; ignored", f.name).map_err(stderr_failure)?;
         }
-        None => None,
-    };
-    let eval = match &eval_inputs {
-        Some(given) => {
-            let f = select(&module, &opts.function, "-eval")?;
-            for name in given.keys() {
-                if !f.inputs.iter().any(|&v| f.name_of(v) == name) {
-                    writeln!(stderr, "warning: `{name}` is not an input of @{}; ignored", f.name)
-                        .map_err(stderr_failure)?;
-                }
-            }
-            let r = evaluate(f, given, opts.eval_f32);
-            for c in &r.callback_standins {
-                writeln!(
-                    stderr,
-                    "warning: @{} calls user callback `{c}`; evaluated with the stand-in (a linear form of its \
-                     arguments, robovec_ir::interp::callback_standin)",
-                    f.name
-                )
-                .map_err(stderr_failure)?;
-            }
-            Some(serde_json::to_string_pretty(&r).expect("eval serialises") + "\n")
-        }
-        None => None,
-    };
+    }
+    let r = evaluate(f, given, opts.eval_f32);
+    for c in &r.callback_standins {
+        writeln!(
+            stderr,
+            "warning: @{} calls user callback `{c}`; evaluated with the stand-in (a linear form of its \
+             arguments, robovec_ir::interp::callback_standin)",
+            f.name
+        )
+        .map_err(stderr_failure)?;
+    }
+    Ok(serde_json::to_string_pretty(&r).expect("eval serialises") + "\n")
+}
+
+/// The generated code `-o` writes when the pipeline ends in a back end.
+fn generated_code<'a>(pm: &PassManager, ran: &'a Ran) -> Result<Option<&'a GeneratedCode>, Failure> {
+    if pm.code_companions().is_none() {
+        return Ok(None);
+    }
+    let last = pm.last_index();
+    ran.cx
+        .artifacts
+        .iter()
+        .filter(|p| p.pass_index == last)
+        .find_map(|p| p.artifact.code())
+        .map(Some)
+        .ok_or_else(|| Failure::Input("error: the pipeline's last pass is a back end but generated no code\n".into()))
+}
+
+/// Renders every output in memory, stages every file in `out`, commits them at once, then
+/// writes stdout.
+#[allow(clippy::too_many_arguments)]
+fn write_outputs(
+    opts: &Options,
+    pm: &PassManager,
+    module: &Module,
+    ran: &Ran,
+    eval_inputs: Option<&BTreeMap<String, f64>>,
+    mut out: OutputSet,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> Result<(), Failure> {
+    let cx = &ran.cx;
+    let report = opts.report.as_ref().map(|_| report_json(opts, pm, module, ran)).transpose()?;
+    let eval = eval_inputs.map(|given| eval_json(opts, module, given, stderr)).transpose()?;
     if opts.stats {
-        write!(stderr, "{}", crate::report::stats_text(&module, &cx, opts.function.as_deref()))
+        write!(stderr, "{}", robovec_passes::figures::stats_text(module, cx, opts.function.as_deref()))
             .map_err(stderr_failure)?;
     }
-    if !cx.sweep.is_empty() {
-        write!(stderr, "{}", robovec_passes::sweep::to_table(&cx.sweep)).map_err(stderr_failure)?;
+    for a in cx.artifacts() {
+        write!(stderr, "{}", a.log_text(opts.stats)).map_err(stderr_failure)?;
     }
-    if !cx.accuracy.is_empty() {
-        write!(stderr, "{}", robovec_passes::accuracy::report::to_text(&cx.accuracy, opts.stats))
-            .map_err(stderr_failure)?;
-    }
+    let code = generated_code(pm, ran)?;
     // The IR is printed straight into its file or stdout (never held as one string: at 7× the
     // size of a Robotran input it would be the largest allocation of a run).
-    let mut print_ir = |w: &mut dyn Write| write!(w, "{module}");
+    let mut print_main = |w: &mut dyn Write| match code {
+        Some(c) => w.write_all(c.main.as_bytes()),
+        None => write!(w, "{module}"),
+    };
 
     // Then put every file in place at once, and write stdout last.
-    stage_worst_points(&mut out, &cx.accuracy, module.functions.len() > 1)?;
+    for a in cx.artifacts() {
+        for file in a.files(module.functions.len() > 1) {
+            if let Some(dir) = file.path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                out.ensure_folder(dir).map_err(output_failure)?;
+            }
+            out.stage(&file.path, &file.bytes).map_err(output_failure)?;
+        }
+    }
     if let Some(path) = &opts.sweep_csv {
-        out.stage(path, robovec_passes::sweep::to_csv(&cx.sweep).as_bytes()).map_err(output_failure)?;
+        let csv: String = cx.artifacts().filter_map(|a| a.csv()).collect();
+        out.stage(path, csv.as_bytes()).map_err(output_failure)?;
     }
     if let (Some(path), Some(r)) = (&opts.report, &report) {
         out.stage(path, r.as_bytes()).map_err(output_failure)?;
     }
-    let ir_to_stdout = match &opts.output {
+    let to_stdout = match &opts.output {
         Some(p) if p.as_os_str() == "-" => true,
         Some(p) => {
-            out.stage_with(p, &mut print_ir).map_err(output_failure)?;
+            out.stage_with(p, &mut print_main).map_err(output_failure)?;
+            if let Some(code) = code {
+                for (ext, text) in &code.companions {
+                    if let Some(c) = crate::preflight::companion_path(p, ext) {
+                        out.stage(&c, text.as_bytes()).map_err(output_failure)?;
+                    }
+                }
+            }
             false
         }
         None => eval.is_none(),
     };
     let written = out.commit().map_err(output_failure)?;
     let mut put = || -> std::io::Result<()> {
-        if ir_to_stdout {
+        if to_stdout {
             let mut buf = std::io::BufWriter::with_capacity(1 << 16, &mut *stdout);
-            print_ir(&mut buf)?;
+            print_main(&mut buf)?;
             buf.flush()?;
         }
         if let Some(e) = &eval {
@@ -396,9 +457,6 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             let names: Vec<String> = written.iter().map(|p| format!("`{}`", p.display())).collect();
             format!("; files already written: {}", names.join(", "))
         };
-        Failure::Output(format!(
-            "error: cannot write to stdout: {e}{already}
-"
-        ))
+        Failure::Output(format!("error: cannot write to stdout: {e}{already}\n"))
     })
 }

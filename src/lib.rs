@@ -4,12 +4,10 @@
 //! files (C, Matlab, Python) into IR modules ([`front`]), runs pipelines on them
 //! ([`driver::run`]) and writes reports ([`report`]).
 
-pub mod check;
 pub mod cli;
 pub mod diagnostics;
 pub mod driver;
 pub mod front;
 pub mod output;
-pub mod pareto;
 pub mod preflight;
 pub mod report;

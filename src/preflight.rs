@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use robovec_ir::Module;
-use robovec_passes::PassManager;
+use robovec_passes::{ParamKind, PassManager};
 
 use crate::driver::{output_failure, select, Failure, Options};
 use crate::output;
@@ -18,17 +18,23 @@ use crate::output;
 /// [`Failure::Output`] for a path the policy refuses; [`Failure::Input`] for a file a pass
 /// parameter names that cannot be opened.
 pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
-    if opts.sweep_csv.is_some() && !pm.specs().any(|s| s.name == "sweep") {
-        return Err(Failure::Usage("error: -sweep-csv needs a `sweep` pass in the pipeline\n".into()));
+    if opts.sweep_csv.is_some() && !pm.passes().any(|p| p.makes_csv_table()) {
+        return Err(Failure::Usage(format!(
+            "error: -sweep-csv needs a {} pass in the pipeline (a pass whose results include a CSV table)\n",
+            csv_passes()
+        )));
     }
-    let files: Vec<(&str, &Path)> = [
-        ("-o", opts.output.as_deref().filter(|p| p.as_os_str() != "-")),
-        ("-report", opts.report.as_deref()),
-        ("-sweep-csv", opts.sweep_csv.as_deref()),
-    ]
-    .into_iter()
-    .filter_map(|(flag, p)| p.map(|p| (flag, p)))
-    .collect();
+    let output = opts.output.as_deref().filter(|p| p.as_os_str() != "-");
+    let companions: Vec<PathBuf> = match (output, pm.code_companions()) {
+        (Some(o), Some(exts)) => exts.iter().filter_map(|e| companion_path(o, e)).collect(),
+        _ => Vec::new(),
+    };
+    let files: Vec<(&str, &Path)> =
+        [("-o", output), ("-report", opts.report.as_deref()), ("-sweep-csv", opts.sweep_csv.as_deref())]
+            .into_iter()
+            .filter_map(|(flag, p)| p.map(|p| (flag, p)))
+            .chain(companions.iter().map(|p| ("-o's companion", p.as_path())))
+            .collect();
     for (_, p) in &files {
         output::check_file(p).map_err(output_failure)?;
     }
@@ -45,41 +51,71 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
             }
         }
     }
-    let worst_dirs = pm
-        .specs()
-        .filter(|s| s.name == "accuracy")
-        .filter_map(|s| s.params.iter().find(|(k, _)| k == "worst").and_then(|(_, v)| v.clone()))
-        .filter(|v| !v.is_empty());
-    for d in opts.instr.dump_dir.iter().cloned().chain(worst_dirs.map(PathBuf::from)) {
+    let folders =
+        pass_paths(pm, |k| matches!(k, ParamKind::OutputFolder)).into_iter().map(|(_, _, d)| PathBuf::from(d));
+    for d in opts.instr.dump_dir.iter().cloned().chain(folders) {
         output::check_folder(&d).map_err(output_failure)?;
     }
     check_pass_files(pm)?;
     // `-pareto`'s pipelines: every name, parameter and file they read, before any work too.
     if let Some(text) = &opts.pareto {
-        for (_, other) in crate::pareto::managers(text)? {
+        let managers = robovec_passes::study::pareto::managers(text).map_err(|f| match f {
+            robovec_passes::study::Failure::Usage(s) => Failure::Usage(s),
+            robovec_passes::study::Failure::Input(s) => Failure::Input(s),
+        })?;
+        for (_, other) in managers {
             check_pass_files(&other)?;
         }
     }
     Ok(())
 }
 
-/// Files a pass reads when it runs (`accuracy<params=…>`, `specialize<params=…>`,
-/// `eqsat<rules=…>`) must be readable before any work, so a typo fails at once; the pass
-/// checks their content when it runs.
+/// Where a back end's companion file with extension `ext` goes when the code goes to `output`
+/// (`model.c` → `model.h`): beside it, for a regular file or a path that does not exist yet.
+/// `None` for a device, a FIFO or anything else that is not a regular file (`-o /dev/null`
+/// writes no `/dev/null.h`).
+pub fn companion_path(output: &Path, ext: &str) -> Option<PathBuf> {
+    match std::fs::metadata(output) {
+        Ok(m) if !m.is_file() => None,
+        _ => Some(output.with_extension(ext)),
+    }
+}
+
+/// The registered passes whose artifact has a CSV table, for messages (`` `sweep` ``).
+fn csv_passes() -> String {
+    robovec_passes::PASSES
+        .iter()
+        .filter(|i| (i.build)(&robovec_passes::Params::defaults(i)).is_ok_and(|p| p.makes_csv_table()))
+        .map(|i| format!("`{}`", i.name))
+        .collect::<Vec<_>>()
+        .join(" or ")
+}
+
+/// Every path parameter of the pipeline whose declared kind satisfies `want`: `(pass, key, path)`.
+fn pass_paths(pm: &PassManager, want: impl Fn(&ParamKind) -> bool) -> Vec<(&str, &str, &str)> {
+    let mut out = Vec::new();
+    for spec in pm.specs() {
+        let Some(info) = robovec_passes::pass_info(&spec.name) else { continue };
+        for (key, value) in &spec.params {
+            let Some(decl) = info.params.iter().find(|p| p.name == key) else { continue };
+            if let Some(value) = value.as_deref().filter(|v| !v.is_empty() && want(&decl.kind)) {
+                out.push((spec.name.as_str(), key.as_str(), value));
+            }
+        }
+    }
+    out
+}
+
+/// Files a pass reads when it runs (every parameter declared [`ParamKind::Path`]:
+/// `accuracy<params=…>`, `specialize<params=…>`, `eqsat<rules=…>`) must be readable before
+/// any work, so a typo fails at once; the pass checks their content when it runs.
 ///
 /// # Errors
 /// [`Failure::Input`] naming the pass, the parameter and the file.
 fn check_pass_files(pm: &PassManager) -> Result<(), Failure> {
-    const READ_BY_PASSES: [(&str, &str); 3] = [("accuracy", "params"), ("specialize", "params"), ("eqsat", "rules")];
-    for spec in pm.specs() {
-        for (key, file) in &spec.params {
-            let Some(file) = file.as_deref().filter(|f| !f.is_empty()) else { continue };
-            if READ_BY_PASSES.contains(&(spec.name.as_str(), key.as_str())) {
-                std::fs::File::open(file).map_err(|e| {
-                    Failure::Input(format!("error: pass `{}`: cannot read {key} file `{file}`: {e}\n", spec.name))
-                })?;
-            }
-        }
+    for (pass, key, file) in pass_paths(pm, |k| matches!(k, ParamKind::Path)) {
+        std::fs::File::open(file)
+            .map_err(|e| Failure::Input(format!("error: pass `{pass}`: cannot read {key} file `{file}`: {e}\n")))?;
     }
     Ok(())
 }

@@ -7,6 +7,7 @@
 #![deny(missing_docs)]
 
 pub mod accuracy;
+pub mod artifact;
 pub mod asap_alap;
 pub mod atomise;
 pub mod dag_gen;
@@ -14,12 +15,14 @@ pub mod dce;
 pub mod eqsat;
 pub mod exact;
 pub mod expr_gen;
+pub mod figures;
 pub mod manager;
 pub mod numeric_check;
 pub mod params;
 pub mod pipeline;
 pub mod place;
 pub mod sim;
+pub mod study;
 pub mod sweep;
 pub mod thr;
 
@@ -27,8 +30,9 @@ use robovec_ir::analysis::Latencies;
 use robovec_ir::verifier::VerifierError;
 use robovec_ir::{Module, Phase, Span};
 
+pub use artifact::{Artifact, ArtifactFile, GeneratedCode, Merge, Produced, ReportEntry};
 pub use manager::{DumpSink, Instrumentation, PassManager, PassRecord, PrintSelector};
-pub use params::{ParamInfo, Params};
+pub use params::{ParamInfo, ParamKind, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
 
 /// What a pass may fail with.
@@ -140,22 +144,17 @@ impl PassError {
 }
 
 /// State that passes share across one pipeline run.
-#[derive(Clone, Debug, Default)]
+///
+/// Results a pass makes for the user (tables, figures, files, generated code) are not fields
+/// here: the pass hands them over as [`Artifact`]s with [`PassContext::emit`].
+#[derive(Debug, Default)]
 pub struct PassContext {
     /// Latencies of the last `asap-alap` or `place` run (defaults otherwise); used for the
     /// report's stats and by `sweep`.
     pub latencies: Latencies,
-    /// Rows of every `sweep` run.
-    pub sweep: Vec<sweep::SweepRow>,
-    /// What every `eqsat` run did, one entry per function (printed by `-stats`).
-    pub eqsat: Vec<eqsat::EqsatStats>,
     /// One line per run of a rewriting pass saying what it changed (ops added or removed,
     /// critical path before and after); the driver prints them with `-stats`.
     pub notes: Vec<String>,
-    /// One report per function of every `accuracy` run.
-    pub accuracy: Vec<accuracy::AccuracyReport>,
-    /// What every `sim` run checked, one entry per run (printed by `-stats`, reported).
-    pub sim: Vec<sim::SimStats>,
     /// `-time-limit=SECONDS`: the instant by which the pipeline should end, with the limit it
     /// came from. Passes with long loops (eqsat's windows, place's restarts and search, sweep's
     /// configurations) check [`PassContext::out_of_time`] between steps, stop early with a valid
@@ -170,6 +169,11 @@ pub struct PassContext {
     /// against (issue 10). The manager sets it when a pass asks for it
     /// ([`Pass::needs_original`]) and it is not set yet (`-pareto` presets it).
     pub original: Option<robovec_ir::Module>,
+    /// What the passes produced, in the order they produced it (see [`crate::artifact`]).
+    pub artifacts: Vec<Produced>,
+    /// Index in the pipeline of the pass running now (set by the manager; `None` outside a
+    /// pipeline), recorded with every artifact.
+    pub pass_index: Option<usize>,
 }
 
 /// A wall-clock limit on a pipeline run (`-time-limit=SECONDS`).
@@ -224,6 +228,22 @@ impl PassContext {
     pub fn note_stop(&mut self, pass: &str, what: &str) {
         self.stopped.push(format!("{pass} stopped {what}"));
     }
+
+    /// Hands over a result of the running pass (see [`crate::artifact`]).
+    pub fn emit(&mut self, artifact: impl Artifact + 'static) {
+        self.artifacts.push(Produced { pass_index: self.pass_index, artifact: Box::new(artifact) });
+    }
+
+    /// The artifacts produced so far, in order.
+    pub fn artifacts(&self) -> impl Iterator<Item = &dyn Artifact> {
+        self.artifacts.iter().map(|p| p.artifact.as_ref())
+    }
+
+    /// The artifacts of type `T` produced so far, in order (for tests and for passes that read
+    /// an earlier pass's result).
+    pub fn artifacts_of<T: Artifact + 'static>(&self) -> impl Iterator<Item = &T> {
+        self.artifacts.iter().filter_map(|p| (p.artifact.as_ref() as &dyn std::any::Any).downcast_ref::<T>())
+    }
 }
 
 /// A transformation or analysis over a whole module (`Debug` shows its options).
@@ -248,6 +268,16 @@ pub trait Pass: std::fmt::Debug {
     /// the module as it entered the pipeline).
     fn needs_original(&self) -> bool {
         false
+    }
+    /// True when the pass's artifact has a CSV table (what `-sweep-csv=FILE` writes).
+    fn makes_csv_table(&self) -> bool {
+        false
+    }
+    /// For a back end: the extensions of the companion files of the code it generates (`["h"]`
+    /// for C's header). A pipeline whose last pass returns `Some` writes that pass's code with
+    /// `-o FILE` instead of the IR, and the companions beside `FILE` (SPEC §8).
+    fn code_companions(&self) -> Option<&'static [&'static str]> {
+        None
     }
 }
 

@@ -141,6 +141,22 @@ impl PassManager {
         self.passes.iter().map(|(s, _)| s)
     }
 
+    /// The built passes, in order.
+    pub fn passes(&self) -> impl Iterator<Item = &dyn Pass> {
+        self.passes.iter().map(|(_, p)| p.as_ref())
+    }
+
+    /// When the pipeline ends in a back end ([`Pass::code_companions`]): the extensions of the
+    /// companion files of its code. `-o FILE` then receives the code, not the IR.
+    pub fn code_companions(&self) -> Option<&'static [&'static str]> {
+        self.passes.last().and_then(|(_, p)| p.code_companions())
+    }
+
+    /// Index of the last pipeline element (the one whose code `-o` writes).
+    pub fn last_index(&self) -> Option<usize> {
+        self.passes.len().checked_sub(1)
+    }
+
     /// Runs the pipeline on `m`; IR prints and the timing table go to `log`. With `dump_dir`
     /// set, use [`PassManager::run_with_dumps`] (this one fails at the first dump).
     ///
@@ -185,7 +201,10 @@ impl PassManager {
             }
             let ops_before = module_ops(m);
             let t0 = Instant::now();
-            pass.run(m, cx)?;
+            cx.pass_index = Some(i);
+            let ran = pass.run(m, cx);
+            cx.pass_index = None;
+            ran?;
             let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
             if !pass.preserves_timing() {
                 m.functions.iter_mut().for_each(|f| f.clear_timing());

@@ -62,8 +62,12 @@ pub enum ParamKind {
         /// Value when the parameter is not given.
         default: bool,
     },
-    /// A file or folder path; nothing when not given.
+    /// A file the pass reads; nothing when not given. `robovec-opt` checks it can be opened
+    /// before any work.
     Path,
+    /// A folder the pass writes files into; nothing when not given. `robovec-opt` checks it
+    /// under its output policy before any work, and creates it with the run's other outputs.
+    OutputFolder,
     /// A comma-separated, non-empty list of integers, each in `min..=max`.
     U32List {
         /// The list used when the parameter is not given (comma-separated).
@@ -100,7 +104,7 @@ impl ParamInfo {
             ParamKind::F64 { default, .. } => format!("{default}"),
             ParamKind::Choice { default, .. } => default.to_string(),
             ParamKind::Flag { default } => if default { "on" } else { "off" }.to_string(),
-            ParamKind::Path => "none".to_string(),
+            ParamKind::Path | ParamKind::OutputFolder => "none".to_string(),
             ParamKind::U32List { default, .. } => default.to_string(),
             ParamKind::Names => "all".to_string(),
         }
@@ -109,7 +113,7 @@ impl ParamInfo {
     /// True when [`ParamInfo::default_text`] is a value the parameter accepts (giving it
     /// explicitly changes nothing).
     pub fn default_is_literal(&self) -> bool {
-        !matches!(self.kind, ParamKind::U32Or { .. } | ParamKind::Path | ParamKind::Names)
+        !matches!(self.kind, ParamKind::U32Or { .. } | ParamKind::Path | ParamKind::OutputFolder | ParamKind::Names)
     }
 
     /// The accepted values, as `--print-passes` shows them (`2..=64`, `on|off`).
@@ -121,6 +125,7 @@ impl ParamInfo {
             ParamKind::Choice { choices, .. } => choices.join("|"),
             ParamKind::Flag { .. } => "on|off".to_string(),
             ParamKind::Path => "path".to_string(),
+            ParamKind::OutputFolder => "folder".to_string(),
             ParamKind::U32List { min, max, .. } => format!("list of {min}..={max}"),
             ParamKind::Names => "list of names".to_string(),
         }
@@ -367,12 +372,14 @@ impl Params {
         }
     }
 
-    /// A `Path` parameter: the path given, if any.
+    /// A `Path` or `OutputFolder` parameter: the path given, if any.
     ///
     /// # Errors
     /// [`PassError::BadParameter`] when it is empty.
     pub fn path(&self, key: &str) -> Result<Option<String>, PassError> {
-        let ParamKind::Path = self.decl(key) else { panic!("parameter `{key}` of `{}` is not a path", self.pass) };
+        let (ParamKind::Path | ParamKind::OutputFolder) = self.decl(key) else {
+            panic!("parameter `{key}` of `{}` is not a path", self.pass)
+        };
         match self.get(key) {
             None => Ok(None),
             Some("") => Err(PassError::BadParameter {
@@ -468,7 +475,7 @@ mod tests {
                     }
                     _ => {}
                 }
-                if !matches!(p.kind, ParamKind::Path | ParamKind::Names) {
+                if !matches!(p.kind, ParamKind::Path | ParamKind::OutputFolder | ParamKind::Names) {
                     assert!(ok("x").is_err(), "{} {}=x accepted", info.name, p.name);
                 }
             }

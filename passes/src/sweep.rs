@@ -114,6 +114,10 @@ impl Pass for Sweep {
         true
     }
 
+    fn makes_csv_table(&self) -> bool {
+        true
+    }
+
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         // The seed's algorithm alone (improve = 0) for the Table 2.2 / Fig. 2.4–2.7 comparisons,
         // then robovec's default (forward-backward improvement).
@@ -125,6 +129,7 @@ impl Pass for Sweep {
         ];
         let total = m.functions.len() * self.ns.len() * configs.len();
         let mut done = 0usize;
+        let mut rows = Vec::new();
         for f in &m.functions {
             let ops = f.op_counts().total;
             let (n_add_side, n_mul) = ops_per_side(f);
@@ -132,6 +137,7 @@ impl Pass for Sweep {
                 for (priority, select, improve, pname, sname) in configs {
                     if let Some(d) = cx.deadline.filter(|d| d.reached()) {
                         cx.note_stop("sweep", &format!("after {done} of {total} configurations: {}", d.reason()));
+                        cx.emit(SweepTable { rows });
                         return Ok(());
                     }
                     done += 1;
@@ -159,7 +165,7 @@ impl Pass for Sweep {
                     let side = |k: u64, lat: u32| if k == 0 { 0 } else { (k.div_ceil(n as u64) - 1) as u32 + lat };
                     let na = n as usize;
                     let indirect = p.writes.iter().filter(|w| w.buffer_addr.is_some()).count() as u64;
-                    cx.sweep.push(SweepRow {
+                    rows.push(SweepRow {
                         function: f.name.clone(),
                         n,
                         priority: pname,
@@ -181,7 +187,39 @@ impl Pass for Sweep {
                 }
             }
         }
+        cx.emit(SweepTable { rows });
         Ok(())
+    }
+}
+
+/// What one `sweep` run measured: its rows, printed as a table on stderr, written as CSV with
+/// `-sweep-csv`, and listed in the report's `sweep` (rows of the reported function).
+#[derive(Clone, Debug)]
+pub struct SweepTable {
+    /// One row per function, N and configuration, in the order measured.
+    pub rows: Vec<SweepRow>,
+}
+
+impl crate::Artifact for SweepTable {
+    fn pass(&self) -> &'static str {
+        "sweep"
+    }
+
+    fn log_text(&self, _detail: bool) -> String {
+        if self.rows.is_empty() {
+            String::new()
+        } else {
+            to_table(&self.rows)
+        }
+    }
+
+    fn report(&self, function: &str) -> Option<crate::ReportEntry> {
+        let rows: Vec<&SweepRow> = self.rows.iter().filter(|r| r.function == function).collect();
+        Some(crate::ReportEntry::new("sweep", &rows, crate::Merge::Append))
+    }
+
+    fn csv(&self) -> Option<String> {
+        Some(to_csv(&self.rows))
     }
 }
 

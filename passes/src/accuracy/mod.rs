@@ -124,7 +124,7 @@ pub const INFO: PassInfo = PassInfo {
         },
         ParamInfo {
             name: "worst",
-            kind: ParamKind::Path,
+            kind: ParamKind::OutputFolder,
             doc: "folder for worst-K.json, the worst points in -eval's input format",
         },
         ParamInfo {
@@ -202,6 +202,7 @@ impl Pass for Accuracy {
             }
         }
         let fail = |message: String| PassError::Failed { pass: "accuracy".into(), message };
+        let mut reports = Vec::new();
         for f in &m.functions {
             let original = match &cx.original {
                 None => None,
@@ -214,8 +215,9 @@ impl Pass for Accuracy {
             };
             // An early stop (work budget or `-time-limit`) is in the report's
             // `accuracy.stopped_early` and printed with the accuracy summary.
-            cx.accuracy.push(measure_against(f, original, &o).map_err(fail)?);
+            reports.push(measure_against(f, original, &o).map_err(fail)?);
         }
+        cx.emit(report::AccuracyRun { reports });
         Ok(())
     }
 

@@ -274,3 +274,38 @@ pub fn worst_files(r: &AccuracyReport, prefix: bool) -> Vec<(String, String)> {
         })
         .collect()
 }
+
+/// What one `accuracy` run measured, one report per function: its summary lines on stderr
+/// (per-output lines under `-stats`), the report's `accuracy` (the last measurement of the
+/// reported function) and the `worst-K.json` files of `accuracy<worst=DIR>`.
+#[derive(Clone, Debug)]
+pub struct AccuracyRun {
+    /// One report per function, in module order.
+    pub reports: Vec<AccuracyReport>,
+}
+
+impl crate::Artifact for AccuracyRun {
+    fn pass(&self) -> &'static str {
+        "accuracy"
+    }
+
+    fn log_text(&self, detail: bool) -> String {
+        to_text(&self.reports, detail)
+    }
+
+    fn report(&self, function: &str) -> Option<crate::ReportEntry> {
+        let r = self.reports.iter().rev().find(|r| r.function == function)?;
+        Some(crate::ReportEntry::new("accuracy", r, crate::Merge::Last))
+    }
+
+    fn files(&self, several_functions: bool) -> Vec<crate::ArtifactFile> {
+        let mut out = Vec::new();
+        for r in &self.reports {
+            let Some(dir) = &r.worst_dir else { continue };
+            for (name, json) in worst_files(r, several_functions) {
+                out.push(crate::ArtifactFile { path: std::path::Path::new(dir).join(name), bytes: json.into_bytes() });
+            }
+        }
+        out
+    }
+}

@@ -158,6 +158,7 @@ impl Pass for Eqsat {
                 .map_err(|message| PassError::Failed { pass: "eqsat".into(), message })?;
             rules.extend(extra);
         }
+        let mut runs = Vec::new();
         for f in &mut m.functions {
             let stats = eqsat_function_within(f, &self.opts, &rules, cx.deadline);
             if let Some(why) = &stats.stopped_early {
@@ -165,8 +166,32 @@ impl Pass for Eqsat {
                     format!("after {} of {} windows of @{}: {why}", stats.windows_tried, stats.windows_total, f.name);
                 cx.note_stop("eqsat", &what);
             }
-            cx.eqsat.push(stats);
+            runs.push(stats);
         }
+        cx.emit(EqsatRun { functions: runs });
         Ok(())
+    }
+}
+
+/// What one `eqsat` run did, one entry per function: printed by `-stats`, listed in the
+/// report's `eqsat` (entries of the reported function).
+#[derive(Clone, Debug)]
+pub struct EqsatRun {
+    /// Per function: windows, stop reasons, time per window, critical path before and after.
+    pub functions: Vec<EqsatStats>,
+}
+
+impl crate::Artifact for EqsatRun {
+    fn pass(&self) -> &'static str {
+        "eqsat"
+    }
+
+    fn stats_text(&self, function: Option<&str>) -> String {
+        self.functions.iter().filter(|e| function.is_none_or(|n| n == e.function)).map(|e| format!("{e}\n")).collect()
+    }
+
+    fn report(&self, function: &str) -> Option<crate::ReportEntry> {
+        let runs: Vec<&EqsatStats> = self.functions.iter().filter(|e| e.function == function).collect();
+        Some(crate::ReportEntry::new("eqsat", &runs, crate::Merge::Append))
     }
 }

@@ -21,6 +21,7 @@
 pub mod bound;
 pub mod feed;
 pub mod memory;
+pub mod report;
 pub mod schedule;
 pub mod search;
 

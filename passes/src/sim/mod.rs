@@ -269,7 +269,7 @@ impl Pass for Sim {
                 writes_indirect: r.writes_indirect,
             });
         }
-        cx.sim.push(SimStats {
+        cx.emit(SimStats {
             placements: functions.len(),
             seeds: self.seeds,
             precisions: vec!["f32", "f64"],
@@ -277,6 +277,22 @@ impl Pass for Sim {
             functions,
         });
         Ok(())
+    }
+}
+
+impl crate::Artifact for SimStats {
+    fn pass(&self) -> &'static str {
+        "sim"
+    }
+
+    fn stats_text(&self, _function: Option<&str>) -> String {
+        format!("{self}\n")
+    }
+
+    fn report(&self, function: &str) -> Option<crate::ReportEntry> {
+        let mut s = self.clone();
+        s.functions.retain(|x| x.function == function);
+        Some(crate::ReportEntry::new("sim", &s, crate::Merge::Last))
     }
 }
 

@@ -1,14 +1,14 @@
 //! `-check`: after the pipeline, every function (or the one `-function` names) must keep the
-//! numeric property of `robovec_passes::accuracy::check` against the module as it entered the
+//! numeric property of [`crate::accuracy::check`] against the module as it entered the
 //! pipeline; the first output that breaks it ends the run with exit 1 (bad input: the rules
 //! or passes changed the mathematics), before any output file is written.
 
 use std::io::Write;
 
 use robovec_ir::Module;
-use robovec_passes::accuracy::check::{check_function, pipeline_is_bit_exact};
 
-use crate::driver::Failure;
+use super::Failure;
+use crate::accuracy::check::{check_function, pipeline_is_bit_exact};
 
 /// Checks `after` against `original` at `samples` points of `seed`; one line per function on
 /// `stderr` when it passes.

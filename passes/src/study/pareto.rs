@@ -21,13 +21,13 @@
 //! pipeline that fails on the input is bad input (exit 1).
 
 use robovec_ir::{Function, Module};
-use robovec_passes::accuracy::check::{check_function, pipeline_is_bit_exact};
-use robovec_passes::accuracy::{measure_against, BitsSummary, Options as AccuracyOptions};
-use robovec_passes::{Instrumentation, PassContext, PassManager};
 use serde::Serialize;
 
-use crate::driver::Failure;
-use crate::report::stats;
+use super::Failure;
+use crate::accuracy::check::{check_function, pipeline_is_bit_exact};
+use crate::accuracy::{measure_against, BitsSummary, Options as AccuracyOptions};
+use crate::figures::stats;
+use crate::{Instrumentation, PassContext, PassManager};
 
 /// One pipeline's figures.
 #[derive(Clone, Debug, Serialize)]
@@ -134,11 +134,43 @@ pub fn managers(text: &str) -> Result<Vec<(String, PassManager)>, Failure> {
         .collect()
 }
 
+/// The rows of one `-pareto` study of one function: the table on stderr and the report's
+/// `pareto`.
+#[derive(Clone, Debug)]
+pub struct ParetoStudy {
+    /// The function measured.
+    pub function: String,
+    /// One row per pipeline, in the order given.
+    pub rows: Vec<ParetoRow>,
+}
+
+impl crate::Artifact for ParetoStudy {
+    fn pass(&self) -> &'static str {
+        "-pareto"
+    }
+
+    fn log_text(&self, _detail: bool) -> String {
+        to_table(&self.function, &self.rows)
+    }
+
+    fn report(&self, function: &str) -> Option<crate::ReportEntry> {
+        (function == self.function).then(|| crate::ReportEntry::new("pareto", &self.rows, crate::Merge::Last))
+    }
+}
+
 /// Runs every pipeline of `text` on a copy of `module` and measures function `function`.
 /// `module` must be verified (the driver's `load` does it): the pipelines do not check it again.
 ///
 /// # Errors
 /// [`Failure::Usage`] for a bad pipeline, [`Failure::Input`] when a pipeline fails.
+pub fn study(module: &Module, function: &str, text: &str, samples: u32, seed: u64) -> Result<ParetoStudy, Failure> {
+    Ok(ParetoStudy { function: function.to_string(), rows: run(module, function, text, samples, seed)? })
+}
+
+/// The rows of [`study`].
+///
+/// # Errors
+/// As [`study`].
 pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64) -> Result<Vec<ParetoRow>, Failure> {
     let original =
         module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
@@ -154,7 +186,7 @@ pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64)
             .function(function)
             .ok_or_else(|| Failure::Input(format!("error: -pareto pipeline `{p}` removed function @{function}\n")))?;
         let s = stats(f, &cx.latencies);
-        let placed = f.placement.as_ref().map(|pl| (pl.arch.n_add, robovec_passes::place::cycles(f, pl)));
+        let placed = f.placement.as_ref().map(|pl| (pl.arch.n_add, crate::place::cycles(f, pl)));
         let fail = |e: String| Failure::Input(format!("error: -pareto pipeline `{p}`: {e}\n"));
         let acc = measure_against(f, Some(original), &opts).map_err(fail)?;
         let check = check_function(f, original, pipeline_is_bit_exact(p), samples, seed).map_err(fail)?;

@@ -1,0 +1,16 @@
+//! Studies over a whole run rather than passes of a pipeline: `-pareto` (several pipelines on
+//! the same input, speed against error) and `-check` (the final IR against the input's error
+//! budget). They return artifacts or lines like passes do, and fail with a [`Failure`] whose
+//! text is ready for stderr.
+
+pub mod check;
+pub mod pareto;
+
+/// Why a study failed; the text is one or more lines ready for stderr (ending in a newline).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Failure {
+    /// Bad usage (exit status 2): a pipeline that does not parse, an unknown pass.
+    Usage(String),
+    /// Bad input (exit status 1): a pipeline that fails on the input, a violated error budget.
+    Input(String),
+}
