@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use clap::{ArgAction, Parser};
 use robovec_passes::{Instrumentation, PrintSelector, PASSES};
 
-use crate::driver::Options;
+use crate::options::Options;
 
 /// `robovec-opt INPUT -passes=PIPELINE [options]`
 #[derive(Parser, Debug)]

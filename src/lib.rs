@@ -8,6 +8,7 @@ pub mod cli;
 pub mod diagnostics;
 pub mod driver;
 pub mod front;
+pub mod options;
 pub mod output;
 pub mod preflight;
 pub mod report;

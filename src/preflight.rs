@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use robovec_ir::Module;
 use robovec_passes::{ParamKind, PassManager};
 
-use crate::driver::{output_failure, select, Failure, Options};
+use crate::options::{output_failure, select, Failure, Options};
 use crate::output;
 
 /// Checks every option against the pipeline and every output path and folder under the output
