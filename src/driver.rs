@@ -194,8 +194,8 @@ fn run_passes(
     let mut cx = PassContext { original: opts.check.map(|_| module.clone()), deadline, ..PassContext::default() };
     if let Some(text) = &opts.pareto {
         let name = select(module, &opts.function, "-pareto")?.name.clone();
-        let study =
-            study::pareto::study(module, &name, text, opts.pareto_samples, opts.pareto_seed).map_err(study_failure)?;
+        let study = study::pareto::study(module, &name, text, opts.pareto_samples, opts.pareto_seed, deadline)
+            .map_err(study_failure)?;
         cx.emit(study);
     }
     let records = {
@@ -287,6 +287,24 @@ fn generated_code<'a>(pm: &PassManager, ran: &'a Ran) -> Result<Option<&'a Gener
         .ok_or_else(|| Failure::Input("error: the pipeline's last pass is a back end but generated no code\n".into()))
 }
 
+/// The CSV tables of several artifacts as one file: a header line equal to the first table's is
+/// written once.
+fn join_csv(tables: impl Iterator<Item = String>) -> String {
+    let mut out = String::new();
+    let mut header: Option<String> = None;
+    for t in tables {
+        let (first, rest) = t.split_once('\n').unwrap_or((&t, ""));
+        match &header {
+            Some(h) if h == first => out += rest,
+            _ => {
+                header.get_or_insert_with(|| first.to_string());
+                out += &t;
+            }
+        }
+    }
+    out
+}
+
 /// Renders every output in memory, stages every file in `out`, commits them at once, then
 /// writes stdout.
 #[allow(clippy::too_many_arguments)]
@@ -328,8 +346,7 @@ fn write_outputs(
         }
     }
     if let Some(path) = &opts.sweep_csv {
-        let csv: String = cx.artifacts().filter_map(|a| a.csv()).collect();
-        out.stage(path, csv.as_bytes()).map_err(output_failure)?;
+        out.stage(path, join_csv(cx.artifacts().filter_map(|a| a.csv())).as_bytes()).map_err(output_failure)?;
     }
     if let (Some(path), Some(r)) = (&opts.report, &report) {
         out.stage(path, r.as_bytes()).map_err(output_failure)?;

@@ -163,3 +163,32 @@ fn time_limit_stops_accuracy_with_its_figures_and_a_note() {
     assert!((1..10_000_000).contains(&samples), "{samples} samples measured");
     assert!(r["accuracy"]["f32"]["mean_bits"].as_f64().unwrap().is_finite());
 }
+
+#[test]
+fn time_limit_stops_pareto_measurements_with_a_note_per_pipeline() {
+    let d = tmp("pareto_limit");
+    let report = d.join("r.json");
+    let example =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/double_pendulum/mbs_invdyna_double_pendulum.c");
+    let o = opt(&[
+        example.to_str().unwrap(),
+        "-passes=atomise",
+        "-pareto=atomise;atomise,balance",
+        "-pareto-samples=10000000",
+        "-time-limit=1",
+        &format!("-report={}", report.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    for p in ["atomise", "atomise,balance"] {
+        assert!(err.contains(&format!("note: -pareto pipeline {p}: accuracy stopped early: time limit")), "{err}");
+    }
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    for row in r["pareto"].as_array().unwrap() {
+        let samples = row["samples"].as_u64().unwrap();
+        assert!((1..10_000_000).contains(&samples), "{samples} samples measured");
+        assert!(row["stopped_early"][0].as_str().unwrap().starts_with("accuracy stopped early: time limit"));
+    }
+}

@@ -6,6 +6,7 @@
 mod common;
 
 mod accuracy;
+mod artifacts;
 mod bounds;
 mod cli;
 mod corpus;

@@ -62,6 +62,10 @@ pub struct ParetoRow {
     pub violation: Option<String>,
     /// User callbacks evaluated with the interpreter's stand-in.
     pub callback_standins: Vec<String>,
+    /// Passes of this pipeline, and its accuracy measurement, that stopped early under
+    /// `-time-limit` or a work budget, one line each (absent when none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stopped_early: Vec<String>,
     /// True when no other row dominates this one (never for a row that is not sound).
     pub pareto_optimal: bool,
 }
@@ -163,23 +167,39 @@ impl crate::Artifact for ParetoStudy {
 ///
 /// # Errors
 /// [`Failure::Usage`] for a bad pipeline, [`Failure::Input`] when a pipeline fails.
-pub fn study(module: &Module, function: &str, text: &str, samples: u32, seed: u64) -> Result<ParetoStudy, Failure> {
-    Ok(ParetoStudy { function: function.to_string(), rows: run(module, function, text, samples, seed)? })
+pub fn study(
+    module: &Module,
+    function: &str,
+    text: &str,
+    samples: u32,
+    seed: u64,
+    deadline: Option<crate::Deadline>,
+) -> Result<ParetoStudy, Failure> {
+    Ok(ParetoStudy { function: function.to_string(), rows: run(module, function, text, samples, seed, deadline)? })
 }
 
-/// The rows of [`study`].
+/// The rows of [`study`]. Under `-time-limit` (`deadline`), each pipeline and measurement stops
+/// early as in a normal run (a valid result, fewer samples) and its row says so in
+/// `stopped_early`; the pipelines after the limit still run their passes' minimal work.
 ///
 /// # Errors
 /// As [`study`].
-pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64) -> Result<Vec<ParetoRow>, Failure> {
+pub fn run(
+    module: &Module,
+    function: &str,
+    text: &str,
+    samples: u32,
+    seed: u64,
+    deadline: Option<crate::Deadline>,
+) -> Result<Vec<ParetoRow>, Failure> {
     let original =
         module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
     let (pipelines, managers): (Vec<String>, Vec<PassManager>) = managers(text)?.into_iter().unzip();
-    let opts = AccuracyOptions { samples, seed, ..AccuracyOptions::default() };
+    let opts = AccuracyOptions { samples, seed, deadline: deadline.map(|d| d.at), ..AccuracyOptions::default() };
     let mut rows = Vec::new();
     for (p, pm) in pipelines.iter().zip(&managers) {
         let mut m = module.clone();
-        let mut cx = PassContext { original: Some(module.clone()), ..PassContext::default() };
+        let mut cx = PassContext { original: Some(module.clone()), deadline, ..PassContext::default() };
         pm.run(&mut m, &mut cx, &mut std::io::sink())
             .map_err(|e| Failure::Input(format!("error: -pareto pipeline `{p}`: {e}\n")))?;
         let f: &Function = m
@@ -189,7 +209,9 @@ pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64)
         let placed = f.placement.as_ref().map(|pl| (pl.arch.n_add, crate::place::cycles(f, pl)));
         let fail = |e: String| Failure::Input(format!("error: -pareto pipeline `{p}`: {e}\n"));
         let acc = measure_against(f, Some(original), &opts).map_err(fail)?;
-        let check = check_function(f, original, pipeline_is_bit_exact(p), samples, seed).map_err(fail)?;
+        // The same points as the measurement (fewer when it stopped early under `-time-limit`).
+        let measured = u32::try_from(acc.samples).unwrap_or(samples).min(samples);
+        let check = check_function(f, original, pipeline_is_bit_exact(p), measured, seed).map_err(fail)?;
         rows.push(ParetoRow {
             pipeline: pm.pipeline_text(),
             ops: s.ops.total,
@@ -205,6 +227,12 @@ pub fn run(module: &Module, function: &str, text: &str, samples: u32, seed: u64)
             sound: check.violation.is_none(),
             violation: check.violation.map(|v| v.to_string()),
             callback_standins: acc.callback_standins,
+            stopped_early: cx
+                .stopped
+                .iter()
+                .cloned()
+                .chain(acc.stopped_early.map(|w| format!("accuracy stopped early: {w}")))
+                .collect(),
             pareto_optimal: false,
         });
     }
@@ -251,6 +279,9 @@ pub fn to_table(function: &str, rows: &[ParetoRow]) -> String {
         if let Some(v) = &r.violation {
             s += &format!("! {}: {v}\n", r.pipeline);
         }
+        for w in &r.stopped_early {
+            s += &format!("note: -pareto pipeline {}: {w}\n", r.pipeline);
+        }
         for c in &r.callback_standins {
             s += &format!(
                 "warning: @{function} calls user callback `{c}`; evaluated with the stand-in (pipeline {})\n",
@@ -286,6 +317,7 @@ mod tests {
             sound,
             violation: None,
             callback_standins: Vec::new(),
+            stopped_early: Vec::new(),
             pareto_optimal: false,
         }
     }
