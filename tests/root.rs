@@ -15,6 +15,7 @@ mod error_reference;
 mod exact_gap;
 mod example;
 mod filetests;
+mod inline_specialize;
 mod numerics;
 #[cfg(unix)]
 mod outputs;
@@ -23,5 +24,4 @@ mod placement;
 mod placement_verify;
 mod props;
 mod roundtrip;
-mod thr;
-mod thr_passes;
+mod tree_height;
