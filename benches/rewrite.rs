@@ -19,8 +19,8 @@ use std::time::{Duration, Instant};
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use robovec_ir::analysis::Latencies;
 use robovec_ir::Function;
-use robovec_passes::dag_gen::generate;
 use robovec_passes::tree_height::{rewrite, Shape};
+use robovec_testkit::dag_gen::generate;
 
 #[path = "common.rs"]
 mod common;

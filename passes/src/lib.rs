@@ -9,14 +9,10 @@
 pub mod accuracy;
 pub mod asap_alap;
 pub mod atomise;
-pub mod dag_gen;
 pub mod dce;
 pub mod eqsat;
-pub mod exact;
-pub mod expr_gen;
 pub mod inline;
 pub mod manager;
-pub mod numeric_check;
 pub mod params;
 pub mod pipeline;
 pub mod place;
