@@ -20,8 +20,8 @@ use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use robovec_ir::Function;
-use robovec_passes::dag_gen::generate;
 use robovec_passes::place::{cycles, place_function, PlaceOptions};
+use robovec_testkit::dag_gen::generate;
 
 #[path = "common.rs"]
 mod common;

@@ -1,4 +1,4 @@
-//! Speed of the cluster rewrites `zero-removal` and `balance` (`robovec_passes::thr::rewrite`,
+//! Speed of the cluster rewrites `zero-removal` and `balance` (`robovec_passes::tree_height::rewrite`,
 //! what the passes run per function, including the whole-function contract check) on
 //!
 //! - `walkman`: the largest corpus file, the Matlab direct dynamics of WALK-MAN
@@ -19,8 +19,8 @@ use std::time::{Duration, Instant};
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use robovec_ir::analysis::Latencies;
 use robovec_ir::Function;
-use robovec_passes::dag_gen::generate;
-use robovec_passes::thr::{rewrite, Shape};
+use robovec_passes::tree_height::{rewrite, Shape};
+use robovec_testkit::dag_gen::generate;
 
 #[path = "common.rs"]
 mod common;

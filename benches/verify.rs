@@ -16,8 +16,8 @@ use std::time::Instant;
 
 use robovec_ir::verifier::{placement::verify_placement, verify_function};
 use robovec_ir::Function;
-use robovec_passes::dag_gen::generate;
 use robovec_passes::place::{place_function, PlaceOptions};
+use robovec_testkit::dag_gen::generate;
 
 #[path = "common.rs"]
 mod common;

@@ -9,11 +9,12 @@
 //! (`cargo test --test root exact_gap -- --nocapture`).
 
 use robovec_ir::analysis::Latencies;
+use robovec_ir::rng::SplitMix64;
 use robovec_ir::verifier::verify_function;
 use robovec_ir::{BinOp, Def, Function, Operand, Phase, Span, Value};
-use robovec_passes::dag_gen::{generate, SplitMix64};
-use robovec_passes::exact::optimal_cycles;
 use robovec_passes::place::{cycles, lower_bound, place_function, tight_lower_bound, PlaceOptions, Priority, Select};
+use robovec_testkit::dag_gen::generate;
+use robovec_testkit::exact::optimal_cycles;
 
 /// A random layered DAG of `m` ops (add/sub/mul): ops sorted into 3–6 levels; an op's first
 /// operand is an op of an earlier level (90 %, mostly the level just before), its second one

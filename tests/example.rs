@@ -5,6 +5,7 @@
 
 use std::collections::HashMap;
 
+use robovec_ir::rng::SplitMix64;
 use robovec_ir::{interp, verifier, Function, Phase};
 use robovec_passes::atomise::atomise_function;
 
@@ -12,42 +13,29 @@ fn example_path() -> String {
     format!("{}/examples/double_pendulum/mbs_invdyna_double_pendulum.c", env!("CARGO_MANIFEST_DIR"))
 }
 
-/// splitmix64: a small deterministic generator, enough for sampling states.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [lo, hi).
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
-    }
+/// Uniform in [lo, hi).
+fn range(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
+    lo + (hi - lo) * rng.unit()
 }
 
 /// One sampled state and parameter set, by canonical input name (SPEC §2).
-fn sample(rng: &mut Rng) -> HashMap<&'static str, f64> {
+fn sample(rng: &mut SplitMix64) -> HashMap<&'static str, f64> {
     let pi = std::f64::consts::PI;
     HashMap::from([
-        ("q[1]", rng.range(-pi, pi)),
-        ("q[2]", rng.range(-pi, pi)),
-        ("qd[1]", rng.range(-3.0, 3.0)),
-        ("qd[2]", rng.range(-3.0, 3.0)),
-        ("qdd[1]", rng.range(-5.0, 5.0)),
-        ("qdd[2]", rng.range(-5.0, 5.0)),
-        ("m[1]", rng.range(0.1, 5.0)),
-        ("m[2]", rng.range(0.1, 5.0)),
-        ("l[2][1]", rng.range(0.05, 1.5)),
-        ("l[2][2]", rng.range(0.05, 1.5)),
-        ("dpt[2][2]", rng.range(0.1, 2.0)),
-        ("In[1][1]", rng.range(0.01, 1.0)),
-        ("In[1][2]", rng.range(0.01, 1.0)),
-        ("g[3]", rng.range(-12.0, 12.0)),
+        ("q[1]", range(rng, -pi, pi)),
+        ("q[2]", range(rng, -pi, pi)),
+        ("qd[1]", range(rng, -3.0, 3.0)),
+        ("qd[2]", range(rng, -3.0, 3.0)),
+        ("qdd[1]", range(rng, -5.0, 5.0)),
+        ("qdd[2]", range(rng, -5.0, 5.0)),
+        ("m[1]", range(rng, 0.1, 5.0)),
+        ("m[2]", range(rng, 0.1, 5.0)),
+        ("l[2][1]", range(rng, 0.05, 1.5)),
+        ("l[2][2]", range(rng, 0.05, 1.5)),
+        ("dpt[2][2]", range(rng, 0.1, 2.0)),
+        ("In[1][1]", range(rng, 0.01, 1.0)),
+        ("In[1][2]", range(rng, 0.01, 1.0)),
+        ("g[3]", range(rng, -12.0, 12.0)),
     ])
 }
 
@@ -126,7 +114,7 @@ fn example_matches_lagrangian_model() {
     let f = load_example();
     let a = atomise_function(&f);
     assert!(verifier::verify_function(&a).is_empty(), "atomised example does not verify");
-    let mut rng = Rng(0x5eed_d0b1_e9e7_d01d);
+    let mut rng = SplitMix64::new(0x5eed_d0b1_e9e7_d01d);
     for k in 0..64 {
         let x = sample(&mut rng);
         let want = lagrange(&x);

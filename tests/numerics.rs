@@ -8,11 +8,11 @@ use proptest::test_runner::Config;
 use robovec_ir::interp::{eval, pseudo_random_input};
 use robovec_ir::numerics::reference::{eval_big, BIG_BITS};
 use robovec_ir::numerics::{Reference, Tape};
+use robovec_ir::rng::SplitMix64;
 use robovec_ir::Function;
 use robovec_passes::atomise::atomise_function;
-use robovec_passes::dag_gen::SplitMix64;
-use robovec_passes::expr_gen;
-use robovec_passes::numeric_check::{check, checked_passes, pipeline_text, NEEDS_FILE};
+use robovec_testkit::expr_gen;
+use robovec_testkit::numeric_check::{check, checked_passes, pipeline_text, NEEDS_FILE};
 
 use crate::common::{corpus_dir, corpus_files, is_loop_file};
 

@@ -113,7 +113,7 @@ proptest::proptest! {
         naive in proptest::bool::ANY,
         improve in 0u32..3,
     ) {
-        let f = robovec_passes::dag_gen::generate(n_ops, seed);
+        let f = robovec_testkit::dag_gen::generate(n_ops, seed);
         let mut o = PlaceOptions::with_pes(1);
         o.arch.n_add = n_add;
         o.arch.n_mul = n_mul;
@@ -133,7 +133,7 @@ proptest::proptest! {
     /// The list scheduler with a feeding bonus (restarts use 8–1000 cycles) places validly too.
     #[test]
     fn feeding_schedules_place_validly(n_ops in 1usize..300, seed in 0u64..1_000_000, n in 1u32..4, feed in 0u32..80) {
-        let f = robovec_passes::dag_gen::generate(n_ops, seed);
+        let f = robovec_testkit::dag_gen::generate(n_ops, seed);
         let o = PlaceOptions::with_pes(n);
         let dag = schedule::OpDag::new(&f);
         let keys = schedule::seed_keys(&f, &o.arch, Priority::Classical);

@@ -16,6 +16,7 @@ mod error_reference;
 mod exact_gap;
 mod example;
 mod filetests;
+mod inline_specialize;
 mod numerics;
 #[cfg(unix)]
 mod outputs;
@@ -24,5 +25,4 @@ mod placement;
 mod placement_verify;
 mod props;
 mod roundtrip;
-mod thr;
-mod thr_passes;
+mod tree_height;

@@ -1,12 +1,12 @@
-//! Random `+ − ×` expression DAGs (built from the bytes by `robovec_passes::expr_gen`) through a
+//! Random `+ − ×` expression DAGs (built from the bytes by `robovec_testkit::expr_gen`) through a
 //! random pipeline of registered passes: the module verifies after every pass and every output
 //! stays within the error budget of the exact value (bit-exact for passes that must not change
-//! values); see `robovec_passes::numeric_check`.
+//! values); see `robovec_testkit::numeric_check`.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use robovec_passes::dag_gen::SplitMix64;
-use robovec_passes::{expr_gen, numeric_check};
+use robovec_ir::rng::SplitMix64;
+use robovec_testkit::{expr_gen, numeric_check};
 
 fuzz_target!(|data: &[u8]| {
     // Byte 0: pipeline length 1–4; bytes 1–4: passes; the rest: the function.

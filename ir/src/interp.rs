@@ -181,17 +181,14 @@ pub fn eval<T: Float>(f: &Function, input: impl FnMut(&str) -> f64) -> Vec<(Stri
         .collect()
 }
 
-/// Deterministic pseudo-random value in [-1, 1] for input `name` under `seed` (splitmix64 of
-/// an FNV-1a hash); used for inputs a user does not give (SPEC §7 `-eval`).
+/// Deterministic pseudo-random value in [-1, 1) for input `name` under `seed` (the first draw of
+/// [`crate::rng::SplitMix64`] seeded with an FNV-1a hash); used for inputs a user does not give
+/// (SPEC §7 `-eval`).
 pub fn pseudo_random_input(name: &str, seed: u64) -> f64 {
     let mut h: u64 = 0xcbf29ce484222325 ^ seed;
     for b in name.bytes() {
         h ^= b as u64;
         h = h.wrapping_mul(0x100000001b3);
     }
-    let mut z = h.wrapping_add(0x9e3779b97f4a7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58476d1ce4e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d049bb133111eb);
-    z ^= z >> 31;
-    ((z >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    crate::rng::SplitMix64::new(h).unit() * 2.0 - 1.0
 }

@@ -25,7 +25,7 @@
 //! The [`verifier`] checks these rules; [`text`] reads and writes the `.rvir` form;
 //! [`interp`] evaluates any function in `f64` or `f32`; [`analysis`] holds the dependence
 //! graph and ASAP/ALAP timing; [`numerics`] holds the extended-precision reference and the
-//! bits-of-error metric (SPEC §6).
+//! bits-of-error metric (SPEC §6); [`rng`] is the one pseudo-random generator.
 #![deny(missing_docs)]
 
 pub mod analysis;
@@ -36,6 +36,7 @@ pub mod function;
 pub mod interp;
 pub mod numerics;
 pub mod placement;
+pub mod rng;
 pub mod span;
 pub mod syntax;
 pub mod text;

@@ -10,21 +10,19 @@ pub mod accuracy;
 pub mod artifact;
 pub mod asap_alap;
 pub mod atomise;
-pub mod dag_gen;
 pub mod dce;
 pub mod eqsat;
-pub mod exact;
-pub mod expr_gen;
 pub mod figures;
+pub mod inline;
 pub mod manager;
-pub mod numeric_check;
 pub mod params;
 pub mod pipeline;
 pub mod place;
 pub mod sim;
+pub mod specialize;
 pub mod study;
 pub mod sweep;
-pub mod thr;
+pub mod tree_height;
 
 use robovec_ir::analysis::Latencies;
 use robovec_ir::verifier::VerifierError;
@@ -302,12 +300,12 @@ pub const PASSES: &[PassInfo] = &[
     sim::INFO,
     sweep::INFO,
     accuracy::INFO,
-    thr::zero_removal::INFO,
-    thr::swap::INFO,
-    thr::balance::INFO,
-    thr::inline::INFO,
-    thr::distribute::INFO,
-    thr::specialize::INFO,
+    tree_height::zero_removal::INFO,
+    tree_height::swap::INFO,
+    tree_height::balance::INFO,
+    inline::INFO,
+    tree_height::distribute::INFO,
+    specialize::INFO,
     eqsat::INFO,
 ];
 

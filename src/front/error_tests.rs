@@ -199,7 +199,7 @@ fn diagnostics_render_with_codespan() {
     assert!(out.contains("unknown function `tan`"), "{out}");
 }
 
-/// A tiny deterministic generator (no dependency): mutates corpus-like text and throws
+/// The workspace's deterministic generator (`robovec_ir::rng`) mutates corpus-like text and throws
 /// random bytes at every front end; none may panic.
 #[test]
 fn no_panic_on_mutated_or_random_input() {
@@ -208,13 +208,8 @@ fn no_panic_on_mutated_or_random_input() {
         b"function [M,c] = dirdyna(s,tsim,usrfun)\n M = zeros(2,2);\nq = s.q;\n  C2 = cos(q(2));\n  A = -(s.dpt(2,4)*C2+...\n s.m(3));\n  M(1,1) = A;\n",
         b"def invdyna(phi,s,tsim):\n  Qq = phi\n  C4 = np.cos(q[4])\n  A = C4*(-s.m[2]+ \\\n  q[1])\n  Qq[1] = A\n",
     ];
-    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
-    let mut next = move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
+    let mut rng = robovec_ir::rng::SplitMix64::new(0x9E37_79B9_7F4A_7C15);
+    let mut next = move || rng.next_u64();
     let alphabet = b"()[];=+-*/,.\n\\%#{}sq1 0.2xX_-> \r\xe9";
     for round in 0..3000 {
         let seed = seeds[round % 3];

@@ -6,10 +6,13 @@
 //! the `#define q s->q` aliases, trig initial variables `C1 = cos(q[1]);`, then blocks of
 //! temporaries `T7 = qd[3]*S2+s->dpt[1][4]*(T5-T2*(2.0));` whose operands are earlier
 //! temporaries, trig variables, inputs and parenthesised literals, each block ending in outputs
-//! `M[i][j] = T7;`, `c[i] = T7*C3-T6;`. Everything is deterministic (a fixed xorshift seed), so
-//! two calls with the same [`Shape`] give the same bytes.
+//! `M[i][j] = T7;`, `c[i] = T7*C3-T6;`. Everything is deterministic (a fixed seed of the
+//! workspace's one generator, [`SplitMix64`]), so two calls with the same [`Shape`] give the same
+//! bytes.
 
 use std::fmt::Write as _;
+
+use robovec_ir::rng::SplitMix64;
 
 /// What to generate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,27 +49,12 @@ pub struct Generated {
     pub ops: u64,
 }
 
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n.max(1)
-    }
-}
-
 /// Width of the output matrix `M`: outputs fill `M[1][1..=W]`, `M[2][…]`, … row by row.
 const M_WIDTH: u64 = 64;
 
 /// Generates a file of about `shape.bytes` bytes (see the module doc).
 pub fn straight_line_c(shape: Shape) -> Generated {
-    let mut rng = Rng(0x2545_F491_4F6C_DD1D);
+    let mut rng = SplitMix64::new(0x2545_F491_4F6C_DD1D);
     let mut g = Generated { text: String::with_capacity(shape.bytes + 4096), ..Generated::default() };
     let t = &mut g.text;
     t.push_str("//\n//\tROBOTRAN - Version 6.6 (build : february 22, 2008)\n//\tsynthetic straight-line file\n//\n\n");
@@ -121,7 +109,7 @@ pub fn straight_line_c(shape: Shape) -> Generated {
 
 /// One operand of temporary `k`: an earlier temporary (mostly a recent one), a trig variable,
 /// an input or a parenthesised literal.
-fn operand(t: &mut String, rng: &mut Rng, k: u64, joints: u64) {
+fn operand(t: &mut String, rng: &mut SplitMix64, k: u64, joints: u64) {
     let j = 1 + rng.below(joints);
     match rng.below(8) {
         0..=3 if k > 1 => {

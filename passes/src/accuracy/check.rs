@@ -1,5 +1,6 @@
-//! `-check`: the numeric property of [`crate::numeric_check`] on any pipeline and any function
-//! (trig, division, square root and callbacks included), at the command line.
+//! `-check`: the numeric property of the fuzzing and property tests (`robovec-testkit`'s
+//! `numeric_check`) on any pipeline and any function (trig, division, square root and callbacks
+//! included), at the command line.
 //!
 //! At `samples` sampled points (the `accuracy` sampled draws, stream 0: point `i` of seed `s`
 //! is `accuracy<seed=s>`'s point `i`), every output of the function after the pipeline, computed
@@ -20,8 +21,7 @@
 //! A sound rewrite (the same real function) always passes: its exact value is the original's,
 //! and each bound covers its own rounding. An output where a bound is infinite (a divisor
 //! interval through zero, an overflow) or the reference is not finite is not decided at that
-//! point (counted in `undecided`). Pipelines made only of [`crate::numeric_check::BIT_EXACT`]
-//! passes must also reproduce the original bit for bit (the sign of an exact zero aside).
+//! point (counted in `undecided`). Pipelines made only of [`BIT_EXACT`] passes must also reproduce the original bit for bit (the sign of an exact zero aside).
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -201,11 +201,16 @@ pub fn check_function(
     })
 }
 
+/// Passes that never change a computed value (no reassociation, no rewriting of arithmetic):
+/// a pipeline of these is checked bit for bit, by `-check` and by the fuzzing and property tests.
+/// Any other registered pass gets the budget check.
+pub const BIT_EXACT: &[&str] = &["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy"];
+
 /// True when every pass of `pipeline` (comma-separated, parameters allowed) is in
-/// [`crate::numeric_check::BIT_EXACT`].
+/// [`BIT_EXACT`].
 pub fn pipeline_is_bit_exact(pipeline: &str) -> bool {
     crate::parse_pipeline(pipeline)
-        .map(|specs| specs.iter().all(|s| crate::numeric_check::BIT_EXACT.contains(&s.name.as_str())))
+        .map(|specs| specs.iter().all(|s| BIT_EXACT.contains(&s.name.as_str())))
         .unwrap_or(false)
 }
 

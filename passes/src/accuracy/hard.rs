@@ -10,7 +10,7 @@
 
 use rayon::prelude::*;
 
-use super::inputs::{draw_hard, rng_for, unit, Family, Range};
+use super::inputs::{draw_hard, rng_for, Family, Range};
 use super::measure::{errors_at, PointErrors, Subject, Workspace};
 use super::stream::{Acc, Kept};
 use super::Options;
@@ -65,9 +65,9 @@ pub fn climb(
                         y[k] = if rng.below(8) == 0 {
                             draw_hard(&mut rng, &ranges[k])
                         } else if ranges[k].family == Family::Angle {
-                            y[k] + sign * 2f64.powf(-(2.0 + 28.0 * unit(&mut rng)))
+                            y[k] + sign * 2f64.powf(-(2.0 + 28.0 * rng.unit()))
                         } else {
-                            y[k] * (1.0 + sign * 2f64.powf(-(1.0 + 23.0 * unit(&mut rng))))
+                            y[k] * (1.0 + sign * 2f64.powf(-(1.0 + 23.0 * rng.unit())))
                         } as f32 as f64;
                     }
                     let ey = errors_at(sub, &y, ws, Some(skip));
@@ -96,7 +96,7 @@ pub fn climb(
 #[cfg(test)]
 mod tests {
     use crate::accuracy::{measure_function, Mode, Options};
-    use crate::expr_gen;
+    use robovec_testkit::expr_gen;
 
     #[test]
     fn climbing_is_deterministic_and_never_loses_the_worst_point() {

@@ -31,7 +31,7 @@
 
 use std::collections::BTreeMap;
 
-use crate::dag_gen::SplitMix64;
+use robovec_ir::rng::SplitMix64;
 
 /// Family of an input, from its canonical name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,15 +90,13 @@ pub fn range_of(name: &str) -> Range {
     }
 }
 
-/// A uniform number in [0, 1) (53 random bits).
-pub fn unit(rng: &mut SplitMix64) -> f64 {
-    (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-}
-
 /// A value drawn from `r`, rounded to binary32.
 pub fn draw(rng: &mut SplitMix64, r: &Range) -> f64 {
-    let x =
-        if r.log { (r.lo.ln() + unit(rng) * (r.hi.ln() - r.lo.ln())).exp() } else { r.lo + unit(rng) * (r.hi - r.lo) };
+    let x = if r.log {
+        (r.lo.ln() + rng.unit() * (r.hi.ln() - r.lo.ln())).exp()
+    } else {
+        r.lo + rng.unit() * (r.hi - r.lo)
+    };
     x as f32 as f64
 }
 
@@ -112,13 +110,13 @@ pub fn draw_hard(rng: &mut SplitMix64, r: &Range) -> f64 {
             if rng.below(4) == 0 {
                 base
             } else {
-                let k = 8.0 + unit(rng) * 22.0;
+                let k = 8.0 + rng.unit() * 22.0;
                 base + sign(rng) * 2f64.powf(-k)
             }
         }
-        Family::Rate => sign(rng) * 10f64.powf(1.0 + 2.0 * unit(rng)),
+        Family::Rate => sign(rng) * 10f64.powf(1.0 + 2.0 * rng.unit()),
         Family::Parameter => draw(rng, r) * 10f64.powi(rng.below(6) as i32 - 3),
-        Family::Time => unit(rng) * 1000.0,
+        Family::Time => rng.unit() * 1000.0,
     };
     x as f32 as f64
 }

@@ -227,7 +227,7 @@ mod tests {
     #[test]
     fn streamed_statistics_equal_the_batch_computation() {
         // Values as the metric produces them: log2(1 + n), small n mostly, a few large ones.
-        let mut rng = crate::dag_gen::SplitMix64::new(5);
+        let mut rng = robovec_ir::rng::SplitMix64::new(5);
         let xs: Vec<f64> = (0..5000)
             .map(|_| {
                 let n = match rng.below(10) {

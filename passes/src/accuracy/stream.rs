@@ -241,7 +241,7 @@ mod tests {
     use crate::accuracy::measure::summarise;
     use crate::accuracy::stats::BIN_WIDTH_BITS;
     use crate::accuracy::{measure_function, Options};
-    use crate::expr_gen;
+    use robovec_testkit::expr_gen;
 
     #[test]
     fn streamed_run_equals_a_batch_computation_and_ignores_chunking() {

@@ -8,8 +8,9 @@ use robovec_ir::verifier::placement::verify_placement as verifier_check;
 use robovec_ir::Function;
 
 use super::{verify_with, SimErrorKind as K};
-use crate::dag_gen::{generate, SplitMix64};
 use crate::place::{place_function, PlaceOptions};
+use robovec_ir::rng::SplitMix64;
+use robovec_testkit::dag_gen::generate;
 
 fn placed(n_ops: usize, seed: u64, buffer: bool) -> Function {
     let mut f = generate(n_ops, seed);

@@ -509,7 +509,7 @@ const MIXED: &str = "func @f { phase atomised input %q input %m %s = sin %q %c =
 #[test]
 fn naive_placements_verify_and_peaks_match_sizes() {
     let mut fs = vec![func(MIXED)];
-    fs.extend((1..4).map(|seed| crate::dag_gen::generate(300, seed)));
+    fs.extend((1..4).map(|seed| robovec_testkit::dag_gen::generate(300, seed)));
     for f in &fs {
         let p = naive_placement(f);
         let r = verify_with(f, &p, &[0, 1, 2]).unwrap_or_else(|e| panic!("@{}: {e}", f.name));
@@ -523,14 +523,14 @@ fn naive_placements_verify_and_peaks_match_sizes() {
 
 #[test]
 fn mutants_are_rejected_or_still_exact_and_never_panic() {
-    let f = crate::dag_gen::generate(200, 7);
+    let f = robovec_testkit::dag_gen::generate(200, 7);
     let p0 = naive_placement(&f);
-    let mut rng = crate::dag_gen::SplitMix64::new(3);
+    let mut rng = robovec_ir::rng::SplitMix64::new(3);
     let ops: Vec<usize> = (0..p0.issue.len()).filter(|&i| p0.issue[i].is_some()).collect();
     let mut rejected = 0;
     for _ in 0..600 {
         let mut p = p0.clone();
-        let pick = |rng: &mut crate::dag_gen::SplitMix64, n: usize| rng.below(n as u64) as usize;
+        let pick = |rng: &mut robovec_ir::rng::SplitMix64, n: usize| rng.below(n as u64) as usize;
         match pick(&mut rng, 6) {
             0 => p.issue[ops[pick(&mut rng, ops.len())]].as_mut().unwrap().cycle ^= 1,
             1 => drop(p.loads.remove(pick(&mut rng, p0.loads.len()))),

@@ -402,7 +402,7 @@ impl Search<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dag_gen::SplitMix64;
+    use robovec_ir::rng::SplitMix64;
     use robovec_ir::{BinOp, Def, Operand, Phase, Span};
 
     const LAT: Latencies = Latencies { add: 12, mul: 7, div: 12, call: 12 };

@@ -142,7 +142,7 @@ proptest::proptest! {
     fn rewrites_keep_their_contract_on_random_dags(
         n_ops in 1usize..300, seed in 0u64..1_000_000, la in 1u32..20, lm in 1u32..20,
     ) {
-        let f = crate::dag_gen::generate(n_ops, seed);
+        let f = robovec_testkit::dag_gen::generate(n_ops, seed);
         let lat = Latencies { add: la, mul: lm, ..Latencies::default() };
         let (ops, cp0) = (f.op_counts().total, compute_timing(&f, &lat).1.asap_cycle);
         // Zero removal under the default latencies is not longer under these either.

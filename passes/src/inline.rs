@@ -21,8 +21,8 @@ use std::collections::HashMap;
 
 use robovec_ir::{Def, Function, Module, Operand, Phase, Value};
 
-use super::cluster::{Class, Clusters};
 use crate::params::ParamKind;
+use crate::tree_height::cluster::{Class, Clusters};
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.

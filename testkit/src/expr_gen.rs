@@ -16,7 +16,7 @@
 
 use robovec_ir::{BinOp, Def, Expr, Function, Operand, Phase, Span, Value};
 
-use crate::dag_gen::SplitMix64;
+use robovec_ir::rng::SplitMix64;
 
 /// A source of choices: a seeded generator or fuzzer bytes.
 pub trait Choices {
@@ -196,7 +196,7 @@ mod tests {
             assert_eq!(f, generate(seed));
             let m = Module { functions: vec![f.clone()] };
             verifier::verify(&m).unwrap_or_else(|e| panic!("seed {seed}: {e:?}\n{m}"));
-            let a = Module { functions: vec![crate::atomise::atomise_function(&f)] };
+            let a = Module { functions: vec![robovec_passes::atomise::atomise_function(&f)] };
             verifier::verify(&a).unwrap_or_else(|e| panic!("seed {seed} atomised: {e:?}\n{a}"));
             assert!(!f.outputs.is_empty());
             // The text form reads back to the same function.

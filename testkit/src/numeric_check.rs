@@ -1,5 +1,6 @@
 //! The numeric property every pipeline must keep (shared by the proptest suite and the
-//! cargo-fuzz target `pipeline_numerics`): run a pipeline on a `+ − ×` function, then
+//! cargo-fuzz target `pipeline_numerics`; `-check` applies the same property at the command
+//! line, `robovec_passes::accuracy::check`): run a pipeline on a `+ − ×` function, then
 //! - the module verifies after every pass (the manager's `verify-each`);
 //! - every output of the result stays within the error budget of `robovec_ir::numerics::budget`
 //!   around the exact value of the **original** function, in binary32 and binary64:
@@ -17,11 +18,8 @@ use robovec_ir::numerics::budget::{allowed, gamma, terms, U32, U64};
 use robovec_ir::numerics::{Tape, DD};
 use robovec_ir::{Function, Module, Phase};
 
-use crate::{Instrumentation, PassContext, PassManager, PASSES};
-
-/// Passes that never change a computed value (no reassociation, no rewriting of arithmetic):
-/// a pipeline of these is checked bit for bit. Any other registered pass gets the budget check.
-pub const BIT_EXACT: &[&str] = &["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy"];
+pub use robovec_passes::accuracy::check::BIT_EXACT;
+use robovec_passes::{Instrumentation, PassContext, PassManager, PASSES};
 
 /// Registered passes the property cannot build from default parameters because they need a
 /// file (none today: `accuracy`'s `params` file is optional).
@@ -43,8 +41,8 @@ pub fn pipeline_text(names: &[&str]) -> String {
     let mut out: Vec<&str> = Vec::new();
     let mut atomised = false;
     let mut push = |n: &'static str, out: &mut Vec<&'static str>| {
-        let p = crate::pass_info(n).expect("registered pass");
-        let needs = (p.build)(&crate::Params::defaults(p)).ok().and_then(|b| b.requires());
+        let p = robovec_passes::pass_info(n).expect("registered pass");
+        let needs = (p.build)(&robovec_passes::Params::defaults(p)).ok().and_then(|b| b.requires());
         if needs == Some(Phase::Atomised) && !atomised {
             out.push("atomise");
             atomised = true;

@@ -8,7 +8,7 @@
 //! `placement.cycles`). A file with several functions (sensors) gets one row: ops summed,
 //! critical path and cycles the largest over its functions.
 //!
-//! Run with `cargo bench --bench thr_table` (a few minutes); `-- --quick` skips the placements;
+//! Run with `cargo bench --bench tree_height_table` (a few minutes); `-- --quick` skips the placements;
 //! `-- FILTER` keeps the files whose name contains FILTER. Prints a Markdown table.
 
 use std::path::PathBuf;

@@ -11,7 +11,7 @@ use robovec_passes::place::{place_function, PlaceOptions};
 use robovec_passes::sim::verify_placement;
 
 use crate::common::corpus_dir;
-use crate::thr::{check_error_bound, corpus_functions, run};
+use crate::tree_height::{check_error_bound, corpus_functions, run};
 
 fn cp(f: &Function) -> u32 {
     compute_timing(f, &Latencies::default()).1.asap_cycle
@@ -116,7 +116,7 @@ fn segway_dirdyna() -> Function {
 }
 
 fn write_params(name: &str, params: &BTreeMap<String, f64>) -> String {
-    let d = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("thr");
+    let d = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("inline_specialize");
     std::fs::create_dir_all(&d).unwrap();
     let p = d.join(name);
     std::fs::write(&p, serde_json::to_string(params).unwrap()).unwrap();

@@ -6,9 +6,12 @@
 //! | `zero-removal` | [`zero_removal`] | removes the `0 − x` ops of SPEC §3 by moving signs (seed §2.4.1) |
 //! | `swap` | [`swap`] | reorders each cluster's terms, latest nearest the root (seed §2.4.2) |
 //! | `balance` | [`balance`] | rebuilds each cluster as the two-earliest-first tree (seed §2.4.3) |
-//! | `inline<max-uses=K>` | [`inline`] | duplicates values used ≤ K times into their consumers' clusters |
 //! | `distribute` | [`distribute`] | opt-in: distributes critical products over sums, within an ops budget |
-//! | `specialize<params=FILE>` | [`specialize`] | folds known model parameters, then drops dead code |
+//!
+//! Two passes that prepare the ground live beside this folder: `inline<max-uses=K>`
+//! ([`crate::inline`]: duplicates values used ≤ K times into their consumers' clusters, reading
+//! [`cluster`]) and `specialize<params=FILE>` ([`crate::specialize`]: folds known model
+//! parameters, then drops dead code).
 //!
 //! The first three share [`cluster`] (maximal associative clusters), [`sign`] (where a sign
 //! can go for free), [`shape`] (the tree of one cluster) and [`rebuild`] (the rewriter that
@@ -26,11 +29,9 @@ pub mod balance;
 pub mod cluster;
 pub mod distribute;
 mod emit;
-pub mod inline;
 pub mod rebuild;
 pub mod shape;
 pub mod sign;
-pub mod specialize;
 pub mod swap;
 pub mod zero_removal;
 

@@ -32,41 +32,13 @@
 //! # Outputs
 //! Every op whose result no op reads becomes an output `Qq[i]` (1-based, in body order).
 //!
-//! Deterministic for a seed (splitmix64, no external RNG). Cost: O(n_ops) time and memory;
-//! 600k ops take ≈ 0.4 s in release builds (0.4–0.6 s measured on a loaded 2-core machine), of
-//! which ≈ 0.05 s is the DAG itself and the rest the value names and the function's name index.
+//! Deterministic for a seed ([`SplitMix64`], the workspace's one generator). Cost: O(n_ops) time
+//! and memory; 600k ops take ≈ 0.4 s in release builds (0.4–0.6 s measured on a loaded 2-core
+//! machine), of which ≈ 0.05 s is the DAG itself and the rest the value names and the function's
+//! name index.
 
+use robovec_ir::rng::SplitMix64;
 use robovec_ir::{BinOp, Def, Function, Operand, Output, Phase, Span, TrigFn, Value, ValueData};
-
-/// splitmix64 (Steele, Lea, Flood 2014): a tiny, good-enough deterministic generator.
-#[derive(Clone, Debug)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    /// A generator seeded with `seed`.
-    pub fn new(seed: u64) -> SplitMix64 {
-        SplitMix64(seed)
-    }
-
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// A uniform integer in `0..n` (`n > 0`; multiply-high, bias below 2⁻³²  for small `n`).
-    pub fn below(&mut self, n: u64) -> u64 {
-        ((self.next_u64() as u128 * n as u128) >> 64) as u64
-    }
-
-    /// True with probability `per_mille / 1000`.
-    pub fn chance(&mut self, per_mille: u64) -> bool {
-        self.below(1000) < per_mille
-    }
-}
 
 /// An operand while generating: a leaf slot, an op (index into the op list) or a constant.
 #[derive(Clone, Copy, Debug)]

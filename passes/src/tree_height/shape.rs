@@ -156,7 +156,7 @@ mod tests {
 
     #[test]
     fn greedy_is_optimal_on_small_instances() {
-        let mut s = crate::dag_gen::SplitMix64::new(7);
+        let mut s = robovec_ir::rng::SplitMix64::new(7);
         for _ in 0..400 {
             let k = 1 + s.below(6) as usize;
             let lat = [1, 7, 12][s.below(3) as usize];
