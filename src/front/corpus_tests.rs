@@ -113,13 +113,8 @@ fn frank_segway_dirdyna_matches_spec() {
 #[ignore = "long fuzz run; run on demand"]
 fn corpus_mutations_never_panic() {
     let files = corpus_files();
-    let mut x: u64 = 0x2545_F491_4F6C_DD1D;
-    let mut next = move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
+    let mut rng = robovec_ir::rng::SplitMix64::new(0x2545_F491_4F6C_DD1D);
+    let mut next = move || rng.next_u64();
     let rounds: usize = std::env::var("FRONT_FUZZ_ROUNDS").ok().and_then(|s| s.parse().ok()).unwrap_or(20_000);
     for _ in 0..rounds {
         let p = &files[(next() as usize) % files.len()];
