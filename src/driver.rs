@@ -41,6 +41,8 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
         (b, input.to_string())
     };
     let src = SourceFile::from_bytes(name, &bytes);
+    // The text is the one copy of the input kept (for diagnostics and the parse).
+    drop(bytes);
     let path = Path::new(input);
     let module = match front::language_of(path) {
         Some(lang) if input != "-" => {
@@ -49,7 +51,7 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
             } else {
                 None
             };
-            front::parse_str(lang, &bytes, header.as_deref()).map_err(|errs| {
+            front::parse_text(lang, &src.text, header.as_deref()).map_err(|errs| {
                 Failure::Input(src.render(&errs.iter().map(|e| e.to_diagnostic(())).collect::<Vec<_>>()))
             })?
         }

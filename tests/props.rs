@@ -496,7 +496,7 @@ fn to_expr(g: &G, avail: &[String], f: &Function) -> Expr {
         G::Const(c) => Expr::Operand(Operand::Const(*c)),
         G::Neg(x) => Expr::Neg(Box::new(to_expr(x, avail, f))),
         G::Bin(op, a, b) => Expr::Binary(*op, Box::new(to_expr(a, avail, f)), Box::new(to_expr(b, avail, f))),
-        G::Sqrt(x) => Expr::Call(Callee { name: "sqrt".into(), elem: None }, vec![to_expr(x, avail, f)]),
+        G::Sqrt(x) => Expr::call(Callee { name: "sqrt".into(), elem: None }, vec![to_expr(x, avail, f)]),
     }
 }
 

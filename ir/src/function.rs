@@ -5,7 +5,7 @@ use rustc_hash::FxHashMap as HashMap;
 
 use crate::entities::Value;
 use crate::span::Span;
-use crate::syntax::{Def, Expr, OpKind, Operand, Output, Phase, ValueData};
+use crate::syntax::{Callee, Def, Expr, OpKind, Operand, Output, Phase, ValueData};
 
 /// One Robotran function in SSA form (`dirdyna`, `invdyna`, `sensor_3`, …).
 ///
@@ -462,6 +462,11 @@ impl Def {
 }
 
 impl Expr {
+    /// The call of `callee` on `args` ([`Expr::Call`] boxes both).
+    pub fn call(callee: Callee, args: Vec<Expr>) -> Expr {
+        Expr::Call(Box::new(callee), Box::new(args))
+    }
+
     /// Calls `f` on every value the expression reads, left to right.
     pub fn for_each_value(&self, f: &mut impl FnMut(Value)) {
         match self {

@@ -79,8 +79,9 @@ pub enum Expr {
     Neg(Box<Expr>),
     /// A binary operation.
     Binary(BinOp, Box<Expr>, Box<Expr>),
-    /// A call with its numeric arguments.
-    Call(Callee, Vec<Expr>),
+    /// A call with its numeric arguments (both boxed: an expression node is 24 bytes, not 56 —
+    /// the parsed form of a large file is mostly expression nodes; issue 10 §3).
+    Call(Box<Callee>, Box<Vec<Expr>>),
 }
 
 /// How a value is defined.
@@ -92,8 +93,9 @@ pub enum Def {
     Trig(TrigFn, Value),
     /// One binary operation (both phases).
     Binary(BinOp, Operand, Operand),
-    /// One call on operands (both phases).
-    Call(Callee, Vec<Operand>),
+    /// One call on operands (both phases). The callee is boxed: a definition is 40 bytes, not
+    /// 64 (calls are rare; every value holds a definition).
+    Call(Box<Callee>, Vec<Operand>),
     /// A nested expression (parsed phase only).
     Expr(Expr),
 }

@@ -21,7 +21,9 @@
 //! Cost: O(expression nodes).
 
 use robovec_ir::count::neg_folds;
-use robovec_ir::{BinOp, Def, Expr, Function, Module, Operand, Phase, Span};
+use std::borrow::Cow;
+
+use robovec_ir::{BinOp, Def, Expr, Function, Module, Operand, Phase, Span, Value, ValueData};
 
 use crate::{Params, Pass, PassContext, PassError, PassInfo};
 
@@ -44,7 +46,8 @@ impl Pass for Atomise {
 
     fn run(&self, m: &mut Module, _cx: &mut PassContext) -> Result<(), PassError> {
         for f in &mut m.functions {
-            *f = atomise_function(f);
+            let parsed = std::mem::replace(f, Function::new(String::new(), Phase::Atomised));
+            *f = atomise_owned(parsed);
         }
         Ok(())
     }
@@ -52,43 +55,77 @@ impl Pass for Atomise {
 
 /// Returns the atomised form of `f` (which must verify).
 pub fn atomise_function(f: &Function) -> Function {
-    let mut out = Function::new(f.name.clone(), Phase::Atomised);
-    out.equations = f.equations;
-    out.span = f.span;
-    let mut map: Vec<Operand> = vec![Operand::Const(f64::NAN); f.values.len()];
-    for &v in &f.inputs {
-        let d = f.value(v);
-        let nv = out.add_input(d.name.clone(), d.span).expect("input names are unique");
+    atomise(Cow::Borrowed(f))
+}
+
+/// [`atomise_function`] consuming `f`: each equation's expression is dropped as soon as it is
+/// atomised and names move instead of being copied, so the parsed and the atomised function
+/// are never both whole in memory (issue 10 §3). Same result as [`atomise_function`].
+pub fn atomise_owned(f: Function) -> Function {
+    atomise(Cow::Owned(f))
+}
+
+/// The name, definition and span of `v`: borrowed, or taken out of an owned function.
+fn take<'a>(src: &mut Cow<'a, Function>, v: Value) -> (Cow<'a, str>, Cow<'a, Def>, Span) {
+    match src {
+        Cow::Borrowed(f) => {
+            let d: &'a ValueData = &f.values[v.index()];
+            (Cow::Borrowed(d.name.as_str()), Cow::Borrowed(&d.def), d.span)
+        }
+        Cow::Owned(f) => {
+            let d = &mut f.values[v.index()];
+            (Cow::Owned(std::mem::take(&mut d.name)), Cow::Owned(std::mem::replace(&mut d.def, Def::Input)), d.span)
+        }
+    }
+}
+
+fn atomise(mut src: Cow<'_, Function>) -> Function {
+    let mut out = Function::new(src.name.clone(), Phase::Atomised);
+    out.equations = src.equations;
+    out.span = src.span;
+    let mut map: Vec<Operand> = vec![Operand::Const(f64::NAN); src.values.len()];
+    for i in 0..src.inputs.len() {
+        let v = src.inputs[i];
+        let (name, _, span) = take(&mut src, v);
+        let nv = out.add_input(name.into_owned(), span).expect("input names are unique");
         map[v.index()] = Operand::Value(nv);
     }
-    for &v in &f.body {
-        let d = f.value(v);
+    for i in 0..src.body.len() {
+        let v = src.body[i];
+        let (name, def, span) = take(&mut src, v);
         let m = |o: &Operand| match o {
             Operand::Value(x) => map[x.index()],
             c => *c,
         };
-        let result = match &d.def {
+        let result = match def.as_ref() {
             Def::Input => unreachable!("inputs are not in the body"),
             Def::Trig(t, a) => {
                 let Operand::Value(a) = map[a.index()] else { unreachable!("inputs map to inputs") };
-                Operand::Value(out.define(d.name.clone(), Def::Trig(*t, a), d.span).expect("unique name"))
+                Operand::Value(out.define(name.into_owned(), Def::Trig(*t, a), span).expect("unique name"))
             }
             Def::Binary(op, a, b) => {
                 let def = Def::Binary(*op, m(a), m(b));
-                Operand::Value(out.define(d.name.clone(), def, d.span).expect("unique name"))
+                Operand::Value(out.define(name.into_owned(), def, span).expect("unique name"))
             }
             Def::Call(c, args) => {
                 let def = Def::Call(c.clone(), args.iter().map(m).collect());
-                Operand::Value(out.define(d.name.clone(), def, d.span).expect("unique name"))
+                Operand::Value(out.define(name.into_owned(), def, span).expect("unique name"))
             }
             Def::Expr(e) => {
-                let mut em = Emitter { out: &mut out, root: &d.name, span: d.span, next: 1, map: &map };
+                let mut em = Emitter { out: &mut out, root: name.into_owned(), span, next: 1, map: &map };
                 em.emit(e, true)
             }
         };
+        // An owned expression is dropped here, before the next equation grows `out`.
+        drop(def);
         map[v.index()] = result;
     }
-    for o in &f.outputs {
+    let outputs = match &mut src {
+        Cow::Borrowed(f) => Cow::Borrowed(&f.outputs[..]),
+        Cow::Owned(f) => Cow::Owned(std::mem::take(&mut f.outputs)),
+    };
+    drop(src);
+    for o in outputs.iter() {
         let value = match o.value {
             Operand::Value(x) => map[x.index()],
             c => c,
@@ -100,7 +137,8 @@ pub fn atomise_function(f: &Function) -> Function {
 
 struct Emitter<'a> {
     out: &'a mut Function,
-    root: &'a str,
+    /// The equation's name: the root operation's (taken by it, the last one defined).
+    root: String,
     span: Span,
     next: u32,
     map: &'a [Operand],
@@ -109,7 +147,7 @@ struct Emitter<'a> {
 impl Emitter<'_> {
     fn define(&mut self, top: bool, def: Def) -> Operand {
         let name = if top {
-            self.root.to_string()
+            std::mem::take(&mut self.root)
         } else {
             loop {
                 let n = format!("{}.{}", self.root, self.next);
@@ -218,5 +256,20 @@ mod tests {
         let before = robovec_ir::interp::eval::<f64>(&m.functions[0], |n| if n == "a" { 1.25 } else { 0.75 });
         let after = robovec_ir::interp::eval::<f64>(&f, |n| if n == "a" { 1.25 } else { 0.75 });
         assert_eq!(before[0].1.to_bits(), after[0].1.to_bits());
+    }
+
+    #[test]
+    fn the_consuming_form_gives_the_same_function() {
+        let src =
+            "func @f { input %a input %b %C1 = cos %a %x = -(%a - 3.0*%b)*(-%a/%b) + @sqrt(%a*%a) %y = %x*%C1 - %x \
+                   %z = %y output o = %x output p = %z output q = 2.0 }";
+        let m = parse(src).unwrap();
+        let f = &m.functions[0];
+        let owned = atomise_owned(f.clone());
+        let borrowed = atomise_function(f);
+        assert_eq!(owned, borrowed);
+        assert_eq!(owned.to_string(), borrowed.to_string());
+        assert_eq!(owned.lookup("x.1").map(|v| owned.name_of(v).to_string()), Some("x.1".to_string()));
+        assert_eq!(owned.outputs.iter().map(|o| o.name.as_str()).collect::<Vec<_>>(), ["o", "p", "q"]);
     }
 }

@@ -12,6 +12,11 @@ use super::lower::Lower;
 use super::scan::{self, Parsed};
 use super::Language;
 
+mod stream;
+
+pub use stream::scan_and_lower;
+use stream::{Stream, Streamed};
+
 const TYPES: &[&str] =
     &["void", "int", "double", "float", "long", "unsigned", "static", "const", "MbsData", "MBSdataStruct", "MbsSensor"];
 
@@ -19,43 +24,6 @@ const TYPES: &[&str] =
 /// `double *X;` pointers.
 pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
     scan_impl(src, toks, header, errors, None)
-}
-
-/// Functions lowered while their body is scanned, each statement as soon as it is parsed (the
-/// whole file's statement trees are never held at once: they took ~30× the input's size).
-#[derive(Default)]
-struct Streamed {
-    functions: Vec<robovec_ir::Function>,
-    /// A case the streaming path does not cover (a `switch`, a `#define` or pointer declared
-    /// after the first statement, a poisoned statement): the batch path decides.
-    broken: bool,
-}
-
-/// One function's lowering in progress.
-struct Stream<'s> {
-    lower: Option<Lower<'s>>,
-    /// `#define`s and pointers known when lowering started.
-    at: (usize, usize),
-}
-
-/// The streaming path of [`super::parse_str`]: scans and lowers `src` in one go. `None` when
-/// the file has any error or a form the streaming path leaves to the batch path
-/// ([`scan`] then [`super::lower::lower_module`]), whose diagnostics are the reference.
-pub fn scan_and_lower(src: &str, toks: &[Spanned<'_>], header: Option<&str>) -> Option<robovec_ir::Module> {
-    let mut errors = Vec::new();
-    let mut streamed = Streamed::default();
-    let funcs = scan_impl(src, toks, header, &mut errors, Some(&mut streamed));
-    if !errors.is_empty() || streamed.broken || funcs.is_empty() || funcs.len() != streamed.functions.len() {
-        return None;
-    }
-    let mut m = robovec_ir::Module::default();
-    for f in streamed.functions {
-        if m.function(&f.name).is_some() {
-            return None;
-        }
-        m.functions.push(f);
-    }
-    Some(m)
 }
 
 fn scan_impl(
@@ -148,7 +116,14 @@ fn scan_impl(
                         f.pointers = header_pointers.clone();
                         let mark = errors.len();
                         let mut stream = streamed.as_ref().map(|_| Stream { lower: None, at: (0, 0) });
-                        if body(src, &toks[body_open + 1..body_close], end, &mut f, errors, stream.as_mut()) {
+                        let scanned = match stream.as_mut() {
+                            // The outline left the body out: it is lexed again, a window at a time.
+                            Some(stream) => {
+                                stream::body_in_windows(src, toks[body_open].2, end, &mut f, errors, stream)
+                            }
+                            None => body(src, &toks[body_open + 1..body_close], end, &mut f, errors, None, &mut None),
+                        };
+                        if scanned {
                             if let (Some(st), Some(stream)) = (streamed.as_deref_mut(), stream) {
                                 st.broken |= f.cases.is_some()
                                     || !f.poisoned.is_empty()
@@ -266,8 +241,9 @@ enum Target {
     Suffix,
 }
 
-/// Scans a function body into `f`; false after a fatal (control-flow or structure) error,
-/// which is then the last error pushed.
+/// Scans a function body (or a part of one ending after a `;`) into `f`; false after a fatal
+/// (control-flow or structure) error, which is then the last error pushed. `returned` is the
+/// `return;` seen so far in the body (statements after it are unreachable).
 fn body<'s>(
     src: &'s str,
     toks: &[Spanned<'_>],
@@ -275,12 +251,12 @@ fn body<'s>(
     f: &mut FuncAst,
     errors: &mut Vec<FrontError>,
     mut stream: Option<&mut Stream<'s>>,
+    returned: &mut Option<Span>,
 ) -> bool {
     let mut i = 0;
     let mut target = Target::Prefix;
     let mut cases: Option<Vec<Case>> = None;
     let mut switch_close: Option<usize> = None;
-    let mut returned: Option<Span> = None;
     let mut push =
         |s: Stmt, target: &Target, f: &mut FuncAst, cases: &mut Option<Vec<Case>>, errors: &mut Vec<FrontError>| {
             match target {
@@ -390,7 +366,7 @@ fn body<'s>(
                 i += 2;
             }
             (_, Some("return")) if matches!(next, Some(Tok::Semi)) => {
-                returned = Some(Span::new(t.0, toks[i + 1].2));
+                *returned = Some(Span::new(t.0, toks[i + 1].2));
                 i += 2;
             }
             (_, Some("return")) => {
@@ -427,7 +403,7 @@ fn body<'s>(
                     i = stop;
                     continue;
                 }
-                if let Some(r) = returned {
+                if let Some(r) = *returned {
                     let line = scan::line_of(src, r.start as usize);
                     errors.push(
                         FrontError::new(

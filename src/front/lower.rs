@@ -313,7 +313,7 @@ impl<'a> Lower<'a> {
         }
         if let Some((callee, args)) = self.vectors.get(&base).cloned() {
             if let [i] = idx[..] {
-                let def = Def::Expr(IrExpr::Call(Callee { name: callee, elem: Some(i) }, args));
+                let def = Def::Expr(IrExpr::call(Callee { name: callee, elem: Some(i) }, args));
                 let v = self.f.define_fresh(&full, def, r.span);
                 self.current.insert(full, Operand::Value(v));
                 return Ok(IrExpr::Operand(Operand::Value(v)));
@@ -343,7 +343,7 @@ impl<'a> Lower<'a> {
         if name == "sqrt" {
             if let [a] = args.as_slice() {
                 let e = self.expr(a)?;
-                return Ok(IrExpr::Call(Callee { name: "sqrt".into(), elem: None }, vec![e]));
+                return Ok(IrExpr::call(Callee { name: "sqrt".into(), elem: None }, vec![e]));
             }
             self.err(
                 FrontError::new(r.span, "`sqrt` takes one argument", "wrong number of arguments")
@@ -399,7 +399,7 @@ impl<'a> Lower<'a> {
 
     fn callback(&mut self, r: &Ref) -> R<IrExpr> {
         let (name, args) = self.callback_parts(r)?;
-        Ok(IrExpr::Call(Callee { name, elem: None }, args))
+        Ok(IrExpr::call(Callee { name, elem: None }, args))
     }
 
     fn expr(&mut self, e: &Expr) -> R<IrExpr> {

@@ -85,27 +85,36 @@ pub const MAX_ERRORS: usize = 100;
 /// # Errors
 /// Every problem found (up to [`MAX_ERRORS`]); no module is returned when there is one.
 pub fn parse_str(lang: Language, src: &[u8], header: Option<&[u8]>) -> Result<robovec_ir::Module, Vec<FrontError>> {
-    let text = source_text(src);
+    parse_text(lang, &source_text(src), header)
+}
+
+/// [`parse_str`] on text already made by [`source_text`] (the driver keeps that text for its
+/// diagnostics and drops the bytes: one copy of the input, not three).
+///
+/// # Errors
+/// As [`parse_str`].
+pub fn parse_text(lang: Language, text: &str, header: Option<&[u8]>) -> Result<robovec_ir::Module, Vec<FrontError>> {
     let mut errors = Vec::new();
     // The tokens live only while scanning: the statements own their text.
     let funcs = match lang {
         Language::C => {
             let header = header.map(source_text);
-            let toks = lexer::lex_where(&text, |t| !c::ignored(t));
-            // Statements lowered as soon as they are parsed; on any error (or a form it leaves
-            // out) the batch path below runs from the start and gives the diagnostics.
-            if let Some(module) = c::scan_and_lower(&text, &toks, header.as_deref()) {
+            // Statements lowered as soon as they are parsed, the bodies lexed a window at a
+            // time; on any error (or a form it leaves out) the batch path below runs from the
+            // start and gives the diagnostics.
+            if let Some(module) = c::scan_and_lower(text, header.as_deref()) {
                 return Ok(module);
             }
-            c::scan(&text, &toks, header.as_deref(), &mut errors)
+            let toks = lexer::lex_where(text, |t| !c::ignored(t));
+            c::scan(text, &toks, header.as_deref(), &mut errors)
         }
-        Language::Matlab => matlab::scan(&text, &lexer::lex(&text), &mut errors),
-        Language::Python => python::scan(&text, &lexer::lex(&text), &mut errors),
+        Language::Matlab => matlab::scan(text, &lexer::lex(text), &mut errors),
+        Language::Python => python::scan(text, &lexer::lex(text), &mut errors),
     };
     if funcs.is_empty() && errors.is_empty() {
         errors.push(scan::no_function(lang, text.len()));
     }
-    let module = lower::lower_module(&text, lang, &funcs, &mut errors);
+    let module = lower::lower_module(text, lang, &funcs, &mut errors);
     if errors.is_empty() {
         Ok(module)
     } else {

@@ -169,7 +169,7 @@ fn c_callbacks_vectors_and_local_arrays() {
     );
     let f = &m.functions[0];
     let args = vec![val(f, "PxF1[1]"), val(f, "RxF1[1][2]"), val(f, "RxF1[2][1]"), val(f, "tsim")];
-    let call = |elem| Expr::Call(Callee { name: "user_ExtForces.1".into(), elem: Some(elem) }, args.clone());
+    let call = |elem| Expr::call(Callee { name: "user_ExtForces.1".into(), elem: Some(elem) }, args.clone());
     assert_eq!(expr(f, "SWr1[3]"), &call(3));
     assert_eq!(expr(f, "SWr1[1]"), &call(1));
     assert!(f.lookup("SWr1[2]").is_none(), "only used elements are defined");
@@ -177,10 +177,10 @@ fn c_callbacks_vectors_and_local_arrays() {
         expr(f, "x"),
         &bin(BinOp::Add, bin(BinOp::Mul, val(f, "SWr1[3]"), val(f, "SWr1[1]")), val(f, "SWr1[3]"))
     );
-    assert_eq!(expr(f, "Z1"), &Expr::Call(Callee { name: "sqrt".into(), elem: None }, vec![val(f, "x")]));
+    assert_eq!(expr(f, "Z1"), &Expr::call(Callee { name: "sqrt".into(), elem: None }, vec![val(f, "x")]));
     assert_eq!(
         expr(f, "F1"),
-        &Expr::Call(
+        &Expr::call(
             Callee { name: "user_LinkForces.2".into(), elem: None },
             vec![val(f, "Z1"), val(f, "x"), val(f, "tsim")]
         )
@@ -241,7 +241,7 @@ fn matlab_function_aliases_continuations_and_callbacks() {
     );
     assert_eq!(
         expr(f, "Flink1"),
-        &Expr::Call(
+        &Expr::call(
             Callee { name: "usrfun.flink.1".into(), elem: None },
             vec![val(f, "A"), val(f, "C2"), val(f, "tsim")]
         )

@@ -67,7 +67,7 @@ fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
                         }
                     },
                     RhsAst::Call(c, args) => {
-                        Def::Call(c, args.into_iter().map(|a| operand(&func, a, errors)).collect())
+                        Def::Call(Box::new(c), args.into_iter().map(|a| operand(&func, a, errors)).collect())
                     }
                     RhsAst::Expr(e) => Def::Expr(expr(&func, e, errors)),
                 };
@@ -117,7 +117,7 @@ fn expr(func: &Function, e: ExprAst<'_>, errors: &mut Vec<ParseError>) -> Expr {
         ExprAst::Operand(o) => Expr::Operand(operand(func, o, errors)),
         ExprAst::Neg(x) => Expr::Neg(Box::new(expr(func, *x, errors))),
         ExprAst::Bin(op, a, b) => Expr::Binary(op, Box::new(expr(func, *a, errors)), Box::new(expr(func, *b, errors))),
-        ExprAst::Call(c, args) => Expr::Call(c, args.into_iter().map(|a| expr(func, a, errors)).collect()),
+        ExprAst::Call(c, args) => Expr::call(c, args.into_iter().map(|a| expr(func, a, errors)).collect()),
     }
 }
 
