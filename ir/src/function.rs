@@ -587,6 +587,15 @@ mod tests {
         assert!(crate::verifier::verify_function(&f).is_empty());
     }
 
+    /// Issue 10 §3: a large function is mostly value records and, parsed, expression nodes.
+    #[test]
+    fn value_records_and_expression_nodes_stay_small() {
+        use std::mem::size_of;
+        assert_eq!(size_of::<Expr>(), 24, "an expression node (a call boxes its callee and arguments)");
+        assert_eq!(size_of::<Def>(), 40, "a definition (a call boxes its callee)");
+        assert_eq!(size_of::<ValueData>(), 96, "name 24 + definition 40 + timing 24 + span 8");
+    }
+
     #[test]
     fn set_output_replaces_by_name_even_after_direct_edits_of_outputs() {
         let mut f = Function::new("f", Phase::Parsed);
