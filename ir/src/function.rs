@@ -1,8 +1,6 @@
 //! Functions and modules: value arena, body order, outputs, and the builder API used by front
 //! ends and passes.
 
-use rustc_hash::FxHashMap as HashMap;
-
 use crate::entities::Value;
 use crate::span::Span;
 use crate::syntax::{Callee, Def, Expr, OpKind, Operand, Output, Phase, ValueData};
@@ -90,7 +88,9 @@ impl NameIndex {
 /// number calls [`Function::reindex_names`]). Ignored by `==`.
 #[derive(Clone, Debug, Default)]
 struct OutputIndex {
-    pos: HashMap<String, usize>,
+    /// (hash of the name the output had when indexed, position): 16 bytes per output, the
+    /// names stay in `outputs` (issue 10 §3).
+    pos: hashbrown::HashTable<(u64, usize)>,
     /// Outputs compared by name while locating outputs (one per lookup when the index is
     /// current; a rebuild counts every output): the work counter behind
     /// [`Function::output_probes`].
@@ -100,6 +100,28 @@ struct OutputIndex {
 impl PartialEq for OutputIndex {
     fn eq(&self, _: &OutputIndex) -> bool {
         true
+    }
+}
+
+impl OutputIndex {
+    /// The index of `outputs` (the last of equal names wins, as in a map built in order).
+    fn build(outputs: &[Output]) -> hashbrown::HashTable<(u64, usize)> {
+        let mut pos = hashbrown::HashTable::with_capacity(outputs.len());
+        for (i, o) in outputs.iter().enumerate() {
+            let h = name_hash(&o.name);
+            match pos.find_mut(h, |&(eh, j): &(u64, usize)| eh == h && outputs[j].name == o.name) {
+                Some(e) => e.1 = i,
+                None => {
+                    pos.insert_unique(h, (h, i), |&(eh, _)| eh);
+                }
+            }
+        }
+        pos
+    }
+
+    /// The position indexed under the name hashed `h` and whether an entry is there.
+    fn get(&self, h: u64) -> Option<usize> {
+        self.pos.find(h, |&(eh, _)| eh == h).map(|&(_, i)| i)
     }
 }
 
@@ -260,7 +282,8 @@ impl Function {
             o.value = value;
             o.span = span;
         } else {
-            self.outputs_by_name.pos.insert(name.clone(), self.outputs.len());
+            let h = name_hash(&name);
+            self.outputs_by_name.pos.insert_unique(h, (h, self.outputs.len()), |&(eh, _)| eh);
             self.outputs.push(Output { name, value, span });
         }
     }
@@ -270,21 +293,22 @@ impl Function {
     pub fn output_position(&mut self, name: &str) -> Option<usize> {
         let idx = &mut self.outputs_by_name;
         let n = self.outputs.len();
-        let last_ok = self.outputs.last().is_none_or(|o| idx.pos.get(&o.name) == Some(&(n - 1)));
+        let last_ok = self.outputs.last().is_none_or(|o| idx.get(name_hash(&o.name)) == Some(n - 1));
         if idx.pos.len() != n || !last_ok {
             idx.probes += self.outputs.len() as u64;
-            idx.pos = self.outputs.iter().enumerate().map(|(i, o)| (o.name.clone(), i)).collect();
+            idx.pos = OutputIndex::build(&self.outputs);
         }
-        match idx.pos.get(name) {
-            Some(&i) => {
+        let h = name_hash(name);
+        match idx.get(h) {
+            Some(i) => {
                 idx.probes += 1;
                 if self.outputs.get(i).is_some_and(|o| o.name == name) {
                     return Some(i);
                 }
                 // Stale (an output renamed or reordered in place): rebuild and look again.
                 idx.probes += self.outputs.len() as u64;
-                idx.pos = self.outputs.iter().enumerate().map(|(i, o)| (o.name.clone(), i)).collect();
-                idx.pos.get(name).copied()
+                idx.pos = OutputIndex::build(&self.outputs);
+                idx.get(h).filter(|&i| self.outputs.get(i).is_some_and(|o| o.name == name))
             }
             None => None,
         }
@@ -332,7 +356,7 @@ impl Function {
     /// Rebuilds the name indexes (values and outputs); for code that edits `values` or renames
     /// `outputs` directly.
     pub fn reindex_names(&mut self) {
-        self.outputs_by_name.pos = self.outputs.iter().enumerate().map(|(i, o)| (o.name.clone(), i)).collect();
+        self.outputs_by_name.pos = OutputIndex::build(&self.outputs);
         self.names = NameIndex::build(&self.values);
     }
 
@@ -561,6 +585,15 @@ mod tests {
         f.value_mut(b).name = "b".into();
         f.reindex_names();
         assert!(crate::verifier::verify_function(&f).is_empty());
+    }
+
+    /// Issue 10 §3: a large function is mostly value records and, parsed, expression nodes.
+    #[test]
+    fn value_records_and_expression_nodes_stay_small() {
+        use std::mem::size_of;
+        assert_eq!(size_of::<Expr>(), 24, "an expression node (a call boxes its callee and arguments)");
+        assert_eq!(size_of::<Def>(), 40, "a definition (a call boxes its callee)");
+        assert_eq!(size_of::<ValueData>(), 96, "name 24 + definition 40 + timing 24 + span 8");
     }
 
     #[test]

@@ -5,7 +5,7 @@
 //! Phase: atomised → atomised; an analysis: the function is otherwise unchanged. The
 //! latencies also become those of the report's `stats.asap_cycle`. Cost: O(values + operands).
 
-use robovec_ir::analysis::{compute_timing, Latencies};
+use robovec_ir::analysis::{annotate_timing, Latencies};
 use robovec_ir::{Module, Phase};
 
 use crate::{Params, Pass, PassContext, PassError, PassInfo};
@@ -40,10 +40,7 @@ impl Pass for AsapAlap {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         for f in &mut m.functions {
-            let (t, _) = compute_timing(f, &self.lat);
-            for (d, t) in f.values.iter_mut().zip(t) {
-                d.timing = t;
-            }
+            annotate_timing(f, &self.lat);
         }
         cx.latencies = self.lat;
         Ok(())

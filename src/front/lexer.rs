@@ -140,7 +140,8 @@ pub fn lex(src: &str) -> Vec<Spanned<'_>> {
 }
 
 /// The tokens of `src` for which `keep` holds (the C scanner drops comments and newlines while
-/// lexing: the token vector is the largest structure of a parse, 40 bytes per token).
+/// lexing: the token vector is the largest structure of a batch parse, 40 bytes per token;
+/// the streaming path, `super::c::scan_and_lower`, never builds it).
 pub fn lex_where(src: &str, keep: impl Fn(&Tok<'_>) -> bool) -> Vec<Spanned<'_>> {
     Tok::lexer(src).spanned().map(|(t, r)| (r.start, t.unwrap_or(Tok::Error), r.end)).filter(|t| keep(&t.1)).collect()
 }

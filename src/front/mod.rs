@@ -5,7 +5,9 @@
 //! statements by the file scanner of the language ([`c`], [`matlab`], [`python`]), each
 //! statement parsed by the shared lalrpop grammar (`expr.lalrpop`, glue in [`stmt`]) into the
 //! language-agnostic [`ast`], and lowered to IR by [`lower`] (whose module doc states the
-//! lowering rules).
+//! lowering rules). A C file without errors takes the streaming path ([`c::scan_and_lower`]):
+//! its function bodies are lexed again a window at a time and each statement lowered as soon
+//! as it is parsed, so memory does not grow with the tokens of a body.
 //!
 //! # Encoding
 //! Input is bytes. Valid UTF-8 is kept; each byte of an invalid UTF-8 sequence (a Latin-1

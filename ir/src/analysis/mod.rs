@@ -8,4 +8,4 @@ pub mod dep_graph;
 pub mod timing;
 
 pub use dep_graph::DepGraph;
-pub use timing::{compute_timing, Latencies, TimingSummary};
+pub use timing::{annotate_timing, compute_timing, Latencies, TimingSummary};
