@@ -13,7 +13,7 @@ use std::process::Command;
 
 use robovec_ir::interp::{callback_standin, eval, pseudo_random_input, Float};
 use robovec_ir::{Callee, Def, Module, TrigFn};
-use robovec_passes::codegen::c::{split_callee, CodegenC};
+use robovec_passes::codegen::c::{robotran, split_callee, CodegenC};
 use robovec_passes::codegen::input_values;
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
@@ -140,7 +140,12 @@ fn check_plain<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64) ->
     let w = o.batch;
     let mut files = vec!["main.c".to_string(), "callbacks.c".to_string()];
     let mut uses = Vec::new();
-    let mut main = format!("#include <stdio.h>\n#include <string.h>\n#include <stdint.h>\n");
+    let robotran_abi = o.abi == "robotran";
+    let mut main = String::from("#include <stdio.h>\n#include <stdlib.h>\n#include <string.h>\n#include <stdint.h>\n");
+    if robotran_abi {
+        std::fs::write(dir.join("mbs_data.h"), robotran::mbs_data_header()).unwrap();
+        main += &robotran_globals(cases);
+    }
     let mut calls = String::new();
     let mut inputs: Vec<u8> = Vec::new();
     let mut want: Vec<(String, T)> = Vec::new();
@@ -152,8 +157,18 @@ fn check_plain<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64) ->
         callback_uses(&case.m, &mut uses);
         for (f, iface) in case.m.functions.iter().zip(&art.interfaces) {
             let (ni, no) = (iface.inputs.len(), iface.outputs.len());
-            let _ = writeln!(main, "void {}(const {real} *restrict in, {real} *restrict out);", iface.symbol);
-            let _ = writeln!(
+            if robotran_abi {
+                let proto =
+                    art.code.companions[0].1.lines().find(|l| l.starts_with(&format!("void {}(", iface.symbol)));
+                let proto = proto.expect("prototype in the header");
+                if !main.contains(proto) {
+                    main += proto;
+                    main += "\n";
+                }
+                calls += &robotran_call(f, iface);
+            } else {
+                let _ = writeln!(main, "void {}(const {real} *restrict in, {real} *restrict out);", iface.symbol);
+                let _ = writeln!(
                 calls,
                 "  {{ static {real} in[{}], out[{}]; if (fread(in, sizeof *in, {}, stdin) != {}) return 1; {}(in, out); \
                  for (int i = 0; i < {}; i++) {{ double x = out[i]; uint64_t b; memcpy(&b, &x, 8); printf(\"%016llx\\n\", (unsigned long long)b); }} }}",
@@ -164,6 +179,7 @@ fn check_plain<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64) ->
                 iface.symbol,
                 no * w as usize
             );
+            }
             // Inputs of every lane; trig inputs are the interpreter's own sin/cos of their
             // joint coordinate in precision T.
             let ins = input_values(f, o.trig_input);
@@ -199,7 +215,8 @@ fn check_plain<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64) ->
             }
         }
     }
-    main += &format!("int main(void)\n{{\n{calls}  return 0;\n}}\n");
+    let init = if robotran_abi { "  robovec_test_alloc();\n" } else { "" };
+    main += &format!("int main(void)\n{{\n{init}{calls}  return 0;\n}}\n");
     std::fs::write(dir.join("main.c"), main).unwrap();
     std::fs::write(dir.join("callbacks.c"), callbacks_c::<T>(&uses, f32, false)).unwrap();
     let exe = cc(dir, &files, "-O0");
@@ -222,6 +239,112 @@ fn check_plain<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64) ->
     want.len()
 }
 
+/// Largest index in any input or output name of the cases, plus one.
+fn array_size(cases: &[Case]) -> usize {
+    let mut k = 1;
+    for c in cases {
+        for f in &c.m.functions {
+            let names = f.inputs.iter().map(|&v| f.name_of(v)).chain(f.outputs.iter().map(|o| o.name.as_str()));
+            for n in names {
+                for part in n.split('[').skip(1) {
+                    k = k.max(part.trim_end_matches(']').parse::<usize>().unwrap_or(0) + 1);
+                }
+            }
+        }
+    }
+    k
+}
+
+/// Globals of the robotran-ABI driver: one `MbsData`, one `MbsSensor` and the output arrays,
+/// every dimension `array_size` long.
+fn robotran_globals(cases: &[Case]) -> String {
+    let k = array_size(cases);
+    let mut s = format!(
+        "#include \"mbs_data.h\"\nstatic double *v1(void) {{ return calloc({k}, sizeof(double)); }}\n\
+         static double **v2(void) {{ double **r = calloc({k}, sizeof *r); for (int i = 0; i < {k}; i++) r[i] = v1(); return r; }}\n\
+         static MbsData s; static MbsSensor sens; static double tsim;\n"
+    );
+    let outs: &[(&str, usize)] = &[
+        ("M", 2),
+        ("c", 1),
+        ("Qq", 1),
+        ("h", 1),
+        ("Jac", 2),
+        ("Jdqd", 1),
+        ("frc", 2),
+        ("trq", 2),
+        ("Flnk", 1),
+        ("Flink", 1),
+        ("Z", 1),
+        ("Zd", 1),
+    ];
+    let mut alloc = String::new();
+    for (n, d) in outs {
+        let _ = writeln!(s, "static double {}out_{n};", "*".repeat(*d));
+        let _ = writeln!(alloc, "  out_{n} = v{d}();");
+    }
+    for (n, d) in robotran::MBS_FIELDS {
+        let _ = writeln!(alloc, "  s.{n} = v{d}();");
+    }
+    for (n, d) in robotran::SENSOR_FIELDS {
+        let _ = writeln!(alloc, "  sens.{n} = v{d}();");
+    }
+    let _ = write!(s, "static void robovec_test_alloc(void)\n{{\n{alloc}}}\n");
+    s
+}
+
+/// The driver's block for one function of the robotran ABI: reads the inputs into `s`, calls,
+/// prints the outputs' bits.
+fn robotran_call(f: &robovec_ir::Function, iface: &robovec_passes::codegen::Interface) -> String {
+    let ni = iface.inputs.len();
+    let mut b =
+        format!("  {{ static double in[{}]; if (fread(in, sizeof *in, {ni}, stdin) != {ni}) return 1;\n", ni.max(1));
+    let sensor = f.name.contains("sensor_");
+    for (i, n) in iface.inputs.iter().enumerate() {
+        let target = match n.as_str() {
+            "tsim" if sensor => "s.tsim".to_string(),
+            "tsim" => "tsim".to_string(),
+            _ => format!("s.{n}"),
+        };
+        let _ = writeln!(b, "    {target} = in[{i}];");
+    }
+    if sensor {
+        let k: u32 = f.name.rsplit('_').next().unwrap().parse().unwrap();
+        let _ = writeln!(b, "    {}(&sens, &s, {k});", iface.symbol);
+    } else {
+        let _ = writeln!(b, "    {}({}&s, tsim);", iface.symbol, robotran_out_args(f));
+    }
+    for n in &iface.outputs {
+        let x = match n.strip_prefix("sens.") {
+            Some(r) => format!("sens.{r}"),
+            None if n == "flag_stop" => "(double)s.flag_stop".to_string(),
+            None => format!("out_{n}"),
+        };
+        let _ = writeln!(
+            b,
+            "    {{ double x = {x}; uint64_t u; memcpy(&u, &x, 8); printf(\"%016llx\\n\", (unsigned long long)u); }}"
+        );
+    }
+    b + "  }\n"
+}
+
+/// The output arguments of a Robotran function kind, in its signature's order (GRAMMAR-NOTES
+/// §1.3), independently of the emitter's table.
+fn robotran_out_args(f: &robovec_ir::Function) -> String {
+    let flink = f.outputs.iter().any(|o| o.name.starts_with("Flink["));
+    let list: &[&str] = match f.name.as_str() {
+        "dirdyna" => &["M", "c"],
+        "invdyna" => &["Qq"],
+        "cons_hJ" => &["h", "Jac"],
+        "cons_jdqd" => &["Jdqd"],
+        "link" if flink => &["frc", "trq", "Flink", "Z", "Zd"],
+        "link" => &["frc", "trq", "Flnk", "Z", "Zd"],
+        "link3D" | "extforces" => &["frc", "trq"],
+        other => panic!("no Robotran signature known to the test for @{other}"),
+    };
+    list.iter().map(|n| format!("out_{n}, ")).collect()
+}
+
 fn plain(f32: bool, batch: u32, trig_input: bool) -> CodegenC {
     CodegenC { f32, batch, trig_input, ..CodegenC::default() }
 }
@@ -242,4 +365,149 @@ fn plain_f32_equals_the_interpreter_bit_for_bit_on_every_corpus_file() {
         let n = check_plain::<f32>(&tmp(&format!("plain_f32_{k}")), &cases, &plain(true, 1, true), 2);
         assert!(n > 5_000, "{pipeline}: only {n} outputs compared");
     }
+}
+
+#[test]
+fn robotran_drop_in_equals_the_interpreter_bit_for_bit_on_every_c_corpus_file() {
+    for (k, pipeline) in ["atomise", "atomise,zero-removal,balance"].into_iter().enumerate() {
+        let cases = corpus_cases(pipeline, true);
+        let o = CodegenC { abi: "robotran", ..CodegenC::default() };
+        let n = check_plain::<f64>(&tmp(&format!("robotran_{k}")), &cases, &o, 3);
+        assert!(n > 3_000, "{pipeline}: only {n} outputs compared");
+    }
+}
+
+/// Small corpus files (callbacks, sqrt, sensors, trig) and random DAGs, for the batched forms.
+fn batch_cases() -> Vec<Case> {
+    let mut cases: Vec<Case> = corpus_cases("atomise,zero-removal,balance", true)
+        .into_iter()
+        .filter(|c| {
+            ["tricycle__mbs_dirdyna", "frank_segway__mbs_extforces", "jeep__mbs_link", "m454__mbs_sensor"]
+                .iter()
+                .any(|p| c.label.starts_with(p))
+        })
+        .collect();
+    assert_eq!(cases.len(), 4, "the batch test's corpus files");
+    for seed in 0..6 {
+        let f = robovec_passes::dag_gen::generate(300, seed);
+        cases.push(Case { label: format!("dag_gen seed {seed}"), m: Module { functions: vec![f] } });
+        let f = robovec_passes::expr_gen::generate(seed);
+        let m = run_pipeline(Module { functions: vec![f] }, "atomise");
+        cases.push(Case { label: format!("expr_gen seed {seed}"), m });
+    }
+    cases
+}
+
+#[test]
+fn batched_lanes_equal_the_interpreter_bit_for_bit_for_every_width_precision_and_trig() {
+    let cases = batch_cases();
+    // Every width in both precisions; each trig mode in both precisions.
+    let combos = [
+        (2, false, false),
+        (2, true, true),
+        (4, true, false),
+        (4, false, true),
+        (8, false, true),
+        (8, true, false),
+        (16, true, false),
+        (16, false, true),
+    ];
+    for (batch, f32, trig_input) in combos {
+        let dir = tmp(&format!("batch_{batch}_{f32}_{trig_input}"));
+        let o = plain(f32, batch, trig_input);
+        let n = if f32 { check_plain::<f32>(&dir, &cases, &o, 4) } else { check_plain::<f64>(&dir, &cases, &o, 4) };
+        assert!(n > 600 * batch as usize, "batch {batch}: only {n} outputs compared");
+    }
+}
+
+#[test]
+fn scalar_forms_equal_the_interpreter_on_random_dags() {
+    let cases = batch_cases();
+    for (f32, trig_input) in [(false, true), (true, false)] {
+        let dir = tmp(&format!("scalar_{f32}_{trig_input}"));
+        let o = plain(f32, 1, trig_input);
+        let n = if f32 { check_plain::<f32>(&dir, &cases, &o, 5) } else { check_plain::<f64>(&dir, &cases, &o, 5) };
+        assert!(n > 600, "only {n} outputs compared");
+    }
+}
+
+const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";
+
+#[test]
+fn options_that_cannot_go_together_are_bad_usage() {
+    for bad in ["abi=robotran;batch=4", "abi=robotran;precision=f32", "abi=robotran;trig=input"] {
+        let o = crate::common::opt(&[PENDULUM, &format!("-passes=atomise,codegen<c;{bad}>")]);
+        let err = crate::common::stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {err}");
+        assert!(err.contains("`abi=robotran` cannot go with") && err.contains(bad.split(';').nth(1).unwrap()), "{err}");
+        assert!(o.stdout.is_empty(), "no code written on bad usage");
+    }
+    let o = crate::common::opt(&[PENDULUM, "-passes=atomise,codegen<c;batch=3>"]);
+    assert_eq!(o.status.code(), Some(2), "{}", crate::common::stderr(&o));
+    let o = crate::common::opt(&[PENDULUM, "-passes=atomise,codegen<c;name=not-c>"]);
+    assert_eq!(o.status.code(), Some(2), "{}", crate::common::stderr(&o));
+    assert!(crate::common::stderr(&o).contains("one C identifier"));
+}
+
+#[test]
+fn a_function_in_the_parsed_phase_gets_the_phase_diagnostic() {
+    let o = crate::common::opt(&[PENDULUM, "-passes=codegen<c>"]);
+    let err = crate::common::stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("needs phase Atomised") && err.contains("run `atomise` first"), "{err}");
+    assert!(o.stdout.is_empty());
+}
+
+#[test]
+fn an_unknown_function_kind_has_no_robotran_signature() {
+    let dir = tmp("unknown_kind");
+    let ir = dir.join("f.rvir");
+    std::fs::write(&ir, "func @foo {\n  input %q[1]\n  %x = %q[1] * %q[1]\n  output c[1] = %x\n}\n").unwrap();
+    let o = crate::common::opt(&[ir.to_str().unwrap(), "-passes=atomise,codegen<c;abi=robotran>"]);
+    let err = crate::common::stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("@foo: no Robotran signature is known"), "{err}");
+}
+
+#[test]
+fn dash_o_writes_the_c_file_its_header_and_the_report_entry() {
+    let dir = tmp("dash_o");
+    let c = dir.join("model.c");
+    let report = dir.join("r.json");
+    let o = crate::common::opt(&[
+        PENDULUM,
+        "-passes=atomise,zero-removal,balance,codegen<c;abi=plain>",
+        "-o",
+        c.to_str().unwrap(),
+        &format!("-report={}", report.display()),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", crate::common::stderr(&o));
+    let code = std::fs::read_to_string(&c).unwrap();
+    assert!(code.contains("#pragma STDC FP_CONTRACT OFF") && code.contains("-ffp-contract=off"), "{code}");
+    assert!(code.contains("void invdyna(const double *restrict in, double *restrict out)"), "{code}");
+    assert!(!code.contains("func @"), "C, not IR");
+    let h = std::fs::read_to_string(dir.join("model.h")).unwrap();
+    assert!(h.contains("void invdyna(const double *restrict in, double *restrict out);"), "{h}");
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    // One function: its entries are at the top of the report (SPEC §7).
+    assert_eq!(r["function"], "invdyna", "{r}");
+    let cg = &r["codegen"];
+    assert_eq!(cg["symbol"], "invdyna", "{r}");
+    assert_eq!(cg["abi"], "plain");
+    assert_eq!(cg["precision"], "f64");
+    assert_eq!(cg["batch"], 1);
+    // The IR's input order (first use in the source: q[1], q[2], then s->g[3] …).
+    let inputs: Vec<&str> = cg["inputs"].as_array().unwrap().iter().map(|x| x.as_str().unwrap()).collect();
+    assert_eq!(&inputs[..3], ["q[1]", "q[2]", "g[3]"]);
+    assert_eq!(inputs.len(), 14);
+    assert_eq!(cg["outputs"], serde_json::json!(["Qq[1]", "Qq[2]"]));
+    // The header documents the same order.
+    assert!(h.contains("in[0] q[1], in[1] q[2], in[2] g[3]"), "{h}");
+
+    // Without -o the C goes to stdout (and no header is written anywhere).
+    let o = crate::common::opt(&[PENDULUM, "-passes=atomise,codegen<c;precision=f32;batch=4>"]);
+    assert_eq!(o.status.code(), Some(0), "{}", crate::common::stderr(&o));
+    let out = String::from_utf8(o.stdout).unwrap();
+    assert!(out.starts_with("/* Generated by robovec codegen<c;abi=plain;precision=f32;batch=4;trig=libm>"), "{out}");
+    assert!(out.contains("typedef float robovec_vec __attribute__((vector_size(16)));"), "{out}");
 }

@@ -67,14 +67,15 @@ pub const SENSOR_FIELDS: &[(&str, usize)] = &[("P", 1), ("V", 1), ("OM", 1), ("A
 
 /// A minimal `mbs_data.h`: `MbsData` and `MbsSensor` with the fields of [`MBS_FIELDS`] and
 /// [`SENSOR_FIELDS`] as Robotran's `mbs_data.h` declares them (`double *q; double **dpt;`,
-/// 1-based: the caller allocates one more element per dimension) and `double tsim`. Enough to
+/// 1-based: the caller allocates one more element per dimension), `double tsim` and
+/// `int flag_stop` (set by `mbs_link3D`). Enough to
 /// compile and call the `abi=robotran` code outside MBsysC (tests, benchmarks).
 pub fn mbs_data_header() -> String {
     let field = |(n, dims): &(&str, usize)| format!("    double {}{n};\n", "*".repeat(*dims));
     let mut s = String::from(
         "/* Minimal MbsData and MbsSensor for robovec's abi=robotran code (fields as in Robotran's\n \
          * mbs_data.h: 1-based arrays, one extra element per dimension). */\n\
-         #ifndef MBS_DATA_H\n#define MBS_DATA_H\n\ntypedef struct MbsData {\n    double tsim;\n",
+         #ifndef MBS_DATA_H\n#define MBS_DATA_H\n\ntypedef struct MbsData {\n    double tsim;\n    int flag_stop;\n",
     );
     MBS_FIELDS.iter().for_each(|f| s += &field(f));
     s += "} MbsData;\n\ntypedef struct MbsSensor {\n";
@@ -184,6 +185,7 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> Result<(String, Str
     for out in &f.outputs {
         let lvalue = match out.name.strip_prefix("sens.") {
             Some(rest) if sens.is_some() => format!("sens->{rest}"),
+            None if out.name == "flag_stop" => "s->flag_stop".to_string(),
             _ if sens.is_none() && outs.contains(&split_base(&out.name).0) => out.name.clone(),
             _ => return Err(fail(format!("output `{}` is no output parameter of {symbol}", out.name))),
         };
