@@ -207,9 +207,10 @@ fn check_plain<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64) ->
             }
             let per_lane: Vec<Vec<(String, T)>> =
                 (0..w).map(|lane| eval::<T>(f, |name| input_value(name, seed, lane))).collect();
+            // Output j of lane l is printed at j*W + l.
             for j in 0..no {
-                for lane in 0..w as usize {
-                    let (n, x) = &per_lane[lane][j];
+                for (lane, outs) in per_lane.iter().enumerate() {
+                    let (n, x) = &outs[j];
                     want.push((format!("{} @{} {n} lane {lane}", case.label, f.name), *x));
                 }
             }
