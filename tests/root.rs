@@ -9,6 +9,7 @@ mod accuracy;
 mod artifacts;
 mod bounds;
 mod cli;
+mod codegen_c;
 mod corpus;
 mod diagnostics;
 mod eqsat;

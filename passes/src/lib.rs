@@ -10,6 +10,7 @@ pub mod accuracy;
 pub mod artifact;
 pub mod asap_alap;
 pub mod atomise;
+pub mod codegen;
 pub mod dce;
 pub mod eqsat;
 pub mod figures;
@@ -307,6 +308,7 @@ pub const PASSES: &[PassInfo] = &[
     tree_height::distribute::INFO,
     specialize::INFO,
     eqsat::INFO,
+    codegen::INFO,
 ];
 
 /// Looks up a registered pass.
