@@ -63,8 +63,8 @@ fn callback_uses(m: &Module, out: &mut Vec<(Callee, usize)>) {
     for f in &m.functions {
         for &v in &f.body {
             if let Def::Call(c, args) = &f.value(v).def {
-                if !robovec_passes::codegen::c::is_sqrt(c, args.len()) && !out.iter().any(|(k, _)| k == c) {
-                    out.push((c.clone(), args.len()));
+                if !robovec_passes::codegen::c::is_sqrt(c, args.len()) && !out.iter().any(|(k, _)| k == &**c) {
+                    out.push(((**c).clone(), args.len()));
                 }
             }
         }
@@ -390,9 +390,9 @@ fn batch_cases() -> Vec<Case> {
         .collect();
     assert_eq!(cases.len(), 4, "the batch test's corpus files");
     for seed in 0..6 {
-        let f = robovec_passes::dag_gen::generate(300, seed);
+        let f = robovec_testkit::dag_gen::generate(300, seed);
         cases.push(Case { label: format!("dag_gen seed {seed}"), m: Module { functions: vec![f] } });
-        let f = robovec_passes::expr_gen::generate(seed);
+        let f = robovec_testkit::expr_gen::generate(seed);
         let m = run_pipeline(Module { functions: vec![f] }, "atomise");
         cases.push(Case { label: format!("expr_gen seed {seed}"), m });
     }
