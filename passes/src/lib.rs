@@ -10,6 +10,7 @@ pub mod accuracy;
 pub mod artifact;
 pub mod asap_alap;
 pub mod atomise;
+pub mod cpu_order;
 pub mod dag_gen;
 pub mod dce;
 pub mod eqsat;
@@ -309,6 +310,7 @@ pub const PASSES: &[PassInfo] = &[
     thr::distribute::INFO,
     thr::specialize::INFO,
     eqsat::INFO,
+    cpu_order::INFO,
 ];
 
 /// Looks up a registered pass.
