@@ -10,6 +10,7 @@ pub mod accuracy;
 pub mod artifact;
 pub mod asap_alap;
 pub mod atomise;
+pub mod codegen;
 pub mod cpu_order;
 pub mod dag_gen;
 pub mod dce;
@@ -311,6 +312,7 @@ pub const PASSES: &[PassInfo] = &[
     thr::specialize::INFO,
     eqsat::INFO,
     cpu_order::INFO,
+    codegen::INFO,
 ];
 
 /// Looks up a registered pass.

@@ -79,6 +79,14 @@ pub enum ParamKind {
     },
     /// A comma-separated, non-empty list of names; `all` (nothing selected) when not given.
     Names,
+    /// One word of `choices` that may also be given bare, without its key: `codegen<c>` is
+    /// `codegen<back-end=c>` (a pass family's member; at most one per pass).
+    Selector {
+        /// The accepted words.
+        choices: &'static [&'static str],
+        /// The word used when the parameter is not given (one of `choices`).
+        default: &'static str,
+    },
 }
 
 /// A declared parameter of a pass: name, type with default and range, and doc.
@@ -102,7 +110,7 @@ impl ParamInfo {
             ParamKind::U32Or { fallback, .. } => format!("`{fallback}`"),
             ParamKind::U64 { default, .. } => default.to_string(),
             ParamKind::F64 { default, .. } => format!("{default}"),
-            ParamKind::Choice { default, .. } => default.to_string(),
+            ParamKind::Choice { default, .. } | ParamKind::Selector { default, .. } => default.to_string(),
             ParamKind::Flag { default } => if default { "on" } else { "off" }.to_string(),
             ParamKind::Path | ParamKind::OutputFolder => "none".to_string(),
             ParamKind::U32List { default, .. } => default.to_string(),
@@ -122,7 +130,7 @@ impl ParamInfo {
             ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => format!("{min}..={max}"),
             ParamKind::U64 { min, max, .. } => format!("{min}..={max}"),
             ParamKind::F64 { min, max, .. } => format!("{min}..={max}"),
-            ParamKind::Choice { choices, .. } => choices.join("|"),
+            ParamKind::Choice { choices, .. } | ParamKind::Selector { choices, .. } => choices.join("|"),
             ParamKind::Flag { .. } => "on|off".to_string(),
             ParamKind::Path => "path".to_string(),
             ParamKind::OutputFolder => "folder".to_string(),
@@ -212,6 +220,16 @@ impl Params {
         };
         let mut values: Vec<(String, String)> = Vec::new();
         for (k, v) in raw {
+            // A bare word naming a choice of the pass's selector (`codegen<c>`): `selector=word`.
+            let selector = info.params.iter().find(|p| matches!(p.kind, ParamKind::Selector { choices, .. } if v.is_none() && choices.contains(&k.as_str())));
+            let bare;
+            let (k, v) = match selector {
+                Some(p) if !info.params.iter().any(|q| q.name == k) => {
+                    bare = Some(k.clone());
+                    (p.name, &bare)
+                }
+                _ => (k.as_str(), v),
+            };
             if !info.params.iter().any(|p| p.name == k) {
                 return Err(PassError::BadParameter {
                     pass: info.name.into(),
@@ -230,7 +248,7 @@ impl Params {
                     message: format!("parameter `{k}` needs a value (`{k}=…`)"),
                 });
             };
-            values.push((k.clone(), v.clone()));
+            values.push((k.to_string(), v.clone()));
         }
         Ok(Params { pass: info.name, decls: info.params, values })
     }
@@ -340,7 +358,7 @@ impl Params {
     /// # Errors
     /// [`PassError::BadParameter`] when the word is not one of the choices.
     pub fn choice(&self, key: &str) -> Result<&'static str, PassError> {
-        let ParamKind::Choice { choices, default } = self.decl(key) else {
+        let (ParamKind::Choice { choices, default } | ParamKind::Selector { choices, default }) = self.decl(key) else {
             panic!("parameter `{key}` of `{}` is not a choice", self.pass)
         };
         match self.get(key) {
@@ -463,7 +481,7 @@ mod tests {
                     }
                 }
                 match p.kind {
-                    ParamKind::Choice { choices, .. } => {
+                    ParamKind::Choice { choices, .. } | ParamKind::Selector { choices, .. } => {
                         for c in choices {
                             ok(c).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, p.name));
                         }

@@ -1,0 +1,233 @@
+//! The statements of a function body, shared by both ABIs: one C statement per IR value, in
+//! the IR's order; user callbacks and the vector helpers of `batch=W`.
+
+use std::fmt::Write as _;
+
+use robovec_ir::{BinOp, Callee, Def, Function, Module, Operand, TrigFn};
+
+use super::{is_sqrt, CodegenC};
+use crate::codegen::literal::hex;
+use crate::PassError;
+
+/// A user callback the generated code calls: Robotran's name without the integer arguments
+/// the IR appends (`user_ExtForces.1` → `user_ExtForces`, one index).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Callback {
+    /// The C name (`user_ExtForces`).
+    pub base: String,
+    /// How many integer arguments of the source call the IR appended to the name (`.1`).
+    pub indices: usize,
+}
+
+/// `user_ExtForces.1` → (`user_ExtForces`, `[1]`).
+pub(crate) fn split_callee(c: &Callee) -> Result<(String, Vec<i64>), PassError> {
+    let mut parts = c.name.split('.');
+    let base = parts.next().unwrap_or_default().to_string();
+    let idx: Result<Vec<i64>, _> = parts.map(str::parse::<i64>).collect();
+    match idx {
+        Ok(idx) if crate::codegen::names::is_c_identifier(&base) => Ok((base, idx)),
+        _ => Err(PassError::Failed {
+            pass: "codegen".into(),
+            message: format!("callee `@{}` is not a C name followed by integer arguments (`user_X.1`)", c.name),
+        }),
+    }
+}
+
+/// Every user callback of `m`, in order of first use.
+///
+/// # Errors
+/// [`PassError::Failed`] when a callee is not a C name, or one name is called with two
+/// different numbers of integer arguments (C has one signature per name).
+pub(crate) fn callbacks(m: &Module) -> Result<Vec<Callback>, PassError> {
+    let mut out: Vec<Callback> = Vec::new();
+    for f in &m.functions {
+        for &v in &f.body {
+            if let Def::Call(c, args) = &f.value(v).def {
+                if is_sqrt(c, args.len()) {
+                    continue;
+                }
+                let (base, idx) = split_callee(c)?;
+                match out.iter().find(|k| k.base == base) {
+                    Some(k) if k.indices != idx.len() => {
+                        return Err(PassError::Failed {
+                            pass: "codegen".into(),
+                            message: format!(
+                                "callback `{base}` is called with {} and with {} integer arguments",
+                                k.indices,
+                                idx.len()
+                            ),
+                        })
+                    }
+                    Some(_) => {}
+                    None => out.push(Callback { base, indices: idx.len() }),
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The extern declarations of the callbacks (also in the header).
+pub(crate) fn callback_decls(cbs: &[Callback], real: &str) -> String {
+    if cbs.is_empty() {
+        return String::new();
+    }
+    let mut s = format!(
+        "/* User callbacks, defined by the user (Robotran's names). A call `user_X(i1, …, elem, n, args)`\n \
+         * returns element `elem` (1-based; 0 for a scalar result) of Robotran's `user_X(…, i1, …)` for the\n \
+         * n {real} arguments args[0..n] (the numbers the Robotran call reads, in robovec's IR order). */\n"
+    );
+    for k in cbs {
+        let idx: String = (1..=k.indices).map(|i| format!("int index{i}, ")).collect();
+        let _ = writeln!(s, "extern {real} {}({idx}int elem, int nargs, const {real} *args);", k.base);
+    }
+    s.push('\n');
+    s
+}
+
+/// The vector type `robovec_vec` of `lanes` lanes of `real` and its per-lane helpers.
+pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
+    let bytes = lanes * if f32 { 4 } else { 8 };
+    let sfx = if f32 { "f" } else { "" };
+    let mut s = format!(
+        "/* {lanes} states per call: lane l of element i is in[i*{lanes} + l] (GCC/Clang vector extensions). */\n\
+         typedef {real} robovec_vec __attribute__((vector_size({bytes})));\n\
+         static inline robovec_vec robovec_splat({real} x) {{ robovec_vec r; for (int lane = 0; lane < {lanes}; lane++) r[lane] = x; return r; }}\n"
+    );
+    for f in ["sin", "cos", "sqrt"] {
+        let _ = writeln!(
+            s,
+            "static inline robovec_vec robovec_{f}(robovec_vec x) {{ robovec_vec r; for (int lane = 0; lane < {lanes}; lane++) r[lane] = {f}{sfx}(x[lane]); return r; }}"
+        );
+    }
+    s.push('\n');
+    s
+}
+
+/// Writes the statements of one function body.
+pub(crate) struct Body<'a> {
+    pub o: &'a CodegenC,
+    pub f: &'a Function,
+    /// C name of every value.
+    pub names: &'a [String],
+}
+
+impl Body<'_> {
+    /// An exact literal in the precision (`f32`: the constant rounded to binary32, as the
+    /// interpreter does).
+    pub fn literal(&self, c: f64) -> String {
+        if self.o.f32 {
+            hex(c as f32 as f64, true)
+        } else {
+            hex(c, false)
+        }
+    }
+
+    /// An operand as a C expression.
+    pub fn operand(&self, x: &Operand) -> String {
+        match x {
+            Operand::Value(v) => self.names[v.index()].clone(),
+            Operand::Const(c) => {
+                let l = self.literal(*c);
+                if l.starts_with('-') {
+                    format!("({l})")
+                } else {
+                    l
+                }
+            }
+        }
+    }
+
+    /// The type of a value: `double`, `float` or `robovec_vec`.
+    pub fn value_type(&self) -> &'static str {
+        if self.o.batch > 1 {
+            "robovec_vec"
+        } else {
+            self.o.real()
+        }
+    }
+
+    /// An operand as a value of [`Body::value_type`] (a constant is splat in a batch).
+    pub fn operand_value(&self, x: &Operand) -> String {
+        match x {
+            Operand::Const(_) if self.o.batch > 1 => format!("robovec_splat({})", self.operand(x)),
+            _ => self.operand(x),
+        }
+    }
+
+    /// Every body value, one statement each, in the IR's order (trig values are skipped with
+    /// `trig=input`: they are inputs).
+    pub fn statements(&self, s: &mut String) {
+        let ty = self.value_type();
+        let vec = self.o.batch > 1;
+        let sfx = if self.o.f32 { "f" } else { "" };
+        for &v in &self.f.body {
+            let name = &self.names[v.index()];
+            match &self.f.value(v).def {
+                Def::Input | Def::Expr(_) => unreachable!("atomised bodies hold trig, binary ops and calls"),
+                Def::Trig(t, a) => {
+                    if self.o.trig_input {
+                        continue;
+                    }
+                    let fun = match t {
+                        TrigFn::Sin => "sin",
+                        TrigFn::Cos => "cos",
+                    };
+                    let arg = &self.names[a.index()];
+                    if vec {
+                        let _ = writeln!(s, "  const {ty} {name} = robovec_{fun}({arg});");
+                    } else {
+                        let _ = writeln!(s, "  const {ty} {name} = {fun}{sfx}({arg});");
+                    }
+                }
+                Def::Binary(op, a, b) => {
+                    let op = match op {
+                        BinOp::Add => '+',
+                        BinOp::Sub => '-',
+                        BinOp::Mul => '*',
+                        BinOp::Div => '/',
+                    };
+                    // Scalar with vector is fine in a batch; two constants need one splat.
+                    let a = if matches!((a, b), (Operand::Const(_), Operand::Const(_))) {
+                        self.operand_value(a)
+                    } else {
+                        self.operand(a)
+                    };
+                    let _ = writeln!(s, "  const {ty} {name} = {a} {op} {};", self.operand(b));
+                }
+                Def::Call(c, args) if is_sqrt(c, args.len()) => {
+                    let a = self.operand_value(&args[0]);
+                    if vec {
+                        let _ = writeln!(s, "  const {ty} {name} = robovec_sqrt({a});");
+                    } else {
+                        let _ = writeln!(s, "  const {ty} {name} = sqrt{sfx}({a});");
+                    }
+                }
+                Def::Call(c, args) => {
+                    let (base, idx) = split_callee(c).expect("checked by callbacks()");
+                    let lane = |x: &Operand| match x {
+                        Operand::Value(_) if vec => format!("{}[lane]", self.operand(x)),
+                        _ => self.operand(x),
+                    };
+                    let list: Vec<String> = args.iter().map(lane).collect();
+                    let argv = if list.is_empty() {
+                        format!("(const {} *)0", self.o.real())
+                    } else {
+                        format!("(const {}[]){{{}}}", self.o.real(), list.join(", "))
+                    };
+                    let idx: String = idx.iter().map(|i| format!("{i}, ")).collect();
+                    let call = format!("{base}({idx}{}, {}, {argv})", c.elem.unwrap_or(0), args.len());
+                    if vec {
+                        let _ = writeln!(
+                            s,
+                            "  {ty} {name};\n  for (int lane = 0; lane < {}; lane++) {name}[lane] = {call};",
+                            self.o.batch
+                        );
+                    } else {
+                        let _ = writeln!(s, "  const {ty} {name} = {call};");
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,269 @@
+//! `codegen<c;abi=plain|robotran;precision=f64|f32;batch=1|2|4|8|16;trig=libm|input;name=…>`:
+//! the functions as C (issue 11, SPEC §8).
+//!
+//! Every IR operation becomes one C statement, in the IR's order, so that the compiled code
+//! computes bit for bit what robovec's interpreter computes (`-eval`, `-eval-precision=f32`)
+//! when compiled without contraction (`-ffp-contract=off`; the file also says
+//! `#pragma STDC FP_CONTRACT OFF`). `batch=W` computes W independent states per call with
+//! GCC/Clang vector extensions (one source for SSE, AVX2, AVX-512 and NEON), lane-contiguous:
+//! element `i` of lane `l` is `in[i*W + l]`. With `trig=input` the `sin`/`cos` of the joint
+//! coordinates are inputs (after the IR's inputs); with `trig=libm` they are computed (per lane).
+//!
+//! ABIs: `plain` ([`plain`]) is `void NAME(const REAL *restrict in, REAL *restrict out)`;
+//! `robotran` ([`robotran`]) has the signature and `MbsData` field access of the Robotran
+//! function the IR came from, a drop-in replacement of its file.
+
+mod body;
+pub mod plain;
+pub mod robotran;
+
+use robovec_ir::{Callee, Def, Function, Module};
+
+use super::names::is_c_identifier;
+use super::{CodegenArtifact, Interface};
+use crate::params::ParamKind;
+use crate::{GeneratedCode, ParamInfo, Params, Pass, PassContext, PassError};
+
+/// `abi=plain|robotran`.
+pub const ABI: ParamInfo = ParamInfo {
+    name: "abi",
+    kind: ParamKind::Choice { choices: &["plain", "robotran"], default: "plain" },
+    doc: "C: `plain` (in/out arrays) or `robotran` (drop-in, Robotran's signature and MbsData)",
+};
+/// `precision=f64|f32`.
+pub const PRECISION: ParamInfo = ParamInfo {
+    name: "precision",
+    kind: ParamKind::Choice { choices: &["f64", "f32"], default: "f64" },
+    doc: "C: arithmetic in `double` (f64) or `float` (f32)",
+};
+/// `batch=1|2|4|8|16`.
+pub const BATCH: ParamInfo = ParamInfo {
+    name: "batch",
+    kind: ParamKind::Choice { choices: &["1", "2", "4", "8", "16"], default: "1" },
+    doc: "C: states per call, lanes (`in[i*W + lane]`); plain ABI only",
+};
+/// `trig=libm|input`.
+pub const TRIG: ParamInfo = ParamInfo {
+    name: "trig",
+    kind: ParamKind::Choice { choices: &["libm", "input"], default: "libm" },
+    doc: "C: sin/cos of joint coordinates computed (`libm`) or taken as inputs (`input`)",
+};
+/// `name=SYMBOL`.
+pub const NAME: ParamInfo = ParamInfo {
+    name: "name",
+    kind: ParamKind::Names,
+    doc: "C: symbol of the function (a prefix `NAME_function` with several functions)",
+};
+
+/// The C back end's options.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CodegenC {
+    /// `plain` or `robotran`.
+    pub abi: &'static str,
+    /// True for `precision=f32`.
+    pub f32: bool,
+    /// States per call, lanes.
+    pub batch: u32,
+    /// True for `trig=input`.
+    pub trig_input: bool,
+    /// The symbol (or prefix, with several functions); `None`: from the function's name.
+    pub name: Option<String>,
+}
+
+impl Default for CodegenC {
+    fn default() -> CodegenC {
+        CodegenC { abi: "plain", f32: false, batch: 1, trig_input: false, name: None }
+    }
+}
+
+fn bad(message: String) -> PassError {
+    PassError::BadParameter { pass: "codegen".into(), message }
+}
+
+impl CodegenC {
+    /// The options from checked parameters.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] for options that cannot go together (`abi=robotran` with
+    /// `batch>1`, `precision=f32` or `trig=input`: Robotran's signature is one state of
+    /// `double`s that computes its own trig) and for a `name` that is not one C identifier.
+    pub fn from_params(p: &Params) -> Result<CodegenC, PassError> {
+        let o = CodegenC {
+            abi: p.choice("abi")?,
+            f32: p.choice("precision")? == "f32",
+            batch: p.choice("batch")?.parse().expect("batch choices are integers"),
+            trig_input: p.choice("trig")? == "input",
+            name: p.names("name")?.map(|n| n.join(",")),
+        };
+        if let Some(n) = &o.name {
+            if !is_c_identifier(n) {
+                return Err(bad(format!("parameter `name` must be one C identifier, found `{n}`")));
+            }
+        }
+        if o.abi == "robotran" {
+            let clash = if o.batch > 1 {
+                Some(format!("batch={}", o.batch))
+            } else if o.f32 {
+                Some("precision=f32".into())
+            } else if o.trig_input {
+                Some("trig=input".into())
+            } else {
+                None
+            };
+            if let Some(c) = clash {
+                return Err(bad(format!(
+                    "`abi=robotran` cannot go with `{c}`: Robotran's signature takes one state of doubles \
+                     and computes its own sin/cos (use `abi=plain`)"
+                )));
+            }
+        }
+        Ok(o)
+    }
+
+    /// `double` or `float`.
+    pub fn real(&self) -> &'static str {
+        if self.f32 {
+            "float"
+        } else {
+            "double"
+        }
+    }
+
+    /// The report's `precision`.
+    pub fn precision(&self) -> &'static str {
+        if self.f32 {
+            "f32"
+        } else {
+            "f64"
+        }
+    }
+
+    fn symbol(&self, f: &Function, several: bool) -> Result<String, PassError> {
+        let base = match (&self.name, self.abi) {
+            (Some(n), _) if several => format!("{n}_{}", f.name),
+            (Some(n), _) => n.clone(),
+            (None, "robotran") => return robotran::symbol(f),
+            (None, _) => super::names::sanitise(&f.name),
+        };
+        Ok(base)
+    }
+
+    /// The C file, its header and the interfaces, for every function of `m` (atomised).
+    ///
+    /// # Errors
+    /// [`PassError::Failed`] when a function cannot be written in this ABI (an unknown
+    /// Robotran function kind for `abi=robotran`, a callback used with two arities).
+    pub fn emit(&self, m: &Module) -> Result<CodegenArtifact, PassError> {
+        let several = m.functions.len() > 1;
+        let mut c = self.preamble();
+        let mut h = String::new();
+        let mut interfaces = Vec::new();
+        let callbacks = body::callbacks(m)?;
+        c += &body::callback_decls(&callbacks, self.real());
+        if self.abi == "robotran" {
+            c += "#include \"mbs_data.h\"\n\n";
+        }
+        for f in &m.functions {
+            let symbol = self.symbol(f, several)?;
+            let (code, proto, iface) = if self.abi == "robotran" {
+                robotran::function(self, f, &symbol)?
+            } else {
+                plain::function(self, f, &symbol)
+            };
+            c += &code;
+            h += &proto;
+            interfaces.push(iface);
+        }
+        let header = self.header(&h, &callbacks);
+        Ok(CodegenArtifact {
+            code: GeneratedCode { language: "C", main: c, companions: vec![("h", header)] },
+            interfaces,
+        })
+    }
+
+    fn options_text(&self) -> String {
+        format!(
+            "codegen<c;abi={};precision={};batch={};trig={}>",
+            self.abi,
+            self.precision(),
+            self.batch,
+            if self.trig_input { "input" } else { "libm" }
+        )
+    }
+
+    fn preamble(&self) -> String {
+        let mut s = format!(
+            "/* Generated by robovec {}.\n * Every operation of robovec's IR is one statement, in the IR's order: compiled without\n \
+             * floating-point contraction it computes bit for bit what robovec's interpreter computes.\n \
+             * Compile with -ffp-contract=off (GCC contracts a*b+c into an FMA under -march=native),\n \
+             * e.g. cc -O2 -ffp-contract=off -c model.c; link with -lm. */\n\
+             #pragma STDC FP_CONTRACT OFF\n#include <math.h>\n#include <string.h>\n\n",
+            self.options_text()
+        );
+        if self.batch > 1 {
+            s += &body::vector_helpers(self.real(), self.batch, self.f32);
+        }
+        s
+    }
+
+    fn header(&self, prototypes: &str, callbacks: &[body::Callback]) -> String {
+        let mut s = format!(
+            "/* Generated by robovec {}: prototypes of the C file beside this one. */\n\
+             #ifndef ROBOVEC_GENERATED_H\n#define ROBOVEC_GENERATED_H\n\n",
+            self.options_text()
+        );
+        if self.abi == "robotran" {
+            s += "#include \"mbs_data.h\"\n\n";
+        }
+        s += prototypes;
+        s += &body::callback_decls(callbacks, self.real());
+        s += "#endif\n";
+        s
+    }
+}
+
+impl Pass for CodegenC {
+    fn name(&self) -> &'static str {
+        "codegen"
+    }
+
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        super::run_emitter(m, cx, |m| self.emit(m))
+    }
+
+    fn requires(&self) -> Option<robovec_ir::Phase> {
+        Some(robovec_ir::Phase::Atomised)
+    }
+
+    fn preserves_timing(&self) -> bool {
+        true
+    }
+
+    fn code_companions(&self) -> Option<&'static [&'static str]> {
+        Some(&["h"])
+    }
+}
+
+/// The callee of a `call` that is `sqrt` (libm), as opposed to a user callback.
+pub fn is_sqrt(c: &Callee, args: usize) -> bool {
+    c.name == "sqrt" && c.elem.is_none() && args == 1
+}
+
+/// True when `f` has a trig value (`sin`/`cos` of a joint coordinate).
+pub fn has_trig(f: &Function) -> bool {
+    f.body.iter().any(|&v| matches!(f.value(v).def, Def::Trig(..)))
+}
+
+/// The interface (SPEC §8) of `f` written as `symbol` under options `o`.
+pub(crate) fn interface(o: &CodegenC, f: &Function, symbol: &str) -> Interface {
+    Interface {
+        function: f.name.clone(),
+        symbol: symbol.to_string(),
+        abi: o.abi,
+        precision: o.precision(),
+        batch: o.batch,
+        trig: if o.trig_input { "input" } else { "libm" },
+        inputs: super::input_values(f, o.trig_input).iter().map(|&v| f.name_of(v).to_string()).collect(),
+        outputs: f.outputs.iter().map(|x| x.name.clone()).collect(),
+    }
+}
