@@ -1,6 +1,9 @@
 //! Speed of the generated C against Robotran's own C (issue 11, "Fast, measured side by side").
 //!
-//! `cargo bench --bench codegen_c -- [MODEL…] [--flags=o2|native|both] [--reps=N] [--quick]`
+//! `cargo bench --bench codegen_c -- [MODEL…] [--flags=o2|native|both] [--reps=N] [--quick] [--core]`
+//!
+//! `--quick`: no `trig=libm` batches, 20 accuracy samples; `--core`: only the variants of the
+//! issue's goals (`atomise`, `atomise,schedule-cpu`, 8 × f64 and 16 × f32 with `trig=input`).
 //!
 //! For each model (a corpus `dirdyna`/`invdyna` C file, named by its prefix: `m454` (default),
 //! `coman_longarms`, `jeep`, `walkman`, `tricycle`, `frank_segway`, `coman_longarms:invdyna`), it
@@ -46,7 +49,7 @@ struct Variant {
     trig: &'static str,
 }
 
-fn variants(params_json: &Path, dce_outputs: &str, quick: bool) -> Vec<Variant> {
+fn variants(params_json: &Path, dce_outputs: &str, quick: bool, core: bool) -> Vec<Variant> {
     let v = |label: &str, pipeline: &str, precision, batch, trig| Variant {
         label: label.into(),
         pipeline: pipeline.into(),
@@ -76,6 +79,14 @@ fn variants(params_json: &Path, dce_outputs: &str, quick: bool) -> Vec<Variant> 
     out.push(v("specialize(params),schedule-cpu batch=8 f64 trig=input", &spec, "f64", 8, "input"));
     let dce = format!("atomise,dce<outputs={dce_outputs}>,schedule-cpu");
     out.push(v(&format!("dce<outputs={dce_outputs}>,schedule-cpu"), &dce, "f64", 1, "libm"));
+    if core {
+        // The goals' variants only (big models compile for minutes per file).
+        let keep = |l: &str| {
+            l == "atomise" || l == "atomise,schedule-cpu" || l.ends_with("batch=8 f64 trig=input") && !l.starts_with("spec")
+                || l.ends_with("batch=16 f32 trig=input")
+        };
+        out.retain(|v| keep(&v.label));
+    }
     out
 }
 
@@ -136,6 +147,13 @@ fn value_of(name: &str, k: usize) -> f64 {
     }
 }
 
+/// Writes `data` to `path` unless the file already holds it (so its time stamp stays).
+fn write_if_changed(path: &Path, data: &[u8]) {
+    if std::fs::read(path).ok().as_deref() != Some(data) {
+        std::fs::write(path, data).unwrap();
+    }
+}
+
 fn run(cmd: &mut Command) -> String {
     let o = cmd.output().unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
     if !o.status.success() {
@@ -193,10 +211,11 @@ struct Row {
     check: String,
 }
 
-fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, quick: bool, rows: &mut Vec<Row>) {
+fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core): (bool, bool), rows: &mut Vec<Row>) {
     let model = find_model(spec);
     let work = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/codegen_c_bench").join(spec.replace(':', "_"));
-    let _ = std::fs::remove_dir_all(&work);
+    // Kept between runs: files are rewritten only when their content changes, and an object
+    // newer than its source is not compiled again (coman's TUs take minutes at -O2).
     std::fs::create_dir_all(&work).unwrap();
     eprintln!("== {} ({})", model.label, model.c_file.display());
 
@@ -209,11 +228,11 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, quick: bool, r
         .expect("the companion header include")
         .to_string();
     let h_file = model.c_file.with_extension("h");
-    std::fs::copy(&h_file, work.join(&inc)).unwrap();
-    std::fs::write(work.join("robotran.c"), &src).unwrap();
+    write_if_changed(&work.join(&inc), &std::fs::read(&h_file).unwrap());
+    write_if_changed(&work.join("robotran.c"), src.as_bytes());
     let stubs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("benches/codegen_c");
     for h in ["mbs_data.h", "mbs_project_interface.h", "MBSdataStructR7.h", "MBSfunR7.h", "driver.c"] {
-        std::fs::copy(stubs.join(h), work.join(h)).unwrap();
+        write_if_changed(&work.join(h), &std::fs::read(stubs.join(h)).unwrap());
     }
 
     // Inputs of the original function (atomise keeps them all) and the parameters file.
@@ -242,7 +261,7 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, quick: bool, r
     let nout_robotran = if model.kind == "dirdyna" { ndof * ndof + ndof } else { ndof };
 
     // robovec's side: one C file per variant, and the error of each pipeline.
-    let vs = variants(&params_json, &dce_outputs, quick);
+    let vs = variants(&params_json, &dce_outputs, quick, core);
     let mut columns: Vec<String> = all_inputs.clone();
     let mut table = String::new();
     let mut errors: BTreeMap<(String, &str), String> = BTreeMap::new();
@@ -250,12 +269,14 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, quick: bool, r
     for (i, v) in vs.iter().enumerate() {
         let rep = work.join(format!("rv{i}.json"));
         let cg = format!("codegen<c;abi=plain;precision={};batch={};trig={};name=rv{i}>", v.precision, v.batch, v.trig);
+        let fresh = work.join(format!("rv{i}.new.c"));
         run(opt()
             .arg(&model.c_file)
             .arg(format!("-passes={},{cg}", v.pipeline))
             .arg("-o")
-            .arg(work.join(format!("rv{i}.c")))
+            .arg(&fresh)
             .arg(format!("-report={}", rep.display())));
+        write_if_changed(&work.join(format!("rv{i}.c")), &std::fs::read(&fresh).unwrap());
         let j = read_json(&rep);
         let ins = names(&j, "inputs");
         let outs = names(&j, "outputs");
@@ -355,7 +376,7 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, quick: bool, r
         ));
     }
     let _ = writeln!(table, "#define NVARIANTS {}\nstatic const Variant VARIANTS[NVARIANTS] = {{\n{}\n}};", vs.len(), entries.join("\n"));
-    std::fs::write(work.join("model.inc"), table).unwrap();
+    write_if_changed(&work.join("model.inc"), table.as_bytes());
 
     let function = if src.contains("void mbs_") { format!("mbs_{}", model.kind) } else { model.kind.to_string() };
     let mut baseline = BTreeMap::new();
@@ -367,6 +388,14 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, quick: bool, r
         let mut jobs = Vec::new();
         let w = work.to_string_lossy().into_owned();
         let mut tu = |src: String, o: String, extra: Vec<String>| {
+            let newer = |a: &str, b: &str| {
+                let t = |p: &str| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+                matches!((t(a), t(b)), (Some(x), Some(y)) if x >= y)
+            };
+            let inc = format!("{w}/model.inc");
+            if newer(&o, &src) && (!src.ends_with("driver.c") || newer(&o, &inc)) {
+                return;
+            }
             let mut a = fl.clone();
             a.push("-Wno-psabi".into());
             a.extend(extra);
@@ -431,6 +460,7 @@ fn main() {
     let mut flags = "both".to_string();
     let mut reps = 61;
     let mut quick = false;
+    let mut core = false;
     for a in std::env::args().skip(1) {
         if let Some(f) = a.strip_prefix("--flags=") {
             flags = f.into();
@@ -438,6 +468,8 @@ fn main() {
             reps = r.parse().expect("--reps=N");
         } else if a == "--quick" {
             quick = true;
+        } else if a == "--core" {
+            core = true;
         } else if a == "--bench" || a.starts_with('-') {
             // cargo bench passes `--bench`; ignore other harness flags.
         } else {
@@ -456,7 +488,7 @@ fn main() {
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     let mut rows = Vec::new();
     for m in &models {
-        bench_model(m, &flag_sets, reps, quick, &mut rows);
+        bench_model(m, &flag_sets, reps, (quick, core), &mut rows);
     }
     println!("load average before: {}", load.trim());
     println!("| model | variant | flags | ns/state median (min–max) | vs Robotran | error bits mean / max | check vs Robotran (state 0) |");

@@ -23,5 +23,6 @@ mod placement;
 mod placement_verify;
 mod props;
 mod roundtrip;
+mod schedule_cpu;
 mod thr;
 mod thr_passes;
