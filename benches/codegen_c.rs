@@ -82,7 +82,9 @@ fn variants(params_json: &Path, dce_outputs: &str, quick: bool, core: bool) -> V
     if core {
         // The goals' variants only (big models compile for minutes per file).
         let keep = |l: &str| {
-            l == "atomise" || l == "atomise,schedule-cpu" || l.ends_with("batch=8 f64 trig=input") && !l.starts_with("spec")
+            l == "atomise"
+                || l == "atomise,schedule-cpu"
+                || l.ends_with("batch=8 f64 trig=input") && !l.starts_with("spec")
                 || l.ends_with("batch=16 f32 trig=input")
         };
         out.retain(|v| keep(&v.label));
@@ -188,10 +190,8 @@ fn robotran_index(name: &str, kind: &str, ndof: usize) -> Option<usize> {
 /// Compiles `jobs` (argument lists for `cc`) two at a time.
 fn compile_all(jobs: Vec<Vec<String>>) {
     for pair in jobs.chunks(2) {
-        let children: Vec<_> = pair
-            .iter()
-            .map(|a| (a.clone(), Command::new("cc").args(a).spawn().expect("cc runs")))
-            .collect();
+        let children: Vec<_> =
+            pair.iter().map(|a| (a.clone(), Command::new("cc").args(a).spawn().expect("cc runs"))).collect();
         for (a, c) in children {
             let o = c.wait_with_output().unwrap();
             assert!(o.status.success(), "cc {} failed", a.join(" "));
@@ -256,7 +256,8 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core):
         .collect();
     let params_json = work.join("params.json");
     std::fs::write(&params_json, serde_json::to_string(&params).unwrap()).unwrap();
-    let dce_outputs = if model.kind == "dirdyna" { "c".to_string() } else { "Qq[1],Qq[2],Qq[3],Qq[4],Qq[5],Qq[6]".into() };
+    let dce_outputs =
+        if model.kind == "dirdyna" { "c".to_string() } else { "Qq[1],Qq[2],Qq[3],Qq[4],Qq[5],Qq[6]".into() };
     let ndof = outputs.iter().filter(|o| o.starts_with("c[") || o.starts_with("Qq[")).count();
     let nout_robotran = if model.kind == "dirdyna" { ndof * ndof + ndof } else { ndof };
 
@@ -304,7 +305,11 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core):
             let a = read_json(&acc);
             for p in ["f64", "f32"] {
                 let s = &a["accuracy"][p];
-                let e = format!("{:.2} / {:.0}", s["mean_bits"].as_f64().unwrap_or(f64::NAN), s["max_bits"].as_f64().unwrap_or(f64::NAN));
+                let e = format!(
+                    "{:.2} / {:.0}",
+                    s["mean_bits"].as_f64().unwrap_or(f64::NAN),
+                    s["max_bits"].as_f64().unwrap_or(f64::NAN)
+                );
                 errors.insert((v.pipeline.clone(), if p == "f64" { "f64" } else { "f32" }), e);
             }
         }
@@ -367,7 +372,11 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core):
             .collect();
         let _ = writeln!(table, "static const int in_map{i}[] = {{{},0}};", im.join(","));
         let _ = writeln!(table, "static const int out_map{i}[] = {{{},0}};", om.join(","));
-        let (f64p, f32p) = if v.precision == "f32" { ("0".to_string(), format!("rv{i}")) } else { (format!("rv{i}"), "0".to_string()) };
+        let (f64p, f32p) = if v.precision == "f32" {
+            ("0".to_string(), format!("rv{i}"))
+        } else {
+            (format!("rv{i}"), "0".to_string())
+        };
         entries.push(format!(
             "  {{\"v{i}\", {f64p}, {f32p}, {}, {}, {}, in_map{i}, out_map{i}}},",
             v.batch,
@@ -375,7 +384,12 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core):
             outs.len()
         ));
     }
-    let _ = writeln!(table, "#define NVARIANTS {}\nstatic const Variant VARIANTS[NVARIANTS] = {{\n{}\n}};", vs.len(), entries.join("\n"));
+    let _ = writeln!(
+        table,
+        "#define NVARIANTS {}\nstatic const Variant VARIANTS[NVARIANTS] = {{\n{}\n}};",
+        vs.len(),
+        entries.join("\n")
+    );
     write_if_changed(&work.join("model.inc"), table.as_bytes());
 
     let function = if src.contains("void mbs_") { format!("mbs_{}", model.kind) } else { model.kind.to_string() };
@@ -423,7 +437,7 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core):
             let f: Vec<&str> = line.split('\t').collect();
             match f.as_slice() {
                 ["check", v, n, same, worst] => {
-                    checks.insert(v.to_string(), format!("{same}/{n} same, rel {worst}"));
+                    checks.insert(v.to_string(), format!("{same}/{n} bit-identical, max diff {worst} of max |out|"));
                 }
                 ["time", v, med, min, max] => {
                     let med: f64 = med.parse().unwrap();
