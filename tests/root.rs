@@ -8,6 +8,7 @@ mod common;
 mod accuracy;
 mod bounds;
 mod cli;
+mod codegen_c;
 mod corpus;
 mod diagnostics;
 mod eqsat;

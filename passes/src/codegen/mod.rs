@@ -120,3 +120,27 @@ pub(crate) fn run_emitter(
     cx.emit(a);
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::{build_pass, parse_pipeline, PassError};
+
+    fn build(text: &str) -> Result<String, PassError> {
+        let spec = parse_pipeline(text).unwrap().remove(0);
+        build_pass(&spec).map(|p| format!("{p:?}"))
+    }
+
+    #[test]
+    fn the_first_bare_word_selects_the_back_end() {
+        let plain = build("codegen").unwrap();
+        assert_eq!(build("codegen<c>").unwrap(), plain, "`c` is the default back end");
+        assert_eq!(build("codegen<back-end=c>").unwrap(), plain);
+        let robotran = build("codegen<c;abi=robotran>").unwrap();
+        assert!(robotran.contains("abi: \"robotran\""), "{robotran}");
+        assert!(matches!(build("codegen<fpga>"), Err(PassError::BadParameter { .. })), "not a back end yet");
+        let twice = build("codegen<c;back-end=c>").unwrap_err().to_string();
+        assert!(twice.contains("given twice"), "{twice}");
+        let bad = build("codegen<c;abi=robotran;batch=8>").unwrap_err().to_string();
+        assert!(bad.contains("`abi=robotran` cannot go with `batch=8`"), "{bad}");
+    }
+}

@@ -19,17 +19,24 @@ pub(crate) struct Callback {
     pub indices: usize,
 }
 
-/// `user_ExtForces.1` → (`user_ExtForces`, `[1]`).
-pub(crate) fn split_callee(c: &Callee) -> Result<(String, Vec<i64>), PassError> {
-    let mut parts = c.name.split('.');
-    let base = parts.next().unwrap_or_default().to_string();
-    let idx: Result<Vec<i64>, _> = parts.map(str::parse::<i64>).collect();
-    match idx {
-        Ok(idx) if crate::codegen::names::is_c_identifier(&base) => Ok((base, idx)),
-        _ => Err(PassError::Failed {
+/// The C name and integer arguments of a callback: `user_ExtForces.1` → (`user_ExtForces`,
+/// `[1]`); Matlab's `usrfun.flink.1` → (`usrfun_flink`, `[1]`) (the trailing integer segments
+/// are the source call's integer arguments, the others part of the name).
+///
+/// # Errors
+/// [`PassError::Failed`] when what is left is not a C identifier.
+pub fn split_callee(c: &Callee) -> Result<(String, Vec<i64>), PassError> {
+    let parts: Vec<&str> = c.name.split('.').collect();
+    let n_idx = parts.iter().rev().take_while(|p| p.parse::<i64>().is_ok()).count().min(parts.len() - 1);
+    let base = parts[..parts.len() - n_idx].join("_");
+    let idx: Vec<i64> = parts[parts.len() - n_idx..].iter().map(|p| p.parse().expect("checked")).collect();
+    if crate::codegen::names::is_c_identifier(&base) {
+        Ok((base, idx))
+    } else {
+        Err(PassError::Failed {
             pass: "codegen".into(),
             message: format!("callee `@{}` is not a C name followed by integer arguments (`user_X.1`)", c.name),
-        }),
+        })
     }
 }
 

@@ -14,6 +14,7 @@
 //! function the IR came from, a drop-in replacement of its file.
 
 mod body;
+pub use body::split_callee;
 pub mod plain;
 pub mod robotran;
 
@@ -139,13 +140,13 @@ impl CodegenC {
     }
 
     fn symbol(&self, f: &Function, several: bool) -> Result<String, PassError> {
-        let base = match (&self.name, self.abi) {
-            (Some(n), _) if several => format!("{n}_{}", f.name),
-            (Some(n), _) => n.clone(),
-            (None, "robotran") => return robotran::symbol(f),
-            (None, _) => super::names::sanitise(&f.name),
-        };
-        Ok(base)
+        match (&self.name, self.abi) {
+            (Some(n), "robotran") if several => Ok(format!("{n}_{}", robotran::symbol(f)?)),
+            (Some(n), _) if several => Ok(format!("{n}_{}", f.name)),
+            (Some(n), _) => Ok(n.clone()),
+            (None, "robotran") => robotran::symbol(f),
+            (None, _) => Ok(super::names::sanitise(&f.name)),
+        }
     }
 
     /// The C file, its header and the interfaces, for every function of `m` (atomised).
@@ -173,6 +174,12 @@ impl CodegenC {
             c += &code;
             h += &proto;
             interfaces.push(iface);
+        }
+        if self.abi == "robotran" {
+            let (code, proto) =
+                robotran::sensor_dispatch(m, |f| self.symbol(f, several).expect("symbols checked above"));
+            c += &code;
+            h += &proto;
         }
         let header = self.header(&h, &callbacks);
         Ok(CodegenArtifact {

@@ -1,26 +1,222 @@
-//! `abi=robotran`: a drop-in replacement of the Robotran function the IR came from.
-use robovec_ir::Function;
+//! `abi=robotran`: a drop-in replacement of the Robotran function the IR came from, with its
+//! signature and `MbsData` field access (1-based arrays as Robotran uses them), so the file
+//! replaces Robotran's own in an MBsysC project (GRAMMAR-NOTES §1.3, §2.3 list the signatures).
+//!
+//! Inputs are read into locals first (`const double q_4 = s->q[4];`), outputs written last
+//! (`M[1][2] = CM12;`), so an output array that aliases an `MbsData` field (`mbs_link(s->frc,
+//! …)`) is never read after being written. Sensors (`@sensor_3`, `@gensensor_3`) become one
+//! static function each and one `mbs_sensor(MbsSensor *sens, MbsData *s, int isens)` (or
+//! `mbs_gensensor`) that switches on `isens`, as Robotran's does.
 
-use super::CodegenC;
+use std::fmt::Write as _;
+
+use robovec_ir::{Function, Module};
+
+use super::body::Body;
+use super::{interface, CodegenC};
+use crate::codegen::names::c_names;
 use crate::codegen::Interface;
 use crate::PassError;
 
-/// The Robotran symbol of `f` (`dirdyna` → `mbs_dirdyna`).
+/// A Robotran function kind: the IR function name, Robotran's symbol and its output arrays.
+struct Kind {
+    ir: &'static str,
+    symbol: &'static str,
+    /// Output parameters `(C type, name)` before `MbsData *s, double tsim`.
+    outputs: &'static [(&'static str, &'static str)],
+}
+
+const KINDS: &[Kind] = &[
+    Kind { ir: "dirdyna", symbol: "mbs_dirdyna", outputs: &[("double **", "M"), ("double *", "c")] },
+    Kind { ir: "invdyna", symbol: "mbs_invdyna", outputs: &[("double *", "Qq")] },
+    Kind { ir: "cons_hJ", symbol: "mbs_cons_hJ", outputs: &[("double *", "h"), ("double **", "Jac")] },
+    Kind { ir: "cons_jdqd", symbol: "mbs_cons_jdqd", outputs: &[("double *", "Jdqd")] },
+    Kind {
+        ir: "link",
+        symbol: "mbs_link",
+        outputs: &[
+            ("double **", "frc"),
+            ("double **", "trq"),
+            ("double *", "Flnk"),
+            ("double *", "Z"),
+            ("double *", "Zd"),
+        ],
+    },
+    Kind { ir: "link3D", symbol: "mbs_link3D", outputs: &[("double **", "frc"), ("double **", "trq")] },
+    Kind { ir: "extforces", symbol: "mbs_extforces", outputs: &[("double **", "frc"), ("double **", "trq")] },
+];
+
+/// `MbsData` fields robovec's functions read (SPEC §2 names): `(name, number of indices)`.
+pub const MBS_FIELDS: &[(&str, usize)] = &[
+    ("q", 1),
+    ("qd", 1),
+    ("qdd", 1),
+    ("m", 1),
+    ("g", 1),
+    ("lrod", 1),
+    ("Qq", 1),
+    ("dpt", 2),
+    ("l", 2),
+    ("In", 2),
+    ("frc", 2),
+    ("trq", 2),
+];
+
+/// `MbsSensor` fields (`sens.P[1]`…): `(name, number of indices)`.
+pub const SENSOR_FIELDS: &[(&str, usize)] = &[("P", 1), ("V", 1), ("OM", 1), ("A", 1), ("OMP", 1), ("R", 2), ("J", 2)];
+
+/// A minimal `mbs_data.h`: `MbsData` and `MbsSensor` with the fields of [`MBS_FIELDS`] and
+/// [`SENSOR_FIELDS`] as Robotran's `mbs_data.h` declares them (`double *q; double **dpt;`,
+/// 1-based: the caller allocates one more element per dimension), `double tsim` and
+/// `int flag_stop` (set by `mbs_link3D`). Enough to
+/// compile and call the `abi=robotran` code outside MBsysC (tests, benchmarks).
+pub fn mbs_data_header() -> String {
+    let field = |(n, dims): &(&str, usize)| format!("    double {}{n};\n", "*".repeat(*dims));
+    let mut s = String::from(
+        "/* Minimal MbsData and MbsSensor for robovec's abi=robotran code (fields as in Robotran's\n \
+         * mbs_data.h: 1-based arrays, one extra element per dimension). */\n\
+         #ifndef MBS_DATA_H\n#define MBS_DATA_H\n\ntypedef struct MbsData {\n    double tsim;\n    int flag_stop;\n",
+    );
+    MBS_FIELDS.iter().for_each(|f| s += &field(f));
+    s += "} MbsData;\n\ntypedef struct MbsSensor {\n";
+    SENSOR_FIELDS.iter().for_each(|f| s += &field(f));
+    s += "} MbsSensor;\n\n#endif\n";
+    s
+}
+
+/// `sensor_3` → (`mbs_sensor`, 3); `gensensor_3` → (`mbs_gensensor`, 3).
+fn sensor(f: &Function) -> Option<(&'static str, u32)> {
+    for (prefix, symbol) in [("sensor_", "mbs_sensor"), ("gensensor_", "mbs_gensensor")] {
+        if let Some(k) = f.name.strip_prefix(prefix).and_then(|k| k.parse().ok()) {
+            return Some((symbol, k));
+        }
+    }
+    None
+}
+
+fn unknown(f: &Function) -> PassError {
+    let known: Vec<&str> = KINDS.iter().map(|k| k.ir).chain(["sensor_N", "gensensor_N"]).collect();
+    PassError::Failed {
+        pass: "codegen".into(),
+        message: format!(
+            "@{}: no Robotran signature is known for this function (abi=robotran knows @{}); use abi=plain",
+            f.name,
+            known.join(", @")
+        ),
+    }
+}
+
+/// The Robotran symbol of `f` (`dirdyna` → `mbs_dirdyna`, `sensor_3` → `mbs_sensor`).
 ///
 /// # Errors
 /// [`PassError::Failed`] for a function kind with no known Robotran signature.
 pub fn symbol(f: &Function) -> Result<String, PassError> {
-    Err(unknown(f))
+    if let Some((s, _)) = sensor(f) {
+        return Ok(s.to_string());
+    }
+    KINDS.iter().find(|k| k.ir == f.name).map(|k| k.symbol.to_string()).ok_or_else(|| unknown(f))
 }
 
-fn unknown(f: &Function) -> PassError {
-    PassError::Failed { pass: "codegen".into(), message: format!("@{}: abi=robotran is not written yet", f.name) }
+fn split_base(name: &str) -> (&str, &str) {
+    let i = name.find('[').unwrap_or(name.len());
+    (&name[..i], &name[i..])
 }
 
-/// The drop-in definition of `f`.
+/// The drop-in definition of `f` as `symbol`, its prototype and its interface. A sensor gives
+/// a static function `robovec_<symbol>_<k>`; [`sensor_dispatch`] writes the switch.
 ///
 /// # Errors
-/// [`PassError::Failed`] for a function kind with no known Robotran signature.
-pub fn function(_o: &CodegenC, f: &Function, _symbol: &str) -> Result<(String, String, Interface), PassError> {
-    Err(unknown(f))
+/// [`PassError::Failed`] for a function kind with no known Robotran signature, an input that
+/// is no `MbsData` field, or an output that is no output parameter of the signature.
+pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> Result<(String, String, Interface), PassError> {
+    let fail =
+        |message: String| PassError::Failed { pass: "codegen".into(), message: format!("@{}: {message}", f.name) };
+    let sens = sensor(f);
+    let (params, outs): (String, Vec<&str>) = match sens {
+        Some(_) => ("MbsSensor *sens, MbsData *s".into(), vec!["sens"]),
+        None => {
+            let k = KINDS.iter().find(|k| k.ir == f.name).ok_or_else(|| unknown(f))?;
+            let flink = f.outputs.iter().any(|x| split_base(&x.name).0 == "Flink");
+            let list: Vec<(&str, &str)> =
+                k.outputs.iter().map(|&(t, n)| if n == "Flnk" && flink { (t, "Flink") } else { (t, n) }).collect();
+            let p: String = list.iter().map(|(t, n)| format!("{t}{n}, ")).collect();
+            (format!("{p}MbsData *s, double tsim"), list.iter().map(|x| x.1).collect())
+        }
+    };
+    let mut reserved: Vec<&str> = vec!["s", "tsim", "sens", "isens", symbol];
+    reserved.extend(&outs);
+    let callee_names: Vec<String> = f
+        .body
+        .iter()
+        .filter_map(|&v| match &f.value(v).def {
+            robovec_ir::Def::Call(c, _) => super::body::split_callee(c).ok().map(|(b, _)| b),
+            _ => None,
+        })
+        .collect();
+    reserved.extend(callee_names.iter().map(String::as_str));
+    let names = c_names(f, &reserved);
+    let b = Body { o, f, names: &names };
+    let (sig, proto) = match sens {
+        Some((_, k)) => (format!("static void robovec_{symbol}_{k}({params})"), String::new()),
+        None => {
+            let sig = format!("void {symbol}({params})");
+            (sig.clone(), format!("/* @{} as Robotran's {symbol} (drop-in). */\n{sig};\n\n", f.name))
+        }
+    };
+    let mut s = format!("/* @{} */\n{sig}\n{{\n", f.name);
+    for &v in &f.inputs {
+        let n = f.name_of(v);
+        let access = if n == "tsim" {
+            if sens.is_some() {
+                "s->tsim".to_string()
+            } else {
+                "tsim".to_string()
+            }
+        } else {
+            let (base, _) = split_base(n);
+            if !MBS_FIELDS.iter().any(|(x, _)| *x == base) {
+                return Err(fail(format!("input `{n}` is no MbsData field (abi=robotran reads s->q, s->dpt, …)")));
+            }
+            format!("s->{n}")
+        };
+        let _ = writeln!(s, "  const double {} = {access};", names[v.index()]);
+    }
+    b.statements(&mut s);
+    for out in &f.outputs {
+        let lvalue = match out.name.strip_prefix("sens.") {
+            Some(rest) if sens.is_some() => format!("sens->{rest}"),
+            None if out.name == "flag_stop" => "s->flag_stop".to_string(),
+            _ if sens.is_none() && outs.contains(&split_base(&out.name).0) => out.name.clone(),
+            _ => return Err(fail(format!("output `{}` is no output parameter of {symbol}", out.name))),
+        };
+        let _ = writeln!(s, "  {lvalue} = {};", b.operand(&out.value));
+    }
+    s += "}\n\n";
+    Ok((s, proto, interface(o, f, symbol)))
+}
+
+/// The `mbs_sensor`/`mbs_gensensor` functions that switch on `isens` to the sensors of `m`,
+/// and their prototypes (empty when `m` has no sensor).
+pub fn sensor_dispatch(m: &Module, symbol_of: impl Fn(&Function) -> String) -> (String, String) {
+    let mut groups: Vec<(String, Vec<u32>)> = Vec::new();
+    for f in &m.functions {
+        if let Some((_, k)) = sensor(f) {
+            let sym = symbol_of(f);
+            match groups.iter_mut().find(|(s, _)| *s == sym) {
+                Some((_, ks)) => ks.push(k),
+                None => groups.push((sym, vec![k])),
+            }
+        }
+    }
+    let (mut code, mut proto) = (String::new(), String::new());
+    for (sym, ks) in groups {
+        let sig = format!("void {sym}(MbsSensor *sens, MbsData *s, int isens)");
+        let _ = write!(code, "{sig}\n{{\n  switch (isens) {{\n");
+        for k in ks {
+            let _ = writeln!(code, "  case {k}: robovec_{sym}_{k}(sens, s); break;");
+        }
+        code += "  default: break;\n  }\n}\n\n";
+        let _ = write!(proto, "/* Robotran's {sym} (drop-in): sensor isens. */\n{sig};\n\n");
+    }
+    (code, proto)
 }

@@ -1,0 +1,514 @@
+//! Issue 11, "Correct, by execution": the C that `codegen<c>` writes is compiled with the
+//! system C compiler (`cc -O0 -ffp-contract=off`: gcc -O1 takes over a minute on the largest corpus function, -O0 2 s; x86-64 and AArch64 round the same at every level), run on pseudo-random inputs and compared
+//! bit for bit with robovec's interpreter (`robovec_ir::interp::eval`) in f64 and f32.
+//!
+//! One build per test: every module of the test is one translation unit (`t<k>.c`, symbols
+//! prefixed `t<k>` with `name=`), plus the user callbacks (C definitions of the interpreter's
+//! documented stand-in, `callback_standin`) and a driver that reads the inputs as raw reals
+//! and prints every output's bits in hex.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use robovec_ir::interp::{callback_standin, eval, pseudo_random_input, Float};
+use robovec_ir::{Callee, Def, Module, TrigFn};
+use robovec_passes::codegen::c::{robotran, split_callee, CodegenC};
+use robovec_passes::codegen::input_values;
+use robovec_passes::{Instrumentation, PassContext, PassManager};
+
+use crate::common::{corpus_files, is_loop_file, tmp};
+
+/// A module to test, with a label for messages.
+pub struct Case {
+    label: String,
+    m: Module,
+}
+
+/// Runs `pipeline` (which must not end in codegen) on `m`.
+fn run_pipeline(mut m: Module, pipeline: &str) -> Module {
+    let pm = PassManager::new(pipeline, Instrumentation::default()).unwrap();
+    pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink()).unwrap();
+    m
+}
+
+/// Every straight-line corpus file (C, Matlab, Python) after `pipeline`.
+fn corpus_cases(pipeline: &str, only_c: bool) -> Vec<Case> {
+    let files: Vec<PathBuf> = corpus_files()
+        .into_iter()
+        .filter(|p| !is_loop_file(p) && (!only_c || p.extension().is_some_and(|e| e == "c")))
+        .collect();
+    assert!(files.len() >= 20, "corpus: {} straight-line files", files.len());
+    files
+        .iter()
+        .map(|p| {
+            let (m, _) = robovec::driver::load(p.to_str().unwrap())
+                .unwrap_or_else(|f| panic!("{}: {}", p.display(), f.message()));
+            Case { label: p.file_name().unwrap().to_string_lossy().into_owned(), m: run_pipeline(m, pipeline) }
+        })
+        .collect()
+}
+
+fn cc(dir: &Path, files: &[String], opt: &str) -> PathBuf {
+    let exe = dir.join("run");
+    let mut cmd = Command::new("cc");
+    cmd.current_dir(dir).args([opt, "-ffp-contract=off", "-w", "-o"]).arg(&exe).args(files).arg("-lm");
+    let o = cmd.output().expect("a C compiler `cc` on PATH (.ci/run installs gcc)");
+    assert!(o.status.success(), "cc failed in {}:\n{}", dir.display(), String::from_utf8_lossy(&o.stderr));
+    exe
+}
+
+/// Callee, element and argument count of every user callback of `m`.
+fn callback_uses(m: &Module, out: &mut Vec<(Callee, usize)>) {
+    for f in &m.functions {
+        for &v in &f.body {
+            if let Def::Call(c, args) = &f.value(v).def {
+                if !robovec_passes::codegen::c::is_sqrt(c, args.len()) && !out.iter().any(|(k, _)| k == c) {
+                    out.push((c.clone(), args.len()));
+                }
+            }
+        }
+    }
+}
+
+fn lit<T: Float>(x: T, f32: bool) -> String {
+    robovec_passes::codegen::literal::hex(x.to_f64(), f32)
+}
+
+/// C definitions of the callbacks computing exactly [`callback_standin`]: weight `k` is the
+/// stand-in of the unit vector `e_k` (exact: the other terms are signed zeros).
+fn callbacks_c<T: Float>(uses: &[(Callee, usize)], f32: bool, robotran_abi: bool) -> String {
+    let real = if f32 { "float" } else { "double" };
+    let mut bases: Vec<(String, usize)> = Vec::new();
+    for (c, _) in uses {
+        let (base, idx) = split_callee(c).unwrap();
+        let n = idx.len();
+        if !bases.iter().any(|(b, _)| *b == base) {
+            bases.push((base, n));
+        }
+    }
+    let mut s = String::from("#include <stdlib.h>\n");
+    for (base, nidx) in &bases {
+        let idx_params: String = (1..=*nidx).map(|i| format!("int index{i}, ")).collect();
+        let _ = writeln!(s, "{real} {base}({idx_params}int elem, int nargs, const {real} *a)\n{{");
+        for (c, n) in uses.iter().filter(|(c, _)| split_callee(c).unwrap().0 == *base) {
+            let idx = split_callee(c).unwrap().1;
+            let mut cond: Vec<String> = idx.iter().enumerate().map(|(i, x)| format!("index{} == {x}", i + 1)).collect();
+            cond.push(format!("elem == {}", c.elem.unwrap_or(0)));
+            cond.push(format!("nargs == {n}"));
+            let w = |k: usize| {
+                let mut e = vec![T::from_f64(0.0); *n];
+                if *n == 0 {
+                    return callback_standin::<T>(c, &[]);
+                }
+                e[k] = T::from_f64(1.0);
+                callback_standin(c, &e)
+            };
+            let body = if *n == 0 {
+                format!("return {};", lit(w(0), f32))
+            } else {
+                let mut b = format!("{real} acc = {} * a[0];", lit(w(0), f32));
+                for k in 1..*n {
+                    let _ = write!(b, " acc = acc + {} * a[{k}];", lit(w(k), f32));
+                }
+                b + " return acc;"
+            };
+            let _ = writeln!(s, "  if ({}) {{ {body} }}", cond.join(" && "));
+        }
+        s += "  abort();\n}\n";
+    }
+    let _ = robotran_abi;
+    s
+}
+
+/// The value of input `name` in lane `lane` under `seed`, as the test feeds it.
+fn input_value(name: &str, seed: u64, lane: u32) -> f64 {
+    pseudo_random_input(name, seed.wrapping_add(lane as u64 * 7919))
+}
+
+fn same<T: Float>(got: u64, want: T) -> bool {
+    let w = want.to_f64();
+    (w.is_nan() && f64::from_bits(got).is_nan()) || got == w.to_bits()
+}
+
+/// Emits every case with `o` (plain ABI), compiles one program, runs it on the inputs of
+/// `seed` and compares every output of every lane with the interpreter in precision `T`.
+/// Returns the number of output values compared.
+fn check_plain<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64) -> usize {
+    let f32 = o.f32;
+    let real = o.real();
+    let w = o.batch;
+    let mut files = vec!["main.c".to_string(), "callbacks.c".to_string()];
+    let mut uses = Vec::new();
+    let robotran_abi = o.abi == "robotran";
+    let mut main = String::from("#include <stdio.h>\n#include <stdlib.h>\n#include <string.h>\n#include <stdint.h>\n");
+    if robotran_abi {
+        std::fs::write(dir.join("mbs_data.h"), robotran::mbs_data_header()).unwrap();
+        main += &robotran_globals(cases);
+    }
+    let mut calls = String::new();
+    let mut inputs: Vec<u8> = Vec::new();
+    let mut want: Vec<(String, T)> = Vec::new();
+    for (k, case) in cases.iter().enumerate() {
+        let ok = CodegenC { name: Some(format!("t{k}")), ..o.clone() };
+        let art = ok.emit(&case.m).unwrap_or_else(|e| panic!("{}: {e}", case.label));
+        std::fs::write(dir.join(format!("t{k}.c")), &art.code.main).unwrap();
+        files.push(format!("t{k}.c"));
+        callback_uses(&case.m, &mut uses);
+        for (f, iface) in case.m.functions.iter().zip(&art.interfaces) {
+            let (ni, no) = (iface.inputs.len(), iface.outputs.len());
+            if robotran_abi {
+                let proto =
+                    art.code.companions[0].1.lines().find(|l| l.starts_with(&format!("void {}(", iface.symbol)));
+                let proto = proto.expect("prototype in the header");
+                if !main.contains(proto) {
+                    main += proto;
+                    main += "\n";
+                }
+                calls += &robotran_call(f, iface);
+            } else {
+                let _ = writeln!(main, "void {}(const {real} *restrict in, {real} *restrict out);", iface.symbol);
+                let _ = writeln!(
+                calls,
+                "  {{ static {real} in[{}], out[{}]; if (fread(in, sizeof *in, {}, stdin) != {}) return 1; {}(in, out); \
+                 for (int i = 0; i < {}; i++) {{ double x = out[i]; uint64_t b; memcpy(&b, &x, 8); printf(\"%016llx\\n\", (unsigned long long)b); }} }}",
+                (ni * w as usize).max(1),
+                (no * w as usize).max(1),
+                ni * w as usize,
+                ni * w as usize,
+                iface.symbol,
+                no * w as usize
+            );
+            }
+            // Inputs of every lane; trig inputs are the interpreter's own sin/cos of their
+            // joint coordinate in precision T.
+            let ins = input_values(f, o.trig_input);
+            let lane_value = |v: robovec_ir::Value, lane: u32| -> T {
+                match f.value(v).def {
+                    Def::Trig(t, q) => {
+                        let x = T::from_f64(input_value(f.name_of(q), seed, lane));
+                        match t {
+                            TrigFn::Sin => x.sin(),
+                            TrigFn::Cos => x.cos(),
+                        }
+                    }
+                    _ => T::from_f64(input_value(f.name_of(v), seed, lane)),
+                }
+            };
+            for &v in &ins {
+                for lane in 0..w {
+                    let x = lane_value(v, lane);
+                    if f32 {
+                        inputs.extend((x.to_f64() as f32).to_le_bytes());
+                    } else {
+                        inputs.extend(x.to_f64().to_le_bytes());
+                    }
+                }
+            }
+            let per_lane: Vec<Vec<(String, T)>> =
+                (0..w).map(|lane| eval::<T>(f, |name| input_value(name, seed, lane))).collect();
+            // Output j of lane l is printed at j*W + l.
+            for j in 0..no {
+                for (lane, outs) in per_lane.iter().enumerate() {
+                    let (n, x) = &outs[j];
+                    want.push((format!("{} @{} {n} lane {lane}", case.label, f.name), *x));
+                }
+            }
+        }
+    }
+    let init = if robotran_abi { "  robovec_test_alloc();\n" } else { "" };
+    main += &format!("int main(void)\n{{\n{init}{calls}  return 0;\n}}\n");
+    std::fs::write(dir.join("main.c"), main).unwrap();
+    std::fs::write(dir.join("callbacks.c"), callbacks_c::<T>(&uses, f32, false)).unwrap();
+    let exe = cc(dir, &files, "-O0");
+    let mut child =
+        Command::new(&exe).stdin(std::process::Stdio::piped()).stdout(std::process::Stdio::piped()).spawn().unwrap();
+    std::io::Write::write_all(child.stdin.as_mut().unwrap(), &inputs).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "{} exited with {:?}", exe.display(), out.status);
+    let got: Vec<u64> =
+        String::from_utf8(out.stdout).unwrap().lines().map(|l| u64::from_str_radix(l, 16).unwrap()).collect();
+    assert_eq!(got.len(), want.len(), "number of outputs printed");
+    let bad: Vec<String> = got
+        .iter()
+        .zip(&want)
+        .filter(|(g, (_, x))| !same(**g, *x))
+        .map(|(g, (what, x))| format!("{what}: C {:e} vs interpreter {:e}", f64::from_bits(*g), x.to_f64()))
+        .take(10)
+        .collect();
+    assert!(bad.is_empty(), "{} ({}): outputs differ from the interpreter:\n{}", dir.display(), real, bad.join("\n"));
+    want.len()
+}
+
+/// Largest index in any input or output name of the cases, plus one.
+fn array_size(cases: &[Case]) -> usize {
+    let mut k = 1;
+    for c in cases {
+        for f in &c.m.functions {
+            let names = f.inputs.iter().map(|&v| f.name_of(v)).chain(f.outputs.iter().map(|o| o.name.as_str()));
+            for n in names {
+                for part in n.split('[').skip(1) {
+                    k = k.max(part.trim_end_matches(']').parse::<usize>().unwrap_or(0) + 1);
+                }
+            }
+        }
+    }
+    k
+}
+
+/// Globals of the robotran-ABI driver: one `MbsData`, one `MbsSensor` and the output arrays,
+/// every dimension `array_size` long.
+fn robotran_globals(cases: &[Case]) -> String {
+    let k = array_size(cases);
+    let mut s = format!(
+        "#include \"mbs_data.h\"\nstatic double *v1(void) {{ return calloc({k}, sizeof(double)); }}\n\
+         static double **v2(void) {{ double **r = calloc({k}, sizeof *r); for (int i = 0; i < {k}; i++) r[i] = v1(); return r; }}\n\
+         static MbsData s; static MbsSensor sens; static double tsim;\n"
+    );
+    let outs: &[(&str, usize)] = &[
+        ("M", 2),
+        ("c", 1),
+        ("Qq", 1),
+        ("h", 1),
+        ("Jac", 2),
+        ("Jdqd", 1),
+        ("frc", 2),
+        ("trq", 2),
+        ("Flnk", 1),
+        ("Flink", 1),
+        ("Z", 1),
+        ("Zd", 1),
+    ];
+    let mut alloc = String::new();
+    for (n, d) in outs {
+        let _ = writeln!(s, "static double {}out_{n};", "*".repeat(*d));
+        let _ = writeln!(alloc, "  out_{n} = v{d}();");
+    }
+    for (n, d) in robotran::MBS_FIELDS {
+        let _ = writeln!(alloc, "  s.{n} = v{d}();");
+    }
+    for (n, d) in robotran::SENSOR_FIELDS {
+        let _ = writeln!(alloc, "  sens.{n} = v{d}();");
+    }
+    let _ = write!(s, "static void robovec_test_alloc(void)\n{{\n{alloc}}}\n");
+    s
+}
+
+/// The driver's block for one function of the robotran ABI: reads the inputs into `s`, calls,
+/// prints the outputs' bits.
+fn robotran_call(f: &robovec_ir::Function, iface: &robovec_passes::codegen::Interface) -> String {
+    let ni = iface.inputs.len();
+    let mut b =
+        format!("  {{ static double in[{}]; if (fread(in, sizeof *in, {ni}, stdin) != {ni}) return 1;\n", ni.max(1));
+    let sensor = f.name.contains("sensor_");
+    for (i, n) in iface.inputs.iter().enumerate() {
+        let target = match n.as_str() {
+            "tsim" if sensor => "s.tsim".to_string(),
+            "tsim" => "tsim".to_string(),
+            _ => format!("s.{n}"),
+        };
+        let _ = writeln!(b, "    {target} = in[{i}];");
+    }
+    if sensor {
+        let k: u32 = f.name.rsplit('_').next().unwrap().parse().unwrap();
+        let _ = writeln!(b, "    {}(&sens, &s, {k});", iface.symbol);
+    } else {
+        let _ = writeln!(b, "    {}({}&s, tsim);", iface.symbol, robotran_out_args(f));
+    }
+    for n in &iface.outputs {
+        let x = match n.strip_prefix("sens.") {
+            Some(r) => format!("sens.{r}"),
+            None if n == "flag_stop" => "(double)s.flag_stop".to_string(),
+            None => format!("out_{n}"),
+        };
+        let _ = writeln!(
+            b,
+            "    {{ double x = {x}; uint64_t u; memcpy(&u, &x, 8); printf(\"%016llx\\n\", (unsigned long long)u); }}"
+        );
+    }
+    b + "  }\n"
+}
+
+/// The output arguments of a Robotran function kind, in its signature's order (GRAMMAR-NOTES
+/// §1.3), independently of the emitter's table.
+fn robotran_out_args(f: &robovec_ir::Function) -> String {
+    let flink = f.outputs.iter().any(|o| o.name.starts_with("Flink["));
+    let list: &[&str] = match f.name.as_str() {
+        "dirdyna" => &["M", "c"],
+        "invdyna" => &["Qq"],
+        "cons_hJ" => &["h", "Jac"],
+        "cons_jdqd" => &["Jdqd"],
+        "link" if flink => &["frc", "trq", "Flink", "Z", "Zd"],
+        "link" => &["frc", "trq", "Flnk", "Z", "Zd"],
+        "link3D" | "extforces" => &["frc", "trq"],
+        other => panic!("no Robotran signature known to the test for @{other}"),
+    };
+    list.iter().map(|n| format!("out_{n}, ")).collect()
+}
+
+fn plain(f32: bool, batch: u32, trig_input: bool) -> CodegenC {
+    CodegenC { f32, batch, trig_input, ..CodegenC::default() }
+}
+
+#[test]
+fn plain_f64_equals_the_interpreter_bit_for_bit_on_every_corpus_file() {
+    for (k, pipeline) in ["atomise", "atomise,zero-removal,balance"].into_iter().enumerate() {
+        let cases = corpus_cases(pipeline, false);
+        let n = check_plain::<f64>(&tmp(&format!("plain_f64_{k}")), &cases, &plain(false, 1, false), 1);
+        assert!(n > 5_000, "{pipeline}: only {n} outputs compared");
+    }
+}
+
+#[test]
+fn plain_f32_equals_the_interpreter_bit_for_bit_on_every_corpus_file() {
+    for (k, pipeline) in ["atomise", "atomise,zero-removal,balance"].into_iter().enumerate() {
+        let cases = corpus_cases(pipeline, false);
+        let n = check_plain::<f32>(&tmp(&format!("plain_f32_{k}")), &cases, &plain(true, 1, true), 2);
+        assert!(n > 5_000, "{pipeline}: only {n} outputs compared");
+    }
+}
+
+#[test]
+fn robotran_drop_in_equals_the_interpreter_bit_for_bit_on_every_c_corpus_file() {
+    for (k, pipeline) in ["atomise", "atomise,zero-removal,balance"].into_iter().enumerate() {
+        let cases = corpus_cases(pipeline, true);
+        let o = CodegenC { abi: "robotran", ..CodegenC::default() };
+        let n = check_plain::<f64>(&tmp(&format!("robotran_{k}")), &cases, &o, 3);
+        assert!(n > 3_000, "{pipeline}: only {n} outputs compared");
+    }
+}
+
+/// Small corpus files (callbacks, sqrt, sensors, trig) and random DAGs, for the batched forms.
+fn batch_cases() -> Vec<Case> {
+    let mut cases: Vec<Case> = corpus_cases("atomise,zero-removal,balance", true)
+        .into_iter()
+        .filter(|c| {
+            ["tricycle__mbs_dirdyna", "frank_segway__mbs_extforces", "jeep__mbs_link", "m454__mbs_sensor"]
+                .iter()
+                .any(|p| c.label.starts_with(p))
+        })
+        .collect();
+    assert_eq!(cases.len(), 4, "the batch test's corpus files");
+    for seed in 0..6 {
+        let f = robovec_passes::dag_gen::generate(300, seed);
+        cases.push(Case { label: format!("dag_gen seed {seed}"), m: Module { functions: vec![f] } });
+        let f = robovec_passes::expr_gen::generate(seed);
+        let m = run_pipeline(Module { functions: vec![f] }, "atomise");
+        cases.push(Case { label: format!("expr_gen seed {seed}"), m });
+    }
+    cases
+}
+
+#[test]
+fn batched_lanes_equal_the_interpreter_bit_for_bit_for_every_width_precision_and_trig() {
+    let cases = batch_cases();
+    // Every width in both precisions; each trig mode in both precisions.
+    let combos = [
+        (2, false, false),
+        (2, true, true),
+        (4, true, false),
+        (4, false, true),
+        (8, false, true),
+        (8, true, false),
+        (16, true, false),
+        (16, false, true),
+    ];
+    for (batch, f32, trig_input) in combos {
+        let dir = tmp(&format!("batch_{batch}_{f32}_{trig_input}"));
+        let o = plain(f32, batch, trig_input);
+        let n = if f32 { check_plain::<f32>(&dir, &cases, &o, 4) } else { check_plain::<f64>(&dir, &cases, &o, 4) };
+        assert!(n > 600 * batch as usize, "batch {batch}: only {n} outputs compared");
+    }
+}
+
+#[test]
+fn scalar_forms_equal_the_interpreter_on_random_dags() {
+    let cases = batch_cases();
+    for (f32, trig_input) in [(false, true), (true, false)] {
+        let dir = tmp(&format!("scalar_{f32}_{trig_input}"));
+        let o = plain(f32, 1, trig_input);
+        let n = if f32 { check_plain::<f32>(&dir, &cases, &o, 5) } else { check_plain::<f64>(&dir, &cases, &o, 5) };
+        assert!(n > 600, "only {n} outputs compared");
+    }
+}
+
+const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";
+
+#[test]
+fn options_that_cannot_go_together_are_bad_usage() {
+    for bad in ["abi=robotran;batch=4", "abi=robotran;precision=f32", "abi=robotran;trig=input"] {
+        let o = crate::common::opt(&[PENDULUM, &format!("-passes=atomise,codegen<c;{bad}>")]);
+        let err = crate::common::stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {err}");
+        assert!(err.contains("`abi=robotran` cannot go with") && err.contains(bad.split(';').nth(1).unwrap()), "{err}");
+        assert!(o.stdout.is_empty(), "no code written on bad usage");
+    }
+    let o = crate::common::opt(&[PENDULUM, "-passes=atomise,codegen<c;batch=3>"]);
+    assert_eq!(o.status.code(), Some(2), "{}", crate::common::stderr(&o));
+    let o = crate::common::opt(&[PENDULUM, "-passes=atomise,codegen<c;name=not-c>"]);
+    assert_eq!(o.status.code(), Some(2), "{}", crate::common::stderr(&o));
+    assert!(crate::common::stderr(&o).contains("one C identifier"));
+}
+
+#[test]
+fn a_function_in_the_parsed_phase_gets_the_phase_diagnostic() {
+    let o = crate::common::opt(&[PENDULUM, "-passes=codegen<c>"]);
+    let err = crate::common::stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("needs phase Atomised") && err.contains("run `atomise` first"), "{err}");
+    assert!(o.stdout.is_empty());
+}
+
+#[test]
+fn an_unknown_function_kind_has_no_robotran_signature() {
+    let dir = tmp("unknown_kind");
+    let ir = dir.join("f.rvir");
+    std::fs::write(&ir, "func @foo {\n  input %q[1]\n  %x = %q[1] * %q[1]\n  output c[1] = %x\n}\n").unwrap();
+    let o = crate::common::opt(&[ir.to_str().unwrap(), "-passes=atomise,codegen<c;abi=robotran>"]);
+    let err = crate::common::stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("@foo: no Robotran signature is known"), "{err}");
+}
+
+#[test]
+fn dash_o_writes_the_c_file_its_header_and_the_report_entry() {
+    let dir = tmp("dash_o");
+    let c = dir.join("model.c");
+    let report = dir.join("r.json");
+    let o = crate::common::opt(&[
+        PENDULUM,
+        "-passes=atomise,zero-removal,balance,codegen<c;abi=plain>",
+        "-o",
+        c.to_str().unwrap(),
+        &format!("-report={}", report.display()),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", crate::common::stderr(&o));
+    let code = std::fs::read_to_string(&c).unwrap();
+    assert!(code.contains("#pragma STDC FP_CONTRACT OFF") && code.contains("-ffp-contract=off"), "{code}");
+    assert!(code.contains("void invdyna(const double *restrict in, double *restrict out)"), "{code}");
+    assert!(!code.contains("func @"), "C, not IR");
+    let h = std::fs::read_to_string(dir.join("model.h")).unwrap();
+    assert!(h.contains("void invdyna(const double *restrict in, double *restrict out);"), "{h}");
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    // One function: its entries are at the top of the report (SPEC §7).
+    assert_eq!(r["function"], "invdyna", "{r}");
+    let cg = &r["codegen"];
+    assert_eq!(cg["symbol"], "invdyna", "{r}");
+    assert_eq!(cg["abi"], "plain");
+    assert_eq!(cg["precision"], "f64");
+    assert_eq!(cg["batch"], 1);
+    // The IR's input order (first use in the source: q[1], q[2], then s->g[3] …).
+    let inputs: Vec<&str> = cg["inputs"].as_array().unwrap().iter().map(|x| x.as_str().unwrap()).collect();
+    assert_eq!(&inputs[..3], ["q[1]", "q[2]", "g[3]"]);
+    assert_eq!(inputs.len(), 14);
+    assert_eq!(cg["outputs"], serde_json::json!(["Qq[1]", "Qq[2]"]));
+    // The header documents the same order.
+    assert!(h.contains("in[0] q[1], in[1] q[2], in[2] g[3]"), "{h}");
+
+    // Without -o the C goes to stdout (and no header is written anywhere).
+    let o = crate::common::opt(&[PENDULUM, "-passes=atomise,codegen<c;precision=f32;batch=4>"]);
+    assert_eq!(o.status.code(), Some(0), "{}", crate::common::stderr(&o));
+    let out = String::from_utf8(o.stdout).unwrap();
+    assert!(out.starts_with("/* Generated by robovec codegen<c;abi=plain;precision=f32;batch=4;trig=libm>"), "{out}");
+    assert!(out.contains("typedef float robovec_vec __attribute__((vector_size(16)));"), "{out}");
+}
