@@ -26,4 +26,5 @@ mod placement;
 mod placement_verify;
 mod props;
 mod roundtrip;
+mod schedule_cpu;
 mod tree_height;

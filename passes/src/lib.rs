@@ -11,6 +11,7 @@ pub mod artifact;
 pub mod asap_alap;
 pub mod atomise;
 pub mod codegen;
+pub mod cpu_order;
 pub mod dce;
 pub mod eqsat;
 pub mod figures;
@@ -308,6 +309,7 @@ pub const PASSES: &[PassInfo] = &[
     tree_height::distribute::INFO,
     specialize::INFO,
     eqsat::INFO,
+    cpu_order::INFO,
     codegen::INFO,
 ];
 
