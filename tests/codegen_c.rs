@@ -75,8 +75,33 @@ fn lit<T: Float>(x: T, f32: bool) -> String {
     robovec_passes::codegen::literal::hex(x.to_f64(), f32)
 }
 
-/// C definitions of the callbacks computing exactly [`callback_standin`]: weight `k` is the
-/// stand-in of the unit vector `e_k` (exact: the other terms are signed zeros).
+/// The stand-in of callee `c` on `n` operands `a[0..n]` as C statements ending in
+/// `return`: weight `k` is the stand-in of the unit vector `e_k` (exact: the other terms are
+/// signed zeros).
+fn standin_c<T: Float>(c: &Callee, n: usize, f32: bool) -> String {
+    let real = if f32 { "float" } else { "double" };
+    let w = |k: usize| {
+        let mut e = vec![T::from_f64(0.0); n];
+        e[k] = T::from_f64(1.0);
+        callback_standin(c, &e)
+    };
+    if n == 0 {
+        return format!("return {};", lit(callback_standin::<T>(c, &[]), f32));
+    }
+    let mut b = format!("{real} acc = {} * a[0];", lit(w(0), f32));
+    for k in 1..n {
+        let _ = write!(b, " acc = acc + {} * a[{k}];", lit(w(k), f32));
+    }
+    b + " return acc;"
+}
+
+/// C definitions of the callbacks computing exactly [`callback_standin`]: the adapter form
+/// `REAL user_X(int index1, …, int elem, int nargs, const REAL *a)` (plain ABI), or with
+/// `robotran_abi` MBsysC's native signatures (`double *user_ExtForces(double PxF[4], double
+/// RxF[4][4], …, MbsData *s, double tsim, int ixF)`, `double user_LinkForces(double Z, double
+/// Zd, MbsData *s, double tsim, int ilnk)`), which flatten their arrays back into the IR's
+/// operand order (row-major elements from index 1, then `tsim`; the C front end's order) and
+/// return the stand-in of every element read (a static 1-based vector).
 fn callbacks_c<T: Float>(uses: &[(Callee, usize)], f32: bool, robotran_abi: bool) -> String {
     let real = if f32 { "float" } else { "double" };
     let mut bases: Vec<(String, usize)> = Vec::new();
@@ -88,36 +113,57 @@ fn callbacks_c<T: Float>(uses: &[(Callee, usize)], f32: bool, robotran_abi: bool
         }
     }
     let mut s = String::from("#include <stdlib.h>\n");
+    if robotran_abi {
+        s += "#include \"mbs_data.h\"\n";
+    }
     for (base, nidx) in &bases {
+        let mine = || uses.iter().filter(|(c, _)| split_callee(c).unwrap().0 == *base);
+        if robotran_abi {
+            assert_eq!(*nidx, 1, "{base}: one integer index");
+            if base.ends_with("ExtForces") {
+                let _ = writeln!(
+                    s,
+                    "double *{base}(double PxF[4], double RxF[4][4], double VxF[4], double OMxF[4], double AxF[4], \
+                     double OMPxF[4], MbsData *s, double tsim, int ixF)\n{{\n  static double r[10]; double a[25]; int n = 0; (void)s;\n  \
+                     for (int i = 1; i <= 3; i++) a[n++] = PxF[i];\n  \
+                     for (int i = 1; i <= 3; i++) for (int j = 1; j <= 3; j++) a[n++] = RxF[i][j];\n  \
+                     for (int i = 1; i <= 3; i++) a[n++] = VxF[i];\n  for (int i = 1; i <= 3; i++) a[n++] = OMxF[i];\n  \
+                     for (int i = 1; i <= 3; i++) a[n++] = AxF[i];\n  for (int i = 1; i <= 3; i++) a[n++] = OMPxF[i];\n  \
+                     a[n++] = tsim;\n  for (int i = 0; i < 10; i++) r[i] = 0.0 / 0.0;"
+                );
+                for (c, n) in mine() {
+                    assert_eq!(*n, 25, "{}: operands", c.name);
+                    let (ix, elem) = (split_callee(c).unwrap().1[0], c.elem.unwrap());
+                    let body = standin_c::<T>(c, *n, f32).replace("return acc;", &format!("r[{elem}] = acc;"));
+                    let _ = writeln!(s, "  if (ixF == {ix}) {{ {body} }}");
+                }
+                s += "  return r;\n}\n";
+            } else {
+                let _ = writeln!(
+                    s,
+                    "double {base}(double Z, double Zd, MbsData *s, double tsim, int ilnk)\n{{\n  \
+                     double a[3] = {{Z, Zd, tsim}}; (void)s;"
+                );
+                for (c, n) in mine() {
+                    assert_eq!((*n, c.elem), (3, None), "{}: operands", c.name);
+                    let ix = split_callee(c).unwrap().1[0];
+                    let _ = writeln!(s, "  if (ilnk == {ix}) {{ {} }}", standin_c::<T>(c, *n, f32));
+                }
+                s += "  abort();\n}\n";
+            }
+            continue;
+        }
         let idx_params: String = (1..=*nidx).map(|i| format!("int index{i}, ")).collect();
         let _ = writeln!(s, "{real} {base}({idx_params}int elem, int nargs, const {real} *a)\n{{");
-        for (c, n) in uses.iter().filter(|(c, _)| split_callee(c).unwrap().0 == *base) {
+        for (c, n) in mine() {
             let idx = split_callee(c).unwrap().1;
             let mut cond: Vec<String> = idx.iter().enumerate().map(|(i, x)| format!("index{} == {x}", i + 1)).collect();
             cond.push(format!("elem == {}", c.elem.unwrap_or(0)));
             cond.push(format!("nargs == {n}"));
-            let w = |k: usize| {
-                let mut e = vec![T::from_f64(0.0); *n];
-                if *n == 0 {
-                    return callback_standin::<T>(c, &[]);
-                }
-                e[k] = T::from_f64(1.0);
-                callback_standin(c, &e)
-            };
-            let body = if *n == 0 {
-                format!("return {};", lit(w(0), f32))
-            } else {
-                let mut b = format!("{real} acc = {} * a[0];", lit(w(0), f32));
-                for k in 1..*n {
-                    let _ = write!(b, " acc = acc + {} * a[{k}];", lit(w(k), f32));
-                }
-                b + " return acc;"
-            };
-            let _ = writeln!(s, "  if ({}) {{ {body} }}", cond.join(" && "));
+            let _ = writeln!(s, "  if ({}) {{ {} }}", cond.join(" && "), standin_c::<T>(c, *n, f32));
         }
         s += "  abort();\n}\n";
     }
-    let _ = robotran_abi;
     s
 }
 
@@ -219,7 +265,7 @@ fn check_plain<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64) ->
     let init = if robotran_abi { "  robovec_test_alloc();\n" } else { "" };
     main += &format!("int main(void)\n{{\n{init}{calls}  return 0;\n}}\n");
     std::fs::write(dir.join("main.c"), main).unwrap();
-    std::fs::write(dir.join("callbacks.c"), callbacks_c::<T>(&uses, f32, false)).unwrap();
+    std::fs::write(dir.join("callbacks.c"), callbacks_c::<T>(&uses, f32, robotran_abi)).unwrap();
     let exe = cc(dir, &files, "-O0");
     let mut child =
         Command::new(&exe).stdin(std::process::Stdio::piped()).stdout(std::process::Stdio::piped()).spawn().unwrap();
@@ -511,4 +557,67 @@ fn dash_o_writes_the_c_file_its_header_and_the_report_entry() {
     let out = String::from_utf8(o.stdout).unwrap();
     assert!(out.starts_with("/* Generated by robovec codegen<c;abi=plain;precision=f32;batch=4;trig=libm>"), "{out}");
     assert!(out.contains("typedef float robovec_vec __attribute__((vector_size(16)));"), "{out}");
+}
+
+/// `abi=robotran` calls MBsysC's native callbacks: operands that do not fit the native
+/// signature, elements of one call with different operands and unknown callbacks are
+/// diagnostics (exit 1), while `abi=plain` (adapter form) writes all three.
+#[test]
+fn robotran_callbacks_that_do_not_fit_the_native_signature_are_diagnostics() {
+    let dir = tmp("native_callbacks");
+    let cases = [
+        ("short", "  %a[1] = call @user_ExtForces.1[1](%q[1], %tsim)\n", "has 2 operands; Robotran's user_ExtForces takes 25"),
+        (
+            "unknown",
+            "  %a[1] = call @user_LinkForces.1(%q[1], %q[1], %tsim)\n  %b = call @user_LinkForces.2(%q[1], %tsim, %tsim)\n  \
+             %a[2] = call @user_Other.1(%q[1])\n",
+            "callback `user_Other` has no known Robotran signature",
+        ),
+        (
+            "elems",
+            "  %a[1] = call @user_LinkForces.1[1](%q[1], %q[1], %tsim)\n  %a[2] = %q[1] * %q[1]\n  %b = %a[2] * %q[1]\n",
+            "returns one number, not a vector",
+        ),
+    ];
+    for (label, body, want) in cases {
+        let ir = dir.join(format!("{label}.rvir"));
+        let outs =
+            if label == "short" { "  output c[1] = %a[1]\n" } else { "  output c[1] = %a[1]\n  output c[2] = %a[2]\n" };
+        std::fs::write(&ir, format!("func @dirdyna {{\n  input %q[1]\n  input %tsim\n{body}{outs}}}\n")).unwrap();
+        let o = crate::common::opt(&[ir.to_str().unwrap(), "-passes=atomise,codegen<c;abi=robotran>"]);
+        let err = crate::common::stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{label}: {err}");
+        assert!(err.contains(want), "{label}: {err}");
+        let out = dir.join(format!("{label}.c"));
+        let o = crate::common::opt(&[
+            ir.to_str().unwrap(),
+            "-passes=atomise,codegen<c;abi=plain>",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{label} plain: {}", crate::common::stderr(&o));
+    }
+}
+
+/// Two elements of one `user_ExtForces` instance read with different operands cannot be one
+/// native call: a diagnostic, not C that calls it with the first element's operands.
+#[test]
+fn robotran_elements_of_one_callback_with_different_operands_are_a_diagnostic() {
+    let dir = tmp("native_callbacks_differ");
+    let ops = |x: &str| std::iter::repeat_n(x, 24).chain(["%tsim"]).collect::<Vec<_>>().join(", ");
+    let ir = dir.join("f.rvir");
+    std::fs::write(
+        &ir,
+        format!(
+            "func @extforces {{\n  input %q[1]\n  input %q[2]\n  input %tsim\n  %a[1] = call @user_ExtForces.1[1]({})\n  \
+             %a[2] = call @user_ExtForces.1[2]({})\n  output frc[1][1] = %a[1]\n  output frc[2][1] = %a[2]\n}}\n",
+            ops("%q[1]"),
+            ops("%q[2]")
+        ),
+    )
+    .unwrap();
+    let o = crate::common::opt(&[ir.to_str().unwrap(), "-passes=atomise,codegen<c;abi=robotran>"]);
+    let err = crate::common::stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("the elements of callback `user_ExtForces(…, 1)` have different operands"), "{err}");
 }

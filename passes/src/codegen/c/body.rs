@@ -117,6 +117,9 @@ pub(crate) struct Body<'a> {
     pub f: &'a Function,
     /// C name of every value.
     pub names: &'a [String],
+    /// `abi=robotran`: the statements of every user callback value (native signatures,
+    /// [`super::native::statements`]); `None`: the adapter form of both ABIs' plain code.
+    pub native: Option<&'a std::collections::HashMap<usize, String>>,
 }
 
 impl Body<'_> {
@@ -209,6 +212,9 @@ impl Body<'_> {
                     } else {
                         let _ = writeln!(s, "  const {ty} {name} = sqrt{sfx}({a});");
                     }
+                }
+                Def::Call(..) if self.native.is_some() => {
+                    s.push_str(&self.native.expect("checked")[&v.index()]);
                 }
                 Def::Call(c, args) => {
                     let (base, idx) = split_callee(c).expect("checked by callbacks()");

@@ -32,7 +32,7 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> (String, String, In
         .collect();
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
-    let b = Body { o, f, names: &names };
+    let b = Body { o, f, names: &names, native: None };
     let real = o.real();
     let w = o.batch as usize;
     let sig = format!("void {symbol}(const {real} *restrict in, {real} *restrict out)");

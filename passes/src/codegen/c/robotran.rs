@@ -155,7 +155,8 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> Result<(String, Str
         .collect();
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
-    let b = Body { o, f, names: &names };
+    let native = super::native::statements(&Body { o, f, names: &names, native: None })?;
+    let b = Body { o, f, names: &names, native: Some(&native) };
     let (sig, proto) = match sens {
         Some((_, k)) => (format!("static void robovec_{symbol}_{k}({params})"), String::new()),
         None => {
