@@ -19,6 +19,18 @@ pub(crate) struct Callback {
     pub indices: usize,
 }
 
+/// The C names of the callbacks `f` calls (one per call op, in body order): names the emitter
+/// must not give to a value.
+pub fn callee_names(f: &robovec_ir::Function) -> Vec<String> {
+    f.body
+        .iter()
+        .filter_map(|&v| match &f.value(v).def {
+            robovec_ir::Def::Call(c, _) => split_callee(c).ok().map(|(b, _)| b),
+            _ => None,
+        })
+        .collect()
+}
+
 /// The C name and integer arguments of a callback: `user_ExtForces.1` → (`user_ExtForces`,
 /// `[1]`); Matlab's `usrfun.flink.1` → (`usrfun_flink`, `[1]`) (the trailing integer segments
 /// are the source call's integer arguments, the others part of the name).

@@ -22,14 +22,7 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> (String, String, In
     let iface = interface(o, f, symbol);
     let mut reserved: Vec<&str> = RESERVED.to_vec();
     reserved.push(symbol);
-    let callee_names: Vec<String> = f
-        .body
-        .iter()
-        .filter_map(|&v| match &f.value(v).def {
-            robovec_ir::Def::Call(c, _) => super::body::split_callee(c).ok().map(|(b, _)| b),
-            _ => None,
-        })
-        .collect();
+    let callee_names = super::body::callee_names(f);
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
     let b = Body { o, f, names: &names, native: None };

@@ -145,14 +145,7 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> Result<(String, Str
     };
     let mut reserved: Vec<&str> = vec!["s", "tsim", "sens", "isens", symbol];
     reserved.extend(&outs);
-    let callee_names: Vec<String> = f
-        .body
-        .iter()
-        .filter_map(|&v| match &f.value(v).def {
-            robovec_ir::Def::Call(c, _) => super::body::split_callee(c).ok().map(|(b, _)| b),
-            _ => None,
-        })
-        .collect();
+    let callee_names = super::body::callee_names(f);
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
     let native = super::native::statements(&Body { o, f, names: &names, native: None })?;
