@@ -21,11 +21,11 @@ use robovec_passes::{
 };
 
 use crate::diagnostics::SourceFile;
+use crate::eval::evaluate;
 use crate::front;
 use crate::options::{output_failure, select};
 pub use crate::options::{Failure, Options};
 use crate::output::OutputSet;
-use crate::report::evaluate;
 
 /// Reads and lowers `input` to an IR module (parsed phase for Robotran files) and verifies it.
 ///

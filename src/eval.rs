@@ -1,4 +1,6 @@
-//! The JSON report (`-report=FILE`, SPEC §7) and the `-eval` output.
+//! `-eval=FILE` (SPEC §7): the final IR evaluated on given inputs, in binary64 or binary32. (The
+//! JSON report of `-report` is built by the driver from the figures of the final IR and the
+//! artifacts of the passes.)
 
 use std::collections::BTreeMap;
 
