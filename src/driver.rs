@@ -16,6 +16,7 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use robovec_ir::{text, verifier, Module};
+use robovec_passes::figures::{self, Figures};
 use robovec_passes::{
     study, DumpSink, GeneratedCode, Instrumentation, PassContext, PassError, PassManager, PassRecord,
 };
@@ -228,16 +229,31 @@ fn study_failure(f: study::Failure) -> Failure {
 
 /// The report (SPEC §7) of the function `-report` describes: the run's own fields, the figures
 /// of the final IR, then each artifact's entry (merged by key), then the early stops.
-fn report_json(opts: &Options, pm: &PassManager, module: &Module, ran: &Ran) -> Result<String, Failure> {
+/// `computed` are those of [`figures::figures`] for `-function` (the reported function is among
+/// them; they are computed again only if it were not).
+fn report_json(
+    opts: &Options,
+    pm: &PassManager,
+    module: &Module,
+    ran: &Ran,
+    computed: &[Figures],
+) -> Result<String, Failure> {
     let f = select(module, &opts.function, "-report")?;
+    let fallback;
+    let own = match computed.iter().find(|g| g.function == f.name) {
+        Some(g) => g,
+        None => {
+            fallback = Figures::of(f, &ran.cx);
+            &fallback
+        }
+    };
     let mut r = serde_json::Map::new();
     r.insert("input".into(), opts.input.clone().into());
     r.insert("function".into(), f.name.clone().into());
     r.insert("pipeline".into(), pm.pipeline_text().into());
     r.insert("passes".into(), serde_json::to_value(&ran.records).expect("records serialise"));
-    let entries = robovec_passes::figures::report_entries(f, &ran.cx)
-        .into_iter()
-        .chain(robovec_passes::artifact::report_entries(ran.cx.artifacts(), &f.name));
+    let entries =
+        own.report_entries().into_iter().chain(robovec_passes::artifact::report_entries(ran.cx.artifacts(), &f.name));
     for (key, value) in entries {
         r.insert(key.into(), value);
     }
@@ -321,11 +337,17 @@ fn write_outputs(
     stderr: &mut dyn Write,
 ) -> Result<(), Failure> {
     let cx = &ran.cx;
-    let report = opts.report.as_ref().map(|_| report_json(opts, pm, module, ran)).transpose()?;
+    // The final IR's figures, once for both the report and `-stats` (the placement's include
+    // the tight lower bound, and a parsed function is atomised to be measured).
+    let figs = if opts.stats || opts.report.is_some() {
+        figures::figures(module, cx, opts.function.as_deref())
+    } else {
+        Vec::new()
+    };
+    let report = opts.report.as_ref().map(|_| report_json(opts, pm, module, ran, &figs)).transpose()?;
     let eval = eval_inputs.map(|given| eval_json(opts, module, given, stderr)).transpose()?;
     if opts.stats {
-        write!(stderr, "{}", robovec_passes::figures::stats_text(module, cx, opts.function.as_deref()))
-            .map_err(stderr_failure)?;
+        write!(stderr, "{}", figures::stats_text(&figs, cx, opts.function.as_deref())).map_err(stderr_failure)?;
     }
     for a in cx.artifacts() {
         write!(stderr, "{}", a.log_text(opts.stats)).map_err(stderr_failure)?;

@@ -6,7 +6,7 @@ use robovec_ir::{Def, Function, Module, OpCounts, Phase};
 use serde::Serialize;
 
 use crate::atomise::atomise_function;
-use crate::place::report::placement_report;
+use crate::place::report::{placement_report, PlacementReport};
 use crate::PassContext;
 
 /// `stats` of SPEC §7: the IR at the end of the pipeline.
@@ -58,34 +58,58 @@ pub fn stats(f: &Function, lat: &Latencies) -> Stats {
     }
 }
 
-/// The report entries (SPEC §7) that describe `f` itself at the end of the pipeline: `stats`,
-/// and `placement` when it is placed.
-pub fn report_entries(f: &Function, cx: &PassContext) -> Vec<(&'static str, serde_json::Value)> {
-    let mut out = vec![("stats", serde_json::to_value(stats(f, &cx.latencies)).expect("stats serialise"))];
-    if let Some(p) = placement_report(f) {
-        out.push(("placement", serde_json::to_value(p).expect("placement figures serialise")));
-    }
-    out
+/// The figures of one function at the end of the pipeline — its `stats` and, when placed, its
+/// `placement` (SPEC §7) — computed once and read by both the report and `-stats`.
+#[derive(Clone, Debug)]
+pub struct Figures {
+    /// The function's name.
+    pub function: String,
+    /// Its `stats`.
+    pub stats: Stats,
+    /// Its `placement` figures, when it is placed.
+    pub placement: Option<PlacementReport>,
 }
 
-/// The `-stats` lines on stderr: each rewriting pass's note, then per function (only
-/// `function` when given) its figures (equations, ops by kind, inputs, outputs, critical path in
+impl Figures {
+    /// The figures of `f` under the run's latencies.
+    pub fn of(f: &Function, cx: &PassContext) -> Figures {
+        Figures { function: f.name.clone(), stats: stats(f, &cx.latencies), placement: placement_report(f) }
+    }
+
+    /// The report entries (SPEC §7) that describe the function itself: `stats`, and
+    /// `placement` when it is placed.
+    pub fn report_entries(&self) -> Vec<(&'static str, serde_json::Value)> {
+        let mut out = vec![("stats", serde_json::to_value(&self.stats).expect("stats serialise"))];
+        if let Some(p) = &self.placement {
+            out.push(("placement", serde_json::to_value(p).expect("placement figures serialise")));
+        }
+        out
+    }
+}
+
+/// The figures of every function of `module` (only `function` when given), in module order.
+pub fn figures(module: &Module, cx: &PassContext, function: Option<&str>) -> Vec<Figures> {
+    module.functions.iter().filter(|f| function.is_none_or(|n| n == f.name)).map(|f| Figures::of(f, cx)).collect()
+}
+
+/// The `-stats` lines on stderr: each rewriting pass's note, then per function of `figures`
+/// (see [`figures`]; artifacts' lines are restricted to `function` when given) its figures (equations, ops by kind, inputs, outputs, critical path in
 /// ops and cycles, number Y) and, when placed, its placement's (cycles, lower bound, rate, PE
 /// memory and buffer words, direct/indirect writes), then every `eqsat` run's and every `sim`
 /// run's line (each artifact's [`crate::Artifact::stats_text`]).
-pub fn stats_text(module: &Module, cx: &PassContext, function: Option<&str>) -> String {
+pub fn stats_text(figures: &[Figures], cx: &PassContext, function: Option<&str>) -> String {
     use std::fmt::Write;
     let mut out = String::new();
     for note in &cx.notes {
         let _ = writeln!(out, "{note}");
     }
-    for f in module.functions.iter().filter(|f| function.is_none_or(|n| n == f.name)) {
-        let s = stats(f, &cx.latencies);
+    for g in figures {
+        let s = &g.stats;
         let _ = writeln!(
             out,
             "@{}: equations {}, ops {} (add {}, sub {}, mul {}, div {}, call {}), inputs {}, outputs {}, \
              critical path {} ops / {} cycles, Y = {:.2}",
-            f.name,
+            g.function,
             s.equations.map_or("?".to_string(), |e| e.to_string()),
             s.ops.total,
             s.ops.add,
@@ -99,13 +123,13 @@ pub fn stats_text(module: &Module, cx: &PassContext, function: Option<&str>) -> 
             s.asap_cycle,
             s.y
         );
-        if let Some(p) = placement_report(f) {
+        if let Some(p) = &g.placement {
             let max = |v: &[u32]| v.iter().copied().max().unwrap_or(0);
             let _ = writeln!(
                 out,
                 "@{}: placed on {} ADD + {} MULTI PEs: {} cycles, lower bound {} (x{:.3}), parallelisation rate {:.3}, \
                  PE memory up to {} words, buffer up to {} words, writes {} direct / {} indirect",
-                f.name,
+                g.function,
                 p.n_add,
                 p.n_mul,
                 p.cycles,

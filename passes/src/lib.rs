@@ -238,12 +238,6 @@ impl PassContext {
     pub fn artifacts(&self) -> impl Iterator<Item = &dyn Artifact> {
         self.artifacts.iter().map(|p| p.artifact.as_ref())
     }
-
-    /// The artifacts of type `T` produced so far, in order (for tests and for passes that read
-    /// an earlier pass's result).
-    pub fn artifacts_of<T: Artifact + 'static>(&self) -> impl Iterator<Item = &T> {
-        self.artifacts.iter().filter_map(|p| (p.artifact.as_ref() as &dyn std::any::Any).downcast_ref::<T>())
-    }
 }
 
 /// A transformation or analysis over a whole module (`Debug` shows its options).
