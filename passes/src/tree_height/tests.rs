@@ -151,7 +151,9 @@ proptest::proptest! {
         for shape in [Shape::Keep, Shape::Swap, Shape::Balance] {
             let (g, o) = rewrite(&f, shape, &lat);
             proptest::prop_assert!(verifier::verify_function(&g).is_empty());
-            proptest::prop_assert_eq!(o.fallback, 0);
+            // A rebuild is kept: the trusting one, or the cautious one when two moved signs meet
+            // in one cluster (see `two_signs_meeting_in_one_cluster_take_the_cautious_rebuild`).
+            proptest::prop_assert!(o.fallback <= 1, "fallback {}", o.fallback);
             proptest::prop_assert!(g.op_counts().total <= ops);
             proptest::prop_assert!(compute_timing(&g, &lat).1.asap_cycle <= cp0);
             let input = |n: &str| pseudo_random_input(n, seed);
@@ -164,4 +166,30 @@ proptest::proptest! {
             }
         }
     }
+}
+
+#[test]
+fn two_signs_meeting_in_one_cluster_take_the_cautious_rebuild() {
+    // `n`'s sign is free in each consumer taken alone (`s` keeps `c` positive, `r` and `q` keep
+    // another positive term), so the trusting rebuild removes `n` and flips `p1`, `p2`, `p3`,
+    // `p4`: but `r = −p1 − p2` and `q = −p3 − p4` are outputs and then need a negation each,
+    // 10 ops for 9. The sign analysis reasons one sign at a time (`sign.rs`), so `rewrite`
+    // checks the result and keeps the cautious rebuild, which leaves `n` where it is. Found by
+    // `rewrites_keep_their_contract_on_random_dags` (n_ops = 105, seed = 302314, lat 1/1).
+    let src = format!(
+        "{HEAD} %x = add %a, %b %n = sub 0.0, %x %s = add %c, %n %p1 = mul %n, %c %p2 = mul %d, %n \
+         %r = add %p1, %p2 %p3 = mul %n, %a %p4 = mul %b, %n %q = add %p3, %p4 \
+         output o1 = %s output o2 = %r output o3 = %q }}"
+    );
+    let f = parse(&src).unwrap().functions.remove(0);
+    let lat = Latencies::default();
+    let orig = super::rebuild::ready_times(&f, &lat);
+    let (trusting, _, _) = super::rebuild::rebuild(&f, Shape::Keep, &lat, &orig, true);
+    assert_eq!(trusting.op_counts().total, 10, "{trusting}");
+    let (g, o) = rewrite(&f, Shape::Keep, &lat);
+    assert_eq!(o.fallback, 1, "{g}");
+    assert_eq!(o.ops, (9, 9));
+    assert!(o.asap_cycle.1 <= o.asap_cycle.0);
+    let input = |n: &str| pseudo_random_input(n, 7);
+    assert_eq!(eval::<f64>(&f, input), eval::<f64>(&g, input));
 }
