@@ -21,7 +21,10 @@
 //!    equations, SPEC §6; Robotran's C evaluates each equation left to right, which is the
 //!    `atomise` pipeline's order, so its error is `atomise`'s);
 //! 4. prints one table: model, variant, flags, ns/state (median, min–max), ratio vs Robotran at
-//!    the same flags (> 1: faster), error bits (f64 or f32 mean / max), and the check.
+//!    the same flags (> 1: faster) as the median and quartiles of the **paired** ratios (both
+//!    functions' ns/state from the same rep, a few ms apart: on a shared machine whose speed
+//!    drifts by 2× between runs, the ratio of neighbouring samples is stable where the ratio of
+//!    medians is not), error bits (f64 or f32 mean / max), and the check.
 //!
 //! Needs `cc` (GCC or Clang) and the corpus at `../shared`. Work files go to
 //! `target/codegen_c_bench/`. CI never runs it (`cargo bench --no-run` only builds this file).
@@ -206,7 +209,10 @@ struct Row {
     median: f64,
     min: f64,
     max: f64,
+    /// Median of the paired ratios (Robotran's ns / this variant's ns in the same rep).
     ratio: f64,
+    /// First and third quartiles of the paired ratios.
+    ratio_q: (f64, f64),
     error: String,
     check: String,
 }
@@ -393,7 +399,6 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core):
     write_if_changed(&work.join("model.inc"), table.as_bytes());
 
     let function = if src.contains("void mbs_") { format!("mbs_{}", model.kind) } else { model.kind.to_string() };
-    let mut baseline = BTreeMap::new();
     for (flag_label, flags) in flag_sets {
         let fl: Vec<String> = flags.split_whitespace().map(String::from).collect();
         let dir = work.join(flag_label);
@@ -439,12 +444,8 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core):
                 ["check", v, n, same, worst] => {
                     checks.insert(v.to_string(), format!("{same}/{n} bit-identical, max diff {worst} of max |out|"));
                 }
-                ["time", v, med, min, max] => {
+                ["time", v, med, min, max, ratio, q1, q3] => {
                     let med: f64 = med.parse().unwrap();
-                    if *v == "robotran" {
-                        baseline.insert(flag_label.to_string(), med);
-                    }
-                    let base = baseline[*flag_label];
                     let (variant, error) = if *v == "robotran" {
                         ("Robotran's C".to_string(), errors[&("atomise".to_string(), "f64")].clone())
                     } else {
@@ -458,7 +459,8 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core):
                         median: med,
                         min: min.parse().unwrap(),
                         max: max.parse().unwrap(),
-                        ratio: base / med,
+                        ratio: ratio.parse().unwrap(),
+                        ratio_q: (q1.parse().unwrap(), q3.parse().unwrap()),
                         error,
                         check: checks.get(*v).cloned().unwrap_or_default(),
                     });
@@ -505,12 +507,12 @@ fn main() {
         bench_model(m, &flag_sets, reps, (quick, core), &mut rows);
     }
     println!("load average before: {}", load.trim());
-    println!("| model | variant | flags | ns/state median (min–max) | vs Robotran | error bits mean / max | check vs Robotran (state 0) |");
+    println!("| model | variant | flags | ns/state median (min–max) | vs Robotran: paired median (quartiles) | error bits mean / max | check vs Robotran (state 0) |");
     println!("|---|---|---|---:|---:|---|---|");
     for r in &rows {
         println!(
-            "| {} | {} | {} | {:.1} ({:.1}–{:.1}) | {:.2}× | {} | {} |",
-            r.model, r.variant, r.flags, r.median, r.min, r.max, r.ratio, r.error, r.check
+            "| {} | {} | {} | {:.1} ({:.1}–{:.1}) | {:.2}× ({:.2}–{:.2}) | {} | {} |",
+            r.model, r.variant, r.flags, r.median, r.min, r.max, r.ratio, r.ratio_q.0, r.ratio_q.1, r.error, r.check
         );
     }
 }

@@ -7,7 +7,9 @@
  *   and fill_mbs(MbsData *s, const double *set): one state into a stub MbsData;
  *   NVARIANTS and VARIANTS[]: robovec's functions with their input maps (names -> SETS columns).
  * Output: one check line per variant (outputs compared, bit-identical, largest difference relative
- * to the largest |output|), then one time line per variant: name, median, min, max ns/state.
+ * to the largest |output|), then one time line per variant: name, median, min, max ns/state, then
+ * the median, first and third quartiles of the paired ratio (Robotran's ns over the variant's ns
+ * per state, both from the same rep).
  */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
@@ -167,11 +169,17 @@ int main(int argc, char **argv) {
             samples[v * reps + r] = t / ((double)calls[v] * lanes);
         }
     }
+    /* Paired ratios: Robotran's time over the variant's in the same rep (neighbouring samples),
+     * which cancels the drifts of a shared machine that move both alike; median and quartiles. */
+    double *ratio = malloc(sizeof(double) * nv * reps);
+    for (int v = 0; v < nv; v++)
+        for (int r = 0; r < reps; r++) ratio[v * reps + r] = samples[r] / samples[v * reps + r];
     for (int v = 0; v < nv; v++) {
-        double *s = samples + v * reps;
+        double *s = samples + v * reps, *q = ratio + v * reps;
         qsort(s, reps, sizeof *s, cmp);
-        printf("time\t%s\t%.2f\t%.2f\t%.2f\n", v == 0 ? "robotran" : VARIANTS[v - 1].name, s[reps / 2], s[0],
-               s[reps - 1]);
+        qsort(q, reps, sizeof *q, cmp);
+        printf("time\t%s\t%.2f\t%.2f\t%.2f\t%.3f\t%.3f\t%.3f\n", v == 0 ? "robotran" : VARIANTS[v - 1].name,
+               s[reps / 2], s[0], s[reps - 1], q[reps / 2], q[reps / 4], q[3 * reps / 4]);
     }
     return sink == 12345.678 ? 1 : 0;
 }
