@@ -104,24 +104,45 @@ pub(crate) fn callback_decls(cbs: &[Callback], real: &str) -> String {
     s
 }
 
-/// The vector type `robovec_vec` of `lanes` lanes of `real` and its per-lane helpers.
+/// The vector type `robovec_vec` of a batch of `lanes` states and its per-lane helpers.
+///
+/// The body runs on vectors of `ROBOVEC_VL` lanes — the widest the compiler targets (64 bytes
+/// with AVX-512, 32 with AVX, otherwise 16: SSE2, NEON), at most `lanes` — `lanes / ROBOVEC_VL`
+/// times per call (see [`chunk_loop`]). Vectors wider than the target's are lowered by the
+/// compiler into pieces, which at `-O2` without `-march` made coman's `batch=8` file take
+/// 35 min and 5 GB of GCC (issue 11); `-DROBOVEC_VBYTES=N` chooses the width by hand.
+/// Every lane computes the same operations either way, so results are bit-identical.
 pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
-    let bytes = lanes * if f32 { 4 } else { 8 };
     let sfx = if f32 { "f" } else { "" };
     let mut s = format!(
-        "/* {lanes} states per call: lane l of element i is in[i*{lanes} + l] (GCC/Clang vector extensions). */\n\
-         typedef {real} robovec_vec __attribute__((vector_size({bytes})));\n\
-         static inline robovec_vec robovec_splat({real} x) {{ robovec_vec r; for (int lane = 0; lane < {lanes}; lane++) r[lane] = x; return r; }}\n"
+        "/* {lanes} states per call: lane l of element i is in[i*{lanes} + l] (GCC/Clang vector extensions).\n \
+         * The body runs on vectors of ROBOVEC_VL lanes, the widest the compiler targets (AVX-512: 64 bytes,\n \
+         * AVX: 32, otherwise 16: SSE2, NEON; -DROBOVEC_VBYTES=N chooses), {lanes}/ROBOVEC_VL times per call:\n \
+         * wider vectors than the target's are split by the compiler, slowly to compile and to run. */\n\
+         #ifndef ROBOVEC_VBYTES\n\
+         #if defined(__AVX512F__)\n#define ROBOVEC_VBYTES 64\n\
+         #elif defined(__AVX__)\n#define ROBOVEC_VBYTES 32\n\
+         #else\n#define ROBOVEC_VBYTES 16\n#endif\n#endif\n\
+         #define ROBOVEC_W {lanes}\n\
+         #define ROBOVEC_VL (ROBOVEC_VBYTES / (int)sizeof({real}) < ROBOVEC_W ? ROBOVEC_VBYTES / (int)sizeof({real}) : ROBOVEC_W)\n\
+         _Static_assert(ROBOVEC_VL >= 1 && ROBOVEC_W % ROBOVEC_VL == 0, \"ROBOVEC_VBYTES must be a power of two of at least one {real}\");\n\
+         typedef {real} robovec_vec __attribute__((vector_size(ROBOVEC_VL * sizeof({real}))));\n\
+         static inline robovec_vec robovec_splat({real} x) {{ robovec_vec r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = x; return r; }}\n"
     );
     for f in ["sin", "cos", "sqrt"] {
         let _ = writeln!(
             s,
-            "static inline robovec_vec robovec_{f}(robovec_vec x) {{ robovec_vec r; for (int lane = 0; lane < {lanes}; lane++) r[lane] = {f}{sfx}(x[lane]); return r; }}"
+            "static inline robovec_vec robovec_{f}(robovec_vec x) {{ robovec_vec r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = {f}{sfx}(x[lane]); return r; }}"
         );
     }
     s.push('\n');
     s
 }
+
+/// The loop of a batched body over its chunks of `ROBOVEC_VL` lanes (see [`vector_helpers`]):
+/// lane `l` of chunk `robovec_chunk` is state `robovec_chunk*ROBOVEC_VL + l`.
+pub(crate) const CHUNK_LOOP: &str =
+    "  for (int robovec_chunk = 0; robovec_chunk < ROBOVEC_W / ROBOVEC_VL; robovec_chunk++) {\n";
 
 /// Writes the statements of one function body.
 pub(crate) struct Body<'a> {
@@ -245,8 +266,7 @@ impl Body<'_> {
                     if vec {
                         let _ = writeln!(
                             s,
-                            "  {ty} {name};\n  for (int lane = 0; lane < {}; lane++) {name}[lane] = {call};",
-                            self.o.batch
+                            "  {ty} {name};\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) {name}[lane] = {call};"
                         );
                     } else {
                         let _ = writeln!(s, "  const {ty} {name} = {call};");

@@ -36,10 +36,15 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> (String, String, In
         iface.outputs.len()
     );
     let ty = b.value_type();
+    // A batch: one pass of the body per chunk of ROBOVEC_VL lanes, at offset `at` in a block.
+    let at = "robovec_chunk * ROBOVEC_VL";
+    if w > 1 {
+        s += super::body::CHUNK_LOOP;
+    }
     for (i, &v) in input_values(f, o.trig_input).iter().enumerate() {
         let n = &names[v.index()];
         if w > 1 {
-            let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, in + {}, sizeof {n});", i * w);
+            let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, in + {} + {at}, sizeof {n});", i * w);
         } else {
             let _ = writeln!(s, "  const {ty} {n} = in[{i}];");
         }
@@ -50,15 +55,18 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> (String, String, In
         if w > 1 {
             match out.value {
                 Operand::Value(_) => {
-                    let _ = writeln!(s, "  memcpy(out + {}, &{x}, sizeof {x});", j * w);
+                    let _ = writeln!(s, "  memcpy(out + {} + {at}, &{x}, sizeof {x});", j * w);
                 }
                 Operand::Const(_) => {
-                    let _ = writeln!(s, "  {{ const {ty} k = {x}; memcpy(out + {}, &k, sizeof k); }}", j * w);
+                    let _ = writeln!(s, "  {{ const {ty} k = {x}; memcpy(out + {} + {at}, &k, sizeof k); }}", j * w);
                 }
             }
         } else {
             let _ = writeln!(s, "  out[{j}] = {x};");
         }
+    }
+    if w > 1 {
+        s += "  }\n";
     }
     s += "}\n\n";
     let mut proto = format!("/* @{} as {symbol}", f.name);
