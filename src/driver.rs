@@ -366,7 +366,11 @@ fn write_outputs(
             if let Some(dir) = file.path.parent().filter(|d| !d.as_os_str().is_empty()) {
                 out.ensure_folder(dir).map_err(output_failure)?;
             }
-            out.stage(&file.path, &file.bytes).map_err(output_failure)?;
+            if file.executable {
+                out.stage_executable(&file.path, &file.bytes).map_err(output_failure)?;
+            } else {
+                out.stage(&file.path, &file.bytes).map_err(output_failure)?;
+            }
         }
     }
     if let Some(path) = &opts.sweep_csv {

@@ -17,6 +17,7 @@ mod error_reference;
 mod exact_gap;
 mod example;
 mod filetests;
+mod fpga;
 mod inline_specialize;
 mod numerics;
 #[cfg(unix)]

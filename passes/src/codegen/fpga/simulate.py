@@ -80,6 +80,27 @@ def trig_bits(fn, arg_bits):
     return struct.unpack("<I", struct.pack("<f", y))[0]
 
 
+def read_mif(path):
+    """The words of an Intel MIF as codegen<fpga> writes it (ADDRESS_RADIX=UNS, DATA_RADIX=HEX)."""
+    words, content = [], False
+    with open(path) as f:
+        for line in f:
+            line = line.split("--")[0].strip()
+            if not line:
+                continue
+            up = line.upper()
+            if up.startswith("DEPTH"):
+                words = [0] * int(up.split("=")[1].strip(" ;"))
+            elif up.startswith("CONTENT"):
+                content = True
+            elif up.startswith("END"):
+                break
+            elif content:
+                a, w = line.rstrip(";").split(":")
+                words[int(a)] = int(w, 16)
+    return words
+
+
 def number(b):
     x = bits_f32(b)
     return x if math.isfinite(x) else None
@@ -125,7 +146,12 @@ def main(argv):
         for pe in man["pes"]:
             for m in pe["memories"].values():
                 src = os.path.join(HERE, "hex", m["file"] + ".hex")
-                shutil.copy(src, os.path.join(tmp, m["file"] + ".hex"))
+                if os.path.exists(src):
+                    shutil.copy(src, os.path.join(tmp, m["file"] + ".hex"))
+                else:
+                    words = read_mif(os.path.join(HERE, "mif", m["file"] + ".mif"))
+                    with open(os.path.join(tmp, m["file"] + ".hex"), "w") as f:
+                        f.write("".join("%x\n" % w for w in words))
         images = {}
         for pe in man["pes"]:
             images[pe["slot"]] = {
