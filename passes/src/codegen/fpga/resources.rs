@@ -166,8 +166,10 @@ pub fn yosys_cells(d: &Design) -> Result<Option<YosysCells>, String> {
          synth_intel_alm -family cyclonev -top robovec_top\ntee -q -o stat.json stat -json\n"
             .to_string(),
     ));
-    for (n, t) in &files {
-        if std::fs::write(dir.0.join(n), t).is_err() {
+    // the output memories are registers initialised from their images
+    let outs: Vec<(String, String)> = d.pes.iter().map(|p| (format!("{}.hex", p.out.name), p.out.to_hex())).collect();
+    for (n, t) in files.iter().map(|(n, t)| (n.to_string(), t)).chain(outs.iter().map(|(n, t)| (n.clone(), t))) {
+        if std::fs::write(dir.0.join(&n), t).is_err() {
             return Ok(None);
         }
     }
