@@ -34,6 +34,7 @@ pub mod diagnostic;
 pub mod entities;
 pub mod function;
 pub mod interp;
+pub mod machine;
 pub mod numerics;
 pub mod placement;
 pub mod rng;

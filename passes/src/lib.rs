@@ -16,6 +16,7 @@ pub mod dce;
 pub mod eqsat;
 pub mod figures;
 pub mod inline;
+pub mod machine;
 pub mod manager;
 pub mod params;
 pub mod pipeline;
