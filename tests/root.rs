@@ -28,4 +28,5 @@ mod placement_verify;
 mod props;
 mod roundtrip;
 mod schedule_cpu;
+mod target;
 mod tree_height;

@@ -174,28 +174,66 @@ impl ParamInfo {
 pub const LAT_ADD: ParamInfo = ParamInfo {
     name: "lat-add",
     kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
-    doc: "add/sub latency, cycles (10 pipeline + 2 write)",
+    doc: "add/sub latency, cycles; when not given, the pipeline's (-target; de10-nano 12 = 10 pipeline + 2 write)",
 };
 /// The mul latency parameter (SPEC §1), cycles.
 pub const LAT_MUL: ParamInfo = ParamInfo {
     name: "lat-mul",
     kind: ParamKind::U32 { default: 7, min: 1, max: 10_000 },
-    doc: "mul latency, cycles (5 pipeline + 2 write)",
+    doc: "mul latency, cycles; when not given, the pipeline's (-target; de10-nano 7 = 5 pipeline + 2 write)",
 };
 /// The div latency parameter (SPEC §1), cycles.
 pub const LAT_DIV: ParamInfo = ParamInfo {
     name: "lat-div",
     kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
-    doc: "div latency, cycles (ADD side)",
+    doc: "div latency, cycles (ADD side); when not given, the pipeline's (-target)",
 };
 /// The call latency parameter (SPEC §1), cycles.
 pub const LAT_CALL: ParamInfo = ParamInfo {
     name: "lat-call",
     kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
-    doc: "call (sqrt, callbacks) latency, cycles (ADD side)",
+    doc: "call (sqrt, callbacks) latency, cycles (ADD side); when not given, the pipeline's (-target)",
 };
 /// The four latency parameters, for passes that take only them.
 pub const LATENCY_PARAMS: &[ParamInfo] = &[LAT_ADD, LAT_MUL, LAT_DIV, LAT_CALL];
+
+/// Latencies given explicitly on one pass (`lat-add`, `lat-mul`, `lat-div`, `lat-call`), cycles;
+/// `None` where not given. An explicit latency overrides the pipeline's latencies (the
+/// target's, `-target`) from that pass on: see [`crate::PassContext::latencies_for`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LatencyOverride {
+    /// `lat-add`.
+    pub add: Option<u32>,
+    /// `lat-mul`.
+    pub mul: Option<u32>,
+    /// `lat-div`.
+    pub div: Option<u32>,
+    /// `lat-call`.
+    pub call: Option<u32>,
+}
+
+impl LatencyOverride {
+    /// True when no latency was given.
+    pub fn is_empty(&self) -> bool {
+        *self == LatencyOverride::default()
+    }
+
+    /// `base` with the given latencies replaced.
+    pub fn apply(&self, base: &Latencies) -> Latencies {
+        Latencies {
+            add: self.add.unwrap_or(base.add),
+            mul: self.mul.unwrap_or(base.mul),
+            div: self.div.unwrap_or(base.div),
+            call: self.call.unwrap_or(base.call),
+        }
+    }
+
+    /// The parameters as written in a pipeline (`lat-add=6;lat-mul=4`).
+    pub fn text(&self) -> String {
+        let parts = [("lat-add", self.add), ("lat-mul", self.mul), ("lat-div", self.div), ("lat-call", self.call)];
+        parts.iter().filter_map(|(k, v)| v.map(|v| format!("{k}={v}"))).collect::<Vec<_>>().join(";")
+    }
+}
 
 /// Checked parameters of one pipeline element: `(name, value)` pairs, each name declared.
 #[derive(Clone, Debug)]
@@ -298,6 +336,35 @@ impl Params {
             div: get("lat-div", d.div)?,
             call: get("lat-call", d.call)?,
         })
+    }
+
+    /// The latencies given explicitly on this pass (`lat-add=6` → `add: Some(6)`); the others
+    /// come from the pipeline's current latencies (the target's, `-target`), see
+    /// [`crate::PassContext::latencies_for`].
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when one is out of range.
+    pub fn latency_override(&self) -> Result<LatencyOverride, PassError> {
+        let get = |key: &str| -> Result<Option<u32>, PassError> {
+            if self.decls.iter().any(|p| p.name == key) && self.get(key).is_some() {
+                self.u32(key).map(Some)
+            } else {
+                Ok(None)
+            }
+        };
+        Ok(LatencyOverride { add: get("lat-add")?, mul: get("lat-mul")?, div: get("lat-div")?, call: get("lat-call")? })
+    }
+
+    /// A `U32` parameter when given explicitly (`None`: not given, the caller takes the
+    /// target's value).
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when the value is out of range.
+    pub fn u32_given(&self, key: &str) -> Result<Option<u32>, PassError> {
+        match self.get(key) {
+            Some(_) => self.u32(key).map(Some),
+            None => Ok(None),
+        }
     }
 
     /// A `U32` (or `U32Or`) parameter: its value, or its declared default.
@@ -508,12 +575,22 @@ mod tests {
         assert_eq!(window.default_text(), crate::eqsat::EqsatOptions::default().window.to_string());
         assert_eq!(
             build(eqsat, &[]).unwrap(),
-            format!("{:?}", crate::eqsat::Eqsat { opts: crate::eqsat::EqsatOptions::default() })
+            format!(
+                "{:?}",
+                crate::eqsat::Eqsat { opts: crate::eqsat::EqsatOptions::default(), lat: Default::default() }
+            )
         );
         let place = crate::pass_info("place").unwrap();
         assert_eq!(
             build(place, &[]).unwrap(),
-            format!("{:?}", crate::place::Place { opts: crate::place::PlaceOptions::with_pes(4) })
+            format!(
+                "{:?}",
+                crate::place::Place {
+                    opts: crate::place::PlaceOptions::with_pes(4),
+                    lat: Default::default(),
+                    writes: None
+                }
+            )
         );
         let accuracy = crate::pass_info("accuracy").unwrap();
         assert_eq!(
