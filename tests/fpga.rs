@@ -191,3 +191,95 @@ fn yosys_sizes_the_design_and_resources_json_has_the_figures() {
     let m10k: u64 = r["memories"].as_array().unwrap().iter().map(|m| m["m10k"].as_u64().unwrap()).sum();
     assert_eq!(r["m10k"].as_u64().unwrap(), m10k);
 }
+
+/// The pendulum placed at `n` PEs, in-process.
+fn placed_pendulum(n: u32) -> robovec_ir::Module {
+    let (mut m, _) = robovec::driver::load(PENDULUM).unwrap_or_else(|f| panic!("{}", f.message()));
+    let pipeline = format!("atomise,place<pe={n};restarts=0;search=0>");
+    let pm = robovec_passes::PassManager::new(&pipeline, robovec_passes::Instrumentation::default()).unwrap();
+    pm.run(&mut m, &mut robovec_passes::PassContext::default(), &mut std::io::sink()).unwrap();
+    m
+}
+
+#[test]
+fn images_read_back_from_hex_and_mif_reproduce_the_machine_program_exactly() {
+    use robovec_ir::machine::encode::{decode, Images, Layout};
+    use robovec_ir::target::Target;
+    use robovec_passes::codegen::fpga::images::Image;
+    use robovec_passes::codegen::fpga::lower::{design, Limits};
+
+    let t = Target::de10_nano();
+    for n in [2u32, 4] {
+        let m = placed_pendulum(n);
+        let f = &m.functions[0];
+        let prog = robovec_passes::machine::lower(f, f.placement.as_ref().unwrap()).unwrap();
+        let d = design(f, &prog, &Limits::of(&t)).unwrap();
+        let layout = Layout::new(&prog, t.pe_words, t.buffer_words, t.instr_width).unwrap();
+        for from_mif in [false, true] {
+            let read = |img: &Image| -> Vec<u64> {
+                if from_mif {
+                    Image::parse_mif(&img.name, &img.to_mif()).unwrap().words
+                } else {
+                    Image::parse_hex(&img.name, img.width, &img.to_hex()).unwrap().words
+                }
+            };
+            let im = Images {
+                layout,
+                instr: d.pes.iter().map(|p| read(&p.instr)).collect(),
+                crossbar: d.pes.iter().map(|p| read(&p.xbar)).collect(),
+                buffer: d.pes.iter().map(|p| read(&p.bufi)).collect(),
+                capture: d.pes.iter().map(|p| read(&p.capt)).collect(),
+            };
+            let steps = decode(&im).unwrap();
+            for (s, pe) in prog.pes.iter().enumerate() {
+                assert_eq!(steps[s], pe.steps, "N={n} slot {s}: decoded steps (mif: {from_mif})");
+                // initial data: every constant word is its binary32 rounding, others 0
+                let data = read(&d.pes[s].data);
+                assert_eq!(data.len(), pe.init.len().max(1));
+                for (a, w) in pe.init.iter().enumerate() {
+                    let want = match w {
+                        Some(robovec_ir::machine::Word::Const(c)) => u64::from((*c as f32).to_bits()),
+                        _ => 0,
+                    };
+                    assert_eq!(data[a], want, "N={n} slot {s} word {a}");
+                }
+            }
+        }
+        // the simulated cycle count and the instruction memory depth
+        assert!(d.pes.iter().all(|p| p.instr.words.len() == prog.cycles as usize + 1));
+        assert_eq!(d.cycles, prog.cycles);
+    }
+}
+
+/// A DE10-Nano target file with `field` changed.
+fn target_with(dir: &Path, field: &str, value: serde_json::Value) -> PathBuf {
+    let text = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/targets/de10-nano.json")).unwrap();
+    let mut t: serde_json::Value = serde_json::from_str(&text).unwrap();
+    t[field] = value;
+    let p = dir.join(format!("{field}.json"));
+    std::fs::write(&p, t.to_string()).unwrap();
+    p
+}
+
+#[test]
+fn memories_beyond_the_target_are_diagnostics_with_the_figures_and_nothing_is_written() {
+    let d = tmp("limits");
+    let dir = d.join("out");
+    let run = |target: &Path| {
+        let passes = format!("-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=estimate>", dir.display());
+        opt(&[PENDULUM, &passes, &format!("-target={}", target.display()), "-o", "/dev/null"])
+    };
+    // the pendulum at N = 2 runs well over 32 cycles
+    let o = run(&target_with(&d, "instr_words", serde_json::json!(32)));
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("the target's instruction memory has 32"), "{}", stderr(&o));
+    assert!(!dir.exists(), "nothing written");
+    let o = run(&target_with(&d, "pe_words", serde_json::json!(4)));
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("the target has 4 words per PE memory"), "{}", stderr(&o));
+    assert!(!dir.exists(), "nothing written");
+    let o = run(&target_with(&d, "writes", serde_json::json!(3)));
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("3 write port(s)"), "{}", stderr(&o));
+    assert!(!dir.exists(), "nothing written");
+}

@@ -304,22 +304,21 @@ pub fn function_dir(out: &Path, function: &str, several: bool) -> PathBuf {
     }
 }
 
-/// The DE10-Nano's figures used until the target description is merged: seed §1.3 / Table 1.4
-/// (Cyclone V SE 5CSEBA6: 41910 ALM, 553 M10K, 112 DSP; ADD PE 360 ALM + 2 DSP, MULTI PE 100
-/// ALM + 3 DSP, crossbar 2080 ALM for 8 PEs; clock 178 MHz, Table 1.3 for ADD 10 + MULTI 5
-/// stages; 2048-word PE memories, 16-word buffers, 52-bit instruction words).
-pub fn de10_nano() -> (lower::Limits, resources::CostModel) {
-    (
-        lower::Limits { pe_words: 2048, buffer_words: 16, instr_words: 8192, instr_width: 52, writes: 2 },
-        resources::CostModel {
-            target: "de10-nano".into(),
-            capacity: resources::UnitCost { alm: 41910, m10k: 553, dsp: 112 },
-            fp_add: resources::UnitCost { alm: 360, dsp: 2, m10k: 0 },
-            fp_mul: resources::UnitCost { alm: 100, dsp: 3, m10k: 0 },
-            crossbar_alm_per_pe: 260,
-            clock_mhz: 178.0,
-        },
-    )
+/// The cost model of target `t` (its capacities, per-unit costs and clock; the analytic logic
+/// per PE from its crossbar, PE memory and control costs, used without Yosys).
+pub fn cost_model(t: &robovec_ir::target::Target) -> resources::CostModel {
+    let unit = |u: &robovec_ir::target::UnitCost| resources::UnitCost { alm: u.alm.ceil() as u64, dsp: u64::from(u.dsp), m10k: u64::from(u.m10k) };
+    resources::CostModel {
+        target: t.name.clone(),
+        capacity: resources::UnitCost { alm: u64::from(t.alm), m10k: u64::from(t.m10k), dsp: u64::from(t.dsp) },
+        fp_add: unit(&t.fp_add),
+        fp_mul: unit(&t.fp_mul),
+        crossbar_alm: t.crossbar_alm,
+        pe_memory_alm: t.pe_memory_alm,
+        control_alm: t.control_alm,
+        writes: t.writes,
+        clock_mhz: t.clock_mhz,
+    }
 }
 
 impl CodegenFpga {
@@ -371,7 +370,7 @@ impl Pass for CodegenFpga {
 
     fn run(&self, m: &mut robovec_ir::Module, cx: &mut PassContext) -> Result<(), PassError> {
         crate::require_phase("codegen", m, robovec_ir::Phase::Atomised)?;
-        let (limits, model) = de10_nano();
+        let (limits, model) = (lower::Limits::of(&cx.target), cost_model(&cx.target));
         let mut functions = Vec::new();
         for f in &m.functions {
             let (_, report, files) = self.build(f, &limits, &model).map_err(failed)?;

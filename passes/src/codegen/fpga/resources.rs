@@ -8,8 +8,9 @@
 //!   ALMs are packed as Quartus would at best: a 6-input LUT fills an ALM, two smaller LUTs or
 //!   two arithmetic bits share one, and an ALM holds two registers, so
 //!   `alm = max(LUT6 + ⌈(LUT2…LUT5 + ARITH)/2⌉, ⌈FF/2⌉)`. Yosys' DSP cells (`MISTRAL_MUL*`)
-//!   count as DSP blocks. Without `yosys` on `PATH` the logic is the analytic estimate: the
-//!   target's crossbar cost per PE (seed Table 1.4: 2080 ALM for 8 PEs) times the PEs.
+//!   count as DSP blocks. Without `yosys` on `PATH` the logic is the target's analytic model
+//!   (`robovec_ir::target`, seed Table 1.4): `crossbar_alm · n_pe · writes · 2n_pe +
+//!   pe_memory_alm · n_pe + control_alm`.
 //! - **FP units**: the target's per-unit costs (seed §1.3.1 / Table 1.4: ADD PE 360 ALM, 2 DSP;
 //!   MULTI PE 100 ALM, 3 DSP) times the PEs of each type.
 //! - **Memories**: every PE memory, instruction, crossbar, buffer-instruction and capture memory
@@ -64,8 +65,14 @@ pub struct CostModel {
     pub fp_add: UnitCost,
     /// One MULTI PE's floating-point unit.
     pub fp_mul: UnitCost,
-    /// Crossbar ALMs per PE (analytic estimate only).
-    pub crossbar_alm_per_pe: u64,
+    /// Analytic logic (without Yosys): ALMs per (PE-memory write port × crossbar source).
+    pub crossbar_alm: f64,
+    /// Analytic logic: ALMs per PE memory.
+    pub pe_memory_alm: f64,
+    /// Analytic logic: control ALMs.
+    pub control_alm: f64,
+    /// Write ports per PE memory.
+    pub writes: u32,
     /// Clock, MHz.
     pub clock_mhz: f64,
 }
@@ -224,7 +231,11 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
     let mem_m10k: u64 = memories.iter().map(|c| c.m10k).sum();
     let (logic_from, logic_alm, logic_dsp) = match &yosys {
         Some(y) => ("yosys", y.alm(), y.dsp),
-        None => ("estimate", m.crossbar_alm_per_pe * (na + nm), 0),
+        None => {
+            let n = (na + nm) as f64;
+            let a = m.crossbar_alm * n * f64::from(m.writes) * 2.0 * n + m.pe_memory_alm * n + m.control_alm;
+            ("estimate", a.ceil() as u64, 0)
+        }
     };
     let alm = logic_alm + fp.alm;
     let m10k = mem_m10k + fp.m10k;
