@@ -149,7 +149,6 @@ pub(super) fn lower(f: &Function, p: &Placement) -> Result<(MachineProgram, Occu
                 let k = Key::of(&o.value);
                 let a = *init_out.entry(k).or_insert_with(|| {
                     output_words[0] += 1;
-                    pes[0].output_init.push(Some(word(k)));
                     output_words[0] - 1
                 });
                 (0, a)
@@ -159,6 +158,9 @@ pub(super) fn lower(f: &Function, p: &Placement) -> Result<(MachineProgram, Occu
     }
     for (s, q) in pes.iter_mut().enumerate() {
         q.output_init.resize(output_words[s] as usize, None);
+    }
+    for (&k, &a) in &init_out {
+        pes[0].output_init[a as usize] = Some(word(k));
     }
 
     // The placement line of memory event `e` (a load, then the writes).
