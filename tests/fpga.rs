@@ -169,10 +169,12 @@ fn yosys_sizes_the_design_and_resources_json_has_the_figures() {
     let d = tmp("yosys");
     let dir = d.join("out");
     let rep = d.join("report.json");
-    let passes = format!("-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=yosys>", dir.display());
+    let passes =
+        format!("-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=yosys>", dir.display());
     let o = opt(&[PENDULUM, &passes, &format!("-report={}", rep.display()), "-o", "/dev/null"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
     assert_eq!(r["logic_from"], "yosys");
     let fp_alm = 2 * 360 + 2 * 100;
     assert_eq!(r["fp_units"]["alm"], fp_alm, "target's per-unit costs (seed Table 1.4)");
@@ -253,7 +255,9 @@ fn images_read_back_from_hex_and_mif_reproduce_the_machine_program_exactly() {
 
 /// A DE10-Nano target file with `field` changed.
 fn target_with(dir: &Path, field: &str, value: serde_json::Value) -> PathBuf {
-    let text = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/targets/de10-nano.json")).unwrap();
+    let text =
+        std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/targets/de10-nano.json"))
+            .unwrap();
     let mut t: serde_json::Value = serde_json::from_str(&text).unwrap();
     t[field] = value;
     let p = dir.join(format!("{field}.json"));
@@ -266,7 +270,10 @@ fn memories_beyond_the_target_are_diagnostics_with_the_figures_and_nothing_is_wr
     let d = tmp("limits");
     let dir = d.join("out");
     let run = |target: &Path| {
-        let passes = format!("-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=estimate>", dir.display());
+        let passes = format!(
+            "-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=estimate>",
+            dir.display()
+        );
         opt(&[PENDULUM, &passes, &format!("-target={}", target.display()), "-o", "/dev/null"])
     };
     // the pendulum at N = 2 runs well over 32 cycles

@@ -218,7 +218,13 @@ impl Design {
         }
         let mut bus: Vec<String> = (0..n).rev().map(|i| format!("buffer{i}")).collect();
         bus.extend((0..n).rev().map(|i| format!("result{i}")));
-        let _ = writeln!(s, "  // crossbar sources: select s = 1..{n} is result s-1, {}..{} is buffer s-{}", n + 1, 2 * n, n + 1);
+        let _ = writeln!(
+            s,
+            "  // crossbar sources: select s = 1..{n} is result s-1, {}..{} is buffer s-{}",
+            n + 1,
+            2 * n,
+            n + 1
+        );
         let _ = writeln!(s, "  wire [{}:0] sources = {{{}}};", 64 * n - 1, bus.join(", "));
         for p in &self.pes {
             let lat = if p.is_mul { self.lat_mul } else { self.lat_add };

@@ -128,7 +128,8 @@ impl Image {
                     let _ = w;
                     continue;
                 }
-                let (k, v) = upper.trim_end_matches(';').split_once('=').ok_or_else(|| err(n, "expected KEY=VALUE;"))?;
+                let (k, v) =
+                    upper.trim_end_matches(';').split_once('=').ok_or_else(|| err(n, "expected KEY=VALUE;"))?;
                 let v = v.trim();
                 match k.trim() {
                     "WIDTH" => width = Some(v.parse::<u32>().map_err(|_| err(n, "bad WIDTH"))?),
@@ -150,7 +151,8 @@ impl Image {
                 let width = width.unwrap_or(0);
                 return Ok(Image { name: name.into(), width, words });
             }
-            let (a, w) = line.trim_end_matches(';').split_once(':').ok_or_else(|| err(n, "expected `ADDRESS : WORD;`"))?;
+            let (a, w) =
+                line.trim_end_matches(';').split_once(':').ok_or_else(|| err(n, "expected `ADDRESS : WORD;`"))?;
             let word = parse_word(w.trim(), width.unwrap_or(64)).map_err(|m| err(n, m))?;
             let a = a.trim();
             let range = match a.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
@@ -230,7 +232,8 @@ mod tests {
             "-- robovec codegen<fpga>: t\nWIDTH=6;\nDEPTH=2;\nADDRESS_RADIX=UNS;\nDATA_RADIX=HEX;\nCONTENT BEGIN\n\t0 : 3f;\n\t1 : 01;\nEND;\n"
         );
         assert_eq!(Image::parse_mif("t", &i.to_mif()).unwrap(), i);
-        let ranged = "WIDTH=8;\nDEPTH=4;\nADDRESS_RADIX=HEX;\nDATA_RADIX=HEX;\nCONTENT BEGIN\n[0..2] : 7;\n3 : a;\nEND;\n";
+        let ranged =
+            "WIDTH=8;\nDEPTH=4;\nADDRESS_RADIX=HEX;\nDATA_RADIX=HEX;\nCONTENT BEGIN\n[0..2] : 7;\n3 : a;\nEND;\n";
         assert_eq!(Image::parse_mif("t", ranged).unwrap().words, vec![7, 7, 7, 10]);
         assert!(Image::parse_mif("t", "WIDTH=8;\nDEPTH=1;\nDATA_RADIX=BIN;\n").is_err());
     }

@@ -120,7 +120,11 @@ pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
         ));
     }
     if let Some((s, w)) = worst(&m.buffer_words).filter(|&(_, w)| w > limits.buffer_words) {
-        out.push(format!("buffer of {} needs {w} words; the target's buffers have {} words", name(s), limits.buffer_words));
+        out.push(format!(
+            "buffer of {} needs {w} words; the target's buffers have {} words",
+            name(s),
+            limits.buffer_words
+        ));
     }
     let depth = u64::from(m.cycles) + 1;
     if depth > u64::from(limits.instr_words) {

@@ -132,11 +132,22 @@ pub struct FpgaReport {
     pub resources: Resources,
 }
 
+/// One file of a design, its path relative to the function's folder.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DesignFile {
+    /// Path under `DIR` (`hex/pe0_instr.hex`).
+    pub path: String,
+    /// Content.
+    pub bytes: Vec<u8>,
+    /// True for `simulate`.
+    pub executable: bool,
+}
+
 /// What `codegen<fpga>` produced: per function, its design, files and figures.
 #[derive(Debug)]
 pub struct FpgaArtifact {
     /// Per function: name, report, files relative to the function's folder.
-    pub functions: Vec<(String, FpgaReport, Vec<(String, Vec<u8>, bool)>)>,
+    pub functions: Vec<(String, FpgaReport, Vec<DesignFile>)>,
     /// `out=DIR`.
     pub out: PathBuf,
 }
@@ -176,8 +187,8 @@ impl Artifact for FpgaArtifact {
         let mut v = Vec::new();
         for (f, _, files) in &self.functions {
             let base = if several_functions { self.out.join(f) } else { self.out.clone() };
-            for (rel, bytes, executable) in files {
-                v.push(ArtifactFile { path: base.join(rel), bytes: bytes.clone(), executable: *executable });
+            for x in files {
+                v.push(ArtifactFile { path: base.join(&x.path), bytes: x.bytes.clone(), executable: x.executable });
             }
         }
         v
@@ -185,28 +196,29 @@ impl Artifact for FpgaArtifact {
 }
 
 /// The files of a design: `(path relative to DIR, bytes, executable)`.
-pub fn design_files(d: &Design, format: &str, r: &Resources, manifest: &str) -> Vec<(String, Vec<u8>, bool)> {
-    let mut v: Vec<(String, Vec<u8>, bool)> = Vec::new();
+pub fn design_files(d: &Design, format: &str, r: &Resources, manifest: &str) -> Vec<DesignFile> {
+    let mut v: Vec<DesignFile> = Vec::new();
+    let mut add = |path: String, bytes: Vec<u8>, executable: bool| v.push(DesignFile { path, bytes, executable });
     for p in &d.pes {
         for img in p.images() {
             if format != "mif" {
-                v.push((format!("hex/{}.hex", img.name), img.to_hex().into_bytes(), false));
+                add(format!("hex/{}.hex", img.name), img.to_hex().into_bytes(), false);
             }
             if format != "hex" {
-                v.push((format!("mif/{}.mif", img.name), img.to_mif().into_bytes(), false));
+                add(format!("mif/{}.mif", img.name), img.to_mif().into_bytes(), false);
             }
         }
     }
     for (n, t) in HDL_LIBRARY {
-        v.push((format!("hdl/{n}"), t.as_bytes().to_vec(), false));
+        add(format!("hdl/{n}"), t.as_bytes().to_vec(), false);
     }
-    v.push(("hdl/robovec_top.v".into(), d.top("").into_bytes(), false));
-    v.push(("hdl/testbench.v".into(), d.testbench().into_bytes(), false));
-    v.push(("manifest.json".into(), manifest.as_bytes().to_vec(), false));
-    v.push(("simulate".into(), SIMULATE.as_bytes().to_vec(), true));
+    add("hdl/robovec_top.v".into(), d.top("").into_bytes(), false);
+    add("hdl/testbench.v".into(), d.testbench().into_bytes(), false);
+    add("manifest.json".into(), manifest.as_bytes().to_vec(), false);
+    add("simulate".into(), SIMULATE.as_bytes().to_vec(), true);
     let mut res = serde_json::to_string_pretty(r).expect("resources serialise");
     res.push('\n');
-    v.push(("resources.json".into(), res.into_bytes(), false));
+    add("resources.json".into(), res.into_bytes(), false);
     v
 }
 
@@ -307,7 +319,11 @@ pub fn function_dir(out: &Path, function: &str, several: bool) -> PathBuf {
 /// The cost model of target `t` (its capacities, per-unit costs and clock; the analytic logic
 /// per PE from its crossbar, PE memory and control costs, used without Yosys).
 pub fn cost_model(t: &robovec_ir::target::Target) -> resources::CostModel {
-    let unit = |u: &robovec_ir::target::UnitCost| resources::UnitCost { alm: u.alm.ceil() as u64, dsp: u64::from(u.dsp), m10k: u64::from(u.m10k) };
+    let unit = |u: &robovec_ir::target::UnitCost| resources::UnitCost {
+        alm: u.alm.ceil() as u64,
+        dsp: u64::from(u.dsp),
+        m10k: u64::from(u.m10k),
+    };
     resources::CostModel {
         target: t.name.clone(),
         capacity: resources::UnitCost { alm: u64::from(t.alm), m10k: u64::from(t.m10k), dsp: u64::from(t.dsp) },
@@ -332,7 +348,7 @@ impl CodegenFpga {
         f: &robovec_ir::Function,
         limits: &lower::Limits,
         model: &resources::CostModel,
-    ) -> Result<(Design, FpgaReport, Vec<(String, Vec<u8>, bool)>), String> {
+    ) -> Result<(Design, FpgaReport, Vec<DesignFile>), String> {
         let Some(p) = &f.placement else {
             return Err(format!("function @{} has no placement; run `place` before `codegen<fpga>`", f.name));
         };
@@ -340,10 +356,9 @@ impl CodegenFpga {
             .map_err(|e| format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target))?;
         let cells = match self.resources {
             "estimate" => None,
-            "yosys" => Some(
-                resources::yosys_cells(&d)?
-                    .ok_or("`resources=yosys` but `yosys` cannot be run (Debian package `yosys`); use resources=estimate")?,
-            ),
+            "yosys" => Some(resources::yosys_cells(&d)?.ok_or(
+                "`resources=yosys` but `yosys` cannot be run (Debian package `yosys`); use resources=estimate",
+            )?),
             _ => resources::yosys_cells(&d)?,
         };
         let r = resources::estimate(&d, model, cells);

@@ -152,7 +152,12 @@ pub fn memory_costs(d: &Design) -> Vec<MemoryCost> {
     for p in &d.pes {
         for (img, tdp) in [(&p.instr, false), (&p.xbar, false), (&p.bufi, false), (&p.capt, false), (&p.data, true)] {
             let words = img.words.len().max(1) as u64;
-            v.push(MemoryCost { name: img.name.clone(), words, width: img.width, m10k: m10k_blocks(words, img.width, tdp) });
+            v.push(MemoryCost {
+                name: img.name.clone(),
+                words,
+                width: img.width,
+                m10k: m10k_blocks(words, img.width, tdp),
+            });
         }
     }
     v
@@ -165,7 +170,10 @@ pub fn memory_costs(d: &Design) -> Vec<MemoryCost> {
 pub fn yosys_cells(d: &Design) -> Result<Option<YosysCells>, String> {
     let Some(dir) = TempDir::new() else { return Ok(None) };
     let mut files = vec![("synth_stubs.v", SYNTH_STUBS.to_string())];
-    files.push(("rv_lib.v", HDL_LIBRARY.iter().find(|(n, _)| *n == "rv_lib.v").map(|x| x.1.to_string()).unwrap_or_default()));
+    files.push((
+        "rv_lib.v",
+        HDL_LIBRARY.iter().find(|(n, _)| *n == "rv_lib.v").map(|x| x.1.to_string()).unwrap_or_default(),
+    ));
     files.push(("robovec_top.v", d.top("")));
     files.push((
         "synth.ys",
@@ -189,7 +197,8 @@ pub fn yosys_cells(d: &Design) -> Result<Option<YosysCells>, String> {
         let tail: Vec<&str> = text.lines().rev().take(8).collect();
         return Err(format!("yosys failed: {}", tail.into_iter().rev().collect::<Vec<_>>().join("\n")));
     }
-    let stat = std::fs::read_to_string(dir.0.join("stat.json")).map_err(|e| format!("yosys wrote no statistics: {e}"))?;
+    let stat =
+        std::fs::read_to_string(dir.0.join("stat.json")).map_err(|e| format!("yosys wrote no statistics: {e}"))?;
     parse_stat(&stat).map(Some)
 }
 
