@@ -6,8 +6,9 @@
 //!   Yosys `synth_intel_alm -family cyclonev` on the generated top with the FP units and the
 //!   M10K memories as black boxes (`hdl/synth_stubs.v`). Yosys reports Mistral cells, not ALMs;
 //!   ALMs are packed as Quartus would at best: a 6-input LUT fills an ALM, two smaller LUTs or
-//!   two arithmetic bits share one, and an ALM holds two registers, so
-//!   `alm = max(LUT6 + ⌈(LUT2…LUT5 + ARITH)/2⌉, ⌈FF/2⌉)`. Yosys' DSP cells (`MISTRAL_MUL*`)
+//!   two arithmetic bits share one, and an ALM holds two registers; a Yosys MLAB cell (32 × 1 bit)
+//!   is half an ALM of a 640-bit MLAB, so
+//!   `alm = max(LUT6 + ⌈(LUT2…LUT5 + ARITH)/2⌉, ⌈FF/2⌉) + ⌈MLAB/2⌉`. Yosys' DSP cells (`MISTRAL_MUL*`)
 //!   count as DSP blocks. Without `yosys` on `PATH` the logic is the target's analytic model
 //!   (`robovec_ir::target`, seed Table 1.4): `crossbar_alm · n_pe · writes · 2n_pe +
 //!   pe_memory_alm · n_pe + control_alm`.
@@ -16,21 +17,28 @@
 //! - **Memories**: every PE memory, instruction, crossbar, buffer-instruction and capture memory
 //!   as M10K blocks from its size ([`super::images::m10k_blocks`]; PE memories true dual-port).
 //!
-//! ## Against the seed's Table 1.4 (8 PE: 4 ADD + 4 MULTI, 987 cycles)
-//! The seed totals 4413 ALM, 120 M10K (of which 20 for the interconnection memory), 20 DSP.
-//! Our figures for the same configuration differ in two places, for two reasons:
-//! - *Crossbar ALMs.* The seed's crossbar is 16-input multiplexers per PE, 110–150 ALM each
-//!   (2080 ALM for 8 PEs as synthesized by Quartus with its own retiming). Our crossbar has two
-//!   write ports per PE memory, each a 17-way 32-bit multiplexer, plus the output memories and
-//!   buffers as registers: Yosys maps these to about 3–4× the seed's crossbar ALMs (measured in
-//!   the issue note). Quartus packs LUTs into ALMs more tightly than our bound, and the seed's
-//!   design registers the crossbar differently (its M10K-based buffers).
-//! - *M10K.* The seed counts the PE memory as 7 M10K (we agree, 2048 × 32 in the 2K×5
-//!   configuration) and the instruction memories as 3–4 M10K (we count 6 for a 988 × 52 ROM:
-//!   the 52-bit word does not fit 4 blocks in any configuration; the seed's figure is below
-//!   the bit count ⌈48128/10240⌉ = 5); the crossbar memory is per PE memory (2 selects of 5 bits
-//!   per cycle) rather than the seed's one 65536-bit block, and the buffers are registers
-//!   (Yosys counts them in ALMs) rather than 1 M10K each.
+//! ## Against the seed's Table 1.4 (8 PE: 4 ADD + 4 MULTI)
+//! The seed totals 4413 ALM, 120 M10K, 20 DSP for its 23-dof railway bogie (987 cycles). The
+//! bogie is not in the corpus; the Segway `dirdyna` placed on the same configuration
+//! (`place<pe=4>`, 720 cycles, 6.0 µs at 120 MHz) measures, with Yosys 0.23:
+//! **6277 ALM, 88 M10K, 20 DSP** (fits: 15 % / 16 % / 18 % of the device).
+//! - *DSP*: 20, equal by construction (the FP units are the seed's per-unit costs).
+//! - *ALM*: +42 % (6277 against 4413). The FP units are the seed's (1840 ALM); the rest, 4437 ALM
+//!   from Yosys (2212 LUT6, 4200 smaller LUTs, 90 arithmetic bits, 4016 registers, 160 MLAB
+//!   slices) against the seed's 2573 (crossbar 2080 + PE memories 24 + the 469 the table does
+//!   not itemise), is 1.7×: (a) our crossbar has two 17-way 32-bit multiplexers per PE memory (one
+//!   per write port, 16 in all), where the seed reports 110–150 ALM per PE for its
+//!   multiplexers; (b) the buffers and output memories are read in the cycle they are addressed
+//!   (store-then-read in one clock), so they are registers and MLAB slices (with their
+//!   address decoding and output multiplexers), where the seed spends one M10K per buffer; (c) the packing bound above is pessimistic
+//!   against Quartus' fitter, which packs two LUTs of up to 8 inputs in total per ALM and
+//!   retimes.
+//! - *M10K*: −27 % (88 against 120), and differently spread: instruction memories 6 each
+//!   (a 721 × 52 ROM: the 52-bit word needs 6 blocks in any configuration; the seed reports
+//!   3–4, below its own bit count ⌈48128/10240⌉ = 5), crossbar 1 per PE memory (8 against the
+//!   seed's 20), buffer instructions and captures 1 each, PE memories 2 each because they hold
+//!   only the 64 words the placement uses (the seed's fixed 2048 × 32 takes 7, which we agree
+//!   with for a full memory), buffers none (MLABs).
 //!
 //! The PE memory's depth is the words the placement uses (rounded up to what the blocks hold),
 //! not the target's 2048: a placement that uses fewer words takes fewer M10K.
@@ -103,14 +111,15 @@ pub struct YosysCells {
     pub ff: u64,
     /// DSP blocks.
     pub dsp: u64,
-    /// MLAB memories (a Cyclone V MLAB is one LAB: counted as 10 ALMs each).
+    /// MLAB bit slices (Yosys' `MISTRAL_MLAB`: 32 words × 1 bit; an MLAB is a LAB of 10 ALMs
+    /// holding 640 bits, so a slice is half an ALM).
     pub mlab: u64,
 }
 
 impl YosysCells {
     /// ALMs (see the module doc).
     pub fn alm(&self) -> u64 {
-        (self.lut6 + (self.lut_small + self.arith).div_ceil(2)).max(self.ff.div_ceil(2)) + 10 * self.mlab
+        (self.lut6 + (self.lut_small + self.arith).div_ceil(2)).max(self.ff.div_ceil(2)) + self.mlab.div_ceil(2)
     }
 }
 
@@ -306,6 +315,9 @@ mod tests {
         assert_eq!(y.alm(), 14);
         let y = YosysCells { ff: 41, ..y };
         assert_eq!(y.alm(), 21);
+        // 3 MLAB slices of 32 bits: ⌈3/2⌉ = 2 ALMs
+        let y = YosysCells { mlab: 3, ..y };
+        assert_eq!(y.alm(), 23);
     }
 
     #[test]
