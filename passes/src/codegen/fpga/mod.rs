@@ -75,8 +75,17 @@ pub const RESOURCES: ParamInfo = ParamInfo {
     doc: "FPGA: logic ALMs from Yosys (auto: when on PATH) or the analytic estimate",
 };
 
-/// The parameters of the C back end, refused with `codegen<fpga>`.
-const C_ONLY: &[&str] = &["abi", "precision", "batch", "trig", "name"];
+/// The parameters of the C back end, refused with `codegen<fpga>` when given another value
+/// than their default.
+pub const C_ONLY: &[ParamInfo] = &[super::c::ABI, super::c::PRECISION, super::c::BATCH, super::c::TRIG, super::c::NAME];
+/// The parameters of this back end, refused with `codegen<c>` likewise.
+pub const FPGA_ONLY: &[ParamInfo] = &[OUT, FORMAT, RESOURCES];
+
+/// The first of `decls` given with a value other than its declared default (`out=`, `name=`:
+/// any value), if any.
+pub fn given_beyond_default(p: &Params, decls: &[ParamInfo]) -> Option<&'static str> {
+    decls.iter().find(|d| p.get(d.name).is_some_and(|v| !d.default_is_literal() || v != d.default_text())).map(|d| d.name)
+}
 
 /// The `codegen<fpga;…>` pass.
 #[derive(Debug, Clone)]
@@ -103,7 +112,7 @@ impl CodegenFpga {
     /// # Errors
     /// [`PassError::BadParameter`] without `out`, or with a parameter of the C back end.
     pub fn from_params(p: &Params) -> Result<CodegenFpga, PassError> {
-        if let Some(k) = C_ONLY.iter().find(|k| p.get(k).is_some()) {
+        if let Some(k) = given_beyond_default(p, C_ONLY) {
             return Err(bad(format!("parameter `{k}` belongs to `codegen<c>`, not `codegen<fpga>`")));
         }
         let out = p.path("out")?.ok_or_else(|| bad("`codegen<fpga>` needs `out=DIR`, the folder it writes".into()))?;
