@@ -488,4 +488,40 @@ mod tests {
         assert!(decode_step(&l, 0, 0, [1 << 44, 5, 0, 0]).unwrap_err().message.contains("beyond 2·2"));
         assert!(decode_step(&l, 0, 0, [1 << 44, 0, 0, 0]).unwrap_err().message.contains("selects no source"));
     }
+
+    use proptest::prelude::*;
+
+    /// Any step a program on `layout(n_pe, n_add)` can hold on an ADD (`is_add`) or MULTI PE: 0–2 writes from
+    /// any source, optional issue of the PE's ops, buffer and capture instructions.
+    fn any_step(n_pe: usize, is_add: bool) -> impl Strategy<Value = Step> {
+        let addr = 0u32..2048;
+        let src = (any::<bool>(), 0..n_pe).prop_map(|(b, s)| if b { Source::Buffer(s) } else { Source::Result(s) });
+        let write = (addr.clone(), src).prop_map(|(addr, src)| MemWrite { addr, src });
+        let op = if is_add {
+            prop_oneof![Just(MachineOp::Add), Just(MachineOp::Sub)].boxed()
+        } else {
+            Just(MachineOp::Mul).boxed()
+        };
+        let issue =
+            proptest::option::of((op, addr.clone(), addr).prop_map(|(op, a, b)| Instr { op, reads: vec![a, b] }));
+        let small = || proptest::option::of(0u32..16);
+        (issue, proptest::collection::vec(write, 0..=2), small(), small(), proptest::option::of(0u32..8)).prop_map(
+            |(issue, writes, store, read, capture)| Step { issue, writes, buffer: BufferOp { store, read }, capture },
+        )
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+        #[test]
+        fn decode_inverts_encode_on_any_step(
+            (n_pe, slot, step) in (1usize..=8)
+                .prop_flat_map(|n| (Just(n), 0..n))
+                .prop_flat_map(|(n, s)| (Just(n), Just(s), any_step(n, s < n.div_ceil(2))))
+        ) {
+            let l = layout(n_pe, n_pe.div_ceil(2));
+            let w = encode_step(&l, slot, 0, &step).unwrap();
+            prop_assert_eq!(decode_step(&l, slot, 0, w).unwrap(), step);
+        }
+    }
 }

@@ -234,6 +234,23 @@ impl MachineProgram {
         }
     }
 
+    /// The binary32 initial contents of PE slot `slot`'s memory, one word per address (0 where
+    /// nothing is loaded), `input(name)` giving each input ([`Word::binary32`]).
+    ///
+    /// # Panics
+    /// When `slot` is not below [`MachineProgram::n_pe`].
+    pub fn pe_image(&self, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
+        self.pes[slot].init.iter().map(|w| w.as_ref().map_or(0, |w| w.binary32(&input))).collect()
+    }
+
+    /// The binary32 initial contents of PE slot `slot`'s output memory (0 for captured words).
+    ///
+    /// # Panics
+    /// When `slot` is not below [`MachineProgram::n_pe`].
+    pub fn output_image(&self, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
+        self.pes[slot].output_init.iter().map(|w| w.as_ref().map_or(0, |w| w.binary32(&input))).collect()
+    }
+
     /// Direct writes (crossbar source a result) in the whole program.
     pub fn writes_direct(&self) -> u32 {
         self.count_writes(|s| matches!(s, Source::Result(_)))

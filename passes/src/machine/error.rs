@@ -68,7 +68,9 @@ pub enum MachineErrorKind {
     /// An address written while the value it holds still has a read in this or a later cycle,
     /// or written twice in one cycle.
     AddressReused,
-    /// An output whose value was never computed.
+    /// An output whose value was never computed. Kept for `sim`'s callers; the lowering no
+    /// longer produces it (an unissued op is [`MachineErrorKind::MissingIssue`] first, and
+    /// every output of an issued op is captured at its arrival).
     OutputUnavailable,
     /// A simulated output differs from the interpreter (`sim`'s `verify_placement`).
     Mismatch,

@@ -51,17 +51,19 @@
 //!   executes them); the FPGA has no unit for them, so [`robovec_ir::machine::encode`] — and
 //!   with it `codegen<fpga>` — rejects them with a typed error, as it rejects targets whose
 //!   words cannot hold the program. The lowering rejects what no machine of the model can do.
-//! - **Size.** At most [`lower::MAX_STEPS`] steps (PEs × cycles) are built.
+//! - **Size.** At most [`MAX_STEPS`] steps (PEs × cycles) are built.
 
 mod error;
 mod exec;
-pub mod lower;
+mod lowering;
 mod plan;
 
 use robovec_ir::machine::MachineProgram;
 use robovec_ir::placement::Placement;
 use robovec_ir::verifier::machine::verify_machine;
 use robovec_ir::Function;
+
+pub use lowering::MAX_STEPS;
 
 pub use error::{MachineError, MachineErrorKind, When};
 pub use exec::{execute, Executed};
@@ -91,7 +93,7 @@ pub fn lower(f: &Function, p: &Placement) -> Result<MachineProgram, MachineError
 /// # Errors
 /// As [`lower`].
 pub fn lower_measured(f: &Function, p: &Placement) -> Result<(MachineProgram, Occupancy), MachineError> {
-    let (m, occ) = lower::lower(f, p)?;
+    let (m, occ) = lowering::lower(f, p)?;
     let errs = verify_machine(f, &m);
     if let Some(e) = errs.first() {
         return Err(MachineError::new(

@@ -314,3 +314,29 @@ proptest! {
         lowered_encoded_decoded_equals_interp(n_ops, seed, n, buffer);
     }
 }
+
+/// The binary32 data words are what `interp` computes in f32: an input rounded to nearest, a
+/// trig value in f32 of the rounded input, a constant rounded (0.1 is not exact in binary32).
+#[test]
+fn data_words_are_interp_binary32() {
+    let f = func(
+        "func @f { phase atomised input %q %s = cos %q %x = mul %s, 0.1 output o = %x output a = %q \
+         output c = 0.1 output t = %s }",
+    );
+    let p = place_function(&f, &PlaceOptions::with_pes(1));
+    let m = lower(&f, &p).unwrap();
+    let expected = eval::<f32>(&f, input);
+    let out = m.output_image(0, input);
+    for (loc, (name, x)) in m.outputs.iter().zip(&expected).skip(1) {
+        assert_eq!(&loc.name, name);
+        assert_eq!((loc.slot, out[loc.addr as usize]), (0, x.to_bits()), "output `{name}`");
+    }
+    assert_eq!(out[m.outputs[2].addr as usize], 0.1f32.to_bits());
+    // The multiplier reads cos q and 0.1 from its memory image.
+    let mul = &m.pes[1];
+    let image = m.pe_image(1, input);
+    let reads = &mul.steps.iter().find_map(|s| s.issue.as_ref()).unwrap().reads;
+    let (cos_q, tenth) = (image[reads[0] as usize], image[reads[1] as usize]);
+    assert_eq!(cos_q, (input("q") as f32).cos().to_bits());
+    assert_eq!(tenth, 0.1f32.to_bits());
+}
