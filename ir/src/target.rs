@@ -15,7 +15,7 @@
 //! | `instr_words` | 65 536 words | the depth of the instruction memories the top may generate (a 16-bit cycle counter); the seed's 987-cycle design used 1024-word memories (48 128 bits, §1.3.1); what a deeper memory costs is counted in M10K by [`Target::estimate`] |
 //! | `instr_width` | 52 bits | seed §1.3.1 (two read and two write addresses of 11 bits as 3 hex digits, enables, add/sub bit) |
 //! | `clock_mhz` | 120 MHz | seed §1.3 and §1.3.2 (see below) |
-//! | `alm`, `m10k`, `dsp` | 41 910 ALM, 553 M10K, 112 DSP | Intel, *Cyclone V Device Overview* (CV-51001), Cyclone V SE A6 (5CSEBA6U23I7, the DE10-Nano's device), as Quartus reports it and the seed's Table 1.4 totals (`4413/41910`, `120/553`, `20/112`) |
+//! | `alm`, `m10k`, `dsp` | 41 910 ALM, 553 M10K, 112 DSP | the DE10-Nano's Cyclone V SE 5CSEBA6U23I7 as Quartus' fitter counts it, the denominators of the seed's Table 1.4 (`4413/41910`, `120/553`, `20/112`); Intel's *Cyclone V Device Overview* (CV-51001, SE A6 row) gives the 112 variable-precision DSP blocks and the 10-Kbit M10K (its family table rounds ALM and block counts slightly differently; the fitter's usable counts are the ones a fit is judged against) |
 //! | `m10k_bits` | 10 240 bits | Intel, *Cyclone V Device Overview*: M10K = 10 Kbit blocks |
 //! | `fp_add` | 360 ALM, 2 DSP, 0 M10K per ADD PE | seed Table 1.4, row "PE ADD" (Quartus figures of the 8-PE design) |
 //! | `fp_mul` | 100 ALM, 3 DSP, 0 M10K per MULTI PE | seed Table 1.4, row "PE MULTI" |

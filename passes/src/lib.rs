@@ -381,3 +381,35 @@ pub fn require_phase(pass: &str, m: &Module, phase: Phase) -> Result<(), PassErr
         None => Ok(()),
     }
 }
+
+#[cfg(test)]
+mod target_tests {
+    use super::*;
+
+    #[test]
+    fn the_default_context_is_the_built_in_target_with_its_latencies() {
+        let cx = PassContext::default();
+        assert_eq!(cx.target, Target::de10_nano());
+        assert_eq!(cx.latencies, cx.target.latencies);
+        assert_eq!(cx.latencies_source(), "target de10-nano");
+    }
+
+    #[test]
+    fn given_latencies_replace_only_theirs_and_stay_for_later_passes() {
+        let t = Target { latencies: Latencies { add: 5, mul: 3, div: 9, call: 11 }, ..Target::de10_nano() };
+        let mut cx = PassContext::with_target(t);
+        assert_eq!(
+            cx.latencies_for("balance", &LatencyOverride::default()),
+            Latencies { add: 5, mul: 3, div: 9, call: 11 }
+        );
+        assert_eq!(cx.latencies_from, None);
+        let given = LatencyOverride { add: Some(6), ..LatencyOverride::default() };
+        assert_eq!(cx.latencies_for("asap-alap", &given), Latencies { add: 6, mul: 3, div: 9, call: 11 });
+        // A later pass without lat-* keeps them, and the source names the pass that gave them.
+        assert_eq!(
+            cx.latencies_for("place", &LatencyOverride::default()),
+            Latencies { add: 6, mul: 3, div: 9, call: 11 }
+        );
+        assert_eq!(cx.latencies_source(), "asap-alap<lat-add=6>");
+    }
+}

@@ -32,6 +32,18 @@ pub enum ParamKind {
         /// Largest accepted value.
         max: u32,
     },
+    /// An integer in `min..=max` whose default is the target's (`-target`): a latency or the
+    /// write ports. [`Params::u32`] returns `builtin` (the `de10-nano` value) when it is not
+    /// given; passes read the target's through [`Params::latency_override`] /
+    /// [`Params::u32_given`] and the pass context.
+    U32Target {
+        /// The built-in `de10-nano` target's value.
+        builtin: u32,
+        /// Smallest accepted value.
+        min: u32,
+        /// Largest accepted value.
+        max: u32,
+    },
     /// A 64-bit integer in `min..=max`.
     U64 {
         /// Value when the parameter is not given.
@@ -108,6 +120,7 @@ impl ParamInfo {
         match self.kind {
             ParamKind::U32 { default, .. } => default.to_string(),
             ParamKind::U32Or { fallback, .. } => format!("`{fallback}`"),
+            ParamKind::U32Target { builtin, .. } => format!("the target's, de10-nano {builtin}"),
             ParamKind::U64 { default, .. } => default.to_string(),
             ParamKind::F64 { default, .. } => format!("{default}"),
             ParamKind::Choice { default, .. } | ParamKind::Selector { default, .. } => default.to_string(),
@@ -121,13 +134,22 @@ impl ParamInfo {
     /// True when [`ParamInfo::default_text`] is a value the parameter accepts (giving it
     /// explicitly changes nothing).
     pub fn default_is_literal(&self) -> bool {
-        !matches!(self.kind, ParamKind::U32Or { .. } | ParamKind::Path | ParamKind::OutputFolder | ParamKind::Names)
+        !matches!(
+            self.kind,
+            ParamKind::U32Or { .. }
+                | ParamKind::U32Target { .. }
+                | ParamKind::Path
+                | ParamKind::OutputFolder
+                | ParamKind::Names
+        )
     }
 
     /// The accepted values, as `--print-passes` shows them (`2..=64`, `on|off`).
     pub fn range_text(&self) -> String {
         match self.kind {
-            ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => format!("{min}..={max}"),
+            ParamKind::U32 { min, max, .. }
+            | ParamKind::U32Or { min, max, .. }
+            | ParamKind::U32Target { min, max, .. } => format!("{min}..={max}"),
             ParamKind::U64 { min, max, .. } => format!("{min}..={max}"),
             ParamKind::F64 { min, max, .. } => format!("{min}..={max}"),
             ParamKind::Choice { choices, .. } | ParamKind::Selector { choices, .. } => choices.join("|"),
@@ -142,9 +164,9 @@ impl ParamInfo {
     /// The smallest and largest accepted value of a numeric parameter, as text.
     pub fn bounds(&self) -> Option<(String, String)> {
         match self.kind {
-            ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => {
-                Some((min.to_string(), max.to_string()))
-            }
+            ParamKind::U32 { min, max, .. }
+            | ParamKind::U32Or { min, max, .. }
+            | ParamKind::U32Target { min, max, .. } => Some((min.to_string(), max.to_string())),
             ParamKind::U64 { min, max, .. } => Some((min.to_string(), max.to_string())),
             ParamKind::F64 { min, max, .. } => Some((format!("{min}"), format!("{max}"))),
             _ => None,
@@ -154,7 +176,9 @@ impl ParamInfo {
     /// Values just outside the range (`min − 1`, `max + 1`) where they are representable.
     pub fn out_of_bounds(&self) -> Vec<String> {
         match self.kind {
-            ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => {
+            ParamKind::U32 { min, max, .. }
+            | ParamKind::U32Or { min, max, .. }
+            | ParamKind::U32Target { min, max, .. } => {
                 let mut v: Vec<String> = min.checked_sub(1).map(|x| x.to_string()).into_iter().collect();
                 v.push((max as u64 + 1).to_string());
                 v
@@ -173,25 +197,25 @@ impl ParamInfo {
 /// The add/sub latency parameter (SPEC §1), cycles.
 pub const LAT_ADD: ParamInfo = ParamInfo {
     name: "lat-add",
-    kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
-    doc: "add/sub latency, cycles; when not given, the pipeline's (-target; de10-nano 12 = 10 pipeline + 2 write)",
+    kind: ParamKind::U32Target { builtin: 12, min: 1, max: 10_000 },
+    doc: "add/sub latency, cycles; when not given, the pipeline's (-target; de10-nano: 10 pipeline + 2 write)",
 };
 /// The mul latency parameter (SPEC §1), cycles.
 pub const LAT_MUL: ParamInfo = ParamInfo {
     name: "lat-mul",
-    kind: ParamKind::U32 { default: 7, min: 1, max: 10_000 },
-    doc: "mul latency, cycles; when not given, the pipeline's (-target; de10-nano 7 = 5 pipeline + 2 write)",
+    kind: ParamKind::U32Target { builtin: 7, min: 1, max: 10_000 },
+    doc: "mul latency, cycles; when not given, the pipeline's (-target; de10-nano: 5 pipeline + 2 write)",
 };
 /// The div latency parameter (SPEC §1), cycles.
 pub const LAT_DIV: ParamInfo = ParamInfo {
     name: "lat-div",
-    kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
+    kind: ParamKind::U32Target { builtin: 12, min: 1, max: 10_000 },
     doc: "div latency, cycles (ADD side); when not given, the pipeline's (-target)",
 };
 /// The call latency parameter (SPEC §1), cycles.
 pub const LAT_CALL: ParamInfo = ParamInfo {
     name: "lat-call",
-    kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
+    kind: ParamKind::U32Target { builtin: 12, min: 1, max: 10_000 },
     doc: "call (sqrt, callbacks) latency, cycles (ADD side); when not given, the pipeline's (-target)",
 };
 /// The four latency parameters, for passes that take only them.
@@ -374,6 +398,7 @@ impl Params {
     pub fn u32(&self, key: &str) -> Result<u32, PassError> {
         let (default, min, max) = match self.decl(key) {
             ParamKind::U32 { default, min, max } => (default, min, max),
+            ParamKind::U32Target { builtin, min, max } => (builtin, min, max),
             ParamKind::U32Or { fallback, min, max } => (self.u32(fallback)?, min, max),
             k => panic!("parameter `{key}` of `{}` is {k:?}, not an integer", self.pass),
         };
@@ -597,8 +622,10 @@ mod tests {
             build(accuracy, &[]).unwrap(),
             format!("{:?}", crate::accuracy::Accuracy { opts: crate::accuracy::Options::default() })
         );
-        let d = Latencies::default();
+        // The latencies default to the target's; the declared built-in values are de10-nano's.
+        let d = robovec_ir::target::Target::de10_nano().latencies;
+        assert_eq!(d, Latencies::default());
         let lat: Vec<String> = LATENCY_PARAMS.iter().map(ParamInfo::default_text).collect();
-        assert_eq!(lat, [d.add, d.mul, d.div, d.call].map(|x| x.to_string()));
+        assert_eq!(lat, [d.add, d.mul, d.div, d.call].map(|x| format!("the target's, de10-nano {x}")));
     }
 }

@@ -263,8 +263,8 @@ pub const INFO: PassInfo = PassInfo {
         crate::params::LAT_CALL,
         ParamInfo {
             name: "writes",
-            kind: ParamKind::U32 { default: 2, min: 1, max: 64 },
-            doc: "write ports per PE memory per cycle; when not given, the target's (-target; de10-nano 2)",
+            kind: ParamKind::U32Target { builtin: 2, min: 1, max: 64 },
+            doc: "write ports per PE memory per cycle; when not given, the target's (-target)",
         },
         ParamInfo {
             name: "buffer",
