@@ -9,13 +9,16 @@
 //!
 //! Prints, per workload, the median of 7 runs of the whole verifier
 //! (`robovec_ir::verifier::verify_function`) and of its placement checks alone
-//! (`verifier::placement::verify_placement`), and the time per op. Run with
-//! `cargo bench --bench verify`.
+//! (`verifier::placement::verify_placement`), and the time per op; then the lowering into the
+//! machine program (`robovec_passes::machine::lower`, which always runs the lowered check) and
+//! the lowered check alone (`verifier::machine::verify_machine`), to size what running the
+//! check on every lowering costs (issue 12). Run with `cargo bench --bench verify`.
 
 use std::time::Instant;
 
-use robovec_ir::verifier::{placement::verify_placement, verify_function};
+use robovec_ir::verifier::{machine::verify_machine, placement::verify_placement, verify_function};
 use robovec_ir::Function;
+use robovec_passes::machine::lower;
 use robovec_passes::place::{place_function, PlaceOptions};
 use robovec_testkit::dag_gen::generate;
 
@@ -55,6 +58,16 @@ fn main() {
             f.placement.as_ref().unwrap().writes.len(),
             f.placement.as_ref().unwrap().loads.len(),
             place * 1e6 / ops as f64
+        );
+        let p = f.placement.as_ref().unwrap();
+        let m = lower(&f, p).expect("the placer's placement lowers");
+        let lowering = median_ms(|| drop(lower(&f, p).unwrap()));
+        let lowered = median_ms(|| assert!(verify_machine(&f, &m).is_empty()));
+        println!(
+            "{name:>15}: {} cycles × {} PEs: lowering {lowering:.1} ms, of which the lowered check {lowered:.1} ms ({:.0}%)",
+            m.cycles,
+            m.n_pe(),
+            100.0 * lowered / lowering
         );
     }
 }

@@ -95,6 +95,12 @@ pub struct Cli {
     /// List the registered passes with their parameters and exit.
     #[arg(long)]
     pub print_passes: bool,
+    /// The machine every pass targets: `de10-nano` (built in, seed ch. 1) or a JSON target
+    /// file (latencies, write ports, memory words, clock, device capacities, unit costs; see
+    /// the README's "Targets"). A pass's `lat-*`/`writes` parameter overrides it only where
+    /// given.
+    #[arg(long, value_name = "de10-nano|FILE.json")]
+    pub target: Option<String>,
     /// Wall-clock limit of the whole run, seconds (> 0): passes with long searches (eqsat,
     /// place, sweep) stop early once it is reached, keep a valid result and say so on stderr
     /// (`note: … stopped …`) and in the report (`stopped_early`).
@@ -182,6 +188,7 @@ impl Cli {
             eval_f32: self.eval_precision == "f32",
             check: self.check.then_some((self.check_samples, self.check_seed)),
             time_limit: self.time_limit,
+            target: self.target,
         })
     }
 }

@@ -173,13 +173,14 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     let instr = Instrumentation { input_verified: true, ..opts.instr.clone() };
     let pm = PassManager::new(&opts.passes, instr).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     crate::preflight::check_options(opts, &pm)?;
+    let target = crate::options::target(opts)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
     let (mut module, src) = load(&opts.input)?;
     crate::preflight::check_functions(opts, &module)?;
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
     // removes what it staged.
     let mut out = OutputSet::new();
-    let ran = run_passes(opts, &pm, &mut module, &src, &mut out, stderr)?;
+    let ran = run_passes(opts, &pm, target, &mut module, &src, &mut out, stderr)?;
     write_outputs(opts, &pm, &module, &ran, eval_inputs.as_ref(), out, stdout, stderr)
 }
 
@@ -188,17 +189,20 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
 fn run_passes(
     opts: &Options,
     pm: &PassManager,
+    target: robovec_ir::target::Target,
     module: &mut Module,
     src: &SourceFile,
     out: &mut OutputSet,
     stderr: &mut dyn Write,
 ) -> Result<Ran, Failure> {
     let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
-    let mut cx = PassContext { original: opts.check.map(|_| module.clone()), deadline, ..PassContext::default() };
+    let mut cx =
+        PassContext { original: opts.check.map(|_| module.clone()), deadline, ..PassContext::with_target(target) };
     if let Some(text) = &opts.pareto {
         let name = select(module, &opts.function, "-pareto")?.name.clone();
-        let study = study::pareto::study(module, &name, text, opts.pareto_samples, opts.pareto_seed, deadline)
-            .map_err(study_failure)?;
+        let study =
+            study::pareto::study(module, &name, text, opts.pareto_samples, opts.pareto_seed, deadline, &cx.target)
+                .map_err(study_failure)?;
         cx.emit(study);
     }
     let records = {
@@ -366,7 +370,11 @@ fn write_outputs(
             if let Some(dir) = file.path.parent().filter(|d| !d.as_os_str().is_empty()) {
                 out.ensure_folder(dir).map_err(output_failure)?;
             }
-            out.stage(&file.path, &file.bytes).map_err(output_failure)?;
+            if file.executable {
+                out.stage_executable(&file.path, &file.bytes).map_err(output_failure)?;
+            } else {
+                out.stage(&file.path, &file.bytes).map_err(output_failure)?;
+            }
         }
     }
     if let Some(path) = &opts.sweep_csv {

@@ -40,6 +40,30 @@ pub struct Options {
     pub check: Option<(u32, u64)>,
     /// `-time-limit=SECONDS`: wall-clock limit of the run (see `PassContext::deadline`).
     pub time_limit: Option<f64>,
+    /// `-target=de10-nano|FILE.json` as given (`None`: `de10-nano`); read by
+    /// [`target`] before any work.
+    pub target: Option<String>,
+}
+
+/// The target `-target` selects (`de10-nano` when absent).
+///
+/// # Errors
+/// [`Failure::Input`] (exit 1): a file that cannot be read, is not JSON of the target format
+/// (`FILE:LINE:COLUMN: unknown field …`) or holds a senseless value (the field and why).
+pub fn target(opts: &Options) -> Result<robovec_ir::target::Target, Failure> {
+    use robovec_ir::target::{Target, TargetError};
+    let Some(spec) = &opts.target else { return Ok(Target::de10_nano()) };
+    Target::resolve(spec).map_err(|e| {
+        let hint = match &e {
+            TargetError::Io { .. } => {
+                format!("\n  = -target takes a built-in target ({}) or a JSON target file", Target::BUILT_IN.join(", "))
+            }
+            TargetError::Syntax { .. } | TargetError::Value { .. } => {
+                "\n  = the target format is described in the README (\"Targets\") and `robovec_ir::target`".to_string()
+            }
+        };
+        Failure::Input(format!("error: -target: {e}{hint}\n"))
+    })
 }
 
 /// Why a run failed; the text is ready for stderr.

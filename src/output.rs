@@ -259,6 +259,25 @@ impl OutputSet {
         self.stage_with(path, &mut |w| w.write_all(data))
     }
 
+    /// Like [`OutputSet::stage`] for a program: the temporary file gets the execute bits
+    /// (`rwxr-xr-x` when new; an existing file's mode plus execute wherever it is readable)
+    /// before the rename. A device or FIFO is written as it is.
+    ///
+    /// # Errors
+    /// As [`OutputSet::stage`], or when the mode cannot be set.
+    pub fn stage_executable(&mut self, path: &Path, data: &[u8]) -> Result<(), String> {
+        self.stage(path, data)?;
+        #[cfg(unix)]
+        if let Some(tmp) = self.staged.last().and_then(|s| s.tmp.clone()) {
+            use std::os::unix::fs::PermissionsExt;
+            let fail = |e: io::Error| format!("error: cannot write `{}`: {e}", path.display());
+            let mode = fs::metadata(&tmp).map_err(fail)?.permissions().mode() & 0o7777;
+            let mode = if fs::metadata(path).is_ok_and(|m| m.is_file()) { mode | ((mode & 0o444) >> 2) } else { 0o755 };
+            fs::set_permissions(&tmp, fs::Permissions::from_mode(mode)).map_err(fail)?;
+        }
+        Ok(())
+    }
+
     /// Like [`OutputSet::stage`], with the bytes produced by `write` into the temporary file
     /// through a buffer, so a large output (the printed IR) is never held in memory whole.
     /// A device or FIFO still collects the bytes for the commit (nothing may reach it before).

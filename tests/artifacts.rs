@@ -25,7 +25,7 @@ fn report_keys_come_in_order_and_artifacts_merge_by_key() {
         "artifacts_report",
     );
     let keys: Vec<&str> = r.as_object().unwrap().keys().map(String::as_str).collect();
-    assert_eq!(keys, ["input", "function", "pipeline", "passes", "stats", "sweep", "accuracy"]);
+    assert_eq!(keys, ["input", "function", "pipeline", "passes", "stats", "sweep", "sweep_fit", "accuracy"]);
     // 4 configurations per N: 1 N in the first sweep, 2 in the second, rows appended in order.
     let ns: Vec<u64> = r["sweep"].as_array().unwrap().iter().map(|row| row["n"].as_u64().unwrap()).collect();
     assert_eq!(ns, [1, 1, 1, 1, 2, 2, 2, 2, 4, 4, 4, 4]);

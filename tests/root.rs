@@ -17,6 +17,7 @@ mod error_reference;
 mod exact_gap;
 mod example;
 mod filetests;
+mod fpga;
 mod inline_specialize;
 mod numerics;
 #[cfg(unix)]
@@ -27,4 +28,5 @@ mod placement_verify;
 mod props;
 mod roundtrip;
 mod schedule_cpu;
+mod target;
 mod tree_height;

@@ -34,11 +34,13 @@ pub mod diagnostic;
 pub mod entities;
 pub mod function;
 pub mod interp;
+pub mod machine;
 pub mod numerics;
 pub mod placement;
 pub mod rng;
 pub mod span;
 pub mod syntax;
+pub mod target;
 pub mod text;
 pub mod verifier;
 

@@ -24,8 +24,13 @@
 //! - **cycles** = the largest arrival cycle (0 without ops); a lone add takes 12 cycles.
 //!
 //! The verifier checks every rule above except word lifetimes (address reuse) whenever a
-//! placement is read or left by a pass ([`crate::verifier::placement`]); the simulator `sim`
-//! checks them all.
+//! placement is read or left by a pass ([`crate::verifier::placement`]); the lowering into the
+//! machine program (`robovec_passes::machine::lower`, which `sim` executes and `codegen<fpga>`
+//! encodes) checks them all.
+//!
+//! A placement is the placer's decision at the level of values, carried by the `.rvir` text;
+//! the address- and cycle-level program the hardware runs is derived from it once, in
+//! [`crate::machine`] (see there why the split is here).
 //!
 //! Memory sizes (`pe_words`, `buffer_words`) are the number of addresses each memory uses
 //! (addresses are `0..words`), which the placer keeps equal to the largest number of words the

@@ -51,6 +51,9 @@ pub struct ArtifactFile {
     pub path: PathBuf,
     /// Its content.
     pub bytes: Vec<u8>,
+    /// True for a program (`codegen<fpga>`'s `simulate`): written with the execute bits set
+    /// (`rwxr-xr-x` for a new file; an existing file's mode plus execute where it can read).
+    pub executable: bool,
 }
 
 /// Generated code: a back end's main output. When the pipeline's last pass produced it, `-o

@@ -2,27 +2,28 @@
 //! ASAPCycle, ALAPCycle and mobility (seed §2.2, SPEC §4), printed in the IR as
 //! `{asap=…, alap=…, asap_cycle=…, alap_cycle=…, mobility=…}` and read back by the parser.
 //!
-//! Phase: atomised → atomised; an analysis: the function is otherwise unchanged. The
-//! latencies also become those of the report's `stats.asap_cycle`. Cost: O(values + operands).
+//! Phase: atomised → atomised; an analysis: the function is otherwise unchanged. Latencies are
+//! the pipeline's (the target's, `-target`), a `lat-*` given here replacing them from this
+//! pass on (also for the report's `stats.asap_cycle`). Cost: O(values + operands).
 
-use robovec_ir::analysis::{annotate_timing, Latencies};
+use robovec_ir::analysis::annotate_timing;
 use robovec_ir::{Module, Phase};
 
-use crate::{Params, Pass, PassContext, PassError, PassInfo};
+use crate::{LatencyOverride, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
     name: "asap-alap",
     doc: "annotate ops with ASAP/ALAP (unit) and ASAPCycle/ALAPCycle (latency) and mobility",
     params: crate::params::LATENCY_PARAMS,
-    build: |p: &Params| Ok(Box::new(AsapAlap { lat: p.latencies()? })),
+    build: |p: &Params| Ok(Box::new(AsapAlap { lat: p.latency_override()? })),
 };
 
 /// The `asap-alap` pass.
 #[derive(Debug)]
 pub struct AsapAlap {
-    /// Latencies in cycles.
-    pub lat: Latencies,
+    /// Latencies given on the pass (the others are the pipeline's), cycles.
+    pub lat: LatencyOverride,
 }
 
 impl Pass for AsapAlap {
@@ -39,10 +40,10 @@ impl Pass for AsapAlap {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        let lat = cx.latencies_for("asap-alap", &self.lat);
         for f in &mut m.functions {
-            annotate_timing(f, &self.lat);
+            annotate_timing(f, &lat);
         }
-        cx.latencies = self.lat;
         Ok(())
     }
 }
@@ -62,7 +63,7 @@ mod tests {
             "func @f { phase atomised input %a input %b input %c %x = mul %a, %b %y = add %x, %c %z = mul %y, %x %w = mul %a, %c output o = %z output p = %w }",
         )
         .unwrap();
-        AsapAlap { lat: Latencies::default() }.run(&mut m, &mut PassContext::default()).unwrap();
+        AsapAlap { lat: LatencyOverride::default() }.run(&mut m, &mut PassContext::default()).unwrap();
         let f = &m.functions[0];
         let t = |n: &str| f.value(f.lookup(n).unwrap()).timing.unwrap();
         let row = |n: &str| {

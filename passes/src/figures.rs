@@ -30,6 +30,10 @@ pub struct Stats {
     pub y: f64,
     /// Latencies used for `asap_cycle`, cycles.
     pub latencies: Latencies,
+    /// Where `latencies` come from: `target de10-nano` (the `-target`), or the pass that gave
+    /// them last (`asap-alap<lat-add=6;lat-mul=4>`); extra key. `None` outside a run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub latencies_from: Option<String>,
 }
 
 /// Computes the stats of `f`. A parsed-phase function is measured on its atomised form (SPEC
@@ -55,6 +59,7 @@ pub fn stats(f: &Function, lat: &Latencies) -> Stats {
         asap_cycle: t.asap_cycle,
         y: if t.asap_cycle == 0 { 0.0 } else { ops.total as f64 / t.asap_cycle as f64 },
         latencies: *lat,
+        latencies_from: None,
     }
 }
 
@@ -73,7 +78,8 @@ pub struct Figures {
 impl Figures {
     /// The figures of `f` under the run's latencies.
     pub fn of(f: &Function, cx: &PassContext) -> Figures {
-        Figures { function: f.name.clone(), stats: stats(f, &cx.latencies), placement: placement_report(f) }
+        let stats = Stats { latencies_from: Some(cx.latencies_source()), ..stats(f, &cx.latencies) };
+        Figures { function: f.name.clone(), stats, placement: placement_report(f, &cx.target) }
     }
 
     /// The report entries (SPEC §7) that describe the function itself: `stats`, and
@@ -108,7 +114,7 @@ pub fn stats_text(figures: &[Figures], cx: &PassContext, function: Option<&str>)
         let _ = writeln!(
             out,
             "@{}: equations {}, ops {} (add {}, sub {}, mul {}, div {}, call {}), inputs {}, outputs {}, \
-             critical path {} ops / {} cycles, Y = {:.2}",
+             critical path {} ops / {} cycles, Y = {:.2} (latencies add {}, mul {}: {})",
             g.function,
             s.equations.map_or("?".to_string(), |e| e.to_string()),
             s.ops.total,
@@ -121,14 +127,18 @@ pub fn stats_text(figures: &[Figures], cx: &PassContext, function: Option<&str>)
             s.outputs,
             s.asap,
             s.asap_cycle,
-            s.y
+            s.y,
+            s.latencies.add,
+            s.latencies.mul,
+            s.latencies_from.as_deref().unwrap_or("given")
         );
         if let Some(p) = &g.placement {
             let max = |v: &[u32]| v.iter().copied().max().unwrap_or(0);
             let _ = writeln!(
                 out,
                 "@{}: placed on {} ADD + {} MULTI PEs: {} cycles, lower bound {} (x{:.3}), parallelisation rate {:.3}, \
-                 PE memory up to {} words, buffer up to {} words, writes {} direct / {} indirect",
+                 PE memory up to {} words, buffer up to {} words, writes {} direct / {} indirect; \
+                 {:.3} µs at {} MHz (latencies add {}, mul {})",
                 g.function,
                 p.n_add,
                 p.n_mul,
@@ -139,7 +149,11 @@ pub fn stats_text(figures: &[Figures], cx: &PassContext, function: Option<&str>)
                 max(&p.pe_memory_words),
                 max(&p.buffer_words),
                 p.writes_direct,
-                p.writes_indirect
+                p.writes_indirect,
+                p.us,
+                p.clock_mhz,
+                p.lat_add,
+                p.lat_mul
             );
         }
     }

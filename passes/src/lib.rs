@@ -16,6 +16,7 @@ pub mod dce;
 pub mod eqsat;
 pub mod figures;
 pub mod inline;
+pub mod machine;
 pub mod manager;
 pub mod params;
 pub mod pipeline;
@@ -27,12 +28,13 @@ pub mod sweep;
 pub mod tree_height;
 
 use robovec_ir::analysis::Latencies;
+use robovec_ir::target::Target;
 use robovec_ir::verifier::VerifierError;
 use robovec_ir::{Module, Phase, Span};
 
 pub use artifact::{Artifact, ArtifactFile, GeneratedCode, Merge, Produced, ReportEntry};
 pub use manager::{DumpSink, Instrumentation, PassManager, PassRecord, PrintSelector};
-pub use params::{ParamInfo, ParamKind, Params};
+pub use params::{LatencyOverride, ParamInfo, ParamKind, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
 
 /// What a pass may fail with.
@@ -149,9 +151,18 @@ impl PassError {
 /// here: the pass hands them over as [`Artifact`]s with [`PassContext::emit`].
 #[derive(Debug, Default)]
 pub struct PassContext {
-    /// Latencies of the last `asap-alap` or `place` run (defaults otherwise); used for the
-    /// report's stats and by `sweep`.
+    /// The machine the run targets (`-target=de10-nano|FILE.json`, selected once; default
+    /// `de10-nano`): latencies, write ports, memory sizes, clock and device capacities for
+    /// every pass (see `robovec_ir::target`). Set it with [`PassContext::with_target`].
+    pub target: Target,
+    /// The pipeline's latencies now, cycles: the target's, until a pass gives `lat-*`
+    /// explicitly; from that pass on the given ones replace them (the others stay), for every
+    /// later pass and for the final figures (`-stats`, the report's `stats`). Passes read them
+    /// with [`PassContext::latencies_for`].
     pub latencies: Latencies,
+    /// Which pass last overrode [`PassContext::latencies`] and how (`asap-alap<lat-add=6;lat-mul=4>`);
+    /// `None`: they are the target's.
+    pub latencies_from: Option<String>,
     /// One line per run of a rewriting pass saying what it changed (ops added or removed,
     /// critical path before and after); the driver prints them with `-stats`.
     pub notes: Vec<String>,
@@ -213,6 +224,32 @@ impl Deadline {
 }
 
 impl PassContext {
+    /// A context for `target`, its latencies the pipeline's.
+    pub fn with_target(target: Target) -> PassContext {
+        PassContext { latencies: target.latencies, target, ..PassContext::default() }
+    }
+
+    /// The latencies `pass` runs with: the pipeline's ([`PassContext::latencies`]) with those
+    /// given on the pass (`given`) replacing theirs. When some are given, they become the
+    /// pipeline's from now on and [`PassContext::latencies_from`] names the pass.
+    pub fn latencies_for(&mut self, pass: &str, given: &LatencyOverride) -> Latencies {
+        let lat = given.apply(&self.latencies);
+        if !given.is_empty() {
+            self.latencies = lat;
+            self.latencies_from = Some(format!("{pass}<{}>", given.text()));
+        }
+        lat
+    }
+
+    /// Where the pipeline's latencies come from, for reports: `target de10-nano` or the pass
+    /// that last gave them (`asap-alap<lat-add=6;lat-mul=4>`).
+    pub fn latencies_source(&self) -> String {
+        match &self.latencies_from {
+            Some(p) => p.clone(),
+            None => format!("target {}", self.target.name),
+        }
+    }
+
     /// Time left before `-time-limit` is reached (`None`: no limit).
     pub fn time_left(&self) -> Option<std::time::Duration> {
         self.deadline.map(|d| d.time_left())
@@ -342,5 +379,37 @@ pub fn require_phase(pass: &str, m: &Module, phase: Phase) -> Result<(), PassErr
             span: f.span,
         }),
         None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod target_tests {
+    use super::*;
+
+    #[test]
+    fn the_default_context_is_the_built_in_target_with_its_latencies() {
+        let cx = PassContext::default();
+        assert_eq!(cx.target, Target::de10_nano());
+        assert_eq!(cx.latencies, cx.target.latencies);
+        assert_eq!(cx.latencies_source(), "target de10-nano");
+    }
+
+    #[test]
+    fn given_latencies_replace_only_theirs_and_stay_for_later_passes() {
+        let t = Target { latencies: Latencies { add: 5, mul: 3, div: 9, call: 11 }, ..Target::de10_nano() };
+        let mut cx = PassContext::with_target(t);
+        assert_eq!(
+            cx.latencies_for("balance", &LatencyOverride::default()),
+            Latencies { add: 5, mul: 3, div: 9, call: 11 }
+        );
+        assert_eq!(cx.latencies_from, None);
+        let given = LatencyOverride { add: Some(6), ..LatencyOverride::default() };
+        assert_eq!(cx.latencies_for("asap-alap", &given), Latencies { add: 6, mul: 3, div: 9, call: 11 });
+        // A later pass without lat-* keeps them, and the source names the pass that gave them.
+        assert_eq!(
+            cx.latencies_for("place", &LatencyOverride::default()),
+            Latencies { add: 6, mul: 3, div: 9, call: 11 }
+        );
+        assert_eq!(cx.latencies_source(), "asap-alap<lat-add=6>");
     }
 }

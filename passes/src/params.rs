@@ -32,6 +32,18 @@ pub enum ParamKind {
         /// Largest accepted value.
         max: u32,
     },
+    /// An integer in `min..=max` whose default is the target's (`-target`): a latency or the
+    /// write ports. [`Params::u32`] returns `builtin` (the `de10-nano` value) when it is not
+    /// given; passes read the target's through [`Params::latency_override`] /
+    /// [`Params::u32_given`] and the pass context.
+    U32Target {
+        /// The built-in `de10-nano` target's value.
+        builtin: u32,
+        /// Smallest accepted value.
+        min: u32,
+        /// Largest accepted value.
+        max: u32,
+    },
     /// A 64-bit integer in `min..=max`.
     U64 {
         /// Value when the parameter is not given.
@@ -108,6 +120,7 @@ impl ParamInfo {
         match self.kind {
             ParamKind::U32 { default, .. } => default.to_string(),
             ParamKind::U32Or { fallback, .. } => format!("`{fallback}`"),
+            ParamKind::U32Target { builtin, .. } => format!("the target's, de10-nano {builtin}"),
             ParamKind::U64 { default, .. } => default.to_string(),
             ParamKind::F64 { default, .. } => format!("{default}"),
             ParamKind::Choice { default, .. } | ParamKind::Selector { default, .. } => default.to_string(),
@@ -121,13 +134,22 @@ impl ParamInfo {
     /// True when [`ParamInfo::default_text`] is a value the parameter accepts (giving it
     /// explicitly changes nothing).
     pub fn default_is_literal(&self) -> bool {
-        !matches!(self.kind, ParamKind::U32Or { .. } | ParamKind::Path | ParamKind::OutputFolder | ParamKind::Names)
+        !matches!(
+            self.kind,
+            ParamKind::U32Or { .. }
+                | ParamKind::U32Target { .. }
+                | ParamKind::Path
+                | ParamKind::OutputFolder
+                | ParamKind::Names
+        )
     }
 
     /// The accepted values, as `--print-passes` shows them (`2..=64`, `on|off`).
     pub fn range_text(&self) -> String {
         match self.kind {
-            ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => format!("{min}..={max}"),
+            ParamKind::U32 { min, max, .. }
+            | ParamKind::U32Or { min, max, .. }
+            | ParamKind::U32Target { min, max, .. } => format!("{min}..={max}"),
             ParamKind::U64 { min, max, .. } => format!("{min}..={max}"),
             ParamKind::F64 { min, max, .. } => format!("{min}..={max}"),
             ParamKind::Choice { choices, .. } | ParamKind::Selector { choices, .. } => choices.join("|"),
@@ -142,9 +164,9 @@ impl ParamInfo {
     /// The smallest and largest accepted value of a numeric parameter, as text.
     pub fn bounds(&self) -> Option<(String, String)> {
         match self.kind {
-            ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => {
-                Some((min.to_string(), max.to_string()))
-            }
+            ParamKind::U32 { min, max, .. }
+            | ParamKind::U32Or { min, max, .. }
+            | ParamKind::U32Target { min, max, .. } => Some((min.to_string(), max.to_string())),
             ParamKind::U64 { min, max, .. } => Some((min.to_string(), max.to_string())),
             ParamKind::F64 { min, max, .. } => Some((format!("{min}"), format!("{max}"))),
             _ => None,
@@ -154,7 +176,9 @@ impl ParamInfo {
     /// Values just outside the range (`min − 1`, `max + 1`) where they are representable.
     pub fn out_of_bounds(&self) -> Vec<String> {
         match self.kind {
-            ParamKind::U32 { min, max, .. } | ParamKind::U32Or { min, max, .. } => {
+            ParamKind::U32 { min, max, .. }
+            | ParamKind::U32Or { min, max, .. }
+            | ParamKind::U32Target { min, max, .. } => {
                 let mut v: Vec<String> = min.checked_sub(1).map(|x| x.to_string()).into_iter().collect();
                 v.push((max as u64 + 1).to_string());
                 v
@@ -173,29 +197,67 @@ impl ParamInfo {
 /// The add/sub latency parameter (SPEC §1), cycles.
 pub const LAT_ADD: ParamInfo = ParamInfo {
     name: "lat-add",
-    kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
-    doc: "add/sub latency, cycles (10 pipeline + 2 write)",
+    kind: ParamKind::U32Target { builtin: 12, min: 1, max: 10_000 },
+    doc: "add/sub latency, cycles; when not given, the pipeline's (-target; de10-nano: 10 pipeline + 2 write)",
 };
 /// The mul latency parameter (SPEC §1), cycles.
 pub const LAT_MUL: ParamInfo = ParamInfo {
     name: "lat-mul",
-    kind: ParamKind::U32 { default: 7, min: 1, max: 10_000 },
-    doc: "mul latency, cycles (5 pipeline + 2 write)",
+    kind: ParamKind::U32Target { builtin: 7, min: 1, max: 10_000 },
+    doc: "mul latency, cycles; when not given, the pipeline's (-target; de10-nano: 5 pipeline + 2 write)",
 };
 /// The div latency parameter (SPEC §1), cycles.
 pub const LAT_DIV: ParamInfo = ParamInfo {
     name: "lat-div",
-    kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
-    doc: "div latency, cycles (ADD side)",
+    kind: ParamKind::U32Target { builtin: 12, min: 1, max: 10_000 },
+    doc: "div latency, cycles (ADD side); when not given, the pipeline's (-target)",
 };
 /// The call latency parameter (SPEC §1), cycles.
 pub const LAT_CALL: ParamInfo = ParamInfo {
     name: "lat-call",
-    kind: ParamKind::U32 { default: 12, min: 1, max: 10_000 },
-    doc: "call (sqrt, callbacks) latency, cycles (ADD side)",
+    kind: ParamKind::U32Target { builtin: 12, min: 1, max: 10_000 },
+    doc: "call (sqrt, callbacks) latency, cycles (ADD side); when not given, the pipeline's (-target)",
 };
 /// The four latency parameters, for passes that take only them.
 pub const LATENCY_PARAMS: &[ParamInfo] = &[LAT_ADD, LAT_MUL, LAT_DIV, LAT_CALL];
+
+/// Latencies given explicitly on one pass (`lat-add`, `lat-mul`, `lat-div`, `lat-call`), cycles;
+/// `None` where not given. An explicit latency overrides the pipeline's latencies (the
+/// target's, `-target`) from that pass on: see [`crate::PassContext::latencies_for`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LatencyOverride {
+    /// `lat-add`.
+    pub add: Option<u32>,
+    /// `lat-mul`.
+    pub mul: Option<u32>,
+    /// `lat-div`.
+    pub div: Option<u32>,
+    /// `lat-call`.
+    pub call: Option<u32>,
+}
+
+impl LatencyOverride {
+    /// True when no latency was given.
+    pub fn is_empty(&self) -> bool {
+        *self == LatencyOverride::default()
+    }
+
+    /// `base` with the given latencies replaced.
+    pub fn apply(&self, base: &Latencies) -> Latencies {
+        Latencies {
+            add: self.add.unwrap_or(base.add),
+            mul: self.mul.unwrap_or(base.mul),
+            div: self.div.unwrap_or(base.div),
+            call: self.call.unwrap_or(base.call),
+        }
+    }
+
+    /// The parameters as written in a pipeline (`lat-add=6;lat-mul=4`).
+    pub fn text(&self) -> String {
+        let parts = [("lat-add", self.add), ("lat-mul", self.mul), ("lat-div", self.div), ("lat-call", self.call)];
+        parts.iter().filter_map(|(k, v)| v.map(|v| format!("{k}={v}"))).collect::<Vec<_>>().join(";")
+    }
+}
 
 /// Checked parameters of one pipeline element: `(name, value)` pairs, each name declared.
 #[derive(Clone, Debug)]
@@ -300,6 +362,35 @@ impl Params {
         })
     }
 
+    /// The latencies given explicitly on this pass (`lat-add=6` → `add: Some(6)`); the others
+    /// come from the pipeline's current latencies (the target's, `-target`), see
+    /// [`crate::PassContext::latencies_for`].
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when one is out of range.
+    pub fn latency_override(&self) -> Result<LatencyOverride, PassError> {
+        let get = |key: &str| -> Result<Option<u32>, PassError> {
+            if self.decls.iter().any(|p| p.name == key) && self.get(key).is_some() {
+                self.u32(key).map(Some)
+            } else {
+                Ok(None)
+            }
+        };
+        Ok(LatencyOverride { add: get("lat-add")?, mul: get("lat-mul")?, div: get("lat-div")?, call: get("lat-call")? })
+    }
+
+    /// A `U32` parameter when given explicitly (`None`: not given, the caller takes the
+    /// target's value).
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when the value is out of range.
+    pub fn u32_given(&self, key: &str) -> Result<Option<u32>, PassError> {
+        match self.get(key) {
+            Some(_) => self.u32(key).map(Some),
+            None => Ok(None),
+        }
+    }
+
     /// A `U32` (or `U32Or`) parameter: its value, or its declared default.
     ///
     /// # Errors
@@ -307,6 +398,7 @@ impl Params {
     pub fn u32(&self, key: &str) -> Result<u32, PassError> {
         let (default, min, max) = match self.decl(key) {
             ParamKind::U32 { default, min, max } => (default, min, max),
+            ParamKind::U32Target { builtin, min, max } => (builtin, min, max),
             ParamKind::U32Or { fallback, min, max } => (self.u32(fallback)?, min, max),
             k => panic!("parameter `{key}` of `{}` is {k:?}, not an integer", self.pass),
         };
@@ -508,20 +600,32 @@ mod tests {
         assert_eq!(window.default_text(), crate::eqsat::EqsatOptions::default().window.to_string());
         assert_eq!(
             build(eqsat, &[]).unwrap(),
-            format!("{:?}", crate::eqsat::Eqsat { opts: crate::eqsat::EqsatOptions::default() })
+            format!(
+                "{:?}",
+                crate::eqsat::Eqsat { opts: crate::eqsat::EqsatOptions::default(), lat: Default::default() }
+            )
         );
         let place = crate::pass_info("place").unwrap();
         assert_eq!(
             build(place, &[]).unwrap(),
-            format!("{:?}", crate::place::Place { opts: crate::place::PlaceOptions::with_pes(4) })
+            format!(
+                "{:?}",
+                crate::place::Place {
+                    opts: crate::place::PlaceOptions::with_pes(4),
+                    lat: Default::default(),
+                    writes: None
+                }
+            )
         );
         let accuracy = crate::pass_info("accuracy").unwrap();
         assert_eq!(
             build(accuracy, &[]).unwrap(),
             format!("{:?}", crate::accuracy::Accuracy { opts: crate::accuracy::Options::default() })
         );
-        let d = Latencies::default();
+        // The latencies default to the target's; the declared built-in values are de10-nano's.
+        let d = robovec_ir::target::Target::de10_nano().latencies;
+        assert_eq!(d, Latencies::default());
         let lat: Vec<String> = LATENCY_PARAMS.iter().map(ParamInfo::default_text).collect();
-        assert_eq!(lat, [d.add, d.mul, d.div, d.call].map(|x| x.to_string()));
+        assert_eq!(lat, [d.add, d.mul, d.div, d.call].map(|x| format!("the target's, de10-nano {x}")));
     }
 }

@@ -8,6 +8,15 @@
 //!
 //! Every placement of a sweep is executed by the simulator (`sim`) in f32 and f64 and must
 //! reproduce the interpreter bit for bit; a failure stops the pipeline.
+//!
+//! Placements use the pipeline's latencies (the target's, or those a pass before gave
+//! explicitly, `PassContext::latencies_for`) and the target's write ports. Each row also gives
+//! `us` (cycles at the target's clock) and the analytic resource estimate
+//! (`robovec_ir::target::Target::estimate`; `fits` also needs the placement's memories within
+//! the target's). A second artifact, [`SweepFit`] (report `sweep_fit`, lines after the table),
+//! names per function the smallest N whose placement reaches the critical path (cycles =
+//! largest ASAPCycle, in any configuration) and the smallest and largest N of the sweep that
+//! fit the device (in any configuration); `null` when none does.
 
 use robovec_ir::analysis::compute_timing;
 use robovec_ir::{Module, Phase};
@@ -54,6 +63,8 @@ pub struct SweepRow {
     pub select: &'static str,
     /// Cycles of the placement.
     pub cycles: u32,
+    /// `cycles` in µs at the target's clock.
+    pub us: f64,
     /// SPEC §4 lower bound, cycles.
     pub lower_bound: u32,
     /// The tighter bound of [`crate::place::tight_lower_bound`] (no placement beats it either),
@@ -80,6 +91,102 @@ pub struct SweepRow {
     pub writes_direct: u64,
     /// Indirect writes.
     pub writes_indirect: u64,
+    /// add/sub latency of the placement, cycles.
+    pub lat_add: u32,
+    /// mul latency of the placement, cycles.
+    pub lat_mul: u32,
+    /// Estimated ALM ([`robovec_ir::target::Target::estimate`]).
+    pub alm: u32,
+    /// Estimated M10K blocks.
+    pub m10k: u32,
+    /// Estimated DSP blocks.
+    pub dsp: u32,
+    /// True when the estimate is within the device's capacity and the placement's memories
+    /// within the target's (`place::report::fits_memories`).
+    pub fits: bool,
+}
+
+/// What a sweep says of one function on the target: see the module doc.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FitRow {
+    /// Function name.
+    pub function: String,
+    /// The target's name.
+    pub target: String,
+    /// Critical path (largest ASAPCycle), cycles.
+    pub critical_path: u32,
+    /// Smallest N of the sweep whose placement reaches the critical path (any configuration).
+    pub n_critical_path: Option<u32>,
+    /// Smallest N of the sweep that fits the device (any configuration).
+    pub n_fits_min: Option<u32>,
+    /// Largest N of the sweep that fits the device (any configuration).
+    pub n_fits_max: Option<u32>,
+    /// Fewest cycles of the sweep and its N (smallest N on ties).
+    pub best_cycles: Option<u32>,
+    /// N of `best_cycles`.
+    pub n_best: Option<u32>,
+    /// `best_cycles` in µs at the target's clock.
+    pub best_us: Option<f64>,
+}
+
+/// The [`FitRow`]s of one `sweep` run: report `sweep_fit`, lines on stderr after the table.
+#[derive(Clone, Debug)]
+pub struct SweepFit {
+    /// One per function swept.
+    pub rows: Vec<FitRow>,
+}
+
+impl crate::Artifact for SweepFit {
+    fn pass(&self) -> &'static str {
+        "sweep"
+    }
+
+    fn log_text(&self, _detail: bool) -> String {
+        let n = |x: Option<u32>| x.map_or("none".to_string(), |n| format!("N = {n}"));
+        self.rows
+            .iter()
+            .map(|r| {
+                format!(
+                    "sweep @{} on {}: critical path {} cycles reached from {}; fits the device from {} to {}; \
+                     fewest cycles {} ({}, {})\n",
+                    r.function,
+                    r.target,
+                    r.critical_path,
+                    n(r.n_critical_path),
+                    n(r.n_fits_min),
+                    n(r.n_fits_max),
+                    r.best_cycles.map_or("-".to_string(), |c| c.to_string()),
+                    n(r.n_best),
+                    r.best_us.map_or("-".to_string(), |u| format!("{u:.3} µs"))
+                )
+            })
+            .collect()
+    }
+
+    fn report(&self, function: &str) -> Option<crate::ReportEntry> {
+        let rows: Vec<&FitRow> = self.rows.iter().filter(|r| r.function == function).collect();
+        Some(crate::ReportEntry::new("sweep_fit", &rows, crate::Merge::Append))
+    }
+}
+
+/// The [`FitRow`] of `function` from its rows.
+fn fit_row(function: &str, target: &robovec_ir::target::Target, critical_path: u32, rows: &[SweepRow]) -> FitRow {
+    let mine = || rows.iter().filter(|r| r.function == function);
+    let n_critical_path = mine().filter(|r| r.cycles <= critical_path).map(|r| r.n).min();
+    let n_fits_min = mine().filter(|r| r.fits).map(|r| r.n).min();
+    let n_fits_max = mine().filter(|r| r.fits).map(|r| r.n).max();
+    let best = mine().min_by_key(|r| (r.cycles, r.n));
+    FitRow {
+        function: function.to_string(),
+        target: target.name.clone(),
+        critical_path,
+        n_critical_path,
+        n_fits_min,
+        n_fits_max,
+        best_cycles: best.map(|r| r.cycles),
+        n_best: best.map(|r| r.n),
+        best_us: best.map(|r| target.us(r.cycles)),
+    }
 }
 
 /// Registry entry.
@@ -130,20 +237,25 @@ impl Pass for Sweep {
         let total = m.functions.len() * self.ns.len() * configs.len();
         let mut done = 0usize;
         let mut rows = Vec::new();
+        let mut fit = Vec::new();
         for f in &m.functions {
             let ops = f.op_counts().total;
+            let cp_now = compute_timing(f, &cx.latencies).1.asap_cycle;
             let (n_add_side, n_mul) = ops_per_side(f);
             for &n in &self.ns {
                 for (priority, select, improve, pname, sname) in configs {
                     if let Some(d) = cx.deadline.filter(|d| d.reached()) {
                         cx.note_stop("sweep", &format!("after {done} of {total} configurations: {}", d.reason()));
+                        fit.push(fit_row(&f.name, &cx.target, cp_now, &rows));
                         cx.emit(SweepTable { rows });
+                        cx.emit(SweepFit { rows: fit });
                         return Ok(());
                     }
                     done += 1;
                     let mut o = PlaceOptions::with_pes(n);
                     o.deadline = cx.deadline;
                     o.arch.lat = cx.latencies;
+                    o.arch.writes = cx.target.writes;
                     o.priority = priority;
                     o.select = select;
                     o.improve = improve;
@@ -165,12 +277,14 @@ impl Pass for Sweep {
                     let side = |k: u64, lat: u32| if k == 0 { 0 } else { (k.div_ceil(n as u64) - 1) as u32 + lat };
                     let na = n as usize;
                     let indirect = p.writes.iter().filter(|w| w.buffer_addr.is_some()).count() as u64;
+                    let est = crate::place::report::estimate(p, c, &cx.target);
                     rows.push(SweepRow {
                         function: f.name.clone(),
                         n,
                         priority: pname,
                         select: sname,
                         cycles: c,
+                        us: cx.target.us(c),
                         lower_bound: lower_bound(f, &o.arch),
                         tight_lower_bound: tight_lower_bound(f, &o.arch),
                         resource_bound: side(n_add_side, o.arch.lat.add).max(side(n_mul, o.arch.lat.mul)),
@@ -183,11 +297,19 @@ impl Pass for Sweep {
                         buffer_words_mul: word_stats(&p.buffer_words[na..]),
                         writes_direct: p.writes.len() as u64 - indirect,
                         writes_indirect: indirect,
+                        lat_add: o.arch.lat.add,
+                        lat_mul: o.arch.lat.mul,
+                        alm: est.alm,
+                        m10k: est.m10k,
+                        dsp: est.dsp,
+                        fits: est.fits,
                     });
                 }
             }
+            fit.push(fit_row(&f.name, &cx.target, cp_now, &rows));
         }
         cx.emit(SweepTable { rows });
+        cx.emit(SweepFit { rows: fit });
         Ok(())
     }
 }
@@ -229,12 +351,12 @@ pub fn to_csv(rows: &[SweepRow]) -> String {
         "function,n,priority,select,cycles,lower_bound,resource_bound,critical_path,y,parallelisation_rate,\
          pe_words_add_min,pe_words_add_mean,pe_words_add_max,pe_words_mul_min,pe_words_mul_mean,pe_words_mul_max,\
          buffer_words_add_min,buffer_words_add_mean,buffer_words_add_max,buffer_words_mul_min,buffer_words_mul_mean,\
-         buffer_words_mul_max,writes_direct,writes_indirect,tight_lower_bound\n",
+         buffer_words_mul_max,writes_direct,writes_indirect,tight_lower_bound,us,lat_add,lat_mul,alm,m10k,dsp,fits\n",
     );
     for r in rows {
         let w = |x: &WordStats| format!("{},{:.2},{}", x.min, x.mean, x.max);
         s += &format!(
-            "{},{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{},{},{},{},{:.6},{},{},{},{},{},{}\n",
             r.function,
             r.n,
             r.priority,
@@ -251,7 +373,14 @@ pub fn to_csv(rows: &[SweepRow]) -> String {
             w(&r.buffer_words_mul),
             r.writes_direct,
             r.writes_indirect,
-            r.tight_lower_bound
+            r.tight_lower_bound,
+            r.us,
+            r.lat_add,
+            r.lat_mul,
+            r.alm,
+            r.m10k,
+            r.dsp,
+            r.fits
         );
     }
     s
@@ -260,7 +389,7 @@ pub fn to_csv(rows: &[SweepRow]) -> String {
 /// The rows as a text table (Table 2.2 style: one line per N and configuration).
 pub fn to_table(rows: &[SweepRow]) -> String {
     let mut s = format!(
-        "{:<10} {:>4} {:<13} {:<12} {:>8} {:>8} {:>7} {:>8} {:>7} {:>8} {:>8} {:>6} {:>15} {:>15} {:>13} {:>13}\n",
+        "{:<10} {:>4} {:<13} {:<12} {:>8} {:>8} {:>7} {:>8} {:>7} {:>8} {:>8} {:>6} {:>15} {:>15} {:>13} {:>13} {:>9} {:>4}\n",
         "function",
         "N",
         "priority",
@@ -276,12 +405,14 @@ pub fn to_table(rows: &[SweepRow]) -> String {
         "PE words ADD",
         "PE words MUL",
         "buffer ADD",
-        "buffer MUL"
+        "buffer MUL",
+        "µs",
+        "fits"
     );
     for r in rows {
         let w = |x: &WordStats| format!("{}/{:.0}/{}", x.min, x.mean, x.max);
         s += &format!(
-            "{:<10} {:>4} {:<13} {:<12} {:>8} {:>8} {:>7.3} {:>8} {:>7.3} {:>8} {:>8} {:>6.3} {:>15} {:>15} {:>13} {:>13}\n",
+            "{:<10} {:>4} {:<13} {:<12} {:>8} {:>8} {:>7.3} {:>8} {:>7.3} {:>8} {:>8} {:>6.3} {:>15} {:>15} {:>13} {:>13} {:>9.3} {:>4}\n",
             r.function,
             r.n,
             r.priority,
@@ -297,7 +428,9 @@ pub fn to_table(rows: &[SweepRow]) -> String {
             w(&r.pe_words_add),
             w(&r.pe_words_mul),
             w(&r.buffer_words_add),
-            w(&r.buffer_words_mul)
+            w(&r.buffer_words_mul),
+            r.us,
+            if r.fits { "yes" } else { "no" }
         );
     }
     s

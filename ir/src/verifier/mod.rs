@@ -28,8 +28,14 @@
 //! issued once on an existing PE of its type, one op per PE per cycle, write cycles, ports and
 //! buffer reads, operands present at issue, addresses within the reported memory sizes.
 //!
+//! Lowered (on a machine program, not on a module: the program is derived, never stored in
+//! the IR): see [`machine`] — every read address holds the right value at its cycle, every
+//! write source exists, ports within `writes`, addresses within memory sizes, output map
+//! complete. The lowering (`robovec_passes::machine::lower`) runs it on every program it builds.
+//!
 //! TODO: types beyond `f64` scalars do not exist yet; nothing to check there.
 
+pub mod machine;
 pub mod placement;
 
 use rustc_hash::FxHashSet as HashSet;
@@ -52,6 +58,8 @@ pub enum Location {
     Output(usize),
     /// The placement block (an `issue`, `load` or `write` line, or the block itself).
     Placement,
+    /// The machine program lowered from the placement ([`machine`]).
+    Machine,
 }
 
 /// One broken invariant.

@@ -27,6 +27,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 
 use super::{Location, VerifierError};
 use crate::function::Function;
+use crate::machine::Held as Key;
 use crate::placement::{Pe, Placement};
 use crate::span::Span;
 use crate::syntax::{Def, OpKind, Operand, Phase};
@@ -69,18 +70,9 @@ fn map<K, V>(capacity: usize) -> Map<K, V> {
     Map::with_capacity_and_hasher(capacity, Default::default())
 }
 
-/// What a memory word holds: a value or a constant (by its `f64` bits, as `sim` matches them).
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
-enum Key {
-    Value(Value),
-    Const(u64),
-}
-
+/// The memory-word key shared with the placer and the lowering.
 fn key_of(o: &Operand) -> Key {
-    match o {
-        Operand::Value(v) => Key::Value(*v),
-        Operand::Const(c) => Key::Const(c.to_bits()),
-    }
+    Key::of(o)
 }
 
 struct Sink<'f> {

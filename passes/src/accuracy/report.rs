@@ -303,7 +303,11 @@ impl crate::Artifact for AccuracyRun {
         for r in &self.reports {
             let Some(dir) = &r.worst_dir else { continue };
             for (name, json) in worst_files(r, several_functions) {
-                out.push(crate::ArtifactFile { path: std::path::Path::new(dir).join(name), bytes: json.into_bytes() });
+                out.push(crate::ArtifactFile {
+                    path: std::path::Path::new(dir).join(name),
+                    bytes: json.into_bytes(),
+                    executable: false,
+                });
             }
         }
         out

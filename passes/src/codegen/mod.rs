@@ -7,6 +7,7 @@
 //! SPEC §2 names ([`Interface`]) and literals that round-trip exactly ([`literal`]).
 
 pub mod c;
+pub mod fpga;
 pub mod literal;
 pub mod names;
 
@@ -27,16 +28,19 @@ pub struct BackEnd {
 }
 
 /// The back ends, selected by the first word of `codegen<…>`.
-pub const BACK_ENDS: &[BackEnd] = &[BackEnd { name: "c", build: |p| Ok(Box::new(c::CodegenC::from_params(p)?)) }];
+pub const BACK_ENDS: &[BackEnd] = &[
+    BackEnd { name: "c", build: |p| Ok(Box::new(c::CodegenC::from_params(p)?)) },
+    BackEnd { name: "fpga", build: |p| Ok(Box::new(fpga::CodegenFpga::from_params(p)?)) },
+];
 
 /// Registry entry: the back-end selector, then each back end's parameters.
 pub const INFO: PassInfo = PassInfo {
     name: "codegen",
-    doc: "write the functions as code (`codegen<c;…>`: C; SPEC §8); `-o FILE` gets the code",
+    doc: "write the functions as code (`codegen<c;…>`: C, SPEC §8, `-o FILE` gets the code; `codegen<fpga;out=DIR;…>`: the placed design's images, Verilog, simulate script and resources, issue 12)",
     params: &[
         ParamInfo {
             name: "back-end",
-            kind: ParamKind::Selector { choices: &["c"], default: "c" },
+            kind: ParamKind::Selector { choices: &["c", "fpga"], default: "c" },
             doc: "back end, given as the first bare word (`codegen<c;…>`)",
         },
         c::ABI,
@@ -44,6 +48,9 @@ pub const INFO: PassInfo = PassInfo {
         c::BATCH,
         c::TRIG,
         c::NAME,
+        fpga::OUT,
+        fpga::FORMAT,
+        fpga::RESOURCES,
     ],
     build: |p: &Params| {
         let which = p.choice("back-end")?;

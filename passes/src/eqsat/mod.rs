@@ -86,7 +86,7 @@ pub const INFO: PassInfo = PassInfo {
         ParamInfo { doc: "add/sub latency for extraction, cycles", ..crate::params::LAT_ADD },
         ParamInfo { doc: "mul latency for extraction, cycles", ..crate::params::LAT_MUL },
     ],
-    build: |p: &Params| Ok(Box::new(Eqsat { opts: options_from(p)? })),
+    build: |p: &Params| Ok(Box::new(Eqsat { opts: options_from(p)?, lat: p.latency_override()? })),
 };
 
 /// Options of the `eqsat` pass (see [`INFO`] for the parameters they come from).
@@ -138,8 +138,11 @@ impl Default for EqsatOptions {
 /// The `eqsat` pass.
 #[derive(Debug)]
 pub struct Eqsat {
-    /// Options.
+    /// Options (`opts.lat` is replaced at run time by the pipeline's latencies with `lat`
+    /// applied, [`PassContext::latencies_for`]).
     pub opts: EqsatOptions,
+    /// Latencies given on the pass.
+    pub lat: crate::LatencyOverride,
 }
 
 impl Pass for Eqsat {
@@ -159,8 +162,9 @@ impl Pass for Eqsat {
             rules.extend(extra);
         }
         let mut runs = Vec::new();
+        let opts = EqsatOptions { lat: cx.latencies_for("eqsat", &self.lat), ..self.opts.clone() };
         for f in &mut m.functions {
-            let stats = eqsat_function_within(f, &self.opts, &rules, cx.deadline);
+            let stats = eqsat_function_within(f, &opts, &rules, cx.deadline);
             if let Some(why) = &stats.stopped_early {
                 let what =
                     format!("after {} of {} windows of @{}: {why}", stats.windows_tried, stats.windows_total, f.name);

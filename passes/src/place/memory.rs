@@ -10,6 +10,7 @@
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
 
+use robovec_ir::machine::Held;
 use robovec_ir::placement::{Arch, Issue, Load, Pe, Placement, Write};
 use robovec_ir::{Function, Operand};
 
@@ -21,20 +22,6 @@ pub fn pe_of(arch: &Arch, slot: usize) -> Pe {
         Pe::Add(slot as u32)
     } else {
         Pe::Mul((slot - arch.n_add as usize) as u32)
-    }
-}
-
-/// An item stored in one memory: an initial operand or a result.
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
-enum Key {
-    Value(u32),
-    Const(u64),
-}
-
-fn key(o: &Operand) -> Key {
-    match o {
-        Operand::Value(v) => Key::Value(v.index() as u32),
-        Operand::Const(c) => Key::Const(c.to_bits()),
     }
 }
 
@@ -87,7 +74,7 @@ pub fn build(f: &Function, arch: &Arch, s: &Schedule) -> Placement {
     // Last read cycle of each booking, and of each initial item loaded into each PE memory.
     let mut last_booking = vec![0u32; s.bookings.len()];
     let mut loads_wanted: Vec<Vec<Operand>> = vec![Vec::new(); n_pe];
-    let mut load_index: Vec<HashMap<Key, usize>> = vec![HashMap::new(); n_pe];
+    let mut load_index: Vec<HashMap<Held, usize>> = vec![HashMap::new(); n_pe];
     let mut last_load: Vec<Vec<u32>> = vec![Vec::new(); n_pe];
     for &v in &f.body {
         let Some((q, t)) = s.issue[v.index()] else { continue };
@@ -100,7 +87,7 @@ pub fn build(f: &Function, arch: &Arch, s: &Schedule) -> Placement {
             }
         });
         for o in initial_operands(f, v) {
-            let i = *load_index[q].entry(key(&o)).or_insert_with(|| {
+            let i = *load_index[q].entry(Held::of(&o)).or_insert_with(|| {
                 loads_wanted[q].push(o);
                 last_load[q].push(0);
                 loads_wanted[q].len() - 1

@@ -263,8 +263,8 @@ pub const INFO: PassInfo = PassInfo {
         crate::params::LAT_CALL,
         ParamInfo {
             name: "writes",
-            kind: ParamKind::U32 { default: 2, min: 1, max: 64 },
-            doc: "write ports per PE memory per cycle",
+            kind: ParamKind::U32Target { builtin: 2, min: 1, max: 64 },
+            doc: "write ports per PE memory per cycle; when not given, the target's (-target)",
         },
         ParamInfo {
             name: "buffer",
@@ -272,14 +272,22 @@ pub const INFO: PassInfo = PassInfo {
             doc: "on | off: results may wait in buffer memories",
         },
     ],
-    build: |p: &Params| Ok(Box::new(Place { opts: options_from(p)? })),
+    build: |p: &Params| {
+        Ok(Box::new(Place { opts: options_from(p)?, lat: p.latency_override()?, writes: p.u32_given("writes")? }))
+    },
 };
 
 /// The `place` pass.
 #[derive(Debug)]
 pub struct Place {
-    /// Options.
+    /// Options (`opts.arch.lat` and `opts.arch.writes` are replaced at run time: the
+    /// pipeline's latencies with `lat` applied, [`PassContext::latencies_for`], and `writes`
+    /// or the target's write ports).
     pub opts: PlaceOptions,
+    /// Latencies given on the pass.
+    pub lat: crate::LatencyOverride,
+    /// `writes` when given on the pass (`None`: the target's).
+    pub writes: Option<u32>,
 }
 
 impl Pass for Place {
@@ -296,7 +304,9 @@ impl Pass for Place {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let opts = PlaceOptions { deadline: cx.deadline, ..self.opts };
+        let lat = cx.latencies_for("place", &self.lat);
+        let arch = Arch { lat, writes: self.writes.unwrap_or(cx.target.writes), ..self.opts.arch };
+        let opts = PlaceOptions { deadline: cx.deadline, arch, ..self.opts };
         for f in &mut m.functions {
             let (p, stopped) = try_place_function_within(f, &opts)
                 .map_err(|e| PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) })?;
@@ -306,7 +316,6 @@ impl Pass for Place {
             }
             f.placement = Some(p);
         }
-        cx.latencies = self.opts.arch.lat;
         Ok(())
     }
 }

@@ -1,6 +1,7 @@
 //! The placement's figures (SPEC §7 `placement`, seed §3.4–3.6): cycles against the lower
 //! bounds, parallelisation rate, memories, writes and occupation.
 
+use robovec_ir::target::{Resources, Target};
 use robovec_ir::Function;
 use serde::Serialize;
 
@@ -19,6 +20,10 @@ pub struct PlacementReport {
     pub lat_mul: u32,
     /// Cycles of the placement (largest arrival).
     pub cycles: u32,
+    /// `cycles` in µs at the target's clock (`cycles / clock_mhz`); extra key.
+    pub us: f64,
+    /// The target's clock, MHz; extra key.
+    pub clock_mhz: f64,
     /// Lower bound LB (SPEC §4), cycles.
     pub lower_bound: u32,
     /// cycles / LB (1 is optimal).
@@ -39,6 +44,26 @@ pub struct PlacementReport {
     /// Occupation rate per cycle of each PE type: issued ops / N, rolling mean over 50 cycles
     /// (seed §3.6).
     pub occupation: Occupation,
+    /// The analytic resource estimate of this configuration on the target
+    /// (`robovec_ir::target::Target::estimate`: unit costs of seed Table 1.4, memories in M10K
+    /// blocks), with `fits` also requiring the placement's memories to fit the target's
+    /// ([`fits_memories`]); extra key. The FPGA back end gives Yosys' figures instead.
+    pub estimate: Resources,
+}
+
+/// True when the placement's memories fit the target's: every PE memory within `pe_words`,
+/// every buffer within `buffer_words`, and `cycles + 1` instruction words within
+/// `instr_words`.
+pub fn fits_memories(p: &robovec_ir::placement::Placement, cycles: u32, target: &Target) -> bool {
+    p.pe_words.iter().all(|&w| w <= target.pe_words)
+        && p.buffer_words.iter().all(|&w| w <= target.buffer_words)
+        && u64::from(cycles) < u64::from(target.instr_words)
+}
+
+/// The estimate of [`PlacementReport::estimate`].
+pub fn estimate(p: &robovec_ir::placement::Placement, cycles: u32, target: &Target) -> Resources {
+    let r = target.estimate(p.arch.n_add, p.arch.n_mul, cycles);
+    Resources { fits: r.fits && fits_memories(p, cycles, target), ..r }
 }
 
 /// Per-cycle occupation rates (0 to 1), one entry per cycle.
@@ -50,8 +75,9 @@ pub struct Occupation {
     pub mul: Vec<f64>,
 }
 
-/// The placement figures of `f`, if it is placed.
-pub fn placement_report(f: &Function) -> Option<PlacementReport> {
+/// The placement figures of `f`, if it is placed, on `target` (its clock for `us`, its
+/// capacities for `estimate`; latencies are the placement's own).
+pub fn placement_report(f: &Function, target: &Target) -> Option<PlacementReport> {
     let p = f.placement.as_ref()?;
     let a = &p.arch;
     let c = cycles(f, p);
@@ -65,6 +91,8 @@ pub fn placement_report(f: &Function) -> Option<PlacementReport> {
         lat_add: a.lat.add,
         lat_mul: a.lat.mul,
         cycles: c,
+        us: target.us(c),
+        clock_mhz: target.clock_mhz,
         lower_bound: lb,
         cycles_over_lower_bound: if lb == 0 { 1.0 } else { c as f64 / lb as f64 },
         tight_lower_bound: tight_lower_bound(f, a),
@@ -74,5 +102,6 @@ pub fn placement_report(f: &Function) -> Option<PlacementReport> {
         writes_direct: p.writes.len() as u64 - indirect,
         writes_indirect: indirect,
         occupation: Occupation { add: occupation(&add, a.n_add, 50), mul: occupation(&mul, a.n_mul, 50) },
+        estimate: estimate(p, c, target),
     })
 }

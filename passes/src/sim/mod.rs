@@ -1,62 +1,41 @@
 //! `sim<seeds>`: a cycle-accurate simulator of placed functions, and the pass that checks every
 //! placement with it against the interpreter, bit for bit, in f32 and f64.
 //!
-//! The simulator reads only the [`Placement`] (never the placer) and enforces the machine model
-//! of [`robovec_ir::placement`]. From the placement it derives each PE's instruction stream
-//! (which op issues when, reading which addresses of its memory), each PE memory's writes and
-//! each buffer's entries and reads, then runs:
+//! The simulator reads only the [`Placement`] (never the placer): it lowers it once into the
+//! public machine program ([`crate::machine::lower`], which checks every rule of the machine
+//! model of [`robovec_ir::placement`] and keeps the diagnostics below), then executes that
+//! program cycle by cycle ([`crate::machine::execute`]) — the same program `codegen<fpga>`
+//! encodes:
 //!
-//! - **before cycle 0** the loads: inputs as `T::from_f64(input(name))`, trig initial variables
-//!   as `sin`/`cos` of their input computed in `T` (as [`interp`] does), constants as
+//! - **before cycle 0** the initial words: inputs as `T::from_f64(input(name))`, trig initial
+//!   variables as `sin`/`cos` of their input computed in `T` (as [`interp`] does), constants as
 //!   `T::from_f64(c)`;
-//! - **each cycle `c`**, in this order:
-//!   1. results arriving at `c` (issued at `c − latency`) enter their producer's buffer at the
-//!      `buffer_addr` of their indirect writes (one entry per value);
-//!   2. the writes of cycle `c`, in `Placement::writes` order: direct writes (the value must
-//!      arrive at `c`) and buffer reads (the value must have arrived; one distinct buffer
-//!      address read per buffer per cycle, fanning out to any number of memories), each taking
-//!      one write port of its target memory;
-//!   3. the ops issued at `c` read their operands from the issuing PE's memory and enter the
-//!      pipeline, computed in `T` by [`interp::eval_binop`] / [`interp::eval_call`].
+//! - **each cycle `c`**, in this order: results arriving at `c` (issued at `c − latency`) enter
+//!   their producer's buffer and output memory; buffers are read; PE memories take their
+//!   writes (direct from a result arriving now, or indirect from a buffer read now); the ops
+//!   issued at `c` read their operands from the issuing PE's memory and enter the pipeline,
+//!   computed in `T` by [`interp::eval_binop`] / [`interp::eval_call`];
+//! - **at the end** the outputs are read from the output memories.
 //!
-//! # Choices where the machine model is silent
-//! - **Read addresses.** A placement does not list them: an op on PE `p` at cycle `c` reads
-//!   an operand at the address of the latest load or write of that operand into `p` at a cycle
-//!   `≤ c` (loads count as cycle −1; on a tie, the first in placement order). That read counts
-//!   as a read of that word when checking address reuse.
-//! - **Constants** live in memories like inputs: an operand `2.0` must be loaded into the PE's
-//!   memory; constants are matched by their `f64` bits (`0.0` and `-0.0` differ).
-//! - **Calls** read all their operands in their issue cycle, even more than 2 (a call with
-//!   more than 2 operands is the only op that reads more than 2 words per cycle); a call
-//!   without operands reads nothing.
-//! - **Occupancy.** A word is occupied from its write (loads: before cycle 0) to its last read,
-//!   or only in its write cycle when it is never read; a buffer word from arrival to its last
-//!   buffer read. Writing an occupied word in a cycle ≤ its last read is an error ("address
-//!   reused while its value is still needed"), and so is writing one word twice in one cycle.
-//!   An overwrite of a word an op still needs is reported there, at the overwriting write,
-//!   not at the later read. `max_words_per_memory`/`max_buffer_words` are the peaks of these
-//!   intervals, so they never exceed a correct `pe_words`/`buffer_words`.
-//! - **Buffer entries.** A value enters its producer's buffer once: all its indirect writes
-//!   must name the same `buffer_addr`. Loads are not writes: they take no write port.
-//! - **Outputs** are taken from the pipeline (an op output must have been issued; an input or
-//!   trig output is its initial value); they need not be written into any memory.
-//! - **Errors.** Structural errors (sizes, unknown PEs or values, missing issues, issues or
-//!   writes of non-ops, loads of op results, a value in two buffer addresses) come first;
-//!   all other errors are found in time order and the first one is returned.
+//! The choices where the machine model is silent (read addresses, constants, calls, word
+//! occupancy, buffer entries, outputs, error order) are listed in [`crate::machine`]'s module
+//! doc. Errors are [`SimError`] (= [`crate::machine::MachineError`]): the first broken rule,
+//! with cycle, PE, value and the span of the offending line when the placement was read from
+//! text.
 //!
 //! [`interp`]: robovec_ir::interp
 //! [`interp::eval_binop`]: robovec_ir::interp::eval_binop
 //! [`interp::eval_call`]: robovec_ir::interp::eval_call
 
-mod error;
-mod machine;
-mod plan;
+use std::collections::HashMap;
 
 use robovec_ir::interp::{eval, pseudo_random_input, Float};
+use robovec_ir::machine::{MachineOp, MachineProgram};
 use robovec_ir::placement::Placement;
 use robovec_ir::{Function, Module};
 
-pub use error::{SimError, SimErrorKind, When};
+use crate::machine::{execute, lower_measured, Occupancy};
+pub use crate::machine::{MachineError as SimError, MachineErrorKind as SimErrorKind, When};
 
 use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
@@ -162,7 +141,41 @@ pub fn simulate<T: Float>(
     p: &Placement,
     input: impl FnMut(&str) -> f64,
 ) -> Result<SimOutcome<T>, SimError> {
-    machine::run(f, p, input)
+    let (m, occ) = lower_measured(f, p)?;
+    run(f, &m, &occ, input)
+}
+
+/// Executes lowered program `m` of `f` on `input` (called once per input, in `f.inputs`
+/// order) and gathers the figures.
+fn run<T: Float>(
+    f: &Function,
+    m: &MachineProgram,
+    occ: &Occupancy,
+    mut input: impl FnMut(&str) -> f64,
+) -> Result<SimOutcome<T>, SimError> {
+    let values: HashMap<&str, f64> = f.inputs.iter().map(|&v| (f.name_of(v), input(f.name_of(v)))).collect();
+    let x = execute::<T>(m, |n| values.get(n).copied().unwrap_or(f64::NAN))?;
+    let mut issued_add = vec![0u32; m.cycles as usize];
+    let mut issued_mul = vec![0u32; m.cycles as usize];
+    for q in &m.pes {
+        for (c, st) in q.steps.iter().enumerate() {
+            match &st.issue {
+                Some(i) if matches!(i.op, MachineOp::Mul) => issued_mul[c] += 1,
+                Some(_) => issued_add[c] += 1,
+                None => {}
+            }
+        }
+    }
+    Ok(SimOutcome {
+        outputs: x.outputs,
+        cycles: m.cycles,
+        writes_direct: m.writes_direct(),
+        writes_indirect: m.writes_indirect(),
+        max_words_per_memory: occ.max_words_per_memory.clone(),
+        max_buffer_words: occ.max_buffer_words.clone(),
+        issued_per_cycle_add: issued_add,
+        issued_per_cycle_mul: issued_mul,
+    })
 }
 
 /// Simulates `f.placement` in f64 and f32 on `interp::pseudo_random_input(name, seed)` for each
@@ -185,10 +198,11 @@ pub fn verify_placement(f: &Function, seeds: &[u64]) -> Result<SimReport, SimErr
 /// As [`verify_placement`].
 pub fn verify_with(f: &Function, p: &Placement, seeds: &[u64]) -> Result<SimReport, SimError> {
     let seeds: &[u64] = if seeds.is_empty() { &[0] } else { seeds };
+    let (m, occ) = lower_measured(f, p)?;
     let mut report = None;
     for &seed in seeds {
-        let o = compare::<f64>(f, p, seed, "f64")?;
-        compare::<f32>(f, p, seed, "f32")?;
+        let o = compare::<f64>(f, &m, &occ, seed, "f64")?;
+        compare::<f32>(f, &m, &occ, seed, "f32")?;
         report.get_or_insert(SimReport {
             cycles: o.cycles,
             writes_direct: o.writes_direct,
@@ -204,9 +218,15 @@ pub fn verify_with(f: &Function, p: &Placement, seeds: &[u64]) -> Result<SimRepo
     Ok(report.expect("at least one seed"))
 }
 
-fn compare<T: Float>(f: &Function, p: &Placement, seed: u64, precision: &str) -> Result<SimOutcome<T>, SimError> {
+fn compare<T: Float>(
+    f: &Function,
+    m: &MachineProgram,
+    occ: &Occupancy,
+    seed: u64,
+    precision: &str,
+) -> Result<SimOutcome<T>, SimError> {
     let input = |n: &str| pseudo_random_input(n, seed);
-    let sim = simulate::<T>(f, p, input)?;
+    let sim = run::<T>(f, m, occ, input)?;
     let reference = eval::<T>(f, input);
     for (((name, s), (_, e)), o) in sim.outputs.iter().zip(&reference).zip(&f.outputs) {
         let (s, e) = (s.to_f64(), e.to_f64());

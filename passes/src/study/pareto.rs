@@ -174,8 +174,12 @@ pub fn study(
     samples: u32,
     seed: u64,
     deadline: Option<crate::Deadline>,
+    target: &robovec_ir::target::Target,
 ) -> Result<ParetoStudy, Failure> {
-    Ok(ParetoStudy { function: function.to_string(), rows: run(module, function, text, samples, seed, deadline)? })
+    Ok(ParetoStudy {
+        function: function.to_string(),
+        rows: run(module, function, text, samples, seed, deadline, target)?,
+    })
 }
 
 /// The rows of [`study`]. Under `-time-limit` (`deadline`), each pipeline and measurement stops
@@ -191,6 +195,7 @@ pub fn run(
     samples: u32,
     seed: u64,
     deadline: Option<crate::Deadline>,
+    target: &robovec_ir::target::Target,
 ) -> Result<Vec<ParetoRow>, Failure> {
     let original =
         module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
@@ -199,7 +204,8 @@ pub fn run(
     let mut rows = Vec::new();
     for (p, pm) in pipelines.iter().zip(&managers) {
         let mut m = module.clone();
-        let mut cx = PassContext { original: Some(module.clone()), deadline, ..PassContext::default() };
+        let mut cx =
+            PassContext { original: Some(module.clone()), deadline, ..PassContext::with_target(target.clone()) };
         pm.run(&mut m, &mut cx, &mut std::io::sink())
             .map_err(|e| Failure::Input(format!("error: -pareto pipeline `{p}`: {e}\n")))?;
         let f: &Function = m

@@ -28,5 +28,7 @@ pub const INFO: PassInfo = PassInfo {
     name: "balance",
     doc: "tree-height reduction: rebuild each associative cluster as the two-earliest-first tree (seed §2.4.3)",
     params: LATENCY_PARAMS,
-    build: |p: &Params| Ok(Box::new(ClusterRewrite { name: "balance", shape: Shape::Balance, lat: p.latencies()? })),
+    build: |p: &Params| {
+        Ok(Box::new(ClusterRewrite { name: "balance", shape: Shape::Balance, lat: p.latency_override()? }))
+    },
 };

@@ -57,12 +57,13 @@ pub const INFO: PassInfo = PassInfo {
             max_growth: p.f64("max-growth")?,
             slack: p.u32("slack")?,
             lat: p.latencies()?,
+            given: p.latency_override()?,
         }))
     },
 };
 
 /// The `distribute` pass.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Distribute {
     /// Rounds at most.
     pub rounds: u32,
@@ -70,8 +71,11 @@ pub struct Distribute {
     pub max_growth: f64,
     /// Largest slack of a distributed product after balance, cycles.
     pub slack: u32,
-    /// Latencies, cycles.
+    /// Latencies, cycles (the pass replaces them at run time by the pipeline's with
+    /// `given` applied, [`PassContext::latencies_for`]).
     pub lat: Latencies,
+    /// Latencies given on the pass.
+    pub given: crate::LatencyOverride,
 }
 
 impl Pass for Distribute {
@@ -85,9 +89,10 @@ impl Pass for Distribute {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let mut parts = Vec::new();
+        let opts = Distribute { lat: cx.latencies_for("distribute", &self.given), ..self.clone() };
         for f in &mut m.functions {
             let ops0 = f.op_counts().total;
-            let (g, s) = distribute_function(f, self);
+            let (g, s) = distribute_function(f, &opts);
             *f = g;
             parts.push(format!(
                 "@{}: {} products distributed in {} rounds, ops {ops0} -> {}, balanced critical path {} -> {} cycles",

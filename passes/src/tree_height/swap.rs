@@ -20,5 +20,5 @@ pub const INFO: PassInfo = PassInfo {
     name: "swap",
     doc: "reorder each cluster's terms so the latest-ready sit nearest the root, shape kept (seed §2.4.2)",
     params: LATENCY_PARAMS,
-    build: |p: &Params| Ok(Box::new(ClusterRewrite { name: "swap", shape: Shape::Swap, lat: p.latencies()? })),
+    build: |p: &Params| Ok(Box::new(ClusterRewrite { name: "swap", shape: Shape::Swap, lat: p.latency_override()? })),
 };

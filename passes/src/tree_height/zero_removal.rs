@@ -33,7 +33,9 @@ pub const INFO: PassInfo = PassInfo {
     name: "zero-removal",
     doc: "remove the `0 - x` ops of atomise by moving signs into parents and consumers (seed §2.4.1)",
     params: LATENCY_PARAMS,
-    build: |p: &Params| Ok(Box::new(ClusterRewrite { name: "zero-removal", shape: Shape::Keep, lat: p.latencies()? })),
+    build: |p: &Params| {
+        Ok(Box::new(ClusterRewrite { name: "zero-removal", shape: Shape::Keep, lat: p.latency_override()? }))
+    },
 };
 
 /// A pass that rebuilds every cluster with one [`Shape`] (`zero-removal`, `swap`, `balance`).
@@ -43,8 +45,9 @@ pub struct ClusterRewrite {
     pub name: &'static str,
     /// Tree of each cluster.
     pub shape: Shape,
-    /// Latencies the ready times (and the critical-path check) use, cycles.
-    pub lat: robovec_ir::analysis::Latencies,
+    /// Latencies given on the pass for the ready times (and the critical-path check), cycles;
+    /// the others are the pipeline's ([`PassContext::latencies_for`]).
+    pub lat: crate::LatencyOverride,
 }
 
 impl Pass for ClusterRewrite {
@@ -58,8 +61,9 @@ impl Pass for ClusterRewrite {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let mut outcomes = Vec::new();
+        let lat = cx.latencies_for(self.name, &self.lat);
         for f in &mut m.functions {
-            let (g, o) = rewrite(f, self.shape, &self.lat);
+            let (g, o) = rewrite(f, self.shape, &lat);
             *f = g;
             outcomes.push((f.name.clone(), o));
         }

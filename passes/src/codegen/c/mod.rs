@@ -90,6 +90,9 @@ impl CodegenC {
     /// `batch>1`, `precision=f32` or `trig=input`: Robotran's signature is one state of
     /// `double`s that computes its own trig) and for a `name` that is not one C identifier.
     pub fn from_params(p: &Params) -> Result<CodegenC, PassError> {
+        if let Some(k) = crate::codegen::fpga::given_beyond_default(p, crate::codegen::fpga::FPGA_ONLY) {
+            return Err(bad(format!("parameter `{k}` belongs to `codegen<fpga>`, not `codegen<c>`")));
+        }
         let o = CodegenC {
             abi: p.choice("abi")?,
             f32: p.choice("precision")? == "f32",

@@ -1,4 +1,4 @@
-//! The plan: everything the simulator derives from a [`Placement`] before running it — arrival
+//! The plan: everything the lowering derives from a [`Placement`] before running it — arrival
 //! cycles, every PE memory write (loads and `Write`s) with the reads that use it, every buffer
 //! entry with its reads, and the events of each cycle.
 
@@ -8,23 +8,16 @@ use robovec_ir::placement::{Issue, Pe, Placement};
 use robovec_ir::syntax::{Def, OpKind, Operand};
 use robovec_ir::{Function, Value};
 
-use super::error::{SimError, SimErrorKind as K, When};
+use robovec_ir::machine::Held as Key;
 
-/// Longest run the simulator accepts, cycles (guards the per-cycle counters).
+use super::error::{MachineError as SimError, MachineErrorKind as K, When};
+
+/// Longest run the lowering accepts, cycles (guards the per-cycle steps).
 const MAX_CYCLES: u32 = 50_000_000;
 
-/// What a memory word holds: a value of the function or a constant (by its `f64` bits).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(super) enum Key {
-    Value(Value),
-    Const(u64),
-}
-
+/// The key of an operand's word.
 pub(super) fn key_of(o: &Operand) -> Key {
-    match o {
-        Operand::Value(v) => Key::Value(*v),
-        Operand::Const(c) => Key::Const(c.to_bits()),
-    }
+    Key::of(o)
 }
 
 /// One write into a PE memory word (a load, time −1, or a `Write`, time = its cycle).
@@ -53,6 +46,8 @@ pub(super) struct BufEvent {
 /// Events of one cycle, in the order they happen.
 #[derive(Default)]
 pub(super) struct Bucket {
+    /// Ops whose results arrive now, in body order.
+    pub arrivals: Vec<Value>,
     /// Buffer entries (`BufEvent` indices) of results arriving now.
     pub entries: Vec<usize>,
     /// `Placement::writes` indices written into PE memories now.
@@ -251,7 +246,7 @@ impl Run<'_> {
             let Some(kind) = f.op_kind(v) else { continue };
             let is = issue(v);
             let a = is.cycle.checked_add(p.latency(kind)).filter(|&a| a <= MAX_CYCLES).ok_or_else(|| {
-                SimError::new(K::Malformed, format!("arrives after cycle {MAX_CYCLES}, too late to simulate"))
+                SimError::new(K::Malformed, format!("arrives after cycle {MAX_CYCLES}, too late to lower"))
                     .at(When::Cycle(is.cycle))
                     .on(is.pe)
                     .of(r.vname(v))
@@ -362,6 +357,8 @@ impl Run<'_> {
         for &v in &f.body {
             if f.op_kind(v).is_some() {
                 buckets.entry(issue(v).cycle).or_default().issues.push(v);
+                let a = arrival[v.index()].expect("ops arrive");
+                buckets.entry(a).or_default().arrivals.push(v);
             }
         }
         Ok(Plan { arrival, cycles, n_loads, mem_ev, reads, buf_ev, buf_of_write, buckets })

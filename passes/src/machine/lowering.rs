@@ -1,15 +1,22 @@
-//! The machine: runs a [`Plan`] cycle by cycle (see the module doc of [`super`] for the rules).
+//! The lowering: checks a [`Placement`] against every rule of the machine model and builds the
+//! [`MachineProgram`] (see the module doc of [`super`] for the rules and choices).
 
 use std::collections::HashMap;
 
-use robovec_ir::interp::{eval_binop, eval_call, Float};
-use robovec_ir::placement::{Pe, Placement};
-use robovec_ir::syntax::{Def, Operand, TrigFn};
+use robovec_ir::machine::{
+    Held as Key, Instr, MachineOp, MachineProgram, MemWrite, OutputLoc, PeProgram, Source, Step, Word,
+};
+use robovec_ir::placement::Placement;
+use robovec_ir::syntax::{BinOp, Def, Operand};
 use robovec_ir::{Function, Value};
 
-use super::error::{SimError, SimErrorKind as K, When};
-use super::plan::{Key, Plan, Run};
-use super::SimOutcome;
+use super::error::{MachineError as SimError, MachineErrorKind as K, When};
+use super::plan::{Plan, Run};
+use super::Occupancy;
+
+/// Largest program the lowering builds, steps (PEs × cycles): bounds its memory (a step is
+/// about 90 bytes) on absurd placements.
+pub const MAX_STEPS: u64 = 16 << 20;
 
 /// Marks word `at` as holding event `new` from `now`; `start`/`last` give an event's write
 /// time and last read. Errors name the old event when it is still needed or was written in
@@ -71,40 +78,90 @@ fn peak(n: usize, items: impl Iterator<Item = (usize, i64, i64)>) -> Vec<u32> {
         .collect()
 }
 
-/// Simulates `p` on `f`; see [`super::simulate`].
-pub(super) fn run<T: Float>(
-    f: &Function,
-    p: &Placement,
-    mut input: impl FnMut(&str) -> f64,
-) -> Result<SimOutcome<T>, SimError> {
+/// Lowers `p` of `f`; see [`super::lower`].
+pub(super) fn lower(f: &Function, p: &Placement) -> Result<(MachineProgram, Occupancy), SimError> {
     let r = Run { f, p };
     let Plan { arrival, cycles, n_loads, mem_ev, reads, buf_ev, buf_of_write, buckets } = r.derive()?;
     let n = f.values.len();
     let arch = p.arch;
+    let n_pe = arch.n_pe();
     let issue = |v: Value| r.issue(v);
-
-    // Initial data in precision T, exactly as `interp` computes it.
-    let mut init: Vec<Option<T>> = vec![None; n];
-    for &v in &f.inputs {
-        init[v.index()] = Some(T::from_f64(input(f.name_of(v))));
+    let steps = (n_pe as u64) * (cycles as u64 + 1);
+    if steps > MAX_STEPS {
+        return Err(SimError::new(
+            K::Malformed,
+            format!(
+                "the program would have {steps} steps ({n_pe} PEs × {} cycles), more than the {MAX_STEPS} \
+                 the lowering builds",
+                cycles as u64 + 1
+            ),
+        ));
     }
-    for &v in &f.body {
-        if let Def::Trig(t, a) = f.value(v).def {
-            let x = init[a.index()].unwrap_or(T::from_f64(f64::NAN));
-            init[v.index()] = Some(match t {
-                TrigFn::Sin => x.sin(),
-                TrigFn::Cos => x.cos(),
-            });
-        }
-    }
+    let mut pes: Vec<PeProgram> = arch
+        .pes()
+        .enumerate()
+        .map(|(s, pe)| PeProgram {
+            pe,
+            init: vec![None; p.pe_words[s] as usize],
+            output_init: Vec::new(),
+            steps: vec![Step::default(); cycles as usize + 1],
+        })
+        .collect();
+    let mut issue_of: Vec<Option<(usize, u32)>> = vec![None; n];
 
     let mut mem: HashMap<(usize, u32), usize> = HashMap::new();
-    let mut mem_data: Vec<Option<T>> = vec![None; mem_ev.len()];
     let mut buf: HashMap<(usize, u32), usize> = HashMap::new();
-    let mut buf_data: Vec<Option<T>> = vec![None; buf_ev.len()];
-    let mut result: Vec<Option<T>> = vec![None; n];
-    let mut issued_add = vec![0u32; cycles as usize];
-    let mut issued_mul = vec![0u32; cycles as usize];
+    let word = |k: Key| -> Word {
+        match k {
+            Key::Const(b) => Word::Const(f64::from_bits(b)),
+            Key::Value(v) => match f.value(v).def {
+                Def::Trig(t, a) => Word::Trig(t, f.name_of(a).to_string()),
+                _ => Word::Input(f.name_of(v).to_string()),
+            },
+        }
+    };
+    // Output capture: each op output is captured once, at its arrival, into its producer's
+    // output memory; outputs that are initial data or constants are loaded into slot 0's.
+    let mut capture_at: Vec<Option<u32>> = vec![None; n];
+    let mut output_words = vec![0u32; n_pe];
+    let mut outputs = Vec::with_capacity(f.outputs.len());
+    let mut init_out: HashMap<Key, u32> = HashMap::new();
+    for o in &f.outputs {
+        if let Operand::Value(v) = o.value {
+            r.value_ok(v, "an output")?;
+        }
+        let (slot, addr) = match o.value {
+            Operand::Value(v) if f.op_kind(v).is_some() => {
+                let slot = r.slot(issue(v).pe);
+                let a = *capture_at[v.index()].get_or_insert_with(|| {
+                    output_words[slot] += 1;
+                    output_words[slot] - 1
+                });
+                (slot, a)
+            }
+            _ => {
+                if n_pe == 0 {
+                    return Err(SimError::new(K::Malformed, "no PE holds an output memory")
+                        .at(When::End)
+                        .of(format!("output `{}`", o.name))
+                        .src(o.span));
+                }
+                let k = Key::of(&o.value);
+                let a = *init_out.entry(k).or_insert_with(|| {
+                    output_words[0] += 1;
+                    output_words[0] - 1
+                });
+                (0, a)
+            }
+        };
+        outputs.push(OutputLoc { name: o.name.clone(), slot, addr });
+    }
+    for (s, q) in pes.iter_mut().enumerate() {
+        q.output_init.resize(output_words[s] as usize, None);
+    }
+    for (&k, &a) in &init_out {
+        pes[0].output_init[a as usize] = Some(word(k));
+    }
 
     // The placement line of memory event `e` (a load, then the writes).
     let mem_span = |e: usize| if e < n_loads { p.spans.load(e) } else { p.spans.write(e - n_loads) };
@@ -136,14 +193,30 @@ pub(super) fn run<T: Float>(
     // Loads, before cycle 0.
     for (i, l) in p.loads.iter().enumerate() {
         store(&mut mem, i, -1, When::Load)?;
-        mem_data[i] = Some(match l.operand {
-            Operand::Const(c) => T::from_f64(c),
-            Operand::Value(v) => init[v.index()].expect("checked: loads are inputs or trig"),
-        });
+        pes[r.slot(l.pe)].init[l.addr as usize] = Some(word(Key::of(&l.operand)));
     }
 
     for (&c, bucket) in &buckets {
         let now = When::Cycle(c);
+        // Results arriving now: one per PE (one result bus), captured when outputs.
+        let mut bus: HashMap<usize, Value> = HashMap::new();
+        for &v in &bucket.arrivals {
+            let pe = issue(v).pe;
+            if let Some(u) = bus.insert(r.slot(pe), v) {
+                return Err(SimError::new(
+                    K::ResultCollision,
+                    format!(
+                        "arrives on {pe} in the same cycle as {}; a PE has one result bus (latencies differ)",
+                        r.vname(u)
+                    ),
+                )
+                .at(now)
+                .on(pe)
+                .of(r.vname(v))
+                .src(p.spans.issue(v)));
+            }
+            pes[r.slot(pe)].steps[c as usize].capture = capture_at[v.index()];
+        }
         // Results arriving now enter their producer's buffer.
         for &b in &bucket.entries {
             let ev = &buf_ev[b];
@@ -182,7 +255,7 @@ pub(super) fn run<T: Float>(
                     .on(ev.pe)
                     .src(p.spans.write(ev.write))
             })?;
-            buf_data[b] = Some(result[ev.value.index()].expect("issued before arrival"));
+            pes[ev.slot].steps[c as usize].buffer.store = Some(ev.addr);
         }
 
         // Writes into PE memories: direct (arrivals) and from buffers.
@@ -192,7 +265,7 @@ pub(super) fn run<T: Float>(
             let w = &p.writes[wi];
             let v = w.value;
             let arr = arrival[v.index()].expect("ops arrive");
-            let data = match buf_of_write[wi] {
+            let src = match buf_of_write[wi] {
                 None => {
                     if c != arr {
                         return Err(SimError::new(
@@ -204,7 +277,7 @@ pub(super) fn run<T: Float>(
                         .of(r.vname(v))
                         .src(p.spans.write(wi)));
                     }
-                    result[v.index()].expect("issued before arrival")
+                    Source::Result(r.slot(issue(v).pe))
                 }
                 Some(b) => {
                     let ev = &buf_ev[b];
@@ -260,7 +333,8 @@ pub(super) fn run<T: Float>(
                         .of(r.vname(v))
                         .src(p.spans.write(wi)));
                     }
-                    buf_data[b].expect("entered at arrival")
+                    pes[ev.slot].steps[c as usize].buffer.read = Some(ev.addr);
+                    Source::Buffer(ev.slot)
                 }
             };
             let e = n_loads + wi;
@@ -281,7 +355,7 @@ pub(super) fn run<T: Float>(
                 .src(p.spans.issue(v)));
             }
             store(&mut mem, e, c as i64, now)?;
-            mem_data[e] = Some(data);
+            pes[slot].steps[c as usize].writes.push(MemWrite { addr: w.addr, src });
         }
 
         // Ops issued now read their operands and enter the pipeline.
@@ -310,7 +384,7 @@ pub(super) fn run<T: Float>(
                 .src(p.spans.issue(v)));
             }
             busy.insert(r.slot(is.pe), v);
-            let mut args: Vec<T> = Vec::new();
+            let mut addrs: Vec<u32> = Vec::new();
             for &(k, res) in &reads[v.index()] {
                 if let Key::Value(u) = k {
                     if let Some(a) = arrival[u.index()].filter(|&a| a > c) {
@@ -345,51 +419,34 @@ pub(super) fn run<T: Float>(
                         if mem.get(&(mem_ev[e].slot, mem_ev[e].addr)) != Some(&e) {
                             return Err(missing(format!("overwritten at address {}", mem_ev[e].addr)));
                         }
-                        args.push(mem_data[e].expect("written"));
+                        addrs.push(mem_ev[e].addr);
                     }
                 }
             }
-            result[v.index()] = Some(match &f.value(v).def {
-                Def::Binary(op, _, _) => eval_binop(*op, args[0], args[1]),
-                Def::Call(callee, _) => eval_call(callee, &args),
+            let op = match &f.value(v).def {
+                Def::Binary(BinOp::Add, _, _) => MachineOp::Add,
+                Def::Binary(BinOp::Sub, _, _) => MachineOp::Sub,
+                Def::Binary(BinOp::Mul, _, _) => MachineOp::Mul,
+                Def::Binary(BinOp::Div, _, _) => MachineOp::Div,
+                Def::Call(callee, _) => MachineOp::Call(callee.clone()),
                 _ => unreachable!("ops are binary or calls"),
-            });
-            match is.pe {
-                Pe::Add(_) => issued_add[c as usize] += 1,
-                Pe::Mul(_) => issued_mul[c as usize] += 1,
-            }
+            };
+            pes[r.slot(is.pe)].steps[c as usize].issue = Some(Instr { op, reads: addrs });
+            issue_of[v.index()] = Some((r.slot(is.pe), c));
         }
     }
 
-    let mut outputs = Vec::with_capacity(f.outputs.len());
-    for o in &f.outputs {
-        let x = match o.value {
-            Operand::Const(c) => T::from_f64(c),
-            Operand::Value(v) => {
-                r.value_ok(v, "an output")?;
-                match result[v.index()].or(init[v.index()]) {
-                    Some(x) => x,
-                    None => {
-                        return Err(SimError::new(
-                            K::OutputUnavailable,
-                            format!("output `{}` was never computed", o.name),
-                        )
-                        .at(When::End)
-                        .of(r.vname(v))
-                        .src(o.span))
-                    }
-                }
-            }
-        };
-        outputs.push((o.name.clone(), x));
-    }
-
-    let n_pe = arch.n_pe();
-    Ok(SimOutcome {
-        outputs,
+    let program = MachineProgram {
+        arch,
         cycles,
-        writes_direct: p.writes.iter().filter(|w| w.buffer_addr.is_none()).count() as u32,
-        writes_indirect: p.writes.iter().filter(|w| w.buffer_addr.is_some()).count() as u32,
+        pe_words: p.pe_words.clone(),
+        buffer_words: p.buffer_words.clone(),
+        output_words,
+        pes,
+        outputs,
+        issue_of,
+    };
+    let occupancy = Occupancy {
         max_words_per_memory: peak(
             n_pe,
             mem_ev.iter().map(|e| (e.slot, e.time, e.last_read.unwrap_or(e.time).max(e.time))),
@@ -398,7 +455,6 @@ pub(super) fn run<T: Float>(
             n_pe,
             buf_ev.iter().map(|b| (b.slot, b.arrival as i64, b.last_read.max(b.arrival) as i64)),
         ),
-        issued_per_cycle_add: issued_add,
-        issued_per_cycle_mul: issued_mul,
-    })
+    };
+    Ok((program, occupancy))
 }

@@ -1,4 +1,6 @@
-//! What the simulator rejects: one [`SimError`] naming when, where and which value.
+//! What the lowering (and so `sim`, which executes what it lowers) rejects: one
+//! [`MachineError`] naming when, where and which value. `sim` re-exports these types as
+//! `MachineError` and `MachineErrorKind`.
 
 use robovec_ir::placement::Pe;
 use robovec_ir::Span;
@@ -24,9 +26,9 @@ impl std::fmt::Display for When {
     }
 }
 
-/// The rule a placement breaks (one per check of the simulator).
+/// The rule a placement breaks (one per check of the lowering), or what `sim` found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum SimErrorKind {
+pub enum MachineErrorKind {
     /// The function or placement cannot be simulated at all (vector sizes, unknown values,
     /// a zero latency, parsed-phase expressions).
     Malformed,
@@ -66,19 +68,28 @@ pub enum SimErrorKind {
     /// An address written while the value it holds still has a read in this or a later cycle,
     /// or written twice in one cycle.
     AddressReused,
-    /// An output whose value was never computed.
+    /// An output whose value was never computed. Kept for `sim`'s callers; the lowering no
+    /// longer produces it (an unissued op is [`MachineErrorKind::MissingIssue`] first, and
+    /// every output of an issued op is captured at its arrival).
     OutputUnavailable,
-    /// A simulated output differs from the interpreter (`verify_placement`).
+    /// A simulated output differs from the interpreter (`sim`'s `verify_placement`).
     Mismatch,
+    /// Two results arrive on one PE in one cycle (ops of different latencies, `div`/`call`
+    /// against `add`): a PE has one result bus, so the crossbar, buffer and output capture
+    /// could not tell them apart.
+    ResultCollision,
+    /// The lowered program fails the verifier's lowered check (a lowering bug), or an
+    /// executed program is inconsistent (a word read before anything was written there).
+    Unverified,
 }
 
-/// A placement the simulator rejects: the first broken rule, with the cycle, the PE and the
+/// A placement the lowering rejects (or a `sim` mismatch): the first broken rule, with the cycle, the PE and the
 /// value involved when there are such. Displays as `cycle 7, add0, %x: message`.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("{}", self.render())]
-pub struct SimError {
+pub struct MachineError {
     /// The broken rule.
-    pub kind: SimErrorKind,
+    pub kind: MachineErrorKind,
     /// When, if the error has a time.
     pub when: Option<When>,
     /// The PE (memory, buffer or issuing PE) involved.
@@ -92,27 +103,27 @@ pub struct SimError {
     pub span: Span,
 }
 
-impl SimError {
-    pub(crate) fn new(kind: SimErrorKind, message: impl Into<String>) -> SimError {
-        SimError { kind, when: None, pe: None, value: None, message: message.into(), span: Span::DUMMY }
+impl MachineError {
+    pub(crate) fn new(kind: MachineErrorKind, message: impl Into<String>) -> MachineError {
+        MachineError { kind, when: None, pe: None, value: None, message: message.into(), span: Span::DUMMY }
     }
 
-    pub(crate) fn at(mut self, when: When) -> SimError {
+    pub(crate) fn at(mut self, when: When) -> MachineError {
         self.when = Some(when);
         self
     }
 
-    pub(crate) fn on(mut self, pe: Pe) -> SimError {
+    pub(crate) fn on(mut self, pe: Pe) -> MachineError {
         self.pe = Some(pe);
         self
     }
 
-    pub(crate) fn of(mut self, value: impl Into<String>) -> SimError {
+    pub(crate) fn of(mut self, value: impl Into<String>) -> MachineError {
         self.value = Some(value.into());
         self
     }
 
-    pub(crate) fn src(mut self, span: Span) -> SimError {
+    pub(crate) fn src(mut self, span: Span) -> MachineError {
         self.span = span;
         self
     }

@@ -1,0 +1,267 @@
+//! The machine program: a placed function lowered once into what the seed's architecture
+//! executes cycle by cycle (seed ch. 1 §1.1–§1.3, §2.3; SPEC §5) — per PE the instruction
+//! stream, per buffer its store/read instructions, per PE memory the crossbar selection, the
+//! output capture, the initial contents of every memory and the output map. `sim` executes it,
+//! `codegen<fpga>` encodes it ([`encode`]), the verifier checks it
+//! ([`crate::verifier::machine`]).
+//!
+//! # Why a placement and a machine program
+//! [`crate::placement::Placement`] (with [`Arch`]) is the *decision* a placer makes, at the
+//! level of values: which PE issues each op when, which value goes to which address of which
+//! memory. It is part of the textual IR (`placement { … }` in `.rvir`), small, and checkable
+//! without time order (the placed verifier check). The machine program is *derived* from it
+//! and holds no value: per PE slot and per cycle the addresses read and written, the crossbar
+//! selects, the buffer and output-capture instructions — exactly the words of the FPGA images.
+//! It is never printed in `.rvir` (it is recomputed from the placement by
+//! `robovec_passes::machine::lower`), so the split is: `placement.rs` = what the user or the
+//! placer decides and the text format carries; `machine` = the one lowering every consumer
+//! executes or encodes.
+//!
+//! # Timing (the contract of [`crate::placement`])
+//! An op issued at cycle `t` on PE slot `s` with latency `L` has its result **arrive** at
+//! `t + L` on `s`'s result bus: in that cycle it may be written into any PE memory (crossbar
+//! source [`Source::Result`]`(s)`), enter `s`'s buffer ([`BufferOp::store`]) and be captured into
+//! `s`'s output memory ([`Step::capture`]). Within a cycle the hardware **writes before it
+//! reads** (the seed's double-pumped M10K): in cycle `c`, in this order,
+//! 1. results arriving at `c` are stored in buffers and captured in output memories;
+//! 2. each buffer is read at its [`BufferOp::read`] address (a word stored in step 1 is
+//!    readable now);
+//! 3. each PE memory takes its writes ([`Step::writes`], one per write port);
+//! 4. each PE issues its instruction, reading its operands from its own memory (a word written
+//!    in step 3 is readable now).
+//!
+//! Steps cover cycles `0..=cycles` (`cycles` = the largest arrival, 0 without ops); a lone add
+//! takes 12 cycles on the default latencies.
+//!
+//! # Ops the hardware has
+//! The FPGA has an add/sub unit on ADD PEs and a multiplier on MULTI PEs only. The machine
+//! program also carries `div` and `call` (on ADD PEs, as the machine model allows) so that
+//! `sim` can execute every placement; [`encode`] rejects them with
+//! [`encode::EncodeError::NoUnit`] (so `codegen<fpga>` reports them), and so it rejects a step
+//! with more than two writes or an address wider than the layout's fields.
+//!
+//! # Binary32 data words
+//! Constants and inputs are rounded to nearest from `f64` (`x as f32`, as
+//! `-eval-precision=f32` and `interp`'s `Float::from_f64` for `f32` do); trig initial
+//! variables are `sin`/`cos` computed in binary32 on the rounded input, as `interp` does in
+//! `f32` ([`Word::binary32`]).
+//!
+//! The image encoding is documented bit by bit in [`encode`].
+
+pub mod encode;
+
+use crate::placement::{Arch, Pe};
+use crate::syntax::{Callee, Operand, TrigFn};
+use crate::Value;
+
+/// What a memory word holds: a value of the function or a constant, by its `f64` bits (`0.0`
+/// and `-0.0` differ). The one memory-word key of the placer, the lowering and the verifier.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Held {
+    /// An input, trig initial variable or op result.
+    Value(Value),
+    /// A constant, by `f64::to_bits`.
+    Const(u64),
+}
+
+impl Held {
+    /// The key of an operand.
+    pub fn of(o: &Operand) -> Held {
+        match o {
+            Operand::Value(v) => Held::Value(*v),
+            Operand::Const(c) => Held::Const(c.to_bits()),
+        }
+    }
+}
+
+/// Initial contents of one word of a PE memory or output memory (loaded before cycle 0).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Word {
+    /// The input of this canonical name (SPEC §2), supplied at run time.
+    Input(String),
+    /// `sin`/`cos` of the named input, computed by the host in the run's precision.
+    Trig(TrigFn, String),
+    /// A constant (its binary32 rounding in the images).
+    Const(f64),
+}
+
+impl Word {
+    /// The binary32 bits of this word, `input(name)` giving each input's value: inputs and
+    /// constants rounded to nearest (`x as f32`), trig values as `sin`/`cos` in `f32` of the
+    /// rounded input (what `interp::eval::<f32>` computes).
+    pub fn binary32(&self, input: impl Fn(&str) -> f64) -> u32 {
+        match self {
+            Word::Input(n) => (input(n) as f32).to_bits(),
+            Word::Trig(t, n) => {
+                let x = input(n) as f32;
+                match t {
+                    TrigFn::Sin => x.sin().to_bits(),
+                    TrigFn::Cos => x.cos().to_bits(),
+                }
+            }
+            Word::Const(c) => (*c as f32).to_bits(),
+        }
+    }
+}
+
+/// The operation an instruction issues. `Add`/`Sub` run on ADD PEs, `Mul` on MULTI PEs; `Div`
+/// and `Call` (ADD PEs) exist in the machine model for `sim` but not on the FPGA.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MachineOp {
+    /// `a + b` (ADD PE, sub bit 0).
+    Add,
+    /// `a − b` (ADD PE, sub bit 1).
+    Sub,
+    /// `a · b` (MULTI PE).
+    Mul,
+    /// `a / b` (ADD PE; no FPGA unit).
+    Div,
+    /// A call (ADD PE; no FPGA unit), reading all its operands in its issue cycle.
+    Call(Box<Callee>),
+}
+
+/// One instruction: the op issued this cycle and the addresses of its operands in the issuing
+/// PE's memory, in operand order (two for binary ops; a call reads as many as it has).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Instr {
+    /// The op.
+    pub op: MachineOp,
+    /// Read addresses (words of this PE's memory).
+    pub reads: Vec<u32>,
+}
+
+/// Where a PE-memory write takes its data (the crossbar select).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Source {
+    /// The result arriving now from PE slot `s` (a direct write).
+    Result(usize),
+    /// The word read now from PE slot `s`'s buffer (an indirect write).
+    Buffer(usize),
+}
+
+/// One write into this PE's memory in one cycle, on one write port.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemWrite {
+    /// Address written.
+    pub addr: u32,
+    /// Crossbar source.
+    pub src: Source,
+}
+
+/// The buffer memory's instruction in one cycle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BufferOp {
+    /// Store the result arriving now on this PE at this buffer address.
+    pub store: Option<u32>,
+    /// Read this buffer address now (the crossbar source [`Source::Buffer`] of this PE).
+    pub read: Option<u32>,
+}
+
+/// What one PE (its issue port, PE memory, buffer and output memory) does in one cycle.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Step {
+    /// The instruction issued, if any.
+    pub issue: Option<Instr>,
+    /// Writes into this PE's memory, in write-port order (at most `arch.writes`).
+    pub writes: Vec<MemWrite>,
+    /// The buffer's instruction.
+    pub buffer: BufferOp,
+    /// Capture the result arriving now on this PE at this output-memory address.
+    pub capture: Option<u32>,
+}
+
+/// The program of one PE slot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PeProgram {
+    /// The PE ([`Pe::slot`] order: ADD PEs first).
+    pub pe: Pe,
+    /// Initial contents of the PE memory by address (`pe_words` entries; `None`: not loaded).
+    pub init: Vec<Option<Word>>,
+    /// Initial contents of the output memory by address (`output_words` entries): outputs that
+    /// are inputs, trig values or constants; `None` for captured words.
+    pub output_init: Vec<Option<Word>>,
+    /// One step per cycle `0..=cycles`.
+    pub steps: Vec<Step>,
+}
+
+/// Where an output is read after the run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct OutputLoc {
+    /// Output name (SPEC §2).
+    pub name: String,
+    /// PE slot whose output memory holds it.
+    pub slot: usize,
+    /// Output-memory address.
+    pub addr: u32,
+}
+
+/// A lowered function: what the machine executes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MachineProgram {
+    /// PE counts, latencies (cycles), write ports, buffers.
+    pub arch: Arch,
+    /// Largest arrival cycle (0 without ops); steps cover `0..=cycles`.
+    pub cycles: u32,
+    /// Words of each PE memory (addresses `0..pe_words`), by slot.
+    pub pe_words: Vec<u32>,
+    /// Words of each buffer, by slot.
+    pub buffer_words: Vec<u32>,
+    /// Words of each output memory, by slot.
+    pub output_words: Vec<u32>,
+    /// Programs by slot.
+    pub pes: Vec<PeProgram>,
+    /// Every output of the function, in `Function::outputs` order.
+    pub outputs: Vec<OutputLoc>,
+    /// Provenance (not encoded): the `(slot, cycle)` where each op issues, by
+    /// `Value::index()` (`None` for non-ops). Lets the verifier name values.
+    pub issue_of: Vec<Option<(usize, u32)>>,
+}
+
+impl MachineProgram {
+    /// Number of PEs (ADD then MULTI).
+    pub fn n_pe(&self) -> usize {
+        self.pes.len()
+    }
+
+    /// The latency of an op on this program's architecture, cycles.
+    pub fn latency(&self, op: &MachineOp) -> u32 {
+        let l = &self.arch.lat;
+        match op {
+            MachineOp::Add | MachineOp::Sub => l.add,
+            MachineOp::Mul => l.mul,
+            MachineOp::Div => l.div,
+            MachineOp::Call(_) => l.call,
+        }
+    }
+
+    /// The binary32 initial contents of PE slot `slot`'s memory, one word per address (0 where
+    /// nothing is loaded), `input(name)` giving each input ([`Word::binary32`]).
+    ///
+    /// # Panics
+    /// When `slot` is not below [`MachineProgram::n_pe`].
+    pub fn pe_image(&self, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
+        self.pes[slot].init.iter().map(|w| w.as_ref().map_or(0, |w| w.binary32(&input))).collect()
+    }
+
+    /// The binary32 initial contents of PE slot `slot`'s output memory (0 for captured words).
+    ///
+    /// # Panics
+    /// When `slot` is not below [`MachineProgram::n_pe`].
+    pub fn output_image(&self, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
+        self.pes[slot].output_init.iter().map(|w| w.as_ref().map_or(0, |w| w.binary32(&input))).collect()
+    }
+
+    /// Direct writes (crossbar source a result) in the whole program.
+    pub fn writes_direct(&self) -> u32 {
+        self.count_writes(|s| matches!(s, Source::Result(_)))
+    }
+
+    /// Indirect writes (crossbar source a buffer read) in the whole program.
+    pub fn writes_indirect(&self) -> u32 {
+        self.count_writes(|s| matches!(s, Source::Buffer(_)))
+    }
+
+    fn count_writes(&self, pick: impl Fn(Source) -> bool) -> u32 {
+        self.pes.iter().flat_map(|p| &p.steps).flat_map(|s| &s.writes).filter(|w| pick(w.src)).count() as u32
+    }
+}

@@ -1,0 +1,550 @@
+//! The target description: one record of the machine every pass places for, sizes against and
+//! converts cycles with (issue 12). Selected once on the command line (`-target=de10-nano` or
+//! `-target=FILE.json`) and carried by the pass context; a pass parameter (`lat-add=…`) only
+//! overrides it where given.
+//!
+//! # The built-in `de10-nano` (seed ch. 1, SPEC §1 and §5)
+//! | field | value | source |
+//! |---|---|---|
+//! | `latencies.add` | 12 cycles = 10 stages + 2 | seed §1.3: ADD IP of 10 stages (Table 1.1, 178 MHz) + 2 cycles of crossbar and write; SPEC §1 |
+//! | `latencies.mul` | 7 cycles = 5 stages + 2 | seed §1.3: MULTI IP of 5 stages (Table 1.2, 199 MHz) + 2; SPEC §1 |
+//! | `latencies.div`, `latencies.call` | 12 cycles | on the ADD side (SPEC §1; the seed has neither) |
+//! | `writes` | 2 write ports per PE memory per cycle | seed §1.1.2 (M10K: 2 ports, double-pumped) |
+//! | `pe_words` | 2048 words | seed §1.3.1 ("our PE memory contains 2048 addresses", 11 address bits, 7 M10K) |
+//! | `buffer_words` | 16 words | seed §1.3.1 ("we use 16 addresses to save the results") |
+//! | `instr_words` | 65 536 words | the depth of the instruction memories the top may generate (a 16-bit cycle counter); the seed's 987-cycle design used 1024-word memories (48 128 bits, §1.3.1); what a deeper memory costs is counted in M10K by [`Target::estimate`] |
+//! | `instr_width` | 52 bits | seed §1.3.1 (two read and two write addresses of 11 bits as 3 hex digits, enables, add/sub bit) |
+//! | `clock_mhz` | 120 MHz | seed §1.3 and §1.3.2 (see below) |
+//! | `alm`, `m10k`, `dsp` | 41 910 ALM, 553 M10K, 112 DSP | the DE10-Nano's Cyclone V SE 5CSEBA6U23I7 as Quartus' fitter counts it, the denominators of the seed's Table 1.4 (`4413/41910`, `120/553`, `20/112`); Intel's *Cyclone V Device Overview* (CV-51001, SE A6 row) gives the 112 variable-precision DSP blocks and the 10-Kbit M10K (its family table rounds ALM and block counts slightly differently; the fitter's usable counts are the ones a fit is judged against) |
+//! | `m10k_bits` | 10 240 bits | Intel, *Cyclone V Device Overview*: M10K = 10 Kbit blocks |
+//! | `fp_add` | 360 ALM, 2 DSP, 0 M10K per ADD PE | seed Table 1.4, row "PE ADD" (Quartus figures of the 8-PE design) |
+//! | `fp_mul` | 100 ALM, 3 DSP, 0 M10K per MULTI PE | seed Table 1.4, row "PE MULTI" |
+//! | `pe_memory_alm` | 3 ALM per PE memory | seed Table 1.4, row "PE Memory" |
+//! | `crossbar_alm` | 8.125 ALM per (PE-memory write port × crossbar source) | seed Table 1.4, row "Interconnections": 2080 ALM for 8 PE memories × 2 write ports (one multiplexer each, 16 in all, §1.3.1) × 16 sources (8 results + 8 buffer reads) |
+//! | `control_alm` | 469 ALM | seed Table 1.4: the total (4413) minus the rows (4·360 + 4·100 + 8·3 + 2080 = 3944): cycle counter, start/done and glue the table does not itemise |
+//!
+//! ## The clock
+//! Seed §1.3: the M10K is limited to 240 MHz on the DE10-Nano and the PE memory runs at twice the
+//! PE clock (two memory cycles per PE cycle: read, then write, §1.1.2), so the PE clock is at
+//! most 120 MHz; the ADD/MULTI couple (10, 5) was chosen so that the PEs (178 / 199 MHz,
+//! Table 1.3) are not the limit. §1.3.2 names the two clocks CLK120 and CLK240 ("respectively …
+//! 120 and 240 MHz") and the conclusion calls 120 MHz the design's "theoretical maximal
+//! frequency". The design as built reached only about 50 MHz on CLK240 (§1.3.2; the conclusion's
+//! "two clock design which limited the frequency of 50 MHz"), i.e. 25 MHz of PE clock, because
+//! CLK120 was derived from CLK240's edges. The built-in target takes **120 MHz**, the clock the
+//! architecture is designed for and that a top with a proper PLL pair can run at; the as-built
+//! 25 MHz is `examples/targets/de10-nano-as-built.json`.
+//!
+//! # The JSON format (`-target=FILE.json`)
+//! One object, every key required except `latencies.div` and `latencies.call` (default: the
+//! `add` latency, as they run on ADD PEs); an unknown key anywhere is an error, as is a value
+//! that makes no sense (zero latency, ports, words, width or capacity; a clock that is not a
+//! positive finite number; a negative or non-finite cost):
+//!
+//! ```json
+//! {
+//!   "name": "de10-nano",
+//!   "clock_mhz": 120.0,
+//!   "latencies": { "add": 12, "mul": 7, "div": 12, "call": 12 },
+//!   "writes": 2,
+//!   "pe_words": 2048,
+//!   "buffer_words": 16,
+//!   "instr_words": 65536,
+//!   "instr_width": 52,
+//!   "alm": 41910,
+//!   "m10k": 553,
+//!   "dsp": 112,
+//!   "m10k_bits": 10240,
+//!   "fp_add": { "alm": 360, "dsp": 2, "m10k": 0 },
+//!   "fp_mul": { "alm": 100, "dsp": 3, "m10k": 0 },
+//!   "pe_memory_alm": 3,
+//!   "crossbar_alm": 8.125,
+//!   "control_alm": 469
+//! }
+//! ```
+//!
+//! # The analytic resource estimate ([`Target::estimate`])
+//! For `n_add` ADD and `n_mul` MULTI PEs (`n_pe = n_add + n_mul`) running `cycles` cycles:
+//! - ALM = `n_add·fp_add.alm + n_mul·fp_mul.alm + n_pe·pe_memory_alm
+//!   + crossbar_alm·n_pe·writes·(2·n_pe) + control_alm` (the crossbar: one multiplexer per
+//!   PE-memory write port over the `2·n_pe` sources, each result and each buffer read);
+//! - DSP = `n_add·fp_add.dsp + n_mul·fp_mul.dsp`;
+//! - M10K = per PE, `fp_*.m10k` plus each of its memories as ⌈bits / m10k_bits⌉ (at least 1):
+//!   PE memory `pe_words × 32`, buffer memory `buffer_words × 32`, instruction memory
+//!   `(cycles + 1) × instr_width`, buffer instructions `(cycles + 1) × (2·bw + 2)`, crossbar
+//!   memory `(cycles + 1) × writes·sw`, with `bw = ⌈log2 buffer_words⌉` and
+//!   `sw = ⌈log2(2·n_pe + 1)⌉` (the encoding of issue 12). Memories are sized by the target
+//!   (the fixed 2048-word PE memory of Table 1.4), not by what a placement uses.
+//!
+//! On the seed's own configuration (4 + 4 PE, 987 cycles, §1.3.1) this gives 4413 ALM and
+//! 20 DSP (Table 1.4, by construction of `control_alm`) and 128 M10K against the table's 120:
+//! the bit count puts a 988 × 52-bit instruction memory in 6 blocks where the seed reports 3–4,
+//! and the crossbar memories in 8 where it reports 20. The FPGA back end replaces this estimate
+//! by Yosys' figures for one N; `sweep` uses it to say which N fit.
+
+use crate::analysis::Latencies;
+use crate::placement::Arch;
+
+/// What one floating-point unit (with its PE wrapper) costs, per PE (seed Table 1.4).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnitCost {
+    /// Adaptive logic modules.
+    pub alm: f64,
+    /// Variable-precision DSP blocks.
+    pub dsp: u32,
+    /// M10K blocks (outside the PE's memories).
+    pub m10k: u32,
+}
+
+/// A machine description (see the module doc for every field's source on the DE10-Nano).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Target {
+    /// Name (`de10-nano`, or the JSON file's `name`).
+    pub name: String,
+    /// PE clock, MHz (one cycle of the placement = one period).
+    pub clock_mhz: f64,
+    /// Latencies, cycles from issue to a result written in the target PE memory (SPEC §1).
+    pub latencies: Latencies,
+    /// Write ports per PE memory per cycle.
+    pub writes: u32,
+    /// Words (binary32) per PE memory.
+    pub pe_words: u32,
+    /// Words (binary32) per buffer memory.
+    pub buffer_words: u32,
+    /// Largest instruction-memory depth, words (one word per cycle `0..=cycles`).
+    pub instr_words: u32,
+    /// Bits of an instruction-memory word.
+    pub instr_width: u32,
+    /// Device capacity, ALM.
+    pub alm: u32,
+    /// Device capacity, M10K blocks.
+    pub m10k: u32,
+    /// Device capacity, DSP blocks.
+    pub dsp: u32,
+    /// Bits of one M10K block.
+    pub m10k_bits: u32,
+    /// Cost of one ADD PE's floating-point adder/subtractor.
+    pub fp_add: UnitCost,
+    /// Cost of one MULTI PE's floating-point multiplier.
+    pub fp_mul: UnitCost,
+    /// ALM of the logic around one PE memory.
+    pub pe_memory_alm: f64,
+    /// ALM per PE-memory write port per crossbar source.
+    pub crossbar_alm: f64,
+    /// ALM of the control (cycle counter, start/done) shared by the whole design.
+    pub control_alm: f64,
+}
+
+/// The resources a configuration needs, against the target's capacity ([`Target::estimate`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Resources {
+    /// ALM (rounded up).
+    pub alm: u32,
+    /// M10K blocks.
+    pub m10k: u32,
+    /// DSP blocks.
+    pub dsp: u32,
+    /// True when all three are within the device's capacity.
+    pub fits: bool,
+}
+
+/// A target file that cannot be used: unreadable, not JSON of the format, or a senseless value.
+#[derive(Debug, thiserror::Error)]
+pub enum TargetError {
+    /// The file cannot be read.
+    #[error("cannot read target file {path}: {source}")]
+    Io {
+        /// The path as given.
+        path: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// JSON syntax or shape error (unknown field, missing field, wrong type), at a 1-based
+    /// line and column.
+    #[error("{path}:{line}:{column}: {message}")]
+    Syntax {
+        /// The path as given.
+        path: String,
+        /// Line, 1-based.
+        line: usize,
+        /// Column, 1-based.
+        column: usize,
+        /// What serde says.
+        message: String,
+    },
+    /// A value out of its range.
+    #[error("{path}: {message}")]
+    Value {
+        /// The path as given.
+        path: String,
+        /// The field and why.
+        message: String,
+    },
+}
+
+/// The JSON form of [`Latencies`]: `div` and `call` default to `add`.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LatenciesFile {
+    add: u32,
+    mul: u32,
+    div: Option<u32>,
+    call: Option<u32>,
+}
+
+/// The JSON form of [`Target`].
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TargetFile {
+    name: String,
+    clock_mhz: f64,
+    latencies: LatenciesFile,
+    writes: u32,
+    pe_words: u32,
+    buffer_words: u32,
+    instr_words: u32,
+    instr_width: u32,
+    alm: u32,
+    m10k: u32,
+    dsp: u32,
+    m10k_bits: u32,
+    fp_add: UnitCost,
+    fp_mul: UnitCost,
+    pe_memory_alm: f64,
+    crossbar_alm: f64,
+    control_alm: f64,
+}
+
+/// ⌈log2 n⌉ for n ≥ 1 (0 for n ≤ 1): the address bits of an n-word memory.
+pub fn address_bits(n: u32) -> u32 {
+    if n <= 1 {
+        0
+    } else {
+        32 - (n - 1).leading_zeros()
+    }
+}
+
+impl Target {
+    /// The names of the built-in targets, for diagnostics.
+    pub const BUILT_IN: &'static [&'static str] = &["de10-nano"];
+
+    /// The DE10-Nano of the seed (module doc: every value and its source).
+    pub fn de10_nano() -> Target {
+        Target {
+            name: "de10-nano".into(),
+            clock_mhz: 120.0,
+            latencies: Latencies { add: 12, mul: 7, div: 12, call: 12 },
+            writes: 2,
+            pe_words: 2048,
+            buffer_words: 16,
+            instr_words: 65536,
+            instr_width: 52,
+            alm: 41_910,
+            m10k: 553,
+            dsp: 112,
+            m10k_bits: 10_240,
+            fp_add: UnitCost { alm: 360.0, dsp: 2, m10k: 0 },
+            fp_mul: UnitCost { alm: 100.0, dsp: 3, m10k: 0 },
+            pe_memory_alm: 3.0,
+            crossbar_alm: 8.125,
+            control_alm: 469.0,
+        }
+    }
+
+    /// A built-in target by name (`None`: no such target).
+    pub fn built_in(name: &str) -> Option<Target> {
+        match name {
+            "de10-nano" => Some(Target::de10_nano()),
+            _ => None,
+        }
+    }
+
+    /// Reads a target from JSON text (`path` only names it in errors).
+    ///
+    /// # Errors
+    /// [`TargetError::Syntax`] with line and column for bad JSON, unknown or missing fields and
+    /// wrong types; [`TargetError::Value`] for senseless values.
+    pub fn from_json(path: &str, text: &str) -> Result<Target, TargetError> {
+        let f: TargetFile = serde_json::from_str(text).map_err(|e| TargetError::Syntax {
+            path: path.to_string(),
+            line: e.line(),
+            column: e.column(),
+            message: strip_position(&e.to_string()),
+        })?;
+        let t = Target {
+            name: f.name,
+            clock_mhz: f.clock_mhz,
+            latencies: Latencies {
+                add: f.latencies.add,
+                mul: f.latencies.mul,
+                div: f.latencies.div.unwrap_or(f.latencies.add),
+                call: f.latencies.call.unwrap_or(f.latencies.add),
+            },
+            writes: f.writes,
+            pe_words: f.pe_words,
+            buffer_words: f.buffer_words,
+            instr_words: f.instr_words,
+            instr_width: f.instr_width,
+            alm: f.alm,
+            m10k: f.m10k,
+            dsp: f.dsp,
+            m10k_bits: f.m10k_bits,
+            fp_add: f.fp_add,
+            fp_mul: f.fp_mul,
+            pe_memory_alm: f.pe_memory_alm,
+            crossbar_alm: f.crossbar_alm,
+            control_alm: f.control_alm,
+        };
+        t.validate().map_err(|message| TargetError::Value { path: path.to_string(), message })?;
+        Ok(t)
+    }
+
+    /// Reads a target file.
+    ///
+    /// # Errors
+    /// As [`Target::from_json`], plus [`TargetError::Io`].
+    pub fn from_file(path: &std::path::Path) -> Result<Target, TargetError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| TargetError::Io { path: shown.clone(), source })?;
+        Target::from_json(&shown, &text)
+    }
+
+    /// `de10-nano` or a JSON file's path.
+    ///
+    /// # Errors
+    /// As [`Target::from_file`].
+    pub fn resolve(spec: &str) -> Result<Target, TargetError> {
+        match Target::built_in(spec) {
+            Some(t) => Ok(t),
+            None => Target::from_file(std::path::Path::new(spec)),
+        }
+    }
+
+    /// Checks every value makes sense; the message names the field.
+    ///
+    /// # Errors
+    /// `"field: why"`.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.name.trim().is_empty() {
+            return Err("`name` must not be empty".into());
+        }
+        if !(self.clock_mhz.is_finite() && self.clock_mhz > 0.0) {
+            return Err(format!("`clock_mhz` must be a positive number of MHz, got {}", self.clock_mhz));
+        }
+        let l = &self.latencies;
+        for (k, v) in [("add", l.add), ("mul", l.mul), ("div", l.div), ("call", l.call)] {
+            if v == 0 {
+                return Err(format!("`latencies.{k}` must be at least 1 cycle, got 0"));
+            }
+        }
+        let counts = [
+            ("writes", self.writes),
+            ("pe_words", self.pe_words),
+            ("buffer_words", self.buffer_words),
+            ("instr_words", self.instr_words),
+            ("instr_width", self.instr_width),
+            ("alm", self.alm),
+            ("m10k", self.m10k),
+            ("dsp", self.dsp),
+            ("m10k_bits", self.m10k_bits),
+        ];
+        for (k, v) in counts {
+            if v == 0 {
+                return Err(format!("`{k}` must be at least 1, got 0"));
+            }
+        }
+        let costs = [
+            ("fp_add.alm", self.fp_add.alm),
+            ("fp_mul.alm", self.fp_mul.alm),
+            ("pe_memory_alm", self.pe_memory_alm),
+            ("crossbar_alm", self.crossbar_alm),
+            ("control_alm", self.control_alm),
+        ];
+        for (k, v) in costs {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("`{k}` must be a non-negative number of ALM, got {v}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The architecture of `n_add` ADD and `n_mul` MULTI PEs on this target (its latencies and
+    /// write ports).
+    pub fn arch(&self, n_add: u32, n_mul: u32, buffer: bool) -> Arch {
+        Arch { n_add, n_mul, lat: self.latencies, writes: self.writes, buffer }
+    }
+
+    /// Microseconds that `cycles` cycles take at [`Target::clock_mhz`] (`cycles / clock_mhz`).
+    pub fn us(&self, cycles: u32) -> f64 {
+        f64::from(cycles) / self.clock_mhz
+    }
+
+    /// Address bits of a PE memory (⌈log2 pe_words⌉; 11 on the DE10-Nano).
+    pub fn pe_address_bits(&self) -> u32 {
+        address_bits(self.pe_words)
+    }
+
+    /// Address bits of a buffer memory (⌈log2 buffer_words⌉; 4 on the DE10-Nano).
+    pub fn buffer_address_bits(&self) -> u32 {
+        address_bits(self.buffer_words)
+    }
+
+    /// M10K blocks of a memory of `words × width` bits: ⌈bits / m10k_bits⌉, at least 1.
+    pub fn m10k_blocks(&self, words: u64, width: u32) -> u32 {
+        let bits = words * u64::from(width);
+        let b = bits.div_ceil(u64::from(self.m10k_bits)).max(1);
+        u32::try_from(b).unwrap_or(u32::MAX)
+    }
+
+    /// The analytic resource estimate of `n_add` ADD and `n_mul` MULTI PEs running `cycles`
+    /// cycles (module doc: the model and its figures against seed Table 1.4).
+    pub fn estimate(&self, n_add: u32, n_mul: u32, cycles: u32) -> Resources {
+        let n_pe = u64::from(n_add) + u64::from(n_mul);
+        let sources = 2 * n_pe;
+        let alm = f64::from(n_add) * self.fp_add.alm
+            + f64::from(n_mul) * self.fp_mul.alm
+            + n_pe as f64 * self.pe_memory_alm
+            + self.crossbar_alm * (n_pe * u64::from(self.writes) * sources) as f64
+            + self.control_alm;
+        let dsp = u64::from(n_add) * u64::from(self.fp_add.dsp) + u64::from(n_mul) * u64::from(self.fp_mul.dsp);
+        let depth = u64::from(cycles) + 1;
+        let bw = self.buffer_address_bits();
+        let sw = address_bits(u32::try_from(sources + 1).unwrap_or(u32::MAX));
+        let per_pe = u64::from(self.m10k_blocks(u64::from(self.pe_words), 32))
+            + u64::from(self.m10k_blocks(u64::from(self.buffer_words), 32))
+            + u64::from(self.m10k_blocks(depth, self.instr_width))
+            + u64::from(self.m10k_blocks(depth, 2 * bw + 2))
+            + u64::from(self.m10k_blocks(depth, self.writes * sw));
+        let m10k = n_pe * per_pe
+            + u64::from(n_add) * u64::from(self.fp_add.m10k)
+            + u64::from(n_mul) * u64::from(self.fp_mul.m10k);
+        let sat = |x: u64| u32::try_from(x).unwrap_or(u32::MAX);
+        let alm = if alm >= f64::from(u32::MAX) { u32::MAX } else { alm.ceil() as u32 };
+        let (m10k, dsp) = (sat(m10k), sat(dsp));
+        Resources { alm, m10k, dsp, fits: alm <= self.alm && m10k <= self.m10k && dsp <= self.dsp }
+    }
+}
+
+impl Default for Target {
+    fn default() -> Self {
+        Target::de10_nano()
+    }
+}
+
+/// serde_json appends " at line L column C" to its messages; the diagnostic gives them first.
+fn strip_position(msg: &str) -> String {
+    match msg.rfind(" at line ") {
+        Some(i) => msg[..i].to_string(),
+        None => msg.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn de10_json() -> String {
+        serde_json::to_string_pretty(&Target::de10_nano()).unwrap()
+    }
+
+    #[test]
+    fn built_in_round_trips_through_json() {
+        let t = Target::from_json("x.json", &de10_json()).unwrap();
+        assert_eq!(t, Target::de10_nano());
+    }
+
+    #[test]
+    fn shipped_example_files_are_the_built_in_and_its_as_built_clock() {
+        let file = include_str!("../../examples/targets/de10-nano.json");
+        assert_eq!(Target::from_json("de10-nano.json", file).unwrap(), Target::de10_nano());
+        let built = include_str!("../../examples/targets/de10-nano-as-built.json");
+        let t = Target::from_json("de10-nano-as-built.json", built).unwrap();
+        // Seed §1.3.2: CLK240 reached about 50 MHz, so the PE clock (half of it) 25 MHz.
+        assert_eq!(t.clock_mhz, 25.0);
+        assert_eq!(Target { name: "de10-nano".into(), clock_mhz: 120.0, ..t }, Target::de10_nano());
+    }
+
+    #[test]
+    fn div_and_call_default_to_add() {
+        let mut v: serde_json::Value = serde_json::from_str(&de10_json()).unwrap();
+        let lat = v["latencies"].as_object_mut().unwrap();
+        lat.remove("div");
+        lat.remove("call");
+        lat.insert("add".into(), 9.into());
+        let t = Target::from_json("x.json", &v.to_string()).unwrap();
+        assert_eq!(t.latencies, Latencies { add: 9, mul: 7, div: 9, call: 9 });
+    }
+
+    #[test]
+    fn unknown_field_has_line_and_column() {
+        let text = "{\n  \"name\": \"x\",\n  \"clok_mhz\": 50\n}";
+        match Target::from_json("t.json", text) {
+            Err(TargetError::Syntax { line, column, message, .. }) => {
+                assert_eq!(line, 3);
+                assert!(column >= 3, "{column}");
+                assert!(message.contains("unknown field `clok_mhz`"), "{message}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn unknown_nested_field_is_rejected() {
+        let text = de10_json().replace("\"mul\": 7", "\"mul\": 7, \"fma\": 3");
+        let e = Target::from_json("t.json", &text).unwrap_err().to_string();
+        assert!(e.contains("unknown field `fma`"), "{e}");
+    }
+
+    #[test]
+    fn senseless_values_are_rejected() {
+        for (from, to, field) in [
+            ("\"add\": 12", "\"add\": 0", "latencies.add"),
+            ("\"writes\": 2", "\"writes\": 0", "writes"),
+            ("\"pe_words\": 2048", "\"pe_words\": 0", "pe_words"),
+            ("\"clock_mhz\": 120.0", "\"clock_mhz\": 0.0", "clock_mhz"),
+            ("\"clock_mhz\": 120.0", "\"clock_mhz\": -5.0", "clock_mhz"),
+            ("\"crossbar_alm\": 8.125", "\"crossbar_alm\": -1.0", "crossbar_alm"),
+        ] {
+            let text = de10_json().replace(from, to);
+            assert_ne!(text, de10_json(), "{from}");
+            match Target::from_json("t.json", &text) {
+                Err(TargetError::Value { message, .. }) => assert!(message.contains(field), "{message}"),
+                other => panic!("{from}: {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn microseconds_at_the_clock() {
+        let t = Target::de10_nano();
+        // 987 cycles (seed §1.3.1) at 120 MHz: 987 / 120 = 8.225 µs.
+        assert!((t.us(987) - 8.225).abs() < 1e-12);
+        assert_eq!(t.us(0), 0.0);
+    }
+
+    #[test]
+    fn address_bits_of_the_seed() {
+        assert_eq!(address_bits(2048), 11);
+        assert_eq!(address_bits(16), 4);
+        assert_eq!(address_bits(17), 5);
+        assert_eq!(address_bits(1), 0);
+        assert_eq!(Target::de10_nano().pe_address_bits(), 11);
+    }
+
+    #[test]
+    fn estimate_of_the_seed_design_matches_table_1_4() {
+        let t = Target::de10_nano();
+        let r = t.estimate(4, 4, 987);
+        // Table 1.4 totals: 4413 ALM, 20 DSP.
+        assert_eq!(r.alm, 4413);
+        assert_eq!(r.dsp, 20);
+        // Per PE: PE memory 2048·32/10240 → 7, buffer 16·32 → 1, instructions 988·52 = 51376
+        // bits → 6, buffer instructions 988·10 → 1, crossbar 988·2·5 → 1: 16 × 8 PE = 128.
+        assert_eq!(r.m10k, 128);
+        assert!(r.fits);
+        // 23 + 23 PE need 23·2 + 23·3 = 115 DSP > 112.
+        assert!(!t.estimate(23, 23, 100).fits);
+        assert_eq!(t.estimate(22, 22, 100).dsp, 110);
+    }
+}

@@ -1,0 +1,302 @@
+//! The design of one placed function: its configuration (PEs, latencies, word widths) and its
+//! memory images, from which the Verilog top, the testbench, the manifest and the image files
+//! are written.
+
+use std::fmt::Write;
+
+use serde::Serialize;
+
+use super::images::Image;
+
+/// Bit widths of the design's words (the encoding of the `machine` module doc, LSB first).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Widths {
+    /// PE memory address bits (`aw`, ⌈log2 pe_words⌉ of the target: 11 on the DE10-Nano).
+    pub aw: u32,
+    /// Buffer address bits (`bw`).
+    pub bw: u32,
+    /// Crossbar select bits (`sw` = ⌈log2(2·n_pe + 1)⌉).
+    pub sw: u32,
+    /// Output memory address bits (`ow`).
+    pub ow: u32,
+    /// Program counter bits (`cw`: cycles `0..=cycles + 1` fit).
+    pub cw: u32,
+    /// Instruction word bits (the target's `instr_width`, 52 on the DE10-Nano; `4·aw + 4` used).
+    pub instr: u32,
+}
+
+impl Widths {
+    /// Crossbar word bits: two selects.
+    pub fn xbar(&self) -> u32 {
+        2 * self.sw
+    }
+    /// Buffer instruction word bits: store and read addresses, store and read enables.
+    pub fn bufi(&self) -> u32 {
+        2 * self.bw + 2
+    }
+    /// Output capture word bits: address and enable.
+    pub fn capt(&self) -> u32 {
+        self.ow + 1
+    }
+}
+
+/// Bits needed to address `n` words (at least 1).
+pub fn addr_bits(n: u64) -> u32 {
+    if n <= 2 {
+        1
+    } else {
+        64 - (n - 1).leading_zeros()
+    }
+}
+
+/// Where a word of initial data comes from.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Source {
+    /// An input of the function, by canonical name (SPEC §2).
+    Input {
+        /// Input name (`q[1]`).
+        input: String,
+    },
+    /// A trig initial value: `sin`/`cos` of an input, computed in binary32 by the host.
+    Trig {
+        /// Its name in the IR (`S4`).
+        name: String,
+        /// `sin` or `cos`.
+        trig: &'static str,
+        /// The input it is of.
+        of: String,
+    },
+    /// A constant: its binary32 word (the `f64` literal rounded to nearest).
+    Const {
+        /// The literal.
+        value: f64,
+        /// Its binary32 bits, `0x…`.
+        bits: String,
+    },
+}
+
+/// A word of initial data: PE slot, address, source.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LoadWord {
+    /// PE slot ([`robovec_ir::placement::Pe::slot`]).
+    pub slot: usize,
+    /// PE name (`add0`, `mul1`).
+    pub pe: String,
+    /// Address in the PE memory (or output memory).
+    pub addr: u32,
+    /// What is loaded.
+    #[serde(flatten)]
+    pub source: Source,
+}
+
+/// Where an output is read after `done`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct OutputWord {
+    /// Output name (SPEC §2).
+    pub name: String,
+    /// PE slot whose output memory holds it.
+    pub slot: usize,
+    /// PE name.
+    pub pe: String,
+    /// Output memory address.
+    pub addr: u32,
+}
+
+/// The memory images of one PE.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PeImages {
+    /// Slot (ADD PEs first, then MULTI PEs).
+    pub slot: usize,
+    /// Name (`add0`).
+    pub pe: String,
+    /// True for a MULTI PE.
+    pub is_mul: bool,
+    /// Instruction memory, one word per cycle `0..=cycles`.
+    pub instr: Image,
+    /// Crossbar memory (this PE memory's two write selects), one word per cycle.
+    pub xbar: Image,
+    /// Buffer instruction memory, one word per cycle.
+    pub bufi: Image,
+    /// Output capture memory, one word per cycle.
+    pub capt: Image,
+    /// Initial PE memory contents (constants; input words are 0 here and filled by `simulate`
+    /// or the host from the load map).
+    pub data: Image,
+    /// Initial output memory contents (outputs that are constants; input outputs 0).
+    pub out: Image,
+    /// Buffer words (depth of the buffer memory).
+    pub buffer_words: u32,
+}
+
+impl PeImages {
+    /// The six images, in file order.
+    pub fn images(&self) -> [&Image; 6] {
+        [&self.instr, &self.xbar, &self.bufi, &self.capt, &self.data, &self.out]
+    }
+}
+
+/// Everything the back end writes for one function.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Design {
+    /// Function name.
+    pub function: String,
+    /// ADD PEs.
+    pub n_add: u32,
+    /// MULTI PEs.
+    pub n_mul: u32,
+    /// ADD PE latency, cycles from issue to arrival (SPEC §1: unit stages + 2).
+    pub lat_add: u32,
+    /// MULTI PE latency, cycles.
+    pub lat_mul: u32,
+    /// Last cycle of the program (the largest arrival, `ir/src/placement.rs`).
+    pub cycles: u32,
+    /// Word widths.
+    pub widths: Widths,
+    /// Per PE, in slot order.
+    pub pes: Vec<PeImages>,
+    /// The function's inputs, canonical names, in order.
+    pub inputs: Vec<String>,
+    /// Initial PE memory words that are inputs, trig values or constants.
+    pub loads: Vec<LoadWord>,
+    /// Initial output memory words (outputs that are inputs, trig values or constants).
+    pub output_loads: Vec<LoadWord>,
+    /// The output map.
+    pub outputs: Vec<OutputWord>,
+}
+
+/// The fixed Verilog files, `(name, text)`: the FP unit models, the memories and the PE.
+pub const HDL_LIBRARY: &[(&str, &str)] = &[
+    ("fp_units.v", include_str!("hdl/fp_units.v")),
+    ("rv_mem.v", include_str!("hdl/rv_mem.v")),
+    ("rv_lib.v", include_str!("hdl/rv_lib.v")),
+];
+
+/// Black-box stubs of the FP units and memories for the Yosys resource estimate.
+pub const SYNTH_STUBS: &str = include_str!("hdl/synth_stubs.v");
+
+impl Design {
+    /// PEs of both types.
+    pub fn n_pe(&self) -> usize {
+        (self.n_add + self.n_mul) as usize
+    }
+
+    /// Bits of the output read port's PE select.
+    fn pe_bits(&self) -> u32 {
+        addr_bits(self.n_pe() as u64)
+    }
+
+    /// The generated top `robovec_top` (synthesizable Verilog-2005): control, one `rv_pe` per
+    /// PE, the crossbar bus and an output read port (`out_pe`, `out_addr` → `out_data`, read
+    /// after `done`). `dir` prefixes the image file names (`""`: the simulator's working folder).
+    pub fn top(&self, dir: &str) -> String {
+        let w = self.widths;
+        let n = self.n_pe();
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "// robovec codegen<fpga>: function `{}`, {} ADD + {} MULTI PEs, {} cycles (generated; do not edit).",
+            self.function, self.n_add, self.n_mul, self.cycles
+        );
+        s += "// Ports: start (one clock high while idle) runs the program once; done rises after its last\n";
+        s += "// cycle; the outputs are then read through out_pe / out_addr (manifest.json's output map).\n";
+        s += "// host_* is not provided: new inputs are written into the PE memory images (load map).\n";
+        let _ = writeln!(
+            s,
+            "module robovec_top (\n  input  wire clk,\n  input  wire rst,\n  input  wire start,\n  output wire done,\n  output wire busy,\n  input  wire [{}:0] out_pe,\n  input  wire [{}:0] out_addr,\n  output reg  [31:0] out_data\n);",
+            self.pe_bits() - 1,
+            w.ow - 1
+        );
+        let _ = writeln!(s, "  wire run;\n  wire [{0}:0] pc, fetch;\n  assign busy = run;", w.cw - 1);
+        let _ = writeln!(
+            s,
+            "  rv_control #(.CW({}), .CYCLES({})) ctl (.clk(clk), .rst(rst), .start(start), .run(run), .done(done), .pc(pc), .fetch(fetch));",
+            w.cw, self.cycles
+        );
+        for p in &self.pes {
+            let _ = writeln!(s, "  wire [31:0] result{0}, buffer{0}, out{0};", p.slot);
+        }
+        let mut bus: Vec<String> = (0..n).rev().map(|i| format!("buffer{i}")).collect();
+        bus.extend((0..n).rev().map(|i| format!("result{i}")));
+        let _ = writeln!(
+            s,
+            "  // crossbar sources: select s = 1..{n} is result s-1, {}..{} is buffer s-{}",
+            n + 1,
+            2 * n,
+            n + 1
+        );
+        let _ = writeln!(s, "  wire [{}:0] sources = {{{}}};", 64 * n - 1, bus.join(", "));
+        for p in &self.pes {
+            let lat = if p.is_mul { self.lat_mul } else { self.lat_add };
+            let f = |i: &Image| format!("\"{dir}{}.hex\"", i.name);
+            let _ = writeln!(
+                s,
+                "  rv_pe #(.IS_MUL({mul}), .LAT({lat}), .NPE({n}), .AW({aw}), .BW({bw}), .SW({sw}), .OW({ow}), .CW({cw}), .IW({iw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}),\n        .INSTR_FILE({fi}), .XBAR_FILE({fx}), .BUFI_FILE({fb}), .CAPT_FILE({fc}),\n        .DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .sources(sources), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
+                mul = u8::from(p.is_mul),
+                aw = w.aw,
+                bw = w.bw,
+                sw = w.sw,
+                ow = w.ow,
+                cw = w.cw,
+                iw = w.instr,
+                c = self.cycles,
+                md = p.data.words.len().max(1),
+                bd = p.buffer_words.max(1),
+                od = p.out.words.len().max(1),
+                fi = f(&p.instr),
+                fx = f(&p.xbar),
+                fb = f(&p.bufi),
+                fc = f(&p.capt),
+                fd = f(&p.data),
+                fo = f(&p.out),
+                name = p.pe,
+                k = p.slot,
+            );
+        }
+        s += "  always @* begin\n    case (out_pe)\n";
+        for p in &self.pes {
+            let _ = writeln!(s, "      {}: out_data = out{};", p.slot, p.slot);
+        }
+        s += "      default: out_data = 32'h0;\n    endcase\n  end\nendmodule\n";
+        s
+    }
+
+    /// The testbench `testbench` for Icarus Verilog: pulses `start`, waits for `done`, writes
+    /// every output memory to `capturedS.hex` and prints `robovec-done CYCLES CLOCKS` (CYCLES =
+    /// the last cycle executed, CLOCKS = clocks with `run` high = CYCLES + 1).
+    pub fn testbench(&self) -> String {
+        let mut s = String::new();
+        s += "`timescale 1ns/1ps\n// robovec codegen<fpga> testbench (generated; `simulate` runs it).\nmodule testbench;\n";
+        s += "  reg clk = 0, rst = 0, start = 0;\n  wire done, busy;\n  integer clocks = 0;\n";
+        let _ = writeln!(
+            s,
+            "  robovec_top dut (.clk(clk), .rst(rst), .start(start), .done(done), .busy(busy), .out_pe({}'d0), .out_addr({}'d0), .out_data());",
+            self.pe_bits(),
+            self.widths.ow
+        );
+        s += "  always #5 clk = ~clk;\n  always @(posedge clk) if (busy) clocks = clocks + 1;\n";
+        s += "  initial begin\n    @(negedge clk); start = 1; @(negedge clk); start = 0;\n    while (!done) @(negedge clk);\n";
+        for p in &self.pes {
+            let _ = writeln!(s, "    $writememh(\"captured{}.hex\", dut.{}.omem);", p.slot, p.pe);
+        }
+        s += "    $display(\"robovec-done %0d %0d\", clocks - 1, clocks);\n    $finish;\n  end\n";
+        let _ = writeln!(
+            s,
+            "  initial begin\n    #(64'd10 * {});\n    $display(\"robovec-timeout\");\n    $finish;\n  end\nendmodule",
+            u64::from(self.cycles) + 16
+        );
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn address_bits() {
+        assert_eq!([addr_bits(1), addr_bits(2), addr_bits(3), addr_bits(2048), addr_bits(2049)], [1, 1, 2, 11, 12]);
+        // crossbar of the seed's 8 PEs: 17 selects → 5 bits
+        assert_eq!(addr_bits(2 * 8 + 1), 5);
+    }
+}

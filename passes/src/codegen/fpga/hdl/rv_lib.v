@@ -1,0 +1,158 @@
+// robovec codegen<fpga>: the building blocks of the generated design (issue 12; seed §1.1, §1.3;
+// SPEC §5). The generated top `robovec_top` instantiates `rv_pe` once per PE (ADD PEs first,
+// then MULTI PEs, in `Pe::slot` order) and wires every PE's arriving result and buffer read
+// into every PE's crossbar.
+//
+// Timing (machine cycle k of the program = clock k of the run, counted from `start`):
+//   * the instruction, crossbar, buffer-instruction and output-capture words of cycle k are
+//     registered ROM outputs during clock k (fetched at the edge before it);
+//   * during clock k the result of an op issued at k - LAT arrives (`result`, the register
+//     after the crossbar: the seed's "+2" = one clock for the PE-memory read register, one for the
+//     interconnect register); the buffer stores it (`store`) and is read (`read`, a store of the
+//     same clock is seen: store before read); the crossbar selects up to two words for the PE
+//     memory's two write ports; the output memory captures the arriving result;
+//   * at the edge ending clock k the PE memory commits the writes and registers the two operand
+//     reads of cycle k, write-first (a word written in cycle k is read in cycle k: the seed's
+//     double-pumped M10K, `ir/src/placement.rs`);
+//   * the floating-point unit takes the operands during clock k + 1 and has LAT - 2 stages, so
+//     its result is in `result` during clock k + LAT.
+
+// One PE: instruction memory, crossbar memory, PE memory, floating-point unit, buffer (with its
+// instruction memory) and output memory (with its capture memory). Word layouts: see the
+// manifest's `layout` and the `machine` module doc (LSB first).
+module rv_pe #(
+    parameter integer IS_MUL = 0,      // 0: ADD PE (fp_add_sub), 1: MULTI PE (fp_mul)
+    parameter integer LAT = 12,        // cycles from issue to arrival (>= 3)
+    parameter integer NPE = 2,         // PEs in the design (crossbar sources: 2 NPE)
+    parameter integer AW = 11,         // PE memory address bits
+    parameter integer BW = 4,          // buffer address bits
+    parameter integer SW = 3,          // crossbar select bits
+    parameter integer OW = 1,          // output memory address bits
+    parameter integer CW = 1,          // program counter bits
+    parameter integer IW = 52,         // instruction word bits
+    parameter integer CYCLES = 0,      // last cycle of the program
+    parameter integer MEM_DEPTH = 1,   // PE memory words
+    parameter integer BUF_DEPTH = 1,   // buffer words
+    parameter integer OUT_DEPTH = 1,   // output memory words
+    parameter INSTR_FILE = "",
+    parameter XBAR_FILE = "",
+    parameter BUFI_FILE = "",
+    parameter CAPT_FILE = "",
+    parameter DATA_FILE = "",
+    parameter OUT_FILE = ""
+) (
+    input  wire                 clk,
+    input  wire                 run,       // executing cycle `pc` of the program
+    input  wire [CW-1:0]        fetch,     // the cycle whose words are fetched at this edge
+    input  wire [64*NPE-1:0]    sources,   // {buffer reads, results}, PE slot order
+    output reg  [31:0]          result,    // the result arriving this cycle
+    output wire [31:0]          buf_read,  // this cycle's buffer read
+    input  wire [OW-1:0]        out_addr,  // output memory read port
+    output wire [31:0]          out_data
+);
+  localparam integer XW = 2 * SW;
+  localparam integer BIW = 2 * BW + 2;
+  localparam integer OCW = OW + 1;
+  localparam integer ROM_DEPTH = CYCLES + 1;
+
+  wire [IW-1:0]  instr;
+  wire [XW-1:0]  xbar;
+  wire [BIW-1:0] bufi;
+  wire [OCW-1:0] capt;
+  rv_rom #(.WIDTH(IW),  .DEPTH(ROM_DEPTH), .AW(CW), .FILE(INSTR_FILE)) u_instr (.clk(clk), .addr(fetch), .q(instr));
+  rv_rom #(.WIDTH(XW),  .DEPTH(ROM_DEPTH), .AW(CW), .FILE(XBAR_FILE))  u_xbar  (.clk(clk), .addr(fetch), .q(xbar));
+  rv_rom #(.WIDTH(BIW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(BUFI_FILE))  u_bufi  (.clk(clk), .addr(fetch), .q(bufi));
+  rv_rom #(.WIDTH(OCW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CAPT_FILE))  u_capt  (.clk(clk), .addr(fetch), .q(capt));
+
+  // instruction word fields
+  wire [AW-1:0] ra  = instr[AW-1:0];
+  wire [AW-1:0] rb  = instr[2*AW-1:AW];
+  wire [AW-1:0] wa0 = instr[3*AW-1:2*AW];
+  wire [AW-1:0] wa1 = instr[4*AW-1:3*AW];
+  wire          we0 = instr[4*AW] & run;
+  wire          we1 = instr[4*AW+1] & run;
+  wire          sub = instr[4*AW+3];
+
+  // crossbar: 0 = none, 1..NPE = result of slot s-1, NPE+1..2NPE = buffer read of slot s-NPE-1
+  wire [SW-1:0] sel0 = xbar[SW-1:0];
+  wire [SW-1:0] sel1 = xbar[2*SW-1:SW];
+  wire [31:0] wd0 = (sel0 == 0 || sel0 > 2 * NPE) ? 32'h0 : sources[32*(sel0-1) +: 32];
+  wire [31:0] wd1 = (sel1 == 0 || sel1 > 2 * NPE) ? 32'h0 : sources[32*(sel1-1) +: 32];
+
+  wire [31:0] qa, qb;
+  rv_pe_mem #(.AW(AW), .DEPTH(MEM_DEPTH), .FILE(DATA_FILE)) u_mem (
+      .clk(clk), .we0(we0), .wa0(wa0), .wd0(wd0), .we1(we1), .wa1(wa1), .wd1(wd1),
+      .ra(ra), .rb(rb), .qa(qa), .qb(qb));
+
+  reg sub_q;
+  initial sub_q = 0;
+  always @(posedge clk) sub_q <= sub;
+
+  wire [31:0] y;
+  generate
+    if (IS_MUL != 0) begin : g_mul
+      fp_mul #(.LATENCY(LAT - 2)) u_fp (.clk(clk), .a(qa), .b(qb), .y(y));
+    end else begin : g_add
+      fp_add_sub #(.LATENCY(LAT - 2)) u_fp (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .y(y));
+    end
+  endgenerate
+
+  // interconnect register: the result arrives one clock after the unit's last stage
+  initial result = 0;
+  always @(posedge clk) result <= y;
+
+  // buffer: store the arriving result at `st`, read `rd` in the same clock (store first)
+  wire [BW-1:0] st    = bufi[BW-1:0];
+  wire [BW-1:0] rd    = bufi[2*BW-1:BW];
+  wire          st_en = bufi[2*BW] & run;
+  reg [31:0] bmem [0:BUF_DEPTH-1];
+  assign buf_read = (st_en && st == rd) ? result : bmem[rd];
+  always @(posedge clk) if (st_en) bmem[st] <= result;
+
+  // output memory: captures the arriving result; initial contents: outputs that are inputs or
+  // constants
+  wire [OW-1:0] oa   = capt[OW-1:0];
+  wire          o_en = capt[OW] & run;
+  reg [31:0] omem [0:OUT_DEPTH-1];
+  initial if (OUT_FILE != "") $readmemh(OUT_FILE, omem);
+  always @(posedge clk) if (o_en) omem[oa] <= result;
+  assign out_data = omem[out_addr];
+endmodule
+
+// Program counter, start/done. `fetch` is the cycle whose words the ROMs register at the next
+// edge; `run` is high during clocks 0..CYCLES of the program.
+module rv_control #(
+    parameter integer CW = 1,
+    parameter integer CYCLES = 0
+) (
+    input  wire          clk,
+    input  wire          rst,
+    input  wire          start,
+    output reg           run,
+    output reg           done,
+    output reg  [CW-1:0] pc,
+    output wire [CW-1:0] fetch
+);
+  assign fetch = run ? pc + 1'b1 : {CW{1'b0}};
+  initial begin
+    run = 0;
+    done = 0;
+    pc = 0;
+  end
+  always @(posedge clk) begin
+    if (rst) begin
+      run <= 0;
+      done <= 0;
+      pc <= 0;
+    end else if (!run && start) begin
+      run <= 1;
+      done <= 0;
+      pc <= 0;
+    end else if (run) begin
+      if (pc == CYCLES) begin
+        run <= 0;
+        done <= 1;
+      end else pc <= pc + 1'b1;
+    end
+  end
+endmodule

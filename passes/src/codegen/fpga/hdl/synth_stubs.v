@@ -1,0 +1,26 @@
+// Black boxes for the resource estimate (codegen<fpga>'s Yosys run): the floating-point units
+// are counted from the target's per-unit costs (seed Table 1.4) and the memories as M10K blocks
+// from their sizes, so Yosys counts only the logic around them (crossbar, control, buffers,
+// output memories, address decoding).
+(* blackbox *)
+module fp_add_sub #(parameter integer LATENCY = 10) (
+    input wire clk, input wire [31:0] a, input wire [31:0] b, input wire sub, output wire [31:0] y);
+endmodule
+
+(* blackbox *)
+module fp_mul #(parameter integer LATENCY = 5) (
+    input wire clk, input wire [31:0] a, input wire [31:0] b, output wire [31:0] y);
+endmodule
+
+(* blackbox *)
+module rv_rom #(parameter integer WIDTH = 8, parameter integer DEPTH = 1, parameter integer AW = 1,
+                parameter FILE = "") (
+    input wire clk, input wire [AW-1:0] addr, output wire [WIDTH-1:0] q);
+endmodule
+
+(* blackbox *)
+module rv_pe_mem #(parameter integer AW = 11, parameter integer DEPTH = 1, parameter FILE = "") (
+    input wire clk, input wire we0, input wire [AW-1:0] wa0, input wire [31:0] wd0,
+    input wire we1, input wire [AW-1:0] wa1, input wire [31:0] wd1,
+    input wire [AW-1:0] ra, input wire [AW-1:0] rb, output wire [31:0] qa, output wire [31:0] qb);
+endmodule

@@ -1,0 +1,238 @@
+//! From a placed function to the [`Design`]'s images: the machine program
+//! (`crate::machine::lower`, the one lowering `sim` executes) encoded with
+//! `robovec_ir::machine::encode` (the layout of its module doc, LSB first), checked against the
+//! target's memories first so that every problem is reported with the figures needed and
+//! available.
+
+use robovec_ir::machine::encode::{self, Layout};
+use robovec_ir::machine::{MachineOp, MachineProgram, Word};
+use robovec_ir::placement::Placement;
+use robovec_ir::syntax::TrigFn;
+use robovec_ir::target::Target;
+use robovec_ir::Function;
+
+use super::design::{addr_bits, Design, LoadWord, OutputWord, PeImages, Source, Widths};
+use super::images::Image;
+
+/// The target's limits the design must fit (from [`Target`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// Words per PE memory (2048 on the DE10-Nano: one M10K-based memory, seed §1.3.1).
+    pub pe_words: u32,
+    /// Words per buffer memory.
+    pub buffer_words: u32,
+    /// Instruction memory depth, cycles.
+    pub instr_words: u32,
+    /// Instruction word bits (52 on the DE10-Nano, seed §1.3.1).
+    pub instr_width: u32,
+    /// Write ports per PE memory per cycle.
+    pub writes: u32,
+}
+
+impl Limits {
+    /// The limits of target `t`.
+    pub fn of(t: &Target) -> Limits {
+        Limits {
+            pe_words: t.pe_words,
+            buffer_words: t.buffer_words,
+            instr_words: t.instr_words,
+            instr_width: t.instr_width,
+            writes: t.writes,
+        }
+    }
+}
+
+/// binary32 bits of an `f64` literal rounded to nearest (what `-eval-precision=f32` does).
+pub fn f32_bits(x: f64) -> u32 {
+    (x as f32).to_bits()
+}
+
+fn source(w: &Word) -> Source {
+    match w {
+        Word::Input(n) => Source::Input { input: n.clone() },
+        Word::Trig(t, n) => {
+            let trig = match t {
+                TrigFn::Sin => "sin",
+                TrigFn::Cos => "cos",
+            };
+            Source::Trig { name: format!("{trig}({n})"), trig, of: n.clone() }
+        }
+        Word::Const(c) => Source::Const { value: *c, bits: format!("0x{:08x}", f32_bits(*c)) },
+    }
+}
+
+fn initial_word(w: &Option<Word>) -> u64 {
+    match w {
+        Some(Word::Const(c)) => u64::from(f32_bits(*c)),
+        _ => 0,
+    }
+}
+
+/// What the target cannot hold or the hardware cannot do, one line each with the figures
+/// needed and available (empty: the program fits).
+pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
+    let mut out = Vec::new();
+    let name = |s: usize| pe_name(&m.arch, s);
+    if limits.writes != 2 {
+        out.push(format!(
+            "the target has {} write port(s) per PE memory; the instruction word has exactly 2 (write-0, write-1)",
+            limits.writes
+        ));
+    }
+    for (what, l) in [("ADD", m.arch.lat.add), ("MULTI", m.arch.lat.mul)] {
+        if l < 2 {
+            out.push(format!(
+                "{what} latency is {l} cycles; the hardware needs at least 2 (PE memory read and crossbar registers)"
+            ));
+        }
+    }
+    let mut unsupported = Vec::new();
+    for (s, pe) in m.pes.iter().enumerate() {
+        for (c, st) in pe.steps.iter().enumerate() {
+            match st.issue.as_ref().map(|i| &i.op) {
+                Some(MachineOp::Div) => unsupported.push(format!("div on {} at cycle {c}", name(s))),
+                Some(MachineOp::Call(_)) => unsupported.push(format!("call on {} at cycle {c}", name(s))),
+                _ => {}
+            }
+            if st.writes.len() > 2 {
+                out.push(format!(
+                    "PE memory of {} takes {} writes at cycle {c}; the hardware has 2 write ports",
+                    name(s),
+                    st.writes.len()
+                ));
+            }
+        }
+    }
+    if !unsupported.is_empty() {
+        out.push(format!(
+            "{} op(s) need a divider or a function unit, which the PEs lack (ADD: fp_add_sub, MULTI: fp_mul): {}{}",
+            unsupported.len(),
+            unsupported.iter().take(4).cloned().collect::<Vec<_>>().join(", "),
+            if unsupported.len() > 4 { ", …" } else { "" }
+        ));
+    }
+    let worst = |v: &[u32]| v.iter().enumerate().max_by_key(|&(i, &w)| (w, std::cmp::Reverse(i))).map(|(i, &w)| (i, w));
+    if let Some((s, w)) = worst(&m.pe_words).filter(|&(_, w)| w > limits.pe_words) {
+        out.push(format!(
+            "PE memory of {} needs {w} words; the target has {} words per PE memory",
+            name(s),
+            limits.pe_words
+        ));
+    }
+    if let Some((s, w)) = worst(&m.buffer_words).filter(|&(_, w)| w > limits.buffer_words) {
+        out.push(format!(
+            "buffer of {} needs {w} words; the target's buffers have {} words",
+            name(s),
+            limits.buffer_words
+        ));
+    }
+    let depth = u64::from(m.cycles) + 1;
+    if depth > u64::from(limits.instr_words) {
+        out.push(format!(
+            "the program needs {depth} instruction words per PE (cycles 0..={}); the target's instruction memory has {}",
+            m.cycles, limits.instr_words
+        ));
+    }
+    let aw = addr_bits(u64::from(limits.pe_words));
+    if 4 * aw + 4 > limits.instr_width.min(64) {
+        out.push(format!(
+            "the instruction word needs {} bits (4 addresses of {aw} bits + 4 flags); the target's is {} bits",
+            4 * aw + 4,
+            limits.instr_width
+        ));
+    }
+    out
+}
+
+/// Lowers placed function `f` (placement `p`) onto `limits`: the machine program, checked,
+/// encoded into the design's images.
+///
+/// # Errors
+/// A diagnostic (one line per problem) with the figures needed and available: an op the PEs do
+/// not have (`div`, `call`), `writes` ≠ 2, a latency below 2, a memory beyond the target, or a
+/// placement the machine model rejects.
+pub fn lower(f: &Function, p: &Placement, limits: &Limits) -> Result<Design, String> {
+    let m = crate::machine::lower(f, p).map_err(|e| format!("the placement cannot be lowered: {e}"))?;
+    let found = problems(&m, limits);
+    if !found.is_empty() {
+        return Err(found.join("\n"));
+    }
+    design(f, &m, limits)
+}
+
+/// The design of machine program `m` of `f`.
+///
+/// # Errors
+/// What [`encode::encode`] rejects.
+pub fn design(f: &Function, m: &MachineProgram, limits: &Limits) -> Result<Design, String> {
+    let layout = Layout::new(m, limits.pe_words, limits.buffer_words, limits.instr_width).map_err(|e| e.to_string())?;
+    let im = encode::encode(m, &layout).map_err(|e| e.to_string())?;
+    let widths = Widths {
+        aw: layout.aw,
+        bw: layout.bw,
+        sw: layout.sw,
+        ow: layout.ow,
+        cw: addr_bits(u64::from(m.cycles) + 2),
+        instr: layout.instr_width,
+    };
+    let mut loads = Vec::new();
+    let mut output_loads = Vec::new();
+    let mut pes = Vec::new();
+    for (s, pe) in m.pes.iter().enumerate() {
+        let pname = pe_name(&m.arch, s);
+        for (a, w) in pe.init.iter().enumerate() {
+            if let Some(w) = w {
+                loads.push(LoadWord { slot: s, pe: pname.clone(), addr: a as u32, source: source(w) });
+            }
+        }
+        for (a, w) in pe.output_init.iter().enumerate() {
+            if let Some(w) = w {
+                output_loads.push(LoadWord { slot: s, pe: pname.clone(), addr: a as u32, source: source(w) });
+            }
+        }
+        let img = |k: &str, width: u32, words: Vec<u64>| Image { name: format!("pe{s}_{k}"), width, words };
+        let mut data: Vec<u64> = pe.init.iter().map(initial_word).collect();
+        let mut out: Vec<u64> = pe.output_init.iter().map(initial_word).collect();
+        data.resize(data.len().max(1), 0);
+        out.resize(out.len().max(1), 0);
+        pes.push(PeImages {
+            slot: s,
+            pe: pname,
+            is_mul: s >= m.arch.n_add as usize,
+            instr: img("instr", widths.instr, im.instr[s].clone()),
+            xbar: img("xbar", widths.xbar(), im.crossbar[s].clone()),
+            bufi: img("bufi", widths.bufi(), im.buffer[s].clone()),
+            capt: img("capt", widths.capt(), im.capture[s].clone()),
+            data: img("data", 32, data),
+            out: img("out", 32, out),
+            buffer_words: m.buffer_words[s],
+        });
+    }
+    Ok(Design {
+        function: f.name.clone(),
+        n_add: m.arch.n_add,
+        n_mul: m.arch.n_mul,
+        lat_add: m.arch.lat.add,
+        lat_mul: m.arch.lat.mul,
+        cycles: m.cycles,
+        widths,
+        pes,
+        inputs: f.inputs.iter().map(|&v| f.name_of(v).to_string()).collect(),
+        loads,
+        output_loads,
+        outputs: m
+            .outputs
+            .iter()
+            .map(|o| OutputWord { name: o.name.clone(), slot: o.slot, pe: pe_name(&m.arch, o.slot), addr: o.addr })
+            .collect(),
+    })
+}
+
+/// `add0`, `mul1` for slot `s`.
+pub fn pe_name(arch: &robovec_ir::placement::Arch, s: usize) -> String {
+    if s < arch.n_add as usize {
+        format!("add{s}")
+    } else {
+        format!("mul{}", s - arch.n_add as usize)
+    }
+}

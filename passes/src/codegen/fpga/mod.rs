@@ -1,0 +1,406 @@
+//! `codegen<fpga;out=DIR;format=mif|hex|both;resources=auto|yosys|estimate>`: the seed's
+//! architecture (ch. 1, §2.3; SPEC §5) for a placed function, as files an FPGA engineer loads,
+//! simulates and sizes (issue 12).
+//!
+//! `DIR` receives (with several functions, `DIR/FUNCTION/` per function):
+//! - `hex/NAME.hex` (`$readmemh`) and/or `mif/NAME.mif` (Intel MIF), per PE slot `S`:
+//!   `peS_instr` (instruction memory, one word per cycle `0..=cycles`), `peS_xbar` (crossbar
+//!   memory: the two write selects of PE memory `S`), `peS_bufi` (buffer instructions),
+//!   `peS_capt` (output capture), `peS_data` (initial PE memory: constants, input words 0),
+//!   `peS_out` (initial output memory). Word layouts: the `machine` module doc and the
+//!   manifest's `widths`.
+//! - `manifest.json`: sizes, widths, the load map (input / trig value / constant → PE slot,
+//!   address), the output map (output → PE slot, output-memory address), target, cycles.
+//! - `hdl/`: `fp_units.v` (the FP unit boundary `fp_add_sub`, `fp_mul` with bit-exact binary32
+//!   models: see that file's header for how to bind Intel's IP), `rv_mem.v` (inferred RAM/ROM
+//!   initialised with `$readmemh`), `rv_lib.v` (PE, control), `robovec_top.v` (generated top:
+//!   N ADD + N MULTI PEs, crossbar bus, cycle counter, start/done, output read port) and
+//!   `testbench.v`.
+//! - `simulate` (executable, Python 3 standard library + Icarus Verilog): `DIR/simulate
+//!   INPUTS.json` runs the design and prints `{"cycles", "clocks", "outputs", "bits"}`.
+//! - `resources.json`: ALM / M10K / DSP, fit, cycles, clock, µs ([`resources`]).
+//!
+//! ## Design choices (where the issue is silent)
+//! - The images are written from the machine program's encoding; the design's RTL
+//!   (`hdl/rv_lib.v`) executes cycle `k` of the program in clock `k` after `start` and keeps
+//!   `ir/src/placement.rs`'s timing exactly: the FP unit is a combinational binary32 core plus
+//!   a delay line of `latency − 2` stages (the "+2" are the PE memory's read register and the
+//!   crossbar register), so a result issued at `t` is written at `t + latency`.
+//! - Inputs are not ports: they are words of the initial PE memory images at the load map's
+//!   addresses (as the seed loads "initial data"); `simulate` writes them before running.
+//! - The resource estimate runs Yosys inside the pass when `yosys` is on `PATH`
+//!   (`resources=auto`, the default); `resources=yosys` requires it, `resources=estimate`
+//!   skips it (analytic crossbar cost; deterministic and fast for tests).
+//! - Trig initial values (`S4 = sin q[4]`) are loaded words computed by the host in binary32
+//!   (`simulate` calls the C library's `sinf`/`cosf`, as robovec's interpreter does).
+//! - Rejected with a diagnostic and nothing written: a function without placement, `div` or
+//!   `call` ops (the PEs have only `fp_add_sub` and `fp_mul`), targets with `writes` ≠ 2 (the
+//!   instruction word has two write ports), memories beyond the target (PE memory words, buffer
+//!   depth, instruction memory depth) and latencies below 2.
+
+pub mod design;
+pub mod images;
+pub mod lower;
+pub mod resources;
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use crate::params::ParamKind;
+use crate::{Artifact, ArtifactFile, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry};
+use design::{Design, HDL_LIBRARY};
+use images::Image;
+use resources::Resources;
+
+/// The `simulate` script written into `DIR`.
+pub const SIMULATE: &str = include_str!("simulate.py");
+
+/// `out=DIR`.
+pub const OUT: ParamInfo = ParamInfo {
+    name: "out",
+    kind: ParamKind::OutputFolder,
+    doc: "FPGA: folder for images, manifest, Verilog, simulate script and resources.json (required)",
+};
+/// `format=mif|hex|both`.
+pub const FORMAT: ParamInfo = ParamInfo {
+    name: "format",
+    kind: ParamKind::Choice { choices: &["both", "mif", "hex"], default: "both" },
+    doc: "FPGA: memory images as Intel MIF, $readmemh hex, or both",
+};
+/// `resources=auto|yosys|estimate`.
+pub const RESOURCES: ParamInfo = ParamInfo {
+    name: "resources",
+    kind: ParamKind::Choice { choices: &["auto", "yosys", "estimate"], default: "auto" },
+    doc: "FPGA: logic ALMs from Yosys (auto: when on PATH) or the analytic estimate",
+};
+
+/// The parameters of the C back end, refused with `codegen<fpga>` when given another value
+/// than their default.
+pub const C_ONLY: &[ParamInfo] = &[super::c::ABI, super::c::PRECISION, super::c::BATCH, super::c::TRIG, super::c::NAME];
+/// The parameters of this back end, refused with `codegen<c>` likewise.
+pub const FPGA_ONLY: &[ParamInfo] = &[OUT, FORMAT, RESOURCES];
+
+/// The first of `decls` given with a value other than its declared default (`out=`, `name=`:
+/// any value), if any.
+pub fn given_beyond_default(p: &Params, decls: &[ParamInfo]) -> Option<&'static str> {
+    decls.iter().find(|d| p.get(d.name).is_some_and(|v| !d.default_is_literal() || v != d.default_text())).map(|d| d.name)
+}
+
+/// The `codegen<fpga;…>` pass.
+#[derive(Debug, Clone)]
+pub struct CodegenFpga {
+    /// Output folder.
+    pub out: PathBuf,
+    /// `mif`, `hex` or `both`.
+    pub format: &'static str,
+    /// `auto`, `yosys` or `estimate`.
+    pub resources: &'static str,
+}
+
+fn bad(message: String) -> PassError {
+    PassError::BadParameter { pass: "codegen".into(), message }
+}
+
+fn failed(message: String) -> PassError {
+    PassError::Failed { pass: "codegen".into(), message }
+}
+
+impl CodegenFpga {
+    /// The options from checked parameters.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] without `out`, or with a parameter of the C back end.
+    pub fn from_params(p: &Params) -> Result<CodegenFpga, PassError> {
+        if let Some(k) = given_beyond_default(p, C_ONLY) {
+            return Err(bad(format!("parameter `{k}` belongs to `codegen<c>`, not `codegen<fpga>`")));
+        }
+        let out = p.path("out")?.ok_or_else(|| bad("`codegen<fpga>` needs `out=DIR`, the folder it writes".into()))?;
+        Ok(CodegenFpga { out: out.into(), format: p.choice("format")?, resources: p.choice("resources")? })
+    }
+}
+
+/// The report's `fpga` entry for one function.
+#[derive(Clone, Debug, Serialize)]
+pub struct FpgaReport {
+    /// The folder written.
+    pub out: String,
+    /// Image formats.
+    pub format: &'static str,
+    /// ADD PEs.
+    pub n_add: u32,
+    /// MULTI PEs.
+    pub n_mul: u32,
+    /// Cycles per evaluation.
+    pub cycles: u32,
+    /// Clock, MHz.
+    pub clock_mhz: f64,
+    /// µs per evaluation.
+    pub us: f64,
+    /// ALM / M10K / DSP, fit.
+    pub resources: Resources,
+}
+
+/// One file of a design, its path relative to the function's folder.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DesignFile {
+    /// Path under `DIR` (`hex/pe0_instr.hex`).
+    pub path: String,
+    /// Content.
+    pub bytes: Vec<u8>,
+    /// True for `simulate`.
+    pub executable: bool,
+}
+
+/// What `codegen<fpga>` produced: per function, its design, files and figures.
+#[derive(Debug)]
+pub struct FpgaArtifact {
+    /// Per function: name, report, files relative to the function's folder.
+    pub functions: Vec<(String, FpgaReport, Vec<DesignFile>)>,
+    /// `out=DIR`.
+    pub out: PathBuf,
+}
+
+impl Artifact for FpgaArtifact {
+    fn pass(&self) -> &'static str {
+        "codegen"
+    }
+
+    fn report(&self, function: &str) -> Option<ReportEntry> {
+        let (_, r, _) = self.functions.iter().find(|(f, _, _)| f == function)?;
+        Some(ReportEntry::new("fpga", r, Merge::Last))
+    }
+
+    fn stats_text(&self, function: Option<&str>) -> String {
+        let mut s = String::new();
+        for (f, r, _) in self.functions.iter().filter(|(f, _, _)| function.is_none_or(|x| x == f)) {
+            let x = &r.resources;
+            s += &format!(
+                "fpga @{f}: {} ADD + {} MULTI PEs, {} cycles, {:.3} us at {} MHz; {} ALM, {} M10K, {} DSP ({}; {})\n",
+                r.n_add,
+                r.n_mul,
+                r.cycles,
+                r.us,
+                r.clock_mhz,
+                x.alm,
+                x.m10k,
+                x.dsp,
+                if x.fits { "fits" } else { "does not fit" },
+                x.logic_from
+            );
+        }
+        s
+    }
+
+    fn files(&self, several_functions: bool) -> Vec<ArtifactFile> {
+        let mut v = Vec::new();
+        for (f, _, files) in &self.functions {
+            let base = if several_functions { self.out.join(f) } else { self.out.clone() };
+            for x in files {
+                v.push(ArtifactFile { path: base.join(&x.path), bytes: x.bytes.clone(), executable: x.executable });
+            }
+        }
+        v
+    }
+}
+
+/// The files of a design: `(path relative to DIR, bytes, executable)`.
+pub fn design_files(d: &Design, format: &str, r: &Resources, manifest: &str) -> Vec<DesignFile> {
+    let mut v: Vec<DesignFile> = Vec::new();
+    let mut add = |path: String, bytes: Vec<u8>, executable: bool| v.push(DesignFile { path, bytes, executable });
+    for p in &d.pes {
+        for img in p.images() {
+            if format != "mif" {
+                add(format!("hex/{}.hex", img.name), img.to_hex().into_bytes(), false);
+            }
+            if format != "hex" {
+                add(format!("mif/{}.mif", img.name), img.to_mif().into_bytes(), false);
+            }
+        }
+    }
+    for (n, t) in HDL_LIBRARY {
+        add(format!("hdl/{n}"), t.as_bytes().to_vec(), false);
+    }
+    add("hdl/robovec_top.v".into(), d.top("").into_bytes(), false);
+    add("hdl/testbench.v".into(), d.testbench().into_bytes(), false);
+    add("manifest.json".into(), manifest.as_bytes().to_vec(), false);
+    add("simulate".into(), SIMULATE.as_bytes().to_vec(), true);
+    let mut res = serde_json::to_string_pretty(r).expect("resources serialise");
+    res.push('\n');
+    add("resources.json".into(), res.into_bytes(), false);
+    v
+}
+
+/// One memory in the manifest.
+#[derive(Clone, Debug, Serialize)]
+struct ManifestMemory {
+    file: String,
+    words: usize,
+    width: u32,
+}
+
+#[derive(Clone, Debug, Serialize)]
+struct ManifestPe<'a> {
+    slot: usize,
+    pe: &'a str,
+    kind: &'static str,
+    latency: u32,
+    buffer_words: u32,
+    memories: std::collections::BTreeMap<&'static str, ManifestMemory>,
+}
+
+/// The manifest (`manifest.json`): everything a host or a script needs to load and read the
+/// design. `target` is the target's name, `clock_mhz` its clock.
+pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> String {
+    let pes: Vec<ManifestPe> = d
+        .pes
+        .iter()
+        .map(|p| {
+            let m = |i: &Image| ManifestMemory { file: i.name.clone(), words: i.words.len().max(1), width: i.width };
+            let memories = [
+                ("instr", m(&p.instr)),
+                ("xbar", m(&p.xbar)),
+                ("bufi", m(&p.bufi)),
+                ("capt", m(&p.capt)),
+                ("data", m(&p.data)),
+                ("out", m(&p.out)),
+            ]
+            .into_iter()
+            .collect();
+            ManifestPe {
+                slot: p.slot,
+                pe: &p.pe,
+                kind: if p.is_mul { "mul" } else { "add" },
+                latency: if p.is_mul { d.lat_mul } else { d.lat_add },
+                buffer_words: p.buffer_words,
+                memories,
+            }
+        })
+        .collect();
+    let mut hdl: Vec<&str> = HDL_LIBRARY.iter().map(|(n, _)| *n).collect();
+    hdl.push("robovec_top.v");
+    let w = d.widths;
+    let (e, n) = (4 * w.aw, d.n_pe());
+    let layout = serde_json::json!({
+        "instr": format!("[0,{a}) read A, [{a},{b}) read B, [{b},{c}) write-0 address, [{c},{e}) write-1 address, \
+            bit {e} we0, bit {} we1, bit {} issue valid, bit {} sub (ADD PE: 1 = a - b), zero up to {}",
+            e + 1, e + 2, e + 3, w.instr, a = w.aw, b = 2 * w.aw, c = 3 * w.aw),
+        "xbar": format!("[0,{s}) port-0 select, [{s},{}) port-1 select: 0 none, 1..={n} result of slot s-1, {}..={} buffer read of slot s-{}",
+            2 * w.sw, n + 1, 2 * n, n + 1, s = w.sw),
+        "bufi": format!("[0,{b}) store address, [{b},{}) read address, bit {} store enable, bit {} read enable",
+            2 * w.bw, 2 * w.bw, 2 * w.bw + 1, b = w.bw),
+        "capt": format!("[0,{o}) output-memory address, bit {o} enable", o = w.ow),
+        "data": "binary32",
+    });
+    let v = serde_json::json!({
+        "format": "robovec-fpga/1",
+        "function": d.function,
+        "target": target,
+        "clock_mhz": clock_mhz,
+        "images": format,
+        "cycles": d.cycles,
+        "n_add": d.n_add,
+        "n_mul": d.n_mul,
+        "latency": {"add": d.lat_add, "mul": d.lat_mul},
+        "widths": w,
+        "layout": layout,
+        "hdl": hdl,
+        "pes": pes,
+        "inputs": d.inputs,
+        "loads": d.loads,
+        "output_loads": d.output_loads,
+        "outputs": d.outputs,
+    });
+    let mut s = serde_json::to_string_pretty(&v).expect("manifest serialises");
+    s.push('\n');
+    s
+}
+
+/// The path `codegen<fpga>` writes for `function` (for messages and tests).
+pub fn function_dir(out: &Path, function: &str, several: bool) -> PathBuf {
+    if several {
+        out.join(function)
+    } else {
+        out.to_path_buf()
+    }
+}
+
+/// The cost model of target `t` (its capacities, per-unit costs and clock; the analytic logic
+/// per PE from its crossbar, PE memory and control costs, used without Yosys).
+pub fn cost_model(t: &robovec_ir::target::Target) -> resources::CostModel {
+    let unit = |u: &robovec_ir::target::UnitCost| resources::UnitCost {
+        alm: u.alm.ceil() as u64,
+        dsp: u64::from(u.dsp),
+        m10k: u64::from(u.m10k),
+    };
+    resources::CostModel {
+        target: t.name.clone(),
+        capacity: resources::UnitCost { alm: u64::from(t.alm), m10k: u64::from(t.m10k), dsp: u64::from(t.dsp) },
+        fp_add: unit(&t.fp_add),
+        fp_mul: unit(&t.fp_mul),
+        crossbar_alm: t.crossbar_alm,
+        pe_memory_alm: t.pe_memory_alm,
+        control_alm: t.control_alm,
+        writes: t.writes,
+        clock_mhz: t.clock_mhz,
+    }
+}
+
+impl CodegenFpga {
+    /// The design, report and files of one placed function.
+    ///
+    /// # Errors
+    /// A diagnostic naming the function: no placement, or what [`lower::lower`] refuses, or a
+    /// Yosys failure (with `resources=yosys`: Yosys missing).
+    pub fn build(
+        &self,
+        f: &robovec_ir::Function,
+        limits: &lower::Limits,
+        model: &resources::CostModel,
+    ) -> Result<(Design, FpgaReport, Vec<DesignFile>), String> {
+        let Some(p) = &f.placement else {
+            return Err(format!("function @{} has no placement; run `place` before `codegen<fpga>`", f.name));
+        };
+        let d = lower::lower(f, p, limits)
+            .map_err(|e| format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target))?;
+        let cells = match self.resources {
+            "estimate" => None,
+            "yosys" => Some(resources::yosys_cells(&d)?.ok_or(
+                "`resources=yosys` but `yosys` cannot be run (Debian package `yosys`); use resources=estimate",
+            )?),
+            _ => resources::yosys_cells(&d)?,
+        };
+        let r = resources::estimate(&d, model, cells);
+        let man = manifest(&d, &model.target, model.clock_mhz, self.format);
+        let files = design_files(&d, self.format, &r, &man);
+        let report = FpgaReport {
+            out: self.out.display().to_string(),
+            format: self.format,
+            n_add: d.n_add,
+            n_mul: d.n_mul,
+            cycles: d.cycles,
+            clock_mhz: model.clock_mhz,
+            us: r.us,
+            resources: r,
+        };
+        Ok((d, report, files))
+    }
+}
+
+impl Pass for CodegenFpga {
+    fn name(&self) -> &'static str {
+        "codegen"
+    }
+
+    fn run(&self, m: &mut robovec_ir::Module, cx: &mut PassContext) -> Result<(), PassError> {
+        crate::require_phase("codegen", m, robovec_ir::Phase::Atomised)?;
+        let (limits, model) = (lower::Limits::of(&cx.target), cost_model(&cx.target));
+        let mut functions = Vec::new();
+        for f in &m.functions {
+            let (_, report, files) = self.build(f, &limits, &model).map_err(failed)?;
+            functions.push((f.name.clone(), report, files));
+        }
+        cx.emit(FpgaArtifact { functions, out: self.out.clone() });
+        Ok(())
+    }
+}

@@ -1,0 +1,331 @@
+//! The resource estimate of a design: ALM / M10K / DSP against the device, and the time per
+//! evaluation at the target clock (`DIR/resources.json`, the report's `fpga` entry).
+//!
+//! Three parts are added:
+//! - **Logic** (crossbar multiplexers, control, buffers, output memories, address decoding):
+//!   Yosys `synth_intel_alm -family cyclonev` on the generated top with the FP units and the
+//!   M10K memories as black boxes (`hdl/synth_stubs.v`). Yosys reports Mistral cells, not ALMs;
+//!   ALMs are packed as Quartus would at best: a 6-input LUT fills an ALM, two smaller LUTs or
+//!   two arithmetic bits share one, and an ALM holds two registers; a Yosys MLAB cell (32 × 1 bit)
+//!   is half an ALM of a 640-bit MLAB, so
+//!   `alm = max(LUT6 + ⌈(LUT2…LUT5 + ARITH)/2⌉, ⌈FF/2⌉) + ⌈MLAB/2⌉`. Yosys' DSP cells (`MISTRAL_MUL*`)
+//!   count as DSP blocks. Without `yosys` on `PATH` the logic is the target's analytic model
+//!   (`robovec_ir::target`, seed Table 1.4): `crossbar_alm · n_pe · writes · 2n_pe +
+//!   pe_memory_alm · n_pe + control_alm`.
+//! - **FP units**: the target's per-unit costs (seed §1.3.1 / Table 1.4: ADD PE 360 ALM, 2 DSP;
+//!   MULTI PE 100 ALM, 3 DSP) times the PEs of each type.
+//! - **Memories**: every PE memory, instruction, crossbar, buffer-instruction and capture memory
+//!   as M10K blocks from its size ([`super::images::m10k_blocks`]; PE memories true dual-port).
+//!
+//! ## Against the seed's Table 1.4 (8 PE: 4 ADD + 4 MULTI)
+//! The seed totals 4413 ALM, 120 M10K, 20 DSP for its 23-dof railway bogie (987 cycles). The
+//! bogie is not in the corpus; the Segway `dirdyna` placed on the same configuration
+//! (`place<pe=4>`, 720 cycles, 6.0 µs at 120 MHz) measures, with Yosys 0.23:
+//! **6277 ALM, 88 M10K, 20 DSP** (fits: 15 % / 16 % / 18 % of the device).
+//! - *DSP*: 20, equal by construction (the FP units are the seed's per-unit costs).
+//! - *ALM*: +42 % (6277 against 4413). The FP units are the seed's (1840 ALM); the rest, 4437 ALM
+//!   from Yosys (2212 LUT6, 4200 smaller LUTs, 90 arithmetic bits, 4016 registers, 160 MLAB
+//!   slices) against the seed's 2573 (crossbar 2080 + PE memories 24 + the 469 the table does
+//!   not itemise), is 1.7×: (a) our crossbar has two 17-way 32-bit multiplexers per PE memory (one
+//!   per write port, 16 in all), where the seed reports 110–150 ALM per PE for its
+//!   multiplexers; (b) the buffers and output memories are read in the cycle they are addressed
+//!   (store-then-read in one clock), so they are registers and MLAB slices (with their
+//!   address decoding and output multiplexers), where the seed spends one M10K per buffer; (c) the packing bound above is pessimistic
+//!   against Quartus' fitter, which packs two LUTs of up to 8 inputs in total per ALM and
+//!   retimes.
+//! - *M10K*: −27 % (88 against 120), and differently spread: instruction memories 6 each
+//!   (a 721 × 52 ROM: the 52-bit word needs 6 blocks in any configuration; the seed reports
+//!   3–4, below its own bit count ⌈48128/10240⌉ = 5), crossbar 1 per PE memory (8 against the
+//!   seed's 20), buffer instructions and captures 1 each, PE memories 2 each because they hold
+//!   only the 64 words the placement uses (the seed's fixed 2048 × 32 takes 7, which we agree
+//!   with for a full memory), buffers none (MLABs).
+//!
+//! The PE memory's depth is the words the placement uses (rounded up to what the blocks hold),
+//! not the target's 2048: a placement that uses fewer words takes fewer M10K.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use serde::Serialize;
+
+use super::design::{Design, HDL_LIBRARY, SYNTH_STUBS};
+use super::images::m10k_blocks;
+
+/// Cost of one unit in device resources.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct UnitCost {
+    /// ALMs.
+    pub alm: u64,
+    /// DSP blocks.
+    pub dsp: u64,
+    /// M10K blocks.
+    pub m10k: u64,
+}
+
+/// What the estimate needs from the target (see `robovec_ir::target`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CostModel {
+    /// Target name.
+    pub target: String,
+    /// Device capacity: ALMs, M10K blocks, DSP blocks.
+    pub capacity: UnitCost,
+    /// One ADD PE's floating-point unit.
+    pub fp_add: UnitCost,
+    /// One MULTI PE's floating-point unit.
+    pub fp_mul: UnitCost,
+    /// Analytic logic (without Yosys): ALMs per (PE-memory write port × crossbar source).
+    pub crossbar_alm: f64,
+    /// Analytic logic: ALMs per PE memory.
+    pub pe_memory_alm: f64,
+    /// Analytic logic: control ALMs.
+    pub control_alm: f64,
+    /// Write ports per PE memory.
+    pub writes: u32,
+    /// Clock, MHz.
+    pub clock_mhz: f64,
+}
+
+/// One memory's M10K count.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct MemoryCost {
+    /// Image name (`pe0_instr`).
+    pub name: String,
+    /// Words.
+    pub words: u64,
+    /// Bits per word.
+    pub width: u32,
+    /// M10K blocks.
+    pub m10k: u64,
+}
+
+/// Yosys' cell counts for the logic around the black boxes.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct YosysCells {
+    /// 6-input LUTs.
+    pub lut6: u64,
+    /// LUTs of 2 to 5 inputs.
+    pub lut_small: u64,
+    /// Arithmetic (carry-chain) bits.
+    pub arith: u64,
+    /// Registers.
+    pub ff: u64,
+    /// DSP blocks.
+    pub dsp: u64,
+    /// MLAB bit slices (Yosys' `MISTRAL_MLAB`: 32 words × 1 bit; an MLAB is a LAB of 10 ALMs
+    /// holding 640 bits, so a slice is half an ALM).
+    pub mlab: u64,
+}
+
+impl YosysCells {
+    /// ALMs (see the module doc).
+    pub fn alm(&self) -> u64 {
+        (self.lut6 + (self.lut_small + self.arith).div_ceil(2)).max(self.ff.div_ceil(2)) + self.mlab.div_ceil(2)
+    }
+}
+
+/// The estimate (`DIR/resources.json`, the report's `fpga.resources`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Resources {
+    /// ALMs: logic + FP units.
+    pub alm: u64,
+    /// M10K blocks: memories + FP units.
+    pub m10k: u64,
+    /// DSP blocks: FP units + logic.
+    pub dsp: u64,
+    /// True when all three are within the device.
+    pub fits: bool,
+    /// Cycles per evaluation (the program's last cycle, SPEC §4).
+    pub cycles: u32,
+    /// Clock, MHz.
+    pub clock_mhz: f64,
+    /// Time per evaluation, µs: `cycles / clock_mhz`.
+    pub us: f64,
+    /// Device capacity.
+    pub capacity: UnitCost,
+    /// `yosys` (logic synthesized) or `estimate` (no yosys on PATH: analytic crossbar cost).
+    pub logic_from: &'static str,
+    /// Logic ALMs (from Yosys or the estimate).
+    pub logic_alm: u64,
+    /// Yosys' cells when it ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub yosys: Option<YosysCells>,
+    /// FP unit ALMs / DSP (target's per-unit costs).
+    pub fp_units: UnitCost,
+    /// Per memory M10K.
+    pub memories: Vec<MemoryCost>,
+}
+
+/// Every M10K memory of the design and its blocks.
+pub fn memory_costs(d: &Design) -> Vec<MemoryCost> {
+    let mut v = Vec::new();
+    for p in &d.pes {
+        for (img, tdp) in [(&p.instr, false), (&p.xbar, false), (&p.bufi, false), (&p.capt, false), (&p.data, true)] {
+            let words = img.words.len().max(1) as u64;
+            v.push(MemoryCost {
+                name: img.name.clone(),
+                words,
+                width: img.width,
+                m10k: m10k_blocks(words, img.width, tdp),
+            });
+        }
+    }
+    v
+}
+
+/// Runs Yosys on the design's top with black boxes; `None` when `yosys` cannot be run.
+///
+/// # Errors
+/// A message when Yosys runs but fails (its last lines), or its statistics do not parse.
+pub fn yosys_cells(d: &Design) -> Result<Option<YosysCells>, String> {
+    let Some(dir) = TempDir::new() else { return Ok(None) };
+    let mut files = vec![("synth_stubs.v", SYNTH_STUBS.to_string())];
+    files.push((
+        "rv_lib.v",
+        HDL_LIBRARY.iter().find(|(n, _)| *n == "rv_lib.v").map(|x| x.1.to_string()).unwrap_or_default(),
+    ));
+    files.push(("robovec_top.v", d.top("")));
+    files.push((
+        "synth.ys",
+        "read_verilog synth_stubs.v\nread_verilog rv_lib.v\nread_verilog robovec_top.v\nhierarchy -top robovec_top\n\
+         synth_intel_alm -family cyclonev -top robovec_top\ntee -q -o stat.json stat -json\n"
+            .to_string(),
+    ));
+    // the output memories are registers initialised from their images
+    let outs: Vec<(String, String)> = d.pes.iter().map(|p| (format!("{}.hex", p.out.name), p.out.to_hex())).collect();
+    for (n, t) in files.iter().map(|(n, t)| (n.to_string(), t)).chain(outs.iter().map(|(n, t)| (n.clone(), t))) {
+        if std::fs::write(dir.0.join(&n), t).is_err() {
+            return Ok(None);
+        }
+    }
+    let out = match Command::new("yosys").args(["-q", "-s", "synth.ys"]).current_dir(&dir.0).output() {
+        Ok(o) => o,
+        Err(_) => return Ok(None),
+    };
+    if !out.status.success() {
+        let text = String::from_utf8_lossy(&out.stderr).to_string() + &String::from_utf8_lossy(&out.stdout);
+        let tail: Vec<&str> = text.lines().rev().take(8).collect();
+        return Err(format!("yosys failed: {}", tail.into_iter().rev().collect::<Vec<_>>().join("\n")));
+    }
+    let stat =
+        std::fs::read_to_string(dir.0.join("stat.json")).map_err(|e| format!("yosys wrote no statistics: {e}"))?;
+    parse_stat(&stat).map(Some)
+}
+
+/// Cell counts from `stat -json` (the `design` totals).
+///
+/// # Errors
+/// A message when the JSON does not have `design.num_cells_by_type`.
+pub fn parse_stat(json: &str) -> Result<YosysCells, String> {
+    let v: serde_json::Value = serde_json::from_str(json).map_err(|e| format!("yosys statistics: {e}"))?;
+    let cells = v
+        .pointer("/design/num_cells_by_type")
+        .and_then(|c| c.as_object())
+        .ok_or("yosys statistics: no design.num_cells_by_type")?;
+    let mut y = YosysCells::default();
+    for (k, n) in cells {
+        let n = n.as_u64().unwrap_or(0);
+        match k.as_str() {
+            "MISTRAL_ALUT6" => y.lut6 += n,
+            "MISTRAL_ALUT2" | "MISTRAL_ALUT3" | "MISTRAL_ALUT4" | "MISTRAL_ALUT5" | "MISTRAL_NOT" => y.lut_small += n,
+            "MISTRAL_ALUT_ARITH" => y.arith += n,
+            "MISTRAL_FF" => y.ff += n,
+            "MISTRAL_MLAB" => y.mlab += n,
+            k if k.starts_with("MISTRAL_MUL") => y.dsp += n,
+            _ => {}
+        }
+    }
+    Ok(y)
+}
+
+/// The estimate for `d` under `m`, with Yosys' cells when it ran.
+pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resources {
+    let (na, nm) = (u64::from(d.n_add), u64::from(d.n_mul));
+    let fp = UnitCost {
+        alm: na * m.fp_add.alm + nm * m.fp_mul.alm,
+        dsp: na * m.fp_add.dsp + nm * m.fp_mul.dsp,
+        m10k: na * m.fp_add.m10k + nm * m.fp_mul.m10k,
+    };
+    let memories = memory_costs(d);
+    let mem_m10k: u64 = memories.iter().map(|c| c.m10k).sum();
+    let (logic_from, logic_alm, logic_dsp) = match &yosys {
+        Some(y) => ("yosys", y.alm(), y.dsp),
+        None => {
+            let n = (na + nm) as f64;
+            let a = m.crossbar_alm * n * f64::from(m.writes) * 2.0 * n + m.pe_memory_alm * n + m.control_alm;
+            ("estimate", a.ceil() as u64, 0)
+        }
+    };
+    let alm = logic_alm + fp.alm;
+    let m10k = mem_m10k + fp.m10k;
+    let dsp = logic_dsp + fp.dsp;
+    Resources {
+        alm,
+        m10k,
+        dsp,
+        fits: alm <= m.capacity.alm && m10k <= m.capacity.m10k && dsp <= m.capacity.dsp,
+        cycles: d.cycles,
+        clock_mhz: m.clock_mhz,
+        us: f64::from(d.cycles) / m.clock_mhz,
+        capacity: m.capacity,
+        logic_from,
+        logic_alm,
+        yosys,
+        fp_units: fp,
+        memories,
+    }
+}
+
+/// A folder under the system's temporary folder, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new() -> Option<TempDir> {
+        use std::sync::atomic::{AtomicU32, Ordering};
+        static N: AtomicU32 = AtomicU32::new(0);
+        let base = std::env::temp_dir();
+        for _ in 0..16 {
+            let p = base.join(format!("robovec-yosys-{}-{}", std::process::id(), N.fetch_add(1, Ordering::Relaxed)));
+            if std::fs::create_dir(&p).is_ok() {
+                return Some(TempDir(p));
+            }
+        }
+        None
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// True when `yosys` can be started.
+pub fn yosys_available() -> bool {
+    Command::new("yosys").arg("-V").output().map(|o| o.status.success()).unwrap_or(false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn alm_packing_bound() {
+        let y = YosysCells { lut6: 10, lut_small: 5, arith: 2, ff: 20, dsp: 0, mlab: 0 };
+        // 10 + ⌈7/2⌉ = 14 vs ⌈20/2⌉ = 10
+        assert_eq!(y.alm(), 14);
+        let y = YosysCells { ff: 41, ..y };
+        assert_eq!(y.alm(), 21);
+        // 3 MLAB slices of 32 bits: ⌈3/2⌉ = 2 ALMs
+        let y = YosysCells { mlab: 3, ..y };
+        assert_eq!(y.alm(), 23);
+    }
+
+    #[test]
+    fn stat_json_cells() {
+        let s = r#"{"design": {"num_cells_by_type": {"MISTRAL_ALUT6": 3, "MISTRAL_ALUT2": 1, "MISTRAL_ALUT5": 2,
+            "MISTRAL_FF": 7, "MISTRAL_MUL27X27": 1, "fp_mul": 4}}}"#;
+        let y = parse_stat(s).unwrap();
+        assert_eq!(y, YosysCells { lut6: 3, lut_small: 3, arith: 0, ff: 7, dsp: 1, mlab: 0 });
+        assert!(parse_stat("{}").is_err());
+    }
+}

@@ -1,0 +1,144 @@
+//! Execution of a [`MachineProgram`] on numbers of precision `T`, cycle by cycle in the order
+//! of [`robovec_ir::machine`]'s timing contract: arrivals (buffer stores, output capture),
+//! buffer reads, PE-memory writes, issues. The executor knows nothing of values: it reads
+//! addresses, routes the crossbar and computes with the PE's unit — what the hardware does.
+
+use std::collections::HashMap;
+
+use robovec_ir::interp::{eval_binop, eval_call, Float};
+use robovec_ir::machine::{MachineOp, MachineProgram, Source, Word};
+use robovec_ir::syntax::{BinOp, TrigFn};
+
+use super::error::{MachineError, MachineErrorKind as K, When};
+
+/// What one execution computed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Executed<T> {
+    /// Outputs in the program's output-map order (`Function::outputs` order).
+    pub outputs: Vec<(String, T)>,
+    /// Cycles run (the program's `cycles`).
+    pub cycles: u32,
+}
+
+/// Runs `p` in precision `T`; `input(name)` gives each input's value (called once per name,
+/// on first use). Inputs and constants are `T::from_f64(x)`, trig words `sin`/`cos` in `T` of
+/// the input, ops [`eval_binop`] / [`eval_call`] in `T` (as `interp` computes).
+///
+/// # Errors
+/// [`K::Unverified`] when the program is inconsistent (a word read before it was written, a
+/// crossbar source carrying nothing, an address beyond its memory, a result after the last
+/// cycle) — never for a program [`super::lower`] returned.
+pub fn execute<T: Float>(p: &MachineProgram, mut input: impl FnMut(&str) -> f64) -> Result<Executed<T>, MachineError> {
+    let n_pe = p.n_pe();
+    let span = p.cycles as usize + 1;
+    let bad = |when: When, s: usize, message: String| {
+        let e = MachineError::new(K::Unverified, message).at(when);
+        match p.pes.get(s) {
+            Some(q) => e.on(q.pe),
+            None => e,
+        }
+    };
+    if p.pes.iter().any(|q| q.steps.len() != span) || p.buffer_words.len() != n_pe {
+        return Err(MachineError::new(K::Unverified, "program steps do not cover cycles 0..=cycles"));
+    }
+    let mut inputs: HashMap<String, T> = HashMap::new();
+    let mut value = |w: &Word| -> T {
+        let mut get = |n: &str| *inputs.entry(n.to_string()).or_insert_with(|| T::from_f64(input(n)));
+        match w {
+            Word::Input(n) => get(n),
+            Word::Trig(TrigFn::Sin, n) => get(n).sin(),
+            Word::Trig(TrigFn::Cos, n) => get(n).cos(),
+            Word::Const(c) => T::from_f64(*c),
+        }
+    };
+    let mut mem: Vec<Vec<Option<T>>> =
+        p.pes.iter().map(|q| q.init.iter().map(|w| w.as_ref().map(&mut value)).collect()).collect();
+    let mut out: Vec<Vec<Option<T>>> =
+        p.pes.iter().map(|q| q.output_init.iter().map(|w| w.as_ref().map(&mut value)).collect()).collect();
+    let mut buf: Vec<Vec<Option<T>>> = p.buffer_words.iter().map(|&w| vec![None; w as usize]).collect();
+    // Results by (slot, arrival cycle).
+    let mut arriving: Vec<Option<T>> = vec![None; n_pe * span];
+    let mut bus: Vec<Option<T>> = vec![None; n_pe];
+    let mut args: Vec<T> = Vec::new();
+    for c in 0..span {
+        let when = When::Cycle(c as u32);
+        for (s, q) in p.pes.iter().enumerate() {
+            let st = &q.steps[c];
+            let now = arriving[s * span + c];
+            if let Some(a) = st.buffer.store {
+                let w = buf[s]
+                    .get_mut(a as usize)
+                    .ok_or_else(|| bad(when, s, format!("buffer address {a} out of range")))?;
+                *w = Some(now.ok_or_else(|| bad(when, s, "buffer store without an arriving result".into()))?);
+            }
+            if let Some(a) = st.capture {
+                let w = out[s]
+                    .get_mut(a as usize)
+                    .ok_or_else(|| bad(when, s, format!("output address {a} out of range")))?;
+                *w = Some(now.ok_or_else(|| bad(when, s, "output capture without an arriving result".into()))?);
+            }
+        }
+        for (s, q) in p.pes.iter().enumerate() {
+            bus[s] = match q.steps[c].buffer.read {
+                Some(a) => Some(
+                    buf[s]
+                        .get(a as usize)
+                        .copied()
+                        .flatten()
+                        .ok_or_else(|| bad(when, s, format!("buffer address {a} read empty or out of range")))?,
+                ),
+                None => None,
+            };
+        }
+        for (s, q) in p.pes.iter().enumerate() {
+            for w in &q.steps[c].writes {
+                let data = match w.src {
+                    Source::Result(t) if t < n_pe => arriving[t * span + c],
+                    Source::Buffer(t) if t < n_pe => bus[t],
+                    _ => None,
+                }
+                .ok_or_else(|| bad(when, s, format!("write source {:?} carries nothing", w.src)))?;
+                *mem[s]
+                    .get_mut(w.addr as usize)
+                    .ok_or_else(|| bad(when, s, format!("write address {} out of range", w.addr)))? = Some(data);
+            }
+        }
+        for (s, q) in p.pes.iter().enumerate() {
+            let Some(i) = &q.steps[c].issue else { continue };
+            args.clear();
+            for &a in &i.reads {
+                args.push(
+                    mem[s]
+                        .get(a as usize)
+                        .copied()
+                        .flatten()
+                        .ok_or_else(|| bad(when, s, format!("read address {a} empty or out of range")))?,
+                );
+            }
+            let binary = |op: BinOp, args: &[T]| match args {
+                [a, b] => Ok(eval_binop(op, *a, *b)),
+                _ => Err(bad(when, s, format!("{op:?} reads {} words", args.len()))),
+            };
+            let x = match &i.op {
+                MachineOp::Add => binary(BinOp::Add, &args)?,
+                MachineOp::Sub => binary(BinOp::Sub, &args)?,
+                MachineOp::Mul => binary(BinOp::Mul, &args)?,
+                MachineOp::Div => binary(BinOp::Div, &args)?,
+                MachineOp::Call(callee) => eval_call(callee, &args),
+            };
+            let at = c + p.latency(&i.op) as usize;
+            if at >= span {
+                return Err(bad(when, s, format!("result arrives at cycle {at}, after the last cycle")));
+            }
+            arriving[s * span + at] = Some(x);
+        }
+    }
+    let mut outputs = Vec::with_capacity(p.outputs.len());
+    for o in &p.outputs {
+        let x = out.get(o.slot).and_then(|m| m.get(o.addr as usize)).copied().flatten().ok_or_else(|| {
+            MachineError::new(K::Unverified, format!("output `{}` is not in its output memory", o.name)).at(When::End)
+        })?;
+        outputs.push((o.name.clone(), x));
+    }
+    Ok(Executed { outputs, cycles: p.cycles })
+}

@@ -1,0 +1,291 @@
+//! `codegen<fpga>` (issue 12): the FP unit models against C `float`, the generated design
+//! simulated in Icarus Verilog against robovec's binary32 evaluation bit for bit, the images read
+//! back, the diagnostics and the Yosys resource estimate. Needs `cc`, `iverilog`/`vvp`, `yosys`
+//! and `python3` (`.ci/run` installs them).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::common::{opt, stderr, tmp};
+
+fn tool(name: &str) {
+    let ok = Command::new(name).arg(if name == "iverilog" { "-V" } else { "--version" }).output().is_ok();
+    assert!(ok, "`{name}` is needed by the codegen<fpga> tests (Debian: apt-get install iverilog verilator yosys)");
+}
+
+fn inputs_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/inputs/fpga")
+}
+
+fn hdl(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("passes/src/codegen/fpga/hdl").join(name)
+}
+
+#[test]
+fn fp_units_equal_c_float_bit_for_bit_on_random_and_edge_operands() {
+    tool("iverilog");
+    let d = tmp("fp_units");
+    let gen = d.join("gen");
+    let st = Command::new("cc")
+        .args(["-O1", "-ffp-contract=off", "-o"])
+        .arg(&gen)
+        .arg(inputs_dir().join("fp_vectors.c"))
+        .status()
+        .expect("cc runs");
+    assert!(st.success());
+    let vec = Command::new(&gen).arg("20000").output().expect("generator runs");
+    assert!(vec.status.success());
+    let n = vec.stdout.iter().filter(|&&b| b == b'\n').count();
+    // 20000 random pairs plus every pair of the 26 edge values for 3 ops
+    assert_eq!(n, 20000 + 26 * 26 * 3);
+    std::fs::write(d.join("vec.hex"), &vec.stdout).unwrap();
+    let st = Command::new("iverilog")
+        .current_dir(&d)
+        .args(["-g2005", &format!("-DN={n}"), "-DVEC=\"vec.hex\"", "-o", "tb.vvp"])
+        .arg(inputs_dir().join("fp_check_tb.v"))
+        .arg(hdl("fp_units.v"))
+        .status()
+        .expect("iverilog runs");
+    assert!(st.success());
+    let out = Command::new("vvp").current_dir(&d).args(["-n", "tb.vvp"]).output().expect("vvp runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains(&format!("checked {n} vectors, 0 mismatches")), "{text}");
+}
+
+#[test]
+fn fp_units_and_pe_library_pass_verilator_lint() {
+    tool("verilator");
+    let out = Command::new("verilator")
+        .args(["--lint-only", "-Wno-fatal", "-Wno-WIDTH", "-Wno-DECLFILENAME", "--top-module", "rv_pe"])
+        .arg(hdl("fp_units.v"))
+        .arg(hdl("rv_mem.v"))
+        .arg(hdl("rv_lib.v"))
+        .output()
+        .expect("verilator runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";
+
+fn corpus(name: &str) -> String {
+    crate::common::corpus_dir().join("c").join(name).display().to_string()
+}
+
+/// Runs `robovec-opt SRC atomise,place<pe=N>,codegen<fpga…>` with `-eval` in binary32 on
+/// `inputs`; returns the folder and the evaluation's outputs.
+fn emit(src: &str, n: u32, dir: &Path, extra: &str, inputs: &Path) -> serde_json::Value {
+    let passes = format!(
+        "-passes=atomise,place<pe={n};restarts=0;search=0>,codegen<fpga;out={};resources=estimate{extra}>",
+        dir.display()
+    );
+    let o = opt(&[src, &passes, &format!("-eval={}", inputs.display()), "-eval-precision=f32"]);
+    assert!(o.status.success(), "{src} N={n}: {}", stderr(&o));
+    serde_json::from_slice(&o.stdout).expect("eval JSON")
+}
+
+fn simulate(dir: &Path, inputs: &Path) -> serde_json::Value {
+    let o = Command::new(dir.join("simulate")).arg(inputs).output().expect("simulate runs");
+    assert!(o.status.success(), "simulate: {}", stderr(&o));
+    serde_json::from_slice(&o.stdout).expect("simulate JSON")
+}
+
+/// Every output of the simulation equals the evaluation's binary32 value bit for bit.
+fn same_outputs(what: &str, eval: &serde_json::Value, sim: &serde_json::Value) {
+    let want = eval["outputs"].as_object().expect("outputs");
+    let bits = sim["bits"].as_object().expect("bits");
+    assert_eq!(want.len(), bits.len(), "{what}: outputs");
+    for (k, v) in want {
+        let w = v.as_f64().map(|x| (x as f32).to_bits());
+        let got = u32::from_str_radix(bits[k].as_str().unwrap().trim_start_matches("0x"), 16).unwrap();
+        match w {
+            Some(w) => assert_eq!(got, w, "{what}: output {k}: simulated {got:#010x}, evaluated {w:#010x}"),
+            // -eval prints a NaN or infinity as null
+            None => assert!(!f32::from_bits(got).is_finite(), "{what}: output {k}"),
+        }
+    }
+}
+
+#[test]
+fn placed_designs_simulate_in_iverilog_bit_for_bit_like_the_binary32_evaluation() {
+    tool("iverilog");
+    let d = tmp("proof");
+    // given inputs for the pendulum (others pseudo-random, which the script must reproduce)
+    let given = d.join("given.json");
+    std::fs::write(&given, r#"{"q[1]": 0.75, "qd[2]": -1.25, "qdd[1]": 3.0e-3}"#).unwrap();
+    let none = d.join("none.json");
+    std::fs::write(&none, "{}").unwrap();
+    let cases = [
+        (PENDULUM.to_string(), &given, "pendulum"),
+        (corpus("m454__mbs_dirdyna_m454_project.c"), &none, "m454-dirdyna"),
+        (corpus("tricycle__mbs_cons_hJ_tricycle.c"), &none, "tricycle-cons_hJ"),
+    ];
+    for (src, inputs, name) in &cases {
+        for n in [2u32, 4] {
+            let dir = d.join(format!("{name}-{n}"));
+            let eval = emit(src, n, &dir, "", inputs);
+            let sim = simulate(&dir, inputs);
+            let man: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+            assert_eq!(sim["cycles"], man["cycles"], "{name} N={n}: the hardware ran the program's cycles");
+            assert_eq!(sim["clocks"].as_u64().unwrap(), man["cycles"].as_u64().unwrap() + 1);
+            same_outputs(&format!("{name} N={n}"), &eval, &sim);
+        }
+    }
+}
+
+#[test]
+fn mif_only_designs_simulate_too_and_unknown_inputs_are_refused() {
+    let d = tmp("mif");
+    let none = d.join("none.json");
+    std::fs::write(&none, "{}").unwrap();
+    let dir = d.join("out");
+    let eval = emit(PENDULUM, 2, &dir, ";format=mif", &none);
+    assert!(!dir.join("hex").exists() && dir.join("mif/pe0_instr.mif").is_file());
+    same_outputs("pendulum mif", &eval, &simulate(&dir, &none));
+    let bad = d.join("bad.json");
+    std::fs::write(&bad, r#"{"q[9]": 1}"#).unwrap();
+    let o = Command::new(dir.join("simulate")).arg(&bad).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("`q[9]`"), "{}", stderr(&o));
+}
+
+#[test]
+fn an_unplaced_function_is_a_diagnostic_and_nothing_is_written() {
+    let d = tmp("unplaced");
+    let dir = d.join("out");
+    let o = opt(&[PENDULUM, &format!("-passes=atomise,codegen<fpga;out={}>", dir.display())]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("has no placement"), "{}", stderr(&o));
+    assert!(!dir.exists(), "nothing written");
+    let o = opt(&[PENDULUM, "-passes=atomise,place,codegen<fpga>"]);
+    assert_eq!(o.status.code(), Some(2), "out= is required: {}", stderr(&o));
+    let o = opt(&[PENDULUM, &format!("-passes=atomise,place,codegen<fpga;out={};abi=plain>", dir.display())]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+#[test]
+fn yosys_sizes_the_design_and_resources_json_has_the_figures() {
+    tool("yosys");
+    let d = tmp("yosys");
+    let dir = d.join("out");
+    let rep = d.join("report.json");
+    let passes =
+        format!("-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=yosys>", dir.display());
+    let o = opt(&[PENDULUM, &passes, &format!("-report={}", rep.display()), "-o", "/dev/null"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
+    assert_eq!(r["logic_from"], "yosys");
+    let fp_alm = 2 * 360 + 2 * 100;
+    assert_eq!(r["fp_units"]["alm"], fp_alm, "target's per-unit costs (seed Table 1.4)");
+    assert_eq!(r["fp_units"]["dsp"], 2 * 2 + 2 * 3);
+    let logic = r["logic_alm"].as_u64().unwrap();
+    assert!(logic > 100, "the crossbar and control take logic: {logic}");
+    assert_eq!(r["alm"].as_u64().unwrap(), logic + fp_alm);
+    assert_eq!(r["fits"], true);
+    let cycles = r["cycles"].as_f64().unwrap();
+    assert!((r["us"].as_f64().unwrap() - cycles / r["clock_mhz"].as_f64().unwrap()).abs() < 1e-12);
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    assert_eq!(report["fpga"]["resources"]["alm"], r["alm"], "the report's fpga entry is resources.json's");
+    assert_eq!(report["fpga"]["cycles"], r["cycles"]);
+    // the M10K count is the memories' sum
+    let m10k: u64 = r["memories"].as_array().unwrap().iter().map(|m| m["m10k"].as_u64().unwrap()).sum();
+    assert_eq!(r["m10k"].as_u64().unwrap(), m10k);
+}
+
+/// The pendulum placed at `n` PEs, in-process.
+fn placed_pendulum(n: u32) -> robovec_ir::Module {
+    let (mut m, _) = robovec::driver::load(PENDULUM).unwrap_or_else(|f| panic!("{}", f.message()));
+    let pipeline = format!("atomise,place<pe={n};restarts=0;search=0>");
+    let pm = robovec_passes::PassManager::new(&pipeline, robovec_passes::Instrumentation::default()).unwrap();
+    pm.run(&mut m, &mut robovec_passes::PassContext::default(), &mut std::io::sink()).unwrap();
+    m
+}
+
+#[test]
+fn images_read_back_from_hex_and_mif_reproduce_the_machine_program_exactly() {
+    use robovec_ir::machine::encode::{decode, Images, Layout};
+    use robovec_ir::target::Target;
+    use robovec_passes::codegen::fpga::images::Image;
+    use robovec_passes::codegen::fpga::lower::{design, Limits};
+
+    let t = Target::de10_nano();
+    for n in [2u32, 4] {
+        let m = placed_pendulum(n);
+        let f = &m.functions[0];
+        let prog = robovec_passes::machine::lower(f, f.placement.as_ref().unwrap()).unwrap();
+        let d = design(f, &prog, &Limits::of(&t)).unwrap();
+        let layout = Layout::new(&prog, t.pe_words, t.buffer_words, t.instr_width).unwrap();
+        for from_mif in [false, true] {
+            let read = |img: &Image| -> Vec<u64> {
+                if from_mif {
+                    Image::parse_mif(&img.name, &img.to_mif()).unwrap().words
+                } else {
+                    Image::parse_hex(&img.name, img.width, &img.to_hex()).unwrap().words
+                }
+            };
+            let im = Images {
+                layout,
+                instr: d.pes.iter().map(|p| read(&p.instr)).collect(),
+                crossbar: d.pes.iter().map(|p| read(&p.xbar)).collect(),
+                buffer: d.pes.iter().map(|p| read(&p.bufi)).collect(),
+                capture: d.pes.iter().map(|p| read(&p.capt)).collect(),
+            };
+            let steps = decode(&im).unwrap();
+            for (s, pe) in prog.pes.iter().enumerate() {
+                assert_eq!(steps[s], pe.steps, "N={n} slot {s}: decoded steps (mif: {from_mif})");
+                // initial data: every constant word is its binary32 rounding, others 0
+                let data = read(&d.pes[s].data);
+                assert_eq!(data.len(), pe.init.len().max(1));
+                for (a, w) in pe.init.iter().enumerate() {
+                    let want = match w {
+                        Some(robovec_ir::machine::Word::Const(c)) => u64::from((*c as f32).to_bits()),
+                        _ => 0,
+                    };
+                    assert_eq!(data[a], want, "N={n} slot {s} word {a}");
+                }
+            }
+        }
+        // the simulated cycle count and the instruction memory depth
+        assert!(d.pes.iter().all(|p| p.instr.words.len() == prog.cycles as usize + 1));
+        assert_eq!(d.cycles, prog.cycles);
+    }
+}
+
+/// A DE10-Nano target file with `field` changed.
+fn target_with(dir: &Path, field: &str, value: serde_json::Value) -> PathBuf {
+    let text =
+        std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/targets/de10-nano.json"))
+            .unwrap();
+    let mut t: serde_json::Value = serde_json::from_str(&text).unwrap();
+    t[field] = value;
+    let p = dir.join(format!("{field}.json"));
+    std::fs::write(&p, t.to_string()).unwrap();
+    p
+}
+
+#[test]
+fn memories_beyond_the_target_are_diagnostics_with_the_figures_and_nothing_is_written() {
+    let d = tmp("limits");
+    let dir = d.join("out");
+    let run = |target: &Path| {
+        let passes = format!(
+            "-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=estimate>",
+            dir.display()
+        );
+        opt(&[PENDULUM, &passes, &format!("-target={}", target.display()), "-o", "/dev/null"])
+    };
+    // the pendulum at N = 2 runs well over 32 cycles
+    let o = run(&target_with(&d, "instr_words", serde_json::json!(32)));
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("the target's instruction memory has 32"), "{}", stderr(&o));
+    assert!(!dir.exists(), "nothing written");
+    let o = run(&target_with(&d, "pe_words", serde_json::json!(4)));
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("the target has 4 words per PE memory"), "{}", stderr(&o));
+    assert!(!dir.exists(), "nothing written");
+    let o = run(&target_with(&d, "writes", serde_json::json!(3)));
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("3 write port(s)"), "{}", stderr(&o));
+    assert!(!dir.exists(), "nothing written");
+}
