@@ -157,10 +157,11 @@ fn an_unplaced_function_is_a_diagnostic_and_nothing_is_written() {
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("has no placement"), "{}", stderr(&o));
     assert!(!dir.exists(), "nothing written");
-    let o = opt(&[PENDULUM, "-passes=atomise,place,codegen<fpga>"]);
-    assert_eq!(o.status.code(), Some(2), "out= is required: {}", stderr(&o));
-    let o = opt(&[PENDULUM, &format!("-passes=atomise,place,codegen<fpga;out={};abi=plain>", dir.display())]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let o = opt(&[PENDULUM, &format!("-passes=atomise,place,codegen<fpga;out={};abi=robotran>", dir.display())]);
+    assert_eq!(o.status.code(), Some(2), "a C parameter: {}", stderr(&o));
+    let o = opt(&[PENDULUM, &format!("-passes=atomise,codegen<c;out={}>", dir.display())]);
+    assert_eq!(o.status.code(), Some(2), "an FPGA parameter: {}", stderr(&o));
+    assert!(!dir.exists(), "nothing written");
 }
 
 #[test]

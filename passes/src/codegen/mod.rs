@@ -54,6 +54,10 @@ pub const INFO: PassInfo = PassInfo {
     ],
     build: |p: &Params| {
         let which = p.choice("back-end")?;
+        // every choice of the family is checked, whichever back end reads it
+        for d in fpga::FPGA_CHOICES {
+            p.choice(d.name)?;
+        }
         let b = BACK_ENDS.iter().find(|b| b.name == which).expect("every selector choice has a back end");
         (b.build)(p)
     },
@@ -144,7 +148,10 @@ mod tests {
         assert_eq!(build("codegen<back-end=c>").unwrap(), plain);
         let robotran = build("codegen<c;abi=robotran>").unwrap();
         assert!(robotran.contains("abi: \"robotran\""), "{robotran}");
-        assert!(matches!(build("codegen<fpga>"), Err(PassError::BadParameter { .. })), "not a back end yet");
+        let fpga = build("codegen<fpga;out=x>").unwrap();
+        assert!(fpga.contains("CodegenFpga") && fpga.contains("\"x\""), "{fpga}");
+        assert!(matches!(build("codegen<fpga;abi=robotran>"), Err(PassError::BadParameter { .. })));
+        assert!(matches!(build("codegen<c;out=x>"), Err(PassError::BadParameter { .. })));
         let twice = build("codegen<c;back-end=c>").unwrap_err().to_string();
         assert!(twice.contains("given twice"), "{twice}");
         let bad = build("codegen<c;abi=robotran;batch=8>").unwrap_err().to_string();

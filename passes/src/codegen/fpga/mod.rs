@@ -60,7 +60,7 @@ pub const SIMULATE: &str = include_str!("simulate.py");
 pub const OUT: ParamInfo = ParamInfo {
     name: "out",
     kind: ParamKind::OutputFolder,
-    doc: "FPGA: folder for images, manifest, Verilog, simulate script and resources.json (required)",
+    doc: "FPGA: folder for images, manifest, Verilog, simulate script and resources.json (default `fpga`)",
 };
 /// `format=mif|hex|both`.
 pub const FORMAT: ParamInfo = ParamInfo {
@@ -78,13 +78,20 @@ pub const RESOURCES: ParamInfo = ParamInfo {
 /// The parameters of the C back end, refused with `codegen<fpga>` when given another value
 /// than their default.
 pub const C_ONLY: &[ParamInfo] = &[super::c::ABI, super::c::PRECISION, super::c::BATCH, super::c::TRIG, super::c::NAME];
-/// The parameters of this back end, refused with `codegen<c>` likewise.
-pub const FPGA_ONLY: &[ParamInfo] = &[OUT, FORMAT, RESOURCES];
+/// The parameter of this back end refused with `codegen<c>` (`format` and `resources` have
+/// defaults and are ignored there, as every choice of a family parameter must build).
+pub const FPGA_ONLY: &[ParamInfo] = &[OUT];
+
+/// This back end's choice parameters (checked by the family whichever back end runs).
+pub const FPGA_CHOICES: &[ParamInfo] = &[FORMAT, RESOURCES];
 
 /// The first of `decls` given with a value other than its declared default (`out=`, `name=`:
 /// any value), if any.
 pub fn given_beyond_default(p: &Params, decls: &[ParamInfo]) -> Option<&'static str> {
-    decls.iter().find(|d| p.get(d.name).is_some_and(|v| !d.default_is_literal() || v != d.default_text())).map(|d| d.name)
+    decls
+        .iter()
+        .find(|d| p.get(d.name).is_some_and(|v| !d.default_is_literal() || v != d.default_text()))
+        .map(|d| d.name)
 }
 
 /// The `codegen<fpga;…>` pass.
@@ -110,12 +117,13 @@ impl CodegenFpga {
     /// The options from checked parameters.
     ///
     /// # Errors
-    /// [`PassError::BadParameter`] without `out`, or with a parameter of the C back end.
+    /// [`PassError::BadParameter`] with a parameter of the C back end given another value than
+    /// its default. Without `out`, the folder is `fpga` (in the working folder).
     pub fn from_params(p: &Params) -> Result<CodegenFpga, PassError> {
         if let Some(k) = given_beyond_default(p, C_ONLY) {
             return Err(bad(format!("parameter `{k}` belongs to `codegen<c>`, not `codegen<fpga>`")));
         }
-        let out = p.path("out")?.ok_or_else(|| bad("`codegen<fpga>` needs `out=DIR`, the folder it writes".into()))?;
+        let out = p.path("out")?.unwrap_or_else(|| "fpga".into());
         Ok(CodegenFpga { out: out.into(), format: p.choice("format")?, resources: p.choice("resources")? })
     }
 }
