@@ -105,4 +105,4 @@ pub fn lower_measured(f: &Function, p: &Placement) -> Result<(MachineProgram, Oc
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -20,19 +20,19 @@ use crate::place::{place_function, PlaceOptions};
 
 use Pe::{Add, Mul};
 
-fn func(src: &str) -> Function {
+pub(crate) fn func(src: &str) -> Function {
     parse(src).unwrap_or_else(|e| panic!("{e:?}")).functions.remove(0)
 }
 
-fn v(f: &Function, name: &str) -> Value {
+pub(crate) fn v(f: &Function, name: &str) -> Value {
     f.lookup(name).unwrap_or_else(|| panic!("no %{name}"))
 }
 
-fn arch(n_add: u32, n_mul: u32) -> Arch {
+pub(crate) fn arch(n_add: u32, n_mul: u32) -> Arch {
     Arch { n_add, n_mul, lat: Latencies::default(), writes: 2, buffer: true }
 }
 
-fn load(f: &Function, pe: Pe, addr: u32, name: &str) -> Load {
+pub(crate) fn load(f: &Function, pe: Pe, addr: u32, name: &str) -> Load {
     Load { pe, addr, operand: Operand::Value(v(f, name)) }
 }
 

@@ -1,7 +1,6 @@
 use super::*;
-use robovec_ir::analysis::Latencies;
 use robovec_ir::interp::pseudo_random_input;
-use robovec_ir::placement::{Arch, Issue, Load, Pe, Write};
+use robovec_ir::placement::{Issue, Load, Pe, Write};
 use robovec_ir::text::parse;
 use robovec_ir::{Operand, Value};
 
@@ -9,21 +8,7 @@ use Pe::{Add, Mul};
 
 const SRC: &str = "func @f { phase atomised input %a input %b %x = mul %a, %b %y = add %x, %a output o = %y }";
 
-fn func(src: &str) -> Function {
-    parse(src).unwrap_or_else(|e| panic!("{e:?}")).functions.remove(0)
-}
-
-fn v(f: &Function, name: &str) -> Value {
-    f.lookup(name).unwrap_or_else(|| panic!("no %{name}"))
-}
-
-fn arch(n_add: u32, n_mul: u32) -> Arch {
-    Arch { n_add, n_mul, lat: Latencies::default(), writes: 2, buffer: true }
-}
-
-fn load(f: &Function, pe: Pe, addr: u32, name: &str) -> Load {
-    Load { pe, addr, operand: Operand::Value(v(f, name)) }
-}
+use crate::machine::tests::{arch, func, load, v};
 
 fn direct(f: &Function, name: &str, pe: Pe, addr: u32, cycle: u32) -> Write {
     Write { value: v(f, name), pe, addr, cycle, buffer_addr: None }
