@@ -194,6 +194,23 @@ fn yosys_sizes_the_design_and_resources_json_has_the_figures() {
     assert_eq!(r["m10k"].as_u64().unwrap(), m10k);
 }
 
+/// `resources=auto` gives Yosys only designs of at most `AUTO_YOSYS_MAX_PES` PEs (its time grows
+/// with the crossbar): 5 + 5 PEs get the analytic estimate and a `-stats` note, at once.
+#[test]
+fn auto_resources_leave_large_designs_to_the_estimate_with_a_note() {
+    assert_eq!(robovec_passes::codegen::fpga::AUTO_YOSYS_MAX_PES, 8);
+    let d = tmp("auto_large");
+    let dir = d.join("out");
+    let passes = format!("-passes=atomise,place<pe=5;restarts=0;search=0>,codegen<fpga;out={}>", dir.display());
+    let o = opt(&[PENDULUM, &passes, "-stats", "-o", "/dev/null"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
+    assert_eq!(r["logic_from"], "estimate");
+    let err = stderr(&o);
+    assert!(err.contains("10 PEs: resources from the analytic estimate"), "{err}");
+}
+
 /// The pendulum placed at `n` PEs, in-process.
 fn placed_pendulum(n: u32) -> robovec_ir::Module {
     let (mut m, _) = robovec::driver::load(PENDULUM).unwrap_or_else(|f| panic!("{}", f.message()));

@@ -28,9 +28,11 @@
 //!   crossbar register), so a result issued at `t` is written at `t + latency`.
 //! - Inputs are not ports: they are words of the initial PE memory images at the load map's
 //!   addresses (as the seed loads "initial data"); `simulate` writes them before running.
-//! - The resource estimate runs Yosys inside the pass when `yosys` is on `PATH`
-//!   (`resources=auto`, the default); `resources=yosys` requires it, `resources=estimate`
-//!   skips it (analytic crossbar cost; deterministic and fast for tests).
+//! - The resource estimate runs Yosys inside the pass when `yosys` is on `PATH` and the design
+//!   has at most [`AUTO_YOSYS_MAX_PES`] PEs (`resources=auto`, the default; larger designs get
+//!   the analytic estimate and a `-stats` note, since Yosys' time grows with the crossbar);
+//!   `resources=yosys` requires it at any size, `resources=estimate` skips it (analytic crossbar
+//!   cost; deterministic and fast for tests).
 //! - Trig initial values (`S4 = sin q[4]`) are loaded words computed by the host in binary32
 //!   (`simulate` calls the C library's `sinf`/`cosf`, as robovec's interpreter does).
 //! - Rejected with a diagnostic and nothing written: a function without placement, `div` or
@@ -72,7 +74,7 @@ pub const FORMAT: ParamInfo = ParamInfo {
 pub const RESOURCES: ParamInfo = ParamInfo {
     name: "resources",
     kind: ParamKind::Choice { choices: &["auto", "yosys", "estimate"], default: "auto" },
-    doc: "FPGA: logic ALMs from Yosys (auto: when on PATH) or the analytic estimate",
+    doc: "FPGA: logic ALMs from Yosys (auto: when on PATH and at most 8 PEs) or the analytic estimate",
 };
 
 /// The parameters of the C back end, refused with `codegen<fpga>` when given another value
@@ -354,6 +356,12 @@ pub fn cost_model(t: &robovec_ir::target::Target) -> resources::CostModel {
     }
 }
 
+/// Largest design (ADD + MULTI PEs) that `resources=auto` gives to Yosys: its time grows about
+/// with the square of the PE count through the crossbar (4 + 4 PEs: 3.5 min on the 2-core
+/// development machine; 8 + 8 did not finish in 25 min). Larger designs get the analytic
+/// estimate and a note; `resources=yosys` runs Yosys whatever the size.
+pub const AUTO_YOSYS_MAX_PES: u32 = 8;
+
 impl CodegenFpga {
     /// The design, report and files of one placed function.
     ///
@@ -376,6 +384,7 @@ impl CodegenFpga {
             "yosys" => Some(resources::yosys_cells(&d)?.ok_or(
                 "`resources=yosys` but `yosys` cannot be run (Debian package `yosys`); use resources=estimate",
             )?),
+            _ if d.n_add + d.n_mul > AUTO_YOSYS_MAX_PES => None,
             _ => resources::yosys_cells(&d)?,
         };
         let r = resources::estimate(&d, model, cells);
@@ -406,6 +415,13 @@ impl Pass for CodegenFpga {
         let mut functions = Vec::new();
         for f in &m.functions {
             let (_, report, files) = self.build(f, &limits, &model).map_err(failed)?;
+            if self.resources == "auto" && report.n_add + report.n_mul > AUTO_YOSYS_MAX_PES {
+                cx.notes.push(format!(
+                    "codegen<fpga> @{}: {} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway, for a long time)",
+                    f.name,
+                    report.n_add + report.n_mul
+                ));
+            }
             functions.push((f.name.clone(), report, files));
         }
         cx.emit(FpgaArtifact { functions, out: self.out.clone() });
