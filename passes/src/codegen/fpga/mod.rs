@@ -363,6 +363,12 @@ pub fn cost_model(t: &robovec_ir::target::Target) -> resources::CostModel {
 pub const AUTO_YOSYS_MAX_PES: u32 = 8;
 
 impl CodegenFpga {
+    /// True when `resources=auto` leaves a design of `n_pes` PEs (ADD + MULTI) to the analytic
+    /// estimate instead of Yosys (see [`AUTO_YOSYS_MAX_PES`]).
+    fn auto_skips_yosys(&self, n_pes: u32) -> bool {
+        self.resources == "auto" && n_pes > AUTO_YOSYS_MAX_PES
+    }
+
     /// The design, report and files of one placed function.
     ///
     /// # Errors
@@ -384,7 +390,7 @@ impl CodegenFpga {
             "yosys" => Some(resources::yosys_cells(&d)?.ok_or(
                 "`resources=yosys` but `yosys` cannot be run (Debian package `yosys`); use resources=estimate",
             )?),
-            _ if d.n_add + d.n_mul > AUTO_YOSYS_MAX_PES => None,
+            _ if self.auto_skips_yosys(d.n_add + d.n_mul) => None,
             _ => resources::yosys_cells(&d)?,
         };
         let r = resources::estimate(&d, model, cells);
@@ -415,7 +421,7 @@ impl Pass for CodegenFpga {
         let mut functions = Vec::new();
         for f in &m.functions {
             let (_, report, files) = self.build(f, &limits, &model).map_err(failed)?;
-            if self.resources == "auto" && report.n_add + report.n_mul > AUTO_YOSYS_MAX_PES {
+            if self.auto_skips_yosys(report.n_add + report.n_mul) {
                 cx.notes.push(format!(
                     "codegen<fpga> @{}: {} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway, for a long time)",
                     f.name,
