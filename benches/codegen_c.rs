@@ -1,6 +1,6 @@
 //! Speed of the generated C against Robotran's own C (issue 11, "Fast, measured side by side").
 //!
-//! `cargo bench --bench codegen_c -- [MODEL…] [--flags=o2|native|both] [--reps=N] [--quick] [--core]`
+//! `cargo bench --bench codegen_c -- [MODEL…] [--flags=o2|native|both] [--reps=N] [--runs=K] [--quick] [--core]`
 //!
 //! `--quick`: no `trig=libm` batches, 20 accuracy samples; `--core`: only the variants of the
 //! issue's goals (`atomise`, `atomise,schedule-cpu`, 8 × f64 and 16 × f32 with `trig=input`).
@@ -16,15 +16,19 @@
 //!    filled with pseudo-random values), every variant, and the timing driver
 //!    `benches/codegen_c/driver.c`, which checks each variant against Robotran's outputs on one
 //!    state and then times them all, alternating, rotating who goes first: median ns per state
-//!    over `reps` samples of ~0.5 ms, inputs cycling over 64 states between calls;
+//!    over `reps` samples of ~0.5 ms, inputs cycling over the same 64 states between calls
+//!    for every variant (a batch of W lanes holds W of them); the binary runs `runs` times
+//!    (default 5) as separate processes;
 //! 3. measures each pipeline's error with `accuracy` (bits of error against the original
 //!    equations, SPEC §6; Robotran's C evaluates each equation left to right, which is the
 //!    `atomise` pipeline's order, so its error is `atomise`'s);
 //! 4. prints one table: model, variant, flags, ns/state (median, min–max), ratio vs Robotran at
-//!    the same flags (> 1: faster) as the median and quartiles of the **paired** ratios (both
-//!    functions' ns/state from the same rep, a few ms apart: on a shared machine whose speed
-//!    drifts by 2× between runs, the ratio of neighbouring samples is stable where the ratio of
-//!    medians is not), error bits (f64 or f32 mean / max), and the check.
+//!    the same flags (> 1: faster) from **paired** ratios (both functions' ns/state from the
+//!    same rep, a few ms apart: on a shared machine whose speed drifts by 2× between runs, the
+//!    ratio of neighbouring samples is stable where the ratio of medians is not): each run's
+//!    median paired ratio, then the median over the runs and their min–max (one process's
+//!    median is tight but moves by ±20 % between processes on this VM), error bits (f64 or f32
+//!    mean / max), and the check.
 //!
 //! Needs `cc` (GCC or Clang) and the corpus at `../shared`. Work files go to
 //! `target/codegen_c_bench/`. CI never runs it (`cargo bench --no-run` only builds this file).
@@ -209,15 +213,22 @@ struct Row {
     median: f64,
     min: f64,
     max: f64,
-    /// Median of the paired ratios (Robotran's ns / this variant's ns in the same rep).
+    /// Median over the runs of each run's median paired ratio (Robotran's ns / this variant's
+    /// ns in the same rep).
     ratio: f64,
-    /// First and third quartiles of the paired ratios.
-    ratio_q: (f64, f64),
+    /// Smallest and largest of the runs' median paired ratios.
+    ratio_range: (f64, f64),
     error: String,
     check: String,
 }
 
-fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core): (bool, bool), rows: &mut Vec<Row>) {
+fn bench_model(
+    spec: &str,
+    flag_sets: &[(&str, &str)],
+    (reps, runs): (u32, u32),
+    (quick, core): (bool, bool),
+    rows: &mut Vec<Row>,
+) {
     let model = find_model(spec);
     let work = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/codegen_c_bench").join(spec.replace(':', "_"));
     // Kept between runs: files are rewritten only when their content changes, and an object
@@ -436,37 +447,60 @@ fn bench_model(spec: &str, flag_sets: &[(&str, &str)], reps: u32, (quick, core):
         link.extend((0..vs.len()).map(|i| obj(&format!("rv{i}"))));
         link.push("-lm".into());
         run(Command::new("cc").args(&link));
-        let out = run(Command::new(&exe).arg(reps.to_string()));
+        // `runs` processes, alternating nothing but themselves: a process's paired median is
+        // stable within it (tight quartiles) but moves by ±20 % between processes on a shared VM
+        // (the host's load), so the table gives the median over processes.
         let mut checks = BTreeMap::new();
-        for line in out.lines() {
-            let f: Vec<&str> = line.split('\t').collect();
-            match f.as_slice() {
-                ["check", v, n, same, worst] => {
-                    checks.insert(v.to_string(), format!("{same}/{n} bit-identical, max diff {worst} of max |out|"));
+        let mut per_variant: BTreeMap<String, Vec<[f64; 6]>> = BTreeMap::new();
+        let mut order = Vec::new();
+        for _ in 0..runs {
+            let out = run(Command::new(&exe).arg(reps.to_string()));
+            for line in out.lines() {
+                let f: Vec<&str> = line.split('\t').collect();
+                match f.as_slice() {
+                    ["check", v, n, same, worst] => {
+                        checks
+                            .insert(v.to_string(), format!("{same}/{n} bit-identical, max diff {worst} of max |out|"));
+                    }
+                    ["time", v, rest @ ..] if rest.len() == 6 => {
+                        let x: Vec<f64> = rest.iter().map(|t| t.parse().unwrap()).collect();
+                        if !per_variant.contains_key(*v) {
+                            order.push(v.to_string());
+                        }
+                        per_variant.entry(v.to_string()).or_default().push([x[0], x[1], x[2], x[3], x[4], x[5]]);
+                    }
+                    _ => {}
                 }
-                ["time", v, med, min, max, ratio, q1, q3] => {
-                    let med: f64 = med.parse().unwrap();
-                    let (variant, error) = if *v == "robotran" {
-                        ("Robotran's C".to_string(), errors[&("atomise".to_string(), "f64")].clone())
-                    } else {
-                        let i: usize = v[1..].parse().unwrap();
-                        (vs[i].label.clone(), errors[&(vs[i].pipeline.clone(), vs[i].precision)].clone())
-                    };
-                    rows.push(Row {
-                        model: model.label.clone(),
-                        variant,
-                        flags: flag_label.to_string(),
-                        median: med,
-                        min: min.parse().unwrap(),
-                        max: max.parse().unwrap(),
-                        ratio: ratio.parse().unwrap(),
-                        ratio_q: (q1.parse().unwrap(), q3.parse().unwrap()),
-                        error,
-                        check: checks.get(*v).cloned().unwrap_or_default(),
-                    });
-                }
-                _ => {}
             }
+        }
+        for v in &order {
+            let xs = &per_variant[v];
+            let median = |k: usize| {
+                let mut c: Vec<f64> = xs.iter().map(|x| x[k]).collect();
+                c.sort_by(f64::total_cmp);
+                c[c.len() / 2]
+            };
+            let (variant, error) = if v == "robotran" {
+                ("Robotran's C".to_string(), errors[&("atomise".to_string(), "f64")].clone())
+            } else {
+                let i: usize = v[1..].parse().unwrap();
+                (vs[i].label.clone(), errors[&(vs[i].pipeline.clone(), vs[i].precision)].clone())
+            };
+            rows.push(Row {
+                model: model.label.clone(),
+                variant,
+                flags: flag_label.to_string(),
+                median: median(0),
+                min: xs.iter().map(|x| x[1]).fold(f64::INFINITY, f64::min),
+                max: xs.iter().map(|x| x[2]).fold(0.0, f64::max),
+                ratio: median(3),
+                ratio_range: (
+                    xs.iter().map(|x| x[3]).fold(f64::INFINITY, f64::min),
+                    xs.iter().map(|x| x[3]).fold(0.0, f64::max),
+                ),
+                error,
+                check: checks.get(v).cloned().unwrap_or_default(),
+            });
         }
     }
 }
@@ -475,6 +509,7 @@ fn main() {
     let mut models = Vec::new();
     let mut flags = "both".to_string();
     let mut reps = 61;
+    let mut runs = 5;
     let mut quick = false;
     let mut core = false;
     for a in std::env::args().skip(1) {
@@ -482,6 +517,8 @@ fn main() {
             flags = f.into();
         } else if let Some(r) = a.strip_prefix("--reps=") {
             reps = r.parse().expect("--reps=N");
+        } else if let Some(r) = a.strip_prefix("--runs=") {
+            runs = r.parse().expect("--runs=N");
         } else if a == "--quick" {
             quick = true;
         } else if a == "--core" {
@@ -504,15 +541,25 @@ fn main() {
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     let mut rows = Vec::new();
     for m in &models {
-        bench_model(m, &flag_sets, reps, (quick, core), &mut rows);
+        bench_model(m, &flag_sets, (reps, runs), (quick, core), &mut rows);
     }
     println!("load average before: {}", load.trim());
-    println!("| model | variant | flags | ns/state median (min–max) | vs Robotran: paired median (quartiles) | error bits mean / max | check vs Robotran (state 0) |");
+    println!("| model | variant | flags | ns/state median (min–max) | vs Robotran: paired median over {runs} runs (min–max) | error bits mean / max | check vs Robotran (state 0) |");
     println!("|---|---|---|---:|---:|---|---|");
     for r in &rows {
         println!(
             "| {} | {} | {} | {:.1} ({:.1}–{:.1}) | {:.2}× ({:.2}–{:.2}) | {} | {} |",
-            r.model, r.variant, r.flags, r.median, r.min, r.max, r.ratio, r.ratio_q.0, r.ratio_q.1, r.error, r.check
+            r.model,
+            r.variant,
+            r.flags,
+            r.median,
+            r.min,
+            r.max,
+            r.ratio,
+            r.ratio_range.0,
+            r.ratio_range.1,
+            r.error,
+            r.check
         );
     }
 }

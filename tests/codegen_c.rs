@@ -645,3 +645,40 @@ fn robotran_elements_of_one_callback_with_different_operands_are_a_diagnostic() 
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("the elements of callback `user_ExtForces(…, 1)` have different operands"), "{err}");
 }
+
+/// The plain ABI reads each input just before its first use and writes each output right after
+/// the statement that computes it (outputs that are inputs last): the order that keeps GCC's
+/// frame of coman's batched `dirdyna` in L1 (`plain.rs`'s module doc).
+#[test]
+fn plain_code_reads_inputs_at_first_use_and_writes_outputs_when_computed() {
+    let dir = tmp("order");
+    let ir = dir.join("f.rvir");
+    std::fs::write(
+        &ir,
+        "func @f {\n  phase atomised\n  input %x\n  input %y\n  input %z\n  %m1 = mul %x, %y\n  \
+         %m2 = mul %m1, %z\n  output o1 = %m1\n  output o2 = %m2\n  output o3 = %y\n}\n",
+    )
+    .unwrap();
+    for (batch, load, store) in [
+        (1, ["in[0]", "in[1]", "in[2]"], ["out[0]", "out[1]", "out[2]"]),
+        (4, ["in + 0 ", "in + 4 ", "in + 8 "], ["out + 0 ", "out + 4 ", "out + 8 "]),
+    ] {
+        let c = dir.join(format!("f{batch}.c"));
+        let o = crate::common::opt(&[
+            ir.to_str().unwrap(),
+            &format!("-passes=codegen<c;abi=plain;batch={batch}>"),
+            "-o",
+            c.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", crate::common::stderr(&o));
+        let code = std::fs::read_to_string(&c).unwrap();
+        let at = |needle: &str| code.find(needle).unwrap_or_else(|| panic!("no `{needle}` in\n{code}"));
+        let (m1, m2) = (at("m1 = x * y;"), at("m2 = m1 * z;"));
+        // x and y before m1, z between m1 and m2; o1 between m1 and m2, o2 after m2, o3 last.
+        assert!(at(load[0]) < m1 && at(load[1]) < m1, "{code}");
+        assert!(m1 < at(load[2]) && at(load[2]) < m2, "{code}");
+        assert!(m1 < at(store[0]) && at(store[0]) < at(load[2]), "{code}");
+        assert!(m2 < at(store[1]) && at(store[1]) < at(store[2]), "{code}");
+        assert_eq!(code.matches(load[1]).count(), 1, "y is read once: {code}");
+    }
+}

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use robovec_ir::{BinOp, Callee, Def, Function, Module, Operand, TrigFn};
+use robovec_ir::{BinOp, Callee, Def, Function, Module, Operand, TrigFn, Value};
 
 use super::{is_sqrt, CodegenC};
 use crate::codegen::literal::hex;
@@ -201,17 +201,31 @@ impl Body<'_> {
     /// Every body value, one statement each, in the IR's order (trig values are skipped with
     /// `trig=input`: they are inputs).
     pub fn statements(&self, s: &mut String) {
+        self.statements_with(s, &mut |_, _| {}, &mut |_, _| {});
+    }
+
+    /// [`Body::statements`], calling `before(s, v)` just before and `after(s, v)` just after the
+    /// statement of each value `v` that has one (the plain ABI reads inputs at their first use
+    /// and writes outputs as soon as they are computed).
+    pub fn statements_with(
+        &self,
+        s: &mut String,
+        before: &mut dyn FnMut(&mut String, Value),
+        after: &mut dyn FnMut(&mut String, Value),
+    ) {
         let ty = self.value_type();
         let vec = self.o.batch > 1;
         let sfx = if self.o.f32 { "f" } else { "" };
         for &v in &self.f.body {
             let name = &self.names[v.index()];
-            match &self.f.value(v).def {
+            let def = &self.f.value(v).def;
+            if self.o.trig_input && matches!(def, Def::Trig(..)) {
+                continue;
+            }
+            before(s, v);
+            match def {
                 Def::Input | Def::Expr(_) => unreachable!("atomised bodies hold trig, binary ops and calls"),
                 Def::Trig(t, a) => {
-                    if self.o.trig_input {
-                        continue;
-                    }
                     let fun = match t {
                         TrigFn::Sin => "sin",
                         TrigFn::Cos => "cos",
@@ -273,6 +287,7 @@ impl Body<'_> {
                     }
                 }
             }
+            after(s, v);
         }
     }
 }
