@@ -3,12 +3,12 @@
 //! `cargo bench --bench codegen_c -- [MODEL…] [--flags=o2|native|both] [--reps=N] [--runs=K] [--quick] [--core]`
 //!
 //! `--quick`: no `trig=libm` batches, 20 accuracy samples; `--core`: only the variants of the
-//! issue's goals (`atomise`, `atomise,schedule-cpu`, 8 × f64 and 16 × f32 with `trig=input`).
+//! issue's goals (`atomise`, `atomise[,cse],schedule-cpu`, 8 × f64 and 16 × f32 with `trig=input`).
 //!
 //! For each model (a corpus `dirdyna`/`invdyna` C file, named by its prefix: `m454` (default),
 //! `coman_longarms`, `jeep`, `walkman`, `tricycle`, `frank_segway`, `coman_longarms:invdyna`), it
 //! 1. writes robovec's C with `robovec-opt FILE -passes=PIPELINE,codegen<c;abi=plain;…>` for
-//!    every variant of [`variants`] (pipelines `atomise`, `atomise,schedule-cpu`,
+//!    every variant of [`variants`] (pipelines `atomise`, `atomise[,cse],schedule-cpu`,
 //!    `atomise,zero-removal,balance[,schedule-cpu]`, `specialize` with the model parameters
 //!    fixed, `dce<outputs=c>`; `batch=4,8` f64 and `batch=8,16` f32 with `trig=input|libm`);
 //! 2. builds ONE binary per flag set (`-O2`, and `-O3 -march=native -ffp-contract=off`) with
@@ -81,6 +81,11 @@ fn variants(params_json: &Path, dce_outputs: &str, quick: bool, core: bool) -> V
             }
         }
     }
+    // Common-subexpression elimination first: schedule-cpu then orders the DAG GCC allocates.
+    let cse = "atomise,cse,schedule-cpu";
+    out.push(v(cse, cse, "f64", 1, "libm"));
+    out.push(v(&format!("{cse} batch=8 f64 trig=input"), cse, "f64", 8, "input"));
+    out.push(v(&format!("{cse} batch=16 f32 trig=input"), cse, "f32", 16, "input"));
     let spec = format!("atomise,specialize<params={}>,schedule-cpu", params_json.display());
     out.push(v("specialize(params),schedule-cpu", &spec, "f64", 1, "libm"));
     out.push(v("specialize(params),schedule-cpu batch=8 f64 trig=input", &spec, "f64", 8, "input"));
@@ -91,6 +96,7 @@ fn variants(params_json: &Path, dce_outputs: &str, quick: bool, core: bool) -> V
         let keep = |l: &str| {
             l == "atomise"
                 || l == "atomise,schedule-cpu"
+                || l.starts_with("atomise,cse,schedule-cpu")
                 || l.ends_with("batch=8 f64 trig=input") && !l.starts_with("spec")
                 || l.ends_with("batch=16 f32 trig=input")
         };

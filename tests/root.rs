@@ -11,6 +11,7 @@ mod bounds;
 mod cli;
 mod codegen_c;
 mod corpus;
+mod cse;
 mod diagnostics;
 mod eqsat;
 mod error_reference;

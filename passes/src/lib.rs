@@ -12,6 +12,7 @@ pub mod asap_alap;
 pub mod atomise;
 pub mod codegen;
 pub mod cpu_order;
+pub mod cse;
 pub mod dce;
 pub mod eqsat;
 pub mod figures;
@@ -328,6 +329,7 @@ pub struct PassInfo {
 pub const PASSES: &[PassInfo] = &[
     atomise::INFO,
     dce::INFO,
+    cse::INFO,
     asap_alap::INFO,
     place::INFO,
     sim::INFO,
