@@ -329,7 +329,6 @@ pub struct PassInfo {
 pub const PASSES: &[PassInfo] = &[
     atomise::INFO,
     dce::INFO,
-    cse::INFO,
     asap_alap::INFO,
     place::INFO,
     sim::INFO,
@@ -342,6 +341,7 @@ pub const PASSES: &[PassInfo] = &[
     tree_height::distribute::INFO,
     specialize::INFO,
     eqsat::INFO,
+    cse::INFO,
     cpu_order::INFO,
     codegen::INFO,
 ];
