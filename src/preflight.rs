@@ -56,6 +56,9 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     for d in opts.instr.dump_dir.iter().cloned().chain(folders) {
         output::check_folder(&d).map_err(output_failure)?;
     }
+    if let Some(dir) = &opts.report_dir {
+        output::check_replaceable_folder(dir).map_err(output_failure)?;
+    }
     check_pass_files(pm)?;
     // `-pareto`'s pipelines: every name, parameter and file they read, before any work too.
     if let Some(text) = &opts.pareto {
@@ -120,7 +123,7 @@ fn check_pass_files(pm: &PassManager) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Checks `-function` and the one-function needs of `-report`, `-eval` and `-pareto` against
+/// Checks `-function` and the one-function needs of `-report`, `-report-dir`, `-eval` and `-pareto` against
 /// the input, before any pass runs.
 ///
 /// # Errors
@@ -129,9 +132,12 @@ pub fn check_functions(opts: &Options, module: &Module) -> Result<(), Failure> {
     if opts.function.is_some() {
         select(module, &opts.function, "-function")?;
     }
-    for (given, what) in
-        [(opts.report.is_some(), "-report"), (opts.eval.is_some(), "-eval"), (opts.pareto.is_some(), "-pareto")]
-    {
+    for (given, what) in [
+        (opts.report.is_some(), "-report"),
+        (opts.report_dir.is_some(), "-report-dir"),
+        (opts.eval.is_some(), "-eval"),
+        (opts.pareto.is_some(), "-pareto"),
+    ] {
         if given {
             select(module, &opts.function, what)?;
         }
