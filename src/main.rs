@@ -62,7 +62,6 @@ fn run() -> i32 {
     match robovec::driver::run_with(&opts, terminal, &mut stdout, &mut stderr) {
         Ok(()) => 0,
         Err(f) => {
-            drop(stderr);
             to_stderr(f.message());
             f.exit_code()
         }

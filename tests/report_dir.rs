@@ -208,11 +208,14 @@ fn the_folder_is_replaced_whole_and_foreign_content_is_refused() {
     }
 }
 
-/// A progress sink recording `(label, total)` at start and every position set.
-#[derive(Default, Clone)]
-struct Recorder(Arc<Mutex<Vec<(String, u64, Vec<u64>)>>>);
+/// Every task started: label, total, and the positions set, in order.
+type Log = Arc<Mutex<Vec<(String, u64, Vec<u64>)>>>;
 
-struct Line(Arc<Mutex<Vec<(String, u64, Vec<u64>)>>>, usize);
+/// A progress sink recording every task into its [`Log`].
+#[derive(Default, Clone)]
+struct Recorder(Log);
+
+struct Line(Log, usize);
 
 impl robovec_passes::progress::ProgressSink for Recorder {
     fn start(&self, label: &str, total: u64) -> Box<dyn robovec_passes::progress::ProgressDisplay> {

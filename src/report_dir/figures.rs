@@ -39,6 +39,13 @@ const PALETTE: [RGBColor; 7] = [
 
 type Result<T> = std::result::Result<T, String>;
 
+/// One drawn series: legend label, points (x, y), and whether it is a dashed (bound) or thin
+/// (min/max) line rather than the main line with markers.
+type Series = (String, Vec<(f64, f64)>, bool);
+
+/// A memory panel: its title and the words it reads from a sweep row.
+type Panel = (&'static str, fn(&SweepRow) -> Words);
+
 fn err(e: impl std::fmt::Display) -> String {
     format!("drawing a figure failed: {e}")
 }
@@ -152,7 +159,7 @@ fn n_chart(
     caption: &str,
     y_desc: &str,
     ns: &[u32],
-    series: &[(String, Vec<(f64, f64)>, bool)],
+    series: &[Series],
     marks: &[(String, f64)],
 ) -> Result<()> {
     // Head room above the data for the legend.
@@ -230,7 +237,7 @@ fn per_n(rows: &[SweepRow]) -> Vec<&SweepRow> {
 fn cycles(d: &ReportData) -> Result<Figure> {
     let rows = &d.sweep;
     let ns = ns(rows);
-    let mut series: Vec<(String, Vec<(f64, f64)>, bool)> = Vec::new();
+    let mut series: Vec<Series> = Vec::new();
     let mut csv = String::from("configuration,n,cycles\n");
     for c in configs(rows) {
         let pts: Vec<(f64, f64)> = of_config(rows, &c).iter().map(|r| (lx(r.n), r.cycles)).collect();
@@ -337,7 +344,7 @@ fn parallelisation(d: &ReportData) -> Result<Figure> {
 fn memory(d: &ReportData) -> Result<Figure> {
     let rows = &d.sweep;
     let ns = ns(rows);
-    let picks: [(&str, fn(&SweepRow) -> Words); 4] = [
+    let picks: [Panel; 4] = [
         ("PE memory, ADD PEs", |r| r.pe_words_add),
         ("PE memory, MULTI PEs", |r| r.pe_words_mul),
         ("buffer, ADD PEs", |r| r.buffer_words_add),
@@ -383,7 +390,7 @@ fn n_chart_grouped(
     caption: &str,
     y_desc: &str,
     ns: &[u32],
-    series: &[(String, Vec<(f64, f64)>, bool)],
+    series: &[Series],
 ) -> Result<()> {
     let y_max = max_of(series.iter().flat_map(|s| s.1.iter().map(|p| p.1))).max(1.0) * 1.7;
     let range = n_range(ns);
