@@ -294,3 +294,28 @@ fn the_ir_is_held_back_from_a_terminal_unless_asked_for() {
     let (out, _) = run(&["-passes=atomise", "-o", "-"]);
     assert!(out.starts_with("func @invdyna") || out.contains("func @invdyna"), "{out}");
 }
+
+#[test]
+fn no_other_output_may_go_inside_the_report_folder() {
+    let d = tmp("inside");
+    let dir = d.join("rep");
+    std::fs::create_dir(&dir).unwrap();
+    let o = opt(&[
+        PENDULUM,
+        "-passes=atomise",
+        &format!("-report-dir={}", dir.display()),
+        "-o",
+        d.join("rep/out.rvir").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("inside -report-dir"), "{}", stderr(&o));
+    let o = opt(&[
+        PENDULUM,
+        "-passes=atomise",
+        "-q",
+        &format!("-report-dir={}", dir.display()),
+        &format!("-dump-dir={}", dir.display()),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing written");
+}
