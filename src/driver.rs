@@ -265,9 +265,17 @@ fn run_passes(
     };
     if let Some(text) = &opts.pareto {
         let name = select(module, &opts.function, "-pareto")?.name.clone();
-        let study =
-            study::pareto::study(module, &name, text, opts.pareto_samples, opts.pareto_seed, deadline, &cx.target)
-                .map_err(study_failure)?;
+        let study = study::pareto::study(
+            module,
+            &name,
+            text,
+            opts.pareto_samples,
+            opts.pareto_seed,
+            deadline,
+            &cx.target,
+            &cx.progress,
+        )
+        .map_err(study_failure)?;
         cx.emit(study);
     }
     let records = {

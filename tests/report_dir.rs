@@ -250,6 +250,16 @@ fn long_loops_report_progress_through_the_hook() {
     let acc = log.iter().find(|x| x.0 == "accuracy @invdyna: samples").expect("accuracy task");
     assert_eq!(acc.1, 300);
     assert_eq!(acc.2.last(), Some(&300), "all samples measured");
+
+    // -pareto: one step per pipeline.
+    let (m, _) = robovec::driver::load(PENDULUM).unwrap();
+    let rec = Recorder::default();
+    let progress = robovec_passes::progress::Progress::shown(Arc::new(rec.clone()));
+    let target = robovec_ir::target::Target::de10_nano();
+    robovec_passes::study::pareto::study(&m, "invdyna", "atomise;atomise,balance", 20, 1, None, &target, &progress)
+        .unwrap();
+    let log = rec.0.lock().unwrap().clone();
+    assert_eq!(log, [("-pareto: pipelines".to_string(), 2, vec![1, 2])]);
 }
 
 #[test]
