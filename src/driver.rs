@@ -476,14 +476,13 @@ fn write_outputs(
         }
         _ => {}
     }
-    let written = out.commit().map_err(output_failure)?;
     if choice == (StdoutChoice::HeldBack { note: true }) {
-        writeln!(
-            stderr,
-            "note: the final IR is not printed on a terminal; write it with -o FILE, or print it with -o -"
-        )
-        .map_err(stderr_failure)?;
+        // Before the commit: a failed write to stderr leaves no file behind.
+        let what = code.map_or("final IR".to_string(), |c| format!("generated {}", c.language));
+        writeln!(stderr, "note: the {what} is not printed on a terminal; write it with -o FILE, or print it with -o -")
+            .map_err(stderr_failure)?;
     }
+    let written = out.commit().map_err(output_failure)?;
     let mut put = || -> std::io::Result<()> {
         if choice == StdoutChoice::Main {
             let mut buf = std::io::BufWriter::with_capacity(1 << 16, &mut *stdout);
