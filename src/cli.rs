@@ -52,6 +52,15 @@ pub struct Cli {
     /// Write the JSON report (SPEC §7) to FILE.
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
+    /// Write the report as a folder: report.json (as -report), report.md and SVG figures with
+    /// the CSV of the numbers each draws (cycles, µs, parallelisation rate and memory against
+    /// N from `sweep`; occupation and timeline from `place`; the -pareto front). DIR must be
+    /// missing, empty or a report folder written before; it is replaced as a whole.
+    #[arg(long, value_name = "DIR")]
+    pub report_dir: Option<PathBuf>,
+    /// Quiet: no progress bars on stderr (they are shown only when stderr is a terminal).
+    #[arg(short = 'q', long)]
+    pub quiet: bool,
     /// Evaluate the final IR (in f64, or f32 with -eval-precision=f32) on the inputs in FILE
     /// (JSON object name → number); print inputs and outputs as JSON on stdout.
     #[arg(long, value_name = "FILE")]
@@ -178,6 +187,8 @@ impl Cli {
                 ..Instrumentation::default()
             },
             report: self.report,
+            report_dir: self.report_dir,
+            quiet: self.quiet,
             eval: self.eval,
             function: self.function,
             stats: self.stats,

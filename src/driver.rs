@@ -161,6 +161,59 @@ struct Ran {
     cx: PassContext,
 }
 
+/// Which of the run's standard streams are terminals (`robovec-opt` asks the OS; tests and
+/// library callers say so). Both false by default: a piped run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Terminal {
+    /// stdout is a terminal: the final IR is not printed there without `-o -`
+    /// ([`stdout_choice`]).
+    pub stdout: bool,
+    /// stderr is a terminal: long work shows progress bars unless `-q`
+    /// ([`crate::progress::progress_for`]).
+    pub stderr: bool,
+}
+
+/// What stdout receives at the end of a run (see [`stdout_choice`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StdoutChoice {
+    /// The final IR (or generated code).
+    Main,
+    /// `-eval`'s JSON.
+    Eval,
+    /// Nothing: `-o FILE` took the IR.
+    Nothing,
+    /// Nothing, because stdout is a terminal: the IR would flood it. `note` is true when the
+    /// run printed no table, so a note on stderr says how to get the IR.
+    HeldBack {
+        /// Say so on stderr.
+        note: bool,
+    },
+}
+
+/// Decides what stdout receives, as LLVM's `opt` refuses to print bitcode to a terminal:
+/// `-o -` forces the IR; `-o FILE` takes it; `-eval` prints its JSON; otherwise the IR goes to
+/// stdout only when stdout is not a terminal. On a terminal it is held back, with a note
+/// unless the run printed tables on stderr (`-stats`, a `sweep` or `-pareto` table: the reader
+/// came for those).
+pub fn stdout_choice(output: Option<&Path>, eval: bool, stdout_is_terminal: bool, tables_shown: bool) -> StdoutChoice {
+    match output {
+        Some(p) if p.as_os_str() == "-" => StdoutChoice::Main,
+        Some(_) if eval => StdoutChoice::Eval,
+        Some(_) => StdoutChoice::Nothing,
+        None if eval => StdoutChoice::Eval,
+        None if stdout_is_terminal => StdoutChoice::HeldBack { note: !tables_shown },
+        None => StdoutChoice::Main,
+    }
+}
+
+/// Runs one `robovec-opt` invocation with stdout and stderr not terminals (see [`run_with`]).
+///
+/// # Errors
+/// [`Failure`] with its exit status.
+pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
+    run_with(opts, Terminal::default(), stdout, stderr)
+}
+
 /// Runs one `robovec-opt` invocation: check options → load → run passes (and the studies
 /// `-pareto` and `-check`) → render every output in memory → put every file in place at once →
 /// stdout. `stdout` receives the IR, the generated code or the `-eval` JSON; `stderr` receives
@@ -168,7 +221,12 @@ struct Ran {
 ///
 /// # Errors
 /// [`Failure`] with its exit status.
-pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
+pub fn run_with(
+    opts: &Options,
+    terminal: Terminal,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> Result<(), Failure> {
     // `load` verifies the input (always, whatever `-verify-each` says): the manager need not.
     let instr = Instrumentation { input_verified: true, ..opts.instr.clone() };
     let pm = PassManager::new(&opts.passes, instr).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
@@ -180,29 +238,44 @@ pub fn run(opts: &Options, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
     // removes what it staged.
     let mut out = OutputSet::new();
-    let ran = run_passes(opts, &pm, target, &mut module, &src, &mut out, stderr)?;
-    write_outputs(opts, &pm, &module, &ran, eval_inputs.as_ref(), out, stdout, stderr)
+    let progress = crate::progress::progress_for(terminal.stderr, opts.quiet);
+    let ran = run_passes(opts, &pm, target, progress, &mut module, &src, &mut out, stderr)?;
+    write_outputs(opts, &pm, &module, &ran, eval_inputs.as_ref(), terminal, out, stdout, stderr)
 }
 
 /// Runs `-pareto` (before the pipeline, on the input), the pipeline with its dumps staged in
 /// `out`, then `-check`; prints the early-stop notes.
+#[allow(clippy::too_many_arguments)]
 fn run_passes(
     opts: &Options,
     pm: &PassManager,
     target: robovec_ir::target::Target,
+    progress: robovec_passes::progress::Progress,
     module: &mut Module,
     src: &SourceFile,
     out: &mut OutputSet,
     stderr: &mut dyn Write,
 ) -> Result<Ran, Failure> {
     let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
-    let mut cx =
-        PassContext { original: opts.check.map(|_| module.clone()), deadline, ..PassContext::with_target(target) };
+    let mut cx = PassContext {
+        original: opts.check.map(|_| module.clone()),
+        deadline,
+        progress,
+        ..PassContext::with_target(target)
+    };
     if let Some(text) = &opts.pareto {
         let name = select(module, &opts.function, "-pareto")?.name.clone();
-        let study =
-            study::pareto::study(module, &name, text, opts.pareto_samples, opts.pareto_seed, deadline, &cx.target)
-                .map_err(study_failure)?;
+        let study = study::pareto::study(
+            module,
+            &name,
+            text,
+            opts.pareto_samples,
+            opts.pareto_seed,
+            deadline,
+            &cx.target,
+            &cx.progress,
+        )
+        .map_err(study_failure)?;
         cx.emit(study);
     }
     let records = {
@@ -336,6 +409,7 @@ fn write_outputs(
     module: &Module,
     ran: &Ran,
     eval_inputs: Option<&BTreeMap<String, f64>>,
+    terminal: Terminal,
     mut out: OutputSet,
     stdout: &mut dyn Write,
     stderr: &mut dyn Write,
@@ -343,18 +417,19 @@ fn write_outputs(
     let cx = &ran.cx;
     // The final IR's figures, once for both the report and `-stats` (the placement's include
     // the tight lower bound, and a parsed function is atomised to be measured).
-    let figs = if opts.stats || opts.report.is_some() {
-        figures::figures(module, cx, opts.function.as_deref())
-    } else {
-        Vec::new()
-    };
-    let report = opts.report.as_ref().map(|_| report_json(opts, pm, module, ran, &figs)).transpose()?;
+    let reporting = opts.report.is_some() || opts.report_dir.is_some();
+    let figs =
+        if opts.stats || reporting { figures::figures(module, cx, opts.function.as_deref()) } else { Vec::new() };
+    let report = reporting.then(|| report_json(opts, pm, module, ran, &figs)).transpose()?;
     let eval = eval_inputs.map(|given| eval_json(opts, module, given, stderr)).transpose()?;
     if opts.stats {
         write!(stderr, "{}", figures::stats_text(&figs, cx, opts.function.as_deref())).map_err(stderr_failure)?;
     }
+    let mut tables_shown = opts.stats;
     for a in cx.artifacts() {
-        write!(stderr, "{}", a.log_text(opts.stats)).map_err(stderr_failure)?;
+        let text = a.log_text(opts.stats);
+        tables_shown |= !text.is_empty();
+        write!(stderr, "{text}").map_err(stderr_failure)?;
     }
     let code = generated_code(pm, ran)?;
     // The IR is printed straight into its file or stdout (never held as one string: at 7× the
@@ -383,9 +458,13 @@ fn write_outputs(
     if let (Some(path), Some(r)) = (&opts.report, &report) {
         out.stage(path, r.as_bytes()).map_err(output_failure)?;
     }
-    let to_stdout = match &opts.output {
-        Some(p) if p.as_os_str() == "-" => true,
-        Some(p) => {
+    if let (Some(dir), Some(r)) = (&opts.report_dir, &report) {
+        let files = crate::report_dir::files(r).map_err(|e| Failure::Output(format!("error: -report-dir: {e}\n")))?;
+        out.stage_folder(dir, &files).map_err(output_failure)?;
+    }
+    let choice = stdout_choice(opts.output.as_deref(), eval.is_some(), terminal.stdout, tables_shown);
+    match &opts.output {
+        Some(p) if p.as_os_str() != "-" => {
             out.stage_with(p, &mut print_main).map_err(output_failure)?;
             if let Some(code) = code {
                 for (ext, text) in &code.companions {
@@ -394,13 +473,18 @@ fn write_outputs(
                     }
                 }
             }
-            false
         }
-        None => eval.is_none(),
-    };
+        _ => {}
+    }
+    if choice == (StdoutChoice::HeldBack { note: true }) {
+        // Before the commit: a failed write to stderr leaves no file behind.
+        let what = code.map_or("final IR".to_string(), |c| format!("generated {}", c.language));
+        writeln!(stderr, "note: the {what} is not printed on a terminal; write it with -o FILE, or print it with -o -")
+            .map_err(stderr_failure)?;
+    }
     let written = out.commit().map_err(output_failure)?;
     let mut put = || -> std::io::Result<()> {
-        if to_stdout {
+        if choice == StdoutChoice::Main {
             let mut buf = std::io::BufWriter::with_capacity(1 << 16, &mut *stdout);
             print_main(&mut buf)?;
             buf.flush()?;

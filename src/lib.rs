@@ -12,3 +12,5 @@ pub mod front;
 pub mod options;
 pub mod output;
 pub mod preflight;
+pub mod progress;
+pub mod report_dir;

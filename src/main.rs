@@ -53,12 +53,15 @@ fn run() -> i32 {
             return 2;
         }
     };
+    use std::io::IsTerminal;
+    let terminal =
+        robovec::driver::Terminal { stdout: std::io::stdout().is_terminal(), stderr: std::io::stderr().is_terminal() };
     let mut stdout = std::io::stdout().lock();
-    let mut stderr = std::io::stderr().lock();
-    match robovec::driver::run(&opts, &mut stdout, &mut stderr) {
+    // Not locked for the whole run: the progress bars (issue 13) draw on stderr too.
+    let mut stderr = std::io::stderr();
+    match robovec::driver::run_with(&opts, terminal, &mut stdout, &mut stderr) {
         Ok(()) => 0,
         Err(f) => {
-            drop(stderr);
             to_stderr(f.message());
             f.exit_code()
         }

@@ -20,6 +20,11 @@ pub struct Options {
     pub instr: Instrumentation,
     /// `-report=FILE`.
     pub report: Option<PathBuf>,
+    /// `-report-dir=DIR`: report.json, report.md, SVG figures and their CSVs
+    /// ([`crate::report_dir`]), written as one folder.
+    pub report_dir: Option<PathBuf>,
+    /// `-q`: no progress display on stderr.
+    pub quiet: bool,
     /// `-eval=FILE`.
     pub eval: Option<PathBuf>,
     /// `-function=NAME`.

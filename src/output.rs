@@ -28,6 +28,15 @@
 //! rename or a direct write fails during the commit, the diagnostic names each file already
 //! written. A run killed by a signal can leave `.robovec-tmp` files behind; no other file is
 //! ever touched before the commit.
+//!
+//! **Folders written as a whole** (`-report-dir=DIR`, [`OutputSet::stage_folder`]): the files
+//! go into a temporary folder beside `DIR` (`.DIR.PID.K.robovec-tmp`), which the commit renames
+//! to `DIR`, so a reader sees the old report folder or the new one, never a mix. `DIR` may be
+//! missing, an empty folder, or a folder robovec wrote before (a `report.json` and nothing but
+//! regular files named `*.json`, `*.md`, `*.svg`, `*.csv`, `*.png`); an existing one is renamed
+//! aside first (`.DIR.PID.K.robovec-old`), then removed once the new folder is in place, or put
+//! back if the rename fails. Anything else — a file, a symbolic link, a folder with other
+//! content — is refused before any work (robovec never deletes what it did not write).
 
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, Write};
@@ -203,6 +212,63 @@ fn copy_owner_and_mode(file: &File, existing: &fs::Metadata) -> io::Result<()> {
     file.set_permissions(existing.permissions())
 }
 
+/// Checks that `dir` may be replaced as a whole by [`OutputSet::stage_folder`] (see the
+/// module doc), without touching it.
+///
+/// # Errors
+/// A one-line message naming the folder and the obstacle.
+pub fn check_replaceable_folder(dir: &Path) -> Result<(), String> {
+    let fail = |why: String| format!("error: cannot write folder `{}`: {why}", dir.display());
+    match fs::symlink_metadata(dir) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            match fs::metadata(parent) {
+                Ok(m) if m.is_dir() => Ok(()),
+                Ok(_) => Err(fail(format!("`{}` is not a folder", parent.display()))),
+                Err(e) => Err(fail(format!("folder `{}`: {e}", parent.display()))),
+            }
+        }
+        Err(e) => Err(fail(e.to_string())),
+        Ok(m) if m.file_type().is_symlink() => Err(fail("it is a symbolic link; give the folder it points to".into())),
+        Ok(m) if !m.is_dir() => Err(fail("it exists and is not a folder".into())),
+        Ok(_) => {
+            let entries: Vec<fs::DirEntry> = fs::read_dir(dir)
+                .map_err(|e| fail(e.to_string()))?
+                .collect::<Result<_, _>>()
+                .map_err(|e| fail(e.to_string()))?;
+            if entries.is_empty() {
+                return Ok(());
+            }
+            let ours = |e: &fs::DirEntry| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                e.file_type().is_ok_and(|t| t.is_file())
+                    && [".json", ".md", ".svg", ".csv", ".png"].iter().any(|x| name.ends_with(x))
+            };
+            let has_report = entries.iter().any(|e| e.file_name() == "report.json");
+            match entries.iter().find(|e| !ours(e)) {
+                Some(e) => Err(fail(format!(
+                    "it holds `{}`, which robovec did not write; robovec replaces only an empty folder or a report folder it wrote",
+                    e.file_name().to_string_lossy()
+                ))),
+                None if !has_report => Err(fail(
+                    "it is not empty and has no report.json; robovec replaces only an empty folder or a report folder it wrote"
+                        .into(),
+                )),
+                None => Ok(()),
+            }
+        }
+    }
+}
+
+/// A folder staged as a whole, waiting for the commit.
+#[derive(Debug)]
+struct StagedFolder {
+    /// The path as the user gave it.
+    shown: PathBuf,
+    /// The temporary folder holding the new content.
+    tmp: PathBuf,
+}
+
 /// One staged output waiting for the commit.
 #[derive(Debug)]
 struct Staged {
@@ -221,6 +287,7 @@ struct Staged {
 #[derive(Debug, Default)]
 pub struct OutputSet {
     staged: Vec<Staged>,
+    folders: Vec<StagedFolder>,
     created_dirs: Vec<PathBuf>,
     counter: u32,
     committed: bool,
@@ -328,8 +395,66 @@ impl OutputSet {
         }
     }
 
-    /// Puts every staged output in place: renames all temporary files (phase 2), then writes
-    /// the devices and FIFOs (phase 3). Returns the paths written, in order.
+    /// Stages the folder `dir` as a whole with `files` (`(file name, bytes)`): they are written
+    /// into a temporary folder beside `dir` now, and the commit renames it to `dir` (see the
+    /// module doc).
+    ///
+    /// # Errors
+    /// A one-line message: `dir` is not replaceable ([`check_replaceable_folder`]), or a write
+    /// failed.
+    pub fn stage_folder(&mut self, dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), String> {
+        check_replaceable_folder(dir)?;
+        let fail = |e: io::Error| format!("error: cannot write folder `{}`: {e}", dir.display());
+        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let name = dir.file_name().ok_or_else(|| fail(io::Error::other("not a folder name")))?.to_string_lossy();
+        self.counter += 1;
+        let tmp = parent.join(format!(".{name}.{}.{}.robovec-tmp", std::process::id(), self.counter));
+        fs::create_dir(&tmp).map_err(fail)?;
+        self.folders.push(StagedFolder { shown: dir.into(), tmp: tmp.clone() });
+        for (file, bytes) in files {
+            let mut f = OpenOptions::new().write(true).create_new(true).open(tmp.join(file)).map_err(fail)?;
+            f.write_all(bytes).and_then(|()| f.sync_all()).map_err(fail)?;
+        }
+        Ok(())
+    }
+
+    /// Renames a staged folder into place (see the module doc); an existing report folder is
+    /// moved aside first and removed after.
+    fn commit_folder(&mut self, s: &StagedFolder) -> Result<(), String> {
+        let fail = |e: io::Error| format!("error: cannot write folder `{}`: {e}", s.shown.display());
+        // Checked again: the folder may have changed since the preflight.
+        check_replaceable_folder(&s.shown)?;
+        let old = match fs::symlink_metadata(&s.shown) {
+            Ok(_) => {
+                self.counter += 1;
+                let parent = s.tmp.parent().unwrap_or(Path::new("."));
+                let name = s.shown.file_name().unwrap_or_default().to_string_lossy().into_owned();
+                let old = parent.join(format!(".{name}.{}.{}.robovec-old", std::process::id(), self.counter));
+                fs::rename(&s.shown, &old).map_err(fail)?;
+                Some(old)
+            }
+            Err(_) => None,
+        };
+        if let Err(e) = fs::rename(&s.tmp, &s.shown) {
+            if let Some(old) = &old {
+                let _ = fs::rename(old, &s.shown);
+            }
+            return Err(fail(e));
+        }
+        if let Some(old) = old {
+            // Only regular files robovec wrote are in it (checked above).
+            if let Ok(rd) = fs::read_dir(&old) {
+                for e in rd.flatten() {
+                    let _ = fs::remove_file(e.path());
+                }
+            }
+            let _ = fs::remove_dir(&old);
+        }
+        Ok(())
+    }
+
+    /// Puts every staged output in place: renames all temporary files and folders (phase 2),
+    /// then writes the devices and FIFOs (phase 3). Returns the paths written, in order.
     ///
     /// # Errors
     /// A one-line message naming the file that failed and each file already written.
@@ -358,6 +483,16 @@ impl OutputSet {
             }
             done.push(s.shown.clone());
         }
+        let folders = std::mem::take(&mut self.folders);
+        for (i, f) in folders.iter().enumerate() {
+            if let Err(e) = self.commit_folder(f) {
+                for rest in &folders[i..] {
+                    let _ = fs::remove_dir_all(&rest.tmp);
+                }
+                return Err(format!("{e}{}", already(&done)));
+            }
+            done.push(f.shown.clone());
+        }
         for s in &directs {
             let r = OpenOptions::new()
                 .write(true)
@@ -381,6 +516,10 @@ impl Drop for OutputSet {
             if let Some(t) = &s.tmp {
                 let _ = fs::remove_file(t);
             }
+        }
+        for f in &self.folders {
+            // The temporary folder is this run's own.
+            let _ = fs::remove_dir_all(&f.tmp);
         }
         // Innermost first; `remove_dir` leaves a folder that is not empty.
         for d in self.created_dirs.iter().rev() {

@@ -56,6 +56,27 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     for d in opts.instr.dump_dir.iter().cloned().chain(folders) {
         output::check_folder(&d).map_err(output_failure)?;
     }
+    if let Some(dir) = &opts.report_dir {
+        output::check_replaceable_folder(dir).map_err(output_failure)?;
+        // The folder is replaced whole: no other output may go inside it.
+        let inside = |p: &Path| {
+            let parent = p.parent().filter(|q| !q.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            match (std::fs::canonicalize(parent), std::fs::canonicalize(dir)) {
+                (Ok(a), Ok(b)) => a.starts_with(b),
+                _ => parent.starts_with(dir),
+            }
+        };
+        // A dump folder counts by a file inside it.
+        let dumps: Vec<(&str, PathBuf)> = opts.instr.dump_dir.iter().map(|d| ("-dump-dir", d.join("dump"))).collect();
+        let mut all = files.iter().map(|&(f, p)| (f, p.to_path_buf())).chain(dumps);
+        if let Some((flag, p)) = all.find(|(_, p)| inside(p)) {
+            return Err(Failure::Usage(format!(
+                "error: {flag} `{}` is inside -report-dir `{}`, which is replaced as a whole; choose another path\n",
+                p.display(),
+                dir.display()
+            )));
+        }
+    }
     check_pass_files(pm)?;
     // `-pareto`'s pipelines: every name, parameter and file they read, before any work too.
     if let Some(text) = &opts.pareto {
@@ -120,7 +141,7 @@ fn check_pass_files(pm: &PassManager) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Checks `-function` and the one-function needs of `-report`, `-eval` and `-pareto` against
+/// Checks `-function` and the one-function needs of `-report`, `-report-dir`, `-eval` and `-pareto` against
 /// the input, before any pass runs.
 ///
 /// # Errors
@@ -129,9 +150,12 @@ pub fn check_functions(opts: &Options, module: &Module) -> Result<(), Failure> {
     if opts.function.is_some() {
         select(module, &opts.function, "-function")?;
     }
-    for (given, what) in
-        [(opts.report.is_some(), "-report"), (opts.eval.is_some(), "-eval"), (opts.pareto.is_some(), "-pareto")]
-    {
+    for (given, what) in [
+        (opts.report.is_some(), "-report"),
+        (opts.report_dir.is_some(), "-report-dir"),
+        (opts.eval.is_some(), "-eval"),
+        (opts.pareto.is_some(), "-pareto"),
+    ] {
         if given {
             select(module, &opts.function, what)?;
         }

@@ -27,6 +27,7 @@ mod params;
 mod placement;
 mod placement_verify;
 mod props;
+mod report_dir;
 mod roundtrip;
 mod schedule_cpu;
 mod target;

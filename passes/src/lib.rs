@@ -22,6 +22,7 @@ pub mod manager;
 pub mod params;
 pub mod pipeline;
 pub mod place;
+pub mod progress;
 pub mod sim;
 pub mod specialize;
 pub mod study;
@@ -186,6 +187,10 @@ pub struct PassContext {
     /// Index in the pipeline of the pass running now (set by the manager; `None` outside a
     /// pipeline), recorded with every artifact.
     pub pass_index: Option<usize>,
+    /// Where long loops report progress (samples, sweep configurations, search iterations):
+    /// hidden by default; the driver plugs a display in when stderr is a terminal (see
+    /// [`progress`]). Passes never write to the terminal themselves.
+    pub progress: progress::Progress,
 }
 
 /// A wall-clock limit on a pipeline run (`-time-limit=SECONDS`).

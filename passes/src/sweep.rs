@@ -236,6 +236,7 @@ impl Pass for Sweep {
         ];
         let total = m.functions.len() * self.ns.len() * configs.len();
         let mut done = 0usize;
+        let task = cx.progress.task("sweep: placements", total as u64);
         let mut rows = Vec::new();
         let mut fit = Vec::new();
         for f in &m.functions {
@@ -245,6 +246,7 @@ impl Pass for Sweep {
             for &n in &self.ns {
                 for (priority, select, improve, pname, sname) in configs {
                     if let Some(d) = cx.deadline.filter(|d| d.reached()) {
+                        task.finish();
                         cx.note_stop("sweep", &format!("after {done} of {total} configurations: {}", d.reason()));
                         fit.push(fit_row(&f.name, &cx.target, cp_now, &rows));
                         cx.emit(SweepTable { rows });
@@ -304,10 +306,12 @@ impl Pass for Sweep {
                         dsp: est.dsp,
                         fits: est.fits,
                     });
+                    task.set(done as u64);
                 }
             }
             fit.push(fit_row(&f.name, &cx.target, cp_now, &rows));
         }
+        task.finish();
         cx.emit(SweepTable { rows });
         cx.emit(SweepFit { rows: fit });
         Ok(())

@@ -85,6 +85,9 @@ pub struct Options {
     pub max_work: u64,
     /// Stop (and say so) when this instant passes; checked once per chunk of samples.
     pub deadline: Option<std::time::Instant>,
+    /// Samples measured so far, advanced once per chunk (hidden unless the driver shows
+    /// progress; see [`crate::progress`]).
+    pub progress: crate::progress::Task,
 }
 
 /// Default work budget, op evaluations (about 10 minutes on two cores).
@@ -164,6 +167,7 @@ fn options_from(p: &Params) -> Result<Options, PassError> {
         climb_points: p.u32("climb-points")?,
         max_work: p.u64("max-work")?,
         deadline: None,
+        progress: crate::progress::Task::default(),
     })
 }
 
@@ -215,7 +219,9 @@ impl Pass for Accuracy {
             };
             // An early stop (work budget or `-time-limit`) is in the report's
             // `accuracy.stopped_early` and printed with the accuracy summary.
+            o.progress = cx.progress.task(&format!("accuracy @{}: samples", f.name), u64::from(o.samples));
             reports.push(measure_against(f, original, &o).map_err(fail)?);
+            o.progress.finish();
         }
         cx.emit(report::AccuracyRun { reports });
         Ok(())

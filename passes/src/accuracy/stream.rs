@@ -221,6 +221,7 @@ pub fn run_chunked(sub: &Subject, o: &Options, chunk: u64) -> Run {
             .reduce(|| Acc::new(n_out, keep), Acc::merge);
         acc = acc.merge(part);
         start = end;
+        o.progress.set(start);
     }
     let mut evaluations = n;
     if hard {

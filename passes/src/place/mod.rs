@@ -122,6 +122,19 @@ pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement
 /// # Errors
 /// As [`try_place_function`].
 pub fn try_place_function_within(f: &Function, opts: &PlaceOptions) -> Result<(Placement, bool), String> {
+    try_place_function_progress(f, opts, &crate::progress::Progress::hidden())
+}
+
+/// [`try_place_function_within`] reporting the restarts and search iterations, when they run,
+/// as one task of `progress` (`place @f: search`).
+///
+/// # Errors
+/// As [`try_place_function`].
+pub fn try_place_function_progress(
+    f: &Function,
+    opts: &PlaceOptions,
+    progress: &crate::progress::Progress,
+) -> Result<(Placement, bool), String> {
     let a = &opts.arch;
     let dag = schedule::OpDag::new(f);
     let seed = schedule::seed_keys(f, a, opts.priority);
@@ -130,7 +143,7 @@ pub fn try_place_function_within(f: &Function, opts: &PlaceOptions) -> Result<(P
     // Within 2% of SPEC §4's bound (hence of the tight bound too): nothing to search for, and
     // the tight bound (O(n log n) but not free) is not computed.
     if (opts.restarts > 0 || opts.search > 0) && end(&best) as u64 * 100 > spec * 102 {
-        let (best, stopped) = search::restarts_and_search(f, &dag, opts, seed, best)?;
+        let (best, stopped) = search::restarts_and_search(f, &dag, opts, seed, best, progress)?;
         return Ok((memory::build(f, a, &best), stopped));
     }
     Ok((memory::build(f, a, &best), false))
@@ -308,7 +321,7 @@ impl Pass for Place {
         let arch = Arch { lat, writes: self.writes.unwrap_or(cx.target.writes), ..self.opts.arch };
         let opts = PlaceOptions { deadline: cx.deadline, arch, ..self.opts };
         for f in &mut m.functions {
-            let (p, stopped) = try_place_function_within(f, &opts)
+            let (p, stopped) = try_place_function_progress(f, &opts, &cx.progress)
                 .map_err(|e| PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) })?;
             if let (true, Some(d)) = (stopped, cx.deadline) {
                 let what = format!("searching @{} early (best schedule so far kept): {}", f.name, d.reason());

@@ -44,6 +44,9 @@ pub struct PlacementReport {
     /// Occupation rate per cycle of each PE type: issued ops / N, rolling mean over 50 cycles
     /// (seed §3.6).
     pub occupation: Occupation,
+    /// The first [`TIMELINE_CYCLES`] cycles of the placement, issue by issue: which PE issues
+    /// which op when (the placement timeline figure of `-report-dir`); extra key.
+    pub timeline: Timeline,
     /// The analytic resource estimate of this configuration on the target
     /// (`robovec_ir::target::Target::estimate`: unit costs of seed Table 1.4, memories in M10K
     /// blocks), with `fits` also requiring the placement's memories to fit the target's
@@ -64,6 +67,68 @@ pub fn fits_memories(p: &robovec_ir::placement::Placement, cycles: u32, target: 
 pub fn estimate(p: &robovec_ir::placement::Placement, cycles: u32, target: &Target) -> Resources {
     let r = target.estimate(p.arch.n_add, p.arch.n_mul, cycles);
     Resources { fits: r.fits && fits_memories(p, cycles, target), ..r }
+}
+
+/// Cycles of the placement that [`PlacementReport::timeline`] covers, from cycle 0: a window
+/// an FPGA engineer can read issue by issue (issue 13: "a few hundred cycles").
+pub const TIMELINE_CYCLES: u32 = 256;
+
+/// The issues of a window of cycles (see [`PlacementReport::timeline`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct Timeline {
+    /// First cycle of the window.
+    pub start: u32,
+    /// One past the last cycle of the window (at most the placement's cycles).
+    pub end: u32,
+    /// Every op issued in the window, by cycle then PE.
+    pub issues: Vec<TimelineIssue>,
+}
+
+/// One issue of [`Timeline`].
+#[derive(Clone, Debug, Serialize)]
+pub struct TimelineIssue {
+    /// `add` or `mul`: the PE type.
+    pub pe_type: &'static str,
+    /// Index of the PE within its type (0-based).
+    pub pe: u32,
+    /// Issue cycle.
+    pub cycle: u32,
+    /// Cycles from issue to the result in the PE memory (the op's latency).
+    pub latency: u32,
+    /// The op (`add`, `sub`, `mul`, `div`, `call`).
+    pub op: String,
+    /// The value it defines (its IR name).
+    pub value: String,
+}
+
+/// The [`Timeline`] of cycles `0..min(cycles, TIMELINE_CYCLES)` of `p`.
+pub fn timeline(f: &Function, p: &robovec_ir::placement::Placement, cycles: u32) -> Timeline {
+    use robovec_ir::placement::Pe;
+    let end = cycles.min(TIMELINE_CYCLES);
+    let mut issues: Vec<TimelineIssue> = f
+        .body
+        .iter()
+        .filter_map(|&v| {
+            let i = p.issue[v.index()]?;
+            let k = f.op_kind(v)?;
+            (i.cycle < end).then(|| {
+                let (pe_type, pe) = match i.pe {
+                    Pe::Add(x) => ("add", x),
+                    Pe::Mul(x) => ("mul", x),
+                };
+                TimelineIssue {
+                    pe_type,
+                    pe,
+                    cycle: i.cycle,
+                    latency: p.latency(k),
+                    op: format!("{k:?}").to_lowercase(),
+                    value: f.name_of(v).to_string(),
+                }
+            })
+        })
+        .collect();
+    issues.sort_by_key(|x| (x.cycle, x.pe_type, x.pe));
+    Timeline { start: 0, end, issues }
 }
 
 /// Per-cycle occupation rates (0 to 1), one entry per cycle.
@@ -102,6 +167,7 @@ pub fn placement_report(f: &Function, target: &Target) -> Option<PlacementReport
         writes_direct: p.writes.len() as u64 - indirect,
         writes_indirect: indirect,
         occupation: Occupation { add: occupation(&add, a.n_add, 50), mul: occupation(&mul, a.n_mul, 50) },
+        timeline: timeline(f, p, c),
         estimate: estimate(p, c, target),
     })
 }

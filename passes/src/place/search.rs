@@ -66,6 +66,7 @@ pub fn restarts_and_search(
     opts: &PlaceOptions,
     seed: Vec<Key>,
     mut best: Schedule,
+    progress: &crate::progress::Progress,
 ) -> Result<(Schedule, bool), String> {
     let out_of_time = || opts.deadline.is_some_and(|d| d.reached());
     let a = &opts.arch;
@@ -80,6 +81,9 @@ pub fn restarts_and_search(
     // The best plan so far: keys and feeding bonus.
     let mut plan = (seed.clone(), 0u32);
     let restarts = (opts.restarts as u64).min((RESTART_WORK / per_run).max(1));
+    let iterations = (opts.search as u64).min(SEARCH_WORK / per_run);
+    // One task for both loops; it ends (dropped) on every return.
+    let task = progress.task(&format!("place @{}: restarts and search", f.name), restarts + iterations);
     for r in 0..restarts {
         if done(&best) {
             return Ok((best, false));
@@ -87,6 +91,7 @@ pub fn restarts_and_search(
         if out_of_time() {
             return Ok((best, true));
         }
+        task.set(r);
         let feed = FEEDS[r as usize % FEEDS.len()];
         let keys = if r == 0 {
             let other = if opts.priority == Priority::Classical { Priority::Mobility } else { Priority::Classical };
@@ -108,14 +113,16 @@ pub fn restarts_and_search(
             plan = (keys, feed);
         }
     }
-    let iterations = (opts.search as u64).min(SEARCH_WORK / per_run);
     let window = a.lat.add.max(a.lat.mul).max(a.lat.div).max(a.lat.call);
-    for _ in 0..iterations {
+    for i in 0..iterations {
         if done(&best) {
             break;
         }
         if out_of_time() {
             return Ok((best, true));
+        }
+        if i % 16 == 0 {
+            task.set(restarts + i);
         }
         let mut keys = plan.0.clone();
         for k in keys.iter_mut() {

@@ -164,9 +164,11 @@ impl crate::Artifact for ParetoStudy {
 
 /// Runs every pipeline of `text` on a copy of `module` and measures function `function`.
 /// `module` must be verified (the driver's `load` does it): the pipelines do not check it again.
+/// `progress` shows the pipelines done (one task, `-pareto: pipelines`).
 ///
 /// # Errors
 /// [`Failure::Usage`] for a bad pipeline, [`Failure::Input`] when a pipeline fails.
+#[allow(clippy::too_many_arguments)]
 pub fn study(
     module: &Module,
     function: &str,
@@ -175,11 +177,14 @@ pub fn study(
     seed: u64,
     deadline: Option<crate::Deadline>,
     target: &robovec_ir::target::Target,
+    progress: &crate::progress::Progress,
 ) -> Result<ParetoStudy, Failure> {
-    Ok(ParetoStudy {
-        function: function.to_string(),
-        rows: run(module, function, text, samples, seed, deadline, target)?,
-    })
+    // A bad text fails in `run_reporting` with its own message; the total is then moot.
+    let pipelines = split_pipelines(text).map_or(0, |v| v.len());
+    let task = progress.task("-pareto: pipelines", pipelines as u64);
+    let rows = run_reporting(module, function, text, samples, seed, deadline, target, &task)?;
+    task.finish();
+    Ok(ParetoStudy { function: function.to_string(), rows })
 }
 
 /// The rows of [`study`]. Under `-time-limit` (`deadline`), each pipeline and measurement stops
@@ -196,6 +201,21 @@ pub fn run(
     seed: u64,
     deadline: Option<crate::Deadline>,
     target: &robovec_ir::target::Target,
+) -> Result<Vec<ParetoRow>, Failure> {
+    run_reporting(module, function, text, samples, seed, deadline, target, &crate::progress::Task::default())
+}
+
+/// [`run`], setting `task` to the pipelines done after each one.
+#[allow(clippy::too_many_arguments)]
+fn run_reporting(
+    module: &Module,
+    function: &str,
+    text: &str,
+    samples: u32,
+    seed: u64,
+    deadline: Option<crate::Deadline>,
+    target: &robovec_ir::target::Target,
+    task: &crate::progress::Task,
 ) -> Result<Vec<ParetoRow>, Failure> {
     let original =
         module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
@@ -241,6 +261,7 @@ pub fn run(
                 .collect(),
             pareto_optimal: false,
         });
+        task.set(rows.len() as u64);
     }
     mark_front(&mut rows);
     Ok(rows)
