@@ -23,6 +23,7 @@ mod numerics;
 #[cfg(unix)]
 mod outputs;
 mod params;
+mod pinocchio;
 mod placement;
 mod placement_verify;
 mod props;
