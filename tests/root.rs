@@ -31,3 +31,4 @@ mod roundtrip;
 mod schedule_cpu;
 mod target;
 mod tree_height;
+mod urdf;

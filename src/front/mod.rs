@@ -47,6 +47,17 @@ pub enum Language {
     Python,
 }
 
+/// The Robotran language of a file from its extension: `.c`/`.h` → C, `.m` → Matlab, `.py` →
+/// Python (the Robotran front ends' own map; the driver goes through [`registry`]).
+pub fn language_of(path: &std::path::Path) -> Option<Language> {
+    match path.extension()?.to_str()? {
+        "c" | "h" => Some(Language::C),
+        "m" => Some(Language::Matlab),
+        "py" => Some(Language::Python),
+        _ => None,
+    }
+}
+
 /// The bytes as text with every byte offset kept: each byte of an invalid UTF-8 sequence
 /// becomes `?` (see the module doc).
 pub fn source_text(bytes: &[u8]) -> String {

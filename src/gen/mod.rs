@@ -72,18 +72,18 @@ impl Layout {
                     Some(nq)
                 }
             });
-            for k in 0..3 {
-                values.insert(format!("dpt[{}][{body}]", k + 1), joint.origin.xyz[k]);
+            for (k, x) in joint.origin.xyz.iter().enumerate() {
+                values.insert(format!("dpt[{}][{body}]", k + 1), *x);
             }
             let inertial = robot.links[joint.child].inertial;
             let (mass, com, inn) = inertial.map_or((0.0, [0.0; 3], [[0.0; 3]; 3]), |x| (x.mass, x.com, x.inertia));
             values.insert(format!("m[{body}]"), mass);
-            for k in 0..3 {
-                values.insert(format!("l[{}][{body}]", k + 1), com[k]);
+            for (k, x) in com.iter().enumerate() {
+                values.insert(format!("l[{}][{body}]", k + 1), *x);
             }
-            for r in 0..3 {
-                for c in r..3 {
-                    values.insert(Layout::inertia_name(r, c, body), inn[r][c]);
+            for (r, row) in inn.iter().enumerate() {
+                for (c, x) in row.iter().enumerate().skip(r) {
+                    values.insert(Layout::inertia_name(r, c, body), *x);
                 }
             }
         }

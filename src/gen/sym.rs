@@ -91,10 +91,10 @@ pub fn mul(a: Term, b: Term) -> Term {
     match (a, b) {
         (a, b) if a.is_zero() || b.is_zero() => ZERO,
         (Term::C(x), Term::C(y)) => Term::C(x * y),
-        (Term::C(x), b) if x == 1.0 => b,
-        (a, Term::C(y)) if y == 1.0 => a,
-        (Term::C(x), b) if x == -1.0 => neg(b),
-        (a, Term::C(y)) if y == -1.0 => neg(a),
+        (Term::C(1.0), b) => b,
+        (a, Term::C(1.0)) => a,
+        (Term::C(-1.0), b) => neg(b),
+        (a, Term::C(-1.0)) => neg(a),
         (Term::C(x), b) if x < 0.0 => neg(mul(Term::C(-x), b)),
         (a, Term::C(y)) if y < 0.0 => neg(mul(a, Term::C(-y))),
         (Term::Neg(a), b) => neg(mul(*a, b)),
@@ -112,7 +112,6 @@ pub fn sum(terms: impl IntoIterator<Item = Term>) -> Term {
 pub struct Builder {
     /// The function being built.
     pub f: Function,
-    equations: u32,
     consts: FxHashMap<String, f64>,
 }
 
@@ -120,7 +119,7 @@ impl Builder {
     /// An empty function `name`. Inputs named in `consts` are folded to their value instead of
     /// becoming inputs (`--fold-params`).
     pub fn new(name: &str, consts: FxHashMap<String, f64>) -> Builder {
-        Builder { f: Function::new(name, Phase::Parsed), equations: 0, consts }
+        Builder { f: Function::new(name, Phase::Parsed), consts }
     }
 
     /// The input `name` (canonical SPEC §2 name), created on first use; a folded constant when
@@ -148,7 +147,6 @@ impl Builder {
         }
         let e = to_expr(&t);
         let n = self.f.fresh_name(name);
-        self.equations += 1;
         Term::V(self.f.define(n, Def::Expr(e), Span::DUMMY).expect("fresh"))
     }
 
@@ -169,13 +167,16 @@ impl Builder {
     fn bind_always(&mut self, name: &str, t: Term) -> Term {
         let e = to_expr(&t);
         let n = self.f.fresh_name(name);
-        self.equations += 1;
         Term::V(self.f.define(n, Def::Expr(e), Span::DUMMY).expect("fresh"))
     }
 
-    /// The finished function.
+    /// The finished function: what no output needs is dropped (Robotran writes only the
+    /// equations its outputs read), inputs included; `equations` counts what is left.
     pub fn finish(mut self) -> Function {
-        self.f.equations = Some(self.equations);
+        let live = self.f.live_values(&[]);
+        self.f.retain(|_, v| live[v.index()]);
+        let kept = self.f.body.iter().filter(|&&v| matches!(self.f.value(v).def, Def::Expr(_))).count();
+        self.f.equations = Some(kept as u32);
         self.f
     }
 }

@@ -4,7 +4,7 @@ use super::*;
 
 fn err(text: &str) -> (String, usize) {
     let e = parse(text).expect_err("bad input");
-    let (line, _) = robovec_ir::span::line_col(text, e.span.start);
+    let (line, _) = robovec_ir::span::line_col(text, e.span.start as usize);
     (e.message, line)
 }
 
