@@ -97,7 +97,12 @@ pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) {
     om[0] = [ZERO, ZERO, ZERO];
     omp[0] = [ZERO, ZERO, ZERO];
     alpha[0] = g;
-    let body_of_link = |l: usize| order.iter().position(|&j| robot.joints[j].child == l).map_or(0, |p| p + 1);
+    // Body of each link (0: the root, the base).
+    let mut link_body = vec![0; robot.links.len()];
+    for (i, &j) in order.iter().enumerate() {
+        link_body[robot.joints[j].child] = i + 1;
+    }
+    let body_of_link = |l: usize| link_body[l];
     let mut motions: Vec<Motion> = Vec::with_capacity(nb + 1);
     motions.push(Motion { rot: None, shift: None });
     // Trig variables first, in joint order (Robotran's "Trigonometric Variables" block).
