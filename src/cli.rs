@@ -15,12 +15,12 @@ use crate::options::Options;
 #[command(
     name = "robovec-opt",
     version,
-    about = "Run a pipeline of passes over Robotran equations (C, Matlab, Python) or robovec IR (.rvir)",
+    about = "Run a pipeline of passes over Robotran equations (C, Matlab, Python), a URDF robot's generated equations or robovec IR (.rvir)",
     after_help = "Single-dash spellings (-passes=…, -print-after-all) are accepted as in LLVM's opt.\n\
                   Exit status: 0 success, 1 bad input, 2 bad usage."
 )]
 pub struct Cli {
-    /// Input: a Robotran file (.c, .m, .py) or robovec IR (.rvir); `-` reads IR from stdin.
+    /// Input: a Robotran file (.c, .m, .py), a URDF robot (.urdf) or robovec IR (.rvir); `-` reads IR from stdin.
     pub input: Option<String>,
     /// Pipeline, LLVM syntax: `atomise,dce<outputs=c>,asap-alap<lat-add=12>`.
     #[arg(long = "passes", short = 'p', value_name = "PIPELINE", default_value = "")]
@@ -110,6 +110,14 @@ pub struct Cli {
     /// given.
     #[arg(long, value_name = "de10-nano|FILE.json")]
     pub target: Option<String>,
+    /// URDF input: fold the model's numeric parameters (masses, inertias, lengths) into the
+    /// equations instead of keeping them as inputs `dpt`, `l`, `m`, `In`.
+    #[arg(long)]
+    pub fold_params: bool,
+    /// URDF input: write the values of the parameters kept as inputs to FILE, the JSON object
+    /// (`{"m[1]": 2.5, …}`) that `specialize<params=FILE>` and `-eval` read.
+    #[arg(long, value_name = "FILE")]
+    pub params_out: Option<PathBuf>,
     /// Wall-clock limit of the whole run, seconds (> 0): passes with long searches (eqsat,
     /// place, sweep) stop early once it is reached, keep a valid result and say so on stderr
     /// (`note: … stopped …`) and in the report (`stopped_early`).
@@ -200,6 +208,8 @@ impl Cli {
             check: self.check.then_some((self.check_samples, self.check_seed)),
             time_limit: self.time_limit,
             target: self.target,
+            front: crate::front::FrontOptions { fold_params: self.fold_params },
+            params_out: self.params_out,
         })
     }
 }

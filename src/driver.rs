@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
-use robovec_ir::{text, verifier, Module};
+use robovec_ir::{verifier, Module};
 use robovec_passes::figures::{self, Figures};
 use robovec_passes::{
     study, DumpSink, GeneratedCode, Instrumentation, PassContext, PassError, PassManager, PassRecord,
@@ -33,6 +33,17 @@ use crate::output::OutputSet;
 /// # Errors
 /// [`Failure::Input`] with codespan diagnostics naming file, line and column.
 pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
+    load_with(input, &front::FrontOptions::default()).map(|(l, src)| (l.module, src))
+}
+
+/// [`load`] with the front-end options of the command line; also returns the parameter values
+/// the front end knows ([`front::Loaded::params`]). The front end is the registered one for the
+/// input's extension ([`front::front_end_for`]); the driver names none.
+///
+/// # Errors
+/// [`Failure::Usage`] for an extension no front end claims; [`Failure::Input`] with codespan
+/// diagnostics naming file, line and column.
+pub fn load_with(input: &str, opts: &front::FrontOptions) -> Result<(front::Loaded, SourceFile), Failure> {
     let (bytes, name) = if input == "-" {
         let mut b = Vec::new();
         std::io::stdin().read_to_end(&mut b).map_err(|e| Failure::Input(format!("error: cannot read stdin: {e}\n")))?;
@@ -41,48 +52,33 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
         let b = std::fs::read(input).map_err(|e| Failure::Input(format!("error: cannot read `{input}`: {e}\n")))?;
         (b, input.to_string())
     };
+    let Some(fe) = front::front_end_for(input) else {
+        return Err(Failure::Usage(format!(
+            "error: cannot tell the language of `{input}`: expected a {} file (or - for IR on stdin)\n",
+            front::extension_list()
+        )));
+    };
     let src = SourceFile::from_bytes(name, &bytes);
     // The text is the one copy of the input kept (for diagnostics and the parse).
     drop(bytes);
-    let path = Path::new(input);
-    let module = match front::language_of(path) {
-        Some(lang) if input != "-" => {
-            let header = if path.extension().is_some_and(|e| e == "c") {
-                std::fs::read(path.with_extension("h")).ok()
-            } else {
-                None
-            };
-            front::parse_text(lang, &src.text, header.as_deref()).map_err(|errs| {
-                Failure::Input(src.render(&errs.iter().map(|e| e.to_diagnostic(())).collect::<Vec<_>>()))
-            })?
-        }
-        _ => {
-            if input != "-" && path.extension().is_none_or(|e| e != "rvir") {
-                return Err(Failure::Usage(format!(
-                    "error: cannot tell the language of `{input}`: expected a .c, .m, .py or .rvir file (or - for IR on stdin)\n"
-                )));
-            }
-            text::parse(&src.text).map_err(|errs| {
-                Failure::Input(src.render(&errs.iter().map(|e| e.to_diagnostic(())).collect::<Vec<_>>()))
-            })?
-        }
-    };
+    let loaded = fe
+        .load(Path::new(input), &src.text, opts)
+        .map_err(|errs| Failure::Input(src.render(&errs.iter().map(|e| e.to_diagnostic(())).collect::<Vec<_>>())))?;
+    let module = &loaded.module;
     if module.functions.is_empty() {
         // An empty or comment-only file is bad input, not a module to describe (issue 10).
-        let is_ir = front::language_of(path).is_none() || input == "-";
-        let message = if is_ir { "expected at least one `func`" } else { "expected at least one function" };
         let d = codespan_reporting::diagnostic::Diagnostic::error()
-            .with_message(format!("{message}: the input has no function"))
+            .with_message(format!("{}: the input has no function", fe.no_function_message()))
             .with_labels(vec![
                 codespan_reporting::diagnostic::Label::primary((), 0..0).with_message("no function in this input")
             ]);
         return Err(Failure::Input(src.render(&[d])));
     }
-    if let Err(errs) = verifier::verify(&module) {
+    if let Err(errs) = verifier::verify(module) {
         let diags: Vec<_> = errs.iter().map(|e| e.to_diagnostic((), "on input")).collect();
         return Err(Failure::Input(src.render(&diags)));
     }
-    Ok((module, src))
+    Ok((loaded, src))
 }
 
 /// Writes one file under the output policy ([`crate::output`]) on its own. Inside a run, stage
@@ -233,11 +229,23 @@ pub fn run_with(
     crate::preflight::check_options(opts, &pm)?;
     let target = crate::options::target(opts)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
-    let (mut module, src) = load(&opts.input)?;
+    let (loaded, src) = load_with(&opts.input, &opts.front)?;
+    let mut module = loaded.module;
     crate::preflight::check_functions(opts, &module)?;
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
     // removes what it staged.
     let mut out = OutputSet::new();
+    if let Some(path) = &opts.params_out {
+        let Some(params) = &loaded.params else {
+            return Err(Failure::Usage(format!(
+                "error: -params-out: `{}` states no parameter values (a URDF does; add --fold-params to fold them instead)\n",
+                opts.input
+            )));
+        };
+        let json =
+            serde_json::to_string_pretty(params).map_err(|e| Failure::Output(format!("error: -params-out: {e}\n")))?;
+        out.stage(path, format!("{json}\n").as_bytes()).map_err(output_failure)?;
+    }
     let progress = crate::progress::progress_for(terminal.stderr, opts.quiet);
     let ran = run_passes(opts, &pm, target, progress, &mut module, &src, &mut out, stderr)?;
     write_outputs(opts, &pm, &module, &ran, eval_inputs.as_ref(), terminal, out, stdout, stderr)

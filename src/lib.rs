@@ -9,6 +9,7 @@ pub mod diagnostics;
 pub mod driver;
 pub mod eval;
 pub mod front;
+pub mod gen;
 pub mod options;
 pub mod output;
 pub mod preflight;

@@ -10,7 +10,7 @@ use robovec_passes::Instrumentation;
 /// What the command line asked for.
 #[derive(Clone, Debug, Default)]
 pub struct Options {
-    /// Input path (`.c`, `.m`, `.py`, `.rvir`), or `-` for IR on stdin.
+    /// Input path (`.c`, `.m`, `.py`, `.urdf`, `.rvir`), or `-` for IR on stdin.
     pub input: String,
     /// Pipeline text (`atomise,asap-alap`).
     pub passes: String,
@@ -45,6 +45,11 @@ pub struct Options {
     pub check: Option<(u32, u64)>,
     /// `-time-limit=SECONDS`: wall-clock limit of the run (see `PassContext::deadline`).
     pub time_limit: Option<f64>,
+    /// Front-end options (`--fold-params`).
+    pub front: crate::front::FrontOptions,
+    /// `-params-out=FILE`: the values of the model parameters the input states (a URDF's),
+    /// as the JSON object `specialize<params=…>` and `-eval` read.
+    pub params_out: Option<PathBuf>,
     /// `-target=de10-nano|FILE.json` as given (`None`: `de10-nano`); read by
     /// [`target`] before any work.
     pub target: Option<String>,

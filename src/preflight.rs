@@ -29,12 +29,16 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
         (Some(o), Some(exts)) => exts.iter().filter_map(|e| companion_path(o, e)).collect(),
         _ => Vec::new(),
     };
-    let files: Vec<(&str, &Path)> =
-        [("-o", output), ("-report", opts.report.as_deref()), ("-sweep-csv", opts.sweep_csv.as_deref())]
-            .into_iter()
-            .filter_map(|(flag, p)| p.map(|p| (flag, p)))
-            .chain(companions.iter().map(|p| ("-o's companion", p.as_path())))
-            .collect();
+    let files: Vec<(&str, &Path)> = [
+        ("-o", output),
+        ("-report", opts.report.as_deref()),
+        ("-sweep-csv", opts.sweep_csv.as_deref()),
+        ("-params-out", opts.params_out.as_deref()),
+    ]
+    .into_iter()
+    .filter_map(|(flag, p)| p.map(|p| (flag, p)))
+    .chain(companions.iter().map(|p| ("-o's companion", p.as_path())))
+    .collect();
     for (_, p) in &files {
         output::check_file(p).map_err(output_failure)?;
     }

@@ -24,6 +24,7 @@ mod numerics;
 #[cfg(unix)]
 mod outputs;
 mod params;
+mod pinocchio;
 mod placement;
 mod placement_verify;
 mod props;
@@ -32,3 +33,4 @@ mod roundtrip;
 mod schedule_cpu;
 mod target;
 mod tree_height;
+mod urdf;

@@ -1,4 +1,6 @@
-//! Front ends: Robotran C, Matlab and Python outputs → IR modules (parsed phase).
+//! Front ends: Robotran C, Matlab and Python outputs, and URDF robot descriptions ([`urdf`],
+//! through the symbolic generator [`crate::gen`]) → IR modules (parsed phase). The driver
+//! reaches them through one table, [`registry::FRONT_ENDS`].
 //!
 //! Pipeline (naga style): the bytes are made text by [`source_text`] (every byte offset kept),
 //! lexed once by the shared logos lexer ([`lexer`]), grouped into functions and logical
@@ -23,16 +25,18 @@ pub mod lexer;
 pub mod lower;
 pub mod matlab;
 pub mod python;
+pub mod registry;
 pub mod scan;
 pub mod sensor;
 pub mod stmt;
 pub mod synth;
-
-use std::path::Path;
+pub mod urdf;
 
 pub use error::FrontError;
+pub use registry::{extension_list, front_end_for, FrontEnd, FrontOptions, Loaded, FRONT_ENDS};
 
-/// A Robotran output language.
+/// A Robotran output language (the Robotran front ends' own parameter; the driver goes
+/// through [`registry`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Language {
     /// C (`.c`, companion `.h`).
@@ -43,8 +47,9 @@ pub enum Language {
     Python,
 }
 
-/// The language of a file from its extension: `.c`/`.h` → C, `.m` → Matlab, `.py` → Python.
-pub fn language_of(path: &Path) -> Option<Language> {
+/// The Robotran language of a file from its extension: `.c`/`.h` → C, `.m` → Matlab, `.py` →
+/// Python (the Robotran front ends' own map; the driver goes through [`registry`]).
+pub fn language_of(path: &std::path::Path) -> Option<Language> {
     match path.extension()?.to_str()? {
         "c" | "h" => Some(Language::C),
         "m" => Some(Language::Matlab),

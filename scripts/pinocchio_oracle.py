@@ -1,0 +1,66 @@
+#!/usr/bin/env python3
+"""Pinocchio reference values for robovec's URDF front end (issue 14).
+
+Usage: pinocchio_oracle.py URDF STATES SEED
+
+URDF is a path, or `erd:REL` for a file of example-robot-data (`erd:ur_description/urdf/ur5_robot.urdf`),
+found under the installed package's share folder. Builds the fixed-base model with
+`pinocchio.buildModelFromUrdf` and prints JSON on stdout:
+  {"path", "joints": [names in Pinocchio's order], "gravity": [gx, gy, gz],
+   "states": [{"q": [...], "qd": [...], "qdd": [...], "tau": [...]}]}
+with one angle (or length) per joint: a continuous joint's (cos, sin) pair is built from it.
+States are uniform: angles in [-pi, pi], lengths in [-0.2, 0.2], velocities and accelerations in [-2, 2].
+"""
+import glob
+import json
+import math
+import os
+import sys
+
+import numpy as np
+import pinocchio as pin
+
+
+def locate(spec):
+    if not spec.startswith("erd:"):
+        return spec
+    rel = spec[4:]
+    roots = glob.glob(os.path.join(sys.prefix, "**", "share", "example-robot-data", "robots"), recursive=True)
+    for r in roots:
+        p = os.path.join(r, rel)
+        if os.path.exists(p):
+            return p
+    sys.exit(f"example-robot-data file {rel} not found under {sys.prefix}")
+
+
+def main():
+    path = locate(sys.argv[1])
+    n, seed = int(sys.argv[2]), int(sys.argv[3])
+    model = pin.buildModelFromUrdf(path)
+    data = model.createData()
+    rng = np.random.default_rng(seed)
+    joints = list(model.joints)[1:]
+    out = {"path": path, "joints": list(model.names)[1:], "gravity": list(map(float, model.gravity.linear)), "states": []}
+    for _ in range(n):
+        q = pin.neutral(model)
+        v = rng.uniform(-2.0, 2.0, model.nv)
+        a = rng.uniform(-2.0, 2.0, model.nv)
+        coords = []
+        for j in joints:
+            if j.nv != 1:
+                sys.exit(f"joint {j.shortname()} has {j.nv} degrees of freedom: not a fixed-base tree of 1-dof joints")
+            prismatic = j.shortname().replace("JointModel", "").startswith("P")
+            x = rng.uniform(-0.2, 0.2) if prismatic else rng.uniform(-math.pi, math.pi)
+            coords.append(x)
+            if j.nq == 2:
+                q[j.idx_q] = math.cos(x)
+                q[j.idx_q + 1] = math.sin(x)
+            else:
+                q[j.idx_q] = x
+        tau = pin.rnea(model, data, q, v, a)
+        out["states"].append({"q": coords, "qd": list(map(float, v)), "qdd": list(map(float, a)), "tau": list(map(float, tau))})
+    json.dump(out, sys.stdout)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,136 @@
+//! The symbolic generator (issue 14): equations of motion of a robot described by a URDF
+//! ([`crate::front::urdf::Robot`]), written as the same parsed-phase IR the Robotran front ends
+//! produce, so every pass, report and back end applies unchanged.
+//!
+//! # What is generated
+//! `invdyna`: inverse dynamics `Qq[i]` of a fixed-base tree by the recursive Newton–Euler
+//! algorithm ([`rnea`]), symbolic in the joint coordinates `q[i]`, `qd[i]`, `qdd[i]`, the
+//! gravity vector `g[1..3]` (Pinocchio's default is `g[3] = −9.81`) and the model parameters.
+//! Direct dynamics and a floating base are later work (issue 14).
+//!
+//! # Numbering (Pinocchio's)
+//! Joints are numbered depth first from the root link, the joints leaving a link taken in
+//! byte order of their names (urdfdom's sorted map, which `pinocchio.buildModelFromUrdf`
+//! walks). Body `b` is the child link of the `b`-th joint of that walk (fixed joints included);
+//! the moving (revolute, continuous, prismatic) joints are numbered `q[1..nq]` in the same walk,
+//! so `q[i]`, `qd[i]`, `qdd[i]` and `Qq[i]` are Pinocchio's entry `i − 1` of a fixed-base model.
+//!
+//! # Parameters (Robotran's layout, SPEC §2)
+//! - `dpt[k][b]`: the origin of joint `b` in its parent link frame (URDF joint `<origin xyz>`), m;
+//! - `l[k][b]`: the centre of mass of body `b` in its frame, m; `m[b]`: its mass, kg;
+//! - `In[k][b]`: its inertia tensor about the centre of mass in its frame, kg·m², row-major
+//!   `k = 1..9`; the tensor is symmetric, so the lower entries read the upper ones' names
+//!   (`In[2][b]` stands for both (1,2) and (2,1); `In[4]`, `In[7]`, `In[8]` never appear).
+//!
+//! A parameter whose URDF value is exactly 0 is a structural zero and folded, as Robotran folds
+//! the parameters a model sets to 0; the others stay inputs and their values go to
+//! [`Generated::params`] (what `-params-out` writes for `specialize<params=…>` and `-eval`),
+//! unless `--fold-params` folds them all. Constant rotations (URDF `rpy`) are numbers.
+
+pub mod rnea;
+pub mod sym;
+
+use std::collections::BTreeMap;
+
+use robovec_ir::Module;
+use rustc_hash::FxHashMap;
+
+use crate::front::urdf::{JointKind, Robot};
+use sym::{Builder, Term, ZERO};
+
+/// A robot to generate equations for.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The checked kinematic tree.
+    pub robot: Robot,
+}
+
+/// The numbering and parameter values of a model (see the module doc).
+#[derive(Clone, Debug)]
+pub struct Layout {
+    /// For each joint of the depth-first walk, its coordinate index `i` of `q[i]` (1-based), or
+    /// `None` for a fixed joint.
+    pub q_index: Vec<Option<usize>>,
+    /// Every parameter (canonical name) → value, zeros included.
+    pub values: BTreeMap<String, f64>,
+}
+
+impl Layout {
+    /// The numbering and parameters of `robot`.
+    pub fn of(robot: &Robot) -> Layout {
+        let order = robot.dfs_joints();
+        let mut q_index = Vec::with_capacity(order.len());
+        let mut nq = 0;
+        let mut values = BTreeMap::new();
+        for (i, &j) in order.iter().enumerate() {
+            let body = i + 1;
+            let joint = &robot.joints[j];
+            q_index.push(match joint.kind {
+                JointKind::Fixed => None,
+                _ => {
+                    nq += 1;
+                    Some(nq)
+                }
+            });
+            for (k, x) in joint.origin.xyz.iter().enumerate() {
+                values.insert(format!("dpt[{}][{body}]", k + 1), *x);
+            }
+            let inertial = robot.links[joint.child].inertial;
+            let (mass, com, inn) = inertial.map_or((0.0, [0.0; 3], [[0.0; 3]; 3]), |x| (x.mass, x.com, x.inertia));
+            values.insert(format!("m[{body}]"), mass);
+            for (k, x) in com.iter().enumerate() {
+                values.insert(format!("l[{}][{body}]", k + 1), *x);
+            }
+            for (r, row) in inn.iter().enumerate() {
+                for (c, x) in row.iter().enumerate().skip(r) {
+                    values.insert(Layout::inertia_name(r, c, body), *x);
+                }
+            }
+        }
+        Layout { q_index, values }
+    }
+
+    /// `In[k][b]` for row `r`, column `c` (0-based) of body `b`'s tensor: the upper entry's name.
+    pub fn inertia_name(r: usize, c: usize, body: usize) -> String {
+        let (r, c) = (r.min(c), r.max(c));
+        format!("In[{}][{body}]", 3 * r + c + 1)
+    }
+
+    /// The term of parameter `name`: a structural zero when its value is 0, else the input
+    /// (folded by the builder under `--fold-params`).
+    pub fn param(&self, b: &mut Builder, name: &str) -> Term {
+        match self.values.get(name) {
+            Some(&x) if x != 0.0 => b.input(name),
+            _ => ZERO,
+        }
+    }
+
+    /// The parameters that are inputs (non-zero values).
+    pub fn nonzero(&self) -> BTreeMap<String, f64> {
+        self.values.iter().filter(|(_, &x)| x != 0.0).map(|(k, &x)| (k.clone(), x)).collect()
+    }
+}
+
+/// What the generator hands to the front end.
+#[derive(Clone, Debug)]
+pub struct Generated {
+    /// The functions (`invdyna`).
+    pub module: Module,
+    /// Values of the parameters left as inputs (`None` when they were folded).
+    pub params: Option<BTreeMap<String, f64>>,
+}
+
+/// Generates `invdyna` for `model`; `fold` folds every parameter into the equations.
+pub fn generate(model: &Model, fold: bool) -> Generated {
+    let layout = Layout::of(&model.robot);
+    let consts: FxHashMap<String, f64> =
+        if fold { layout.nonzero().into_iter().collect() } else { FxHashMap::default() };
+    let mut b = Builder::new("invdyna", consts);
+    rnea::invdyna(model, &layout, &mut b);
+    let f = b.finish();
+    let params = (!fold).then(|| {
+        // Only the parameters the equations read.
+        layout.nonzero().into_iter().filter(|(k, _)| f.lookup(k).is_some()).collect()
+    });
+    Generated { module: Module { functions: vec![f] }, params }
+}
