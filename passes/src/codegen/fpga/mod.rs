@@ -361,8 +361,8 @@ pub fn cost_model(t: &robovec_ir::target::Target) -> resources::CostModel {
 /// N of issue 12's table. Since the crossbar is a tree of 2:1 multiplexers in one module that
 /// the hierarchical synthesis maps once ([`resources`]' module doc), Yosys' time grows with the
 /// PEs and their output memories, not with the square of the PEs: measured Yosys 0.23 CPU times
-/// are in the module doc (Segway `dirdyna`, 32 + 32 PEs: about a minute of CPU). Larger designs
-/// get the analytic estimate and a note; `resources=yosys` runs Yosys whatever the size.
+/// are in the module doc (Segway `dirdyna`: 8 + 8 PEs 27 s, 16 + 16 50 s). Larger designs get the
+/// analytic estimate and a note; `resources=yosys` runs Yosys whatever the size.
 pub const AUTO_YOSYS_MAX_PES: u32 = 64;
 
 impl CodegenFpga {

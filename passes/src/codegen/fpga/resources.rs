@@ -44,10 +44,13 @@
 //! flat (+6.8 %: flattening merges each PE's output-memory read with the top's output
 //! multiplexer), at 4 + 4 PEs 4548 against 4486 (+1.4 %); the double pendulum at 2 + 2 PEs is
 //! `tests/fpga.rs`' check (within 10 %). The barrel-shifter form flattened gave 4402 at 4 + 4.
-//! CPU times on the 2-core development machine (wall times were 3–8× longer under the load of
-//! other builds): 2 + 2 PEs 16 s (flat 22 s), 4 + 4 19 s (flat 44 s), 8 + 8 27 s, 16 + 16 TIME16,
-//! 32 + 32 TIME32 (Segway); WALK-MAN `dirdyna`, whose 1306 outputs make large output memories,
-//! WMTIMES. So `resources=auto` runs Yosys up to 32 + 32 PEs (`super::AUTO_YOSYS_MAX_PES`).
+//! Yosys CPU times on the 2-core development machine (wall times were 3–10× longer: the machine
+//! was shared with other builds), Segway `dirdyna`: 2 + 2 PEs 16 s (flat 22 s), 4 + 4 19 s
+//! (flat 44 s), 8 + 8 27 s, 16 + 16 50 s; WALK-MAN `dirdyna` at 4 + 4, whose 1306 outputs make
+//! output memories of about 160 words per PE, 114 s. The time now grows with the PEs and their
+//! output memories (the crossbar port is mapped once), not with the square of the PEs; 32 + 32
+//! passed 100 s of CPU (the README has the measured table). So `resources=auto` runs Yosys up
+//! to 32 + 32 PEs (`super::AUTO_YOSYS_MAX_PES`), the largest N of issue 12's table.
 //!
 //! ## Against the seed's Table 1.4 (8 PE: 4 ADD + 4 MULTI)
 //! The seed totals 4413 ALM, 120 M10K, 20 DSP for its 23-dof railway bogie (987 cycles). The
