@@ -22,6 +22,7 @@
 //! | `pe_memory_alm` | 3 ALM per PE memory | seed Table 1.4, row "PE Memory" |
 //! | `crossbar_alm` | 8.125 ALM per (PE-memory write port × crossbar source) | seed Table 1.4, row "Interconnections": 2080 ALM for 8 PE memories × 2 write ports (one multiplexer each, 16 in all, §1.3.1) × 16 sources (8 results + 8 buffer reads) |
 //! | `control_alm` | 469 ALM | seed Table 1.4: the total (4413) minus the rows (4·360 + 4·100 + 8·3 + 2080 = 3944): cycle counter, start/done and glue the table does not itemise |
+//! | `output_word_alm` | 16 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are 32-bit registers read asynchronously, 32 registers at two per ALM = 16 ALM a word, which is also the slope Yosys measures per PE (`passes/src/codegen/fpga/resources.rs`). Used only where the output words are known (the FPGA back end's estimate); optional in a JSON target (default 0: not counted) |
 //!
 //! ## The clock
 //! Seed §1.3: the M10K is limited to 240 MHz on the DE10-Nano and the PE memory runs at twice the
@@ -36,10 +37,10 @@
 //! 25 MHz is `examples/targets/de10-nano-as-built.json`.
 //!
 //! # The JSON format (`-target=FILE.json`)
-//! One object, every key required except `latencies.div` and `latencies.call` (default: the
-//! `add` latency, as they run on ADD PEs); an unknown key anywhere is an error, as is a value
-//! that makes no sense (zero latency, ports, words, width or capacity; a clock that is not a
-//! positive finite number; a negative or non-finite cost):
+//! One object, every key required except `output_word_alm` (default 0), `latencies.div` and
+//! `latencies.call` (default: the `add` latency, as they run on ADD PEs); an unknown key
+//! anywhere is an error, as is a value that makes no sense (zero latency, ports, words, width
+//! or capacity; a clock that is not a positive finite number; a negative or non-finite cost):
 //!
 //! ```json
 //! {
@@ -59,7 +60,8 @@
 //!   "fp_mul": { "alm": 100, "dsp": 3, "m10k": 0 },
 //!   "pe_memory_alm": 3,
 //!   "crossbar_alm": 8.125,
-//!   "control_alm": 469
+//!   "control_alm": 469,
+//!   "output_word_alm": 16
 //! }
 //! ```
 //!
@@ -134,6 +136,9 @@ pub struct Target {
     pub crossbar_alm: f64,
     /// ALM of the control (cycle counter, start/done) shared by the whole design.
     pub control_alm: f64,
+    /// ALM per output-memory word (32-bit registers the outputs are captured in; the FPGA back
+    /// end's analytic estimate, which knows the output words per PE).
+    pub output_word_alm: f64,
 }
 
 /// The resources a configuration needs, against the target's capacity ([`Target::estimate`]).
@@ -214,6 +219,8 @@ struct TargetFile {
     pe_memory_alm: f64,
     crossbar_alm: f64,
     control_alm: f64,
+    #[serde(default)]
+    output_word_alm: f64,
 }
 
 /// ⌈log2 n⌉ for n ≥ 1 (0 for n ≤ 1): the address bits of an n-word memory.
@@ -249,6 +256,7 @@ impl Target {
             pe_memory_alm: 3.0,
             crossbar_alm: 8.125,
             control_alm: 469.0,
+            output_word_alm: 16.0,
         }
     }
 
@@ -295,6 +303,7 @@ impl Target {
             pe_memory_alm: f.pe_memory_alm,
             crossbar_alm: f.crossbar_alm,
             control_alm: f.control_alm,
+            output_word_alm: f.output_word_alm,
         };
         t.validate().map_err(|message| TargetError::Value { path: path.to_string(), message })?;
         Ok(t)
@@ -360,6 +369,7 @@ impl Target {
             ("pe_memory_alm", self.pe_memory_alm),
             ("crossbar_alm", self.crossbar_alm),
             ("control_alm", self.control_alm),
+            ("output_word_alm", self.output_word_alm),
         ];
         for (k, v) in costs {
             if !(v.is_finite() && v >= 0.0) {

@@ -30,7 +30,7 @@
 //!   addresses (as the seed loads "initial data"); `simulate` writes them before running.
 //! - The resource estimate runs Yosys inside the pass when `yosys` is on `PATH` and the design
 //!   has at most [`AUTO_YOSYS_MAX_PES`] PEs (`resources=auto`, the default; larger designs get
-//!   the analytic estimate and a `-stats` note, since Yosys' time grows with the crossbar);
+//!   the analytic estimate and a `-stats` note);
 //!   `resources=yosys` requires it at any size, `resources=estimate` skips it (analytic crossbar
 //!   cost; deterministic and fast for tests).
 //! - Trig initial values (`S4 = sin q[4]`) are loaded words computed by the host in binary32
@@ -351,16 +351,19 @@ pub fn cost_model(t: &robovec_ir::target::Target) -> resources::CostModel {
         crossbar_alm: t.crossbar_alm,
         pe_memory_alm: t.pe_memory_alm,
         control_alm: t.control_alm,
+        output_word_alm: t.output_word_alm,
         writes: t.writes,
         clock_mhz: t.clock_mhz,
     }
 }
 
-/// Largest design (ADD + MULTI PEs) that `resources=auto` gives to Yosys: its time grows about
-/// with the square of the PE count through the crossbar (4 + 4 PEs: 3.5 min on the 2-core
-/// development machine; 8 + 8 did not finish in 25 min). Larger designs get the analytic
-/// estimate and a note; `resources=yosys` runs Yosys whatever the size.
-pub const AUTO_YOSYS_MAX_PES: u32 = 8;
+/// Largest design (ADD + MULTI PEs) that `resources=auto` gives to Yosys: 32 + 32, the largest
+/// N of issue 12's table. Since the crossbar is a tree of 2:1 multiplexers in one module that
+/// the hierarchical synthesis maps once ([`resources`]' module doc), Yosys' time grows with the
+/// PEs and their output memories, not with the square of the PEs: measured Yosys 0.23 CPU times
+/// are in the module doc (Segway `dirdyna`: 8 + 8 PEs 27 s, 16 + 16 50 s). Larger designs get the
+/// analytic estimate and a note; `resources=yosys` runs Yosys whatever the size.
+pub const AUTO_YOSYS_MAX_PES: u32 = 64;
 
 impl CodegenFpga {
     /// True when `resources=auto` leaves a design of `n_pes` PEs (ADD + MULTI) to the analytic
@@ -423,7 +426,7 @@ impl Pass for CodegenFpga {
             let (_, report, files) = self.build(f, &limits, &model).map_err(failed)?;
             if self.auto_skips_yosys(report.n_add + report.n_mul) {
                 cx.notes.push(format!(
-                    "codegen<fpga> @{}: {} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway, for a long time)",
+                    "codegen<fpga> @{}: {} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway)",
                     f.name,
                     report.n_add + report.n_mul
                 ));

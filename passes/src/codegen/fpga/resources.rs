@@ -3,36 +3,71 @@
 //!
 //! Three parts are added:
 //! - **Logic** (crossbar multiplexers, control, buffers, output memories, address decoding):
-//!   Yosys `synth_intel_alm -family cyclonev` on the generated top with the FP units and the
-//!   M10K memories as black boxes (`hdl/synth_stubs.v`). Yosys reports Mistral cells, not ALMs;
-//!   ALMs are packed as Quartus would at best: a 6-input LUT fills an ALM, two smaller LUTs or
-//!   two arithmetic bits share one, and an ALM holds two registers; a Yosys MLAB cell (32 × 1 bit)
-//!   is half an ALM of a 640-bit MLAB, so
-//!   `alm = max(LUT6 + ⌈(LUT2…LUT5 + ARITH)/2⌉, ⌈FF/2⌉) + ⌈MLAB/2⌉`. Yosys' DSP cells (`MISTRAL_MUL*`)
-//!   count as DSP blocks. Without `yosys` on `PATH` the logic is the target's analytic model
-//!   (`robovec_ir::target`, seed Table 1.4): `crossbar_alm · n_pe · writes · 2n_pe +
-//!   pe_memory_alm · n_pe + control_alm`.
+//!   Yosys `synth_intel_alm -family cyclonev -noflatten` on the generated top with the FP units
+//!   and the M10K memories as black boxes (`hdl/synth_stubs.v`), see "Hierarchical synthesis"
+//!   below. Yosys reports Mistral cells, not ALMs; ALMs are packed as Quartus would at best: a
+//!   6-input LUT fills an ALM, two smaller LUTs or two arithmetic bits share one, and an ALM
+//!   holds two registers; a Yosys MLAB cell (32 × 1 bit) is half an ALM of a 640-bit MLAB, so
+//!   `alm = max(LUT6 + ⌈(LUT2…LUT5 + ARITH)/2⌉, ⌈FF/2⌉) + ⌈MLAB/2⌉`. Yosys' DSP cells
+//!   (`MISTRAL_MUL*`) count as DSP blocks. Without `yosys` (or with `resources=estimate`) the
+//!   logic is the target's analytic model (`robovec_ir::target`, seed Table 1.4):
+//!   `crossbar_alm · n_pe · writes · 2n_pe + pe_memory_alm · n_pe + control_alm +
+//!   output_word_alm · output words`, the last term the output memories (32-bit registers:
+//!   16 ALM a word on the DE10-Nano, the slope Yosys measures per PE: 16.0 ALM per word over
+//!   the Segway's 4 + 4 PEs holding 1 to 33 output words each).
 //! - **FP units**: the target's per-unit costs (seed §1.3.1 / Table 1.4: ADD PE 360 ALM, 2 DSP;
 //!   MULTI PE 100 ALM, 3 DSP) times the PEs of each type.
 //! - **Memories**: every PE memory, instruction, crossbar, buffer-instruction and capture memory
 //!   as M10K blocks from its size ([`super::images::m10k_blocks`]; PE memories true dual-port).
 //!
+//! ## Hierarchical synthesis
+//! Where the time went: the crossbar was written `sources[32*(sel-1) +: 32]`, a variable
+//! part-select of the whole `64·n_pe`-bit bus that Yosys maps (`techmap` of `$shiftx`) as a
+//! barrel shifter over the bus, about `64·n_pe · 32 · log2` 2:1 multiplexers per write port
+//! before `opt`/`abc` shrink it back to a 32-bit `2n_pe+1`-way multiplexer. At 4 + 4 PEs that
+//! was 52 s of CPU (opt_expr 21 %, techmap 16 %); at 8 + 8 the `techmap` of the 32 shifters
+//! alone passed 1.6 GB and the run did not finish in 25 min (`abc9` was never the problem: it
+//! maps the 4 + 4 design in under a second). Two changes, the Verilog staying functionally the
+//! same (the iverilog bit-for-bit tests of `tests/fpga.rs` unchanged):
+//! - the write-port multiplexer is its own module `rv_xbar_port` (`hdl/rv_lib.v`): a balanced
+//!   tree of 2:1 multiplexers on the bits of `sel - 1`, gated to 0 outside `1..=2n_pe`, which
+//!   Yosys packs four data inputs to a LUT6 (17-way × 32 bits: 161 LUT6 + 32 small LUTs, the
+//!   barrel-shifter form gave 160 + 33 after minutes);
+//! - Yosys maps the design without flattening (`-noflatten`): each distinct module once (the
+//!   crossbar port is one module for all `2·n_pe` ports; each PE is its own module since its
+//!   images differ), then the mapped netlist is flattened only to count its cells (`stat`
+//!   sums modules × instances; Yosys 0.23's `stat -json` does not write a nested hierarchy
+//!   as valid JSON).
+//!
+//! Checked against flat synthesis of the same Verilog (Yosys 0.23; logic ALM by the bound
+//! above; registers identical): Segway `dirdyna` at 2 + 2 PEs 2281 hierarchical against 2135
+//! flat (+6.8 %: flattening merges each PE's output-memory read with the top's output
+//! multiplexer), at 4 + 4 PEs 4548 against 4486 (+1.4 %); the double pendulum at 2 + 2 PEs is
+//! `tests/fpga.rs`' check (within 10 %). The barrel-shifter form flattened gave 4402 at 4 + 4.
+//! Yosys CPU times on the 2-core development machine (wall times were 3–10× longer: the machine
+//! was shared with other builds), Segway `dirdyna`: 2 + 2 PEs 16 s (flat 22 s), 4 + 4 19 s
+//! (flat 44 s), 8 + 8 27 s, 16 + 16 50 s; WALK-MAN `dirdyna` at 4 + 4, whose 1306 outputs make
+//! output memories of about 160 words per PE, 114 s. The time now grows with the PEs and their
+//! output memories (the crossbar port is mapped once), not with the square of the PEs; 32 + 32
+//! passed 100 s of CPU (the README has the measured table). So `resources=auto` runs Yosys up
+//! to 32 + 32 PEs (`super::AUTO_YOSYS_MAX_PES`), the largest N of issue 12's table.
+//!
 //! ## Against the seed's Table 1.4 (8 PE: 4 ADD + 4 MULTI)
 //! The seed totals 4413 ALM, 120 M10K, 20 DSP for its 23-dof railway bogie (987 cycles). The
 //! bogie is not in the corpus; the Segway `dirdyna` placed on the same configuration
 //! (`place<pe=4>`, 720 cycles, 6.0 µs at 120 MHz) measures, with Yosys 0.23:
-//! **6277 ALM, 88 M10K, 20 DSP** (fits: 15 % / 16 % / 18 % of the device).
+//! **6388 ALM, 88 M10K, 20 DSP** (fits: 15 % / 16 % / 18 % of the device).
 //! - *DSP*: 20, equal by construction (the FP units are the seed's per-unit costs).
-//! - *ALM*: +42 % (6277 against 4413). The FP units are the seed's (1840 ALM); the rest, 4437 ALM
-//!   from Yosys (2212 LUT6, 4200 smaller LUTs, 90 arithmetic bits, 4016 registers, 160 MLAB
+//! - *ALM*: +45 % (6388 against 4413). The FP units are the seed's (1840 ALM); the rest, 4548 ALM
+//!   from Yosys (3578 LUT6, 1673 smaller LUTs, 106 arithmetic bits, 4016 registers, 160 MLAB
 //!   slices) against the seed's 2573 (crossbar 2080 + PE memories 24 + the 469 the table does
-//!   not itemise), is 1.7×: (a) our crossbar has two 17-way 32-bit multiplexers per PE memory (one
-//!   per write port, 16 in all), where the seed reports 110–150 ALM per PE for its
-//!   multiplexers; (b) the buffers and output memories are read in the cycle they are addressed
-//!   (store-then-read in one clock), so they are registers and MLAB slices (with their
-//!   address decoding and output multiplexers), where the seed spends one M10K per buffer; (c) the packing bound above is pessimistic
-//!   against Quartus' fitter, which packs two LUTs of up to 8 inputs in total per ALM and
-//!   retimes.
+//!   not itemise), is 1.8×: (a) our crossbar has two 17-way 32-bit multiplexers per PE memory
+//!   (one per write port, 16 in all, about 180 ALM each), where the seed reports 110–150 ALM
+//!   per PE for its multiplexers; (b) the buffers and output memories are read in the cycle
+//!   they are addressed (store-then-read in one clock), so they are registers and MLAB slices
+//!   (with their address decoding and output multiplexers), where the seed spends one M10K per
+//!   buffer and has no output memories; (c) the packing bound above is pessimistic against
+//!   Quartus' fitter, which packs two LUTs of up to 8 inputs in total per ALM and retimes.
 //! - *M10K*: −27 % (88 against 120), and differently spread: instruction memories 6 each
 //!   (a 721 × 52 ROM: the 52-bit word needs 6 blocks in any configuration; the seed reports
 //!   3–4, below its own bit count ⌈48128/10240⌉ = 5), crossbar 1 per PE memory (8 against the
@@ -79,6 +114,8 @@ pub struct CostModel {
     pub pe_memory_alm: f64,
     /// Analytic logic: control ALMs.
     pub control_alm: f64,
+    /// Analytic logic: ALMs per output-memory word (32 registers).
+    pub output_word_alm: f64,
     /// Write ports per PE memory.
     pub writes: u32,
     /// Clock, MHz.
@@ -172,11 +209,36 @@ pub fn memory_costs(d: &Design) -> Vec<MemoryCost> {
     v
 }
 
-/// Runs Yosys on the design's top with black boxes; `None` when `yosys` cannot be run.
+/// How Yosys maps the design (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Synthesis {
+    /// `synth_intel_alm -noflatten`: each distinct module mapped once, `stat` sums
+    /// instances × cells over the hierarchy (the estimate's method).
+    Hierarchical,
+    /// `synth_intel_alm` flattening the design first (the reference the hierarchical method is
+    /// checked against; slow beyond 4 + 4 PEs).
+    Flat,
+}
+
+/// Words of all output memories (each PE's output memory depth, at least 1).
+pub fn output_words(d: &Design) -> u64 {
+    d.pes.iter().map(|p| p.out.words.len().max(1) as u64).sum()
+}
+
+/// Runs Yosys on the design's top with black boxes, hierarchically (see the module doc);
+/// `None` when `yosys` cannot be run.
 ///
 /// # Errors
 /// A message when Yosys runs but fails (its last lines), or its statistics do not parse.
 pub fn yosys_cells(d: &Design) -> Result<Option<YosysCells>, String> {
+    yosys_cells_with(d, Synthesis::Hierarchical)
+}
+
+/// [`yosys_cells`] with the mapping chosen.
+///
+/// # Errors
+/// As [`yosys_cells`].
+pub fn yosys_cells_with(d: &Design, how: Synthesis) -> Result<Option<YosysCells>, String> {
     let Some(dir) = TempDir::new() else { return Ok(None) };
     let mut files = vec![("synth_stubs.v", SYNTH_STUBS.to_string())];
     files.push((
@@ -184,11 +246,19 @@ pub fn yosys_cells(d: &Design) -> Result<Option<YosysCells>, String> {
         HDL_LIBRARY.iter().find(|(n, _)| *n == "rv_lib.v").map(|x| x.1.to_string()).unwrap_or_default(),
     ));
     files.push(("robovec_top.v", d.top("")));
+    // Hierarchical: map each distinct module once, then flatten the mapped netlist (a copy of
+    // its cells, seconds) so that `stat -json` has one module: Yosys 0.23's `stat -json` writes
+    // a nested hierarchy's instance tree as plain text into the JSON.
+    let (map_flag, after_map) = match how {
+        Synthesis::Hierarchical => (" -noflatten", "flatten\n"),
+        Synthesis::Flat => ("", ""),
+    };
     files.push((
         "synth.ys",
-        "read_verilog synth_stubs.v\nread_verilog rv_lib.v\nread_verilog robovec_top.v\nhierarchy -top robovec_top\n\
-         synth_intel_alm -family cyclonev -top robovec_top\ntee -q -o stat.json stat -json\n"
-            .to_string(),
+        format!(
+            "read_verilog synth_stubs.v\nread_verilog rv_lib.v\nread_verilog robovec_top.v\nhierarchy -top robovec_top\n\
+             synth_intel_alm -family cyclonev{map_flag} -top robovec_top\n{after_map}tee -q -o stat.json stat -json\n"
+        ),
     ));
     // the output memories are registers initialised from their images
     let outs: Vec<(String, String)> = d.pes.iter().map(|p| (format!("{}.hex", p.out.name), p.out.to_hex())).collect();
@@ -211,7 +281,8 @@ pub fn yosys_cells(d: &Design) -> Result<Option<YosysCells>, String> {
     parse_stat(&stat).map(Some)
 }
 
-/// Cell counts from `stat -json` (the `design` totals).
+/// Cell counts from `stat -json` (the `design` totals: for a hierarchical design, every
+/// module's cells times its instances, black boxes included as cells).
 ///
 /// # Errors
 /// A message when the JSON does not have `design.num_cells_by_type`.
@@ -251,7 +322,10 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
         Some(y) => ("yosys", y.alm(), y.dsp),
         None => {
             let n = (na + nm) as f64;
-            let a = m.crossbar_alm * n * f64::from(m.writes) * 2.0 * n + m.pe_memory_alm * n + m.control_alm;
+            let a = m.crossbar_alm * n * f64::from(m.writes) * 2.0 * n
+                + m.pe_memory_alm * n
+                + m.control_alm
+                + m.output_word_alm * output_words(d) as f64;
             ("estimate", a.ceil() as u64, 0)
         }
     };

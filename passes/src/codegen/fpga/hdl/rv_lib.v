@@ -76,8 +76,9 @@ module rv_pe #(
   // crossbar: 0 = none, 1..NPE = result of slot s-1, NPE+1..2NPE = buffer read of slot s-NPE-1
   wire [SW-1:0] sel0 = xbar[SW-1:0];
   wire [SW-1:0] sel1 = xbar[2*SW-1:SW];
-  wire [31:0] wd0 = (sel0 == 0 || sel0 > 2 * NPE) ? 32'h0 : sources[32*(sel0-1) +: 32];
-  wire [31:0] wd1 = (sel1 == 0 || sel1 > 2 * NPE) ? 32'h0 : sources[32*(sel1-1) +: 32];
+  wire [31:0] wd0, wd1;
+  rv_xbar_port #(.NPE(NPE), .SW(SW)) u_x0 (.sources(sources), .sel(sel0), .y(wd0));
+  rv_xbar_port #(.NPE(NPE), .SW(SW)) u_x1 (.sources(sources), .sel(sel1), .y(wd1));
 
   wire [31:0] qa, qb;
   rv_pe_mem #(.AW(AW), .DEPTH(MEM_DEPTH), .FILE(DATA_FILE)) u_mem (
@@ -117,6 +118,46 @@ module rv_pe #(
   initial if (OUT_FILE != "") $readmemh(OUT_FILE, omem);
   always @(posedge clk) if (o_en) omem[oa] <= result;
   assign out_data = omem[out_addr];
+endmodule
+
+// One write port's crossbar multiplexer: y = 0 for sel = 0 or sel > 2 NPE, else the 32-bit word
+// sel - 1 of `sources`. Written as a balanced tree of 2:1 multiplexers on the bits of sel - 1
+// (level k decides on bit k) over 2^SW leaves, gated by `valid`, so that synthesis sees
+// 32 (2^SW - 1) multiplexers that it packs four data inputs to a LUT6, and not a variable shift
+// of the whole 64 NPE-bit bus (the form `sources[32*(sel-1) +: 32]`, which Yosys maps as a
+// barrel shifter first: its time exploded beyond 4 + 4 PEs). One module for every write port of
+// every PE of a design (parameters NPE and SW only): a hierarchical synthesis maps it once.
+module rv_xbar_port #(
+    parameter integer NPE = 2,
+    parameter integer SW = 3
+) (
+    input  wire [64*NPE-1:0] sources,
+    input  wire [SW-1:0]     sel,
+    output wire [31:0]       y
+);
+  localparam integer L = 1 << SW;
+  wire [SW-1:0] idx = sel - 1'b1;
+  wire valid = sel != 0 && sel <= 2 * NPE;
+  // level k holds L >> k words; level 0 are the leaves (source j at leaf j, zeros beyond 2 NPE)
+  wire [32*L-1:0] lv [0:SW];
+  genvar k, j;
+  generate
+    for (j = 0; j < L; j = j + 1) begin : g_leaf
+      if (j < 2 * NPE) begin : g_src
+        assign lv[0][32*j +: 32] = sources[32*j +: 32];
+      end else begin : g_zero
+        assign lv[0][32*j +: 32] = 32'h0;
+      end
+    end
+    for (k = 0; k < SW; k = k + 1) begin : g_level
+      for (j = 0; j < (L >> (k + 1)); j = j + 1) begin : g_mux
+        assign lv[k+1][32*j +: 32] = idx[k] ? lv[k][32*(2*j+1) +: 32] : lv[k][32*(2*j) +: 32];
+      end
+      // the upper words of a level are unused: tie them off
+      assign lv[k+1][32*L-1:32*(L >> (k + 1))] = {(32*L - 32*(L >> (k + 1))){1'b0}};
+    end
+  endgenerate
+  assign y = valid ? lv[SW][31:0] : 32'h0;
 endmodule
 
 // Program counter, start/done. `fetch` is the cycle whose words the ROMs register at the next
