@@ -278,65 +278,61 @@ fn cycles(d: &ReportData) -> Result<Figure> {
     })
 }
 
-/// µs against N at the target's clock.
-fn microseconds(d: &ReportData) -> Result<Figure> {
+/// One line per sweep configuration of `value` against N: the figure `name`, its CSV column
+/// `column`, chart title `what` and y label `y_label`.
+fn per_config(
+    d: &ReportData,
+    (name, caption): (&'static str, String),
+    (what, y_label): (&str, &str),
+    column: &str,
+    value: fn(&SweepRow) -> f64,
+) -> Result<Figure> {
     let rows = &d.sweep;
     let ns = ns(rows);
     let mut series = Vec::new();
-    let mut csv = String::from("configuration,n,us\n");
+    let mut csv = format!("configuration,n,{column}\n");
     for c in configs(rows) {
         let of = of_config(rows, &c);
         for r in &of {
-            csv += &format!("{c},{},{}\n", r.n, r.us);
+            csv += &format!("{c},{},{}\n", r.n, value(r));
         }
-        series.push((c, of.iter().map(|r| (lx(r.n), r.us)).collect(), false));
+        series.push((c, of.iter().map(|r| (lx(r.n), value(r))).collect(), false));
     }
-    let clock = rows.iter().find(|r| r.us > 0.0).map(|r| r.cycles / r.us);
+    let mut svg = String::new();
+    {
+        let root = svg_area(&mut svg, SIZE);
+        let area = titled(&root, d)?;
+        n_chart(&area, what, y_label, &ns, &series, &[])?;
+        root.present().map_err(err)?;
+    }
+    Ok(Figure { name, caption, svg, csv })
+}
+
+/// µs against N at the target's clock.
+fn microseconds(d: &ReportData) -> Result<Figure> {
+    let clock = d.sweep.iter().find(|r| r.us > 0.0).map(|r| r.cycles / r.us);
     let what = match clock {
         Some(mhz) => format!("µs vs N at {mhz:.0} MHz"),
         None => "µs vs N".into(),
     };
-    let mut svg = String::new();
-    {
-        let root = svg_area(&mut svg, SIZE);
-        let area = titled(&root, d)?;
-        n_chart(&area, &what, "time (µs)", &ns, &series, &[])?;
-        root.present().map_err(err)?;
-    }
-    Ok(Figure {
-        name: "microseconds",
-        caption: "Time of one evaluation (µs) against N at the target's clock".into(),
-        svg,
-        csv,
-    })
+    per_config(
+        d,
+        ("microseconds", "Time of one evaluation (µs) against N at the target's clock".into()),
+        (&what, "time (µs)"),
+        "us",
+        |r| r.us,
+    )
 }
 
 /// Seed Fig. 3.9–3.13: parallelisation rate against N.
 fn parallelisation(d: &ReportData) -> Result<Figure> {
-    let rows = &d.sweep;
-    let ns = ns(rows);
-    let mut series = Vec::new();
-    let mut csv = String::from("configuration,n,parallelisation_rate\n");
-    for c in configs(rows) {
-        let of = of_config(rows, &c);
-        for r in &of {
-            csv += &format!("{c},{},{}\n", r.n, r.parallelisation_rate);
-        }
-        series.push((c, of.iter().map(|r| (lx(r.n), r.parallelisation_rate)).collect(), false));
-    }
-    let mut svg = String::new();
-    {
-        let root = svg_area(&mut svg, SIZE);
-        let area = titled(&root, d)?;
-        n_chart(&area, "Parallelisation rate vs N", "parallelisation rate (ops / (cycles x 2N))", &ns, &series, &[])?;
-        root.present().map_err(err)?;
-    }
-    Ok(Figure {
-        name: "parallelisation",
-        caption: "Parallelisation rate ops / (cycles × 2N) against N (seed Fig. 3.9–3.13)".into(),
-        svg,
-        csv,
-    })
+    per_config(
+        d,
+        ("parallelisation", "Parallelisation rate ops / (cycles × 2N) against N (seed Fig. 3.9–3.13)".into()),
+        ("Parallelisation rate vs N", "parallelisation rate (ops / (cycles x 2N))"),
+        "parallelisation_rate",
+        |r| r.parallelisation_rate,
+    )
 }
 
 /// Seed Fig. 2.4–2.7: PE memory and buffer words per PE (min / mean / max), naive against
