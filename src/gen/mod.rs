@@ -1,5 +1,5 @@
 //! The symbolic generator (issue 14): equations of motion of a robot described by a URDF
-//! ([`crate::front::urdf::Robot`]), written as the same parsed-phase IR the Robotran front ends
+//! ([`robot::Robot`], built by the URDF front end), written as the same parsed-phase IR the Robotran front ends
 //! produce, so every pass, report and back end applies unchanged.
 //!
 //! # What is generated
@@ -28,6 +28,7 @@
 //! unless `--fold-params` folds them all. Constant rotations (URDF `rpy`) are numbers.
 
 pub mod rnea;
+pub mod robot;
 pub mod sym;
 
 use std::collections::BTreeMap;
@@ -35,7 +36,7 @@ use std::collections::BTreeMap;
 use robovec_ir::Module;
 use rustc_hash::FxHashMap;
 
-use crate::front::urdf::{JointKind, Robot};
+use robot::{JointKind, Robot};
 use sym::{Builder, Term, ZERO};
 
 /// A robot to generate equations for.

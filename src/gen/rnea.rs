@@ -21,9 +21,9 @@
 
 use robovec_ir::TrigFn;
 
+use super::robot::JointKind;
 use super::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
 use super::{Layout, Model};
-use crate::front::urdf::JointKind;
 
 type V3 = [Term; 3];
 type M3 = [[Term; 3]; 3];

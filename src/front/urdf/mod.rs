@@ -11,7 +11,9 @@ mod parse;
 
 use std::path::Path;
 
-pub use parse::{parse, Inertial, Joint, JointKind, Link, Origin, Robot};
+pub use parse::parse;
+
+use crate::gen::robot::JointKind;
 
 use super::{FrontEnd, FrontError, FrontOptions, Loaded};
 

@@ -1,0 +1,146 @@
+//! The robot the symbolic generator reads: a kinematic tree of links and joints with every
+//! number the dynamics needs (issue 14). Front ends build it — the URDF front end
+//! (`crate::front::urdf`) today, the topology families next — and [`crate::gen`] writes its
+//! equations; the generator depends on no input format.
+
+use robovec_ir::Span;
+
+/// A rigid transform given as URDF's `<origin xyz="…" rpy="…"/>`: translation (m) and the
+/// rotation `R = Rz(yaw)·Ry(pitch)·Rx(roll)` (URDF's fixed-axis roll-pitch-yaw), as a row-major
+/// 3×3 matrix mapping child coordinates to parent coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Origin {
+    /// Translation `xyz`, metres.
+    pub xyz: [f64; 3],
+    /// Rotation matrix `R` (row-major), child → parent.
+    pub rot: [[f64; 3]; 3],
+}
+
+impl Origin {
+    /// The identity transform (an absent `<origin>`).
+    pub const IDENTITY: Origin = Origin { xyz: [0.0; 3], rot: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] };
+
+    /// From `xyz` and `rpy` (radians). Angles of exactly 0 give exact 0/1 entries; entries
+    /// within 1e-15 of 0 or ±1 (the rounding noise of `cos(π/2)` = 6·10⁻¹⁷ for a quarter turn
+    /// written as `1.5707963267948966`) are snapped to it, so that quarter turns fold as
+    /// structural zeros and ones, as Robotran's exact rotations do. The change is below 10⁻¹⁵
+    /// of the entry, far under the 10⁻¹⁰ agreement with Pinocchio the tests ask.
+    pub fn from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Origin {
+        let (sr, cr) = rpy[0].sin_cos();
+        let (sp, cp) = rpy[1].sin_cos();
+        let (sy, cy) = rpy[2].sin_cos();
+        let rot = [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+        .map(|row| row.map(snap));
+        Origin { xyz, rot }
+    }
+}
+
+/// `x` snapped to 0 or ±1 when within 1e-15 of it (see [`Origin::from_xyz_rpy`]).
+fn snap(x: f64) -> f64 {
+    if x.abs() < 1e-15 {
+        0.0
+    } else if (x.abs() - 1.0).abs() < 1e-15 {
+        x.signum()
+    } else {
+        x
+    }
+}
+
+/// The mass properties of a link (URDF `<inertial>`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inertial {
+    /// Mass, kg (≥ 0).
+    pub mass: f64,
+    /// Centre of mass in the link frame, m.
+    pub com: [f64; 3],
+    /// Inertia tensor about the centre of mass **in the link frame** (the `<inertial>` origin's
+    /// rotation applied), kg·m², row-major, symmetric positive (semi-)definite.
+    pub inertia: [[f64; 3]; 3],
+}
+
+/// A joint type robovec's generator handles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointKind {
+    /// `revolute` (limits ignored) or `continuous`: rotation about `axis` by `q`.
+    Revolute,
+    /// `prismatic`: translation along `axis` by `q`.
+    Prismatic,
+    /// `fixed`: no degree of freedom.
+    Fixed,
+}
+
+/// One joint of the tree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    /// The URDF name.
+    pub name: String,
+    /// Its type.
+    pub kind: JointKind,
+    /// Index of the parent link in [`Robot::links`].
+    pub parent: usize,
+    /// Index of the child link in [`Robot::links`].
+    pub child: usize,
+    /// Child joint frame in the parent link frame.
+    pub origin: Origin,
+    /// Unit axis in the joint (= child link) frame (URDF default `1 0 0`).
+    pub axis: [f64; 3],
+    /// The `<joint>` element.
+    pub span: Span,
+}
+
+/// One link.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Link {
+    /// The URDF name.
+    pub name: String,
+    /// Mass properties; `None` when the link has no `<inertial>` (massless).
+    pub inertial: Option<Inertial>,
+    /// The `<link>` element.
+    pub span: Span,
+}
+
+/// A checked URDF tree: one root link, every other link the child of exactly one joint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Robot {
+    /// `<robot name>`.
+    pub name: String,
+    /// Links in file order.
+    pub links: Vec<Link>,
+    /// Joints in file order.
+    pub joints: Vec<Joint>,
+    /// The root link (child of no joint).
+    pub root: usize,
+}
+
+impl Robot {
+    /// The joints leaving link `l`, ordered by joint name (byte order): the order urdfdom (and
+    /// so `pinocchio.buildModelFromUrdf`) visits them, since it keeps joints in a sorted map.
+    pub fn children(&self, l: usize) -> Vec<usize> {
+        let mut c: Vec<usize> = (0..self.joints.len()).filter(|&j| self.joints[j].parent == l).collect();
+        c.sort_by(|&a, &b| self.joints[a].name.as_bytes().cmp(self.joints[b].name.as_bytes()));
+        c
+    }
+
+    /// Every joint in depth-first pre-order from the root, children by [`Robot::children`]:
+    /// Pinocchio's joint order once the fixed joints are left out. Cost: O(joints · log joints).
+    pub fn dfs_joints(&self) -> Vec<usize> {
+        let mut children: Vec<Vec<usize>> = vec![Vec::new(); self.links.len()];
+        for (j, joint) in self.joints.iter().enumerate() {
+            children[joint.parent].push(j);
+        }
+        for c in &mut children {
+            c.sort_by(|&a, &b| self.joints[a].name.as_bytes().cmp(self.joints[b].name.as_bytes()));
+        }
+        let mut out = Vec::with_capacity(self.joints.len());
+        let mut stack: Vec<usize> = children[self.root].iter().rev().copied().collect();
+        while let Some(j) = stack.pop() {
+            out.push(j);
+            stack.extend(children[self.joints[j].child].iter().rev());
+        }
+        out
+    }
+}
