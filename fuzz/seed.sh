@@ -12,7 +12,8 @@ cd "$(dirname "$0")"
 SHARED=${SHARED:-../../shared/corpus/robotran}
 MAX=${MAX:-8192}
 test -d "$SHARED" || { echo "no Robotran corpus at $SHARED (set SHARED=...)" >&2; exit 1; }
-mkdir -p corpus/parse_text corpus/roundtrip corpus/front_c corpus/front_matlab corpus/front_python
+mkdir -p corpus/parse_text corpus/roundtrip corpus/front_c corpus/front_matlab corpus/front_python corpus/front_urdf
+cp ../examples/*/*.urdf corpus/front_urdf/
 
 for f in "$SHARED"/c/*.c ../examples/*/*.c; do
     b=$(basename "$f" .c)
