@@ -21,7 +21,19 @@
 //! parallel-axis theorem) that would have to be verified separately; the unit-acceleration
 //! form reuses the RNEA that is already checked against Pinocchio, so `M` and `c` inherit its
 //! conventions (frames, numbering, parameters) by construction. CRBA stays a later
-//! optimisation; the op counts of this form are in the README ("URDF input").
+//! optimisation.
+//!
+//! # Size (`-passes=atomise -stats`, symbolic parameters / `--fold-params`)
+//! | robot | dof | `dirdyna` ops | `invdyna` ops |
+//! |---|---|---|---|
+//! | double pendulum (example) | 2 | 53 / 47 | 42 |
+//! | three_link_arm (example) | 3 | 854 / 760 | 510 |
+//! | UR5 (example-robot-data) | 6 | 1291 / 1282 | 575 |
+//! | Panda with fingers (example-robot-data) | 9 | 4068 / 3966 | 1365 |
+//!
+//! For scale, the corpus's Robotran `mbs_dirdyna` of Frank_segway (17 joints) states 4287 flops.
+
+use rustc_hash::FxHashMap;
 
 use super::rnea::{motions, sweep, Drive};
 use super::sym::{Builder, Term, ZERO};
@@ -34,7 +46,7 @@ pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) {
     let drive = Drive::inputs(b, nq, false);
     let motions = motions(model, layout, b);
     // Upper triangle, column by column.
-    let mut upper: Vec<Vec<Term>> = vec![vec![ZERO; nq]; nq];
+    let mut upper: FxHashMap<(usize, usize), Term> = FxHashMap::default();
     for j in 0..nq {
         let unit = Drive {
             qd: vec![ZERO; nq],
@@ -44,7 +56,8 @@ pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) {
         for (qi, t) in sweep(model, layout, b, &motions, &unit) {
             let i = qi - 1;
             if i <= j {
-                upper[i][j] = b.bind(&format!("M{qi}_{}", j + 1), t);
+                let t = b.bind(&format!("M{qi}_{}", j + 1), t);
+                upper.insert((i, j), t);
             }
         }
     }
@@ -54,7 +67,7 @@ pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) {
     }
     for i in 0..nq {
         for j in 0..nq {
-            let t = upper[i.min(j)][i.max(j)].clone();
+            let t = upper.get(&(i.min(j), i.max(j))).cloned().unwrap_or(ZERO);
             b.output(&format!("M[{}][{}]", i + 1, j + 1), &format!("M{}_{}", i + 1, j + 1), t);
         }
     }

@@ -116,16 +116,18 @@ impl Layout {
 /// What the generator hands to the front end.
 #[derive(Clone, Debug)]
 pub struct Generated {
-    /// The functions (`invdyna`).
+    /// The functions (`invdyna`, then `dirdyna`).
     pub module: Module,
     /// Values of the parameters left as inputs (`None` when they were folded).
     pub params: Option<BTreeMap<String, f64>>,
 }
 
+/// Writes one function's equations and outputs into the builder.
+type Writer = fn(&Model, &Layout, &mut Builder);
+
 /// The functions the generator writes, in module order (`-function=NAME` picks one): the
 /// one place that selects a formulation per function.
-const FUNCTIONS: [(&str, fn(&Model, &Layout, &mut Builder)); 2] =
-    [("invdyna", rnea::invdyna), ("dirdyna", dirdyna::dirdyna)];
+const FUNCTIONS: [(&str, Writer); 2] = [("invdyna", rnea::invdyna), ("dirdyna", dirdyna::dirdyna)];
 
 /// Generates `invdyna` and `dirdyna` for `model`; `fold` folds every parameter into the
 /// equations.
