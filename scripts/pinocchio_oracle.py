@@ -7,7 +7,9 @@ URDF is a path, or `erd:REL` for a file of example-robot-data (`erd:ur_descripti
 found under the installed package's share folder. Builds the fixed-base model with
 `pinocchio.buildModelFromUrdf` and prints JSON on stdout:
   {"path", "joints": [names in Pinocchio's order], "gravity": [gx, gy, gz],
-   "states": [{"q": [...], "qd": [...], "qdd": [...], "tau": [...]}]}
+   "states": [{"q": [...], "qd": [...], "qdd": [...], "tau": [...], "M": [[...]], "nle": [...]}]}
+where tau = rnea(q, qd, qdd), M = crba(q) (Pinocchio fills the upper triangle only: symmetrized
+here) and nle = nonLinearEffects(q, qd).
 with one angle (or length) per joint: a continuous joint's (cos, sin) pair is built from it.
 States are uniform: angles in [-pi, pi], lengths in [-0.2, 0.2], velocities and accelerations in [-2, 2].
 """
@@ -58,7 +60,17 @@ def main():
             else:
                 q[j.idx_q] = x
         tau = pin.rnea(model, data, q, v, a)
-        out["states"].append({"q": coords, "qd": list(map(float, v)), "qdd": list(map(float, a)), "tau": list(map(float, tau))})
+        upper = np.triu(pin.crba(model, data, q))
+        mass = upper + np.triu(upper, 1).T
+        nle = pin.nonLinearEffects(model, data, q, v)
+        out["states"].append({
+            "q": coords,
+            "qd": list(map(float, v)),
+            "qdd": list(map(float, a)),
+            "tau": list(map(float, tau)),
+            "M": [list(map(float, row)) for row in mass],
+            "nle": list(map(float, nle)),
+        })
     json.dump(out, sys.stdout)
 
 

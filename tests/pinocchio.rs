@@ -1,6 +1,7 @@
 //! Numerical truth for the URDF front end (issue 14): robovec's generated inverse dynamics
-//! `Qq` against `pinocchio.rnea` on random states, relative error ≤ 1e-10 (∞-norm of the
-//! difference over the ∞-norm of Pinocchio's torques).
+//! `Qq` against `pinocchio.rnea`, and its direct dynamics `M`, `c` against `pinocchio.crba`
+//! (symmetrized by the oracle) and `pinocchio.nonLinearEffects`, on random states, relative
+//! error ≤ 1e-10 (∞-norm of the difference over the ∞-norm of Pinocchio's values).
 //!
 //! Pinocchio (PyPI `pin`) and `example-robot-data` live in a virtual environment that `.ci/run`
 //! creates at `target/pinocchio-venv` (or the Python named by `ROBOVEC_PINOCCHIO_PYTHON`);
@@ -36,6 +37,9 @@ struct State {
     qd: Vec<f64>,
     qdd: Vec<f64>,
     tau: Vec<f64>,
+    #[serde(rename = "M")]
+    mass: Vec<Vec<f64>>,
+    nle: Vec<f64>,
 }
 
 #[derive(serde::Deserialize)]
@@ -56,8 +60,26 @@ fn oracle(py: &PathBuf, urdf: &str, states: usize, seed: u64) -> Oracle {
     serde_json::from_slice(&out.stdout).expect("oracle JSON")
 }
 
-/// Worst relative error of robovec's `Qq` (symbolic parameters with their values given, and
-/// parameters folded) against Pinocchio over the oracle's states; also returns the ops.
+/// Pinocchio's values of `function`'s outputs in state `s`, by output name.
+fn expected(function: &str, s: &State) -> BTreeMap<String, f64> {
+    let n = s.q.len();
+    let mut e = BTreeMap::new();
+    for i in 0..n {
+        if function == "invdyna" {
+            e.insert(format!("Qq[{}]", i + 1), s.tau[i]);
+        } else {
+            e.insert(format!("c[{}]", i + 1), s.nle[i]);
+            for j in 0..n {
+                e.insert(format!("M[{}][{}]", i + 1, j + 1), s.mass[i][j]);
+            }
+        }
+    }
+    e
+}
+
+/// Worst relative error of robovec's `Qq` (invdyna) and `M`, `c` (dirdyna), with symbolic
+/// parameters given their values and with parameters folded, against Pinocchio over the
+/// oracle's states.
 fn compare(urdf: &str, dof: usize) -> f64 {
     let Some(py) = python() else { return 0.0 };
     let o = oracle(&py, urdf, 8, 7);
@@ -67,10 +89,11 @@ fn compare(urdf: &str, dof: usize) -> f64 {
         let (loaded, _) = robovec::driver::load_with(&o.path, &FrontOptions { fold_params: fold })
             .unwrap_or_else(|e| panic!("{}: {}", o.path, e.message()));
         assert_eq!(loaded.params.is_some(), !fold);
-        let f = &loaded.module.functions[0];
-        assert_eq!(f.name, "invdyna");
-        assert_eq!(f.outputs.len(), dof);
-        for s in &o.states {
+        let names: Vec<&str> = loaded.module.functions.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(names, ["invdyna", "dirdyna"]);
+        for (f, s) in loaded.module.functions.iter().flat_map(|f| o.states.iter().map(move |s| (f, s))) {
+            let want = expected(&f.name, s);
+            assert_eq!(f.outputs.len(), want.len(), "{}: outputs", f.name);
             let mut given: BTreeMap<String, f64> = loaded.params.clone().unwrap_or_default();
             for (k, g) in o.gravity.iter().enumerate() {
                 given.insert(format!("g[{}]", k + 1), *g);
@@ -85,36 +108,44 @@ fn compare(urdf: &str, dof: usize) -> f64 {
                 assert!(given.contains_key(f.name_of(v)), "input {} not given", f.name_of(v));
             }
             let r = robovec::eval::evaluate(f, &given, false);
-            let norm = s.tau.iter().fold(0.0f64, |m, t| m.max(t.abs()));
-            let diff = (0..dof).fold(0.0f64, |m, i| m.max((r.outputs[&format!("Qq[{}]", i + 1)] - s.tau[i]).abs()));
-            let rel = diff / norm;
-            assert!(
-                rel <= 1e-10,
-                "{} (fold {fold}): relative error {rel:e}\n robovec {:?}\n pinocchio {:?}",
-                o.path,
-                r.outputs,
-                s.tau
-            );
-            worst = worst.max(rel);
+            // Per group (Qq, M, c): ∞-norm of the difference over Pinocchio's ∞-norm.
+            for group in ["Qq[", "M[", "c["] {
+                let keys: Vec<&String> = want.keys().filter(|k| k.starts_with(group)).collect();
+                if keys.is_empty() {
+                    continue;
+                }
+                let norm = keys.iter().fold(0.0f64, |m, k| m.max(want[*k].abs()));
+                let diff = keys.iter().fold(0.0f64, |m, k| m.max((r.outputs[*k] - want[*k]).abs()));
+                let rel = diff / norm;
+                assert!(
+                    rel <= 1e-10,
+                    "{} {} {group} (fold {fold}): relative error {rel:e}\n robovec {:?}\n pinocchio {:?}",
+                    o.path,
+                    f.name,
+                    r.outputs,
+                    want
+                );
+                worst = worst.max(rel);
+            }
         }
     }
     worst
 }
 
 #[test]
-fn three_link_arm_matches_pinocchio_rnea() {
+fn three_link_arm_matches_pinocchio_rnea_crba_nle() {
     let e = compare("examples/three_link_arm/three_link_arm.urdf", 3);
     eprintln!("three_link_arm: worst relative error {e:e}");
 }
 
 #[test]
-fn ur5_matches_pinocchio_rnea() {
+fn ur5_matches_pinocchio_rnea_crba_nle() {
     let e = compare("erd:ur_description/urdf/ur5_robot.urdf", 6);
     eprintln!("ur5: worst relative error {e:e}");
 }
 
 #[test]
-fn panda_matches_pinocchio_rnea() {
+fn panda_matches_pinocchio_rnea_crba_nle() {
     let e = compare("erd:panda_description/urdf/panda.urdf", 9);
     eprintln!("panda: worst relative error {e:e}");
 }

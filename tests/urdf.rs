@@ -47,6 +47,50 @@ fn double_pendulum_matches_the_hand_derived_file() {
     assert!(ops(g) <= ops(h), "generated {} ops, hand-derived {}", ops(g), ops(h));
 }
 
+/// `dirdyna` against `invdyna` without any outside reference: `Qq(q, qd, qdd) = M(q) qdd +
+/// c(q, qd)` at random states (random gravity too), with the URDF's parameters given and
+/// folded; `M` symmetric.
+#[test]
+fn direct_dynamics_agrees_with_inverse_dynamics() {
+    for (urdf, n) in [(URDF, 2), ("examples/three_link_arm/three_link_arm.urdf", 3)] {
+        for fold in [false, true] {
+            let (gen, _) =
+                robovec::driver::load_with(&path(urdf), &FrontOptions { fold_params: fold }).expect("URDF loads");
+            let fs = &gen.module.functions;
+            let (inv, dir) = (&fs[0], &fs[1]);
+            assert_eq!((inv.name.as_str(), dir.name.as_str()), ("invdyna", "dirdyna"));
+            assert_eq!(dir.outputs.len(), n * n + n, "{urdf}: M and c");
+            let mut rng = robovec_ir::rng::SplitMix64::new(5);
+            for _ in 0..10 {
+                let mut given: BTreeMap<String, f64> = gen.params.clone().unwrap_or_default();
+                for k in 1..=3 {
+                    given.insert(format!("g[{k}]"), 20.0 * rng.unit() - 10.0);
+                }
+                for i in 1..=n {
+                    for v in ["q", "qd", "qdd"] {
+                        given.insert(format!("{v}[{i}]"), 4.0 * rng.unit() - 2.0);
+                    }
+                }
+                let qq = robovec::eval::evaluate(inv, &given, false).outputs;
+                let mc = robovec::eval::evaluate(dir, &given, false).outputs;
+                for i in 1..=n {
+                    let mut rhs = mc[&format!("c[{i}]")];
+                    for j in 1..=n {
+                        let (mij, mji) = (mc[&format!("M[{i}][{j}]")], mc[&format!("M[{j}][{i}]")]);
+                        assert_eq!(mij, mji, "{urdf}: M[{i}][{j}] symmetric");
+                        rhs += mij * given[&format!("qdd[{j}]")];
+                    }
+                    let lhs = qq[&format!("Qq[{i}]")];
+                    assert!(
+                        (lhs - rhs).abs() <= 1e-12 * lhs.abs().max(1.0),
+                        "{urdf} (fold {fold}) Qq[{i}] {lhs} vs M qdd + c {rhs}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn runs_like_a_robotran_file() {
     let o = opt(&[URDF, "-function=invdyna", "-passes=atomise", "-stats", "-o", "/dev/null"]);
@@ -71,11 +115,13 @@ fn parameter_file_feeds_specialize_and_eval() {
         serde_json::from_value(v["outputs"].clone()).unwrap()
     };
     let spec = format!("-passes=atomise,specialize<params={}>", p.display());
-    let a = eval(&[URDF, &spec, &format!("-eval={}", s.display())]);
-    let b = eval(&[URDF, "--fold-params", "-passes=atomise", &format!("-eval={}", s.display())]);
-    assert_eq!(a.len(), 2);
-    for (k, x) in &a {
-        assert!((x - b[k]).abs() <= 1e-12 * x.abs().max(1.0), "{k}: {x} vs {}", b[k]);
+    for (function, outputs) in [("-function=invdyna", 2), ("-function=dirdyna", 6)] {
+        let a = eval(&[URDF, function, &spec, &format!("-eval={}", s.display())]);
+        let b = eval(&[URDF, function, "--fold-params", "-passes=atomise", &format!("-eval={}", s.display())]);
+        assert_eq!(a.len(), outputs, "{function}");
+        for (k, x) in &a {
+            assert!((x - b[k]).abs() <= 1e-12 * x.abs().max(1.0), "{k}: {x} vs {}", b[k]);
+        }
     }
 }
 

@@ -6,7 +6,8 @@
 //! `invdyna`: inverse dynamics `Qq[i]` of a fixed-base tree by the recursive Newton–Euler
 //! algorithm ([`rnea`]), symbolic in the joint coordinates `q[i]`, `qd[i]`, `qdd[i]`, the
 //! gravity vector `g[1..3]` (Pinocchio's default is `g[3] = −9.81`) and the model parameters.
-//! Direct dynamics and a floating base are later work (issue 14).
+//! `dirdyna`: direct dynamics `M[i][j]`, `c[i]` with `M qdd + c = Qq` ([`dirdyna`]).
+//! A floating base is later work (issue 14).
 //!
 //! # Numbering (Pinocchio's)
 //! Joints are numbered depth first from the root link, the joints leaving a link taken in
@@ -27,6 +28,7 @@
 //! [`Generated::params`] (what `-params-out` writes for `specialize<params=…>` and `-eval`),
 //! unless `--fold-params` folds them all. Constant rotations (URDF `rpy`) are numbers.
 
+pub mod dirdyna;
 pub mod rnea;
 pub mod robot;
 pub mod sym;
@@ -115,23 +117,36 @@ impl Layout {
 /// What the generator hands to the front end.
 #[derive(Clone, Debug)]
 pub struct Generated {
-    /// The functions (`invdyna`).
+    /// The functions (`invdyna`, then `dirdyna`).
     pub module: Module,
     /// Values of the parameters left as inputs (`None` when they were folded).
     pub params: Option<BTreeMap<String, f64>>,
 }
 
-/// Generates `invdyna` for `model`; `fold` folds every parameter into the equations.
+/// Writes one function's equations and outputs into the builder.
+type Writer = fn(&Model, &Layout, &mut Builder);
+
+/// The functions the generator writes, in module order (`-function=NAME` picks one): the
+/// one place that selects a formulation per function.
+const FUNCTIONS: [(&str, Writer); 2] = [("invdyna", rnea::invdyna), ("dirdyna", dirdyna::dirdyna)];
+
+/// Generates `invdyna` and `dirdyna` for `model`; `fold` folds every parameter into the
+/// equations.
 pub fn generate(model: &Model, fold: bool) -> Generated {
     let layout = Layout::of(&model.robot);
     let consts: FxHashMap<String, f64> =
         if fold { layout.nonzero().into_iter().collect() } else { FxHashMap::default() };
-    let mut b = Builder::new("invdyna", consts);
-    rnea::invdyna(model, &layout, &mut b);
-    let f = b.finish();
+    let functions: Vec<_> = FUNCTIONS
+        .iter()
+        .map(|(name, write)| {
+            let mut b = Builder::new(name, consts.clone());
+            write(model, &layout, &mut b);
+            b.finish()
+        })
+        .collect();
     let params = (!fold).then(|| {
-        // Only the parameters the equations read.
-        layout.nonzero().into_iter().filter(|(k, _)| f.lookup(k).is_some()).collect()
+        // Only the parameters some function reads.
+        layout.nonzero().into_iter().filter(|(k, _)| functions.iter().any(|f| f.lookup(k).is_some())).collect()
     });
-    Generated { module: Module { functions: vec![f] }, params }
+    Generated { module: Module { functions }, params }
 }

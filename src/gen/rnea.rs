@@ -25,7 +25,8 @@ use super::robot::JointKind;
 use super::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
 use super::{Layout, Model};
 
-type V3 = [Term; 3];
+/// A 3-vector of terms.
+pub type V3 = [Term; 3];
 type M3 = [[Term; 3]; 3];
 
 fn cross(a: &V3, b: &V3) -> V3 {
@@ -79,33 +80,44 @@ fn bind3(b: &mut Builder, name: &str, body: usize, v: V3) -> V3 {
 
 /// The joint's rotation (child → joint frame) and translation (child origin in the joint
 /// frame) as terms of its coordinate.
-struct Motion {
+#[derive(Clone)]
+pub struct Motion {
     rot: Option<M3>,
     shift: Option<V3>,
 }
 
-/// Writes `invdyna` (outputs `Qq[1..nq]`) into `b`.
-pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) {
+/// What drives one RNEA sweep: joint rates and accelerations per coordinate (index `i − 1` for
+/// `q[i]`) and the gravity vector `g`, as terms (inputs, or constants such as 0 and 1).
+pub struct Drive {
+    /// `qd[i]` terms.
+    pub qd: Vec<Term>,
+    /// `qdd[i]` terms.
+    pub qdd: Vec<Term>,
+    /// The gravity vector (`g[1..3]`), m/s².
+    pub g: V3,
+}
+
+impl Drive {
+    /// The symbolic drive: `qd[i]`, `qdd[i]` and `g[k]` inputs (`qdd` zero when `with_qdd` is
+    /// false, which gives Robotran's `c`).
+    pub fn inputs(b: &mut Builder, nq: usize, with_qdd: bool) -> Drive {
+        let g = [1, 2, 3].map(|k| b.input(&format!("g[{k}]")));
+        let (mut qd, mut qdd) = (Vec::with_capacity(nq), Vec::with_capacity(nq));
+        for i in 1..=nq {
+            qd.push(b.input(&format!("qd[{i}]")));
+            qdd.push(if with_qdd { b.input(&format!("qdd[{i}]")) } else { ZERO });
+        }
+        Drive { qd, qdd, g }
+    }
+}
+
+/// The trig variables (`C1 = cos(q[1])`, `S1`…, Robotran's "Trigonometric Variables" block, in
+/// joint order) and each body's joint motion (index = body, 0 = the base).
+pub fn motions(model: &Model, layout: &Layout, b: &mut Builder) -> Vec<Motion> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
-    let nb = order.len();
-    // Per body (1-based index = position in `order` + 1): kinematics in its frame.
-    let g: V3 = [1, 2, 3].map(|k| neg(b.input(&format!("g[{k}]"))));
-    let mut om: Vec<V3> = vec![Default::default(); nb + 1];
-    let mut omp: Vec<V3> = vec![Default::default(); nb + 1];
-    let mut alpha: Vec<V3> = vec![Default::default(); nb + 1];
-    om[0] = [ZERO, ZERO, ZERO];
-    omp[0] = [ZERO, ZERO, ZERO];
-    alpha[0] = g;
-    // Body of each link (0: the root, the base).
-    let mut link_body = vec![0; robot.links.len()];
-    for (i, &j) in order.iter().enumerate() {
-        link_body[robot.joints[j].child] = i + 1;
-    }
-    let body_of_link = |l: usize| link_body[l];
-    let mut motions: Vec<Motion> = Vec::with_capacity(nb + 1);
+    let mut motions: Vec<Motion> = Vec::with_capacity(order.len() + 1);
     motions.push(Motion { rot: None, shift: None });
-    // Trig variables first, in joint order (Robotran's "Trigonometric Variables" block).
     for (i, &j) in order.iter().enumerate() {
         let joint = &robot.joints[j];
         let motion = match (joint.kind, layout.q_index[i]) {
@@ -123,6 +135,39 @@ pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) {
         };
         motions.push(motion);
     }
+    motions
+}
+
+/// Writes `invdyna` (outputs `Qq[1..nq]`) into `b`.
+pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) {
+    let nq = layout.q_index.iter().flatten().count();
+    let drive = Drive::inputs(b, nq, true);
+    let motions = motions(model, layout, b);
+    for (qi, t) in sweep(model, layout, b, &motions, &drive) {
+        b.output(&format!("Qq[{qi}]"), &format!("Qq{qi}"), t);
+    }
+}
+
+/// One RNEA sweep driven by `drive`: the joint forces `(i, Q_i)` of the coordinates that bear
+/// one, sorted by `i` (terms, not yet bound).
+pub fn sweep(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion], drive: &Drive) -> Vec<(usize, Term)> {
+    let robot = &model.robot;
+    let order = robot.dfs_joints();
+    let nb = order.len();
+    // Per body (1-based index = position in `order` + 1): kinematics in its frame.
+    let g: V3 = drive.g.clone().map(neg);
+    let mut om: Vec<V3> = vec![Default::default(); nb + 1];
+    let mut omp: Vec<V3> = vec![Default::default(); nb + 1];
+    let mut alpha: Vec<V3> = vec![Default::default(); nb + 1];
+    om[0] = [ZERO, ZERO, ZERO];
+    omp[0] = [ZERO, ZERO, ZERO];
+    alpha[0] = g;
+    // Body of each link (0: the root, the base).
+    let mut link_body = vec![0; robot.links.len()];
+    for (i, &j) in order.iter().enumerate() {
+        link_body[robot.joints[j].child] = i + 1;
+    }
+    let body_of_link = |l: usize| link_body[l];
     // Forward kinematics.
     for (i, &j) in order.iter().enumerate() {
         let body = i + 1;
@@ -137,7 +182,7 @@ pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) {
         let mut al_j = matvec(&ro, &acc, true);
         let m = &motions[body];
         let (qd, qdd) = match layout.q_index[i] {
-            Some(qi) => (b.input(&format!("qd[{qi}]")), b.input(&format!("qdd[{qi}]"))),
+            Some(qi) => (drive.qd[qi - 1].clone(), drive.qdd[qi - 1].clone()),
             None => (ZERO, ZERO),
         };
         let (om_b, omp_b, al_b) = match (&m.rot, &m.shift) {
@@ -218,7 +263,5 @@ pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) {
         cq[p] = vadd(&cq[p], &c_p);
     }
     torque.sort_by_key(|&(qi, _)| qi);
-    for (qi, t) in torque {
-        b.output(&format!("Qq[{qi}]"), &format!("Qq{qi}"), t);
-    }
+    torque
 }

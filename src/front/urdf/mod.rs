@@ -1,7 +1,8 @@
 //! The URDF front end (issue 14): a robot description in, equations of motion out.
 //!
 //! [`parse`] reads and checks the tree (diagnostics with line and column); the symbolic
-//! generator [`crate::gen`] writes its inverse dynamics as parsed-phase IR, the form the
+//! generator [`crate::gen`] writes its inverse (`invdyna`) and direct (`dirdyna`) dynamics as
+//! parsed-phase IR, the form the
 //! Robotran front ends produce, so `robovec-opt robot.urdf -function=invdyna -passes=…` runs
 //! like on a Robotran file. `--fold-params` folds the URDF's numbers into the equations;
 //! by default they stay inputs in Robotran's layout and their values are
