@@ -191,21 +191,10 @@ pub fn study(
 /// early as in a normal run (a valid result, fewer samples) and its row says so in
 /// `stopped_early`; the pipelines after the limit still run their passes' minimal work.
 ///
+/// `task` is set to the pipelines done after each one.
+///
 /// # Errors
 /// As [`study`].
-pub fn run(
-    module: &Module,
-    function: &str,
-    text: &str,
-    samples: u32,
-    seed: u64,
-    deadline: Option<crate::Deadline>,
-    target: &robovec_ir::target::Target,
-) -> Result<Vec<ParetoRow>, Failure> {
-    run_reporting(module, function, text, samples, seed, deadline, target, &crate::progress::Task::default())
-}
-
-/// [`run`], setting `task` to the pipelines done after each one.
 #[allow(clippy::too_many_arguments)]
 fn run_reporting(
     module: &Module,
