@@ -1,6 +1,6 @@
 //! The robot the symbolic generator reads: a kinematic tree of links and joints with every
 //! number the dynamics needs (issue 14). Front ends build it — the URDF front end
-//! (`crate::front::urdf`) today, the topology families next — and [`crate::gen`] writes its
+//! (`crate::front::urdf`) and the study's topology families (`crate::gen::topology`) — and [`crate::gen`] writes its
 //! equations; the generator depends on no input format.
 
 use robovec_ir::Span;
