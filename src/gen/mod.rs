@@ -6,7 +6,8 @@
 //! `invdyna`: inverse dynamics `Qq[i]` of a fixed-base tree by the recursive Newton–Euler
 //! algorithm ([`rnea`]), symbolic in the joint coordinates `q[i]`, `qd[i]`, `qdd[i]`, the
 //! gravity vector `g[1..3]` (Pinocchio's default is `g[3] = −9.81`) and the model parameters.
-//! `dirdyna`: direct dynamics `M[i][j]`, `c[i]` with `M qdd + c = Qq` ([`dirdyna`]).
+//! `dirdyna`: direct dynamics `M[i][j]` (by CRBA, [`crba`]), `c[i]` (by RNEA) with
+//! `M qdd + c = Qq` ([`dirdyna`]).
 //! A floating base is later work (issue 14).
 //!
 //! # Numbering (Pinocchio's)
@@ -28,6 +29,7 @@
 //! [`Generated::params`] (what `-params-out` writes for `specialize<params=…>` and `-eval`),
 //! unless `--fold-params` folds them all. Constant rotations (URDF `rpy`) are numbers.
 
+pub mod crba;
 pub mod dirdyna;
 pub mod rnea;
 pub mod robot;

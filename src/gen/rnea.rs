@@ -27,9 +27,10 @@ use super::{Layout, Model};
 
 /// A 3-vector of terms.
 pub type V3 = [Term; 3];
-type M3 = [[Term; 3]; 3];
+/// A 3×3 matrix of terms (row-major).
+pub type M3 = [[Term; 3]; 3];
 
-fn cross(a: &V3, b: &V3) -> V3 {
+pub(super) fn cross(a: &V3, b: &V3) -> V3 {
     [
         sub(mul(a[1].clone(), b[2].clone()), mul(a[2].clone(), b[1].clone())),
         sub(mul(a[2].clone(), b[0].clone()), mul(a[0].clone(), b[2].clone())),
@@ -37,7 +38,7 @@ fn cross(a: &V3, b: &V3) -> V3 {
     ]
 }
 
-fn vadd(a: &V3, b: &V3) -> V3 {
+pub(super) fn vadd(a: &V3, b: &V3) -> V3 {
     [add(a[0].clone(), b[0].clone()), add(a[1].clone(), b[1].clone()), add(a[2].clone(), b[2].clone())]
 }
 
@@ -45,17 +46,17 @@ fn scale(a: &[f64; 3], s: &Term) -> V3 {
     [mul(Term::C(a[0]), s.clone()), mul(Term::C(a[1]), s.clone()), mul(Term::C(a[2]), s.clone())]
 }
 
-fn dot(a: &[f64; 3], b: &V3) -> Term {
+pub(super) fn dot(a: &[f64; 3], b: &V3) -> Term {
     sum((0..3).map(|i| mul(Term::C(a[i]), b[i].clone())))
 }
 
 /// `m·v` (or `mᵀ·v` when `transpose`).
-fn matvec(m: &M3, v: &V3, transpose: bool) -> V3 {
+pub(super) fn matvec(m: &M3, v: &V3, transpose: bool) -> V3 {
     let e = |i: usize, j: usize| if transpose { m[j][i].clone() } else { m[i][j].clone() };
     [0, 1, 2].map(|i| sum((0..3).map(|j| mul(e(i, j), v[j].clone()))))
 }
 
-fn numeric(r: &[[f64; 3]; 3]) -> M3 {
+pub(super) fn numeric(r: &[[f64; 3]; 3]) -> M3 {
     r.map(|row| row.map(Term::C))
 }
 
@@ -73,7 +74,7 @@ fn axis_rotation(k: &[f64; 3], c: &Term, s: &Term) -> M3 {
     r
 }
 
-fn bind3(b: &mut Builder, name: &str, body: usize, v: V3) -> V3 {
+pub(super) fn bind3(b: &mut Builder, name: &str, body: usize, v: V3) -> V3 {
     let [x, y, z] = v;
     [b.bind(&format!("{name}1{body}"), x), b.bind(&format!("{name}2{body}"), y), b.bind(&format!("{name}3{body}"), z)]
 }
@@ -82,8 +83,10 @@ fn bind3(b: &mut Builder, name: &str, body: usize, v: V3) -> V3 {
 /// frame) as terms of its coordinate.
 #[derive(Clone)]
 pub struct Motion {
-    rot: Option<M3>,
-    shift: Option<V3>,
+    /// `R_axis(q)` of a revolute joint.
+    pub(super) rot: Option<M3>,
+    /// `axis·q` of a prismatic joint.
+    pub(super) shift: Option<V3>,
 }
 
 /// What drives one RNEA sweep: joint rates and accelerations per coordinate (index `i − 1` for

@@ -1,0 +1,226 @@
+//! The joint-space mass matrix `M(q)` by the composite-rigid-body algorithm (CRBA; Walker &
+//! Orin 1982, method 3; Featherstone, *Rigid Body Dynamics Algorithms*, 2008, §6.2), in body
+//! frames with Robotran's parameters and the same frames, numbering and joint motions as the
+//! RNEA of [`super::rnea`].
+//!
+//! # The recursion
+//! A composite body is `(m, h, J)`: mass, first moment `h = Σ mₖ rₖ` and rotational inertia
+//! `J = −Σ mₖ [rₖ]×²` about the frame origin. Body `b` alone is `(m_b, m_b l_b,
+//! In_b − m_b [l_b]×²)`. Leaves to root, each composite is moved into its parent's frame by
+//! `x_parent = t + R x_child` and added there:
+//! `m' = m`, `h' = R h + m t`, `J' = R J Rᵀ + m (|t|² I − t tᵀ) + 2 (t·u) I − u tᵀ − t uᵀ`
+//! with `u = R h` (the parallel-axis theorem for a rotated, shifted body; symmetric, so only
+//! the upper triangle is formed). The joint motion (`R = R_axis(q)`, or a shift `axis·q`) and
+//! the constant joint origin (`dpt`, URDF `rpy`) are applied as two such moves.
+//!
+//! Column `j` of `M`: the spatial force that the composite below joint `j` needs for a unit
+//! joint acceleration, `n = J a`, `f = a × h` (revolute axis `a`) or `n = h × a`, `f = m a`
+//! (prismatic), gives `M[j][j] = a·n` (or `a·f`); carried up the path to the root (`f ← R f`,
+//! `n ← R n + t × (R f)`), it gives `M[i][j]` for every ancestor joint `i`. Only the upper
+//! triangle `i ≤ j` is written (joints are numbered depth first, so an ancestor has the smaller
+//! index).
+//!
+//! # Why CRBA
+//! The unit-acceleration RNEA (Walker & Orin's method 1) re-runs the forward and backward
+//! recursion of joint `j`'s whole subtree for every column; CRBA forms each subtree's inertia
+//! once and then only carries one force per column to the root. Counts in the
+//! [`super::dirdyna`] module doc.
+
+use super::rnea::{bind3, cross, dot, matvec, numeric, vadd, Motion, M3, V3};
+use super::robot::JointKind;
+use super::sym::{add, mul, neg, sum, Builder, Term, ZERO};
+use super::{Layout, Model};
+
+/// The upper triangle of a symmetric 3×3 matrix, row by row.
+const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+/// A composite rigid body in one frame: mass, first moment and rotational inertia about the
+/// frame origin (see the module doc).
+#[derive(Clone)]
+struct Composite {
+    m: Term,
+    h: V3,
+    j: M3,
+}
+
+impl Composite {
+    fn zero() -> Composite {
+        Composite { m: ZERO, h: [ZERO, ZERO, ZERO], j: Default::default() }
+    }
+
+    /// One body: mass `m`, centre of mass `l`, inertia `inn` about the centre of mass:
+    /// `(m, m l, In + m (|l|² I − l lᵀ))`.
+    fn body(m: Term, l: V3, inn: M3) -> Composite {
+        let mut j: M3 = Default::default();
+        for a in 0..3 {
+            for c in a..3 {
+                let shift = if a == c {
+                    let (x, y) = ((a + 1) % 3, (a + 2) % 3);
+                    mul(m.clone(), add(mul(l[x].clone(), l[x].clone()), mul(l[y].clone(), l[y].clone())))
+                } else {
+                    neg(mul(m.clone(), mul(l[a].clone(), l[c].clone())))
+                };
+                j[a][c] = add(inn[a][c].clone(), shift);
+                j[c][a] = j[a][c].clone();
+            }
+        }
+        Composite { h: l.map(|x| mul(m.clone(), x)), m, j }
+    }
+
+    fn add(&self, o: &Composite) -> Composite {
+        let j: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| add(self.j[r][c].clone(), o.j[r][c].clone())));
+        Composite { m: add(self.m.clone(), o.m.clone()), h: vadd(&self.h, &o.h), j }
+    }
+
+    /// Rotated by `r` (child → parent), then shifted by `t` (the child origin in the parent).
+    fn moved(&self, r: Option<&M3>, t: Option<&V3>) -> Composite {
+        let (h, j) = match r {
+            Some(r) => {
+                let rj: M3 = [0, 1, 2]
+                    .map(|i| [0, 1, 2].map(|k| sum((0..3).map(|l| mul(r[i][l].clone(), self.j[l][k].clone())))));
+                // Upper triangle of (R J) Rᵀ, mirrored.
+                let mut j: M3 = Default::default();
+                for a in 0..3 {
+                    for c in a..3 {
+                        j[a][c] = sum((0..3).map(|k| mul(rj[a][k].clone(), r[c][k].clone())));
+                        j[c][a] = j[a][c].clone();
+                    }
+                }
+                (matvec(r, &self.h, false), j)
+            }
+            None => (self.h.clone(), self.j.clone()),
+        };
+        let Some(t) = t else {
+            return Composite { m: self.m.clone(), h, j };
+        };
+        // m (|t|² I − t tᵀ) + 2 (t·u) I − u tᵀ − t uᵀ, with u = R h.
+        let tt = |a: usize, c: usize| mul(t[a].clone(), t[c].clone());
+        let tu = |a: usize, c: usize| add(mul(h[a].clone(), t[c].clone()), mul(t[a].clone(), h[c].clone()));
+        let mut out: M3 = Default::default();
+        for a in 0..3 {
+            for c in a..3 {
+                let shift = if a == c {
+                    let (x, y) = ((a + 1) % 3, (a + 2) % 3);
+                    // m (t_x² + t_y²) + 2 (t_x u_x + t_y u_y): the other two axes.
+                    add(mul(self.m.clone(), add(tt(x, x), tt(y, y))), add(tu(x, x), tu(y, y)))
+                } else {
+                    neg(add(mul(self.m.clone(), tt(a, c)), tu(a, c)))
+                };
+                out[a][c] = add(j[a][c].clone(), shift);
+                out[c][a] = out[a][c].clone();
+            }
+        }
+        let h = vadd(&h, &t.clone().map(|x| mul(self.m.clone(), x)));
+        Composite { m: self.m.clone(), h, j: out }
+    }
+
+    fn bind(&self, b: &mut Builder, body: usize) -> Composite {
+        let m = b.bind(&format!("MC{body}"), self.m.clone());
+        let h = bind3(b, "HC", body, self.h.clone());
+        let mut j: M3 = Default::default();
+        for (a, c) in UPPER {
+            j[a][c] = b.bind(&format!("JC{}{}{body}", a + 1, c + 1), self.j[a][c].clone());
+            j[c][a] = j[a][c].clone();
+        }
+        Composite { m, h, j }
+    }
+}
+
+/// Binds a column force carried to body `body` for column `col`: `FM{k}{body}_{col}`
+/// (Robotran's `FM31_24` style).
+fn column_bind(b: &mut Builder, name: &str, body: usize, col: usize, v: V3) -> V3 {
+    let [x, y, z] = v;
+    [
+        b.bind(&format!("{name}1{body}_{col}"), x),
+        b.bind(&format!("{name}2{body}_{col}"), y),
+        b.bind(&format!("{name}3{body}_{col}"), z),
+    ]
+}
+
+/// `r·v` for a rotation that may be absent (identity).
+fn rotate(r: Option<&M3>, v: &V3) -> V3 {
+    r.map_or_else(|| v.clone(), |r| matvec(r, v, false))
+}
+
+/// The upper triangle of `M`: `(i, j) → term` for `i ≤ j` (1-based coordinates), entries that
+/// fold to 0 left out. Writes the composites and column forces into `b` as temporaries `MC`,
+/// `HC`, `JC` (per body) and `FM`, `CM` (per body and column).
+pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]) -> Vec<((usize, usize), Term)> {
+    let robot = &model.robot;
+    let order = robot.dfs_joints();
+    let nb = order.len();
+    let mut link_body = vec![0; robot.links.len()];
+    for (i, &j) in order.iter().enumerate() {
+        link_body[robot.joints[j].child] = i + 1;
+    }
+    let parent: Vec<usize> =
+        std::iter::once(0).chain(order.iter().map(|&j| link_body[robot.joints[j].parent])).collect();
+    let mut moves = vec![false; nb + 1];
+    for i in 0..nb {
+        moves[i + 1] = moves[parent[i + 1]] || layout.q_index[i].is_some();
+    }
+    // Each body alone, then leaves to root: the composite of its subtree.
+    let mut comp: Vec<Composite> = vec![Composite::zero(); nb + 1];
+    for body in (1..=nb).rev() {
+        if !moves[body] {
+            continue;
+        }
+        let m = layout.param(b, &format!("m[{body}]"));
+        let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
+        let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
+        let own = Composite::body(m, l, inn);
+        let c = own.add(&comp[body]).bind(b, body);
+        let p = parent[body];
+        if moves[p] {
+            let mo = &motions[body];
+            let joint = &robot.joints[order[body - 1]];
+            let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
+            let ro = numeric(&joint.origin.rot);
+            let in_joint = c.moved(mo.rot.as_ref(), mo.shift.as_ref());
+            let in_parent = in_joint.moved(Some(&ro), Some(&d));
+            comp[p] = comp[p].add(&in_parent);
+        }
+        comp[body] = c;
+    }
+    let mut upper = Vec::new();
+    for (i, &jt) in order.iter().enumerate() {
+        let Some(qj) = layout.q_index[i] else { continue };
+        let body = i + 1;
+        let joint = &robot.joints[jt];
+        let a = joint.axis;
+        let c = &comp[body];
+        let av = a.map(Term::C);
+        let (mut n, mut f) = match joint.kind {
+            JointKind::Revolute => (matvec(&c.j, &av, false), cross(&av, &c.h)),
+            _ => (cross(&c.h, &av), av.clone().map(|x| mul(c.m.clone(), x))),
+        };
+        let mut at = body;
+        loop {
+            if let Some(qi) = layout.q_index[at - 1] {
+                let jo = &robot.joints[order[at - 1]];
+                let t = if jo.kind == JointKind::Revolute { dot(&jo.axis, &n) } else { dot(&jo.axis, &f) };
+                upper.push(((qi, qj), t));
+            }
+            let p = parent[at];
+            if !moves[p] {
+                break;
+            }
+            // Into the parent's frame: the joint motion, then the joint origin.
+            let mo = &motions[at];
+            let jo = &robot.joints[order[at - 1]];
+            let f1 = rotate(mo.rot.as_ref(), &f);
+            let mut n1 = rotate(mo.rot.as_ref(), &n);
+            if let Some(s) = &mo.shift {
+                n1 = vadd(&n1, &cross(s, &f1));
+            }
+            let ro = numeric(&jo.origin.rot);
+            let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{at}]")));
+            let f2 = column_bind(b, "FM", p, qj, matvec(&ro, &f1, false));
+            let n2 = vadd(&matvec(&ro, &n1, false), &cross(&d, &f2));
+            n = column_bind(b, "CM", p, qj, n2);
+            f = f2;
+            at = p;
+        }
+    }
+    upper
+}
