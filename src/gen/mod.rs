@@ -32,6 +32,7 @@ pub mod dirdyna;
 pub mod rnea;
 pub mod robot;
 pub mod sym;
+pub mod urdf_out;
 
 use std::collections::BTreeMap;
 
