@@ -35,6 +35,7 @@ pub mod rnea;
 pub mod robot;
 pub mod sym;
 pub mod topology;
+pub mod urdf_out;
 
 use std::collections::BTreeMap;
 
