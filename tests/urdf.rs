@@ -144,3 +144,40 @@ fn bad_urdf_is_a_located_diagnostic() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains(".urdf"), "{}", stderr(&o));
 }
+
+/// `robovec-gen` writes a topology family's robot as the library's URDF text (file and stdout
+/// alike), `robovec-opt` reads it, and bad usage exits 2 with nothing written.
+#[test]
+fn robovec_gen_writes_a_topology_as_urdf_that_robovec_opt_reads() {
+    use robovec::gen::topology::{build, Topology};
+    let gen = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_robovec-gen")).args(args).output().expect("robovec-gen runs")
+    };
+    let d = tmp("robovec_gen");
+    let file = d.join("semi.urdf");
+    let o = gen(&["--topology", "semi-serial", "--dof", "9", "--seed", "4", "-o", file.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let want = robovec::gen::urdf_out::write_urdf(&build(Topology::SemiSerial, 9, 4));
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), want);
+    let o = gen(&["--topology", "semi-serial", "--dof", "9", "--seed", "4"]);
+    assert_eq!(String::from_utf8_lossy(&o.stdout), want);
+    // The same equations as the generator writes straight from the robot.
+    let direct = robovec::gen::generate(&robovec::gen::Model { robot: build(Topology::SemiSerial, 9, 4) }, false);
+    let rvir = d.join("direct.rvir");
+    std::fs::write(&rvir, direct.module.to_string()).unwrap();
+    let stats = |input: &str| {
+        let o = opt(&[input, "-function=dirdyna", "-passes=atomise", "-stats", "-o", "/dev/null"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o).lines().find(|l| l.starts_with("@dirdyna")).expect("stats line").to_string()
+    };
+    assert_eq!(stats(file.to_str().unwrap()), stats(rvir.to_str().unwrap()));
+    // Bad usage: exit 2, no file.
+    for bad in [&["--topology", "tree", "--dof", "3"][..], &["--topology", "serial", "--dof", "0"], &["--dof", "3"]] {
+        let out = d.join("bad.urdf");
+        let mut args = bad.to_vec();
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = gen(&args);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+        assert!(!out.exists());
+    }
+}
