@@ -1,7 +1,11 @@
 #!/usr/bin/env python3
 """Pinocchio reference values for robovec's URDF front end (issue 14).
 
-Usage: pinocchio_oracle.py URDF STATES SEED
+Usage: pinocchio_oracle.py URDF STATES SEED [floating]
+
+With `floating`, the model is on Robotran's floating base: root joint
+`JointModelComposite([PX, PY, PZ, RX, RY, RZ])` (robovec's `--floating-base`, T1-T3 then R1-R3),
+whose six coordinates are plain lengths and angles, so q, qd, qdd map one to one.
 
 URDF is a path, or `erd:REL` for a file of example-robot-data (`erd:ur_description/urdf/ur5_robot.urdf`),
 found under the installed package's share folder. Builds the fixed-base model with
@@ -38,7 +42,15 @@ def locate(spec):
 def main():
     path = locate(sys.argv[1])
     n, seed = int(sys.argv[2]), int(sys.argv[3])
-    model = pin.buildModelFromUrdf(path)
+    floating = len(sys.argv) > 4 and sys.argv[4] == "floating"
+    if floating:
+        root = pin.JointModelComposite()
+        for j in (pin.JointModelPX(), pin.JointModelPY(), pin.JointModelPZ(),
+                  pin.JointModelRX(), pin.JointModelRY(), pin.JointModelRZ()):
+            root.addJoint(j)
+        model = pin.buildModelFromUrdf(path, root)
+    else:
+        model = pin.buildModelFromUrdf(path)
     data = model.createData()
     rng = np.random.default_rng(seed)
     joints = list(model.joints)[1:]
@@ -49,6 +61,11 @@ def main():
         a = rng.uniform(-2.0, 2.0, model.nv)
         coords = []
         for j in joints:
+            if floating and j.id == 1:
+                x = np.concatenate([rng.uniform(-0.2, 0.2, 3), rng.uniform(-math.pi, math.pi, 3)])
+                coords.extend(map(float, x))
+                q[j.idx_q:j.idx_q + 6] = x
+                continue
             if j.nv != 1:
                 sys.exit(f"joint {j.shortname()} has {j.nv} degrees of freedom: not a fixed-base tree of 1-dof joints")
             prismatic = j.shortname().replace("JointModel", "").startswith("P")

@@ -114,6 +114,10 @@ pub struct Cli {
     /// equations instead of keeping them as inputs `dpt`, `l`, `m`, `In`.
     #[arg(long)]
     pub fold_params: bool,
+    /// URDF input: put the robot on Robotran's floating base (`T1`–`T3` translations along x,
+    /// y, z, then `R1`–`R3` rotations about x, y, z: `q[1..6]`; the URDF's joints follow).
+    #[arg(long)]
+    pub floating_base: bool,
     /// URDF input: write the values of the parameters kept as inputs to FILE, the JSON object
     /// (`{"m[1]": 2.5, …}`) that `specialize<params=FILE>` and `-eval` read.
     #[arg(long, value_name = "FILE")]
@@ -208,7 +212,7 @@ impl Cli {
             check: self.check.then_some((self.check_samples, self.check_seed)),
             time_limit: self.time_limit,
             target: self.target,
-            front: crate::front::FrontOptions { fold_params: self.fold_params },
+            front: crate::front::FrontOptions { fold_params: self.fold_params, floating_base: self.floating_base },
             params_out: self.params_out,
         })
     }

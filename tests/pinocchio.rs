@@ -50,10 +50,11 @@ struct Oracle {
     states: Vec<State>,
 }
 
-fn oracle(py: &PathBuf, urdf: &str, states: usize, seed: u64) -> Oracle {
+fn oracle(py: &PathBuf, urdf: &str, states: usize, seed: u64, floating: bool) -> Oracle {
+    let base = if floating { "floating" } else { "fixed" };
     let out = Command::new(py)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["scripts/pinocchio_oracle.py", urdf, &states.to_string(), &seed.to_string()])
+        .args(["scripts/pinocchio_oracle.py", urdf, &states.to_string(), &seed.to_string(), base])
         .output()
         .expect("run the oracle script");
     assert!(out.status.success(), "oracle failed on {urdf}: {}", String::from_utf8_lossy(&out.stderr));
@@ -81,13 +82,20 @@ fn expected(function: &str, s: &State) -> BTreeMap<String, f64> {
 /// parameters given their values and with parameters folded, against Pinocchio over the
 /// oracle's states.
 fn compare(urdf: &str, dof: usize) -> f64 {
+    compare_on(urdf, dof, false)
+}
+
+/// [`compare`] on a fixed or (`floating`) Robotran floating base: `dof` counts the base's six
+/// coordinates, which Pinocchio holds in one composite root joint.
+fn compare_on(urdf: &str, dof: usize, floating: bool) -> f64 {
     let Some(py) = python() else { return 0.0 };
-    let o = oracle(&py, urdf, 8, 7);
-    assert_eq!(o.joints.len(), dof, "{}: joints {:?}", o.path, o.joints);
+    let o = oracle(&py, urdf, 8, 7, floating);
+    assert_eq!(o.joints.len() + if floating { 5 } else { 0 }, dof, "{}: joints {:?}", o.path, o.joints);
     let mut worst: f64 = 0.0;
     for fold in [false, true] {
-        let (loaded, _) = robovec::driver::load_with(&o.path, &FrontOptions { fold_params: fold })
-            .unwrap_or_else(|e| panic!("{}: {}", o.path, e.message()));
+        let (loaded, _) =
+            robovec::driver::load_with(&o.path, &FrontOptions { fold_params: fold, floating_base: floating })
+                .unwrap_or_else(|e| panic!("{}: {}", o.path, e.message()));
         assert_eq!(loaded.params.is_some(), !fold);
         let names: Vec<&str> = loaded.module.functions.iter().map(|f| f.name.as_str()).collect();
         assert_eq!(names, ["invdyna", "dirdyna"]);
@@ -174,4 +182,17 @@ fn topology_families_match_pinocchio_rnea_crba_nle() {
             eprintln!("{t} {dof}: worst relative error {e:e}");
         }
     }
+}
+
+/// Robotran's floating base (`--floating-base`: T1–T3, R1–R3 as `q[1..6]`) against Pinocchio's
+/// composite root joint PX PY PZ RX RY RZ: the three-link arm (its root link has a mass, which
+/// now moves), Solo-12, a quadruped (6 + 12 coordinates), and Talos, a humanoid (6 + 32).
+#[test]
+fn floating_base_matches_pinocchio_composite_root_joint() {
+    let e = compare_on("examples/three_link_arm/three_link_arm.urdf", 3 + 6, true);
+    eprintln!("three_link_arm floating: worst relative error {e:e}");
+    let e = compare_on("erd:solo_description/robots/solo12.urdf", 12 + 6, true);
+    eprintln!("solo12 floating: worst relative error {e:e}");
+    let e = compare_on("erd:talos_data/robots/talos_reduced.urdf", 32 + 6, true);
+    eprintln!("talos floating: worst relative error {e:e}");
 }

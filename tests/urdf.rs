@@ -55,7 +55,8 @@ fn direct_dynamics_agrees_with_inverse_dynamics() {
     for (urdf, n) in [(URDF, 2), ("examples/three_link_arm/three_link_arm.urdf", 3)] {
         for fold in [false, true] {
             let (gen, _) =
-                robovec::driver::load_with(&path(urdf), &FrontOptions { fold_params: fold }).expect("URDF loads");
+                robovec::driver::load_with(&path(urdf), &FrontOptions { fold_params: fold, ..FrontOptions::default() })
+                    .expect("URDF loads");
             let fs = &gen.module.functions;
             let (inv, dir) = (&fs[0], &fs[1]);
             assert_eq!((inv.name.as_str(), dir.name.as_str()), ("invdyna", "dirdyna"));
@@ -143,6 +144,18 @@ fn bad_urdf_is_a_located_diagnostic() {
     let o = opt(&[sdf.to_str().unwrap(), "-passes="]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains(".urdf"), "{}", stderr(&o));
+    // A URDF joint named like a floating-base joint cannot take --floating-base.
+    let clash = d.join("clash.urdf");
+    std::fs::write(
+        &clash,
+        "<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"b\"/>\n<joint name=\"R2\" type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/></joint>\n</robot>\n",
+    )
+    .unwrap();
+    let o = opt(&[clash.to_str().unwrap(), "--floating-base", "-passes=atomise"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("`R2` is a name of robovec's floating base") && e.contains("clash.urdf:2:"), "{e}");
+    assert!(opt(&[clash.to_str().unwrap(), "-passes=atomise", "-o", "/dev/null"]).status.success());
 }
 
 /// `robovec-gen` writes a topology family's robot as the library's URDF text (file and stdout

@@ -24,6 +24,10 @@ pub struct FrontOptions {
     /// keeping them as inputs (`dpt`, `l`, `m`, `In`). Front ends whose input has no numeric
     /// parameters (Robotran files, IR) ignore it.
     pub fold_params: bool,
+    /// `--floating-base`: put the robot on Robotran's floating base (six joints `T1`–`T3`,
+    /// `R1`–`R3` before the root link, `q[1..6]`; see `gen::robot::Robot::with_floating_base`).
+    /// Front ends of fixed equations (Robotran files, IR) ignore it.
+    pub floating_base: bool,
 }
 
 /// A loaded input: the module, and the values of the model parameters it keeps as inputs.

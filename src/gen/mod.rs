@@ -8,7 +8,15 @@
 //! gravity vector `g[1..3]` (Pinocchio's default is `g[3] = −9.81`) and the model parameters.
 //! `dirdyna`: direct dynamics `M[i][j]` (by CRBA, [`crba`]), `c[i]` (by RNEA) with
 //! `M qdd + c = Qq` ([`dirdyna`]).
-//! A floating base is later work (issue 14).
+//! `--floating-base` puts the robot on Robotran's floating base first
+//! ([`robot::Robot::with_floating_base`]): six joints `T1`, `T2`, `T3` (prismatic along the
+//! world x, y, z) and `R1`, `R2`, `R3` (revolute about x, then the new y, then the new z) are
+//! `q[1..6]`, the URDF's moving joints follow. Pinocchio's model with these coordinates is
+//! `buildModelFromUrdf(path, JointModelComposite([PX, PY, PZ, RX, RY, RZ]))` (what the oracle
+//! tests build); from a `JointModelFreeFlyer` state (position, quaternion, velocity in the base
+//! frame) take the position as `q[1..3]`, the quaternion's x-y'-z'' Cardan angles as `q[4..6]`,
+//! and map the velocities through the Cardan rates (`ω = E(q) qd[4..6]`, linear velocity
+//! rotated to the world frame).
 //!
 //! # Numbering (Pinocchio's)
 //! Joints are numbered depth first from the root link, the joints leaving a link taken in

@@ -144,3 +144,45 @@ impl Robot {
         out
     }
 }
+
+/// The names of Robotran's six floating-base joints, in chain order (`q[1..6]`).
+pub const FLOATING_BASE: [&str; 6] = ["T1", "T2", "T3", "R1", "R2", "R3"];
+
+impl Robot {
+    /// `self` on a floating base as Robotran models it: six joints between a new fixed root
+    /// link `world` and the old root, `T1`, `T2`, `T3` (prismatic along x, y, z) then `R1`,
+    /// `R2`, `R3` (revolute about x, then the new y, then the new z), joined by massless links
+    /// `T1_link` … `R2_link`; the old root is the child of `R3`. These joints are `q[1..6]`
+    /// and the URDF's moving joints follow from `q[7]`. Pinocchio's model of the same
+    /// coordinates is `buildModelFromUrdf(path, JointModelComposite([PX, PY, PZ, RX, RY, RZ]))`.
+    ///
+    /// # Errors
+    /// The name of a URDF joint or link that clashes with the names above.
+    pub fn with_floating_base(mut self) -> Result<Robot, String> {
+        let taken = |n: &str| self.joints.iter().any(|j| j.name == n) || self.links.iter().any(|l| l.name == n);
+        for n in FLOATING_BASE.iter().flat_map(|j| [j.to_string(), format!("{j}_link")]).chain(["world".to_string()]) {
+            if taken(&n) {
+                return Err(n);
+            }
+        }
+        let old_root = self.root;
+        let span = self.links[old_root].span;
+        self.links.push(Link { name: "world".into(), inertial: None, span });
+        let mut parent = self.links.len() - 1;
+        self.root = parent;
+        for (k, name) in FLOATING_BASE.iter().enumerate() {
+            let child = if k == 5 {
+                old_root
+            } else {
+                self.links.push(Link { name: format!("{name}_link"), inertial: None, span });
+                self.links.len() - 1
+            };
+            let mut axis = [0.0; 3];
+            axis[k % 3] = 1.0;
+            let kind = if k < 3 { JointKind::Prismatic } else { JointKind::Revolute };
+            self.joints.push(Joint { name: (*name).into(), kind, parent, child, origin: Origin::IDENTITY, axis, span });
+            parent = child;
+        }
+        Ok(self)
+    }
+}
