@@ -1,5 +1,5 @@
 //! Any bytes → the URDF front end (through the front-end registry, symbolic and folded
-//! parameters) returns (Ok or errors), never panics; when it returns a module, that module
+//! parameters, fixed and floating base) returns (Ok or errors), never panics; when it returns a module, that module
 //! verifies, atomises, and the atomised module verifies.
 #![no_main]
 
@@ -11,8 +11,8 @@ use robovec::front::{check_accepted, front_end_for, FrontOptions};
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
     let fe = front_end_for("robot.urdf").expect("the URDF front end is registered");
-    for fold_params in [false, true] {
-        let opts = FrontOptions { fold_params, ..FrontOptions::default() };
+    for (fold_params, floating_base) in [(false, false), (true, false), (false, true)] {
+        let opts = FrontOptions { fold_params, floating_base };
         let Ok(loaded) = fe.load(Path::new("robot.urdf"), text, &opts) else { return };
         if let Err(e) = check_accepted(&loaded.module) {
             panic!("{e}");
