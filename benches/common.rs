@@ -1,5 +1,6 @@
 //! Inputs shared by the benches (included with `#[path = "common.rs"] mod common;`; with
 //! `autobenches = false` this file is not a bench target of its own).
+#![allow(dead_code, reason = "each bench uses a different subset")]
 
 use std::path::PathBuf;
 
@@ -16,4 +17,44 @@ pub fn walkman() -> Function {
         .unwrap_or_else(|e| panic!("cannot load {} (the corpus must sit at ../shared): {}", p.display(), e.message()));
     assert_eq!(m.functions.len(), 1, "{WALKMAN} holds one function");
     atomise_function(&m.functions[0])
+}
+
+/// `VmHWM` (peak resident memory) of process `pid` in bytes, if readable (Linux
+/// `/proc/PID/status`).
+pub fn vm_hwm(pid: u32) -> Option<u64> {
+    let s = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Runs `cmd` (stdout discarded, stderr captured) and samples its `VmHWM` every 2 ms until it
+/// exits: `(success, wall seconds, peak bytes, stderr)`.
+pub fn run_measured(cmd: &mut std::process::Command) -> (bool, f64, u64, String) {
+    use std::io::Read;
+    let t0 = std::time::Instant::now();
+    let mut child = cmd
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn the measured process");
+    // Drain stderr on a thread so a chatty child never blocks on a full pipe.
+    let mut err_pipe = child.stderr.take().expect("stderr piped");
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = err_pipe.read_to_string(&mut s);
+        s
+    });
+    let mut peak = 0;
+    let status = loop {
+        if let Some(h) = vm_hwm(child.id()) {
+            peak = peak.max(h);
+        }
+        if let Some(s) = child.try_wait().expect("wait") {
+            break s;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    };
+    let secs = t0.elapsed().as_secs_f64();
+    (status.success(), secs, peak, reader.join().unwrap_or_default())
 }

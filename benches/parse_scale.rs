@@ -14,18 +14,12 @@
 //! generated files in the temporary folder.
 
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
 
 use robovec::front::synth::{straight_line_c, Shape};
 
-/// `VmHWM` of process `pid` in bytes, if readable.
-fn vm_hwm(pid: u32) -> Option<u64> {
-    let s = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
-    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
+#[path = "common.rs"]
+mod common;
 
 fn main() {
     let mut sizes: Vec<f64> = Vec::new();
@@ -61,32 +55,11 @@ fn main() {
         let len = g.text.len() as f64;
         let (outputs, ops) = (g.outputs, g.ops);
         drop(g);
-        let t0 = Instant::now();
-        let mut child = Command::new(&bin)
-            .arg(&input)
-            .arg("-passes=atomise,asap-alap")
-            .arg("-o")
-            .arg(&output)
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("run robovec-opt");
-        let mut peak = 0;
-        let status = loop {
-            if let Some(h) = vm_hwm(child.id()) {
-                peak = peak.max(h);
-            }
-            if let Some(s) = child.try_wait().expect("wait") {
-                break s;
-            }
-            std::thread::sleep(Duration::from_millis(2));
-        };
-        let secs = t0.elapsed().as_secs_f64();
-        if !status.success() {
-            let mut err = String::new();
-            use std::io::Read;
-            let _ = child.stderr.take().map(|mut e| e.read_to_string(&mut err));
-            println!("{:>8.1} robovec-opt failed ({status}): {}", len / 1e6, err.lines().next().unwrap_or(""));
+        let (ok, secs, peak, err) = common::run_measured(
+            Command::new(&bin).arg(&input).arg("-passes=atomise,asap-alap").arg("-o").arg(&output),
+        );
+        if !ok {
+            println!("{:>8.1} robovec-opt failed: {}", len / 1e6, err.lines().next().unwrap_or(""));
             continue;
         }
         println!(
