@@ -165,8 +165,7 @@ fn panda_matches_pinocchio_rnea_crba_nle() {
 #[test]
 fn topology_families_match_pinocchio_rnea_crba_nle() {
     use robovec::gen::topology::{build, Topology};
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("pinocchio_topology");
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::tmp("topology");
     for t in Topology::ALL {
         for dof in [4, 9, 23] {
             let robot = build(t, dof, 1);

@@ -22,7 +22,7 @@ use robovec::gen::topology::{build, Topology};
 struct Args {
     /// Topology family: serial (one chain), semi-serial (a few medium chains) or parallel (many
     /// short chains from the base).
-    #[arg(long, value_parser = parse_topology)]
+    #[arg(long)]
     topology: Topology,
     /// Degrees of freedom (revolute joints), at least 1.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
@@ -33,10 +33,6 @@ struct Args {
     /// Output file (written whole or not at all); stdout when absent.
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
-}
-
-fn parse_topology(s: &str) -> Result<Topology, String> {
-    s.parse()
 }
 
 fn main() -> ExitCode {
