@@ -154,8 +154,18 @@ fn bad_urdf_is_a_located_diagnostic() {
     let o = opt(&[clash.to_str().unwrap(), "--floating-base", "-passes=atomise"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let e = stderr(&o);
-    assert!(e.contains("`R2` is a name of robovec's floating base") && e.contains("clash.urdf:2:"), "{e}");
+    assert!(e.contains("`R2` is a name of robovec's floating base") && e.contains("clash.urdf:4:1"), "{e}");
     assert!(opt(&[clash.to_str().unwrap(), "-passes=atomise", "-o", "/dev/null"]).status.success());
+    // A link named `world` (the base's fixed root): the diagnostic points at that `<link>`.
+    std::fs::write(
+        &clash,
+        "<robot name=\"r\">\n<link name=\"a\"/>\n  <link name=\"world\"/>\n<joint name=\"j\" type=\"continuous\"><parent link=\"a\"/><child link=\"world\"/></joint>\n</robot>\n",
+    )
+    .unwrap();
+    let o = opt(&[clash.to_str().unwrap(), "--floating-base", "-passes=atomise"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("`world` is a name of robovec's floating base") && e.contains("clash.urdf:3:3"), "{e}");
 }
 
 /// `robovec-gen` writes a topology family's robot as the library's URDF text (file and stdout

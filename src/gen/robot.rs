@@ -157,13 +157,20 @@ impl Robot {
     /// coordinates is `buildModelFromUrdf(path, JointModelComposite([PX, PY, PZ, RX, RY, RZ]))`.
     ///
     /// # Errors
-    /// The name of a URDF joint or link that clashes with the names above.
-    pub fn with_floating_base(mut self) -> Result<Robot, String> {
-        let taken = |n: &str| self.joints.iter().any(|j| j.name == n) || self.links.iter().any(|l| l.name == n);
-        for n in FLOATING_BASE.iter().flat_map(|j| [j.to_string(), format!("{j}_link")]).chain(["world".to_string()]) {
-            if taken(&n) {
-                return Err(n);
-            }
+    /// The name and the element (`<joint>` or `<link>` span) of the first URDF joint or link, in
+    /// the file's order, whose name clashes with the names above.
+    pub fn with_floating_base(mut self) -> Result<Robot, (String, Span)> {
+        let reserved: Vec<String> =
+            FLOATING_BASE.iter().flat_map(|j| [j.to_string(), format!("{j}_link")]).chain(["world".to_string()]).collect();
+        let clash = self
+            .joints
+            .iter()
+            .map(|j| (&j.name, j.span))
+            .chain(self.links.iter().map(|l| (&l.name, l.span)))
+            .filter(|(n, _)| reserved.contains(n))
+            .min_by_key(|(_, span)| span.start);
+        if let Some((name, span)) = clash {
+            return Err((name.clone(), span));
         }
         let old_root = self.root;
         let span = self.links[old_root].span;

@@ -41,10 +41,9 @@ impl FrontEnd for Urdf {
             .note("expected at least one revolute, continuous or prismatic joint")]);
         }
         let robot = if opts.floating_base {
-            let span = robot.links[robot.root].span;
-            robot.with_floating_base().map_err(|name| {
-                vec![FrontError::new(span, format!("`{name}` is a name of robovec's floating base"), "root link")
-                    .note("rename the URDF joint or link to use --floating-base")]
+            robot.with_floating_base().map_err(|(name, span)| {
+                vec![FrontError::new(span, format!("`{name}` is a name of robovec's floating base"), "this element")
+                    .note("rename this URDF joint or link to use --floating-base")]
             })?
         } else {
             robot
