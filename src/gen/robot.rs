@@ -160,8 +160,11 @@ impl Robot {
     /// The name and the element (`<joint>` or `<link>` span) of the first URDF joint or link, in
     /// the file's order, whose name clashes with the names above.
     pub fn with_floating_base(mut self) -> Result<Robot, (String, Span)> {
-        let reserved: Vec<String> =
-            FLOATING_BASE.iter().flat_map(|j| [j.to_string(), format!("{j}_link")]).chain(["world".to_string()]).collect();
+        let reserved: Vec<String> = FLOATING_BASE
+            .iter()
+            .flat_map(|j| [j.to_string(), format!("{j}_link")])
+            .chain(["world".to_string()])
+            .collect();
         let clash = self
             .joints
             .iter()
