@@ -1,0 +1,242 @@
+// Timing and value harness of `cargo bench --bench pinocchio` (issue 14): Pinocchio's C++ `rnea`,
+// `crba` and `crba` + `nonLinearEffects` against robovec's generated C, on the same states.
+//
+//   harness MODEL.txt STATES.txt VALUES.bin REPS
+//
+// MODEL.txt is `model.saveToText` of `export_model.py`, STATES.txt its states (format in that
+// script). robovec's side is linked in from `table.c` (written by the bench): `RV_SETS` holds every
+// robovec input of every state (`RV_NCOLS` columns), `RV_VARIANTS` the generated functions with
+// their group (0: inverse dynamics vs `rnea`; 1: `M` vs `crba`; 2: `M`, `c` vs `crba` +
+// `nonLinearEffects`), lanes per call, and maps: input k reads column `in_map[k]`, output k is entry
+// `out_map[k]` of the group's layout (0: `tau[i]`; 1: `M[i][j]` at `i*nv + j`; 2: that, then
+// `c[i]` at `nv*nv + i`; `crba`'s upper triangle mirrored into the lower one).
+//
+// Prints `contestant\tINDEX\tGROUP\tNAME` per contestant, then `time\tINDEX\tREP\tNS_PER_STATE` for
+// every rep: in each rep every contestant of a group is timed once, the group's order rotated by
+// one each rep, a sample being enough calls for ~0.3 ms, cycling over all states (a batch of W
+// lanes takes W consecutive states). Writes VALUES.bin, native f64: per group, the reference
+// (Pinocchio on `long double`, its 64-bit significand, rounded to f64 once), then each
+// contestant's values in index order, each block `nsets x group size`.
+#include "pinocchio/algorithm/crba.hpp"
+#include "pinocchio/algorithm/joint-configuration.hpp"
+#include "pinocchio/algorithm/rnea.hpp"
+#include "pinocchio/multibody.hpp"
+#include "pinocchio/serialization.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+extern "C" {
+typedef void (*rv_fn)(const double *in, double *out);
+typedef struct {
+  const char *label;
+  rv_fn fn;
+  int group;
+  int batch;
+  int n_in;
+  int n_out;
+  const int *in_map;
+  const int *out_map;
+} RvVariant;
+extern const int RV_NSETS, RV_NCOLS, RV_NVARIANTS;
+extern const double RV_SETS[];
+extern const RvVariant RV_VARIANTS[];
+}
+
+typedef Eigen::Matrix<long double, Eigen::Dynamic, 1> VecL;
+typedef Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic> MatL;
+
+struct Contestant {
+  std::string name;
+  int group;
+  int batch;
+  // Evaluates block `k` (states k*batch .. k*batch + batch - 1).
+  std::function<void(int)> call;
+  // Values of state `s` in the group's layout.
+  std::function<void(int, double *)> values;
+};
+
+static double now_ns() {
+  return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+int main(int argc, char **argv) {
+  if (argc != 5) {
+    std::fprintf(stderr, "usage: harness MODEL.txt STATES.txt VALUES.bin REPS\n");
+    return 2;
+  }
+  pinocchio::Model model;
+  model.loadFromText(argv[1]);
+  pinocchio::Data data(model);
+  std::ifstream in(argv[2]);
+  int n = 0, nq = 0, nv = 0;
+  in >> n >> nq >> nv;
+  if (!in || n != RV_NSETS || nq != model.nq || nv != model.nv) {
+    std::fprintf(stderr, "%s: %d states nq %d nv %d; expected %d states nq %d nv %d\n", argv[2], n, nq, nv, RV_NSETS,
+                 model.nq, model.nv);
+    return 1;
+  }
+  double g[3];
+  in >> g[0] >> g[1] >> g[2];
+  std::vector<int> idx_q(nv), kind(nv);
+  for (int i = 0; i < nv; i++) in >> idx_q[i] >> kind[i];
+  std::vector<Eigen::VectorXd> x(n, Eigen::VectorXd(nv)), q(n, Eigen::VectorXd(nq)), v(n, Eigen::VectorXd(nv)),
+      a(n, Eigen::VectorXd(nv));
+  for (int s = 0; s < n; s++) {
+    for (int i = 0; i < nv; i++) in >> x[s][i];
+    for (int i = 0; i < nq; i++) in >> q[s][i];
+    for (int i = 0; i < nv; i++) in >> v[s][i];
+    for (int i = 0; i < nv; i++) in >> a[s][i];
+  }
+  if (!in) {
+    std::fprintf(stderr, "%s: truncated\n", argv[2]);
+    return 1;
+  }
+  const int reps = std::atoi(argv[4]);
+  const int sizes[3] = {nv, nv * nv, nv * nv + nv};
+
+  // The reference: Pinocchio on long double, each configuration rebuilt from the exact
+  // coordinates (a continuous joint's cos, sin in long double, not Pinocchio's rounded doubles).
+  pinocchio::ModelTpl<long double> model_l = model.cast<long double>();
+  pinocchio::DataTpl<long double> data_l(model_l);
+  std::vector<std::vector<double>> ref(3, std::vector<double>());
+  for (int gi = 0; gi < 3; gi++) ref[gi].resize((size_t)n * sizes[gi]);
+  for (int s = 0; s < n; s++) {
+    VecL ql = q[s].cast<long double>();
+    for (int i = 0; i < nv; i++) {
+      long double xi = x[s][i];
+      if (kind[i] == 1) {
+        ql[idx_q[i]] = std::cos(xi);
+        ql[idx_q[i] + 1] = std::sin(xi);
+      } else {
+        ql[idx_q[i]] = xi;
+      }
+    }
+    VecL vl = v[s].cast<long double>(), al = a[s].cast<long double>();
+    VecL tau = pinocchio::rnea(model_l, data_l, ql, vl, al);
+    MatL m = pinocchio::crba(model_l, data_l, ql);
+    VecL nle = pinocchio::nonLinearEffects(model_l, data_l, ql, vl);
+    for (int i = 0; i < nv; i++) {
+      ref[0][(size_t)s * sizes[0] + i] = (double)tau[i];
+      ref[2][(size_t)s * sizes[2] + nv * nv + i] = (double)nle[i];
+      for (int j = 0; j < nv; j++) {
+        double mij = (double)(i <= j ? m(i, j) : m(j, i));
+        ref[1][(size_t)s * sizes[1] + i * nv + j] = mij;
+        ref[2][(size_t)s * sizes[2] + i * nv + j] = mij;
+      }
+    }
+  }
+
+  // Contestants: Pinocchio's algorithms, then robovec's variants.
+  std::vector<Contestant> cs;
+  volatile double sink = 0;
+  auto mirror = [nv](const Eigen::MatrixXd &m, double *out) {
+    for (int i = 0; i < nv; i++)
+      for (int j = 0; j < nv; j++) out[i * nv + j] = i <= j ? m(i, j) : m(j, i);
+  };
+  cs.push_back({"pinocchio rnea", 0, 1, [&](int k) { pinocchio::rnea(model, data, q[k], v[k], a[k]); },
+                [&](int s, double *out) {
+                  Eigen::VectorXd t = pinocchio::rnea(model, data, q[s], v[s], a[s]);
+                  for (int i = 0; i < nv; i++) out[i] = t[i];
+                }});
+  for (int world = 0; world < 2; world++) {
+    pinocchio::Convention conv = world ? pinocchio::Convention::WORLD : pinocchio::Convention::LOCAL;
+    std::string cname = world ? "WORLD" : "LOCAL";
+    cs.push_back({"pinocchio crba " + cname, 1, 1, [&, conv](int k) { pinocchio::crba(model, data, q[k], conv); },
+                  [&, conv](int s, double *out) { mirror(pinocchio::crba(model, data, q[s], conv), out); }});
+    cs.push_back({"pinocchio crba " + cname + " + nonLinearEffects", 2, 1,
+                  [&, conv](int k) {
+                    pinocchio::crba(model, data, q[k], conv);
+                    pinocchio::nonLinearEffects(model, data, q[k], v[k]);
+                  },
+                  [&, conv](int s, double *out) {
+                    mirror(pinocchio::crba(model, data, q[s], conv), out);
+                    Eigen::VectorXd c = pinocchio::nonLinearEffects(model, data, q[s], v[s]);
+                    for (int i = 0; i < nv; i++) out[nv * nv + i] = c[i];
+                  }});
+  }
+  // robovec: inputs packed once per variant, lane-contiguous (`in[i*W + lane]`).
+  std::vector<std::vector<double>> packed(RV_NVARIANTS), outbuf(RV_NVARIANTS);
+  for (int vi = 0; vi < RV_NVARIANTS; vi++) {
+    const RvVariant &rv = RV_VARIANTS[vi];
+    const int w = rv.batch;
+    if (n % w != 0) {
+      std::fprintf(stderr, "%d states are not a whole number of %d-lane batches\n", n, w);
+      return 1;
+    }
+    packed[vi].resize((size_t)n * rv.n_in);
+    outbuf[vi].resize((size_t)rv.n_out * w);
+    for (int b = 0; b < n / w; b++)
+      for (int lane = 0; lane < w; lane++)
+        for (int i = 0; i < rv.n_in; i++)
+          packed[vi][((size_t)b * rv.n_in + i) * w + lane] = RV_SETS[(size_t)(b * w + lane) * RV_NCOLS + rv.in_map[i]];
+    cs.push_back({std::string("robovec ") + rv.label, rv.group, w,
+                  [&, vi](int k) {
+                    const RvVariant &r = RV_VARIANTS[vi];
+                    r.fn(packed[vi].data() + (size_t)k * r.n_in * r.batch, outbuf[vi].data());
+                  },
+                  [&, vi, nv](int s, double *out) {
+                    const RvVariant &r = RV_VARIANTS[vi];
+                    const int b = s / r.batch, lane = s % r.batch;
+                    std::vector<double> o((size_t)r.n_out * r.batch);
+                    r.fn(packed[vi].data() + (size_t)b * r.n_in * r.batch, o.data());
+                    (void)nv;
+                    for (int k = 0; k < r.n_out; k++)
+                      if (r.out_map[k] >= 0) out[r.out_map[k]] = o[(size_t)k * r.batch + lane];
+                  }});
+  }
+
+  // Values.
+  {
+    std::ofstream f(argv[3], std::ios::binary);
+    for (int gi = 0; gi < 3; gi++) {
+      f.write((const char *)ref[gi].data(), ref[gi].size() * sizeof(double));
+      for (size_t c = 0; c < cs.size(); c++) {
+        if (cs[c].group != gi) continue;
+        std::vector<double> vals((size_t)n * sizes[gi], std::numeric_limits<double>::quiet_NaN());
+        for (int s = 0; s < n; s++) cs[c].values(s, vals.data() + (size_t)s * sizes[gi]);
+        f.write((const char *)vals.data(), vals.size() * sizeof(double));
+      }
+    }
+    if (!f) {
+      std::fprintf(stderr, "cannot write %s\n", argv[3]);
+      return 1;
+    }
+  }
+  for (size_t c = 0; c < cs.size(); c++) std::printf("contestant\t%zu\t%d\t%s\n", c, cs[c].group, cs[c].name.c_str());
+
+  // Calibration: calls per sample for ~0.3 ms.
+  std::vector<long> calls(cs.size());
+  for (size_t c = 0; c < cs.size(); c++) {
+    const int blocks = n / cs[c].batch;
+    long k = 0;
+    double t0 = now_ns();
+    while (now_ns() - t0 < 2e6) cs[c].call((int)(k++ % blocks));
+    double per = (now_ns() - t0) / (double)k;
+    calls[c] = std::max(1L, (long)(3e5 / per));
+  }
+  for (int rep = 0; rep < reps; rep++) {
+    for (int gi = 0; gi < 3; gi++) {
+      std::vector<size_t> members;
+      for (size_t c = 0; c < cs.size(); c++)
+        if (cs[c].group == gi) members.push_back(c);
+      for (size_t m = 0; m < members.size(); m++) {
+        const size_t c = members[(m + rep) % members.size()];
+        const int blocks = n / cs[c].batch;
+        double t0 = now_ns();
+        for (long k = 0; k < calls[c]; k++) cs[c].call((int)(k % blocks));
+        double t = now_ns() - t0;
+        std::printf("time\t%zu\t%d\t%.4f\n", c, rep, t / (double)(calls[c] * cs[c].batch));
+      }
+    }
+  }
+  sink = sink + data.tau[0];
+  return 0;
+}

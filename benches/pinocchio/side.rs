@@ -1,0 +1,259 @@
+//! Helpers of `benches/pinocchio.rs`: the Pinocchio environment and the harness build, the shared
+//! states, input and output maps, bits of error from the harness's values.
+
+use std::collections::BTreeMap;
+use std::hash::{Hash, Hasher};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Flags of the C++ harness (Pinocchio header-only: its `double` and `long double` instances are
+/// compiled here, for this CPU; the Boost limits are those of Pinocchio's CMake config).
+const CXX_FLAGS: &[&str] = &[
+    "-O3",
+    "-march=native",
+    "-DNDEBUG",
+    "-Wno-deprecated-declarations",
+    "-std=c++17",
+    "-DBOOST_MPL_LIMIT_LIST_SIZE=30",
+    "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
+    "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS",
+    "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
+];
+
+/// Flags of robovec's generated C (the `native` set of `cargo bench --bench codegen_c`; no
+/// contraction, so the values are `-eval`'s).
+const C_FLAGS: &[&str] = &["-O3", "-march=native", "-ffp-contract=off", "-Wno-psabi"];
+
+/// How to create the environment (the commands of `.ci/run`, plus Eigen's headers).
+const HOW: &str = "python3 -m venv target/pinocchio-venv && \
+    target/pinocchio-venv/bin/pip install pin example-robot-data cmeel-eigen";
+
+/// The Pinocchio environment and the bench's work folder.
+pub struct Env {
+    /// The repository.
+    pub root: PathBuf,
+    /// The venv's Python.
+    pub python: PathBuf,
+    /// `cmeel.prefix` (include/, lib/ of Pinocchio, Boost, Eigen).
+    pub prefix: PathBuf,
+    /// `target/pinocchio_bench`.
+    pub work: PathBuf,
+    /// The compiled harness object.
+    harness: PathBuf,
+}
+
+impl Env {
+    /// Finds the venv (panics with [`HOW`] when it is missing or lacks a header) and builds the
+    /// harness object unless a build of the same source and flags is cached.
+    pub fn new() -> Env {
+        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+        let python = std::env::var_os("ROBOVEC_PINOCCHIO_PYTHON")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| root.join("target/pinocchio-venv/bin/python"));
+        assert!(python.exists(), "Pinocchio's environment is missing at {}; create it with: {HOW}", python.display());
+        let purelib =
+            run(Command::new(&python).args(["-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"]));
+        let prefix = PathBuf::from(purelib.trim()).join("cmeel.prefix");
+        for h in ["include/pinocchio/algorithm/rnea.hpp", "include/eigen3/Eigen/Core", "include/boost/version.hpp"] {
+            assert!(
+                prefix.join(h).exists(),
+                "{} is missing; create the environment with: {HOW}",
+                prefix.join(h).display()
+            );
+        }
+        let work = root.join("target/pinocchio_bench");
+        std::fs::create_dir_all(&work).unwrap();
+        let src = root.join("benches/pinocchio/harness.cpp");
+        let text = std::fs::read(&src).unwrap();
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        (text, CXX_FLAGS, &prefix).hash(&mut h);
+        let harness = work.join(format!("harness-{:016x}.o", h.finish()));
+        if !harness.exists() {
+            eprintln!("compiling {} (about 3 min; cached as {})", src.display(), harness.display());
+            let tmp = harness.with_extension("tmp.o");
+            let inc = |p: &str| format!("-I{}", prefix.join(p).display());
+            run(Command::new("g++")
+                .args(CXX_FLAGS)
+                .args([inc("include"), inc("include/eigen3")])
+                .arg("-c")
+                .arg(&src)
+                .arg("-o")
+                .arg(&tmp));
+            std::fs::rename(&tmp, &harness).unwrap();
+        }
+        Env { root, python, prefix, work, harness }
+    }
+
+    /// Compiles `sources` (C, in `dir`) two at a time when newer than their objects, links them
+    /// with the harness, returns the executable.
+    pub fn link(&self, dir: &Path, sources: &[PathBuf]) -> PathBuf {
+        let objs: Vec<PathBuf> = sources.iter().map(|s| s.with_extension("o")).collect();
+        let stale: Vec<(&PathBuf, &PathBuf)> = sources.iter().zip(&objs).filter(|(s, o)| !newer(o, s)).collect();
+        let t0 = std::time::Instant::now();
+        for pair in stale.chunks(2) {
+            let children: Vec<_> = pair
+                .iter()
+                .map(|(s, o)| {
+                    let c =
+                        Command::new("cc").args(C_FLAGS).arg("-c").arg(s).arg("-o").arg(o).spawn().expect("cc runs");
+                    (s, c)
+                })
+                .collect();
+            for (s, c) in children {
+                let out = c.wait_with_output().unwrap();
+                assert!(out.status.success(), "cc {} failed", s.display());
+            }
+        }
+        eprintln!("   compiled {} C files in {:.1} s", stale.len(), t0.elapsed().as_secs_f64());
+        let exe = dir.join("bench");
+        let lib = self.prefix.join("lib");
+        run(Command::new("g++")
+            .arg("-o")
+            .arg(&exe)
+            .arg(&self.harness)
+            .args(&objs)
+            .arg(format!("-L{}", lib.display()))
+            .arg(format!("-Wl,-rpath,{}", lib.display()))
+            .args(["-lboost_serialization", "-lm"]));
+        exe
+    }
+}
+
+/// Whether file `a` exists and is at least as new as `b`.
+fn newer(a: &Path, b: &Path) -> bool {
+    let t = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    matches!((t(a), t(b)), (Some(x), Some(y)) if x >= y)
+}
+
+/// Writes `data` to `path` unless the file already holds it (so its time stamp stays).
+pub fn write_if_changed(path: &Path, data: &[u8]) {
+    if std::fs::read(path).ok().as_deref() != Some(data) {
+        std::fs::write(path, data).unwrap();
+    }
+}
+
+/// Runs `cmd`, panics with its stderr on failure, returns its stdout.
+pub fn run(cmd: &mut Command) -> String {
+    let o = cmd.output().unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
+    assert!(o.status.success(), "{cmd:?} failed:\n{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Median (upper middle) of `xs`, which must not be empty.
+pub fn median(xs: &[f64]) -> f64 {
+    let mut c = xs.to_vec();
+    c.sort_by(f64::total_cmp);
+    c[c.len() / 2]
+}
+
+/// The CPU's model name and the clock `/proc/cpuinfo` reports.
+pub fn clock() -> String {
+    let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let field = |k: &str| {
+        info.lines()
+            .find(|l| l.starts_with(k))
+            .and_then(|l| l.split(':').nth(1))
+            .map_or("?".into(), |v| v.trim().to_string())
+    };
+    format!("{}, {} MHz", field("model name"), field("cpu MHz"))
+}
+
+/// The states of `export_model.py`'s `states.txt`: per state the robovec coordinates `x`
+/// (`q[1..nv]`), velocities `v` and accelerations `a`; gravity `g`.
+pub struct States {
+    pub nv: usize,
+    pub g: [f64; 3],
+    pub x: Vec<Vec<f64>>,
+    pub v: Vec<Vec<f64>>,
+    pub a: Vec<Vec<f64>>,
+}
+
+/// Reads `states.txt` (format in `export_model.py`).
+pub fn read_states(path: &Path) -> States {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut w = text.split_whitespace();
+    let mut int = || -> usize { w.next().unwrap().parse().unwrap() };
+    let (n, nq, nv) = (int(), int(), int());
+    let mut w = text.split_whitespace().skip(3);
+    let mut num = || -> f64 { w.next().expect("states.txt truncated").parse().unwrap() };
+    let g = [num(), num(), num()];
+    for _ in 0..2 * nv {
+        num();
+    }
+    let mut s = States { nv, g, x: vec![], v: vec![], a: vec![] };
+    for _ in 0..n {
+        let mut take = |k: usize| (0..k).map(|_| num()).collect::<Vec<f64>>();
+        s.x.push(take(nv));
+        take(nq);
+        s.v.push(take(nv));
+        s.a.push(take(nv));
+    }
+    s
+}
+
+/// Value of robovec input `name` in state `s`: `q[i]`, `qd[i]`, `qdd[i]` the state's coordinate,
+/// velocity, acceleration `i − 1`; `g[k]` gravity; `S4`/`C4` (`trig=input`) sin/cos of `q[4]`.
+pub fn robovec_inputs(name: &str, st: &States, s: usize) -> f64 {
+    let index = |p: &str| -> Option<usize> { name.strip_prefix(p)?.strip_suffix(']')?.parse().ok() };
+    let trig = |p: char| -> Option<usize> { name.strip_prefix(p)?.parse().ok() };
+    if let Some(i) = index("q[") {
+        st.x[s][i - 1]
+    } else if let Some(i) = index("qd[") {
+        st.v[s][i - 1]
+    } else if let Some(i) = index("qdd[") {
+        st.a[s][i - 1]
+    } else if let Some(k) = index("g[") {
+        st.g[k - 1]
+    } else if let Some(i) = trig('S') {
+        st.x[s][i - 1].sin()
+    } else if let Some(i) = trig('C') {
+        st.x[s][i - 1].cos()
+    } else {
+        panic!("robovec input {name}: no value in the shared states")
+    }
+}
+
+/// Slot of robovec output `name` in the harness's layout of group `g` (0: `Qq[i]` → `i − 1`;
+/// 1, 2: `M[i][j]` → `(i − 1)·nv + j − 1`; 2: `c[i]` → `nv² + i − 1`).
+pub fn output_slot(name: &str, g: usize, nv: usize) -> usize {
+    let idx: Vec<usize> = name.split('[').skip(1).filter_map(|p| p.trim_end_matches(']').parse().ok()).collect();
+    match (name.split('[').next().unwrap(), g, idx.as_slice()) {
+        ("Qq", 0, [i]) => i - 1,
+        ("M", 1 | 2, [i, j]) => (i - 1) * nv + j - 1,
+        ("c", 2, [i]) => nv * nv + i - 1,
+        _ => panic!("robovec output {name} in group {g}"),
+    }
+}
+
+/// Bits of error (mean, max over states and entries) of each contestant's values in the
+/// harness's `values.bin` against the `long double` reference; for `M` the upper triangle only.
+pub fn bits_of_error(
+    path: &Path,
+    names: &BTreeMap<usize, (usize, String)>,
+    nv: usize,
+    nsets: usize,
+) -> BTreeMap<usize, (f64, f64)> {
+    let bytes = std::fs::read(path).unwrap();
+    let vals: Vec<f64> = bytes.chunks_exact(8).map(|c| f64::from_ne_bytes(c.try_into().unwrap())).collect();
+    let sizes = [nv, nv * nv, nv * nv + nv];
+    let counted = |g: usize, k: usize| g == 0 || k >= nv * nv || k / nv <= k % nv;
+    let mut at = 0;
+    let mut out = BTreeMap::new();
+    for (g, &size) in sizes.iter().enumerate() {
+        let block = nsets * size;
+        let reference = &vals[at..at + block];
+        at += block;
+        for (&c, _) in names.iter().filter(|(_, (gg, _))| *gg == g) {
+            let mine = &vals[at..at + block];
+            at += block;
+            let bits: Vec<f64> = (0..block)
+                .filter(|&i| counted(g, i % size))
+                .map(|i| robovec_ir::numerics::bits_f64(mine[i], reference[i]))
+                .collect();
+            let mean = bits.iter().sum::<f64>() / bits.len() as f64;
+            out.insert(c, (mean, bits.iter().copied().fold(0.0, f64::max)));
+        }
+    }
+    assert_eq!(at, vals.len(), "{}: size", path.display());
+    out
+}
