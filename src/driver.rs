@@ -332,20 +332,29 @@ fn report_json(
             &fallback
         }
     };
+    Ok(report_text(&opts.input, &pm.pipeline_text(), &ran.records, &ran.cx, own))
+}
+
+/// The report JSON text (SPEC §7) of one function after a run: `input` (as given), `function`,
+/// `pipeline` (normalised text), `passes` (the records), the function's own figures (`stats`,
+/// `placement`), each artifact's entry for it (merged by key), then `stopped_early` when a pass
+/// stopped early. What `-report` writes; `robovec-gen --study` ([`crate::study`]) calls it for
+/// each case's report folder.
+pub fn report_text(input: &str, pipeline: &str, records: &[PassRecord], cx: &PassContext, own: &Figures) -> String {
     let mut r = serde_json::Map::new();
-    r.insert("input".into(), opts.input.clone().into());
-    r.insert("function".into(), f.name.clone().into());
-    r.insert("pipeline".into(), pm.pipeline_text().into());
-    r.insert("passes".into(), serde_json::to_value(&ran.records).expect("records serialise"));
+    r.insert("input".into(), input.into());
+    r.insert("function".into(), own.function.clone().into());
+    r.insert("pipeline".into(), pipeline.into());
+    r.insert("passes".into(), serde_json::to_value(records).expect("records serialise"));
     let entries =
-        own.report_entries().into_iter().chain(robovec_passes::artifact::report_entries(ran.cx.artifacts(), &f.name));
+        own.report_entries().into_iter().chain(robovec_passes::artifact::report_entries(cx.artifacts(), &own.function));
     for (key, value) in entries {
         r.insert(key.into(), value);
     }
-    if !ran.cx.stopped.is_empty() {
-        r.insert("stopped_early".into(), ran.cx.stopped.clone().into());
+    if !cx.stopped.is_empty() {
+        r.insert("stopped_early".into(), cx.stopped.clone().into());
     }
-    Ok(serde_json::to_string_pretty(&serde_json::Value::Object(r)).expect("report serialises") + "\n")
+    serde_json::to_string_pretty(&serde_json::Value::Object(r)).expect("report serialises") + "\n"
 }
 
 /// `-eval`'s JSON, with a warning on stderr for each input given that the function does not

@@ -15,3 +15,4 @@ pub mod output;
 pub mod preflight;
 pub mod progress;
 pub mod report_dir;
+pub mod study;

@@ -32,8 +32,10 @@
 //! **Folders written as a whole** (`-report-dir=DIR`, [`OutputSet::stage_folder`]): the files
 //! go into a temporary folder beside `DIR` (`.DIR.PID.K.robovec-tmp`), which the commit renames
 //! to `DIR`, so a reader sees the old report folder or the new one, never a mix. `DIR` may be
-//! missing, an empty folder, or a folder robovec wrote before (a `report.json` and nothing but
-//! regular files named `*.json`, `*.md`, `*.svg`, `*.csv`, `*.png`); an existing one is renamed
+//! missing, an empty folder, or a folder robovec wrote before (a `report.json` or a
+//! `study.json`, and nothing but regular files named `*.json`, `*.md`, `*.svg`, `*.csv`,
+//! `*.png`, in it or in subfolders up to two levels deep, as a study's `cases/<case>/`); an
+//! existing one is renamed
 //! aside first (`.DIR.PID.K.robovec-old`), then removed once the new folder is in place, or put
 //! back if the rename fails. Anything else — a file, a symbolic link, a folder with other
 //! content — is refused before any work (robovec never deletes what it did not write).
@@ -239,25 +241,69 @@ pub fn check_replaceable_folder(dir: &Path) -> Result<(), String> {
             if entries.is_empty() {
                 return Ok(());
             }
-            let ours = |e: &fs::DirEntry| {
-                let name = e.file_name().to_string_lossy().into_owned();
-                e.file_type().is_ok_and(|t| t.is_file())
-                    && [".json", ".md", ".svg", ".csv", ".png"].iter().any(|x| name.ends_with(x))
-            };
-            let has_report = entries.iter().any(|e| e.file_name() == "report.json");
-            match entries.iter().find(|e| !ours(e)) {
-                Some(e) => Err(fail(format!(
-                    "it holds `{}`, which robovec did not write; robovec replaces only an empty folder or a report folder it wrote",
-                    e.file_name().to_string_lossy()
+            let has_marker =
+                entries.iter().any(|e| FOLDER_MARKERS.iter().any(|m| e.file_name() == *m) && is_our_file(e));
+            match foreign_entry(dir, FOLDER_DEPTH).map_err(|e| fail(e.to_string()))? {
+                Some(name) => Err(fail(format!(
+                    "it holds `{name}`, which robovec did not write; robovec replaces only an empty folder or a report folder it wrote"
                 ))),
-                None if !has_report => Err(fail(
-                    "it is not empty and has no report.json; robovec replaces only an empty folder or a report folder it wrote"
+                None if !has_marker => Err(fail(
+                    "it is not empty and has no report.json or study.json; robovec replaces only an empty folder or a report folder it wrote"
                         .into(),
                 )),
                 None => Ok(()),
             }
         }
     }
+}
+
+/// The files that mark a folder robovec wrote: `report.json` (`-report-dir`) or `study.json`
+/// (`robovec-gen --study --report-dir`).
+const FOLDER_MARKERS: [&str; 2] = ["report.json", "study.json"];
+
+/// How deep a folder robovec wrote may nest (a study's `cases/<case>/` is 2).
+const FOLDER_DEPTH: u32 = 2;
+
+/// A regular file (not a link) named like the files robovec writes in a folder.
+fn is_our_file(e: &fs::DirEntry) -> bool {
+    let name = e.file_name().to_string_lossy().into_owned();
+    e.file_type().is_ok_and(|t| t.is_file())
+        && [".json", ".md", ".svg", ".csv", ".png"].iter().any(|x| name.ends_with(x))
+}
+
+/// The first entry of `dir` (relative path) that robovec would not have written: anything but
+/// [`is_our_file`] files and, up to `depth` levels, folders holding only those.
+fn foreign_entry(dir: &Path, depth: u32) -> io::Result<Option<String>> {
+    for e in fs::read_dir(dir)? {
+        let e = e?;
+        let name = e.file_name().to_string_lossy().into_owned();
+        if is_our_file(&e) {
+            continue;
+        }
+        if depth > 0 && e.file_type().is_ok_and(|t| t.is_dir()) {
+            if let Some(inner) = foreign_entry(&e.path(), depth - 1)? {
+                return Ok(Some(format!("{name}/{inner}")));
+            }
+            continue;
+        }
+        return Ok(Some(name));
+    }
+    Ok(None)
+}
+
+/// Removes a folder [`check_replaceable_folder`] accepted: its files and subfolders, never
+/// following a link (there is none: checked).
+fn remove_our_folder(dir: &Path) {
+    if let Ok(rd) = fs::read_dir(dir) {
+        for e in rd.flatten() {
+            if e.file_type().is_ok_and(|t| t.is_dir()) {
+                remove_our_folder(&e.path());
+            } else {
+                let _ = fs::remove_file(e.path());
+            }
+        }
+    }
+    let _ = fs::remove_dir(dir);
 }
 
 /// A folder staged as a whole, waiting for the commit.
@@ -412,6 +458,14 @@ impl OutputSet {
         fs::create_dir(&tmp).map_err(fail)?;
         self.folders.push(StagedFolder { shown: dir.into(), tmp: tmp.clone() });
         for (file, bytes) in files {
+            // A name may hold subfolders (`cases/23-serial/report.json`), never `..` or a root.
+            let rel = Path::new(file);
+            if !rel.components().all(|c| matches!(c, std::path::Component::Normal(_))) {
+                return Err(fail(io::Error::other(format!("bad file name `{file}` in the folder"))));
+            }
+            if let Some(sub) = rel.parent().filter(|p| !p.as_os_str().is_empty()) {
+                fs::create_dir_all(tmp.join(sub)).map_err(fail)?;
+            }
             let mut f = OpenOptions::new().write(true).create_new(true).open(tmp.join(file)).map_err(fail)?;
             f.write_all(bytes).and_then(|()| f.sync_all()).map_err(fail)?;
         }
@@ -442,13 +496,8 @@ impl OutputSet {
             return Err(fail(e));
         }
         if let Some(old) = old {
-            // Only regular files robovec wrote are in it (checked above).
-            if let Ok(rd) = fs::read_dir(&old) {
-                for e in rd.flatten() {
-                    let _ = fs::remove_file(e.path());
-                }
-            }
-            let _ = fs::remove_dir(&old);
+            // Only files robovec wrote are in it (checked above).
+            remove_our_folder(&old);
         }
         Ok(())
     }
