@@ -14,7 +14,7 @@ use std::process::Command;
 
 use robovec::front::FrontOptions;
 
-fn python() -> Option<PathBuf> {
+pub(crate) fn python() -> Option<PathBuf> {
     let p = std::env::var_os("ROBOVEC_PINOCCHIO_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/pinocchio-venv/bin/python"));

@@ -29,6 +29,7 @@ mod placement;
 mod placement_verify;
 mod props;
 mod report_dir;
+mod robotran_c;
 mod roundtrip;
 mod schedule_cpu;
 mod target;

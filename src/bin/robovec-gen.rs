@@ -1,4 +1,4 @@
-//! `robovec-gen`: robots robovec builds itself, written as URDF (issue 14).
+//! `robovec-gen`: robots robovec builds itself, written as URDF or as Robotran C (issue 14).
 //!
 //! `robovec-gen --topology serial|semi-serial|parallel --dof N [--seed S] [-o FILE.urdf]` writes
 //! one model of the study's topology families (`robovec::gen::topology`, seed §3.2 Table 3.1)
@@ -7,39 +7,76 @@
 //! (the URDF front end reads it back to the same IR the generator writes directly: tested in
 //! `tests/pinocchio.rs`, which also checks every family against Pinocchio).
 //!
+//! `robovec-gen (--topology T --dof N | --urdf FILE.urdf) --format c --function invdyna|dirdyna
+//! [--floating-base] [--fold-params] [--params-out P.json] -o mbs_invdyna_X.c` writes one
+//! function as a Robotran 6.6 C file and its header `mbs_invdyna_X.h` beside it
+//! (`robovec::gen::robotran_c`), which robovec's C front end reads back to the same IR
+//! (`tests/robotran_c.rs`); see `robovec::gen::export`.
+//!
 //! `robovec-gen --study [--dof 23,50,…] [--topology serial,…] [--seed S] [--samples K]
 //! [--best PIPELINE] [--report-dir DIR] [-q]` runs the thesis's study (seed §3.2, Table 3.1) on
 //! the families instead: see `robovec::study`.
 //!
-//! Exit status: 0 on success, 1 when the output cannot be written, 2 on bad usage (clap).
+//! Exit status: 0 on success, 1 for a bad URDF or when the output cannot be written, 2 on bad
+//! usage.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Parser;
-use robovec::gen::topology::{build, Topology};
+use robovec::gen::export::{Export, Format, Source};
+use robovec::gen::topology::Topology;
 
 /// Command line of `robovec-gen`.
 #[derive(Parser, Debug)]
-#[command(name = "robovec-gen", version, about = "Write a robot of the study's topology families as URDF")]
+#[command(
+    name = "robovec-gen",
+    version,
+    about = "Write a robot (a topology family or a URDF) as URDF or as Robotran C, or run the study"
+)]
 struct Args {
     /// Topology family: serial (one chain), semi-serial (a few medium chains) or parallel (many
     /// short chains from the base). With --study: a comma-separated list (default all three).
-    #[arg(long, value_delimiter = ',', required_unless_present = "study")]
+    #[arg(long, value_delimiter = ',', required_unless_present_any = ["study", "urdf"], conflicts_with = "urdf")]
     topology: Vec<Topology>,
     /// Degrees of freedom (revolute joints), at least 1. With --study: a comma-separated list
     /// (default 23,50,70,100,130).
-    #[arg(long, value_delimiter = ',', required_unless_present = "study", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    #[arg(long, value_delimiter = ',', required_unless_present_any = ["study", "urdf"], conflicts_with = "urdf", value_parser = clap::value_parser!(u32).range(1..=100_000))]
     dof: Vec<u32>,
     /// Seed of the random parameters (the same seed gives the same robot on every machine).
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Output file (written whole or not at all); stdout when absent.
+    /// Output file (written whole or not at all); stdout when absent. With --format c: the .c
+    /// file, its header goes beside it with the extension .h.
     #[arg(short = 'o', long = "output", conflicts_with = "study")]
     output: Option<PathBuf>,
     #[command(flatten)]
+    model: ModelArgs,
+    #[command(flatten)]
     study: StudyArgs,
+}
+
+/// What is written for one robot (`robovec::gen::export`).
+#[derive(clap::Args, Debug)]
+struct ModelArgs {
+    /// Read the robot from this URDF instead of building a topology family.
+    #[arg(long, conflicts_with = "study")]
+    urdf: Option<PathBuf>,
+    /// urdf: the robot as URDF; c: one function (--function) as a Robotran 6.6 C file and header.
+    #[arg(long, value_enum, default_value = "urdf", conflicts_with = "study")]
+    format: Format,
+    /// With --format c: the function, invdyna (Qq) or dirdyna (M, c).
+    #[arg(long, default_value = "invdyna", value_parser = ["invdyna", "dirdyna"], conflicts_with = "study")]
+    function: String,
+    /// Put the robot on Robotran's floating base (T1 T2 T3 R1 R2 R3 as q[1..6]).
+    #[arg(long, conflicts_with = "study")]
+    floating_base: bool,
+    /// With --format c: fold the model parameters into the equations.
+    #[arg(long, conflicts_with = "study")]
+    fold_params: bool,
+    /// With --format c: write the values of the parameters left as inputs to this JSON file.
+    #[arg(long, conflicts_with = "study")]
+    params_out: Option<PathBuf>,
 }
 
 /// The `--study` flag group (`robovec::study`).
@@ -97,27 +134,35 @@ fn main() -> ExitCode {
     if args.study.study {
         return study(&args);
     }
-    let (&[topology], &[dof]) = (args.topology.as_slice(), args.dof.as_slice()) else {
-        use clap::CommandFactory;
-        Args::command()
-            .error(clap::error::ErrorKind::ArgumentConflict, "--topology and --dof take one value each without --study")
-            .exit();
-    };
-    let robot = build(topology, dof as usize, args.seed);
-    let text = robovec::gen::urdf_out::write_urdf(&robot);
-    match &args.output {
+    let source = match &args.model.urdf {
+        Some(path) => Source::Urdf(path.clone()),
         None => {
-            if std::io::stdout().write_all(text.as_bytes()).is_err() {
-                return ExitCode::from(1);
-            }
+            let (&[topology], &[dof]) = (args.topology.as_slice(), args.dof.as_slice()) else {
+                use clap::CommandFactory;
+                Args::command()
+                    .error(
+                        clap::error::ErrorKind::ArgumentConflict,
+                        "--topology and --dof take one value each without --study",
+                    )
+                    .exit();
+            };
+            Source::Topology { topology, dof: dof as usize, seed: args.seed }
         }
-        Some(path) => {
-            let mut set = robovec::output::OutputSet::new();
-            if let Err(e) = set.stage(path, text.as_bytes()).and_then(|()| set.commit().map(|_| ())) {
-                eprintln!("{e}");
-                return ExitCode::from(1);
-            }
+    };
+    let export = Export {
+        source,
+        format: args.model.format,
+        function: args.model.function.clone(),
+        floating_base: args.model.floating_base,
+        fold_params: args.model.fold_params,
+        params_out: args.model.params_out.clone(),
+        output: args.output.clone(),
+    };
+    match robovec::gen::export::run(&export, &mut std::io::stdout().lock()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprint!("{}", f.message());
+            ExitCode::from(f.exit_code() as u8)
         }
     }
-    ExitCode::SUCCESS
 }

@@ -39,8 +39,10 @@
 
 pub mod crba;
 pub mod dirdyna;
+pub mod export;
 pub mod rnea;
 pub mod robot;
+pub mod robotran_c;
 pub mod sym;
 pub mod topology;
 pub mod urdf_out;

@@ -25,51 +25,82 @@ fn write_callee(out: &mut impl Write, c: &Callee) -> fmt::Result {
     Ok(())
 }
 
+/// How the leaves of an infix expression are spelled: the `.rvir` text writes `%name`, `1.5`
+/// and `@callee`; another printer of the same grammar (sum → product → factor, the grammar of
+/// Robotran's C, Matlab and Python expressions too) spells them its own way and keeps the tree.
+pub trait Leaves {
+    /// Writes an operand (a value or a non-negative constant).
+    fn operand<W: Write>(&self, out: &mut W, o: &Operand) -> fmt::Result;
+    /// Writes a callee's name (what precedes the parenthesised arguments).
+    fn callee<W: Write>(&self, out: &mut W, c: &Callee) -> fmt::Result;
+    /// Whether `+` and `-` between terms are spaced (` + `, the `.rvir` text) or not (`+`,
+    /// Robotran's C).
+    fn spaced_sums(&self) -> bool {
+        true
+    }
+}
+
+/// The `.rvir` spelling of the leaves of a function's expressions.
+struct IrLeaves<'a>(&'a Function);
+
+impl Leaves for IrLeaves<'_> {
+    fn operand<W: Write>(&self, out: &mut W, o: &Operand) -> fmt::Result {
+        write_operand(out, self.0, o)
+    }
+    fn callee<W: Write>(&self, out: &mut W, c: &Callee) -> fmt::Result {
+        write_callee(out, c)
+    }
+}
+
 // Expression printing mirrors the grammar (sum → product → factor) so that the tree reads back
 // unchanged: a negation or sum in factor position is parenthesised.
-fn write_sum(out: &mut impl Write, f: &Function, e: &Expr) -> fmt::Result {
+fn write_sum(out: &mut impl Write, l: &impl Leaves, e: &Expr) -> fmt::Result {
     match e {
         Expr::Binary(op @ (BinOp::Add | BinOp::Sub), a, b) => {
-            write_sum(out, f, a)?;
-            write!(out, " {} ", op.symbol())?;
-            write_product(out, f, b)
+            write_sum(out, l, a)?;
+            if l.spaced_sums() {
+                write!(out, " {} ", op.symbol())?;
+            } else {
+                out.write_char(op.symbol())?;
+            }
+            write_product(out, l, b)
         }
         Expr::Neg(x) => {
             out.write_char('-')?;
-            write_product(out, f, x)
+            write_product(out, l, x)
         }
-        _ => write_product(out, f, e),
+        _ => write_product(out, l, e),
     }
 }
 
-fn write_product(out: &mut impl Write, f: &Function, e: &Expr) -> fmt::Result {
+fn write_product(out: &mut impl Write, l: &impl Leaves, e: &Expr) -> fmt::Result {
     match e {
         Expr::Binary(op @ (BinOp::Mul | BinOp::Div), a, b) => {
-            write_product(out, f, a)?;
+            write_product(out, l, a)?;
             write!(out, "{}", op.symbol())?;
-            write_factor(out, f, b)
+            write_factor(out, l, b)
         }
-        _ => write_factor(out, f, e),
+        _ => write_factor(out, l, e),
     }
 }
 
-fn write_factor(out: &mut impl Write, f: &Function, e: &Expr) -> fmt::Result {
+fn write_factor(out: &mut impl Write, l: &impl Leaves, e: &Expr) -> fmt::Result {
     match e {
-        Expr::Operand(o) => write_operand(out, f, o),
+        Expr::Operand(o) => l.operand(out, o),
         Expr::Call(c, args) => {
-            write_callee(out, c)?;
+            l.callee(out, c)?;
             out.write_char('(')?;
             for (i, a) in args.iter().enumerate() {
                 if i > 0 {
                     out.write_str(", ")?;
                 }
-                write_sum(out, f, a)?;
+                write_sum(out, l, a)?;
             }
             out.write_char(')')
         }
         _ => {
             out.write_char('(')?;
-            write_sum(out, f, e)?;
+            write_sum(out, l, e)?;
             out.write_char(')')
         }
     }
@@ -77,7 +108,14 @@ fn write_factor(out: &mut impl Write, f: &Function, e: &Expr) -> fmt::Result {
 
 /// Writes an infix expression of `f`.
 pub fn write_expr(out: &mut impl Write, f: &Function, e: &Expr) -> fmt::Result {
-    write_sum(out, f, e)
+    write_sum(out, &IrLeaves(f), e)
+}
+
+/// Writes an infix expression with the leaves spelled by `leaves`, with the parentheses the
+/// `.rvir` text uses (only where the grammar needs them, so the text parses back to the same
+/// tree; `*` and `/` unspaced, `+` and `-` as [`Leaves::spaced_sums`] says).
+pub fn write_expr_with(out: &mut impl Write, leaves: &impl Leaves, e: &Expr) -> fmt::Result {
+    write_sum(out, leaves, e)
 }
 
 /// Writes one function.
