@@ -18,7 +18,7 @@
 //!    for `double` and `long double`, `g++ -O3 -march=native -DNDEBUG`; compiled once and cached
 //!    in `target/pinocchio_bench/` under the hash of its source and flags: ~3 min), robovec's C
 //!    (`cc -O3 -march=native -ffp-contract=off`) and the table of inputs and maps `table.c`;
-//! 4. runs it `runs` times (default 3): each rep times every contestant of a function once,
+//! 4. runs it `runs` times (default 5, `reps` default 101): each rep times every contestant of a function once,
 //!    alternating, the order rotated each rep, ~0.3 ms per sample cycling over the 64 states; the
 //!    ratio is built from **paired** samples (Pinocchio's ns over robovec's in the same rep; for
 //!    `crba` the faster of Pinocchio's LOCAL and WORLD conventions in that run), median per run,
@@ -44,11 +44,15 @@ use side::{read_states, robovec_inputs, run, Env, States};
 /// States both sides evaluate (a multiple of every batch width).
 const NSETS: usize = 64;
 
-/// robovec's variants of each function: label, pipeline before `codegen`, lanes, `trig`.
-const VARIANTS: [(&str, &str, u32, &str); 4] = [
+/// robovec's variants of each function: label, pipeline before `codegen`, lanes, `trig`. One
+/// state without `schedule-cpu` (it does not help one state: README "Speed of the generated C");
+/// batches of 4 (one AVX2 vector of doubles, the fastest width on this machine: 8 and 16 lanes
+/// were 5–45 % slower per state on TIAGo Pro and serial30) and 8.
+const VARIANTS: [(&str, &str, u32, &str); 5] = [
     ("1 state, trig=libm", "atomise,cse", 1, "libm"),
     ("1 state, trig=input", "atomise,cse", 1, "input"),
-    ("batch=8, trig=libm", "atomise,cse,schedule-cpu", 8, "libm"),
+    ("batch=4, trig=libm", "atomise,cse,schedule-cpu", 4, "libm"),
+    ("batch=4, trig=input", "atomise,cse,schedule-cpu", 4, "input"),
     ("batch=8, trig=input", "atomise,cse,schedule-cpu", 8, "input"),
 ];
 
@@ -84,7 +88,7 @@ struct Figures {
     ns: (f64, f64, f64),
     /// Median over runs of the median paired ratio Pinocchio / this (1 for Pinocchio's best).
     ratio: f64,
-    bits: (f64, f64),
+    errors: side::Errors,
 }
 
 fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Vec<Figures>) {
@@ -217,8 +221,8 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
         }
         eprintln!("   run {} of {runs} done", r + 1);
     }
-    let bits = side::bits_of_error(&work.join("values.bin"), &names, nv, NSETS);
-    let figures = names
+    let errors = side::errors(&work.join("values.bin"), &names, nv, NSETS);
+    let figures: Vec<Figures> = names
         .iter()
         .map(|(c, (g, name))| {
             let runs = &per_run[c];
@@ -233,16 +237,52 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
                     ns.iter().copied().fold(0.0, f64::max),
                 ),
                 ratio: side::median(&ratios),
-                bits: bits[c],
+                errors: errors[c],
             }
         })
         .collect();
+    // Both sides must compute the same function: a wrong map or a broken variant fails loudly.
+    for f in &figures {
+        assert!(
+            f.errors.relative <= 1e-9,
+            "{} {}: relative error {:e} against the long double reference",
+            robot.name,
+            f.name,
+            f.errors.relative
+        );
+    }
     (nv, figures)
+}
+
+/// One row of the summary: Pinocchio's fastest algorithm against each robovec variant.
+fn summary_row(robot: &str, nv: usize, g: usize, figs: &[Figures], mhz: f64) -> String {
+    let mine: Vec<&Figures> = figs.iter().filter(|f| f.group == g).collect();
+    let pin = mine
+        .iter()
+        .filter(|f| f.name.starts_with("pinocchio"))
+        .min_by(|a, b| a.ns.0.total_cmp(&b.ns.0))
+        .expect("a Pinocchio contestant");
+    let mut row = format!(
+        "| {robot} | {nv} | {} (`{}`) | {:.0} ({:.0} cycles) |",
+        GROUPS[g].0,
+        pin.name.trim_start_matches("pinocchio "),
+        pin.ns.0,
+        pin.ns.0 * mhz / 1e3
+    );
+    let mut robovec_bits = None;
+    for (label, ..) in VARIANTS {
+        let f = mine.iter().find(|f| f.name.starts_with("robovec") && f.name.ends_with(label)).expect("each variant");
+        let _ = write!(row, " {:.0} ({:.1}×) |", f.ns.0, f.ratio);
+        robovec_bits.get_or_insert((f.errors.mean_bits, f.errors.max_bits));
+    }
+    let (rm, rx) = robovec_bits.unwrap();
+    let _ = write!(row, " {:.2} / {:.0} | {rm:.2} / {rx:.0} |", pin.errors.mean_bits, pin.errors.max_bits);
+    row
 }
 
 fn main() {
     let mut wanted = Vec::new();
-    let (mut reps, mut runs) = (51, 3);
+    let (mut reps, mut runs) = (101, 5);
     for a in std::env::args().skip(1) {
         if let Some(r) = a.strip_prefix("--reps=") {
             reps = r.parse().expect("--reps=N");
@@ -260,23 +300,46 @@ fn main() {
     }
     let env = Env::new();
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
-    let mut out = String::new();
-    let _ = writeln!(out, "clock: {}; load average before: {}", side::clock(), load.trim());
-    let _ = writeln!(
-        out,
-        "\n| robot | dof | function | contestant | ns/state median over {runs} runs (min–max) | Pinocchio ÷ this (paired) | bits of error mean / max |"
+    let (cpu, mhz) = side::clock();
+    let mut summary = format!(
+        "{cpu} at {mhz} MHz (cycles = ns × that clock); load average before: {}; {runs} runs × {reps} reps, medians; \
+         (×) = Pinocchio's ns ÷ robovec's, paired per rep\n\n",
+        load.trim()
     );
-    out += "|---|---:|---|---|---:|---:|---|\n";
+    summary += "| robot | dof | function (Pinocchio's fastest) | Pinocchio ns/state |";
+    for (label, ..) in VARIANTS {
+        let _ = write!(summary, " robovec {label} |");
+    }
+    summary += " bits of error mean / max: Pinocchio | robovec |\n|---|---:|---|---:|";
+    summary += &"---:|".repeat(VARIANTS.len());
+    summary += "---|---|\n";
+    let mut detail = format!(
+        "| robot | dof | function | contestant | ns/state median over {runs} runs (min–max) | Pinocchio ÷ this (paired) | bits of error mean / max | worst relative error |\n|---|---:|---|---|---:|---:|---|---:|\n"
+    );
     for robot in ROBOTS.iter().filter(|r| wanted.is_empty() || wanted.iter().any(|w| w == r.name)) {
         let (nv, figs) = bench_robot(&env, robot, (reps, runs));
         for f in &figs {
             let _ = writeln!(
-                out,
-                "| {} | {nv} | {} | {} | {:.1} ({:.1}–{:.1}) | {:.2}× | {:.2} / {:.0} |",
-                robot.name, GROUPS[f.group].0, f.name, f.ns.0, f.ns.1, f.ns.2, f.ratio, f.bits.0, f.bits.1
+                detail,
+                "| {} | {nv} | {} | {} | {:.1} ({:.1}–{:.1}) | {:.2}× | {:.2} / {:.0} | {:.1e} |",
+                robot.name,
+                GROUPS[f.group].0,
+                f.name,
+                f.ns.0,
+                f.ns.1,
+                f.ns.2,
+                f.ratio,
+                f.errors.mean_bits,
+                f.errors.max_bits,
+                f.errors.relative
             );
         }
+        for g in 0..GROUPS.len() {
+            summary += &summary_row(robot.name, nv, g, &figs, mhz);
+            summary.push('\n');
+        }
     }
+    let out = format!("{summary}\nEvery contestant:\n\n{detail}");
     print!("{out}");
     let path = env.work.join("table.md");
     std::fs::write(&path, &out).unwrap();

@@ -146,16 +146,16 @@ pub fn median(xs: &[f64]) -> f64 {
     c[c.len() / 2]
 }
 
-/// The CPU's model name and the clock `/proc/cpuinfo` reports.
-pub fn clock() -> String {
+/// The CPU's model name and the clock `/proc/cpuinfo` reports (MHz; NaN when unknown).
+pub fn clock() -> (String, f64) {
     let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
     let field = |k: &str| {
-        info.lines()
-            .find(|l| l.starts_with(k))
-            .and_then(|l| l.split(':').nth(1))
-            .map_or("?".into(), |v| v.trim().to_string())
+        info.lines().find(|l| l.starts_with(k)).and_then(|l| l.split(':').nth(1)).map(|v| v.trim().to_string())
     };
-    format!("{}, {} MHz", field("model name"), field("cpu MHz"))
+    (
+        field("model name").unwrap_or_else(|| "?".into()),
+        field("cpu MHz").and_then(|m| m.parse().ok()).unwrap_or(f64::NAN),
+    )
 }
 
 /// The states of `export_model.py`'s `states.txt`: per state the robovec coordinates `x`
@@ -225,14 +225,25 @@ pub fn output_slot(name: &str, g: usize, nv: usize) -> usize {
     }
 }
 
-/// Bits of error (mean, max over states and entries) of each contestant's values in the
-/// harness's `values.bin` against the `long double` reference; for `M` the upper triangle only.
-pub fn bits_of_error(
+/// Error figures of one contestant on one function.
+#[derive(Clone, Copy)]
+pub struct Errors {
+    /// Bits of error, mean and max over states and entries.
+    pub mean_bits: f64,
+    pub max_bits: f64,
+    /// Worst over states of ‖values − reference‖∞ / ‖reference‖∞.
+    pub relative: f64,
+}
+
+/// [`Errors`] of each contestant's values in the harness's `values.bin` against the
+/// `long double` reference; for `M` the upper triangle only (the lower one is a copy on both
+/// sides).
+pub fn errors(
     path: &Path,
     names: &BTreeMap<usize, (usize, String)>,
     nv: usize,
     nsets: usize,
-) -> BTreeMap<usize, (f64, f64)> {
+) -> BTreeMap<usize, Errors> {
     let bytes = std::fs::read(path).unwrap();
     let vals: Vec<f64> = bytes.chunks_exact(8).map(|c| f64::from_ne_bytes(c.try_into().unwrap())).collect();
     let sizes = [nv, nv * nv, nv * nv + nv];
@@ -246,12 +257,24 @@ pub fn bits_of_error(
         for (&c, _) in names.iter().filter(|(_, (gg, _))| *gg == g) {
             let mine = &vals[at..at + block];
             at += block;
-            let bits: Vec<f64> = (0..block)
-                .filter(|&i| counted(g, i % size))
-                .map(|i| robovec_ir::numerics::bits_f64(mine[i], reference[i]))
-                .collect();
-            let mean = bits.iter().sum::<f64>() / bits.len() as f64;
-            out.insert(c, (mean, bits.iter().copied().fold(0.0, f64::max)));
+            let entries = || (0..block).filter(|&i| counted(g, i % size));
+            let bits: Vec<f64> = entries().map(|i| robovec_ir::numerics::bits_f64(mine[i], reference[i])).collect();
+            let mut relative: f64 = 0.0;
+            for s in 0..nsets {
+                let range = s * size..(s + 1) * size;
+                let norm = range.clone().fold(0.0f64, |m, i| m.max(reference[i].abs()));
+                let diff = range.fold(0.0f64, |m, i| m.max((mine[i] - reference[i]).abs()));
+                // A NaN (a value never written) stays NaN and fails the caller's check.
+                relative = if relative.is_nan() || diff.is_nan() { f64::NAN } else { relative.max(diff / norm) };
+            }
+            out.insert(
+                c,
+                Errors {
+                    mean_bits: bits.iter().sum::<f64>() / bits.len() as f64,
+                    max_bits: bits.iter().copied().fold(0.0, f64::max),
+                    relative,
+                },
+            );
         }
     }
     assert_eq!(at, vals.len(), "{}: size", path.display());
