@@ -31,6 +31,7 @@ mod props;
 mod report_dir;
 mod roundtrip;
 mod schedule_cpu;
+mod study;
 mod target;
 mod tree_height;
 mod urdf;
