@@ -239,3 +239,18 @@ pub fn json(results: &[CaseResult], seed: u64, samples: u32, best: &str) -> Stri
     };
     serde_json::to_string_pretty(&j).expect("the study serialises") + "\n"
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trends_and_orderings_read_as_stated() {
+        assert_eq!(trend(&[1.0, 2.0, 2.0, 3.0]), "grows");
+        assert_eq!(trend(&[298.0, 298.0, 298.0]), "stays flat");
+        assert_eq!(trend(&[3.0, 2.0]), "falls");
+        assert_eq!(trend(&[5.03, 10.64, 15.61, 29.39, 27.12]), "is not monotone");
+        let o = ordering([(Topology::Serial, 15.61), (Topology::SemiSerial, 12.51), (Topology::Parallel, 15.83)]);
+        assert_eq!(o, "parallel > serial > semi-serial");
+    }
+}
