@@ -108,8 +108,11 @@ fn chart(title: &str, x_desc: &str, y_desc: &str, lines: &[Line], log2_x: bool) 
             });
             c.draw_series(l.points.iter().map(|&p| Circle::new(p, 3, col.filled()))).map_err(err)?;
         }
+        // Lines rise to the right against dof and fall to the right against N: the legend
+        // goes to the emptier upper corner.
+        let corner = if log2_x { SeriesLabelPosition::UpperRight } else { SeriesLabelPosition::UpperLeft };
         c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(corner)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
