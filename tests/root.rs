@@ -32,6 +32,7 @@ mod report_dir;
 mod robotran_c;
 mod roundtrip;
 mod schedule_cpu;
+mod study;
 mod target;
 mod tree_height;
 mod urdf;

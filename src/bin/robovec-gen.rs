@@ -117,7 +117,10 @@ fn study(args: &Args) -> ExitCode {
         ns: robovec::study::DEFAULT_NS.to_vec(),
         report_dir: args.study.report_dir.clone(),
         quiet: args.study.quiet,
-        command: std::env::args().collect::<Vec<_>>().join(" "),
+        command: std::iter::once("robovec-gen".to_string())
+            .chain(std::env::args().skip(1))
+            .collect::<Vec<_>>()
+            .join(" "),
     };
     let terminal = std::io::stderr().is_terminal();
     match robovec::study::run(&opts, terminal, &mut std::io::stdout().lock(), &mut std::io::stderr()) {

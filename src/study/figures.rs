@@ -28,11 +28,22 @@ fn err(e: impl std::fmt::Display) -> String {
     format!("drawing a study figure failed: {e}")
 }
 
-/// One line: label, colour index, dashed, points.
+/// How a line is drawn.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Stroke {
+    /// Solid, 2 px.
+    Solid,
+    /// Dashed, 2 px.
+    Dashed,
+    /// Solid, 1 px.
+    Thin,
+}
+
+/// One line: label, colour index, stroke, points.
 struct Line {
     label: String,
     colour: usize,
-    dashed: bool,
+    stroke: Stroke,
     points: Vec<(f64, f64)>,
 }
 
@@ -80,21 +91,28 @@ fn chart(title: &str, x_desc: &str, y_desc: &str, lines: &[Line], log2_x: bool) 
         mesh.draw().map_err(err)?;
         for l in lines {
             let col = PALETTE[l.colour % PALETTE.len()];
-            let style = col.stroke_width(2);
-            let s = if l.dashed {
+            let w = if l.stroke == Stroke::Thin { 1 } else { 2 };
+            let style = col.stroke_width(w);
+            let s = if l.stroke == Stroke::Dashed {
                 c.draw_series(DashedLineSeries::new(l.points.iter().copied(), 6, 4, style)).map_err(err)?
             } else {
                 c.draw_series(LineSeries::new(l.points.iter().copied(), style)).map_err(err)?
             };
-            let dashed = l.dashed;
+            let stroke = l.stroke;
             s.label(l.label.as_str()).legend(move |(x, y)| {
-                let w = if dashed { 1 } else { 2 };
-                PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(w))
+                if stroke == Stroke::Dashed {
+                    PathElement::new(vec![(x, y), (x + 6, y)], col.stroke_width(w))
+                } else {
+                    PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(w))
+                }
             });
             c.draw_series(l.points.iter().map(|&p| Circle::new(p, 3, col.filled()))).map_err(err)?;
         }
+        // Lines rise to the right against dof and fall to the right against N: the legend
+        // goes to the emptier upper corner.
+        let corner = if log2_x { SeriesLabelPosition::UpperRight } else { SeriesLabelPosition::UpperLeft };
         c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(corner)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
@@ -114,8 +132,8 @@ fn pipelines(r: &CaseResult) -> [(&'static str, &Shape); 3] {
     [("generated", &r.generated), ("zero-removal,balance", &r.zero_balance), ("best", &r.best)]
 }
 
-/// One figure of a shape figure against dof: per topology (colour) and pipeline (solid for
-/// the best, dashed otherwise).
+/// A shape figure against dof: colour per topology; as generated dashed, after
+/// `zero-removal,balance` thin, after the best pipeline solid.
 fn per_dof(
     results: &[CaseResult],
     (name, caption, title, y_desc): (&'static str, &str, &str, &str),
@@ -133,12 +151,8 @@ fn per_dof(
                 points.push((r.case.dof as f64, value(s)));
                 csv += &format!("{t},{p},{},{}\n", r.case.dof, value(s));
             }
-            lines.push(Line {
-                label: format!("{t}, {p}"),
-                colour: ci * 2 + usize::from(pi == 2),
-                dashed: pi == 0,
-                points,
-            });
+            let stroke = [Stroke::Dashed, Stroke::Thin, Stroke::Solid][pi];
+            lines.push(Line { label: format!("{t}, {p}"), colour: ci, stroke, points });
         }
     }
     let svg = chart(title, "degrees of freedom", y_desc, &lines, false)?;
@@ -153,19 +167,19 @@ pub fn all(results: &[CaseResult]) -> Result<Vec<Figure>> {
     let mut out = vec![
         per_dof(
             results,
-            ("ops", "Ops of dirdyna against dof per topology: as generated (dashed), after zero-removal,balance and after the best pipeline", "Ops vs dof", "ops"),
+            ("ops", "Ops of dirdyna against dof per topology: as generated (dashed), after zero-removal,balance (thin) and after the best pipeline (solid); colour per topology", "Ops vs dof", "ops"),
             "ops",
             |s| s.ops as f64,
         )?,
         per_dof(
             results,
-            ("critical_path", "Critical path in cycles (largest ASAPCycle, add 12 / mul 7) against dof, the three pipelines", "Critical path vs dof", "ASAPCycle (cycles)"),
+            ("critical_path", "Critical path in cycles (largest ASAPCycle, add 12 / mul 7) against dof, the three pipelines (as in the ops figure)", "Critical path vs dof", "ASAPCycle (cycles)"),
             "asap_cycle",
             |s| s.asap_cycle as f64,
         )?,
         per_dof(
             results,
-            ("y", "Number Y = ops / ASAPCycle (seed §3.2) against dof, the three pipelines", "Y vs dof", "Y = ops / ASAPCycle"),
+            ("y", "Number Y = ops / ASAPCycle (seed §3.2) against dof, the three pipelines (as in the ops figure)", "Y vs dof", "Y = ops / ASAPCycle"),
             "y",
             |s| s.y,
         )?,
@@ -177,16 +191,20 @@ pub fn all(results: &[CaseResult]) -> Result<Vec<Figure>> {
     let mut csv = String::from("dof,topology,n,cycles\n");
     for r in results {
         let colour = dofs.iter().position(|&d| d == r.case.dof).unwrap_or(0);
-        let dashed = r.case.topology != Topology::Serial;
+        let stroke = match r.case.topology {
+            Topology::Serial => Stroke::Solid,
+            Topology::SemiSerial => Stroke::Dashed,
+            Topology::Parallel => Stroke::Thin,
+        };
         let points = r.placed.iter().map(|p| ((p.n.max(1) as f64).log2(), p.cycles as f64)).collect();
         for p in &r.placed {
             csv += &format!("{},{},{},{}\n", r.case.dof, r.case.topology, p.n, p.cycles);
         }
-        lines.push(Line { label: r.case.label(), colour, dashed, points });
+        lines.push(Line { label: r.case.label(), colour, stroke, points });
     }
     out.push(Figure {
         name: "cycles",
-        caption: "Placed cycles (place<pe=N> after the best pipeline) against N per case; serial solid, semi-serial and parallel dashed".into(),
+        caption: "Placed cycles (place<pe=N> after the best pipeline) against N per case; colour per dof, serial solid, semi-serial dashed, parallel thin".into(),
         svg: chart("Placed cycles vs N", "N (ADD PEs = MULTI PEs), log scale", "cycles", &lines, true)?,
         csv,
     });
@@ -201,7 +219,8 @@ pub fn all(results: &[CaseResult]) -> Result<Vec<Figure>> {
                 points.push((r.case.dof as f64, v));
                 csv += &format!("{t},{stat},{},{v}\n", r.case.dof);
             }
-            lines.push(Line { label: format!("{t}, {stat}"), colour: ci * 2, dashed: k == 1, points });
+            let stroke = if k == 0 { Stroke::Solid } else { Stroke::Dashed };
+            lines.push(Line { label: format!("{t}, {stat}"), colour: ci, stroke, points });
         }
     }
     out.push(Figure {

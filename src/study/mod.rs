@@ -12,14 +12,26 @@
 //! `robovec-gen --topology T --dof N --seed S` writes (the tests check it through the binaries).
 //!
 //! # The best rewrite pipeline
-//! [`DEFAULT_BEST`] = `atomise,zero-removal,cse,distribute,balance`: among the candidates
-//! measured on the 15 cases (README "The study"), it gives the shortest critical path and
-//! fewest placed cycles at every N, with fewer ops than `zero-removal,balance` and binary32
-//! error of the same order. `cse` merges the repeated products of the generator's CRBA/RNEA
-//! (bit-exact: an op equal to an earlier one is dropped); `distribute` multiplies critical
-//! products of sums out (ops budget 1.5×) so that `balance` can reorder the terms, which cuts
-//! the critical path further than `balance` alone. `eqsat` windows and `inline` were slower
-//! to run on 200k-op functions for a smaller gain. `--best PIPELINE` runs another one.
+//! [`DEFAULT_BEST`] = `atomise,zero-removal,cse,distribute,balance`. Rule: fewest placed
+//! cycles summed over N = 8, 16, 32, 64, at binary32 error no worse than
+//! `zero-removal,balance`'s. Measured on the 23-, 70- and 130-dof cases (9 cases, 100
+//! samples; sums over the cases):
+//!
+//! | best pipeline candidate | ops | ASAPCycle | cycles N = 8 / 16 / 32 / 64 (sum) | f32 bits mean / max |
+//! |---|---:|---:|---:|---:|
+//! | `atomise,cse,zero-removal,balance` | 335 205 | 17 487 | 26 192 / 18 024 / 17 502 / 17 487 (79 205) | 0.88 / 22.0 |
+//! | `atomise,zero-removal,cse,distribute,balance` | 361 590 | 13 457 | 27 087 / 15 604 / 13 499 / 13 457 (69 647) | 0.88 / 22.0 |
+//! | `atomise,zero-removal,cse,inline<max-uses=3>,balance` | 346 060 | 14 305 | 26 252 / 15 700 / 14 360 / 14 305 (70 617) | 0.88 / 21.4 |
+//! | `atomise,zero-removal,cse,distribute,inline<max-uses=3>,balance` | 419 073 | 12 556 | 31 141 / 16 389 / 12 642 / 12 556 (72 728) | 0.88 / 21.4 |
+//!
+//! `cse` merges the repeated products of the generator's CRBA/RNEA (bit-exact); `distribute`
+//! multiplies critical products of sums out (ops budget 1.5×; `max-growth=2` gives the same
+//! IR) so that `balance` can reorder the terms: the critical path is 23% shorter than with
+//! `cse,zero-removal,balance` for 8% more ops. Only at N = 8, where placement is bound by
+//! ops / N, does the smaller IR of `cse,zero-removal,balance` place in fewer cycles (3%).
+//! Adding `inline` shortens the critical path further but costs 16% more ops and 15% more
+//! cycles at N = 8. `eqsat` windows were not measured on these sizes. `--best PIPELINE` runs
+//! another pipeline.
 //!
 //! # Outputs
 //! Without `--report-dir`, the markdown table ([`table::markdown`]) on stdout. With

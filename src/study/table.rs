@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use super::cases::{thesis_row, ThesisRow};
 use super::run::{CaseResult, Shape, GENERATED, ZERO_BALANCE};
+use crate::gen::topology::Topology;
 
 /// `ops, ASAP − ASAPCycle, Y` of a shape, as the thesis prints them.
 fn shape_cell(s: &Shape) -> String {
@@ -77,30 +78,67 @@ pub fn study_md(results: &[CaseResult], best: &str, command: &str, figures: &[(&
     out
 }
 
-/// Checks of the thesis's shapes on `results`, one sentence each: growth with dof, topology
-/// ordering, Y, ratio to the thesis's rows.
+/// How a sequence moves: `grows` (never falls, rises somewhere), `stays flat`, `falls` or
+/// `is not monotone`.
+fn trend(xs: &[f64]) -> &'static str {
+    let up = xs.windows(2).any(|w| w[1] > w[0]);
+    let down = xs.windows(2).any(|w| w[1] < w[0]);
+    match (up, down) {
+        (true, false) => "grows",
+        (false, false) => "stays flat",
+        (false, true) => "falls",
+        (true, true) => "is not monotone",
+    }
+}
+
+/// The order of the three topologies by `value`, largest first (`serial > semi-serial >
+/// parallel`).
+fn ordering(values: [(Topology, f64); 3]) -> String {
+    let mut v = values;
+    v.sort_by(|a, b| b.1.total_cmp(&a.1));
+    v.iter().map(|(t, _)| t.name()).collect::<Vec<_>>().join(" > ")
+}
+
+/// Checks of the thesis's shapes on `results`, one sentence each, robovec's against the
+/// thesis's rows: growth with dof (ops, critical path, Y) per topology, the topology ordering
+/// of ops and of Y per dof, and the ratio of sizes.
 pub fn shape_notes(results: &[CaseResult]) -> Vec<String> {
-    use crate::gen::topology::Topology;
     let mut notes = Vec::new();
     let of = |dof: usize, t: Topology| results.iter().find(|r| r.case.dof == dof && r.case.topology == t);
     let mut dofs: Vec<usize> = results.iter().map(|r| r.case.dof).collect();
     dofs.dedup();
+    let fmt = |xs: &[f64], decimals: usize| xs.iter().map(|x| format!("{x:.decimals$}")).collect::<Vec<_>>().join(", ");
     for t in Topology::ALL {
         let rows: Vec<&CaseResult> = dofs.iter().filter_map(|&d| of(d, t)).collect();
         if rows.len() < 2 {
             continue;
         }
-        let grows = |f: fn(&CaseResult) -> f64| rows.windows(2).all(|w| f(w[1]) >= f(w[0]));
-        let ops: Vec<String> = rows.iter().map(|r| r.generated.ops.to_string()).collect();
-        let ys: Vec<String> = rows.iter().map(|r| format!("{:.2}", r.generated.y)).collect();
-        notes.push(format!(
-            "{t}: ops as generated {} with dof ({}); critical path {}; Y {} ({})",
-            if grows(|r| r.generated.ops as f64) { "grow" } else { "do not all grow" },
-            ops.join(", "),
-            if grows(|r| r.generated.asap_cycle as f64) { "grows" } else { "stays flat or falls somewhere" },
-            if grows(|r| r.generated.y) { "grows" } else { "does not all grow" },
-            ys.join(", ")
-        ));
+        let ops: Vec<f64> = rows.iter().map(|r| r.generated.ops as f64).collect();
+        let cp: Vec<f64> = rows.iter().map(|r| r.generated.asap_cycle as f64).collect();
+        let y: Vec<f64> = rows.iter().map(|r| r.generated.y).collect();
+        let mut note = format!(
+            "{t}, as generated: ops count {} ({}), critical path {} ({} cycles), Y {} ({})",
+            trend(&ops),
+            fmt(&ops, 0),
+            trend(&cp),
+            fmt(&cp, 0),
+            trend(&y),
+            fmt(&y, 2)
+        );
+        let th: Vec<&ThesisRow> = rows.iter().filter_map(|r| thesis_row(&r.case)).collect();
+        if th.len() == rows.len() {
+            let tops: Vec<f64> = th.iter().map(|r| r.ops as f64).collect();
+            let tcp: Vec<f64> = th.iter().map(|r| r.asap_cycle as f64).collect();
+            let ty: Vec<f64> = th.iter().map(|r| r.y).collect();
+            note += &format!(
+                "; thesis: ops count {}, critical path {}, Y {} ({})",
+                trend(&tops),
+                trend(&tcp),
+                trend(&ty),
+                fmt(&ty, 2)
+            );
+        }
+        notes.push(note);
     }
     for &d in &dofs {
         let (Some(s), Some(m), Some(p)) =
@@ -108,17 +146,27 @@ pub fn shape_notes(results: &[CaseResult]) -> Vec<String> {
         else {
             continue;
         };
-        let ordered = s.generated.ops >= m.generated.ops && m.generated.ops >= p.generated.ops;
-        notes.push(format!(
-            "{d} dof: ops serial {} semi-serial {} parallel ({} ≥ {} ≥ {} {}; serial / parallel {:.1}×)",
-            if ordered { "≥" } else { "vs" },
-            if ordered { "≥" } else { "vs" },
-            s.generated.ops,
-            m.generated.ops,
-            p.generated.ops,
-            if ordered { "as in the thesis" } else { "unlike the thesis" },
-            s.generated.ops as f64 / p.generated.ops.max(1) as f64
-        ));
+        let three = |f: &dyn Fn(&CaseResult) -> f64| {
+            [(Topology::Serial, f(s)), (Topology::SemiSerial, f(m)), (Topology::Parallel, f(p))]
+        };
+        let mut note = format!(
+            "{d} dof: ops {} (serial / parallel {:.1}×), Y {}",
+            ordering(three(&|r| r.generated.ops as f64)),
+            s.generated.ops as f64 / p.generated.ops.max(1) as f64,
+            ordering(three(&|r| r.generated.y))
+        );
+        if let (Some(ts), Some(tm), Some(tp)) = (thesis_row(&s.case), thesis_row(&m.case), thesis_row(&p.case)) {
+            let t3 = |f: fn(&ThesisRow) -> f64| {
+                [(Topology::Serial, f(ts)), (Topology::SemiSerial, f(tm)), (Topology::Parallel, f(tp))]
+            };
+            note += &format!(
+                "; thesis: ops {} ({:.1}×), Y {}",
+                ordering(t3(|r| r.ops as f64)),
+                ts.ops as f64 / tp.ops as f64,
+                ordering(t3(|r| r.y))
+            );
+        }
+        notes.push(note);
     }
     let ratios: Vec<(f64, f64)> = results
         .iter()
@@ -134,7 +182,8 @@ pub fn shape_notes(results: &[CaseResult]) -> Vec<String> {
             format!("{lo:.1}–{hi:.1}×")
         };
         notes.push(format!(
-            "the thesis's models have {} robovec's ops as generated and {} its critical path in cycles (different robots: shapes compare, not sizes)",
+            "sizes: the thesis's models have {} robovec's ops as generated and {} its critical path in cycles \
+             (different robots: the shapes compare, not the sizes)",
             span(|r| r.0),
             span(|r| r.1)
         ));
@@ -189,4 +238,19 @@ pub fn json(results: &[CaseResult], seed: u64, samples: u32, best: &str) -> Stri
         cases: results.iter().map(|r| CaseJson { result: r, thesis: thesis_row(&r.case) }).collect(),
     };
     serde_json::to_string_pretty(&j).expect("the study serialises") + "\n"
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trends_and_orderings_read_as_stated() {
+        assert_eq!(trend(&[1.0, 2.0, 2.0, 3.0]), "grows");
+        assert_eq!(trend(&[298.0, 298.0, 298.0]), "stays flat");
+        assert_eq!(trend(&[3.0, 2.0]), "falls");
+        assert_eq!(trend(&[5.03, 10.64, 15.61, 29.39, 27.12]), "is not monotone");
+        let o = ordering([(Topology::Serial, 15.61), (Topology::SemiSerial, 12.51), (Topology::Parallel, 15.83)]);
+        assert_eq!(o, "parallel > serial > semi-serial");
+    }
 }
