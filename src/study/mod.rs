@@ -19,6 +19,7 @@
 //!
 //! | best pipeline candidate | ops | ASAPCycle | cycles N = 8 / 16 / 32 / 64 (sum) | f32 bits mean / max |
 //! |---|---:|---:|---:|---:|
+//! | `atomise,zero-removal,balance` (the thesis's rewrites, for reference) | 369 234 | 17 487 | 29 016 / 18 635 / 17 577 / 17 487 (82 715) | 0.88 / 22.2 |
 //! | `atomise,cse,zero-removal,balance` | 335 205 | 17 487 | 26 192 / 18 024 / 17 502 / 17 487 (79 205) | 0.88 / 22.0 |
 //! | `atomise,zero-removal,cse,distribute,balance` | 361 590 | 13 457 | 27 087 / 15 604 / 13 499 / 13 457 (69 647) | 0.88 / 22.0 |
 //! | `atomise,zero-removal,cse,inline<max-uses=3>,balance` | 346 060 | 14 305 | 26 252 / 15 700 / 14 360 / 14 305 (70 617) | 0.88 / 21.4 |
