@@ -142,8 +142,12 @@ fn robot(source: &Source, floating_base: bool) -> Result<super::robot::Robot, Fa
     }
 }
 
+/// Equations of one robot: the module, the values of the parameters left as inputs, and the
+/// project name.
+type Equations = (Module, Option<BTreeMap<String, f64>>, String);
+
 /// The equations, parameter values and project name of `source`.
-fn equations(source: &Source, front: FrontOptions) -> Result<(Module, Option<BTreeMap<String, f64>>, String), Failure> {
+fn equations(source: &Source, front: FrontOptions) -> Result<Equations, Failure> {
     match source {
         Source::Topology { topology, dof, seed } => {
             let robot = robot(source, front.floating_base)?;
