@@ -24,10 +24,10 @@ pub struct Figure {
 }
 
 /// Size of a single-panel figure, pixels.
-const SIZE: (u32, u32) = (900, 560);
+pub(crate) const SIZE: (u32, u32) = (900, 560);
 
 /// Series colours (colour-blind safe: Okabe–Ito).
-const PALETTE: [RGBColor; 7] = [
+pub(crate) const PALETTE: [RGBColor; 7] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 158, 115),

@@ -7,22 +7,9 @@ use plotters::prelude::*;
 
 use super::run::{CaseResult, Shape};
 use crate::gen::topology::Topology;
-use crate::report_dir::figures::Figure;
+use crate::report_dir::figures::{Figure, PALETTE, SIZE};
 
 type Result<T> = std::result::Result<T, String>;
-
-/// Size of a figure, pixels.
-const SIZE: (u32, u32) = (900, 560);
-
-/// Colours (Okabe–Ito, colour-blind safe).
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
-];
 
 fn err(e: impl std::fmt::Display) -> String {
     format!("drawing a study figure failed: {e}")
