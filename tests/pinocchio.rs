@@ -205,3 +205,57 @@ fn mobile_manipulator_matches_pinocchio_composite_root_joint() {
     let e = compare_on("erd:tiago_pro_description/robots/tiago_pro.urdf", 33 + 6, true);
     eprintln!("tiago_pro floating: worst relative error {e:e}");
 }
+
+/// The contract between `benches/pinocchio/export_model.py` and the bench's C++ harness (which
+/// rebuilds Pinocchio's configuration from robovec's coordinates for its `long double`
+/// reference): on TIAGo Pro (floating base, continuous wheel joints), `states.txt` has the sizes
+/// the JSON names, the six base coordinates first, one coordinate per velocity, `nq − nv`
+/// continuous joints whose configuration is `(cos x, sin x)`, every other entry `x` itself, and
+/// the oracle's ranges; `model.txt` is a Boost text archive.
+#[test]
+fn bench_export_states_follow_the_harness_layout() {
+    let Some(py) = python() else { return };
+    let dir = crate::common::tmp("export");
+    let out = Command::new(&py)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("benches/pinocchio/export_model.py")
+        .args(["erd:tiago_pro_description/robots/tiago_pro.urdf", dir.to_str().unwrap(), "3", "5", "floating"])
+        .output()
+        .expect("run export_model.py");
+    assert!(out.status.success(), "export_model.py: {}", String::from_utf8_lossy(&out.stderr));
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).expect("export JSON");
+    let (nq, nv) = (info["nq"].as_u64().unwrap() as usize, info["nv"].as_u64().unwrap() as usize);
+    assert_eq!(nv, 33 + 6);
+    let archive = std::fs::read_to_string(dir.join("model.txt")).unwrap();
+    assert!(archive.contains("serialization::archive"), "model.txt: {}", &archive[..archive.len().min(80)]);
+    let text = std::fs::read_to_string(dir.join("states.txt")).unwrap();
+    let w: Vec<f64> = text.split_whitespace().map(|t| t.parse().unwrap()).collect();
+    assert_eq!(&w[..3], &[3.0, nq as f64, nv as f64]);
+    assert_eq!(&w[3..6], &[0.0, 0.0, -9.81]);
+    let layout: Vec<(usize, u8)> = w[6..6 + 2 * nv].chunks(2).map(|c| (c[0] as usize, c[1] as u8)).collect();
+    let continuous = layout.iter().filter(|l| l.1 == 1).count();
+    assert!(continuous > 0, "TIAGo Pro's wheels are continuous joints");
+    assert_eq!(nq - nv, continuous);
+    assert_eq!(&layout[..6], &[(0, 0), (1, 0), (2, 0), (3, 0), (4, 0), (5, 0)]);
+    let mut states = w[6 + 2 * nv..].chunks(nv + nq + 2 * nv);
+    for _ in 0..3 {
+        let s = states.next().expect("3 states");
+        assert_eq!(s.len(), nv + nq + 2 * nv);
+        let (x, rest) = s.split_at(nv);
+        let (q, va) = rest.split_at(nq);
+        let mut covered = vec![false; nq];
+        for (&(i, kind), &xi) in layout.iter().zip(x) {
+            assert!(xi.abs() <= std::f64::consts::PI);
+            if kind == 1 {
+                assert!((q[i] - xi.cos()).abs() <= 1e-15 && (q[i + 1] - xi.sin()).abs() <= 1e-15);
+                covered[i + 1] = true;
+            } else {
+                assert_eq!(q[i], xi);
+            }
+            covered[i] = true;
+        }
+        assert!(covered.iter().all(|&c| c), "every configuration entry comes from a coordinate");
+        assert!(va.iter().all(|t| t.abs() <= 2.0));
+    }
+    assert!(states.next().is_none());
+}
