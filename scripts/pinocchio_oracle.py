@@ -39,18 +39,23 @@ def locate(spec):
     sys.exit(f"example-robot-data file {rel} not found under {sys.prefix}")
 
 
+def build_model(path, floating):
+    """Pinocchio's model of the URDF at `path`: fixed base, or (`floating`) on the root joint
+    JointModelComposite([PX, PY, PZ, RX, RY, RZ]), the layout of robovec's --floating-base."""
+    if not floating:
+        return pin.buildModelFromUrdf(path)
+    root = pin.JointModelComposite()
+    for j in (pin.JointModelPX(), pin.JointModelPY(), pin.JointModelPZ(),
+              pin.JointModelRX(), pin.JointModelRY(), pin.JointModelRZ()):
+        root.addJoint(j)
+    return pin.buildModelFromUrdf(path, root)
+
+
 def main():
     path = locate(sys.argv[1])
     n, seed = int(sys.argv[2]), int(sys.argv[3])
     floating = len(sys.argv) > 4 and sys.argv[4] == "floating"
-    if floating:
-        root = pin.JointModelComposite()
-        for j in (pin.JointModelPX(), pin.JointModelPY(), pin.JointModelPZ(),
-                  pin.JointModelRX(), pin.JointModelRY(), pin.JointModelRZ()):
-            root.addJoint(j)
-        model = pin.buildModelFromUrdf(path, root)
-    else:
-        model = pin.buildModelFromUrdf(path)
+    model = build_model(path, floating)
     data = model.createData()
     rng = np.random.default_rng(seed)
     joints = list(model.joints)[1:]

@@ -28,7 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
-from pinocchio_oracle import locate  # noqa: E402
+from pinocchio_oracle import build_model, locate  # noqa: E402
 
 
 def main():
@@ -37,14 +37,7 @@ def main():
     path = locate(sys.argv[1])
     out_dir, n, seed = sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
     floating = len(sys.argv) > 5 and sys.argv[5] == "floating"
-    if floating:
-        root = pin.JointModelComposite()
-        for j in (pin.JointModelPX(), pin.JointModelPY(), pin.JointModelPZ(),
-                  pin.JointModelRX(), pin.JointModelRY(), pin.JointModelRZ()):
-            root.addJoint(j)
-        model = pin.buildModelFromUrdf(path, root)
-    else:
-        model = pin.buildModelFromUrdf(path)
+    model = build_model(path, floating)
     os.makedirs(out_dir, exist_ok=True)
     model.saveToText(os.path.join(out_dir, "model.txt"))
 
