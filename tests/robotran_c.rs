@@ -211,8 +211,8 @@ fn robovec_gen_refuses_bad_input_and_usage_and_writes_nothing() {
     let cs = c.to_str().unwrap();
     // C needs -o FILE.c (two files); --params-out with folded parameters is meaningless.
     for args in [
-        vec!["--topology", "serial", "--dof", "3", "--format", "c"],
-        vec!["--topology", "serial", "--dof", "3", "--format", "c", "-o", "x.urdf"],
+        vec!["--topology", "serial", "--dof", "3", "--format", "c", "--function", "invdyna"],
+        vec!["--topology", "serial", "--dof", "3", "--format", "c", "--function", "invdyna", "-o", "x.urdf"],
         vec![
             "--topology",
             "serial",
@@ -228,13 +228,16 @@ fn robovec_gen_refuses_bad_input_and_usage_and_writes_nothing() {
         ],
         vec!["--topology", "serial", "--dof", "3", "--format", "c", "--function", "sensor", "-o", cs],
         vec!["--topology", "serial", "--urdf", "a.urdf", "-o", cs],
+        // --function belongs to C (required there), not to the URDF writer.
+        vec!["--topology", "serial", "--dof", "3", "--format", "c", "-o", cs],
+        vec!["--topology", "serial", "--dof", "3", "--function", "dirdyna", "-o", "x.urdf"],
     ] {
         let o = gen(&args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
     }
     let bad = dir.join("bad.urdf");
     std::fs::write(&bad, "<robot name=\"r\">\n  <link name=\"a\"/>\n  <joint name=\"j\" type=\"revolute\">\n    <parent link=\"a\"/>\n  </joint>\n</robot>\n").unwrap();
-    let o = gen(&["--urdf", bad.to_str().unwrap(), "--format", "c", "-o", cs]);
+    let o = gen(&["--urdf", bad.to_str().unwrap(), "--format", "c", "--function", "invdyna", "-o", cs]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("bad.urdf:3:"), "{}", stderr(&o));
     let left: Vec<_> = std::fs::read_dir(&dir).unwrap().flatten().map(|e| e.file_name()).collect();

@@ -65,9 +65,9 @@ struct ModelArgs {
     /// urdf: the robot as URDF; c: one function (--function) as a Robotran 6.6 C file and header.
     #[arg(long, value_enum, default_value = "urdf", conflicts_with = "study")]
     format: Format,
-    /// With --format c: the function, invdyna (Qq) or dirdyna (M, c).
-    #[arg(long, default_value = "invdyna", value_parser = ["invdyna", "dirdyna"], conflicts_with = "study")]
-    function: String,
+    /// With --format c (required there): the function, invdyna (Qq) or dirdyna (M, c).
+    #[arg(long, value_parser = ["invdyna", "dirdyna"], conflicts_with = "study")]
+    function: Option<String>,
     /// Put the robot on Robotran's floating base (T1 T2 T3 R1 R2 R3 as q[1..6]).
     #[arg(long, conflicts_with = "study")]
     floating_base: bool,
@@ -152,10 +152,16 @@ fn main() -> ExitCode {
             Source::Topology { topology, dof: dof as usize, seed: args.seed }
         }
     };
+    let function = match (args.model.format, &args.model.function) {
+        (Format::C, Some(f)) => f.clone(),
+        (Format::Urdf, None) => String::new(),
+        (Format::C, None) => usage("--format c writes one function: add --function invdyna or --function dirdyna"),
+        (Format::Urdf, Some(_)) => usage("--function selects the equations of --format c; a URDF holds the robot"),
+    };
     let export = Export {
         source,
         format: args.model.format,
-        function: args.model.function.clone(),
+        function,
         floating_base: args.model.floating_base,
         fold_params: args.model.fold_params,
         params_out: args.model.params_out.clone(),
@@ -168,4 +174,10 @@ fn main() -> ExitCode {
             ExitCode::from(f.exit_code() as u8)
         }
     }
+}
+
+/// Exits with clap's usage error (status 2) saying `msg`.
+fn usage(msg: &str) -> ! {
+    use clap::CommandFactory;
+    Args::command().error(clap::error::ErrorKind::ArgumentConflict, msg).exit()
 }
