@@ -45,7 +45,8 @@
 //! `BEST,accuracy<samples=K>,sweep<pe=8,16,32,64>,place<pe=8>` with `-pareto` of the three
 //! pipelines.
 //!
-//! Cases run in parallel (rayon); progress is an `indicatif` bar on a terminal without `-q`.
+//! Cases run in parallel (rayon); progress goes through `crate::progress` (an `indicatif` bar
+//! on a terminal without `-q`).
 
 pub mod cases;
 pub mod figures;
@@ -54,6 +55,7 @@ pub mod table;
 
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -119,14 +121,8 @@ pub fn run(
         report: opts.report_dir.is_some(),
     };
     let list = cases::cases(&opts.dofs, &opts.topologies);
-    let bar = crate::progress::shows_progress(stderr_is_terminal, opts.quiet).then(|| {
-        let style =
-            indicatif::ProgressStyle::with_template("study [{bar:30}] {pos}/{len} cases ({elapsed}, ETA {eta})")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-                .progress_chars("=> ");
-        indicatif::ProgressBar::with_draw_target(Some(list.len() as u64), indicatif::ProgressDrawTarget::stderr())
-            .with_style(style)
-    });
+    let task = crate::progress::progress_for(stderr_is_terminal, opts.quiet).task("study cases", list.len() as u64);
+    let finished = AtomicU64::new(0);
     let t0 = Instant::now();
     // Largest cases first, so the parallel run does not end on one big case alone.
     let mut order: Vec<usize> = (0..list.len()).collect();
@@ -135,15 +131,11 @@ pub fn run(
         .par_iter()
         .map(|&i| {
             let r = run::run_case(&list[i], &plan);
-            if let Some(b) = &bar {
-                b.inc(1);
-            }
+            task.set(finished.fetch_add(1, Ordering::Relaxed) + 1);
             (i, r)
         })
         .collect();
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    task.finish();
     done.sort_by_key(|(i, _)| *i);
     let results = done.into_iter().map(|(_, r)| r).collect::<Result<Vec<_>, _>>()?;
     let secs = t0.elapsed().as_secs_f64();

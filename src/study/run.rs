@@ -30,7 +30,8 @@ pub struct Plan {
     pub seed: u64,
     /// `accuracy<samples=K>`: sampled states (accuracy's own seed stays 1, its default).
     pub samples: u32,
-    /// The best rewrite pipeline (from the parsed equations, `atomise` first).
+    /// The best rewrite pipeline (from the parsed equations, `atomise` first), in the pass
+    /// manager's normalised text (`PassManager::pipeline_text`).
     pub best: String,
     /// N of the placements `place<pe=N>` (N ADD + N MULTI PEs) after the best pipeline.
     pub ns: Vec<u32>,
@@ -202,7 +203,7 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
         if let (Some(n), Some(p)) = (n0, &own.placement) {
             placed.push(Placed { n, cycles: p.cycles });
         }
-        let pipeline = format!("{},{tail}", manager(&plan.best)?.pipeline_text());
+        let pipeline = format!("{},{tail}", plan.best);
         report = Some(crate::driver::report_text(&case.urdf_name(plan.seed), &pipeline, &records, &cx, &own));
     }
     for &n in plan.ns.iter().skip(placed.len()) {
