@@ -291,21 +291,6 @@ fn foreign_entry(dir: &Path, depth: u32) -> io::Result<Option<String>> {
     Ok(None)
 }
 
-/// Removes a folder [`check_replaceable_folder`] accepted: its files and subfolders, never
-/// following a link (there is none: checked).
-fn remove_our_folder(dir: &Path) {
-    if let Ok(rd) = fs::read_dir(dir) {
-        for e in rd.flatten() {
-            if e.file_type().is_ok_and(|t| t.is_dir()) {
-                remove_our_folder(&e.path());
-            } else {
-                let _ = fs::remove_file(e.path());
-            }
-        }
-    }
-    let _ = fs::remove_dir(dir);
-}
-
 /// A folder staged as a whole, waiting for the commit.
 #[derive(Debug)]
 struct StagedFolder {
@@ -496,8 +481,9 @@ impl OutputSet {
             return Err(fail(e));
         }
         if let Some(old) = old {
-            // Only files robovec wrote are in it (checked above).
-            remove_our_folder(&old);
+            // Only files robovec wrote are in it (checked above); `remove_dir_all` never follows
+            // a symbolic link.
+            let _ = fs::remove_dir_all(&old);
         }
         Ok(())
     }
