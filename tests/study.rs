@@ -145,6 +145,16 @@ fn report_dir_holds_the_study_its_figures_and_every_cases_report() {
     let o = gen(&a);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(dir.join("cases/4-serial/report.json").is_file());
+    // --no-case-reports: the same study-level table, no cases/ folder and no link to one.
+    let csv = read("study.csv");
+    let mut short = a.to_vec();
+    short.push("--no-case-reports");
+    let o = gen(&short);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(read("study.csv"), csv, "the table does not depend on the per-case reports");
+    assert!(!dir.join("cases").exists(), "no per-case folders");
+    assert!(!read("study.md").contains("](cases/"), "study.md links no case folder");
+    assert!(dir.join("ops.svg").is_file());
 }
 
 #[test]

@@ -43,7 +43,8 @@
 //! CSV ([`figures`]), and per case `cases/<dof>-<topology>/` with `-report-dir`'s content
 //! (`report.json`, `report.md`, the seven SVGs; [`crate::report_dir::files`]) of the run
 //! `BEST,accuracy<samples=K>,sweep<pe=8,16,32,64>,place<pe=8>` with `-pareto` of the three
-//! pipelines.
+//! pipelines. `--no-case-reports` leaves the per-case folders out (and their runs: the table
+//! alone takes under a minute), and `study.md` then links to none; `docs/study/` is written so.
 //!
 //! Cases run in parallel (rayon); progress goes through `crate::progress` (an `indicatif` bar
 //! on a terminal without `-q`).
@@ -88,6 +89,10 @@ pub struct Options {
     pub ns: Vec<u32>,
     /// The report folder; the table goes to stdout without it.
     pub report_dir: Option<PathBuf>,
+    /// With [`Options::report_dir`]: also write each case's full report under
+    /// `cases/<dof>-<topology>/` (53 MB and 5–9 min for the 15 cases; `false`: the study-level
+    /// files only, what `docs/study/` holds).
+    pub case_reports: bool,
     /// No progress bar, no summary line on stderr.
     pub quiet: bool,
     /// The command line, for `study.md`.
@@ -118,7 +123,7 @@ pub fn run(
         samples: opts.samples,
         best: best.clone(),
         ns: opts.ns.clone(),
-        report: opts.report_dir.is_some(),
+        report: opts.report_dir.is_some() && opts.case_reports,
     };
     let list = cases::cases(&opts.dofs, &opts.topologies);
     let task = crate::progress::progress_for(stderr_is_terminal, opts.quiet).task("study cases", list.len() as u64);
