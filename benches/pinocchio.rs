@@ -11,9 +11,11 @@
 //!    distribution) shared by both sides;
 //! 2. writes robovec's C with `robovec-opt URDF -function=F --fold-params [--floating-base]
 //!    -passes=PIPELINE,codegen<c;abi=plain;…>` for [`VARIANTS`] of three functions: `invdyna`
-//!    (against `pinocchio::rnea`), `dirdyna` cut to `M` by `dce<outputs=M>` (against
-//!    `pinocchio::crba`) and the whole `dirdyna`, `M` and `c` (against `crba` then
-//!    `nonLinearEffects`);
+//!    (against `pinocchio::rnea`), `dirdyna` cut by `dce<outputs=…>` to the upper triangle of
+//!    `M` (against `pinocchio::crba`, which fills the upper triangle only) and to that and `c`
+//!    (against `crba` then `nonLinearEffects`): both sides compute and store the same entries
+//!    (Robotran's `M[j][i] = M[i][j]` copies of the lower triangle are 0 ops but 1.9× the
+//!    stores: 13% of `M`'s time on TIAGo Pro at `batch=8`);
 //! 3. builds one binary: `benches/pinocchio/harness.cpp` (Pinocchio header-only, instantiated
 //!    for `double` and `long double`, `g++ -O3 -march=native -DNDEBUG`; compiled once and cached
 //!    in `target/pinocchio_bench/` under the hash of its source and flags: ~3 min), robovec's C
@@ -56,12 +58,35 @@ const VARIANTS: [(&str, &str, u32, &str); 5] = [
     ("batch=8, trig=input", "atomise,cse,schedule-cpu", 8, "input"),
 ];
 
-/// The three comparisons: label, robovec function, pipeline prefix, Pinocchio's side.
-const GROUPS: [(&str, &str, &str, &str); 3] = [
-    ("inverse dynamics", "invdyna", "", "rnea"),
-    ("mass matrix", "dirdyna", "dce<outputs=M>,", "crba"),
-    ("M and c", "dirdyna", "", "crba + nonLinearEffects"),
+/// The three comparisons: label, robovec function, outputs kept (`dce`), Pinocchio's side.
+const GROUPS: [(&str, &str, Keep, &str); 3] = [
+    ("inverse dynamics", "invdyna", Keep::All, "rnea"),
+    ("mass matrix", "dirdyna", Keep::UpperM, "crba"),
+    ("M and c", "dirdyna", Keep::UpperMAndC, "crba + nonLinearEffects"),
 ];
+
+/// The outputs of robovec's function a comparison keeps.
+#[derive(Clone, Copy)]
+enum Keep {
+    All,
+    /// `M[i][j]`, `i ≤ j`: what `crba` fills.
+    UpperM,
+    /// That and `c`.
+    UpperMAndC,
+}
+
+impl Keep {
+    /// The pipeline's `dce<outputs=…>,` (empty for [`Keep::All`]) for `nv` coordinates, and
+    /// its short label.
+    fn dce(self, nv: usize) -> (String, &'static str) {
+        let upper: Vec<String> = (1..=nv).flat_map(|i| (i..=nv).map(move |j| format!("M[{i}][{j}]"))).collect();
+        match self {
+            Keep::All => (String::new(), ""),
+            Keep::UpperM => (format!("dce<outputs={}>,", upper.join(",")), "dce<outputs=M upper>,"),
+            Keep::UpperMAndC => (format!("dce<outputs={},c>,", upper.join(",")), "dce<outputs=M upper,c>,"),
+        }
+    }
+}
 
 /// A robot of the comparison.
 struct Robot {
@@ -121,7 +146,8 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
     let mut entries = Vec::new();
     let mut decls = String::new();
     let mut sources = Vec::new();
-    for (g, (_, function, prefix, _)) in GROUPS.iter().enumerate() {
+    for (g, (_, function, keep, _)) in GROUPS.iter().enumerate() {
+        let (prefix, short) = keep.dce(nv);
         for (v, (label, pipeline, batch, trig)) in VARIANTS.iter().enumerate() {
             let i = g * VARIANTS.len() + v;
             let report = work.join(format!("rv{i}.json"));
@@ -131,8 +157,9 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
             if robot.floating {
                 cmd.arg("--floating-base");
             }
-            let pipeline = pipeline.replacen("atomise,", &format!("atomise,{prefix}"), 1);
-            cmd.arg(format!("-passes={pipeline},codegen<c;abi=plain;batch={batch};trig={trig};name=rv{i}>"));
+            let full = pipeline.replacen("atomise,", &format!("atomise,{prefix}"), 1);
+            cmd.arg(format!("-passes={full},codegen<c;abi=plain;batch={batch};trig={trig};name=rv{i}>"));
+            let pipeline = pipeline.replacen("atomise,", &format!("atomise,{short}"), 1);
             run(cmd.arg("-o").arg(&fresh).arg(format!("-report={}", report.display())));
             let src = work.join(format!("rv{i}.c"));
             side::write_if_changed(&src, &std::fs::read(&fresh).unwrap());

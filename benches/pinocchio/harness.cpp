@@ -9,7 +9,8 @@
 // their group (0: inverse dynamics vs `rnea`; 1: `M` vs `crba`; 2: `M`, `c` vs `crba` +
 // `nonLinearEffects`), lanes per call, and maps: input k reads column `in_map[k]`, output k is entry
 // `out_map[k]` of the group's layout (0: `tau[i]`; 1: `M[i][j]` at `i*nv + j`; 2: that, then
-// `c[i]` at `nv*nv + i`; `crba`'s upper triangle mirrored into the lower one).
+// `c[i]` at `nv*nv + i`; robovec's `M` is the upper triangle, as `crba`'s, and both are
+// mirrored into the lower one).
 //
 // Prints `contestant\tINDEX\tGROUP\tNAME` per contestant, then `time\tINDEX\tREP\tNS_PER_STATE` for
 // every rep: in each rep every contestant of a group is timed once, the group's order rotated by
@@ -187,9 +188,12 @@ int main(int argc, char **argv) {
                     const int b = s / r.batch, lane = s % r.batch;
                     std::vector<double> o((size_t)r.n_out * r.batch);
                     r.fn(packed[vi].data() + (size_t)b * r.n_in * r.batch, o.data());
-                    (void)nv;
                     for (int k = 0; k < r.n_out; k++)
                       if (r.out_map[k] >= 0) out[r.out_map[k]] = o[(size_t)k * r.batch + lane];
+                    // robovec's M is the upper triangle, as crba's: mirrored like crba's.
+                    if (r.group != 0)
+                      for (int i = 0; i < nv; i++)
+                        for (int j = 0; j < i; j++) out[i * nv + j] = out[j * nv + i];
                   }});
   }
 

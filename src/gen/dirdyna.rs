@@ -38,7 +38,7 @@
 //! |---|---|---|---|
 //! | double pendulum (example) | 2 | 51 / 42 | 42 |
 //! | three_link_arm (example) | 3 | 765 / 617 | 510 |
-//! | UR5 (example-robot-data) | 6 | 1135 / 1071 | 575 |
+//! | UR5 (example-robot-data) | 6 | 915 / 851 | 575 |
 //! | Panda with fingers (example-robot-data) | 9 | 2465 / 2201 | 1365 |
 //!
 //! For scale, the corpus's Robotran `mbs_dirdyna` of Frank_segway (17 joints) states 4287 flops.
