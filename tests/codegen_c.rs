@@ -13,7 +13,7 @@ use std::process::Command;
 
 use robovec_ir::interp::{callback_standin, eval, pseudo_random_input, Float};
 use robovec_ir::{Callee, Def, Module, TrigFn};
-use robovec_passes::codegen::c::{robotran, split_callee, CodegenC};
+use robovec_passes::codegen::c::{robotran, split_callee, CodegenC, Trig};
 use robovec_passes::codegen::input_values;
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
@@ -235,7 +235,7 @@ fn check_plain_with<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u6
             }
             // Inputs of every lane; trig inputs are the interpreter's own sin/cos of their
             // joint coordinate in precision T.
-            let ins = input_values(f, o.trig_input);
+            let ins = input_values(f, o.trig == Trig::Input);
             let lane_value = |v: robovec_ir::Value, lane: u32| -> T {
                 match f.value(v).def {
                     Def::Trig(t, q) => {
@@ -401,7 +401,7 @@ fn robotran_out_args(f: &robovec_ir::Function) -> String {
 }
 
 fn plain(f32: bool, batch: u32, trig_input: bool) -> CodegenC {
-    CodegenC { f32, batch, trig_input, ..CodegenC::default() }
+    CodegenC { f32, batch, trig: if trig_input { Trig::Input } else { Trig::Libm }, ..CodegenC::default() }
 }
 
 #[test]
