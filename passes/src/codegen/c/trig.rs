@@ -230,7 +230,7 @@ fn taylor(first: u32, last: u32, f32: bool) -> Vec<f64> {
         .enumerate()
         .map(|(i, n)| {
             let fact: u64 = (1..=u64::from(n)).product();
-            let sign = if i % 2 == 0 { -1.0 } else { 1.0 } * if first % 4 == 0 { -1.0 } else { 1.0 };
+            let sign = if i % 2 == 0 { -1.0 } else { 1.0 } * if first.is_multiple_of(4) { -1.0 } else { 1.0 };
             if f32 {
                 assert_eq!(fact as f32 as u64, fact, "{n}! is exact in float");
                 sign * f64::from(1.0f32 / fact as f32)
