@@ -13,11 +13,13 @@ use std::process::Command;
 
 use robovec_ir::interp::{callback_standin, eval, pseudo_random_input, Float};
 use robovec_ir::{Callee, Def, Module, TrigFn};
-use robovec_passes::codegen::c::{robotran, split_callee, CodegenC};
+use robovec_passes::codegen::c::{robotran, split_callee, CodegenC, Trig};
 use robovec_passes::codegen::input_values;
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
 use crate::common::{corpus_files, is_loop_file, tmp};
+
+mod trig;
 
 /// A module to test, with a label for messages.
 pub struct Case {
@@ -188,6 +190,22 @@ fn check_plain<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64) ->
 
 /// [`check_plain`] with extra C compiler flags (`-DROBOVEC_VBYTES=N`: the batch's vector width).
 fn check_plain_with<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u64, extra: &[&str]) -> usize {
+    check_plain_tol::<T>(dir, cases, o, seed, extra, None).0
+}
+
+/// [`check_plain_with`], comparing bit for bit (`tol: None`) or within a relative error
+/// (`trig=inline`, whose sin/cos are not libm's): output `y` of a function whose outputs have mean
+/// magnitude `m` may differ from the interpreter's `x` by `tol · (|x| + m)` (the `m` term allows
+/// for cancellation: an output near zero made of large terms). Returns the number of outputs
+/// compared and the largest `|y − x| / (|x| + m)` seen.
+fn check_plain_tol<T: Float>(
+    dir: &Path,
+    cases: &[Case],
+    o: &CodegenC,
+    seed: u64,
+    extra: &[&str],
+    tol: Option<f64>,
+) -> (usize, f64) {
     let f32 = o.f32;
     let real = o.real();
     let w = o.batch;
@@ -202,6 +220,9 @@ fn check_plain_with<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u6
     let mut calls = String::new();
     let mut inputs: Vec<u8> = Vec::new();
     let mut want: Vec<(String, T)> = Vec::new();
+    // Per output, the function it belongs to (an index into `scale`).
+    let mut group: Vec<usize> = Vec::new();
+    let mut scale: Vec<f64> = Vec::new();
     for (k, case) in cases.iter().enumerate() {
         let ok = CodegenC { name: Some(format!("t{k}")), ..o.clone() };
         let art = ok.emit(&case.m).unwrap_or_else(|e| panic!("{}: {e}", case.label));
@@ -235,7 +256,7 @@ fn check_plain_with<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u6
             }
             // Inputs of every lane; trig inputs are the interpreter's own sin/cos of their
             // joint coordinate in precision T.
-            let ins = input_values(f, o.trig_input);
+            let ins = input_values(f, o.trig == Trig::Input);
             let lane_value = |v: robovec_ir::Value, lane: u32| -> T {
                 match f.value(v).def {
                     Def::Trig(t, q) => {
@@ -261,12 +282,18 @@ fn check_plain_with<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u6
             let per_lane: Vec<Vec<(String, T)>> =
                 (0..w).map(|lane| eval::<T>(f, |name| input_value(name, seed, lane))).collect();
             // Output j of lane l is printed at j*W + l.
+            let mut mag = (0.0, 0usize);
             for j in 0..no {
                 for (lane, outs) in per_lane.iter().enumerate() {
                     let (n, x) = &outs[j];
                     want.push((format!("{} @{} {n} lane {lane}", case.label, f.name), *x));
+                    group.push(scale.len());
+                    if x.to_f64().is_finite() {
+                        mag = (mag.0 + x.to_f64().abs(), mag.1 + 1);
+                    }
                 }
             }
+            scale.push(mag.0 / mag.1.max(1) as f64);
         }
     }
     let init = if robotran_abi { "  robovec_test_alloc();\n" } else { "" };
@@ -283,15 +310,21 @@ fn check_plain_with<T: Float>(dir: &Path, cases: &[Case], o: &CodegenC, seed: u6
     let got: Vec<u64> =
         String::from_utf8(out.stdout).unwrap().lines().map(|l| u64::from_str_radix(l, 16).unwrap()).collect();
     assert_eq!(got.len(), want.len(), "number of outputs printed");
-    let bad: Vec<String> = got
-        .iter()
-        .zip(&want)
-        .filter(|(g, (_, x))| !same(**g, *x))
-        .map(|(g, (what, x))| format!("{what}: C {:e} vs interpreter {:e}", f64::from_bits(*g), x.to_f64()))
-        .take(10)
-        .collect();
+    let mut worst = 0.0f64;
+    let mut bad: Vec<String> = Vec::new();
+    for (i, (g, (what, x))) in got.iter().zip(&want).enumerate() {
+        if same(*g, *x) {
+            continue;
+        }
+        let (y, x) = (f64::from_bits(*g), x.to_f64());
+        let rel = (y - x).abs() / (x.abs() + scale[group[i]]);
+        worst = worst.max(if rel.is_nan() { f64::INFINITY } else { rel });
+        if !tol.is_some_and(|t| rel <= t) && bad.len() < 10 {
+            bad.push(format!("{what}: C {y:e} vs interpreter {x:e}"));
+        }
+    }
     assert!(bad.is_empty(), "{} ({}): outputs differ from the interpreter:\n{}", dir.display(), real, bad.join("\n"));
-    want.len()
+    (want.len(), worst)
 }
 
 /// Largest index in any input or output name of the cases, plus one.
@@ -401,7 +434,7 @@ fn robotran_out_args(f: &robovec_ir::Function) -> String {
 }
 
 fn plain(f32: bool, batch: u32, trig_input: bool) -> CodegenC {
-    CodegenC { f32, batch, trig_input, ..CodegenC::default() }
+    CodegenC { f32, batch, trig: if trig_input { Trig::Input } else { Trig::Libm }, ..CodegenC::default() }
 }
 
 #[test]
@@ -494,11 +527,37 @@ fn scalar_forms_equal_the_interpreter_on_random_dags() {
     }
 }
 
+/// `trig=inline`: not libm's sin/cos, so not bit-exact; every output within a small relative error
+/// of the interpreter's, for the batch cases (corpus functions and random DAGs) in both
+/// precisions, scalar and batched (`trig.rs` measures the sin/cos themselves).
+#[test]
+fn inline_trig_agrees_with_the_interpreter_to_a_small_relative_error() {
+    let cases = batch_cases();
+    for (batch, f32, tol, width) in
+        [(1, false, 1e-12, ""), (4, false, 1e-12, "-DROBOVEC_VBYTES=32"), (8, true, 1e-4, "")]
+    {
+        let dir = tmp(&format!("inline_{batch}_{f32}"));
+        let o = CodegenC { f32, batch, trig: Trig::Inline, ..CodegenC::default() };
+        let extra: Vec<&str> = [width].into_iter().filter(|w| !w.is_empty()).collect();
+        let (n, worst) = if f32 {
+            check_plain_tol::<f32>(&dir, &cases, &o, 6, &extra, Some(tol))
+        } else {
+            check_plain_tol::<f64>(&dir, &cases, &o, 6, &extra, Some(tol))
+        };
+        eprintln!("trig=inline batch={batch} f32={f32}: {n} outputs, largest relative difference {worst:e}");
+        assert!(n > 600 * batch as usize, "only {n} outputs compared");
+        // Not bit-exact: some outputs do differ (else this would test nothing new).
+        assert!(worst > 0.0, "batch={batch} f32={f32}: every output bit-exact with libm's trig?");
+    }
+}
+
 const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";
 
 #[test]
 fn options_that_cannot_go_together_are_bad_usage() {
-    for bad in ["abi=robotran;batch=4", "abi=robotran;precision=f32", "abi=robotran;trig=input"] {
+    for bad in
+        ["abi=robotran;batch=4", "abi=robotran;precision=f32", "abi=robotran;trig=input", "abi=robotran;trig=inline"]
+    {
         let o = crate::common::opt(&[PENDULUM, &format!("-passes=atomise,codegen<c;{bad}>")]);
         let err = crate::common::stderr(&o);
         assert_eq!(o.status.code(), Some(2), "{bad}: {err}");
@@ -581,6 +640,37 @@ fn dash_o_writes_the_c_file_its_header_and_the_report_entry() {
         out.contains("for (int robovec_chunk = 0; robovec_chunk < ROBOVEC_W / ROBOVEC_VL; robovec_chunk++) {"),
         "{out}"
     );
+}
+
+/// `trig=inline` on the CLI: the report's `codegen.trig` says so, the inputs are the IR's only, and
+/// the file holds the helpers and one fused call per coordinate.
+#[test]
+fn trig_inline_is_in_the_report_and_the_file() {
+    let dir = tmp("trig_inline_cli");
+    let c = dir.join("model.c");
+    let report = dir.join("r.json");
+    for batch in [1, 4] {
+        let o = crate::common::opt(&[
+            PENDULUM,
+            &format!("-passes=atomise,cse,codegen<c;batch={batch};trig=inline>"),
+            "-o",
+            c.to_str().unwrap(),
+            &format!("-report={}", report.display()),
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", crate::common::stderr(&o));
+        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert_eq!(r["codegen"]["trig"], "inline", "{r}");
+        assert_eq!(r["codegen"]["inputs"].as_array().unwrap().len(), 14, "{r}");
+        let code = std::fs::read_to_string(&c).unwrap();
+        assert!(code.starts_with(&format!(
+            "/* Generated by robovec codegen<c;abi=plain;precision=f64;batch={batch};trig=inline>"
+        )));
+        assert!(code.contains("static inline void robovec_sincos_inline("), "{code}");
+        // The pendulum has sin and cos of q[1] and q[2]: two fused calls, no libm sin/cos call in the body.
+        assert_eq!(code.matches("  robovec_sincos_inline(q_").count(), 2, "{code}");
+        let body = &code[code.find("void invdyna(").unwrap()..];
+        assert!(!body.contains("sin(") && !body.contains("cos("), "{body}");
+    }
 }
 
 /// `abi=robotran` calls MBsysC's native callbacks: operands that do not fit the native

@@ -77,7 +77,7 @@ pub struct Interface {
     pub precision: &'static str,
     /// States per call (lanes).
     pub batch: u32,
-    /// `libm` or `input`.
+    /// `libm`, `input` or `inline`.
     pub trig: &'static str,
     /// Canonical input names (SPEC §2), in argument order: `in[i]` (or `in[i*W + lane]`) is
     /// input `i`. With `trig=input` the trig values (`S4`, `C4`) follow the IR's inputs.

@@ -31,7 +31,8 @@
 //!
 //! Trig initial variables (`sin`/`cos` of an input) all go first, in their original order: with
 //! `trig=libm` they are calls, which clobber every vector register under the System V and
-//! AAPCS64 ABIs, so they belong where nothing is live yet; with `trig=input` they are loads.
+//! AAPCS64 ABIs, so they belong where nothing is live yet; with `trig=input` they are loads;
+//! with `trig=inline` they are inline vector code whose libm fallback is also a call.
 //! Values no output needs keep their original relative order, after everything else.
 //!
 //! Runs on the atomised phase and keeps it; clears timing attributes. Cost: O(values +

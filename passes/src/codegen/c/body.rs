@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use robovec_ir::{BinOp, Callee, Def, Function, Module, Operand, TrigFn, Value};
 
-use super::{is_sqrt, CodegenC};
+use super::{is_sqrt, CodegenC, Trig};
 use crate::codegen::literal::hex;
 use crate::PassError;
 
@@ -199,9 +199,32 @@ impl Body<'_> {
     }
 
     /// Every body value, one statement each, in the IR's order (trig values are skipped with
-    /// `trig=input`: they are inputs).
+    /// `trig=input`: they are inputs; with `trig=inline` the first of a `sin` and a `cos` of one
+    /// coordinate computes both, see [`Body::fused_trig`]).
     pub fn statements(&self, s: &mut String) {
         self.statements_with(s, &mut |_, _| {}, &mut |_, _| {});
+    }
+
+    /// `trig=inline`: for the first `sin` and the first `cos` of each coordinate that has both,
+    /// the index of the value that comes first → the other one (its statement computes both with
+    /// one reduction; the other's statement is empty).
+    fn fused_trig(&self) -> std::collections::HashMap<usize, Value> {
+        let mut first: std::collections::HashMap<(usize, bool), Value> = std::collections::HashMap::new();
+        for &v in &self.f.body {
+            if let Def::Trig(t, a) = self.f.value(v).def {
+                first.entry((a.index(), t == TrigFn::Sin)).or_insert(v);
+            }
+        }
+        let mut out = std::collections::HashMap::new();
+        for (&(a, is_sin), &v) in &first {
+            if let (true, Some(&w)) = (is_sin, first.get(&(a, false))) {
+                let pos = |x: Value| self.f.body.iter().position(|&b| b == x).expect("a body value");
+                let (lead, other) = if pos(v) < pos(w) { (v, w) } else { (w, v) };
+                out.insert(lead.index(), other);
+                out.insert(other.index(), lead);
+            }
+        }
+        out
     }
 
     /// [`Body::statements`], calling `before(s, v)` just before and `after(s, v)` just after the
@@ -216,15 +239,30 @@ impl Body<'_> {
         let ty = self.value_type();
         let vec = self.o.batch > 1;
         let sfx = if self.o.f32 { "f" } else { "" };
+        let fused = if self.o.trig == Trig::Inline { self.fused_trig() } else { Default::default() };
+        let mut done = vec![false; self.f.values.len()];
         for &v in &self.f.body {
             let name = &self.names[v.index()];
             let def = &self.f.value(v).def;
-            if self.o.trig_input && matches!(def, Def::Trig(..)) {
+            if self.o.trig == Trig::Input && matches!(def, Def::Trig(..)) {
                 continue;
             }
             before(s, v);
             match def {
                 Def::Input | Def::Expr(_) => unreachable!("atomised bodies hold trig, binary ops and calls"),
+                Def::Trig(..) if done[v.index()] => {} // computed with its partner
+                Def::Trig(t, a) if self.o.trig == Trig::Inline => {
+                    let arg = &self.names[a.index()];
+                    if let Some(&other) = fused.get(&v.index()) {
+                        done[other.index()] = true;
+                        let other_name = &self.names[other.index()];
+                        let (sin, cos) = if *t == TrigFn::Sin { (name, other_name) } else { (other_name, name) };
+                        let _ = writeln!(s, "  {ty} {sin}, {cos};\n  robovec_sincos_inline({arg}, &{sin}, &{cos});");
+                    } else {
+                        let fun = if *t == TrigFn::Sin { "sin" } else { "cos" };
+                        let _ = writeln!(s, "  const {ty} {name} = robovec_{fun}_inline({arg});");
+                    }
+                }
                 Def::Trig(t, a) => {
                     let fun = match t {
                         TrigFn::Sin => "sin",

@@ -1,4 +1,4 @@
-//! `codegen<c;abi=plain|robotran;precision=f64|f32;batch=1|2|4|8|16;trig=libm|input;name=…>`:
+//! `codegen<c;abi=plain|robotran;precision=f64|f32;batch=1|2|4|8|16;trig=libm|input|inline;name=…>`:
 //! the functions as C (issue 11, SPEC §8).
 //!
 //! Every IR operation becomes one C statement, in the IR's order, so that the compiled code
@@ -8,6 +8,10 @@
 //! GCC/Clang vector extensions (one source for SSE, AVX2, AVX-512 and NEON), lane-contiguous:
 //! element `i` of lane `l` is `in[i*W + l]`. With `trig=input` the `sin`/`cos` of the joint
 //! coordinates are inputs (after the IR's inputs); with `trig=libm` they are computed (per lane).
+//! With `trig=inline` they are computed by robovec's own branch-free sin/cos, written into the
+//! file ([`trig`]: vectorised over the lanes, one reduction for the sin and cos of one
+//! coordinate, within 1 ulp): that code is **not** bit-exact with the interpreter, whose
+//! sin/cos are libm's.
 //!
 //! ABIs: `plain` ([`plain`]) is `void NAME(const REAL *restrict in, REAL *restrict out)`;
 //! `robotran` ([`robotran`]) has the signature and `MbsData` field access of the Robotran
@@ -18,6 +22,7 @@ mod native;
 pub use body::split_callee;
 pub mod plain;
 pub mod robotran;
+pub mod trig;
 
 use robovec_ir::{Callee, Def, Function, Module};
 
@@ -44,11 +49,12 @@ pub const BATCH: ParamInfo = ParamInfo {
     kind: ParamKind::Choice { choices: &["1", "2", "4", "8", "16"], default: "1" },
     doc: "C: states per call, lanes (`in[i*W + lane]`); plain ABI only",
 };
-/// `trig=libm|input`.
+/// `trig=libm|input|inline`.
 pub const TRIG: ParamInfo = ParamInfo {
     name: "trig",
-    kind: ParamKind::Choice { choices: &["libm", "input"], default: "libm" },
-    doc: "C: sin/cos of joint coordinates computed (`libm`) or taken as inputs (`input`)",
+    kind: ParamKind::Choice { choices: &["libm", "input", "inline"], default: "libm" },
+    doc: "C: sin/cos of joint coordinates computed by libm (`libm`), taken as inputs (`input`), or computed \
+          by robovec's own vectorised code in the file (`inline`: within 1 ulp, not bit-exact with `-eval`)",
 };
 /// `name=SYMBOL`.
 pub const NAME: ParamInfo = ParamInfo {
@@ -56,6 +62,34 @@ pub const NAME: ParamInfo = ParamInfo {
     kind: ParamKind::Names,
     doc: "C: symbol of the function (a prefix `NAME_function` with several functions)",
 };
+
+/// How the generated C gets the sin/cos of the joint coordinates (`trig=`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Trig {
+    /// `libm`: `sin`/`cos` (`sinf`/`cosf`), lane by lane in a batch; bit-exact with `-eval`.
+    #[default]
+    Libm,
+    /// `input`: the values are inputs after the IR's own.
+    Input,
+    /// `inline`: robovec's own branch-free code ([`trig`]), vectorised over the lanes.
+    Inline,
+}
+
+impl Trig {
+    /// The parameter's spelling: `libm`, `input`, `inline`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Trig::Libm => "libm",
+            Trig::Input => "input",
+            Trig::Inline => "inline",
+        }
+    }
+
+    /// The mode spelled `s`.
+    pub fn from_name(s: &str) -> Option<Trig> {
+        [Trig::Libm, Trig::Input, Trig::Inline].into_iter().find(|t| t.name() == s)
+    }
+}
 
 /// The C back end's options.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -66,15 +100,15 @@ pub struct CodegenC {
     pub f32: bool,
     /// States per call, lanes.
     pub batch: u32,
-    /// True for `trig=input`.
-    pub trig_input: bool,
+    /// `trig=`.
+    pub trig: Trig,
     /// The symbol (or prefix, with several functions); `None`: from the function's name.
     pub name: Option<String>,
 }
 
 impl Default for CodegenC {
     fn default() -> CodegenC {
-        CodegenC { abi: "plain", f32: false, batch: 1, trig_input: false, name: None }
+        CodegenC { abi: "plain", f32: false, batch: 1, trig: Trig::Libm, name: None }
     }
 }
 
@@ -87,7 +121,7 @@ impl CodegenC {
     ///
     /// # Errors
     /// [`PassError::BadParameter`] for options that cannot go together (`abi=robotran` with
-    /// `batch>1`, `precision=f32` or `trig=input`: Robotran's signature is one state of
+    /// `batch>1`, `precision=f32`, `trig=input` or `trig=inline`: Robotran's signature is one state of
     /// `double`s that computes its own trig) and for a `name` that is not one C identifier.
     pub fn from_params(p: &Params) -> Result<CodegenC, PassError> {
         if let Some(k) = crate::codegen::fpga::given_beyond_default(p, crate::codegen::fpga::FPGA_ONLY) {
@@ -97,7 +131,7 @@ impl CodegenC {
             abi: p.choice("abi")?,
             f32: p.choice("precision")? == "f32",
             batch: p.choice("batch")?.parse().expect("batch choices are integers"),
-            trig_input: p.choice("trig")? == "input",
+            trig: Trig::from_name(p.choice("trig")?).expect("trig choices are Trig names"),
             name: p.names("name")?.map(|n| n.join(",")),
         };
         if let Some(n) = &o.name {
@@ -110,8 +144,8 @@ impl CodegenC {
                 Some(format!("batch={}", o.batch))
             } else if o.f32 {
                 Some("precision=f32".into())
-            } else if o.trig_input {
-                Some("trig=input".into())
+            } else if o.trig != Trig::Libm {
+                Some(format!("trig={}", o.trig.name()))
             } else {
                 None
             };
@@ -201,21 +235,30 @@ impl CodegenC {
             self.abi,
             self.precision(),
             self.batch,
-            if self.trig_input { "input" } else { "libm" }
+            self.trig.name()
         )
     }
 
     fn preamble(&self) -> String {
         let mut s = format!(
             "/* Generated by robovec {}.\n * Every operation of robovec's IR is one statement, in the IR's order: compiled without\n \
-             * floating-point contraction it computes bit for bit what robovec's interpreter computes.\n \
+             * floating-point contraction it computes bit for bit what robovec's interpreter computes{}.\n \
              * Compile with -ffp-contract=off (GCC contracts a*b+c into an FMA under -march=native),\n \
              * e.g. cc -O2 -ffp-contract=off -c model.c; link with -lm. */\n\
              #pragma STDC FP_CONTRACT OFF\n#include <math.h>\n#include <string.h>\n\n",
-            self.options_text()
+            self.options_text(),
+            if self.trig == Trig::Inline {
+                ",\n * except sin/cos: with trig=inline they are robovec's own (below), within 1 ulp but not libm's bits;\n \
+                 * never compile with -ffast-math (it would fold their rounding trick)"
+            } else {
+                ""
+            }
         );
         if self.batch > 1 {
             s += &body::vector_helpers(self.real(), self.batch, self.f32);
+        }
+        if self.trig == Trig::Inline {
+            s += &trig::helpers(self.f32, self.batch > 1);
         }
         s
     }
@@ -276,8 +319,8 @@ pub(crate) fn interface(o: &CodegenC, f: &Function, symbol: &str) -> Interface {
         abi: o.abi,
         precision: o.precision(),
         batch: o.batch,
-        trig: if o.trig_input { "input" } else { "libm" },
-        inputs: super::input_values(f, o.trig_input).iter().map(|&v| f.name_of(v).to_string()).collect(),
+        trig: o.trig.name(),
+        inputs: super::input_values(f, o.trig == Trig::Input).iter().map(|&v| f.name_of(v).to_string()).collect(),
         outputs: f.outputs.iter().map(|x| x.name.clone()).collect(),
     }
 }

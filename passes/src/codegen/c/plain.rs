@@ -54,7 +54,7 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> (String, String, In
     // Inputs are read just before their first use and outputs written right after their value
     // is computed (`in` and `out` are `restrict`: nothing aliases), which keeps the compiler's
     // live ranges short (see the module doc). Outputs that are inputs or constants come last.
-    let inputs = input_values(f, o.trig_input);
+    let inputs = input_values(f, o.trig == super::Trig::Input);
     let mut input_at: Vec<Option<usize>> = vec![None; f.values.len()];
     for (i, &v) in inputs.iter().enumerate() {
         input_at[v.index()] = Some(i);

@@ -1,0 +1,497 @@
+//! `trig=inline`: robovec's own sin/cos of the joint coordinates, emitted into the C file —
+//! branch-free code on `robovec_vec` (every lane of a batch at once, GCC/Clang vector
+//! extensions) or on one `double`/`float` at `batch=1`, the same operations either way.
+//!
+//! # Algorithm
+//! 1. **Quadrant.** `k = round(x·2/π)` by the "magic number" trick: `t = x·(2/π) + 1.5·2^52`
+//!    (`1.5·2^23` in `float`) rounds `x·2/π` to an integer held in the low bits of `t`'s
+//!    significand, `k = t − 1.5·2^52` is that integer as a real and `t`'s bits reinterpreted as an
+//!    integer give `k mod 4`. Exact for `|x·2/π| < 2^51` (`2^22`) in round-to-nearest without
+//!    contraction or excess precision (the file says `#pragma STDC FP_CONTRACT OFF`; compile with
+//!    `-ffp-contract=off`, never `-ffast-math`, which folds `(a + M) − M`).
+//! 2. **Reduction** (Cody & Waite): `r = x − k·π/2` with π/2 split into pieces
+//!    `A1 + A2 + B1 (+ B2) + C`. With `|k| < 2^kb` (see *Range*) every piece but `C` has at most
+//!    `p − kb` significant bits (`p` = 53 or 24), so `k·A1`, `k·A2`, `k·B1`, `k·B2` are exact.
+//!    `A1` and `A2` end at bit `2^−p`: when `k ≠ 0`, `|x| > 1/2` is a multiple of `2^−p`, so
+//!    `x − k·A1` and then `− k·A2` are multiples of `2^−p` below 1 in magnitude, hence exact.
+//!    The subtraction of each `k·B` keeps its rounding error (Knuth's TwoSum), and `k·C` is
+//!    rounded; the result is `r` as an unevaluated sum `rh + rl`, accurate to about
+//!    `2^−119` (`2^−63` in `float`) absolutely — far below an ulp of the smallest `|r|` that an
+//!    argument within the range gives: `|r| ≥ 2^−60.5` for doubles below `2^20` (a lower bound
+//!    per binade from the continued fraction of π/2: `‖kα‖ ≥ ‖q_n α‖` for `k < q_{n+1}`) and
+//!    `|r| ≥ 2^−27.8` for floats below `2^11` (every float checked, in `__float128`). Without the
+//!    TwoSum the error reaches 1.4 ulp.
+//! 3. **Kernels** on `|r| ≤ π/4` (plus `2^−32`, from the rounding of `k`), Taylor polynomials
+//!    in Horner form: `sin r = r + r³·P(r²)`, `P` through `r^17` (`float`: `r^11`), and
+//!    `cos r = 1 − r²/2 + r⁴·Q(r²)`, `Q` through `r^18` (`float`: `r^12`); the first omitted
+//!    term is below `2^−63` (`2^−36`) relative. The low part enters to first order,
+//!    `sin(rh + rl) ≈ sin rh + rl·(1 − rh²/2)`, `cos(rh + rl) ≈ cos rh − rl·rh`, and
+//!    `1 − rh²/2` is summed with its rounding error (as fdlibm's `__kernel_cos` does).
+//! 4. **Quadrant selection** with masks, no per-lane branch: odd `k` swaps sin and cos
+//!    (bit-select), `sin` is negated in quadrants 2 and 3, `cos` in 1 and 2 (sign-bit xor).
+//!    `sin(−0) = −0` is selected by mask too.
+//!
+//! When the IR has both `sin` and `cos` of one joint coordinate, the body computes both with
+//! one `robovec_sincos_inline` (one reduction) at the first of the two statements.
+//!
+//! # Constants
+//! Derived here at generation time, not copied from a table: π is [`PI_HEX`], its first 256
+//! fraction bits in hexadecimal (the digits of π, checked in the unit tests against Machin's
+//! formula `π/4 = 4·atan(1/5) − atan(1/239)` evaluated in exact integer arithmetic); the pieces
+//! are cut from it by two's-complement integer arithmetic, each rounded to nearest at its
+//! last bit (`A1` at `2^−(p−kb−1)`, `A2` at `2^−p`, `Bi` at `2^−(p+i·(p−kb))`, `C` to `p`
+//! significant bits), so the remainders alternate in sign and the unit tests check that the
+//! pieces sum to π/2 within `2^−139` (`2^−74`). The polynomial coefficients are `±1/n!`, each
+//! one correctly rounded division (`n!` is exact in the format for every `n` used).
+//!
+//! # Range and accuracy
+//! The inline code is used for `|x| ≤ L`, `L = 2^20` in `double` (`|k| < 2^20`) and `L = 2^11`
+//! in `float` (`|k| < 2^11`). A batch with any lane beyond `L`, or not finite, computes those
+//! lanes with libm's `sin`/`cos` (`sinf`/`cosf`) one at a time (one vector-wide test, then a
+//! rarely taken scalar loop); so NaN and ±∞ give NaN, as libm does.
+//!
+//! **Accuracy: error below 1 ulp of the exact value, so at most 1 ulp from the correctly
+//! rounded result** (often the correctly rounded result itself), in `double` and in `float`.
+//! Measured by `tests/codegen_c/trig.rs` against a reference accurate to about 2^−100 (exact
+//! integer reduction, double-double series), on 40 000 arguments per set, sin and cos, largest
+//! / mean error: uniform in `[−π, π]` 0.747 / 0.253 ulp (`float` 0.760 / 0.253), uniform in
+//! `[−100, 100]` 0.723 / 0.253 (0.750 / 0.253), log-uniform from `2^−30` to `L` 0.725 / 0.236
+//! (0.750 / 0.149), the nearest numbers to `k·π/2` and their neighbours (hard cases of the
+//! reduction) 0.500 / 0.125 (0.500 / 0.175). The error analysis gives the same picture: 0.5 ulp
+//! from the last addition, up to about 0.25 from `rh²` (the tail is at most 0.1·|r|, resp. `r²/2`
+//! at most 0.31 in `cos`), a few hundredths from the rest.
+//!
+//! The results are not libm's bit for bit, so `trig=inline` code is **not** bit-exact with
+//! robovec's interpreter (`-eval`, Rust's `sin`/`cos`, i.e. the system libm): outputs that
+//! depend on sin/cos differ in their last bits (the tests compare them within a relative
+//! tolerance). Batched lanes equal `batch=1` bit for bit (same operations, same order).
+//!
+//! # Sources
+//! W. J. Cody and W. Waite, *Software Manual for the Elementary Functions*, Prentice-Hall,
+//! 1980 (the split of π/2 and the additive reduction); J.-M. Muller, *Elementary Functions:
+//! Algorithms and Implementation*, Birkhäuser, chapter "Range reduction" (why the pieces need
+//! trailing zeros, the worst cases near multiples of π/2); D. E. Knuth, *The Art of Computer
+//! Programming* vol. 2, §4.2.2 (TwoSum).
+
+use std::fmt::Write as _;
+
+use crate::codegen::literal::hex;
+
+/// π in hexadecimal: `3.` and 64 fraction digits (256 bits); the pieces of π/2 are cut from it.
+pub const PI_HEX: &str = "3.243F6A8885A308D313198A2E03707344A4093822299F31D0082EFA98EC4E6C89";
+
+/// Fraction bits of [`Big`] values: `I` stands for `I / 2^257`, so `PI_HEX` read as an integer
+/// (`π·2^256`) is π/2 at this scale.
+const SCALE: i32 = 257;
+
+/// A two's-complement integer of 320 bits (little-endian limbs), enough for π/2·2^257.
+type Big = [u64; 5];
+
+fn big_from_i64(n: i64) -> Big {
+    let ext = if n < 0 { u64::MAX } else { 0 };
+    [n as u64, ext, ext, ext, ext]
+}
+
+fn big_sub(a: &Big, b: &Big) -> Big {
+    let mut out = [0; 5];
+    let mut borrow = false;
+    for i in 0..5 {
+        let (d, b1) = a[i].overflowing_sub(b[i]);
+        let (d, b2) = d.overflowing_sub(u64::from(borrow));
+        out[i] = d;
+        borrow = b1 || b2;
+    }
+    out
+}
+
+fn big_is_neg(a: &Big) -> bool {
+    a[4] >> 63 == 1
+}
+
+/// `a · 2^s`.
+fn big_shl(a: &Big, s: u32) -> Big {
+    let (words, bits) = ((s / 64) as usize, s % 64);
+    let mut out = [0; 5];
+    for i in words..5 {
+        let lo = a[i - words] << bits;
+        let carry = if bits > 0 && i > words { a[i - words - 1] >> (64 - bits) } else { 0 };
+        out[i] = lo | carry;
+    }
+    out
+}
+
+/// `floor(a / 2^s)` (arithmetic shift).
+fn big_sar(a: &Big, s: u32) -> Big {
+    let fill = if big_is_neg(a) { u64::MAX } else { 0 };
+    let (words, bits) = ((s / 64) as usize, s % 64);
+    let word = |i: usize| if i < 5 { a[i] } else { fill };
+    let mut out = [0; 5];
+    for (i, o) in out.iter_mut().enumerate() {
+        let lo = word(i + words) >> bits;
+        let hi = if bits > 0 { word(i + words + 1) << (64 - bits) } else { 0 };
+        *o = lo | hi;
+    }
+    out
+}
+
+/// The number of bits of `|a|`.
+fn big_bit_len(a: &Big) -> u32 {
+    let m = if big_is_neg(a) { big_sub(&[0; 5], a) } else { *a };
+    (0..5).rev().find(|&i| m[i] != 0).map_or(0, |i| 64 * i as u32 + 64 - m[i].leading_zeros())
+}
+
+/// `round(a / 2^s)` (half up), which must fit in an `i64`.
+fn big_round_shr(a: &Big, s: u32) -> i64 {
+    assert!(s >= 1);
+    let t = big_sar(a, s - 1);
+    ((t[0] as i64) >> 1) + (t[0] & 1) as i64
+}
+
+/// π/2 at [`SCALE`], from [`PI_HEX`].
+fn half_pi() -> Big {
+    let mut a: Big = [0; 5];
+    for d in PI_HEX.chars().filter(|&c| c != '.') {
+        let d = d.to_digit(16).expect("hex digit") as u64;
+        let mut carry = d as u128;
+        for l in &mut a {
+            let v = (*l as u128) * 16 + carry;
+            *l = v as u64;
+            carry = v >> 64;
+        }
+    }
+    a
+}
+
+/// `2^e` as an `f64` (normal range).
+fn pow2(e: i32) -> f64 {
+    assert!((-1022..=1023).contains(&e));
+    f64::from_bits(((e + 1023) as u64) << 52)
+}
+
+/// The Cody–Waite split of π/2 for one format, and the polynomial coefficients.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Constants {
+    /// Significand bits: 53 (`double`) or 24 (`float`).
+    pub p: u32,
+    /// `|k| < 2^kb` for `|x| ≤ L = 2^kb`.
+    pub kb: u32,
+    /// `A1`, `A2`: `x − k·A1 − k·A2` is exact.
+    pub heads: [f64; 2],
+    /// `B1` (`float`: `B1`, `B2`): `k·Bi` exact, subtracted with TwoSum.
+    pub tails: Vec<f64>,
+    /// `C`: the rest of π/2 to `p` bits; `k·C` rounds.
+    pub last: f64,
+    /// `sin`: the coefficients of `r³, r⁵, …` (`−1/3!, 1/5!, …`).
+    pub sin: Vec<f64>,
+    /// `cos`: the coefficients of `r⁴, r⁶, …` (`1/4!, −1/6!, …`).
+    pub cos: Vec<f64>,
+}
+
+impl Constants {
+    /// The constants of `double` (`f32 = false`) or `float`.
+    pub fn new(f32: bool) -> Constants {
+        let (p, kb, n_tails, sin_last, cos_last) = if f32 { (24, 11, 2, 11, 12) } else { (53, 20, 1, 17, 18) };
+        let m = p - kb;
+        let mut rest = half_pi();
+        // Cuts the piece of `rest` ending at bit 2^lsb (rounded to nearest there).
+        let cut = |rest: &mut Big, lsb: i32| -> f64 {
+            let s = (lsb + SCALE) as u32;
+            let n = big_round_shr(rest, s);
+            *rest = big_sub(rest, &big_shl(&big_from_i64(n), s));
+            n as f64 * pow2(lsb)
+        };
+        let heads = [cut(&mut rest, -(m as i32 - 1)), cut(&mut rest, -(p as i32))];
+        let tails: Vec<f64> = (1..=n_tails).map(|i| cut(&mut rest, -((p + i * m) as i32))).collect();
+        // C: p significant bits from the leading bit of what is left.
+        let lead = big_bit_len(&rest) as i32 - 1 - SCALE;
+        let last = cut(&mut rest, lead - (p as i32 - 1));
+        let c = Constants { p, kb, heads, tails, last, sin: taylor(3, sin_last, f32), cos: taylor(4, cos_last, f32) };
+        c.check();
+        c
+    }
+
+    /// `L`: the inline code's range `|x| ≤ L`.
+    pub fn limit(&self) -> f64 {
+        pow2(self.kb as i32)
+    }
+
+    /// The conditions the reduction's exactness rests on (module doc, step 2).
+    fn check(&self) {
+        let bits = |x: f64| -> u32 {
+            // Significant bits of x (an integer times a power of two).
+            let m = (x.abs().to_bits() & ((1 << 52) - 1)) | (1 << 52);
+            53 - m.trailing_zeros()
+        };
+        let m = self.p - self.kb;
+        for &x in self.heads.iter().chain(&self.tails) {
+            assert!(bits(x) <= m, "piece {x:e} has {} bits, more than {m}", bits(x));
+        }
+        assert!(bits(self.last) <= self.p);
+        // |k| < 2^kb for |x| ≤ L; x − k·A1 stays below 1 in magnitude (so it is exact).
+        let k_max = (self.limit() * std::f64::consts::FRAC_2_PI).round() + 1.0;
+        assert!(k_max < pow2(self.kb as i32));
+        let rem_a1 = (std::f64::consts::FRAC_PI_2 - self.heads[0]).abs() + pow2(-(self.p as i32));
+        assert!(k_max * rem_a1 + std::f64::consts::FRAC_PI_4 + 0.01 < 1.0, "x − k·A1 can reach 1");
+    }
+}
+
+/// `(−1)^i / n!` for `n = first, first + 2, …, last`, rounded once to the format.
+fn taylor(first: u32, last: u32, f32: bool) -> Vec<f64> {
+    (first..=last)
+        .step_by(2)
+        .enumerate()
+        .map(|(i, n)| {
+            let fact: u64 = (1..=u64::from(n)).product();
+            let sign = if i % 2 == 0 { -1.0 } else { 1.0 } * if first.is_multiple_of(4) { -1.0 } else { 1.0 };
+            if f32 {
+                assert_eq!(fact as f32 as u64, fact, "{n}! is exact in float");
+                sign * f64::from(1.0f32 / fact as f32)
+            } else {
+                assert_eq!(fact as f64 as u64, fact, "{n}! is exact in double");
+                sign / fact as f64
+            }
+        })
+        .collect()
+}
+
+/// The C helpers `robovec_sincos_inline(x, &s, &c)`, `robovec_sin_inline(x)` and
+/// `robovec_cos_inline(x)`: on `robovec_vec` with `vector` (a batch: the vector helpers are
+/// already written), otherwise on one `double` (`float` with `f32`).
+pub(crate) fn helpers(f32: bool, vector: bool) -> String {
+    let c = Constants::new(f32);
+    let real = if f32 { "float" } else { "double" };
+    let v = if vector { "robovec_vec" } else { real };
+    let u = match (vector, f32) {
+        (true, _) => "robovec_uvec",
+        (false, true) => "unsigned int",
+        (false, false) => "unsigned long long",
+    };
+    let lit = |x: f64| {
+        let l = if f32 { hex(x as f32 as f64, true) } else { hex(x, false) };
+        if l.starts_with('-') {
+            format!("({l})")
+        } else {
+            l
+        }
+    };
+    let bits = |e: &str| if vector { format!("({u})({e})") } else { format!("robovec_bits({e})") };
+    let as_real = |e: &str| if vector { format!("({v})({e})") } else { format!("robovec_real({e})") };
+    let mask = |e: &str| if vector { format!("({u})({e})") } else { format!("-({u})({e})") };
+    let horner = |cs: &[f64]| -> String {
+        let mut s = lit(cs[cs.len() - 1]);
+        for &x in cs[..cs.len() - 1].iter().rev() {
+            s = format!("{} + z * ({s})", lit(x));
+        }
+        s
+    };
+    let sfx = if f32 { "f" } else { "" };
+    let magic = if f32 { 1.5 * pow2(23) } else { 1.5 * pow2(52) };
+    let two_pi = if f32 { f64::from(std::f32::consts::FRAC_2_PI) } else { std::f64::consts::FRAC_2_PI };
+    let sign_shift = if f32 { 30 } else { 62 };
+    let (half, one, l) = (lit(0.5), lit(1.0), c.limit());
+
+    let mut s = format!(
+        "/* trig=inline: sin/cos by robovec's own branch-free code (passes/src/codegen/c/trig.rs): k = round(x*2/pi),\n \
+         * r = x - k*pi/2 by Cody-Waite with pi/2 split into exact pieces, Taylor polynomials on |r| <= pi/4, quadrant\n \
+         * by masks; |x| > {} or not finite: libm. Within 1 ulp of the correctly rounded result; not libm's bits. */\n",
+        if f32 { "2^11" } else { "2^20" }
+    );
+    if vector {
+        let _ = writeln!(
+            s,
+            "typedef unsigned {} robovec_uvec __attribute__((vector_size(ROBOVEC_VL * sizeof({real}))));",
+            if f32 { "int" } else { "long long" }
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "static inline {u} robovec_bits({real} x) {{ {u} i; memcpy(&i, &x, sizeof i); return i; }}\n\
+             static inline {real} robovec_real({u} i) {{ {real} x; memcpy(&x, &i, sizeof x); return x; }}"
+        );
+    }
+    let _ = writeln!(s, "static inline void robovec_sincos_inline({v} x, {v} *sin_out, {v} *cos_out)\n{{");
+    let _ = writeln!(
+        s,
+        "  /* k = round(x*2/pi): adding 1.5*2^{} rounds to an integer, whose low bits are t's. */\n  \
+         const {v} t = x * {} + {};\n  const {v} k = t - {};\n  const {u} q = {};",
+        if f32 { 23 } else { 52 },
+        lit(two_pi),
+        lit(magic),
+        lit(magic),
+        bits("t")
+    );
+    let _ = writeln!(
+        s,
+        "  /* r = rh + rl = x - k*pi/2: k*A1, k*A2 and both subtractions exact; k*B exact, its subtraction by TwoSum. */\n  \
+         const {v} y1 = x - k * {};\n  const {v} h0 = y1 - k * {};",
+        lit(c.heads[0]),
+        lit(c.heads[1])
+    );
+    for (i, &b) in c.tails.iter().enumerate() {
+        let (h, n) = (format!("h{i}"), i + 1);
+        let _ = writeln!(
+            s,
+            "  const {v} b{n} = k * {};\n  const {v} h{n} = {h} + b{n};\n  const {v} a{n} = h{n} - b{n};\n  \
+             const {v} e{n} = ({h} - a{n}) + (b{n} - (h{n} - a{n}));",
+            lit(-b)
+        );
+    }
+    let n = c.tails.len();
+    let errs: Vec<String> = (1..=n).map(|i| format!("e{i}")).collect();
+    let errs = if n > 1 { format!("({})", errs.join(" + ")) } else { errs[0].clone() };
+    let _ = writeln!(s, "  const {v} rh = h{n};\n  const {v} rl = {errs} + k * {};", lit(-c.last));
+    let _ = writeln!(
+        s,
+        "  /* sin(rh + rl) ~ rh + rh^3 P(rh^2) + rl (1 - rh^2/2); cos(rh + rl) ~ 1 - rh^2/2 + rh^4 Q(rh^2) - rl rh. */\n  \
+         const {v} z = rh * rh;\n  const {v} ps = {};\n  const {v} sr = rh + ((rh * z) * ps + (rl - ({half} * z) * rl));\n  \
+         const {v} pc = {};\n  const {v} hz = {half} * z;\n  const {v} w = {one} - hz;\n  \
+         const {v} cr = w + ((({one} - w) - hz) + ((z * z) * pc - rh * rl));",
+        horner(&c.sin),
+        horner(&c.cos)
+    );
+    let _ = writeln!(
+        s,
+        "  /* q = k mod 4: odd q swaps sin and cos; sin is negated for q = 2, 3, cos for q = 1, 2; sin(-0) = -0. */\n  \
+         const {u} swap = -(q & 1);\n  \
+         const {u} sb = ((swap & {cb}) | (~swap & {sb})) ^ ((q & 2) << {sign_shift});\n  \
+         const {u} cb = ((swap & {sb}) | (~swap & {cb})) ^ (((q + 1) & 2) << {sign_shift});\n  \
+         const {u} zero = {};\n  {v} s = {};\n  {v} c = {};",
+        mask(&format!("x == {}", lit(0.0))),
+        as_real(&format!("(zero & {}) | (~zero & sb)", bits("x"))),
+        as_real("cb"),
+        sb = bits("sr"),
+        cb = bits("cr"),
+    );
+    let range = format!("x >= {} && x <= {}", lit(-l), lit(l));
+    if vector {
+        let _ = writeln!(
+            s,
+            "  /* Lanes beyond the range or not finite (rare): libm. */\n  \
+             const {u} out = ~{};\n  {elem} any = out[0];\n  \
+             for (int lane = 1; lane < ROBOVEC_VL; lane++) any |= out[lane];\n  \
+             if (any)\n    for (int lane = 0; lane < ROBOVEC_VL; lane++)\n      \
+             if (out[lane]) {{ s[lane] = sin{sfx}(x[lane]); c[lane] = cos{sfx}(x[lane]); }}",
+            mask(&format!("(x >= {}) & (x <= {})", lit(-l), lit(l))),
+            elem = if f32 { "unsigned int" } else { "unsigned long long" },
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "  /* Beyond the range or not finite (rare): libm. */\n  if (!({range})) {{ s = sin{sfx}(x); c = cos{sfx}(x); }}"
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  *sin_out = s;\n  *cos_out = c;\n}}\n\
+         static inline {v} robovec_sin_inline({v} x) {{ {v} s, c; robovec_sincos_inline(x, &s, &c); return s; }}\n\
+         static inline {v} robovec_cos_inline({v} x) {{ {v} s, c; robovec_sincos_inline(x, &s, &c); return c; }}\n"
+    );
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `floor(π·2^bits)` by Machin's formula `π = 16·atan(1/5) − 4·atan(1/239)`, in integer
+    /// arithmetic on 32-bit limbs (most significant first) with 32 guard bits: independent of
+    /// [`PI_HEX`].
+    fn machin_pi(bits: u32) -> Vec<u32> {
+        let limbs = (bits / 32 + 2) as usize; // one integer limb, the fraction, one guard limb
+        let div = |a: &mut Vec<u32>, d: u64| {
+            let mut r = 0u64;
+            for l in a.iter_mut() {
+                let v = (r << 32) | u64::from(*l);
+                *l = (v / d) as u32;
+                r = v % d;
+            }
+        };
+        let add = |a: &mut Vec<u32>, b: &[u32], sub: bool| {
+            let mut carry = 0i64;
+            for i in (0..a.len()).rev() {
+                let v = i64::from(a[i]) + if sub { -i64::from(b[i]) } else { i64::from(b[i]) } + carry;
+                a[i] = v.rem_euclid(1 << 32) as u32;
+                carry = v.div_euclid(1 << 32);
+            }
+        };
+        let is_zero = |a: &[u32]| a.iter().all(|&l| l == 0);
+        // atan(1/x) · mult at the scale 2^(32·(limbs−1)).
+        let atan = |x: u64, mult: u32| -> Vec<u32> {
+            let mut power = vec![0u32; limbs];
+            power[0] = mult;
+            div(&mut power, x);
+            let mut sum = vec![0u32; limbs];
+            let mut n = 0u64;
+            while !is_zero(&power) {
+                let mut term = power.clone();
+                div(&mut term, 2 * n + 1);
+                add(&mut sum, &term, n % 2 == 1);
+                div(&mut power, x * x);
+                n += 1;
+            }
+            sum
+        };
+        let mut pi = atan(5, 16);
+        add(&mut pi, &atan(239, 4), true);
+        pi.truncate(limbs - 1); // drop the guard limb
+        pi
+    }
+
+    #[test]
+    fn pi_hex_is_pi_by_machins_formula() {
+        let pi = machin_pi(256);
+        let hex: String =
+            std::iter::once(format!("{:X}", pi[0])).chain(pi[1..=8].iter().map(|l| format!("{l:08X}"))).collect();
+        assert_eq!(hex, PI_HEX.replace('.', ""));
+    }
+
+    /// The pieces' sum, exactly, at [`SCALE`].
+    fn sum(c: &Constants) -> Big {
+        let mut acc: Big = [0; 5];
+        for &x in c.heads.iter().chain(&c.tails).chain([&c.last]) {
+            let (m, e) = (x.abs().to_bits() & ((1 << 52) - 1) | (1 << 52), ((x.abs().to_bits() >> 52) as i32) - 1075);
+            let n = big_shl(&big_from_i64(m as i64), (e + SCALE) as u32);
+            acc = if x < 0.0 { big_sub(&acc, &n) } else { big_sub(&acc, &big_sub(&[0; 5], &n)) };
+        }
+        acc
+    }
+
+    /// Machin's `π·2^256` as a [`Big`] (= π/2 at [`SCALE`]).
+    fn machin_half_pi() -> Big {
+        let mut a: Big = [0; 5];
+        for &l in &machin_pi(256) {
+            a = big_shl(&a, 32);
+            a[0] |= u64::from(l);
+        }
+        a
+    }
+
+    #[test]
+    fn the_pieces_sum_to_half_pi_far_beyond_the_format() {
+        assert_eq!(machin_half_pi(), half_pi());
+        for (f32, want) in [(false, -139), (true, -74)] {
+            let c = Constants::new(f32);
+            let err = big_sub(&machin_half_pi(), &sum(&c));
+            let err_bits = big_bit_len(&err) as i32 - SCALE;
+            assert!(err_bits <= want, "f32={f32}: |π/2 − Σ pieces| < 2^{err_bits}");
+            // A1 + A2 is π/2 to the format's precision.
+            let hi = c.heads[0] + c.heads[1];
+            assert!((hi - std::f64::consts::FRAC_PI_2).abs() <= pow2(-(c.p as i32)), "f32={f32}: {hi:e}");
+        }
+    }
+
+    #[test]
+    fn double_split_has_the_documented_shape() {
+        let c = Constants::new(false);
+        assert_eq!(c.limit(), 1048576.0);
+        assert_eq!(c.sin.len(), 8);
+        assert_eq!(c.cos.len(), 8);
+        assert_eq!(c.sin[0], -1.0 / 6.0);
+        assert_eq!(c.cos[0], 1.0 / 24.0);
+        assert_eq!(c.sin[7], 1.0 / 355687428096000.0);
+        assert_eq!(c.cos[7], -1.0 / 6402373705728000.0);
+        let f = Constants::new(true);
+        assert_eq!((f.limit(), f.sin.len(), f.cos.len(), f.tails.len()), (2048.0, 5, 5, 2));
+        assert_eq!(f.cos[1], f64::from(-1.0f32 / 720.0));
+    }
+}
