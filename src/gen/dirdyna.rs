@@ -127,31 +127,60 @@ mod tests {
     use crate::gen::topology::{build, Topology};
     use crate::gen::Layout;
 
+    /// `M` of `robot` by `how` at pseudo-random `q`, parameters given their values.
+    fn mass_matrix(robot: &crate::gen::robot::Robot, how: MassMatrix) -> BTreeMap<String, f64> {
+        let model = Model { robot: robot.clone() };
+        let layout = Layout::of(&model.robot);
+        let mut given: BTreeMap<String, f64> = layout.nonzero();
+        let nq = layout.q_index.iter().flatten().count();
+        for i in 1..=nq {
+            given.insert(format!("q[{i}]"), (i as f64 * 0.7).sin() * 3.0);
+        }
+        let mut b = Builder::new("dirdyna", Default::default());
+        dirdyna_with(&model, &layout, &mut b, how);
+        let f = b.finish();
+        crate::eval::evaluate(&f, &given, false).outputs.into_iter().filter(|(k, _)| k.starts_with("M[")).collect()
+    }
+
+    fn assert_close(what: &str, a: &BTreeMap<String, f64>, b: &BTreeMap<String, f64>, n: usize) {
+        assert_eq!(a.len(), n * n, "{what}");
+        assert_eq!(b.len(), n * n, "{what}");
+        let norm = b.values().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(norm > 0.1, "{what}: M is not trivially zero");
+        for (k, x) in a {
+            assert!((x - b[k]).abs() <= 1e-12 * norm, "{what} {k}: {x} vs {}", b[k]);
+        }
+    }
+
     /// CRBA's `M` against the unit-acceleration RNEA's (an independent recursion) on every
-    /// topology family, parameters given their values and `q` pseudo-random: equal to 1e-12.
+    /// topology family, on Robotran's floating base (the CRBA's root-segment projection) and on
+    /// a chain of dense URDF rotations (merged rotations), that chain also in the frames of
+    /// `crate::gen::frames` (the same `M`: the coordinates keep their meaning): equal to 1e-12.
     #[test]
     fn crba_mass_matrix_equals_the_unit_acceleration_rnea() {
         for t in Topology::ALL {
-            let model = Model { robot: build(t, 9, 3) };
-            let layout = Layout::of(&model.robot);
-            let mut given: BTreeMap<String, f64> = layout.nonzero();
-            for i in 1..=9 {
-                given.insert(format!("q[{i}]"), (i as f64 * 0.7).sin() * 3.0);
-            }
-            let run = |how| {
-                let mut b = Builder::new("dirdyna", Default::default());
-                dirdyna_with(&model, &layout, &mut b, how);
-                let f = b.finish();
-                crate::eval::evaluate(&f, &given, false).outputs
-            };
-            let (crba, unit) = (run(MassMatrix::Crba), run(MassMatrix::UnitAcceleration));
-            let m: Vec<&String> = unit.keys().filter(|k| k.starts_with("M[")).collect();
-            assert_eq!(m.len(), 81);
-            let norm = m.iter().fold(0.0f64, |a, k| a.max(unit[*k].abs()));
-            assert!(norm > 0.1, "{t}: M is not trivially zero");
-            for k in m {
-                assert!((crba[k] - unit[k]).abs() <= 1e-12 * norm, "{t} {k}: {} vs {}", crba[k], unit[k]);
-            }
+            let r = build(t, 9, 3);
+            assert_close(
+                &t.to_string(),
+                &mass_matrix(&r, MassMatrix::Crba),
+                &mass_matrix(&r, MassMatrix::UnitAcceleration),
+                9,
+            );
         }
+        let floating = build(Topology::Serial, 5, 2).with_floating_base().unwrap();
+        let (crba, unit) =
+            (mass_matrix(&floating, MassMatrix::Crba), mass_matrix(&floating, MassMatrix::UnitAcceleration));
+        assert_close("floating base", &crba, &unit, 11);
+        let mut dense = build(Topology::Serial, 7, 5);
+        for (i, j) in dense.joints.iter_mut().enumerate() {
+            let x = i as f64;
+            j.origin = crate::gen::robot::Origin::from_xyz_rpy(j.origin.xyz, [0.3 * x - 1.0, 0.2 * x - 0.7, 1.1 * x]);
+        }
+        let crba = mass_matrix(&dense, MassMatrix::Crba);
+        assert_close("dense rpy", &crba, &mass_matrix(&dense, MassMatrix::UnitAcceleration), 7);
+        let reframed = crate::gen::frames::reframe(&dense).expect("a chain of dense rotations is reframed");
+        assert!(reframed.joints.iter().any(|j| j.offset != 0.0), "offsets are used");
+        assert_close("dense rpy, reframed", &mass_matrix(&reframed, MassMatrix::Crba), &crba, 7);
+        assert_close("dense rpy, reframed, unit", &mass_matrix(&reframed, MassMatrix::UnitAcceleration), &crba, 7);
     }
 }

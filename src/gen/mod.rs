@@ -35,11 +35,14 @@
 //! A parameter whose URDF value is exactly 0 is a structural zero and folded, as Robotran folds
 //! the parameters a model sets to 0; the others stay inputs and their values go to
 //! [`Generated::params`] (what `-params-out` writes for `specialize<params=…>` and `-eval`),
-//! unless `--fold-params` folds them all. Constant rotations (URDF `rpy`) are numbers.
+//! unless `--fold-params` folds them all. Constant rotations (URDF `rpy`) are numbers. A chain
+//! of joints with dense `rpy` may be written in other body frames ([`frames`], when that
+//! lowers the op count); the parameters of those links are then in these frames.
 
 pub mod crba;
 pub mod dirdyna;
 pub mod export;
+pub mod frames;
 pub mod rnea;
 pub mod robot;
 pub mod robotran_c;
@@ -145,8 +148,24 @@ type Writer = fn(&Model, &Layout, &mut Builder);
 const FUNCTIONS: [(&str, Writer); 2] = [("invdyna", rnea::invdyna), ("dirdyna", dirdyna::dirdyna)];
 
 /// Generates `invdyna` and `dirdyna` for `model`; `fold` folds every parameter into the
-/// equations.
+/// equations. The robot is written in the frames of [`frames::reframe`] when that gives both
+/// functions together fewer ops (then the parameters of the links it turns are in those
+/// frames), otherwise in its own.
 pub fn generate(model: &Model, fold: bool) -> Generated {
+    let plain = generate_in_frames(model, fold);
+    // The frames of `frames` where they lower the op count of both functions together.
+    let Some(robot) = frames::reframe(&model.robot) else { return plain };
+    let reframed = generate_in_frames(&Model { robot }, fold);
+    let ops = |g: &Generated| g.module.functions.iter().map(|f| f.op_counts().total).sum::<u64>();
+    if ops(&reframed) < ops(&plain) {
+        reframed
+    } else {
+        plain
+    }
+}
+
+/// [`generate`] in the robot's own frames.
+fn generate_in_frames(model: &Model, fold: bool) -> Generated {
     let layout = Layout::of(&model.robot);
     let consts: FxHashMap<String, f64> =
         if fold { layout.nonzero().into_iter().collect() } else { FxHashMap::default() };

@@ -21,7 +21,7 @@
 
 use robovec_ir::TrigFn;
 
-use super::robot::JointKind;
+use super::robot::{snap, JointKind};
 use super::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
 use super::{Layout, Model};
 
@@ -126,8 +126,17 @@ pub fn motions(model: &Model, layout: &Layout, b: &mut Builder) -> Vec<Motion> {
         let motion = match (joint.kind, layout.q_index[i]) {
             (JointKind::Revolute, Some(qi)) => {
                 let q = b.input(&format!("q[{qi}]"));
-                let c = b.trig(&format!("C{qi}"), TrigFn::Cos, q.clone());
-                let s = b.trig(&format!("S{qi}"), TrigFn::Sin, q);
+                let mut c = b.trig(&format!("C{qi}"), TrigFn::Cos, q.clone());
+                let mut s = b.trig(&format!("S{qi}"), TrigFn::Sin, q);
+                if joint.offset != 0.0 {
+                    // cos and sin of q + offset (`crate::gen::frames`), bound as CQ, SQ.
+                    let (so, co) = joint.offset.sin_cos();
+                    let (so, co) = (Term::C(snap(so)), Term::C(snap(co)));
+                    let c2 = sub(mul(c.clone(), co.clone()), mul(s.clone(), so.clone()));
+                    let s2 = add(mul(s, co), mul(c, so));
+                    c = b.bind(&format!("CQ{qi}"), c2);
+                    s = b.bind(&format!("SQ{qi}"), s2);
+                }
                 Motion { rot: Some(axis_rotation(&joint.axis, &c, &s)), shift: None }
             }
             (JointKind::Prismatic, Some(qi)) => {

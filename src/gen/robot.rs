@@ -40,7 +40,7 @@ impl Origin {
 }
 
 /// `x` snapped to 0 or ±1 when within 1e-15 of it (see [`Origin::from_xyz_rpy`]).
-fn snap(x: f64) -> f64 {
+pub(super) fn snap(x: f64) -> f64 {
     if x.abs() < 1e-15 {
         0.0
     } else if (x.abs() - 1.0).abs() < 1e-15 {
@@ -88,6 +88,9 @@ pub struct Joint {
     pub origin: Origin,
     /// Unit axis in the joint (= child link) frame (URDF default `1 0 0`).
     pub axis: [f64; 3],
+    /// A revolute joint turns its child by `q + offset` (radians): 0 as read from a URDF; set
+    /// by the generator's choice of body frames ([`crate::gen::frames`]).
+    pub offset: f64,
     /// The `<joint>` element.
     pub span: Span,
 }
@@ -190,7 +193,16 @@ impl Robot {
             let mut axis = [0.0; 3];
             axis[k % 3] = 1.0;
             let kind = if k < 3 { JointKind::Prismatic } else { JointKind::Revolute };
-            self.joints.push(Joint { name: (*name).into(), kind, parent, child, origin: Origin::IDENTITY, axis, span });
+            self.joints.push(Joint {
+                name: (*name).into(),
+                kind,
+                parent,
+                child,
+                origin: Origin::IDENTITY,
+                axis,
+                offset: 0.0,
+                span,
+            });
             parent = child;
         }
         Ok(self)

@@ -158,6 +158,7 @@ pub fn build(topology: Topology, dof: usize, seed: u64) -> Robot {
                 child,
                 origin: Origin { xyz, rot: Origin::IDENTITY.rot },
                 axis,
+                offset: 0.0,
                 span: Span::DUMMY,
             });
             parent = child;

@@ -216,6 +216,7 @@ pub fn parse(text: &str) -> Result<Robot, FrontError> {
             child,
             origin: origin(j)?,
             axis,
+            offset: 0.0,
             span: span_of(j.range()),
         });
     }
