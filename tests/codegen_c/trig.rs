@@ -294,16 +294,7 @@ fn inline_sin_cos_are_within_one_ulp_and_lanes_equal_the_scalar_code() {
     }
     main += "int main(void) { return run_d1() || run_d4() || run_s1() || run_s8(); }\n";
     std::fs::write(dir.join("main.c"), main).unwrap();
-    let exe = dir.join("run");
-    let o = Command::new("cc")
-        .current_dir(&dir)
-        .args(["-O1", "-ffp-contract=off", "-o"])
-        .arg(&exe)
-        .args(&files)
-        .arg("-lm")
-        .output()
-        .expect("a C compiler `cc` on PATH");
-    assert!(o.status.success(), "cc: {}", String::from_utf8_lossy(&o.stderr));
+    let exe = super::cc(&dir, &files, &["-O1"]);
 
     let hp = half_pi();
     let (c64, c32) = (Constants::new(false), Constants::new(true));

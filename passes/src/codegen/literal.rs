@@ -30,6 +30,18 @@ pub fn hex(x: f64, float_suffix: bool) -> String {
     format!("{sign}0x{lead}{dot}p{e:+}{suffix}")
 }
 
+/// A constant as a C operand in the back end's precision: [`hex`] of `x` (with `f32`, of `x`
+/// rounded to binary32, as the interpreter rounds it, with the `f` suffix), parenthesised when
+/// negative so that it can follow an operator (`x * (-0x1p-3)`).
+pub fn operand(x: f64, f32: bool) -> String {
+    let l = if f32 { hex(x as f32 as f64, true) } else { hex(x, false) };
+    if l.starts_with('-') {
+        format!("({l})")
+    } else {
+        l
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::hex;

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use robovec_ir::{BinOp, Callee, Def, Function, Module, Operand, TrigFn, Value};
 
 use super::{is_sqrt, CodegenC, Trig};
-use crate::codegen::literal::hex;
+use crate::codegen::literal;
 use crate::PassError;
 
 /// A user callback the generated code calls: Robotran's name without the integer arguments
@@ -156,28 +156,11 @@ pub(crate) struct Body<'a> {
 }
 
 impl Body<'_> {
-    /// An exact literal in the precision (`f32`: the constant rounded to binary32, as the
-    /// interpreter does).
-    pub fn literal(&self, c: f64) -> String {
-        if self.o.f32 {
-            hex(c as f32 as f64, true)
-        } else {
-            hex(c, false)
-        }
-    }
-
-    /// An operand as a C expression.
+    /// An operand as a C expression (a constant exact in the precision: [`literal::operand`]).
     pub fn operand(&self, x: &Operand) -> String {
         match x {
             Operand::Value(v) => self.names[v.index()].clone(),
-            Operand::Const(c) => {
-                let l = self.literal(*c);
-                if l.starts_with('-') {
-                    format!("({l})")
-                } else {
-                    l
-                }
-            }
+            Operand::Const(c) => literal::operand(*c, self.o.f32),
         }
     }
 
@@ -209,19 +192,20 @@ impl Body<'_> {
     /// the index of the value that comes first → the other one (its statement computes both with
     /// one reduction; the other's statement is empty).
     fn fused_trig(&self) -> std::collections::HashMap<usize, Value> {
+        // The first sin and the first cos of each coordinate, in body order: when the second of
+        // the two appears, its partner is already here and comes first.
         let mut first: std::collections::HashMap<(usize, bool), Value> = std::collections::HashMap::new();
-        for &v in &self.f.body {
-            if let Def::Trig(t, a) = self.f.value(v).def {
-                first.entry((a.index(), t == TrigFn::Sin)).or_insert(v);
-            }
-        }
         let mut out = std::collections::HashMap::new();
-        for (&(a, is_sin), &v) in &first {
-            if let (true, Some(&w)) = (is_sin, first.get(&(a, false))) {
-                let pos = |x: Value| self.f.body.iter().position(|&b| b == x).expect("a body value");
-                let (lead, other) = if pos(v) < pos(w) { (v, w) } else { (w, v) };
-                out.insert(lead.index(), other);
-                out.insert(other.index(), lead);
+        for &v in &self.f.body {
+            let Def::Trig(t, a) = self.f.value(v).def else { continue };
+            let is_sin = t == TrigFn::Sin;
+            if first.contains_key(&(a.index(), is_sin)) {
+                continue;
+            }
+            first.insert((a.index(), is_sin), v);
+            if let Some(&lead) = first.get(&(a.index(), !is_sin)) {
+                out.insert(lead.index(), v);
+                out.insert(v.index(), lead);
             }
         }
         out

@@ -75,7 +75,7 @@
 
 use std::fmt::Write as _;
 
-use crate::codegen::literal::hex;
+use crate::codegen::literal;
 
 /// π in hexadecimal: `3.` and 64 fraction digits (256 bits); the pieces of π/2 are cut from it.
 pub const PI_HEX: &str = "3.243F6A8885A308D313198A2E03707344A4093822299F31D0082EFA98EC4E6C89";
@@ -266,14 +266,7 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
         (false, true) => "unsigned int",
         (false, false) => "unsigned long long",
     };
-    let lit = |x: f64| {
-        let l = if f32 { hex(x as f32 as f64, true) } else { hex(x, false) };
-        if l.starts_with('-') {
-            format!("({l})")
-        } else {
-            l
-        }
-    };
+    let lit = |x: f64| literal::operand(x, f32);
     let bits = |e: &str| if vector { format!("({u})({e})") } else { format!("robovec_bits({e})") };
     let as_real = |e: &str| if vector { format!("({v})({e})") } else { format!("robovec_real({e})") };
     let mask = |e: &str| if vector { format!("({u})({e})") } else { format!("-({u})({e})") };
