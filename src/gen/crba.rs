@@ -247,12 +247,14 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
     for i in 0..nb {
         moves[i + 1] = moves[parent[i + 1]] || layout.q_index[i].is_some();
     }
-    // Constant and joint rotations merged where that is cheaper (see `merged_rotation`).
+    // Each body's constant joint rotation (`ro`, index = body), and the constant and joint
+    // rotations merged where that is cheaper (see `merged_rotation`).
+    let ro: Vec<M3> =
+        std::iter::once(M3::default()).chain(order.iter().map(|&j| numeric(&robot.joints[j].origin.rot))).collect();
     let mut merged: Vec<Option<M3>> = vec![None; nb + 1];
     for body in 1..=nb {
         if moves[parent[body]] {
-            let ro = numeric(&robot.joints[order[body - 1]].origin.rot);
-            merged[body] = merged_rotation(b, body, &ro, motions[body].rot.as_ref());
+            merged[body] = merged_rotation(b, body, &ro[body], motions[body].rot.as_ref());
         }
     }
     // Each body alone, then leaves to root: the composite of its subtree.
@@ -269,14 +271,10 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
         let p = parent[body];
         if moves[p] {
             let mo = &motions[body];
-            let joint = &robot.joints[order[body - 1]];
             let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
             let in_parent = match &merged[body] {
                 Some(p) => c.moved(Some(p), Some(&d)),
-                None => {
-                    let ro = numeric(&joint.origin.rot);
-                    c.moved(mo.rot.as_ref(), mo.shift.as_ref()).moved(Some(&ro), Some(&d))
-                }
+                None => c.moved(mo.rot.as_ref(), mo.shift.as_ref()).moved(Some(&ro[body]), Some(&d)),
             };
             comp[p] = comp[p].add(&in_parent);
         }
@@ -334,14 +332,12 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
                 Some(r) => (matvec(r, &f, false), matvec(r, &n, false)),
                 None => {
                     let mo = &motions[at];
-                    let jo = &robot.joints[order[at - 1]];
                     let f1 = rotate(mo.rot.as_ref(), &f);
                     let mut n1 = rotate(mo.rot.as_ref(), &n);
                     if let Some(s) = &mo.shift {
                         n1 = vadd(&n1, &cross(s, &f1));
                     }
-                    let ro = numeric(&jo.origin.rot);
-                    (matvec(&ro, &f1, false), matvec(&ro, &n1, false))
+                    (matvec(&ro[at], &f1, false), matvec(&ro[at], &n1, false))
                 }
             };
             let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{at}]")));
