@@ -40,7 +40,7 @@
 //! `l`, `In`) are in these frames instead of the URDF's (rounding-level differences; entries
 //! within 10⁻¹⁵ of 0 or ±1 are snapped as [`Origin::from_xyz_rpy`] does).
 
-use super::robot::{snap, Inertial, JointKind, Origin, Robot};
+use super::robot::{rotate_tensor, snap, Inertial, JointKind, Origin, Robot};
 
 type Mat = [[f64; 3]; 3];
 type Vec3 = [f64; 3];
@@ -209,7 +209,7 @@ pub fn reframe(robot: &Robot) -> Option<Robot> {
             out.links[l].inertial = Some(Inertial {
                 mass: i.mass,
                 com: mat_vec(&qt, &i.com).map(tidy),
-                inertia: mat_mul(&mat_mul(&qt, &i.inertia), &ql).map(|row| row.map(tidy)),
+                inertia: rotate_tensor(&qt, &i.inertia).map(|row| row.map(tidy)),
             });
         }
     }

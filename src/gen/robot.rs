@@ -50,6 +50,18 @@ pub(super) fn snap(x: f64) -> f64 {
     }
 }
 
+/// `R·T·Rᵀ`: a tensor `T` (an inertia) given in a frame turned by `R` into the frame `R` maps
+/// to (both 3×3, row-major).
+pub(crate) fn rotate_tensor(r: &[[f64; 3]; 3], t: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut out = [[0.0; 3]; 3];
+    for (a, row) in out.iter_mut().enumerate() {
+        for (b, x) in row.iter_mut().enumerate() {
+            *x = (0..3).flat_map(|k| (0..3).map(move |l| (k, l))).map(|(k, l)| r[a][k] * t[k][l] * r[b][l]).sum();
+        }
+    }
+    out
+}
+
 /// The mass properties of a link (URDF `<inertial>`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Inertial {

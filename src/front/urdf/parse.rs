@@ -11,7 +11,7 @@
 use robovec_ir::Span;
 
 use crate::front::FrontError;
-use crate::gen::robot::{Inertial, Joint, JointKind, Link, Origin, Robot};
+use crate::gen::robot::{rotate_tensor, Inertial, Joint, JointKind, Link, Origin, Robot};
 
 fn span_of(r: std::ops::Range<usize>) -> Span {
     Span::new(r.start, r.end)
@@ -106,14 +106,7 @@ fn inertial(node: roxmltree::Node) -> Result<Option<Inertial>, FrontError> {
             ));
     }
     // The tensor in the link frame: R I Rᵀ with the inertial origin's rotation.
-    let r = o.rot;
-    let mut out = [[0.0; 3]; 3];
-    for (a, row) in out.iter_mut().enumerate() {
-        for (b, x) in row.iter_mut().enumerate() {
-            *x = (0..3).flat_map(|k| (0..3).map(move |l| (k, l))).map(|(k, l)| r[a][k] * m[k][l] * r[b][l]).sum();
-        }
-    }
-    Ok(Some(Inertial { mass, com: o.xyz, inertia: out }))
+    Ok(Some(Inertial { mass, com: o.xyz, inertia: rotate_tensor(&o.rot, &m) }))
 }
 
 /// Parses and checks a URDF document.
