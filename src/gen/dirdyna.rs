@@ -155,22 +155,23 @@ mod tests {
     /// CRBA's `M` against the unit-acceleration RNEA's (an independent recursion) on every
     /// topology family, on Robotran's floating base (the CRBA's root-segment projection) and on
     /// a chain of dense URDF rotations (merged rotations), that chain also in the frames of
-    /// `crate::gen::frames` (the same `M`: the coordinates keep their meaning): equal to 1e-12.
+    /// `crate::gen::frames`, and the families with the origins of `crate::gen::origins` (the
+    /// same `M`: the coordinates keep their meaning): equal to 1e-12.
     #[test]
     fn crba_mass_matrix_equals_the_unit_acceleration_rnea() {
         for t in Topology::ALL {
             let r = build(t, 9, 3);
-            assert_close(
-                &t.to_string(),
-                &mass_matrix(&r, MassMatrix::Crba),
-                &mass_matrix(&r, MassMatrix::UnitAcceleration),
-                9,
-            );
+            let crba = mass_matrix(&r, MassMatrix::Crba);
+            assert_close(&t.to_string(), &crba, &mass_matrix(&r, MassMatrix::UnitAcceleration), 9);
+            let slid = crate::gen::origins::slide(&r).expect("the families have offsets along their axes");
+            assert_close(&format!("{t}, slid"), &mass_matrix(&slid, MassMatrix::Crba), &crba, 9);
         }
         let floating = build(Topology::Serial, 5, 2).with_floating_base().unwrap();
         let (crba, unit) =
             (mass_matrix(&floating, MassMatrix::Crba), mass_matrix(&floating, MassMatrix::UnitAcceleration));
         assert_close("floating base", &crba, &unit, 11);
+        let slid = crate::gen::origins::slide(&floating).expect("the chain above the base slides");
+        assert_close("floating base, slid", &mass_matrix(&slid, MassMatrix::Crba), &crba, 11);
         let mut dense = build(Topology::Serial, 7, 5);
         for (i, j) in dense.joints.iter_mut().enumerate() {
             let x = i as f64;
@@ -182,5 +183,7 @@ mod tests {
         assert!(reframed.joints.iter().any(|j| j.offset != 0.0), "offsets are used");
         assert_close("dense rpy, reframed", &mass_matrix(&reframed, MassMatrix::Crba), &crba, 7);
         assert_close("dense rpy, reframed, unit", &mass_matrix(&reframed, MassMatrix::UnitAcceleration), &crba, 7);
+        let slid = crate::gen::origins::slide(&reframed).expect("reframed joints turn about z");
+        assert_close("dense rpy, reframed, slid", &mass_matrix(&slid, MassMatrix::Crba), &crba, 7);
     }
 }

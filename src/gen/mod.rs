@@ -36,13 +36,15 @@
 //! the parameters a model sets to 0; the others stay inputs and their values go to
 //! [`Generated::params`] (what `-params-out` writes for `specialize<params=…>` and `-eval`),
 //! unless `--fold-params` folds them all. Constant rotations (URDF `rpy`) are numbers. A chain
-//! of joints with dense `rpy` may be written in other body frames ([`frames`], when that
-//! lowers the op count); the parameters of those links are then in these frames.
+//! of joints with dense `rpy` may be written in other body frames ([`frames`]), and link
+//! frames may be slid along their joint axes ([`origins`]), when that lowers the op count; the
+//! parameters of those links are then in these frames.
 
 pub mod crba;
 pub mod dirdyna;
 pub mod export;
 pub mod frames;
+pub mod origins;
 pub mod rnea;
 pub mod robot;
 pub mod robotran_c;
@@ -148,20 +150,26 @@ type Writer = fn(&Model, &Layout, &mut Builder);
 const FUNCTIONS: [(&str, Writer); 2] = [("invdyna", rnea::invdyna), ("dirdyna", dirdyna::dirdyna)];
 
 /// Generates `invdyna` and `dirdyna` for `model`; `fold` folds every parameter into the
-/// equations. The robot is written in the frames of [`frames::reframe`] when that gives both
-/// functions together fewer ops (then the parameters of the links it turns are in those
-/// frames), otherwise in its own.
+/// equations. The robot is written in its own frames, in the body frames of
+/// [`frames::reframe`], or in either with the origins of [`origins::slide`]: whichever gives
+/// both functions together the fewest ops (the first of equals in that order; then the
+/// parameters of the links they move are in those frames). Cost: up to four generations.
 pub fn generate(model: &Model, fold: bool) -> Generated {
-    let plain = generate_in_frames(model, fold);
-    // The frames of `frames` where they lower the op count of both functions together.
-    let Some(robot) = frames::reframe(&model.robot) else { return plain };
-    let reframed = generate_in_frames(&Model { robot }, fold);
-    let ops = |g: &Generated| g.module.functions.iter().map(|f| f.op_counts().total).sum::<u64>();
-    if ops(&reframed) < ops(&plain) {
-        reframed
-    } else {
-        plain
+    let mut robots = vec![model.robot.clone()];
+    robots.extend(frames::reframe(&model.robot));
+    for i in 0..robots.len() {
+        robots.extend(origins::slide(&robots[i]));
     }
+    let ops = |g: &Generated| g.module.functions.iter().map(|f| f.op_counts().total).sum::<u64>();
+    let mut best: Option<(u64, Generated)> = None;
+    for robot in robots {
+        let g = generate_in_frames(&Model { robot }, fold);
+        let n = ops(&g);
+        if best.as_ref().is_none_or(|(m, _)| n < *m) {
+            best = Some((n, g));
+        }
+    }
+    best.expect("the robot's own frames are a candidate").1
 }
 
 /// [`generate`] in the robot's own frames.
