@@ -15,7 +15,7 @@
 //! [`DEFAULT_BEST`] = `atomise,zero-removal,cse,distribute,balance`. Rule: fewest placed
 //! cycles summed over N = 8, 16, 32, 64, at binary32 error no worse than
 //! `zero-removal,balance`'s. Measured on the 23-, 70- and 130-dof cases (9 cases, 100
-//! samples; sums over the cases):
+//! samples; sums over the cases; the generator before `crate::gen::origins`):
 //!
 //! | best pipeline candidate | ops | ASAPCycle | cycles N = 8 / 16 / 32 / 64 (sum) | f32 bits mean / max |
 //! |---|---:|---:|---:|---:|
