@@ -533,6 +533,7 @@ fn scalar_forms_equal_the_interpreter_on_random_dags() {
 #[test]
 fn inline_trig_agrees_with_the_interpreter_to_a_small_relative_error() {
     let cases = batch_cases();
+    let mut worsts = Vec::new();
     for (batch, f32, tol, width) in
         [(1, false, 1e-12, ""), (4, false, 1e-12, "-DROBOVEC_VBYTES=32"), (8, true, 1e-4, "")]
     {
@@ -546,9 +547,12 @@ fn inline_trig_agrees_with_the_interpreter_to_a_small_relative_error() {
         };
         eprintln!("trig=inline batch={batch} f32={f32}: {n} outputs, largest relative difference {worst:e}");
         assert!(n > 600 * batch as usize, "only {n} outputs compared");
-        // Not bit-exact: some outputs do differ (else this would test nothing new).
-        assert!(worst > 0.0, "batch={batch} f32={f32}: every output bit-exact with libm's trig?");
+        worsts.push(worst);
     }
+    // Not bit-exact: some outputs do differ (else this would test nothing new). Not in every
+    // configuration: the inline sin/cos are often the correctly rounded results, as glibc's are,
+    // and the scalar f64 outputs of these cases all agree with libm's.
+    assert!(worsts.iter().any(|&w| w > 0.0), "every output bit-exact with libm's trig? {worsts:?}");
 }
 
 const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";

@@ -21,15 +21,21 @@
 //!    per binade from the continued fraction of π/2: `‖kα‖ ≥ ‖q_n α‖` for `k < q_{n+1}`) and
 //!    `|r| ≥ 2^−27.8` for floats below `2^11` (every float checked, in `__float128`). Without the
 //!    TwoSum the error reaches 1.4 ulp.
-//! 3. **Kernels** on `|r| ≤ π/4` (plus `2^−32`, from the rounding of `k`), Taylor polynomials
-//!    in Horner form: `sin r = r + r³·P(r²)`, `P` through `r^17` (`float`: `r^11`), and
-//!    `cos r = 1 − r²/2 + r⁴·Q(r²)`, `Q` through `r^18` (`float`: `r^12`); the first omitted
-//!    term is below `2^−63` (`2^−36`) relative. The low part enters to first order,
-//!    `sin(rh + rl) ≈ sin rh + rl·(1 − rh²/2)`, `cos(rh + rl) ≈ cos rh − rl·rh`, and
-//!    `1 − rh²/2` is summed with its rounding error (as fdlibm's `__kernel_cos` does).
-//! 4. **Quadrant selection** with masks, no per-lane branch: odd `k` swaps sin and cos
-//!    (bit-select), `sin` is negated in quadrants 2 and 3, `cos` in 1 and 2 (sign-bit xor).
-//!    `sin(−0) = −0` is selected by mask too.
+//! 3. **Kernels** on `|r| ≤ R_MAX` ([`kernel_r_max`]: π/4 plus `2^−30`, resp. `2^−10` in
+//!    `float`, covering the rounding of `k`), polynomials in Horner form:
+//!    `sin r = r + r³·P(r²)`, `P` through `r^13` (`float`: `r^9`), and
+//!    `cos r = 1 − r²/2 + r⁴·Q(r²)`, `Q` through `r^14` (`float`: `r^8`), near-minimax for the
+//!    relative error of the result (see *Constants*): at most `2^−57.9` for `sin`, `2^−63.9` for
+//!    `cos` (`float`: `2^−32.5`, `2^−33.0`), measured in the unit tests (Taylor polynomials of
+//!    these degrees: about `2^−45` and `2^−49`). The low part enters to
+//!    first order, `sin(rh + rl) ≈ sin rh + rl·w`, `w = 1 − rh²/2` rounded (shared with `cos`),
+//!    `cos(rh + rl) ≈ cos rh − rl·rh`, and `1 − rh²/2` is summed with its rounding error (as
+//!    fdlibm's `__kernel_cos` does).
+//! 4. **Quadrant selection** with bit operations, no per-lane branch: `q`'s bit 0 shifted to
+//!    the sign bit gives (by a signed comparison with 0) the mask of odd `k`, under which sin and
+//!    cos are swapped by xor with their difference; sin's sign bit is flipped by `q`'s bit 1
+//!    (quadrants 2 and 3), cos's by bit 1 xor bit 0 (quadrants 1 and 2). `sin(−0) = −0`: the
+//!    arithmetic gives `+0` for both zeros, and the sign of a zero `x` is or-ed in.
 //!
 //! When the IR has both `sin` and `cos` of one joint coordinate, the body computes both with
 //! one `robovec_sincos_inline` (one reduction) at the first of the two statements.
@@ -41,25 +47,39 @@
 //! are cut from it by two's-complement integer arithmetic, each rounded to nearest at its
 //! last bit (`A1` at `2^−(p−kb−1)`, `A2` at `2^−p`, `Bi` at `2^−(p+i·(p−kb))`, `C` to `p`
 //! significant bits), so the remainders alternate in sign and the unit tests check that the
-//! pieces sum to π/2 within `2^−139` (`2^−74`). The polynomial coefficients are `±1/n!`, each
-//! one correctly rounded division (`n!` is exact in the format for every `n` used).
+//! pieces sum to π/2 within `2^−139` (`2^−74`). The polynomial coefficients are derived here
+//! too ([`KERNEL_TERMS`] of them): a weighted minimax fit (discrete Remez exchange in
+//! double-double arithmetic, [`robovec_ir::numerics::DD`]) of `(sin r − r)/r³` and
+//! `(cos r − 1 + r²/2)/r⁴` as polynomials in `z = r²` on 4096 Chebyshev-spaced points of
+//! `(0, R_MAX²]`, the functions summed from their Taylor series; the weights `z/(sin r/r)` and
+//! `z²/cos r` make the fitted error the relative error of `sin r` and `cos r`. The coefficients
+//! are rounded to the format one at a time from the lowest power, the higher ones fitted again
+//! after each rounding so that they absorb its error. The unit tests bound the result against
+//! an independent double-double sin/cos and check the coefficients against `±1/n!`.
 //!
 //! # Range and accuracy
 //! The inline code is used for `|x| ≤ L`, `L = 2^20` in `double` (`|k| < 2^20`) and `L = 2^11`
-//! in `float` (`|k| < 2^11`). A batch with any lane beyond `L`, or not finite, computes those
-//! lanes with libm's `sin`/`cos` (`sinf`/`cosf`) one at a time (one vector-wide test, then a
-//! rarely taken scalar loop); so NaN and ±∞ give NaN, as libm does.
+//! in `float` (`|k| < 2^11`). A batch with any lane beyond `L` (±∞ included) or NaN computes
+//! those lanes with libm's `sin`/`cos` (`sinf`/`cosf`) one at a time; so NaN and ±∞ give NaN,
+//! as libm does. The test is `x·x ≤ L²`: `L²` is exact and rounding is monotonic, so it holds
+//! exactly when `|x| ≤ L` (false for NaN), in two operations. A batch tests all its lanes at
+//! once, with one intrinsic when `robovec_vec` is one x86 register (`vptest` with AVX,
+//! `pmovmskb` with SSE2, a mask compare with AVX-512F), otherwise with an and over the lanes;
+//! then a rarely taken scalar loop.
 //!
 //! **Accuracy: error below 1 ulp of the exact value, so at most 1 ulp from the correctly
 //! rounded result** (often the correctly rounded result itself), in `double` and in `float`.
 //! Measured by `tests/codegen_c/trig.rs` against a reference accurate to about 2^−100 (exact
 //! integer reduction, double-double series), on 40 000 arguments per set, sin and cos, largest
-//! / mean error: uniform in `[−π, π]` 0.747 / 0.253 ulp (`float` 0.760 / 0.253), uniform in
-//! `[−100, 100]` 0.723 / 0.253 (0.750 / 0.253), log-uniform from `2^−30` to `L` 0.725 / 0.236
+//! / mean error: uniform in `[−π, π]` 0.744 / 0.253 ulp (`float` 0.738 / 0.252), uniform in
+//! `[−100, 100]` 0.739 / 0.253 (0.750 / 0.253), log-uniform from `2^−30` to `L` 0.735 / 0.236
 //! (0.750 / 0.149), the nearest numbers to `k·π/2` and their neighbours (hard cases of the
-//! reduction) 0.500 / 0.125 (0.500 / 0.175). The error analysis gives the same picture: 0.5 ulp
-//! from the last addition, up to about 0.25 from `rh²` (the tail is at most 0.1·|r|, resp. `r²/2`
-//! at most 0.31 in `cos`), a few hundredths from the rest.
+//! reduction) 0.500 / 0.125 (0.500 / 0.175), special values 0.418 / 0.135 (0.366 / 0.126).
+//! (With the earlier Taylor kernels through `r^17`/`r^18`, `float` `r^11`/`r^12`: 0.747, 0.723,
+//! 0.725, 0.500 (0.760, 0.750, 0.750, 0.500), the same means.) The error analysis gives the same
+//! picture: 0.5 ulp from the last addition, up to about 0.25 from `rh²` (the tail is at most
+//! 0.1·|r|, resp. `r²/2` at most 0.31 in `cos`), a few hundredths from the rest, the kernels'
+//! approximation error included (at most `2^−57.9` relative: 0.03 ulp).
 //!
 //! The results are not libm's bit for bit, so `trig=inline` code is **not** bit-exact with
 //! robovec's interpreter (`-eval`, Rust's `sin`/`cos`, i.e. the system libm): outputs that
@@ -74,6 +94,10 @@
 //! Programming* vol. 2, §4.2.2 (TwoSum).
 
 use std::fmt::Write as _;
+
+use std::sync::OnceLock;
+
+use robovec_ir::numerics::DD;
 
 use crate::codegen::literal;
 
@@ -190,7 +214,7 @@ pub struct Constants {
 impl Constants {
     /// The constants of `double` (`f32 = false`) or `float`.
     pub fn new(f32: bool) -> Constants {
-        let (p, kb, n_tails, sin_last, cos_last) = if f32 { (24, 11, 2, 11, 12) } else { (53, 20, 1, 17, 18) };
+        let (p, kb, n_tails) = if f32 { (24, 11, 2) } else { (53, 20, 1) };
         let m = p - kb;
         let mut rest = half_pi();
         // Cuts the piece of `rest` ending at bit 2^lsb (rounded to nearest there).
@@ -205,7 +229,8 @@ impl Constants {
         // C: p significant bits from the leading bit of what is left.
         let lead = big_bit_len(&rest) as i32 - 1 - SCALE;
         let last = cut(&mut rest, lead - (p as i32 - 1));
-        let c = Constants { p, kb, heads, tails, last, sin: taylor(3, sin_last, f32), cos: taylor(4, cos_last, f32) };
+        let (sin, cos) = kernels(f32);
+        let c = Constants { p, kb, heads, tails, last, sin, cos };
         c.check();
         c
     }
@@ -235,23 +260,165 @@ impl Constants {
     }
 }
 
-/// `(−1)^i / n!` for `n = first, first + 2, …, last`, rounded once to the format.
-fn taylor(first: u32, last: u32, f32: bool) -> Vec<f64> {
-    (first..=last)
-        .step_by(2)
-        .enumerate()
-        .map(|(i, n)| {
-            let fact: u64 = (1..=u64::from(n)).product();
-            let sign = if i % 2 == 0 { -1.0 } else { 1.0 } * if first.is_multiple_of(4) { -1.0 } else { 1.0 };
-            if f32 {
-                assert_eq!(fact as f32 as u64, fact, "{n}! is exact in float");
-                sign * f64::from(1.0f32 / fact as f32)
-            } else {
-                assert_eq!(fact as f64 as u64, fact, "{n}! is exact in double");
-                sign / fact as f64
-            }
+/// The number of coefficients `(sin, cos)` of the kernel polynomials, `[double, float]`: `sin`
+/// through `r^13` and `cos` through `r^14` in `double`, `sin` through `r^9` and `cos` through
+/// `r^8` in `float` — the fewest that keep the approximation error far below half an ulp (see
+/// the unit test `kernel_polynomials_are_within_their_bound`; one fewer gives `2^−53.3` for the
+/// `double` `cos`, `2^−27.9` for the `float` `sin`).
+pub const KERNEL_TERMS: [(usize, usize); 2] = [(6, 6), (4, 3)];
+
+/// The kernels' coefficients `(sin, cos)` of one format ([`kernel_poly`]), derived once.
+fn kernels(f32: bool) -> (Vec<f64>, Vec<f64>) {
+    static CACHE: [OnceLock<(Vec<f64>, Vec<f64>)>; 2] = [OnceLock::new(), OnceLock::new()];
+    let i = usize::from(f32);
+    CACHE[i]
+        .get_or_init(|| {
+            let (ms, mc) = KERNEL_TERMS[i];
+            (kernel_poly(3, ms, f32), kernel_poly(4, mc, f32))
         })
-        .collect()
+        .clone()
+}
+
+/// The kernels' domain: `|r| ≤ R_MAX` with `R_MAX = π/4 + 2^−30` in `double` (the rounding of
+/// `k` lets `|r|` exceed π/4 by about `2^−32`) and `π/4 + 2^−10` in `float` (about `2^−13`
+/// there); `z = r²` in `[0, R_MAX²]`.
+pub fn kernel_r_max(f32: bool) -> f64 {
+    std::f64::consts::FRAC_PI_4 + if f32 { pow2(-10) } else { pow2(-30) }
+}
+
+/// `(sin r − r)/r³` (`first = 3`) or `(cos r − 1 + r²/2)/r⁴` (`first = 4`) as a function of
+/// `z = r²`: the Taylor series `∓Σ (−1)^n z^n / (2n + first)!` (`−1/3! + z/5! − …`,
+/// `1/4! − z/6! + …`), summed in double-double until
+/// the terms fall below `2^−110` of the sum (`0 ≤ z < 1`). Units: 1.
+fn kernel_series(first: u32, z: DD) -> DD {
+    let fact: f64 = (1..=first).map(f64::from).product();
+    let sign = if first == 3 { -1.0 } else { 1.0 };
+    let mut term = DD::from_f64(sign) / DD::from_f64(fact);
+    let mut sum = term;
+    let mut n = first;
+    loop {
+        term = -(term * z) / DD::from_f64(f64::from((n + 1) * (n + 2)));
+        sum = sum + term;
+        n += 2;
+        if term.hi.abs() < sum.hi.abs() * pow2(-110) {
+            return sum;
+        }
+    }
+}
+
+/// `(f(z), w(z))` of one kernel at `z`: the function the polynomial approximates (see
+/// [`kernel_series`]) and the weight that turns its error into the relative error of the
+/// result, `z/(sin r / r)` for `sin`, `z²/cos r` for `cos`.
+fn kernel_target(first: u32, z: DD) -> (DD, DD) {
+    let f = kernel_series(first, z);
+    let one = DD::from_f64(1.0);
+    let w = if first == 3 { z / (one + z * f) } else { (z * z) / (one - z.mul_f64(0.5) + z * z * f) };
+    (f, w)
+}
+
+/// The weighted minimax polynomial `Σ_{j<m} c_j z^j` for the values `g` with weights `w` on the
+/// points `z` (discrete Remez exchange, double-double): minimises `max |w·(g − p)|`.
+fn remez(z: &[DD], g: &[DD], w: &[DD], m: usize) -> Vec<DD> {
+    let n = z.len();
+    let one = DD::from_f64(1.0);
+    let zero = DD::from_f64(0.0);
+    // Start from the Chebyshev points of order m + 1 on the grid (Chebyshev-spaced itself).
+    let mut refs: Vec<usize> = (0..=m).map(|i| ((i as f64 + 0.5) / (m as f64 + 1.0) * n as f64) as usize).collect();
+    let mut coef = vec![zero; m];
+    for _ in 0..40 {
+        // Σ c_j z_i^j + (−1)^i E / w_i = g_i: m + 1 equations, Gaussian elimination.
+        let mut a: Vec<Vec<DD>> = refs
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| {
+                let mut row = Vec::with_capacity(m + 2);
+                let mut p = one;
+                for _ in 0..m {
+                    row.push(p);
+                    p = p * z[k];
+                }
+                let e = one / w[k];
+                row.push(if i % 2 == 0 { e } else { -e });
+                row.push(g[k]);
+                row
+            })
+            .collect();
+        for col in 0..=m {
+            let piv = (col..=m).max_by(|&i, &j| a[i][col].hi.abs().total_cmp(&a[j][col].hi.abs())).unwrap();
+            a.swap(col, piv);
+            let pivot = a[col].clone();
+            for (r, row) in a.iter_mut().enumerate() {
+                if r != col {
+                    let f = row[col] / pivot[col];
+                    for (x, &v) in row.iter_mut().zip(&pivot).skip(col) {
+                        *x = *x - f * v;
+                    }
+                }
+            }
+        }
+        coef = (0..m).map(|j| a[j][m + 1] / a[j][j]).collect();
+        // The weighted error on the grid; the extremum of each run of one sign.
+        let err: Vec<f64> = (0..n).map(|k| (w[k] * (g[k] - horner_dd(&coef, z[k]))).hi).collect();
+        let mut ext: Vec<usize> = Vec::new();
+        for k in 0..n {
+            match ext.last() {
+                Some(&e) if (err[e] > 0.0) == (err[k] > 0.0) => {
+                    if err[k].abs() > err[e].abs() {
+                        *ext.last_mut().unwrap() = k;
+                    }
+                }
+                _ => ext.push(k),
+            }
+        }
+        while ext.len() > m + 1 {
+            if err[ext[0]].abs() < err[ext[ext.len() - 1]].abs() {
+                ext.remove(0);
+            } else {
+                ext.pop();
+            }
+        }
+        if ext.len() < m + 1 || ext == refs {
+            break;
+        }
+        refs = ext;
+    }
+    coef
+}
+
+/// `Σ c_j z^j` in double-double (Horner).
+fn horner_dd(c: &[DD], z: DD) -> DD {
+    c.iter().rev().fold(DD::from_f64(0.0), |acc, &x| acc * z + x)
+}
+
+/// The kernel polynomial of `sin` (`first = 3`: coefficients of `r³, r⁵, …`) or `cos`
+/// (`first = 4`: `r⁴, r⁶, …`) with `m` coefficients, each rounded to the format: weighted
+/// minimax ([`remez`]) on 4096 Chebyshev-spaced points of `z ∈ (0, R_MAX²]`; the coefficients
+/// are rounded one at a time from the lowest power, the higher ones re-optimised after each
+/// rounding so they absorb its error.
+fn kernel_poly(first: u32, m: usize, f32: bool) -> Vec<f64> {
+    let n = 4096;
+    let zmax = DD::from_f64(kernel_r_max(f32)) * DD::from_f64(kernel_r_max(f32));
+    let z: Vec<DD> = (0..n)
+        .map(|k| zmax.mul_f64((1.0 - (std::f64::consts::PI * (k as f64 + 0.5) / n as f64).cos()) * 0.5))
+        .collect();
+    let (f, w): (Vec<DD>, Vec<DD>) = z.iter().map(|&z| kernel_target(first, z)).unzip();
+    let mut rounded: Vec<f64> = Vec::with_capacity(m);
+    for j in 0..m {
+        // What is left to approximate, over z^j, with the weight times z^j.
+        let done: Vec<DD> = rounded.iter().map(|&c| DD::from_f64(c)).collect();
+        let (g, wj): (Vec<DD>, Vec<DD>) = (0..n)
+            .map(|k| {
+                let mut zj = DD::from_f64(1.0);
+                for _ in 0..j {
+                    zj = zj * z[k];
+                }
+                ((f[k] - horner_dd(&done, z[k])) / zj, w[k] * zj)
+            })
+            .collect();
+        let c = remez(&z, &g, &wj, m - j)[0];
+        rounded.push(if f32 { f64::from(c.round_f32()) } else { c.round_f64() });
+    }
+    rounded
 }
 
 /// The C helpers `robovec_sincos_inline(x, &s, &c)`, `robovec_sin_inline(x)` and
@@ -280,20 +447,21 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
     let sfx = if f32 { "f" } else { "" };
     let magic = if f32 { 1.5 * pow2(23) } else { 1.5 * pow2(52) };
     let two_pi = if f32 { f64::from(std::f32::consts::FRAC_2_PI) } else { std::f64::consts::FRAC_2_PI };
-    let sign_shift = if f32 { 30 } else { 62 };
+    let sign_shift = if f32 { 31 } else { 63 };
     let (half, one, l) = (lit(0.5), lit(1.0), c.limit());
 
     let mut s = format!(
         "/* trig=inline: sin/cos by robovec's own branch-free code (passes/src/codegen/c/trig.rs): k = round(x*2/pi),\n \
-         * r = x - k*pi/2 by Cody-Waite with pi/2 split into exact pieces, Taylor polynomials on |r| <= pi/4, quadrant\n \
-         * by masks; |x| > {} or not finite: libm. Within 1 ulp of the correctly rounded result; not libm's bits. */\n",
+         * r = x - k*pi/2 by Cody-Waite with pi/2 split into exact pieces, minimax polynomials on |r| <= pi/4, quadrant\n \
+         * by masks; |x| > {} or NaN: libm. Within 1 ulp of the correctly rounded result; not libm's bits. */\n",
         if f32 { "2^11" } else { "2^20" }
     );
     if vector {
         let _ = writeln!(
             s,
-            "typedef unsigned {} robovec_uvec __attribute__((vector_size(ROBOVEC_VL * sizeof({real}))));",
-            if f32 { "int" } else { "long long" }
+            "typedef unsigned {int} robovec_uvec __attribute__((vector_size(ROBOVEC_VL * sizeof({real}))));\n\
+             typedef {int} robovec_ivec __attribute__((vector_size(ROBOVEC_VL * sizeof({real}))));",
+            int = if f32 { "int" } else { "long long" }
         );
     } else {
         let _ = writeln!(
@@ -336,41 +504,60 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
     let _ = writeln!(
         s,
         "  /* sin(rh + rl) ~ rh + rh^3 P(rh^2) + rl (1 - rh^2/2); cos(rh + rl) ~ 1 - rh^2/2 + rh^4 Q(rh^2) - rl rh. */\n  \
-         const {v} z = rh * rh;\n  const {v} ps = {};\n  const {v} sr = rh + ((rh * z) * ps + (rl - ({half} * z) * rl));\n  \
-         const {v} pc = {};\n  const {v} hz = {half} * z;\n  const {v} w = {one} - hz;\n  \
-         const {v} cr = w + ((({one} - w) - hz) + ((z * z) * pc - rh * rl));",
+         const {v} z = rh * rh;\n  const {v} hz = {half} * z;\n  const {v} w = {one} - hz;\n  \
+         const {v} ps = {};\n  const {v} sr = rh + ((rh * z) * ps + rl * w);\n  \
+         const {v} pc = {};\n  const {v} cr = w + ((({one} - w) - hz) + ((z * z) * pc - rh * rl));",
         horner(&c.sin),
         horner(&c.cos)
     );
     let _ = writeln!(
         s,
-        "  /* q = k mod 4: odd q swaps sin and cos; sin is negated for q = 2, 3, cos for q = 1, 2; sin(-0) = -0. */\n  \
-         const {u} swap = -(q & 1);\n  \
-         const {u} sb = ((swap & {cb}) | (~swap & {sb})) ^ ((q & 2) << {sign_shift});\n  \
-         const {u} cb = ((swap & {sb}) | (~swap & {cb})) ^ (((q + 1) & 2) << {sign_shift});\n  \
-         const {u} zero = {};\n  {v} s = {};\n  {v} c = {};",
+        "  /* q = k mod 4: odd q swaps sin and cos (xor with their difference under a mask); sin is negated for\n   \
+         * q = 2, 3, cos for q = 1, 2 (sign-bit xor); sin(-0) = -0 (sr is +0 there). */\n  \
+         const {u} qs = q << {sign_shift};\n  const {u} swap = {};\n  const {u} ss = (q >> 1) << {sign_shift};\n  \
+         const {u} d = ({sb} ^ {cb}) & swap;\n  const {u} zero = {};\n  \
+         {v} s = {};\n  {v} c = {};",
+        if vector { format!("({u})((robovec_ivec)qs < 0)") } else { format!("-(qs >> {sign_shift})") },
         mask(&format!("x == {}", lit(0.0))),
-        as_real(&format!("(zero & {}) | (~zero & sb)", bits("x"))),
-        as_real("cb"),
+        as_real(&format!("({} ^ d ^ ss) | (zero & {})", bits("sr"), bits("x"))),
+        as_real(&format!("{} ^ d ^ ss ^ qs", bits("cr"))),
         sb = bits("sr"),
         cb = bits("cr"),
     );
-    let range = format!("x >= {} && x <= {}", lit(-l), lit(l));
+    let in_range = format!("x * x <= {}", lit(l * l));
     if vector {
+        let size = if f32 { 4 } else { 8 };
         let _ = writeln!(
             s,
-            "  /* Lanes beyond the range or not finite (rare): libm. */\n  \
-             const {u} out = ~{};\n  {elem} any = out[0];\n  \
-             for (int lane = 1; lane < ROBOVEC_VL; lane++) any |= out[lane];\n  \
-             if (any)\n    for (int lane = 0; lane < ROBOVEC_VL; lane++)\n      \
-             if (out[lane]) {{ s[lane] = sin{sfx}(x[lane]); c[lane] = cos{sfx}(x[lane]); }}",
-            mask(&format!("(x >= {}) & (x <= {})", lit(-l), lit(l))),
+            "  /* Lanes with |x| > L or NaN (rare): libm. x*x <= L^2 is |x| <= L exactly (L^2 exact, rounding\n   \
+             * monotonic) and false for NaN; one test of all lanes, by an intrinsic where the vector is one register. */\n  \
+             const {u} in = {};\n\
+             #if defined(__AVX__) && ROBOVEC_TRIG_VBYTES == 32\n  \
+             if (!_mm256_testc_si256((__m256i)in, _mm256_set1_epi32(-1)))\n\
+             #elif defined(__SSE2__) && ROBOVEC_TRIG_VBYTES == 16\n  \
+             if (_mm_movemask_epi8((__m128i)in) != 0xffff)\n\
+             #elif defined(__AVX512F__) && ROBOVEC_TRIG_VBYTES == 64\n  \
+             if (_mm512_cmpneq_epi32_mask((__m512i)in, _mm512_set1_epi32(-1)))\n\
+             #else\n  \
+             {elem} all = in[0];\n  for (int lane = 1; lane < ROBOVEC_VL; lane++) all &= in[lane];\n  if (!all)\n\
+             #endif\n    \
+             for (int lane = 0; lane < ROBOVEC_VL; lane++)\n      \
+             if (!in[lane]) {{ s[lane] = sin{sfx}(x[lane]); c[lane] = cos{sfx}(x[lane]); }}",
+            mask(&in_range),
             elem = if f32 { "unsigned int" } else { "unsigned long long" },
         );
+        // ROBOVEC_TRIG_VBYTES: the bytes of one robovec_vec, for the preprocessor.
+        let def = format!(
+            "#define ROBOVEC_TRIG_VBYTES (ROBOVEC_VBYTES < ROBOVEC_W * {size} ? ROBOVEC_VBYTES : ROBOVEC_W * {size})\n\
+             #if defined(__SSE2__) || defined(__AVX__)\n#include <immintrin.h>\n#endif\n"
+        );
+        let at = s.find("typedef unsigned").expect("the vector typedefs");
+        s.insert_str(at, &def);
     } else {
         let _ = writeln!(
             s,
-            "  /* Beyond the range or not finite (rare): libm. */\n  if (!({range})) {{ s = sin{sfx}(x); c = cos{sfx}(x); }}"
+            "  /* |x| > L or NaN (rare): libm (x*x <= L^2 is |x| <= L exactly, false for NaN). */\n  \
+             if (!({in_range})) {{ s = sin{sfx}(x); c = cos{sfx}(x); }}"
         );
     }
     let _ = writeln!(
@@ -477,14 +664,69 @@ mod tests {
     fn double_split_has_the_documented_shape() {
         let c = Constants::new(false);
         assert_eq!(c.limit(), 1048576.0);
-        assert_eq!(c.sin.len(), 8);
-        assert_eq!(c.cos.len(), 8);
-        assert_eq!(c.sin[0], -1.0 / 6.0);
-        assert_eq!(c.cos[0], 1.0 / 24.0);
-        assert_eq!(c.sin[7], 1.0 / 355687428096000.0);
-        assert_eq!(c.cos[7], -1.0 / 6402373705728000.0);
+        assert_eq!((c.sin.len(), c.cos.len(), c.tails.len()), (6, 6, 1));
         let f = Constants::new(true);
-        assert_eq!((f.limit(), f.sin.len(), f.cos.len(), f.tails.len()), (2048.0, 5, 5, 2));
-        assert_eq!(f.cos[1], f64::from(-1.0f32 / 720.0));
+        assert_eq!((f.limit(), f.sin.len(), f.cos.len(), f.tails.len()), (2048.0, 4, 3, 2));
+    }
+
+    /// The largest relative error of the kernel polynomials with the rounded coefficients,
+    /// `r + r³·p(r²)` against `sin r` and `1 − r²/2 + r⁴·q(r²)` against `cos r`, on 20 000
+    /// evenly spaced `r` in `(0, R_MAX]`, evaluated exactly enough (double-double) that only the
+    /// approximation error shows; the reference is [`DD::sin`] / [`DD::cos`] (reduction in
+    /// triple-double and Taylor series, absolute error below 2^−98), independent of the series
+    /// the coefficients were fitted to.
+    fn kernel_errors(c: &Constants, f32: bool) -> (f64, f64) {
+        let to_dd = |cs: &[f64]| cs.iter().map(|&x| DD::from_f64(x)).collect::<Vec<_>>();
+        let (ps, pc) = (to_dd(&c.sin), to_dd(&c.cos));
+        let n = 20_000;
+        let (mut es, mut ec) = (0.0f64, 0.0f64);
+        for i in 1..=n {
+            let r = DD::from_f64(kernel_r_max(f32) * i as f64 / n as f64);
+            let z = r * r;
+            let s = r + r * z * horner_dd(&ps, z);
+            let c = DD::from_f64(1.0) - z.mul_f64(0.5) + z * z * horner_dd(&pc, z);
+            let (ts, tc) = (r.sin(), r.cos());
+            es = es.max(((s - ts) / ts).hi.abs());
+            ec = ec.max(((c - tc) / tc).hi.abs());
+        }
+        (es, ec)
+    }
+
+    #[test]
+    fn kernel_polynomials_are_within_their_bound() {
+        // (f32, bounds on the relative error of sin and cos): far below half an ulp (2^−53,
+        // resp. 2^−24 relative at most).
+        for (f32, bound_sin, bound_cos) in [(false, -57.5f64, -63.0f64), (true, -32.0, -32.5)] {
+            let c = Constants::new(f32);
+            let (es, ec) = kernel_errors(&c, f32);
+            eprintln!("f32={f32}: sin 2^{:.2}, cos 2^{:.2}", es.log2(), ec.log2());
+            assert!(es < bound_sin.exp2() && ec < bound_cos.exp2(), "f32={f32}: sin {es:e}, cos {ec:e}");
+        }
+    }
+
+    #[test]
+    fn kernel_coefficients_are_near_the_taylor_ones() {
+        // Minimax moves each coefficient a little from ±1/n!, more the higher the power; the
+        // signs alternate like the series'.
+        for f32 in [false, true] {
+            let c = Constants::new(f32);
+            for (first, cs) in [(3u32, &c.sin), (4, &c.cos)] {
+                for (j, &x) in cs.iter().enumerate() {
+                    let n = first + 2 * j as u32;
+                    let fact: f64 = (1..=n).map(f64::from).product();
+                    let sign = if j % 2 == 0 { -1.0 } else { 1.0 } * if first == 4 { -1.0 } else { 1.0 };
+                    let rel = x * fact * sign - 1.0;
+                    eprintln!("f32={f32} r^{n}: {x:e} (1/n! · (1 {rel:+e}))");
+                    let tol = if j > 0 {
+                        0.1
+                    } else if f32 {
+                        pow2(-18)
+                    } else {
+                        pow2(-40)
+                    };
+                    assert!(rel.abs() < tol, "f32={f32} r^{n}: {x:e}, relative to ±1/{n}! {rel:e}");
+                }
+            }
+        }
     }
 }
