@@ -92,10 +92,10 @@ pub fn slide(robot: &Robot) -> Option<Robot> {
     let weight = |l: usize| 2 + below[l];
     // Per link: its axis in its own frame (`a`) and in its parent's (`u = ro·a`); zero for a
     // link that does not slide.
-    let slides = |l: usize| {
-        joint_of[l].is_some_and(|j: usize| robot.joints[j].kind == JointKind::Revolute) && !in_segment[l]
-    };
-    let a: Vec<Vec3> = (0..nl).map(|l| if slides(l) { robot.joints[joint_of[l].unwrap()].axis } else { [0.0; 3] }).collect();
+    let slides =
+        |l: usize| joint_of[l].is_some_and(|j: usize| robot.joints[j].kind == JointKind::Revolute) && !in_segment[l];
+    let a: Vec<Vec3> =
+        (0..nl).map(|l| if slides(l) { robot.joints[joint_of[l].unwrap()].axis } else { [0.0; 3] }).collect();
     let u: Vec<Vec3> = (0..nl)
         .map(|l| if slides(l) { mat_vec(&robot.joints[joint_of[l].unwrap()].origin.rot, &a[l]) } else { [0.0; 3] })
         .collect();
@@ -156,7 +156,10 @@ pub fn slide(robot: &Robot) -> Option<Robot> {
             let t = cand[l][i];
             let mut cost = com(l).map_or(0, |m| nnz(&moved(&m, 0.0, &[0.0; 3], t, &a[l])));
             for &ch in &children[l] {
-                cost += (0..cand[ch].len()).map(|k| edge(ch, t, cand[ch][k]) + best[ch][k]).min().expect("0 is a candidate");
+                cost += (0..cand[ch].len())
+                    .map(|k| edge(ch, t, cand[ch][k]) + best[ch][k])
+                    .min()
+                    .expect("0 is a candidate");
             }
             best[l][i] = cost;
         }
