@@ -61,7 +61,7 @@ fn transpose(a: &Mat) -> Mat {
     [0, 1, 2].map(|i| [0, 1, 2].map(|j| a[j][i]))
 }
 
-fn mat_vec(a: &Mat, v: &Vec3) -> Vec3 {
+pub(super) fn mat_vec(a: &Mat, v: &Vec3) -> Vec3 {
     [0, 1, 2].map(|i| (0..3).map(|k| a[i][k] * v[k]).sum())
 }
 
@@ -80,7 +80,7 @@ fn snapped(m: &Mat) -> Mat {
 }
 
 /// `x` with magnitudes below 10⁻¹⁵ set to 0 (a zero turned into rounding noise by a rotation).
-fn tidy(x: f64) -> f64 {
+pub(super) fn tidy(x: f64) -> f64 {
     if x.abs() < 1e-15 {
         0.0
     } else {

@@ -33,6 +33,7 @@
 //! root down: Robotran's floating base `T1…R3`, whose meeting axes the CRBA's projection uses)
 //! are not slid. Values that a slide brings within 10⁻¹⁵ of 0 are set to 0.
 
+use super::frames::{mat_vec, tidy};
 use super::robot::{JointKind, Origin, Robot};
 
 type Vec3 = [f64; 3];
@@ -41,15 +42,6 @@ type Vec3 = [f64; 3];
 /// make, and a bound on the dynamic program's work (`O(links · MAX_CANDIDATES²)`).
 pub const MAX_CANDIDATES: usize = 8;
 
-/// `x` with magnitudes below 10⁻¹⁵ set to 0.
-fn tidy(x: f64) -> f64 {
-    if x.abs() < 1e-15 {
-        0.0
-    } else {
-        x
-    }
-}
-
 fn nnz(v: &Vec3) -> usize {
     v.iter().filter(|x| tidy(**x) != 0.0).count()
 }
@@ -57,10 +49,6 @@ fn nnz(v: &Vec3) -> usize {
 /// `v + s·u − t·w`, tidied.
 fn moved(v: &Vec3, s: f64, u: &Vec3, t: f64, w: &Vec3) -> Vec3 {
     [0, 1, 2].map(|k| tidy(v[k] + s * u[k] - t * w[k]))
-}
-
-fn mat_vec(a: &[[f64; 3]; 3], v: &Vec3) -> Vec3 {
-    [0, 1, 2].map(|i| (0..3).map(|k| a[i][k] * v[k]).sum())
 }
 
 /// The robot with link frames slid along their joint axes (module doc); `None` when no slide
