@@ -93,7 +93,6 @@ pub fn slide(robot: &Robot) -> Option<Robot> {
     for jo in &robot.joints {
         children[jo.parent].push(jo.child);
     }
-    let parent = |l: usize| joint_of[l].map(|j| robot.joints[j].parent);
 
     // Candidates, top down: 0, and the slides that zero a component of the link's own offset
     // (for each candidate of its parent), of a child's offset, or of the centre of mass, along
@@ -131,32 +130,25 @@ pub fn slide(robot: &Robot) -> Option<Robot> {
     // offsets and below) when l slides by cand[l][i]; choice[c][i] = the child's best candidate
     // given its parent's i-th.
     let mut best: Vec<Vec<usize>> = cand.iter().map(|c| vec![0; c.len()]).collect();
-    let mut choice: Vec<Vec<usize>> = cand.iter().map(|c| vec![0; c.len()]).collect();
-    let edge = |c: usize, sp: f64, sc: f64| {
-        let p = parent(c).expect("a child has a parent");
-        weight(c) * nnz(&moved(&xyz(c), sc, &u[c], sp, &a[p]))
-    };
+    let mut choice: Vec<Vec<usize>> = vec![Vec::new(); nl];
     let mut post: Vec<usize> = order.iter().map(|&j| robot.joints[j].child).collect();
     post.reverse();
     post.push(robot.root);
     for &l in &post {
+        for &ch in &children[l] {
+            choice[ch] = vec![0; cand[l].len()];
+        }
         for i in 0..cand[l].len() {
             let t = cand[l][i];
             let mut cost = com(l).map_or(0, |m| nnz(&moved(&m, 0.0, &[0.0; 3], t, &a[l])));
             for &ch in &children[l] {
-                cost += (0..cand[ch].len())
-                    .map(|k| edge(ch, t, cand[ch][k]) + best[ch][k])
-                    .min()
-                    .expect("0 is a candidate");
+                // The child's offset moves by its own slide along u and by l's along a.
+                let total = |k: usize| weight(ch) * nnz(&moved(&xyz(ch), cand[ch][k], &u[ch], t, &a[l])) + best[ch][k];
+                let k = (0..cand[ch].len()).min_by_key(|&k| (total(k), k)).expect("0 is a candidate");
+                choice[ch][i] = k;
+                cost += total(k);
             }
             best[l][i] = cost;
-        }
-        if let Some(p) = parent(l) {
-            choice[l] = (0..cand[p].len())
-                .map(|i| {
-                    (0..cand[l].len()).min_by_key(|&k| (edge(l, cand[p][i], cand[l][k]) + best[l][k], k)).expect("0")
-                })
-                .collect();
         }
     }
     // Top down: the chosen slide of each link.
