@@ -280,21 +280,15 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
         }
         comp[body] = c;
     }
-    // The root segment: bodies whose every joint up to the root has no offset and no constant
-    // rotation, with no prismatic joint below a revolute one (Robotran's floating base
-    // T1 T2 T3 R1 R2 R3). Their joints all act at one point, so a column force that reaches
-    // such a body gives every entry above it by projection (see `projection`).
-    let mut in_segment = vec![false; nb + 1];
-    let mut segment_rev = vec![false; nb + 1];
+    // The root segment (`Robot::root_segment`, here per body): its joints all act at one point,
+    // so a column force that reaches such a body gives every entry above it by projection (see
+    // `projection`).
+    let segment_of_link = robot.root_segment();
+    let in_segment: Vec<bool> =
+        std::iter::once(true).chain(order.iter().map(|&j| segment_of_link[robot.joints[j].child])).collect();
     let mut segment_moving = vec![0usize; nb + 1];
-    in_segment[0] = true;
     for body in 1..=nb {
-        let p = parent[body];
-        let jo = &robot.joints[order[body - 1]];
-        let plain = jo.origin.xyz == [0.0; 3] && jo.origin.rot == super::robot::Origin::IDENTITY.rot;
-        in_segment[body] = in_segment[p] && plain && !(jo.kind == JointKind::Prismatic && segment_rev[p]);
-        segment_rev[body] = segment_rev[p] || jo.kind == JointKind::Revolute;
-        segment_moving[body] = segment_moving[p] + usize::from(layout.q_index[body - 1].is_some());
+        segment_moving[body] = segment_moving[parent[body]] + usize::from(layout.q_index[body - 1].is_some());
     }
     let mut projections: FxHashMap<(usize, usize), V3> = FxHashMap::default();
     let mut upper = Vec::new();

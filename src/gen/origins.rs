@@ -34,7 +34,7 @@
 //! are not slid. Values that a slide brings within 10⁻¹⁵ of 0 are set to 0.
 
 use super::frames::{mat_vec, tidy};
-use super::robot::{JointKind, Origin, Robot};
+use super::robot::{JointKind, Robot};
 
 type Vec3 = [f64; 3];
 
@@ -60,17 +60,8 @@ pub fn slide(robot: &Robot) -> Option<Robot> {
     for (j, joint) in robot.joints.iter().enumerate() {
         joint_of[joint.child] = Some(j);
     }
-    // The root segment (as the CRBA defines it), and the moving joints at and below each link.
-    let mut in_segment = vec![false; nl];
-    let mut segment_rev = vec![false; nl];
-    in_segment[robot.root] = true;
-    for &j in &order {
-        let jo = &robot.joints[j];
-        let plain = jo.origin.xyz == [0.0; 3] && jo.origin.rot == Origin::IDENTITY.rot;
-        in_segment[jo.child] =
-            in_segment[jo.parent] && plain && !(jo.kind == JointKind::Prismatic && segment_rev[jo.parent]);
-        segment_rev[jo.child] = segment_rev[jo.parent] || jo.kind == JointKind::Revolute;
-    }
+    // The root segment, and the moving joints at and below each link.
+    let in_segment = robot.root_segment();
     let mut below = vec![0usize; nl];
     for &j in order.iter().rev() {
         let jo = &robot.joints[j];

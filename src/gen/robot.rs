@@ -140,6 +140,25 @@ impl Robot {
         c
     }
 
+    /// The root segment, per link: the root and every link whose joints up to the root all have
+    /// no offset and no constant rotation, with no prismatic joint below a revolute one
+    /// (Robotran's floating base `T1 T2 T3 R1 R2 R3`). Their joints all act at one point: the
+    /// CRBA projects column forces there ([`crate::gen::crba`]) and [`crate::gen::origins`]
+    /// leaves them in place. Cost: O(joints · log joints).
+    pub fn root_segment(&self) -> Vec<bool> {
+        let mut in_segment = vec![false; self.links.len()];
+        let mut revolute_above = vec![false; self.links.len()];
+        in_segment[self.root] = true;
+        for j in self.dfs_joints() {
+            let jo = &self.joints[j];
+            let plain = jo.origin.xyz == [0.0; 3] && jo.origin.rot == Origin::IDENTITY.rot;
+            in_segment[jo.child] =
+                in_segment[jo.parent] && plain && !(jo.kind == JointKind::Prismatic && revolute_above[jo.parent]);
+            revolute_above[jo.child] = revolute_above[jo.parent] || jo.kind == JointKind::Revolute;
+        }
+        in_segment
+    }
+
     /// Every joint in depth-first pre-order from the root, children by [`Robot::children`]:
     /// Pinocchio's joint order once the fixed joints are left out. Cost: O(joints · log joints).
     pub fn dfs_joints(&self) -> Vec<usize> {

@@ -457,6 +457,13 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
         if f32 { "2^11" } else { "2^20" }
     );
     if vector {
+        // ROBOVEC_TRIG_VBYTES: the bytes of one robovec_vec, for the preprocessor (the range test).
+        let size = if f32 { 4 } else { 8 };
+        let _ = write!(
+            s,
+            "#define ROBOVEC_TRIG_VBYTES (ROBOVEC_VBYTES < ROBOVEC_W * {size} ? ROBOVEC_VBYTES : ROBOVEC_W * {size})\n\
+             #if defined(__SSE2__) || defined(__AVX__)\n#include <immintrin.h>\n#endif\n"
+        );
         let _ = writeln!(
             s,
             "typedef unsigned {int} robovec_uvec __attribute__((vector_size(ROBOVEC_VL * sizeof({real}))));\n\
@@ -526,7 +533,6 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
     );
     let in_range = format!("x * x <= {}", lit(l * l));
     if vector {
-        let size = if f32 { 4 } else { 8 };
         let _ = writeln!(
             s,
             "  /* Lanes with |x| > L or NaN (rare): libm. x*x <= L^2 is |x| <= L exactly (L^2 exact, rounding\n   \
@@ -546,13 +552,6 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
             mask(&in_range),
             elem = if f32 { "unsigned int" } else { "unsigned long long" },
         );
-        // ROBOVEC_TRIG_VBYTES: the bytes of one robovec_vec, for the preprocessor.
-        let def = format!(
-            "#define ROBOVEC_TRIG_VBYTES (ROBOVEC_VBYTES < ROBOVEC_W * {size} ? ROBOVEC_VBYTES : ROBOVEC_W * {size})\n\
-             #if defined(__SSE2__) || defined(__AVX__)\n#include <immintrin.h>\n#endif\n"
-        );
-        let at = s.find("typedef unsigned").expect("the vector typedefs");
-        s.insert_str(at, &def);
     } else {
         let _ = writeln!(
             s,
