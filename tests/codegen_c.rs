@@ -67,7 +67,7 @@ fn callback_uses(m: &Module, out: &mut Vec<(Callee, usize)>) {
     for f in &m.functions {
         for &v in &f.body {
             if let Def::Call(c, args) = &f.value(v).def {
-                if !robovec_passes::codegen::c::is_sqrt(c, args.len()) && !out.iter().any(|(k, _)| k == &**c) {
+                if !robovec_passes::codegen::c::is_intrinsic(c, args.len()) && !out.iter().any(|(k, _)| k == &**c) {
                     out.push(((**c).clone(), args.len()));
                 }
             }
@@ -524,6 +524,32 @@ fn scalar_forms_equal_the_interpreter_on_random_dags() {
         let o = plain(f32, 1, trig_input);
         let n = if f32 { check_plain::<f32>(&dir, &cases, &o, 5) } else { check_plain::<f64>(&dir, &cases, &o, 5) };
         assert!(n > 600, "only {n} outputs compared");
+    }
+}
+
+/// `contract`'s fused multiply-adds are C99 `fma` in the C (`robovec_fma` in a batch: one FMA
+/// intrinsic where the target has FMA, `fma` per lane otherwise): every output equals the
+/// interpreter's (`mul_add`) bit for bit, scalar and batched, in both precisions, compiled for
+/// a generic target and for the host's own (`-march=native`: the FMA intrinsics on an x86-64
+/// with FMA or AVX-512).
+#[test]
+fn contracted_functions_equal_the_interpreter_bit_for_bit() {
+    let cases: Vec<Case> =
+        batch_cases().into_iter().map(|c| Case { label: c.label, m: run_pipeline(c.m, "contract") }).collect();
+    let fused = cases.iter().flat_map(|c| &c.m.functions).filter(|f| robovec_passes::codegen::c::has_fused(f)).count();
+    assert!(fused >= 12, "only {fused} functions have fused multiply-adds");
+    for (batch, f32, native) in
+        [(1, false, false), (1, true, true), (4, false, true), (8, true, false), (8, false, true)]
+    {
+        let dir = tmp(&format!("contract_{batch}_{f32}_{native}"));
+        let o = plain(f32, batch, true);
+        let extra: &[&str] = if native { &["-march=native"] } else { &[] };
+        let n = if f32 {
+            check_plain_with::<f32>(&dir, &cases, &o, 6, extra)
+        } else {
+            check_plain_with::<f64>(&dir, &cases, &o, 6, extra)
+        };
+        assert!(n > 600 * batch as usize, "batch {batch}: only {n} outputs compared");
     }
 }
 

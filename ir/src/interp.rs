@@ -34,6 +34,9 @@ pub trait Float:
     fn sin(self) -> Self;
     /// Cosine in this precision.
     fn cos(self) -> Self;
+    /// `self·b + c` rounded once (IEEE 754 `fusedMultiplyAdd`), for the fused intrinsics
+    /// ([`crate::intrinsic::Intrinsic`]).
+    fn mul_add(self, b: Self, c: Self) -> Self;
 }
 
 impl Float for f64 {
@@ -52,6 +55,9 @@ impl Float for f64 {
     fn cos(self) -> Self {
         f64::cos(self)
     }
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        f64::mul_add(self, b, c)
+    }
 }
 
 impl Float for f32 {
@@ -69,6 +75,9 @@ impl Float for f32 {
     }
     fn cos(self) -> Self {
         f32::cos(self)
+    }
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        f32::mul_add(self, b, c)
     }
 }
 
@@ -99,10 +108,9 @@ pub fn callback_standin<T: Float>(callee: &Callee, args: &[T]) -> T {
 
 /// Evaluates a call in precision `T`.
 pub fn eval_call<T: Float>(callee: &Callee, args: &[T]) -> T {
-    if callee.name == "sqrt" && callee.elem.is_none() && args.len() == 1 {
-        args[0].sqrt()
-    } else {
-        callback_standin(callee, args)
+    match crate::intrinsic::Intrinsic::of(callee, args.len()) {
+        Some(i) => i.eval(args),
+        None => callback_standin(callee, args),
     }
 }
 

@@ -6,7 +6,8 @@
 //! - **inputs**: values known before the equations run — joint coordinates `q[i] qd[i] qdd[i]`,
 //!   model parameters `dpt[k][j] l[k][b] m[b] In[k][b] g[k] frc[k][b] …`, `tsim` (SPEC §1–§2);
 //! - a **body** of definitions in order: trig initial variables (`%C4 = cos %q[4]`, not
-//!   operations), binary operations (`add sub mul div`), calls (`sqrt`, opaque user callbacks),
+//!   operations), binary operations (`add sub mul div`), calls (the [`intrinsic`]s `sqrt`, `fma`, `fms`,
+//!   `fnma`, and opaque user callbacks),
 //!   and — in the parsed phase only — nested expressions (one Robotran equation each);
 //! - **outputs**: named results (`M[1][2]`, `c[3]`, `Qq[1]`, `sens.P[1]`), each a value or a
 //!   constant.
@@ -34,6 +35,7 @@ pub mod diagnostic;
 pub mod entities;
 pub mod function;
 pub mod interp;
+pub mod intrinsic;
 pub mod machine;
 pub mod numerics;
 pub mod placement;
@@ -47,5 +49,6 @@ pub mod verifier;
 pub use diagnostic::SourceError;
 pub use entities::Value;
 pub use function::{Function, Module, OpCounts};
+pub use intrinsic::Intrinsic;
 pub use span::Span;
 pub use syntax::*;

@@ -11,6 +11,7 @@ pub mod artifact;
 pub mod asap_alap;
 pub mod atomise;
 pub mod codegen;
+pub mod contract;
 pub mod cpu_order;
 pub mod cse;
 pub mod dce;
@@ -347,6 +348,7 @@ pub const PASSES: &[PassInfo] = &[
     specialize::INFO,
     eqsat::INFO,
     cse::INFO,
+    contract::INFO,
     cpu_order::INFO,
     codegen::INFO,
 ];

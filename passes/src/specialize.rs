@@ -135,8 +135,12 @@ pub fn specialize_function(f: &mut Function, params: &BTreeMap<String, f64>) -> 
             }
             Def::Call(c, args) => {
                 let args: Vec<Operand> = args.into_iter().map(|o| m(o, &map)).collect();
-                let to = match (c.name.as_str(), c.elem, args.as_slice()) {
-                    ("sqrt", None, [Operand::Const(x)]) if *x >= 0.0 => Some(Operand::Const(x.sqrt())),
+                // An intrinsic of constants folds (a non-finite result, e.g. `sqrt` of a
+                // negative constant, stays a call: see below).
+                let consts: Option<Vec<f64>> =
+                    args.iter().map(|a| if let Operand::Const(x) = a { Some(*x) } else { None }).collect();
+                let to = match (robovec_ir::Intrinsic::of(&c, args.len()), consts) {
+                    (Some(i), Some(xs)) => Some(Operand::Const(i.eval(&xs))),
                     _ => None,
                 };
                 (Some(Def::Call(c, args)), to)

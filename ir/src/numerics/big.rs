@@ -5,6 +5,7 @@
 use astro_float::{BigFloat, Consts, RoundingMode, Sign};
 
 use super::tape::{Step, Tape};
+use crate::intrinsic::Intrinsic;
 use crate::syntax::{BinOp, TrigFn};
 
 const RM: RoundingMode = RoundingMode::ToEven;
@@ -134,10 +135,14 @@ pub fn eval(tape: &Tape, inputs: &[f64], bits: usize, mask: Option<&[bool]>) -> 
                 let args: Vec<&BigFloat> =
                     tape.args[start as usize..(start + len) as usize].iter().map(|&x| &slots[x as usize]).collect();
                 let callee = &tape.callees[c as usize];
-                if super::is_sqrt(callee, args.len()) {
-                    args[0].sqrt(bits, RM)
-                } else {
-                    standin(callee, &args, bits)
+                match Intrinsic::of(callee, args.len()) {
+                    Some(Intrinsic::Sqrt) => args[0].sqrt(bits, RM),
+                    // One rounding, as fused: the product of two `bits`-bit values is exact
+                    // at `2·bits`, so only the sum rounds (and sets the inexact flag).
+                    Some(Intrinsic::Fma) => args[0].mul(args[1], 2 * bits, RM).add(args[2], bits, RM),
+                    Some(Intrinsic::Fms) => args[0].mul(args[1], 2 * bits, RM).sub(args[2], bits, RM),
+                    Some(Intrinsic::Fnma) => args[2].sub(&args[0].mul(args[1], 2 * bits, RM), bits, RM),
+                    None => standin(callee, &args, bits),
                 }
             }
         };

@@ -307,6 +307,11 @@ impl Float for DD {
     fn cos(self) -> Self {
         DD::cos(self)
     }
+    /// `self·b + c` in double-double: two roundings of ≈ 2⁻¹⁰⁶, not one (a reference, not
+    /// an emulation of binary64's fused rounding).
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        self * b + c
+    }
 }
 
 #[cfg(test)]

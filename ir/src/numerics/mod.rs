@@ -13,7 +13,7 @@
 //! - [`budget`]: the rigorous `γ_K·M` error budget of `+ − ×` functions (Higham ch. 3).
 //!
 //! "Exact" means: the real-number value of the IR's expression on the given `f64` inputs, with
-//! `sin`/`cos`/`sqrt` exact and user callbacks replaced by the interpreter's stand-in (a linear
+//! `sin`/`cos`/`sqrt` and the fused multiply-adds exact and user callbacks replaced by the interpreter's stand-in (a linear
 //! form with exact weights) evaluated exactly.
 
 pub mod big;
@@ -27,10 +27,3 @@ pub use bits::{bits_f32, bits_f64};
 pub use dd::DD;
 pub use reference::{RefValue, Reference};
 pub use tape::Tape;
-
-use crate::syntax::Callee;
-
-/// True when a call is the square root (`@sqrt` with one argument), as the interpreter decides.
-pub fn is_sqrt(c: &Callee, n_args: usize) -> bool {
-    c.name == "sqrt" && c.elem.is_none() && n_args == 1
-}

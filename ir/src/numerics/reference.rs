@@ -30,6 +30,7 @@ use astro_float::{BigFloat, RoundingMode};
 
 use super::dd::{DD, DD_TRIG_ABS, DD_UNIT};
 use super::tape::{Step, Tape};
+use crate::intrinsic::Intrinsic;
 use crate::syntax::BinOp;
 
 /// Precision of the certified path, bits.
@@ -120,7 +121,8 @@ fn propagate_from(tape: &Tape, val: &[f64], known: Known, u: f64, trig_abs: f64,
             Step::Trig(_, a) => err[a as usize] + trig_abs,
             Step::Call(c, start, len) => {
                 let args = &tape.args[start as usize..(start + len) as usize];
-                if super::is_sqrt(&tape.callees[c as usize], args.len()) {
+                let intrinsic = Intrinsic::of(&tape.callees[c as usize], args.len());
+                if intrinsic == Some(Intrinsic::Sqrt) {
                     let (va, ea) = (val[args[0] as usize], err[args[0] as usize]);
                     if r.is_nan() && va + ea < 0.0 {
                         0.0 // the exact argument is negative: the exact result is NaN too
@@ -129,6 +131,12 @@ fn propagate_from(tape: &Tape, val: &[f64], known: Known, u: f64, trig_abs: f64,
                     } else {
                         ea.sqrt() + ru
                     }
+                } else if intrinsic.is_some() {
+                    // ±a·b ± c: the product's error, the addend's, and a rounding of the
+                    // product and of the sum (two for a double-double evaluation, one fused).
+                    let [a, b, c] = [0, 1, 2].map(|k| args[k] as usize);
+                    let (va, vb) = (val[a].abs(), val[b].abs());
+                    va * err[b] + vb * err[a] + err[a] * err[b] + err[c] + u * va * vb + ru
                 } else {
                     let sum_e: f64 = args.iter().map(|&x| err[x as usize]).sum();
                     let sum_a: f64 = args.iter().map(|&x| val[x as usize].abs()).sum();

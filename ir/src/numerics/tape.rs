@@ -9,6 +9,7 @@
 
 use crate::function::Function;
 use crate::interp::{eval_call, Float};
+use crate::intrinsic::Intrinsic;
 use crate::syntax::{BinOp, Callee, Def, Expr, Operand, TrigFn};
 
 /// One step of a tape; operands are slot numbers (inputs, then constants, then steps).
@@ -268,8 +269,8 @@ impl Tape {
         mask
     }
 
-    /// The user callbacks the outputs depend on (every callee but the square root, see
-    /// [`super::is_sqrt`]): robovec cannot see them and evaluates them with the interpreter's
+    /// The user callbacks the outputs depend on (every callee but the intrinsics, see
+    /// [`crate::intrinsic::Intrinsic`]): robovec cannot see them and evaluates them with the interpreter's
     /// stand-in ([`crate::interp::callback_standin`]). Distinct names (`name` or `name[elem]`),
     /// sorted.
     pub fn standin_callees(&self) -> Vec<String> {
@@ -277,7 +278,7 @@ impl Tape {
             .steps
             .iter()
             .filter_map(|s| match *s {
-                Step::Call(c, _, len) if !super::is_sqrt(&self.callees[c as usize], len as usize) => {
+                Step::Call(c, _, len) if Intrinsic::of(&self.callees[c as usize], len as usize).is_none() => {
                     let c = &self.callees[c as usize];
                     Some(match c.elem {
                         Some(e) => format!("{}[{e}]", c.name),

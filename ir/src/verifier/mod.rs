@@ -43,8 +43,9 @@ use rustc_hash::FxHashSet as HashSet;
 use codespan_reporting::diagnostic::{Diagnostic, Label};
 
 use crate::function::{Function, Module};
+use crate::intrinsic::Intrinsic;
 use crate::span::Span;
-use crate::syntax::{Def, Expr, Operand, Phase};
+use crate::syntax::{Callee, Def, Expr, Operand, Phase};
 use crate::Value;
 
 /// Where a verifier error was found.
@@ -85,6 +86,22 @@ impl VerifierError {
         } else {
             d.with_labels(vec![Label::primary(file, self.span.range()).with_message(&self.message)])
         }
+    }
+}
+
+/// The message for a call of an intrinsic's name ([`Intrinsic`]) with the wrong number of
+/// operands or a vector element (`@sqrt[2]`): such a call would otherwise be taken for a
+/// user callback.
+fn intrinsic_misuse(i: Intrinsic, c: &Callee, n: usize) -> String {
+    if c.elem.is_some() {
+        format!(
+            "`@{}` is an intrinsic with a scalar result; `@{}[{}]` selects an element",
+            i.name(),
+            i.name(),
+            c.elem.unwrap_or(0)
+        )
+    } else {
+        format!("`@{}` takes {} operand{}, found {n}", i.name(), i.arity(), if i.arity() == 1 { "" } else { "s" })
     }
 }
 
@@ -194,8 +211,8 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
             }
             Def::Call(c, args) => {
                 args.iter().for_each(|a| check_operand(a, &mut local, false));
-                if c.name == "sqrt" && args.len() != 1 {
-                    local.push(format!("`call @sqrt` takes 1 operand, found {}", args.len()));
+                if let Some(i) = Intrinsic::named(&c.name).filter(|i| i.arity() != args.len() || c.elem.is_some()) {
+                    local.push(intrinsic_misuse(i, c, args.len()));
                 }
             }
             Def::Expr(e) => {
@@ -212,8 +229,10 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
                             stack.push(a);
                         }
                         Expr::Call(c, args) => {
-                            if c.name == "sqrt" && args.len() != 1 {
-                                local.push(format!("`@sqrt` takes 1 argument, found {}", args.len()));
+                            if let Some(i) =
+                                Intrinsic::named(&c.name).filter(|i| i.arity() != args.len() || c.elem.is_some())
+                            {
+                                local.push(intrinsic_misuse(i, c, args.len()));
                             }
                             stack.extend(args.iter().rev());
                         }

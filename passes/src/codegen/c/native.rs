@@ -22,7 +22,7 @@ use std::fmt::Write as _;
 use robovec_ir::{Def, Function, Module, Operand};
 
 use super::body::{split_callee, Body};
-use super::is_sqrt;
+use super::is_intrinsic;
 use crate::PassError;
 
 /// The local arrays of a vector callback, `(name prefix, number of indices)`, in the order of
@@ -79,7 +79,7 @@ pub(crate) fn prototypes(m: &Module) -> Result<String, PassError> {
     for f in &m.functions {
         for &v in &f.body {
             if let Def::Call(c, args) = &f.value(v).def {
-                if is_sqrt(c, args.len()) {
+                if is_intrinsic(c, args.len()) {
                     continue;
                 }
                 let (base, _) = split_callee(c)?;
@@ -140,7 +140,7 @@ pub(crate) fn statements(b: &Body<'_>) -> Result<HashMap<usize, String>, PassErr
     let mut out = HashMap::new();
     for &v in &f.body {
         let Def::Call(c, args) = &f.value(v).def else { continue };
-        if is_sqrt(c, args.len()) {
+        if is_intrinsic(c, args.len()) {
             continue;
         }
         let (base, idx) = split_callee(c)?;

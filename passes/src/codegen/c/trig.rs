@@ -457,13 +457,7 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
         if f32 { "2^11" } else { "2^20" }
     );
     if vector {
-        // ROBOVEC_TRIG_VBYTES: the bytes of one robovec_vec, for the preprocessor (the range test).
-        let size = if f32 { 4 } else { 8 };
-        let _ = write!(
-            s,
-            "#define ROBOVEC_TRIG_VBYTES (ROBOVEC_VBYTES < ROBOVEC_W * {size} ? ROBOVEC_VBYTES : ROBOVEC_W * {size})\n\
-             #if defined(__SSE2__) || defined(__AVX__)\n#include <immintrin.h>\n#endif\n"
-        );
+        // ROBOVEC_VEC_BYTES and <immintrin.h> come with the vector type (body::vector_helpers).
         let _ = writeln!(
             s,
             "typedef unsigned {int} robovec_uvec __attribute__((vector_size(ROBOVEC_VL * sizeof({real}))));\n\
@@ -538,11 +532,11 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
             "  /* Lanes with |x| > L or NaN (rare): libm. x*x <= L^2 is |x| <= L exactly (L^2 exact, rounding\n   \
              * monotonic) and false for NaN; one test of all lanes, by an intrinsic where the vector is one register. */\n  \
              const {u} in = {};\n\
-             #if defined(__AVX__) && ROBOVEC_TRIG_VBYTES == 32\n  \
+             #if defined(__AVX__) && ROBOVEC_VEC_BYTES == 32\n  \
              if (!_mm256_testc_si256((__m256i)in, _mm256_set1_epi32(-1)))\n\
-             #elif defined(__SSE2__) && ROBOVEC_TRIG_VBYTES == 16\n  \
+             #elif defined(__SSE2__) && ROBOVEC_VEC_BYTES == 16\n  \
              if (_mm_movemask_epi8((__m128i)in) != 0xffff)\n\
-             #elif defined(__AVX512F__) && ROBOVEC_TRIG_VBYTES == 64\n  \
+             #elif defined(__AVX512F__) && ROBOVEC_VEC_BYTES == 64\n  \
              if (_mm512_cmpneq_epi32_mask((__m512i)in, _mm512_set1_epi32(-1)))\n\
              #else\n  \
              {elem} all = in[0];\n  for (int lane = 1; lane < ROBOVEC_VL; lane++) all &= in[lane];\n  if (!all)\n\
