@@ -15,8 +15,9 @@
 //! with it as one operand (GCC's rule in its `widening_mul` pass): then every such addition
 //! becomes a fused op and the `mul` disappears, one instruction fewer per `mul` and none more.
 //! `m + y`, `y + m` → `fma(a, b, y)`; `m − y` → `fms(a, b, y)`; `y − m` → `fnma(a, b, y)`, for
-//! `m = a·b`. An addition of two such multiplies absorbs the one with fewer uses, then the later
-//! one (its result is ready last, so fusing it shortens the chain); a multiply some of whose
+//! `m = a·b`. An addition of two such multiplies absorbs the one with fewer uses, then the
+//! earlier one (GCC converts multiplies in statement order; absorbing the later one instead was
+//! no faster on serial30's `M`), and keeps the other as its addend; a multiply some of whose
 //! additions absorbed their other operand is left unfused, and those additions choose again,
 //! until no choice changes.
 //!
@@ -105,7 +106,7 @@ pub fn contract_function(f: &mut Function) -> Contracted {
         let Def::Binary(_, a, b) = &f.value(v).def else { return None };
         let cand = |k: usize, o: &Operand| match o {
             Operand::Value(x) if eligible[x.index()] => {
-                Some((adds_of[x.index()].len(), std::cmp::Reverse(x.index()), k))
+                Some((adds_of[x.index()].len(), x.index(), k))
             }
             _ => None,
         };
