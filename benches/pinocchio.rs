@@ -306,8 +306,9 @@ fn summary_row(robot: &str, nv: usize, g: usize, figs: &[Figures], mhz: f64) -> 
         pin.ns.0,
         pin.ns.0 * mhz / 1e3
     );
-    let variant =
-        |label: &str| mine.iter().find(|f| f.name.starts_with("robovec") && f.name.ends_with(label)).expect("each variant");
+    let variant = |label: &str| {
+        mine.iter().find(|f| f.name.starts_with("robovec") && f.name.ends_with(label)).expect("each variant")
+    };
     for (label, ..) in VARIANTS {
         let f = variant(label);
         let _ = write!(row, " {:.0} ({:.1}×) |", f.ns.0, f.ratio);

@@ -15,16 +15,12 @@
 //! with it as one operand (GCC's rule in its `widening_mul` pass): then every such addition
 //! becomes a fused op and the `mul` disappears, one instruction fewer per `mul` and none more.
 //! `m + y`, `y + m` → `fma(a, b, y)`; `m − y` → `fms(a, b, y)`; `y − m` → `fnma(a, b, y)`, for
-//! `m = a·b`. An addition of two such multiplies absorbs the one with fewer uses, then the
-//! earlier one (GCC converts multiplies in statement order; absorbing the later one instead was
-//! no faster on serial30's `M`), and keeps the other as its addend; a multiply some of whose
-//! additions absorbed their other operand is left unfused, and those additions choose again,
-//! until no choice changes.
+//! `m = a·b`. Multiplies are taken in statement order (GCC's order): an addition of two
+//! products absorbs the earlier one, which leaves the other as its addend, unfused.
 //!
 //! Runs on the atomised phase and keeps it; clears timing attributes. A fused op is a `call`
 //! (SPEC §3 counts it as one op of kind `call`), which `place` runs as a call and
-//! `codegen<fpga>` rejects: this pass is for CPU back ends. Cost: O(values + operands) per
-//! round; rounds are few (each one drops a multiply for good).
+//! `codegen<fpga>` rejects: this pass is for CPU back ends. Cost: O(values + operands).
 
 use robovec_ir::{BinOp, Def, Function, Intrinsic, Module, Operand, Value};
 
@@ -53,15 +49,6 @@ pub struct Contracted {
     pub fnma: usize,
     /// Multiplies removed (every use fused).
     pub muls_removed: usize,
-}
-
-/// The multiply `a·b` defining `o`, if `o` is one.
-fn mul_of(f: &Function, o: &Operand) -> Option<(Value, Operand, Operand)> {
-    let Operand::Value(v) = *o else { return None };
-    match f.value(v).def {
-        Def::Binary(BinOp::Mul, a, b) => Some((v, a, b)),
-        _ => None,
-    }
 }
 
 /// Fuses the multiplies of `f` into their additions (see the module doc).
@@ -94,81 +81,41 @@ pub fn contract_function(f: &mut Function) -> Contracted {
             def => def.for_each_value(|x| other_use[x.index()] = true),
         }
     }
-    let mut eligible: Vec<bool> = (0..n)
-        .map(|i| {
-            let v = Value::with_number(i as u32);
-            !other_use[i] && !adds_of[i].is_empty() && mul_of(f, &Operand::Value(v)).is_some()
-        })
-        .collect();
-    // Each addition's choice: the operand (0 or 1) whose multiply it absorbs.
-    let mut choice: Vec<Option<usize>> = vec![None; n];
-    let choose = |f: &Function, eligible: &[bool], v: Value| -> Option<usize> {
-        let Def::Binary(_, a, b) = &f.value(v).def else { return None };
-        let cand = |k: usize, o: &Operand| match o {
-            Operand::Value(x) if eligible[x.index()] => {
-                Some((adds_of[x.index()].len(), x.index(), k))
-            }
-            _ => None,
-        };
-        [cand(0, a), cand(1, b)].into_iter().flatten().min().map(|(_, _, k)| k)
-    };
-    let adds: Vec<Value> = f
-        .body
-        .iter()
-        .copied()
-        .filter(|&v| matches!(f.value(v).def, Def::Binary(BinOp::Add | BinOp::Sub, a, b) if a != b))
-        .collect();
-    for &v in &adds {
-        choice[v.index()] = choose(f, &eligible, v);
-    }
-    loop {
-        let chosen = |f: &Function, choice: &[Option<usize>], add: Value| -> Option<Value> {
-            let Def::Binary(_, a, b) = &f.value(add).def else { return None };
-            match (choice[add.index()], [a, b]) {
-                (Some(k), ops) => match ops[k] {
-                    Operand::Value(x) => Some(*x),
-                    Operand::Const(_) => None,
-                },
-                (None, _) => None,
-            }
-        };
-        let mut dropped = Vec::new();
-        for i in 0..n {
-            if eligible[i] && !adds_of[i].iter().all(|&a| chosen(f, &choice, a) == Some(Value::with_number(i as u32))) {
-                eligible[i] = false;
-                dropped.push(i);
-            }
-        }
-        if dropped.is_empty() {
-            break;
-        }
-        for i in dropped {
-            for &a in &adds_of[i] {
-                choice[a.index()] = choose(f, &eligible, a);
-            }
-        }
-    }
+    // GCC's order: each multiply in statement order is fused when all its uses are still
+    // additions; an addition that absorbed one is a fused op, so the other product it reads
+    // (now the addend of a call) is not.
+    let mut converted = vec![false; n];
+    let mut removed = vec![false; n];
     let mut out = Contracted::default();
-    for &v in &adds {
-        let Some(k) = choice[v.index()] else { continue };
-        let Def::Binary(op, x, y) = f.value(v).def.clone() else { continue };
-        let (m, other) = if k == 0 { (x, y) } else { (y, x) };
-        let (_, a, b) = mul_of(f, &m).expect("an eligible operand is a multiply");
-        let i = match (op, k) {
-            (BinOp::Add, _) => Intrinsic::Fma,
-            (_, 0) => Intrinsic::Fms,
-            _ => Intrinsic::Fnma,
-        };
-        match i {
-            Intrinsic::Fma => out.fma += 1,
-            Intrinsic::Fms => out.fms += 1,
-            _ => out.fnma += 1,
+    for i in 0..f.body.len() {
+        let m = f.body[i];
+        let Def::Binary(BinOp::Mul, a, b) = f.value(m).def else { continue };
+        let uses = &adds_of[m.index()];
+        if other_use[m.index()] || uses.is_empty() || uses.iter().any(|u| converted[u.index()]) {
+            continue;
         }
-        f.value_mut(v).def = Def::Call(Box::new(i.callee()), vec![a, b, other]);
+        for &u in uses {
+            let Def::Binary(op, x, y) = f.value(u).def else { unreachable!("an addition") };
+            let first = x == Operand::Value(m);
+            let addend = if first { y } else { x };
+            let i = match (op, first) {
+                (BinOp::Add, _) => Intrinsic::Fma,
+                (_, true) => Intrinsic::Fms,
+                _ => Intrinsic::Fnma,
+            };
+            match i {
+                Intrinsic::Fma => out.fma += 1,
+                Intrinsic::Fms => out.fms += 1,
+                _ => out.fnma += 1,
+            }
+            f.value_mut(u).def = Def::Call(Box::new(i.callee()), vec![a, b, addend]);
+            converted[u.index()] = true;
+        }
+        removed[m.index()] = true;
+        out.muls_removed += 1;
     }
-    out.muls_removed = eligible.iter().filter(|&&e| e).count();
     if out.muls_removed > 0 {
-        f.retain(|_, v| !eligible[v.index()]);
+        f.retain(|_, v| !removed[v.index()]);
     }
     f.clear_timing();
     out

@@ -1,5 +1,5 @@
 //! `trig=inline` (`passes/src/codegen/c/trig.rs`): the emitted sin/cos, compiled
-//! (`cc -O1 -ffp-contract=off`, one program), against a reference computed here in exact
+//! (`cc -O1 -ffp-contract=off`, one program, for a generic target and with `-march=native`), against a reference computed here in exact
 //! integer arithmetic (the reduction) and double-double (the series) — accurate to about
 //! 2^−100, far beyond the ulp being measured; batched lanes equal `batch=1` bit for bit;
 //! libm's exact results beyond the range and on NaN/±∞; `sin(±0) = ±0`.
@@ -272,9 +272,18 @@ fn driver(sym: &str, real: &str, w: u32) -> String {
     )
 }
 
+/// Compiled for a generic target (no FMA: the polynomials as products and sums) and for the
+/// host's own (`-march=native`: with FMA where the host has it, `ROBOVEC_MADD` fuses them).
 #[test]
 fn inline_sin_cos_are_within_one_ulp_and_lanes_equal_the_scalar_code() {
-    let dir = tmp("trig_inline");
+    for (k, flags) in [&["-O1"][..], &["-O1", "-march=native"]].into_iter().enumerate() {
+        check_inline_sin_cos(&format!("trig_inline_{k}"), flags);
+    }
+}
+
+/// The test above for one set of C compiler flags.
+fn check_inline_sin_cos(dir: &str, flags: &[&str]) {
+    let dir = tmp(dir);
     let m = robovec_ir::text::parse(IR).unwrap_or_else(|e| panic!("{e:?}"));
     // (symbol, f32, batch): the scalar form and a batch in each precision.
     let forms = [("d1", false, 1), ("d4", false, 4), ("s1", true, 1), ("s8", true, 8)];
@@ -294,7 +303,7 @@ fn inline_sin_cos_are_within_one_ulp_and_lanes_equal_the_scalar_code() {
     }
     main += "int main(void) { return run_d1() || run_d4() || run_s1() || run_s8(); }\n";
     std::fs::write(dir.join("main.c"), main).unwrap();
-    let exe = super::cc(&dir, &files, &["-O1"]);
+    let exe = super::cc(&dir, &files, flags);
 
     let hp = half_pi();
     let (c64, c32) = (Constants::new(false), Constants::new(true));
@@ -382,7 +391,7 @@ fn inline_sin_cos_are_within_one_ulp_and_lanes_equal_the_scalar_code() {
                 let _ = std::fmt::Write::write_fmt(
                     &mut report,
                     format_args!(
-                        "{label} {name}: {count} results (sin and cos), max {max:.3} ulp, mean {:.4} ulp\n",
+                        "{flags:?} {label} {name}: {count} results (sin and cos), max {max:.3} ulp, mean {:.4} ulp\n",
                         sum / count as f64
                     ),
                 );

@@ -62,20 +62,27 @@ fn a_multiply_read_by_several_additions_is_fused_into_each() {
 }
 
 #[test]
-fn an_addition_of_two_multiplies_absorbs_one_and_the_other_is_left_whole() {
-    // %r = %m1 + %m2: both single-use, so the later %m2 is absorbed and %m1 stays.
+fn an_addition_of_two_multiplies_absorbs_the_earlier_and_keeps_the_other_whole() {
+    // %r = %m1 + %m2: the earlier %m1 is absorbed, %m2 stays as the addend.
     let src = format!("{HEAD}  %m1 = mul %a, %b\n  %m2 = mul %c, %d\n  %r = add %m1, %m2\n  output o = %r\n}}\n");
     let (f, _) = run(&src);
-    assert_eq!(body(&f), ["%m1 = mul %a, %b", "%r = call @fma(%c, %d, %m1)"]);
-    // %m1 has two uses and %m2 one: %r1 absorbs %m2; %m1 then cannot be fused everywhere, so
-    // %r2 keeps its addition instead of computing %a·%b a second time.
+    assert_eq!(body(&f), ["%m2 = mul %c, %d", "%r = call @fma(%a, %b, %m2)"]);
+    // %m1 is read by two additions: it fuses into both; %m2's addition is then a fused op,
+    // so %m2 stays a multiply (GCC's order).
     let src = format!(
-        "{HEAD}  %m1 = mul %a, %b\n  %m2 = mul %c, %d\n  %r1 = add %m1, %m2\n  %r2 = add %m1, %c\n  \
+        "{HEAD}  %m1 = mul %a, %b\n  %m2 = mul %c, %d\n  %r1 = add %m2, %m1\n  %r2 = sub %m1, %c\n  \
          output o1 = %r1\n  output o2 = %r2\n}}\n"
     );
     let (f, c) = run(&src);
-    assert_eq!(body(&f), ["%m1 = mul %a, %b", "%r1 = call @fma(%c, %d, %m1)", "%r2 = add %m1, %c"]);
-    assert_eq!(c, Contracted { fma: 1, fms: 0, fnma: 0, muls_removed: 1 });
+    assert_eq!(body(&f), ["%m2 = mul %c, %d", "%r1 = call @fma(%a, %b, %m2)", "%r2 = call @fms(%a, %b, %c)"]);
+    assert_eq!(c, Contracted { fma: 1, fms: 1, fnma: 0, muls_removed: 1 });
+    // An earlier multiply with a use that is no addition leaves the later one to be fused.
+    let src = format!(
+        "{HEAD}  %m1 = mul %a, %b\n  %m2 = mul %c, %d\n  %r1 = add %m1, %m2\n  %p = mul %m1, %c\n  \
+         output o1 = %r1\n  output o2 = %p\n}}\n"
+    );
+    let (f, _) = run(&src);
+    assert_eq!(body(&f), ["%m1 = mul %a, %b", "%r1 = call @fma(%c, %d, %m1)", "%p = mul %m1, %c"]);
 }
 
 #[test]
