@@ -20,20 +20,34 @@
 //! triangle `i ≤ j` is written (joints are numbered depth first, so an ancestor has the smaller
 //! index).
 //!
+//! # Turns about the joint axis
+//! A revolute joint about `±x`, `±y` or `±z` turns the composite's `J` in one coordinate plane.
+//! `Composite::moved` writes those three entries with `c² + s² = 1` (`turned`: `J'pp = Jpp − B`,
+//! `J'qq = Jqq + B`, `J'pq = Jpq + s·c·d − 2Jpq·s²`, `d = Jpp − Jqq`, `B = d·s² + 2Jpq·s·c`)
+//! instead of the rows-times-columns product `R J Rᵀ`; a constant rotation about one axis (a
+//! URDF `rpy` about one axis, not a quarter turn) takes the same path with numbers for `c`,
+//! `s`. Upper triangle of `M`, `--fold-params`, after `atomise,cse`: serial30 7 805 → 7 639
+//! ops, UR5 175 → 153, Panda (9 coordinates) 547 → 515, Solo-12 984 → 906, Talos 4 235 →
+//! 3 993, TIAGo Pro 8 466 → 8 271.
+//!
 //! # Constant rotations
 //! A joint whose URDF `rpy` is neither a quarter turn nor about one axis has a dense constant
 //! rotation `ro` (TIAGo Pro's and UR5's arms). Where it saves ops (`merged_rotation`), the
 //! CRBA moves composites and column forces across such a joint by one rotation
 //! `P = ro·R_axis(q)`, bound once per joint as `RP{r}{c}{body}`, instead of `R_axis(q)` then
 //! `ro`: 15 ops per vector instead of up to 6 + 15. `M` of TIAGo Pro (floating base, 39
-//! coordinates, `--fold-params`, after `atomise,cse`): 11 195 → 10 428 ops; UR5: 303 → 228.
+//! coordinates, `--fold-params`, after `atomise,cse`): 11 195 → 10 428 ops; UR5: 303 → 228
+//! (measured when introduced, before the slid origins, `sym`'s gathered constants and the
+//! turns above). The composite still crosses such a joint by `P` (turning it about the joint
+//! axis, then by `ro`, cost more on UR5's `M`: 153 → 185 ops).
 //!
 //! # Robotran's floating base
 //! The joints `T1 T2 T3 R1 R2 R3` have no offset and no constant rotation, so their axes meet
 //! at the base's origin: a column force that reaches the base (or any body of that root
 //! segment) gives all six entries by projection on the axes expressed in the base frame
 //! (`WM`, formed once per body), `projection`, instead of being carried through five more
-//! frames. `M` of TIAGo Pro: 10 032 → 9 908 ops; Talos 4 971 → 4 856; Solo-12 1 230 → 1 192.
+//! frames. `M` of TIAGo Pro: 10 032 → 9 908 ops; Talos 4 971 → 4 856; Solo-12 1 230 → 1 192
+//! (measured when introduced).
 //!
 //! # Why CRBA
 //! The unit-acceleration RNEA (Walker & Orin's method 1) re-runs the forward and backward
@@ -43,7 +57,7 @@
 
 use super::rnea::{bind3, cross, dot, matvec, numeric, vadd, Motion, M3, V3};
 use super::robot::JointKind;
-use super::sym::{add, mul, neg, sum, Builder, Term, ZERO};
+use super::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
 use rustc_hash::FxHashMap;
 
 use super::{Layout, Model};
@@ -90,8 +104,14 @@ impl Composite {
     }
 
     /// Rotated by `r` (child → parent), then shifted by `t` (the child origin in the parent).
-    fn moved(&self, r: Option<&M3>, t: Option<&V3>) -> Composite {
+    /// A rotation about a coordinate axis ([`axis_turn`]) turns `J` by [`turned`], its
+    /// temporaries named after `tag` (`"2"` for body 2's joint, `"O2"` for its origin).
+    fn moved(&self, b: &mut Builder, tag: &str, r: Option<&M3>, t: Option<&V3>) -> Composite {
         let (h, j) = match r {
+            Some(r) if axis_turn(r).is_some() => {
+                let turn = axis_turn(r).expect("checked");
+                (matvec(r, &self.h, false), turned(b, tag, &self.j, &turn))
+            }
             Some(r) => {
                 let rj: M3 = [0, 1, 2]
                     .map(|i| [0, 1, 2].map(|k| sum((0..3).map(|l| mul(r[i][l].clone(), self.j[l][k].clone())))));
@@ -141,6 +161,61 @@ impl Composite {
         }
         Composite { m, h, j }
     }
+}
+
+/// A rotation about the coordinate axis `k`: in the rows and columns `p = k + 1`,
+/// `q = k + 2` (mod 3) it is `[[c, −s], [s, c]]`, elsewhere the identity (`c = cos q`,
+/// `s = ± sin q`, the sign that of the axis).
+struct Turn {
+    k: usize,
+    p: usize,
+    q: usize,
+    c: Term,
+    s: Term,
+}
+
+/// `r` as a [`Turn`], when it is one (a revolute joint about `±x`, `±y` or `±z`, as
+/// `rnea::axis_rotation` writes it).
+fn axis_turn(r: &M3) -> Option<Turn> {
+    let one = Term::C(1.0);
+    let k = (0..3).find(|&k| r[k][k] == one && (0..3).all(|i| i == k || (r[k][i] == ZERO && r[i][k] == ZERO)))?;
+    let (p, q) = ((k + 1) % 3, (k + 2) % 3);
+    let (c, s) = (r[p][p].clone(), r[q][p].clone());
+    // A quarter or half turn (a signed permutation) is free to apply entry by entry.
+    let quarter = c == ZERO || s == ZERO;
+    (!quarter && r[q][q] == c && r[p][q] == neg(s.clone())).then_some(Turn { k, p, q, c, s })
+}
+
+/// `R J Rᵀ` for a [`Turn`] `R` and a symmetric `J`, with `c² + s² = 1` used to share the work
+/// of the three entries in the plane of the turn:
+/// `J'pp = Jpp − B`, `J'qq = Jqq + B`, `J'pq = Jpq + s·c·d − 2Jpq·s²`, with `d = Jpp − Jqq` and
+/// `B = d·s² + 2Jpq·s·c` (expand `c² Jpp − 2cs Jpq + s² Jqq` and replace `c²` by `1 − s²`);
+/// `J'pk = c Jpk − s Jqk`, `J'qk = s Jpk + c Jqk`, `J'kk = Jkk`. `s²`, `s·c` (`SS`, `SC`),
+/// `d`, `2Jpq` and `B` (`JD`, `JE`, `JB`) are bound once per turn: 13 ops for the plane where
+/// the rows-times-columns product costs up to 18 (6 more for `J'pk`, `J'qk` in both), and a
+/// numeric `J` (a leaf body, `--fold-params`) folds `d` and `2Jpq` into constants. Named
+/// after `tag` (see `Composite::moved`).
+fn turned(b: &mut Builder, tag: &str, j: &M3, t: &Turn) -> M3 {
+    let Turn { k, p, q, c, s } = t;
+    let (k, p, q) = (*k, *p, *q);
+    let ss = b.bind(&format!("SS{tag}"), mul(s.clone(), s.clone()));
+    let sc = b.bind(&format!("SC{tag}"), mul(s.clone(), c.clone()));
+    let d = b.bind(&format!("JD{tag}"), sub(j[p][p].clone(), j[q][q].clone()));
+    // With a numeric turn (a constant rotation) the 2 joins the numbers `s·c`, `s²` instead.
+    let e = mul(Term::C(2.0), j[p][q].clone());
+    let e = if matches!(sc, Term::C(_)) { e } else { b.bind(&format!("JE{tag}"), e) };
+    let bb = b.bind(&format!("JB{tag}"), add(mul(d.clone(), ss.clone()), mul(e.clone(), sc.clone())));
+    let mut out: M3 = Default::default();
+    out[k][k] = j[k][k].clone();
+    out[p][p] = sub(j[p][p].clone(), bb.clone());
+    out[q][q] = add(j[q][q].clone(), bb);
+    out[p][q] = add(j[p][q].clone(), sub(mul(d, sc), mul(e, ss)));
+    out[p][k] = sub(mul(c.clone(), j[p][k].clone()), mul(s.clone(), j[q][k].clone()));
+    out[q][k] = add(mul(s.clone(), j[p][k].clone()), mul(c.clone(), j[q][k].clone()));
+    for (a, c) in [(p, q), (p, k), (q, k)] {
+        out[c][a] = out[a][c].clone();
+    }
+    out
 }
 
 /// Binds a column force carried to body `body` for column `col`: `FM{k}{body}_{col}`
@@ -273,8 +348,11 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
             let mo = &motions[body];
             let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
             let in_parent = match &merged[body] {
-                Some(p) => c.moved(Some(p), Some(&d)),
-                None => c.moved(mo.rot.as_ref(), mo.shift.as_ref()).moved(Some(&ro[body]), Some(&d)),
+                Some(p) => c.moved(b, &body.to_string(), Some(p), Some(&d)),
+                None => {
+                    let turned = c.moved(b, &body.to_string(), mo.rot.as_ref(), mo.shift.as_ref());
+                    turned.moved(b, &format!("O{body}"), Some(&ro[body]), Some(&d))
+                }
             };
             comp[p] = comp[p].add(&in_parent);
         }
