@@ -7,7 +7,7 @@
 //! temporary (one equation of the parsed IR); atoms (a value, a constant, a negated atom) stay
 //! inline, so structural zeros and ones never reach the equations.
 //!
-//! Beyond Robotran's rules, three reorderings that only change rounding:
+//! Beyond Robotran's rules, four rewritings that only change rounding:
 //! - the numbers of a sum are gathered into one at its top (`(x + 0.4) + 0.1 = x + 0.5`), and a
 //!   number times such a sum is distributed (`k·(x + c) = k·x + k·c`), so that with
 //!   `--fold-params` the constants of a composite inertia cost one addition, not one each;
@@ -17,9 +17,16 @@
 //!   and hands back `−name`, so the readers' sums and products absorb the sign instead of a
 //!   `0 − x` op (serial30's `M`, `--fold-params`, after `atomise,cse`: 59 such ops → 1).
 //!
-//! Together, on the upper triangle of `M` (`--fold-params`, `atomise,cse`): serial30 8 017 →
-//! 7 805 ops, UR5 190 → 175, Panda (9 × 9) 599 → 547, Solo-12 1 061 → 984, Talos 4 511 →
-//! 4 235, TIAGo Pro 9 044 → 8 466.
+//! - what two products share is taken out of their sum or difference (`x·y ± x·z = x·(y ± z)`,
+//!   `k₁·x ± k₂·x = (k₁ ± k₂)·x`, `k·y ± k·z = k·(y ± z)`): the RNEA's `ω × (In·ω)` with a
+//!   diagonal `In` becomes `(Iyy − Izz)·ωy·ωz`, `m·a + m·b` one product.
+//!
+//! The first three, on the upper triangle of `M` (`--fold-params`, `atomise,cse`): serial30
+//! 8 017 → 7 805 ops, UR5 190 → 175, Panda (9 × 9) 599 → 547, Solo-12 1 061 → 984, Talos
+//! 4 511 → 4 235, TIAGo Pro 9 044 → 8 466. The factoring, after [`super::crba`]'s turns:
+//! `invdyna` (`atomise,cse`, folded / symbolic parameters) serial30 3 352 → 3 145 / 3 392 →
+//! 3 266, UR5 473 → 419 / 486 → 451, TIAGo Pro 7 666 → 7 600 / 7 955 → 7 928; `M` of Panda
+//! 515 → 512, Talos 3 993 → 3 989, TIAGo Pro 8 271 → 8 269 (the others unchanged).
 
 use robovec_ir::{BinOp, Def, Expr, Function, Operand, Phase, Span, TrigFn, Value};
 use rustc_hash::FxHashMap;
@@ -129,8 +136,54 @@ fn add_core(a: Term, b: Term) -> Term {
         (a, Term::Neg(b)) => sub_core(a, *b),
         (Term::Neg(a), b) => sub_core(b, *a),
         (a, b) if a == b => mul(Term::C(2.0), a),
-        (a, b) => Term::Add(Box::new(a), Box::new(b)),
+        (a, b) => match factored(&a, &b, true) {
+            Some(t) => t,
+            None => Term::Add(Box::new(a), Box::new(b)),
+        },
     }
+}
+
+/// The factors of a product: its number (1 when none) and the other factors, in order.
+fn factors(t: &Term) -> (f64, Vec<Term>) {
+    match t {
+        Term::C(k) => (*k, Vec::new()),
+        Term::Mul(a, b) => {
+            let (ka, mut fa) = factors(a);
+            let (kb, fb) = factors(b);
+            fa.extend(fb);
+            (ka * kb, fa)
+        }
+        t => (1.0, vec![t.clone()]),
+    }
+}
+
+/// `a ± b` with what the two products share taken out: `x·y ± x·z = x·(y ± z)` (numbers
+/// combined, `k₁·x ± k₂·x = (k₁ ± k₂)·x`), or a common number `k·y ± k·z = k·(y ± z)`;
+/// `None` when they share nothing.
+fn factored(a: &Term, b: &Term, plus: bool) -> Option<Term> {
+    if !matches!(a, Term::Mul(..)) && !matches!(b, Term::Mul(..)) {
+        return None;
+    }
+    let (ka, mut fa) = factors(a);
+    let (kb, mut fb) = factors(b);
+    let mut common = Vec::new();
+    fa.retain(|x| match fb.iter().position(|y| y == x) {
+        Some(i) => {
+            common.push(fb.remove(i));
+            false
+        }
+        None => true,
+    });
+    let product = |k: f64, f: Vec<Term>| f.into_iter().fold(Term::C(k), mul);
+    let (k, inner) = if !common.is_empty() {
+        (1.0, (product(ka, fa), product(kb, fb)))
+    } else if ka == kb && ka != 1.0 {
+        (ka, (product(1.0, fa), product(1.0, fb)))
+    } else {
+        return None;
+    };
+    let inner = if plus { add(inner.0, inner.1) } else { sub(inner.0, inner.1) };
+    Some(mul(product(k, common), inner))
 }
 
 /// `a - b` of two terms without a top number (see [`add_core`]).
@@ -140,7 +193,10 @@ fn sub_core(a: Term, b: Term) -> Term {
         (a, b) if a.is_zero() => neg(b),
         (a, Term::Neg(b)) => add_core(a, *b),
         (Term::Neg(a), b) => neg(add_core(*a, b)),
-        (a, b) => Term::Sub(Box::new(a), Box::new(b)),
+        (a, b) => match factored(&a, &b, false) {
+            Some(t) => t,
+            None => Term::Sub(Box::new(a), Box::new(b)),
+        },
     }
 }
 
@@ -339,5 +395,15 @@ mod tests {
         let Term::Neg(v) = t else { panic!("{t:?}") };
         let Term::V(v) = *v else { panic!("{v:?}") };
         assert!(matches!(&b.f.value(v).def, Def::Expr(Expr::Binary(BinOp::Add, _, _))));
+        // What two products share comes out: x·y − y·z·3 = y·(x − 3·z); 2·x + 3·x = 5·x.
+        let z = b.input("z");
+        let (xy, yz3) = (mul(x.clone(), y.clone()), mul(mul(y.clone(), z.clone()), Term::C(3.0)));
+        assert_eq!(sub(xy, yz3), mul(y.clone(), sub(x.clone(), mul(Term::C(3.0), z.clone()))));
+        assert_eq!(add(mul(Term::C(2.0), x.clone()), mul(x.clone(), Term::C(3.0))), mul(Term::C(5.0), x.clone()));
+        // A common number: 2·x + 2·z = 2·(x + z).
+        assert_eq!(
+            add(mul(Term::C(2.0), x.clone()), mul(Term::C(2.0), z.clone())),
+            mul(Term::C(2.0), Term::Add(bx(), Box::new(z)))
+        );
     }
 }
