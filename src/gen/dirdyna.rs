@@ -21,13 +21,13 @@
 //! It re-runs the recursion over joint `j`'s whole subtree for every column, so it grows as
 //! O(dof³) on a chain where CRBA grows as O(dof²):
 //!
-//! | model (symbolic parameters) | dof | `dirdyna` ops, CRBA | unit-acceleration RNEA |
+//! | model (symbolic parameters, own frames) | dof | `dirdyna` ops, CRBA | unit-acceleration RNEA |
 //! |---|---|---|---|
-//! | `--topology parallel --dof 23 --seed 1` | 23 | 3 073 | 3 337 |
-//! | `--topology semi-serial --dof 23 --seed 1` | 23 | 6 700 | 11 480 |
-//! | `--topology serial --dof 23 --seed 1` | 23 | 9 771 | 23 074 |
-//! | `--topology serial --dof 50 --seed 1` | 50 | 34 866 | 106 028 |
-//! | `--topology serial --dof 130 --seed 1` | 130 | 188 884 | 693 594 |
+//! | `--topology parallel --dof 23 --seed 1` | 23 | 2 676 | 3 128 |
+//! | `--topology semi-serial --dof 23 --seed 1` | 23 | 5 954 | 11 189 |
+//! | `--topology serial --dof 23 --seed 1` | 23 | 8 931 | 22 766 |
+//! | `--topology serial --dof 50 --seed 1` | 50 | 32 962 | 105 363 |
+//! | `--topology serial --dof 130 --seed 1` | 130 | 183 883 | 691 775 |
 //!
 //! The critical path is the same for both (it runs through `c`'s velocity recursion).
 //! The thesis's Robotran models have 19 970, 93 525 and 620 257 ops for the serial 23, 50
@@ -36,10 +36,10 @@
 //! # Size (`-passes=atomise -stats`, symbolic parameters / `--fold-params`)
 //! | robot | dof | `dirdyna` ops | `invdyna` ops |
 //! |---|---|---|---|
-//! | double pendulum (example) | 2 | 51 / 42 | 42 |
-//! | three_link_arm (example) | 3 | 765 / 617 | 510 |
-//! | UR5 (example-robot-data) | 6 | 915 / 851 | 575 |
-//! | Panda with fingers (example-robot-data) | 9 | 2465 / 2201 | 1365 |
+//! | double pendulum (example) | 2 | 47 / 35 | 41 / 41 |
+//! | three_link_arm (example) | 3 | 657 / 507 | 475 / 469 |
+//! | UR5 (example-robot-data) | 6 | 774 / 664 | 529 / 499 |
+//! | Panda with fingers (example-robot-data) | 9 | 2184 / 1886 | 1282 / 1267 |
 //!
 //! For scale, the corpus's Robotran `mbs_dirdyna` of Frank_segway (17 joints) states 4287 flops.
 
