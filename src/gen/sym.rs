@@ -15,8 +15,7 @@
 //!   that a minus in front folds into it when atomised (SPEC §3), and `x + x` is `2·x`;
 //! - a minus is never bound: `−a − b` is `−(a + b)`, and [`Builder::bind`] of `−x` binds `x`
 //!   and hands back `−name`, so the readers' sums and products absorb the sign instead of a
-//!   `0 − x` op (serial30's `M`, `--fold-params`, after `atomise,cse`: 59 such ops → 1).
-//!
+//!   `0 − x` op (serial30's `M`, `--fold-params`, after `atomise,cse`: 59 such ops → 1);
 //! - what two products share is taken out of their sum or difference (`x·y ± x·z = x·(y ± z)`,
 //!   `k₁·x ± k₂·x = (k₁ ± k₂)·x`, `k·y ± k·z = k·(y ± z)`): the RNEA's `ω × (In·ω)` with a
 //!   diagonal `In` becomes `(Iyy − Izz)·ωy·ωz`, `m·a + m·b` one product.
