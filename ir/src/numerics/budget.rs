@@ -13,7 +13,8 @@
 //!   same before and after reassociating rewrites.
 //! - `K(e)`: the number of roundings a monomial of `e` can accumulate, by structure:
 //!   `K(leaf) = 0`, `K(a ± b) = max(K(a), K(b)) + 1`, `K(a × b) = K(a) + K(b) + 1`,
-//!   `K(−a) = K(a)`. Proof: each rounded op multiplies the monomials below it by one `(1 + δ)`,
+//!   `K(−a) = K(a)`, and for a fused multiply-add (`@fma`, `@fms`, `@fnma`: `±a·b ± c` rounded
+//!   once) `K = max(K(a) + K(b), K(c)) + 1`, `M = M(a)·M(b) + M(c)`. Proof: each rounded op multiplies the monomials below it by one `(1 + δ)`,
 //!   `|δ| ≤ u`; a product multiplies the monomials of both factors, so their factor counts add;
 //!   Lemma 3.1 bounds a product of `k` such factors by `1 + θ_k`, `|θ_k| ≤ γ_k`.
 //!
@@ -26,6 +27,7 @@
 
 use super::dd::{DD, DD_UNIT};
 use super::tape::{Step, Tape};
+use crate::intrinsic::Intrinsic;
 use crate::syntax::BinOp;
 
 /// Unit roundoff of binary32.
@@ -54,7 +56,8 @@ pub struct Terms {
 }
 
 /// `K` and an upper bound of `M` for every output of `tape` at `inputs` (see the module doc),
-/// or `None` when the tape has a division, a call or a trig variable (no such budget).
+/// or `None` when the tape has a division, a call other than a fused multiply-add or a trig
+/// variable (no such budget).
 pub fn terms(tape: &Tape, inputs: &[f64]) -> Option<Terms> {
     let n = tape.inputs.len() + tape.consts.len();
     let mut k: Vec<u64> = vec![0; n];
@@ -70,6 +73,14 @@ pub fn terms(tape: &Tape, inputs: &[f64]) -> Option<Terms> {
                 }
             }
             Step::Neg(a) => (k[a as usize], m[a as usize]),
+            // ±a·b ± c rounded once: the product's monomials carry a's and b's factors and the
+            // one rounding, c's its own and that rounding.
+            Step::Call(c, start, len)
+                if Intrinsic::of(&tape.callees[c as usize], len as usize).is_some_and(|i| i.is_fused()) =>
+            {
+                let [a, b, c] = [0, 1, 2].map(|j| tape.args[start as usize + j] as usize);
+                (k[a].saturating_add(k[b]).max(k[c]).saturating_add(1), m[a] * m[b] + m[c])
+            }
             Step::Trig(..) | Step::Call(..) => return None,
         };
         k.push(kk);
@@ -116,6 +127,18 @@ mod tests {
             terms(&t, &[2.0, 3.0]).unwrap().outputs[0],
             (1, 6.0 * (1.0 + gamma(1, DD_UNIT)) * (1.0 + 2f64.powi(-40)))
         );
+        // Fused: y = fma(a, b, c) rounds once (K = 1, M = |a||b| + |c|); z = (y·d) − e fused
+        // again: K = max(1 + 0, 0) + 1 = 2, M = M(y)|d| + |e|.
+        let t = tape(
+            "func @f {\n  phase atomised\n  input %a\n  input %b\n  input %c\n  input %d\n  \
+             %y = call @fma(%a, %b, %c)\n  %z = call @fms(%y, %d, %a)\n  output y = %y\n  output z = %z\n}\n",
+        );
+        let r = terms(&t, &[1.0, -2.0, 3.0, 5.0]).unwrap().outputs;
+        assert_eq!((r[0].0, r[1].0), (1, 2));
+        assert!(r[0].1 >= 5.0 && r[0].1 - 5.0 < 1e-10 && r[1].1 >= 26.0 && r[1].1 - 26.0 < 1e-10, "{r:?}");
+        // A square root has no such budget.
+        let t = tape("func @f {\n  phase atomised\n  input %a\n  %y = call @sqrt(%a)\n  output y = %y\n}\n");
+        assert!(terms(&t, &[2.0]).is_none());
     }
 
     #[test]
