@@ -541,16 +541,17 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
         let _ = writeln!(
             s,
             "  /* Lanes with |x| > L or NaN (rare): libm. x*x <= L^2 is |x| <= L exactly (L^2 exact, rounding\n   \
-             * monotonic) and false for NaN; one test of all lanes, by an intrinsic where the vector is one register. */\n  \
+             * monotonic) and false for NaN; one test of all lanes, by an intrinsic where the vector is one register;\n   \
+             * marked unlikely, so that the compiler puts the libm calls out of the straight-line path. */\n  \
              const {u} in = {};\n\
              #if defined(__AVX__) && ROBOVEC_VEC_BYTES == 32\n  \
-             if (!_mm256_testc_si256((__m256i)in, _mm256_set1_epi32(-1)))\n\
+             if (__builtin_expect(!_mm256_testc_si256((__m256i)in, _mm256_set1_epi32(-1)), 0))\n\
              #elif defined(__SSE2__) && ROBOVEC_VEC_BYTES == 16\n  \
-             if (_mm_movemask_epi8((__m128i)in) != 0xffff)\n\
+             if (__builtin_expect(_mm_movemask_epi8((__m128i)in) != 0xffff, 0))\n\
              #elif defined(__AVX512F__) && ROBOVEC_VEC_BYTES == 64\n  \
-             if (_mm512_cmpneq_epi32_mask((__m512i)in, _mm512_set1_epi32(-1)))\n\
+             if (__builtin_expect(_mm512_cmpneq_epi32_mask((__m512i)in, _mm512_set1_epi32(-1)) != 0, 0))\n\
              #else\n  \
-             {elem} all = in[0];\n  for (int lane = 1; lane < ROBOVEC_VL; lane++) all &= in[lane];\n  if (!all)\n\
+             {elem} all = in[0];\n  for (int lane = 1; lane < ROBOVEC_VL; lane++) all &= in[lane];\n  if (__builtin_expect(!all, 0))\n\
              #endif\n    \
              for (int lane = 0; lane < ROBOVEC_VL; lane++)\n      \
              if (!in[lane]) {{ s[lane] = sin{sfx}(x[lane]); c[lane] = cos{sfx}(x[lane]); }}",
@@ -561,7 +562,7 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
         let _ = writeln!(
             s,
             "  /* |x| > L or NaN (rare): libm (x*x <= L^2 is |x| <= L exactly, false for NaN). */\n  \
-             if (!({in_range})) {{ s = sin{sfx}(x); c = cos{sfx}(x); }}"
+             if (__builtin_expect(!({in_range}), 0)) {{ s = sin{sfx}(x); c = cos{sfx}(x); }}"
         );
     }
     let _ = writeln!(
