@@ -87,8 +87,8 @@ pub fn contract_function(f: &mut Function) -> Contracted {
     let mut converted = vec![false; n];
     let mut removed = vec![false; n];
     let mut out = Contracted::default();
-    for i in 0..f.body.len() {
-        let m = f.body[i];
+    for k in 0..f.body.len() {
+        let m = f.body[k];
         let Def::Binary(BinOp::Mul, a, b) = f.value(m).def else { continue };
         let uses = &adds_of[m.index()];
         if other_use[m.index()] || uses.is_empty() || uses.iter().any(|u| converted[u.index()]) {
@@ -98,17 +98,13 @@ pub fn contract_function(f: &mut Function) -> Contracted {
             let Def::Binary(op, x, y) = f.value(u).def else { unreachable!("an addition") };
             let first = x == Operand::Value(m);
             let addend = if first { y } else { x };
-            let i = match (op, first) {
-                (BinOp::Add, _) => Intrinsic::Fma,
-                (_, true) => Intrinsic::Fms,
-                _ => Intrinsic::Fnma,
+            let (fused, count) = match (op, first) {
+                (BinOp::Add, _) => (Intrinsic::Fma, &mut out.fma),
+                (_, true) => (Intrinsic::Fms, &mut out.fms),
+                _ => (Intrinsic::Fnma, &mut out.fnma),
             };
-            match i {
-                Intrinsic::Fma => out.fma += 1,
-                Intrinsic::Fms => out.fms += 1,
-                _ => out.fnma += 1,
-            }
-            f.value_mut(u).def = Def::Call(Box::new(i.callee()), vec![a, b, addend]);
+            *count += 1;
+            f.value_mut(u).def = Def::Call(Box::new(fused.callee()), vec![a, b, addend]);
             converted[u.index()] = true;
         }
         removed[m.index()] = true;

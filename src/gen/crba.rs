@@ -107,12 +107,9 @@ impl Composite {
     /// A rotation about a coordinate axis ([`axis_turn`]) turns `J` by [`turned`], its
     /// temporaries named after `tag` (`"2"` for body 2's joint, `"O2"` for its origin).
     fn moved(&self, b: &mut Builder, tag: &str, r: Option<&M3>, t: Option<&V3>) -> Composite {
-        let (h, j) = match r {
-            Some(r) if axis_turn(r).is_some() => {
-                let turn = axis_turn(r).expect("checked");
-                (matvec(r, &self.h, false), turned(b, tag, &self.j, &turn))
-            }
-            Some(r) => {
+        let (h, j) = match (r, r.and_then(axis_turn)) {
+            (Some(r), Some(turn)) => (matvec(r, &self.h, false), turned(b, tag, &self.j, &turn)),
+            (Some(r), None) => {
                 let rj: M3 = [0, 1, 2]
                     .map(|i| [0, 1, 2].map(|k| sum((0..3).map(|l| mul(r[i][l].clone(), self.j[l][k].clone())))));
                 // Upper triangle of (R J) Rᵀ, mirrored.
@@ -125,7 +122,7 @@ impl Composite {
                 }
                 (matvec(r, &self.h, false), j)
             }
-            None => (self.h.clone(), self.j.clone()),
+            (None, _) => (self.h.clone(), self.j.clone()),
         };
         let Some(t) = t else {
             return Composite { m: self.m.clone(), h, j };

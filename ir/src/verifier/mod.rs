@@ -89,19 +89,17 @@ impl VerifierError {
     }
 }
 
-/// The message for a call of an intrinsic's name ([`Intrinsic`]) with the wrong number of
-/// operands or a vector element (`@sqrt[2]`): such a call would otherwise be taken for a
-/// user callback.
-fn intrinsic_misuse(i: Intrinsic, c: &Callee, n: usize) -> String {
-    if c.elem.is_some() {
-        format!(
-            "`@{}` is an intrinsic with a scalar result; `@{}[{}]` selects an element",
-            i.name(),
-            i.name(),
-            c.elem.unwrap_or(0)
-        )
+/// The message for a call of an intrinsic's name ([`Intrinsic`]) with `n` operands when that
+/// is the wrong number or the call selects a vector element (`@sqrt[2]`): such a call would
+/// otherwise be taken for a user callback. `None` for any other call.
+fn intrinsic_misuse(c: &Callee, n: usize) -> Option<String> {
+    let i = Intrinsic::named(&c.name)?;
+    if let Some(e) = c.elem {
+        Some(format!("`@{}` is an intrinsic with a scalar result; `@{}[{e}]` selects an element", i.name(), i.name()))
+    } else if n != i.arity() {
+        Some(format!("`@{}` takes {} operand{}, found {n}", i.name(), i.arity(), if i.arity() == 1 { "" } else { "s" }))
     } else {
-        format!("`@{}` takes {} operand{}, found {n}", i.name(), i.arity(), if i.arity() == 1 { "" } else { "s" })
+        None
     }
 }
 
@@ -211,9 +209,7 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
             }
             Def::Call(c, args) => {
                 args.iter().for_each(|a| check_operand(a, &mut local, false));
-                if let Some(i) = Intrinsic::named(&c.name).filter(|i| i.arity() != args.len() || c.elem.is_some()) {
-                    local.push(intrinsic_misuse(i, c, args.len()));
-                }
+                local.extend(intrinsic_misuse(c, args.len()));
             }
             Def::Expr(e) => {
                 if f.phase == Phase::Atomised {
@@ -229,11 +225,7 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
                             stack.push(a);
                         }
                         Expr::Call(c, args) => {
-                            if let Some(i) =
-                                Intrinsic::named(&c.name).filter(|i| i.arity() != args.len() || c.elem.is_some())
-                            {
-                                local.push(intrinsic_misuse(i, c, args.len()));
-                            }
+                            local.extend(intrinsic_misuse(c, args.len()));
                             stack.extend(args.iter().rev());
                         }
                     }
