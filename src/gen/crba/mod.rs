@@ -1,0 +1,164 @@
+//! The joint-space mass matrix `M(q)` by the composite-rigid-body algorithm (CRBA; Walker &
+//! Orin 1982, method 3; Featherstone, *Rigid Body Dynamics Algorithms*, 2008, §6.2), in body
+//! frames with Robotran's parameters and the same frames, numbering and joint motions as the
+//! RNEA of [`super::rnea`].
+//!
+//! # The recursion
+//! A composite body is `(m, h, J)`: mass, first moment `h = Σ mₖ rₖ` and rotational inertia
+//! `J = −Σ mₖ [rₖ]×²` about the frame origin. Body `b` alone is `(m_b, m_b l_b,
+//! In_b − m_b [l_b]×²)`. Leaves to root, each composite is moved into its parent's frame by
+//! `x_parent = t + R x_child` and added there:
+//! `m' = m`, `h' = R h + m t`, `J' = R J Rᵀ + m (|t|² I − t tᵀ) + 2 (t·u) I − u tᵀ − t uᵀ`
+//! with `u = R h` (the parallel-axis theorem for a rotated, shifted body; symmetric, so only
+//! the upper triangle is formed). The joint motion (`R = R_axis(q)`, or a shift `axis·q`) and
+//! the constant joint origin (`dpt`, URDF `rpy`) are applied as two such moves.
+//!
+//! Column `j` of `M`: the spatial force that the composite below joint `j` needs for a unit
+//! joint acceleration, `n = J a`, `f = a × h` (revolute axis `a`) or `n = h × a`, `f = m a`
+//! (prismatic), gives `M[j][j] = a·n` (or `a·f`); carried up the path to the root (`f ← R f`,
+//! `n ← R n + t × (R f)`), it gives `M[i][j]` for every ancestor joint `i`. Only the upper
+//! triangle `i ≤ j` is written (joints are numbered depth first, so an ancestor has the smaller
+//! index).
+//!
+//! # Turns about the joint axis
+//! A revolute joint about `±x`, `±y` or `±z` turns the composite's `J` in one coordinate plane.
+//! `Composite::moved` writes those three entries with `c² + s² = 1` (`turned`: `J'pp = Jpp − B`,
+//! `J'qq = Jqq + B`, `J'pq = Jpq + s·c·d − 2Jpq·s²`, `d = Jpp − Jqq`, `B = d·s² + 2Jpq·s·c`)
+//! instead of the rows-times-columns product `R J Rᵀ`; a constant rotation about one axis (a
+//! URDF `rpy` about one axis, not a quarter turn) takes the same path with numbers for `c`,
+//! `s`. Upper triangle of `M`, `--fold-params`, after `atomise,cse`: serial30 7 805 → 7 639
+//! ops, UR5 175 → 153, Panda (9 coordinates) 547 → 515, Solo-12 984 → 906, Talos 4 235 →
+//! 3 993, TIAGo Pro 8 466 → 8 271.
+//!
+//! # Constant rotations
+//! A joint whose URDF `rpy` is neither a quarter turn nor about one axis has a dense constant
+//! rotation `ro` (TIAGo Pro's and UR5's arms). Where it saves ops (`merged_rotation`), the
+//! CRBA moves composites and column forces across such a joint by one rotation
+//! `P = ro·R_axis(q)`, bound once per joint as `RP{r}{c}{body}`, instead of `R_axis(q)` then
+//! `ro`: 15 ops per vector instead of up to 6 + 15. `M` of TIAGo Pro (floating base, 39
+//! coordinates, `--fold-params`, after `atomise,cse`): 11 195 → 10 428 ops; UR5: 303 → 228
+//! (measured when introduced, before the slid origins, `sym`'s gathered constants and the
+//! turns above). The composite still crosses such a joint by `P` (turning it about the joint
+//! axis, then by `ro`, cost more on UR5's `M`: 153 → 185 ops).
+//!
+//! # Robotran's floating base
+//! The joints `T1 T2 T3 R1 R2 R3` have no offset and no constant rotation, so their axes meet
+//! at the base's origin: a column force that reaches the base (or any body of that root
+//! segment) gives all six entries by projection on the axes expressed in the base frame
+//! (`WM`, formed once per body), `projection`, instead of being carried through five more
+//! frames. `M` of TIAGo Pro: 10 032 → 9 908 ops; Talos 4 971 → 4 856; Solo-12 1 230 → 1 192
+//! (measured when introduced).
+//!
+//! # Order of the statements
+//! Each column is written right after its body's composite, leaves to root, so the composite's
+//! `J a`, `a × h` are read as soon as they are formed and the column's force is carried up
+//! before the next body's composite begins. Forming every composite first and then every
+//! column kept the composites of all bodies live until their column: serial30's `M` (after
+//! `atomise,cse,zero-removal,contract`) had 153 values live at once, this order 26, and its
+//! `batch=4` C is 4–5 % faster (same ops; GCC keeps the statement order, so fewer spills).
+//!
+//! # Why CRBA
+//! The unit-acceleration RNEA (Walker & Orin's method 1) re-runs the forward and backward
+//! recursion of joint `j`'s whole subtree for every column; CRBA forms each subtree's inertia
+//! once and then only carries one force per column to the root. Counts in the
+//! [`super::dirdyna`] module doc.
+
+mod column;
+mod composite;
+
+use super::rnea::{numeric, Motion, M3, V3};
+use super::robot::Robot;
+use super::sym::{Builder, Term};
+use super::{Layout, Model};
+use column::merged_rotation;
+use composite::Composite;
+use rustc_hash::FxHashMap;
+
+/// The robot as the CRBA walks it: bodies numbered `1..=nb` depth first (`0` is the fixed
+/// root), each indexed by body.
+struct Tree<'a> {
+    robot: &'a Robot,
+    layout: &'a Layout,
+    motions: &'a [Motion],
+    /// The joint of body `i` is `robot.joints[order[i - 1]]`.
+    order: Vec<usize>,
+    parent: Vec<usize>,
+    /// Whether the body moves (a coordinate on its path to the root).
+    moves: Vec<bool>,
+    /// The constant rotation of the body's joint origin.
+    ro: Vec<M3>,
+    /// The joint's constant and joint rotations as one, where cheaper (`merged_rotation`).
+    merged: Vec<Option<M3>>,
+    /// Whether the body is in the root segment (`Robot::root_segment`): its joints all act at
+    /// one point, so a column force that reaches it gives every entry above by projection.
+    in_segment: Vec<bool>,
+    /// Coordinates on the path from the root to the body.
+    segment_moving: Vec<usize>,
+}
+
+/// The upper triangle of `M`: `(i, j) → term` for `i ≤ j` (1-based coordinates), entries that
+/// fold to 0 left out. Writes the composites and column forces into `b` as temporaries `MC`,
+/// `HC`, `JC` (per body) and `FM`, `CM` (per body and column), each column right after its
+/// body's composite (module doc, "Order of the statements").
+pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]) -> Vec<((usize, usize), Term)> {
+    let robot = &model.robot;
+    let order = robot.dfs_joints();
+    let nb = order.len();
+    let mut link_body = vec![0; robot.links.len()];
+    for (i, &j) in order.iter().enumerate() {
+        link_body[robot.joints[j].child] = i + 1;
+    }
+    let parent: Vec<usize> =
+        std::iter::once(0).chain(order.iter().map(|&j| link_body[robot.joints[j].parent])).collect();
+    let mut moves = vec![false; nb + 1];
+    for i in 0..nb {
+        moves[i + 1] = moves[parent[i + 1]] || layout.q_index[i].is_some();
+    }
+    let ro: Vec<M3> =
+        std::iter::once(M3::default()).chain(order.iter().map(|&j| numeric(&robot.joints[j].origin.rot))).collect();
+    let mut merged: Vec<Option<M3>> = vec![None; nb + 1];
+    for body in 1..=nb {
+        if moves[parent[body]] {
+            merged[body] = merged_rotation(b, body, &ro[body], motions[body].rot.as_ref());
+        }
+    }
+    let segment_of_link = robot.root_segment();
+    let in_segment: Vec<bool> =
+        std::iter::once(true).chain(order.iter().map(|&j| segment_of_link[robot.joints[j].child])).collect();
+    let mut segment_moving = vec![0usize; nb + 1];
+    for body in 1..=nb {
+        segment_moving[body] = segment_moving[parent[body]] + usize::from(layout.q_index[body - 1].is_some());
+    }
+    let tree = Tree { robot, layout, motions, order, parent, moves, ro, merged, in_segment, segment_moving };
+    let mut projections: FxHashMap<(usize, usize), V3> = FxHashMap::default();
+    let mut upper = Vec::new();
+    // Each body alone, then leaves to root: the composite of its subtree, then its column.
+    let mut comp: Vec<Composite> = vec![Composite::zero(); nb + 1];
+    for body in (1..=nb).rev() {
+        if !tree.moves[body] {
+            continue;
+        }
+        let m = layout.param(b, &format!("m[{body}]"));
+        let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
+        let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
+        let c = Composite::body(m, l, inn).add(&comp[body]).bind(b, ["MC", "HC", "JC"], body);
+        let p = tree.parent[body];
+        if tree.moves[p] {
+            let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
+            let in_parent = match &tree.merged[body] {
+                Some(r) => c.moved(b, &body.to_string(), Some(r), Some(&d)),
+                None => {
+                    let mo = &motions[body];
+                    let turned = c.moved(b, &body.to_string(), mo.rot.as_ref(), mo.shift.as_ref());
+                    turned.moved(b, &format!("O{body}"), Some(&tree.ro[body]), Some(&d))
+                }
+            };
+            comp[p] = comp[p].add(&in_parent);
+        }
+        if let Some(qj) = layout.q_index[body - 1] {
+            tree.column(b, &mut projections, body, qj, &c, &mut upper);
+        }
+        comp[body] = c;
+    }
+    upper
+}
