@@ -58,63 +58,102 @@ pub(super) fn merged_rotation(b: &mut Builder, body: usize, ro: &M3, joint: Opti
     Some([0, 1, 2].map(|i| [0, 1, 2].map(|j| b.bind(&format!("RP{}{}{body}", i + 1, j + 1), p[i][j].clone()))))
 }
 
+/// A column on its way up: coordinate `qj` (1-based), the force `(n, f)` (moment about the
+/// origin of body `at`, force, both in its frame).
+pub(super) struct Carry {
+    qj: usize,
+    at: usize,
+    n: V3,
+    f: V3,
+}
+
+impl Carry {
+    /// The body the force is at.
+    pub(super) fn at(&self) -> usize {
+        self.at
+    }
+}
+
 impl Tree<'_> {
-    /// Column `qj` of `M` (1-based), the coordinate of body `body`'s joint, whose composite is
-    /// `c`: pushes `((i, qj), term)` onto `upper` for every moving joint `i` from `body` up
-    /// to the root, and binds the carried force as `FM`, `CM` (per body and column).
-    pub(super) fn column(
-        &self,
-        b: &mut Builder,
-        projections: &mut FxHashMap<(usize, usize), V3>,
-        body: usize,
-        qj: usize,
-        c: &Composite,
-        upper: &mut Vec<((usize, usize), Term)>,
-    ) {
+    /// The column of coordinate `qj`, body `body`'s joint, whose composite is `c`: the force
+    /// of a unit acceleration of that joint, at `body`.
+    pub(super) fn start(&self, body: usize, qj: usize, c: &Composite) -> Carry {
         let joint = &self.robot.joints[self.order[body - 1]];
         let av = joint.axis.map(Term::C);
-        let (mut n, mut f) = match joint.kind {
+        let (n, f) = match joint.kind {
             JointKind::Revolute => (matvec(&c.j, &av, false), cross(&av, &c.h)),
             _ => (cross(&c.h, &av), av.clone().map(|x| mul(c.m.clone(), x))),
         };
-        let mut at = body;
-        loop {
-            if self.in_segment[at] && self.segment_moving[at] >= 2 {
-                for (qi, t) in self.projection(b, projections, at, &n, &f) {
-                    upper.push(((qi, qj), entry(b, qi, qj, t)));
-                }
-                return;
-            }
-            if let Some(qi) = self.layout.q_index[at - 1] {
-                let jo = &self.robot.joints[self.order[at - 1]];
-                let t = if jo.kind == JointKind::Revolute { dot(&jo.axis, &n) } else { dot(&jo.axis, &f) };
+        Carry { qj, at: body, n, f }
+    }
+
+    /// One step of column `col`: pushes `((i, qj), term)` onto `upper` for the joint `i` of
+    /// body `col.at` (or, in the root segment, every entry above by projection) and carries
+    /// the force into the parent's frame, bound as `FM`, `CM` (per body and column). `false`
+    /// when the column is complete.
+    pub(super) fn step(
+        &self,
+        b: &mut Builder,
+        projections: &mut FxHashMap<(usize, usize), V3>,
+        col: &mut Carry,
+        upper: &mut Vec<((usize, usize), Term)>,
+    ) -> bool {
+        let Carry { qj, at, .. } = *col;
+        if self.in_segment[at] && self.segment_moving[at] >= 2 {
+            for (qi, t) in self.projection(b, projections, at, &col.n, &col.f) {
                 upper.push(((qi, qj), entry(b, qi, qj, t)));
             }
-            let p = self.parent[at];
-            if !self.moves[p] {
-                return;
-            }
-            // Into the parent's frame: the joint motion, then the joint origin (merged into one
-            // rotation where `merged_rotation` chose to).
-            let (f1, n1) = match &self.merged[at] {
-                Some(r) => (matvec(r, &f, false), matvec(r, &n, false)),
-                None => {
-                    let mo = &self.motions[at];
-                    let f1 = rotate(mo.rot.as_ref(), &f);
-                    let mut n1 = rotate(mo.rot.as_ref(), &n);
-                    if let Some(s) = &mo.shift {
-                        n1 = vadd(&n1, &cross(s, &f1));
-                    }
-                    (matvec(&self.ro[at], &f1, false), matvec(&self.ro[at], &n1, false))
-                }
-            };
-            let d: V3 = [1, 2, 3].map(|k| self.layout.param(b, &format!("dpt[{k}][{at}]")));
-            let f2 = column_bind(b, "FM", p, qj, f1);
-            let n2 = vadd(&n1, &cross(&d, &f2));
-            n = column_bind(b, "CM", p, qj, n2);
-            f = f2;
-            at = p;
+            return false;
         }
+        if let Some(qi) = self.layout.q_index[at - 1] {
+            let jo = &self.robot.joints[self.order[at - 1]];
+            let t = if jo.kind == JointKind::Revolute { dot(&jo.axis, &col.n) } else { dot(&jo.axis, &col.f) };
+            upper.push(((qi, qj), entry(b, qi, qj, t)));
+        }
+        let p = self.parent[at];
+        if !self.moves[p] {
+            return false;
+        }
+        // Into the parent's frame: the joint motion, then the joint origin (merged into one
+        // rotation where `merged_rotation` chose to).
+        let (f1, n1) = match &self.merged[at] {
+            Some(r) => (matvec(r, &col.f, false), matvec(r, &col.n, false)),
+            None => {
+                let mo = &self.motions[at];
+                let f1 = rotate(mo.rot.as_ref(), &col.f);
+                let mut n1 = rotate(mo.rot.as_ref(), &col.n);
+                if let Some(s) = &mo.shift {
+                    n1 = vadd(&n1, &cross(s, &f1));
+                }
+                (matvec(&self.ro[at], &f1, false), matvec(&self.ro[at], &n1, false))
+            }
+        };
+        let d: V3 = [1, 2, 3].map(|k| self.layout.param(b, &format!("dpt[{k}][{at}]")));
+        let f2 = column_bind(b, "FM", p, qj, f1);
+        let n2 = vadd(&n1, &cross(&d, &f2));
+        col.n = column_bind(b, "CM", p, qj, n2);
+        col.f = f2;
+        col.at = p;
+        true
+    }
+
+    /// Carries every column of `cols` to its end, one step of each in turn, and empties it.
+    pub(super) fn finish(
+        &self,
+        b: &mut Builder,
+        projections: &mut FxHashMap<(usize, usize), V3>,
+        cols: &mut Vec<Carry>,
+        upper: &mut Vec<((usize, usize), Term)>,
+    ) {
+        let mut going = vec![true; cols.len()];
+        while going.iter().any(|&g| g) {
+            for (g, col) in going.iter_mut().zip(cols.iter_mut()) {
+                if *g {
+                    *g = self.step(b, projections, col, upper);
+                }
+            }
+        }
+        cols.clear();
     }
 
     /// The entries `(i, t)` of a column whose force `(n, f)` (moment about the origin of body

@@ -50,12 +50,25 @@
 //! (measured when introduced).
 //!
 //! # Order of the statements
-//! Each column is written right after its body's composite, leaves to root, so the composite's
-//! `J a`, `a × h` are read as soon as they are formed and the column's force is carried up
-//! before the next body's composite begins. Forming every composite first and then every
-//! column kept the composites of all bodies live until their column: serial30's `M` (after
-//! `atomise,cse,zero-removal,contract`) had 153 values live at once, this order 26, and its
-//! `batch=4` C is 4–5 % faster (same ops; GCC keeps the statement order, so fewer spills).
+//! GCC keeps the statement order of a straight-line function, so the order the generator
+//! writes decides what its register allocator spills; the ops are the same in any order.
+//! - **Each column right after its body's composite**, leaves to root, so the composite's
+//!   `J a`, `a × h` are read as soon as they are formed, and every entry of `M` bound where it
+//!   is formed (not at the end, which kept the forces that a projection reads live). Forming
+//!   every composite first and every column after kept all composites live until their
+//!   column: serial30's `M` (after `atomise,cse,zero-removal,contract`) had 153 values live at
+//!   once, this order 26; TIAGo Pro's 289 (after `schedule-cpu`'s greedy order), now 161.
+//!   `batch=4` C, same-process A/B: serial30 4–5 % faster, TIAGo Pro 3–6 %.
+//! - **Columns in pairs.** A column whose parent is the next body waits there (one step up)
+//!   for the parent's column, and the two go up together, one step of each in turn: the
+//!   joint's `C`, `S` of each step are loaded once for both (two 6-vectors and the two
+//!   values fit the 16 vector registers of x86-64; three columns at once did not: 15 % slower
+//!   than pairs on serial30). Only where the walk to the root segment is at least
+//!   `PAIR_WALK` (8) steps and crosses no merged (dense) rotation: on short walks (Panda's arm,
+//!   Solo-12's legs) and across the 9 entries of a dense rotation (TIAGo Pro's arms) the
+//!   extra pressure cost 1–9 %. serial30's `M`, `batch=4` with `contract`: 10–11 % faster
+//!   than single columns (`batch=8`: 9–11 %, one state: 0–1 %); Talos 0–2 %; the others'
+//!   code is unchanged.
 //!
 //! # Why CRBA
 //! The unit-acceleration RNEA (Walker & Orin's method 1) re-runs the forward and backward
@@ -96,6 +109,33 @@ struct Tree<'a> {
     segment_moving: Vec<usize>,
 }
 
+/// Steps a column must be carried (moving bodies between its body and the root segment) for
+/// it to go up in a pair with its parent's (module doc, "Order of the statements").
+const PAIR_WALK: usize = 8;
+
+impl Tree<'_> {
+    /// Per body: whether its column waits for its parent's to go up with it — the parent is
+    /// the next body the leaves-to-root loop forms, has a coordinate, the walk to the root
+    /// segment is at least [`PAIR_WALK`] steps and crosses no merged (dense) rotation.
+    fn waits(&self) -> Vec<bool> {
+        let nb = self.order.len();
+        let (mut walk, mut dense) = (vec![0usize; nb + 1], vec![false; nb + 1]);
+        let mut waits = vec![false; nb + 1];
+        for body in 1..=nb {
+            let p = self.parent[body];
+            walk[body] = walk[p] + usize::from(self.moves[body] && !self.in_segment[body]);
+            dense[body] = dense[p] || self.merged[body].is_some();
+            waits[body] = p > 0
+                && p + 1 == body
+                && self.moves[p]
+                && self.layout.q_index[p - 1].is_some()
+                && walk[body] >= PAIR_WALK
+                && !dense[body];
+        }
+        waits
+    }
+}
+
 /// The upper triangle of `M`: `(i, j) → term` for `i ≤ j` (1-based coordinates), entries that
 /// fold to 0 left out. Writes the composites and column forces into `b` as temporaries `MC`,
 /// `HC`, `JC` (per body) and `FM`, `CM` (per body and column), each column right after its
@@ -130,10 +170,12 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
         segment_moving[body] = segment_moving[parent[body]] + usize::from(layout.q_index[body - 1].is_some());
     }
     let tree = Tree { robot, layout, motions, order, parent, moves, ro, merged, in_segment, segment_moving };
+    let waits = tree.waits();
     let mut projections: FxHashMap<(usize, usize), V3> = FxHashMap::default();
     let mut upper = Vec::new();
     // Each body alone, then leaves to root: the composite of its subtree, then its column.
     let mut comp: Vec<Composite> = vec![Composite::zero(); nb + 1];
+    let mut pending: Vec<column::Carry> = Vec::new();
     for body in (1..=nb).rev() {
         if !tree.moves[body] {
             continue;
@@ -156,9 +198,19 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
             comp[p] = comp[p].add(&in_parent);
         }
         if let Some(qj) = layout.q_index[body - 1] {
-            tree.column(b, &mut projections, body, qj, &c, &mut upper);
+            // A column waiting for this body's (its child's, one step up already) goes up with it.
+            if pending.first().is_some_and(|o| o.at() != body) {
+                tree.finish(b, &mut projections, &mut pending, &mut upper);
+            }
+            pending.push(tree.start(body, qj, &c));
+            if pending.len() == 1 && waits[body] {
+                tree.step(b, &mut projections, &mut pending[0], &mut upper);
+            } else {
+                tree.finish(b, &mut projections, &mut pending, &mut upper);
+            }
         }
         comp[body] = c;
     }
+    tree.finish(b, &mut projections, &mut pending, &mut upper);
     upper
 }
