@@ -78,6 +78,8 @@
 
 mod column;
 mod composite;
+#[cfg(test)]
+mod tests;
 
 use super::rnea::{numeric, Motion, M3, V3};
 use super::robot::Robot;
