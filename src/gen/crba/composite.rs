@@ -91,18 +91,16 @@ impl Composite {
         Composite { m: self.m.clone(), h, j: out }
     }
 
-    /// Every entry bound as a temporary `{m}{body}`, `{h}{k}{body}`, `{j}{r}{c}{body}` (`MC`,
-    /// `HC`, `JC` for a body's composite).
-    pub(super) fn bind(&self, b: &mut Builder, [m, h, j]: [&str; 3], body: usize) -> Composite {
-        let mass = b.bind(&format!("{m}{body}"), self.m.clone());
-        let first = bind3(b, h, body, self.h.clone());
-        let jn = j;
+    /// Every entry bound as a temporary: `MC{body}`, `HC{k}{body}`, `JC{r}{c}{body}`.
+    pub(super) fn bind(&self, b: &mut Builder, body: usize) -> Composite {
+        let m = b.bind(&format!("MC{body}"), self.m.clone());
+        let h = bind3(b, "HC", body, self.h.clone());
         let mut j: M3 = Default::default();
         for (a, c) in UPPER {
-            j[a][c] = b.bind(&format!("{jn}{}{}{body}", a + 1, c + 1), self.j[a][c].clone());
+            j[a][c] = b.bind(&format!("JC{}{}{body}", a + 1, c + 1), self.j[a][c].clone());
             j[c][a] = j[a][c].clone();
         }
-        Composite { m: mass, h: first, j }
+        Composite { m, h, j }
     }
 }
 

@@ -185,7 +185,7 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
         let m = layout.param(b, &format!("m[{body}]"));
         let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
         let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
-        let c = Composite::body(m, l, inn).add(&comp[body]).bind(b, ["MC", "HC", "JC"], body);
+        let c = Composite::body(m, l, inn).add(&comp[body]).bind(b, body);
         let p = tree.parent[body];
         if tree.moves[p] {
             let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
