@@ -60,6 +60,13 @@ pub enum MassMatrix {
     UnitAcceleration,
 }
 
+/// `M[i][j]` (1-based) bound as the temporary `M{i}_{j}` where it is formed: both ways of
+/// forming `M` bind each entry as soon as it is known, so nothing it reads stays live until
+/// the outputs are written.
+pub(super) fn bind_entry(b: &mut Builder, i: usize, j: usize, t: Term) -> Term {
+    b.bind(&format!("M{i}_{j}"), t)
+}
+
 /// Writes `dirdyna` (outputs `M[i][j]`, then `c[i]`) into `b`, `M` by CRBA.
 pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) {
     dirdyna_with(model, layout, b, MassMatrix::Crba);
@@ -77,7 +84,6 @@ pub fn dirdyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: MassMa
         MassMatrix::UnitAcceleration => unit_acceleration(model, layout, b, &motions, nq),
     };
     for ((i, j), t) in entries {
-        let t = b.bind(&format!("M{i}_{j}"), t);
         upper.insert((i - 1, j - 1), t);
     }
     let mut c = vec![ZERO; nq];
@@ -112,7 +118,7 @@ fn unit_acceleration(
         };
         for (qi, t) in sweep(model, layout, b, motions, &unit) {
             if qi <= j + 1 {
-                upper.push(((qi, j + 1), t));
+                upper.push(((qi, j + 1), bind_entry(b, qi, j + 1, t)));
             }
         }
     }

@@ -6,6 +6,7 @@ use rustc_hash::FxHashMap;
 
 use super::composite::Composite;
 use super::Tree;
+use crate::gen::dirdyna::bind_entry;
 use crate::gen::rnea::{cross, dot, matvec, vadd, M3, V3};
 use crate::gen::robot::JointKind;
 use crate::gen::sym::{mul, sum, Builder, Term};
@@ -19,12 +20,6 @@ fn column_bind(b: &mut Builder, name: &str, body: usize, col: usize, v: V3) -> V
         b.bind(&format!("{name}2{body}_{col}"), y),
         b.bind(&format!("{name}3{body}_{col}"), z),
     ]
-}
-
-/// `M[qi][qj]` bound as `M{qi}_{qj}` where it is formed, so the column's force is not kept
-/// live until the end of the function for it (the module doc's "Order of the statements").
-fn entry(b: &mut Builder, qi: usize, qj: usize, t: Term) -> Term {
-    b.bind(&format!("M{qi}_{qj}"), t)
 }
 
 /// `r·v` for a rotation that may be absent (identity).
@@ -101,14 +96,14 @@ impl Tree<'_> {
         let Carry { qj, at, .. } = *col;
         if self.in_segment[at] && self.segment_moving[at] >= 2 {
             for (qi, t) in self.projection(b, projections, at, &col.n, &col.f) {
-                upper.push(((qi, qj), entry(b, qi, qj, t)));
+                upper.push(((qi, qj), bind_entry(b, qi, qj, t)));
             }
             return false;
         }
         if let Some(qi) = self.layout.q_index[at - 1] {
             let jo = &self.robot.joints[self.order[at - 1]];
             let t = if jo.kind == JointKind::Revolute { dot(&jo.axis, &col.n) } else { dot(&jo.axis, &col.f) };
-            upper.push(((qi, qj), entry(b, qi, qj, t)));
+            upper.push(((qi, qj), bind_entry(b, qi, qj, t)));
         }
         let p = self.parent[at];
         if !self.moves[p] {

@@ -141,7 +141,8 @@ impl Tree<'_> {
 /// The upper triangle of `M`: `(i, j) → term` for `i ≤ j` (1-based coordinates), entries that
 /// fold to 0 left out. Writes the composites and column forces into `b` as temporaries `MC`,
 /// `HC`, `JC` (per body) and `FM`, `CM` (per body and column), each column right after its
-/// body's composite (module doc, "Order of the statements").
+/// body's composite, and every entry as `M{i}_{j}` where it is formed
+/// ([`super::dirdyna::bind_entry`]; module doc, "Order of the statements").
 pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]) -> Vec<((usize, usize), Term)> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
