@@ -201,10 +201,9 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
             comp[p] = comp[p].add(&in_parent);
         }
         if let Some(qj) = layout.q_index[body - 1] {
-            // A column waiting for this body's (its child's, one step up already) goes up with it.
-            if pending.first().is_some_and(|o| o.at() != body) {
-                tree.finish(b, &mut projections, &mut pending, &mut upper);
-            }
+            // A column waiting for this body's (its child's, one step up already) goes up with it:
+            // a body waits only for its parent, which is the next body this loop forms.
+            debug_assert!(pending.iter().all(|o| o.at() == body), "a waiting column is at its parent");
             pending.push(tree.start(body, qj, &c));
             if pending.len() == 1 && waits[body] {
                 tree.step(b, &mut projections, &mut pending[0], &mut upper);
@@ -214,6 +213,6 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
         }
         comp[body] = c;
     }
-    tree.finish(b, &mut projections, &mut pending, &mut upper);
+    debug_assert!(pending.is_empty(), "the root waits for no column");
     upper
 }
