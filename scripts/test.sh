@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# The test command (README "The two commands"; `.ci/run` calls it too, so the two cannot drift).
+#
+# On a fresh machine it first installs what the tests run besides Rust:
+# - a C compiler (gcc): the C back end's tests compile and execute generated C;
+# - Icarus Verilog, Verilator and Yosys: `codegen<fpga>`'s tests simulate, lint and size the
+#   generated Verilog;
+# - Pinocchio and example-robot-data from PyPI, in the virtual environment
+#   `target/pinocchio-venv` (about 50 s; kept across runs): the numerical oracle of the URDF
+#   front end's tests.
+# Debian packages come from `apt-get` (as root, or through `sudo`). Then it runs
+# `cargo test --workspace --locked` with the arguments given (`scripts/test.sh -p robovec-ir`).
+# The tests read the Robotran corpus from `../shared` beside the repository and fail without it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+as_root() {
+    if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi
+}
+
+apt_updated=no
+apt_install() {
+    if ! command -v apt-get >/dev/null 2>&1; then
+        echo "no apt-get: install $* with this system's package manager" >&2
+        exit 1
+    fi
+    if [ "$apt_updated" = no ]; then
+        as_root apt-get update -qq
+        apt_updated=yes
+    fi
+    echo "installing $*" >&2
+    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$@" >/dev/null
+}
+
+if ! command -v cargo >/dev/null 2>&1; then
+    echo "cargo not found: install the Rust toolchain (https://rustup.rs), then run this again" >&2
+    exit 1
+fi
+
+command -v cc >/dev/null 2>&1 || apt_install gcc libc6-dev
+
+missing=()
+for tool in iverilog:iverilog vvp:iverilog verilator:verilator yosys:yosys; do
+    command -v "${tool%%:*}" >/dev/null 2>&1 || missing+=("${tool##*:}")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    apt_install $(printf '%s\n' "${missing[@]}" | sort -u)
+fi
+for tool in cc iverilog vvp verilator yosys; do
+    command -v "$tool" >/dev/null 2>&1 || { echo "$tool not found after installing it" >&2; exit 1; }
+done
+
+venv=target/pinocchio-venv
+if ! "$venv/bin/python" -c "import pinocchio, example_robot_data" >/dev/null 2>&1; then
+    if ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
+        apt_install python3-venv
+    fi
+    echo "installing pin and example-robot-data into $venv" >&2
+    rm -rf "$venv"
+    python3 -m venv "$venv"
+    "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen
+    "$venv/bin/python" -c "import pinocchio, example_robot_data" \
+        || { echo "pinocchio did not install into $venv" >&2; exit 1; }
+fi
+
+test -d ../shared/corpus/robotran || { echo "../shared/corpus/robotran is missing beside the repository" >&2; exit 1; }
+
+exec cargo test --workspace --locked "$@"
