@@ -51,7 +51,11 @@ for tool in cc iverilog vvp verilator yosys; do
 done
 
 venv=target/pinocchio-venv
-if ! "$venv/bin/python" -c "import pinocchio, example_robot_data" >/dev/null 2>&1; then
+venv_ready() {
+    "$venv/bin/python" -c "import pinocchio" >/dev/null 2>&1 \
+        && "$venv/bin/pip" show -q example-robot-data cmeel-eigen >/dev/null 2>&1
+}
+if ! venv_ready; then
     if ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
         apt_install python3-venv
     fi
@@ -59,8 +63,7 @@ if ! "$venv/bin/python" -c "import pinocchio, example_robot_data" >/dev/null 2>&
     rm -rf "$venv"
     python3 -m venv "$venv"
     "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen
-    "$venv/bin/python" -c "import pinocchio, example_robot_data" \
-        || { echo "pinocchio did not install into $venv" >&2; exit 1; }
+    venv_ready || { echo "pinocchio and example-robot-data did not install into $venv" >&2; exit 1; }
 fi
 
 test -d ../shared/corpus/robotran || { echo "../shared/corpus/robotran is missing beside the repository" >&2; exit 1; }
