@@ -42,7 +42,6 @@ pub mod placement;
 pub mod rng;
 pub mod span;
 pub mod syntax;
-pub mod target;
 pub mod text;
 pub mod verifier;
 

@@ -25,7 +25,7 @@
 //!
 //! The verifier checks every rule above except word lifetimes (address reuse) whenever a
 //! placement is read or left by a pass ([`crate::verifier::placement`]); the lowering into the
-//! machine program (`robovec_passes::machine::lower`, which `sim` executes and `codegen<fpga>`
+//! machine program (`robovec_fpga::lower::lower`, which `sim` executes and `codegen<fpga>`
 //! encodes) checks them all.
 //!
 //! A placement is the placer's decision at the level of values, carried by the `.rvir` text;
@@ -85,9 +85,16 @@ impl std::fmt::Display for Pe {
     }
 }
 
-/// The architecture a placement targets.
+/// The PE array a placement is made for: how many PEs of each type, their latencies, the
+/// write ports of a PE memory and whether buffers exist — what the placer, the verifier, the
+/// lowering and `sim` read of the machine (the `placement n_add=… n_mul=…` header of `.rvir`).
+///
+/// It is one view of the machine, not the device: the device (capacities, per-unit costs,
+/// memory sizes, clock) is `robovec_fpga::target::Target`, and `Target::pe_array(n_add, n_mul,
+/// buffer)` builds the array of that device's latencies and write ports. A pass parameter
+/// (`place<lat-add=…>`) may override a field.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub struct Arch {
+pub struct PeArray {
     /// ADD PEs.
     pub n_add: u32,
     /// MULTI PEs.
@@ -100,7 +107,7 @@ pub struct Arch {
     pub buffer: bool,
 }
 
-impl Arch {
+impl PeArray {
     /// Number of PEs of both types.
     pub fn n_pe(&self) -> usize {
         (self.n_add + self.n_mul) as usize
@@ -184,8 +191,8 @@ impl PlacementSpans {
 /// Equality compares the placement itself, never its [`PlacementSpans`].
 #[derive(Clone, Debug)]
 pub struct Placement {
-    /// Target architecture.
-    pub arch: Arch,
+    /// The PE array placed on.
+    pub arch: PeArray,
     /// Issue of every op, indexed by `Value::index()` (`None` for non-ops).
     pub issue: Vec<Option<Issue>>,
     /// Initial data.

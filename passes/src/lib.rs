@@ -18,7 +18,6 @@ pub mod dce;
 pub mod eqsat;
 pub mod figures;
 pub mod inline;
-pub mod machine;
 pub mod manager;
 pub mod params;
 pub mod pipeline;
@@ -30,8 +29,8 @@ pub mod study;
 pub mod sweep;
 pub mod tree_height;
 
+use robovec_fpga::target::Target;
 use robovec_ir::analysis::Latencies;
-use robovec_ir::target::Target;
 use robovec_ir::verifier::VerifierError;
 use robovec_ir::{Module, Phase, Span};
 
@@ -156,7 +155,7 @@ impl PassError {
 pub struct PassContext {
     /// The machine the run targets (`-target=de10-nano|FILE.json`, selected once; default
     /// `de10-nano`): latencies, write ports, memory sizes, clock and device capacities for
-    /// every pass (see `robovec_ir::target`). Set it with [`PassContext::with_target`].
+    /// every pass (see [`robovec_fpga::target`]). Set it with [`PassContext::with_target`].
     pub target: Target,
     /// The pipeline's latencies now, cycles: the target's, until a pass gives `lat-*`
     /// explicitly; from that pass on the given ones replace them (the others stay), for every

@@ -20,11 +20,11 @@ use super::ast::{OperandAst, PlacementAst, PlacementLineAst};
 use super::error::ParseError;
 use crate::analysis::Latencies;
 use crate::function::Function;
-use crate::placement::{Arch, Issue, Load, Pe, Placement, PlacementSpans, Write};
+use crate::placement::{Issue, Load, Pe, PeArray, Placement, PlacementSpans, Write};
 use crate::span::Span;
 use crate::syntax::Operand;
 
-fn pe_name(text: &str, arch: &Arch) -> Option<Pe> {
+fn pe_name(text: &str, arch: &PeArray) -> Option<Pe> {
     let index = |digits: &str| digits.parse::<u32>().ok().filter(|_| digits.bytes().all(|b| b.is_ascii_digit()));
     if let Some(i) = text.strip_prefix("add").and_then(index) {
         (i < arch.n_add).then_some(Pe::Add(i))
@@ -57,7 +57,7 @@ pub fn resolve(f: &Function, p: PlacementAst<'_>, errors: &mut Vec<ParseError>) 
         }
     }
     let d = Latencies::default();
-    let arch = Arch {
+    let arch = PeArray {
         n_add: key("n_add", None, errors),
         n_mul: key("n_mul", None, errors),
         lat: Latencies {

@@ -19,7 +19,7 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use robovec_ir::analysis::compute_timing;
-use robovec_ir::placement::Arch;
+use robovec_ir::placement::PeArray;
 use robovec_ir::{Function, OpKind, Value};
 
 /// Ops that run on the ADD side (add, sub, div, call) and on the MULTI side.
@@ -30,7 +30,7 @@ pub fn ops_per_side(f: &Function) -> (u64, u64) {
 
 /// The lower bound LB of SPEC §4: max(ASAPCycle critical path, ⌈n_add_side/N_add⌉ − 1 + lat_add,
 /// ⌈n_mul/N_mul⌉ − 1 + lat_mul), in cycles. No valid placement has fewer cycles.
-pub fn lower_bound(f: &Function, arch: &Arch) -> u32 {
+pub fn lower_bound(f: &Function, arch: &PeArray) -> u32 {
     let (_, cp) = compute_timing(f, &arch.lat);
     let (na, nm) = ops_per_side(f);
     let side = |n: u64, pes: u32, lat: u32| if n == 0 { 0 } else { (n.div_ceil(pes as u64) - 1) as u32 + lat };
@@ -77,7 +77,7 @@ struct Dag {
 }
 
 impl Dag {
-    fn build(f: &Function, arch: &Arch) -> Dag {
+    fn build(f: &Function, arch: &PeArray) -> Dag {
         let mut node = vec![u32::MAX; f.values.len()];
         let mut dag = Dag { ops: Vec::new(), mul: Vec::new(), lat: Vec::new(), preds: Vec::new(), succs: Vec::new() };
         for &v in &f.body {
@@ -116,7 +116,7 @@ const TIGHTEN_BUDGET: u64 = 1_000_000;
 /// spent.
 fn tighten(
     dag: &Dag,
-    arch: &Arch,
+    arch: &PeArray,
     order: &[u32],
     edges_in: &[Vec<u32>],
     w: &dyn Fn(u32, u32) -> u32,
@@ -186,7 +186,7 @@ fn tighten(
 /// Valid: in any placement, an op issues no earlier than its head, and at least its tail
 /// remains after its issue; the relaxation drops only constraints. Cost: O(n log n) plus the
 /// bounded tightening (at most `TIGHTEN_BUDGET` = 10⁶ ancestor visits).
-pub fn tight_lower_bound(f: &Function, arch: &Arch) -> u32 {
+pub fn tight_lower_bound(f: &Function, arch: &PeArray) -> u32 {
     let Some((dag, head, rhead)) = heads_and_tails(f, arch) else { return 0 };
     let mut best = lower_bound(f, arch);
     let mut jobs: [Vec<(u32, u32)>; 2] = [Vec::new(), Vec::new()];
@@ -202,7 +202,7 @@ pub fn tight_lower_bound(f: &Function, arch: &Arch) -> u32 {
 /// is a lower bound on the op's issue cycle; the tail `ρ` says that at least `ρ + 1` cycles
 /// remain from its issue to the end of any placement (its latency included). Both account for
 /// the PEs of both types (see the module doc); list scheduling uses the tails as priorities.
-pub fn tightened_heads_tails(f: &Function, arch: &Arch) -> Vec<Option<(u32, u32)>> {
+pub fn tightened_heads_tails(f: &Function, arch: &PeArray) -> Vec<Option<(u32, u32)>> {
     let mut out = vec![None; f.values.len()];
     if let Some((dag, head, rhead)) = heads_and_tails(f, arch) {
         for (j, v) in dag.ops.iter().enumerate() {
@@ -213,7 +213,7 @@ pub fn tightened_heads_tails(f: &Function, arch: &Arch) -> Vec<Option<(u32, u32)
 }
 
 /// The DAG with tightened heads and reverse heads (`None` without ops).
-fn heads_and_tails(f: &Function, arch: &Arch) -> Option<(Dag, Vec<u32>, Vec<u32>)> {
+fn heads_and_tails(f: &Function, arch: &PeArray) -> Option<(Dag, Vec<u32>, Vec<u32>)> {
     let dag = Dag::build(f, arch);
     let n = dag.ops.len();
     if n == 0 {

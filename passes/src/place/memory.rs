@@ -11,13 +11,13 @@ use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
 
 use robovec_ir::machine::Held;
-use robovec_ir::placement::{Arch, Issue, Load, Pe, Placement, Write};
+use robovec_ir::placement::{Issue, Load, Pe, PeArray, Placement, Write};
 use robovec_ir::{Function, Operand};
 
 use super::schedule::{initial_operands, Schedule};
 
 /// The PE of a dense slot.
-pub fn pe_of(arch: &Arch, slot: usize) -> Pe {
+pub fn pe_of(arch: &PeArray, slot: usize) -> Pe {
     if slot < arch.n_add as usize {
         Pe::Add(slot as u32)
     } else {
@@ -54,7 +54,7 @@ fn allocate(items: &[(u32, u32)]) -> (Vec<u32>, u32) {
 }
 
 /// Builds the placement of `f` from its schedule.
-pub fn build(f: &Function, arch: &Arch, s: &Schedule) -> Placement {
+pub fn build(f: &Function, arch: &PeArray, s: &Schedule) -> Placement {
     let n_pe = arch.n_pe();
     let n = f.values.len();
     // Bookings of each value (compressed rows), to find the one an op reads on its PE.

@@ -25,7 +25,7 @@ pub mod report;
 pub mod schedule;
 pub mod search;
 
-use robovec_ir::placement::{Arch, Placement};
+use robovec_ir::placement::{PeArray, Placement};
 use robovec_ir::{Function, Module, OpKind, Phase};
 
 pub use bound::{lower_bound, ops_per_side, tight_lower_bound};
@@ -54,8 +54,8 @@ pub enum Select {
 /// Options of one placement.
 #[derive(Clone, Copy, Debug)]
 pub struct PlaceOptions {
-    /// Target architecture.
-    pub arch: Arch,
+    /// The PE array to place on.
+    pub arch: PeArray,
     /// Ready-list priority.
     pub priority: Priority,
     /// PE selection.
@@ -92,7 +92,7 @@ impl PlaceOptions {
 /// The options of checked parameters `p` (defaults and ranges from [`INFO`]).
 fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
     Ok(PlaceOptions {
-        arch: Arch {
+        arch: PeArray {
             n_add: p.u32("add")?,
             n_mul: p.u32("mul")?,
             lat: p.latencies()?,
@@ -318,7 +318,7 @@ impl Pass for Place {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let lat = cx.latencies_for("place", &self.lat);
-        let arch = Arch { lat, writes: self.writes.unwrap_or(cx.target.writes), ..self.opts.arch };
+        let arch = PeArray { lat, writes: self.writes.unwrap_or(cx.target.writes), ..self.opts.arch };
         let opts = PlaceOptions { deadline: cx.deadline, arch, ..self.opts };
         for f in &mut m.functions {
             let (p, stopped) = try_place_function_progress(f, &opts, &cx.progress)

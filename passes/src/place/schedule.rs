@@ -18,7 +18,7 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use robovec_ir::analysis::compute_timing;
-use robovec_ir::placement::{Arch, Pe};
+use robovec_ir::placement::{Pe, PeArray};
 use robovec_ir::{Function, OpKind, Operand, Value};
 
 use super::feed::Feed;
@@ -102,7 +102,7 @@ impl Ports {
 }
 
 struct Ctx<'a> {
-    arch: &'a Arch,
+    arch: &'a PeArray,
     issue: Vec<Option<(usize, u32)>>,
     arrival: Vec<u32>,
     /// Memories (PE slots) a value has been written into.
@@ -297,7 +297,7 @@ impl OpDag {
 }
 
 /// Priority keys of the seed's orders (smaller = scheduled first), indexed by value index.
-pub fn seed_keys(f: &Function, arch: &Arch, priority: Priority) -> Vec<Key> {
+pub fn seed_keys(f: &Function, arch: &PeArray, priority: Priority) -> Vec<Key> {
     let (timing, _) = compute_timing(f, &arch.lat);
     (0..f.values.len())
         .map(|i| match timing[i] {
@@ -322,7 +322,7 @@ pub type Key = (u32, u32, u32);
 pub fn schedule(
     f: &Function,
     dag: &OpDag,
-    arch: &Arch,
+    arch: &PeArray,
     keys: &[Key],
     select: Select,
     feed: u32,

@@ -8,7 +8,7 @@ use Pe::{Add, Mul};
 
 const SRC: &str = "func @f { phase atomised input %a input %b %x = mul %a, %b %y = add %x, %a output o = %y }";
 
-use crate::machine::tests::{arch, func, load, v};
+use super::machine_tests::{arch, func, load, v};
 
 fn direct(f: &Function, name: &str, pe: Pe, addr: u32, cycle: u32) -> Write {
     Write { value: v(f, name), pe, addr, cycle, buffer_addr: None }

@@ -7,8 +7,8 @@
 //!   `peS_instr` (instruction memory, one word per cycle `0..=cycles`), `peS_xbar` (crossbar
 //!   memory: the two write selects of PE memory `S`), `peS_bufi` (buffer instructions),
 //!   `peS_capt` (output capture), `peS_data` (initial PE memory: constants, input words 0),
-//!   `peS_out` (initial output memory). Word layouts: the `machine` module doc and the
-//!   manifest's `widths`.
+//!   `peS_out` (initial output memory). Word layouts: [`robovec_fpga::encode`]'s module doc
+//!   and the manifest's `widths`.
 //! - `manifest.json`: sizes, widths, the load map (input / trig value / constant → PE slot,
 //!   address), the output map (output → PE slot, output-memory address), target, cycles.
 //! - `hdl/`: `fp_units.v` (the FP unit boundary `fp_add_sub`, `fp_mul` with bit-exact binary32
@@ -18,7 +18,7 @@
 //!   `testbench.v`.
 //! - `simulate` (executable, Python 3 standard library + Icarus Verilog): `DIR/simulate
 //!   INPUTS.json` runs the design and prints `{"cycles", "clocks", "outputs", "bits"}`.
-//! - `resources.json`: ALM / M10K / DSP, fit, cycles, clock, µs ([`resources`]).
+//! - `resources.json`: ALM / M10K / DSP, fit, cycles, clock, µs ([`robovec_fpga::resources`]).
 //!
 //! ## Design choices (where the issue is silent)
 //! - The images are written from the machine program's encoding; the design's RTL
@@ -39,24 +39,21 @@
 //!   `call` ops (the PEs have only `fp_add_sub` and `fp_mul`), targets with `writes` ≠ 2 (the
 //!   instruction word has two write ports), memories beyond the target (PE memory words, buffer
 //!   depth, instruction memory depth) and latencies below 2.
-
-pub mod design;
-pub mod images;
-pub mod lower;
-pub mod resources;
+//!
+//! This file is the pass (its parameters, its report and artifact); the work — lowering,
+//! encoding, design, Verilog, estimate, files — is the machine crate's ([`robovec_fpga::emit`]).
 
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use robovec_fpga::design::build::Limits;
+use robovec_fpga::design::Design;
+use robovec_fpga::emit::{emit, DesignFile};
+use robovec_fpga::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
+
 use crate::params::ParamKind;
 use crate::{Artifact, ArtifactFile, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry};
-use design::{Design, HDL_LIBRARY};
-use images::Image;
-use resources::Resources;
-
-/// The `simulate` script written into `DIR`.
-pub const SIMULATE: &str = include_str!("simulate.py");
 
 /// `out=DIR`.
 pub const OUT: ParamInfo = ParamInfo {
@@ -151,17 +148,6 @@ pub struct FpgaReport {
     pub resources: Resources,
 }
 
-/// One file of a design, its path relative to the function's folder.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct DesignFile {
-    /// Path under `DIR` (`hex/pe0_instr.hex`).
-    pub path: String,
-    /// Content.
-    pub bytes: Vec<u8>,
-    /// True for `simulate`.
-    pub executable: bool,
-}
-
 /// What `codegen<fpga>` produced: per function, its design, files and figures.
 #[derive(Debug)]
 pub struct FpgaArtifact {
@@ -214,118 +200,6 @@ impl Artifact for FpgaArtifact {
     }
 }
 
-/// The files of a design: `(path relative to DIR, bytes, executable)`.
-pub fn design_files(d: &Design, format: &str, r: &Resources, manifest: &str) -> Vec<DesignFile> {
-    let mut v: Vec<DesignFile> = Vec::new();
-    let mut add = |path: String, bytes: Vec<u8>, executable: bool| v.push(DesignFile { path, bytes, executable });
-    for p in &d.pes {
-        for img in p.images() {
-            if format != "mif" {
-                add(format!("hex/{}.hex", img.name), img.to_hex().into_bytes(), false);
-            }
-            if format != "hex" {
-                add(format!("mif/{}.mif", img.name), img.to_mif().into_bytes(), false);
-            }
-        }
-    }
-    for (n, t) in HDL_LIBRARY {
-        add(format!("hdl/{n}"), t.as_bytes().to_vec(), false);
-    }
-    add("hdl/robovec_top.v".into(), d.top("").into_bytes(), false);
-    add("hdl/testbench.v".into(), d.testbench().into_bytes(), false);
-    add("manifest.json".into(), manifest.as_bytes().to_vec(), false);
-    add("simulate".into(), SIMULATE.as_bytes().to_vec(), true);
-    let mut res = serde_json::to_string_pretty(r).expect("resources serialise");
-    res.push('\n');
-    add("resources.json".into(), res.into_bytes(), false);
-    v
-}
-
-/// One memory in the manifest.
-#[derive(Clone, Debug, Serialize)]
-struct ManifestMemory {
-    file: String,
-    words: usize,
-    width: u32,
-}
-
-#[derive(Clone, Debug, Serialize)]
-struct ManifestPe<'a> {
-    slot: usize,
-    pe: &'a str,
-    kind: &'static str,
-    latency: u32,
-    buffer_words: u32,
-    memories: std::collections::BTreeMap<&'static str, ManifestMemory>,
-}
-
-/// The manifest (`manifest.json`): everything a host or a script needs to load and read the
-/// design. `target` is the target's name, `clock_mhz` its clock.
-pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> String {
-    let pes: Vec<ManifestPe> = d
-        .pes
-        .iter()
-        .map(|p| {
-            let m = |i: &Image| ManifestMemory { file: i.name.clone(), words: i.words.len().max(1), width: i.width };
-            let memories = [
-                ("instr", m(&p.instr)),
-                ("xbar", m(&p.xbar)),
-                ("bufi", m(&p.bufi)),
-                ("capt", m(&p.capt)),
-                ("data", m(&p.data)),
-                ("out", m(&p.out)),
-            ]
-            .into_iter()
-            .collect();
-            ManifestPe {
-                slot: p.slot,
-                pe: &p.pe,
-                kind: if p.is_mul { "mul" } else { "add" },
-                latency: if p.is_mul { d.lat_mul } else { d.lat_add },
-                buffer_words: p.buffer_words,
-                memories,
-            }
-        })
-        .collect();
-    let mut hdl: Vec<&str> = HDL_LIBRARY.iter().map(|(n, _)| *n).collect();
-    hdl.push("robovec_top.v");
-    let w = d.widths;
-    let (e, n) = (4 * w.aw, d.n_pe());
-    let layout = serde_json::json!({
-        "instr": format!("[0,{a}) read A, [{a},{b}) read B, [{b},{c}) write-0 address, [{c},{e}) write-1 address, \
-            bit {e} we0, bit {} we1, bit {} issue valid, bit {} sub (ADD PE: 1 = a - b), zero up to {}",
-            e + 1, e + 2, e + 3, w.instr, a = w.aw, b = 2 * w.aw, c = 3 * w.aw),
-        "xbar": format!("[0,{s}) port-0 select, [{s},{}) port-1 select: 0 none, 1..={n} result of slot s-1, {}..={} buffer read of slot s-{}",
-            2 * w.sw, n + 1, 2 * n, n + 1, s = w.sw),
-        "bufi": format!("[0,{b}) store address, [{b},{}) read address, bit {} store enable, bit {} read enable",
-            2 * w.bw, 2 * w.bw, 2 * w.bw + 1, b = w.bw),
-        "capt": format!("[0,{o}) output-memory address, bit {o} enable", o = w.ow),
-        "data": "binary32",
-    });
-    let v = serde_json::json!({
-        "format": "robovec-fpga/1",
-        "function": d.function,
-        "target": target,
-        "clock_mhz": clock_mhz,
-        "images": format,
-        "cycles": d.cycles,
-        "n_add": d.n_add,
-        "n_mul": d.n_mul,
-        "latency": {"add": d.lat_add, "mul": d.lat_mul},
-        "widths": w,
-        "layout": layout,
-        "hdl": hdl,
-        "pes": pes,
-        "inputs": d.inputs,
-        "loads": d.loads,
-        "output_loads": d.output_loads,
-        "outputs": d.outputs,
-    });
-    let mut s = serde_json::to_string_pretty(&v).expect("manifest serialises");
-    s.push('\n');
-    s
-}
-
 /// The path `codegen<fpga>` writes for `function` (for messages and tests).
 pub fn function_dir(out: &Path, function: &str, several: bool) -> PathBuf {
     if several {
@@ -334,36 +208,6 @@ pub fn function_dir(out: &Path, function: &str, several: bool) -> PathBuf {
         out.to_path_buf()
     }
 }
-
-/// The cost model of target `t` (its capacities, per-unit costs and clock; the analytic logic
-/// per PE from its crossbar, PE memory and control costs, used without Yosys).
-pub fn cost_model(t: &robovec_ir::target::Target) -> resources::CostModel {
-    let unit = |u: &robovec_ir::target::UnitCost| resources::UnitCost {
-        alm: u.alm.ceil() as u64,
-        dsp: u64::from(u.dsp),
-        m10k: u64::from(u.m10k),
-    };
-    resources::CostModel {
-        target: t.name.clone(),
-        capacity: resources::UnitCost { alm: u64::from(t.alm), m10k: u64::from(t.m10k), dsp: u64::from(t.dsp) },
-        fp_add: unit(&t.fp_add),
-        fp_mul: unit(&t.fp_mul),
-        crossbar_alm: t.crossbar_alm,
-        pe_memory_alm: t.pe_memory_alm,
-        control_alm: t.control_alm,
-        output_word_alm: t.output_word_alm,
-        writes: t.writes,
-        clock_mhz: t.clock_mhz,
-    }
-}
-
-/// Largest design (ADD + MULTI PEs) that `resources=auto` gives to Yosys: 32 + 32, the largest
-/// N of issue 12's table. Since the crossbar is a tree of 2:1 multiplexers in one module that
-/// the hierarchical synthesis maps once ([`resources`]' module doc), Yosys' time grows with the
-/// PEs and their output memories, not with the square of the PEs: measured Yosys 0.23 CPU times
-/// are in the module doc (Segway `dirdyna`: 8 + 8 PEs 27 s, 16 + 16 50 s). Larger designs get the
-/// analytic estimate and a note; `resources=yosys` runs Yosys whatever the size.
-pub const AUTO_YOSYS_MAX_PES: u32 = 64;
 
 impl CodegenFpga {
     /// True when `resources=auto` leaves a design of `n_pes` PEs (ADD + MULTI) to the analytic
@@ -375,30 +219,24 @@ impl CodegenFpga {
     /// The design, report and files of one placed function.
     ///
     /// # Errors
-    /// A diagnostic naming the function: no placement, or what [`lower::lower`] refuses, or a
-    /// Yosys failure (with `resources=yosys`: Yosys missing).
+    /// A diagnostic naming the function: no placement, or what [`robovec_fpga::emit::emit`]
+    /// refuses (what [`robovec_fpga::design::build::from_placement`] refuses, or a Yosys failure;
+    /// with `resources=yosys`: Yosys missing).
     pub fn build(
         &self,
         f: &robovec_ir::Function,
-        limits: &lower::Limits,
-        model: &resources::CostModel,
+        limits: &Limits,
+        model: &CostModel,
     ) -> Result<(Design, FpgaReport, Vec<DesignFile>), String> {
         let Some(p) = &f.placement else {
             return Err(format!("function @{} has no placement; run `place` before `codegen<fpga>`", f.name));
         };
-        let d = lower::lower(f, p, limits)
-            .map_err(|e| format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target))?;
-        let cells = match self.resources {
-            "estimate" => None,
-            "yosys" => Some(resources::yosys_cells(&d)?.ok_or(
-                "`resources=yosys` but `yosys` cannot be run (Debian package `yosys`); use resources=estimate",
-            )?),
-            _ if self.auto_skips_yosys(d.n_add + d.n_mul) => None,
-            _ => resources::yosys_cells(&d)?,
+        let logic = match self.resources {
+            "estimate" => Logic::Estimate,
+            "yosys" => Logic::Yosys,
+            _ => Logic::Auto,
         };
-        let r = resources::estimate(&d, model, cells);
-        let man = manifest(&d, &model.target, model.clock_mhz, self.format);
-        let files = design_files(&d, self.format, &r, &man);
+        let (d, r, files) = emit(f, p, limits, model, logic, self.format)?;
         let report = FpgaReport {
             out: self.out.display().to_string(),
             format: self.format,
@@ -420,7 +258,7 @@ impl Pass for CodegenFpga {
 
     fn run(&self, m: &mut robovec_ir::Module, cx: &mut PassContext) -> Result<(), PassError> {
         crate::require_phase("codegen", m, robovec_ir::Phase::Atomised)?;
-        let (limits, model) = (lower::Limits::of(&cx.target), cost_model(&cx.target));
+        let (limits, model) = (Limits::of(&cx.target), cost_model(&cx.target));
         let mut functions = Vec::new();
         for f in &m.functions {
             let (_, report, files) = self.build(f, &limits, &model).map_err(failed)?;

@@ -10,9 +10,18 @@ use robovec_ir::placement::Placement;
 use robovec_ir::syntax::{BinOp, Def, Operand};
 use robovec_ir::{Function, Value};
 
-use super::error::{MachineError as SimError, MachineErrorKind as K, When};
 use super::plan::{Plan, Run};
-use super::Occupancy;
+use crate::error::{MachineError as SimError, MachineErrorKind as K, When};
+
+/// Peak occupancy the lowering measured: the largest number of words each memory holds at
+/// once, by [`robovec_ir::placement::Pe::slot`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Occupancy {
+    /// Peak words per PE memory.
+    pub max_words_per_memory: Vec<u32>,
+    /// Peak words per buffer.
+    pub max_buffer_words: Vec<u32>,
+}
 
 /// Largest program the lowering builds, steps (PEs × cycles): bounds its memory (a step is
 /// about 90 bytes) on absurd placements.

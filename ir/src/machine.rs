@@ -2,18 +2,20 @@
 //! executes cycle by cycle (seed ch. 1 §1.1–§1.3, §2.3; SPEC §5) — per PE the instruction
 //! stream, per buffer its store/read instructions, per PE memory the crossbar selection, the
 //! output capture, the initial contents of every memory and the output map. `sim` executes it,
-//! `codegen<fpga>` encodes it ([`encode`]), the verifier checks it
-//! ([`crate::verifier::machine`]).
+//! `codegen<fpga>` encodes it (`robovec_fpga::encode`), the verifier checks it
+//! ([`crate::verifier::machine`]). The types live here, next to [`crate::placement`], so that
+//! the verifier can see them; the lowering, the executor and the encoding are the machine's,
+//! in the `robovec-fpga` crate.
 //!
 //! # Why a placement and a machine program
-//! [`crate::placement::Placement`] (with [`Arch`]) is the *decision* a placer makes, at the
+//! [`crate::placement::Placement`] (with [`PeArray`], the PE array it is made for) is the *decision* a placer makes, at the
 //! level of values: which PE issues each op when, which value goes to which address of which
 //! memory. It is part of the textual IR (`placement { … }` in `.rvir`), small, and checkable
 //! without time order (the placed verifier check). The machine program is *derived* from it
 //! and holds no value: per PE slot and per cycle the addresses read and written, the crossbar
 //! selects, the buffer and output-capture instructions — exactly the words of the FPGA images.
 //! It is never printed in `.rvir` (it is recomputed from the placement by
-//! `robovec_passes::machine::lower`), so the split is: `placement.rs` = what the user or the
+//! `robovec_fpga::lower::lower`), so the split is: `placement.rs` = what the user or the
 //! placer decides and the text format carries; `machine` = the one lowering every consumer
 //! executes or encodes.
 //!
@@ -36,8 +38,8 @@
 //! # Ops the hardware has
 //! The FPGA has an add/sub unit on ADD PEs and a multiplier on MULTI PEs only. The machine
 //! program also carries `div` and `call` (on ADD PEs, as the machine model allows) so that
-//! `sim` can execute every placement; [`encode`] rejects them with
-//! [`encode::EncodeError::NoUnit`] (so `codegen<fpga>` reports them), and so it rejects a step
+//! `sim` can execute every placement; the image encoding (`robovec_fpga::encode`) rejects them
+//! with `EncodeError::NoUnit` (so `codegen<fpga>` reports them), and so it rejects a step
 //! with more than two writes or an address wider than the layout's fields.
 //!
 //! # Binary32 data words
@@ -46,11 +48,9 @@
 //! variables are `sin`/`cos` computed in binary32 on the rounded input, as `interp` does in
 //! `f32` ([`Word::binary32`]).
 //!
-//! The image encoding is documented bit by bit in [`encode`].
+//! The image encoding is documented bit by bit in `robovec_fpga::encode`.
 
-pub mod encode;
-
-use crate::placement::{Arch, Pe};
+use crate::placement::{Pe, PeArray};
 use crate::syntax::{Callee, Operand, TrigFn};
 use crate::Value;
 
@@ -199,7 +199,7 @@ pub struct OutputLoc {
 #[derive(Clone, Debug, PartialEq)]
 pub struct MachineProgram {
     /// PE counts, latencies (cycles), write ports, buffers.
-    pub arch: Arch,
+    pub arch: PeArray,
     /// Largest arrival cycle (0 without ops); steps cover `0..=cycles`.
     pub cycles: u32,
     /// Words of each PE memory (addresses `0..pe_words`), by slot.

@@ -1,7 +1,12 @@
-//! The target description: one record of the machine every pass places for, sizes against and
+//! The target description: one record of the device every pass places for, sizes against and
 //! converts cycles with (issue 12). Selected once on the command line (`-target=de10-nano` or
 //! `-target=FILE.json`) and carried by the pass context; a pass parameter (`lat-add=…`) only
 //! overrides it where given.
+//!
+//! Two records describe the machine, with distinct roles: [`Target`] is the *device* (latencies,
+//! write ports, memory sizes, capacities, per-unit costs, clock); the *PE array* a placement is
+//! made for ([`robovec_ir::placement::PeArray`]: PE counts, latencies, write ports, buffers) is
+//! what the IR carries, built from the device by [`Target::pe_array`].
 //!
 //! # The built-in `de10-nano` (seed ch. 1, SPEC §1 and §5)
 //! | field | value | source |
@@ -22,7 +27,7 @@
 //! | `pe_memory_alm` | 3 ALM per PE memory | seed Table 1.4, row "PE Memory" |
 //! | `crossbar_alm` | 8.125 ALM per (PE-memory write port × crossbar source) | seed Table 1.4, row "Interconnections": 2080 ALM for 8 PE memories × 2 write ports (one multiplexer each, 16 in all, §1.3.1) × 16 sources (8 results + 8 buffer reads) |
 //! | `control_alm` | 469 ALM | seed Table 1.4: the total (4413) minus the rows (4·360 + 4·100 + 8·3 + 2080 = 3944): cycle counter, start/done and glue the table does not itemise |
-//! | `output_word_alm` | 16 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are 32-bit registers read asynchronously, 32 registers at two per ALM = 16 ALM a word, which is also the slope Yosys measures per PE (`passes/src/codegen/fpga/resources.rs`). Used only where the output words are known (the FPGA back end's estimate); optional in a JSON target (default 0: not counted) |
+//! | `output_word_alm` | 16 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are 32-bit registers read asynchronously, 32 registers at two per ALM = 16 ALM a word, which is also the slope Yosys measures per PE ([`crate::resources`]). Used only where the output words are known (the FPGA back end's estimate); optional in a JSON target (default 0: not counted) |
 //!
 //! ## The clock
 //! Seed §1.3: the M10K is limited to 240 MHz on the DE10-Nano and the PE memory runs at twice the
@@ -71,7 +76,8 @@
 //!   + crossbar_alm·n_pe·writes·(2·n_pe) + control_alm` (the crossbar: one multiplexer per
 //!   PE-memory write port over the `2·n_pe` sources, each result and each buffer read);
 //! - DSP = `n_add·fp_add.dsp + n_mul·fp_mul.dsp`;
-//! - M10K = per PE, `fp_*.m10k` plus each of its memories as ⌈bits / m10k_bits⌉ (at least 1):
+//! - M10K = per PE, `fp_*.m10k` plus each of its memories as ⌈bits / m10k_bits⌉ (at least 1;
+//!   [`M10kFit::Bits`], see "M10K blocks" below):
 //!   PE memory `pe_words × 32`, buffer memory `buffer_words × 32`, instruction memory
 //!   `(cycles + 1) × instr_width`, buffer instructions `(cycles + 1) × (2·bw + 2)`, crossbar
 //!   memory `(cycles + 1) × writes·sw`, with `bw = ⌈log2 buffer_words⌉` and
@@ -83,9 +89,32 @@
 //! the bit count puts a 988 × 52-bit instruction memory in 6 blocks where the seed reports 3–4,
 //! and the crossbar memories in 8 where it reports 20. The FPGA back end replaces this estimate
 //! by Yosys' figures for one N; `sweep` uses it to say which N fit.
+//!
+//! # M10K blocks ([`m10k_blocks`])
+//! One function counts the M10K blocks of a memory for both estimates, with the model as a
+//! parameter ([`M10kFit`]), because the two estimates count differently and their figures are
+//! kept:
+//! - [`M10kFit::Bits`] (this module's analytic estimate, [`Target::estimate`], so `place`'s
+//!   report and `sweep`): ⌈words·width / m10k_bits⌉, at least 1 — the bit count, a lower bound
+//!   that follows the target's `m10k_bits`;
+//! - [`M10kFit::Configurations`] (the FPGA back end's estimate of a generated design,
+//!   [`crate::resources::memory_costs`], so `resources.json`): the fewest blocks over the
+//!   Cyclone V M10K configurations (Cyclone V device handbook, "Embedded Memory Blocks": 8K×1,
+//!   4K×2, 2K×5, 1K×10, 512×20, 256×40), 0 for an empty memory; a true dual-port memory (the PE
+//!   memory) cannot use ×40. The configurations are the Cyclone V's whatever the target's
+//!   `m10k_bits`.
+//!
+//! A block of a configuration holds at most 10 240 bits, so on the DE10-Nano the
+//! configurations never give fewer blocks than the bit count; they give more where no
+//! configuration packs the memory: shallow and wide (100 × 52: 1 by bits, 2 by
+//! configurations, as 256×40 needs two blocks side by side), or widths that fill a
+//! configuration badly (1500 × 6: 1 by bits, 2 by configurations). They agree on the seed's
+//! memories, 2048 × 32 (7, true dual-port), 16 × 32 (1) and 988 × 52 (6), and on every memory
+//! 5, 10, 20 or 40 bits wide (2K×5, 1K×10, 512×20 and 256×40 hold exactly 10 240 bits; ×40 not
+//! true dual-port).
 
-use crate::analysis::Latencies;
-use crate::placement::Arch;
+use robovec_ir::analysis::Latencies;
+use robovec_ir::placement::PeArray;
 
 /// What one floating-point unit (with its PE wrapper) costs, per PE (seed Table 1.4).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -221,6 +250,50 @@ struct TargetFile {
     control_alm: f64,
     #[serde(default)]
     output_word_alm: f64,
+}
+
+/// How a memory is mapped onto M10K blocks (module doc, "M10K blocks").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum M10kFit {
+    /// The bit count: ⌈words·width / block_bits⌉, at least 1 (the analytic estimate,
+    /// [`Target::estimate`], with the target's `m10k_bits`).
+    Bits {
+        /// Bits of one block (the target's `m10k_bits`; 10 240 on the DE10-Nano).
+        block_bits: u32,
+    },
+    /// The fewest blocks over the Cyclone V M10K configurations (8K×1, 4K×2, 2K×5, 1K×10,
+    /// 512×20, 256×40): ⌈words/d⌉·⌈width/w⌉ minimised over the configurations `d × w`, 0 for a
+    /// memory without words or width (the FPGA back end's estimate,
+    /// [`crate::resources::memory_costs`]).
+    Configurations {
+        /// Excludes the ×40 configuration (simple dual-port and ROM only): the PE memory's two
+        /// read and two write ports per cycle use both ports of the block at twice the clock
+        /// (seed §1.3), which gives the seed's 7 M10K for a 2048 × 32 PE memory.
+        true_dual_port: bool,
+    },
+}
+
+/// M10K blocks of a memory of `words` words of `width` bits, under `fit` (the one M10K model
+/// of both estimates; module doc, "M10K blocks").
+pub fn m10k_blocks(words: u64, width: u32, fit: M10kFit) -> u64 {
+    match fit {
+        M10kFit::Bits { block_bits } => {
+            let bits = words * u64::from(width);
+            bits.div_ceil(u64::from(block_bits)).max(1)
+        }
+        M10kFit::Configurations { true_dual_port } => {
+            if words == 0 || width == 0 {
+                return 0;
+            }
+            let configs: &[(u64, u64)] = &[(8192, 1), (4096, 2), (2048, 5), (1024, 10), (512, 20), (256, 40)];
+            configs
+                .iter()
+                .filter(|&&(_, w)| !(true_dual_port && w == 40))
+                .map(|&(d, w)| words.div_ceil(d) * u64::from(width).div_ceil(w))
+                .min()
+                .unwrap_or(0)
+        }
+    }
 }
 
 /// ⌈log2 n⌉ for n ≥ 1 (0 for n ≤ 1): the address bits of an n-word memory.
@@ -379,10 +452,11 @@ impl Target {
         Ok(())
     }
 
-    /// The architecture of `n_add` ADD and `n_mul` MULTI PEs on this target (its latencies and
-    /// write ports).
-    pub fn arch(&self, n_add: u32, n_mul: u32, buffer: bool) -> Arch {
-        Arch { n_add, n_mul, lat: self.latencies, writes: self.writes, buffer }
+    /// The PE array of `n_add` ADD and `n_mul` MULTI PEs on this target (its latencies and
+    /// write ports; with buffer memories when `buffer`): what a placement for this device is
+    /// made for.
+    pub fn pe_array(&self, n_add: u32, n_mul: u32, buffer: bool) -> PeArray {
+        PeArray { n_add, n_mul, lat: self.latencies, writes: self.writes, buffer }
     }
 
     /// Microseconds that `cycles` cycles take at [`Target::clock_mhz`] (`cycles / clock_mhz`).
@@ -400,13 +474,6 @@ impl Target {
         address_bits(self.buffer_words)
     }
 
-    /// M10K blocks of a memory of `words × width` bits: ⌈bits / m10k_bits⌉, at least 1.
-    pub fn m10k_blocks(&self, words: u64, width: u32) -> u32 {
-        let bits = words * u64::from(width);
-        let b = bits.div_ceil(u64::from(self.m10k_bits)).max(1);
-        u32::try_from(b).unwrap_or(u32::MAX)
-    }
-
     /// The analytic resource estimate of `n_add` ADD and `n_mul` MULTI PEs running `cycles`
     /// cycles (module doc: the model and its figures against seed Table 1.4).
     pub fn estimate(&self, n_add: u32, n_mul: u32, cycles: u32) -> Resources {
@@ -421,11 +488,14 @@ impl Target {
         let depth = u64::from(cycles) + 1;
         let bw = self.buffer_address_bits();
         let sw = address_bits(u32::try_from(sources + 1).unwrap_or(u32::MAX));
-        let per_pe = u64::from(self.m10k_blocks(u64::from(self.pe_words), 32))
-            + u64::from(self.m10k_blocks(u64::from(self.buffer_words), 32))
-            + u64::from(self.m10k_blocks(depth, self.instr_width))
-            + u64::from(self.m10k_blocks(depth, 2 * bw + 2))
-            + u64::from(self.m10k_blocks(depth, self.writes * sw));
+        // Each memory's count saturates at u32::MAX before the sum (as the figures are u32).
+        let fit = M10kFit::Bits { block_bits: self.m10k_bits };
+        let blocks = |words: u64, width: u32| m10k_blocks(words, width, fit).min(u64::from(u32::MAX));
+        let per_pe = blocks(u64::from(self.pe_words), 32)
+            + blocks(u64::from(self.buffer_words), 32)
+            + blocks(depth, self.instr_width)
+            + blocks(depth, 2 * bw + 2)
+            + blocks(depth, self.writes * sw);
         let m10k = n_pe * per_pe
             + u64::from(n_add) * u64::from(self.fp_add.m10k)
             + u64::from(n_mul) * u64::from(self.fp_mul.m10k);
@@ -540,6 +610,30 @@ mod tests {
         assert_eq!(address_bits(17), 5);
         assert_eq!(address_bits(1), 0);
         assert_eq!(Target::de10_nano().pe_address_bits(), 11);
+    }
+
+    #[test]
+    fn m10k_fits_agree_on_the_seed_memories_and_differ_where_no_configuration_packs() {
+        let bits = M10kFit::Bits { block_bits: 10_240 };
+        let rom = M10kFit::Configurations { true_dual_port: false };
+        let tdp = M10kFit::Configurations { true_dual_port: true };
+        // seed §1.3.1: a 2048 × 32 PE memory takes 7 M10K (2K×5, ⌈32/5⌉ = 7; bits 65536 → 7)
+        assert_eq!((m10k_blocks(2048, 32, bits), m10k_blocks(2048, 32, tdp)), (7, 7));
+        // a ROM of 988 × 52: 1K×10 → 6 blocks; 256×40 → 4·2 = 8; 512×20 → 2·3 = 6; bits 51376 → 6
+        assert_eq!((m10k_blocks(988, 52, bits), m10k_blocks(988, 52, rom)), (6, 6));
+        // 16 × 32 buffer: one block (256×40)
+        assert_eq!((m10k_blocks(16, 32, bits), m10k_blocks(16, 32, rom)), (1, 1));
+        // shallow and wide, and a width no configuration fills: the bit count is lower
+        assert_eq!((m10k_blocks(100, 52, bits), m10k_blocks(100, 52, rom)), (1, 2));
+        assert_eq!((m10k_blocks(1500, 6, bits), m10k_blocks(1500, 6, rom)), (1, 2));
+        // an empty memory: at least 1 by bits, none by configurations
+        assert_eq!((m10k_blocks(0, 32, bits), m10k_blocks(0, 32, rom)), (1, 0));
+        // the configurations never give fewer blocks than the bit count
+        for words in (1..3000).step_by(7) {
+            for width in 1..=64 {
+                assert!(m10k_blocks(words, width, rom) >= m10k_blocks(words, width, bits), "{words} × {width}");
+            }
+        }
     }
 
     #[test]

@@ -1,18 +1,17 @@
 //! From a placed function to the [`Design`]'s images: the machine program
-//! (`crate::machine::lower`, the one lowering `sim` executes) encoded with
-//! `robovec_ir::machine::encode` (the layout of its module doc, LSB first), checked against the
-//! target's memories first so that every problem is reported with the figures needed and
-//! available.
+//! ([`crate::lower::lower`], the one lowering `sim` executes) encoded with [`crate::encode`]
+//! (the layout of its module doc, LSB first), checked against the target's memories first so
+//! that every problem is reported with the figures needed and available.
 
-use robovec_ir::machine::encode::{self, Layout};
 use robovec_ir::machine::{MachineOp, MachineProgram, Word};
-use robovec_ir::placement::Placement;
+use robovec_ir::placement::{PeArray, Placement};
 use robovec_ir::syntax::TrigFn;
-use robovec_ir::target::Target;
 use robovec_ir::Function;
 
-use super::design::{addr_bits, Design, LoadWord, OutputWord, PeImages, Source, Widths};
 use super::images::Image;
+use super::{addr_bits, Design, LoadWord, OutputWord, PeImages, Source, Widths};
+use crate::encode::{self, Layout};
+use crate::target::Target;
 
 /// The target's limits the design must fit (from [`Target`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -151,20 +150,20 @@ pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
 /// A diagnostic (one line per problem) with the figures needed and available: an op the PEs do
 /// not have (`div`, `call`), `writes` ≠ 2, a latency below 2, a memory beyond the target, or a
 /// placement the machine model rejects.
-pub fn lower(f: &Function, p: &Placement, limits: &Limits) -> Result<Design, String> {
-    let m = crate::machine::lower(f, p).map_err(|e| format!("the placement cannot be lowered: {e}"))?;
+pub fn from_placement(f: &Function, p: &Placement, limits: &Limits) -> Result<Design, String> {
+    let m = crate::lower::lower(f, p).map_err(|e| format!("the placement cannot be lowered: {e}"))?;
     let found = problems(&m, limits);
     if !found.is_empty() {
         return Err(found.join("\n"));
     }
-    design(f, &m, limits)
+    from_program(f, &m, limits)
 }
 
 /// The design of machine program `m` of `f`.
 ///
 /// # Errors
 /// What [`encode::encode`] rejects.
-pub fn design(f: &Function, m: &MachineProgram, limits: &Limits) -> Result<Design, String> {
+pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result<Design, String> {
     let layout = Layout::new(m, limits.pe_words, limits.buffer_words, limits.instr_width).map_err(|e| e.to_string())?;
     let im = encode::encode(m, &layout).map_err(|e| e.to_string())?;
     let widths = Widths {
@@ -229,7 +228,7 @@ pub fn design(f: &Function, m: &MachineProgram, limits: &Limits) -> Result<Desig
 }
 
 /// `add0`, `mul1` for slot `s`.
-pub fn pe_name(arch: &robovec_ir::placement::Arch, s: usize) -> String {
+pub fn pe_name(arch: &PeArray, s: usize) -> String {
     if s < arch.n_add as usize {
         format!("add{s}")
     } else {

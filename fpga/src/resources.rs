@@ -10,7 +10,7 @@
 //!   holds two registers; a Yosys MLAB cell (32 × 1 bit) is half an ALM of a 640-bit MLAB, so
 //!   `alm = max(LUT6 + ⌈(LUT2…LUT5 + ARITH)/2⌉, ⌈FF/2⌉) + ⌈MLAB/2⌉`. Yosys' DSP cells
 //!   (`MISTRAL_MUL*`) count as DSP blocks. Without `yosys` (or with `resources=estimate`) the
-//!   logic is the target's analytic model (`robovec_ir::target`, seed Table 1.4):
+//!   logic is the target's analytic model ([`crate::target`], seed Table 1.4):
 //!   `crossbar_alm · n_pe · writes · 2n_pe + pe_memory_alm · n_pe + control_alm +
 //!   output_word_alm · output words`, the last term the output memories (32-bit registers:
 //!   16 ALM a word on the DE10-Nano, the slope Yosys measures per PE: 16.0 ALM per word over
@@ -18,7 +18,8 @@
 //! - **FP units**: the target's per-unit costs (seed §1.3.1 / Table 1.4: ADD PE 360 ALM, 2 DSP;
 //!   MULTI PE 100 ALM, 3 DSP) times the PEs of each type.
 //! - **Memories**: every PE memory, instruction, crossbar, buffer-instruction and capture memory
-//!   as M10K blocks from its size ([`super::images::m10k_blocks`]; PE memories true dual-port).
+//!   as M10K blocks from its size ([`crate::target::m10k_blocks`] by the block configurations,
+//!   [`M10kFit::Configurations`]; PE memories true dual-port).
 //!
 //! ## Hierarchical synthesis
 //! Where the time went: the crossbar was written `sources[32*(sel-1) +: 32]`, a variable
@@ -50,7 +51,7 @@
 //! output memories of about 160 words per PE, 114 s. The time now grows with the PEs and their
 //! output memories (the crossbar port is mapped once), not with the square of the PEs; 32 + 32
 //! passed 100 s of CPU (the README has the measured table). So `resources=auto` runs Yosys up
-//! to 32 + 32 PEs (`super::AUTO_YOSYS_MAX_PES`), the largest N of issue 12's table.
+//! to 32 + 32 PEs ([`AUTO_YOSYS_MAX_PES`]), the largest N of issue 12's table.
 //!
 //! ## Against the seed's Table 1.4 (8 PE: 4 ADD + 4 MULTI)
 //! The seed totals 4413 ALM, 120 M10K, 20 DSP for its 23-dof railway bogie (987 cycles). The
@@ -83,8 +84,8 @@ use std::process::Command;
 
 use serde::Serialize;
 
-use super::design::{Design, HDL_LIBRARY, SYNTH_STUBS};
-use super::images::m10k_blocks;
+use crate::design::{Design, HDL_LIBRARY, SYNTH_STUBS};
+use crate::target::{m10k_blocks, M10kFit, Target};
 
 /// Cost of one unit in device resources.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -97,7 +98,7 @@ pub struct UnitCost {
     pub m10k: u64,
 }
 
-/// What the estimate needs from the target (see `robovec_ir::target`).
+/// What the estimate needs from the target (see [`crate::target`]; built by [`cost_model`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CostModel {
     /// Target name.
@@ -202,11 +203,53 @@ pub fn memory_costs(d: &Design) -> Vec<MemoryCost> {
                 name: img.name.clone(),
                 words,
                 width: img.width,
-                m10k: m10k_blocks(words, img.width, tdp),
+                m10k: m10k_blocks(words, img.width, M10kFit::Configurations { true_dual_port: tdp }),
             });
         }
     }
     v
+}
+
+/// The cost model of target `t` (its capacities, per-unit costs and clock; the analytic logic
+/// per PE from its crossbar, PE memory and control costs, used without Yosys).
+pub fn cost_model(t: &Target) -> CostModel {
+    let unit = |u: &crate::target::UnitCost| UnitCost {
+        alm: u.alm.ceil() as u64,
+        dsp: u64::from(u.dsp),
+        m10k: u64::from(u.m10k),
+    };
+    CostModel {
+        target: t.name.clone(),
+        capacity: UnitCost { alm: u64::from(t.alm), m10k: u64::from(t.m10k), dsp: u64::from(t.dsp) },
+        fp_add: unit(&t.fp_add),
+        fp_mul: unit(&t.fp_mul),
+        crossbar_alm: t.crossbar_alm,
+        pe_memory_alm: t.pe_memory_alm,
+        control_alm: t.control_alm,
+        output_word_alm: t.output_word_alm,
+        writes: t.writes,
+        clock_mhz: t.clock_mhz,
+    }
+}
+
+/// Largest design (ADD + MULTI PEs) that `resources=auto` ([`Logic::Auto`]) gives to Yosys:
+/// 32 + 32, the largest N of issue 12's table. Since the crossbar is a tree of 2:1 multiplexers
+/// in one module that the hierarchical synthesis maps once (module doc), Yosys' time grows with
+/// the PEs and their output memories, not with the square of the PEs: measured Yosys 0.23 CPU
+/// times are in the module doc (Segway `dirdyna`: 8 + 8 PEs 27 s, 16 + 16 50 s). Larger designs
+/// get the analytic estimate and a note; `resources=yosys` runs Yosys whatever the size.
+pub const AUTO_YOSYS_MAX_PES: u32 = 64;
+
+/// Where the logic ALMs come from (`codegen<fpga;resources=auto|yosys|estimate>`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Logic {
+    /// Yosys when it can be run and the design has at most [`AUTO_YOSYS_MAX_PES`] PEs, else the
+    /// analytic estimate.
+    Auto,
+    /// Yosys at any size; an error when it cannot be run.
+    Yosys,
+    /// The analytic estimate (deterministic and fast).
+    Estimate,
 }
 
 /// How Yosys maps the design (see the module doc).

@@ -1,5 +1,5 @@
-//! Execution of a [`MachineProgram`] on numbers of precision `T`, cycle by cycle in the order
-//! of [`robovec_ir::machine`]'s timing contract: arrivals (buffer stores, output capture),
+//! Execution of a [`MachineProgram`] on numbers of precision `T` (what `sim` runs), cycle by
+//! cycle in the order of [`robovec_ir::machine`]'s timing contract: arrivals (buffer stores, output capture),
 //! buffer reads, PE-memory writes, issues. The executor knows nothing of values: it reads
 //! addresses, routes the crossbar and computes with the PE's unit — what the hardware does.
 
@@ -9,7 +9,7 @@ use robovec_ir::interp::{eval_binop, eval_call, Float};
 use robovec_ir::machine::{MachineOp, MachineProgram, Source, Word};
 use robovec_ir::syntax::{BinOp, TrigFn};
 
-use super::error::{MachineError, MachineErrorKind as K, When};
+use crate::error::{MachineError, MachineErrorKind as K, When};
 
 /// What one execution computed.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,7 +27,7 @@ pub struct Executed<T> {
 /// # Errors
 /// [`K::Unverified`] when the program is inconsistent (a word read before it was written, a
 /// crossbar source carrying nothing, an address beyond its memory, a result after the last
-/// cycle) — never for a program [`super::lower`] returned.
+/// cycle) — never for a program [`crate::lower::lower`] returned.
 pub fn execute<T: Float>(p: &MachineProgram, mut input: impl FnMut(&str) -> f64) -> Result<Executed<T>, MachineError> {
     let n_pe = p.n_pe();
     let span = p.cycles as usize + 1;

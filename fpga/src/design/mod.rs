@@ -1,14 +1,19 @@
 //! The design of one placed function: its configuration (PEs, latencies, word widths) and its
 //! memory images, from which the Verilog top, the testbench, the manifest and the image files
-//! are written.
+//! are written ([`crate::emit`]). [`build`] makes it from a placement (the machine program,
+//! encoded); [`images`] writes and reads the memory images; the fixed Verilog (`hdl/`) and the
+//! `simulate` script are [`HDL_LIBRARY`], [`SYNTH_STUBS`] and [`SIMULATE`].
+
+pub mod build;
+pub mod images;
 
 use std::fmt::Write;
 
 use serde::Serialize;
 
-use super::images::Image;
+use images::Image;
 
-/// Bit widths of the design's words (the encoding of the `machine` module doc, LSB first).
+/// Bit widths of the design's words (the encoding of [`crate::encode`], LSB first).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct Widths {
     /// PE memory address bits (`aw`, ⌈log2 pe_words⌉ of the target: 11 on the DE10-Nano).
@@ -174,6 +179,9 @@ pub const HDL_LIBRARY: &[(&str, &str)] = &[
 
 /// Black-box stubs of the FP units and memories for the Yosys resource estimate.
 pub const SYNTH_STUBS: &str = include_str!("hdl/synth_stubs.v");
+
+/// The `simulate` script written into `DIR` (Python 3 standard library + Icarus Verilog).
+pub const SIMULATE: &str = include_str!("simulate.py");
 
 impl Design {
     /// PEs of both types.

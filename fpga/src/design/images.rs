@@ -186,25 +186,6 @@ fn parse_word(tok: &str, width: u32) -> Result<u64, String> {
     Ok(w)
 }
 
-/// M10K blocks (10240 bits; Cyclone V device handbook, "Embedded Memory Blocks": 8K×1, 4K×2,
-/// 2K×5, 1K×10, 512×20, 256×40) for a memory of `depth` words of `width` bits: the fewest over
-/// the block configurations of ⌈depth/d⌉·⌈width/w⌉. `true_dual_port` excludes the ×40
-/// configuration (simple dual-port/ROM only): the PE memory's two read and two write ports per
-/// cycle use both ports of the block at twice the clock (seed §1.3), which gives the seed's
-/// 7 M10K for a 2048 × 32 PE memory.
-pub fn m10k_blocks(depth: u64, width: u32, true_dual_port: bool) -> u64 {
-    if depth == 0 || width == 0 {
-        return 0;
-    }
-    let configs: &[(u64, u64)] = &[(8192, 1), (4096, 2), (2048, 5), (1024, 10), (512, 20), (256, 40)];
-    configs
-        .iter()
-        .filter(|&&(_, w)| !(true_dual_port && w == 40))
-        .map(|&(d, w)| depth.div_ceil(d) * u64::from(width).div_ceil(w))
-        .min()
-        .unwrap_or(0)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -236,16 +217,5 @@ mod tests {
             "WIDTH=8;\nDEPTH=4;\nADDRESS_RADIX=HEX;\nDATA_RADIX=HEX;\nCONTENT BEGIN\n[0..2] : 7;\n3 : a;\nEND;\n";
         assert_eq!(Image::parse_mif("t", ranged).unwrap().words, vec![7, 7, 7, 10]);
         assert!(Image::parse_mif("t", "WIDTH=8;\nDEPTH=1;\nDATA_RADIX=BIN;\n").is_err());
-    }
-
-    #[test]
-    fn m10k_counts_follow_the_block_configurations() {
-        // seed §1.3.1: a 2048 × 32 PE memory takes 7 M10K (2K×5 configuration, ⌈32/5⌉ = 7)
-        assert_eq!(m10k_blocks(2048, 32, true), 7);
-        // a ROM of 988 × 52: 1K×10 → 6 blocks; 256×40 → 4·2 = 8; 512×20 → 2·3 = 6
-        assert_eq!(m10k_blocks(988, 52, false), 6);
-        // 16 × 32 buffer: one block (256×40)
-        assert_eq!(m10k_blocks(16, 32, false), 1);
-        assert_eq!(m10k_blocks(0, 32, false), 0);
     }
 }

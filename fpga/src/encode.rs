@@ -1,4 +1,6 @@
-//! The image words of a [`MachineProgram`], bit by bit, and their decoding.
+//! The image words of a [`MachineProgram`], bit by bit, and their decoding: what the FPGA
+//! back end writes into its instruction, crossbar, buffer-instruction and capture memories
+//! ([`crate::design`]), and what [`robovec_ir::machine`]'s module doc calls the encoding.
 //!
 //! One word per PE slot per cycle `0..=cycles` in each of four images (the seed's 52-bit
 //! instruction word, §1.3.1, is the default instruction layout). Fields are unsigned, LSB
@@ -42,13 +44,13 @@
 //! captured there).
 //!
 //! ## Data words
-//! Initial PE-memory and output-memory contents are binary32 ([`super::Word::binary32`]).
+//! Initial PE-memory and output-memory contents are binary32 ([`robovec_ir::machine::Word::binary32`]).
 //!
 //! [`decode`] inverts [`encode`] exactly: `decode(encode(p)) == steps of p` for every program
 //! `encode` accepts; it rejects words with bits set outside their fields, a select beyond
 //! `2·n_pe`, a write enable without a select (or the reverse), or a sub bit on a MULTI PE.
 
-use super::{BufferOp, Instr, MachineOp, MachineProgram, MemWrite, Source, Step};
+use robovec_ir::machine::{BufferOp, Instr, MachineOp, MachineProgram, MemWrite, Source, Step};
 
 /// Field widths of the four image words, bits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

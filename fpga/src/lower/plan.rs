@@ -10,7 +10,7 @@ use robovec_ir::{Function, Value};
 
 use robovec_ir::machine::Held as Key;
 
-use super::error::{MachineError as SimError, MachineErrorKind as K, When};
+use crate::error::{MachineError as SimError, MachineErrorKind as K, When};
 
 /// Longest run the lowering accepts, cycles (guards the per-cycle steps).
 const MAX_CYCLES: u32 = 50_000_000;

@@ -1,6 +1,6 @@
-//! What the lowering (and so `sim`, which executes what it lowers) rejects: one
-//! [`MachineError`] naming when, where and which value. `sim` re-exports these types as
-//! `MachineError` and `MachineErrorKind`.
+//! What the lowering ([`crate::lower`]) and the executor ([`crate::exec`]) reject — and so
+//! `sim`, which executes what it lowers: one [`MachineError`] naming when, where and which
+//! value. `sim` re-exports these types as `SimError` and `SimErrorKind`.
 
 use robovec_ir::placement::Pe;
 use robovec_ir::Span;
@@ -104,26 +104,32 @@ pub struct MachineError {
 }
 
 impl MachineError {
-    pub(crate) fn new(kind: MachineErrorKind, message: impl Into<String>) -> MachineError {
+    /// An error of `kind` saying `message`, without time, PE, value or span (add them with
+    /// [`MachineError::at`], [`MachineError::on`], [`MachineError::of`], [`MachineError::src`]).
+    pub fn new(kind: MachineErrorKind, message: impl Into<String>) -> MachineError {
         MachineError { kind, when: None, pe: None, value: None, message: message.into(), span: Span::DUMMY }
     }
 
-    pub(crate) fn at(mut self, when: When) -> MachineError {
+    /// This error at `when`.
+    pub fn at(mut self, when: When) -> MachineError {
         self.when = Some(when);
         self
     }
 
-    pub(crate) fn on(mut self, pe: Pe) -> MachineError {
+    /// This error on PE `pe`.
+    pub fn on(mut self, pe: Pe) -> MachineError {
         self.pe = Some(pe);
         self
     }
 
-    pub(crate) fn of(mut self, value: impl Into<String>) -> MachineError {
+    /// This error about `value` (as printed: `%AF24`, a constant `2.0`, or an output name).
+    pub fn of(mut self, value: impl Into<String>) -> MachineError {
         self.value = Some(value.into());
         self
     }
 
-    pub(crate) fn src(mut self, span: Span) -> MachineError {
+    /// This error at `.rvir` span `span`.
+    pub fn src(mut self, span: Span) -> MachineError {
         self.span = span;
         self
     }

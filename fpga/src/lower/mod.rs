@@ -1,9 +1,9 @@
 //! The lowering of a placed function into its [`MachineProgram`] (issue 12, "one lowering,
-//! many consumers"), and the program's execution on numbers. `sim` is [`lower`] then
-//! [`execute`]; `codegen<fpga>` is [`lower`] then [`robovec_ir::machine::encode`].
+//! many consumers"). `sim` is [`lower`] then [`crate::exec::execute`]; `codegen<fpga>` is
+//! [`lower`] then [`crate::encode`].
 //!
-//! The program's types and image encoding live in the IR crate ([`robovec_ir::machine`]) next
-//! to [`robovec_ir::placement`], so that the verifier's lowered check
+//! The program's types live in the IR crate ([`robovec_ir::machine`]) next to
+//! [`robovec_ir::placement`], so that the verifier's lowered check
 //! ([`robovec_ir::verifier::machine`]) can see them; the lowering lives here because it is the
 //! check of every machine-model rule that needs time order (word lifetimes), with `sim`'s
 //! diagnostics ([`MachineError`], re-exported by `sim` as `SimError`).
@@ -48,13 +48,11 @@
 //!   output that is an input, a trig value or a constant is loaded into the output memory of
 //!   slot 0 (one word per distinct value). Outputs need not be written into any PE memory.
 //! - **`div` and `call`** are lowered (the machine model runs them on ADD PEs, and `sim`
-//!   executes them); the FPGA has no unit for them, so [`robovec_ir::machine::encode`] — and
+//!   executes them); the FPGA has no unit for them, so [`crate::encode`] — and
 //!   with it `codegen<fpga>` — rejects them with a typed error, as it rejects targets whose
 //!   words cannot hold the program. The lowering rejects what no machine of the model can do.
 //! - **Size.** At most [`MAX_STEPS`] steps (PEs × cycles) are built.
 
-mod error;
-mod exec;
 mod lowering;
 mod plan;
 
@@ -63,20 +61,9 @@ use robovec_ir::placement::Placement;
 use robovec_ir::verifier::machine::verify_machine;
 use robovec_ir::Function;
 
-pub use lowering::MAX_STEPS;
+pub use lowering::{Occupancy, MAX_STEPS};
 
-pub use error::{MachineError, MachineErrorKind, When};
-pub use exec::{execute, Executed};
-
-/// Peak occupancy the lowering measured: the largest number of words each memory holds at
-/// once, by [`robovec_ir::placement::Pe::slot`].
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Occupancy {
-    /// Peak words per PE memory.
-    pub max_words_per_memory: Vec<u32>,
-    /// Peak words per buffer.
-    pub max_buffer_words: Vec<u32>,
-}
+pub use crate::error::{MachineError, MachineErrorKind, When};
 
 /// Lowers placement `p` of `f` into its machine program, checking every rule of the machine
 /// model (see the module doc), then the verifier's lowered check.
@@ -105,4 +92,4 @@ pub fn lower_measured(f: &Function, p: &Placement) -> Result<(MachineProgram, Oc
 }
 
 #[cfg(test)]
-pub(crate) mod tests;
+mod tests;

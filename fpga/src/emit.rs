@@ -1,0 +1,169 @@
+//! The files of a design, as `codegen<fpga>` writes them into its folder (the pass's module
+//! doc in `robovec-passes` lists them: images, `hdl/`, `manifest.json`, `simulate`,
+//! `resources.json`), and [`emit`], the whole back end for one placed function: design, resource
+//! estimate, manifest and files.
+
+use serde::Serialize;
+
+use robovec_ir::placement::Placement;
+use robovec_ir::Function;
+
+use crate::design::build::{from_placement, Limits};
+use crate::design::images::Image;
+use crate::design::{Design, HDL_LIBRARY, SIMULATE};
+use crate::resources::{self, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
+
+/// One file of a design, its path relative to the function's folder.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DesignFile {
+    /// Path under `DIR` (`hex/pe0_instr.hex`).
+    pub path: String,
+    /// Content.
+    pub bytes: Vec<u8>,
+    /// True for `simulate`.
+    pub executable: bool,
+}
+
+/// The files of a design: `(path relative to DIR, bytes, executable)`; `format` is `mif`, `hex`
+/// or `both` (the image formats written).
+pub fn design_files(d: &Design, format: &str, r: &Resources, manifest: &str) -> Vec<DesignFile> {
+    let mut v: Vec<DesignFile> = Vec::new();
+    let mut add = |path: String, bytes: Vec<u8>, executable: bool| v.push(DesignFile { path, bytes, executable });
+    for p in &d.pes {
+        for img in p.images() {
+            if format != "mif" {
+                add(format!("hex/{}.hex", img.name), img.to_hex().into_bytes(), false);
+            }
+            if format != "hex" {
+                add(format!("mif/{}.mif", img.name), img.to_mif().into_bytes(), false);
+            }
+        }
+    }
+    for (n, t) in HDL_LIBRARY {
+        add(format!("hdl/{n}"), t.as_bytes().to_vec(), false);
+    }
+    add("hdl/robovec_top.v".into(), d.top("").into_bytes(), false);
+    add("hdl/testbench.v".into(), d.testbench().into_bytes(), false);
+    add("manifest.json".into(), manifest.as_bytes().to_vec(), false);
+    add("simulate".into(), SIMULATE.as_bytes().to_vec(), true);
+    let mut res = serde_json::to_string_pretty(r).expect("resources serialise");
+    res.push('\n');
+    add("resources.json".into(), res.into_bytes(), false);
+    v
+}
+
+/// One memory in the manifest.
+#[derive(Clone, Debug, Serialize)]
+struct ManifestMemory {
+    file: String,
+    words: usize,
+    width: u32,
+}
+
+#[derive(Clone, Debug, Serialize)]
+struct ManifestPe<'a> {
+    slot: usize,
+    pe: &'a str,
+    kind: &'static str,
+    latency: u32,
+    buffer_words: u32,
+    memories: std::collections::BTreeMap<&'static str, ManifestMemory>,
+}
+
+/// The manifest (`manifest.json`): everything a host or a script needs to load and read the
+/// design. `target` is the target's name, `clock_mhz` its clock.
+pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> String {
+    let pes: Vec<ManifestPe> = d
+        .pes
+        .iter()
+        .map(|p| {
+            let m = |i: &Image| ManifestMemory { file: i.name.clone(), words: i.words.len().max(1), width: i.width };
+            let memories = [
+                ("instr", m(&p.instr)),
+                ("xbar", m(&p.xbar)),
+                ("bufi", m(&p.bufi)),
+                ("capt", m(&p.capt)),
+                ("data", m(&p.data)),
+                ("out", m(&p.out)),
+            ]
+            .into_iter()
+            .collect();
+            ManifestPe {
+                slot: p.slot,
+                pe: &p.pe,
+                kind: if p.is_mul { "mul" } else { "add" },
+                latency: if p.is_mul { d.lat_mul } else { d.lat_add },
+                buffer_words: p.buffer_words,
+                memories,
+            }
+        })
+        .collect();
+    let mut hdl: Vec<&str> = HDL_LIBRARY.iter().map(|(n, _)| *n).collect();
+    hdl.push("robovec_top.v");
+    let w = d.widths;
+    let (e, n) = (4 * w.aw, d.n_pe());
+    let layout = serde_json::json!({
+        "instr": format!("[0,{a}) read A, [{a},{b}) read B, [{b},{c}) write-0 address, [{c},{e}) write-1 address, \
+            bit {e} we0, bit {} we1, bit {} issue valid, bit {} sub (ADD PE: 1 = a - b), zero up to {}",
+            e + 1, e + 2, e + 3, w.instr, a = w.aw, b = 2 * w.aw, c = 3 * w.aw),
+        "xbar": format!("[0,{s}) port-0 select, [{s},{}) port-1 select: 0 none, 1..={n} result of slot s-1, {}..={} buffer read of slot s-{}",
+            2 * w.sw, n + 1, 2 * n, n + 1, s = w.sw),
+        "bufi": format!("[0,{b}) store address, [{b},{}) read address, bit {} store enable, bit {} read enable",
+            2 * w.bw, 2 * w.bw, 2 * w.bw + 1, b = w.bw),
+        "capt": format!("[0,{o}) output-memory address, bit {o} enable", o = w.ow),
+        "data": "binary32",
+    });
+    let v = serde_json::json!({
+        "format": "robovec-fpga/1",
+        "function": d.function,
+        "target": target,
+        "clock_mhz": clock_mhz,
+        "images": format,
+        "cycles": d.cycles,
+        "n_add": d.n_add,
+        "n_mul": d.n_mul,
+        "latency": {"add": d.lat_add, "mul": d.lat_mul},
+        "widths": w,
+        "layout": layout,
+        "hdl": hdl,
+        "pes": pes,
+        "inputs": d.inputs,
+        "loads": d.loads,
+        "output_loads": d.output_loads,
+        "outputs": d.outputs,
+    });
+    let mut s = serde_json::to_string_pretty(&v).expect("manifest serialises");
+    s.push('\n');
+    s
+}
+
+/// The design, resource estimate and files of function `f` placed by `p`, on a target of
+/// `limits` and `model`, the logic from `logic`, the images in `format` (`mif`, `hex` or `both`).
+///
+/// # Errors
+/// A diagnostic naming the function and the target: what [`from_placement`] refuses, or a
+/// Yosys failure (with [`Logic::Yosys`]: Yosys missing).
+pub fn emit(
+    f: &Function,
+    p: &Placement,
+    limits: &Limits,
+    model: &CostModel,
+    logic: Logic,
+    format: &str,
+) -> Result<(Design, Resources, Vec<DesignFile>), String> {
+    let d = from_placement(f, p, limits)
+        .map_err(|e| format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target))?;
+    let cells =
+        match logic {
+            Logic::Estimate => None,
+            Logic::Yosys => Some(resources::yosys_cells(&d)?.ok_or(
+                "`resources=yosys` but `yosys` cannot be run (Debian package `yosys`); use resources=estimate",
+            )?),
+            Logic::Auto if d.n_add + d.n_mul > AUTO_YOSYS_MAX_PES => None,
+            Logic::Auto => resources::yosys_cells(&d)?,
+        };
+    let r = resources::estimate(&d, model, cells);
+    let man = manifest(&d, &model.target, model.clock_mhz, format);
+    let files = design_files(&d, format, &r, &man);
+    Ok((d, r, files))
+}
