@@ -257,7 +257,7 @@ pub fn run_with(
 fn run_passes(
     opts: &Options,
     pm: &PassManager,
-    target: robovec_fpga::target::Target,
+    target: robovec_machine::target::Target,
     progress: robovec_passes::progress::Progress,
     module: &mut Module,
     src: &SourceFile,

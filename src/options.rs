@@ -60,8 +60,8 @@ pub struct Options {
 /// # Errors
 /// [`Failure::Input`] (exit 1): a file that cannot be read, is not JSON of the target format
 /// (`FILE:LINE:COLUMN: unknown field …`) or holds a senseless value (the field and why).
-pub fn target(opts: &Options) -> Result<robovec_fpga::target::Target, Failure> {
-    use robovec_fpga::target::{Target, TargetError};
+pub fn target(opts: &Options) -> Result<robovec_machine::target::Target, Failure> {
+    use robovec_machine::target::{Target, TargetError};
     let Some(spec) = &opts.target else { return Ok(Target::de10_nano()) };
     Target::resolve(spec).map_err(|e| {
         let hint = match &e {

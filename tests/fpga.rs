@@ -18,7 +18,7 @@ fn inputs_dir() -> PathBuf {
 }
 
 fn hdl(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fpga/src/design/hdl").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("machine/src/design/hdl").join(name)
 }
 
 #[test]
@@ -198,7 +198,7 @@ fn yosys_sizes_the_design_and_resources_json_has_the_figures() {
 /// doc's measured times): larger ones get the analytic estimate and a `-stats` note, at once.
 #[test]
 fn auto_resources_leave_large_designs_to_the_estimate_with_a_note() {
-    let max = robovec_fpga::resources::AUTO_YOSYS_MAX_PES;
+    let max = robovec_machine::resources::AUTO_YOSYS_MAX_PES;
     assert_eq!(max, 64);
     let d = tmp("auto_large");
     let dir = d.join("out");
@@ -245,12 +245,12 @@ fn the_analytic_estimate_counts_the_output_memory_words() {
 /// a flat synthesis of the same top (module doc: 2 + 2 and 4 + 4 PEs).
 #[test]
 fn hierarchical_yosys_agrees_with_flat_synthesis() {
-    use robovec_fpga::design::build::{from_placement, Limits};
-    use robovec_fpga::resources::{yosys_cells_with, Synthesis};
+    use robovec_machine::design::build::{from_placement, Limits};
+    use robovec_machine::resources::{yosys_cells_with, Synthesis};
     tool("yosys");
     let m = placed_pendulum(2);
     let f = &m.functions[0];
-    let t = robovec_fpga::target::Target::de10_nano();
+    let t = robovec_machine::target::Target::de10_nano();
     let limits = Limits::of(&t);
     let design = from_placement(f, f.placement.as_ref().unwrap(), &limits).unwrap();
     let h = yosys_cells_with(&design, Synthesis::Hierarchical).unwrap().unwrap();
@@ -274,16 +274,16 @@ fn placed_pendulum(n: u32) -> robovec_ir::Module {
 
 #[test]
 fn images_read_back_from_hex_and_mif_reproduce_the_machine_program_exactly() {
-    use robovec_fpga::design::build::{from_program, Limits};
-    use robovec_fpga::design::images::Image;
-    use robovec_fpga::encode::{decode, Images, Layout};
-    use robovec_fpga::target::Target;
+    use robovec_machine::design::build::{from_program, Limits};
+    use robovec_machine::design::images::Image;
+    use robovec_machine::encode::{decode, Images, Layout};
+    use robovec_machine::target::Target;
 
     let t = Target::de10_nano();
     for n in [2u32, 4] {
         let m = placed_pendulum(n);
         let f = &m.functions[0];
-        let prog = robovec_fpga::lower::lower(f, f.placement.as_ref().unwrap()).unwrap();
+        let prog = robovec_machine::lower::lower(f, f.placement.as_ref().unwrap()).unwrap();
         let d = from_program(f, &prog, &Limits::of(&t)).unwrap();
         let layout = Layout::new(&prog, t.pe_words, t.buffer_words, t.instr_width).unwrap();
         for from_mif in [false, true] {

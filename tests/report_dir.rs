@@ -255,7 +255,7 @@ fn long_loops_report_progress_through_the_hook() {
     let (m, _) = robovec::driver::load(PENDULUM).unwrap();
     let rec = Recorder::default();
     let progress = robovec_passes::progress::Progress::shown(Arc::new(rec.clone()));
-    let target = robovec_fpga::target::Target::de10_nano();
+    let target = robovec_machine::target::Target::de10_nano();
     robovec_passes::study::pareto::study(&m, "invdyna", "atomise;atomise,balance", 20, 1, None, &target, &progress)
         .unwrap();
     let log = rec.0.lock().unwrap().clone();

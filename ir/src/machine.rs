@@ -2,10 +2,10 @@
 //! executes cycle by cycle (seed ch. 1 §1.1–§1.3, §2.3; SPEC §5) — per PE the instruction
 //! stream, per buffer its store/read instructions, per PE memory the crossbar selection, the
 //! output capture, the initial contents of every memory and the output map. `sim` executes it,
-//! `codegen<fpga>` encodes it (`robovec_fpga::encode`), the verifier checks it
+//! `codegen<fpga>` encodes it (`robovec_machine::encode`), the verifier checks it
 //! ([`crate::verifier::machine`]). The types live here, next to [`crate::placement`], so that
 //! the verifier can see them; the lowering, the executor and the encoding are the machine's,
-//! in the `robovec-fpga` crate.
+//! in the `robovec-machine` crate.
 //!
 //! # Why a placement and a machine program
 //! [`crate::placement::Placement`] (with [`PeArray`], the PE array it is made for) is the *decision* a placer makes, at the
@@ -15,7 +15,7 @@
 //! and holds no value: per PE slot and per cycle the addresses read and written, the crossbar
 //! selects, the buffer and output-capture instructions — exactly the words of the FPGA images.
 //! It is never printed in `.rvir` (it is recomputed from the placement by
-//! `robovec_fpga::lower::lower`), so the split is: `placement.rs` = what the user or the
+//! `robovec_machine::lower::lower`), so the split is: `placement.rs` = what the user or the
 //! placer decides and the text format carries; `machine` = the one lowering every consumer
 //! executes or encodes.
 //!
@@ -38,7 +38,7 @@
 //! # Ops the hardware has
 //! The FPGA has an add/sub unit on ADD PEs and a multiplier on MULTI PEs only. The machine
 //! program also carries `div` and `call` (on ADD PEs, as the machine model allows) so that
-//! `sim` can execute every placement; the image encoding (`robovec_fpga::encode`) rejects them
+//! `sim` can execute every placement; the image encoding (`robovec_machine::encode`) rejects them
 //! with `EncodeError::NoUnit` (so `codegen<fpga>` reports them), and so it rejects a step
 //! with more than two writes or an address wider than the layout's fields.
 //!
@@ -48,7 +48,7 @@
 //! variables are `sin`/`cos` computed in binary32 on the rounded input, as `interp` does in
 //! `f32` ([`Word::binary32`]).
 //!
-//! The image encoding is documented bit by bit in `robovec_fpga::encode`.
+//! The image encoding is documented bit by bit in `robovec_machine::encode`.
 
 use crate::placement::{Pe, PeArray};
 use crate::syntax::{Callee, Operand, TrigFn};

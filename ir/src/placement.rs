@@ -25,7 +25,7 @@
 //!
 //! The verifier checks every rule above except word lifetimes (address reuse) whenever a
 //! placement is read or left by a pass ([`crate::verifier::placement`]); the lowering into the
-//! machine program (`robovec_fpga::lower::lower`, which `sim` executes and `codegen<fpga>`
+//! machine program (`robovec_machine::lower::lower`, which `sim` executes and `codegen<fpga>`
 //! encodes) checks them all.
 //!
 //! A placement is the placer's decision at the level of values, carried by the `.rvir` text;
@@ -90,7 +90,7 @@ impl std::fmt::Display for Pe {
 /// lowering and `sim` read of the machine (the `placement n_add=… n_mul=…` header of `.rvir`).
 ///
 /// It is one view of the machine, not the device: the device (capacities, per-unit costs,
-/// memory sizes, clock) is `robovec_fpga::target::Target`, and `Target::pe_array(n_add, n_mul,
+/// memory sizes, clock) is `robovec_machine::target::Target`, and `Target::pe_array(n_add, n_mul,
 /// buffer)` builds the array of that device's latencies and write ports. A pass parameter
 /// (`place<lat-add=…>`) may override a field.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

@@ -29,7 +29,7 @@ pub mod study;
 pub mod sweep;
 pub mod tree_height;
 
-use robovec_fpga::target::Target;
+use robovec_machine::target::Target;
 use robovec_ir::analysis::Latencies;
 use robovec_ir::verifier::VerifierError;
 use robovec_ir::{Module, Phase, Span};
@@ -155,7 +155,7 @@ impl PassError {
 pub struct PassContext {
     /// The machine the run targets (`-target=de10-nano|FILE.json`, selected once; default
     /// `de10-nano`): latencies, write ports, memory sizes, clock and device capacities for
-    /// every pass (see [`robovec_fpga::target`]). Set it with [`PassContext::with_target`].
+    /// every pass (see [`robovec_machine::target`]). Set it with [`PassContext::with_target`].
     pub target: Target,
     /// The pipeline's latencies now, cycles: the target's, until a pass gives `lat-*`
     /// explicitly; from that pass on the given ones replace them (the others stay), for every

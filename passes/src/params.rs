@@ -623,7 +623,7 @@ mod tests {
             format!("{:?}", crate::accuracy::Accuracy { opts: crate::accuracy::Options::default() })
         );
         // The latencies default to the target's; the declared built-in values are de10-nano's.
-        let d = robovec_fpga::target::Target::de10_nano().latencies;
+        let d = robovec_machine::target::Target::de10_nano().latencies;
         assert_eq!(d, Latencies::default());
         let lat: Vec<String> = LATENCY_PARAMS.iter().map(ParamInfo::default_text).collect();
         assert_eq!(lat, [d.add, d.mul, d.div, d.call].map(|x| format!("the target's, de10-nano {x}")));

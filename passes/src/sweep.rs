@@ -12,7 +12,7 @@
 //! Placements use the pipeline's latencies (the target's, or those a pass before gave
 //! explicitly, `PassContext::latencies_for`) and the target's write ports. Each row also gives
 //! `us` (cycles at the target's clock) and the analytic resource estimate
-//! (`robovec_fpga::target::Target::estimate`; `fits` also needs the placement's memories within
+//! (`robovec_machine::target::Target::estimate`; `fits` also needs the placement's memories within
 //! the target's). A second artifact, [`SweepFit`] (report `sweep_fit`, lines after the table),
 //! names per function the smallest N whose placement reaches the critical path (cycles =
 //! largest ASAPCycle, in any configuration) and the smallest and largest N of the sweep that
@@ -95,7 +95,7 @@ pub struct SweepRow {
     pub lat_add: u32,
     /// mul latency of the placement, cycles.
     pub lat_mul: u32,
-    /// Estimated ALM ([`robovec_fpga::target::Target::estimate`]).
+    /// Estimated ALM ([`robovec_machine::target::Target::estimate`]).
     pub alm: u32,
     /// Estimated M10K blocks.
     pub m10k: u32,
@@ -170,7 +170,7 @@ impl crate::Artifact for SweepFit {
 }
 
 /// The [`FitRow`] of `function` from its rows.
-fn fit_row(function: &str, target: &robovec_fpga::target::Target, critical_path: u32, rows: &[SweepRow]) -> FitRow {
+fn fit_row(function: &str, target: &robovec_machine::target::Target, critical_path: u32, rows: &[SweepRow]) -> FitRow {
     let mine = || rows.iter().filter(|r| r.function == function);
     let n_critical_path = mine().filter(|r| r.cycles <= critical_path).map(|r| r.n).min();
     let n_fits_min = mine().filter(|r| r.fits).map(|r| r.n).min();

@@ -152,7 +152,7 @@ fn continuing(after: &PassContext) -> PassContext {
 /// [`Failure::Usage`] for a pipeline that does not parse; [`Failure::Input`] when a pass fails.
 pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
     let generated = module_of(case, plan.seed);
-    let target = robovec_fpga::target::Target::de10_nano();
+    let target = robovec_machine::target::Target::de10_nano();
     let shape_after = |pipeline: &str| -> Result<Shape, Failure> {
         let mut m = generated.clone();
         let mut cx = PassContext::with_target(target.clone());

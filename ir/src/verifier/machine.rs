@@ -1,5 +1,5 @@
 //! Lowered checks of the verifier: a [`MachineProgram`] computes its function. Run by
-//! `robovec_fpga::lower::lower` on every program it builds (always, not only in debug
+//! `robovec_machine::lower::lower` on every program it builds (always, not only in debug
 //! builds: it costs one pass over the steps, see the lowering's module doc for the figure).
 //!
 //! The check executes the program on *tags* instead of numbers: every word holds the

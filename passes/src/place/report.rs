@@ -1,7 +1,7 @@
 //! The placement's figures (SPEC §7 `placement`, seed §3.4–3.6): cycles against the lower
 //! bounds, parallelisation rate, memories, writes and occupation.
 
-use robovec_fpga::target::{Resources, Target};
+use robovec_machine::target::{Resources, Target};
 use robovec_ir::Function;
 use serde::Serialize;
 
@@ -48,7 +48,7 @@ pub struct PlacementReport {
     /// which op when (the placement timeline figure of `-report-dir`); extra key.
     pub timeline: Timeline,
     /// The analytic resource estimate of this configuration on the target
-    /// (`robovec_fpga::target::Target::estimate`: unit costs of seed Table 1.4, memories in M10K
+    /// (`robovec_machine::target::Target::estimate`: unit costs of seed Table 1.4, memories in M10K
     /// blocks), with `fits` also requiring the placement's memories to fit the target's
     /// ([`fits_memories`]); extra key. The FPGA back end gives Yosys' figures instead.
     pub estimate: Resources,

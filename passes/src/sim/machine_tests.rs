@@ -1,14 +1,14 @@
-//! The machine program of placed functions (`place`, then `robovec_fpga::lower::lower`): the
+//! The machine program of placed functions (`place`, then `robovec_machine::lower::lower`): the
 //! lowered verifier on broken programs, the binary32 data words, and the property of issue 12 —
 //! random DAGs placed at random N, lowered, encoded, decoded, executed: equal to the
-//! interpreter bit for bit in f32 and f64. (The hand-computed lowerings are `robovec-fpga`'s
+//! interpreter bit for bit in f32 and f64. (The hand-computed lowerings are `robovec-machine`'s
 //! own tests; these need the placer.) The helpers are shared with `sim`'s tests.
 
 use proptest::prelude::*;
 
-use robovec_fpga::encode::{decode, encode, Layout};
-use robovec_fpga::exec::execute;
-use robovec_fpga::lower::lower;
+use robovec_machine::encode::{decode, encode, Layout};
+use robovec_machine::exec::execute;
+use robovec_machine::lower::lower;
 use robovec_ir::analysis::Latencies;
 use robovec_ir::interp::{eval, pseudo_random_input};
 use robovec_ir::machine::{MachineProgram, MemWrite, Source};

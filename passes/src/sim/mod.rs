@@ -2,9 +2,9 @@
 //! placement with it against the interpreter, bit for bit, in f32 and f64.
 //!
 //! The simulator reads only the [`Placement`] (never the placer): it lowers it once into the
-//! public machine program ([`robovec_fpga::lower::lower`], which checks every rule of the machine
+//! public machine program ([`robovec_machine::lower::lower`], which checks every rule of the machine
 //! model of [`robovec_ir::placement`] and keeps the diagnostics below), then executes that
-//! program cycle by cycle ([`robovec_fpga::exec::execute`]) — the same program `codegen<fpga>`
+//! program cycle by cycle ([`robovec_machine::exec::execute`]) — the same program `codegen<fpga>`
 //! encodes:
 //!
 //! - **before cycle 0** the initial words: inputs as `T::from_f64(input(name))`, trig initial
@@ -18,8 +18,8 @@
 //! - **at the end** the outputs are read from the output memories.
 //!
 //! The choices where the machine model is silent (read addresses, constants, calls, word
-//! occupancy, buffer entries, outputs, error order) are listed in [`robovec_fpga::lower`]'s module
-//! doc. Errors are [`SimError`] (= [`robovec_fpga::lower::MachineError`]): the first broken rule,
+//! occupancy, buffer entries, outputs, error order) are listed in [`robovec_machine::lower`]'s module
+//! doc. Errors are [`SimError`] (= [`robovec_machine::lower::MachineError`]): the first broken rule,
 //! with cycle, PE, value and the span of the offending line when the placement was read from
 //! text.
 //!
@@ -34,9 +34,9 @@ use robovec_ir::machine::{MachineOp, MachineProgram};
 use robovec_ir::placement::Placement;
 use robovec_ir::{Function, Module};
 
-use robovec_fpga::exec::execute;
-use robovec_fpga::lower::{lower_measured, Occupancy};
-pub use robovec_fpga::lower::{MachineError as SimError, MachineErrorKind as SimErrorKind, When};
+use robovec_machine::exec::execute;
+use robovec_machine::lower::{lower_measured, Occupancy};
+pub use robovec_machine::lower::{MachineError as SimError, MachineErrorKind as SimErrorKind, When};
 
 use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};

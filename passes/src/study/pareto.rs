@@ -176,7 +176,7 @@ pub fn study(
     samples: u32,
     seed: u64,
     deadline: Option<crate::Deadline>,
-    target: &robovec_fpga::target::Target,
+    target: &robovec_machine::target::Target,
     progress: &crate::progress::Progress,
 ) -> Result<ParetoStudy, Failure> {
     // A bad text fails in `run_reporting` with its own message; the total is then moot.
@@ -203,7 +203,7 @@ fn run_reporting(
     samples: u32,
     seed: u64,
     deadline: Option<crate::Deadline>,
-    target: &robovec_fpga::target::Target,
+    target: &robovec_machine::target::Target,
     task: &crate::progress::Task,
 ) -> Result<Vec<ParetoRow>, Failure> {
     let original =

@@ -7,7 +7,7 @@
 //!   `peS_instr` (instruction memory, one word per cycle `0..=cycles`), `peS_xbar` (crossbar
 //!   memory: the two write selects of PE memory `S`), `peS_bufi` (buffer instructions),
 //!   `peS_capt` (output capture), `peS_data` (initial PE memory: constants, input words 0),
-//!   `peS_out` (initial output memory). Word layouts: [`robovec_fpga::encode`]'s module doc
+//!   `peS_out` (initial output memory). Word layouts: [`robovec_machine::encode`]'s module doc
 //!   and the manifest's `widths`.
 //! - `manifest.json`: sizes, widths, the load map (input / trig value / constant → PE slot,
 //!   address), the output map (output → PE slot, output-memory address), target, cycles.
@@ -18,7 +18,7 @@
 //!   `testbench.v`.
 //! - `simulate` (executable, Python 3 standard library + Icarus Verilog): `DIR/simulate
 //!   INPUTS.json` runs the design and prints `{"cycles", "clocks", "outputs", "bits"}`.
-//! - `resources.json`: ALM / M10K / DSP, fit, cycles, clock, µs ([`robovec_fpga::resources`]).
+//! - `resources.json`: ALM / M10K / DSP, fit, cycles, clock, µs ([`robovec_machine::resources`]).
 //!
 //! ## Design choices (where the issue is silent)
 //! - The images are written from the machine program's encoding; the design's RTL
@@ -41,16 +41,16 @@
 //!   depth, instruction memory depth) and latencies below 2.
 //!
 //! This file is the pass (its parameters, its report and artifact); the work — lowering,
-//! encoding, design, Verilog, estimate, files — is the machine crate's ([`robovec_fpga::emit`]).
+//! encoding, design, Verilog, estimate, files — is the machine crate's ([`robovec_machine::emit`]).
 
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use robovec_fpga::design::build::Limits;
-use robovec_fpga::design::Design;
-use robovec_fpga::emit::{emit, DesignFile};
-use robovec_fpga::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
+use robovec_machine::design::build::Limits;
+use robovec_machine::design::Design;
+use robovec_machine::emit::{emit, DesignFile};
+use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
 use crate::params::ParamKind;
 use crate::{Artifact, ArtifactFile, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry};
@@ -219,8 +219,8 @@ impl CodegenFpga {
     /// The design, report and files of one placed function.
     ///
     /// # Errors
-    /// A diagnostic naming the function: no placement, or what [`robovec_fpga::emit::emit`]
-    /// refuses (what [`robovec_fpga::design::build::from_placement`] refuses, or a Yosys failure;
+    /// A diagnostic naming the function: no placement, or what [`robovec_machine::emit::emit`]
+    /// refuses (what [`robovec_machine::design::build::from_placement`] refuses, or a Yosys failure;
     /// with `resources=yosys`: Yosys missing).
     pub fn build(
         &self,
