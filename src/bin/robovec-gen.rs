@@ -15,7 +15,8 @@
 //!
 //! `robovec-gen --study [--dof 23,50,…] [--topology serial,…] [--seed S] [--samples K]
 //! [--best PIPELINE] [--report-dir DIR] [-q]` runs the thesis's study (seed §3.2, Table 3.1) on
-//! the families instead: see `robovec::study`.
+//! the families instead: see `robovec::study` (the command) and `robovec_dynamics::study` (the
+//! cases, what is measured, the table).
 //!
 //! Exit status: 0 on success, 1 for a bad URDF or when the output cannot be written, 2 on bad
 //! usage.

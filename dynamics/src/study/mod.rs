@@ -1,6 +1,6 @@
-//! The study behind `robovec-gen --study` (issue 14): the thesis's study of seed §3.2, Table 3.1, on robovec's
-//! topology families — 23, 50, 70, 100, 130 dof × serial, semi-serial, parallel, direct
-//! dynamics (`dirdyna`) — run in process through the pass manager.
+//! The study behind `robovec-gen --study` (issue 14): the thesis's study of seed §3.2, Table
+//! 3.1, on robovec's topology families — 23, 50, 70, 100, 130 dof × serial, semi-serial,
+//! parallel, direct dynamics (`dirdyna`) — run in process through the pass manager.
 //!
 //! Per case ([`run::run_case`]): ops, ASAP − ASAPCycle and number Y as generated (`atomise`),
 //! after `atomise,zero-removal,balance` and after the best rewrite pipeline; placed cycles of
