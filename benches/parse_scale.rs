@@ -1,6 +1,6 @@
 //! Parse + IR scaling (issue 10 §3): time and peak memory of
 //! `robovec-opt FILE -passes=atomise,asap-alap -o OUT` on generated straight-line Robotran C
-//! files ([`robovec::front::synth`], one output per temporary: ~1.4·10⁶ outputs per 100 MB) of
+//! files ([`robovec_front::synth`], one output per temporary: ~1.4·10⁶ outputs per 100 MB) of
 //! 1, 10 and 100 MB.
 //!
 //! Each size runs the release binary in a child process; the peak resident memory is the
@@ -16,7 +16,7 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-use robovec::front::synth::{straight_line_c, Shape};
+use robovec_front::synth::{straight_line_c, Shape};
 
 #[path = "common.rs"]
 mod common;

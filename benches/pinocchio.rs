@@ -4,7 +4,7 @@
 //!
 //! Robots (default: all): `ur5`, `panda` (fixed base), `solo12`, `talos`, `tiago_pro` (Robotran's
 //! floating base, Pinocchio's composite root joint PX PY PZ RX RY RZ), `serial30` (the 30-dof
-//! serial topology family robot, `robovec::gen::topology`, seed 1) — the robots of
+//! serial topology family robot, `robovec_dynamics::topology`, seed 1) — the robots of
 //! `tests/pinocchio.rs`. For each robot it
 //! 1. runs `benches/pinocchio/export_model.py` with the venv's Python: Pinocchio's model built as
 //!    the oracle builds it, saved with `saveToText`, and 64 random states (the oracle's
@@ -135,9 +135,9 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
     eprintln!("== {}", robot.name);
     let urdf_spec = if let Some(g) = robot.urdf.strip_prefix("gen:") {
         assert_eq!(g, "serial30");
-        let r = robovec::gen::topology::build(robovec::gen::topology::Topology::Serial, 30, 1);
+        let r = robovec_dynamics::topology::build(robovec_dynamics::topology::Topology::Serial, 30, 1);
         let p = work.join("serial30.urdf");
-        side::write_if_changed(&p, robovec::gen::urdf_out::write_urdf(&r).as_bytes());
+        side::write_if_changed(&p, robovec_dynamics::urdf_out::write_urdf(&r).as_bytes());
         p.to_string_lossy().into_owned()
     } else {
         robot.urdf.to_string()

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use robovec::front::{parse_str, Language};
+use robovec_front::{parse_str, Language};
 use robovec_ir::{verifier, Module};
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 

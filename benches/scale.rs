@@ -1,4 +1,4 @@
-//! Scale (issue 14): the 130-dof serial topology family (`robovec::gen::topology`, seed 1),
+//! Scale (issue 14): the 130-dof serial topology family (`robovec_dynamics::topology`, seed 1),
 //! written as a URDF, through
 //! `robovec-opt serial130.urdf -passes=atomise,zero-removal,balance,asap-alap,place<pe=32>,sim,codegen<c> -o serial130.c -time-passes -stats`
 //! (both functions: `invdyna` and the ~189 000-op `dirdyna`; generation included).
@@ -17,7 +17,7 @@ mod common;
 use std::path::PathBuf;
 use std::process::Command;
 
-use robovec::gen::topology::{build, Topology};
+use robovec_dynamics::topology::{build, Topology};
 
 fn main() {
     let mut bin = PathBuf::from(env!("CARGO_BIN_EXE_robovec-opt"));
@@ -39,7 +39,7 @@ fn main() {
     let dir = std::env::temp_dir().join(format!("robovec-scale-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temporary folder");
     let urdf = dir.join(format!("{topology}_{dof}.urdf"));
-    std::fs::write(&urdf, robovec::gen::urdf_out::write_urdf(&build(topology, dof, 1))).expect("write the URDF");
+    std::fs::write(&urdf, robovec_dynamics::urdf_out::write_urdf(&build(topology, dof, 1))).expect("write the URDF");
     let out = dir.join("model.c");
     let pipeline = "-passes=atomise,zero-removal,balance,asap-alap,place<pe=32>,sim,codegen<c>";
     println!("binary: {}\ncase: {topology} {dof} dof, seed 1; {pipeline}", bin.display());

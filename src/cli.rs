@@ -212,7 +212,7 @@ impl Cli {
             check: self.check.then_some((self.check_samples, self.check_seed)),
             time_limit: self.time_limit,
             target: self.target,
-            front: crate::front::FrontOptions { fold_params: self.fold_params, floating_base: self.floating_base },
+            front: robovec_front::FrontOptions { fold_params: self.fold_params, floating_base: self.floating_base },
             params_out: self.params_out,
         })
     }

@@ -35,7 +35,7 @@ pub struct SourceFile {
 impl SourceFile {
     /// Wraps raw bytes, replacing each byte of an invalid UTF-8 sequence by `?`.
     pub fn from_bytes(name: impl Into<String>, bytes: &[u8]) -> SourceFile {
-        SourceFile { name: name.into(), text: crate::front::source_text(bytes) }
+        SourceFile { name: name.into(), text: robovec_front::source_text(bytes) }
     }
 
     /// Renders diagnostics (no colour), each ending in a blank line; long lines and messages

@@ -15,15 +15,16 @@ use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
+use robovec_front::{FrontOptions, Loaded};
 use robovec_ir::{verifier, Module};
 use robovec_passes::figures::{self, Figures};
+use robovec_passes::report::report_text;
 use robovec_passes::{
     study, DumpSink, GeneratedCode, Instrumentation, PassContext, PassError, PassManager, PassRecord,
 };
 
 use crate::diagnostics::SourceFile;
 use crate::eval::evaluate;
-use crate::front;
 use crate::options::{output_failure, select};
 pub use crate::options::{Failure, Options};
 use crate::output::OutputSet;
@@ -33,17 +34,17 @@ use crate::output::OutputSet;
 /// # Errors
 /// [`Failure::Input`] with codespan diagnostics naming file, line and column.
 pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
-    load_with(input, &front::FrontOptions::default()).map(|(l, src)| (l.module, src))
+    load_with(input, &FrontOptions::default()).map(|(l, src)| (l.module, src))
 }
 
 /// [`load`] with the front-end options of the command line; also returns the parameter values
-/// the front end knows ([`front::Loaded::params`]). The front end is the registered one for the
-/// input's extension ([`front::front_end_for`]); the driver names none.
+/// the front end knows ([`Loaded::params`]). The front end is the registered one for the
+/// input's extension ([`robovec_front::front_end_for`]); the driver names none.
 ///
 /// # Errors
 /// [`Failure::Usage`] for an extension no front end claims; [`Failure::Input`] with codespan
 /// diagnostics naming file, line and column.
-pub fn load_with(input: &str, opts: &front::FrontOptions) -> Result<(front::Loaded, SourceFile), Failure> {
+pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile), Failure> {
     let (bytes, name) = if input == "-" {
         let mut b = Vec::new();
         std::io::stdin().read_to_end(&mut b).map_err(|e| Failure::Input(format!("error: cannot read stdin: {e}\n")))?;
@@ -52,10 +53,10 @@ pub fn load_with(input: &str, opts: &front::FrontOptions) -> Result<(front::Load
         let b = std::fs::read(input).map_err(|e| Failure::Input(format!("error: cannot read `{input}`: {e}\n")))?;
         (b, input.to_string())
     };
-    let Some(fe) = front::front_end_for(input) else {
+    let Some(fe) = robovec_front::front_end_for(input) else {
         return Err(Failure::Usage(format!(
             "error: cannot tell the language of `{input}`: expected a {} file (or - for IR on stdin)\n",
-            front::extension_list()
+            robovec_front::extension_list()
         )));
     };
     let src = SourceFile::from_bytes(name, &bytes);
@@ -165,7 +166,7 @@ pub struct Terminal {
     /// ([`stdout_choice`]).
     pub stdout: bool,
     /// stderr is a terminal: long work shows progress bars unless `-q`
-    /// ([`crate::progress::progress_for`]).
+    /// ([`crate::progress_bars::progress_for`]).
     pub stderr: bool,
 }
 
@@ -246,7 +247,7 @@ pub fn run_with(
             serde_json::to_string_pretty(params).map_err(|e| Failure::Output(format!("error: -params-out: {e}\n")))?;
         out.stage(path, format!("{json}\n").as_bytes()).map_err(output_failure)?;
     }
-    let progress = crate::progress::progress_for(terminal.stderr, opts.quiet);
+    let progress = crate::progress_bars::progress_for(terminal.stderr, opts.quiet);
     let ran = run_passes(opts, &pm, target, progress, &mut module, &src, &mut out, stderr)?;
     write_outputs(opts, &pm, &module, &ran, eval_inputs.as_ref(), terminal, out, stdout, stderr)
 }
@@ -333,28 +334,6 @@ fn report_json(
         }
     };
     Ok(report_text(&opts.input, &pm.pipeline_text(), &ran.records, &ran.cx, own))
-}
-
-/// The report JSON text (SPEC §7) of one function after a run: `input` (as given), `function`,
-/// `pipeline` (normalised text), `passes` (the records), the function's own figures (`stats`,
-/// `placement`), each artifact's entry for it (merged by key), then `stopped_early` when a pass
-/// stopped early. What `-report` writes; `robovec-gen --study` ([`crate::study`]) calls it for
-/// each case's report folder.
-pub fn report_text(input: &str, pipeline: &str, records: &[PassRecord], cx: &PassContext, own: &Figures) -> String {
-    let mut r = serde_json::Map::new();
-    r.insert("input".into(), input.into());
-    r.insert("function".into(), own.function.clone().into());
-    r.insert("pipeline".into(), pipeline.into());
-    r.insert("passes".into(), serde_json::to_value(records).expect("records serialise"));
-    let entries =
-        own.report_entries().into_iter().chain(robovec_passes::artifact::report_entries(cx.artifacts(), &own.function));
-    for (key, value) in entries {
-        r.insert(key.into(), value);
-    }
-    if !cx.stopped.is_empty() {
-        r.insert("stopped_early".into(), cx.stopped.clone().into());
-    }
-    serde_json::to_string_pretty(&serde_json::Value::Object(r)).expect("report serialises") + "\n"
 }
 
 /// `-eval`'s JSON, with a warning on stderr for each input given that the function does not

@@ -46,7 +46,7 @@ pub struct Options {
     /// `-time-limit=SECONDS`: wall-clock limit of the run (see `PassContext::deadline`).
     pub time_limit: Option<f64>,
     /// Front-end options (`--fold-params`).
-    pub front: crate::front::FrontOptions,
+    pub front: robovec_front::FrontOptions,
     /// `-params-out=FILE`: the values of the model parameters the input states (a URDF's),
     /// as the JSON object `specialize<params=…>` and `-eval` read.
     pub params_out: Option<PathBuf>,

@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
-use robovec::front::synth::{straight_line_c, Shape};
-use robovec::front::{parse_str, Language};
+use robovec_front::synth::{straight_line_c, Shape};
+use robovec_front::{parse_str, Language};
 
 use crate::common::{corpus_dir, opt, tmp};
 

@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::Command;
 
-use robovec::front::FrontOptions;
+use robovec_front::FrontOptions;
 
 pub(crate) fn python() -> Option<PathBuf> {
     let p = std::env::var_os("ROBOVEC_PINOCCHIO_PYTHON")
@@ -158,21 +158,21 @@ fn panda_matches_pinocchio_rnea_crba_nle() {
     eprintln!("panda: worst relative error {e:e}");
 }
 
-/// Every built-in topology family (`robovec::gen::topology`) at 4, 9 and 23 dof, written as a
+/// Every built-in topology family (`robovec_dynamics::topology`) at 4, 9 and 23 dof, written as a
 /// URDF by `gen::urdf_out` and loaded by Pinocchio and by robovec's URDF front end: `Qq`, `M`,
 /// `c` within 1e-10 of Pinocchio's, and the front end's IR from the written file is the IR
 /// generated straight from the robot (the writer loses nothing the generator reads).
 #[test]
 fn topology_families_match_pinocchio_rnea_crba_nle() {
-    use robovec::gen::topology::{build, Topology};
+    use robovec_dynamics::topology::{build, Topology};
     let dir = crate::common::tmp("topology");
     for t in Topology::ALL {
         for dof in [4, 9, 23] {
             let robot = build(t, dof, 1);
             let path = dir.join(format!("{t}_{dof}.urdf"));
-            std::fs::write(&path, robovec::gen::urdf_out::write_urdf(&robot)).unwrap();
+            std::fs::write(&path, robovec_dynamics::urdf_out::write_urdf(&robot)).unwrap();
             let path = path.to_str().unwrap();
-            let direct = robovec::gen::generate(&robovec::gen::Model { robot }, false);
+            let direct = robovec_dynamics::generate(&robovec_dynamics::Model { robot }, false);
             let (loaded, _) = robovec::driver::load_with(path, &FrontOptions::default())
                 .unwrap_or_else(|e| panic!("{path}: {}", e.message()));
             assert_eq!(loaded.module.to_string(), direct.module.to_string(), "{path}: IR after the URDF round trip");

@@ -2,7 +2,7 @@
 //!
 //! 1. Robustness: arbitrary strings/bytes, token soups over a small alphabet of `.rvir` and
 //!    Robotran tokens, and mutated small well-formed files go into `robovec_ir::text::parse` and
-//!    into each front end (`robovec::front::parse_str` for C, Matlab and Python) without a panic.
+//!    into each front end (`robovec_front::parse_str` for C, Matlab and Python) without a panic.
 //!    When a front end accepts an input, its module must verify, atomise, and the atomised
 //!    module must verify.
 //! 2. Round trip and atomisation on random well-formed parsed-phase functions (random expression
@@ -19,7 +19,7 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::Config;
-use robovec::front::{parse_str, Language};
+use robovec_front::{parse_str, Language};
 use robovec_ir::interp::{self, Float};
 use robovec_ir::{text, verifier, BinOp, Callee, Def, Expr, Function, Module, Operand, Phase};
 use robovec_passes::atomise::atomise_function;
@@ -233,7 +233,7 @@ fn mutate(skeleton: &str, pos: usize, del: usize, insert: &str) -> Vec<u8> {
 /// The front-end contract on any bytes: no panic; an accepted module verifies and atomises.
 fn check_front(lang: Language, src: &[u8], header: Option<&[u8]>) {
     let Ok(m) = parse_str(lang, src, header) else { return };
-    if let Err(e) = robovec::front::check_accepted(&m) {
+    if let Err(e) = robovec_front::check_accepted(&m) {
         panic!("{lang:?}: {e}");
     }
 }

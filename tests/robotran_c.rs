@@ -1,4 +1,4 @@
-//! The Robotran-C writer (`robovec::gen::robotran_c`, issue 14): every generated model, written
+//! The Robotran-C writer (`robovec_dynamics::robotran_c`, issue 14): every generated model, written
 //! as Robotran 6.6 C by `robovec-gen --format c`, reads back through robovec's own C front end to
 //! the same IR, evaluates bit for bit the same, and compiles and runs as C with the system
 //! compiler against a stand-in `MbsData`.
@@ -13,9 +13,9 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use robovec::front::FrontOptions;
-use robovec::gen::export::{Export, Format, Source};
-use robovec::gen::topology::{build, Topology};
+use robovec::export::{Export, Format, Source};
+use robovec_dynamics::topology::{build, Topology};
+use robovec_front::FrontOptions;
 use robovec_ir::interp::{eval, pseudo_random_input};
 use robovec_ir::Function;
 
@@ -62,12 +62,12 @@ fn round_trip(dir: &Path, source: Source, function: &str, fold: bool, floating: 
         params_out: None,
         output: Some(c.clone()),
     };
-    robovec::gen::export::run(&e, &mut Vec::new()).unwrap_or_else(|f| panic!("{}", f.message()));
+    robovec::export::run(&e, &mut Vec::new()).unwrap_or_else(|f| panic!("{}", f.message()));
     let orig = match source {
         Source::Topology { topology, dof, seed } => {
             let robot = build(topology, dof, seed);
             let robot = if floating { robot.with_floating_base().unwrap() } else { robot };
-            robovec::gen::generate(&robovec::gen::Model { robot }, fold).module
+            robovec_dynamics::generate(&robovec_dynamics::Model { robot }, fold).module
         }
         Source::Urdf(p) => {
             let front = FrontOptions { fold_params: fold, floating_base: floating };

@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use robovec::front::FrontOptions;
+use robovec_front::FrontOptions;
 
 use crate::common::{opt, stderr, tmp};
 
@@ -172,7 +172,7 @@ fn bad_urdf_is_a_located_diagnostic() {
 /// alike), `robovec-opt` reads it, and bad usage exits 2 with nothing written.
 #[test]
 fn robovec_gen_writes_a_topology_as_urdf_that_robovec_opt_reads() {
-    use robovec::gen::topology::{build, Topology};
+    use robovec_dynamics::topology::{build, Topology};
     let gen = |args: &[&str]| {
         std::process::Command::new(env!("CARGO_BIN_EXE_robovec-gen")).args(args).output().expect("robovec-gen runs")
     };
@@ -180,12 +180,13 @@ fn robovec_gen_writes_a_topology_as_urdf_that_robovec_opt_reads() {
     let file = d.join("semi.urdf");
     let o = gen(&["--topology", "semi-serial", "--dof", "9", "--seed", "4", "-o", file.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let want = robovec::gen::urdf_out::write_urdf(&build(Topology::SemiSerial, 9, 4));
+    let want = robovec_dynamics::urdf_out::write_urdf(&build(Topology::SemiSerial, 9, 4));
     assert_eq!(std::fs::read_to_string(&file).unwrap(), want);
     let o = gen(&["--topology", "semi-serial", "--dof", "9", "--seed", "4"]);
     assert_eq!(String::from_utf8_lossy(&o.stdout), want);
     // The same equations as the generator writes straight from the robot.
-    let direct = robovec::gen::generate(&robovec::gen::Model { robot: build(Topology::SemiSerial, 9, 4) }, false);
+    let direct =
+        robovec_dynamics::generate(&robovec_dynamics::Model { robot: build(Topology::SemiSerial, 9, 4) }, false);
     let rvir = d.join("direct.rvir");
     std::fs::write(&rvir, direct.module.to_string()).unwrap();
     let stats = |input: &str| {

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use robovec::front::{check_accepted, parse_str, Language};
+use robovec_front::{check_accepted, parse_str, Language};
 
 fuzz_target!(|data: &[u8]| {
     // A NUL byte (never in a Robotran file) splits the input into the .c text and the

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use robovec::front::{check_accepted, parse_str, Language};
+use robovec_front::{check_accepted, parse_str, Language};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(m) = parse_str(Language::Matlab, data, None) else { return };

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use robovec::front::{check_accepted, front_end_for, FrontOptions};
+use robovec_front::{check_accepted, front_end_for, FrontOptions};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };

@@ -8,7 +8,7 @@ use crate::span::Span;
 /// A problem at a place in a source text.
 ///
 /// `span` is a byte range into the text as read (front ends keep every byte offset of the
-/// original bytes, see `robovec::front::source_text`).
+/// original bytes, see `robovec_front::source_text`).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("{message}")]
 pub struct SourceError {

@@ -23,6 +23,7 @@ pub mod params;
 pub mod pipeline;
 pub mod place;
 pub mod progress;
+pub mod report;
 pub mod sim;
 pub mod specialize;
 pub mod study;

@@ -1,8 +1,8 @@
 //! `robovec-gen`: robots robovec builds itself, written as URDF or as Robotran C (issue 14).
 //!
 //! `robovec-gen --topology serial|semi-serial|parallel --dof N [--seed S] [-o FILE.urdf]` writes
-//! one model of the study's topology families (`robovec::gen::topology`, seed §3.2 Table 3.1)
-//! as a URDF (`robovec::gen::urdf_out`: numbers round-trip exact), to stdout without `-o`.
+//! one model of the study's topology families (`robovec_dynamics::topology`, seed §3.2 Table 3.1)
+//! as a URDF (`robovec_dynamics::urdf_out`: numbers round-trip exact), to stdout without `-o`.
 //! `robovec-opt FILE.urdf -function=dirdyna -passes=…` then runs any pipeline on its equations
 //! (the URDF front end reads it back to the same IR the generator writes directly: tested in
 //! `tests/pinocchio.rs`, which also checks every family against Pinocchio).
@@ -10,12 +10,13 @@
 //! `robovec-gen (--topology T --dof N | --urdf FILE.urdf) --format c --function invdyna|dirdyna
 //! [--floating-base] [--fold-params] [--params-out P.json] -o mbs_invdyna_X.c` writes one
 //! function as a Robotran 6.6 C file and its header `mbs_invdyna_X.h` beside it
-//! (`robovec::gen::robotran_c`), which robovec's C front end reads back to the same IR
-//! (`tests/robotran_c.rs`); see `robovec::gen::export`.
+//! (`robovec_dynamics::robotran_c`), which robovec's C front end reads back to the same IR
+//! (`tests/robotran_c.rs`); see `robovec::export`.
 //!
 //! `robovec-gen --study [--dof 23,50,…] [--topology serial,…] [--seed S] [--samples K]
 //! [--best PIPELINE] [--report-dir DIR] [-q]` runs the thesis's study (seed §3.2, Table 3.1) on
-//! the families instead: see `robovec::study`.
+//! the families instead: see `robovec::study` (the command) and `robovec_dynamics::study` (the
+//! cases, what is measured, the table).
 //!
 //! Exit status: 0 on success, 1 for a bad URDF or when the output cannot be written, 2 on bad
 //! usage.
@@ -24,8 +25,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Parser;
-use robovec::gen::export::{Export, Format, Source};
-use robovec::gen::topology::Topology;
+use robovec::export::{Export, Format, Source};
+use robovec_dynamics::topology::Topology;
 
 /// Command line of `robovec-gen`.
 #[derive(Parser, Debug)]
@@ -56,7 +57,7 @@ struct Args {
     study: StudyArgs,
 }
 
-/// What is written for one robot (`robovec::gen::export`).
+/// What is written for one robot (`robovec::export`).
 #[derive(clap::Args, Debug)]
 struct ModelArgs {
     /// Read the robot from this URDF instead of building a topology family.
@@ -89,7 +90,7 @@ struct StudyArgs {
     #[arg(long, default_value_t = 200, requires = "study", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     samples: u32,
     /// --study: the best rewrite pipeline (from the parsed equations).
-    #[arg(long, default_value = robovec::study::DEFAULT_BEST, requires = "study")]
+    #[arg(long, default_value = robovec_dynamics::study::DEFAULT_BEST, requires = "study")]
     best: String,
     /// --study: write the study folder (study.md/json/csv, figures, per-case reports) here.
     #[arg(long, requires = "study")]
@@ -107,7 +108,7 @@ struct StudyArgs {
 fn study(args: &Args) -> ExitCode {
     use std::io::IsTerminal;
     let dofs = if args.dof.is_empty() {
-        robovec::study::cases::THESIS_DOFS.to_vec()
+        robovec_dynamics::study::cases::THESIS_DOFS.to_vec()
     } else {
         args.dof.iter().map(|&d| d as usize).collect()
     };
@@ -118,7 +119,7 @@ fn study(args: &Args) -> ExitCode {
         seed: args.seed,
         samples: args.study.samples,
         best: args.study.best.clone(),
-        ns: robovec::study::DEFAULT_NS.to_vec(),
+        ns: robovec_dynamics::study::DEFAULT_NS.to_vec(),
         report_dir: args.study.report_dir.clone(),
         case_reports: !args.study.no_case_reports,
         quiet: args.study.quiet,
@@ -172,7 +173,7 @@ fn main() -> ExitCode {
         params_out: args.model.params_out.clone(),
         output: args.output.clone(),
     };
-    match robovec::gen::export::run(&export, &mut std::io::stdout().lock()) {
+    match robovec::export::run(&export, &mut std::io::stdout().lock()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(f) => {
             eprint!("{}", f.message());

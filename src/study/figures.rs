@@ -5,8 +5,9 @@
 
 use plotters::prelude::*;
 
-use super::run::{CaseResult, Shape};
-use crate::gen::topology::Topology;
+use robovec_dynamics::study::run::{CaseResult, Shape};
+use robovec_dynamics::topology::Topology;
+
 use crate::report_dir::figures::{Figure, PALETTE, SIZE};
 
 type Result<T> = std::result::Result<T, String>;

@@ -1,0 +1,208 @@
+//! robovec-dynamics: the symbolic generator (issue 14). Equations of motion of a robot
+//! ([`robot::Robot`], built by the URDF front end or by a topology family), written as the same
+//! parsed-phase IR the Robotran front ends produce, so every pass, report and back end applies
+//! unchanged.
+//!
+//! # Dependencies
+//! This crate may import `robovec-ir` (the IR it writes) and `robovec-passes` (the study runs
+//! its cases through the pass manager); never the front ends (`robovec-front`, which depends on
+//! it: the URDF front end parses into [`robot::Robot`] and calls [`generate`]) nor the driver
+//! (`robovec`).
+//!
+//! # Main modules
+//! [`robot`] (the model), [`sym`] (the expression builder), [`rnea`], [`crba`] and [`dirdyna`]
+//! (the formulations), [`frames`] and [`origins`] (the body frames the generator may choose),
+//! [`topology`] (the study's robot families), [`urdf_out`] and [`robotran_c`] (the writers of
+//! `robovec-gen`), [`study`] (the thesis's study: cases, one case's run, the table).
+//!
+//! # What is generated
+//! `invdyna`: inverse dynamics `Qq[i]` of a fixed-base tree by the recursive Newton–Euler
+//! algorithm ([`rnea`]), symbolic in the joint coordinates `q[i]`, `qd[i]`, `qdd[i]`, the
+//! gravity vector `g[1..3]` (Pinocchio's default is `g[3] = −9.81`) and the model parameters.
+//! `dirdyna`: direct dynamics `M[i][j]` (by CRBA, [`crba`]), `c[i]` (by RNEA) with
+//! `M qdd + c = Qq` ([`dirdyna`]).
+//! `--floating-base` puts the robot on Robotran's floating base first
+//! ([`robot::Robot::with_floating_base`]): six joints `T1`, `T2`, `T3` (prismatic along the
+//! world x, y, z) and `R1`, `R2`, `R3` (revolute about x, then the new y, then the new z) are
+//! `q[1..6]`, the URDF's moving joints follow. Pinocchio's model with these coordinates is
+//! `buildModelFromUrdf(path, JointModelComposite([PX, PY, PZ, RX, RY, RZ]))` (what the oracle
+//! tests build); from a `JointModelFreeFlyer` state (position, quaternion, velocity in the base
+//! frame) take the position as `q[1..3]`, the quaternion's x-y'-z'' Cardan angles as `q[4..6]`,
+//! and map the velocities through the Cardan rates (`ω = E(q) qd[4..6]`, linear velocity
+//! rotated to the world frame).
+//!
+//! # Numbering (Pinocchio's)
+//! Joints are numbered depth first from the root link, the joints leaving a link taken in
+//! byte order of their names (urdfdom's sorted map, which `pinocchio.buildModelFromUrdf`
+//! walks). Body `b` is the child link of the `b`-th joint of that walk (fixed joints included);
+//! the moving (revolute, continuous, prismatic) joints are numbered `q[1..nq]` in the same walk,
+//! so `q[i]`, `qd[i]`, `qdd[i]` and `Qq[i]` are Pinocchio's entry `i − 1` of a fixed-base model.
+//!
+//! # Parameters (Robotran's layout, SPEC §2)
+//! - `dpt[k][b]`: the origin of joint `b` in its parent link frame (URDF joint `<origin xyz>`), m;
+//! - `l[k][b]`: the centre of mass of body `b` in its frame, m; `m[b]`: its mass, kg;
+//! - `In[k][b]`: its inertia tensor about the centre of mass in its frame, kg·m², row-major
+//!   `k = 1..9`; the tensor is symmetric, so the lower entries read the upper ones' names
+//!   (`In[2][b]` stands for both (1,2) and (2,1); `In[4]`, `In[7]`, `In[8]` never appear).
+//!
+//! A parameter whose URDF value is exactly 0 is a structural zero and folded, as Robotran folds
+//! the parameters a model sets to 0; the others stay inputs and their values go to
+//! [`Generated::params`] (what `-params-out` writes for `specialize<params=…>` and `-eval`),
+//! unless `--fold-params` folds them all. Constant rotations (URDF `rpy`) are numbers. A chain
+//! of joints with dense `rpy` may be written in other body frames ([`frames`]), and link
+//! frames may be slid along their joint axes ([`origins`]), when that lowers the op count; the
+//! parameters of those links are then in these frames.
+
+#![deny(missing_docs)]
+
+pub mod crba;
+pub mod dirdyna;
+pub mod frames;
+pub mod origins;
+pub mod rnea;
+pub mod robot;
+pub mod robotran_c;
+pub mod study;
+pub mod sym;
+pub mod topology;
+pub mod urdf_out;
+
+use std::collections::BTreeMap;
+
+use robovec_ir::Module;
+use rustc_hash::FxHashMap;
+
+use robot::{JointKind, Robot};
+use sym::{Builder, Term, ZERO};
+
+/// A robot to generate equations for.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The checked kinematic tree.
+    pub robot: Robot,
+}
+
+/// The numbering and parameter values of a model (see the module doc).
+#[derive(Clone, Debug)]
+pub struct Layout {
+    /// For each joint of the depth-first walk, its coordinate index `i` of `q[i]` (1-based), or
+    /// `None` for a fixed joint.
+    pub q_index: Vec<Option<usize>>,
+    /// Every parameter (canonical name) → value, zeros included.
+    pub values: BTreeMap<String, f64>,
+}
+
+impl Layout {
+    /// The numbering and parameters of `robot`.
+    pub fn of(robot: &Robot) -> Layout {
+        let order = robot.dfs_joints();
+        let mut q_index = Vec::with_capacity(order.len());
+        let mut nq = 0;
+        let mut values = BTreeMap::new();
+        for (i, &j) in order.iter().enumerate() {
+            let body = i + 1;
+            let joint = &robot.joints[j];
+            q_index.push(match joint.kind {
+                JointKind::Fixed => None,
+                _ => {
+                    nq += 1;
+                    Some(nq)
+                }
+            });
+            for (k, x) in joint.origin.xyz.iter().enumerate() {
+                values.insert(format!("dpt[{}][{body}]", k + 1), *x);
+            }
+            let inertial = robot.links[joint.child].inertial;
+            let (mass, com, inn) = inertial.map_or((0.0, [0.0; 3], [[0.0; 3]; 3]), |x| (x.mass, x.com, x.inertia));
+            values.insert(format!("m[{body}]"), mass);
+            for (k, x) in com.iter().enumerate() {
+                values.insert(format!("l[{}][{body}]", k + 1), *x);
+            }
+            for (r, row) in inn.iter().enumerate() {
+                for (c, x) in row.iter().enumerate().skip(r) {
+                    values.insert(Layout::inertia_name(r, c, body), *x);
+                }
+            }
+        }
+        Layout { q_index, values }
+    }
+
+    /// `In[k][b]` for row `r`, column `c` (0-based) of body `b`'s tensor: the upper entry's name.
+    pub fn inertia_name(r: usize, c: usize, body: usize) -> String {
+        let (r, c) = (r.min(c), r.max(c));
+        format!("In[{}][{body}]", 3 * r + c + 1)
+    }
+
+    /// The term of parameter `name`: a structural zero when its value is 0, else the input
+    /// (folded by the builder under `--fold-params`).
+    pub fn param(&self, b: &mut Builder, name: &str) -> Term {
+        match self.values.get(name) {
+            Some(&x) if x != 0.0 => b.input(name),
+            _ => ZERO,
+        }
+    }
+
+    /// The parameters that are inputs (non-zero values).
+    pub fn nonzero(&self) -> BTreeMap<String, f64> {
+        self.values.iter().filter(|(_, &x)| x != 0.0).map(|(k, &x)| (k.clone(), x)).collect()
+    }
+}
+
+/// What the generator hands to the front end.
+#[derive(Clone, Debug)]
+pub struct Generated {
+    /// The functions (`invdyna`, then `dirdyna`).
+    pub module: Module,
+    /// Values of the parameters left as inputs (`None` when they were folded).
+    pub params: Option<BTreeMap<String, f64>>,
+}
+
+/// Writes one function's equations and outputs into the builder.
+type Writer = fn(&Model, &Layout, &mut Builder);
+
+/// The functions the generator writes, in module order (`-function=NAME` picks one): the
+/// one place that selects a formulation per function.
+const FUNCTIONS: [(&str, Writer); 2] = [("invdyna", rnea::invdyna), ("dirdyna", dirdyna::dirdyna)];
+
+/// Generates `invdyna` and `dirdyna` for `model`; `fold` folds every parameter into the
+/// equations. The robot is written in its own frames, in the body frames of
+/// [`frames::reframe`], or in either with the origins of [`origins::slide`]: whichever gives
+/// both functions together the fewest ops (the first of equals in that order; then the
+/// parameters of the links they move are in those frames). Cost: up to four generations.
+pub fn generate(model: &Model, fold: bool) -> Generated {
+    let mut robots = vec![model.robot.clone()];
+    robots.extend(frames::reframe(&model.robot));
+    for i in 0..robots.len() {
+        robots.extend(origins::slide(&robots[i]));
+    }
+    let ops = |g: &Generated| g.module.functions.iter().map(|f| f.op_counts().total).sum::<u64>();
+    let mut best: Option<(u64, Generated)> = None;
+    for robot in robots {
+        let g = generate_in_frames(&Model { robot }, fold);
+        let n = ops(&g);
+        if best.as_ref().is_none_or(|(m, _)| n < *m) {
+            best = Some((n, g));
+        }
+    }
+    best.expect("the robot's own frames are a candidate").1
+}
+
+/// [`generate`] in the robot's own frames.
+fn generate_in_frames(model: &Model, fold: bool) -> Generated {
+    let layout = Layout::of(&model.robot);
+    let consts: FxHashMap<String, f64> =
+        if fold { layout.nonzero().into_iter().collect() } else { FxHashMap::default() };
+    let functions: Vec<_> = FUNCTIONS
+        .iter()
+        .map(|(name, write)| {
+            let mut b = Builder::new(name, consts.clone());
+            write(model, &layout, &mut b);
+            b.finish()
+        })
+        .collect();
+    let params = (!fold).then(|| {
+        // Only the parameters some function reads.
+        layout.nonzero().into_iter().filter(|(k, _)| functions.iter().any(|f| f.lookup(k).is_some())).collect()
+    });
+    Generated { module: Module { functions }, params }
+}

@@ -1,0 +1,242 @@
+//! The robot the symbolic generator reads: a kinematic tree of links and joints with every
+//! number the dynamics needs (issue 14). Front ends build it — the URDF front end
+//! (`robovec_front::urdf`, a crate above this one) and the study's topology families
+//! ([`crate::topology`]) — and the generator ([`crate::generate`]) writes its equations; the
+//! generator depends on no input format.
+
+use robovec_ir::Span;
+
+/// A rigid transform given as URDF's `<origin xyz="…" rpy="…"/>`: translation (m) and the
+/// rotation `R = Rz(yaw)·Ry(pitch)·Rx(roll)` (URDF's fixed-axis roll-pitch-yaw), as a row-major
+/// 3×3 matrix mapping child coordinates to parent coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Origin {
+    /// Translation `xyz`, metres.
+    pub xyz: [f64; 3],
+    /// Rotation matrix `R` (row-major), child → parent.
+    pub rot: [[f64; 3]; 3],
+}
+
+impl Origin {
+    /// The identity transform (an absent `<origin>`).
+    pub const IDENTITY: Origin = Origin { xyz: [0.0; 3], rot: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] };
+
+    /// From `xyz` and `rpy` (radians). Angles of exactly 0 give exact 0/1 entries; entries
+    /// within 1e-15 of 0 or ±1 (the rounding noise of `cos(π/2)` = 6·10⁻¹⁷ for a quarter turn
+    /// written as `1.5707963267948966`) are snapped to it, so that quarter turns fold as
+    /// structural zeros and ones, as Robotran's exact rotations do. The change is below 10⁻¹⁵
+    /// of the entry, far under the 10⁻¹⁰ agreement with Pinocchio the tests ask.
+    pub fn from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Origin {
+        let (sr, cr) = rpy[0].sin_cos();
+        let (sp, cp) = rpy[1].sin_cos();
+        let (sy, cy) = rpy[2].sin_cos();
+        let rot = [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+        .map(|row| row.map(snap));
+        Origin { xyz, rot }
+    }
+}
+
+/// `x` snapped to 0 or ±1 when within 1e-15 of it (see [`Origin::from_xyz_rpy`]).
+pub(super) fn snap(x: f64) -> f64 {
+    if x.abs() < 1e-15 {
+        0.0
+    } else if (x.abs() - 1.0).abs() < 1e-15 {
+        x.signum()
+    } else {
+        x
+    }
+}
+
+/// `R·T·Rᵀ`: a tensor `T` (an inertia) given in a frame turned by `R` into the frame `R` maps
+/// to (both 3×3, row-major).
+pub fn rotate_tensor(r: &[[f64; 3]; 3], t: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut out = [[0.0; 3]; 3];
+    for (a, row) in out.iter_mut().enumerate() {
+        for (b, x) in row.iter_mut().enumerate() {
+            *x = (0..3).flat_map(|k| (0..3).map(move |l| (k, l))).map(|(k, l)| r[a][k] * t[k][l] * r[b][l]).sum();
+        }
+    }
+    out
+}
+
+/// The mass properties of a link (URDF `<inertial>`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inertial {
+    /// Mass, kg (≥ 0).
+    pub mass: f64,
+    /// Centre of mass in the link frame, m.
+    pub com: [f64; 3],
+    /// Inertia tensor about the centre of mass **in the link frame** (the `<inertial>` origin's
+    /// rotation applied), kg·m², row-major, symmetric positive (semi-)definite.
+    pub inertia: [[f64; 3]; 3],
+}
+
+/// A joint type robovec's generator handles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointKind {
+    /// `revolute` (limits ignored) or `continuous`: rotation about `axis` by `q`.
+    Revolute,
+    /// `prismatic`: translation along `axis` by `q`.
+    Prismatic,
+    /// `fixed`: no degree of freedom.
+    Fixed,
+}
+
+/// One joint of the tree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    /// The URDF name.
+    pub name: String,
+    /// Its type.
+    pub kind: JointKind,
+    /// Index of the parent link in [`Robot::links`].
+    pub parent: usize,
+    /// Index of the child link in [`Robot::links`].
+    pub child: usize,
+    /// Child joint frame in the parent link frame.
+    pub origin: Origin,
+    /// Unit axis in the joint (= child link) frame (URDF default `1 0 0`).
+    pub axis: [f64; 3],
+    /// A revolute joint turns its child by `q + offset` (radians): 0 as read from a URDF; set
+    /// by the generator's choice of body frames ([`crate::frames`]).
+    pub offset: f64,
+    /// The `<joint>` element.
+    pub span: Span,
+}
+
+/// One link.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Link {
+    /// The URDF name.
+    pub name: String,
+    /// Mass properties; `None` when the link has no `<inertial>` (massless).
+    pub inertial: Option<Inertial>,
+    /// The `<link>` element.
+    pub span: Span,
+}
+
+/// A checked URDF tree: one root link, every other link the child of exactly one joint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Robot {
+    /// `<robot name>`.
+    pub name: String,
+    /// Links in file order.
+    pub links: Vec<Link>,
+    /// Joints in file order.
+    pub joints: Vec<Joint>,
+    /// The root link (child of no joint).
+    pub root: usize,
+}
+
+impl Robot {
+    /// The joints leaving link `l`, ordered by joint name (byte order): the order urdfdom (and
+    /// so `pinocchio.buildModelFromUrdf`) visits them, since it keeps joints in a sorted map.
+    pub fn children(&self, l: usize) -> Vec<usize> {
+        let mut c: Vec<usize> = (0..self.joints.len()).filter(|&j| self.joints[j].parent == l).collect();
+        c.sort_by(|&a, &b| self.joints[a].name.as_bytes().cmp(self.joints[b].name.as_bytes()));
+        c
+    }
+
+    /// The root segment, per link: the root and every link whose joints up to the root all have
+    /// no offset and no constant rotation, with no prismatic joint below a revolute one
+    /// (Robotran's floating base `T1 T2 T3 R1 R2 R3`). Their joints all act at one point: the
+    /// CRBA projects column forces there ([`crate::crba`]) and [`crate::origins`]
+    /// leaves them in place. Cost: O(joints · log joints).
+    pub fn root_segment(&self) -> Vec<bool> {
+        let mut in_segment = vec![false; self.links.len()];
+        let mut revolute_above = vec![false; self.links.len()];
+        in_segment[self.root] = true;
+        for j in self.dfs_joints() {
+            let jo = &self.joints[j];
+            let plain = jo.origin.xyz == [0.0; 3] && jo.origin.rot == Origin::IDENTITY.rot;
+            in_segment[jo.child] =
+                in_segment[jo.parent] && plain && !(jo.kind == JointKind::Prismatic && revolute_above[jo.parent]);
+            revolute_above[jo.child] = revolute_above[jo.parent] || jo.kind == JointKind::Revolute;
+        }
+        in_segment
+    }
+
+    /// Every joint in depth-first pre-order from the root, children by [`Robot::children`]:
+    /// Pinocchio's joint order once the fixed joints are left out. Cost: O(joints · log joints).
+    pub fn dfs_joints(&self) -> Vec<usize> {
+        let mut children: Vec<Vec<usize>> = vec![Vec::new(); self.links.len()];
+        for (j, joint) in self.joints.iter().enumerate() {
+            children[joint.parent].push(j);
+        }
+        for c in &mut children {
+            c.sort_by(|&a, &b| self.joints[a].name.as_bytes().cmp(self.joints[b].name.as_bytes()));
+        }
+        let mut out = Vec::with_capacity(self.joints.len());
+        let mut stack: Vec<usize> = children[self.root].iter().rev().copied().collect();
+        while let Some(j) = stack.pop() {
+            out.push(j);
+            stack.extend(children[self.joints[j].child].iter().rev());
+        }
+        out
+    }
+}
+
+/// The names of Robotran's six floating-base joints, in chain order (`q[1..6]`).
+pub const FLOATING_BASE: [&str; 6] = ["T1", "T2", "T3", "R1", "R2", "R3"];
+
+impl Robot {
+    /// `self` on a floating base as Robotran models it: six joints between a new fixed root
+    /// link `world` and the old root, `T1`, `T2`, `T3` (prismatic along x, y, z) then `R1`,
+    /// `R2`, `R3` (revolute about x, then the new y, then the new z), joined by massless links
+    /// `T1_link` … `R2_link`; the old root is the child of `R3`. These joints are `q[1..6]`
+    /// and the URDF's moving joints follow from `q[7]`. Pinocchio's model of the same
+    /// coordinates is `buildModelFromUrdf(path, JointModelComposite([PX, PY, PZ, RX, RY, RZ]))`.
+    ///
+    /// # Errors
+    /// The name and the element (`<joint>` or `<link>` span) of the first URDF joint or link, in
+    /// the file's order, whose name clashes with the names above.
+    pub fn with_floating_base(mut self) -> Result<Robot, (String, Span)> {
+        let reserved: Vec<String> = FLOATING_BASE
+            .iter()
+            .flat_map(|j| [j.to_string(), format!("{j}_link")])
+            .chain(["world".to_string()])
+            .collect();
+        let clash = self
+            .joints
+            .iter()
+            .map(|j| (&j.name, j.span))
+            .chain(self.links.iter().map(|l| (&l.name, l.span)))
+            .filter(|(n, _)| reserved.contains(n))
+            .min_by_key(|(_, span)| span.start);
+        if let Some((name, span)) = clash {
+            return Err((name.clone(), span));
+        }
+        let old_root = self.root;
+        let span = self.links[old_root].span;
+        self.links.push(Link { name: "world".into(), inertial: None, span });
+        let mut parent = self.links.len() - 1;
+        self.root = parent;
+        for (k, name) in FLOATING_BASE.iter().enumerate() {
+            let child = if k == 5 {
+                old_root
+            } else {
+                self.links.push(Link { name: format!("{name}_link"), inertial: None, span });
+                self.links.len() - 1
+            };
+            let mut axis = [0.0; 3];
+            axis[k % 3] = 1.0;
+            let kind = if k < 3 { JointKind::Prismatic } else { JointKind::Revolute };
+            self.joints.push(Joint {
+                name: (*name).into(),
+                kind,
+                parent,
+                child,
+                origin: Origin::IDENTITY,
+                axis,
+                offset: 0.0,
+                span,
+            });
+            parent = child;
+        }
+        Ok(self)
+    }
+}

@@ -1,0 +1,162 @@
+//! The front-end registry: every input language robovec reads, in one table ([`FRONT_ENDS`]).
+//!
+//! The driver picks the front end of an input by its file extension ([`front_end_for`]) and
+//! calls [`FrontEnd::load`]; it never names a language. Adding a language is one module and
+//! one line in [`FRONT_ENDS`] (the URDF front end, issue 14, is such a line). robovec IR
+//! (`.rvir`, and `-` for stdin) is registered too, so that every input takes the same path.
+//!
+//! A front end returns the module in the parsed phase (or whatever phase an `.rvir` text has)
+//! and, when it knows them, the numeric values of the model parameters it left symbolic
+//! ([`Loaded::params`], canonical input names of SPEC §2 → number: what `-params-out` writes
+//! and what `specialize<params=…>` and `-eval` read).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use robovec_ir::Module;
+
+use super::{parse_text, FrontError, Language};
+
+/// What a front end may be asked beyond the text (command-line options that concern loading).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrontOptions {
+    /// `--fold-params`: fold the model's numeric parameters into the equations instead of
+    /// keeping them as inputs (`dpt`, `l`, `m`, `In`). Front ends whose input has no numeric
+    /// parameters (Robotran files, IR) ignore it.
+    pub fold_params: bool,
+    /// `--floating-base`: put the robot on Robotran's floating base (six joints `T1`–`T3`,
+    /// `R1`–`R3` before the root link, `q[1..6]`; see `robovec_dynamics::robot::Robot::with_floating_base`).
+    /// Front ends of fixed equations (Robotran files, IR) ignore it.
+    pub floating_base: bool,
+}
+
+/// A loaded input: the module, and the values of the model parameters it keeps as inputs.
+#[derive(Clone, Debug, Default)]
+pub struct Loaded {
+    /// The functions read or generated.
+    pub module: Module,
+    /// Canonical parameter name (`m[2]`, `dpt[1][3]`) → value, when the input states them
+    /// (a URDF does; a Robotran file does not: its parameters live in the user's `MbsData`).
+    pub params: Option<BTreeMap<String, f64>>,
+}
+
+impl From<Module> for Loaded {
+    fn from(module: Module) -> Loaded {
+        Loaded { module, params: None }
+    }
+}
+
+/// One input language.
+pub trait FrontEnd: Sync {
+    /// Short name shown in messages (`Robotran C`, `URDF`).
+    fn name(&self) -> &'static str;
+
+    /// File extensions without the dot (`c`, `h`), matched exactly.
+    fn extensions(&self) -> &'static [&'static str];
+
+    /// Reads `text` (made by [`super::source_text`] from the bytes of `path`, every byte
+    /// offset kept) into a module. `path` lets a front end read companion files (a C file's
+    /// `.h`); it is `-` for stdin.
+    ///
+    /// # Errors
+    /// Every problem found, with byte spans into `text` (the driver renders them as
+    /// `file:line:col` diagnostics and exits 1).
+    fn load(&self, path: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>>;
+
+    /// The message when the input holds no function (`expected at least one function`).
+    fn no_function_message(&self) -> &'static str {
+        "expected at least one function"
+    }
+}
+
+/// A Robotran output file (C with its companion `.h`, Matlab or Python).
+struct Robotran(Language);
+
+impl FrontEnd for Robotran {
+    fn name(&self) -> &'static str {
+        match self.0 {
+            Language::C => "Robotran C",
+            Language::Matlab => "Robotran Matlab",
+            Language::Python => "Robotran Python",
+        }
+    }
+
+    fn extensions(&self) -> &'static [&'static str] {
+        match self.0 {
+            Language::C => &["c", "h"],
+            Language::Matlab => &["m"],
+            Language::Python => &["py"],
+        }
+    }
+
+    fn load(&self, path: &Path, text: &str, _: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
+        let header = match self.0 {
+            Language::C if path.extension().is_some_and(|e| e == "c") => std::fs::read(path.with_extension("h")).ok(),
+            _ => None,
+        };
+        parse_text(self.0, text, header.as_deref()).map(Loaded::from)
+    }
+}
+
+/// robovec's own textual IR (`.rvir`; `-` reads it from stdin).
+struct Ir;
+
+impl FrontEnd for Ir {
+    fn name(&self) -> &'static str {
+        "robovec IR"
+    }
+
+    fn extensions(&self) -> &'static [&'static str] {
+        &["rvir"]
+    }
+
+    fn load(&self, _: &Path, text: &str, _: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
+        robovec_ir::text::parse(text).map(Loaded::from)
+    }
+
+    fn no_function_message(&self) -> &'static str {
+        "expected at least one `func`"
+    }
+}
+
+/// Every front end, in the order `--help` lists them.
+pub static FRONT_ENDS: &[&dyn FrontEnd] =
+    &[&Robotran(Language::C), &Robotran(Language::Matlab), &Robotran(Language::Python), &super::urdf::Urdf, &Ir];
+
+/// The front end for `input`: by extension, IR for `-` (stdin); `None` for an unknown extension.
+pub fn front_end_for(input: &str) -> Option<&'static dyn FrontEnd> {
+    if input == "-" {
+        return Some(&Ir);
+    }
+    let ext = Path::new(input).extension()?.to_str()?;
+    FRONT_ENDS.iter().copied().find(|f| f.extensions().contains(&ext))
+}
+
+/// Every registered extension as `.c, .h, .m, …` for messages.
+pub fn extension_list() -> String {
+    FRONT_ENDS.iter().flat_map(|f| f.extensions()).map(|e| format!(".{e}")).collect::<Vec<_>>().join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extensions_pick_one_front_end_each() {
+        assert_eq!(front_end_for("a/b.c").map(|f| f.name()), Some("Robotran C"));
+        assert_eq!(front_end_for("b.h").map(|f| f.name()), Some("Robotran C"));
+        assert_eq!(front_end_for("b.m").map(|f| f.name()), Some("Robotran Matlab"));
+        assert_eq!(front_end_for("b.py").map(|f| f.name()), Some("Robotran Python"));
+        assert_eq!(front_end_for("robot.urdf").map(|f| f.name()), Some("URDF"));
+        assert_eq!(front_end_for("x.rvir").map(|f| f.name()), Some("robovec IR"));
+        assert_eq!(front_end_for("-").map(|f| f.name()), Some("robovec IR"));
+        assert!(front_end_for("x.txt").is_none());
+        assert!(front_end_for("noext").is_none());
+        // No extension is claimed twice.
+        let all: Vec<&str> = FRONT_ENDS.iter().flat_map(|f| f.extensions().iter().copied()).collect();
+        let mut dedup = all.clone();
+        dedup.sort_unstable();
+        dedup.dedup();
+        assert_eq!(all.len(), dedup.len());
+    }
+}
