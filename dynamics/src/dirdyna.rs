@@ -45,7 +45,7 @@
 
 use rustc_hash::FxHashMap;
 
-use super::crba;
+use super::crba::{self, bind_entry};
 use super::rnea::{motions, sweep, Drive, Motion};
 use super::sym::{Builder, Term, ZERO};
 use super::{Layout, Model};
@@ -58,13 +58,6 @@ pub enum MassMatrix {
     Crba,
     /// One RNEA sweep per column with `qdd = e_j`, `qd = 0`, `g = 0`.
     UnitAcceleration,
-}
-
-/// `M[i][j]` (1-based) bound as the temporary `M{i}_{j}` where it is formed: both ways of
-/// forming `M` bind each entry as soon as it is known, so nothing it reads stays live until
-/// the outputs are written.
-pub(super) fn bind_entry(b: &mut Builder, i: usize, j: usize, t: Term) -> Term {
-    b.bind(&format!("M{i}_{j}"), t)
 }
 
 /// Writes `dirdyna` (outputs `M[i][j]`, then `c[i]`) into `b`, `M` by CRBA.

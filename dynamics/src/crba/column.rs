@@ -5,11 +5,17 @@
 use rustc_hash::FxHashMap;
 
 use super::composite::Composite;
-use super::Tree;
-use crate::dirdyna::bind_entry;
+use super::tree::Tree;
 use crate::rnea::{cross, dot, matvec, vadd, M3, V3};
 use crate::robot::JointKind;
 use crate::sym::{mul, sum, Builder, Term};
+
+/// `M[i][j]` (1-based) bound as the temporary `M{i}_{j}` where it is formed: both ways of
+/// forming `M` bind each entry as soon as it is known, so nothing it reads stays live until
+/// the outputs are written.
+pub(crate) fn bind_entry(b: &mut Builder, i: usize, j: usize, t: Term) -> Term {
+    b.bind(&format!("M{i}_{j}"), t)
+}
 
 /// Binds a column force carried to body `body` for column `col`: `FM{k}{body}_{col}`
 /// (Robotran's `FM31_24` style).

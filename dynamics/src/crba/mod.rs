@@ -80,69 +80,22 @@ mod column;
 mod composite;
 #[cfg(test)]
 mod tests;
+mod tree;
 
 use super::rnea::{numeric, Motion, M3, V3};
-use super::robot::Robot;
 use super::sym::{Builder, Term};
 use super::{Layout, Model};
+pub(crate) use column::bind_entry;
 use column::merged_rotation;
 use composite::Composite;
 use rustc_hash::FxHashMap;
-
-/// The robot as the CRBA walks it: bodies numbered `1..=nb` depth first (`0` is the fixed
-/// root), each indexed by body.
-struct Tree<'a> {
-    robot: &'a Robot,
-    layout: &'a Layout,
-    motions: &'a [Motion],
-    /// The joint of body `i` is `robot.joints[order[i - 1]]`.
-    order: Vec<usize>,
-    parent: Vec<usize>,
-    /// Whether the body moves (a coordinate on its path to the root).
-    moves: Vec<bool>,
-    /// The constant rotation of the body's joint origin.
-    ro: Vec<M3>,
-    /// The joint's constant and joint rotations as one, where cheaper (`merged_rotation`).
-    merged: Vec<Option<M3>>,
-    /// Whether the body is in the root segment (`Robot::root_segment`): its joints all act at
-    /// one point, so a column force that reaches it gives every entry above by projection.
-    in_segment: Vec<bool>,
-    /// Coordinates on the path from the root to the body.
-    segment_moving: Vec<usize>,
-}
-
-/// Steps a column must be carried (moving bodies between its body and the root segment) for
-/// it to go up in a pair with its parent's (module doc, "Order of the statements").
-const PAIR_WALK: usize = 8;
-
-impl Tree<'_> {
-    /// Per body: whether its column waits for its parent's to go up with it — the parent is
-    /// the next body the leaves-to-root loop forms, has a coordinate, the walk to the root
-    /// segment is at least [`PAIR_WALK`] steps and crosses no merged (dense) rotation.
-    fn waits(&self) -> Vec<bool> {
-        let nb = self.order.len();
-        let (mut walk, mut dense) = (vec![0usize; nb + 1], vec![false; nb + 1]);
-        let mut waits = vec![false; nb + 1];
-        for body in 1..=nb {
-            let p = self.parent[body];
-            walk[body] = walk[p] + usize::from(self.moves[body] && !self.in_segment[body]);
-            dense[body] = dense[p] || self.merged[body].is_some();
-            waits[body] = p > 0
-                && p + 1 == body
-                && self.moves[p]
-                && self.layout.q_index[p - 1].is_some()
-                && walk[body] >= PAIR_WALK
-                && !dense[body];
-        }
-        waits
-    }
-}
+use tree::Tree;
 
 /// The upper triangle of `M`: `(i, j) → term` for `i ≤ j` (1-based coordinates), entries that
 /// fold to 0 left out. Writes the composites and column forces into `b` as temporaries `MC`,
 /// `HC`, `JC` (per body) and `FM`, `CM` (per body and column), each column right after its
 /// body's composite, and every entry as `M{i}_{j}` where it is formed
-/// ([`super::dirdyna::bind_entry`]; module doc, "Order of the statements").
+/// ([`bind_entry`]; module doc, "Order of the statements").
 pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]) -> Vec<((usize, usize), Term)> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
