@@ -47,7 +47,7 @@ use side::{read_states, robovec_inputs, run, Env, States};
 const NSETS: usize = 64;
 
 /// robovec's variants of each function: label, pipeline before `codegen`, lanes, `trig`. One
-/// state without `schedule-cpu` (it does not help one state: README "Speed of the generated C");
+/// state without `schedule-cpu` (it does not help one state: docs/codegen-c.md "Speed of the generated C");
 /// batches of 4 (one AVX2 vector of doubles) and 8 (one AVX-512 vector: the fastest width per
 /// state where the machine has AVX-512, 4 where it has AVX2 only: 8 and 16 lanes were 5–45 %
 /// slower per state on TIAGo Pro and serial30 on a Zen 3). `trig=libm` and `trig=inline`

@@ -106,7 +106,7 @@ pub struct Cli {
     pub print_passes: bool,
     /// The machine every pass targets: `de10-nano` (built in, seed ch. 1) or a JSON target
     /// file (latencies, write ports, memory words, clock, device capacities, unit costs; see
-    /// the README's "Targets"). A pass's `lat-*`/`writes` parameter overrides it only where
+    /// docs/targets.md). A pass's `lat-*`/`writes` parameter overrides it only where
     /// given.
     #[arg(long, value_name = "de10-nano|FILE.json")]
     pub target: Option<String>,

@@ -69,7 +69,7 @@ pub fn target(opts: &Options) -> Result<robovec_machine::target::Target, Failure
                 format!("\n  = -target takes a built-in target ({}) or a JSON target file", Target::BUILT_IN.join(", "))
             }
             TargetError::Syntax { .. } | TargetError::Value { .. } => {
-                "\n  = the target format is described in the README (\"Targets\") and `robovec_ir::target`".to_string()
+                "\n  = the target format is described in docs/targets.md and `robovec_machine::target`".to_string()
             }
         };
         Failure::Input(format!("error: -target: {e}{hint}\n"))

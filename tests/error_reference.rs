@@ -35,7 +35,7 @@ fn accuracy_after_an_unsound_rule_shows_tens_of_bits() {
     assert!(acc["reference"]["against"].as_str().unwrap().starts_with("input of the pipeline"), "{acc}");
     assert!(stderr(&o).contains("reference (input of the pipeline"), "{}", stderr(&o));
     // The unchanged pipeline measures the same as the function against itself: the original
-    // is bit for bit the same computation (figures of the README table).
+    // is bit for bit the same computation (figures of the table in docs/accuracy.md).
     let o = opt(&[PENDULUM, "-passes=atomise,accuracy<samples=1000;seed=1>", &format!("-report={}", r.display())]);
     assert!(o.status.success(), "{}", stderr(&o));
     let acc = &json(&r)["accuracy"];

@@ -104,7 +104,7 @@ fn example_loads_with_expected_inputs_and_ops() {
 
     let a = atomise_function(&f);
     assert!(verifier::verify_function(&a).is_empty(), "atomised example does not verify");
-    // Counted by hand with SPEC §3 (see README.md: 4 `0 - t`, one `-` in ALPHA32).
+    // Counted by hand with SPEC §3 (see docs/rewrites.md: 4 `0 - t`, one `-` in ALPHA32).
     let c = a.op_counts();
     assert_eq!((c.add, c.sub, c.mul, c.div, c.call, c.total), (16, 5, 27, 0, 0, 48));
 }

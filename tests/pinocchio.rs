@@ -199,7 +199,7 @@ fn floating_base_matches_pinocchio_composite_root_joint() {
 /// A mobile manipulator: PAL's TIAGo Pro (example-robot-data; omnidirectional base on four
 /// continuous wheel joints, a prismatic torso, a head and two 7-dof arms with grippers: 33
 /// moving joints) on Robotran's floating base (6 + 33 coordinates), against Pinocchio's composite
-/// root joint. (The older TIAGo's URDF is refused: see README, an inertia tensor no body has.)
+/// root joint. (The older TIAGo's URDF is refused: see docs/generator.md, an inertia tensor no body has.)
 #[test]
 fn mobile_manipulator_matches_pinocchio_composite_root_joint() {
     let e = compare_on("erd:tiago_pro_description/robots/tiago_pro.urdf", 33 + 6, true);

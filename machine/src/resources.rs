@@ -50,7 +50,7 @@
 //! (flat 44 s), 8 + 8 27 s, 16 + 16 50 s; WALK-MAN `dirdyna` at 4 + 4, whose 1306 outputs make
 //! output memories of about 160 words per PE, 114 s. The time now grows with the PEs and their
 //! output memories (the crossbar port is mapped once), not with the square of the PEs; 32 + 32
-//! passed 100 s of CPU (the README has the measured table). So `resources=auto` runs Yosys up
+//! passed 100 s of CPU (docs/fpga.md has the measured table). So `resources=auto` runs Yosys up
 //! to 32 + 32 PEs ([`AUTO_YOSYS_MAX_PES`]), the largest N of issue 12's table.
 //!
 //! ## Against the seed's Table 1.4 (8 PE: 4 ADD + 4 MULTI)

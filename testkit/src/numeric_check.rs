@@ -8,7 +8,7 @@
 //!   the second term covering the double-double reference (so an algebraically different
 //!   rewrite fails, a reassociation within its rounding passes);
 //! - pipelines made only of passes in [`BIT_EXACT`] reproduce the original bit for bit, except
-//!   the sign of an exact zero (`atomise` writes `−t` as `0 − t`, README "Unary minus
+//!   the sign of an exact zero (`atomise` writes `−t` as `0 − t`; docs/ir.md, "Unary minus
 //!   semantics").
 //!
 //! Points whose `M` comes within a factor 4 of the format's largest value are not checked in

@@ -396,7 +396,7 @@ fn check_inline_sin_cos(dir: &str, flags: &[&str]) {
                     ),
                 );
             }
-            // The documented bound (trig.rs, README): below 1 ulp of the exact value, hence at
+            // The documented bound (trig.rs, docs/codegen-c.md): below 1 ulp of the exact value, hence at
             // most 1 ulp from the correctly rounded result.
             assert!(max < 1.0, "{label} {name}: {max} ulp\n{report}");
         }

@@ -23,7 +23,7 @@
 //!    interval around zero after 256 bits is, in practice, an exact zero reached through
 //!    inexact steps such as `sin(a)·cos(b) − cos(b)·sin(a)`).
 //!
-//! On the corpus the fast path certifies almost every output (figures in the README); the
+//! On the corpus the fast path certifies almost every output (figures in docs/accuracy.md, "Error reference"); the
 //! 256-bit path is the reference wherever it does not.
 
 use astro_float::{BigFloat, RoundingMode};
