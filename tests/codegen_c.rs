@@ -57,7 +57,7 @@ fn cc(dir: &Path, files: &[String], flags: &[&str]) -> PathBuf {
     let exe = dir.join("run");
     let mut cmd = Command::new("cc");
     cmd.current_dir(dir).args(flags).args(["-ffp-contract=off", "-w", "-o"]).arg(&exe).args(files).arg("-lm");
-    let o = cmd.output().expect("a C compiler `cc` on PATH (.ci/run installs gcc)");
+    let o = cmd.output().expect("a C compiler `cc` on PATH (scripts/test.sh installs gcc)");
     assert!(o.status.success(), "cc failed in {}:\n{}", dir.display(), String::from_utf8_lossy(&o.stderr));
     exe
 }

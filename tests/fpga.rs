@@ -1,7 +1,7 @@
 //! `codegen<fpga>` (issue 12): the FP unit models against C `float`, the generated design
 //! simulated in Icarus Verilog against robovec's binary32 evaluation bit for bit, the images read
 //! back, the diagnostics and the Yosys resource estimate. Needs `cc`, `iverilog`/`vvp`, `yosys`
-//! and `python3` (`.ci/run` installs them).
+//! and `python3` (`scripts/test.sh` installs them).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

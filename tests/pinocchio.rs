@@ -3,7 +3,7 @@
 //! (symmetrized by the oracle) and `pinocchio.nonLinearEffects`, on random states, relative
 //! error ≤ 1e-10 (∞-norm of the difference over the ∞-norm of Pinocchio's values).
 //!
-//! Pinocchio (PyPI `pin`) and `example-robot-data` live in a virtual environment that `.ci/run`
+//! Pinocchio (PyPI `pin`) and `example-robot-data` live in a virtual environment that `scripts/test.sh`
 //! creates at `target/pinocchio-venv` (or the Python named by `ROBOVEC_PINOCCHIO_PYTHON`);
 //! `scripts/pinocchio_oracle.py` prints the reference states and torques as JSON. In CI
 //! (`CI` set) a missing environment fails the test; elsewhere it is skipped with a note.
@@ -22,7 +22,7 @@ pub(crate) fn python() -> Option<PathBuf> {
         return Some(p);
     }
     let msg = format!(
-        "Pinocchio's environment is missing at {} (.ci/run creates it: python3 -m venv target/pinocchio-venv && \
+        "Pinocchio's environment is missing at {} (scripts/test.sh creates it: python3 -m venv target/pinocchio-venv && \
          target/pinocchio-venv/bin/pip install pin example-robot-data)",
         p.display()
     );

@@ -24,7 +24,7 @@ const CXX_FLAGS: &[&str] = &[
 /// contraction, so the values are `-eval`'s).
 const C_FLAGS: &[&str] = &["-O3", "-march=native", "-ffp-contract=off", "-Wno-psabi"];
 
-/// How to create the environment (the commands of `.ci/run`, plus Eigen's headers).
+/// How to create the environment (the commands of `scripts/test.sh`, plus Eigen's headers).
 const HOW: &str = "python3 -m venv target/pinocchio-venv && \
     target/pinocchio-venv/bin/pip install pin example-robot-data cmeel-eigen";
 
