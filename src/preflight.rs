@@ -122,7 +122,7 @@ fn pass_paths(pm: &PassManager, want: impl Fn(&ParamKind) -> bool) -> Vec<(&str,
     for spec in pm.specs() {
         let Some(info) = robovec_passes::pass_info(&spec.name) else { continue };
         for (key, value) in &spec.params {
-            let Some(decl) = info.params.iter().find(|p| p.name == key) else { continue };
+            let Some(decl) = info.param(key) else { continue };
             if let Some(value) = value.as_deref().filter(|v| !v.is_empty() && want(&decl.kind)) {
                 out.push((spec.name.as_str(), key.as_str(), value));
             }

@@ -37,7 +37,7 @@ use robovec_ir::{Module, Phase, Span};
 
 pub use artifact::{Artifact, ArtifactFile, GeneratedCode, Merge, Produced, ReportEntry};
 pub use manager::{DumpSink, Instrumentation, PassManager, PassRecord, PrintSelector};
-pub use params::{LatencyOverride, ParamInfo, ParamKind, Params};
+pub use params::{LatencyOverride, Member, ParamInfo, ParamKind, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
 
 /// What a pass may fail with.
@@ -325,10 +325,24 @@ pub struct PassInfo {
     pub name: &'static str,
     /// One-line description.
     pub doc: &'static str,
-    /// Accepted parameters.
+    /// Accepted parameters. A pass family (`codegen`) declares a [`ParamKind::Selector`] here,
+    /// and each of its [`Member`]s its own parameters.
     pub params: &'static [ParamInfo],
-    /// Builds the pass from checked parameters.
+    /// Builds the pass from checked parameters (a family: [`Params::build_member`]).
     pub build: fn(&Params) -> Result<Box<dyn Pass>, PassError>,
+}
+
+impl PassInfo {
+    /// Every parameter declaration of the pass: its own, then (for a pass family) each
+    /// member's, in `--print-passes` order.
+    pub fn every_param(&'static self) -> impl Iterator<Item = &'static ParamInfo> {
+        self.params.iter().chain(self.params.iter().flat_map(ParamInfo::members).flat_map(|m| m.params))
+    }
+
+    /// The declaration of parameter `key`: the pass's own, or a member's (for a pass family).
+    pub fn param(&'static self, key: &str) -> Option<&'static ParamInfo> {
+        self.every_param().find(|p| p.name == key)
+    }
 }
 
 /// The registry: every pass robovec knows, in `--print-passes` order.
