@@ -256,7 +256,7 @@ fn long_loops_report_progress_through_the_hook() {
     let rec = Recorder::default();
     let progress = robovec_passes::progress::Progress::shown(Arc::new(rec.clone()));
     let target = robovec_ir::target::Target::de10_nano();
-    robovec_passes::study::pareto::study(&m, "invdyna", "atomise;atomise,balance", 20, 1, None, &target, &progress)
+    robovec_passes::whole_run::pareto::study(&m, "invdyna", "atomise;atomise,balance", 20, 1, None, &target, &progress)
         .unwrap();
     let log = rec.0.lock().unwrap().clone();
     assert_eq!(log, [("-pareto: pipelines".to_string(), 2, vec![1, 2])]);

@@ -12,11 +12,9 @@ pub mod asap_alap;
 pub mod atomise;
 pub mod codegen;
 pub mod contract;
-pub mod cpu_order;
 pub mod cse;
 pub mod dce;
 pub mod eqsat;
-pub mod figures;
 pub mod inline;
 pub mod machine;
 pub mod manager;
@@ -24,11 +22,13 @@ pub mod params;
 pub mod pipeline;
 pub mod place;
 pub mod progress;
+pub mod schedule_cpu;
 pub mod sim;
 pub mod specialize;
-pub mod study;
+pub mod summary;
 pub mod sweep;
 pub mod tree_height;
+pub mod whole_run;
 
 use robovec_ir::analysis::Latencies;
 use robovec_ir::target::Target;
@@ -363,7 +363,7 @@ pub const PASSES: &[PassInfo] = &[
     eqsat::INFO,
     cse::INFO,
     contract::INFO,
-    cpu_order::INFO,
+    schedule_cpu::INFO,
     codegen::INFO,
 ];
 

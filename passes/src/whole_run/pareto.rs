@@ -26,7 +26,7 @@ use serde::Serialize;
 use super::Failure;
 use crate::accuracy::check::{check_function, pipeline_is_bit_exact};
 use crate::accuracy::{measure_against, BitsSummary, Options as AccuracyOptions};
-use crate::figures::stats;
+use crate::summary::stats;
 use crate::{Instrumentation, PassContext, PassManager};
 
 /// One pipeline's figures.
