@@ -11,7 +11,7 @@
 //! [`Member`]s each declare their own parameters: the parameters of `codegen<c;…>` are the
 //! selector and the C back end's, and a parameter of another member is refused naming the
 //! member it belongs to. A parameter whose values are words (`abi=plain|robotran`) is read as
-//! an enum declared with [`word_enum!`](crate::params::word_enum), whose words are the
+//! an enum declared with `word_enum!` (this module), whose words are the
 //! declaration's choices.
 
 use robovec_ir::analysis::Latencies;
@@ -137,7 +137,7 @@ pub struct Member {
 }
 
 /// A parameter value that is one word of a fixed set (`abi=plain|robotran`), as declared by
-/// [`word_enum!`](crate::params::word_enum).
+/// `word_enum!` (this module).
 pub trait Word: Copy + 'static {
     /// Every word, in the order of the variants: the choices of the parameter's declaration.
     const WORDS: &'static [&'static str];
