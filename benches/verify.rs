@@ -16,9 +16,9 @@
 
 use std::time::Instant;
 
-use robovec_machine::lower::lower;
 use robovec_ir::verifier::{machine::verify_machine, placement::verify_placement, verify_function};
 use robovec_ir::Function;
+use robovec_machine::lower::lower;
 use robovec_passes::place::{place_function, PlaceOptions};
 use robovec_testkit::dag_gen::generate;
 

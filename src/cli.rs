@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use clap::{ArgAction, Parser};
-use robovec_passes::{Instrumentation, PrintSelector, PASSES};
+use robovec_passes::{Instrumentation, ParamInfo, PrintSelector, PASSES};
 
 use crate::options::Options;
 
@@ -158,13 +158,24 @@ pub fn normalise_args(args: impl IntoIterator<Item = String>) -> Vec<String> {
         .collect()
 }
 
-/// The `--print-passes` listing.
+/// The `--print-passes` listing: each pass, its parameters, and for a pass family (`codegen`)
+/// each member (`back end c: …`) with its own parameters.
 pub fn print_passes() -> String {
+    let line =
+        |q: &ParamInfo| format!("      {:<12} (default {}; {}) {}\n", q.name, q.default_text(), q.range_text(), q.doc);
     let mut s = String::from("Passes (use -passes=a,b<k=v;k2=v2>,c):\n");
     for p in PASSES {
         s += &format!("  {:<12} {}\n", p.name, p.doc);
         for q in p.params {
-            s += &format!("      {:<12} (default {}; {}) {}\n", q.name, q.default_text(), q.range_text(), q.doc);
+            s += &line(q);
+        }
+        for q in p.params {
+            for m in q.members() {
+                s += &format!("    {} {}: {}\n", q.name.replace('-', " "), m.name, m.doc);
+                for x in m.params {
+                    s += &line(x);
+                }
+            }
         }
     }
     s

@@ -17,10 +17,10 @@ use std::path::{Path, PathBuf};
 
 use robovec_front::{FrontOptions, Loaded};
 use robovec_ir::{verifier, Module};
-use robovec_passes::figures::{self, Figures};
 use robovec_passes::report::report_text;
+use robovec_passes::summary::{self, Figures};
 use robovec_passes::{
-    study, DumpSink, GeneratedCode, Instrumentation, PassContext, PassError, PassManager, PassRecord,
+    whole_run, DumpSink, GeneratedCode, Instrumentation, PassContext, PassError, PassManager, PassRecord,
 };
 
 use crate::diagnostics::SourceFile;
@@ -274,7 +274,7 @@ fn run_passes(
     };
     if let Some(text) = &opts.pareto {
         let name = select(module, &opts.function, "-pareto")?.name.clone();
-        let study = study::pareto::study(
+        let study = whole_run::pareto::study(
             module,
             &name,
             text,
@@ -300,22 +300,22 @@ fn run_passes(
         writeln!(stderr, "note: {s}").map_err(stderr_failure)?;
     }
     if let (Some((samples, seed)), Some(original)) = (opts.check, &cx.original) {
-        study::check::run(module, original, &pm.pipeline_text(), &opts.function, samples, seed, stderr)
+        whole_run::check::run(module, original, &pm.pipeline_text(), &opts.function, samples, seed, stderr)
             .map_err(study_failure)?;
     }
     Ok(Ran { records, cx })
 }
 
-fn study_failure(f: study::Failure) -> Failure {
+fn study_failure(f: whole_run::Failure) -> Failure {
     match f {
-        study::Failure::Usage(s) => Failure::Usage(s),
-        study::Failure::Input(s) => Failure::Input(s),
+        whole_run::Failure::Usage(s) => Failure::Usage(s),
+        whole_run::Failure::Input(s) => Failure::Input(s),
     }
 }
 
 /// The report (SPEC §7) of the function `-report` describes: the run's own fields, the figures
 /// of the final IR, then each artifact's entry (merged by key), then the early stops.
-/// `computed` are those of [`figures::figures`] for `-function` (the reported function is among
+/// `computed` are those of [`summary::figures`] for `-function` (the reported function is among
 /// them; they are computed again only if it were not).
 fn report_json(
     opts: &Options,
@@ -415,11 +415,11 @@ fn write_outputs(
     // the tight lower bound, and a parsed function is atomised to be measured).
     let reporting = opts.report.is_some() || opts.report_dir.is_some();
     let figs =
-        if opts.stats || reporting { figures::figures(module, cx, opts.function.as_deref()) } else { Vec::new() };
+        if opts.stats || reporting { summary::figures(module, cx, opts.function.as_deref()) } else { Vec::new() };
     let report = reporting.then(|| report_json(opts, pm, module, ran, &figs)).transpose()?;
     let eval = eval_inputs.map(|given| eval_json(opts, module, given, stderr)).transpose()?;
     if opts.stats {
-        write!(stderr, "{}", figures::stats_text(&figs, cx, opts.function.as_deref())).map_err(stderr_failure)?;
+        write!(stderr, "{}", summary::stats_text(&figs, cx, opts.function.as_deref())).map_err(stderr_failure)?;
     }
     let mut tables_shown = opts.stats;
     for a in cx.artifacts() {

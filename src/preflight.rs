@@ -84,9 +84,9 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     check_pass_files(pm)?;
     // `-pareto`'s pipelines: every name, parameter and file they read, before any work too.
     if let Some(text) = &opts.pareto {
-        let managers = robovec_passes::study::pareto::managers(text).map_err(|f| match f {
-            robovec_passes::study::Failure::Usage(s) => Failure::Usage(s),
-            robovec_passes::study::Failure::Input(s) => Failure::Input(s),
+        let managers = robovec_passes::whole_run::pareto::managers(text).map_err(|f| match f {
+            robovec_passes::whole_run::Failure::Usage(s) => Failure::Usage(s),
+            robovec_passes::whole_run::Failure::Input(s) => Failure::Input(s),
         })?;
         for (_, other) in managers {
             check_pass_files(&other)?;
@@ -122,7 +122,7 @@ fn pass_paths(pm: &PassManager, want: impl Fn(&ParamKind) -> bool) -> Vec<(&str,
     for spec in pm.specs() {
         let Some(info) = robovec_passes::pass_info(&spec.name) else { continue };
         for (key, value) in &spec.params {
-            let Some(decl) = info.params.iter().find(|p| p.name == key) else { continue };
+            let Some(decl) = info.param(key) else { continue };
             if let Some(value) = value.as_deref().filter(|v| !v.is_empty() && want(&decl.kind)) {
                 out.push((spec.name.as_str(), key.as_str(), value));
             }

@@ -13,7 +13,7 @@ use std::process::Command;
 
 use robovec_ir::interp::{callback_standin, eval, pseudo_random_input, Float};
 use robovec_ir::{Callee, Def, Module, TrigFn};
-use robovec_passes::codegen::c::{robotran, split_callee, CodegenC, Trig};
+use robovec_passes::codegen::c::{robotran, split_callee, Abi, CodegenC, Precision, Trig};
 use robovec_passes::codegen::input_values;
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
@@ -206,12 +206,12 @@ fn check_plain_tol<T: Float>(
     extra: &[&str],
     tol: Option<f64>,
 ) -> (usize, f64) {
-    let f32 = o.f32;
+    let f32 = o.f32();
     let real = o.real();
     let w = o.batch;
     let mut files = vec!["main.c".to_string(), "callbacks.c".to_string()];
     let mut uses = Vec::new();
-    let robotran_abi = o.abi == "robotran";
+    let robotran_abi = o.abi == Abi::Robotran;
     let mut main = String::from("#include <stdio.h>\n#include <stdlib.h>\n#include <string.h>\n#include <stdint.h>\n");
     if robotran_abi {
         std::fs::write(dir.join("mbs_data.h"), robotran::mbs_data_header()).unwrap();
@@ -434,7 +434,20 @@ fn robotran_out_args(f: &robovec_ir::Function) -> String {
 }
 
 fn plain(f32: bool, batch: u32, trig_input: bool) -> CodegenC {
-    CodegenC { f32, batch, trig: if trig_input { Trig::Input } else { Trig::Libm }, ..CodegenC::default() }
+    CodegenC {
+        precision: precision(f32),
+        batch,
+        trig: if trig_input { Trig::Input } else { Trig::Libm },
+        ..CodegenC::default()
+    }
+}
+
+fn precision(f32: bool) -> Precision {
+    if f32 {
+        Precision::F32
+    } else {
+        Precision::F64
+    }
 }
 
 #[test]
@@ -459,7 +472,7 @@ fn plain_f32_equals_the_interpreter_bit_for_bit_on_every_corpus_file() {
 fn robotran_drop_in_equals_the_interpreter_bit_for_bit_on_every_c_corpus_file() {
     for (k, pipeline) in ["atomise", "atomise,zero-removal,balance"].into_iter().enumerate() {
         let cases = corpus_cases(pipeline, true);
-        let o = CodegenC { abi: "robotran", ..CodegenC::default() };
+        let o = CodegenC { abi: Abi::Robotran, ..CodegenC::default() };
         let n = check_plain::<f64>(&tmp(&format!("robotran_{k}")), &cases, &o, 3);
         assert!(n > 3_000, "{pipeline}: only {n} outputs compared");
     }
@@ -564,7 +577,7 @@ fn inline_trig_agrees_with_the_interpreter_to_a_small_relative_error() {
         [(1, false, 1e-12, ""), (4, false, 1e-12, "-DROBOVEC_VBYTES=32"), (8, true, 1e-4, "")]
     {
         let dir = tmp(&format!("inline_{batch}_{f32}"));
-        let o = CodegenC { f32, batch, trig: Trig::Inline, ..CodegenC::default() };
+        let o = CodegenC { precision: precision(f32), batch, trig: Trig::Inline, ..CodegenC::default() };
         let extra: Vec<&str> = [width].into_iter().filter(|w| !w.is_empty()).collect();
         let (n, worst) = if f32 {
             check_plain_tol::<f32>(&dir, &cases, &o, 6, &extra, Some(tol))

@@ -15,6 +15,7 @@
 
 use robovec_ir::Function;
 use robovec_passes::atomise::atomise_function;
+use robovec_passes::place::dag::OpDag;
 use robovec_passes::place::{
     cycles, lower_bound, memory, place_function, schedule, tight_lower_bound, PlaceOptions, Priority, Select,
 };
@@ -135,7 +136,7 @@ proptest::proptest! {
     fn feeding_schedules_place_validly(n_ops in 1usize..300, seed in 0u64..1_000_000, n in 1u32..4, feed in 0u32..80) {
         let f = robovec_testkit::dag_gen::generate(n_ops, seed);
         let o = PlaceOptions::with_pes(n);
-        let dag = schedule::OpDag::new(&f);
+        let dag = OpDag::new(&f);
         let keys = schedule::seed_keys(&f, &o.arch, Priority::Classical);
         let s = schedule::schedule(&f, &dag, &o.arch, &keys, Select::Preferential, feed).expect("buffers on");
         let mut g = f.clone();
@@ -158,7 +159,7 @@ fn feeding_keeps_both_pe_types_busy_on_mazda_cons_hj() {
     let (m, _) = robovec::driver::load(p.to_str().unwrap()).unwrap_or_else(|e| panic!("{}", e.message()));
     let f = atomise_function(&m.functions[0]);
     let o = PlaceOptions::with_pes(1);
-    let dag = schedule::OpDag::new(&f);
+    let dag = OpDag::new(&f);
     let keys = schedule::seed_keys(&f, &o.arch, Priority::Classical);
     let end = |feed| {
         let s = schedule::schedule(&f, &dag, &o.arch, &keys, Select::Preferential, feed).expect("buffers on");

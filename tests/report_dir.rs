@@ -63,6 +63,16 @@ fn every_figure_is_svg_and_draws_the_reports_numbers() {
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
     assert_eq!(names.len(), 2 + 2 * ALL.len(), "{names:?}");
 
+    // The rows are read back as the types their passes write (serde both ways): each
+    // re-serialises to the report's own JSON.
+    fn round_trip<T: serde::Serialize + serde::de::DeserializeOwned>(v: &Value) {
+        let x: T = serde_json::from_value(v.clone()).unwrap_or_else(|e| panic!("{e}: {v}"));
+        assert_eq!(&serde_json::to_value(&x).unwrap(), v);
+    }
+    round_trip::<Vec<robovec_passes::sweep::SweepRow>>(&r["sweep"]);
+    round_trip::<robovec_passes::place::report::PlacementReport>(&r["placement"]);
+    round_trip::<Vec<robovec_passes::whole_run::pareto::ParetoRow>>(&r["pareto"]);
+
     // Sweep figures: one CSV row per (configuration, N) of the report, same numbers.
     let sweep = r["sweep"].as_array().unwrap();
     assert_eq!(sweep.len(), 3 * 4);
@@ -256,7 +266,7 @@ fn long_loops_report_progress_through_the_hook() {
     let rec = Recorder::default();
     let progress = robovec_passes::progress::Progress::shown(Arc::new(rec.clone()));
     let target = robovec_machine::target::Target::de10_nano();
-    robovec_passes::study::pareto::study(&m, "invdyna", "atomise;atomise,balance", 20, 1, None, &target, &progress)
+    robovec_passes::whole_run::pareto::study(&m, "invdyna", "atomise;atomise,balance", 20, 1, None, &target, &progress)
         .unwrap();
     let log = rec.0.lock().unwrap().clone();
     assert_eq!(log, [("-pareto: pipelines".to_string(), 2, vec![1, 2])]);

@@ -5,7 +5,7 @@
 use robovec_ir::interp::{eval, pseudo_random_input};
 use robovec_ir::{Def, Function};
 use robovec_passes::atomise::atomise_function;
-use robovec_passes::cpu_order::{Order, ScheduleCpu};
+use robovec_passes::schedule_cpu::{Order, ScheduleCpu};
 use robovec_passes::{Pass, PassContext};
 
 use crate::common::corpus_dir;

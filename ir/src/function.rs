@@ -1,6 +1,7 @@
 //! Functions and modules: value arena, body order, outputs, and the builder API used by front
 //! ends and passes.
 
+use crate::count::{count_expr, OpCounts};
 use crate::entities::Value;
 use crate::span::Span;
 use crate::syntax::{Callee, Def, Expr, OpKind, Operand, Output, Phase, ValueData};
@@ -136,37 +137,6 @@ impl Module {
     /// The function called `name`, if any.
     pub fn function(&self, name: &str) -> Option<&Function> {
         self.functions.iter().find(|f| f.name == name)
-    }
-}
-
-/// Counts of operations by kind (SPEC §7 `stats.ops`), units: ops.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-pub struct OpCounts {
-    /// `add` ops.
-    pub add: u64,
-    /// `sub` ops.
-    pub sub: u64,
-    /// `mul` ops.
-    pub mul: u64,
-    /// `div` ops.
-    pub div: u64,
-    /// `call` ops.
-    pub call: u64,
-    /// Sum of the above.
-    pub total: u64,
-}
-
-impl OpCounts {
-    /// Counts one op of `kind`.
-    pub fn bump(&mut self, kind: OpKind) {
-        match kind {
-            OpKind::Add => self.add += 1,
-            OpKind::Sub => self.sub += 1,
-            OpKind::Mul => self.mul += 1,
-            OpKind::Div => self.div += 1,
-            OpKind::Call => self.call += 1,
-        }
-        self.total += 1;
     }
 }
 
@@ -333,7 +303,7 @@ impl Function {
         let mut c = OpCounts::default();
         for &v in &self.body {
             match &self.value(v).def {
-                Def::Expr(e) => crate::count::count_expr(e, &mut c),
+                Def::Expr(e) => count_expr(e, &mut c),
                 d => {
                     if let Some(k) = d.op_kind() {
                         c.bump(k)

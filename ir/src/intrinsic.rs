@@ -15,7 +15,7 @@
 //! all three as C99 `fma`, which the interpreter's `mul_add` matches exactly. They count as
 //! ops of kind `call` (SPEC §3 counts calls), one each.
 
-use crate::interp::Float;
+use crate::float::Float;
 use crate::syntax::Callee;
 
 /// An intrinsic callee (see the module doc).

@@ -36,8 +36,8 @@
 //! (addresses are `0..words`), which the placer keeps equal to the largest number of words the
 //! memory holds at once.
 
-use crate::analysis::Latencies;
 use crate::entities::Value;
+use crate::latency::Latencies;
 use crate::span::Span;
 use crate::syntax::{OpKind, Operand};
 

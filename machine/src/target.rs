@@ -171,7 +171,7 @@ pub struct Target {
 }
 
 /// The resources a configuration needs, against the target's capacity ([`Target::estimate`]).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Resources {
     /// ALM (rounded up).
     pub alm: u32,

@@ -12,11 +12,9 @@ pub mod asap_alap;
 pub mod atomise;
 pub mod codegen;
 pub mod contract;
-pub mod cpu_order;
 pub mod cse;
 pub mod dce;
 pub mod eqsat;
-pub mod figures;
 pub mod inline;
 pub mod manager;
 pub mod params;
@@ -24,20 +22,22 @@ pub mod pipeline;
 pub mod place;
 pub mod progress;
 pub mod report;
+pub mod schedule_cpu;
 pub mod sim;
 pub mod specialize;
-pub mod study;
+pub mod summary;
 pub mod sweep;
 pub mod tree_height;
+pub mod whole_run;
 
-use robovec_machine::target::Target;
 use robovec_ir::analysis::Latencies;
 use robovec_ir::verifier::VerifierError;
 use robovec_ir::{Module, Phase, Span};
+use robovec_machine::target::Target;
 
 pub use artifact::{Artifact, ArtifactFile, GeneratedCode, Merge, Produced, ReportEntry};
 pub use manager::{DumpSink, Instrumentation, PassManager, PassRecord, PrintSelector};
-pub use params::{LatencyOverride, ParamInfo, ParamKind, Params};
+pub use params::{LatencyOverride, Member, ParamInfo, ParamKind, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
 
 /// What a pass may fail with.
@@ -325,10 +325,24 @@ pub struct PassInfo {
     pub name: &'static str,
     /// One-line description.
     pub doc: &'static str,
-    /// Accepted parameters.
+    /// Accepted parameters. A pass family (`codegen`) declares a [`ParamKind::Selector`] here,
+    /// and each of its [`Member`]s its own parameters.
     pub params: &'static [ParamInfo],
-    /// Builds the pass from checked parameters.
+    /// Builds the pass from checked parameters (a family: [`Params::build_member`]).
     pub build: fn(&Params) -> Result<Box<dyn Pass>, PassError>,
+}
+
+impl PassInfo {
+    /// Every parameter declaration of the pass: its own, then (for a pass family) each
+    /// member's, in `--print-passes` order.
+    pub fn every_param(&'static self) -> impl Iterator<Item = &'static ParamInfo> {
+        self.params.iter().chain(self.params.iter().flat_map(ParamInfo::members).flat_map(|m| m.params))
+    }
+
+    /// The declaration of parameter `key`: the pass's own, or a member's (for a pass family).
+    pub fn param(&'static self, key: &str) -> Option<&'static ParamInfo> {
+        self.every_param().find(|p| p.name == key)
+    }
 }
 
 /// The registry: every pass robovec knows, in `--print-passes` order.
@@ -349,7 +363,7 @@ pub const PASSES: &[PassInfo] = &[
     eqsat::INFO,
     cse::INFO,
     contract::INFO,
-    cpu_order::INFO,
+    schedule_cpu::INFO,
     codegen::INFO,
 ];
 

@@ -6,10 +6,17 @@
 //! `choice`, `flag`…) take only the key and read default and range from that declaration, and
 //! `--print-passes` prints them from it, so the parser, the defaults and the listing cannot
 //! disagree.
+//!
+//! A pass family (`codegen<c;…>`, `codegen<fpga;…>`) declares a [`ParamKind::Selector`] whose
+//! [`Member`]s each declare their own parameters: the parameters of `codegen<c;…>` are the
+//! selector and the C back end's, and a parameter of another member is refused naming the
+//! member it belongs to. A parameter whose values are words (`abi=plain|robotran`) is read as
+//! an enum declared with `word_enum!` (this module), whose words are the
+//! declaration's choices.
 
 use robovec_ir::analysis::Latencies;
 
-use crate::{PassError, PassInfo};
+use crate::{Pass, PassError, PassInfo};
 
 /// The type, default and accepted range of a parameter.
 #[derive(Clone, Copy, Debug)]
@@ -91,14 +98,125 @@ pub enum ParamKind {
     },
     /// A comma-separated, non-empty list of names; `all` (nothing selected) when not given.
     Names,
-    /// One word of `choices` that may also be given bare, without its key: `codegen<c>` is
-    /// `codegen<back-end=c>` (a pass family's member; at most one per pass).
+    /// An integer of the set `allowed` (`batch=1|2|4|8|16`).
+    U32Set {
+        /// Value when the parameter is not given (one of `allowed`).
+        default: u32,
+        /// The accepted values, in the order `--print-passes` lists them.
+        allowed: &'static [u32],
+    },
+    /// The member of a pass family (`codegen<c;…>`, `codegen<fpga;…>`): the name of one of
+    /// `members`, which may also be given bare, without its key (`codegen<c>` is
+    /// `codegen<back-end=c>`; at most one selector per pass). The selected member's parameters
+    /// are the pass's too; a parameter of another member is refused naming its member, in the
+    /// words of the selector's name (`back-end`: "belongs to back end `fpga`").
     Selector {
-        /// The accepted words.
-        choices: &'static [&'static str],
-        /// The word used when the parameter is not given (one of `choices`).
+        /// The members, in `--print-passes` order.
+        members: &'static [Member],
+        /// The member used when the parameter is not given (the name of one of `members`).
         default: &'static str,
     },
+}
+
+/// A member of a pass family: a back end of `codegen` (`codegen<c;…>`). Its parameters are
+/// declared here, once: [`Params::check`] accepts them only when this member is selected, the
+/// member's [`Member::build`] reads them, and `--print-passes` lists them under the member.
+#[derive(Clone, Copy, Debug)]
+pub struct Member {
+    /// The word that selects it (`c`).
+    pub name: &'static str,
+    /// One line: what it makes.
+    pub doc: &'static str,
+    /// Its own parameters (beside the family's selector).
+    pub params: &'static [ParamInfo],
+    /// Builds the pass from checked parameters (the selector's and this member's).
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] for options that cannot go together.
+    pub build: fn(&Params) -> Result<Box<dyn Pass>, PassError>,
+}
+
+/// A parameter value that is one word of a fixed set (`abi=plain|robotran`), as declared by
+/// `word_enum!` (this module).
+pub trait Word: Copy + 'static {
+    /// Every word, in the order of the variants: the choices of the parameter's declaration.
+    const WORDS: &'static [&'static str];
+    /// The value's word, as written in a pipeline and in the report.
+    fn as_str(self) -> &'static str;
+    /// The value written `word`, if any.
+    fn from_word(word: &str) -> Option<Self>;
+}
+
+/// Declares an enum whose values are the words of a parameter: each variant is written
+/// `Variant = "word"`. The enum gets `WORDS` (every word, in variant order: what the
+/// parameter's [`ParamKind::Choice`] declares as `choices`), `const fn as_str`, `from_word`,
+/// [`Word`] (for [`Params::word`]), and `Serialize` as its word (the report writes `"robotran"`).
+macro_rules! word_enum {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident {
+            $($(#[$vmeta:meta])* $variant:ident = $word:literal,)+
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum $name {
+            $($(#[$vmeta])* $variant,)+
+        }
+
+        impl $name {
+            /// Every word, in the variants' order: the parameter's choices.
+            pub const WORDS: &'static [&'static str] = &[$($word),+];
+
+            /// The value's word, as written in a pipeline and in the report.
+            pub const fn as_str(self) -> &'static str {
+                match self {
+                    $($name::$variant => $word,)+
+                }
+            }
+
+            /// The value written `word`, if any.
+            pub fn from_word(word: &str) -> Option<$name> {
+                match word {
+                    $($word => Some($name::$variant),)+
+                    _ => None,
+                }
+            }
+        }
+
+        impl $crate::params::Word for $name {
+            const WORDS: &'static [&'static str] = $name::WORDS;
+
+            fn as_str(self) -> &'static str {
+                $name::as_str(self)
+            }
+
+            fn from_word(word: &str) -> Option<$name> {
+                $name::from_word(word)
+            }
+        }
+
+        impl serde::Serialize for $name {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                s.serialize_str(self.as_str())
+            }
+        }
+    };
+}
+pub(crate) use word_enum;
+
+/// The expected-value text of a parameter with a few accepted words: `` `a` or `b` ``,
+/// `` one of `a`, `b`, `c` ``.
+fn one_of(words: impl Iterator<Item = String>) -> String {
+    let quoted: Vec<String> = words.map(|c| format!("`{c}`")).collect();
+    match quoted.as_slice() {
+        [a, b] => format!("{a} or {b}"),
+        q => format!("one of {}", q.join(", ")),
+    }
+}
+
+fn joined(xs: impl Iterator<Item = String>, sep: &str) -> String {
+    xs.collect::<Vec<_>>().join(sep)
 }
 
 /// A declared parameter of a pass: name, type with default and range, and doc.
@@ -128,6 +246,7 @@ impl ParamInfo {
             ParamKind::Path | ParamKind::OutputFolder => "none".to_string(),
             ParamKind::U32List { default, .. } => default.to_string(),
             ParamKind::Names => "all".to_string(),
+            ParamKind::U32Set { default, .. } => default.to_string(),
         }
     }
 
@@ -152,12 +271,34 @@ impl ParamInfo {
             | ParamKind::U32Target { min, max, .. } => format!("{min}..={max}"),
             ParamKind::U64 { min, max, .. } => format!("{min}..={max}"),
             ParamKind::F64 { min, max, .. } => format!("{min}..={max}"),
-            ParamKind::Choice { choices, .. } | ParamKind::Selector { choices, .. } => choices.join("|"),
+            ParamKind::Choice { choices, .. } => choices.join("|"),
+            ParamKind::Selector { members, .. } => joined(members.iter().map(|m| m.name.to_string()), "|"),
+            ParamKind::U32Set { allowed, .. } => joined(allowed.iter().map(u32::to_string), "|"),
             ParamKind::Flag { .. } => "on|off".to_string(),
             ParamKind::Path => "path".to_string(),
             ParamKind::OutputFolder => "folder".to_string(),
             ParamKind::U32List { min, max, .. } => format!("list of {min}..={max}"),
             ParamKind::Names => "list of names".to_string(),
+        }
+    }
+
+    /// The values a test gives one by one to check each is accepted: every choice, member or
+    /// allowed integer, `on` and `off` for a flag; nothing for the other kinds.
+    pub fn every_value(&self) -> Vec<String> {
+        match self.kind {
+            ParamKind::Choice { choices, .. } => choices.iter().map(|c| c.to_string()).collect(),
+            ParamKind::Selector { members, .. } => members.iter().map(|m| m.name.to_string()).collect(),
+            ParamKind::U32Set { allowed, .. } => allowed.iter().map(u32::to_string).collect(),
+            ParamKind::Flag { .. } => vec!["on".into(), "off".into()],
+            _ => Vec::new(),
+        }
+    }
+
+    /// The members of a [`ParamKind::Selector`]; none for any other parameter.
+    pub fn members(&self) -> &'static [Member] {
+        match self.kind {
+            ParamKind::Selector { members, .. } => members,
+            _ => &[],
         }
     }
 
@@ -259,65 +400,128 @@ impl LatencyOverride {
     }
 }
 
-/// Checked parameters of one pipeline element: `(name, value)` pairs, each name declared.
+/// Checked parameters of one pipeline element: `(name, value)` pairs, each name declared by the
+/// pass or by its selected family member.
 #[derive(Clone, Debug)]
 pub struct Params {
     pass: &'static str,
     decls: &'static [ParamInfo],
+    member: Option<&'static Member>,
     values: Vec<(String, String)>,
 }
 
+/// The member of `info`'s family selected by `word` (`None`: the default one); `None` when
+/// `info` is no family.
+///
+/// # Errors
+/// [`PassError::BadParameter`] when `word` names no member.
+fn selected(info: &'static PassInfo, word: Option<&str>) -> Result<Option<&'static Member>, PassError> {
+    let Some(sel) = info.params.iter().find(|p| matches!(p.kind, ParamKind::Selector { .. })) else {
+        return Ok(None);
+    };
+    let ParamKind::Selector { members, default } = sel.kind else { unreachable!("found as a selector") };
+    let word = word.unwrap_or(default);
+    match members.iter().find(|m| m.name == word) {
+        Some(m) => Ok(Some(m)),
+        None => Err(PassError::BadParameter {
+            pass: info.name.into(),
+            message: format!(
+                "parameter `{}` must be {}, found `{word}`",
+                sel.name,
+                one_of(members.iter().map(|m| m.name.to_string()))
+            ),
+        }),
+    }
+}
+
 impl Params {
-    /// Checks raw `(key, value)` pairs against `info`: unknown or repeated keys are errors.
+    /// Checks raw `(key, value)` pairs against `info` (and, for a pass family, against the
+    /// selected member): unknown or repeated keys are errors.
     ///
     /// # Errors
-    /// [`PassError::BadParameter`] listing the valid parameters.
+    /// [`PassError::BadParameter`] listing the valid parameters; for a family, a parameter of
+    /// another member names the member it belongs to; a selector naming no member lists the
+    /// members.
     pub fn check(info: &'static PassInfo, raw: &[(String, Option<String>)]) -> Result<Params, PassError> {
+        let bad = |message: String| PassError::BadParameter { pass: info.name.into(), message };
+        let selector = info.params.iter().find(|p| matches!(p.kind, ParamKind::Selector { .. }));
+        // A bare word naming a member of the pass's selector (`codegen<c>`): `selector=word`.
+        let raw: Vec<(&str, Option<&str>)> = raw
+            .iter()
+            .map(|(k, v)| match selector {
+                Some(s)
+                    if v.is_none()
+                        && s.members().iter().any(|m| m.name == k)
+                        && !info.params.iter().any(|q| q.name == k) =>
+                {
+                    (s.name, Some(k.as_str()))
+                }
+                _ => (k.as_str(), v.as_deref()),
+            })
+            .collect();
+        let member =
+            selected(info, selector.and_then(|s| raw.iter().find(|(k, _)| *k == s.name)).and_then(|(_, v)| *v))?;
+        let own = member.map_or(&[][..], |m| m.params);
         let valid = || {
-            if info.params.is_empty() {
+            let names: Vec<&str> = info.params.iter().chain(own).map(|p| p.name).collect();
+            if names.is_empty() {
                 "it takes no parameters".to_string()
             } else {
-                format!("valid: {}", info.params.iter().map(|p| p.name).collect::<Vec<_>>().join(", "))
+                format!("valid: {}", names.join(", "))
             }
         };
         let mut values: Vec<(String, String)> = Vec::new();
         for (k, v) in raw {
-            // A bare word naming a choice of the pass's selector (`codegen<c>`): `selector=word`.
-            let selector = info.params.iter().find(|p| matches!(p.kind, ParamKind::Selector { choices, .. } if v.is_none() && choices.contains(&k.as_str())));
-            let bare;
-            let (k, v) = match selector {
-                Some(p) if !info.params.iter().any(|q| q.name == k) => {
-                    bare = Some(k.clone());
-                    (p.name, &bare)
-                }
-                _ => (k.as_str(), v),
-            };
-            if !info.params.iter().any(|p| p.name == k) {
-                return Err(PassError::BadParameter {
-                    pass: info.name.into(),
-                    message: format!("unknown parameter `{k}` ({})", valid()),
-                });
+            if !info.params.iter().chain(own).any(|p| p.name == k) {
+                let owner = selector
+                    .and_then(|s| s.members().iter().find(|m| m.params.iter().any(|p| p.name == k)).map(|m| (s, m)));
+                return Err(bad(match (owner, member) {
+                    (Some((s, m)), Some(selected)) => format!(
+                        "parameter `{k}` belongs to {} `{}`, not `{}`",
+                        s.name.replace('-', " "),
+                        m.name,
+                        selected.name
+                    ),
+                    _ => format!("unknown parameter `{k}` ({})", valid()),
+                }));
             }
             if values.iter().any(|(x, _)| x == k) {
-                return Err(PassError::BadParameter {
-                    pass: info.name.into(),
-                    message: format!("parameter `{k}` given twice"),
-                });
+                return Err(bad(format!("parameter `{k}` given twice")));
             }
             let Some(v) = v else {
-                return Err(PassError::BadParameter {
-                    pass: info.name.into(),
-                    message: format!("parameter `{k}` needs a value (`{k}=…`)"),
-                });
+                return Err(bad(format!("parameter `{k}` needs a value (`{k}=…`)")));
             };
-            values.push((k.to_string(), v.clone()));
+            values.push((k.to_string(), v.to_string()));
         }
-        Ok(Params { pass: info.name, decls: info.params, values })
+        Ok(Params { pass: info.name, decls: info.params, member, values })
     }
 
-    /// No parameter given: every getter returns the declared default.
+    /// No parameter given: every getter returns the declared default (a family's default
+    /// member).
     pub fn defaults(info: &'static PassInfo) -> Params {
-        Params { pass: info.name, decls: info.params, values: Vec::new() }
+        let member = selected(info, None).expect("a selector's default names one of its members");
+        Params { pass: info.name, decls: info.params, member, values: Vec::new() }
+    }
+
+    /// The selected member of a pass family (`None` for a pass that is no family).
+    pub fn member(&self) -> Option<&'static Member> {
+        self.member
+    }
+
+    /// Builds the selected member of a pass family: the `build` of a family's [`PassInfo`].
+    ///
+    /// # Errors
+    /// What the member's [`Member::build`] returns.
+    pub fn build_member(&self) -> Result<Box<dyn Pass>, PassError> {
+        match self.member {
+            Some(m) => (m.build)(self),
+            None => panic!("pass `{}` builds a family member but declares no selector", self.pass),
+        }
+    }
+
+    /// The declarations of this element: the pass's, then the selected member's.
+    fn declared(&self) -> impl Iterator<Item = &'static ParamInfo> {
+        self.decls.iter().chain(self.member.map_or(&[][..], |m| m.params))
     }
 
     /// The raw value of `key`, if given.
@@ -327,7 +531,7 @@ impl Params {
 
     /// The declaration of `key`; a getter asking for an undeclared key is a bug of the pass.
     fn decl(&self, key: &str) -> ParamKind {
-        match self.decls.iter().find(|d| d.name == key) {
+        match self.declared().find(|d| d.name == key) {
             Some(d) => d.kind,
             None => panic!("pass `{}` reads undeclared parameter `{key}`", self.pass),
         }
@@ -348,7 +552,7 @@ impl Params {
     pub fn latencies(&self) -> Result<Latencies, PassError> {
         let d = Latencies::default();
         let get = |key: &str, default: u32| {
-            if self.decls.iter().any(|p| p.name == key) {
+            if self.declared().any(|p| p.name == key) {
                 self.u32(key)
             } else {
                 Ok(default)
@@ -370,7 +574,7 @@ impl Params {
     /// [`PassError::BadParameter`] when one is out of range.
     pub fn latency_override(&self) -> Result<LatencyOverride, PassError> {
         let get = |key: &str| -> Result<Option<u32>, PassError> {
-            if self.decls.iter().any(|p| p.name == key) && self.get(key).is_some() {
+            if self.declared().any(|p| p.name == key) && self.get(key).is_some() {
                 self.u32(key).map(Some)
             } else {
                 Ok(None)
@@ -391,11 +595,22 @@ impl Params {
         }
     }
 
-    /// A `U32` (or `U32Or`) parameter: its value, or its declared default.
+    /// A `U32` (or `U32Or`, `U32Target`, `U32Set`) parameter: its value, or its declared
+    /// default.
     ///
     /// # Errors
-    /// [`PassError::BadParameter`] when the value is not an integer in the declared range.
+    /// [`PassError::BadParameter`] when the value is not an integer in the declared range (or
+    /// set).
     pub fn u32(&self, key: &str) -> Result<u32, PassError> {
+        if let ParamKind::U32Set { default, allowed } = self.decl(key) {
+            return match self.get(key) {
+                None => Ok(default),
+                Some(v) => match v.parse::<u32>() {
+                    Ok(x) if allowed.contains(&x) => Ok(x),
+                    _ => Err(self.bad(key, one_of(allowed.iter().map(u32::to_string)), v)),
+                },
+            };
+        }
         let (default, min, max) = match self.decl(key) {
             ParamKind::U32 { default, min, max } => (default, min, max),
             ParamKind::U32Target { builtin, min, max } => (builtin, min, max),
@@ -450,20 +665,35 @@ impl Params {
     /// # Errors
     /// [`PassError::BadParameter`] when the word is not one of the choices.
     pub fn choice(&self, key: &str) -> Result<&'static str, PassError> {
-        let (ParamKind::Choice { choices, default } | ParamKind::Selector { choices, default }) = self.decl(key) else {
+        let ParamKind::Choice { choices, default } = self.decl(key) else {
             panic!("parameter `{key}` of `{}` is not a choice", self.pass)
         };
         match self.get(key) {
             None => Ok(default),
-            Some(v) => choices.iter().find(|c| **c == v).copied().ok_or_else(|| {
-                let quoted: Vec<String> = choices.iter().map(|c| format!("`{c}`")).collect();
-                let expected = match quoted.as_slice() {
-                    [a, b] => format!("{a} or {b}"),
-                    q => format!("one of {}", q.join(", ")),
-                };
-                self.bad(key, expected, v)
-            }),
+            Some(v) => choices
+                .iter()
+                .find(|c| **c == v)
+                .copied()
+                .ok_or_else(|| self.bad(key, one_of(choices.iter().map(|c| c.to_string())), v)),
         }
+    }
+
+    /// A `Choice` parameter declared with the words of `T` (`choices: Abi::WORDS`), as `T`.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] when the word is not one of the choices.
+    pub fn word<T: Word>(&self, key: &str) -> Result<T, PassError> {
+        let ParamKind::Choice { choices, .. } = self.decl(key) else {
+            panic!("parameter `{key}` of `{}` is not a choice", self.pass)
+        };
+        assert_eq!(
+            choices,
+            T::WORDS,
+            "parameter `{key}` of `{}` is declared with other words than its type's",
+            self.pass
+        );
+        let w = self.choice(key)?;
+        Ok(T::from_word(w).unwrap_or_else(|| unreachable!("`{w}` is one of the declared words")))
     }
 
     /// A `Flag` parameter: `on`/`true`/`1` or `off`/`false`/`0`, or the declared default.
@@ -549,47 +779,99 @@ mod tests {
         Ok(format!("{:?}", (info.build)(&p)?))
     }
 
+    /// Each way to build `info`: `(parameters that select it, its declarations)`: the pass, or
+    /// for a family each member with the selector given.
+    fn variants(info: &'static PassInfo) -> Vec<(Vec<(&'static str, String)>, Vec<&'static ParamInfo>)> {
+        let selector = info.params.iter().find(|p| !p.members().is_empty());
+        match selector {
+            None => vec![(Vec::new(), info.params.iter().collect())],
+            Some(s) => s
+                .members()
+                .iter()
+                .map(|m| (vec![(s.name, m.name.to_string())], info.params.iter().chain(m.params).collect()))
+                .collect(),
+        }
+    }
+
     #[test]
     fn every_declared_default_is_the_default_and_every_range_is_enforced() {
         for info in PASSES {
-            let none = build(info, &[]).unwrap_or_else(|e| panic!("{}: {e}", info.name));
-            let given: Vec<(&str, String)> =
-                info.params.iter().filter(|p| p.default_is_literal()).map(|p| (p.name, p.default_text())).collect();
-            let all = build(info, &given).unwrap_or_else(|e| panic!("{}: {e}", info.name));
-            assert_eq!(none, all, "{}: no parameters vs every printed default", info.name);
-            for p in info.params {
-                let ok = |v: &str| build(info, &[(p.name, v.to_string())]);
-                if let Some((lo, hi)) = p.bounds() {
-                    for v in [&lo, &hi] {
-                        ok(v).unwrap_or_else(|e| panic!("{} {}={v}: {e}", info.name, p.name));
-                    }
-                    for v in p.out_of_bounds() {
-                        assert!(
-                            matches!(ok(&v), Err(PassError::BadParameter { .. })),
-                            "{} {}={v} accepted",
-                            info.name,
-                            p.name
-                        );
-                    }
-                }
-                match p.kind {
-                    ParamKind::Choice { choices, .. } | ParamKind::Selector { choices, .. } => {
-                        for c in choices {
-                            ok(c).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, p.name));
+            build(info, &[]).unwrap_or_else(|e| panic!("{}: {e}", info.name));
+            for (select, decls) in variants(info) {
+                let with = |extra: &[(&'static str, String)]| {
+                    let mut raw = select.clone();
+                    raw.extend(extra.iter().filter(|(k, _)| !select.iter().any(|(s, _)| s == k)).cloned());
+                    build(info, &raw)
+                };
+                let none = with(&[]).unwrap_or_else(|e| panic!("{} {select:?}: {e}", info.name));
+                let given: Vec<(&str, String)> =
+                    decls.iter().filter(|p| p.default_is_literal()).map(|p| (p.name, p.default_text())).collect();
+                let all = with(&given).unwrap_or_else(|e| panic!("{} {select:?}: {e}", info.name));
+                assert_eq!(none, all, "{} {select:?}: no parameters vs every printed default", info.name);
+                for p in decls.iter().filter(|p| p.members().is_empty()) {
+                    let ok = |v: &str| with(&[(p.name, v.to_string())]);
+                    if let Some((lo, hi)) = p.bounds() {
+                        for v in [&lo, &hi] {
+                            ok(v).unwrap_or_else(|e| panic!("{} {}={v}: {e}", info.name, p.name));
+                        }
+                        for v in p.out_of_bounds() {
+                            assert!(
+                                matches!(ok(&v), Err(PassError::BadParameter { .. })),
+                                "{} {}={v} accepted",
+                                info.name,
+                                p.name
+                            );
                         }
                     }
-                    ParamKind::Flag { .. } => {
-                        for c in ["on", "off"] {
-                            ok(c).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, p.name));
-                        }
+                    for c in p.every_value() {
+                        ok(&c).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, p.name));
                     }
-                    _ => {}
-                }
-                if !matches!(p.kind, ParamKind::Path | ParamKind::OutputFolder | ParamKind::Names) {
-                    assert!(ok("x").is_err(), "{} {}=x accepted", info.name, p.name);
+                    if !matches!(p.kind, ParamKind::Path | ParamKind::OutputFolder | ParamKind::Names) {
+                        assert!(ok("x").is_err(), "{} {}=x accepted", info.name, p.name);
+                    }
                 }
             }
+            // The selector: each member builds; a word that names none is refused.
+            for s in info.params.iter().filter(|p| !p.members().is_empty()) {
+                for c in s.every_value() {
+                    build(info, &[(s.name, c.clone())]).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, s.name));
+                }
+                assert!(build(info, &[(s.name, "x".into())]).is_err(), "{} {}=x accepted", info.name, s.name);
+            }
         }
+    }
+
+    #[test]
+    fn a_set_parameter_takes_only_its_values() {
+        let info = crate::pass_info("codegen").unwrap();
+        let batch = info.param("batch").unwrap();
+        assert_eq!((batch.default_text(), batch.range_text()), ("1".to_string(), "1|2|4|8|16".to_string()));
+        for bad in ["0", "3", "32", "-1", "x"] {
+            let e = build(info, &[("batch", bad.into())]).unwrap_err().to_string();
+            assert_eq!(
+                e,
+                format!("pass `codegen`: parameter `batch` must be one of `1`, `2`, `4`, `8`, `16`, found `{bad}`")
+            );
+        }
+    }
+
+    #[test]
+    fn word_parameters_are_read_as_their_enums() {
+        use crate::codegen::c::{Abi, Precision, Trig};
+        use crate::codegen::fpga::{Format, ResourceSource};
+        fn round_trip<T: Word + PartialEq + std::fmt::Debug>(all: &[T]) {
+            assert_eq!(all.len(), T::WORDS.len());
+            for (x, w) in all.iter().zip(T::WORDS) {
+                assert_eq!((x.as_str(), T::from_word(w)), (*w, Some(*x)));
+            }
+            assert_eq!(T::from_word("x"), None);
+        }
+        round_trip(&[Abi::Plain, Abi::Robotran]);
+        round_trip(&[Precision::F64, Precision::F32]);
+        round_trip(&[Trig::Libm, Trig::Input, Trig::Inline]);
+        round_trip(&[Format::Both, Format::Mif, Format::Hex]);
+        round_trip(&[ResourceSource::Auto, ResourceSource::Yosys, ResourceSource::Estimate]);
+        assert_eq!(serde_json::to_string(&Abi::Robotran).unwrap(), "\"robotran\"");
     }
 
     #[test]

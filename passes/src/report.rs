@@ -2,7 +2,7 @@
 //! `robovec-gen --study`): one function's figures after a run, the records of the passes and
 //! what each artifact reports for it, in one document.
 
-use crate::figures::Figures;
+use crate::summary::Figures;
 use crate::{PassContext, PassRecord};
 
 /// The report JSON text (SPEC §7) of one function after a run: `input` (as given), `function`,

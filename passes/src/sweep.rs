@@ -28,7 +28,7 @@ use crate::place::{
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// min / mean / max of words over the PEs of one type.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct WordStats {
     /// Smallest memory, words.
     pub min: u32,
@@ -49,8 +49,9 @@ fn word_stats(w: &[u32]) -> WordStats {
     }
 }
 
-/// One placement of a sweep.
-#[derive(Clone, Debug, serde::Serialize)]
+/// One placement of a sweep: a row of the report's `sweep` (written, and read back for
+/// `-report-dir`'s figures), the `-stats` table and `-sweep-csv`.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct SweepRow {
     /// Function name.
     pub function: String,
@@ -58,9 +59,9 @@ pub struct SweepRow {
     pub n: u32,
     /// `classical`, `mobility` (the seed's list scheduling alone) or `classical+fbi` (with
     /// forward-backward improvement).
-    pub priority: &'static str,
+    pub priority: String,
     /// `naive` or `preferential`.
-    pub select: &'static str,
+    pub select: String,
     /// Cycles of the placement.
     pub cycles: u32,
     /// `cycles` in µs at the target's clock.
@@ -104,6 +105,18 @@ pub struct SweepRow {
     /// True when the estimate is within the device's capacity and the placement's memories
     /// within the target's (`place::report::fits_memories`).
     pub fits: bool,
+}
+
+impl SweepRow {
+    /// The configuration's label: `classical`, `mobility`, `classical/naive`, `classical+fbi`
+    /// (the priority, with the selection when it is not the preferential one).
+    pub fn config(&self) -> String {
+        if self.select == "preferential" {
+            self.priority.clone()
+        } else {
+            format!("{}/{}", self.priority, self.select)
+        }
+    }
 }
 
 /// What a sweep says of one function on the target: see the module doc.
@@ -283,8 +296,8 @@ impl Pass for Sweep {
                     rows.push(SweepRow {
                         function: f.name.clone(),
                         n,
-                        priority: pname,
-                        select: sname,
+                        priority: pname.to_string(),
+                        select: sname.to_string(),
                         cycles: c,
                         us: cx.target.us(c),
                         lower_bound: lower_bound(f, &o.arch),

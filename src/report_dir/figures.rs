@@ -8,7 +8,10 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::data::{ReportData, SweepRow, Words};
+use robovec_passes::sweep::{SweepRow, WordStats};
+use robovec_passes::whole_run::pareto::ParetoRow;
+
+use super::data::ReportData;
 
 /// One figure: file stem, title, SVG text and companion CSV.
 #[derive(Clone, Debug)]
@@ -44,7 +47,7 @@ type Result<T> = std::result::Result<T, String>;
 type Series = (String, Vec<(f64, f64)>, bool);
 
 /// A memory panel: its title and the words it reads from a sweep row.
-type Panel = (&'static str, fn(&SweepRow) -> Words);
+type Panel = (&'static str, fn(&SweepRow) -> WordStats);
 
 fn err(e: impl std::fmt::Display) -> String {
     format!("drawing a figure failed: {e}")
@@ -240,7 +243,7 @@ fn cycles(d: &ReportData) -> Result<Figure> {
     let mut series: Vec<Series> = Vec::new();
     let mut csv = String::from("configuration,n,cycles\n");
     for c in configs(rows) {
-        let pts: Vec<(f64, f64)> = of_config(rows, &c).iter().map(|r| (lx(r.n), r.cycles)).collect();
+        let pts: Vec<(f64, f64)> = of_config(rows, &c).iter().map(|r| (lx(r.n), f64::from(r.cycles))).collect();
         for r in of_config(rows, &c) {
             csv += &format!("{c},{},{}\n", r.n, r.cycles);
         }
@@ -249,12 +252,12 @@ fn cycles(d: &ReportData) -> Result<Figure> {
     let bounds = per_n(rows);
     series.push((
         "lower bound 1: ops / N + latency".into(),
-        bounds.iter().map(|r| (lx(r.n), r.resource_bound)).collect(),
+        bounds.iter().map(|r| (lx(r.n), f64::from(r.resource_bound))).collect(),
         true,
     ));
     series.push((
         "lower bound 2: critical path".into(),
-        bounds.iter().map(|r| (lx(r.n), r.critical_path)).collect(),
+        bounds.iter().map(|r| (lx(r.n), f64::from(r.critical_path))).collect(),
         true,
     ));
     for r in &bounds {
@@ -310,7 +313,7 @@ fn per_config(
 
 /// µs against N at the target's clock.
 fn microseconds(d: &ReportData) -> Result<Figure> {
-    let clock = d.sweep.iter().find(|r| r.us > 0.0).map(|r| r.cycles / r.us);
+    let clock = d.sweep.iter().find(|r| r.us > 0.0).map(|r| f64::from(r.cycles) / r.us);
     let what = match clock {
         Some(mhz) => format!("µs vs N at {mhz:.0} MHz"),
         None => "µs vs N".into(),
@@ -363,8 +366,16 @@ fn memory(d: &ReportData) -> Result<Figure> {
                     csv += &format!("{what},{sel},{},{},{},{}\n", r.n, w.min, w.mean, w.max);
                 }
                 series.push((format!("{sel} mean"), of.iter().map(|r| (lx(r.n), pick(r).mean)).collect(), false));
-                series.push((format!("{sel} min"), of.iter().map(|r| (lx(r.n), pick(r).min)).collect(), true));
-                series.push((format!("{sel} max"), of.iter().map(|r| (lx(r.n), pick(r).max)).collect(), true));
+                series.push((
+                    format!("{sel} min"),
+                    of.iter().map(|r| (lx(r.n), f64::from(pick(r).min))).collect(),
+                    true,
+                ));
+                series.push((
+                    format!("{sel} max"),
+                    of.iter().map(|r| (lx(r.n), f64::from(pick(r).max))).collect(),
+                    true,
+                ));
             }
             // Same colour per selection: mean solid, min and max dashed.
             let series: Vec<_> = series.into_iter().collect();
@@ -595,7 +606,7 @@ fn pareto(d: &ReportData) -> Result<Figure> {
         );
     }
     let x_max = max_of(rows.iter().flat_map(|r| [r.f32.mean_bits, r.f64.mean_bits])).max(0.5) * 1.15;
-    let y_max = max_of(rows.iter().map(|r| r.time_cycles)).max(1.0) * 1.4;
+    let y_max = max_of(rows.iter().map(|r| f64::from(r.time_cycles))).max(1.0) * 1.4;
     let mut svg = String::new();
     {
         let root = svg_area(&mut svg, SIZE);
@@ -616,27 +627,32 @@ fn pareto(d: &ReportData) -> Result<Figure> {
             .draw()
             .map_err(err)?;
         let (c32, c64) = (PALETTE[0], PALETTE[1]);
-        let mut front: Vec<&super::data::ParetoRow> = rows.iter().filter(|r| r.pareto_optimal).collect();
+        let mut front: Vec<&ParetoRow> = rows.iter().filter(|r| r.pareto_optimal).collect();
         front.sort_by(|a, b| a.f32.mean_bits.total_cmp(&b.f32.mean_bits));
         chart
-            .draw_series(LineSeries::new(front.iter().map(|r| (r.f32.mean_bits, r.time_cycles)), c32.stroke_width(1)))
+            .draw_series(LineSeries::new(
+                front.iter().map(|r| (r.f32.mean_bits, f64::from(r.time_cycles))),
+                c32.stroke_width(1),
+            ))
             .map_err(err)?
             .label("Pareto front (binary32)")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c32.stroke_width(1)));
         chart
-            .draw_series(rows.iter().map(|r| Circle::new((r.f32.mean_bits, r.time_cycles), 5, c32.filled())))
+            .draw_series(rows.iter().map(|r| Circle::new((r.f32.mean_bits, f64::from(r.time_cycles)), 5, c32.filled())))
             .map_err(err)?
             .label("binary32")
             .legend(move |(x, y)| Circle::new((x + 10, y), 5, c32.filled()));
         chart
-            .draw_series(rows.iter().map(|r| TriangleMarker::new((r.f64.mean_bits, r.time_cycles), 6, c64.filled())))
+            .draw_series(
+                rows.iter().map(|r| TriangleMarker::new((r.f64.mean_bits, f64::from(r.time_cycles)), 6, c64.filled())),
+            )
             .map_err(err)?
             .label("binary64")
             .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, c64.filled()));
         chart
             .draw_series(rows.iter().enumerate().map(|(i, r)| {
                 let mark = if r.sound { "" } else { " (unsound)" };
-                Text::new(format!("{}{mark}", i + 1), (r.f32.mean_bits, r.time_cycles), ("sans-serif", 13))
+                Text::new(format!("{}{mark}", i + 1), (r.f32.mean_bits, f64::from(r.time_cycles)), ("sans-serif", 13))
             }))
             .map_err(err)?;
         chart

@@ -4,9 +4,10 @@
 //! of the numbers it draws (`cycles.svg` + `cycles.csv`, …).
 //!
 //! **Design.** The figures are drawn from the report JSON itself, read back by key
-//! ([`data::ReportData`]: `sweep` rows, `placement`, `pareto` rows), never from the passes or
-//! their artifacts: the driver stays ignorant of passes, a figure can only show numbers the
-//! report holds (what the tests check through the CSVs), and a new report key gets a figure by
+//! ([`data::ReportData`]: `sweep` rows, `placement`, `pareto` rows, each as the row type the
+//! pass that writes it declares), never from the passes' artifacts: the driver stays ignorant
+//! of passes, a figure can only show numbers the report holds (what the tests check through the
+//! CSVs), and a new report key gets a figure by
 //! adding one function to [`figures`]. Figures whose numbers the report lacks are not drawn
 //! (no `sweep` → no cycles-vs-N figures; an unplaced final IR → no occupation or timeline; no
 //! `-pareto` → no Pareto figure); `report.md` says which are missing and why.

@@ -8,7 +8,7 @@ use std::process::{Command, Stdio};
 
 use robovec_ir::rng::SplitMix64;
 use robovec_passes::codegen::c::trig::{Constants, PI_HEX};
-use robovec_passes::codegen::c::{CodegenC, Trig};
+use robovec_passes::codegen::c::{CodegenC, Precision, Trig};
 
 use crate::common::tmp;
 
@@ -290,10 +290,11 @@ fn check_inline_sin_cos(dir: &str, flags: &[&str]) {
     let mut main = String::from("#include <stdio.h>\n");
     let mut files = vec!["main.c".to_string()];
     for (sym, f32, w) in forms {
-        let o = CodegenC { f32, batch: w, trig: Trig::Inline, name: Some(sym.into()), ..CodegenC::default() };
+        let precision = if f32 { Precision::F32 } else { Precision::F64 };
+        let o = CodegenC { precision, batch: w, trig: Trig::Inline, name: Some(sym.into()), ..CodegenC::default() };
         let art = o.emit(&m).unwrap();
         assert_eq!(art.interfaces[0].inputs, ["q[1]", "q[2]", "q[3]"]);
-        assert_eq!(art.interfaces[0].trig, "inline");
+        assert_eq!(art.interfaces[0].trig, Trig::Inline);
         let c = &art.code.main;
         assert!(c.contains("robovec_sincos_inline(q_1, &S1, &C1);"), "{c}");
         assert!(c.contains("robovec_sin_inline(q_2)") && c.contains("robovec_cos_inline(q_3)"), "{c}");

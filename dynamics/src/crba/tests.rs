@@ -1,7 +1,7 @@
 //! The CRBA's statement order (module doc, "Order of the statements"): what GCC's register
 //! allocator sees, checked by the register-pressure measure of `schedule-cpu`.
 
-use robovec_passes::cpu_order::pressure::pressure_of_order;
+use robovec_passes::schedule_cpu::pressure::pressure_of_order;
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
 use crate::topology::{build, Topology};

@@ -6,7 +6,7 @@
 //! after `atomise,zero-removal,balance` and after the best rewrite pipeline; placed cycles of
 //! `place<pe=N>` at N = 8, 16, 32, 64 after the best pipeline; binary32 bits of error
 //! (`accuracy<samples=K>`, mean and max over outputs and samples). Every figure comes from the
-//! code behind `robovec-opt`'s `-stats` and report (`robovec_passes::figures::Figures`, the
+//! code behind `robovec-opt`'s `-stats` and report (`robovec_passes::summary::Figures`, the
 //! placement's figures, the `accuracy` artifact's report entry), so it is what
 //! `robovec-opt FILE.urdf -function=dirdyna -passes=PIPELINE -stats` prints for the URDF
 //! `robovec-gen --topology T --dof N --seed S` writes (the tests check it through the binaries).

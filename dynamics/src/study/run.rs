@@ -6,8 +6,8 @@
 //! error).
 
 use robovec_ir::Module;
-use robovec_passes::figures::Figures;
-use robovec_passes::{study as pstudy, Instrumentation, PassContext, PassManager, PassRecord};
+use robovec_passes::summary::Figures;
+use robovec_passes::{whole_run as pstudy, Instrumentation, PassContext, PassManager, PassRecord};
 use serde::Serialize;
 
 use super::cases::Case;

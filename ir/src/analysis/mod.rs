@@ -7,5 +7,6 @@
 pub mod dep_graph;
 pub mod timing;
 
+pub use crate::latency::Latencies;
 pub use dep_graph::DepGraph;
-pub use timing::{annotate_timing, compute_timing, Latencies, TimingSummary};
+pub use timing::{annotate_timing, compute_timing, TimingSummary};

@@ -23,3 +23,13 @@ pub mod printer;
 
 pub use error::ParseError;
 pub use parser::parse;
+
+/// Prints a constant so that it reads back to the same bits (Rust's shortest round-trip form):
+/// the one spelling of constants in the body ([`printer`]) and in placement lines
+/// ([`placement`]).
+///
+/// # Errors
+/// What `out` returns.
+pub fn write_const(out: &mut impl std::fmt::Write, x: f64) -> std::fmt::Result {
+    write!(out, "{x:?}")
+}

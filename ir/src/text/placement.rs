@@ -200,7 +200,7 @@ pub fn write(out: &mut impl fmt::Write, f: &Function, p: &Placement) -> fmt::Res
         write!(out, "    load {} {} ", l.pe, l.addr)?;
         match l.operand {
             Operand::Value(v) => write!(out, "%{}", f.name_of(v))?,
-            Operand::Const(c) => super::printer::write_const(out, c)?,
+            Operand::Const(c) => super::write_const(out, c)?,
         }
         out.write_char('\n')?;
     }

@@ -2,13 +2,9 @@
 
 use std::fmt::{self, Write};
 
+use super::write_const;
 use crate::function::{Function, Module};
 use crate::syntax::{BinOp, Callee, Def, Expr, Operand, Phase, TrigFn};
-
-/// Prints a constant so that it reads back to the same bits (Rust's shortest round-trip form).
-pub fn write_const(out: &mut impl Write, x: f64) -> fmt::Result {
-    write!(out, "{x:?}")
-}
 
 fn write_operand(out: &mut impl Write, f: &Function, o: &Operand) -> fmt::Result {
     match o {

@@ -10,9 +10,9 @@
 
 use rayon::prelude::*;
 
+use super::acc::{Acc, Kept};
 use super::inputs::{draw_hard, rng_for, Family, Range};
 use super::measure::{errors_at, PointErrors, Subject, Workspace};
-use super::stream::{Acc, Kept};
 use super::Options;
 
 const NEIGHBOURS: u64 = 8;

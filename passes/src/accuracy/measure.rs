@@ -155,7 +155,7 @@ pub fn skip_after_probes(probes: &[PointErrors], n_outputs: usize) -> Vec<bool> 
 }
 
 /// Mean, 95th percentile and maximum of a set of errors, units: bits (Herbie's metric).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BitsSummary {
     /// Mean, bits.
     pub mean_bits: f64,

@@ -23,6 +23,7 @@
 //! ([`stream`]: memory independent of `samples`); cost is O(samples × ops) plus the rare
 //! 256-bit re-evaluations, bounded by the work budget `max-work`.
 
+pub mod acc;
 pub mod check;
 pub mod hard;
 pub mod inputs;
@@ -37,8 +38,9 @@ use robovec_ir::{Function, Module};
 
 use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+pub use acc::ReferenceCounts;
 pub use measure::{BitsSummary, PointErrors, Subject};
-pub use report::{AccuracyReport, OutputAccuracy, ReferenceCounts, ReferenceInfo, WorstPoint};
+pub use report::{AccuracyReport, OutputAccuracy, ReferenceInfo, WorstPoint};
 
 /// Sampled (physical ranges) or hard (near-singular poses, extreme scales, search) inputs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

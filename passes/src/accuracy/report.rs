@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 
 use serde::ser::{Serialize, SerializeMap, Serializer};
 
+use super::acc::ReferenceCounts;
 use super::measure::{BitsSummary, Subject};
 use super::stats::Stream;
 use super::stream::Run;
@@ -32,20 +33,6 @@ impl Serialize for OutputsMap {
         }
         m.end()
     }
-}
-
-/// How many (output, point) reference values each path produced.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-pub struct ReferenceCounts {
-    /// Certified by double-double (≈ 106 bits).
-    pub double_double: u64,
-    /// Certified at 256 bits.
-    pub bits_256: u64,
-    /// Certified at 1024 bits.
-    pub bits_1024: u64,
-    /// Not certified (the 1024-bit value is used; typically an exact zero reached by inexact
-    /// cancellation, e.g. `sin(a) − sin(a)`).
-    pub uncertified: u64,
 }
 
 /// Which reference the errors were measured against, and how its values were obtained.

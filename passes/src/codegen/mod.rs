@@ -1,10 +1,12 @@
-//! `codegen<…>`: the back ends (SPEC §8). `codegen<c;…>` writes C; other members of the family
-//! (`codegen<fpga;…>`) plug in beside it through [`BACK_ENDS`].
+//! `codegen<…>`: the back ends (SPEC §8). `codegen<c;…>` writes C ([`c`]); `codegen<fpga;…>`
+//! writes a placed design's files ([`fpga`]). Each back end is a [`Member`] of the family
+//! ([`BACK_ENDS`]) that declares its own parameters: `codegen<c;format=hex>` is refused,
+//! `format` belonging to the FPGA back end.
 //!
 //! The first, bare word of the parameters selects the back end (`codegen<c;abi=plain>` is
-//! `codegen<back-end=c;abi=plain>`). Shared pieces of every emitter live here: C-identifier
-//! naming that keeps Robotran's value names ([`names`]), the input/output maps in canonical
-//! SPEC §2 names ([`Interface`]) and literals that round-trip exactly ([`literal`]).
+//! `codegen<back-end=c;abi=plain>`). Pieces the C emitter shares with its callers live here:
+//! C-identifier naming that keeps Robotran's value names ([`names`]), the input/output maps in
+//! canonical SPEC §2 names ([`Interface`]) and literals that round-trip exactly ([`literal`]).
 
 pub mod c;
 pub mod fpga;
@@ -14,53 +16,22 @@ pub mod names;
 use robovec_ir::{Def, Function, Module, Phase};
 
 use crate::params::ParamKind;
-use crate::{Artifact, GeneratedCode, Merge, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, ReportEntry};
+use crate::{Artifact, GeneratedCode, Member, Merge, ParamInfo, Params, PassContext, PassError, PassInfo, ReportEntry};
+use c::{Abi, Precision, Trig};
 
-/// A member of the `codegen` family: its selector word and how it builds from parameters.
-pub struct BackEnd {
-    /// The word that selects it (`c`).
-    pub name: &'static str,
-    /// Builds the pass from the family's checked parameters.
-    ///
-    /// # Errors
-    /// [`PassError::BadParameter`] for options that cannot go together.
-    pub build: fn(&Params) -> Result<Box<dyn Pass>, PassError>,
-}
+/// The back ends, selected by the first word of `codegen<…>`, each with its parameters.
+pub const BACK_ENDS: &[Member] = &[c::BACK_END, fpga::BACK_END];
 
-/// The back ends, selected by the first word of `codegen<…>`.
-pub const BACK_ENDS: &[BackEnd] = &[
-    BackEnd { name: "c", build: |p| Ok(Box::new(c::CodegenC::from_params(p)?)) },
-    BackEnd { name: "fpga", build: |p| Ok(Box::new(fpga::CodegenFpga::from_params(p)?)) },
-];
-
-/// Registry entry: the back-end selector, then each back end's parameters.
+/// Registry entry: the back-end selector; each back end declares its own parameters.
 pub const INFO: PassInfo = PassInfo {
     name: "codegen",
-    doc: "write the functions as code (`codegen<c;…>`: C, SPEC §8, `-o FILE` gets the code; `codegen<fpga;out=DIR;…>`: the placed design's images, Verilog, simulate script and resources, issue 12)",
-    params: &[
-        ParamInfo {
-            name: "back-end",
-            kind: ParamKind::Selector { choices: &["c", "fpga"], default: "c" },
-            doc: "back end, given as the first bare word (`codegen<c;…>`)",
-        },
-        c::ABI,
-        c::PRECISION,
-        c::BATCH,
-        c::TRIG,
-        c::NAME,
-        fpga::OUT,
-        fpga::FORMAT,
-        fpga::RESOURCES,
-    ],
-    build: |p: &Params| {
-        let which = p.choice("back-end")?;
-        // every choice of the family is checked, whichever back end reads it
-        for d in fpga::FPGA_CHOICES {
-            p.choice(d.name)?;
-        }
-        let b = BACK_ENDS.iter().find(|b| b.name == which).expect("every selector choice has a back end");
-        (b.build)(p)
-    },
+    doc: "write the functions as code, by the back end the first bare word selects (`codegen<c;…>`, `codegen<fpga;out=DIR;…>`)",
+    params: &[ParamInfo {
+        name: "back-end",
+        kind: ParamKind::Selector { members: BACK_ENDS, default: "c" },
+        doc: "back end, given as the first bare word (`codegen<c;…>`)",
+    }],
+    build: Params::build_member,
 };
 
 /// What one generated function takes and gives, in argument order (SPEC §8 `codegen`).
@@ -71,14 +42,14 @@ pub struct Interface {
     pub function: String,
     /// The C symbol (`dirdyna`, `mbs_dirdyna`).
     pub symbol: String,
-    /// `plain` or `robotran`.
-    pub abi: &'static str,
+    /// `plain` or `robotran` (the report writes the word).
+    pub abi: Abi,
     /// `f64` or `f32`.
-    pub precision: &'static str,
+    pub precision: Precision,
     /// States per call (lanes).
     pub batch: u32,
     /// `libm`, `input` or `inline`.
-    pub trig: &'static str,
+    pub trig: Trig,
     /// Canonical input names (SPEC §2), in argument order: `in[i]` (or `in[i*W + lane]`) is
     /// input `i`. With `trig=input` the trig values (`S4`, `C4`) follow the IR's inputs.
     pub inputs: Vec<String>,
@@ -147,14 +118,58 @@ mod tests {
         assert_eq!(build("codegen<c>").unwrap(), plain, "`c` is the default back end");
         assert_eq!(build("codegen<back-end=c>").unwrap(), plain);
         let robotran = build("codegen<c;abi=robotran>").unwrap();
-        assert!(robotran.contains("abi: \"robotran\""), "{robotran}");
+        assert!(robotran.contains("abi: Robotran"), "{robotran}");
         let fpga = build("codegen<fpga;out=x>").unwrap();
         assert!(fpga.contains("CodegenFpga") && fpga.contains("\"x\""), "{fpga}");
-        assert!(matches!(build("codegen<fpga;abi=robotran>"), Err(PassError::BadParameter { .. })));
-        assert!(matches!(build("codegen<c;out=x>"), Err(PassError::BadParameter { .. })));
         let twice = build("codegen<c;back-end=c>").unwrap_err().to_string();
         assert!(twice.contains("given twice"), "{twice}");
         let bad = build("codegen<c;abi=robotran;batch=8>").unwrap_err().to_string();
         assert!(bad.contains("`abi=robotran` cannot go with `batch=8`"), "{bad}");
+        let verilog = build("codegen<back-end=verilog>").unwrap_err().to_string();
+        assert_eq!(verilog, "pass `codegen`: parameter `back-end` must be `c` or `fpga`, found `verilog`");
+    }
+
+    #[test]
+    fn a_parameter_of_the_other_back_end_is_refused_naming_its_back_end() {
+        // Any value, the default too: each back end accepts its own parameters only.
+        for (text, key, owner, selected) in [
+            ("codegen<c;format=hex>", "format", "fpga", "c"),
+            ("codegen<c;format=both>", "format", "fpga", "c"),
+            ("codegen<c;out=x>", "out", "fpga", "c"),
+            ("codegen<resources=auto>", "resources", "fpga", "c"),
+            ("codegen<fpga;batch=4>", "batch", "c", "fpga"),
+            ("codegen<fpga;abi=plain>", "abi", "c", "fpga"),
+            ("codegen<fpga;name=f>", "name", "c", "fpga"),
+        ] {
+            let e = build(text).unwrap_err();
+            assert!(matches!(e, PassError::BadParameter { .. }), "{text}: {e:?}");
+            assert_eq!(
+                e.to_string(),
+                format!("pass `codegen`: parameter `{key}` belongs to back end `{owner}`, not `{selected}`"),
+                "{text}"
+            );
+        }
+        // A parameter no back end has lists the selected back end's.
+        let e = build("codegen<fpga;frobnicate=1>").unwrap_err().to_string();
+        assert_eq!(e, "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, out, format, resources)");
+        let e = build("codegen<frobnicate=1>").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, abi, precision, batch, trig, name)"
+        );
+    }
+
+    #[test]
+    fn the_registry_declares_each_parameter_once_under_its_back_end() {
+        let info = crate::pass_info("codegen").unwrap();
+        let names: Vec<&str> = info.every_param().map(|p| p.name).collect();
+        assert_eq!(names, ["back-end", "abi", "precision", "batch", "trig", "name", "out", "format", "resources"]);
+        let members: Vec<(&str, Vec<&str>)> =
+            super::BACK_ENDS.iter().map(|m| (m.name, m.params.iter().map(|p| p.name).collect())).collect();
+        assert_eq!(
+            members,
+            [("c", vec!["abi", "precision", "batch", "trig", "name"]), ("fpga", vec!["out", "format", "resources"])]
+        );
+        assert_eq!(info.param("format").map(|p| p.name), Some("format"));
     }
 }

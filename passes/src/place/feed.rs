@@ -4,7 +4,7 @@
 
 use robovec_ir::Value;
 
-use super::schedule::{Key, OpDag};
+use super::dag::{Key, OpDag};
 
 /// Feeding priority: an op that is the last unissued op operand of an op of the *other* PE
 /// type has its priority key lowered by `bonus` cycles, since issuing it makes work for the

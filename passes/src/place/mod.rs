@@ -19,6 +19,7 @@
 //! O(n log n + n·N) for n ops and N PEs per type.
 
 pub mod bound;
+pub mod dag;
 pub mod feed;
 pub mod memory;
 pub mod report;
@@ -136,7 +137,7 @@ pub fn try_place_function_progress(
     progress: &crate::progress::Progress,
 ) -> Result<(Placement, bool), String> {
     let a = &opts.arch;
-    let dag = schedule::OpDag::new(f);
+    let dag = dag::OpDag::new(f);
     let seed = schedule::seed_keys(f, a, opts.priority);
     let best = improved(f, &dag, opts, &seed, 0)?;
     let spec = lower_bound(f, a) as u64;
@@ -158,9 +159,9 @@ pub(crate) fn end(s: &schedule::Schedule) -> u32 {
 /// to `opts.improve` rounds of forward-backward improvement (kept while they shorten it).
 pub(crate) fn improved(
     f: &Function,
-    dag: &schedule::OpDag,
+    dag: &dag::OpDag,
     opts: &PlaceOptions,
-    keys: &[schedule::Key],
+    keys: &[dag::Key],
     feed: u32,
 ) -> Result<schedule::Schedule, String> {
     let a = &opts.arch;
@@ -169,11 +170,10 @@ pub(crate) fn improved(
         // Backward pass: ops that arrived last go first in reverse time; then forward again in
         // order of the backward (justified) start times.
         let t = end(&best);
-        let back: Vec<schedule::Key> =
-            (0..f.values.len()).map(|i| (t - best.arrival[i], keys[i].0, i as u32)).collect();
+        let back: Vec<dag::Key> = (0..f.values.len()).map(|i| (t - best.arrival[i], keys[i].0, i as u32)).collect();
         let r = schedule::backward_starts(f, dag, a.n_add, a.n_mul, &a.lat, &back, feed);
         let r_max = r.iter().copied().max().unwrap_or(0);
-        let fwd: Vec<schedule::Key> = (0..f.values.len()).map(|i| (r_max - r[i], keys[i].0, i as u32)).collect();
+        let fwd: Vec<dag::Key> = (0..f.values.len()).map(|i| (r_max - r[i], keys[i].0, i as u32)).collect();
         let s = schedule::schedule(f, dag, a, &fwd, opts.select, feed)?;
         if end(&s) >= end(&best) {
             break;

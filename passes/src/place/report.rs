@@ -1,14 +1,15 @@
 //! The placement's figures (SPEC §7 `placement`, seed §3.4–3.6): cycles against the lower
 //! bounds, parallelisation rate, memories, writes and occupation.
 
-use robovec_machine::target::{Resources, Target};
 use robovec_ir::Function;
-use serde::Serialize;
+use robovec_machine::target::{Resources, Target};
+use serde::{Deserialize, Serialize};
 
 use super::{cycles, issues_per_cycle, lower_bound, occupation, tight_lower_bound};
 
-/// `placement` of SPEC §7: figures of the placement on the PE architecture (SPEC §4).
-#[derive(Clone, Debug, Serialize)]
+/// `placement` of SPEC §7: figures of the placement on the PE architecture (SPEC §4); read
+/// back from the report for `-report-dir`'s figures.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PlacementReport {
     /// ADD PEs.
     pub n_add: u32,
@@ -74,7 +75,7 @@ pub fn estimate(p: &robovec_ir::placement::Placement, cycles: u32, target: &Targ
 pub const TIMELINE_CYCLES: u32 = 256;
 
 /// The issues of a window of cycles (see [`PlacementReport::timeline`]).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Timeline {
     /// First cycle of the window.
     pub start: u32,
@@ -85,10 +86,10 @@ pub struct Timeline {
 }
 
 /// One issue of [`Timeline`].
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TimelineIssue {
     /// `add` or `mul`: the PE type.
-    pub pe_type: &'static str,
+    pub pe_type: String,
     /// Index of the PE within its type (0-based).
     pub pe: u32,
     /// Issue cycle.
@@ -117,7 +118,7 @@ pub fn timeline(f: &Function, p: &robovec_ir::placement::Placement, cycles: u32)
                     Pe::Mul(x) => ("mul", x),
                 };
                 TimelineIssue {
-                    pe_type,
+                    pe_type: pe_type.to_string(),
                     pe,
                     cycle: i.cycle,
                     latency: p.latency(k),
@@ -127,12 +128,12 @@ pub fn timeline(f: &Function, p: &robovec_ir::placement::Placement, cycles: u32)
             })
         })
         .collect();
-    issues.sort_by_key(|x| (x.cycle, x.pe_type, x.pe));
+    issues.sort_by(|x, y| (x.cycle, &x.pe_type, x.pe).cmp(&(y.cycle, &y.pe_type, y.pe)));
     Timeline { start: 0, end, issues }
 }
 
 /// Per-cycle occupation rates (0 to 1), one entry per cycle.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Occupation {
     /// ADD PEs.
     pub add: Vec<f64>,

@@ -19,7 +19,8 @@
 
 use robovec_ir::Function;
 
-use super::schedule::{self, Key, OpDag, Schedule};
+use super::dag::{Key, OpDag};
+use super::schedule::{self, Schedule};
 use super::{end, improved, lower_bound, tight_lower_bound, PlaceOptions, Priority};
 
 /// Op schedulings allowed for restarts per placement (about a second of work).

@@ -6,9 +6,6 @@
 
 use proptest::prelude::*;
 
-use robovec_machine::encode::{decode, encode, Layout};
-use robovec_machine::exec::execute;
-use robovec_machine::lower::lower;
 use robovec_ir::analysis::Latencies;
 use robovec_ir::interp::{eval, pseudo_random_input};
 use robovec_ir::machine::{MachineProgram, MemWrite, Source};
@@ -16,6 +13,9 @@ use robovec_ir::placement::{Load, Pe, PeArray};
 use robovec_ir::text::parse;
 use robovec_ir::verifier::machine::verify_machine;
 use robovec_ir::{Function, Operand, Value};
+use robovec_machine::encode::{decode, encode, Layout};
+use robovec_machine::exec::execute;
+use robovec_machine::lower::lower;
 
 use crate::place::{place_function, PlaceOptions};
 

@@ -178,7 +178,7 @@ impl Body<'_> {
     pub fn operand(&self, x: &Operand) -> String {
         match x {
             Operand::Value(v) => self.names[v.index()].clone(),
-            Operand::Const(c) => literal::operand(*c, self.o.f32),
+            Operand::Const(c) => literal::operand(*c, self.o.f32()),
         }
     }
 
@@ -240,7 +240,7 @@ impl Body<'_> {
     ) {
         let ty = self.value_type();
         let vec = self.o.batch > 1;
-        let sfx = if self.o.f32 { "f" } else { "" };
+        let sfx = if self.o.f32() { "f" } else { "" };
         let fused = if self.o.trig == Trig::Inline { self.fused_trig() } else { Default::default() };
         let mut done = vec![false; self.f.values.len()];
         for &v in &self.f.body {

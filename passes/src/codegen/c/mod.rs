@@ -28,31 +28,39 @@ use robovec_ir::{Callee, Def, Function, Module};
 
 use super::names::is_c_identifier;
 use super::{CodegenArtifact, Interface};
-use crate::params::ParamKind;
-use crate::{GeneratedCode, ParamInfo, Params, Pass, PassContext, PassError};
+use crate::params::{word_enum, ParamKind};
+use crate::{GeneratedCode, Member, ParamInfo, Params, Pass, PassContext, PassError};
+
+/// The C back end of `codegen`: `codegen<c;…>`, with its parameters.
+pub const BACK_END: Member = Member {
+    name: "c",
+    doc: "C (SPEC §8); `-o FILE` gets the code and FILE.h its prototypes",
+    params: &[ABI, PRECISION, BATCH, TRIG, NAME],
+    build: |p| Ok(Box::new(CodegenC::from_params(p)?)),
+};
 
 /// `abi=plain|robotran`.
 pub const ABI: ParamInfo = ParamInfo {
     name: "abi",
-    kind: ParamKind::Choice { choices: &["plain", "robotran"], default: "plain" },
+    kind: ParamKind::Choice { choices: Abi::WORDS, default: Abi::Plain.as_str() },
     doc: "C: `plain` (in/out arrays) or `robotran` (drop-in, Robotran's signature and MbsData)",
 };
 /// `precision=f64|f32`.
 pub const PRECISION: ParamInfo = ParamInfo {
     name: "precision",
-    kind: ParamKind::Choice { choices: &["f64", "f32"], default: "f64" },
+    kind: ParamKind::Choice { choices: Precision::WORDS, default: Precision::F64.as_str() },
     doc: "C: arithmetic in `double` (f64) or `float` (f32)",
 };
 /// `batch=1|2|4|8|16`.
 pub const BATCH: ParamInfo = ParamInfo {
     name: "batch",
-    kind: ParamKind::Choice { choices: &["1", "2", "4", "8", "16"], default: "1" },
+    kind: ParamKind::U32Set { default: 1, allowed: &[1, 2, 4, 8, 16] },
     doc: "C: states per call, lanes (`in[i*W + lane]`); plain ABI only",
 };
 /// `trig=libm|input|inline`.
 pub const TRIG: ParamInfo = ParamInfo {
     name: "trig",
-    kind: ParamKind::Choice { choices: &["libm", "input", "inline"], default: "libm" },
+    kind: ParamKind::Choice { choices: Trig::WORDS, default: Trig::Libm.as_str() },
     doc: "C: sin/cos of joint coordinates computed by libm (`libm`), taken as inputs (`input`), or computed \
           by robovec's own vectorised code in the file (`inline`: within 1 ulp, not bit-exact with `-eval`)",
 };
@@ -63,42 +71,47 @@ pub const NAME: ParamInfo = ParamInfo {
     doc: "C: symbol of the function (a prefix `NAME_function` with several functions)",
 };
 
-/// How the generated C gets the sin/cos of the joint coordinates (`trig=`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Trig {
-    /// `libm`: `sin`/`cos` (`sinf`/`cosf`), lane by lane in a batch; bit-exact with `-eval`.
-    #[default]
-    Libm,
-    /// `input`: the values are inputs after the IR's own.
-    Input,
-    /// `inline`: robovec's own branch-free code ([`trig`]), vectorised over the lanes.
-    Inline,
+word_enum! {
+    /// The signature of the generated functions (`abi=`).
+    pub enum Abi {
+        /// `plain` ([`plain`]): `void NAME(const REAL *restrict in, REAL *restrict out)`.
+        Plain = "plain",
+        /// `robotran` ([`robotran`]): the signature and `MbsData` field access of the Robotran
+        /// function the IR came from, a drop-in replacement of its file.
+        Robotran = "robotran",
+    }
 }
 
-impl Trig {
-    /// The parameter's spelling: `libm`, `input`, `inline`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Trig::Libm => "libm",
-            Trig::Input => "input",
-            Trig::Inline => "inline",
-        }
+word_enum! {
+    /// The arithmetic of the generated code (`precision=`).
+    pub enum Precision {
+        /// `f64`: `double`.
+        F64 = "f64",
+        /// `f32`: `float`.
+        F32 = "f32",
     }
+}
 
-    /// The mode spelled `s`.
-    pub fn from_name(s: &str) -> Option<Trig> {
-        [Trig::Libm, Trig::Input, Trig::Inline].into_iter().find(|t| t.name() == s)
+word_enum! {
+    /// How the generated C gets the sin/cos of the joint coordinates (`trig=`).
+    pub enum Trig {
+        /// `libm`: `sin`/`cos` (`sinf`/`cosf`), lane by lane in a batch; bit-exact with `-eval`.
+        Libm = "libm",
+        /// `input`: the values are inputs after the IR's own.
+        Input = "input",
+        /// `inline`: robovec's own branch-free code ([`trig`]), vectorised over the lanes.
+        Inline = "inline",
     }
 }
 
 /// The C back end's options.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CodegenC {
-    /// `plain` or `robotran`.
-    pub abi: &'static str,
-    /// True for `precision=f32`.
-    pub f32: bool,
-    /// States per call, lanes.
+    /// `abi=`.
+    pub abi: Abi,
+    /// `precision=`.
+    pub precision: Precision,
+    /// States per call, lanes (`batch=`: 1, 2, 4, 8 or 16).
     pub batch: u32,
     /// `trig=`.
     pub trig: Trig,
@@ -108,7 +121,7 @@ pub struct CodegenC {
 
 impl Default for CodegenC {
     fn default() -> CodegenC {
-        CodegenC { abi: "plain", f32: false, batch: 1, trig: Trig::Libm, name: None }
+        CodegenC { abi: Abi::Plain, precision: Precision::F64, batch: 1, trig: Trig::Libm, name: None }
     }
 }
 
@@ -124,14 +137,11 @@ impl CodegenC {
     /// `batch>1`, `precision=f32`, `trig=input` or `trig=inline`: Robotran's signature is one state of
     /// `double`s that computes its own trig) and for a `name` that is not one C identifier.
     pub fn from_params(p: &Params) -> Result<CodegenC, PassError> {
-        if let Some(k) = crate::codegen::fpga::given_beyond_default(p, crate::codegen::fpga::FPGA_ONLY) {
-            return Err(bad(format!("parameter `{k}` belongs to `codegen<fpga>`, not `codegen<c>`")));
-        }
         let o = CodegenC {
-            abi: p.choice("abi")?,
-            f32: p.choice("precision")? == "f32",
-            batch: p.choice("batch")?.parse().expect("batch choices are integers"),
-            trig: Trig::from_name(p.choice("trig")?).expect("trig choices are Trig names"),
+            abi: p.word("abi")?,
+            precision: p.word("precision")?,
+            batch: p.u32("batch")?,
+            trig: p.word("trig")?,
             name: p.names("name")?.map(|n| n.join(",")),
         };
         if let Some(n) = &o.name {
@@ -139,13 +149,13 @@ impl CodegenC {
                 return Err(bad(format!("parameter `name` must be one C identifier, found `{n}`")));
             }
         }
-        if o.abi == "robotran" {
+        if o.abi == Abi::Robotran {
             let clash = if o.batch > 1 {
                 Some(format!("batch={}", o.batch))
-            } else if o.f32 {
+            } else if o.f32() {
                 Some("precision=f32".into())
             } else if o.trig != Trig::Libm {
-                Some(format!("trig={}", o.trig.name()))
+                Some(format!("trig={}", o.trig.as_str()))
             } else {
                 None
             };
@@ -159,31 +169,27 @@ impl CodegenC {
         Ok(o)
     }
 
+    /// True for `precision=f32`.
+    pub fn f32(&self) -> bool {
+        self.precision == Precision::F32
+    }
+
     /// `double` or `float`.
     pub fn real(&self) -> &'static str {
-        if self.f32 {
+        if self.f32() {
             "float"
         } else {
             "double"
         }
     }
 
-    /// The report's `precision`.
-    pub fn precision(&self) -> &'static str {
-        if self.f32 {
-            "f32"
-        } else {
-            "f64"
-        }
-    }
-
     fn symbol(&self, f: &Function, several: bool) -> Result<String, PassError> {
         match (&self.name, self.abi) {
-            (Some(n), "robotran") if several => Ok(format!("{n}_{}", robotran::symbol(f)?)),
+            (Some(n), Abi::Robotran) if several => Ok(format!("{n}_{}", robotran::symbol(f)?)),
             (Some(n), _) if several => Ok(format!("{n}_{}", f.name)),
             (Some(n), _) => Ok(n.clone()),
-            (None, "robotran") => robotran::symbol(f),
-            (None, _) => Ok(super::names::sanitise(&f.name)),
+            (None, Abi::Robotran) => robotran::symbol(f),
+            (None, Abi::Plain) => Ok(super::names::sanitise(&f.name)),
         }
     }
 
@@ -199,7 +205,7 @@ impl CodegenC {
         let mut h = String::new();
         let mut interfaces = Vec::new();
         let callbacks = body::callbacks(m)?;
-        let decls = if self.abi == "robotran" {
+        let decls = if self.abi == Abi::Robotran {
             c += "#include \"mbs_data.h\"\n\n";
             native::prototypes(m)?
         } else {
@@ -208,7 +214,7 @@ impl CodegenC {
         c += &decls;
         for f in &m.functions {
             let symbol = self.symbol(f, several)?;
-            let (code, proto, iface) = if self.abi == "robotran" {
+            let (code, proto, iface) = if self.abi == Abi::Robotran {
                 robotran::function(self, f, &symbol)?
             } else {
                 plain::function(self, f, &symbol)
@@ -217,7 +223,7 @@ impl CodegenC {
             h += &proto;
             interfaces.push(iface);
         }
-        if self.abi == "robotran" {
+        if self.abi == Abi::Robotran {
             let (code, proto) =
                 robotran::sensor_dispatch(m, |f| self.symbol(f, several).expect("symbols checked above"));
             c += &code;
@@ -233,10 +239,10 @@ impl CodegenC {
     fn options_text(&self) -> String {
         format!(
             "codegen<c;abi={};precision={};batch={};trig={}>",
-            self.abi,
-            self.precision(),
+            self.abi.as_str(),
+            self.precision.as_str(),
             self.batch,
-            self.trig.name()
+            self.trig.as_str()
         )
     }
 
@@ -264,10 +270,10 @@ impl CodegenC {
             }
         );
         if self.batch > 1 {
-            s += &body::vector_helpers(self.real(), self.batch, self.f32);
+            s += &body::vector_helpers(self.real(), self.batch, self.f32());
         }
         if self.trig == Trig::Inline {
-            s += &trig::helpers(self.f32, self.batch > 1);
+            s += &trig::helpers(self.f32(), self.batch > 1);
         }
         s
     }
@@ -278,7 +284,7 @@ impl CodegenC {
              #ifndef ROBOVEC_GENERATED_H\n#define ROBOVEC_GENERATED_H\n\n",
             self.options_text()
         );
-        if self.abi == "robotran" {
+        if self.abi == Abi::Robotran {
             s += "#include \"mbs_data.h\"\n\n";
         }
         s += prototypes;
@@ -335,9 +341,9 @@ pub(crate) fn interface(o: &CodegenC, f: &Function, symbol: &str) -> Interface {
         function: f.name.clone(),
         symbol: symbol.to_string(),
         abi: o.abi,
-        precision: o.precision(),
+        precision: o.precision,
         batch: o.batch,
-        trig: o.trig.name(),
+        trig: o.trig,
         inputs: super::input_values(f, o.trig == Trig::Input).iter().map(|&v| f.name_of(v).to_string()).collect(),
         outputs: f.outputs.iter().map(|x| x.name.clone()).collect(),
     }

@@ -52,8 +52,16 @@ use robovec_machine::design::Design;
 use robovec_machine::emit::{emit, DesignFile};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
-use crate::params::ParamKind;
-use crate::{Artifact, ArtifactFile, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry};
+use crate::params::{word_enum, ParamKind};
+use crate::{Artifact, ArtifactFile, Member, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry};
+
+/// The FPGA back end of `codegen`: `codegen<fpga;…>`, with its parameters.
+pub const BACK_END: Member = Member {
+    name: "fpga",
+    doc: "the placed design's images, manifest, Verilog, simulate script and resources (issue 12), in `out=DIR`",
+    params: &[OUT, FORMAT, RESOURCES],
+    build: |p| Ok(Box::new(CodegenFpga::from_params(p)?)),
+};
 
 /// `out=DIR`.
 pub const OUT: ParamInfo = ParamInfo {
@@ -64,33 +72,39 @@ pub const OUT: ParamInfo = ParamInfo {
 /// `format=mif|hex|both`.
 pub const FORMAT: ParamInfo = ParamInfo {
     name: "format",
-    kind: ParamKind::Choice { choices: &["both", "mif", "hex"], default: "both" },
+    kind: ParamKind::Choice { choices: Format::WORDS, default: Format::Both.as_str() },
     doc: "FPGA: memory images as Intel MIF, $readmemh hex, or both",
 };
 /// `resources=auto|yosys|estimate`.
 pub const RESOURCES: ParamInfo = ParamInfo {
     name: "resources",
-    kind: ParamKind::Choice { choices: &["auto", "yosys", "estimate"], default: "auto" },
+    kind: ParamKind::Choice { choices: ResourceSource::WORDS, default: ResourceSource::Auto.as_str() },
     doc: "FPGA: logic ALMs from Yosys (auto: when on PATH and at most 8 PEs) or the analytic estimate",
 };
 
-/// The parameters of the C back end, refused with `codegen<fpga>` when given another value
-/// than their default.
-pub const C_ONLY: &[ParamInfo] = &[super::c::ABI, super::c::PRECISION, super::c::BATCH, super::c::TRIG, super::c::NAME];
-/// The parameter of this back end refused with `codegen<c>` (`format` and `resources` have
-/// defaults and are ignored there, as every choice of a family parameter must build).
-pub const FPGA_ONLY: &[ParamInfo] = &[OUT];
+word_enum! {
+    /// The memory images written (`format=`).
+    pub enum Format {
+        /// `both`: `hex/` and `mif/`.
+        Both = "both",
+        /// `mif`: Intel MIF only.
+        Mif = "mif",
+        /// `hex`: `$readmemh` hex only.
+        Hex = "hex",
+    }
+}
 
-/// This back end's choice parameters (checked by the family whichever back end runs).
-pub const FPGA_CHOICES: &[ParamInfo] = &[FORMAT, RESOURCES];
-
-/// The first of `decls` given with a value other than its declared default (`out=`, `name=`:
-/// any value), if any.
-pub fn given_beyond_default(p: &Params, decls: &[ParamInfo]) -> Option<&'static str> {
-    decls
-        .iter()
-        .find(|d| p.get(d.name).is_some_and(|v| !d.default_is_literal() || v != d.default_text()))
-        .map(|d| d.name)
+word_enum! {
+    /// Where the logic ALMs of `resources.json` come from (`resources=`).
+    pub enum ResourceSource {
+        /// `auto`: Yosys when on `PATH` and the design has at most [`AUTO_YOSYS_MAX_PES`] PEs,
+        /// else the analytic estimate.
+        Auto = "auto",
+        /// `yosys`: Yosys at any size; an error without it.
+        Yosys = "yosys",
+        /// `estimate`: the analytic estimate (no Yosys).
+        Estimate = "estimate",
+    }
 }
 
 /// The `codegen<fpga;…>` pass.
@@ -98,14 +112,10 @@ pub fn given_beyond_default(p: &Params, decls: &[ParamInfo]) -> Option<&'static 
 pub struct CodegenFpga {
     /// Output folder.
     pub out: PathBuf,
-    /// `mif`, `hex` or `both`.
-    pub format: &'static str,
-    /// `auto`, `yosys` or `estimate`.
-    pub resources: &'static str,
-}
-
-fn bad(message: String) -> PassError {
-    PassError::BadParameter { pass: "codegen".into(), message }
+    /// `format=`.
+    pub format: Format,
+    /// `resources=`.
+    pub resources: ResourceSource,
 }
 
 fn failed(message: String) -> PassError {
@@ -113,17 +123,14 @@ fn failed(message: String) -> PassError {
 }
 
 impl CodegenFpga {
-    /// The options from checked parameters.
+    /// The options from checked parameters. Without `out`, the folder is `fpga` (in the
+    /// working folder).
     ///
     /// # Errors
-    /// [`PassError::BadParameter`] with a parameter of the C back end given another value than
-    /// its default. Without `out`, the folder is `fpga` (in the working folder).
+    /// [`PassError::BadParameter`] for an empty `out`.
     pub fn from_params(p: &Params) -> Result<CodegenFpga, PassError> {
-        if let Some(k) = given_beyond_default(p, C_ONLY) {
-            return Err(bad(format!("parameter `{k}` belongs to `codegen<c>`, not `codegen<fpga>`")));
-        }
         let out = p.path("out")?.unwrap_or_else(|| "fpga".into());
-        Ok(CodegenFpga { out: out.into(), format: p.choice("format")?, resources: p.choice("resources")? })
+        Ok(CodegenFpga { out: out.into(), format: p.word("format")?, resources: p.word("resources")? })
     }
 }
 
@@ -213,7 +220,7 @@ impl CodegenFpga {
     /// True when `resources=auto` leaves a design of `n_pes` PEs (ADD + MULTI) to the analytic
     /// estimate instead of Yosys (see [`AUTO_YOSYS_MAX_PES`]).
     fn auto_skips_yosys(&self, n_pes: u32) -> bool {
-        self.resources == "auto" && n_pes > AUTO_YOSYS_MAX_PES
+        self.resources == ResourceSource::Auto && n_pes > AUTO_YOSYS_MAX_PES
     }
 
     /// The design, report and files of one placed function.
@@ -232,14 +239,14 @@ impl CodegenFpga {
             return Err(format!("function @{} has no placement; run `place` before `codegen<fpga>`", f.name));
         };
         let logic = match self.resources {
-            "estimate" => Logic::Estimate,
-            "yosys" => Logic::Yosys,
-            _ => Logic::Auto,
+            ResourceSource::Estimate => Logic::Estimate,
+            ResourceSource::Yosys => Logic::Yosys,
+            ResourceSource::Auto => Logic::Auto,
         };
-        let (d, r, files) = emit(f, p, limits, model, logic, self.format)?;
+        let (d, r, files) = emit(f, p, limits, model, logic, self.format.as_str())?;
         let report = FpgaReport {
             out: self.out.display().to_string(),
-            format: self.format,
+            format: self.format.as_str(),
             n_add: d.n_add,
             n_mul: d.n_mul,
             cycles: d.cycles,

@@ -1,5 +1,6 @@
-//! Figures of the IR at the end of a pipeline: the report's `stats` and `placement` (SPEC §7)
-//! and the `-stats` lines, with what the run's artifacts add to them.
+//! The summary of the IR at the end of a pipeline, in numbers: the report's `stats` and
+//! `placement` (SPEC §7) and the `-stats` lines, with what the run's artifacts add to them.
+//! (The pictures of `-report-dir` are drawn from the report by `robovec`'s `report_dir`.)
 
 use robovec_ir::analysis::{compute_timing, Latencies};
 use robovec_ir::{Def, Function, Module, OpCounts, Phase};

@@ -1,12 +1,13 @@
-//! Studies over a whole run rather than passes of a pipeline: `-pareto` (several pipelines on
+//! Work over a whole run rather than passes of a pipeline: `-pareto` (several pipelines on
 //! the same input, speed against error) and `-check` (the final IR against the input's error
 //! budget). They return artifacts or lines like passes do, and fail with a [`Failure`] whose
-//! text is ready for stderr.
+//! text is ready for stderr. (`robovec-gen --study`, the thesis's study over generated robots,
+//! is another thing: `robovec`'s `study`.)
 
 pub mod check;
 pub mod pareto;
 
-/// Why a study failed; the text is one or more lines ready for stderr (ending in a newline).
+/// Why `-pareto` or `-check` failed; the text is one or more lines ready for stderr (ending in a newline).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Failure {
     /// Bad usage (exit status 2): a pipeline that does not parse, an unknown pass.

@@ -21,16 +21,17 @@
 //! pipeline that fails on the input is bad input (exit 1).
 
 use robovec_ir::{Function, Module};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::Failure;
 use crate::accuracy::check::{check_function, pipeline_is_bit_exact};
 use crate::accuracy::{measure_against, BitsSummary, Options as AccuracyOptions};
-use crate::figures::stats;
+use crate::summary::stats;
 use crate::{Instrumentation, PassContext, PassManager};
 
-/// One pipeline's figures.
-#[derive(Clone, Debug, Serialize)]
+/// One pipeline's figures: a row of the report's `pareto` (written, and read back for
+/// `-report-dir`'s figures) and of the `-pareto` table.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ParetoRow {
     /// The pipeline as given (normalised).
     pub pipeline: String,
@@ -64,7 +65,7 @@ pub struct ParetoRow {
     pub callback_standins: Vec<String>,
     /// Passes of this pipeline, and its accuracy measurement, that stopped early under
     /// `-time-limit` or a work budget, one line each (absent when none).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stopped_early: Vec<String>,
     /// True when no other row dominates this one (never for a row that is not sound).
     pub pareto_optimal: bool,
