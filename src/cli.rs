@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use clap::{ArgAction, Parser};
-use robovec_passes::{Instrumentation, ParamInfo, PrintSelector, PASSES};
+use robovec_passes::{Instrumentation, PrintSelector};
 
 use crate::options::Options;
 
@@ -101,9 +101,10 @@ pub struct Cli {
     /// Seed of -check's points (point i is `accuracy<seed=S>`'s point i).
     #[arg(long, value_name = "SEED", default_value_t = 1)]
     pub check_seed: u64,
-    /// List the registered passes with their parameters and exit.
-    #[arg(long)]
-    pub print_passes: bool,
+    /// List the registered passes with their parameters and exit: as text, or
+    /// (`--print-passes=markdown`) as the manual's page docs/passes.md.
+    #[arg(long, value_name = "FORMAT", num_args = 0..=1, require_equals = true, default_missing_value = "text")]
+    pub print_passes: Option<PassListing>,
     /// The machine every pass targets: `de10-nano` (built in, seed ch. 1) or a JSON target
     /// file (latencies, write ports, memory words, clock, device capacities, unit costs; see
     /// docs/targets.md). A pass's `lat-*`/`writes` parameter overrides it only where
@@ -158,27 +159,23 @@ pub fn normalise_args(args: impl IntoIterator<Item = String>) -> Vec<String> {
         .collect()
 }
 
-/// The `--print-passes` listing: each pass, its parameters, and for a pass family (`codegen`)
-/// each member (`back end c: …`) with its own parameters.
-pub fn print_passes() -> String {
-    let line =
-        |q: &ParamInfo| format!("      {:<12} (default {}; {}) {}\n", q.name, q.default_text(), q.range_text(), q.doc);
-    let mut s = String::from("Passes (use -passes=a,b<k=v;k2=v2>,c):\n");
-    for p in PASSES {
-        s += &format!("  {:<12} {}\n", p.name, p.doc);
-        for q in p.params {
-            s += &line(q);
-        }
-        for q in p.params {
-            for m in q.members() {
-                s += &format!("    {} {}: {}\n", q.name.replace('-', " "), m.name, m.doc);
-                for x in m.params {
-                    s += &line(x);
-                }
-            }
+/// The formats of `--print-passes` (both read from the registry: [`robovec_passes::reference`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PassListing {
+    /// One line per pass and per parameter (`name (default D; RANGE) doc`).
+    Text,
+    /// The manual's page `docs/passes.md`.
+    Markdown,
+}
+
+impl PassListing {
+    /// The listing in this format.
+    pub fn render(self) -> String {
+        match self {
+            PassListing::Text => robovec_passes::reference::text(),
+            PassListing::Markdown => robovec_passes::reference::markdown(),
         }
     }
-    s
 }
 
 impl Cli {

@@ -6,7 +6,7 @@
 use std::io::Write;
 
 use clap::Parser;
-use robovec::cli::{normalise_args, print_passes, Cli};
+use robovec::cli::{normalise_args, Cli};
 
 fn main() {
     std::process::exit(run());
@@ -43,8 +43,8 @@ fn run() -> i32 {
             return to_stdout(&text, e.exit_code());
         }
     };
-    if cli.print_passes {
-        return to_stdout(&print_passes(), 0);
+    if let Some(listing) = cli.print_passes {
+        return to_stdout(&listing.render(), 0);
     }
     let opts = match cli.options() {
         Ok(o) => o,

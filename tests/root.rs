@@ -24,6 +24,7 @@ mod numerics;
 #[cfg(unix)]
 mod outputs;
 mod params;
+mod passes_reference;
 mod pinocchio;
 mod placement;
 mod placement_verify;

@@ -21,6 +21,7 @@ pub mod params;
 pub mod pipeline;
 pub mod place;
 pub mod progress;
+pub mod reference;
 pub mod report;
 pub mod schedule_cpu;
 pub mod sim;
