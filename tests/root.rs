@@ -6,6 +6,7 @@
 mod common;
 
 mod accuracy;
+mod architecture;
 mod artifacts;
 mod bounds;
 mod cli;

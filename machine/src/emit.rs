@@ -114,7 +114,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "data": "binary32",
     });
     let v = serde_json::json!({
-        "format": "robovec-machine/1",
+        "format": "robovec-fpga/1",
         "function": d.function,
         "target": target,
         "clock_mhz": clock_mhz,
