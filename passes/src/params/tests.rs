@@ -1,0 +1,140 @@
+//! The declarations of every registered pass against the parser and the getters.
+
+use super::*;
+use crate::{PassInfo, PASSES};
+use robovec_ir::analysis::Latencies;
+
+fn build(info: &'static PassInfo, raw: &[(&str, String)]) -> Result<String, PassError> {
+    let raw: Vec<(String, Option<String>)> = raw.iter().map(|(k, v)| (k.to_string(), Some(v.clone()))).collect();
+    let p = Params::check(info, &raw)?;
+    Ok(format!("{:?}", (info.build)(&p)?))
+}
+
+/// Each way to build `info`: `(parameters that select it, its declarations)`: the pass, or
+/// for a family each member with the selector given.
+fn variants(info: &'static PassInfo) -> Vec<(Vec<(&'static str, String)>, Vec<&'static ParamInfo>)> {
+    let selector = info.params.iter().find(|p| !p.members().is_empty());
+    match selector {
+        None => vec![(Vec::new(), info.params.iter().collect())],
+        Some(s) => s
+            .members()
+            .iter()
+            .map(|m| (vec![(s.name, m.name.to_string())], info.params.iter().chain(m.params).collect()))
+            .collect(),
+    }
+}
+
+#[test]
+fn every_declared_default_is_the_default_and_every_range_is_enforced() {
+    for info in PASSES {
+        build(info, &[]).unwrap_or_else(|e| panic!("{}: {e}", info.name));
+        for (select, decls) in variants(info) {
+            let with = |extra: &[(&'static str, String)]| {
+                let mut raw = select.clone();
+                raw.extend(extra.iter().filter(|(k, _)| !select.iter().any(|(s, _)| s == k)).cloned());
+                build(info, &raw)
+            };
+            let none = with(&[]).unwrap_or_else(|e| panic!("{} {select:?}: {e}", info.name));
+            let given: Vec<(&str, String)> =
+                decls.iter().filter(|p| p.default_is_literal()).map(|p| (p.name, p.default_text())).collect();
+            let all = with(&given).unwrap_or_else(|e| panic!("{} {select:?}: {e}", info.name));
+            assert_eq!(none, all, "{} {select:?}: no parameters vs every printed default", info.name);
+            for p in decls.iter().filter(|p| p.members().is_empty()) {
+                let ok = |v: &str| with(&[(p.name, v.to_string())]);
+                if let Some((lo, hi)) = p.bounds() {
+                    for v in [&lo, &hi] {
+                        ok(v).unwrap_or_else(|e| panic!("{} {}={v}: {e}", info.name, p.name));
+                    }
+                    for v in p.out_of_bounds() {
+                        assert!(
+                            matches!(ok(&v), Err(PassError::BadParameter { .. })),
+                            "{} {}={v} accepted",
+                            info.name,
+                            p.name
+                        );
+                    }
+                }
+                for c in p.every_value() {
+                    ok(&c).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, p.name));
+                }
+                if !matches!(p.kind, ParamKind::Path | ParamKind::OutputFolder | ParamKind::Names) {
+                    assert!(ok("x").is_err(), "{} {}=x accepted", info.name, p.name);
+                }
+            }
+        }
+        // The selector: each member builds; a word that names none is refused.
+        for s in info.params.iter().filter(|p| !p.members().is_empty()) {
+            for c in s.every_value() {
+                build(info, &[(s.name, c.clone())]).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, s.name));
+            }
+            assert!(build(info, &[(s.name, "x".into())]).is_err(), "{} {}=x accepted", info.name, s.name);
+        }
+    }
+}
+
+#[test]
+fn a_set_parameter_takes_only_its_values() {
+    let info = crate::pass_info("codegen").unwrap();
+    let batch = info.param("batch").unwrap();
+    assert_eq!((batch.default_text(), batch.range_text()), ("1".to_string(), "1|2|4|8|16".to_string()));
+    for bad in ["0", "3", "32", "-1", "x"] {
+        let e = build(info, &[("batch", bad.into())]).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            format!("pass `codegen`: parameter `batch` must be one of `1`, `2`, `4`, `8`, `16`, found `{bad}`")
+        );
+    }
+}
+
+#[test]
+fn word_parameters_are_read_as_their_enums() {
+    use crate::codegen::c::{Abi, Precision, Trig};
+    use crate::codegen::fpga::{Format, ResourceSource};
+    fn round_trip<T: Word + PartialEq + std::fmt::Debug>(all: &[T]) {
+        assert_eq!(all.len(), T::WORDS.len());
+        for (x, w) in all.iter().zip(T::WORDS) {
+            assert_eq!((x.as_str(), T::from_word(w)), (*w, Some(*x)));
+        }
+        assert_eq!(T::from_word("x"), None);
+    }
+    round_trip(&[Abi::Plain, Abi::Robotran]);
+    round_trip(&[Precision::F64, Precision::F32]);
+    round_trip(&[Trig::Libm, Trig::Input, Trig::Inline]);
+    round_trip(&[Format::Both, Format::Mif, Format::Hex]);
+    round_trip(&[ResourceSource::Auto, ResourceSource::Yosys, ResourceSource::Estimate]);
+    assert_eq!(serde_json::to_string(&Abi::Robotran).unwrap(), "\"robotran\"");
+}
+
+#[test]
+fn option_defaults_come_from_the_declarations() {
+    // Window 6 is what eqsat uses; `--print-passes` printed 8 before the declarations.
+    let eqsat = crate::pass_info("eqsat").unwrap();
+    let window = eqsat.params.iter().find(|p| p.name == "window").unwrap();
+    assert_eq!(window.default_text(), crate::eqsat::EqsatOptions::default().window.to_string());
+    assert_eq!(
+        build(eqsat, &[]).unwrap(),
+        format!("{:?}", crate::eqsat::Eqsat { opts: crate::eqsat::EqsatOptions::default(), lat: Default::default() })
+    );
+    let place = crate::pass_info("place").unwrap();
+    assert_eq!(
+        build(place, &[]).unwrap(),
+        format!(
+            "{:?}",
+            crate::place::Place {
+                opts: crate::place::PlaceOptions::with_pes(4),
+                lat: Default::default(),
+                writes: None
+            }
+        )
+    );
+    let accuracy = crate::pass_info("accuracy").unwrap();
+    assert_eq!(
+        build(accuracy, &[]).unwrap(),
+        format!("{:?}", crate::accuracy::Accuracy { opts: crate::accuracy::Options::default() })
+    );
+    // The latencies default to the target's; the declared built-in values are de10-nano's.
+    let d = robovec_machine::target::Target::de10_nano().latencies;
+    assert_eq!(d, Latencies::default());
+    let lat: Vec<String> = LATENCY_PARAMS.iter().map(ParamInfo::default_text).collect();
+    assert_eq!(lat, [d.add, d.mul, d.div, d.call].map(|x| format!("the target's, de10-nano {x}")));
+}

@@ -1,0 +1,71 @@
+//! Parameter values that are words of a fixed set (`abi=plain|robotran`): the [`Word`] trait
+//! and the `word_enum!` macro that declares such an enum once, words and all.
+
+/// A parameter value that is one word of a fixed set (`abi=plain|robotran`), as declared by
+/// `word_enum!` (below).
+pub trait Word: Copy + 'static {
+    /// Every word, in the order of the variants: the choices of the parameter's declaration.
+    const WORDS: &'static [&'static str];
+    /// The value's word, as written in a pipeline and in the report.
+    fn as_str(self) -> &'static str;
+    /// The value written `word`, if any.
+    fn from_word(word: &str) -> Option<Self>;
+}
+
+/// Declares an enum whose values are the words of a parameter: each variant is written
+/// `Variant = "word"`. The enum gets `WORDS` (every word, in variant order: what the
+/// parameter's [`ParamKind::Choice`] declares as `choices`), `const fn as_str`, `from_word`,
+/// [`Word`] (for [`Params::word`]), and `Serialize` as its word (the report writes `"robotran"`).
+macro_rules! word_enum {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident {
+            $($(#[$vmeta:meta])* $variant:ident = $word:literal,)+
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum $name {
+            $($(#[$vmeta])* $variant,)+
+        }
+
+        impl $name {
+            /// Every word, in the variants' order: the parameter's choices.
+            pub const WORDS: &'static [&'static str] = &[$($word),+];
+
+            /// The value's word, as written in a pipeline and in the report.
+            pub const fn as_str(self) -> &'static str {
+                match self {
+                    $($name::$variant => $word,)+
+                }
+            }
+
+            /// The value written `word`, if any.
+            pub fn from_word(word: &str) -> Option<$name> {
+                match word {
+                    $($word => Some($name::$variant),)+
+                    _ => None,
+                }
+            }
+        }
+
+        impl $crate::params::Word for $name {
+            const WORDS: &'static [&'static str] = $name::WORDS;
+
+            fn as_str(self) -> &'static str {
+                $name::as_str(self)
+            }
+
+            fn from_word(word: &str) -> Option<$name> {
+                $name::from_word(word)
+            }
+        }
+
+        impl serde::Serialize for $name {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                s.serialize_str(self.as_str())
+            }
+        }
+    };
+}
+pub(crate) use word_enum;
