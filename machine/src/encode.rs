@@ -403,6 +403,22 @@ pub fn encode(p: &MachineProgram, l: &Layout) -> Result<Images, EncodeError> {
     Ok(im)
 }
 
+/// The program `p`'s images carry back: `p` with every PE's steps replaced by what [`encode`]
+/// then [`decode`] give (equal to `p` when the encoding keeps every field: what the encoding's
+/// tests compare).
+///
+/// # Errors
+/// The text of the [`EncodeError`] or [`DecodeError`] met on the way.
+pub fn through_images(p: &MachineProgram, l: &Layout) -> Result<MachineProgram, String> {
+    let images = encode(p, l).map_err(|e| e.to_string())?;
+    let steps = decode(&images).map_err(|e| e.to_string())?;
+    let mut back = p.clone();
+    for (pe, s) in back.pes.iter_mut().zip(steps) {
+        pe.steps = s;
+    }
+    Ok(back)
+}
+
 /// Decodes images back into the steps of every PE slot (`[slot][cycle]`).
 ///
 /// # Errors

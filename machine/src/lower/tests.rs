@@ -14,7 +14,7 @@ use robovec_ir::text::parse;
 use robovec_ir::{Function, Operand, Value};
 
 use super::{lower, MachineErrorKind};
-use crate::encode::{decode, encode, EncodeError, Layout};
+use crate::encode::{encode, through_images, EncodeError, Layout};
 use crate::exec::execute;
 
 use Pe::{Add, Mul};
@@ -64,15 +64,9 @@ fn de10_layout(m: &MachineProgram) -> Layout {
     Layout::new(m, 2048, 2048, 52).expect("fits")
 }
 
-/// Encodes, decodes and puts the decoded steps back into the program.
+/// The program the DE10-Nano images of `m` carry back.
 fn round_trip(m: &MachineProgram) -> MachineProgram {
-    let im = encode(m, &de10_layout(m)).expect("encodes");
-    let steps = decode(&im).expect("decodes");
-    let mut back = m.clone();
-    for (q, s) in back.pes.iter_mut().zip(steps) {
-        q.steps = s;
-    }
-    back
+    through_images(m, &de10_layout(m)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]

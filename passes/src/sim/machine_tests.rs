@@ -13,7 +13,7 @@ use robovec_ir::placement::{Load, Pe, PeArray};
 use robovec_ir::text::parse;
 use robovec_ir::verifier::machine::verify_machine;
 use robovec_ir::{Function, Operand, Value};
-use robovec_machine::encode::{decode, encode, Layout};
+use robovec_machine::encode::{through_images, Layout};
 use robovec_machine::exec::execute;
 use robovec_machine::lower::lower;
 
@@ -44,15 +44,9 @@ fn de10_layout(m: &MachineProgram) -> Layout {
     Layout::new(m, 2048, 2048, 52).expect("fits")
 }
 
-/// Encodes, decodes and puts the decoded steps back into the program.
+/// The program the DE10-Nano images of `m` carry back.
 fn round_trip(m: &MachineProgram) -> MachineProgram {
-    let im = encode(m, &de10_layout(m)).expect("encodes");
-    let steps = decode(&im).expect("decodes");
-    let mut back = m.clone();
-    for (q, s) in back.pes.iter_mut().zip(steps) {
-        q.steps = s;
-    }
-    back
+    through_images(m, &de10_layout(m)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
