@@ -11,7 +11,7 @@ use robovec_ir::Function;
 use crate::design::build::{from_placement, Limits};
 use crate::design::images::Image;
 use crate::design::{Design, HDL_LIBRARY, SIMULATE};
-use crate::resources::{self, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
+use crate::resources::{self, CostModel, Logic, Resources};
 
 /// One file of a design, its path relative to the function's folder.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -155,12 +155,12 @@ pub fn emit(
         .map_err(|e| format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target))?;
     let cells =
         match logic {
-            Logic::Estimate => None,
+            _ if logic.skips_yosys(d.n_add + d.n_mul) => None,
             Logic::Yosys => Some(resources::yosys_cells(&d)?.ok_or(
                 "`resources=yosys` but `yosys` cannot be run (Debian package `yosys`); use resources=estimate",
             )?),
-            Logic::Auto if d.n_add + d.n_mul > AUTO_YOSYS_MAX_PES => None,
-            Logic::Auto => resources::yosys_cells(&d)?,
+            // `auto` within the limit: Yosys when it can be run, else the estimate.
+            _ => resources::yosys_cells(&d)?,
         };
     let r = resources::estimate(&d, model, cells);
     let man = manifest(&d, &model.target, model.clock_mhz, format);

@@ -252,6 +252,35 @@ pub enum Logic {
     Estimate,
 }
 
+impl Logic {
+    /// Every word of `resources=`, in the variants' order.
+    pub const WORDS: &'static [&'static str] = &["auto", "yosys", "estimate"];
+
+    /// The value's word (`resources=auto`).
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Logic::Auto => "auto",
+            Logic::Yosys => "yosys",
+            Logic::Estimate => "estimate",
+        }
+    }
+
+    /// The value written `word`, if any.
+    pub fn from_word(word: &str) -> Option<Logic> {
+        [Logic::Auto, Logic::Yosys, Logic::Estimate].into_iter().find(|l| l.as_str() == word)
+    }
+
+    /// True when a design of `n_pes` PEs (ADD + MULTI) gets the analytic estimate without
+    /// trying Yosys: `Estimate`, or `Auto` beyond [`AUTO_YOSYS_MAX_PES`].
+    pub fn skips_yosys(self, n_pes: u32) -> bool {
+        match self {
+            Logic::Estimate => true,
+            Logic::Auto => n_pes > AUTO_YOSYS_MAX_PES,
+            Logic::Yosys => false,
+        }
+    }
+}
+
 /// How Yosys maps the design (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Synthesis {

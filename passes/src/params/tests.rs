@@ -89,7 +89,8 @@ fn a_set_parameter_takes_only_its_values() {
 #[test]
 fn word_parameters_are_read_as_their_enums() {
     use crate::codegen::c::{Abi, Precision, Trig};
-    use crate::codegen::fpga::{Format, ResourceSource};
+    use crate::codegen::fpga::Format;
+    use robovec_machine::resources::Logic;
     fn round_trip<T: Word + PartialEq + std::fmt::Debug>(all: &[T]) {
         assert_eq!(all.len(), T::WORDS.len());
         for (x, w) in all.iter().zip(T::WORDS) {
@@ -101,7 +102,7 @@ fn word_parameters_are_read_as_their_enums() {
     round_trip(&[Precision::F64, Precision::F32]);
     round_trip(&[Trig::Libm, Trig::Input, Trig::Inline]);
     round_trip(&[Format::Both, Format::Mif, Format::Hex]);
-    round_trip(&[ResourceSource::Auto, ResourceSource::Yosys, ResourceSource::Estimate]);
+    round_trip(&[Logic::Auto, Logic::Yosys, Logic::Estimate]);
     assert_eq!(serde_json::to_string(&Abi::Robotran).unwrap(), "\"robotran\"");
 }
 

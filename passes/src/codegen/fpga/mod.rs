@@ -52,7 +52,7 @@ use robovec_machine::design::Design;
 use robovec_machine::emit::{emit, DesignFile};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
-use crate::params::{word_enum, ParamKind};
+use crate::params::{word_enum, ParamKind, Word};
 use crate::{Artifact, ArtifactFile, Member, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry};
 
 /// The FPGA back end of `codegen`: `codegen<fpga;…>`, with its parameters.
@@ -78,7 +78,7 @@ pub const FORMAT: ParamInfo = ParamInfo {
 /// `resources=auto|yosys|estimate`.
 pub const RESOURCES: ParamInfo = ParamInfo {
     name: "resources",
-    kind: ParamKind::Choice { choices: ResourceSource::WORDS, default: ResourceSource::Auto.as_str() },
+    kind: ParamKind::Choice { choices: Logic::WORDS, default: Logic::Auto.as_str() },
     doc: "FPGA: logic ALMs from Yosys (auto: when on PATH and at most 8 PEs) or the analytic estimate",
 };
 
@@ -94,16 +94,16 @@ word_enum! {
     }
 }
 
-word_enum! {
-    /// Where the logic ALMs of `resources.json` come from (`resources=`).
-    pub enum ResourceSource {
-        /// `auto`: Yosys when on `PATH` and the design has at most [`AUTO_YOSYS_MAX_PES`] PEs,
-        /// else the analytic estimate.
-        Auto = "auto",
-        /// `yosys`: Yosys at any size; an error without it.
-        Yosys = "yosys",
-        /// `estimate`: the analytic estimate (no Yosys).
-        Estimate = "estimate",
+/// `resources=` reads its words from the machine's [`Logic`], which holds them.
+impl Word for Logic {
+    const WORDS: &'static [&'static str] = Logic::WORDS;
+
+    fn as_str(self) -> &'static str {
+        Logic::as_str(self)
+    }
+
+    fn from_word(word: &str) -> Option<Logic> {
+        Logic::from_word(word)
     }
 }
 
@@ -115,7 +115,7 @@ pub struct CodegenFpga {
     /// `format=`.
     pub format: Format,
     /// `resources=`.
-    pub resources: ResourceSource,
+    pub resources: Logic,
 }
 
 fn failed(message: String) -> PassError {
@@ -220,7 +220,7 @@ impl CodegenFpga {
     /// True when `resources=auto` leaves a design of `n_pes` PEs (ADD + MULTI) to the analytic
     /// estimate instead of Yosys (see [`AUTO_YOSYS_MAX_PES`]).
     fn auto_skips_yosys(&self, n_pes: u32) -> bool {
-        self.resources == ResourceSource::Auto && n_pes > AUTO_YOSYS_MAX_PES
+        self.resources == Logic::Auto && self.resources.skips_yosys(n_pes)
     }
 
     /// The design, report and files of one placed function.
@@ -238,12 +238,7 @@ impl CodegenFpga {
         let Some(p) = &f.placement else {
             return Err(format!("function @{} has no placement; run `place` before `codegen<fpga>`", f.name));
         };
-        let logic = match self.resources {
-            ResourceSource::Estimate => Logic::Estimate,
-            ResourceSource::Yosys => Logic::Yosys,
-            ResourceSource::Auto => Logic::Auto,
-        };
-        let (d, r, files) = emit(f, p, limits, model, logic, self.format.as_str())?;
+        let (d, r, files) = emit(f, p, limits, model, self.resources, self.format.as_str())?;
         let report = FpgaReport {
             out: self.out.display().to_string(),
             format: self.format.as_str(),
