@@ -284,7 +284,7 @@ fn run_passes(
             &cx.target,
             &cx.progress,
         )
-        .map_err(study_failure)?;
+        .map_err(Failure::from)?;
         cx.emit(study);
     }
     let records = {
@@ -301,16 +301,9 @@ fn run_passes(
     }
     if let (Some((samples, seed)), Some(original)) = (opts.check, &cx.original) {
         whole_run::check::run(module, original, &pm.pipeline_text(), &opts.function, samples, seed, stderr)
-            .map_err(study_failure)?;
+            .map_err(Failure::from)?;
     }
     Ok(Ran { records, cx })
-}
-
-fn study_failure(f: whole_run::Failure) -> Failure {
-    match f {
-        whole_run::Failure::Usage(s) => Failure::Usage(s),
-        whole_run::Failure::Input(s) => Failure::Input(s),
-    }
 }
 
 /// The report (SPEC §7) of the function `-report` describes: the run's own fields, the figures

@@ -89,6 +89,17 @@ pub enum Failure {
     Output(String),
 }
 
+/// `-pareto`, `-check` and the study's cases fail with the same two kinds: usage (exit 2) and
+/// input (exit 1), their text kept.
+impl From<robovec_passes::whole_run::Failure> for Failure {
+    fn from(f: robovec_passes::whole_run::Failure) -> Failure {
+        match f {
+            robovec_passes::whole_run::Failure::Usage(s) => Failure::Usage(s),
+            robovec_passes::whole_run::Failure::Input(s) => Failure::Input(s),
+        }
+    }
+}
+
 impl Failure {
     /// Exit status: 1 for bad input or an output that cannot be written, 2 for bad usage
     /// (SPEC §7).

@@ -84,10 +84,7 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     check_pass_files(pm)?;
     // `-pareto`'s pipelines: every name, parameter and file they read, before any work too.
     if let Some(text) = &opts.pareto {
-        let managers = robovec_passes::whole_run::pareto::managers(text).map_err(|f| match f {
-            robovec_passes::whole_run::Failure::Usage(s) => Failure::Usage(s),
-            robovec_passes::whole_run::Failure::Input(s) => Failure::Input(s),
-        })?;
+        let managers = robovec_passes::whole_run::pareto::managers(text).map_err(Failure::from)?;
         for (_, other) in managers {
             check_pass_files(&other)?;
         }

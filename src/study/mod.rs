@@ -27,21 +27,11 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use robovec_dynamics::study::run::{self, CaseResult, Plan};
-use robovec_dynamics::study::{cases, table, StudyError};
+use robovec_dynamics::study::{cases, table};
 use robovec_dynamics::topology::Topology;
 
 use crate::options::{output_failure, Failure};
 use crate::output::OutputSet;
-
-/// A failed case keeps its message: [`StudyError::Usage`] exits 2, [`StudyError::Input`] exits 1.
-impl From<StudyError> for Failure {
-    fn from(e: StudyError) -> Failure {
-        match e {
-            StudyError::Usage(s) => Failure::Usage(s),
-            StudyError::Input(s) => Failure::Input(s),
-        }
-    }
-}
 
 /// What `robovec-gen --study` was asked.
 #[derive(Clone, Debug)]
@@ -104,7 +94,7 @@ pub fn run(
     // Largest cases first, so the parallel run does not end on one big case alone.
     let mut order: Vec<usize> = (0..list.len()).collect();
     order.sort_by_key(|&i| std::cmp::Reverse((list[i].dof, list[i].topology == Topology::Serial)));
-    let mut done: Vec<(usize, Result<CaseResult, StudyError>)> = order
+    let mut done: Vec<(usize, Result<CaseResult, robovec_passes::whole_run::Failure>)> = order
         .par_iter()
         .map(|&i| {
             let r = run::run_case(&list[i], &plan);

@@ -48,15 +48,3 @@ pub const DEFAULT_BEST: &str = "atomise,zero-removal,cse,distribute,balance";
 
 /// The default N of the placements (N ADD + N MULTI PEs).
 pub const DEFAULT_NS: [u32; 4] = [8, 16, 32, 64];
-
-/// Why a case of the study failed. Each message is the whole text printed (`error: …` and a
-/// newline); `robovec-gen` exits 2 for [`StudyError::Usage`] and 1 for [`StudyError::Input`].
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum StudyError {
-    /// A pipeline that does not parse or names an unknown pass.
-    #[error("{0}")]
-    Usage(String),
-    /// A pass failed on a case, or reported nothing where a figure was expected.
-    #[error("{0}")]
-    Input(String),
-}

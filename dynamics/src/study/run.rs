@@ -7,11 +7,11 @@
 
 use robovec_ir::Module;
 use robovec_passes::summary::Figures;
-use robovec_passes::{whole_run as pstudy, Instrumentation, PassContext, PassManager, PassRecord};
+use robovec_passes::whole_run::{self, Failure};
+use robovec_passes::{Instrumentation, PassContext, PassManager, PassRecord};
 use serde::Serialize;
 
 use super::cases::Case;
-use super::StudyError;
 use crate::{generate, topology::build, Model};
 
 /// The function of the study: direct dynamics (seed §3.2, Table 3.1).
@@ -110,17 +110,17 @@ pub fn module_of(case: &Case, seed: u64) -> Module {
 /// Parses `pipeline` (the input is verified by construction).
 ///
 /// # Errors
-/// [`StudyError::Usage`] for a pipeline that does not parse or names an unknown pass.
-pub fn manager(pipeline: &str) -> Result<PassManager, StudyError> {
+/// [`Failure::Usage`] for a pipeline that does not parse or names an unknown pass.
+pub fn manager(pipeline: &str) -> Result<PassManager, Failure> {
     PassManager::new(pipeline, Instrumentation { input_verified: true, ..Instrumentation::default() })
-        .map_err(|e| StudyError::Usage(format!("error: {e}\n")))
+        .map_err(|e| Failure::Usage(format!("error: {e}\n")))
 }
 
 /// Runs `pipeline` on `m` with `cx`; the passes' records.
-fn run_on(pipeline: &str, m: &mut Module, cx: &mut PassContext, case: &Case) -> Result<Vec<PassRecord>, StudyError> {
+fn run_on(pipeline: &str, m: &mut Module, cx: &mut PassContext, case: &Case) -> Result<Vec<PassRecord>, Failure> {
     manager(pipeline)?
         .run(m, cx, &mut std::io::sink())
-        .map_err(|e| StudyError::Input(format!("error: {}: pipeline `{pipeline}`: {e}\n", case.label())))
+        .map_err(|e| Failure::Input(format!("error: {}: pipeline `{pipeline}`: {e}\n", case.label())))
 }
 
 /// The figures of [`FUNCTION`] in `m`.
@@ -149,11 +149,11 @@ fn continuing(after: &PassContext) -> PassContext {
 /// -pareto=… -report-dir=…` writes.
 ///
 /// # Errors
-/// [`StudyError::Usage`] for a pipeline that does not parse; [`StudyError::Input`] when a pass fails.
-pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, StudyError> {
+/// [`Failure::Usage`] for a pipeline that does not parse; [`Failure::Input`] when a pass fails.
+pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
     let generated = module_of(case, plan.seed);
     let target = robovec_machine::target::Target::de10_nano();
-    let shape_after = |pipeline: &str| -> Result<Shape, StudyError> {
+    let shape_after = |pipeline: &str| -> Result<Shape, Failure> {
         let mut m = generated.clone();
         let mut cx = PassContext::with_target(target.clone());
         run_on(pipeline, &mut m, &mut cx, case)?;
@@ -166,7 +166,7 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, StudyError> {
     let mut cx = PassContext { original: Some(generated.clone()), ..PassContext::with_target(target.clone()) };
     if plan.report {
         let text = format!("{GENERATED};{ZERO_BALANCE};{}", plan.best);
-        let pareto = pstudy::pareto::study(
+        let pareto = whole_run::pareto::study(
             &generated,
             FUNCTION,
             &text,
@@ -177,8 +177,8 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, StudyError> {
             &robovec_passes::progress::Progress::hidden(),
         )
         .map_err(|f| match f {
-            pstudy::Failure::Usage(s) => StudyError::Usage(s),
-            pstudy::Failure::Input(s) => StudyError::Input(format!("{}: {s}", case.label())),
+            Failure::Input(s) => Failure::Input(format!("{}: {s}", case.label())),
+            usage => usage,
         })?;
         cx.emit(pareto);
     }
@@ -226,13 +226,13 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, StudyError> {
 
 /// binary32 mean / max bits of the `accuracy` artifact's report entry for [`FUNCTION`] (the
 /// report's `accuracy.f32`, what `-stats` prints as `f32 mean/p95/max`).
-fn accuracy_bits(cx: &PassContext, case: &Case) -> Result<Bits, StudyError> {
+fn accuracy_bits(cx: &PassContext, case: &Case) -> Result<Bits, Failure> {
     let entries = robovec_passes::artifact::report_entries(cx.artifacts(), FUNCTION);
     let acc = entries
         .iter()
         .find(|(k, _)| *k == "accuracy")
         .map(|(_, v)| v)
-        .ok_or_else(|| StudyError::Input(format!("error: {}: accuracy reported nothing\n", case.label())))?;
+        .ok_or_else(|| Failure::Input(format!("error: {}: accuracy reported nothing\n", case.label())))?;
     let get = |k: &str| acc.pointer(&format!("/f32/{k}")).and_then(serde_json::Value::as_f64).unwrap_or(f64::NAN);
     Ok(Bits { mean: get("mean_bits"), max: get("max_bits") })
 }

@@ -7,7 +7,8 @@
 pub mod check;
 pub mod pareto;
 
-/// Why `-pareto` or `-check` failed; the text is one or more lines ready for stderr (ending in a newline).
+/// Why work over whole runs failed (`-pareto`, `-check`, a case of `robovec-gen --study`); the
+/// text is one or more lines ready for stderr (ending in a newline).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Failure {
     /// Bad usage (exit status 2): a pipeline that does not parse, an unknown pass.
