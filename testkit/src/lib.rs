@@ -1,5 +1,6 @@
 //! Test support for robovec (issue 11: oracles and generators out of the production library).
 //!
+//! - [`copies`]: independent copies of a Robotran Matlab function (the scale benchmark's input);
 //! - [`dag_gen`]: synthetic Robotran-like atomised DAGs of a chosen size (tests and benchmarks);
 //! - [`expr_gen`]: random parsed-phase expression DAGs (property tests, fuzzing);
 //! - [`exact`]: exact minimum-makespan schedules of small DAGs (branch and bound), the oracle the
@@ -12,6 +13,7 @@
 //! dev-dependencies (this crate's types are `robovec_ir` ones, so they line up).
 #![deny(missing_docs)]
 
+pub mod copies;
 pub mod dag_gen;
 pub mod exact;
 pub mod expr_gen;
