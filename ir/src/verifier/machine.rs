@@ -21,6 +21,8 @@
 //! - the output map is complete: one location per output of the function, in order, holding
 //!   that output's value at the end.
 
+use std::collections::HashMap;
+
 use super::{Location, VerifierError};
 use crate::function::Function;
 use crate::machine::{Held, MachineOp, MachineProgram, Source, Word};
@@ -62,8 +64,21 @@ fn name(f: &Function, h: Option<Held>) -> String {
     }
 }
 
-/// The tag of an initial word, or why there is none.
-fn held_of(f: &Function, w: &Word) -> Result<Held, String> {
+/// The trig initial variables of `f` by function and argument: `(sin, %q1) → %S1` (one pass
+/// over the body, so that reading the initial words stays linear in the program).
+fn trig_values(f: &Function) -> HashMap<(TrigFn, Value), Value> {
+    let mut trig = HashMap::new();
+    for &v in &f.body {
+        if let Def::Trig(t, a) = f.value(v).def {
+            // The first such value, as a search of the body would find.
+            trig.entry((t, a)).or_insert(v);
+        }
+    }
+    trig
+}
+
+/// The tag of an initial word, or why there is none; `trig` is [`trig_values`] of `f`.
+fn held_of(f: &Function, trig: &HashMap<(TrigFn, Value), Value>, w: &Word) -> Result<Held, String> {
     let input = |n: &str| match f.lookup(n) {
         Some(v) if matches!(f.value(v).def, Def::Input) => Ok(v),
         _ => Err(format!("initial word names `{n}`, which is not an input")),
@@ -73,12 +88,7 @@ fn held_of(f: &Function, w: &Word) -> Result<Held, String> {
         Word::Input(n) => input(n).map(Held::Value),
         Word::Trig(t, n) => {
             let x = input(n)?;
-            f.body
-                .iter()
-                .copied()
-                .find(|&v| matches!(f.value(v).def, Def::Trig(u, a) if u == *t && a == x))
-                .map(Held::Value)
-                .ok_or_else(|| {
+            trig.get(&(*t, x)).copied().map(Held::Value).ok_or_else(|| {
                     let fun = if *t == TrigFn::Sin { "sin" } else { "cos" };
                     format!("initial word `{fun} {n}` is not a value of the function")
                 })
@@ -210,10 +220,11 @@ fn check(f: &Function, p: &MachineProgram, e: &mut Errs) {
     }
 
     // Initial contents.
+    let trig = trig_values(f);
     let tags = |init: &[Option<Word>], e: &mut Errs| -> Vec<Option<Held>> {
         init.iter()
             .map(|w| {
-                w.as_ref().and_then(|w| match held_of(f, w) {
+                w.as_ref().and_then(|w| match held_of(f, &trig, w) {
                     Ok(h) => Some(h),
                     Err(m) => {
                         e.push(m);
