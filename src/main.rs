@@ -8,6 +8,11 @@ use std::io::Write;
 use clap::Parser;
 use robovec::cli::{normalise_args, Cli};
 
+/// mimalloc instead of the system allocator: the passes allocate and free millions of small
+/// vectors and maps per run, and glibc's allocator slows down as the heap grows (issue 28).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() {
     std::process::exit(run());
 }
