@@ -138,6 +138,10 @@ fn study(args: &Args) -> ExitCode {
     }
 }
 
+/// mimalloc, as in `robovec-opt` (see there): the study runs every case's passes in this process.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() -> ExitCode {
     let args = Args::parse();
     if args.study.study {
