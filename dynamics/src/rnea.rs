@@ -23,7 +23,7 @@ use robovec_ir::TrigFn;
 
 use super::robot::{snap, JointKind};
 use super::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
-use super::{Layout, Model};
+use super::{Layout, Model, Stopped};
 
 /// A 3-vector of terms.
 pub type V3 = [Term; 3];
@@ -151,18 +151,39 @@ pub fn motions(model: &Model, layout: &Layout, b: &mut Builder) -> Vec<Motion> {
 }
 
 /// Writes `invdyna` (outputs `Qq[1..nq]`) into `b`.
-pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) {
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
     let nq = layout.q_index.iter().flatten().count();
     let drive = Drive::inputs(b, nq, true);
     let motions = motions(model, layout, b);
-    for (qi, t) in sweep(model, layout, b, &motions, &drive) {
+    for (qi, t) in sweep(model, layout, b, &motions, &drive)? {
         b.output(&format!("Qq[{qi}]"), &format!("Qq{qi}"), t);
+    }
+    Ok(())
+}
+
+/// `a + b` entry by entry, taking both (no copy of `a`: a link's sum over its children grows
+/// by one child at a time, and copying it each time would cost the square of its children).
+fn vadd_into(a: &mut V3, b: V3) {
+    for (x, y) in a.iter_mut().zip(b) {
+        *x = add(std::mem::take(x), y);
     }
 }
 
 /// One RNEA sweep driven by `drive`: the joint forces `(i, Q_i)` of the coordinates that bear
-/// one, sorted by `i` (terms, not yet bound).
-pub fn sweep(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion], drive: &Drive) -> Vec<(usize, Term)> {
+/// one, sorted by `i` (terms, not yet bound). Cost: linear in the bodies and the ops written.
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per body, forward and backward).
+pub fn sweep(
+    model: &Model,
+    layout: &Layout,
+    b: &mut Builder,
+    motions: &[Motion],
+    drive: &Drive,
+) -> Result<Vec<(usize, Term)>, Stopped> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
     let nb = order.len();
@@ -183,6 +204,7 @@ pub fn sweep(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]
     // Forward kinematics.
     for (i, &j) in order.iter().enumerate() {
         let body = i + 1;
+        b.check(body, nb)?;
         let joint = &robot.joints[j];
         let p = body_of_link(joint.parent);
         let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
@@ -239,6 +261,7 @@ pub fn sweep(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]
         if !moves[body] {
             continue;
         }
+        b.check(body, nb)?;
         let joint = &robot.joints[order[i]];
         let mass = layout.param(b, &format!("m[{body}]"));
         let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
@@ -271,9 +294,9 @@ pub fn sweep(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]
         let f_p = bind3(b, "Fr", body, matvec(&ro, &f_j, false));
         let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
         let c_p = vadd(&matvec(&ro, &c_j, false), &cross(&d, &f_p));
-        fq[p] = vadd(&fq[p], &f_p);
-        cq[p] = vadd(&cq[p], &c_p);
+        vadd_into(&mut fq[p], f_p);
+        vadd_into(&mut cq[p], c_p);
     }
     torque.sort_by_key(|&(qi, _)| qi);
-    torque
+    Ok(torque)
 }
