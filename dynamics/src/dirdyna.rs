@@ -48,7 +48,7 @@ use rustc_hash::FxHashMap;
 use super::crba::{self, bind_entry};
 use super::rnea::{motions, sweep, Drive, Motion};
 use super::sym::{Builder, Term, ZERO};
-use super::{Layout, Model, Stopped};
+use super::{Layout, Model, Reached, Stopped};
 
 /// How `M` is formed: [`crate::crba`] (the default) or the unit-acceleration RNEA (kept as
 /// an independent cross-check of the CRBA in tests).
@@ -95,7 +95,7 @@ pub fn dirdyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: MassMa
     let columns: Vec<String> = (1..=nq).map(|j| format!("[{j}]")).collect();
     b.f.outputs.reserve(nq * nq + nq);
     for i in 0..nq {
-        b.check(i + 1, nq)?;
+        b.check_at(Reached::Row { row: i + 1, rows: nq })?;
         let row = format!("M[{}]", i + 1);
         for (j, column) in columns.iter().enumerate() {
             let t = upper.get(&(i.min(j), i.max(j))).cloned().unwrap_or(ZERO);

@@ -20,7 +20,10 @@
 //! algorithm ([`rnea`]), symbolic in the joint coordinates `q[i]`, `qd[i]`, `qdd[i]`, the
 //! gravity vector `g[1..3]` (Pinocchio's default is `g[3] = −9.81`) and the model parameters.
 //! `dirdyna`: direct dynamics `M[i][j]` (by CRBA, [`crba`]), `c[i]` (by RNEA) with
-//! `M qdd + c = Qq` ([`dirdyna`]).
+//! `M qdd + c = Qq` ([`dirdyna`]). [`generate_with`] writes only the functions a [`Request`]
+//! names (`-function`) and stops at its deadline (`-time-limit`); the cost of each is linear
+//! in the ops it writes, plus `dirdyna`'s `nq²` outputs (issue 28: no table of body pairs, no
+//! copy of a link's sums per child).
 //! `--floating-base` puts the robot on Robotran's floating base first
 //! ([`robot::Robot::with_floating_base`]): six joints `T1`, `T2`, `T3` (prismatic along the
 //! world x, y, z) and `R1`, `R2`, `R3` (revolute about x, then the new y, then the new z) are
@@ -155,7 +158,7 @@ impl Layout {
 /// What the generator hands to the front end.
 #[derive(Clone, Debug)]
 pub struct Generated {
-    /// The functions asked for, in [`FUNCTIONS`] order (`invdyna`, then `dirdyna`).
+    /// The functions asked for, in [`FUNCTION_NAMES`] order (`invdyna`, then `dirdyna`).
     pub module: Module,
     /// Values of the parameters left as inputs (`None` when they were folded).
     pub params: Option<BTreeMap<String, f64>>,
@@ -166,7 +169,7 @@ pub struct Generated {
 pub struct Request {
     /// Fold every parameter into the equations (`--fold-params`).
     pub fold: bool,
-    /// The functions to write, by name (`-function=NAME`); `None`: all of [`FUNCTIONS`]. Names
+    /// The functions to write, by name (`-function=NAME`); `None`: all of [`FUNCTION_NAMES`]. Names
     /// the generator does not write are ignored (the driver reports them against
     /// [`FUNCTION_NAMES`] before loading).
     pub functions: Option<Vec<String>>,
@@ -189,23 +192,40 @@ impl Request {
 pub struct Stopped {
     /// The function being written (`dirdyna`).
     pub function: String,
-    /// The body (1-based, in the numbering of the module doc; `0` before the first body) the
-    /// recursion had reached.
-    pub body: usize,
-    /// Bodies of the robot.
-    pub bodies: usize,
+    /// How far it got.
+    pub at: Reached,
     /// The limit, seconds.
     pub seconds: f64,
 }
 
+/// Where a generation stopped ([`Stopped::at`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reached {
+    /// A body of a recursion: `body` (1-based, in the numbering of the module doc) of `bodies`.
+    Body {
+        /// The body reached.
+        body: usize,
+        /// Bodies of the robot.
+        bodies: usize,
+    },
+    /// A row of `M`'s outputs (`dirdyna`): `row` (1-based) of `rows` (`nq`).
+    Row {
+        /// The row reached.
+        row: usize,
+        /// Rows of `M`.
+        rows: usize,
+    },
+}
+
 impl std::fmt::Display for Stopped {
-    /// `time limit of 5 s reached while generating @dirdyna (body 1200 of 4000)`.
+    /// `time limit of 5 s reached while generating @dirdyna (body 1200 of 4000)`, or
+    /// `(… (row 1200 of 4000 of M)`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "time limit of {} s reached while generating @{} (body {} of {})",
-            self.seconds, self.function, self.body, self.bodies
-        )
+        write!(f, "time limit of {} s reached while generating @{} ", self.seconds, self.function)?;
+        match self.at {
+            Reached::Body { body, bodies } => write!(f, "(body {body} of {bodies})"),
+            Reached::Row { row, rows } => write!(f, "(row {row} of {rows} of M)"),
+        }
     }
 }
 

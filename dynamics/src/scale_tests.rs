@@ -7,7 +7,7 @@ use robovec_passes::Deadline;
 
 use crate::robot::Robot;
 use crate::topology::{build, Topology};
-use crate::{generate_with, Model, Request, FUNCTION_NAMES};
+use crate::{generate_with, Model, Reached, Request, FUNCTION_NAMES};
 
 fn request(functions: Option<&[&str]>) -> Request {
     Request { functions: functions.map(|f| f.iter().map(|s| s.to_string()).collect()), ..Request::default() }
@@ -128,12 +128,10 @@ fn the_deadline_stops_the_generation_at_a_body() {
     for name in FUNCTION_NAMES {
         let r = Request { deadline: Some(past), ..request(Some(&[name])) };
         let stop = generate_with(&Model { robot: robot.clone() }, &r).expect_err("the deadline has passed");
-        assert_eq!((stop.function.as_str(), stop.bodies), (name, 40));
-        assert!((1..=40).contains(&stop.body), "{stop:?}");
-        assert_eq!(
-            stop.to_string(),
-            format!("time limit of 0 s reached while generating @{name} (body {} of 40)", stop.body)
-        );
+        let Reached::Body { body, bodies: 40 } = stop.at else { panic!("{stop:?}") };
+        assert_eq!(stop.function, name);
+        assert!((1..=40).contains(&body), "{stop:?}");
+        assert_eq!(stop.to_string(), format!("time limit of 0 s reached while generating @{name} (body {body} of 40)"));
     }
     let far = Request { deadline: Some(Deadline::after_seconds(3600.0)), ..request(None) };
     assert!(generate_with(&Model { robot }, &far).is_ok());

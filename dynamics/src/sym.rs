@@ -31,7 +31,7 @@ use robovec_ir::{BinOp, Def, Expr, Function, Operand, Output, Phase, Span, TrigF
 use robovec_passes::Deadline;
 use rustc_hash::FxHashMap;
 
-use super::Stopped;
+use super::{Reached, Stopped};
 
 /// A symbolic scalar.
 #[derive(Clone, Debug, PartialEq)]
@@ -288,8 +288,16 @@ impl Builder {
     /// # Errors
     /// [`Stopped`] naming this function and `body` once [`Builder::deadline`] is reached.
     pub fn check(&self, body: usize, bodies: usize) -> Result<(), Stopped> {
+        self.check_at(Reached::Body { body, bodies })
+    }
+
+    /// [`Builder::check`] at any point of the writing (`dirdyna` checks per row of `M`).
+    ///
+    /// # Errors
+    /// [`Stopped`] at `at` once [`Builder::deadline`] is reached.
+    pub fn check_at(&self, at: Reached) -> Result<(), Stopped> {
         match &self.deadline {
-            Some(d) if d.reached() => Err(Stopped { function: self.f.name.clone(), body, bodies, seconds: d.seconds }),
+            Some(d) if d.reached() => Err(Stopped { function: self.f.name.clone(), at, seconds: d.seconds }),
             _ => Ok(()),
         }
     }

@@ -13,7 +13,7 @@
 //! [`registry`] (the front-end table), [`c`], [`matlab`], [`python`] (the file scanners),
 //! [`lexer`], [`stmt`] and [`ast`] (the shared lexer, statement grammar and AST), [`lower`] (AST
 //! → IR), [`urdf`] (URDF → robot → equations), [`sensor`], [`synth`] (synthetic files for the
-//! scale tests and benches), [`error`] (diagnostics).
+//! scale tests and benches), [`error`] (diagnostics), [`clock`] (`-time-limit` while loading).
 //!
 //! # Pipeline
 //! Naga style: the bytes are made text by [`source_text`] (every byte offset kept),

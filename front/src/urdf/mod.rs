@@ -66,9 +66,13 @@ impl FrontEnd for Urdf {
         };
         let model = robovec_dynamics::Model { robot };
         let g = robovec_dynamics::generate_with(&model, &request).map_err(|stop| {
-            // The joint of the body reached (the base's link before the first body).
+            // The joint of the body reached (the root link for a row of M's outputs).
             let order = model.robot.dfs_joints();
-            let span = match stop.body.checked_sub(1).and_then(|k| order.get(k)) {
+            let joint = match stop.at {
+                robovec_dynamics::Reached::Body { body, .. } => body.checked_sub(1).and_then(|k| order.get(k)),
+                robovec_dynamics::Reached::Row { .. } => None,
+            };
+            let span = match joint {
                 Some(&j) => model.robot.joints[j].span,
                 None => model.robot.links[model.robot.root].span,
             };
