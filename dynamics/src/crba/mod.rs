@@ -105,12 +105,7 @@ pub type Entries = Vec<((usize, usize), Term)>;
 ///
 /// # Errors
 /// [`Stopped`] at the builder's deadline (checked per body and per column step).
-pub fn mass_matrix(
-    model: &Model,
-    layout: &Layout,
-    b: &mut Builder,
-    motions: &[Motion],
-) -> Result<Entries, Stopped> {
+pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]) -> Result<Entries, Stopped> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
     let nb = order.len();
