@@ -74,7 +74,7 @@ fn axis_rotation(k: &[f64; 3], c: &Term, s: &Term) -> M3 {
     r
 }
 
-pub(super) fn bind3(b: &mut Builder, name: &str, body: usize, v: V3) -> V3 {
+pub(super) fn bind3(b: &mut Builder, name: &str, body: impl std::fmt::Display, v: V3) -> V3 {
     let [x, y, z] = v;
     [b.bind(&format!("{name}1{body}"), x), b.bind(&format!("{name}2{body}"), y), b.bind(&format!("{name}3{body}"), z)]
 }
@@ -172,6 +172,23 @@ fn vadd_into(a: &mut V3, b: V3) {
     }
 }
 
+/// Children whose terms a link's sum holds before it is bound (issue 28): a sum over a
+/// link's children is one expression whose depth is their number, and every recursion over
+/// expressions (this crate's, the IR's printer, verifier and `atomise`) would overflow the
+/// stack on a hub of 100,000 branches. Binding the partial sum every `SUM_CHUNK` children
+/// keeps every expression shallow; a link of the examples and example-robot-data has at most
+/// a handful of children, whose sums stay as they were.
+pub(super) const SUM_CHUNK: usize = 64;
+
+/// Adds child term `t` to link `p`'s sum `acc` of `children` terms so far and binds the sum
+/// as `{name}{k}{p}_{chunk}` after every [`SUM_CHUNK`]-th child.
+fn add_child(b: &mut Builder, name: &str, p: usize, acc: &mut V3, children: usize, t: V3) {
+    vadd_into(acc, t);
+    if (children + 1).is_multiple_of(SUM_CHUNK) {
+        *acc = bind3(b, name, format_args!("{p}_{}", (children + 1) / SUM_CHUNK), std::mem::take(acc));
+    }
+}
+
 /// One RNEA sweep driven by `drive`: the joint forces `(i, Q_i)` of the coordinates that bear
 /// one, sorted by `i` (terms, not yet bound). Cost: linear in the bodies and the ops written.
 ///
@@ -255,6 +272,7 @@ pub fn sweep(
     // Backward dynamics.
     let mut fq: Vec<V3> = vec![[ZERO, ZERO, ZERO]; nb + 1];
     let mut cq: Vec<V3> = vec![[ZERO, ZERO, ZERO]; nb + 1];
+    let mut children = vec![0usize; nb + 1];
     let mut torque: Vec<(usize, Term)> = Vec::new();
     for i in (0..nb).rev() {
         let body = i + 1;
@@ -294,8 +312,9 @@ pub fn sweep(
         let f_p = bind3(b, "Fr", body, matvec(&ro, &f_j, false));
         let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
         let c_p = vadd(&matvec(&ro, &c_j, false), &cross(&d, &f_p));
-        vadd_into(&mut fq[p], f_p);
-        vadd_into(&mut cq[p], c_p);
+        add_child(b, "FqS", p, &mut fq[p], children[p], f_p);
+        add_child(b, "CqS", p, &mut cq[p], children[p], c_p);
+        children[p] += 1;
     }
     torque.sort_by_key(|&(qi, _)| qi);
     Ok(torque)

@@ -2,7 +2,7 @@
 //! the ops it writes, and stops at its deadline. Sizes are structural counts (values, ops,
 //! outputs) computed from the robot, never times.
 
-use robovec_ir::{Function, Operand};
+use robovec_ir::{Def, Expr, Function, Operand};
 use robovec_passes::Deadline;
 
 use crate::robot::Robot;
@@ -135,4 +135,34 @@ fn the_deadline_stops_the_generation_at_a_body() {
     }
     let far = Request { deadline: Some(Deadline::after_seconds(3600.0)), ..request(None) };
     assert!(generate_with(&Model { robot }, &far).is_ok());
+}
+
+/// Depth of an expression tree (an operand is 1).
+fn depth(e: &Expr) -> usize {
+    match e {
+        Expr::Operand(_) => 1,
+        Expr::Neg(a) => 1 + depth(a),
+        Expr::Binary(_, a, b) => 1 + depth(a).max(depth(b)),
+        Expr::Call(_, args) => 1 + args.iter().map(depth).max().unwrap_or(0),
+    }
+}
+
+#[test]
+fn a_hub_s_sums_are_bound_in_chunks_so_no_expression_is_deep() {
+    // 300 branches off a moving base: its force, moment and composite sum 300 children.
+    let robot = build(Topology::Star, 300, 4).with_floating_base().expect("free names");
+    let g = generate_with(&Model { robot }, &request(None)).expect("no deadline");
+    for f in &g.module.functions {
+        let deepest = f
+            .body
+            .iter()
+            .filter_map(|&v| match &f.value(v).def {
+                Def::Expr(e) => Some(depth(e)),
+                _ => None,
+            })
+            .max()
+            .unwrap_or(0);
+        // Unbound, the base's sums would be 300 deep; bound, a chunk of SUM_CHUNK children.
+        assert!(deepest < 150, "@{}: an expression {deepest} deep", f.name);
+    }
 }

@@ -101,10 +101,11 @@ impl Composite {
         Composite { m: self.m.clone(), h, j: out }
     }
 
-    /// Every entry bound as a temporary: `MC{body}`, `HC{k}{body}`, `JC{r}{c}{body}`.
-    pub(super) fn bind(&self, b: &mut Builder, body: usize) -> Composite {
+    /// Every entry bound as a temporary: `MC{body}`, `HC{k}{body}`, `JC{r}{c}{body}` (`body`
+    /// is any tag: `12`, or `12_3` for the third partial sum of body 12's children).
+    pub(super) fn bind(&self, b: &mut Builder, body: impl std::fmt::Display) -> Composite {
         let m = b.bind(&format!("MC{body}"), self.m.clone());
-        let h = bind3(b, "HC", body, self.h.clone());
+        let h = bind3(b, "HC", &body, self.h.clone());
         let mut j: M3 = Default::default();
         for (a, c) in UPPER {
             j[a][c] = b.bind(&format!("JC{}{}{body}", a + 1, c + 1), self.j[a][c].clone());

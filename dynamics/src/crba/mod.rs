@@ -82,7 +82,7 @@ mod composite;
 mod tests;
 mod tree;
 
-use super::rnea::{numeric, Motion, M3, V3};
+use super::rnea::{numeric, Motion, M3, SUM_CHUNK, V3};
 use super::sym::{Builder, Term};
 use super::{Layout, Model, Stopped};
 pub(crate) use column::bind_entry;
@@ -140,6 +140,8 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
     let mut upper = Vec::new();
     // Each body alone, then leaves to root: the composite of its subtree, then its column.
     let mut comp: Vec<Composite> = vec![Composite::zero(); nb + 1];
+    // Children added to each composite (bound every `SUM_CHUNK`: `rnea::SUM_CHUNK`).
+    let mut children = vec![0usize; nb + 1];
     let mut pending: Vec<column::Carry> = Vec::new();
     for body in (1..=nb).rev() {
         if !tree.moves[body] {
@@ -163,6 +165,10 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
             };
             // In place: a link's composite grows by one child at a time.
             comp[p] = std::mem::take(&mut comp[p]).add(in_parent);
+            children[p] += 1;
+            if children[p].is_multiple_of(SUM_CHUNK) {
+                comp[p] = comp[p].bind(b, format_args!("{p}_{}", children[p] / SUM_CHUNK));
+            }
         }
         if let Some(qj) = layout.q_index[body - 1] {
             // A column waiting for this body's (its child's, one step up already) goes up with it:
