@@ -69,7 +69,7 @@ pub trait FrontEnd: Sync {
     /// # Errors
     /// Every problem found, with byte spans into `text` (the driver renders them as
     /// `file:line:col` diagnostics and exits 1). Once `opts.deadline` is reached: one error,
-    /// `time limit of 5 s reached while reading (line N of M)` at the statement reached, or
+    /// `time limit of 5 s reached while reading (line N of M)` spanning the line reached, or
     /// `… while generating @dirdyna (body k of n)` at that body's joint; nothing is returned,
     /// since no pass can run on part of a module.
     fn load(&self, path: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>>;
