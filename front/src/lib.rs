@@ -13,7 +13,7 @@
 //! [`registry`] (the front-end table), [`c`], [`matlab`], [`python`] (the file scanners),
 //! [`lexer`], [`stmt`] and [`ast`] (the shared lexer, statement grammar and AST), [`lower`] (AST
 //! → IR), [`urdf`] (URDF → robot → equations), [`sensor`], [`synth`] (synthetic files for the
-//! scale tests and benches), [`error`] (diagnostics).
+//! scale tests and benches), [`error`] (diagnostics), [`clock`] (`-time-limit` while loading).
 //!
 //! # Pipeline
 //! Naga style: the bytes are made text by [`source_text`] (every byte offset kept),
@@ -35,6 +35,7 @@
 
 pub mod ast;
 pub mod c;
+pub mod clock;
 pub mod error;
 pub mod lexer;
 pub mod lower;
@@ -116,6 +117,32 @@ pub fn parse_str(lang: Language, src: &[u8], header: Option<&[u8]>) -> Result<ro
 /// # Errors
 /// As [`parse_str`].
 pub fn parse_text(lang: Language, text: &str, header: Option<&[u8]>) -> Result<robovec_ir::Module, Vec<FrontError>> {
+    parse_text_until(lang, text, header, None)
+}
+
+/// [`parse_text`] that stops at `deadline` (`-time-limit`): the lexer, the scanners and the
+/// lowering tick a [`clock::Clock`] per token, line or statement.
+///
+/// # Errors
+/// As [`parse_str`]; once the deadline is reached, only the error of [`clock::Clock::error`]
+/// (`time limit of 5 s reached while reading (line N of M)`).
+pub fn parse_text_until(
+    lang: Language,
+    text: &str,
+    header: Option<&[u8]>,
+    deadline: Option<&robovec_passes::Deadline>,
+) -> Result<robovec_ir::Module, Vec<FrontError>> {
+    parse_with_clock(lang, text, header, &clock::Clock::new(deadline))
+}
+
+/// [`parse_text_until`] with the clock given.
+fn parse_with_clock(
+    lang: Language,
+    text: &str,
+    header: Option<&[u8]>,
+    clock: &clock::Clock,
+) -> Result<robovec_ir::Module, Vec<FrontError>> {
+    let stopped = |clock: &clock::Clock| clock.error(text).map(|e| vec![e]);
     let mut errors = Vec::new();
     // The tokens live only while scanning: the statements own their text.
     let funcs = match lang {
@@ -124,19 +151,29 @@ pub fn parse_text(lang: Language, text: &str, header: Option<&[u8]>) -> Result<r
             // Statements lowered as soon as they are parsed, the bodies lexed a window at a
             // time; on any error (or a form it leaves out) the batch path below runs from the
             // start and gives the diagnostics.
-            if let Some(module) = c::scan_and_lower(text, header.as_deref()) {
+            let streamed = c::scan_and_lower(text, header.as_deref(), clock);
+            if let Some(e) = stopped(clock) {
+                return Err(e);
+            }
+            if let Some(module) = streamed {
                 return Ok(module);
             }
-            let toks = lexer::lex_where(text, |t| !c::ignored(t));
-            c::scan(text, &toks, header.as_deref(), &mut errors)
+            let toks = lexer::lex_until(text, |t| !c::ignored(t), clock);
+            c::scan(text, &toks, header.as_deref(), &mut errors, clock)
         }
-        Language::Matlab => matlab::scan(text, &lexer::lex(text), &mut errors),
-        Language::Python => python::scan(text, &lexer::lex(text), &mut errors),
+        Language::Matlab => matlab::scan(text, &lexer::lex_until(text, |_| true, clock), &mut errors, clock),
+        Language::Python => python::scan(text, &lexer::lex_until(text, |_| true, clock), &mut errors, clock),
     };
+    if let Some(e) = stopped(clock) {
+        return Err(e);
+    }
     if funcs.is_empty() && errors.is_empty() {
         errors.push(scan::no_function(lang, text.len()));
     }
-    let module = lower::lower_module(text, lang, &funcs, &mut errors);
+    let module = lower::lower_module(text, lang, &funcs, &mut errors, clock);
+    if let Some(e) = stopped(clock) {
+        return Err(e);
+    }
     if errors.is_empty() {
         Ok(module)
     } else {
@@ -146,6 +183,8 @@ pub fn parse_text(lang: Language, text: &str, header: Option<&[u8]>) -> Result<r
     }
 }
 
+#[cfg(test)]
+mod clock_tests;
 #[cfg(test)]
 mod corpus_tests;
 #[cfg(test)]

@@ -4,12 +4,14 @@
 use robovec_ir::Span;
 
 use super::ast::FuncAst;
+use super::clock::Clock;
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
 use super::scan;
 
 /// Scans a Matlab file.
-pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
+/// Stops at `clock`'s deadline (one tick per line).
+pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>, clock: &Clock) -> Vec<FuncAst> {
     // Drop comments and continuations (`...` with the rest of its line and the line break).
     let mut flat = Vec::with_capacity(toks.len());
     let mut k = 0;
@@ -32,6 +34,9 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
     let mut mark = errors.len();
     for line in scan::lines(&flat) {
         let first = line[0];
+        if clock.tick(first.0) {
+            break;
+        }
         let word = if let Tok::Ident(w) = first.1 { Some(w) } else { None };
         match word {
             Some("function") => {

@@ -5,6 +5,7 @@
 use robovec_ir::Span;
 
 use super::ast::FuncAst;
+use super::clock::Clock;
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
 use super::scan;
@@ -13,7 +14,8 @@ use super::scan;
 const NOT_OUTPUTS: &[&str] = &["s", "tsim", "usrfun", "self", "isens", "sens"];
 
 /// Scans a Python file.
-pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
+/// Stops at `clock`'s deadline (one tick per line).
+pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>, clock: &Clock) -> Vec<FuncAst> {
     let mut flat = Vec::with_capacity(toks.len());
     let mut k = 0;
     while k < toks.len() {
@@ -30,6 +32,9 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
     let mut mark = errors.len();
     for line in scan::lines(&flat) {
         let first = line[0];
+        if clock.tick(first.0) {
+            break;
+        }
         let word = if let Tok::Ident(w) = first.1 { Some(w) } else { None };
         match word {
             Some("import" | "from") => continue,
