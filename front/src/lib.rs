@@ -11,6 +11,7 @@
 //!
 //! # Main modules
 //! [`registry`] (the front-end table), [`c`], [`matlab`], [`python`] (the file scanners),
+//! [`lines`] (the line-oriented languages' lines and streaming path),
 //! [`lexer`], [`stmt`] and [`ast`] (the shared lexer, statement grammar and AST), [`lower`] (AST
 //! → IR), [`urdf`] (URDF → robot → equations), [`sensor`], [`synth`] (synthetic files for the
 //! scale tests and benches), [`error`] (diagnostics), [`clock`] (`-time-limit` while loading).
@@ -23,7 +24,8 @@
 //! language-agnostic [`ast`], and lowered to IR by [`lower`] (whose module doc states the
 //! lowering rules). A C file without errors takes the streaming path ([`c::scan_and_lower`]):
 //! its function bodies are lexed again a window at a time and each statement lowered as soon
-//! as it is parsed, so memory does not grow with the tokens of a body.
+//! as it is parsed, so memory does not grow with the tokens of a body; Matlab and Python files
+//! are read a logical line at a time and take the same kind of path ([`lines`]).
 //!
 //! # Encoding
 //! Input is bytes. Valid UTF-8 is kept; each byte of an invalid UTF-8 sequence (a Latin-1
@@ -38,6 +40,7 @@ pub mod c;
 pub mod clock;
 pub mod error;
 pub mod lexer;
+pub mod lines;
 pub mod lower;
 pub mod matlab;
 pub mod python;
@@ -161,8 +164,24 @@ fn parse_with_clock(
             let toks = lexer::lex_until(text, |t| !c::ignored(t), clock);
             c::scan(text, &toks, header.as_deref(), &mut errors, clock)
         }
-        Language::Matlab => matlab::scan(text, &lexer::lex_until(text, |_| true, clock), &mut errors, clock),
-        Language::Python => python::scan(text, &lexer::lex_until(text, |_| true, clock), &mut errors, clock),
+        // As C: each statement lowered as soon as its line is scanned; on any error the batch
+        // path below runs from the start ([`lines`]).
+        Language::Matlab | Language::Python => {
+            let streamed = match lang {
+                Language::Matlab => lines::scan_and_lower::<matlab::Scanner>(text, clock),
+                _ => lines::scan_and_lower::<python::Scanner>(text, clock),
+            };
+            if let Some(e) = stopped(clock) {
+                return Err(e);
+            }
+            if let Some(module) = streamed {
+                return Ok(module);
+            }
+            match lang {
+                Language::Matlab => lines::scan::<matlab::Scanner>(text, &mut errors, clock),
+                _ => lines::scan::<python::Scanner>(text, &mut errors, clock),
+            }
+        }
     };
     if let Some(e) = stopped(clock) {
         return Err(e);
@@ -189,6 +208,8 @@ mod clock_tests;
 mod corpus_tests;
 #[cfg(test)]
 mod error_tests;
+#[cfg(test)]
+mod lines_tests;
 #[cfg(test)]
 mod snippet_tests;
 #[cfg(test)]

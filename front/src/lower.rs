@@ -170,6 +170,11 @@ impl<'a> Lower<'a> {
         self.finish(name, errors)
     }
 
+    /// Sets the function's span (the streaming line path knows it only at the function's end).
+    pub(crate) fn set_span(&mut self, span: Span) {
+        self.fa.span = span;
+    }
+
     /// The lowered function, named `name`; its errors are appended to `errors`.
     pub(crate) fn finish(mut self, name: String, errors: &mut Vec<FrontError>) -> Function {
         self.f.name = name;

@@ -189,6 +189,15 @@ impl Function {
         &mut self.values[v.index()]
     }
 
+    /// Reserves room for `values` more values, `body` of them definitions, so that a pass that
+    /// knows its output's size builds it without growing (a growing vector holds up to twice
+    /// its values, and copies them, at each doubling; issue 28 item 4).
+    pub fn reserve(&mut self, values: usize, body: usize) {
+        self.values.reserve_exact(values);
+        self.body.reserve_exact(body);
+        self.names.0.reserve(values, |&x| self.values.get(x.index()).map_or(0, |d| name_hash(&d.name)));
+    }
+
     /// The value named `name` (without `%`).
     pub fn lookup(&self, name: &str) -> Option<Value> {
         self.names.get(&self.values, name)

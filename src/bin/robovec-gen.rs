@@ -139,11 +139,13 @@ fn study(args: &Args) -> ExitCode {
     }
 }
 
-/// mimalloc, as in `robovec-opt` (see there): the study runs every case's passes in this process.
+/// mimalloc, as in `robovec-opt` ([`robovec::allocator`]): the study runs every case's passes in
+/// this process.
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
+    robovec::allocator::configure();
     let args = Args::parse();
     if args.study.study {
         return study(&args);
