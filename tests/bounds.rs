@@ -164,6 +164,69 @@ fn time_limit_stops_accuracy_with_its_figures_and_a_note() {
     assert!(r["accuracy"]["f32"]["mean_bits"].as_f64().unwrap().is_finite());
 }
 
+/// `accuracy<mode=hard>`'s hill climbing reads `-time-limit` once per round (issue 28: Jeep
+/// `dirdyna` with `climb=100;climb-points=1000` ran over 300 s under `-time-limit=5`): 64
+/// climbs of 100 rounds of Jeep (far more than two seconds' work) stop, and say how far they got.
+#[test]
+fn time_limit_stops_accuracy_hill_climbing_with_a_note() {
+    let d = tmp("accuracy_climb");
+    let report = d.join("r.json");
+    let jeep = corpus_dir().join("c/jeep__mbs_dirdyna_Jeep.c");
+    let o = opt(&[
+        jeep.to_str().unwrap(),
+        "-passes=atomise,accuracy<samples=64;mode=hard;climb=100;climb-points=64>",
+        "-time-limit=2",
+        &format!("-report={}", report.display()),
+        "-o",
+        d.join("out.rvir").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let why = r["accuracy"]["stopped_early"].as_str().unwrap_or_else(|| panic!("no stopped_early: {err}"));
+    let cut = why.split("; ").find(|w| w.starts_with("time limit: ")).unwrap_or_else(|| panic!("{why}"));
+    // `time limit: R of 6400 hill-climbing rounds (64 climbs of 100)`.
+    let done: u64 = cut["time limit: ".len()..].split(' ').next().unwrap().parse().unwrap();
+    assert!(cut.ends_with(" of 6400 hill-climbing rounds (64 climbs of 100)") && done < 6400, "{cut}");
+    assert!(err.contains(&format!("@dirdyna: accuracy stopped early: {why}")), "{err}");
+    assert!(r["accuracy"]["f32"]["max_bits"].as_f64().unwrap().is_finite());
+}
+
+/// `sim` reads `-time-limit` between seeds (issue 28: `sim<seeds=10000>` ran 18 s under
+/// `-time-limit=5`): the seeds simulated are checked, the stats say how many, and a note says
+/// where it stopped.
+#[test]
+fn time_limit_stops_sim_between_seeds_with_a_note() {
+    let d = tmp("sim_limit");
+    let placed = d.join("placed.rvir");
+    let segway = corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c");
+    let o = opt(&[segway.to_str().unwrap(), "-passes=atomise,place<pe=4>", "-o", placed.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = d.join("r.json");
+    let o = opt(&[
+        placed.to_str().unwrap(),
+        "-passes=sim<seeds=10000>",
+        "-time-limit=0.5",
+        &format!("-report={}", report.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let note = err.lines().find(|l| l.starts_with("note: sim stopped after ")).unwrap_or_else(|| panic!("{err}"));
+    assert!(note.ends_with(" of 10000 seeds of @dirdyna: time limit of 0.5 s reached"), "{note}");
+    let done: u32 = note["note: sim stopped after ".len()..].split(' ').next().unwrap().parse().unwrap();
+    assert!((1..10_000).contains(&done), "{note}");
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["stopped_early"][0].as_str(), Some(note.trim_start_matches("note: ")));
+    assert_eq!(r["sim"]["seeds"].as_u64(), Some(u64::from(done)), "{}", r["sim"]);
+    // A limit reached before `sim` starts: no function simulated, one note.
+    let o = opt(&[placed.to_str().unwrap(), "-passes=sim", "-time-limit=0.000001", "-o", "/dev/null"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("note: sim stopped before @dirdyna: time limit of 0.000001 s reached"), "{err}");
+}
+
 #[test]
 fn time_limit_stops_pareto_measurements_with_a_note_per_pipeline() {
     let d = tmp("pareto_limit");

@@ -7,6 +7,11 @@
 //! 1 ± 2^−k (k in [1, 24]), or (1 in 8) redrawn as a hard value — rounded to binary32, and
 //! moves to the best neighbour that is worse than the current point. Known inputs (`params`)
 //! never move. Every point has its own generator, so the result does not depend on threads.
+//! `-time-limit` (issue 28): each climb reads the clock once per round and stops there; the
+//! rounds done are in `stopped_early` (and the result then depends on the machine's speed).
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 use rayon::prelude::*;
 
@@ -50,12 +55,18 @@ pub fn climb(
         )
     });
     let starts: Vec<Kept> = acc.worst[..n_starts].to_vec();
+    // `-time-limit`: each climb checks the clock once per round (8 evaluations) and stops there.
+    let rounds_done = AtomicU64::new(0);
     let found: Vec<Kept> = starts
         .par_iter()
         .map_init(Workspace::default, |ws, k| {
             let mut rng = rng_for(o.seed, 2, k.index);
             let (mut x, mut e) = (k.point.clone(), k.errs.clone());
             for _ in 0..rounds {
+                if o.deadline.is_some_and(|d| Instant::now() >= d) {
+                    break;
+                }
+                rounds_done.fetch_add(1, Ordering::Relaxed);
                 let mut best: Option<(Vec<f64>, PointErrors)> = None;
                 for _ in 0..NEIGHBOURS {
                     let mut y = x.clone();
@@ -90,7 +101,15 @@ pub fn climb(
         acc.worst[j] = f;
     }
     acc.sort_worst();
-    (per_round * rounds, note)
+    let done = rounds_done.into_inner();
+    let planned = n_starts as u64 * rounds;
+    let note = if done < planned {
+        let cut = format!("time limit: {done} of {planned} hill-climbing rounds ({n_starts} climbs of {rounds})");
+        Some(note.map_or(cut.clone(), |n| format!("{n}; {cut}")))
+    } else {
+        note
+    };
+    (done * NEIGHBOURS, note)
 }
 
 #[cfg(test)]

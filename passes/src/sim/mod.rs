@@ -198,10 +198,30 @@ pub fn verify_placement(f: &Function, seeds: &[u64]) -> Result<SimReport, SimErr
 /// # Errors
 /// As [`verify_placement`].
 pub fn verify_with(f: &Function, p: &Placement, seeds: &[u64]) -> Result<SimReport, SimError> {
+    verify_until(f, p, seeds, None)
+}
+
+/// [`verify_with`] that stops starting seeds once `deadline` is reached (`-time-limit`, issue
+/// 28): the first seed always runs; the report's `seeds` are those simulated.
+///
+/// # Errors
+/// As [`verify_placement`].
+pub fn verify_until(
+    f: &Function,
+    p: &Placement,
+    seeds: &[u64],
+    deadline: Option<&crate::Deadline>,
+) -> Result<SimReport, SimError> {
     let seeds: &[u64] = if seeds.is_empty() { &[0] } else { seeds };
     let (m, occ) = lower_measured(f, p)?;
-    let mut report = None;
-    for &seed in seeds {
+    let mut report: Option<SimReport> = None;
+    for (i, &seed) in seeds.iter().enumerate() {
+        if i > 0 && deadline.is_some_and(crate::Deadline::reached) {
+            if let Some(r) = report.as_mut() {
+                r.seeds.truncate(i);
+            }
+            break;
+        }
         let o = compare::<f64>(f, &m, &occ, seed, "f64")?;
         compare::<f32>(f, &m, &occ, seed, "f32")?;
         report.get_or_insert(SimReport {
@@ -272,16 +292,30 @@ impl Pass for Sim {
         true
     }
 
+    /// `-time-limit`: once the limit is reached, `sim` starts no further seed (the first seed
+    /// of a function always runs) and no further function, with a note for each; the stats
+    /// then give the fewest seeds simulated and the placements simulated.
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let seeds: Vec<u64> = (0..self.seeds as u64).collect();
         let mut functions = Vec::new();
+        let mut fewest = self.seeds;
         for f in &m.functions {
             let fail = |message: String| PassError::Failed { pass: "sim".into(), message };
             let p = f
                 .placement
                 .as_ref()
                 .ok_or_else(|| fail(format!("function @{} has no placement; run `place` first", f.name)))?;
-            let r = verify_with(f, p, &seeds).map_err(|e| fail(format!("@{}: {e}", f.name)).at(e.span))?;
+            if let Some(d) = cx.deadline.filter(crate::Deadline::reached) {
+                cx.note_stop("sim", &format!("before @{}: {}", f.name, d.reason()));
+                break;
+            }
+            let r = verify_until(f, p, &seeds, cx.deadline.as_ref())
+                .map_err(|e| fail(format!("@{}: {e}", f.name)).at(e.span))?;
+            if r.seeds.len() < seeds.len() {
+                let why = cx.deadline.map(|d| d.reason()).unwrap_or_default();
+                cx.note_stop("sim", &format!("after {} of {} seeds of @{}: {why}", r.seeds.len(), seeds.len(), f.name));
+                fewest = fewest.min(r.seeds.len() as u32);
+            }
             functions.push(SimFunctionStats {
                 function: f.name.clone(),
                 cycles: r.cycles,
@@ -292,7 +326,7 @@ impl Pass for Sim {
         }
         cx.emit(SimStats {
             placements: functions.len(),
-            seeds: self.seeds,
+            seeds: fewest,
             precisions: vec!["f32", "f64"],
             bit_exact: true,
             functions,
