@@ -26,7 +26,13 @@
 //! < 8 GB; the C of K = 16 compiles with `gcc -O2` in < 3 min and < 4 GB; URDF `invdyna`: a
 //! 2,000-joint chain and a 4,000-branch star < 5 s, < 600 MB; 10,000 joints < 10 s, < 1.5 GB.
 //!
-//! Run: `cargo bench --bench scale` (`-- --copies=1,4,16,64,160 --pes=64 --runs=1 --bin PATH`).
+//! **Before/after** (`--before=PATH`, another build of `robovec-opt`): for each K up to
+//! `--before-max=K` (default 16: the quadratic `sim` of older builds takes minutes beyond), the
+//! pipeline runs alternately with that build and this one, and a last table gives both wall
+//! times and peaks and their ratios (medians of the runs).
+//!
+//! Run: `cargo bench --bench scale` (`-- --copies=1,4,16,64,160 --pes=64 --runs=1 --bin PATH
+//! --before=PATH`).
 
 #[path = "common.rs"]
 mod common;
@@ -48,6 +54,7 @@ fn main() {
         .split(',')
         .map(String::from)
         .collect();
+    let (mut before, mut before_max): (Option<PathBuf>, usize) = (None, 16);
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         if let Some(v) = a.strip_prefix("--copies=") {
@@ -64,6 +71,10 @@ fn main() {
             urdf.clear();
         } else if a == "--no-cc" {
             cc = None;
+        } else if let Some(v) = a.strip_prefix("--before=") {
+            before = Some(PathBuf::from(v));
+        } else if let Some(v) = a.strip_prefix("--before-max=") {
+            before_max = v.parse().expect("--before-max=K");
         } else if a == "--bin" {
             bin = PathBuf::from(args.next().expect("--bin PATH"));
         } else if a != "--bench" {
@@ -78,12 +89,30 @@ fn main() {
     let pipeline = format!("-passes=atomise,zero-removal,balance,asap-alap,place<pe={pes}>,sim");
     println!("binary: {}\ninput: WALK-MAN dirdyna × K; {pipeline}", bin.display());
     let mut rows = Vec::new();
+    let mut compared = Vec::new();
     for &k in &copies {
         let input = dir.join(format!("walkman_x{k}.m"));
         std::fs::write(&input, robovec_testkit::copies::matlab_copies(&walkman, k, 55)).expect("write the input");
         let bytes = std::fs::metadata(&input).map(|m| m.len()).unwrap_or(0);
         let r = runs.unwrap_or(if k <= 16 { 3 } else { 1 });
-        let mut all: Vec<PipelineRun> = (0..r).map(|_| run_pipeline(&bin, &input, &pipeline)).collect();
+        let old_bin = before.as_ref().filter(|_| k <= before_max);
+        let mut all: Vec<PipelineRun> = Vec::new();
+        let mut old: Vec<PipelineRun> = Vec::new();
+        for _ in 0..r {
+            if let Some(b) = old_bin {
+                old.push(run_pipeline(b, &input, &pipeline));
+            }
+            all.push(run_pipeline(&bin, &input, &pipeline));
+        }
+        if !old.is_empty() {
+            compared.push((
+                k,
+                median(old.iter().map(|x| x.secs).collect()),
+                median(all.iter().map(|x| x.secs).collect()),
+                median(old.iter().map(|x| x.peak as f64).collect()),
+                median(all.iter().map(|x| x.peak as f64).collect()),
+            ));
+        }
         let c = cc.as_deref().map(|cc| compile_c(&bin, &input, &dir, k, cc));
         let secs = median(all.iter().map(|x| x.secs).collect());
         let peak = median(all.iter().map(|x| x.peak as f64).collect());
@@ -149,6 +178,16 @@ fn main() {
             })
             .collect();
         println!("| × {k} | {} |", rel.join(" | "));
+    }
+    if let (Some(b), false) = (&before, compared.is_empty()) {
+        println!(
+            "\nbefore: {}\n| copies | before s | now s | before / now | before peak MB | now peak MB |",
+            b.display()
+        );
+        println!("|---:|---:|---:|---:|---:|---:|");
+        for (k, bs, s, bp, p) in &compared {
+            println!("| × {k} | {bs:.2} | {s:.2} | {:.2}× | {:.0} | {:.0} |", bs / s, bp / 1e6, p / 1e6);
+        }
     }
     if !urdf.is_empty() {
         urdf_rows(&bin, &dir, &urdf);
