@@ -89,9 +89,9 @@ fn held_of(f: &Function, trig: &HashMap<(TrigFn, Value), Value>, w: &Word) -> Re
         Word::Trig(t, n) => {
             let x = input(n)?;
             trig.get(&(*t, x)).copied().map(Held::Value).ok_or_else(|| {
-                    let fun = if *t == TrigFn::Sin { "sin" } else { "cos" };
-                    format!("initial word `{fun} {n}` is not a value of the function")
-                })
+                let fun = if *t == TrigFn::Sin { "sin" } else { "cos" };
+                format!("initial word `{fun} {n}` is not a value of the function")
+            })
         }
     }
 }
