@@ -303,3 +303,40 @@ fn split_code_compiles_cleanly_in_c99() {
         assert!(o.status.success(), "{f}: {}", String::from_utf8_lossy(&o.stderr));
     }
 }
+
+/// GCC 12's SLP vectoriser fuses `x1 - c, x2 + d` over two products into `vfmaddsub` even under
+/// `-ffp-contract=off` (`codegen::c::SLP_GUARD`): the generated file turns SLP off for GCC 12
+/// with FMA, so its assembly at `-O2 -mfma` has no fused instruction. Compile-only (`-S`), at
+/// `-O2` because GCC vectorises straight-line code from `-O2` on; on GCC 12 the test first
+/// shows that the same file without the guard does get the fused instruction (so it checks
+/// something), on other compilers only that none appears.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn gcc_12_does_not_fuse_products_and_alternating_add_sub_in_generated_code() {
+    let dir = tmp("slp_guard");
+    let ir = dir.join("f.rvir");
+    std::fs::write(
+        &ir,
+        "func @f {\n  phase atomised\n  input %a\n  input %b\n  input %c\n  input %d\n  input %e\n  input %g\n  \
+         %x1 = mul %a, %c\n  %x2 = mul %b, %d\n  %y1 = sub %x1, %e\n  %y2 = add %x2, %g\n  \
+         output y1 = %y1\n  output y2 = %y2\n}\n",
+    )
+    .unwrap();
+    run_ok(&[ir.to_str().unwrap(), "-passes=codegen<c>", "-o", dir.join("f.c").to_str().unwrap()]);
+    let code = std::fs::read_to_string(dir.join("f.c")).unwrap();
+    assert!(code.contains(robovec_passes::codegen::c::SLP_GUARD), "{code}");
+    let fused = |file: &str| {
+        let o = cc(&dir, &["-O2", "-mfma", "-ffp-contract=off", "-S", "-o", "-", file]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let asm = String::from_utf8(o.stdout).unwrap();
+        asm.contains("vfmaddsub") || asm.contains("vfmsubadd")
+    };
+    assert!(!fused("f.c"), "the generated file fuses");
+    let version = cc(&dir, &["-dumpfullversion"]);
+    let gcc12 = String::from_utf8_lossy(&version.stdout).starts_with("12.")
+        && !String::from_utf8_lossy(&cc(&dir, &["--version"]).stdout).contains("clang");
+    if gcc12 {
+        std::fs::write(dir.join("bare.c"), code.replace(robovec_passes::codegen::c::SLP_GUARD, "")).unwrap();
+        assert!(fused("bare.c"), "GCC 12 without the guard: the test input no longer triggers the fusion");
+    }
+}

@@ -130,6 +130,18 @@ word_enum! {
     }
 }
 
+/// Written at the top of every generated file: GCC 12's SLP vectoriser fuses a vector of
+/// products and an alternating subtract/add into `vfmaddsub`/`vfmsubadd` even under
+/// `-ffp-contract=off` (its `addsub` pattern, `tree-vect-slp-patterns.cc`, did not check the
+/// contraction mode; later GCC does), so on a target with FMA (`-march=native` here) the
+/// code is no longer bit-exact. Four statements suffice (`x1 = in[0]*in[2]; x2 = in[1]*in[3];
+/// out[0] = x1 - in[4]; out[1] = x2 + in[5];`); split code, whose live values sit side by side
+/// in `live[]`, met it on coman's `dirdyna` (23 of 682 outputs off by an ulp at `-O2
+/// -march=native`). For GCC 12 with FMA only, the file turns SLP vectorisation off.
+pub const SLP_GUARD: &str = "/* GCC 12 fuses a*b-c, d*e+f into vfmaddsub despite -ffp-contract=off (SLP addsub pattern): */\n\
+    #if defined(__GNUC__) && !defined(__clang__) && __GNUC__ == 12 && defined(__FMA__)\n\
+    #pragma GCC optimize (\"no-tree-slp-vectorize\")\n#endif\n";
+
 /// The C back end's options.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CodegenC {
@@ -394,7 +406,7 @@ impl CodegenC {
         )
     }
 
-    /// The file's opening comment and includes; `fused`: some function has fused
+    /// The file's opening comment, [`SLP_GUARD`] and includes; `fused`: some function has fused
     /// multiply-adds (`contract`); `split`: some function is split into parts
     /// (`ROBOVEC_NOINLINE`).
     fn preamble(&self, fused: bool, split: bool) -> String {
@@ -403,7 +415,7 @@ impl CodegenC {
              * floating-point contraction it computes bit for bit what robovec's interpreter computes{}.\n \
              {}* Compile with -ffp-contract=off (GCC contracts a*b+c into an FMA under -march=native),\n \
              * e.g. cc -O2 -ffp-contract=off -c model.c; link with -lm. */\n\
-             #pragma STDC FP_CONTRACT OFF\n#include <math.h>\n#include <string.h>\n\n",
+             #pragma STDC FP_CONTRACT OFF\n{SLP_GUARD}#include <math.h>\n#include <string.h>\n\n",
             self.options_text(),
             if self.trig == Trig::Inline {
                 ",\n * except sin/cos: with trig=inline they are robovec's own (below), within 1 ulp but not libm's bits;\n \
