@@ -28,8 +28,23 @@ pub fn vm_hwm(pid: u32) -> Option<u64> {
     Some(kb * 1024)
 }
 
-/// Runs `cmd` (stdout discarded, stderr captured) and samples its `VmHWM` every 2 ms until it
-/// exits: `(success, wall seconds, peak bytes, stderr)`.
+/// The largest `VmHWM` of process `pid` and of its descendants alive now (a compiler driver's
+/// `cc1`, an `as`), in bytes; `/proc/PID/task/TID/children` (Linux ≥ 3.5).
+pub fn tree_hwm(pid: u32) -> u64 {
+    let mut peak = vm_hwm(pid).unwrap_or(0);
+    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else { return peak };
+    for t in tasks.flatten() {
+        let children = std::fs::read_to_string(t.path().join("children")).unwrap_or_default();
+        for c in children.split_whitespace().filter_map(|c| c.parse().ok()) {
+            peak = peak.max(tree_hwm(c));
+        }
+    }
+    peak
+}
+
+/// Runs `cmd` (stdout discarded, stderr captured) and samples the `VmHWM` of it and its
+/// descendants ([`tree_hwm`]) every 2 ms until it exits: `(success, wall seconds, peak bytes
+/// of the largest process, stderr)`.
 pub fn run_measured(cmd: &mut std::process::Command) -> (bool, f64, u64, String) {
     use std::io::Read;
     let t0 = std::time::Instant::now();
@@ -47,9 +62,7 @@ pub fn run_measured(cmd: &mut std::process::Command) -> (bool, f64, u64, String)
     });
     let mut peak = 0;
     let status = loop {
-        if let Some(h) = vm_hwm(child.id()) {
-            peak = peak.max(h);
-        }
+        peak = peak.max(tree_hwm(child.id()));
         if let Some(s) = child.try_wait().expect("wait") {
             break s;
         }

@@ -220,7 +220,11 @@ impl Cli {
             check: self.check.then_some((self.check_samples, self.check_seed)),
             time_limit: self.time_limit,
             target: self.target,
-            front: robovec_front::FrontOptions { fold_params: self.fold_params, floating_base: self.floating_base },
+            front: robovec_front::FrontOptions {
+                fold_params: self.fold_params,
+                floating_base: self.floating_base,
+                ..robovec_front::FrontOptions::default()
+            },
             params_out: self.params_out,
         })
     }

@@ -39,11 +39,14 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
 
 /// [`load`] with the front-end options of the command line; also returns the parameter values
 /// the front end knows ([`Loaded::params`]). The front end is the registered one for the
-/// input's extension ([`robovec_front::front_end_for`]); the driver names none.
+/// input's extension ([`robovec_front::front_end_for`]); the driver names none. A front end
+/// that builds its functions (URDF) builds only `opts.functions` and stops at `opts.deadline`.
 ///
 /// # Errors
-/// [`Failure::Usage`] for an extension no front end claims; [`Failure::Input`] with codespan
-/// diagnostics naming file, line and column.
+/// [`Failure::Usage`] for an extension no front end claims, or a requested function a front
+/// end that builds its functions cannot build (`no function `foo` in the input; functions:
+/// invdyna, dirdyna`, as `-function` against a loaded module); [`Failure::Input`] with codespan
+/// diagnostics naming file, line and column (the time limit reached while loading among them).
 pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile), Failure> {
     let (bytes, name) = if input == "-" {
         let mut b = Vec::new();
@@ -59,6 +62,14 @@ pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile
             robovec_front::extension_list()
         )));
     };
+    if let (Some(names), Some(wanted)) = (fe.function_names(), &opts.functions) {
+        if let Some(bad) = wanted.iter().find(|w| !names.contains(&w.as_str())) {
+            return Err(Failure::Usage(format!(
+                "error: no function `{bad}` in the input; functions: {}\n",
+                names.join(", ")
+            )));
+        }
+    }
     let src = SourceFile::from_bytes(name, &bytes);
     // The text is the one copy of the input kept (for diagnostics and the parse).
     drop(bytes);
@@ -224,13 +235,17 @@ pub fn run_with(
     stdout: &mut dyn Write,
     stderr: &mut dyn Write,
 ) -> Result<(), Failure> {
+    // `-time-limit` covers the whole run: loading (parsing, generating) and the passes.
+    let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
     // `load` verifies the input (always, whatever `-verify-each` says): the manager need not.
     let instr = Instrumentation { input_verified: true, ..opts.instr.clone() };
     let pm = PassManager::new(&opts.passes, instr).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     crate::preflight::check_options(opts, &pm)?;
     let target = crate::options::target(opts)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
-    let (loaded, src) = load_with(&opts.input, &opts.front)?;
+    // Only the functions the run uses are built (a URDF's `-function=invdyna` skips `dirdyna`).
+    let front = FrontOptions { functions: opts.function.clone().map(|f| vec![f]), deadline, ..opts.front.clone() };
+    let (loaded, src) = load_with(&opts.input, &front)?;
     let mut module = loaded.module;
     crate::preflight::check_functions(opts, &module)?;
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
@@ -248,24 +263,25 @@ pub fn run_with(
         out.stage(path, format!("{json}\n").as_bytes()).map_err(output_failure)?;
     }
     let progress = crate::progress_bars::progress_for(terminal.stderr, opts.quiet);
-    let ran = run_passes(opts, &pm, target, progress, &mut module, &src, &mut out, stderr)?;
+    let ran = run_passes(opts, &pm, target, progress, deadline, &mut module, &src, &mut out, stderr)?;
     write_outputs(opts, &pm, &module, &ran, eval_inputs.as_ref(), terminal, out, stdout, stderr)
 }
 
 /// Runs `-pareto` (before the pipeline, on the input), the pipeline with its dumps staged in
-/// `out`, then `-check`; prints the early-stop notes.
+/// `out`, then `-check`; prints the early-stop notes. `deadline` is the run's, started before
+/// loading.
 #[allow(clippy::too_many_arguments)]
 fn run_passes(
     opts: &Options,
     pm: &PassManager,
     target: robovec_machine::target::Target,
     progress: robovec_passes::progress::Progress,
+    deadline: Option<robovec_passes::Deadline>,
     module: &mut Module,
     src: &SourceFile,
     out: &mut OutputSet,
     stderr: &mut dyn Write,
 ) -> Result<Ran, Failure> {
-    let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
     let mut cx = PassContext {
         original: opts.check.map(|_| module.clone()),
         deadline,

@@ -63,7 +63,13 @@ pub struct Export {
 /// print; [`Failure::Usage`] (exit 2) for C without `-o FILE.c`, `--params-out` with folded
 /// parameters or with URDF output; [`Failure::Output`] (exit 1) when a file cannot be written.
 pub fn run(e: &Export, stdout: &mut dyn Write) -> Result<(), Failure> {
-    let front = FrontOptions { fold_params: e.fold_params, floating_base: e.floating_base };
+    // Only the function written is generated.
+    let front = FrontOptions {
+        fold_params: e.fold_params,
+        floating_base: e.floating_base,
+        functions: Some(vec![e.function.clone()]),
+        deadline: None,
+    };
     if e.format == Format::Urdf {
         if e.fold_params || e.params_out.is_some() {
             return Err(Failure::Usage(
@@ -127,7 +133,8 @@ fn robot(source: &Source, floating_base: bool) -> Result<robovec_dynamics::robot
                 Some(Some(robot)) => return Ok(robot),
                 // The registered front end renders the located diagnostic (file:line:col).
                 _ => {
-                    crate::driver::load_with(&input, &FrontOptions { fold_params: true, floating_base })?;
+                    let front = FrontOptions { fold_params: true, floating_base, ..FrontOptions::default() };
+                    crate::driver::load_with(&input, &front)?;
                     return Err(Failure::Input(format!("error: `{input}` changed while it was read\n")));
                 }
             }
@@ -151,7 +158,10 @@ fn equations(source: &Source, front: FrontOptions) -> Result<Equations, Failure>
     match source {
         Source::Topology { topology, dof, seed } => {
             let robot = robot(source, front.floating_base)?;
-            let g = robovec_dynamics::generate(&robovec_dynamics::Model { robot }, front.fold_params);
+            let request =
+                robovec_dynamics::Request { fold: front.fold_params, functions: front.functions, deadline: None };
+            let g = robovec_dynamics::generate_with(&robovec_dynamics::Model { robot }, &request)
+                .expect("no deadline, no stop");
             Ok((g.module, g.params, format!("{}{dof}_seed{seed}", topology.name().replace('-', "_"))))
         }
         Source::Urdf(path) => {

@@ -11,6 +11,7 @@
 //! commands are here too: one robot written as URDF or Robotran C ([`export`]) and the study's
 //! folder ([`study`]). The library crates never import this one.
 
+pub mod allocator;
 pub mod cli;
 pub mod diagnostics;
 pub mod driver;

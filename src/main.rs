@@ -8,12 +8,13 @@ use std::io::Write;
 use clap::Parser;
 use robovec::cli::{normalise_args, Cli};
 
-/// mimalloc instead of the system allocator: the passes allocate and free millions of small
-/// vectors and maps per run, and glibc's allocator slows down as the heap grows (issue 28).
+/// mimalloc instead of the system allocator, with [`robovec::allocator::configure`]'s settings
+/// (why and the figures: that module).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() {
+    robovec::allocator::configure();
     std::process::exit(run());
 }
 

@@ -93,9 +93,11 @@ fn compare_on(urdf: &str, dof: usize, floating: bool) -> f64 {
     assert_eq!(o.joints.len() + if floating { 5 } else { 0 }, dof, "{}: joints {:?}", o.path, o.joints);
     let mut worst: f64 = 0.0;
     for fold in [false, true] {
-        let (loaded, _) =
-            robovec::driver::load_with(&o.path, &FrontOptions { fold_params: fold, floating_base: floating })
-                .unwrap_or_else(|e| panic!("{}: {}", o.path, e.message()));
+        let (loaded, _) = robovec::driver::load_with(
+            &o.path,
+            &FrontOptions { fold_params: fold, floating_base: floating, ..FrontOptions::default() },
+        )
+        .unwrap_or_else(|e| panic!("{}: {}", o.path, e.message()));
         assert_eq!(loaded.params.is_some(), !fold);
         let names: Vec<&str> = loaded.module.functions.iter().map(|f| f.name.as_str()).collect();
         assert_eq!(names, ["invdyna", "dirdyna"]);

@@ -67,10 +67,21 @@ fn round_trip(dir: &Path, source: Source, function: &str, fold: bool, floating: 
         Source::Topology { topology, dof, seed } => {
             let robot = build(topology, dof, seed);
             let robot = if floating { robot.with_floating_base().unwrap() } else { robot };
-            robovec_dynamics::generate(&robovec_dynamics::Model { robot }, fold).module
+            // Only the function written is generated, in the frames that suit it (as `robovec-gen`).
+            let request = robovec_dynamics::Request {
+                fold,
+                functions: Some(vec![function.to_string()]),
+                ..robovec_dynamics::Request::default()
+            };
+            robovec_dynamics::generate_with(&robovec_dynamics::Model { robot }, &request).expect("no deadline").module
         }
         Source::Urdf(p) => {
-            let front = FrontOptions { fold_params: fold, floating_base: floating };
+            let front = FrontOptions {
+                fold_params: fold,
+                floating_base: floating,
+                functions: Some(vec![function.to_string()]),
+                ..FrontOptions::default()
+            };
             robovec::driver::load_with(&p.to_string_lossy(), &front)
                 .unwrap_or_else(|f| panic!("{}", f.message()))
                 .0

@@ -36,5 +36,6 @@ mod roundtrip;
 mod schedule_cpu;
 mod study;
 mod target;
+mod time_limit_load;
 mod tree_height;
 mod urdf;

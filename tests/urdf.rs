@@ -205,3 +205,42 @@ fn robovec_gen_writes_a_topology_as_urdf_that_robovec_opt_reads() {
         assert!(!out.exists());
     }
 }
+
+/// Issue 28 item 2: `-function` reaches the generator, which builds only that function; a name
+/// it does not write is refused before any work, as against a loaded module.
+#[test]
+fn function_builds_only_the_function_asked_for() {
+    use robovec_dynamics::topology::{build, Topology};
+    let d = tmp("only_asked");
+    // A star: its dirdyna has n² outputs, its invdyna n.
+    let urdf = d.join("star.urdf");
+    std::fs::write(&urdf, robovec_dynamics::urdf_out::write_urdf(&build(Topology::Star, 60, 3))).unwrap();
+    let urdf = urdf.to_str().unwrap();
+    let funcs = |args: &[&str]| -> Vec<String> {
+        let out = d.join("out.rvir");
+        let mut all = vec![urdf, "-passes=atomise", "-o", out.to_str().unwrap()];
+        all.extend(args);
+        let o = opt(&all);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&out).unwrap();
+        text.lines()
+            .filter_map(|l| l.strip_prefix("func @"))
+            .map(|l| l.split([' ', '{']).next().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(funcs(&[]), ["invdyna", "dirdyna"]);
+    assert_eq!(funcs(&["-function=invdyna"]), ["invdyna"]);
+    assert_eq!(funcs(&["-function=dirdyna"]), ["dirdyna"]);
+    // -params-out writes the parameters the functions built read.
+    let p = d.join("p.json");
+    let o = opt(&[urdf, "-function=invdyna", "-passes=", "-o", "/dev/null", &format!("-params-out={}", p.display())]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: BTreeMap<String, f64> = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    assert!(json.contains_key("m[60]") && json.keys().all(|k| !k.starts_with("q")), "{json:?}");
+    // An unknown name: usage error naming what the generator writes, nothing written.
+    let out = d.join("none.rvir");
+    let o = opt(&[urdf, "-function=sensor_1", "-passes=atomise", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no function `sensor_1` in the input; functions: invdyna, dirdyna"), "{}", stderr(&o));
+    assert!(!out.exists());
+}

@@ -48,7 +48,7 @@ use rustc_hash::FxHashMap;
 use super::crba::{self, bind_entry};
 use super::rnea::{motions, sweep, Drive, Motion};
 use super::sym::{Builder, Term, ZERO};
-use super::{Layout, Model};
+use super::{Layout, Model, Reached, Stopped};
 
 /// How `M` is formed: [`crate::crba`] (the default) or the unit-acceleration RNEA (kept as
 /// an independent cross-check of the CRBA in tests).
@@ -61,37 +61,54 @@ pub enum MassMatrix {
 }
 
 /// Writes `dirdyna` (outputs `M[i][j]`, then `c[i]`) into `b`, `M` by CRBA.
-pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) {
-    dirdyna_with(model, layout, b, MassMatrix::Crba);
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+    dirdyna_with(model, layout, b, MassMatrix::Crba)
 }
 
-/// Writes `dirdyna` with `M` formed by `how`.
-pub fn dirdyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: MassMatrix) {
+/// Writes `dirdyna` with `M` formed by `how`. Cost: the ops of `M` and `c` plus one output per
+/// entry of `M` (`nq²`, Robotran's layout); an entry that folds to 0 or copies the upper one
+/// costs its output and nothing else (no name of a temporary, no table entry).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per body and per row of `M`).
+pub fn dirdyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: MassMatrix) -> Result<(), Stopped> {
     let nq = layout.q_index.iter().flatten().count();
     // `c`'s inputs first (gravity, rates), then the trig variables.
     let drive = Drive::inputs(b, nq, false);
     let motions = motions(model, layout, b);
     let mut upper: FxHashMap<(usize, usize), Term> = FxHashMap::default();
     let entries = match how {
-        MassMatrix::Crba => crba::mass_matrix(model, layout, b, &motions),
-        MassMatrix::UnitAcceleration => unit_acceleration(model, layout, b, &motions, nq),
+        MassMatrix::Crba => crba::mass_matrix(model, layout, b, &motions)?,
+        MassMatrix::UnitAcceleration => unit_acceleration(model, layout, b, &motions, nq)?,
     };
     for ((i, j), t) in entries {
         upper.insert((i - 1, j - 1), t);
     }
     let mut c = vec![ZERO; nq];
-    for (qi, t) in sweep(model, layout, b, &motions, &drive) {
+    for (qi, t) in sweep(model, layout, b, &motions, &drive)? {
         c[qi - 1] = t;
     }
+    // `nq²` names: each made of its row's `M[i]` and its column's `[j]`, formatted once.
+    let columns: Vec<String> = (1..=nq).map(|j| format!("[{j}]")).collect();
+    b.f.outputs.reserve(nq * nq + nq);
     for i in 0..nq {
-        for j in 0..nq {
+        b.check_at(Reached::Row { row: i + 1, rows: nq })?;
+        let row = format!("M[{}]", i + 1);
+        for (j, column) in columns.iter().enumerate() {
             let t = upper.get(&(i.min(j), i.max(j))).cloned().unwrap_or(ZERO);
-            b.output(&format!("M[{}][{}]", i + 1, j + 1), &format!("M{}_{}", i + 1, j + 1), t);
+            let mut name = String::with_capacity(row.len() + column.len());
+            name.push_str(&row);
+            name.push_str(column);
+            b.output_with(name, || format!("M{}_{}", i + 1, j + 1), t);
         }
     }
     for (i, t) in c.into_iter().enumerate() {
         b.output(&format!("c[{}]", i + 1), &format!("c{}", i + 1), t);
     }
+    Ok(())
 }
 
 /// The upper triangle of `M` by one RNEA sweep per column (`qdd = e_j`, `qd = 0`, `g = 0`).
@@ -101,7 +118,7 @@ fn unit_acceleration(
     b: &mut Builder,
     motions: &[Motion],
     nq: usize,
-) -> Vec<((usize, usize), Term)> {
+) -> Result<crba::Entries, Stopped> {
     let mut upper = Vec::new();
     for j in 0..nq {
         let unit = Drive {
@@ -109,13 +126,13 @@ fn unit_acceleration(
             qdd: (0..nq).map(|k| Term::C(if k == j { 1.0 } else { 0.0 })).collect(),
             g: [ZERO, ZERO, ZERO],
         };
-        for (qi, t) in sweep(model, layout, b, motions, &unit) {
+        for (qi, t) in sweep(model, layout, b, motions, &unit)? {
             if qi <= j + 1 {
                 upper.push(((qi, j + 1), bind_entry(b, qi, j + 1, t)));
             }
         }
     }
-    upper
+    Ok(upper)
 }
 
 #[cfg(test)]
@@ -138,7 +155,7 @@ mod tests {
             given.insert(format!("q[{i}]"), (i as f64 * 0.7).sin() * 3.0);
         }
         let mut b = Builder::new("dirdyna", Default::default());
-        dirdyna_with(&model, &layout, &mut b, how);
+        dirdyna_with(&model, &layout, &mut b, how).expect("no deadline");
         let f = b.finish();
         // In binary64, inputs not given (qd, g) pseudo-random with seed 0: what `-eval` does.
         let value = |name: &str| given.get(name).copied().unwrap_or_else(|| interp::pseudo_random_input(name, 0));

@@ -20,7 +20,10 @@
 //! algorithm ([`rnea`]), symbolic in the joint coordinates `q[i]`, `qd[i]`, `qdd[i]`, the
 //! gravity vector `g[1..3]` (Pinocchio's default is `g[3] = −9.81`) and the model parameters.
 //! `dirdyna`: direct dynamics `M[i][j]` (by CRBA, [`crba`]), `c[i]` (by RNEA) with
-//! `M qdd + c = Qq` ([`dirdyna`]).
+//! `M qdd + c = Qq` ([`dirdyna`]). [`generate_with`] writes only the functions a [`Request`]
+//! names (`-function`) and stops at its deadline (`-time-limit`); the cost of each is linear
+//! in the ops it writes, plus `dirdyna`'s `nq²` outputs (issue 28: no table of body pairs, no
+//! copy of a link's sums per child).
 //! `--floating-base` puts the robot on Robotran's floating base first
 //! ([`robot::Robot::with_floating_base`]): six joints `T1`, `T2`, `T3` (prismatic along the
 //! world x, y, z) and `R1`, `R2`, `R3` (revolute about x, then the new y, then the new z) are
@@ -67,9 +70,13 @@ pub mod sym;
 pub mod topology;
 pub mod urdf_out;
 
+#[cfg(test)]
+mod scale_tests;
+
 use std::collections::BTreeMap;
 
 use robovec_ir::Module;
+use robovec_passes::Deadline;
 use rustc_hash::FxHashMap;
 
 use robot::{JointKind, Robot};
@@ -151,25 +158,110 @@ impl Layout {
 /// What the generator hands to the front end.
 #[derive(Clone, Debug)]
 pub struct Generated {
-    /// The functions (`invdyna`, then `dirdyna`).
+    /// The functions asked for, in [`FUNCTION_NAMES`] order (`invdyna`, then `dirdyna`).
     pub module: Module,
     /// Values of the parameters left as inputs (`None` when they were folded).
     pub params: Option<BTreeMap<String, f64>>,
 }
 
-/// Writes one function's equations and outputs into the builder.
-type Writer = fn(&Model, &Layout, &mut Builder);
+/// What to generate ([`generate_with`]): which functions, folded or not, and by when.
+#[derive(Clone, Debug, Default)]
+pub struct Request {
+    /// Fold every parameter into the equations (`--fold-params`).
+    pub fold: bool,
+    /// The functions to write, by name (`-function=NAME`); `None`: all of [`FUNCTION_NAMES`]. Names
+    /// the generator does not write are ignored (the driver reports them against
+    /// [`FUNCTION_NAMES`] before loading).
+    pub functions: Option<Vec<String>>,
+    /// `-time-limit`: checked once per body of every recursion and per row of `M`'s outputs
+    /// (see [`Stopped`]).
+    pub deadline: Option<Deadline>,
+}
+
+impl Request {
+    /// Whether function `name` is asked for.
+    pub fn wants(&self, name: &str) -> bool {
+        self.functions.as_ref().is_none_or(|fs| fs.iter().any(|f| f == name))
+    }
+}
+
+/// The generation stopped at the time limit ([`Request::deadline`]): nothing is returned,
+/// since no pass can run on part of a function (the URDF front end reports it as an error;
+/// issue 28 item 3).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stopped {
+    /// The function being written (`dirdyna`).
+    pub function: String,
+    /// How far it got.
+    pub at: Reached,
+    /// The limit, seconds.
+    pub seconds: f64,
+}
+
+/// Where a generation stopped ([`Stopped::at`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reached {
+    /// A body of a recursion: `body` (1-based, in the numbering of the module doc) of `bodies`.
+    Body {
+        /// The body reached.
+        body: usize,
+        /// Bodies of the robot.
+        bodies: usize,
+    },
+    /// A row of `M`'s outputs (`dirdyna`): `row` (1-based) of `rows` (`nq`).
+    Row {
+        /// The row reached.
+        row: usize,
+        /// Rows of `M`.
+        rows: usize,
+    },
+}
+
+impl std::fmt::Display for Stopped {
+    /// `time limit of 5 s reached while generating @dirdyna (body 1200 of 4000)`, or
+    /// `(… (row 1200 of 4000 of M)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "time limit of {} s reached while generating @{} ", self.seconds, self.function)?;
+        match self.at {
+            Reached::Body { body, bodies } => write!(f, "(body {body} of {bodies})"),
+            Reached::Row { row, rows } => write!(f, "(row {row} of {rows} of M)"),
+        }
+    }
+}
+
+/// Writes one function's equations and outputs into the builder; [`Stopped`] at the deadline
+/// (the builder's, [`Builder::check`]).
+type Writer = fn(&Model, &Layout, &mut Builder) -> Result<(), Stopped>;
 
 /// The functions the generator writes, in module order (`-function=NAME` picks one): the
 /// one place that selects a formulation per function.
 const FUNCTIONS: [(&str, Writer); 2] = [("invdyna", rnea::invdyna), ("dirdyna", dirdyna::dirdyna)];
 
+/// The names of the functions the generator writes, in module order: `invdyna`, `dirdyna`.
+pub const FUNCTION_NAMES: [&str; 2] = [FUNCTIONS[0].0, FUNCTIONS[1].0];
+
 /// Generates `invdyna` and `dirdyna` for `model`; `fold` folds every parameter into the
-/// equations. The robot is written in its own frames, in the body frames of
-/// [`frames::reframe`], or in either with the origins of [`origins::slide`]: whichever gives
-/// both functions together the fewest ops (the first of equals in that order; then the
-/// parameters of the links they move are in those frames). Cost: up to four generations.
+/// equations. [`generate_with`] with every function and no time limit.
 pub fn generate(model: &Model, fold: bool) -> Generated {
+    let request = Request { fold, ..Request::default() };
+    generate_with(model, &request).expect("no deadline, no stop")
+}
+
+/// Generates the functions `request` asks for. The robot is written in its own frames, in the
+/// body frames of [`frames::reframe`], or in either with the origins of [`origins::slide`]:
+/// whichever gives the functions asked for together the fewest ops (the first of equals in
+/// that order; then the parameters of the links they move are in those frames). With every
+/// function asked for, that is both functions together, as before `-function` reached the
+/// generator; with one, its own count decides, so `-function=invdyna` may pick other frames
+/// than a run of both (the same `Qq`; `-params-out` then has that run's parameters).
+///
+/// Cost: up to four generations of the functions asked for, each linear in the ops it writes
+/// plus, for `dirdyna`, its `nq²` outputs (issue 28: no per-pair structure where `M` is
+/// sparse).
+///
+/// # Errors
+/// [`Stopped`] once `request.deadline` is reached (checked per body and per row of outputs).
+pub fn generate_with(model: &Model, request: &Request) -> Result<Generated, Stopped> {
     let mut robots = vec![model.robot.clone()];
     robots.extend(frames::reframe(&model.robot));
     for i in 0..robots.len() {
@@ -178,31 +270,30 @@ pub fn generate(model: &Model, fold: bool) -> Generated {
     let ops = |g: &Generated| g.module.functions.iter().map(|f| f.op_counts().total).sum::<u64>();
     let mut best: Option<(u64, Generated)> = None;
     for robot in robots {
-        let g = generate_in_frames(&Model { robot }, fold);
+        let g = generate_in_frames(&Model { robot }, request)?;
         let n = ops(&g);
         if best.as_ref().is_none_or(|(m, _)| n < *m) {
             best = Some((n, g));
         }
     }
-    best.expect("the robot's own frames are a candidate").1
+    Ok(best.expect("the robot's own frames are a candidate").1)
 }
 
-/// [`generate`] in the robot's own frames.
-fn generate_in_frames(model: &Model, fold: bool) -> Generated {
+/// [`generate_with`] in the robot's own frames.
+fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Stopped> {
     let layout = Layout::of(&model.robot);
     let consts: FxHashMap<String, f64> =
-        if fold { layout.nonzero().into_iter().collect() } else { FxHashMap::default() };
-    let functions: Vec<_> = FUNCTIONS
-        .iter()
-        .map(|(name, write)| {
-            let mut b = Builder::new(name, consts.clone());
-            write(model, &layout, &mut b);
-            b.finish()
-        })
-        .collect();
-    let params = (!fold).then(|| {
+        if request.fold { layout.nonzero().into_iter().collect() } else { FxHashMap::default() };
+    let mut functions = Vec::new();
+    for (name, write) in FUNCTIONS.iter().filter(|(name, _)| request.wants(name)) {
+        let mut b = Builder::new(name, consts.clone());
+        b.deadline = request.deadline;
+        write(model, &layout, &mut b)?;
+        functions.push(b.finish());
+    }
+    let params = (!request.fold).then(|| {
         // Only the parameters some function reads.
         layout.nonzero().into_iter().filter(|(k, _)| functions.iter().any(|f| f.lookup(k).is_some())).collect()
     });
-    Generated { module: Module { functions }, params }
+    Ok(Generated { module: Module { functions }, params })
 }

@@ -23,7 +23,7 @@ use robovec_ir::TrigFn;
 
 use super::robot::{snap, JointKind};
 use super::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
-use super::{Layout, Model};
+use super::{Layout, Model, Stopped};
 
 /// A 3-vector of terms.
 pub type V3 = [Term; 3];
@@ -74,7 +74,7 @@ fn axis_rotation(k: &[f64; 3], c: &Term, s: &Term) -> M3 {
     r
 }
 
-pub(super) fn bind3(b: &mut Builder, name: &str, body: usize, v: V3) -> V3 {
+pub(super) fn bind3(b: &mut Builder, name: &str, body: impl std::fmt::Display, v: V3) -> V3 {
     let [x, y, z] = v;
     [b.bind(&format!("{name}1{body}"), x), b.bind(&format!("{name}2{body}"), y), b.bind(&format!("{name}3{body}"), z)]
 }
@@ -151,18 +151,56 @@ pub fn motions(model: &Model, layout: &Layout, b: &mut Builder) -> Vec<Motion> {
 }
 
 /// Writes `invdyna` (outputs `Qq[1..nq]`) into `b`.
-pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) {
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
     let nq = layout.q_index.iter().flatten().count();
     let drive = Drive::inputs(b, nq, true);
     let motions = motions(model, layout, b);
-    for (qi, t) in sweep(model, layout, b, &motions, &drive) {
+    for (qi, t) in sweep(model, layout, b, &motions, &drive)? {
         b.output(&format!("Qq[{qi}]"), &format!("Qq{qi}"), t);
+    }
+    Ok(())
+}
+
+/// `a + b` entry by entry, taking both (no copy of `a`: a link's sum over its children grows
+/// by one child at a time, and copying it each time would cost the square of its children).
+fn vadd_into(a: &mut V3, b: V3) {
+    for (x, y) in a.iter_mut().zip(b) {
+        *x = add(std::mem::take(x), y);
+    }
+}
+
+/// Children whose terms a link's sum holds before it is bound (issue 28): a sum over a
+/// link's children is one expression whose depth is their number, and every recursion over
+/// expressions (this crate's, the IR's printer, verifier and `atomise`) would overflow the
+/// stack on a hub of 100,000 branches. Binding the partial sum every `SUM_CHUNK` children
+/// keeps every expression shallow; a link of the examples and example-robot-data has at most
+/// a handful of children, whose sums stay as they were.
+pub(super) const SUM_CHUNK: usize = 64;
+
+/// Adds child term `t` to link `p`'s sum `acc` of `children` terms so far and binds the sum
+/// as `{name}{k}{p}_{chunk}` after every [`SUM_CHUNK`]-th child.
+fn add_child(b: &mut Builder, name: &str, p: usize, acc: &mut V3, children: usize, t: V3) {
+    vadd_into(acc, t);
+    if (children + 1).is_multiple_of(SUM_CHUNK) {
+        *acc = bind3(b, name, format_args!("{p}_{}", (children + 1) / SUM_CHUNK), std::mem::take(acc));
     }
 }
 
 /// One RNEA sweep driven by `drive`: the joint forces `(i, Q_i)` of the coordinates that bear
-/// one, sorted by `i` (terms, not yet bound).
-pub fn sweep(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion], drive: &Drive) -> Vec<(usize, Term)> {
+/// one, sorted by `i` (terms, not yet bound). Cost: linear in the bodies and the ops written.
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per body, forward and backward).
+pub fn sweep(
+    model: &Model,
+    layout: &Layout,
+    b: &mut Builder,
+    motions: &[Motion],
+    drive: &Drive,
+) -> Result<Vec<(usize, Term)>, Stopped> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
     let nb = order.len();
@@ -183,6 +221,7 @@ pub fn sweep(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]
     // Forward kinematics.
     for (i, &j) in order.iter().enumerate() {
         let body = i + 1;
+        b.check(body, nb)?;
         let joint = &robot.joints[j];
         let p = body_of_link(joint.parent);
         let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
@@ -233,12 +272,14 @@ pub fn sweep(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]
     // Backward dynamics.
     let mut fq: Vec<V3> = vec![[ZERO, ZERO, ZERO]; nb + 1];
     let mut cq: Vec<V3> = vec![[ZERO, ZERO, ZERO]; nb + 1];
+    let mut children = vec![0usize; nb + 1];
     let mut torque: Vec<(usize, Term)> = Vec::new();
     for i in (0..nb).rev() {
         let body = i + 1;
         if !moves[body] {
             continue;
         }
+        b.check(body, nb)?;
         let joint = &robot.joints[order[i]];
         let mass = layout.param(b, &format!("m[{body}]"));
         let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
@@ -271,9 +312,10 @@ pub fn sweep(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]
         let f_p = bind3(b, "Fr", body, matvec(&ro, &f_j, false));
         let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
         let c_p = vadd(&matvec(&ro, &c_j, false), &cross(&d, &f_p));
-        fq[p] = vadd(&fq[p], &f_p);
-        cq[p] = vadd(&cq[p], &c_p);
+        add_child(b, "FqS", p, &mut fq[p], children[p], f_p);
+        add_child(b, "CqS", p, &mut cq[p], children[p], c_p);
+        children[p] += 1;
     }
     torque.sort_by_key(|&(qi, _)| qi);
-    torque
+    Ok(torque)
 }

@@ -27,8 +27,11 @@
 //! 3 266, UR5 473 → 419 / 486 → 451, TIAGo Pro 7 666 → 7 600 / 7 955 → 7 928; `M` of Panda
 //! 515 → 512, Talos 3 993 → 3 989, TIAGo Pro 8 271 → 8 269 (the others unchanged).
 
-use robovec_ir::{BinOp, Def, Expr, Function, Operand, Phase, Span, TrigFn, Value};
+use robovec_ir::{BinOp, Def, Expr, Function, Operand, Output, Phase, Span, TrigFn, Value};
+use robovec_passes::Deadline;
 use rustc_hash::FxHashMap;
+
+use super::{Reached, Stopped};
 
 /// A symbolic scalar.
 #[derive(Clone, Debug, PartialEq)]
@@ -268,13 +271,35 @@ pub struct Builder {
     /// The function being built.
     pub f: Function,
     consts: FxHashMap<String, f64>,
+    /// The time limit the writers check per body ([`Builder::check`]); `None`: no limit.
+    pub deadline: Option<Deadline>,
 }
 
 impl Builder {
     /// An empty function `name`. Inputs named in `consts` are folded to their value instead of
     /// becoming inputs (`--fold-params`).
     pub fn new(name: &str, consts: FxHashMap<String, f64>) -> Builder {
-        Builder { f: Function::new(name, Phase::Parsed), consts }
+        Builder { f: Function::new(name, Phase::Parsed), consts, deadline: None }
+    }
+
+    /// Checks the time limit once a writer reached `body` of `bodies` (one clock read, tens of
+    /// ns: writers call it per body, whose equations cost far more).
+    ///
+    /// # Errors
+    /// [`Stopped`] naming this function and `body` once [`Builder::deadline`] is reached.
+    pub fn check(&self, body: usize, bodies: usize) -> Result<(), Stopped> {
+        self.check_at(Reached::Body { body, bodies })
+    }
+
+    /// [`Builder::check`] at any point of the writing (`dirdyna` checks per row of `M`).
+    ///
+    /// # Errors
+    /// [`Stopped`] at `at` once [`Builder::deadline`] is reached.
+    pub fn check_at(&self, at: Reached) -> Result<(), Stopped> {
+        match &self.deadline {
+            Some(d) if d.reached() => Err(Stopped { function: self.f.name.clone(), at, seconds: d.seconds }),
+            _ => Ok(()),
+        }
     }
 
     /// The input `name` (canonical SPEC §2 name), created on first use; a folded constant when
@@ -314,16 +339,34 @@ impl Builder {
 
     /// Sets output `name` to `t` (bound first under `temp` when not an atom).
     pub fn output(&mut self, name: &str, temp: &str, t: Term) {
-        let t = self.bind(temp, t);
+        self.output_with(name, || temp.to_string(), t);
+    }
+
+    /// [`Builder::output`] with the temporary's name made only when one is bound (`M`'s
+    /// zeros and copies, `nq²` of them, need none).
+    ///
+    /// Each output name is written once (the writers' `Qq[i]`, `M[i][j]`, `c[i]` are): the
+    /// output is appended without a lookup by name, and [`Builder::finish`] indexes the names
+    /// once (a lookup and an insert into a growing table per output cost `dirdyna` of a
+    /// 2,000-branch star, 4 million outputs, a third of its time; the verifier rejects a
+    /// name written twice).
+    pub fn output_with(&mut self, name: impl Into<String>, temp: impl FnOnce() -> String, t: Term) {
         let op = match t {
             Term::V(v) => Operand::Value(v),
             Term::C(x) if x >= 0.0 => Operand::Const(x),
-            other => match self.bind_always(temp, other) {
-                Term::V(v) => Operand::Value(v),
-                _ => unreachable!(),
-            },
+            t => {
+                let temp = temp();
+                match self.bind(&temp, t) {
+                    Term::V(v) => Operand::Value(v),
+                    Term::C(x) if x >= 0.0 => Operand::Const(x),
+                    other => match self.bind_always(&temp, other) {
+                        Term::V(v) => Operand::Value(v),
+                        _ => unreachable!(),
+                    },
+                }
+            }
         };
-        self.f.set_output(name, op, Span::DUMMY);
+        self.f.outputs.push(Output { name: name.into(), value: op, span: Span::DUMMY });
     }
 
     fn bind_always(&mut self, name: &str, t: Term) -> Term {
@@ -333,7 +376,8 @@ impl Builder {
     }
 
     /// The finished function: what no output needs is dropped (Robotran writes only the
-    /// equations its outputs read), inputs included; `equations` counts what is left.
+    /// equations its outputs read), inputs included; `equations` counts what is left. The
+    /// names of values and outputs are indexed again ([`Function::retain`]).
     pub fn finish(mut self) -> Function {
         let live = self.f.live_values(&[]);
         self.f.retain(|_, v| live[v.index()]);

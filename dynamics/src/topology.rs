@@ -14,6 +14,11 @@
 //! - [`Topology::Parallel`]: chains of [`PARALLEL_CHAIN`] joints (a leg or a finger), the last
 //!   one shorter when `dof` is not a multiple (130 dof → 33 chains).
 //!
+//! Beyond the study, [`Topology::Star`]: `dof` single-joint branches off the base (issue 28's
+//! scale input: its mass matrix is diagonal, so the generator's cost must follow the ops it
+//! writes, not `dof²`). It is not in [`Topology::ALL`] (the study's families, with the thesis's
+//! rows) but is a family like them for [`build`] and `robovec-gen --topology star`.
+//!
 //! # Random parameters (seeded, reproducible: XorShift, `rand_xorshift`)
 //! For each joint: the axis is one of x, y, z of its frame (so the rotations fold to Robotran's
 //! C/S products); the joint origin `dpt` in the parent frame has each coordinate either 0 (a
@@ -50,18 +55,24 @@ pub enum Topology {
     SemiSerial,
     /// Many short chains from the base.
     Parallel,
+    /// One-joint chains from the base (not a study family: see the module doc).
+    Star,
 }
 
 impl Topology {
     /// Every family, in the thesis's order.
     pub const ALL: [Topology; 3] = [Topology::Serial, Topology::SemiSerial, Topology::Parallel];
 
-    /// The command-line name: `serial`, `semi-serial`, `parallel`.
+    /// Every family [`build`] makes: the study's ([`Topology::ALL`]), then [`Topology::Star`].
+    pub const EVERY: [Topology; 4] = [Topology::Serial, Topology::SemiSerial, Topology::Parallel, Topology::Star];
+
+    /// The command-line name: `serial`, `semi-serial`, `parallel`, `star`.
     pub fn name(self) -> &'static str {
         match self {
             Topology::Serial => "serial",
             Topology::SemiSerial => "semi-serial",
             Topology::Parallel => "parallel",
+            Topology::Star => "star",
         }
     }
 }
@@ -80,10 +91,10 @@ impl FromStr for Topology {
     /// # Errors
     /// A message listing the names when `s` is none of them.
     fn from_str(s: &str) -> Result<Topology, String> {
-        Topology::ALL
+        Topology::EVERY
             .into_iter()
             .find(|t| t.name() == s)
-            .ok_or_else(|| format!("unknown topology `{s}`: expected serial, semi-serial or parallel"))
+            .ok_or_else(|| format!("unknown topology `{s}`: expected serial, semi-serial, parallel or star"))
     }
 }
 
@@ -106,6 +117,7 @@ pub fn chains(topology: Topology, dof: usize) -> Vec<usize> {
             }
             c
         }
+        Topology::Star => vec![1; dof],
     }
 }
 
@@ -183,7 +195,8 @@ mod tests {
         assert_eq!(chains(Topology::Parallel, 23), [4, 4, 4, 4, 4, 3]);
         assert_eq!(chains(Topology::Parallel, 130).len(), 33);
         assert!(chains(Topology::Parallel, 0).is_empty());
-        for t in Topology::ALL {
+        assert_eq!(chains(Topology::Star, 5), [1, 1, 1, 1, 1]);
+        for t in Topology::EVERY {
             for dof in 1..140 {
                 assert_eq!(chains(t, dof).iter().sum::<usize>(), dof, "{t} {dof}");
             }
@@ -212,6 +225,11 @@ mod tests {
         }
         assert_eq!(build(Topology::Serial, 1000, 1).joints[999].name, "j1000");
         assert_eq!("semi-serial".parse::<Topology>(), Ok(Topology::SemiSerial));
+        assert_eq!("star".parse::<Topology>(), Ok(Topology::Star));
+        // A star: every joint hangs from the base.
+        let s = build(Topology::Star, 40, 2);
+        assert!(s.joints.iter().all(|j| j.parent == 0));
+        assert_eq!(s.links.len(), 41);
         assert!("tree".parse::<Topology>().is_err());
     }
 }

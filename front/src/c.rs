@@ -6,6 +6,7 @@
 use robovec_ir::Span;
 
 use super::ast::{Case, FuncAst, Stmt};
+use super::clock::Clock;
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
 use super::lower::Lower;
@@ -22,8 +23,15 @@ const TYPES: &[&str] =
 
 /// Scans a C file. `header` is the companion `.h` text: its declarations are only used for
 /// `double *X;` pointers.
-pub fn scan(src: &str, toks: &[Spanned<'_>], header: Option<&str>, errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
-    scan_impl(src, toks, header, errors, None)
+/// Stops at `clock`'s deadline (one tick per statement).
+pub fn scan(
+    src: &str,
+    toks: &[Spanned<'_>],
+    header: Option<&str>,
+    errors: &mut Vec<FrontError>,
+    clock: &Clock,
+) -> Vec<FuncAst> {
+    scan_impl(src, toks, header, errors, None, clock)
 }
 
 fn scan_impl(
@@ -32,6 +40,7 @@ fn scan_impl(
     header: Option<&str>,
     errors: &mut Vec<FrontError>,
     mut streamed: Option<&mut Streamed>,
+    clock: &Clock,
 ) -> Vec<FuncAst> {
     // Without comments and newlines (already so when lexed by `parse_str`: no copy then).
     let filtered: Vec<Spanned<'_>>;
@@ -52,7 +61,7 @@ fn scan_impl(
     let mut defines = Vec::new();
     let mut i = 0;
     let mut junk_reported = false;
-    while i < toks.len() {
+    while i < toks.len() && !clock.stopped() {
         match toks[i].1 {
             Tok::Hash(text) => {
                 directive(text, Span::new(toks[i].0, toks[i].2), &mut defines, errors);
@@ -119,9 +128,11 @@ fn scan_impl(
                         let scanned = match stream.as_mut() {
                             // The outline left the body out: it is lexed again, a window at a time.
                             Some(stream) => {
-                                stream::body_in_windows(src, toks[body_open].2, end, &mut f, errors, stream)
+                                stream::body_in_windows(src, toks[body_open].2, end, &mut f, errors, stream, clock)
                             }
-                            None => body(src, &toks[body_open + 1..body_close], end, &mut f, errors, None, &mut None),
+                            None => {
+                                body(src, &toks[body_open + 1..body_close], end, &mut f, errors, None, &mut None, clock)
+                            }
                         };
                         if scanned {
                             if let (Some(st), Some(stream)) = (streamed.as_deref_mut(), stream) {
@@ -243,7 +254,9 @@ enum Target {
 
 /// Scans a function body (or a part of one ending after a `;`) into `f`; false after a fatal
 /// (control-flow or structure) error, which is then the last error pushed. `returned` is the
-/// `return;` seen so far in the body (statements after it are unreachable).
+/// `return;` seen so far in the body (statements after it are unreachable). Stops at `clock`'s
+/// deadline (one tick per token position visited), returning true: the caller asks the clock.
+#[allow(clippy::too_many_arguments)]
 fn body<'s>(
     src: &'s str,
     toks: &[Spanned<'_>],
@@ -252,6 +265,7 @@ fn body<'s>(
     errors: &mut Vec<FrontError>,
     mut stream: Option<&mut Stream<'s>>,
     returned: &mut Option<Span>,
+    clock: &Clock,
 ) -> bool {
     let mut i = 0;
     let mut target = Target::Prefix;
@@ -288,6 +302,9 @@ fn body<'s>(
         };
     while i < toks.len() {
         let t = toks[i];
+        if clock.tick(t.0) {
+            return true;
+        }
         if Some(i) == switch_close {
             target = Target::Suffix;
             switch_close = None;

@@ -8,6 +8,8 @@
 
 use logos::Logos;
 
+use super::clock::Clock;
+
 /// A token of a Robotran file.
 #[derive(Logos, Clone, Copy, Debug, PartialEq, Eq)]
 #[logos(skip r"[ \t\f\r\x0b\u{FEFF}]+")]
@@ -143,7 +145,18 @@ pub fn lex(src: &str) -> Vec<Spanned<'_>> {
 /// lexing: the token vector is the largest structure of a batch parse, 40 bytes per token;
 /// the streaming path, `super::c::scan_and_lower`, never builds it).
 pub fn lex_where(src: &str, keep: impl Fn(&Tok<'_>) -> bool) -> Vec<Spanned<'_>> {
-    Tok::lexer(src).spanned().map(|(t, r)| (r.start, t.unwrap_or(Tok::Error), r.end)).filter(|t| keep(&t.1)).collect()
+    lex_until(src, keep, &Clock::default())
+}
+
+/// [`lex_where`] that stops at `clock`'s deadline (one tick per token; the tokens so far are
+/// returned and the clock says it stopped).
+pub fn lex_until<'s>(src: &'s str, keep: impl Fn(&Tok<'_>) -> bool, clock: &Clock) -> Vec<Spanned<'s>> {
+    Tok::lexer(src)
+        .spanned()
+        .take_while(|(_, r)| !clock.tick(r.start))
+        .map(|(t, r)| (r.start, t.unwrap_or(Tok::Error), r.end))
+        .filter(|t| keep(&t.1))
+        .collect()
 }
 
 #[cfg(test)]

@@ -11,9 +11,10 @@
 //!
 //! # Main modules
 //! [`registry`] (the front-end table), [`c`], [`matlab`], [`python`] (the file scanners),
+//! [`lines`] (the line-oriented languages' lines and streaming path),
 //! [`lexer`], [`stmt`] and [`ast`] (the shared lexer, statement grammar and AST), [`lower`] (AST
 //! → IR), [`urdf`] (URDF → robot → equations), [`sensor`], [`synth`] (synthetic files for the
-//! scale tests and benches), [`error`] (diagnostics).
+//! scale tests and benches), [`error`] (diagnostics), [`clock`] (`-time-limit` while loading).
 //!
 //! # Pipeline
 //! Naga style: the bytes are made text by [`source_text`] (every byte offset kept),
@@ -23,7 +24,8 @@
 //! language-agnostic [`ast`], and lowered to IR by [`lower`] (whose module doc states the
 //! lowering rules). A C file without errors takes the streaming path ([`c::scan_and_lower`]):
 //! its function bodies are lexed again a window at a time and each statement lowered as soon
-//! as it is parsed, so memory does not grow with the tokens of a body.
+//! as it is parsed, so memory does not grow with the tokens of a body; Matlab and Python files
+//! are read a logical line at a time and take the same kind of path ([`lines`]).
 //!
 //! # Encoding
 //! Input is bytes. Valid UTF-8 is kept; each byte of an invalid UTF-8 sequence (a Latin-1
@@ -35,8 +37,10 @@
 
 pub mod ast;
 pub mod c;
+pub mod clock;
 pub mod error;
 pub mod lexer;
+pub mod lines;
 pub mod lower;
 pub mod matlab;
 pub mod python;
@@ -116,6 +120,32 @@ pub fn parse_str(lang: Language, src: &[u8], header: Option<&[u8]>) -> Result<ro
 /// # Errors
 /// As [`parse_str`].
 pub fn parse_text(lang: Language, text: &str, header: Option<&[u8]>) -> Result<robovec_ir::Module, Vec<FrontError>> {
+    parse_text_until(lang, text, header, None)
+}
+
+/// [`parse_text`] that stops at `deadline` (`-time-limit`): the lexer, the scanners and the
+/// lowering tick a [`clock::Clock`] per token, line or statement.
+///
+/// # Errors
+/// As [`parse_str`]; once the deadline is reached, only the error of [`clock::Clock::error`]
+/// (`time limit of 5 s reached while reading (line N of M)`).
+pub fn parse_text_until(
+    lang: Language,
+    text: &str,
+    header: Option<&[u8]>,
+    deadline: Option<&robovec_passes::Deadline>,
+) -> Result<robovec_ir::Module, Vec<FrontError>> {
+    parse_with_clock(lang, text, header, &clock::Clock::new(deadline))
+}
+
+/// [`parse_text_until`] with the clock given.
+fn parse_with_clock(
+    lang: Language,
+    text: &str,
+    header: Option<&[u8]>,
+    clock: &clock::Clock,
+) -> Result<robovec_ir::Module, Vec<FrontError>> {
+    let stopped = |clock: &clock::Clock| clock.error(text).map(|e| vec![e]);
     let mut errors = Vec::new();
     // The tokens live only while scanning: the statements own their text.
     let funcs = match lang {
@@ -124,19 +154,45 @@ pub fn parse_text(lang: Language, text: &str, header: Option<&[u8]>) -> Result<r
             // Statements lowered as soon as they are parsed, the bodies lexed a window at a
             // time; on any error (or a form it leaves out) the batch path below runs from the
             // start and gives the diagnostics.
-            if let Some(module) = c::scan_and_lower(text, header.as_deref()) {
+            let streamed = c::scan_and_lower(text, header.as_deref(), clock);
+            if let Some(e) = stopped(clock) {
+                return Err(e);
+            }
+            if let Some(module) = streamed {
                 return Ok(module);
             }
-            let toks = lexer::lex_where(text, |t| !c::ignored(t));
-            c::scan(text, &toks, header.as_deref(), &mut errors)
+            let toks = lexer::lex_until(text, |t| !c::ignored(t), clock);
+            c::scan(text, &toks, header.as_deref(), &mut errors, clock)
         }
-        Language::Matlab => matlab::scan(text, &lexer::lex(text), &mut errors),
-        Language::Python => python::scan(text, &lexer::lex(text), &mut errors),
+        // As C: each statement lowered as soon as its line is scanned; on any error the batch
+        // path below runs from the start ([`lines`]).
+        Language::Matlab | Language::Python => {
+            let streamed = match lang {
+                Language::Matlab => lines::scan_and_lower::<matlab::Scanner>(text, clock),
+                _ => lines::scan_and_lower::<python::Scanner>(text, clock),
+            };
+            if let Some(e) = stopped(clock) {
+                return Err(e);
+            }
+            if let Some(module) = streamed {
+                return Ok(module);
+            }
+            match lang {
+                Language::Matlab => lines::scan::<matlab::Scanner>(text, &mut errors, clock),
+                _ => lines::scan::<python::Scanner>(text, &mut errors, clock),
+            }
+        }
     };
+    if let Some(e) = stopped(clock) {
+        return Err(e);
+    }
     if funcs.is_empty() && errors.is_empty() {
         errors.push(scan::no_function(lang, text.len()));
     }
-    let module = lower::lower_module(text, lang, &funcs, &mut errors);
+    let module = lower::lower_module(text, lang, &funcs, &mut errors, clock);
+    if let Some(e) = stopped(clock) {
+        return Err(e);
+    }
     if errors.is_empty() {
         Ok(module)
     } else {
@@ -147,9 +203,13 @@ pub fn parse_text(lang: Language, text: &str, header: Option<&[u8]>) -> Result<r
 }
 
 #[cfg(test)]
+mod clock_tests;
+#[cfg(test)]
 mod corpus_tests;
 #[cfg(test)]
 mod error_tests;
+#[cfg(test)]
+mod lines_tests;
 #[cfg(test)]
 mod snippet_tests;
 #[cfg(test)]

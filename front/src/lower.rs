@@ -44,6 +44,7 @@ use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 use robovec_ir::{Callee, Def, Expr as IrExpr, Function, Module, Operand, Phase, Span, TrigFn};
 
 use super::ast::{Expr, FuncAst, Ref, Stmt, Suffix};
+use super::clock::Clock;
 use super::error::FrontError;
 use super::scan::line_of;
 use super::{sensor, Language};
@@ -53,8 +54,15 @@ const INPUT_ARRAYS: &[&str] = &["q", "qd", "qdd", "dpt", "l", "m", "In", "g", "f
 const ACCEPTED: &str = "accepted functions: `sqrt(x)`, `sin`/`cos` of a joint coordinate as a whole right-hand side \
                         (`C4 = cos(q[4])`), user callbacks `user_*`, `user_call_*`, `usrfun.*`";
 
-/// Lowers every scanned function; sensor functions are split per case.
-pub fn lower_module(src: &str, lang: Language, funcs: &[FuncAst], errors: &mut Vec<FrontError>) -> Module {
+/// Lowers every scanned function; sensor functions are split per case. Stops at `clock`'s
+/// deadline (one tick per statement; the module is then incomplete and the clock says so).
+pub fn lower_module(
+    src: &str,
+    lang: Language,
+    funcs: &[FuncAst],
+    errors: &mut Vec<FrontError>,
+    clock: &Clock,
+) -> Module {
     let mut m = Module::default();
     let mut add = |f: Function, span: Span, errors: &mut Vec<FrontError>| {
         if m.function(&f.name).is_some() {
@@ -67,7 +75,7 @@ pub fn lower_module(src: &str, lang: Language, funcs: &[FuncAst], errors: &mut V
         match &fa.cases {
             None => {
                 let stmts: Vec<&Stmt> = fa.prefix.iter().chain(&fa.suffix).collect();
-                let f = Lower::new(src, lang, fa).run(fa.name.clone(), &stmts, errors);
+                let f = Lower::new(src, lang, fa).run(fa.name.clone(), &stmts, errors, clock);
                 add(f, fa.span, errors);
             }
             Some(cases) => {
@@ -75,7 +83,7 @@ pub fn lower_module(src: &str, lang: Language, funcs: &[FuncAst], errors: &mut V
                     let tail: Vec<&Stmt> = c.body.iter().chain(&fa.suffix).collect();
                     let mut stmts = sensor::needed_prefix(&fa.prefix, &tail, &fa.outputs);
                     stmts.extend(tail);
-                    let f = Lower::new(src, lang, fa).run(format!("{}_{}", fa.name, c.label), &stmts, errors);
+                    let f = Lower::new(src, lang, fa).run(format!("{}_{}", fa.name, c.label), &stmts, errors, clock);
                     add(f, c.span, errors);
                 }
             }
@@ -152,11 +160,19 @@ impl<'a> Lower<'a> {
         }
     }
 
-    fn run(mut self, name: String, stmts: &[&Stmt], errors: &mut Vec<FrontError>) -> Function {
+    fn run(mut self, name: String, stmts: &[&Stmt], errors: &mut Vec<FrontError>, clock: &Clock) -> Function {
         for s in stmts {
+            if clock.tick(s.span.start as usize) {
+                break;
+            }
             self.stmt(s);
         }
         self.finish(name, errors)
+    }
+
+    /// Sets the function's span (the streaming line path knows it only at the function's end).
+    pub(crate) fn set_span(&mut self, span: Span) {
+        self.fa.span = span;
     }
 
     /// The lowered function, named `name`; its errors are appended to `errors`.

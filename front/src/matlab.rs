@@ -6,78 +6,75 @@ use robovec_ir::Span;
 use super::ast::FuncAst;
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
+use super::lines::LineScanner;
 use super::scan;
+use super::Language;
 
-/// Scans a Matlab file.
-pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
-    // Drop comments and continuations (`...` with the rest of its line and the line break).
-    let mut flat = Vec::with_capacity(toks.len());
-    let mut k = 0;
-    while k < toks.len() {
-        match toks[k].1 {
-            Tok::PercentComment => {}
-            Tok::Ellipsis => {
-                if toks.get(k + 1).is_some_and(|t| t.1 == Tok::Newline) {
-                    k += 1;
-                }
-            }
-            _ => flat.push(toks[k]),
-        }
-        k += 1;
-    }
-    let mut funcs: Vec<FuncAst> = Vec::new();
-    let mut ended = false;
-    let mut outside_reported = false;
-    let mut dropped = false;
-    let mut mark = errors.len();
-    for line in scan::lines(&flat) {
+/// The Matlab file scanner, fed one logical line at a time ([`crate::lines`]: comments and
+/// `...` continuations already removed).
+#[derive(Default)]
+pub struct Scanner {
+    funcs: Vec<FuncAst>,
+    ended: bool,
+    outside_reported: bool,
+    dropped: bool,
+    mark: usize,
+}
+
+impl LineScanner for Scanner {
+    const LANG: Language = Language::Matlab;
+
+    fn line(&mut self, src: &str, line: &[Spanned<'_>], errors: &mut Vec<FrontError>) {
         let first = line[0];
         let word = if let Tok::Ident(w) = first.1 { Some(w) } else { None };
         match word {
             Some("function") => {
-                dropped = false;
-                mark = errors.len();
+                self.dropped = false;
+                self.mark = errors.len();
                 if let Some(f) = signature(line, errors) {
-                    funcs.push(f);
-                    ended = false;
+                    self.funcs.push(f);
+                    self.ended = false;
                 }
-                continue;
+                return;
             }
             Some("end") if line.len() == 1 || (line.len() == 2 && line[1].1 == Tok::Semi) => {
-                ended = true;
-                continue;
+                self.ended = true;
+                return;
             }
-            Some("return") if line.len() == 1 || (line.len() == 2 && line[1].1 == Tok::Semi) => continue,
+            Some("return") if line.len() == 1 || (line.len() == 2 && line[1].1 == Tok::Semi) => return,
             Some(w) if scan::control_kind(w).is_some() || w == "return" => {
                 let what = scan::control_kind(w).unwrap_or("`return`");
-                if !dropped {
+                if !self.dropped {
                     // The loop diagnostic alone tells why the file is rejected.
-                    errors.truncate(mark);
+                    errors.truncate(self.mark);
                     errors.push(scan::control_error(src, what, Span::new(first.0, first.2)));
                 }
                 // Drop the function: nothing after a loop can be trusted.
-                if !dropped && !ended {
-                    funcs.pop();
+                if !self.dropped && !self.ended {
+                    self.funcs.pop();
                 }
-                ended = true;
-                dropped = true;
-                continue;
+                self.ended = true;
+                self.dropped = true;
+                return;
             }
             _ => {}
         }
-        let Some(f) = funcs.last_mut().filter(|_| !ended) else {
-            if !outside_reported && !dropped {
+        let Some(f) = self.funcs.last_mut().filter(|_| !self.ended) else {
+            if !self.outside_reported && !self.dropped {
                 errors.push(scan::unexpected(&first, "`function [outputs] = name(s,tsim,usrfun)` before statements"));
-                outside_reported = true;
+                self.outside_reported = true;
             }
-            continue;
+            return;
         };
         for stmt in line.split(|t| t.1 == Tok::Semi).filter(|s| !s.is_empty()) {
             scan::file_statement(stmt, f, errors);
         }
         f.span = f.span.to(Span::new(line[0].0, line[line.len() - 1].2));
     }
-    funcs
+
+    fn funcs(&mut self) -> &mut Vec<FuncAst> {
+        &mut self.funcs
+    }
 }
 
 /// `function [a,b] = name(p, q)`, `function a = name(…)` or `function name(…)`.

@@ -7,66 +7,63 @@ use robovec_ir::Span;
 use super::ast::FuncAst;
 use super::error::FrontError;
 use super::lexer::{Spanned, Tok};
+use super::lines::LineScanner;
 use super::scan;
+use super::Language;
 
 /// Parameters that are never outputs.
 const NOT_OUTPUTS: &[&str] = &["s", "tsim", "usrfun", "self", "isens", "sens"];
 
-/// Scans a Python file.
-pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Vec<FuncAst> {
-    let mut flat = Vec::with_capacity(toks.len());
-    let mut k = 0;
-    while k < toks.len() {
-        match toks[k].1 {
-            Tok::Hash(_) => {}
-            Tok::Backslash if toks.get(k + 1).is_some_and(|t| t.1 == Tok::Newline) => k += 1,
-            _ => flat.push(toks[k]),
-        }
-        k += 1;
-    }
-    let mut funcs: Vec<FuncAst> = Vec::new();
-    let mut outside_reported = false;
-    let mut dropped = false;
-    let mut mark = errors.len();
-    for line in scan::lines(&flat) {
+/// The Python file scanner, fed one logical line at a time ([`crate::lines`]: comments and
+/// `\` continuations already removed).
+#[derive(Default)]
+pub struct Scanner {
+    funcs: Vec<FuncAst>,
+    outside_reported: bool,
+    dropped: bool,
+    mark: usize,
+}
+
+impl LineScanner for Scanner {
+    const LANG: Language = Language::Python;
+
+    fn line(&mut self, src: &str, line: &[Spanned<'_>], errors: &mut Vec<FrontError>) {
         let first = line[0];
         let word = if let Tok::Ident(w) = first.1 { Some(w) } else { None };
         match word {
-            Some("import" | "from") => continue,
+            Some("import" | "from") => return,
             Some("def") => {
-                dropped = false;
-                mark = errors.len();
+                self.dropped = false;
+                self.mark = errors.len();
                 if let Some(f) = signature(line, errors) {
-                    funcs.push(f);
+                    self.funcs.push(f);
                 }
-                continue;
+                return;
             }
-            Some("pass") if line.len() == 1 => continue,
-            Some("return") if line.len() == 1 => continue,
+            Some("pass") if line.len() == 1 => return,
+            Some("return") if line.len() == 1 => return,
             Some(w) if scan::control_kind(w).is_some() || w == "return" => {
                 let what = scan::control_kind(w).unwrap_or("`return` with a value");
-                if !dropped {
+                if !self.dropped {
                     // The loop diagnostic alone tells why the file is rejected.
-                    errors.truncate(mark);
+                    errors.truncate(self.mark);
                     errors.push(scan::control_error(src, what, Span::new(first.0, first.2)));
+                    self.funcs.pop();
                 }
-                if !dropped {
-                    funcs.pop();
-                }
-                dropped = true;
-                continue;
+                self.dropped = true;
+                return;
             }
             _ => {}
         }
-        if dropped {
-            continue;
+        if self.dropped {
+            return;
         }
-        let Some(f) = funcs.last_mut() else {
-            if !outside_reported {
+        let Some(f) = self.funcs.last_mut() else {
+            if !self.outside_reported {
                 errors.push(scan::unexpected(&first, "`def name(M, c, s, tsim):` before statements"));
-                outside_reported = true;
+                self.outside_reported = true;
             }
-            continue;
+            return;
         };
         let stmt = match line {
             [rest @ .., (_, Tok::Semi, _)] => rest,
@@ -75,7 +72,10 @@ pub fn scan(src: &str, toks: &[Spanned<'_>], errors: &mut Vec<FrontError>) -> Ve
         scan::file_statement(stmt, f, errors);
         f.span = f.span.to(Span::new(line[0].0, line[line.len() - 1].2));
     }
-    funcs
+
+    fn funcs(&mut self) -> &mut Vec<FuncAst> {
+        &mut self.funcs
+    }
 }
 
 /// `def name(a, b, s, tsim):`

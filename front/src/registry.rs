@@ -15,10 +15,10 @@ use std::path::Path;
 
 use robovec_ir::Module;
 
-use super::{parse_text, FrontError, Language};
+use super::{parse_text_until, FrontError, Language};
 
 /// What a front end may be asked beyond the text (command-line options that concern loading).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrontOptions {
     /// `--fold-params`: fold the model's numeric parameters into the equations instead of
     /// keeping them as inputs (`dpt`, `l`, `m`, `In`). Front ends whose input has no numeric
@@ -28,6 +28,14 @@ pub struct FrontOptions {
     /// `R1`–`R3` before the root link, `q[1..6]`; see `robovec_dynamics::robot::Robot::with_floating_base`).
     /// Front ends of fixed equations (Robotran files, IR) ignore it.
     pub floating_base: bool,
+    /// `-function=NAME`: the functions the run will use; `None`: all. A front end that builds
+    /// its functions (the URDF's generator) builds only these (issue 28: `-function=invdyna`
+    /// does not build `dirdyna`); front ends that read their functions ignore it.
+    pub functions: Option<Vec<String>>,
+    /// `-time-limit`: the run's deadline, started before loading. Front ends check it in their
+    /// long loops (statements read, bodies generated) and, once it is reached, fail with one
+    /// error saying where they stopped (see [`FrontEnd::load`]).
+    pub deadline: Option<robovec_passes::Deadline>,
 }
 
 /// A loaded input: the module, and the values of the model parameters it keeps as inputs.
@@ -60,8 +68,18 @@ pub trait FrontEnd: Sync {
     ///
     /// # Errors
     /// Every problem found, with byte spans into `text` (the driver renders them as
-    /// `file:line:col` diagnostics and exits 1).
+    /// `file:line:col` diagnostics and exits 1). Once `opts.deadline` is reached: one error,
+    /// `time limit of 5 s reached while reading (line N of M)` spanning the line reached, or
+    /// `… while generating @dirdyna (body k of n)` at that body's joint; nothing is returned,
+    /// since no pass can run on part of a module.
     fn load(&self, path: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>>;
+
+    /// The names of the functions this front end builds whatever its input (the URDF's
+    /// `invdyna`, `dirdyna`), so that a `-function` naming none of them is refused before any
+    /// work; `None` (the default) for front ends whose functions are the input's.
+    fn function_names(&self) -> Option<&'static [&'static str]> {
+        None
+    }
 
     /// The message when the input holds no function (`expected at least one function`).
     fn no_function_message(&self) -> &'static str {
@@ -89,12 +107,12 @@ impl FrontEnd for Robotran {
         }
     }
 
-    fn load(&self, path: &Path, text: &str, _: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
+    fn load(&self, path: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
         let header = match self.0 {
             Language::C if path.extension().is_some_and(|e| e == "c") => std::fs::read(path.with_extension("h")).ok(),
             _ => None,
         };
-        parse_text(self.0, text, header.as_deref()).map(Loaded::from)
+        parse_text_until(self.0, text, header.as_deref(), opts.deadline.as_ref()).map(Loaded::from)
     }
 }
 

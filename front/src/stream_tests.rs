@@ -2,19 +2,20 @@
 //! batch path ([`super::c::scan`] then [`super::lower::lower_module`]), and leaves the files it
 //! does not cover (errors, `switch`, late declarations) to the batch path.
 
+use super::clock::Clock;
 use super::synth::{straight_line_c, Shape};
 use super::{c, lexer, lower, Language};
 
 fn batch(src: &str) -> (robovec_ir::Module, usize) {
     let toks = lexer::lex_where(src, |t| !c::ignored(t));
     let mut errors = Vec::new();
-    let funcs = c::scan(src, &toks, None, &mut errors);
-    let m = lower::lower_module(src, Language::C, &funcs, &mut errors);
+    let funcs = c::scan(src, &toks, None, &mut errors, &Clock::default());
+    let m = lower::lower_module(src, Language::C, &funcs, &mut errors, &Clock::default());
     (m, errors.len())
 }
 
 fn streamed(src: &str) -> Option<robovec_ir::Module> {
-    c::scan_and_lower(src, None)
+    c::scan_and_lower(src, None, &Clock::default())
 }
 
 #[test]
@@ -70,10 +71,10 @@ fn streaming_equals_batch_on_every_corpus_c_file() {
         let name = p.file_name().and_then(|n| n.to_str()).unwrap_or_default();
         let toks = lexer::lex_where(&text, |t| !c::ignored(t));
         let mut errors = Vec::new();
-        let funcs = c::scan(&text, &toks, header.as_deref(), &mut errors);
-        let batch = lower::lower_module(&text, Language::C, &funcs, &mut errors);
+        let funcs = c::scan(&text, &toks, header.as_deref(), &mut errors, &Clock::default());
+        let batch = lower::lower_module(&text, Language::C, &funcs, &mut errors, &Clock::default());
         let straight = !name.contains("accelred") && !name.contains("invdynared") && !name.contains("sensor");
-        match c::scan_and_lower(&text, header.as_deref()) {
+        match c::scan_and_lower(&text, header.as_deref(), &Clock::default()) {
             Some(s) => {
                 assert!(errors.is_empty(), "{name}: streamed although the batch path reports {}", errors[0].message);
                 assert_eq!(s, batch, "{name}: the streaming path gives another module");
@@ -97,7 +98,7 @@ fn state_that_spans_windows_is_kept() {
     assert_eq!(streamed(&ret), None);
     let toks = lexer::lex_where(&ret, |t| !c::ignored(t));
     let mut errors = Vec::new();
-    c::scan(&ret, &toks, None, &mut errors);
+    c::scan(&ret, &toks, None, &mut errors, &Clock::default());
     assert!(errors.iter().any(|e| e.message.contains("unreachable statement after `return;`")));
     // A `switch` in the last window: left to the batch path.
     let sw = format!("{}  switch (isens) {{\n  case 1:\n    c[1] = T1;\n    break;\n  }}\n}}\n", &g.text[..body_end]);

@@ -12,7 +12,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
     let fe = front_end_for("robot.urdf").expect("the URDF front end is registered");
     for (fold_params, floating_base) in [(false, false), (true, false), (false, true)] {
-        let opts = FrontOptions { fold_params, floating_base };
+        let opts = FrontOptions { fold_params, floating_base, ..FrontOptions::default() };
         let Ok(loaded) = fe.load(Path::new("robot.urdf"), text, &opts) else { return };
         if let Err(e) = check_accepted(&loaded.module) {
             panic!("{e}");

@@ -189,6 +189,15 @@ impl Function {
         &mut self.values[v.index()]
     }
 
+    /// Reserves room for `values` more values, `body` of them definitions, so that a pass that
+    /// knows its output's size builds it without growing (a growing vector holds up to twice
+    /// its values, and copies them, at each doubling; issue 28 item 4).
+    pub fn reserve(&mut self, values: usize, body: usize) {
+        self.values.reserve_exact(values);
+        self.body.reserve_exact(body);
+        self.names.0.reserve(values, |&x| self.values.get(x.index()).map_or(0, |d| name_hash(&d.name)));
+    }
+
     /// The value named `name` (without `%`).
     pub fn lookup(&self, name: &str) -> Option<Value> {
         self.names.get(&self.values, name)
@@ -334,27 +343,30 @@ impl Function {
     /// rewriting every reference; `keep` is asked about inputs too. `retain(|_, _| true)`
     /// renumbers into the canonical order (inputs, then body) that the text reader produces.
     ///
-    /// The caller guarantees that no kept value refers to a dropped one.
+    /// The caller guarantees that no kept value refers to a dropped one. The kept values are
+    /// moved, not copied (issue 28: copying every expression doubled the peak memory of the
+    /// URDF generator, which compacts each function it writes).
     pub fn retain(&mut self, mut keep: impl FnMut(&Function, Value) -> bool) {
         let n = self.values.len();
         let mut map: Vec<Option<Value>> = vec![None; n];
-        let mut new_values = Vec::new();
         let order: Vec<Value> = self.inputs.iter().chain(self.body.iter()).copied().collect();
+        let kept: Vec<Value> = order.into_iter().filter(|&v| keep(self, v)).collect();
+        let mut new_values = Vec::with_capacity(kept.len());
+        let mut slots: Vec<Option<ValueData>> = std::mem::take(&mut self.values).into_iter().map(Some).collect();
         let mut new_inputs = Vec::new();
         let mut new_body = Vec::new();
-        for v in order {
-            if !keep(self, v) {
-                continue;
-            }
+        for v in kept {
             let nv = Value::with_number(new_values.len() as u32);
             map[v.index()] = Some(nv);
-            new_values.push(self.values[v.index()].clone());
-            if matches!(self.values[v.index()].def, Def::Input) {
+            let d = slots[v.index()].take().expect("inputs and body name each value once");
+            if matches!(d.def, Def::Input) {
                 new_inputs.push(nv);
             } else {
                 new_body.push(nv);
             }
+            new_values.push(d);
         }
+        drop(slots);
         let remap = |v: Value| map[v.index()].expect("kept value refers to a dropped value");
         for d in &mut new_values {
             d.def.map_values(&remap);

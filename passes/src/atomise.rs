@@ -20,7 +20,7 @@
 //! value; the op counts equal `robovec_ir::count::count_expr` of the source expressions.
 //! Cost: O(expression nodes).
 
-use robovec_ir::count::neg_folds;
+use robovec_ir::count::{count_expr, neg_folds, OpCounts};
 use std::borrow::Cow;
 
 use robovec_ir::{BinOp, Def, Expr, Function, Module, Operand, Phase, Span, Value, ValueData};
@@ -84,6 +84,20 @@ fn atomise(mut src: Cow<'_, Function>) -> Function {
     out.equations = src.equations;
     out.span = src.span;
     let mut map: Vec<Operand> = vec![Operand::Const(f64::NAN); src.values.len()];
+    // The atomised function's exact size (SPEC §3's count of each equation), reserved at once.
+    let defs: usize = src
+        .body
+        .iter()
+        .map(|&v| match &src.values[v.index()].def {
+            Def::Expr(e) => {
+                let mut c = OpCounts::default();
+                count_expr(e, &mut c);
+                c.total as usize
+            }
+            _ => 1,
+        })
+        .sum();
+    out.reserve(src.inputs.len() + defs, defs);
     for i in 0..src.inputs.len() {
         let v = src.inputs[i];
         let (name, _, span) = take(&mut src, v);

@@ -1,6 +1,6 @@
 //! `robovec-gen`: robots robovec builds itself, written as URDF or as Robotran C (issue 14).
 //!
-//! `robovec-gen --topology serial|semi-serial|parallel --dof N [--seed S] [-o FILE.urdf]` writes
+//! `robovec-gen --topology serial|semi-serial|parallel|star --dof N [--seed S] [-o FILE.urdf]` writes
 //! one model of the study's topology families (`robovec_dynamics::topology`, seed §3.2 Table 3.1)
 //! as a URDF (`robovec_dynamics::urdf_out`: numbers round-trip exact), to stdout without `-o`.
 //! `robovec-opt FILE.urdf -function=dirdyna -passes=…` then runs any pipeline on its equations
@@ -36,8 +36,9 @@ use robovec_dynamics::topology::Topology;
     about = "Write a robot (a topology family or a URDF) as URDF or as Robotran C, or run the study"
 )]
 struct Args {
-    /// Topology family: serial (one chain), semi-serial (a few medium chains) or parallel (many
-    /// short chains from the base). With --study: a comma-separated list (default all three).
+    /// Topology family: serial (one chain), semi-serial (a few medium chains), parallel (many
+    /// short chains from the base) or star (one joint per branch, not a study family). With
+    /// --study: a comma-separated list (default serial, semi-serial, parallel).
     #[arg(long, value_delimiter = ',', required_unless_present_any = ["study", "urdf"], conflicts_with = "urdf")]
     topology: Vec<Topology>,
     /// Degrees of freedom (revolute joints), at least 1. With --study: a comma-separated list
@@ -138,7 +139,13 @@ fn study(args: &Args) -> ExitCode {
     }
 }
 
+/// mimalloc, as in `robovec-opt` ([`robovec::allocator`]): the study runs every case's passes in
+/// this process.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() -> ExitCode {
+    robovec::allocator::configure();
     let args = Args::parse();
     if args.study.study {
         return study(&args);

@@ -182,7 +182,7 @@ pub fn all(results: &[CaseResult]) -> Result<Vec<Figure>> {
         let stroke = match r.case.topology {
             Topology::Serial => Stroke::Solid,
             Topology::SemiSerial => Stroke::Dashed,
-            Topology::Parallel => Stroke::Thin,
+            Topology::Parallel | Topology::Star => Stroke::Thin,
         };
         let points = r.placed.iter().map(|p| ((p.n.max(1) as f64).log2(), p.cycles as f64)).collect();
         for p in &r.placed {

@@ -9,6 +9,7 @@ use super::tree::Tree;
 use crate::rnea::{cross, dot, matvec, vadd, M3, V3};
 use crate::robot::JointKind;
 use crate::sym::{mul, sum, Builder, Term};
+use crate::Stopped;
 
 /// `M[i][j]` (1-based) bound as the temporary `M{i}_{j}` where it is formed: both ways of
 /// forming `M` bind each entry as soon as it is known, so nothing it reads stays live until
@@ -92,19 +93,23 @@ impl Tree<'_> {
     /// body `col.at` (or, in the root segment, every entry above by projection) and carries
     /// the force into the parent's frame, bound as `FM`, `CM` (per body and column). `false`
     /// when the column is complete.
+    ///
+    /// # Errors
+    /// [`Stopped`] at the builder's deadline (checked at every step).
     pub(super) fn step(
         &self,
         b: &mut Builder,
         projections: &mut FxHashMap<(usize, usize), V3>,
         col: &mut Carry,
         upper: &mut Vec<((usize, usize), Term)>,
-    ) -> bool {
+    ) -> Result<bool, Stopped> {
         let Carry { qj, at, .. } = *col;
+        b.check(at, self.order.len())?;
         if self.in_segment[at] && self.segment_moving[at] >= 2 {
             for (qi, t) in self.projection(b, projections, at, &col.n, &col.f) {
                 upper.push(((qi, qj), bind_entry(b, qi, qj, t)));
             }
-            return false;
+            return Ok(false);
         }
         if let Some(qi) = self.layout.q_index[at - 1] {
             let jo = &self.robot.joints[self.order[at - 1]];
@@ -113,7 +118,7 @@ impl Tree<'_> {
         }
         let p = self.parent[at];
         if !self.moves[p] {
-            return false;
+            return Ok(false);
         }
         // Into the parent's frame: the joint motion, then the joint origin (merged into one
         // rotation where `merged_rotation` chose to).
@@ -135,26 +140,30 @@ impl Tree<'_> {
         col.n = column_bind(b, "CM", p, qj, n2);
         col.f = f2;
         col.at = p;
-        true
+        Ok(true)
     }
 
     /// Carries every column of `cols` to its end, one step of each in turn, and empties it.
+    ///
+    /// # Errors
+    /// [`Stopped`] at the builder's deadline.
     pub(super) fn finish(
         &self,
         b: &mut Builder,
         projections: &mut FxHashMap<(usize, usize), V3>,
         cols: &mut Vec<Carry>,
         upper: &mut Vec<((usize, usize), Term)>,
-    ) {
+    ) -> Result<(), Stopped> {
         let mut going = vec![true; cols.len()];
         while going.iter().any(|&g| g) {
             for (g, col) in going.iter_mut().zip(cols.iter_mut()) {
                 if *g {
-                    *g = self.step(b, projections, col, upper);
+                    *g = self.step(b, projections, col, upper)?;
                 }
             }
         }
         cols.clear();
+        Ok(())
     }
 
     /// The entries `(i, t)` of a column whose force `(n, f)` (moment about the origin of body

@@ -10,7 +10,7 @@ const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 
 
 /// A composite rigid body in one frame: mass, first moment and rotational inertia about the
 /// frame origin (see the module doc).
-#[derive(Clone)]
+#[derive(Clone, Default)]
 pub(super) struct Composite {
     pub(super) m: Term,
     pub(super) h: V3,
@@ -41,9 +41,19 @@ impl Composite {
         Composite { h: l.map(|x| mul(m.clone(), x)), m, j }
     }
 
-    pub(super) fn add(&self, o: &Composite) -> Composite {
-        let j: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| add(self.j[r][c].clone(), o.j[r][c].clone())));
-        Composite { m: add(self.m.clone(), o.m.clone()), h: vadd(&self.h, &o.h), j }
+    /// `self + o`, taking both: no copy of `self`, which as a link's composite grows by one
+    /// child at a time (a copy per child would cost the square of its children).
+    pub(super) fn add(self, o: Composite) -> Composite {
+        let Composite { m, h, j } = self;
+        let [h0, h1, h2] = h;
+        let [o0, o1, o2] = o.h;
+        let mut j = j;
+        for (row, orow) in j.iter_mut().zip(o.j) {
+            for (x, y) in row.iter_mut().zip(orow) {
+                *x = add(std::mem::take(x), y);
+            }
+        }
+        Composite { m: add(m, o.m), h: [add(h0, o0), add(h1, o1), add(h2, o2)], j }
     }
 
     /// Rotated by `r` (child → parent), then shifted by `t` (the child origin in the parent).
@@ -91,10 +101,11 @@ impl Composite {
         Composite { m: self.m.clone(), h, j: out }
     }
 
-    /// Every entry bound as a temporary: `MC{body}`, `HC{k}{body}`, `JC{r}{c}{body}`.
-    pub(super) fn bind(&self, b: &mut Builder, body: usize) -> Composite {
+    /// Every entry bound as a temporary: `MC{body}`, `HC{k}{body}`, `JC{r}{c}{body}` (`body`
+    /// is any tag: `12`, or `12_3` for the third partial sum of body 12's children).
+    pub(super) fn bind(&self, b: &mut Builder, body: impl std::fmt::Display) -> Composite {
         let m = b.bind(&format!("MC{body}"), self.m.clone());
-        let h = bind3(b, "HC", body, self.h.clone());
+        let h = bind3(b, "HC", &body, self.h.clone());
         let mut j: M3 = Default::default();
         for (a, c) in UPPER {
             j[a][c] = b.bind(&format!("JC{}{}{body}", a + 1, c + 1), self.j[a][c].clone());

@@ -82,21 +82,30 @@ mod composite;
 mod tests;
 mod tree;
 
-use super::rnea::{numeric, Motion, M3, V3};
+use super::rnea::{numeric, Motion, M3, SUM_CHUNK, V3};
 use super::sym::{Builder, Term};
-use super::{Layout, Model};
+use super::{Layout, Model, Stopped};
 pub(crate) use column::bind_entry;
 use column::merged_rotation;
 use composite::Composite;
 use rustc_hash::FxHashMap;
 use tree::Tree;
 
+/// Entries `((i, j), term)` of `M`'s upper triangle, `i ≤ j` (1-based coordinates).
+pub type Entries = Vec<((usize, usize), Term)>;
+
 /// The upper triangle of `M`: `(i, j) → term` for `i ≤ j` (1-based coordinates), entries that
 /// fold to 0 left out. Writes the composites and column forces into `b` as temporaries `MC`,
 /// `HC`, `JC` (per body) and `FM`, `CM` (per body and column), each column right after its
 /// body's composite, and every entry as `M{i}_{j}` where it is formed
 /// ([`bind_entry`]; module doc, "Order of the statements").
-pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]) -> Vec<((usize, usize), Term)> {
+///
+/// Cost: linear in the bodies and the ops written (each column step writes its entry's ops;
+/// no table of body pairs).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per body and per column step).
+pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]) -> Result<Entries, Stopped> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
     let nb = order.len();
@@ -131,15 +140,18 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
     let mut upper = Vec::new();
     // Each body alone, then leaves to root: the composite of its subtree, then its column.
     let mut comp: Vec<Composite> = vec![Composite::zero(); nb + 1];
+    // Children added to each composite (bound every `SUM_CHUNK`: `rnea::SUM_CHUNK`).
+    let mut children = vec![0usize; nb + 1];
     let mut pending: Vec<column::Carry> = Vec::new();
     for body in (1..=nb).rev() {
         if !tree.moves[body] {
             continue;
         }
+        b.check(body, nb)?;
         let m = layout.param(b, &format!("m[{body}]"));
         let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
         let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
-        let c = Composite::body(m, l, inn).add(&comp[body]).bind(b, body);
+        let c = Composite::body(m, l, inn).add(std::mem::take(&mut comp[body])).bind(b, body);
         let p = tree.parent[body];
         if tree.moves[p] {
             let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
@@ -151,7 +163,12 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
                     turned.moved(b, &format!("O{body}"), Some(&tree.ro[body]), Some(&d))
                 }
             };
-            comp[p] = comp[p].add(&in_parent);
+            // In place: a link's composite grows by one child at a time.
+            comp[p] = std::mem::take(&mut comp[p]).add(in_parent);
+            children[p] += 1;
+            if children[p].is_multiple_of(SUM_CHUNK) {
+                comp[p] = comp[p].bind(b, format_args!("{p}_{}", children[p] / SUM_CHUNK));
+            }
         }
         if let Some(qj) = layout.q_index[body - 1] {
             // A column waiting for this body's (its child's, one step up already) goes up with it:
@@ -159,13 +176,13 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
             debug_assert!(pending.iter().all(|o| o.at() == body), "a waiting column is at its parent");
             pending.push(tree.start(body, qj, &c));
             if pending.len() == 1 && waits[body] {
-                tree.step(b, &mut projections, &mut pending[0], &mut upper);
+                tree.step(b, &mut projections, &mut pending[0], &mut upper)?;
             } else {
-                tree.finish(b, &mut projections, &mut pending, &mut upper);
+                tree.finish(b, &mut projections, &mut pending, &mut upper)?;
             }
         }
         comp[body] = c;
     }
     debug_assert!(pending.is_empty(), "the root waits for no column");
-    upper
+    Ok(upper)
 }

@@ -20,6 +20,7 @@ use logos::Logos;
 use robovec_ir::Span;
 
 use super::super::ast::FuncAst;
+use super::super::clock::Clock;
 use super::super::error::FrontError;
 use super::super::lexer::{Spanned, Tok};
 use super::super::lower::Lower;
@@ -50,12 +51,20 @@ pub(super) struct Stream<'s> {
 /// the file has any error or a form the streaming path leaves to the batch path
 /// ([`super::scan`] then [`super::super::lower::lower_module`]), whose diagnostics are the
 /// reference.
-pub fn scan_and_lower(src: &str, header: Option<&str>) -> Option<robovec_ir::Module> {
-    let toks = outline(src)?;
+///
+/// Stops at `clock`'s deadline (one tick per token lexed and per statement), returning `None`:
+/// the caller asks the clock before taking the batch path.
+pub fn scan_and_lower(src: &str, header: Option<&str>, clock: &Clock) -> Option<robovec_ir::Module> {
+    let toks = outline(src, clock)?;
     let mut errors = Vec::new();
     let mut streamed = Streamed::default();
-    let funcs = scan_impl(src, &toks, header, &mut errors, Some(&mut streamed));
-    if !errors.is_empty() || streamed.broken || funcs.is_empty() || funcs.len() != streamed.functions.len() {
+    let funcs = scan_impl(src, &toks, header, &mut errors, Some(&mut streamed), clock);
+    if clock.stopped()
+        || !errors.is_empty()
+        || streamed.broken
+        || funcs.is_empty()
+        || funcs.len() != streamed.functions.len()
+    {
         return None;
     }
     let mut m = robovec_ir::Module::default();
@@ -72,10 +81,13 @@ pub fn scan_and_lower(src: &str, header: Option<&str>) -> Option<robovec_ir::Mod
 /// `{ … }` left out (the braces stay). `None` for unbalanced braces or a brace inside a
 /// top-level parenthesis, where the file scanner's bracket matching on the outline could
 /// differ from the one on every token.
-fn outline(src: &str) -> Option<Vec<Spanned<'_>>> {
+fn outline<'s>(src: &'s str, clock: &Clock) -> Option<Vec<Spanned<'s>>> {
     let mut out = Vec::new();
     let (mut braces, mut parens) = (0usize, 0usize);
     for (t, r) in Tok::lexer(src).spanned() {
+        if clock.tick(r.start) {
+            return None;
+        }
         let t = t.unwrap_or(Tok::Error);
         if ignored(&t) {
             continue;
@@ -107,6 +119,7 @@ pub(super) fn body_in_windows<'s>(
     f: &mut FuncAst,
     errors: &mut Vec<FrontError>,
     stream: &mut Stream<'s>,
+    clock: &Clock,
 ) -> bool {
     let text = &src[start..end];
     let mut toks = Tok::lexer(text)
@@ -126,10 +139,10 @@ pub(super) fn body_in_windows<'s>(
             }
         }
         // A window that is not the last ends with `;`: its end position is never read.
-        if !body(src, &window, end, f, errors, Some(&mut *stream), &mut returned) {
+        if !body(src, &window, end, f, errors, Some(&mut *stream), &mut returned, clock) {
             return false;
         }
-        if last || !errors.is_empty() || f.cases.is_some() {
+        if last || !errors.is_empty() || f.cases.is_some() || clock.stopped() {
             return true;
         }
     }

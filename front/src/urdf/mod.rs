@@ -7,6 +7,13 @@
 //! like on a Robotran file. `--fold-params` folds the URDF's numbers into the equations;
 //! by default they stay inputs in Robotran's layout and their values are
 //! [`Loaded::params`](crate::Loaded::params) (written by `-params-out=FILE`).
+//!
+//! Only the functions `-function` names are generated ([`FrontOptions::functions`]; issue 28:
+//! `-function=invdyna` on a 4,000-branch star no longer writes `dirdyna`'s 16 million
+//! entries of `M`). `-time-limit` is checked per body of the generator's recursions
+//! ([`robovec_dynamics::Request::deadline`]); once it is reached the load fails with
+//! `time limit of 5 s reached while generating @dirdyna (body k of n)` at that body's
+//! `<joint>` and no output is written: no pass can run on part of a function.
 
 mod parse;
 
@@ -30,6 +37,10 @@ impl FrontEnd for Urdf {
         &["urdf"]
     }
 
+    fn function_names(&self) -> Option<&'static [&'static str]> {
+        Some(&robovec_dynamics::FUNCTION_NAMES)
+    }
+
     fn load(&self, _: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
         let robot = parse(text).map_err(|e| vec![e])?;
         if !robot.joints.iter().any(|j| j.kind != JointKind::Fixed) {
@@ -48,7 +59,26 @@ impl FrontEnd for Urdf {
         } else {
             robot
         };
-        let g = robovec_dynamics::generate(&robovec_dynamics::Model { robot }, opts.fold_params);
+        let request = robovec_dynamics::Request {
+            fold: opts.fold_params,
+            functions: opts.functions.clone(),
+            deadline: opts.deadline,
+        };
+        let model = robovec_dynamics::Model { robot };
+        let g = robovec_dynamics::generate_with(&model, &request).map_err(|stop| {
+            // The joint of the body reached (the root link for a row of M's outputs).
+            let order = model.robot.dfs_joints();
+            let joint = match stop.at {
+                robovec_dynamics::Reached::Body { body, .. } => body.checked_sub(1).and_then(|k| order.get(k)),
+                robovec_dynamics::Reached::Row { .. } => None,
+            };
+            let span = match joint {
+                Some(&j) => model.robot.joints[j].span,
+                None => model.robot.links[model.robot.root].span,
+            };
+            vec![FrontError::new(span, stop.to_string(), "reached here")
+                .note("-time-limit covers loading too: nothing is written without a complete module")]
+        })?;
         Ok(Loaded { module: g.module, params: g.params })
     }
 }
