@@ -1,9 +1,15 @@
 //! Speed of the generated C against Robotran's own C (issue 11, "Fast, measured side by side").
 //!
-//! `cargo bench --bench codegen_c -- [MODEL…] [--flags=o2|native|both] [--reps=N] [--runs=K] [--quick] [--core]`
+//! `cargo bench --bench codegen_c -- [MODEL…] [--flags=o2|native|both] [--reps=N] [--runs=K] [--quick] [--core]
+//! [--split[=OPS,OPS…]]`
 //!
 //! `--quick`: no `trig=libm` batches, 20 accuracy samples; `--core`: only the variants of the
 //! issue's goals (`atomise`, `atomise[,cse],schedule-cpu`, 8 × f64 and 16 × f32 with `trig=input`).
+//! `--split`: split code against unsplit instead (issue 28, item 5): `atomise` and `atomise,cse`
+//! one state and `atomise,cse,schedule-cpu` 8 × f64 `trig=input`, each with `chunk=0` (one
+//! function) and with `chunk=OPS` for each OPS given (default: the back end's default), and
+//! the paired ratio of each split variant against its `chunk=0` twin (unsplit ns / split ns in
+//! the same rep: > 1 means the split code is faster).
 //!
 //! For each model (a corpus `dirdyna`/`invdyna` C file, named by its prefix: `m454` (default),
 //! `coman_longarms`, `jeep`, `walkman`, `tricycle`, `frank_segway`, `coman_longarms:invdyna`), it
@@ -54,6 +60,10 @@ struct Variant {
     batch: u32,
     /// `input` or `libm`.
     trig: &'static str,
+    /// `chunk=` (`None`: the back end's default).
+    chunk: Option<u32>,
+    /// The variant (index) this one is paired against: its `chunk=0` twin.
+    base: Option<usize>,
 }
 
 fn variants(params_json: &Path, dce_outputs: &str, quick: bool, core: bool) -> Vec<Variant> {
@@ -63,6 +73,8 @@ fn variants(params_json: &Path, dce_outputs: &str, quick: bool, core: bool) -> V
         precision,
         batch,
         trig,
+        chunk: None,
+        base: None,
     };
     let sched = "atomise,schedule-cpu";
     let mut out = vec![
@@ -102,6 +114,31 @@ fn variants(params_json: &Path, dce_outputs: &str, quick: bool, core: bool) -> V
                 || l.ends_with("batch=16 f32 trig=input")
         };
         out.retain(|v| keep(&v.label));
+    }
+    out
+}
+
+/// `--split`: each pipeline unsplit (`chunk=0`) and split at each of `chunks`, paired.
+fn split_variants(chunks: &[u32]) -> Vec<Variant> {
+    let mut out = Vec::new();
+    for (pipeline, precision, batch, trig) in [
+        ("atomise", "f64", 1, "libm"),
+        ("atomise,cse", "f64", 1, "libm"),
+        ("atomise,cse,schedule-cpu", "f64", 8, "input"),
+    ] {
+        let what = if batch > 1 { format!("{pipeline} batch={batch} {precision} trig={trig}") } else { pipeline.into() };
+        let base = out.len();
+        for &chunk in std::iter::once(&0).chain(chunks) {
+            out.push(Variant {
+                label: format!("{what} chunk={chunk}"),
+                pipeline: pipeline.into(),
+                precision,
+                batch,
+                trig,
+                chunk: Some(chunk),
+                base: (chunk > 0).then_some(base),
+            });
+        }
     }
     out
 }
@@ -225,6 +262,9 @@ struct Row {
     ratio: f64,
     /// Smallest and largest of the runs' median paired ratios.
     ratio_range: (f64, f64),
+    /// Against the `chunk=0` twin: median over the runs of each run's median paired ratio
+    /// (twin's ns / this variant's ns), and its smallest and largest.
+    vs_unsplit: Option<(f64, f64, f64)>,
     error: String,
     check: String,
 }
@@ -234,6 +274,7 @@ fn bench_model(
     flag_sets: &[(&str, &str)],
     (reps, runs): (u32, u32),
     (quick, core): (bool, bool),
+    split: Option<&[u32]>,
     rows: &mut Vec<Row>,
 ) {
     let model = find_model(spec);
@@ -286,14 +327,21 @@ fn bench_model(
     let nout_robotran = if model.kind == "dirdyna" { ndof * ndof + ndof } else { ndof };
 
     // robovec's side: one C file per variant, and the error of each pipeline.
-    let vs = variants(&params_json, &dce_outputs, quick, core);
+    let vs = match split {
+        Some(chunks) => split_variants(chunks),
+        None => variants(&params_json, &dce_outputs, quick, core),
+    };
     let mut columns: Vec<String> = all_inputs.clone();
     let mut table = String::new();
     let mut errors: BTreeMap<(String, &str), String> = BTreeMap::new();
     let mut maps = Vec::new();
     for (i, v) in vs.iter().enumerate() {
         let rep = work.join(format!("rv{i}.json"));
-        let cg = format!("codegen<c;abi=plain;precision={};batch={};trig={};name=rv{i}>", v.precision, v.batch, v.trig);
+        let chunk = v.chunk.map_or(String::new(), |c| format!(";chunk={c}"));
+        let cg = format!(
+            "codegen<c;abi=plain;precision={};batch={};trig={};name=rv{i}{chunk}>",
+            v.precision, v.batch, v.trig
+        );
         let fresh = work.join(format!("rv{i}.new.c"));
         run(opt()
             .arg(&model.c_file)
@@ -402,10 +450,11 @@ fn bench_model(
             (format!("rv{i}"), "0".to_string())
         };
         entries.push(format!(
-            "  {{\"v{i}\", {f64p}, {f32p}, {}, {}, {}, in_map{i}, out_map{i}}},",
+            "  {{\"v{i}\", {f64p}, {f32p}, {}, {}, {}, in_map{i}, out_map{i}, {}}},",
             v.batch,
             ins.len(),
-            outs.len()
+            outs.len(),
+            v.base.map_or(-1, |b| b as i64)
         ));
     }
     let _ = writeln!(
@@ -459,6 +508,7 @@ fn bench_model(
         // (the host's load), so the table gives the median over processes.
         let mut checks = BTreeMap::new();
         let mut per_variant: BTreeMap<String, Vec<[f64; 6]>> = BTreeMap::new();
+        let mut pairs: BTreeMap<String, Vec<f64>> = BTreeMap::new();
         let mut order = Vec::new();
         for _ in 0..runs {
             let out = run(Command::new(&exe).arg(reps.to_string()));
@@ -468,6 +518,9 @@ fn bench_model(
                     ["check", v, n, same, worst] => {
                         checks
                             .insert(v.to_string(), format!("{same}/{n} bit-identical, max diff {worst} of max |out|"));
+                    }
+                    ["pair", v, _base, median, _, _] => {
+                        pairs.entry(v.to_string()).or_default().push(median.parse().unwrap());
                     }
                     ["time", v, rest @ ..] if rest.len() == 6 => {
                         let x: Vec<f64> = rest.iter().map(|t| t.parse().unwrap()).collect();
@@ -505,6 +558,11 @@ fn bench_model(
                     xs.iter().map(|x| x[3]).fold(f64::INFINITY, f64::min),
                     xs.iter().map(|x| x[3]).fold(0.0, f64::max),
                 ),
+                vs_unsplit: pairs.get(v).map(|xs| {
+                    let mut c = xs.clone();
+                    c.sort_by(f64::total_cmp);
+                    (c[c.len() / 2], c[0], c[c.len() - 1])
+                }),
                 error,
                 check: checks.get(v).cloned().unwrap_or_default(),
             });
@@ -519,6 +577,7 @@ fn main() {
     let mut runs = 5;
     let mut quick = false;
     let mut core = false;
+    let mut split: Option<Vec<u32>> = None;
     for a in std::env::args().skip(1) {
         if let Some(f) = a.strip_prefix("--flags=") {
             flags = f.into();
@@ -530,6 +589,10 @@ fn main() {
             quick = true;
         } else if a == "--core" {
             core = true;
+        } else if a == "--split" {
+            split = Some(vec![robovec_passes::codegen::c::DEFAULT_CHUNK]);
+        } else if let Some(list) = a.strip_prefix("--split=") {
+            split = Some(list.split(',').map(|x| x.parse().expect("--split=OPS,OPS…")).collect());
         } else if a == "--bench" || a.starts_with('-') {
             // cargo bench passes `--bench`; ignore other harness flags.
         } else {
@@ -548,14 +611,15 @@ fn main() {
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     let mut rows = Vec::new();
     for m in &models {
-        bench_model(m, &flag_sets, (reps, runs), (quick, core), &mut rows);
+        bench_model(m, &flag_sets, (reps, runs), (quick, core), split.as_deref(), &mut rows);
     }
     println!("load average before: {}", load.trim());
-    println!("| model | variant | flags | ns/state median (min–max) | vs Robotran: paired median over {runs} runs (min–max) | error bits mean / max | check vs Robotran (state 0) |");
-    println!("|---|---|---|---:|---:|---|---|");
+    println!("| model | variant | flags | ns/state median (min–max) | vs Robotran: paired median over {runs} runs (min–max) | vs chunk=0: paired median over {runs} runs (min–max) | error bits mean / max | check vs Robotran (state 0) |");
+    println!("|---|---|---|---:|---:|---:|---|---|");
     for r in &rows {
+        let vs = r.vs_unsplit.map_or(String::new(), |(m, lo, hi)| format!("{m:.3}× ({lo:.3}–{hi:.3})"));
         println!(
-            "| {} | {} | {} | {:.1} ({:.1}–{:.1}) | {:.2}× ({:.2}–{:.2}) | {} | {} |",
+            "| {} | {} | {} | {:.1} ({:.1}–{:.1}) | {:.2}× ({:.2}–{:.2}) | {vs} | {} | {} |",
             r.model,
             r.variant,
             r.flags,

@@ -286,6 +286,7 @@ fn run_passes(
         original: opts.check.map(|_| module.clone()),
         deadline,
         progress,
+        code_file: crate::preflight::code_file(opts, pm),
         ..PassContext::with_target(target)
     };
     if let Some(text) = &opts.pareto {
@@ -476,6 +477,9 @@ fn write_outputs(
                     if let Some(c) = crate::preflight::companion_path(p, ext) {
                         out.stage(&c, text.as_bytes()).map_err(output_failure)?;
                     }
+                }
+                for (k, text) in code.units.iter().enumerate() {
+                    out.stage(&robovec_passes::unit_path(p, k + 1), text.as_bytes()).map_err(output_failure)?;
                 }
             }
         }

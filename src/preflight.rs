@@ -25,10 +25,21 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
         )));
     }
     let output = opts.output.as_deref().filter(|p| p.as_os_str() != "-");
-    let companions: Vec<PathBuf> = match (output, pm.code_companions()) {
+    let units = pm.code_units();
+    let main = code_file(opts, pm);
+    if units > 1 && main.is_none() {
+        return Err(Failure::Usage(format!(
+            "error: the back end writes {units} translation units (`units={units}`) beside `-o FILE`: give -o a \
+             file path (not stdout or a device)\n"
+        )));
+    }
+    let mut companions: Vec<PathBuf> = match (output, pm.code_companions()) {
         (Some(o), Some(exts)) => exts.iter().filter_map(|e| companion_path(o, e)).collect(),
         _ => Vec::new(),
     };
+    if let Some(m) = &main {
+        companions.extend((1..units).map(|k| robovec_passes::unit_path(m, k)));
+    }
     let files: Vec<(&str, &Path)> = [
         ("-o", output),
         ("-report", opts.report.as_deref()),
@@ -90,6 +101,15 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// The file `-o` writes a back end's code to, when the pipeline ends in one and `-o` names a
+/// regular file or a path that does not exist yet (what names its companions and further
+/// translation units); `None` otherwise.
+pub fn code_file(opts: &Options, pm: &PassManager) -> Option<PathBuf> {
+    let o = opts.output.as_deref().filter(|p| p.as_os_str() != "-")?;
+    pm.code_companions()?;
+    companion_path(o, "h").map(|_| o.to_path_buf())
 }
 
 /// Where a back end's companion file with extension `ext` goes when the code goes to `output`

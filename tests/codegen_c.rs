@@ -19,6 +19,7 @@ use robovec_passes::{Instrumentation, PassContext, PassManager};
 
 use crate::common::{corpus_files, is_loop_file, tmp};
 
+mod split;
 mod trig;
 
 /// A module to test, with a label for messages.
@@ -228,6 +229,12 @@ fn check_plain_tol<T: Float>(
         let art = ok.emit(&case.m).unwrap_or_else(|e| panic!("{}: {e}", case.label));
         std::fs::write(dir.join(format!("t{k}.c")), &art.code.main).unwrap();
         files.push(format!("t{k}.c"));
+        // `units=K`: the further translation units, linked with the rest.
+        for (u, text) in art.code.units.iter().enumerate() {
+            let name = format!("t{k}_{}.c", u + 1);
+            std::fs::write(dir.join(&name), text).unwrap();
+            files.push(name);
+        }
         callback_uses(&case.m, &mut uses);
         for (f, iface) in case.m.functions.iter().zip(&art.interfaces) {
             let (ni, no) = (iface.inputs.len(), iface.outputs.len());

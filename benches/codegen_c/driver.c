@@ -9,7 +9,9 @@
  * Output: one check line per variant (outputs compared, bit-identical, largest difference relative
  * to the largest |output|), then one time line per variant: name, median, min, max ns/state, then
  * the median, first and third quartiles of the paired ratio (Robotran's ns over the variant's ns
- * per state, both from the same rep).
+ * per state, both from the same rep); then, for each variant with a base variant (`base` >= 0:
+ * the same code unsplit, `chunk=0`), one pair line: name, base name, median, first and third
+ * quartiles of the paired ratio base's ns over the variant's (> 1: the variant is faster).
  */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
@@ -31,6 +33,7 @@ typedef struct {
     int nin, nout;
     const int *in_map;  /* SETS column of each input */
     const int *out_map; /* Robotran output index of each output (-1: none) */
+    int base;           /* variant to pair against (-1: none) */
 } Variant;
 
 #if ROBOTRAN_KIND == 0
@@ -180,12 +183,27 @@ int main(int argc, char **argv) {
     double *ratio = malloc(sizeof(double) * nv * reps);
     for (int v = 0; v < nv; v++)
         for (int r = 0; r < reps; r++) ratio[v * reps + r] = samples[r] / samples[v * reps + r];
+    /* Against the base variant, in the same rep (before the samples are sorted). */
+    double *pair = malloc(sizeof(double) * nv * reps);
+    for (int v = 1; v < nv; v++) {
+        int b = VARIANTS[v - 1].base;
+        if (b < 0) continue;
+        for (int r = 0; r < reps; r++) pair[v * reps + r] = samples[(b + 1) * reps + r] / samples[v * reps + r];
+    }
     for (int v = 0; v < nv; v++) {
         double *s = samples + v * reps, *q = ratio + v * reps;
         qsort(s, reps, sizeof *s, cmp);
         qsort(q, reps, sizeof *q, cmp);
         printf("time\t%s\t%.2f\t%.2f\t%.2f\t%.3f\t%.3f\t%.3f\n", v == 0 ? "robotran" : VARIANTS[v - 1].name,
                s[reps / 2], s[0], s[reps - 1], q[reps / 2], q[reps / 4], q[3 * reps / 4]);
+    }
+    for (int v = 1; v < nv; v++) {
+        int b = VARIANTS[v - 1].base;
+        if (b < 0) continue;
+        double *q = pair + v * reps;
+        qsort(q, reps, sizeof *q, cmp);
+        printf("pair\t%s\t%s\t%.3f\t%.3f\t%.3f\n", VARIANTS[v - 1].name, VARIANTS[b].name, q[reps / 2], q[reps / 4],
+               q[3 * reps / 4]);
     }
     return sink == 12345.678 ? 1 : 0;
 }

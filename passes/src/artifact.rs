@@ -11,7 +11,7 @@
 //! pass and its output, and what LLVM's `opt` does with analysis printers.
 
 use std::fmt::Debug;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// How report entries with the same key, from several artifacts, combine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,6 +68,24 @@ pub struct GeneratedCode {
     /// Companion files: `(extension, text)`; with `-o model.c`, `("h", …)` goes to `model.h`.
     /// Not written when the code goes to stdout.
     pub companions: Vec<(&'static str, String)>,
+    /// Further translation units (`codegen<c;units=K>`, issue 28): unit `k` (1-based) goes to
+    /// [`unit_path`]`(FILE, k)`. Empty for one file; a back end with several units needs
+    /// `-o FILE` ([`crate::Pass::code_units`]).
+    pub units: Vec<String>,
+}
+
+/// Where translation unit `k` of generated code whose main file is `main` goes: `main` for 0,
+/// else `_k` before the extension (`model.c`, 2 → `model_2.c`; `dir/model` → `dir/model_2`).
+pub fn unit_path(main: &Path, k: usize) -> PathBuf {
+    if k == 0 {
+        return main.to_path_buf();
+    }
+    let stem = main.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let name = match main.extension() {
+        Some(e) => format!("{stem}_{k}.{}", e.to_string_lossy()),
+        None => format!("{stem}_{k}"),
+    };
+    main.with_file_name(name)
 }
 
 /// A typed result of a pass (see the module doc). Every method has a default that renders

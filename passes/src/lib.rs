@@ -36,7 +36,7 @@ use robovec_ir::verifier::VerifierError;
 use robovec_ir::{Module, Phase, Span};
 use robovec_machine::target::Target;
 
-pub use artifact::{Artifact, ArtifactFile, GeneratedCode, Merge, Produced, ReportEntry};
+pub use artifact::{unit_path, Artifact, ArtifactFile, GeneratedCode, Merge, Produced, ReportEntry};
 pub use manager::{DumpSink, Instrumentation, PassManager, PassRecord, PrintSelector};
 pub use params::{LatencyOverride, Member, ParamInfo, ParamKind, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
@@ -186,6 +186,10 @@ pub struct PassContext {
     pub original: Option<robovec_ir::Module>,
     /// What the passes produced, in the order they produced it (see [`crate::artifact`]).
     pub artifacts: Vec<Produced>,
+    /// The file `-o` writes a back end's code to (set by the driver; `None` for stdout or
+    /// outside `robovec-opt`): a back end that writes several files names them after it in
+    /// the code and the report (`codegen<c;units=K>`).
+    pub code_file: Option<std::path::PathBuf>,
     /// Index in the pipeline of the pass running now (set by the manager; `None` outside a
     /// pipeline), recorded with every artifact.
     pub pass_index: Option<usize>,
@@ -317,6 +321,13 @@ pub trait Pass: std::fmt::Debug {
     /// `-o FILE` instead of the IR, and the companions beside `FILE` (SPEC §8).
     fn code_companions(&self) -> Option<&'static [&'static str]> {
         None
+    }
+
+    /// For a back end: the translation units its code is written as (`codegen<c;units=K>`;
+    /// 1: the main file only). With more than one, `-o FILE` is required and unit `k` goes to
+    /// [`unit_path`]`(FILE, k)` ([`GeneratedCode::units`]).
+    fn code_units(&self) -> usize {
+        1
     }
 }
 

@@ -152,6 +152,12 @@ impl PassManager {
         self.passes.last().and_then(|(_, p)| p.code_companions())
     }
 
+    /// The translation units of the back end the pipeline ends in ([`Pass::code_units`]; 1
+    /// otherwise).
+    pub fn code_units(&self) -> usize {
+        self.passes.last().map_or(1, |(_, p)| p.code_units())
+    }
+
     /// Index of the last pipeline element (the one whose code `-o` writes).
     pub fn last_index(&self) -> Option<usize> {
         self.passes.len().checked_sub(1)

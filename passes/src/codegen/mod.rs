@@ -55,6 +55,16 @@ pub struct Interface {
     pub inputs: Vec<String>,
     /// Canonical output names, in result order.
     pub outputs: Vec<String>,
+    /// Functions the body is written as (`chunk=`, issue 28): 1, or the number of parts the
+    /// entry point calls.
+    pub parts: usize,
+    /// The C files to compile, main file first (`-o FILE` and, with `units=K`, its K − 1
+    /// further units); empty (and left out of the report) when the code goes to stdout.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sources: Vec<String>,
+    /// The header written beside the main file; absent when the code goes to stdout.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub header: Option<String>,
 }
 
 /// The inputs of `f` in argument order: the IR's inputs, then (with `trig_as_input`) every trig
@@ -155,7 +165,7 @@ mod tests {
         let e = build("codegen<frobnicate=1>").unwrap_err().to_string();
         assert_eq!(
             e,
-            "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, abi, precision, batch, trig, name)"
+            "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, abi, precision, batch, trig, name, chunk, units)"
         );
     }
 
@@ -163,12 +173,18 @@ mod tests {
     fn the_registry_declares_each_parameter_once_under_its_back_end() {
         let info = crate::pass_info("codegen").unwrap();
         let names: Vec<&str> = info.every_param().map(|p| p.name).collect();
-        assert_eq!(names, ["back-end", "abi", "precision", "batch", "trig", "name", "out", "format", "resources"]);
+        assert_eq!(
+            names,
+            ["back-end", "abi", "precision", "batch", "trig", "name", "chunk", "units", "out", "format", "resources"]
+        );
         let members: Vec<(&str, Vec<&str>)> =
             super::BACK_ENDS.iter().map(|m| (m.name, m.params.iter().map(|p| p.name).collect())).collect();
         assert_eq!(
             members,
-            [("c", vec!["abi", "precision", "batch", "trig", "name"]), ("fpga", vec!["out", "format", "resources"])]
+            [
+                ("c", vec!["abi", "precision", "batch", "trig", "name", "chunk", "units"]),
+                ("fpga", vec!["out", "format", "resources"])
+            ]
         );
         assert_eq!(info.param("format").map(|p| p.name), Some("format"));
     }

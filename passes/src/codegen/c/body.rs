@@ -1,6 +1,7 @@
 //! The statements of a function body, shared by both ABIs: one C statement per IR value, in
 //! the IR's order; user callbacks and the vector helpers of `batch=W`.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 
 use robovec_ir::{BinOp, Callee, Def, Function, Module, Operand, TrigFn, Value};
@@ -170,10 +171,71 @@ pub(crate) struct Body<'a> {
     pub names: &'a [String],
     /// `abi=robotran`: the statements of every user callback value (native signatures,
     /// [`super::native::statements`]); `None`: the adapter form of both ABIs' plain code.
-    pub native: Option<&'a std::collections::HashMap<usize, String>>,
+    pub native: Option<&'a super::native::Native>,
+    /// `trig=inline`: value index → (its partner, true when this value's statement computes
+    /// both); see [`fused_trig`].
+    fused: HashMap<usize, (Value, bool)>,
 }
 
-impl Body<'_> {
+impl<'a> Body<'a> {
+    /// The body writer of `f` under `o`, with the values' C names and (`abi=robotran`) the
+    /// native callback statements.
+    pub fn new(
+        o: &'a CodegenC,
+        f: &'a Function,
+        names: &'a [String],
+        native: Option<&'a super::native::Native>,
+    ) -> Body<'a> {
+        let fused = if o.trig == Trig::Inline { fused_trig(f) } else { HashMap::new() };
+        Body { o, f, names, native, fused }
+    }
+
+    /// The values that have a statement, in the order they are written, and for each whether
+    /// it is *attached* to the value before it. The order is the body's, except that a value
+    /// another value's statement computes (the second of a fused sin/cos pair with
+    /// `trig=inline`) or that reads another's native call (a later element of an `abi=robotran`
+    /// callback instance, [`super::native`]) is attached: it follows that value at once. Such a
+    /// value has the same operands as the one it follows, which come before both, so the order
+    /// stays topological. Trig values are left out with `trig=input` (they are inputs). A
+    /// function split into parts ([`super::split`]) is never cut before an attached value.
+    /// Linear in the body.
+    pub fn order(&self) -> (Vec<Value>, Vec<bool>) {
+        let mut followers: HashMap<usize, Vec<Value>> = HashMap::new();
+        let mut follows = vec![false; self.f.values.len()];
+        let leads = self
+            .fused
+            .iter()
+            .filter(|(_, &(_, leads))| !leads)
+            .map(|(&v, &(lead, _))| (v, lead))
+            .chain(self.native.iter().flat_map(|n| n.lead.iter().map(|(&v, &lead)| (v, lead))));
+        for (v, lead) in leads {
+            follows[v] = true;
+            followers.entry(lead.index()).or_default().push(Value::with_number(v as u32));
+        }
+        let position: HashMap<usize, usize> = if followers.is_empty() {
+            HashMap::new()
+        } else {
+            self.f.body.iter().enumerate().map(|(p, v)| (v.index(), p)).collect()
+        };
+        let mut order = Vec::with_capacity(self.f.body.len());
+        let mut attached = Vec::with_capacity(self.f.body.len());
+        for &v in &self.f.body {
+            if follows[v.index()] || (self.o.trig == Trig::Input && matches!(self.f.value(v).def, Def::Trig(..))) {
+                continue;
+            }
+            order.push(v);
+            attached.push(false);
+            if let Some(fs) = followers.get_mut(&v.index()) {
+                fs.sort_by_key(|w| position[&w.index()]);
+                for &w in fs.iter() {
+                    order.push(w);
+                    attached.push(true);
+                }
+            }
+        }
+        (order, attached)
+    }
+
     /// An operand as a C expression (a constant exact in the precision: [`literal::operand`]).
     pub fn operand(&self, x: &Operand) -> String {
         match x {
@@ -199,41 +261,15 @@ impl Body<'_> {
         }
     }
 
-    /// Every body value, one statement each, in the IR's order (trig values are skipped with
-    /// `trig=input`: they are inputs; with `trig=inline` the first of a `sin` and a `cos` of one
-    /// coordinate computes both, see [`Body::fused_trig`]).
-    pub fn statements(&self, s: &mut String) {
-        self.statements_with(s, &mut |_, _| {}, &mut |_, _| {});
-    }
-
-    /// `trig=inline`: for the first `sin` and the first `cos` of each coordinate that has both,
-    /// the index of the value that comes first → the other one (its statement computes both with
-    /// one reduction; the other's statement is empty).
-    fn fused_trig(&self) -> std::collections::HashMap<usize, Value> {
-        // The first sin and the first cos of each coordinate, in body order: when the second of
-        // the two appears, its partner is already here and comes first.
-        let mut first: std::collections::HashMap<(usize, bool), Value> = std::collections::HashMap::new();
-        let mut out = std::collections::HashMap::new();
-        for &v in &self.f.body {
-            let Def::Trig(t, a) = self.f.value(v).def else { continue };
-            let is_sin = t == TrigFn::Sin;
-            if first.contains_key(&(a.index(), is_sin)) {
-                continue;
-            }
-            first.insert((a.index(), is_sin), v);
-            if let Some(&lead) = first.get(&(a.index(), !is_sin)) {
-                out.insert(lead.index(), v);
-                out.insert(v.index(), lead);
-            }
-        }
-        out
-    }
-
-    /// [`Body::statements`], calling `before(s, v)` just before and `after(s, v)` just after the
-    /// statement of each value `v` that has one (the plain ABI reads inputs at their first use
-    /// and writes outputs as soon as they are computed).
+    /// The statements of `order` (a slice of [`Body::order`] that never starts with an
+    /// attached value), calling `before(s, v)` just before and `after(s, v)` just after the
+    /// statement of each value `v` (the plain ABI reads inputs at their first use and writes
+    /// outputs as soon as they are computed; a split function also reads and writes its live
+    /// values there). The statement of an attached trig value is empty: the value before it
+    /// declared both.
     pub fn statements_with(
         &self,
+        order: &[Value],
         s: &mut String,
         before: &mut dyn FnMut(&mut String, Value),
         after: &mut dyn FnMut(&mut String, Value),
@@ -241,22 +277,16 @@ impl Body<'_> {
         let ty = self.value_type();
         let vec = self.o.batch > 1;
         let sfx = if self.o.f32() { "f" } else { "" };
-        let fused = if self.o.trig == Trig::Inline { self.fused_trig() } else { Default::default() };
-        let mut done = vec![false; self.f.values.len()];
-        for &v in &self.f.body {
+        for &v in order {
             let name = &self.names[v.index()];
             let def = &self.f.value(v).def;
-            if self.o.trig == Trig::Input && matches!(def, Def::Trig(..)) {
-                continue;
-            }
             before(s, v);
             match def {
                 Def::Input | Def::Expr(_) => unreachable!("atomised bodies hold trig, binary ops and calls"),
-                Def::Trig(..) if done[v.index()] => {} // computed with its partner
+                Def::Trig(..) if self.fused.get(&v.index()).is_some_and(|&(_, leads)| !leads) => {} // with its partner
                 Def::Trig(t, a) if self.o.trig == Trig::Inline => {
                     let arg = &self.names[a.index()];
-                    if let Some(&other) = fused.get(&v.index()) {
-                        done[other.index()] = true;
+                    if let Some(&(other, _)) = self.fused.get(&v.index()) {
                         let other_name = &self.names[other.index()];
                         let (sin, cos) = if *t == TrigFn::Sin { (name, other_name) } else { (other_name, name) };
                         let _ = writeln!(s, "  {ty} {sin}, {cos};\n  robovec_sincos_inline({arg}, &{sin}, &{cos});");
@@ -310,7 +340,7 @@ impl Body<'_> {
                     let _ = writeln!(s, "  const {ty} {name} = {callee}({});", list.join(", "));
                 }
                 Def::Call(..) if self.native.is_some() => {
-                    s.push_str(&self.native.expect("checked")[&v.index()]);
+                    s.push_str(&self.native.expect("checked").statements[&v.index()]);
                 }
                 Def::Call(c, args) => {
                     let (base, idx) = split_callee(c).expect("checked by callbacks()");
@@ -339,4 +369,27 @@ impl Body<'_> {
             after(s, v);
         }
     }
+}
+
+/// `trig=inline`: for the first `sin` and the first `cos` of each coordinate that has both,
+/// value index → (the other one, true for the one that comes first in the body: its statement
+/// computes both with one reduction, the other's is empty, [`Body::order`] attaches it).
+fn fused_trig(f: &Function) -> HashMap<usize, (Value, bool)> {
+    // The first sin and the first cos of each coordinate, in body order: when the second of
+    // the two appears, its partner is already here and comes first.
+    let mut first: HashMap<(usize, bool), Value> = HashMap::new();
+    let mut out = HashMap::new();
+    for &v in &f.body {
+        let Def::Trig(t, a) = f.value(v).def else { continue };
+        let is_sin = t == TrigFn::Sin;
+        if first.contains_key(&(a.index(), is_sin)) {
+            continue;
+        }
+        first.insert((a.index(), is_sin), v);
+        if let Some(&lead) = first.get(&(a.index(), !is_sin)) {
+            out.insert(lead.index(), (v, true));
+            out.insert(v.index(), (lead, false));
+        }
+    }
+    out
 }

@@ -22,7 +22,12 @@ mod native;
 pub use body::split_callee;
 pub mod plain;
 pub mod robotran;
+mod split;
 pub mod trig;
+
+use std::collections::HashSet;
+use std::fmt::Write as _;
+use std::path::Path;
 
 use robovec_ir::{Callee, Def, Function, Module};
 
@@ -35,7 +40,7 @@ use crate::{GeneratedCode, Member, ParamInfo, Params, Pass, PassContext, PassErr
 pub const BACK_END: Member = Member {
     name: "c",
     doc: "C (SPEC §8); `-o FILE` gets the code and FILE.h its prototypes",
-    params: &[ABI, PRECISION, BATCH, TRIG, NAME],
+    params: &[ABI, PRECISION, BATCH, TRIG, NAME, CHUNK, UNITS],
     build: |p| Ok(Box::new(CodegenC::from_params(p)?)),
 };
 
@@ -71,6 +76,27 @@ pub const NAME: ParamInfo = ParamInfo {
     doc: "C: symbol of the function (a prefix `NAME_function` with several functions)",
 };
 
+/// The default of `chunk=`: statements per part (see the module doc for the measurements).
+pub const DEFAULT_CHUNK: u32 = 4000;
+
+/// `chunk=OPS`.
+pub const CHUNK: ParamInfo = ParamInfo {
+    name: "chunk",
+    kind: ParamKind::U32 { default: DEFAULT_CHUNK, min: 0, max: u32::MAX },
+    doc: "C: a function of more statements (ops) is written as a chain of parts of at most about this many, \
+          which its entry point calls with its live values in an array on its stack (same symbol and signature; \
+          GCC's time and memory per function grow faster than its size); `0`: one function",
+};
+
+/// `units=K`.
+pub const UNITS: ParamInfo = ParamInfo {
+    name: "units",
+    kind: ParamKind::U32 { default: 1, min: 1, max: 1024 },
+    doc: "C: translation units: `-o model.c` also writes `model_1.c` … `model_{K-1}.c` (parts of about equal size, \
+          listed in the header and the report's `codegen.sources`) to compile in parallel and link together; \
+          needs `-o FILE` and `chunk` > 0",
+};
+
 word_enum! {
     /// The signature of the generated functions (`abi=`).
     pub enum Abi {
@@ -104,6 +130,18 @@ word_enum! {
     }
 }
 
+/// Written at the top of every generated file: GCC 12's SLP vectoriser fuses a vector of
+/// products and an alternating subtract/add into `vfmaddsub`/`vfmsubadd` even under
+/// `-ffp-contract=off` (its `addsub` pattern, `tree-vect-slp-patterns.cc`, did not check the
+/// contraction mode; later GCC does), so on a target with FMA (`-march=native` here) the
+/// code is no longer bit-exact. Four statements suffice (`x1 = in[0]*in[2]; x2 = in[1]*in[3];
+/// out[0] = x1 - in[4]; out[1] = x2 + in[5];`); split code, whose live values sit side by side
+/// in `live[]`, met it on coman's `dirdyna` (23 of 682 outputs off by an ulp at `-O2
+/// -march=native`). For GCC 12 with FMA only, the file turns SLP vectorisation off.
+pub const SLP_GUARD: &str = "/* GCC 12 fuses a*b-c, d*e+f into vfmaddsub despite -ffp-contract=off (SLP addsub pattern): */\n\
+    #if defined(__GNUC__) && !defined(__clang__) && __GNUC__ == 12 && defined(__FMA__)\n\
+    #pragma GCC optimize (\"no-tree-slp-vectorize\")\n#endif\n";
+
 /// The C back end's options.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CodegenC {
@@ -117,12 +155,37 @@ pub struct CodegenC {
     pub trig: Trig,
     /// The symbol (or prefix, with several functions); `None`: from the function's name.
     pub name: Option<String>,
+    /// Statements (ops) per part of a split function (`chunk=`; 0: never split).
+    pub chunk: u32,
+    /// Translation units (`units=`; 1: one file).
+    pub units: u32,
 }
 
 impl Default for CodegenC {
     fn default() -> CodegenC {
-        CodegenC { abi: Abi::Plain, precision: Precision::F64, batch: 1, trig: Trig::Libm, name: None }
+        CodegenC {
+            abi: Abi::Plain,
+            precision: Precision::F64,
+            batch: 1,
+            trig: Trig::Libm,
+            name: None,
+            chunk: DEFAULT_CHUNK,
+            units: 1,
+        }
     }
+}
+
+/// One function as C ([`plain::function`], [`robotran::function`]).
+pub(crate) struct Emitted {
+    /// The definition under the function's symbol with its opening comment: the whole body, or
+    /// (split) the entry point that calls the parts.
+    pub entry: String,
+    /// The parts, in call order; empty when the function is not split.
+    pub parts: Vec<split::Part>,
+    /// Its declarations for the header.
+    pub proto: String,
+    /// Its interface (SPEC §8).
+    pub iface: Interface,
 }
 
 fn bad(message: String) -> PassError {
@@ -135,7 +198,8 @@ impl CodegenC {
     /// # Errors
     /// [`PassError::BadParameter`] for options that cannot go together (`abi=robotran` with
     /// `batch>1`, `precision=f32`, `trig=input` or `trig=inline`: Robotran's signature is one state of
-    /// `double`s that computes its own trig) and for a `name` that is not one C identifier.
+    /// `double`s that computes its own trig; `units>1` with `chunk=0`) and for a `name` that is
+    /// not one C identifier.
     pub fn from_params(p: &Params) -> Result<CodegenC, PassError> {
         let o = CodegenC {
             abi: p.word("abi")?,
@@ -143,7 +207,15 @@ impl CodegenC {
             batch: p.u32("batch")?,
             trig: p.word("trig")?,
             name: p.names("name")?.map(|n| n.join(",")),
+            chunk: p.u32("chunk")?,
+            units: p.u32("units")?,
         };
+        if o.units > 1 && o.chunk == 0 {
+            return Err(bad(format!(
+                "`units={}` spreads the parts of split functions over files; `chunk=0` makes no parts",
+                o.units
+            )));
+        }
         if let Some(n) = &o.name {
             if !is_c_identifier(n) {
                 return Err(bad(format!("parameter `name` must be one C identifier, found `{n}`")));
@@ -193,45 +265,133 @@ impl CodegenC {
         }
     }
 
-    /// The C file, its header and the interfaces, for every function of `m` (atomised).
+    /// The C file, its header and the interfaces, for every function of `m` (atomised), as
+    /// [`CodegenC::emit_as`] without a file name.
+    ///
+    /// # Errors
+    /// As [`CodegenC::emit_as`].
+    pub fn emit(&self, m: &Module) -> Result<CodegenArtifact, PassError> {
+        self.emit_as(m, None)
+    }
+
+    /// The C file, its header, the further translation units (`units=K`: K − 1 of them) and
+    /// the interfaces, for every function of `m` (atomised). `main`: where `-o` writes the C
+    /// file; it names the units (`model.c` → `model_1.c`, [`crate::unit_path`]) in the header
+    /// and in each interface's `sources` and `header` (the report's `codegen`); `None` (the
+    /// code goes to stdout, or a caller of the library) leaves them out.
     ///
     /// # Errors
     /// [`PassError::Failed`] when a function cannot be written in this ABI (an unknown
     /// Robotran function kind for `abi=robotran`, a callback used with two arities).
-    pub fn emit(&self, m: &Module) -> Result<CodegenArtifact, PassError> {
+    pub fn emit_as(&self, m: &Module, main: Option<&Path>) -> Result<CodegenArtifact, PassError> {
         let several = m.functions.len() > 1;
         let fused = m.functions.iter().any(has_fused);
-        let mut c = self.preamble(fused);
-        let mut h = String::new();
-        let mut interfaces = Vec::new();
         let callbacks = body::callbacks(m)?;
         let decls = if self.abi == Abi::Robotran {
-            c += "#include \"mbs_data.h\"\n\n";
             native::prototypes(m)?
         } else {
             body::callback_decls(&callbacks, self.real())
         };
-        c += &decls;
-        for f in &m.functions {
-            let symbol = self.symbol(f, several)?;
-            let (code, proto, iface) = if self.abi == Abi::Robotran {
-                robotran::function(self, f, &symbol)?
+        let symbols: Vec<String> = m.functions.iter().map(|f| self.symbol(f, several)).collect::<Result<_, _>>()?;
+        // The file's global names, which no part may take.
+        let taken: HashSet<String> = symbols.iter().cloned().chain(callbacks.iter().map(|k| k.base.clone())).collect();
+        let mut emitted = Vec::with_capacity(m.functions.len());
+        for (f, symbol) in m.functions.iter().zip(&symbols) {
+            emitted.push(if self.abi == Abi::Robotran {
+                robotran::function(self, f, symbol, &taken)?
             } else {
-                plain::function(self, f, &symbol)
-            };
-            c += &code;
-            h += &proto;
+                plain::function(self, f, symbol, &taken)
+            });
+        }
+        let units = self.units as usize;
+        let unit_of = unit_assignment(&emitted, units);
+        let file_names: Vec<String> = match main {
+            Some(p) => (0..units).map(|k| crate::unit_path(p, k).display().to_string()).collect(),
+            None => Vec::new(),
+        };
+        let header_name = main.map(|p| p.with_extension("h").display().to_string());
+        let base_name = |k: usize| -> String {
+            file_names.get(k).map_or(format!("unit {}", k + 1), |n| {
+                Path::new(n).file_name().map_or(n.clone(), |x| x.to_string_lossy().into_owned())
+            })
+        };
+        let split = emitted.iter().any(|e| !e.parts.is_empty());
+        let mut files: Vec<String> = (0..units)
+            .map(|k| {
+                let mut c = self.preamble(fused, split);
+                if units > 1 {
+                    let list: Vec<String> = (0..units).map(base_name).collect();
+                    let _ = write!(
+                        c,
+                        "/* Translation unit {} of {units} ({}): compile each, link all. */\n\n",
+                        k + 1,
+                        list.join(", ")
+                    );
+                }
+                if self.abi == Abi::Robotran {
+                    c += "#include \"mbs_data.h\"\n\n";
+                }
+                c += &decls;
+                c
+            })
+            .collect();
+        // The parts in other units are declared in the main file (it calls them) and in
+        // their own unit (before their definitions).
+        let mut externs = String::new();
+        for (e, units_of) in emitted.iter().zip(&unit_of) {
+            for (p, &u) in e.parts.iter().zip(units_of) {
+                if u > 0 {
+                    let _ = writeln!(externs, "{};", p.signature);
+                    let _ = writeln!(files[u], "{};", p.signature);
+                }
+            }
+        }
+        if !externs.is_empty() {
+            files[0] += "/* Parts defined in the other translation units. */\n";
+            files[0] += &externs;
+            files[0].push('\n');
+            for f in &mut files[1..] {
+                f.push('\n');
+            }
+        }
+        let mut h = String::new();
+        let mut interfaces = Vec::new();
+        for (e, units_of) in emitted.into_iter().zip(&unit_of) {
+            for (p, &u) in e.parts.iter().zip(units_of) {
+                let storage = if u == 0 { "static " } else { "" };
+                let _ = write!(files[u], "{storage}{}\n{}", p.signature, p.body);
+            }
+            files[0] += &e.entry;
+            h += &e.proto;
+            let mut iface = e.iface;
+            iface.parts = e.parts.len().max(1);
+            iface.sources.clone_from(&file_names);
+            iface.header.clone_from(&header_name);
             interfaces.push(iface);
         }
         if self.abi == Abi::Robotran {
             let (code, proto) =
                 robotran::sensor_dispatch(m, |f| self.symbol(f, several).expect("symbols checked above"));
-            c += &code;
+            files[0] += &code;
             h += &proto;
         }
-        let header = self.header(&h, &decls);
+        let guard = symbols
+            .first()
+            .map_or("ROBOVEC_GENERATED_H".to_string(), |s| format!("ROBOVEC_GENERATED_{}_H", s.to_uppercase()));
+        let units_note = if units > 1 {
+            let list: Vec<String> = (0..units).map(base_name).collect();
+            format!(
+                "/* The code is in {units} translation units: {}. Compile each (in parallel if you wish) and link \
+                 them all. */\n\n",
+                list.join(", ")
+            )
+        } else {
+            String::new()
+        };
+        let header = self.header(&guard, &units_note, &h, &decls);
+        let main_text = files.remove(0);
         Ok(CodegenArtifact {
-            code: GeneratedCode { language: "C", main: c, companions: vec![("h", header)] },
+            code: GeneratedCode { language: "C", main: main_text, companions: vec![("h", header)], units: files },
             interfaces,
         })
     }
@@ -246,15 +406,16 @@ impl CodegenC {
         )
     }
 
-    /// The file's opening comment and includes; `fused`: some function has fused
-    /// multiply-adds (`contract`).
-    fn preamble(&self, fused: bool) -> String {
+    /// The file's opening comment, [`SLP_GUARD`] and includes; `fused`: some function has fused
+    /// multiply-adds (`contract`); `split`: some function is split into parts
+    /// (`ROBOVEC_NOINLINE`).
+    fn preamble(&self, fused: bool, split: bool) -> String {
         let mut s = format!(
             "/* Generated by robovec {}.\n * Every operation of robovec's IR is one statement, in the IR's order: compiled without\n \
              * floating-point contraction it computes bit for bit what robovec's interpreter computes{}.\n \
              {}* Compile with -ffp-contract=off (GCC contracts a*b+c into an FMA under -march=native),\n \
              * e.g. cc -O2 -ffp-contract=off -c model.c; link with -lm. */\n\
-             #pragma STDC FP_CONTRACT OFF\n#include <math.h>\n#include <string.h>\n\n",
+             #pragma STDC FP_CONTRACT OFF\n{SLP_GUARD}#include <math.h>\n#include <string.h>\n\n",
             self.options_text(),
             if self.trig == Trig::Inline {
                 ",\n * except sin/cos: with trig=inline they are robovec's own (below), within 1 ulp but not libm's bits;\n \
@@ -269,6 +430,17 @@ impl CodegenC {
                 ""
             }
         );
+        if split {
+            let _ = write!(
+                s,
+                "/* Functions of more than {} statements are split into parts (chunk={}): the entry point keeps\n \
+                 * its symbol and signature and calls its parts in order, passing the values one part computes\n \
+                 * and a later one reads in an array on its own stack (nothing static: re-entrant). The parts\n \
+                 * are never inlined into it, which would make one large function again. */\n\
+                 #if defined(__GNUC__)\n#define ROBOVEC_NOINLINE __attribute__((noinline))\n#else\n#define ROBOVEC_NOINLINE\n#endif\n\n",
+                self.chunk, self.chunk
+            );
+        }
         if self.batch > 1 {
             s += &body::vector_helpers(self.real(), self.batch, self.f32());
         }
@@ -278,10 +450,12 @@ impl CodegenC {
         s
     }
 
-    fn header(&self, prototypes: &str, callback_decls: &str) -> String {
+    /// The header: `guard` its include guard (from the first symbol, so that the headers of
+    /// two models can be included together), `units_note` the list of translation units.
+    fn header(&self, guard: &str, units_note: &str, prototypes: &str, callback_decls: &str) -> String {
         let mut s = format!(
             "/* Generated by robovec {}: prototypes of the C file beside this one. */\n\
-             #ifndef ROBOVEC_GENERATED_H\n#define ROBOVEC_GENERATED_H\n\n",
+             #ifndef {guard}\n#define {guard}\n\n{units_note}",
             self.options_text()
         );
         if self.abi == Abi::Robotran {
@@ -300,7 +474,8 @@ impl Pass for CodegenC {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        super::run_emitter(m, cx, |m| self.emit(m))
+        let main = cx.code_file.clone();
+        super::run_emitter(m, cx, |m| self.emit_as(m, main.as_deref()))
     }
 
     fn requires(&self) -> Option<robovec_ir::Phase> {
@@ -314,6 +489,31 @@ impl Pass for CodegenC {
     fn code_companions(&self) -> Option<&'static [&'static str]> {
         Some(&["h"])
     }
+
+    fn code_units(&self) -> usize {
+        self.units as usize
+    }
+}
+
+/// Unit of each part of each function (`units` translation units, 0 the main file):
+/// contiguous runs of about equal statements, in call order (part starting after `s` of the
+/// `total` statements of all parts goes to unit `⌊s·units/total⌋`).
+fn unit_assignment(emitted: &[Emitted], units: usize) -> Vec<Vec<usize>> {
+    let total: usize = emitted.iter().flat_map(|e| &e.parts).map(|p| p.ops).sum();
+    let mut before = 0usize;
+    emitted
+        .iter()
+        .map(|e| {
+            e.parts
+                .iter()
+                .map(|p| {
+                    let u = (before * units).checked_div(total).unwrap_or(0);
+                    before += p.ops;
+                    u.min(units - 1)
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// True when a `call` is an intrinsic ([`robovec_ir::Intrinsic`]: `sqrt`, and the fused
@@ -346,5 +546,8 @@ pub(crate) fn interface(o: &CodegenC, f: &Function, symbol: &str) -> Interface {
         trig: o.trig,
         inputs: super::input_values(f, o.trig == Trig::Input).iter().map(|&v| f.name_of(v).to_string()).collect(),
         outputs: f.outputs.iter().map(|x| x.name.clone()).collect(),
+        parts: 1,
+        sources: Vec::new(),
+        header: None,
     }
 }

@@ -8,7 +8,10 @@
 //! then `tsim`; `s` is dropped and the trailing integer is appended to the name (`.1`). The
 //! drop-in rebuilds the arrays (1-based, index 0 zero), makes ONE native call per distinct
 //! callee and index at the position of its first element, and each element becomes
-//! `x = SWr1[k];`. A scalar callback (`user_LinkForces(Z1,Zd1,s,tsim,1)`, IR operands `Z1, Zd1,
+//! `x = SWr1[k];`, read right after the call: the later elements are *attached* to the first
+//! ([`Native::lead`], [`super::body::Body::order`]), so the call's result is read before any
+//! other call can reuse the user's result array, and a function split into parts
+//! ([`super::split`]) never needs the result pointer in another part. A scalar callback (`user_LinkForces(Z1,Zd1,s,tsim,1)`, IR operands `Z1, Zd1,
 //! tsim`) is one direct call per IR call, as in Robotran's source.
 //!
 //! The prototypes ([`prototypes`]) are MBsysC's own (`mbs_project_interface.h`); they are
@@ -19,7 +22,7 @@
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write as _;
 
-use robovec_ir::{Def, Function, Module, Operand};
+use robovec_ir::{Def, Function, Module, Operand, Value};
 
 use super::body::{split_callee, Body};
 use super::is_intrinsic;
@@ -117,14 +120,22 @@ fn unknown(f: &Function, base: &str) -> PassError {
     )
 }
 
-/// The C statements of every user callback of `f` with the native signatures: value index →
-/// statements (declaration of the value included).
+/// The native form of a function's user callbacks ([`statements`]).
+pub(crate) struct Native {
+    /// Value index → its C statements (declaration of the value included).
+    pub statements: HashMap<usize, String>,
+    /// A later element of a vector callback instance → the instance's first element, whose
+    /// statements make the native call that this element reads.
+    pub lead: HashMap<usize, Value>,
+}
+
+/// The C statements of every user callback of `f` with the native signatures.
 ///
 /// # Errors
 /// [`PassError::Failed`] for a callback with no known native signature, a number of
 /// operands or an element that does not fit it, or elements of one call with different
 /// operands.
-pub(crate) fn statements(b: &Body<'_>) -> Result<HashMap<usize, String>, PassError> {
+pub(crate) fn statements(b: &Body<'_>) -> Result<Native, PassError> {
     let f = b.f;
     let mut taken: HashSet<String> = b.names.iter().cloned().collect();
     let mut fresh = |want: String| {
@@ -135,9 +146,10 @@ pub(crate) fn statements(b: &Body<'_>) -> Result<HashMap<usize, String>, PassErr
         taken.insert(n.clone());
         n
     };
-    // (base, index) → (result array name, operands of the first element).
-    let mut done: HashMap<(String, i64), (String, &[Operand])> = HashMap::new();
+    // (base, index) → (result array name, operands of the first element, the first element).
+    let mut done: HashMap<(String, i64), (String, &[Operand], Value)> = HashMap::new();
     let mut out = HashMap::new();
+    let mut lead = HashMap::new();
     for &v in &f.body {
         let Def::Call(c, args) = &f.value(v).def else { continue };
         if is_intrinsic(c, args.len()) {
@@ -181,7 +193,7 @@ pub(crate) fn statements(b: &Body<'_>) -> Result<HashMap<usize, String>, PassErr
                 };
                 let key = (base.clone(), ix);
                 match done.get(&key) {
-                    Some((res, first)) => {
+                    Some((res, first, first_value)) => {
                         if *first != &args[..] {
                             return Err(fail(
                                 f,
@@ -192,6 +204,7 @@ pub(crate) fn statements(b: &Body<'_>) -> Result<HashMap<usize, String>, PassErr
                             ));
                         }
                         let _ = writeln!(s, "  const double {name} = {res}[{elem}];");
+                        lead.insert(v.index(), *first_value);
                     }
                     None => {
                         let mut it = args.iter();
@@ -219,12 +232,12 @@ pub(crate) fn statements(b: &Body<'_>) -> Result<HashMap<usize, String>, PassErr
                         let res = fresh(format!("SWr{ix}"));
                         let _ = writeln!(s, "  double *{res} = {base}({}, s, {tsim}, {ix});", arrays.join(", "));
                         let _ = writeln!(s, "  const double {name} = {res}[{elem}];");
-                        done.insert(key, (res, &args[..]));
+                        done.insert(key, (res, &args[..], v));
                     }
                 }
             }
         }
         out.insert(v.index(), s);
     }
-    Ok(out)
+    Ok(Native { statements: out, lead })
 }

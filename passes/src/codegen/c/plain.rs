@@ -13,44 +13,46 @@
 //! 26 KB with 5.6k, 15 % fewer instructions, and the file compiles in 12 s instead of 144 s
 //! (issue 11's measurements). `abi=robotran` keeps reads first and writes last: its output
 //! arrays may alias `MbsData` fields.
+//!
+//! Split into parts (`chunk=OPS`, [`super::split`]), each part is `static void
+//! SYMBOL_partK(const REAL *restrict in, REAL *restrict out, T *restrict live)` with the same
+//! order inside (each part reads the inputs it uses at their first use in it, and the live
+//! values of earlier parts likewise), and the entry point, with the same signature, calls them
+//! in order; with `batch=W` the entry point runs the loop over the vector chunks and hands each
+//! part `in` and `out` already offset to the chunk.
 
+use std::collections::HashSet;
 use std::fmt::Write as _;
 
 use robovec_ir::{Function, Operand, Value};
 
 use super::body::Body;
-use super::{interface, CodegenC};
+use super::split::{part_name, part_prefix, Part, Plan};
+use super::{interface, CodegenC, Emitted};
+use crate::codegen::input_values;
 use crate::codegen::names::c_names;
-use crate::codegen::{input_values, Interface};
 
 /// The parameter and helper names of the plain ABI (never given to a value).
-pub const RESERVED: &[&str] = &["in", "out"];
+pub const RESERVED: &[&str] = &["in", "out", "live"];
 
-/// The C definition of `f` as `symbol`, its prototype (with the documented input and output
-/// order, for the header) and its interface.
-pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> (String, String, Interface) {
+/// `f` as `symbol`: its definition (split into parts of at most `o.chunk` statements when it
+/// has more; part names avoid `taken`, the file's other global names), its prototype (with the
+/// documented input and output order, for the header) and its interface.
+pub(crate) fn function(o: &CodegenC, f: &Function, symbol: &str, taken: &HashSet<String>) -> Emitted {
     let iface = interface(o, f, symbol);
     let mut reserved: Vec<&str> = RESERVED.to_vec();
     reserved.push(symbol);
     let callee_names = super::body::callee_names(f);
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
-    let b = Body { o, f, names: &names, native: None };
+    let b = Body::new(o, f, &names, None);
+    let (order, attached) = b.order();
+    let plan = Plan::new(f, &order, &attached, o.chunk as usize, &[], &[]);
     let real = o.real();
     let w = o.batch as usize;
-    let sig = format!("void {symbol}(const {real} *restrict in, {real} *restrict out)");
-    let mut s = format!(
-        "/* @{}: {} inputs, {} outputs (order: see the header). */\n{sig}\n{{\n",
-        f.name,
-        iface.inputs.len(),
-        iface.outputs.len()
-    );
+    let params = format!("const {real} *restrict in, {real} *restrict out");
+    let sig = format!("void {symbol}({params})");
     let ty = b.value_type();
-    // A batch: one pass of the body per chunk of ROBOVEC_VL lanes, at offset `at` in a block.
-    let at = "robovec_chunk * ROBOVEC_VL";
-    if w > 1 {
-        s += super::body::CHUNK_LOOP;
-    }
     // Inputs are read just before their first use and outputs written right after their value
     // is computed (`in` and `out` are `restrict`: nothing aliases), which keeps the compiler's
     // live ranges short (see the module doc). Outputs that are inputs or constants come last.
@@ -67,17 +69,27 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> (String, String, In
             }
         }
     }
-    let mut loaded = vec![false; inputs.len()];
-    let mut load = |s: &mut String, v: Value| {
+    let split = plan.parts() > 1;
+    // A batch: one pass of the body per chunk of ROBOVEC_VL lanes, at offset `at` in a block
+    // (a part gets `in` and `out` at the chunk already).
+    let at = if split { "" } else { " + robovec_chunk * ROBOVEC_VL" };
+    // Part k has read value v when read[v] == k + 1.
+    let mut read = vec![0u32; f.values.len()];
+    let mut load = |s: &mut String, v: Value, k: usize| {
+        if read[v.index()] == k as u32 + 1 {
+            return;
+        }
+        let n = &names[v.index()];
         if let Some(i) = input_at[v.index()] {
-            if !std::mem::replace(&mut loaded[i], true) {
-                let n = &names[v.index()];
-                if w > 1 {
-                    let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, in + {} + {at}, sizeof {n});", i * w);
-                } else {
-                    let _ = writeln!(s, "  const {ty} {n} = in[{i}];");
-                }
+            read[v.index()] = k as u32 + 1;
+            if w > 1 {
+                let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, in + {}{at}, sizeof {n});", i * w);
+            } else {
+                let _ = writeln!(s, "  const {ty} {n} = in[{i}];");
             }
+        } else if plan.reads_live(v, k) {
+            read[v.index()] = k as u32 + 1;
+            let _ = writeln!(s, "  const {ty} {n} = live[{}];", plan.slot(v).expect("read from live"));
         }
     };
     let store = |s: &mut String, j: usize, x: &Operand| {
@@ -85,35 +97,99 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> (String, String, In
         if w > 1 {
             match x {
                 Operand::Value(_) => {
-                    let _ = writeln!(s, "  memcpy(out + {} + {at}, &{e}, sizeof {e});", j * w);
+                    let _ = writeln!(s, "  memcpy(out + {}{at}, &{e}, sizeof {e});", j * w);
                 }
                 Operand::Const(_) => {
-                    let _ = writeln!(s, "  {{ const {ty} k = {e}; memcpy(out + {} + {at}, &k, sizeof k); }}", j * w);
+                    let _ = writeln!(s, "  {{ const {ty} k = {e}; memcpy(out + {}{at}, &k, sizeof k); }}", j * w);
                 }
             }
         } else {
             let _ = writeln!(s, "  out[{j}] = {e};");
         }
     };
-    b.statements_with(&mut s, &mut |s, v| f.value(v).def.for_each_value(|a| load(s, a)), &mut |s, v| {
-        for &j in &outputs_of[v.index()] {
-            store(s, j, &f.outputs[j].value);
-        }
-    });
-    for (j, out) in f.outputs.iter().enumerate() {
-        match out.value {
-            Operand::Value(v) if input_at[v.index()].is_none() => {}
-            Operand::Value(v) => {
-                load(&mut s, v);
-                store(&mut s, j, &out.value);
+    // The statements of part k (all of them when not split), then in the last part the
+    // outputs that are inputs or constants.
+    let mut statements = |s: &mut String, k: usize| {
+        let range = plan.bounds[k]..plan.bounds[k + 1];
+        b.statements_with(
+            &order[range],
+            s,
+            &mut |s, v| f.value(v).def.for_each_value(|a| load(s, a, k)),
+            &mut |s, v| {
+                for &j in &outputs_of[v.index()] {
+                    store(s, j, &f.outputs[j].value);
+                }
+                if let Some(slot) = plan.slot(v) {
+                    let _ = writeln!(s, "  live[{slot}] = {};", names[v.index()]);
+                }
+            },
+        );
+        if k + 1 == plan.parts() {
+            for (j, out) in f.outputs.iter().enumerate() {
+                match out.value {
+                    Operand::Value(v) if input_at[v.index()].is_none() => {}
+                    Operand::Value(v) => {
+                        load(s, v, k);
+                        store(s, j, &out.value);
+                    }
+                    Operand::Const(_) => store(s, j, &out.value),
+                }
             }
-            Operand::Const(_) => store(&mut s, j, &out.value),
         }
+    };
+    let mut s = format!(
+        "/* @{}: {} inputs, {} outputs (order: see the header){}. */\n",
+        f.name,
+        iface.inputs.len(),
+        iface.outputs.len(),
+        if split { format!("; {} parts", plan.parts()) } else { String::new() }
+    );
+    let mut parts = Vec::new();
+    if split {
+        let prefix = part_prefix(symbol, plan.parts(), taken);
+        let live_ty = if w > 1 { "robovec_vec" } else { real };
+        for k in 0..plan.parts() {
+            let mut body = String::from("{\n");
+            statements(&mut body, k);
+            body += "}\n\n";
+            parts.push(Part {
+                signature: format!(
+                    "ROBOVEC_NOINLINE void {}({params}, {live_ty} *restrict live)",
+                    part_name(&prefix, k)
+                ),
+                body,
+                ops: plan.bounds[k + 1] - plan.bounds[k],
+            });
+        }
+        let _ = write!(
+            s,
+            "{sig}\n{{\n  /* Values computed in one part and read in a later one. */\n  {live_ty} live[{}];\n",
+            plan.slots.max(1)
+        );
+        let (indent, args) = if w > 1 {
+            s += super::body::CHUNK_LOOP;
+            ("    ", "in + robovec_chunk * ROBOVEC_VL, out + robovec_chunk * ROBOVEC_VL, live")
+        } else {
+            ("  ", "in, out, live")
+        };
+        for k in 0..plan.parts() {
+            let _ = writeln!(s, "{indent}{}({args});", part_name(&prefix, k));
+        }
+        if w > 1 {
+            s += "  }\n";
+        }
+        s += "}\n\n";
+    } else {
+        let _ = write!(s, "{sig}\n{{\n");
+        if w > 1 {
+            s += super::body::CHUNK_LOOP;
+        }
+        statements(&mut s, 0);
+        if w > 1 {
+            s += "  }\n";
+        }
+        s += "}\n\n";
     }
-    if w > 1 {
-        s += "  }\n";
-    }
-    s += "}\n\n";
     let mut proto = format!("/* @{} as {symbol}", f.name);
     if w > 1 {
         let _ = write!(proto, ", {w} states per call (lane l of element i at [i*{w} + l])");
@@ -134,5 +210,5 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> (String, String, In
         symbol.to_uppercase(),
         iface.outputs.len()
     );
-    (s, proto, iface)
+    Emitted { entry: s, parts, proto, iface }
 }

@@ -8,14 +8,15 @@
 //! static function each and one `mbs_sensor(MbsSensor *sens, MbsData *s, int isens)` (or
 //! `mbs_gensensor`) that switches on `isens`, as Robotran's does.
 
+use std::collections::HashSet;
 use std::fmt::Write as _;
 
-use robovec_ir::{Function, Module};
+use robovec_ir::{Function, Module, Operand, Value};
 
 use super::body::Body;
-use super::{interface, CodegenC};
+use super::split::{part_name, part_prefix, Part, Plan};
+use super::{interface, CodegenC, Emitted};
 use crate::codegen::names::c_names;
-use crate::codegen::Interface;
 use crate::PassError;
 
 /// A Robotran function kind: the IR function name, Robotran's symbol and its output arrays.
@@ -122,13 +123,24 @@ fn split_base(name: &str) -> (&str, &str) {
     (&name[..i], &name[i..])
 }
 
-/// The drop-in definition of `f` as `symbol`, its prototype and its interface. A sensor gives
-/// a static function `robovec_<symbol>_<k>`; [`sensor_dispatch`] writes the switch.
+/// The drop-in definition of `f` as `symbol` (split into parts of at most `o.chunk`
+/// statements when it has more; part names avoid `taken`, the file's other global names),
+/// its prototype and its interface. A sensor gives a static function `robovec_<symbol>_<k>`;
+/// [`sensor_dispatch`] writes the switch.
+///
+/// Split, the entry point stores every input the parts read into `live[]` before the first
+/// part (reads first, as unsplit) and the last part writes the outputs after its statements
+/// (writes last); each part takes the entry point's parameters and `double *restrict live`.
 ///
 /// # Errors
 /// [`PassError::Failed`] for a function kind with no known Robotran signature, an input that
 /// is no `MbsData` field, or an output that is no output parameter of the signature.
-pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> Result<(String, String, Interface), PassError> {
+pub(crate) fn function(
+    o: &CodegenC,
+    f: &Function,
+    symbol: &str,
+    taken: &HashSet<String>,
+) -> Result<Emitted, PassError> {
     let fail =
         |message: String| PassError::Failed { pass: "codegen".into(), message: format!("@{}: {message}", f.name) };
     let sens = sensor(f);
@@ -143,24 +155,36 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> Result<(String, Str
             (format!("{p}MbsData *s, double tsim"), list.iter().map(|x| x.1).collect())
         }
     };
-    let mut reserved: Vec<&str> = vec!["s", "tsim", "sens", "isens", symbol];
+    let args = match sens {
+        Some(_) => "sens, s".to_string(),
+        None => outs.iter().map(|n| format!("{n}, ")).collect::<String>() + "s, tsim",
+    };
+    let mut reserved: Vec<&str> = vec!["s", "tsim", "sens", "isens", "live", symbol];
     reserved.extend(&outs);
     let callee_names = super::body::callee_names(f);
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
-    let native = super::native::statements(&Body { o, f, names: &names, native: None })?;
-    let b = Body { o, f, names: &names, native: Some(&native) };
-    let (sig, proto) = match sens {
-        Some((_, k)) => (format!("static void robovec_{symbol}_{k}({params})"), String::new()),
+    let native = super::native::statements(&Body::new(o, f, &names, None))?;
+    let b = Body::new(o, f, &names, Some(&native));
+    let (defined, sig, proto) = match sens {
+        Some((_, k)) => {
+            let d = format!("robovec_{symbol}_{k}");
+            let sig = format!("static void {d}({params})");
+            (d, sig, String::new())
+        }
         None => {
             let sig = format!("void {symbol}({params})");
-            (sig.clone(), format!("/* @{} as Robotran's {symbol} (drop-in). */\n{sig};\n\n", f.name))
+            (
+                symbol.to_string(),
+                sig.clone(),
+                format!("/* @{} as Robotran's {symbol} (drop-in). */\n{sig};\n\n", f.name),
+            )
         }
     };
-    let mut s = format!("/* @{} */\n{sig}\n{{\n", f.name);
+    let mut access = Vec::with_capacity(f.inputs.len());
     for &v in &f.inputs {
         let n = f.name_of(v);
-        let access = if n == "tsim" {
+        access.push(if n == "tsim" {
             if sens.is_some() {
                 "s->tsim".to_string()
             } else {
@@ -172,21 +196,90 @@ pub fn function(o: &CodegenC, f: &Function, symbol: &str) -> Result<(String, Str
                 return Err(fail(format!("input `{n}` is no MbsData field (abi=robotran reads s->q, s->dpt, …)")));
             }
             format!("s->{n}")
-        };
-        let _ = writeln!(s, "  const double {} = {access};", names[v.index()]);
+        });
     }
-    b.statements(&mut s);
+    let mut lvalues = Vec::with_capacity(f.outputs.len());
     for out in &f.outputs {
-        let lvalue = match out.name.strip_prefix("sens.") {
+        lvalues.push(match out.name.strip_prefix("sens.") {
             Some(rest) if sens.is_some() => format!("sens->{rest}"),
             None if out.name == "flag_stop" => "s->flag_stop".to_string(),
             _ if sens.is_none() && outs.contains(&split_base(&out.name).0) => out.name.clone(),
             _ => return Err(fail(format!("output `{}` is no output parameter of {symbol}", out.name))),
-        };
-        let _ = writeln!(s, "  {lvalue} = {};", b.operand(&out.value));
+        });
+    }
+    let (order, attached) = b.order();
+    let end_uses: Vec<Value> =
+        f.outputs.iter().filter_map(|x| if let Operand::Value(v) = x.value { Some(v) } else { None }).collect();
+    let plan = Plan::new(f, &order, &attached, o.chunk as usize, &f.inputs, &end_uses);
+    let iface = interface(o, f, symbol);
+    if plan.parts() == 1 {
+        let mut s = format!("/* @{} */\n{sig}\n{{\n", f.name);
+        for (&v, a) in f.inputs.iter().zip(&access) {
+            let _ = writeln!(s, "  const double {} = {a};", names[v.index()]);
+        }
+        b.statements_with(&order, &mut s, &mut |_, _| {}, &mut |_, _| {});
+        for (out, lvalue) in f.outputs.iter().zip(&lvalues) {
+            let _ = writeln!(s, "  {lvalue} = {};", b.operand(&out.value));
+        }
+        s += "}\n\n";
+        return Ok(Emitted { entry: s, parts: Vec::new(), proto, iface });
+    }
+    // Split: part k has read value v from live[] when read[v] == k + 1.
+    let mut read = vec![0u32; f.values.len()];
+    let mut load = |s: &mut String, v: Value, k: usize| {
+        if read[v.index()] != k as u32 + 1 && plan.reads_live(v, k) {
+            read[v.index()] = k as u32 + 1;
+            let _ = writeln!(s, "  const double {} = live[{}];", names[v.index()], plan.slot(v).expect("live"));
+        }
+    };
+    let prefix = part_prefix(&defined, plan.parts(), taken);
+    let mut parts = Vec::with_capacity(plan.parts());
+    for k in 0..plan.parts() {
+        let mut body = String::from("{\n");
+        b.statements_with(
+            &order[plan.bounds[k]..plan.bounds[k + 1]],
+            &mut body,
+            &mut |s, v| f.value(v).def.for_each_value(|a| load(s, a, k)),
+            &mut |s, v| {
+                if let Some(slot) = plan.slot(v) {
+                    let _ = writeln!(s, "  live[{slot}] = {};", names[v.index()]);
+                }
+            },
+        );
+        if k + 1 == plan.parts() {
+            // Every operand is read before the first write (the outputs may alias MbsData
+            // fields; the live values never do).
+            for v in &end_uses {
+                load(&mut body, *v, k);
+            }
+            for (out, lvalue) in f.outputs.iter().zip(&lvalues) {
+                let _ = writeln!(body, "  {lvalue} = {};", b.operand(&out.value));
+            }
+        }
+        body += "}\n\n";
+        parts.push(Part {
+            signature: format!("ROBOVEC_NOINLINE void {}({params}, double *restrict live)", part_name(&prefix, k)),
+            body,
+            ops: plan.bounds[k + 1] - plan.bounds[k],
+        });
+    }
+    let mut s = format!(
+        "/* @{}: {} parts */\n{sig}\n{{\n  /* Inputs (read first) and values computed in one part and read in a later one. */\n  \
+         double live[{}];\n",
+        f.name,
+        plan.parts(),
+        plan.slots.max(1)
+    );
+    for (&v, a) in f.inputs.iter().zip(&access) {
+        if let Some(slot) = plan.slot(v) {
+            let _ = writeln!(s, "  live[{slot}] = {a};");
+        }
+    }
+    for k in 0..plan.parts() {
+        let _ = writeln!(s, "  {}({args}, live);", part_name(&prefix, k));
     }
     s += "}\n\n";
-    Ok((s, proto, interface(o, f, symbol)))
+    Ok(Emitted { entry: s, parts, proto, iface })
 }
 
 /// The `mbs_sensor`/`mbs_gensensor` functions that switch on `isens` to the sensors of `m`,
