@@ -126,7 +126,8 @@ fn split_variants(chunks: &[u32]) -> Vec<Variant> {
         ("atomise,cse", "f64", 1, "libm"),
         ("atomise,cse,schedule-cpu", "f64", 8, "input"),
     ] {
-        let what = if batch > 1 { format!("{pipeline} batch={batch} {precision} trig={trig}") } else { pipeline.into() };
+        let what =
+            if batch > 1 { format!("{pipeline} batch={batch} {precision} trig={trig}") } else { pipeline.into() };
         let base = out.len();
         for &chunk in std::iter::once(&0).chain(chunks) {
             out.push(Variant {

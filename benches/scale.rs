@@ -7,7 +7,8 @@
 //! **Pipeline:** `robovec-opt wmK.m -passes=atomise,zero-removal,balance,asap-alap,place<pe=N>,sim -time-passes -o /dev/null`
 //! (N = `--pes`, default 32), then the C path the issue measures:
 //! `-passes=atomise,cse,codegen<c;abi=plain> -o wmK.c` and `gcc -O2 -c` on every file it writes
-//! (`--no-cc` skips it, `--cc=CMD` picks the compiler).
+//! (`--no-cc` skips it, `--cc=CMD` picks the compiler, `--cc-max=K`: only up to K copies,
+//! default 16, the issue's goal; WALK-MAN × 64 is four times that compile).
 //!
 //! **Measured** (release `robovec-opt` in a child process, `--runs=R` times per K — default 3 up
 //! to K = 16, 1 above — medians): per pass ns/op (the pass's `-time-passes` wall time over its
@@ -54,7 +55,7 @@ fn main() {
         .split(',')
         .map(String::from)
         .collect();
-    let (mut before, mut before_max): (Option<PathBuf>, usize) = (None, 16);
+    let (mut before, mut before_max, mut cc_max): (Option<PathBuf>, usize, usize) = (None, 16, 16);
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         if let Some(v) = a.strip_prefix("--copies=") {
@@ -71,6 +72,8 @@ fn main() {
             urdf.clear();
         } else if a == "--no-cc" {
             cc = None;
+        } else if let Some(v) = a.strip_prefix("--cc-max=") {
+            cc_max = v.parse().expect("--cc-max=K");
         } else if let Some(v) = a.strip_prefix("--before=") {
             before = Some(PathBuf::from(v));
         } else if let Some(v) = a.strip_prefix("--before-max=") {
@@ -113,7 +116,7 @@ fn main() {
                 median(all.iter().map(|x| x.peak as f64).collect()),
             ));
         }
-        let c = cc.as_deref().map(|cc| compile_c(&bin, &input, &dir, k, cc));
+        let c = cc.as_deref().filter(|_| k <= cc_max).map(|cc| compile_c(&bin, &input, &dir, k, cc));
         let secs = median(all.iter().map(|x| x.secs).collect());
         let peak = median(all.iter().map(|x| x.peak as f64).collect());
         let passes: Vec<(String, u64, f64)> = all[0]

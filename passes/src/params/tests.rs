@@ -10,9 +10,12 @@ fn build(info: &'static PassInfo, raw: &[(&str, String)]) -> Result<String, Pass
     Ok(format!("{:?}", (info.build)(&p)?))
 }
 
-/// Each way to build `info`: `(parameters that select it, its declarations)`: the pass, or
-/// for a family each member with the selector given.
-fn variants(info: &'static PassInfo) -> Vec<(Vec<(&'static str, String)>, Vec<&'static ParamInfo>)> {
+/// One way to build a pass: the parameters that select it, and its declarations.
+type Variant = (Vec<(&'static str, String)>, Vec<&'static ParamInfo>);
+
+/// Each way to build `info` ([`Variant`]): the pass, or for a family each member with the
+/// selector given.
+fn variants(info: &'static PassInfo) -> Vec<Variant> {
     let selector = info.params.iter().find(|p| !p.members().is_empty());
     match selector {
         None => vec![(Vec::new(), info.params.iter().collect())],

@@ -138,7 +138,8 @@ word_enum! {
 /// out[0] = x1 - in[4]; out[1] = x2 + in[5];`); split code, whose live values sit side by side
 /// in `live[]`, met it on coman's `dirdyna` (23 of 682 outputs off by an ulp at `-O2
 /// -march=native`). For GCC 12 with FMA only, the file turns SLP vectorisation off.
-pub const SLP_GUARD: &str = "/* GCC 12 fuses a*b-c, d*e+f into vfmaddsub despite -ffp-contract=off (SLP addsub pattern): */\n\
+pub const SLP_GUARD: &str =
+    "/* GCC 12 fuses a*b-c, d*e+f into vfmaddsub despite -ffp-contract=off (SLP addsub pattern): */\n\
     #if defined(__GNUC__) && !defined(__clang__) && __GNUC__ == 12 && defined(__FMA__)\n\
     #pragma GCC optimize (\"no-tree-slp-vectorize\")\n#endif\n";
 
