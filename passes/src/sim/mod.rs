@@ -92,7 +92,8 @@ pub struct SimReport {
 pub struct SimStats {
     /// Placements (one per function) simulated.
     pub placements: usize,
-    /// Input sets (seeds `0..seeds`), each simulated in every precision.
+    /// Input sets (seeds `0..seeds`), each simulated in every precision: the number asked, or
+    /// the fewest simulated for one placement when `-time-limit` stopped `sim` between seeds.
     pub seeds: u32,
     /// Precisions simulated and compared with the interpreter.
     pub precisions: Vec<&'static str>,
