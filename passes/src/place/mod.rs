@@ -139,7 +139,10 @@ pub fn try_place_function_progress(
     let a = &opts.arch;
     let dag = dag::OpDag::new(f);
     let seed = schedule::seed_keys(f, a, opts.priority);
-    let best = improved(f, &dag, opts, &seed, 0)?;
+    let (best, cut) = improved(f, &dag, opts, &seed, 0)?;
+    if cut {
+        return Ok((memory::build(f, a, &best), true));
+    }
     let spec = lower_bound(f, a) as u64;
     // Within 2% of SPEC §4's bound (hence of the tight bound too): nothing to search for, and
     // the tight bound (O(n log n) but not free) is not computed.
@@ -156,17 +159,21 @@ pub(crate) fn end(s: &schedule::Schedule) -> u32 {
 }
 
 /// The list schedule for `keys` with feeding bonus `feed` (cycles, see [`feed::Feed`]), then up
-/// to `opts.improve` rounds of forward-backward improvement (kept while they shorten it).
+/// to `opts.improve` rounds of forward-backward improvement (kept while they shorten it); no
+/// round starts once `opts.deadline` is reached (`true`: rounds were cut).
 pub(crate) fn improved(
     f: &Function,
     dag: &dag::OpDag,
     opts: &PlaceOptions,
     keys: &[dag::Key],
     feed: u32,
-) -> Result<schedule::Schedule, String> {
+) -> Result<(schedule::Schedule, bool), String> {
     let a = &opts.arch;
     let mut best = schedule::schedule(f, dag, a, keys, opts.select, feed)?;
     for _ in 0..opts.improve {
+        if opts.deadline.is_some_and(|d| d.reached()) {
+            return Ok((best, true));
+        }
         // Backward pass: ops that arrived last go first in reverse time; then forward again in
         // order of the backward (justified) start times.
         let t = end(&best);
@@ -180,7 +187,7 @@ pub(crate) fn improved(
         }
         best = s;
     }
-    Ok(best)
+    Ok((best, false))
 }
 
 /// Places `f` (atomised, verified) on an architecture with buffers.

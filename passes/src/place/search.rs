@@ -108,7 +108,8 @@ pub fn restarts_and_search(
                 })
                 .collect()
         };
-        let s = improved(f, dag, opts, &keys, feed)?;
+        // A cut improvement is seen by the next `out_of_time()`.
+        let (s, _) = improved(f, dag, opts, &keys, feed)?;
         if end(&s) < end(&best) {
             best = s;
             plan = (keys, feed);
@@ -133,7 +134,7 @@ pub fn restarts_and_search(
                 k.0 = (k.0 as i64 + shift).max(0) as u32;
             }
         }
-        let s = improved(f, dag, opts, &keys, plan.1)?;
+        let (s, _) = improved(f, dag, opts, &keys, plan.1)?;
         if score(&s, window) <= score(&best, window) {
             best = s;
             plan.0 = keys;
