@@ -9,7 +9,7 @@
 use robovec_ir::analysis::annotate_timing;
 use robovec_ir::{Module, Phase};
 
-use crate::{LatencyOverride, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{AtTimeLimit, LatencyOverride, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -39,9 +39,20 @@ impl Pass for AsapAlap {
         true
     }
 
+    fn at_time_limit(&self) -> AtTimeLimit {
+        AtTimeLimit::Skip
+    }
+
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let lat = cx.latencies_for("asap-alap", &self.lat);
-        for f in &mut m.functions {
+        // About 30 ns per op: the clock is read between functions only.
+        let ticker = cx.ticker();
+        for (k, f) in m.functions.iter_mut().enumerate() {
+            if ticker.check() {
+                let what = format!("before @{} ({k} functions annotated)", f.name);
+                cx.note_stop("asap-alap", &format!("{what}: {}", ticker.reason()));
+                break;
+            }
             annotate_timing(f, &lat);
         }
         Ok(())

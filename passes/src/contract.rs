@@ -24,7 +24,7 @@
 
 use robovec_ir::{BinOp, Def, Function, Intrinsic, Module, Operand, Value};
 
-use crate::{Params, Pass, PassContext, PassError, PassInfo};
+use crate::{AtTimeLimit, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -53,6 +53,12 @@ pub struct Contracted {
 
 /// Fuses the multiplies of `f` into their additions (see the module doc).
 pub fn contract_function(f: &mut Function) -> Contracted {
+    contract_within(f, &Ticker::default())
+}
+
+/// [`contract_function`] that stops fusing when `ticker` says so (`-time-limit`; one tick per
+/// value): the multiplies fused so far stay fused, the later ones are kept as they are.
+pub fn contract_within(f: &mut Function, ticker: &Ticker) -> Contracted {
     let n = f.values.len();
     // Every use of every value: the additions that read it once, and whether anything else
     // (an output, another op, an addition reading it twice) does.
@@ -88,6 +94,9 @@ pub fn contract_function(f: &mut Function) -> Contracted {
     let mut removed = vec![false; n];
     let mut out = Contracted::default();
     for k in 0..f.body.len() {
+        if ticker.tick() {
+            break;
+        }
         let m = f.body[k];
         let Def::Binary(BinOp::Mul, a, b) = f.value(m).def else { continue };
         let uses = &adds_of[m.index()];
@@ -126,10 +135,23 @@ impl Pass for Contract {
         Some(robovec_ir::Phase::Atomised)
     }
 
+    fn at_time_limit(&self) -> AtTimeLimit {
+        AtTimeLimit::Skip
+    }
+
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let mut parts = Vec::new();
+        let ticker = cx.ticker();
         for f in &mut m.functions {
-            let c = contract_function(f);
+            if ticker.stopped() {
+                cx.note_stop("contract", &format!("before @{}: {}", f.name, ticker.reason()));
+                break;
+            }
+            let c = contract_within(f, &ticker);
+            if ticker.stopped() {
+                let what = format!("in @{} ({} multiplies fused, the later ones kept)", f.name, c.muls_removed);
+                cx.note_stop("contract", &format!("{what}: {}", ticker.reason()));
+            }
             parts.push(format!(
                 "@{} {} fused (fma {}, fms {}, fnma {}), {} mul removed",
                 f.name,

@@ -22,7 +22,7 @@ use std::collections::HashMap;
 
 use robovec_ir::{BinOp, Def, Function, Module, Operand, TrigFn, Value};
 
-use crate::{Params, Pass, PassContext, PassError, PassInfo};
+use crate::{AtTimeLimit, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -74,6 +74,13 @@ fn op_key(def: &Def) -> Option<OpKey> {
 
 /// Merges the repeated ops of `f`; returns how many were dropped.
 pub fn cse_function(f: &mut Function) -> usize {
+    cse_within(f, &Ticker::default())
+}
+
+/// [`cse_function`] that stops looking for repeats when `ticker` says so (`-time-limit`; one
+/// tick per value): the merges found so far are kept, the later ops only read the merged
+/// values (a renaming, without hashing).
+pub fn cse_within(f: &mut Function, ticker: &Ticker) -> usize {
     let mut repr: Vec<Value> = (0..f.values.len()).map(|i| Value::with_number(i as u32)).collect();
     let mut dropped = vec![false; f.values.len()];
     let mut table: HashMap<OpKey, Value> = HashMap::with_capacity(f.body.len());
@@ -82,6 +89,9 @@ pub fn cse_function(f: &mut Function) -> usize {
         // Operands first: a merged operand makes two later ops equal.
         let def = &mut f.value_mut(v).def;
         def.map_values(&|x| repr[x.index()]);
+        if ticker.tick() {
+            continue;
+        }
         if let Some(k) = op_key(def) {
             match table.get(&k) {
                 Some(&first) => {
@@ -112,9 +122,25 @@ impl Pass for Cse {
         "cse"
     }
 
-    fn run(&self, m: &mut Module, _cx: &mut PassContext) -> Result<(), PassError> {
+    fn at_time_limit(&self) -> AtTimeLimit {
+        AtTimeLimit::Skip
+    }
+
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        let ticker = cx.ticker();
         for f in &mut m.functions {
-            cse_function(f);
+            if ticker.stopped() {
+                cx.note_stop("cse", &format!("before @{}: {}", f.name, ticker.reason()));
+                break;
+            }
+            let (seen, n) = (ticker.ticks(), f.body.len() as u64);
+            cse_within(f, &ticker);
+            if ticker.stopped() {
+                let done = ticker.ticks().saturating_sub(seen + 1);
+                let what = format!("in @{} after {done} of {n} values (merges found kept)", f.name);
+                cx.note_stop("cse", &format!("{what}: {}", ticker.reason()));
+                break;
+            }
         }
         Ok(())
     }

@@ -23,7 +23,7 @@ use robovec_ir::{Def, Function, Module, Operand, Phase, Value};
 
 use crate::params::ParamKind;
 use crate::tree_height::cluster::{Class, Clusters};
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -75,10 +75,18 @@ impl Pass for Inline {
         Some(Phase::Atomised)
     }
 
+    fn at_time_limit(&self) -> AtTimeLimit {
+        AtTimeLimit::Skip
+    }
+
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let mut parts = Vec::new();
+        let ticker = cx.ticker();
         for f in &mut m.functions {
-            let (g, s) = inline_function(f, self.max_uses, self.max_size);
+            let Some((g, s)) = inline_within(f, self.max_uses, self.max_size, &ticker) else {
+                cx.note_stop("inline", &format!("in @{} (kept as it was): {}", f.name, ticker.reason()));
+                break;
+            };
             *f = g;
             parts.push(format!(
                 "@{}: {} values copied into {} uses, ops {} -> {} ({} ops added)",
@@ -93,6 +101,12 @@ impl Pass for Inline {
 /// Inlines the values of `f` (atomised, verified) with 2..=`max_uses` uses into their
 /// same-class consumers (see the module doc).
 pub fn inline_function(f: &Function, max_uses: u32, max_size: u32) -> (Function, InlineStats) {
+    inline_within(f, max_uses, max_size, &Ticker::default()).expect("a ticker without a limit never stops")
+}
+
+/// [`inline_function`] that gives up when `ticker` says so (`-time-limit`; one tick per
+/// value): `None`, and the caller keeps `f`.
+pub fn inline_within(f: &Function, max_uses: u32, max_size: u32, ticker: &Ticker) -> Option<(Function, InlineStats)> {
     let cl = Clusters::new(f);
     let n = f.values.len();
     let candidate: Vec<bool> = (0..n)
@@ -117,6 +131,9 @@ pub fn inline_function(f: &Function, max_uses: u32, max_size: u32) -> (Function,
         cx.map[v.index()] = Operand::Value(nv);
     }
     for &v in &f.body {
+        if ticker.tick() {
+            return None;
+        }
         let d = f.value(v);
         let class = cl.class[v.index()];
         let mut def = d.def.clone();
@@ -180,7 +197,7 @@ pub fn inline_function(f: &Function, max_uses: u32, max_size: u32) -> (Function,
     drop_dead(&mut g, &keep);
     stats.ops.1 = g.op_counts().total;
     stats.added = stats.ops.1.saturating_sub(stats.ops.0);
-    (g, stats)
+    Some((g, stats))
 }
 
 fn map_operands(def: Def, map: &[Operand]) -> Def {

@@ -28,6 +28,7 @@ pub mod sim;
 pub mod specialize;
 pub mod summary;
 pub mod sweep;
+pub mod time_limit;
 pub mod tree_height;
 pub mod whole_run;
 
@@ -40,6 +41,7 @@ pub use artifact::{unit_path, Artifact, ArtifactFile, GeneratedCode, Merge, Prod
 pub use manager::{DumpSink, Instrumentation, PassManager, PassRecord, PrintSelector};
 pub use params::{LatencyOverride, Member, ParamInfo, ParamKind, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
+pub use time_limit::{AtTimeLimit, Deadline, Ticker};
 
 /// What a pass may fail with.
 #[derive(Debug, thiserror::Error)]
@@ -107,6 +109,15 @@ pub enum PassError {
         span: Span,
         /// The error.
         error: Box<PassError>,
+    },
+    /// `-time-limit` was reached before or while a pass the output needs ran (see
+    /// [`time_limit`]): nothing is written.
+    #[error("pass `{pass}`: {message}")]
+    TimeLimit {
+        /// Pass name.
+        pass: String,
+        /// The limit and where the pass stopped.
+        message: String,
     },
     /// Writing a dump failed.
     #[error("cannot write dump {path}: {source}")]
@@ -180,6 +191,10 @@ pub struct PassContext {
     /// driver prints each on stderr as a `note:` line (with or without `-stats`) and lists them
     /// in the report's `stopped_early`.
     pub stopped: Vec<String>,
+    /// Tests: every [`Ticker`] of the run ([`PassContext::ticker`]) stops at this tick, so a
+    /// test stops any pass's loop at a chosen step whatever the machine's speed. `None` in
+    /// real runs.
+    pub tick_budget: Option<u64>,
     /// The module as it entered the pipeline: the reference `accuracy` measures errors
     /// against (issue 10). The manager sets it when a pass asks for it
     /// ([`Pass::needs_original`]) and it is not set yet (`-pareto` presets it).
@@ -197,42 +212,6 @@ pub struct PassContext {
     /// hidden by default; the driver plugs a display in when stderr is a terminal (see
     /// [`progress`]). Passes never write to the terminal themselves.
     pub progress: progress::Progress,
-}
-
-/// A wall-clock limit on a pipeline run (`-time-limit=SECONDS`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Deadline {
-    /// When the limit is reached.
-    pub at: std::time::Instant,
-    /// The limit as given, seconds.
-    pub seconds: f64,
-}
-
-impl Deadline {
-    /// A limit of `seconds` from now.
-    pub fn after_seconds(seconds: f64) -> Deadline {
-        let d = std::time::Duration::try_from_secs_f64(seconds.max(0.0)).unwrap_or(std::time::Duration::MAX);
-        let at = std::time::Instant::now().checked_add(d).unwrap_or_else(|| {
-            // Beyond what the clock can represent: about a century is "no limit".
-            std::time::Instant::now() + std::time::Duration::from_secs(100 * 365 * 86_400)
-        });
-        Deadline { at, seconds }
-    }
-
-    /// Time left before the limit (zero once reached).
-    pub fn time_left(&self) -> std::time::Duration {
-        self.at.saturating_duration_since(std::time::Instant::now())
-    }
-
-    /// True once the limit is reached.
-    pub fn reached(&self) -> bool {
-        std::time::Instant::now() >= self.at
-    }
-
-    /// Why a pass stopped: `time limit of 5 s reached`.
-    pub fn reason(&self) -> String {
-        format!("time limit of {} s reached", self.seconds)
-    }
 }
 
 impl PassContext {
@@ -272,6 +251,12 @@ impl PassContext {
         self.deadline.is_some_and(|d| d.reached())
     }
 
+    /// A [`Ticker`] for a pass's long loop: the run's deadline (and the test budget
+    /// [`PassContext::tick_budget`]).
+    pub fn ticker(&self) -> Ticker {
+        Ticker::new(self.deadline, self.tick_budget)
+    }
+
     /// Records that `pass` stopped early: `what` says where and why (`after 12 of 345 windows
     /// of @dirdyna: time limit of 1 s reached`); see [`PassContext::stopped`].
     pub fn note_stop(&mut self, pass: &str, what: &str) {
@@ -301,6 +286,12 @@ pub trait Pass: std::fmt::Debug {
     /// The phase every function must be in, if any; the manager checks it before `run`.
     fn requires(&self) -> Option<Phase> {
         None
+    }
+    /// What the manager does when `-time-limit` is reached before the pass starts
+    /// ([`time_limit`]): by default the run ends ([`AtTimeLimit::Required`]); a pass the
+    /// module is valid and complete without says [`AtTimeLimit::Skip`].
+    fn at_time_limit(&self) -> AtTimeLimit {
+        AtTimeLimit::Required
     }
     /// True when the pass keeps existing timing attributes valid (analyses that only read, or
     /// write timing themselves); otherwise the manager clears them after the pass.

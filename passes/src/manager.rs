@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use robovec_ir::{verifier, Module};
 
-use crate::{build_pass, parse_pipeline, Pass, PassContext, PassError, PassSpec};
+use crate::{build_pass, parse_pipeline, AtTimeLimit, Pass, PassContext, PassError, PassSpec};
 
 /// Which passes to print the IR before/after.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -198,6 +198,26 @@ impl PassManager {
         let mut records = Vec::new();
         for (i, (spec, pass)) in self.passes.iter().enumerate() {
             let name = pass.name();
+            if let Some(d) = cx.deadline.filter(crate::Deadline::reached) {
+                // `-time-limit` reached before the pass starts (crate::time_limit's policy).
+                match pass.at_time_limit() {
+                    AtTimeLimit::Skip => {
+                        cx.stopped.push(format!("{spec} skipped: {} before it started", d.reason()));
+                        let (ops_before, ops_after) = (module_ops(m), module_ops(m));
+                        records.push(PassRecord { name: spec.to_string(), wall_ms: 0.0, ops_before, ops_after });
+                        continue;
+                    }
+                    AtTimeLimit::Required => {
+                        let message = format!(
+                            "{} before it started (pass {} of {}); the output needs it, so nothing is written",
+                            d.reason(),
+                            i + 1,
+                            self.passes.len()
+                        );
+                        return Err(PassError::TimeLimit { pass: spec.to_string(), message });
+                    }
+                }
+            }
             if self.instr.print_before.selects(name) {
                 write!(log, "*** IR Dump Before {spec} ***\n{m}").map_err(PassError::Log)?;
             }

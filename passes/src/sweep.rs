@@ -226,6 +226,10 @@ impl Pass for Sweep {
         "sweep"
     }
 
+    fn at_time_limit(&self) -> crate::AtTimeLimit {
+        crate::AtTimeLimit::Skip
+    }
+
     fn requires(&self) -> Option<Phase> {
         Some(Phase::Atomised)
     }

@@ -150,6 +150,10 @@ impl Pass for Eqsat {
         "eqsat"
     }
 
+    fn at_time_limit(&self) -> crate::AtTimeLimit {
+        crate::AtTimeLimit::Skip
+    }
+
     fn requires(&self) -> Option<Phase> {
         Some(Phase::Atomised)
     }

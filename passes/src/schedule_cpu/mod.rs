@@ -43,7 +43,7 @@ pub mod pressure;
 use robovec_ir::{Def, Function, Module, Operand, Phase, Value};
 
 use crate::params::ParamKind;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 use pressure::{is_result, pressure_of_order, Pressure};
 
 /// Registry entry.
@@ -101,11 +101,22 @@ impl Pass for ScheduleCpu {
         Some(Phase::Atomised)
     }
 
+    fn at_time_limit(&self) -> AtTimeLimit {
+        AtTimeLimit::Skip
+    }
+
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let mut parts = Vec::new();
+        // The clock is read between functions and between the orders `best` compares (each
+        // O(n log n)); a function not started keeps its order.
+        let ticker = cx.ticker();
         for f in &mut m.functions {
+            if ticker.check() {
+                cx.note_stop("schedule-cpu", &format!("before @{} (kept in its order): {}", f.name, ticker.reason()));
+                break;
+            }
             let before = pressure_of_order(f, &f.body, self.registers);
-            let (order, which) = schedule(f, self.order, self.registers);
+            let (order, which) = schedule_within(f, self.order, self.registers, &ticker);
             let after = pressure_of_order(f, &order, self.registers);
             parts.push(format!(
                 "@{} max-live {} -> {}, excess over {} registers {} -> {} ({which})",
@@ -124,6 +135,12 @@ impl Pass for ScheduleCpu {
 /// The body order `order` asks for (a permutation of `f.body` that is a topological order),
 /// with the name of the order chosen (`dfs`, `greedy` or `original`).
 pub fn schedule(f: &Function, order: Order, registers: usize) -> (Vec<Value>, &'static str) {
+    schedule_within(f, order, registers, &Ticker::default())
+}
+
+/// [`schedule`] where `best` compares no further order once `ticker` says stop
+/// (`-time-limit`): the best of those compared (the original order first).
+pub fn schedule_within(f: &Function, order: Order, registers: usize, ticker: &Ticker) -> (Vec<Value>, &'static str) {
     match order {
         Order::Dfs => (dfs_order(f), "dfs"),
         Order::Greedy => (greedy_order(f), "greedy"),
@@ -131,7 +148,12 @@ pub fn schedule(f: &Function, order: Order, registers: usize) -> (Vec<Value>, &'
             let key = |p: Pressure| (p.excess, p.max_live, p.total);
             let mut best = (f.body.clone(), "original");
             let mut best_key = key(pressure_of_order(f, &f.body, registers));
-            for (o, name) in [(dfs_order(f), "dfs"), (greedy_order(f), "greedy")] {
+            let orders: [(fn(&Function) -> Vec<Value>, &'static str); 2] = [(dfs_order, "dfs"), (greedy_order, "greedy")];
+            for (make, name) in orders {
+                if ticker.check() {
+                    break;
+                }
+                let o = make(f);
                 let k = key(pressure_of_order(f, &o, registers));
                 if k < best_key {
                     best_key = k;

@@ -289,6 +289,10 @@ impl Pass for Sim {
         "sim"
     }
 
+    fn at_time_limit(&self) -> crate::AtTimeLimit {
+        crate::AtTimeLimit::Skip
+    }
+
     fn preserves_timing(&self) -> bool {
         true
     }

@@ -22,9 +22,9 @@ use robovec_ir::analysis::{compute_timing, Latencies};
 use robovec_ir::{BinOp, Def, Function, Module, Operand, Phase, Value};
 
 use super::cluster::{Class, Clusters};
-use super::{rewrite, Shape};
+use super::{rewrite_within, Shape};
 use crate::params::ParamKind;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -87,13 +87,25 @@ impl Pass for Distribute {
         Some(Phase::Atomised)
     }
 
+    fn at_time_limit(&self) -> AtTimeLimit {
+        AtTimeLimit::Skip
+    }
+
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let mut parts = Vec::new();
         let opts = Distribute { lat: cx.latencies_for("distribute", &self.given), ..self.clone() };
+        let ticker = cx.ticker();
         for f in &mut m.functions {
+            if ticker.stopped() {
+                break;
+            }
             let ops0 = f.op_counts().total;
-            let (g, s) = distribute_function(f, &opts);
+            let (g, s, stopped) = distribute_within(f, &opts, &ticker);
             *f = g;
+            if stopped {
+                let why = ticker.reason();
+                cx.note_stop("distribute", &format!("in @{} after {} rounds (kept): {why}", f.name, s.rounds));
+            }
             parts.push(format!(
                 "@{}: {} products distributed in {} rounds, ops {ops0} -> {}, balanced critical path {} -> {} cycles",
                 f.name,
@@ -122,19 +134,31 @@ pub struct DistributeStats {
 
 /// Distributes critical products of `f` (atomised, verified) as [`Distribute`] says.
 pub fn distribute_function(f: &Function, opts: &Distribute) -> (Function, DistributeStats) {
+    let (g, stats, _) = distribute_within(f, opts, &Ticker::default());
+    (g, stats)
+}
+
+/// [`distribute_function`] that stops when `ticker` says so (`-time-limit`): the rounds done
+/// are kept (a round stopped in its `balance` is dropped); the flag is true when it stopped.
+pub fn distribute_within(f: &Function, opts: &Distribute, ticker: &Ticker) -> (Function, DistributeStats, bool) {
     let budget = (f.op_counts().total as f64 * opts.max_growth).floor() as u64;
     let mut cur = f.clone();
-    let (mut balanced, _) = rewrite(&cur, Shape::Balance, &opts.lat);
+    let Some((mut balanced, _)) = rewrite_within(&cur, Shape::Balance, &opts.lat, ticker) else {
+        return (cur, DistributeStats::default(), true);
+    };
     let mut cp = compute_timing(&balanced, &opts.lat).1.asap_cycle;
     let mut stats = DistributeStats { cp: (cp, cp), ..DistributeStats::default() };
     for _ in 0..opts.rounds {
+        if ticker.check() {
+            break;
+        }
         let picks = pick(&cur, &balanced, opts, budget);
         if picks.is_empty() {
             break;
         }
         let n = picks.len() as u64;
         let next = apply(&cur, &picks);
-        let (b, _) = rewrite(&next, Shape::Balance, &opts.lat);
+        let Some((b, _)) = rewrite_within(&next, Shape::Balance, &opts.lat, ticker) else { break };
         let c = compute_timing(&b, &opts.lat).1.asap_cycle;
         if c >= cp || next.op_counts().total > budget {
             break;
@@ -144,7 +168,7 @@ pub fn distribute_function(f: &Function, opts: &Distribute) -> (Function, Distri
         stats.rounds += 1;
     }
     stats.cp.1 = cp;
-    (cur, stats)
+    (cur, stats, ticker.stopped())
 }
 
 /// A product to distribute: its cluster's root and the sum factor.

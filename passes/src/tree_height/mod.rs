@@ -41,6 +41,8 @@ mod tests;
 use robovec_ir::analysis::Latencies;
 use robovec_ir::Function;
 
+use crate::Ticker;
+
 pub use rebuild::RebuildStats;
 pub use shape::Shape;
 
@@ -60,19 +62,25 @@ pub struct Outcome {
 /// Rebuilds every cluster of `f` (atomised, verified) with `shape` under latencies `lat`,
 /// keeping the contract above.
 pub fn rewrite(f: &Function, shape: Shape, lat: &Latencies) -> (Function, Outcome) {
+    rewrite_within(f, shape, lat, &Ticker::default()).expect("a ticker without a limit never stops")
+}
+
+/// [`rewrite`] that stops when `ticker` says so (`-time-limit`; one tick per value rebuilt):
+/// `None`, and the caller keeps `f` as it was.
+pub fn rewrite_within(f: &Function, shape: Shape, lat: &Latencies, ticker: &Ticker) -> Option<(Function, Outcome)> {
     let ops = f.op_counts().total;
     let orig = rebuild::ready_times(f, lat);
     let cp = f.body.iter().filter(|&&v| f.op_kind(v).is_some()).map(|&v| orig[v.index()]).max().unwrap_or(0);
     for (fallback, trust) in [(0u8, true), (1, false)] {
-        let (g, stats, g_cp) = rebuild::rebuild(f, shape, lat, &orig, trust);
+        let (g, stats, g_cp) = rebuild::rebuild(f, shape, lat, &orig, trust, ticker)?;
         let g_ops = g.op_counts().total;
         if g_ops <= ops && g_cp <= cp {
-            return (g, Outcome { stats, ops: (ops, g_ops), asap_cycle: (cp, g_cp), fallback });
+            return Some((g, Outcome { stats, ops: (ops, g_ops), asap_cycle: (cp, g_cp), fallback }));
         }
     }
     let mut g = f.clone();
     g.clear_timing();
-    (g, Outcome { stats: RebuildStats::default(), ops: (ops, ops), asap_cycle: (cp, cp), fallback: 2 })
+    Some((g, Outcome { stats: RebuildStats::default(), ops: (ops, ops), asap_cycle: (cp, cp), fallback: 2 }))
 }
 
 /// One line for `-stats` summarising `outcomes` of a pass over a module.

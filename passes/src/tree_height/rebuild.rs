@@ -71,16 +71,24 @@ pub(super) struct Term {
 /// `f` op by op when the sign analysis holds (callers check the whole function).
 ///
 /// `orig` is the ASAPCycle of every value of `f` under `lat` ([`ready_times`]). Returns the new
-/// function, what was done, and its critical path (`asap_cycle`, cycles).
+/// function, what was done, and its critical path (`asap_cycle`, cycles); `None` when `ticker`
+/// (one tick per value) says stop (`-time-limit`): the caller keeps `f`.
 pub fn rebuild(
     f: &Function,
     shape: Shape,
     lat: &Latencies,
     orig: &[u32],
     trust_absorbs: bool,
-) -> (Function, RebuildStats, u32) {
+    ticker: &crate::Ticker,
+) -> Option<(Function, RebuildStats, u32)> {
     let cl = Clusters::new(f);
+    if ticker.check() {
+        return None;
+    }
     let absorb = if trust_absorbs { absorbs(f, &cl) } else { vec![false; f.values.len()] };
+    if ticker.check() {
+        return None;
+    }
     let mut out = Function::new(f.name.clone(), Phase::Atomised);
     out.equations = f.equations;
     out.span = f.span;
@@ -104,6 +112,9 @@ pub fn rebuild(
         e.rep[v.index()] = Some(Rep { op: Operand::Value(nv), neg: false });
     }
     for &v in &f.body {
+        if ticker.tick() {
+            return None;
+        }
         e.value(v);
     }
     for o in &f.outputs {
@@ -115,7 +126,7 @@ pub fn rebuild(
     }
     // Ready times of ops are their ASAPCycles, so the critical path is the latest of them.
     let cp = e.out.body.iter().filter(|&&v| e.out.op_kind(v).is_some()).map(|&v| e.ready[v.index()]).max().unwrap_or(0);
-    (e.out, e.stats, cp)
+    Some((e.out, e.stats, cp))
 }
 
 /// ASAPCycle of every value of `f` (atomised) under `lat`: inputs, trig variables and

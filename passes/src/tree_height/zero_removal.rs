@@ -22,8 +22,8 @@
 
 use robovec_ir::{Module, Phase};
 
-use super::{rewrite, summary, Shape};
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use super::{rewrite_within, summary, Shape};
+use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// The latency parameters the cluster rewrites take (cycles; SPEC §1 defaults).
 pub const LATENCY_PARAMS: &[ParamInfo] = crate::params::LATENCY_PARAMS;
@@ -59,11 +59,21 @@ impl Pass for ClusterRewrite {
         Some(Phase::Atomised)
     }
 
+    fn at_time_limit(&self) -> AtTimeLimit {
+        AtTimeLimit::Skip
+    }
+
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let mut outcomes = Vec::new();
         let lat = cx.latencies_for(self.name, &self.lat);
-        for f in &mut m.functions {
-            let (g, o) = rewrite(f, self.shape, &lat);
+        let ticker = cx.ticker();
+        let n = m.functions.len();
+        for (k, f) in m.functions.iter_mut().enumerate() {
+            let Some((g, o)) = rewrite_within(f, self.shape, &lat, &ticker) else {
+                let what = format!("in @{} ({k} of {n} functions rewritten; @{} kept as it was)", f.name, f.name);
+                cx.note_stop(self.name, &format!("{what}: {}", ticker.reason()));
+                break;
+            };
             *f = g;
             outcomes.push((f.name.clone(), o));
         }
