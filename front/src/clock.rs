@@ -15,68 +15,53 @@
 use std::cell::Cell;
 
 use robovec_ir::Span;
-use robovec_passes::Deadline;
+use robovec_passes::{Deadline, Ticker};
 
 use crate::FrontError;
 
-/// The deadline of one load and where it stopped (module doc).
+/// The deadline of one load and where it stopped (module doc): a [`Ticker`] that also
+/// remembers the byte offset of the step where it stopped.
 #[derive(Debug, Default)]
 pub struct Clock<'d> {
     deadline: Option<&'d Deadline>,
-    /// Tests: stop at this tick instead of reading a deadline (every loop's stop, whatever
-    /// the machine's speed).
-    budget: Option<u32>,
-    ticks: Cell<u32>,
+    ticker: Ticker,
     /// The byte offset of the step at which the deadline was found reached.
     stopped_at: Cell<Option<usize>>,
 }
 
 impl<'d> Clock<'d> {
     /// Ticks between two reads of the clock (a power of two).
-    pub const EVERY: u32 = 1024;
+    pub const EVERY: u64 = Ticker::EVERY;
 
     /// A clock for `deadline` (`None`: never stops).
     pub fn new(deadline: Option<&'d Deadline>) -> Clock<'d> {
-        Clock { deadline, budget: None, ticks: Cell::new(0), stopped_at: Cell::new(None) }
+        Clock { deadline, ticker: Ticker::new(deadline.copied(), None), stopped_at: Cell::new(None) }
     }
 
     /// A clock that stops at its `ticks`-th tick (tests: every loop's stop path, without
     /// timing).
     #[cfg(test)]
     pub(crate) fn after_ticks(ticks: u32) -> Clock<'static> {
-        Clock { budget: Some(ticks), ..Clock::default() }
+        Clock { ticker: Ticker::new(None, Some(u64::from(ticks))), ..Clock::default() }
+    }
+
+    /// Records the first stop, at byte `at`.
+    fn stop_at(&self, stopped: bool, at: usize) -> bool {
+        if stopped && self.stopped_at.get().is_none() {
+            self.stopped_at.set(Some(at));
+        }
+        stopped
     }
 
     /// Counts one step of a long loop, at byte `at` of the source; true once the deadline is
     /// reached (read every [`Clock::EVERY`] ticks): the loop must stop.
     pub fn tick(&self, at: usize) -> bool {
-        if self.stopped_at.get().is_some() {
-            return true;
-        }
-        let n = self.ticks.get().wrapping_add(1);
-        self.ticks.set(n);
-        if self.budget.is_some_and(|b| n >= b) {
-            self.stopped_at.set(Some(at));
-            return true;
-        }
-        let Some(d) = self.deadline else { return false };
-        if n.is_multiple_of(Self::EVERY) && d.reached() {
-            self.stopped_at.set(Some(at));
-            return true;
-        }
-        false
+        self.stop_at(self.ticker.tick(), at)
     }
 
     /// Reads the clock now (between phases), at byte `at`; true once the deadline is reached.
     pub fn check(&self, at: usize) -> bool {
-        if self.stopped_at.get().is_some() {
-            return true;
-        }
-        if self.deadline.is_some_and(Deadline::reached) {
-            self.stopped_at.set(Some(at));
-            return true;
-        }
-        false
+        self.stop_at(self.ticker.check(), at)
     }
 
     /// Whether a tick or check found the deadline reached.

@@ -25,7 +25,7 @@ use std::borrow::Cow;
 
 use robovec_ir::{BinOp, Def, Expr, Function, Module, Operand, Phase, Span, Value, ValueData};
 
-use crate::{Params, Pass, PassContext, PassError, PassInfo};
+use crate::{Params, Pass, PassContext, PassError, PassInfo, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -44,10 +44,17 @@ impl Pass for Atomise {
         "atomise"
     }
 
-    fn run(&self, m: &mut Module, _cx: &mut PassContext) -> Result<(), PassError> {
+    /// `-time-limit`: required (every later pass needs the atomised phase); it ticks once per
+    /// equation and a stop ends the run ([`PassError::TimeLimit`]).
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        let ticker = cx.ticker();
         for f in &mut m.functions {
             let parsed = std::mem::replace(f, Function::new(String::new(), Phase::Atomised));
-            *f = atomise_owned(parsed);
+            let (name, n, seen) = (parsed.name.clone(), parsed.body.len(), ticker.ticks());
+            *f = atomise_within(Cow::Owned(parsed), &ticker).ok_or_else(|| {
+                let done = ticker.ticks().saturating_sub(seen + 1);
+                ticker.error("atomise", &format!("in @{name} after {done} of {n} equations"))
+            })?;
         }
         Ok(())
     }
@@ -55,14 +62,14 @@ impl Pass for Atomise {
 
 /// Returns the atomised form of `f` (which must verify).
 pub fn atomise_function(f: &Function) -> Function {
-    atomise(Cow::Borrowed(f))
+    atomise_within(Cow::Borrowed(f), &Ticker::default()).expect("a ticker without a limit never stops")
 }
 
 /// [`atomise_function`] consuming `f`: each equation's expression is dropped as soon as it is
 /// atomised and names move instead of being copied, so the parsed and the atomised function
 /// are never both whole in memory (issue 10 §3). Same result as [`atomise_function`].
 pub fn atomise_owned(f: Function) -> Function {
-    atomise(Cow::Owned(f))
+    atomise_within(Cow::Owned(f), &Ticker::default()).expect("a ticker without a limit never stops")
 }
 
 /// The name, definition and span of `v`: borrowed, or taken out of an owned function.
@@ -79,7 +86,8 @@ fn take<'a>(src: &mut Cow<'a, Function>, v: Value) -> (Cow<'a, str>, Cow<'a, Def
     }
 }
 
-fn atomise(mut src: Cow<'_, Function>) -> Function {
+/// Atomises `src`; `None` when `ticker` (one tick per equation) says stop (`-time-limit`).
+fn atomise_within(mut src: Cow<'_, Function>, ticker: &Ticker) -> Option<Function> {
     let mut out = Function::new(src.name.clone(), Phase::Atomised);
     out.equations = src.equations;
     out.span = src.span;
@@ -105,6 +113,9 @@ fn atomise(mut src: Cow<'_, Function>) -> Function {
         map[v.index()] = Operand::Value(nv);
     }
     for i in 0..src.body.len() {
+        if ticker.tick() {
+            return None;
+        }
         let v = src.body[i];
         let (name, def, span) = take(&mut src, v);
         let m = |o: &Operand| match o {
@@ -146,7 +157,7 @@ fn atomise(mut src: Cow<'_, Function>) -> Function {
         };
         out.set_output(o.name.clone(), value, o.span);
     }
-    out
+    Some(out)
 }
 
 struct Emitter<'a> {

@@ -38,7 +38,7 @@ impl Pass for Dce {
         "dce"
     }
 
-    fn run(&self, m: &mut Module, _cx: &mut PassContext) -> Result<(), PassError> {
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         if let Some(keep) = &self.keep {
             for e in keep {
                 if !m.functions.iter().any(|f| f.outputs.iter().any(|o| matches(e, &o.name))) {
@@ -52,7 +52,13 @@ impl Pass for Dce {
                 }
             }
         }
-        for f in &mut m.functions {
+        // `-time-limit`: required (it changes what a function outputs and takes); two linear
+        // sweeps per function, so the clock is read between functions.
+        let ticker = cx.ticker();
+        for (k, f) in m.functions.iter_mut().enumerate() {
+            if ticker.check() {
+                return Err(ticker.error("dce", &format!("before @{} ({k} functions done)", f.name)));
+            }
             if let Some(keep) = &self.keep {
                 f.outputs.retain(|o| keep.iter().any(|e| matches(e, &o.name)));
             }

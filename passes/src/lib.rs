@@ -29,6 +29,8 @@ pub mod specialize;
 pub mod summary;
 pub mod sweep;
 pub mod time_limit;
+#[cfg(test)]
+mod time_limit_tests;
 pub mod tree_height;
 pub mod whole_run;
 

@@ -84,7 +84,13 @@ impl Pass for Specialize {
             .map(String::as_str)
             .collect();
         let mut parts = Vec::new();
-        for f in &mut m.functions {
+        // `-time-limit`: required (it changes what a function takes); one linear sweep per
+        // function, so the clock is read between functions (and by `dce` after).
+        let ticker = cx.ticker();
+        for (k, f) in m.functions.iter_mut().enumerate() {
+            if ticker.check() {
+                return Err(ticker.error("specialize", &format!("before @{} ({k} functions done)", f.name)));
+            }
             let before = f.op_counts().total;
             let known = specialize_function(f, &params);
             parts.push((f.name.clone(), before, known));

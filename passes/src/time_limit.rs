@@ -114,9 +114,10 @@ impl Ticker {
         reached
     }
 
-    /// Reads the clock now (between phases of a pass); true once the limit is reached.
+    /// Counts one step and reads the clock now (between phases of a pass, or per function
+    /// of a pass too fast to tick per op); true once the limit is reached.
     pub fn check(&self) -> bool {
-        if !self.stopped.get() && self.deadline.is_some_and(|d| d.reached()) {
+        if !self.tick() && self.deadline.is_some_and(|d| d.reached()) {
             self.stopped.set(true);
         }
         self.stopped.get()
@@ -177,7 +178,10 @@ mod tests {
         assert_eq!(t.ticks(), 3);
         assert_eq!(t.reason(), "tick budget of 3 steps reached");
         let e = t.error("atomise", "in @f after 2 of 9 values");
-        assert_eq!(e.to_string(), "pass `atomise`: tick budget of 3 steps reached: stopped in @f after 2 of 9 values; \
-             the output needs it, so nothing is written");
+        assert_eq!(
+            e.to_string(),
+            "pass `atomise`: tick budget of 3 steps reached: stopped in @f after 2 of 9 values; \
+             the output needs it, so nothing is written"
+        );
     }
 }

@@ -132,6 +132,9 @@ impl Pass for ScheduleCpu {
     }
 }
 
+/// A body order of a function (`dfs_order`, `greedy_order`).
+type OrderFn = fn(&Function) -> Vec<Value>;
+
 /// The body order `order` asks for (a permutation of `f.body` that is a topological order),
 /// with the name of the order chosen (`dfs`, `greedy` or `original`).
 pub fn schedule(f: &Function, order: Order, registers: usize) -> (Vec<Value>, &'static str) {
@@ -148,7 +151,7 @@ pub fn schedule_within(f: &Function, order: Order, registers: usize, ticker: &Ti
             let key = |p: Pressure| (p.excess, p.max_live, p.total);
             let mut best = (f.body.clone(), "original");
             let mut best_key = key(pressure_of_order(f, &f.body, registers));
-            let orders: [(fn(&Function) -> Vec<Value>, &'static str); 2] = [(dfs_order, "dfs"), (greedy_order, "greedy")];
+            let orders: [(OrderFn, &'static str); 2] = [(dfs_order, "dfs"), (greedy_order, "greedy")];
             for (make, name) in orders {
                 if ticker.check() {
                     break;

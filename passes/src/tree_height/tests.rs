@@ -184,7 +184,8 @@ fn two_signs_meeting_in_one_cluster_take_the_cautious_rebuild() {
     let f = parse(&src).unwrap().functions.remove(0);
     let lat = Latencies::default();
     let orig = super::rebuild::ready_times(&f, &lat);
-    let (trusting, _, _) = super::rebuild::rebuild(&f, Shape::Keep, &lat, &orig, true, &crate::Ticker::default()).expect("no limit");
+    let (trusting, _, _) =
+        super::rebuild::rebuild(&f, Shape::Keep, &lat, &orig, true, &crate::Ticker::default()).expect("no limit");
     assert_eq!(trusting.op_counts().total, 10, "{trusting}");
     let (g, o) = rewrite(&f, Shape::Keep, &lat);
     assert_eq!(o.fallback, 1, "{g}");

@@ -175,6 +175,9 @@ pub(crate) struct Body<'a> {
     /// `trig=inline`: value index → (its partner, true when this value's statement computes
     /// both); see [`fused_trig`].
     fused: HashMap<usize, (Value, bool)>,
+    /// `-time-limit`: one tick per statement written; once it says stop, no more statements
+    /// are written and the caller fails with [`crate::PassError::TimeLimit`].
+    ticker: &'a crate::Ticker,
 }
 
 impl<'a> Body<'a> {
@@ -185,9 +188,10 @@ impl<'a> Body<'a> {
         f: &'a Function,
         names: &'a [String],
         native: Option<&'a super::native::Native>,
+        ticker: &'a crate::Ticker,
     ) -> Body<'a> {
         let fused = if o.trig == Trig::Inline { fused_trig(f) } else { HashMap::new() };
-        Body { o, f, names, native, fused }
+        Body { o, f, names, native, fused, ticker }
     }
 
     /// The values that have a statement, in the order they are written, and for each whether
@@ -266,7 +270,7 @@ impl<'a> Body<'a> {
     /// statement of each value `v` (the plain ABI reads inputs at their first use and writes
     /// outputs as soon as they are computed; a split function also reads and writes its live
     /// values there). The statement of an attached trig value is empty: the value before it
-    /// declared both.
+    /// declared both. Stops early, the text incomplete, when the ticker says stop.
     pub fn statements_with(
         &self,
         order: &[Value],
@@ -278,6 +282,9 @@ impl<'a> Body<'a> {
         let vec = self.o.batch > 1;
         let sfx = if self.o.f32() { "f" } else { "" };
         for &v in order {
+            if self.ticker.tick() {
+                return;
+            }
             let name = &self.names[v.index()];
             let def = &self.f.value(v).def;
             before(s, v);

@@ -285,6 +285,21 @@ impl CodegenC {
     /// [`PassError::Failed`] when a function cannot be written in this ABI (an unknown
     /// Robotran function kind for `abi=robotran`, a callback used with two arities).
     pub fn emit_as(&self, m: &Module, main: Option<&Path>) -> Result<CodegenArtifact, PassError> {
+        self.emit_within(m, main, &crate::Ticker::default())
+    }
+
+    /// [`CodegenC::emit_as`] that stops when `ticker` says so (`-time-limit`; one tick per
+    /// statement written).
+    ///
+    /// # Errors
+    /// As [`CodegenC::emit_as`], and [`PassError::TimeLimit`] when stopped (the code is the
+    /// run's output: no part of it is returned).
+    pub fn emit_within(
+        &self,
+        m: &Module,
+        main: Option<&Path>,
+        ticker: &crate::Ticker,
+    ) -> Result<CodegenArtifact, PassError> {
         let several = m.functions.len() > 1;
         let fused = m.functions.iter().any(has_fused);
         let callbacks = body::callbacks(m)?;
@@ -299,10 +314,13 @@ impl CodegenC {
         let mut emitted = Vec::with_capacity(m.functions.len());
         for (f, symbol) in m.functions.iter().zip(&symbols) {
             emitted.push(if self.abi == Abi::Robotran {
-                robotran::function(self, f, symbol, &taken)?
+                robotran::function(self, f, symbol, &taken, ticker)?
             } else {
-                plain::function(self, f, symbol, &taken)
+                plain::function(self, f, symbol, &taken, ticker)
             });
+            if ticker.stopped() {
+                return Err(ticker.error("codegen", &format!("writing @{}", f.name)));
+            }
         }
         let units = self.units as usize;
         let unit_of = unit_assignment(&emitted, units);
@@ -476,7 +494,8 @@ impl Pass for CodegenC {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let main = cx.code_file.clone();
-        super::run_emitter(m, cx, |m| self.emit_as(m, main.as_deref()))
+        let ticker = cx.ticker();
+        super::run_emitter(m, cx, |m| self.emit_within(m, main.as_deref(), &ticker))
     }
 
     fn requires(&self) -> Option<robovec_ir::Phase> {

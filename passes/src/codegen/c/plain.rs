@@ -38,14 +38,20 @@ pub const RESERVED: &[&str] = &["in", "out", "live"];
 /// `f` as `symbol`: its definition (split into parts of at most `o.chunk` statements when it
 /// has more; part names avoid `taken`, the file's other global names), its prototype (with the
 /// documented input and output order, for the header) and its interface.
-pub(crate) fn function(o: &CodegenC, f: &Function, symbol: &str, taken: &HashSet<String>) -> Emitted {
+pub(crate) fn function(
+    o: &CodegenC,
+    f: &Function,
+    symbol: &str,
+    taken: &HashSet<String>,
+    ticker: &crate::Ticker,
+) -> Emitted {
     let iface = interface(o, f, symbol);
     let mut reserved: Vec<&str> = RESERVED.to_vec();
     reserved.push(symbol);
     let callee_names = super::body::callee_names(f);
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
-    let b = Body::new(o, f, &names, None);
+    let b = Body::new(o, f, &names, None, ticker);
     let (order, attached) = b.order();
     let plan = Plan::new(f, &order, &attached, o.chunk as usize, &[], &[]);
     let real = o.real();

@@ -140,6 +140,7 @@ pub(crate) fn function(
     f: &Function,
     symbol: &str,
     taken: &HashSet<String>,
+    ticker: &crate::Ticker,
 ) -> Result<Emitted, PassError> {
     let fail =
         |message: String| PassError::Failed { pass: "codegen".into(), message: format!("@{}: {message}", f.name) };
@@ -164,8 +165,8 @@ pub(crate) fn function(
     let callee_names = super::body::callee_names(f);
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
-    let native = super::native::statements(&Body::new(o, f, &names, None))?;
-    let b = Body::new(o, f, &names, Some(&native));
+    let native = super::native::statements(&Body::new(o, f, &names, None, ticker))?;
+    let b = Body::new(o, f, &names, Some(&native), ticker);
     let (defined, sig, proto) = match sens {
         Some((_, k)) => {
             let d = format!("robovec_{symbol}_{k}");

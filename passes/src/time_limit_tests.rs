@@ -1,0 +1,197 @@
+//! `-time-limit` in every pass (issue 28 item 3): what the manager does with a pass not
+//! started at the limit, and where each pass stops inside with [`PassContext::tick_budget`]
+//! (deterministic: the k-th tick stops whatever the machine's speed).
+
+use robovec_ir::interp::{eval, pseudo_random_input};
+use robovec_ir::text::parse;
+use robovec_ir::{verifier, Module};
+
+use crate::{AtTimeLimit, Deadline, Instrumentation, PassContext, PassError, PassManager};
+
+/// A parsed module of `n` equations with unary minus (zero-removal's `0 − x`), repeated
+/// products (cse), sums to reassociate (balance) and multiply-adds (contract).
+fn parsed(n: usize) -> Module {
+    let mut t = String::from("func @f { input %q[1] input %q[2] input %qd[1] input %qd[2]\n");
+    t += "%t1 = %q[1]*%q[2] + %qd[1]\n%t2 = %q[2]*%qd[1] - %qd[2]\n";
+    for k in 3..=n {
+        t += &format!("%t{k} = -%t{}*%q[1] + %q[2]*%qd[1] + %t{}*%qd[2] - %qd[1]\n", k - 1, k - 2);
+    }
+    t += &format!("output c[1] = %t{n}\noutput c[2] = %t{}\n}}\n", n - 1);
+    parse(&t).expect("the test module parses")
+}
+
+fn atomised(n: usize) -> Module {
+    let mut m = parsed(n);
+    crate::Pass::run(&crate::atomise::Atomise, &mut m, &mut PassContext::default()).expect("atomise runs");
+    m
+}
+
+fn outputs(m: &Module) -> Vec<(String, f64)> {
+    eval::<f64>(&m.functions[0], |n| pseudo_random_input(n, 7))
+}
+
+/// Every registered pass with a pipeline element that builds it and what a limit reached
+/// before it starts does (issue 28: "the README's list of passes that honour it becomes all").
+const EVERY_PASS: &[(&str, AtTimeLimit)] = &[
+    ("atomise", AtTimeLimit::Required),
+    ("dce", AtTimeLimit::Required),
+    ("asap-alap", AtTimeLimit::Skip),
+    ("place<pe=2>", AtTimeLimit::Required),
+    ("sim", AtTimeLimit::Skip),
+    ("sweep", AtTimeLimit::Skip),
+    ("accuracy", AtTimeLimit::Skip),
+    ("zero-removal", AtTimeLimit::Skip),
+    ("swap", AtTimeLimit::Skip),
+    ("balance", AtTimeLimit::Skip),
+    ("inline", AtTimeLimit::Skip),
+    ("distribute", AtTimeLimit::Skip),
+    ("specialize", AtTimeLimit::Required),
+    ("eqsat", AtTimeLimit::Skip),
+    ("cse", AtTimeLimit::Skip),
+    ("contract", AtTimeLimit::Skip),
+    ("schedule-cpu", AtTimeLimit::Skip),
+    ("codegen<c>", AtTimeLimit::Required),
+    ("codegen<fpga;out=unused>", AtTimeLimit::Required),
+];
+
+#[test]
+fn every_registered_pass_is_skipped_or_ends_the_run_when_the_limit_is_reached_before_it() {
+    for info in crate::PASSES {
+        assert!(
+            EVERY_PASS.iter().any(|(p, _)| p.split('<').next() == Some(info.name)),
+            "pass `{}` is missing from EVERY_PASS: say what a reached limit does to it",
+            info.name
+        );
+    }
+    for &(text, policy) in EVERY_PASS {
+        let pm = PassManager::new(text, Instrumentation::default()).expect("builds");
+        assert_eq!(pm.passes().next().map(crate::Pass::at_time_limit), Some(policy), "{text}");
+        let mut m = if text == "atomise" { parsed(20) } else { atomised(20) };
+        let before = m.to_string();
+        let mut cx = PassContext { deadline: Some(Deadline::after_seconds(0.0)), ..PassContext::default() };
+        let ran = pm.run(&mut m, &mut cx, &mut Vec::new());
+        match policy {
+            AtTimeLimit::Skip => {
+                let records = ran.unwrap_or_else(|e| panic!("{text}: {e}"));
+                assert_eq!(cx.stopped, [format!("{text} skipped: time limit of 0 s reached before it started")]);
+                assert_eq!(m.to_string(), before, "{text}: a skipped pass leaves the module as it was");
+                assert_eq!((records.len(), records[0].wall_ms), (1, 0.0), "{text}: listed with no time");
+            }
+            AtTimeLimit::Required => match ran {
+                Err(PassError::TimeLimit { pass, message }) => {
+                    assert_eq!(pass, text);
+                    assert_eq!(
+                        message,
+                        "time limit of 0 s reached before it started (pass 1 of 1); the output needs it, \
+                         so nothing is written"
+                    );
+                }
+                other => panic!("{text}: {other:?}"),
+            },
+        }
+    }
+}
+
+#[test]
+fn a_limit_reached_between_passes_skips_the_rest_or_ends_at_the_first_required_one() {
+    let pm = PassManager::new("atomise,balance,cse,codegen<c>", Instrumentation::default()).expect("builds");
+    let mut m = parsed(20);
+    let mut cx = PassContext { deadline: Some(Deadline::after_seconds(0.0)), ..PassContext::default() };
+    let e = pm.run(&mut m, &mut cx, &mut Vec::new()).expect_err("atomise cannot be skipped");
+    assert!(e.to_string().contains("pass 1 of 4"), "{e}");
+    let pm = PassManager::new("balance,cse,asap-alap", Instrumentation::default()).expect("builds");
+    let mut m = atomised(20);
+    let mut cx = PassContext { deadline: Some(Deadline::after_seconds(0.0)), ..PassContext::default() };
+    pm.run(&mut m, &mut cx, &mut Vec::new()).expect("all skippable");
+    assert_eq!(cx.stopped.len(), 3, "{:?}", cx.stopped);
+}
+
+/// Runs `text` on `m` with every ticker stopping at tick `budget`.
+fn run_budget(text: &str, m: &mut Module, budget: u64) -> (Result<(), PassError>, Vec<String>) {
+    let pm = PassManager::new(text, Instrumentation::default()).expect("builds");
+    let mut cx = PassContext { tick_budget: Some(budget), ..PassContext::default() };
+    let ran = pm.run(m, &mut cx, &mut Vec::new()).map(|_| ());
+    (ran, cx.stopped)
+}
+
+#[test]
+fn rebuilding_rewrites_stopped_inside_keep_the_function_as_it_was() {
+    for text in ["zero-removal", "swap", "balance", "inline", "distribute"] {
+        let mut m = atomised(60);
+        let before = m.to_string();
+        let (ran, stopped) = run_budget(text, &mut m, 5);
+        ran.unwrap_or_else(|e| panic!("{text}: {e}"));
+        assert_eq!(stopped.len(), 1, "{text}: {stopped:?}");
+        assert!(stopped[0].starts_with(&format!("{text} stopped in @f")), "{text}: {}", stopped[0]);
+        assert!(stopped[0].ends_with("tick budget of 5 steps reached"), "{}", stopped[0]);
+        assert_eq!(m.to_string(), before, "{text}: the function being rebuilt is kept");
+        // Without a limit the pass does its work (the module changes), without a note.
+        let mut m = atomised(60);
+        let (ran, stopped) = run_budget(text, &mut m, u64::MAX);
+        ran.unwrap_or_else(|e| panic!("{text}: {e}"));
+        assert!(stopped.is_empty(), "{text}: {stopped:?}");
+        assert!(text == "inline" || text == "distribute" || m.to_string() != before, "{text} changed nothing");
+    }
+}
+
+#[test]
+fn cse_and_contract_stopped_inside_keep_what_they_merged_and_a_valid_function() {
+    let full = |text: &str| {
+        let mut m = atomised(60);
+        run_budget(text, &mut m, u64::MAX).0.expect("runs");
+        m.functions[0].op_counts().total
+    };
+    let ops0 = atomised(60).functions[0].op_counts().total;
+    for text in ["cse", "contract"] {
+        let mut m = atomised(60);
+        let (ran, stopped) = run_budget(text, &mut m, 150);
+        ran.expect("skippable");
+        assert_eq!(stopped.len(), 1, "{stopped:?}");
+        assert!(stopped[0].starts_with(&format!("{text} stopped in @f")), "{}", stopped[0]);
+        assert!(verifier::verify(&m).is_ok(), "{text}: {:?}", verifier::verify(&m));
+        let ops = m.functions[0].op_counts().total;
+        assert!(full(text) < ops && ops < ops0, "{text}: part of the work is kept: {} < {ops} < {ops0}", full(text));
+    }
+    // cse is exact: the outputs stay bit for bit.
+    let mut m = atomised(60);
+    run_budget("cse", &mut m, 150).0.expect("runs");
+    let bits = |o: Vec<(String, f64)>| o.into_iter().map(|(n, x)| (n, x.to_bits())).collect::<Vec<_>>();
+    assert_eq!(bits(outputs(&m)), bits(outputs(&atomised(60))));
+}
+
+#[test]
+fn passes_that_check_between_functions_stop_before_the_next_one() {
+    for text in ["asap-alap", "schedule-cpu"] {
+        let mut m = atomised(60);
+        let before = m.to_string();
+        let (ran, stopped) = run_budget(text, &mut m, 1);
+        ran.unwrap_or_else(|e| panic!("{text}: {e}"));
+        assert_eq!(stopped.len(), 1, "{text}: {stopped:?}");
+        assert!(stopped[0].starts_with(&format!("{text} stopped before @f")), "{}", stopped[0]);
+        assert_eq!(m.to_string(), before, "{text}");
+    }
+}
+
+#[test]
+fn required_passes_stopped_inside_end_the_run_saying_where() {
+    for (text, budget, expect) in [
+        ("atomise", 5, "stopped in @f after 4 of 60 equations"),
+        ("dce", 1, "stopped before @f (0 functions done)"),
+        ("specialize", 1, "stopped before @f (0 functions done)"),
+        ("codegen<c>", 5, "stopped writing @f"),
+        ("codegen<c;abi=robotran>", 5, "stopped writing @dirdyna"),
+    ] {
+        let mut m = if text == "atomise" { parsed(60) } else { atomised(60) };
+        if text.contains("robotran") {
+            m.functions[0].name = "dirdyna".into();
+        }
+        match run_budget(text, &mut m, budget).0 {
+            Err(e @ PassError::TimeLimit { .. }) => {
+                let e = e.to_string();
+                assert!(e.contains(&format!("tick budget of {budget} steps reached: {expect};")), "{text}: {e}");
+                assert!(e.ends_with("the output needs it, so nothing is written"), "{e}");
+            }
+            other => panic!("{text}: {other:?}"),
+        }
+    }
+}
