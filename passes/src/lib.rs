@@ -197,6 +197,10 @@ pub struct PassContext {
     /// test stops any pass's loop at a chosen step whatever the machine's speed. `None` in
     /// real runs.
     pub tick_budget: Option<u64>,
+    /// What `-time-limit` does to the pass running now (set by the manager from
+    /// [`Pass::at_time_limit`]; [`AtTimeLimit::Skip`] outside a pipeline): the tickers of a
+    /// required pass ([`PassContext::ticker`]) run to the limit's grace ([`Deadline::grace`]).
+    pub running: AtTimeLimit,
     /// The module as it entered the pipeline: the reference `accuracy` measures errors
     /// against (issue 10). The manager sets it when a pass asks for it
     /// ([`Pass::needs_original`]) and it is not set yet (`-pareto` presets it).
@@ -253,10 +257,14 @@ impl PassContext {
         self.deadline.is_some_and(|d| d.reached())
     }
 
-    /// A [`Ticker`] for a pass's long loop: the run's deadline (and the test budget
-    /// [`PassContext::tick_budget`]).
+    /// A [`Ticker`] for a pass's long loop: the run's deadline, or its grace for a required
+    /// pass ([`PassContext::running`]), and the test budget [`PassContext::tick_budget`].
     pub fn ticker(&self) -> Ticker {
-        Ticker::new(self.deadline, self.tick_budget)
+        let deadline = match self.running {
+            AtTimeLimit::Skip => self.deadline,
+            AtTimeLimit::Required => self.deadline.map(|d| d.grace()),
+        };
+        Ticker::new(deadline, self.tick_budget)
     }
 
     /// Records that `pass` stopped early: `what` says where and why (`after 12 of 345 windows

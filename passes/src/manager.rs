@@ -207,15 +207,16 @@ impl PassManager {
                         records.push(PassRecord { name: spec.to_string(), wall_ms: 0.0, ops_before, ops_after });
                         continue;
                     }
-                    AtTimeLimit::Required => {
+                    AtTimeLimit::Required if d.grace().reached() => {
                         let message = format!(
                             "{} before it started (pass {} of {}); the output needs it, so nothing is written",
-                            d.reason(),
+                            d.grace().reason(),
                             i + 1,
                             self.passes.len()
                         );
                         return Err(PassError::TimeLimit { pass: spec.to_string(), message });
                     }
+                    AtTimeLimit::Required => {}
                 }
             }
             if self.instr.print_before.selects(name) {
@@ -228,8 +229,10 @@ impl PassManager {
             let ops_before = module_ops(m);
             let t0 = Instant::now();
             cx.pass_index = Some(i);
+            cx.running = pass.at_time_limit();
             let ran = pass.run(m, cx);
             cx.pass_index = None;
+            cx.running = AtTimeLimit::Skip;
             ran?;
             let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
             if !pass.preserves_timing() {

@@ -3,25 +3,28 @@
 //! a pass the limit reaches ([`AtTimeLimit`]).
 //!
 //! # Policy
-//! The deadline starts with the run, before loading (the front ends read it too). Then:
+//! The deadline starts with the run, before loading (the front ends read it too, and a load it
+//! stops ends the run). The limit is for the work a run may cut short; what the output cannot
+//! do without gets a short **grace** after it ([`Deadline::grace`]: 5 % of the limit plus
+//! 0.5 s), so that a search that used the time to the limit (`eqsat`, `place`'s improvement,
+//! `accuracy`) still leaves a result:
 //!
-//! - **A pass not started at the limit**: the manager skips it when the module is valid and
-//!   complete without it ([`AtTimeLimit::Skip`]: the rewrites that only improve, the analyses,
-//!   the checks and measurements), with a note (`balance skipped: time limit of 1 s reached
-//!   before it started`); it ends the run when the output needs it ([`AtTimeLimit::Required`]:
-//!   `atomise`, whose phase every later pass needs, `place`, the back ends, and the passes that
-//!   change what a function computes or takes, `specialize` and `dce`), with
-//!   [`PassError::TimeLimit`] (exit 1, nothing written, as a limit reached while loading).
-//! - **A pass the limit reaches while it runs** stops at its next step (every loop over ops,
-//!   values, cycles or samples ticks a [`Ticker`], read every [`Ticker::EVERY`] steps): a
-//!   skippable pass keeps a valid result and notes where it stopped (a rebuilding rewrite keeps
-//!   the function it was rebuilding as it was; the searches keep the best found so far; the
-//!   measurements report what they measured); a required pass returns
-//!   [`PassError::TimeLimit`] saying where it was.
+//! - **A skippable pass** ([`AtTimeLimit::Skip`]: the rewrites that only improve, the
+//!   analyses, the checks and measurements) not started at the limit is skipped with a note
+//!   (`balance skipped: time limit of 1 s reached before it started`); one the limit reaches
+//!   while it runs stops at its next step with a valid module and a note (a rebuilding rewrite
+//!   keeps the function it was rebuilding as it was; the searches keep the best found so far;
+//!   the measurements report what they measured).
+//! - **A required pass** ([`AtTimeLimit::Required`]: `atomise`, whose phase every later pass
+//!   needs, `place`'s first schedule, the back ends, and the passes that change what a
+//!   function computes or takes, `specialize` and `dce`) runs, its tickers reading the grace;
+//!   at the grace's end it stops with [`PassError::TimeLimit`] (exit 1, nothing written, as a
+//!   limit reached while loading), and so does the manager for one not started by then.
 //!
-//! So a run ends at the limit plus one step of some loop (microseconds) plus what is never
-//! interrupted: the verifier after each pass and writing the outputs, both linear and a
-//! fraction of any pass's time.
+//! Every loop over ops, values, cycles or samples ticks a [`Ticker`] (the clock is read every
+//! [`Ticker::EVERY`] ticks), so a run ends at the limit (or its grace) plus one step of some
+//! loop plus what is never interrupted: the verifier after each pass and writing the outputs,
+//! both linear and a fraction of any pass's time.
 //!
 //! Tests make the stops deterministic with [`crate::PassContext::tick_budget`] (every ticker
 //! of the run stops at that tick whatever the machine's speed) or a deadline already passed.
@@ -30,24 +33,39 @@ use std::cell::Cell;
 
 use crate::PassError;
 
-/// A wall-clock limit on a pipeline run (`-time-limit=SECONDS`).
+/// A wall-clock limit on a pipeline run (`-time-limit=SECONDS`), or its grace (module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Deadline {
     /// When the limit is reached.
     pub at: std::time::Instant,
     /// The limit as given, seconds.
     pub seconds: f64,
+    /// True for [`Deadline::grace`]: the limit plus the grace the passes the output needs get.
+    pub grace: bool,
 }
 
 impl Deadline {
     /// A limit of `seconds` from now.
     pub fn after_seconds(seconds: f64) -> Deadline {
         let d = std::time::Duration::try_from_secs_f64(seconds.max(0.0)).unwrap_or(std::time::Duration::MAX);
-        let at = std::time::Instant::now().checked_add(d).unwrap_or_else(|| {
-            // Beyond what the clock can represent: about a century is "no limit".
-            std::time::Instant::now() + std::time::Duration::from_secs(100 * 365 * 86_400)
-        });
-        Deadline { at, seconds }
+        Deadline { at: later(std::time::Instant::now(), d), seconds, grace: false }
+    }
+
+    /// The grace of a limit of `seconds`: 5 % of it plus 0.5 s, so that a run whose searches
+    /// stopped at the limit still ends within the 10 % + 1 s of it after the required
+    /// passes, the verifier and the output.
+    pub fn grace_seconds(seconds: f64) -> f64 {
+        0.05 * seconds + 0.5
+    }
+
+    /// The deadline of the passes the output needs ([`AtTimeLimit::Required`]): this limit
+    /// plus [`Deadline::grace_seconds`].
+    pub fn grace(&self) -> Deadline {
+        if self.grace {
+            return *self;
+        }
+        let extra = std::time::Duration::try_from_secs_f64(Self::grace_seconds(self.seconds)).unwrap_or_default();
+        Deadline { at: later(self.at, extra), grace: true, ..*self }
     }
 
     /// Time left before the limit (zero once reached).
@@ -60,19 +78,32 @@ impl Deadline {
         std::time::Instant::now() >= self.at
     }
 
-    /// Why a pass stopped: `time limit of 5 s reached`.
+    /// Why a pass stopped: `time limit of 5 s reached` (a grace: `time limit of 5 s and its
+    /// grace of 0.75 s reached`).
     pub fn reason(&self) -> String {
-        format!("time limit of {} s reached", self.seconds)
+        if self.grace {
+            format!("time limit of {} s and its grace of {} s reached", self.seconds, Self::grace_seconds(self.seconds))
+        } else {
+            format!("time limit of {} s reached", self.seconds)
+        }
     }
+}
+
+/// `t + d`, or about a century from now beyond what the clock represents ("no limit").
+fn later(t: std::time::Instant, d: std::time::Duration) -> std::time::Instant {
+    t.checked_add(d).unwrap_or_else(|| std::time::Instant::now() + std::time::Duration::from_secs(100 * 365 * 86_400))
 }
 
 /// What the manager does with a pass that has not started when `-time-limit` is reached
 /// (module doc).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum AtTimeLimit {
-    /// Skip it with a note: the module is valid and complete without it.
+    /// Skip it with a note: the module is valid and complete without it. Its tickers stop at
+    /// the limit.
+    #[default]
     Skip,
-    /// End the run with [`PassError::TimeLimit`]: the output needs it.
+    /// Run it within the grace ([`Deadline::grace`]), whose end stops it with
+    /// [`PassError::TimeLimit`]: the output needs it.
     Required,
 }
 

@@ -26,6 +26,17 @@ fn atomised(n: usize) -> Module {
     m
 }
 
+/// A limit of 0 s reached 1 s ago: its grace (0.5 s) is over too.
+fn passed() -> Deadline {
+    let at = std::time::Instant::now().checked_sub(std::time::Duration::from_secs(1)).expect("clock");
+    Deadline { at, seconds: 0.0, grace: false }
+}
+
+/// A limit of 1000 s reached now: its grace (50.5 s) is far away.
+fn reached_with_grace_left() -> Deadline {
+    Deadline { at: std::time::Instant::now(), seconds: 1000.0, grace: false }
+}
+
 fn outputs(m: &Module) -> Vec<(String, f64)> {
     eval::<f64>(&m.functions[0], |n| pseudo_random_input(n, 7))
 }
@@ -68,7 +79,7 @@ fn every_registered_pass_is_skipped_or_ends_the_run_when_the_limit_is_reached_be
         assert_eq!(pm.passes().next().map(crate::Pass::at_time_limit), Some(policy), "{text}");
         let mut m = if text == "atomise" { parsed(20) } else { atomised(20) };
         let before = m.to_string();
-        let mut cx = PassContext { deadline: Some(Deadline::after_seconds(0.0)), ..PassContext::default() };
+        let mut cx = PassContext { deadline: Some(passed()), ..PassContext::default() };
         let ran = pm.run(&mut m, &mut cx, &mut Vec::new());
         match policy {
             AtTimeLimit::Skip => {
@@ -82,8 +93,8 @@ fn every_registered_pass_is_skipped_or_ends_the_run_when_the_limit_is_reached_be
                     assert_eq!(pass, text);
                     assert_eq!(
                         message,
-                        "time limit of 0 s reached before it started (pass 1 of 1); the output needs it, \
-                         so nothing is written"
+                        "time limit of 0 s and its grace of 0.5 s reached before it started (pass 1 of 1); \
+                         the output needs it, so nothing is written"
                     );
                 }
                 other => panic!("{text}: {other:?}"),
@@ -93,17 +104,35 @@ fn every_registered_pass_is_skipped_or_ends_the_run_when_the_limit_is_reached_be
 }
 
 #[test]
-fn a_limit_reached_between_passes_skips_the_rest_or_ends_at_the_first_required_one() {
+fn after_the_limit_required_passes_run_in_its_grace_and_the_others_are_skipped() {
     let pm = PassManager::new("atomise,balance,cse,codegen<c>", Instrumentation::default()).expect("builds");
     let mut m = parsed(20);
-    let mut cx = PassContext { deadline: Some(Deadline::after_seconds(0.0)), ..PassContext::default() };
+    let mut cx = PassContext { deadline: Some(reached_with_grace_left()), ..PassContext::default() };
+    pm.run(&mut m, &mut cx, &mut Vec::new()).expect("atomise and codegen run in the grace");
+    assert_eq!(
+        cx.stopped,
+        [
+            "balance skipped: time limit of 1000 s reached before it started",
+            "cse skipped: time limit of 1000 s reached before it started"
+        ]
+    );
+    assert_eq!(cx.artifacts().count(), 1, "the code");
+    // Once the grace is over too, the first required pass ends the run.
+    let mut m = parsed(20);
+    let mut cx = PassContext { deadline: Some(passed()), ..PassContext::default() };
     let e = pm.run(&mut m, &mut cx, &mut Vec::new()).expect_err("atomise cannot be skipped");
     assert!(e.to_string().contains("pass 1 of 4"), "{e}");
-    let pm = PassManager::new("balance,cse,asap-alap", Instrumentation::default()).expect("builds");
-    let mut m = atomised(20);
-    let mut cx = PassContext { deadline: Some(Deadline::after_seconds(0.0)), ..PassContext::default() };
-    pm.run(&mut m, &mut cx, &mut Vec::new()).expect("all skippable");
-    assert_eq!(cx.stopped.len(), 3, "{:?}", cx.stopped);
+}
+
+#[test]
+fn a_required_pass_reads_the_grace_and_a_skippable_one_the_limit() {
+    let d = reached_with_grace_left();
+    let mut cx = PassContext { deadline: Some(d), ..PassContext::default() };
+    assert!(cx.ticker().check(), "skippable: the limit");
+    cx.running = AtTimeLimit::Required;
+    assert!(!cx.ticker().check(), "required: the grace");
+    assert_eq!(d.grace().reason(), "time limit of 1000 s and its grace of 50.5 s reached");
+    assert_eq!(d.grace().grace(), d.grace(), "a grace has no grace");
 }
 
 /// Runs `text` on `m` with every ticker stopping at tick `budget`.

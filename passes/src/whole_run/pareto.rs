@@ -190,7 +190,9 @@ pub fn study(
 
 /// The rows of [`study`]. Under `-time-limit` (`deadline`), each pipeline and measurement stops
 /// early as in a normal run (a valid result, fewer samples) and its row says so in
-/// `stopped_early`; the pipelines after the limit still run their passes' minimal work.
+/// `stopped_early`; each pipeline gets an equal share of the time left when it starts (half
+/// of it to measure, half for the check of the same points), so every pipeline is measured
+/// before the limit.
 ///
 /// `task` is set to the pipelines done after each one.
 ///
@@ -210,9 +212,16 @@ fn run_reporting(
     let original =
         module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
     let (pipelines, managers): (Vec<String>, Vec<PassManager>) = managers(text)?.into_iter().unzip();
-    let opts = AccuracyOptions { samples, seed, deadline: deadline.map(|d| d.at), ..AccuracyOptions::default() };
     let mut rows = Vec::new();
-    for (p, pm) in pipelines.iter().zip(&managers) {
+    for (k, (p, pm)) in pipelines.iter().zip(&managers).enumerate() {
+        // Each pipeline gets an equal share of the time left, half of it to measure (the
+        // soundness check of the same points takes about as long), so that every pipeline is
+        // measured (with fewer samples) before the limit.
+        let share = deadline.map(|d| {
+            let now = std::time::Instant::now();
+            now + d.at.saturating_duration_since(now) / (2 * (pipelines.len() - k)) as u32
+        });
+        let opts = AccuracyOptions { samples, seed, deadline: share, ..AccuracyOptions::default() };
         let mut m = module.clone();
         let mut cx =
             PassContext { original: Some(module.clone()), deadline, ..PassContext::with_target(target.clone()) };
