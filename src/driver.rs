@@ -317,7 +317,8 @@ fn run_passes(
         writeln!(stderr, "note: {s}").map_err(stderr_failure)?;
     }
     if let (Some((samples, seed)), Some(original)) = (opts.check, &cx.original) {
-        whole_run::check::run(module, original, &pm.pipeline_text(), &opts.function, samples, seed, stderr)
+        let pipeline = pm.pipeline_text();
+        whole_run::check::run(module, original, &pipeline, &opts.function, samples, seed, deadline, stderr)
             .map_err(Failure::from)?;
     }
     Ok(Ran { records, cx })

@@ -256,3 +256,30 @@ fn time_limit_stops_pareto_measurements_with_a_note_per_pipeline() {
         assert!(row["stopped_early"][0].as_str().unwrap().starts_with("accuracy stopped early: time limit"));
     }
 }
+
+/// `-check` reads `-time-limit` between chunks of points (issue 28: "any run"): ten million
+/// points of the double pendulum (far more than a second's work) stop with a note saying how
+/// many were checked; the run still succeeds and writes its output.
+#[test]
+fn time_limit_stops_check_with_a_note() {
+    let d = tmp("check_limit");
+    let example =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/double_pendulum/mbs_invdyna_double_pendulum.c");
+    let out = d.join("out.rvir");
+    let o = opt(&[
+        example.to_str().unwrap(),
+        "-passes=atomise,balance",
+        "-check",
+        "-check-samples=10000000",
+        "-time-limit=1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let note = err.lines().find(|l| l.starts_with("note: -check stopped after ")).unwrap_or_else(|| panic!("{err}"));
+    assert!(note.ends_with(" of 10000000 samples of @invdyna: time limit of 1 s reached"), "{note}");
+    let done: u64 = note["note: -check stopped after ".len()..].split(' ').next().unwrap().parse().unwrap();
+    assert!(done >= 256 && done < 10_000_000 && done % 256 == 0, "{note}");
+    assert!(out.exists(), "the output is written");
+}

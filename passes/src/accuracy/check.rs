@@ -120,6 +120,26 @@ pub fn check_function(
     samples: u32,
     seed: u64,
 ) -> Result<CheckSummary, String> {
+    check_function_until(after, before, bit_exact, samples, seed, None)
+}
+
+/// Points checked between two reads of the clock by [`check_function_until`].
+pub const CHECK_CHUNK: u64 = 256;
+
+/// [`check_function`] that checks no further chunk of [`CHECK_CHUNK`] points once `deadline`
+/// is reached (`-time-limit`; the first chunk always runs): the summary's `samples` are the
+/// points checked, the first ones of the full check.
+///
+/// # Errors
+/// As [`check_function`].
+pub fn check_function_until(
+    after: &Function,
+    before: &Function,
+    bit_exact: bool,
+    samples: u32,
+    seed: u64,
+    deadline: Option<std::time::Instant>,
+) -> Result<CheckSummary, String> {
     let sub = Subject::new(after, Some(before))?;
     let ranges: Vec<Range> = sub.names.iter().map(|n| range_of(n)).collect();
     let (t1, t0) = (&sub.tape, &sub.reference);
@@ -189,12 +209,20 @@ pub fn check_function(
         }
         (undecided, None)
     };
-    let results: Vec<(u64, Option<Violation>)> = (0..samples as u64).into_par_iter().map(per_point).collect();
+    let (mut results, mut checked) = (Vec::with_capacity(samples as usize), 0u64);
+    while checked < u64::from(samples) {
+        if checked > 0 && deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            break;
+        }
+        let end = (checked + CHECK_CHUNK).min(u64::from(samples));
+        results.par_extend((checked..end).into_par_iter().map(per_point));
+        checked = end;
+    }
     let undecided = results.iter().map(|r| r.0).sum();
     let violation = results.into_iter().find_map(|r| r.1);
     Ok(CheckSummary {
         function: after.name.clone(),
-        samples: samples as u64,
+        samples: checked,
         outputs: t1.outputs.len() as u64,
         undecided,
         violation,

@@ -1,14 +1,16 @@
 //! `-check`: after the pipeline, every function (or the one `-function` names) must keep the
 //! numeric property of [`crate::accuracy::check`] against the module as it entered the
 //! pipeline; the first output that breaks it ends the run with exit 1 (bad input: the rules
-//! or passes changed the mathematics), before any output file is written.
+//! or passes changed the mathematics), before any output file is written. Under
+//! `-time-limit` it checks chunks of points until the limit (the first chunk always runs; a
+//! function not started by then is skipped), with a note saying how many points it checked.
 
 use std::io::Write;
 
 use robovec_ir::Module;
 
 use super::Failure;
-use crate::accuracy::check::{check_function, pipeline_is_bit_exact};
+use crate::accuracy::check::{check_function_until, pipeline_is_bit_exact};
 
 /// Checks `after` against `original` at `samples` points of `seed`; one line per function on
 /// `stderr` when it passes.
@@ -16,6 +18,7 @@ use crate::accuracy::check::{check_function, pipeline_is_bit_exact};
 /// # Errors
 /// [`Failure::Input`] naming the function, output, format, point, computed and exact values
 /// and the budget of the first violation, or an output missing from the original.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     after: &Module,
     original: &Module,
@@ -23,6 +26,7 @@ pub fn run(
     only: &Option<String>,
     samples: u32,
     seed: u64,
+    deadline: Option<crate::Deadline>,
     stderr: &mut dyn Write,
 ) -> Result<(), Failure> {
     let bit_exact = pipeline_is_bit_exact(pipeline);
@@ -30,11 +34,20 @@ pub fn run(
         if only.as_ref().is_some_and(|n| n != &f.name) {
             continue;
         }
+        if let Some(d) = deadline.filter(crate::Deadline::reached) {
+            let _ = writeln!(stderr, "note: -check skipped @{}: {} before it started", f.name, d.reason());
+            continue;
+        }
         let fail = |m: String| Failure::Input(format!("error: -check: {m}\n"));
         let before = original
             .function(&f.name)
             .ok_or_else(|| fail(format!("function @{} is not in the input of the pipeline", f.name)))?;
-        let r = check_function(f, before, bit_exact, samples, seed).map_err(fail)?;
+        let r = check_function_until(f, before, bit_exact, samples, seed, deadline.map(|d| d.at)).map_err(fail)?;
+        if r.samples < u64::from(samples) {
+            let why = deadline.map(|d| d.reason()).unwrap_or_default();
+            let _ =
+                writeln!(stderr, "note: -check stopped after {} of {samples} samples of @{}: {why}", r.samples, f.name);
+        }
         if let Some(v) = r.violation {
             return Err(fail(format!("{v} (pipeline `{pipeline}`, {samples} samples, seed {seed})")));
         }

@@ -24,7 +24,7 @@ use robovec_ir::{Function, Module};
 use serde::{Deserialize, Serialize};
 
 use super::Failure;
-use crate::accuracy::check::{check_function, pipeline_is_bit_exact};
+use crate::accuracy::check::{check_function_until, pipeline_is_bit_exact};
 use crate::accuracy::{measure_against, BitsSummary, Options as AccuracyOptions};
 use crate::summary::stats;
 use crate::{Instrumentation, PassContext, PassManager};
@@ -217,10 +217,9 @@ fn run_reporting(
         // Each pipeline gets an equal share of the time left, half of it to measure (the
         // soundness check of the same points takes about as long), so that every pipeline is
         // measured (with fewer samples) before the limit.
-        let share = deadline.map(|d| {
-            let now = std::time::Instant::now();
-            now + d.at.saturating_duration_since(now) / (2 * (pipelines.len() - k)) as u32
-        });
+        let now = std::time::Instant::now();
+        let share = deadline.map(|d| now + d.at.saturating_duration_since(now) / (2 * (pipelines.len() - k)) as u32);
+        let later_share = deadline.map(|d| now + d.at.saturating_duration_since(now) / (pipelines.len() - k) as u32);
         let opts = AccuracyOptions { samples, seed, deadline: share, ..AccuracyOptions::default() };
         let mut m = module.clone();
         let mut cx =
@@ -236,7 +235,8 @@ fn run_reporting(
         let acc = measure_against(f, Some(original), &opts).map_err(fail)?;
         // The same points as the measurement (fewer when it stopped early under `-time-limit`).
         let measured = u32::try_from(acc.samples).unwrap_or(samples).min(samples);
-        let check = check_function(f, original, pipeline_is_bit_exact(p), measured, seed).map_err(fail)?;
+        let check =
+            check_function_until(f, original, pipeline_is_bit_exact(p), measured, seed, later_share).map_err(fail)?;
         rows.push(ParetoRow {
             pipeline: pm.pipeline_text(),
             ops: s.ops.total,
@@ -257,6 +257,9 @@ fn run_reporting(
                 .iter()
                 .cloned()
                 .chain(acc.stopped_early.map(|w| format!("accuracy stopped early: {w}")))
+                .chain((check.samples < u64::from(measured)).then(|| {
+                    format!("soundness check stopped early: {} of {measured} points: time limit", check.samples)
+                }))
                 .collect(),
             pareto_optimal: false,
         });
