@@ -194,7 +194,7 @@ fn time_limit_stops_accuracy_hill_climbing_with_a_note() {
 
 /// `sim` reads `-time-limit` between seeds (issue 28: `sim<seeds=10000>` ran 18 s under
 /// `-time-limit=5`): the seeds simulated are checked, the stats say how many, and a note says
-/// where it stopped.
+/// where it stopped. (Stops in the lowering and the first seed: `sim`'s unit tests.)
 #[test]
 fn time_limit_stops_sim_between_seeds_with_a_note() {
     let d = tmp("sim_limit");
@@ -220,11 +220,11 @@ fn time_limit_stops_sim_between_seeds_with_a_note() {
     let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["stopped_early"][0].as_str(), Some(note.trim_start_matches("note: ")));
     assert_eq!(r["sim"]["seeds"].as_u64(), Some(u64::from(done)), "{}", r["sim"]);
-    // A limit reached before `sim` starts: no function simulated, one note.
+    // A limit reached before `sim` starts: the manager skips it (sim is skippable), one note.
     let o = opt(&[placed.to_str().unwrap(), "-passes=sim", "-time-limit=0.000001", "-o", "/dev/null"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("note: sim stopped before @dirdyna: time limit of 0.000001 s reached"), "{err}");
+    assert!(err.contains("note: sim skipped: time limit of 0.000001 s reached before it started"), "{err}");
 }
 
 #[test]
