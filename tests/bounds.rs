@@ -195,7 +195,7 @@ fn time_limit_stops_accuracy_hill_climbing_with_a_note() {
 
 /// `sim` reads `-time-limit` between seeds (issue 28: `sim<seeds=10000>` ran 18 s under
 /// `-time-limit=5`): the seeds simulated are checked, the stats say how many, and a note says
-/// where it stopped.
+/// where it stopped. (Stops in the lowering and the first seed: `sim`'s unit tests.)
 #[test]
 fn time_limit_stops_sim_between_seeds_with_a_note() {
     let d = tmp("sim_limit");

@@ -8,7 +8,7 @@ use serde::Serialize;
 use robovec_ir::placement::Placement;
 use robovec_ir::Function;
 
-use crate::design::build::{from_placement, Limits};
+use crate::design::build::{from_placement_until, Limits};
 use crate::design::images::Image;
 use crate::design::{Design, HDL_LIBRARY, SIMULATE};
 use crate::resources::{self, CostModel, Logic, Resources};
@@ -141,8 +141,9 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
 /// `limits` and `model`, the logic from `logic`, the images in `format` (`mif`, `hex` or `both`).
 ///
 /// # Errors
-/// A diagnostic naming the function and the target: what [`from_placement`] refuses, or a
-/// Yosys failure (with [`Logic::Yosys`]: Yosys missing).
+/// A diagnostic naming the function and the target: what
+/// [`crate::design::build::from_placement`] refuses, or a Yosys failure (with
+/// [`Logic::Yosys`]: Yosys missing).
 pub fn emit(
     f: &Function,
     p: &Placement,
@@ -151,7 +152,25 @@ pub fn emit(
     logic: Logic,
     format: &str,
 ) -> Result<(Design, Resources, Vec<DesignFile>), String> {
-    let d = from_placement(f, p, limits)
+    emit_until(f, p, limits, model, logic, format, &|| false)
+}
+
+/// [`emit`] whose lowering gives up when `stop` returns true ([`from_placement_until`]; the
+/// caller's time limit). The encoding, Yosys and the estimate after it are not interrupted.
+///
+/// # Errors
+/// As [`emit`]; when `stop` returned true, the lowering's `stopped: time limit` (the caller
+/// knows it from its hook).
+pub fn emit_until(
+    f: &Function,
+    p: &Placement,
+    limits: &Limits,
+    model: &CostModel,
+    logic: Logic,
+    format: &str,
+    stop: &dyn Fn() -> bool,
+) -> Result<(Design, Resources, Vec<DesignFile>), String> {
+    let d = from_placement_until(f, p, limits, stop)
         .map_err(|e| format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target))?;
     let cells =
         match logic {

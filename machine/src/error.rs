@@ -81,6 +81,11 @@ pub enum MachineErrorKind {
     /// The lowered program fails the verifier's lowered check (a lowering bug), or an
     /// executed program is inconsistent (a word read before anything was written there).
     Unverified,
+    /// The caller's `stop` hook returned true (its time limit, `-time-limit`): the lowering
+    /// ([`crate::lower::lower_measured_until`]) or the execution
+    /// ([`crate::exec::execute_until`]) gave up, nothing is returned. Says nothing about the
+    /// placement. Only a `stop` hook returning true produces it ([`MachineError::stopped`]).
+    Stopped,
 }
 
 /// A placement the lowering rejects (or a `sim` mismatch): the first broken rule, with the cycle, the PE and the
@@ -108,6 +113,12 @@ impl MachineError {
     /// [`MachineError::at`], [`MachineError::on`], [`MachineError::of`], [`MachineError::src`]).
     pub fn new(kind: MachineErrorKind, message: impl Into<String>) -> MachineError {
         MachineError { kind, when: None, pe: None, value: None, message: message.into(), span: Span::DUMMY }
+    }
+
+    /// The error of a lowering or execution its caller's `stop` hook interrupted
+    /// ([`MachineErrorKind::Stopped`]): `stopped: time limit`.
+    pub fn stopped() -> MachineError {
+        MachineError::new(MachineErrorKind::Stopped, "stopped: time limit")
     }
 
     /// This error at `when`.

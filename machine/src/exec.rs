@@ -2,6 +2,7 @@
 //! cycle in the order of [`robovec_ir::machine`]'s timing contract: arrivals (buffer stores, output capture),
 //! buffer reads, PE-memory writes, issues. The executor knows nothing of values: it reads
 //! addresses, routes the crossbar and computes with the PE's unit — what the hardware does.
+//! [`execute_until`] takes a `stop` hook called once per cycle (a caller's time limit).
 
 use std::collections::HashMap;
 
@@ -28,7 +29,21 @@ pub struct Executed<T> {
 /// [`K::Unverified`] when the program is inconsistent (a word read before it was written, a
 /// crossbar source carrying nothing, an address beyond its memory, a result after the last
 /// cycle) — never for a program [`crate::lower::lower`] returned.
-pub fn execute<T: Float>(p: &MachineProgram, mut input: impl FnMut(&str) -> f64) -> Result<Executed<T>, MachineError> {
+pub fn execute<T: Float>(p: &MachineProgram, input: impl FnMut(&str) -> f64) -> Result<Executed<T>, MachineError> {
+    execute_until(p, input, &|| false)
+}
+
+/// [`execute`] that calls `stop` once per cycle, before running it, and gives up when it
+/// returns true (the caller's time limit, `-time-limit`).
+///
+/// # Errors
+/// [`K::Stopped`] at the cycle not run when `stop` returned true (nothing else returns it),
+/// else as [`execute`].
+pub fn execute_until<T: Float>(
+    p: &MachineProgram,
+    mut input: impl FnMut(&str) -> f64,
+    stop: &dyn Fn() -> bool,
+) -> Result<Executed<T>, MachineError> {
     let n_pe = p.n_pe();
     let span = p.cycles as usize + 1;
     let bad = |when: When, s: usize, message: String| {
@@ -62,6 +77,9 @@ pub fn execute<T: Float>(p: &MachineProgram, mut input: impl FnMut(&str) -> f64)
     let mut args: Vec<T> = Vec::new();
     for c in 0..span {
         let when = When::Cycle(c as u32);
+        if stop() {
+            return Err(MachineError::stopped().at(when));
+        }
         for (s, q) in p.pes.iter().enumerate() {
             let st = &q.steps[c];
             let now = arriving[s * span + c];

@@ -1,6 +1,7 @@
 //! Lowered checks of the verifier: a [`MachineProgram`] computes its function. Run by
 //! `robovec_machine::lower::lower` on every program it builds (always, not only in debug
 //! builds: it costs one pass over the steps, see the lowering's module doc for the figure).
+//! [`verify_machine_until`] gives up when its caller's `stop` hook says so (a time limit).
 //!
 //! The check executes the program on *tags* instead of numbers: every word holds the
 //! [`Held`] key of the value or constant it contains. Checklist (each item is one
@@ -118,8 +119,14 @@ fn operands(def: &Def) -> Vec<Operand> {
 /// Checks that `p` computes `f` (see the module doc); returns every violation (at most
 /// [`MAX_ERRORS`] plus one count of the rest), empty when the program verifies.
 pub fn verify_machine(f: &Function, p: &MachineProgram) -> Vec<VerifierError> {
+    verify_machine_until(f, p, &|| false).unwrap_or_default()
+}
+
+/// [`verify_machine`] that calls `stop` once per op of `f` and once per cycle of `p` and gives
+/// up when it returns true (a caller's time limit): `None` then, the check incomplete.
+pub fn verify_machine_until(f: &Function, p: &MachineProgram, stop: &dyn Fn() -> bool) -> Option<Vec<VerifierError>> {
     let mut e = Errs { f, errs: Vec::new(), more: 0 };
-    check(f, p, &mut e);
+    check(f, p, &mut e, stop)?;
     if e.more > 0 {
         let more = e.more;
         e.errs.push(VerifierError {
@@ -129,10 +136,11 @@ pub fn verify_machine(f: &Function, p: &MachineProgram) -> Vec<VerifierError> {
             span: Span::DUMMY,
         });
     }
-    e.errs
+    Some(e.errs)
 }
 
-fn check(f: &Function, p: &MachineProgram, e: &mut Errs) {
+/// Pushes every violation on `e`; `None` when `stop` returned true.
+fn check(f: &Function, p: &MachineProgram, e: &mut Errs, stop: &dyn Fn() -> bool) -> Option<()> {
     let a = p.arch;
     let n_pe = a.n_pe();
     let steps = p.cycles as usize + 1;
@@ -145,7 +153,7 @@ fn check(f: &Function, p: &MachineProgram, e: &mut Errs) {
             p.buffer_words.len(),
             p.output_words.len()
         ));
-        return;
+        return Some(());
     }
     let mut shape_ok = true;
     for (s, (q, pe)) in p.pes.iter().zip(a.pes()).enumerate() {
@@ -173,12 +181,15 @@ fn check(f: &Function, p: &MachineProgram, e: &mut Errs) {
         shape_ok = false;
     }
     if !shape_ok {
-        return;
+        return Some(());
     }
 
     // Provenance: which value each (slot, cycle) issue computes.
     let mut issued_value: Vec<Vec<Option<Value>>> = vec![vec![None; steps]; n_pe];
     for &v in &f.body {
+        if stop() {
+            return None;
+        }
         let Some(kind) = f.op_kind(v) else {
             if p.issue_of[v.index()].is_some() {
                 e.push(format!("%{} is not an op but has an issue", f.name_of(v)));
@@ -261,6 +272,9 @@ fn check(f: &Function, p: &MachineProgram, e: &mut Errs) {
 
     let mut bus: Vec<Option<Held>> = vec![None; n_pe];
     for c in 0..steps {
+        if stop() {
+            return None;
+        }
         // 1. Arrivals enter buffers and output memories.
         for (s, q) in p.pes.iter().enumerate() {
             let st = &q.steps[c];
@@ -362,7 +376,7 @@ fn check(f: &Function, p: &MachineProgram, e: &mut Errs) {
     // The output map.
     if p.outputs.len() != f.outputs.len() {
         e.push(format!("{} output locations for {} outputs", p.outputs.len(), f.outputs.len()));
-        return;
+        return Some(());
     }
     for (loc, o) in p.outputs.iter().zip(&f.outputs) {
         if loc.name != o.name {
@@ -383,4 +397,5 @@ fn check(f: &Function, p: &MachineProgram, e: &mut Errs) {
             Some(_) => {}
         }
     }
+    Some(())
 }

@@ -151,7 +151,22 @@ pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
 /// not have (`div`, `call`), `writes` ≠ 2, a latency below 2, a memory beyond the target, or a
 /// placement the machine model rejects.
 pub fn from_placement(f: &Function, p: &Placement, limits: &Limits) -> Result<Design, String> {
-    let m = crate::lower::lower(f, p).map_err(|e| format!("the placement cannot be lowered: {e}"))?;
+    from_placement_until(f, p, limits, &|| false)
+}
+
+/// [`from_placement`] whose lowering gives up when `stop` returns true
+/// ([`crate::lower::lower_until`]; the caller's time limit).
+///
+/// # Errors
+/// As [`from_placement`]; when `stop` returned true, `the placement cannot be lowered:
+/// stopped: time limit` (the caller knows it from its hook).
+pub fn from_placement_until(
+    f: &Function,
+    p: &Placement,
+    limits: &Limits,
+    stop: &dyn Fn() -> bool,
+) -> Result<Design, String> {
+    let m = crate::lower::lower_until(f, p, stop).map_err(|e| format!("the placement cannot be lowered: {e}"))?;
     let found = problems(&m, limits);
     if !found.is_empty() {
         return Err(found.join("\n"));

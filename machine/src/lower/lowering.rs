@@ -87,9 +87,14 @@ fn peak(n: usize, items: impl Iterator<Item = (usize, i64, i64)>) -> Vec<u32> {
         .collect()
 }
 
-/// Lowers `p` of `f`; see [`super::lower`].
-pub(super) fn lower(f: &Function, p: &Placement) -> Result<(MachineProgram, Occupancy), SimError> {
-    let r = Run { f, p };
+/// Lowers `p` of `f`; see [`super::lower`]. Calls `stop` once per value, write and cycle
+/// bucket ([`super::lower_measured_until`]).
+pub(super) fn lower(
+    f: &Function,
+    p: &Placement,
+    stop: &dyn Fn() -> bool,
+) -> Result<(MachineProgram, Occupancy), SimError> {
+    let r = Run { f, p, stop };
     let Plan { arrival, cycles, n_loads, mem_ev, reads, buf_ev, buf_of_write, buckets } = r.derive()?;
     let n = f.values.len();
     let arch = p.arch;
@@ -206,6 +211,7 @@ pub(super) fn lower(f: &Function, p: &Placement) -> Result<(MachineProgram, Occu
     }
 
     for (&c, bucket) in &buckets {
+        r.poll()?;
         let now = When::Cycle(c);
         // Results arriving now: one per PE (one result bus), captured when outputs.
         let mut bus: HashMap<usize, Value> = HashMap::new();

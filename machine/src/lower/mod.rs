@@ -52,13 +52,19 @@
 //!   with it `codegen<fpga>` — rejects them with a typed error, as it rejects targets whose
 //!   words cannot hold the program. The lowering rejects what no machine of the model can do.
 //! - **Size.** At most [`MAX_STEPS`] steps (PEs × cycles) are built.
+//!
+//! # Interrupting it
+//! [`lower_measured_until`] (and [`lower_until`]) take a `stop` hook, called once per value,
+//! write and cycle in the plan, the steps and the verifier's lowered check: when it returns
+//! true the lowering returns [`MachineErrorKind::Stopped`] and no program. `sim` and
+//! `codegen<fpga>` pass their `-time-limit` ticker there; [`lower`] never stops.
 
 mod lowering;
 mod plan;
 
 use robovec_ir::machine::MachineProgram;
 use robovec_ir::placement::Placement;
-use robovec_ir::verifier::machine::verify_machine;
+use robovec_ir::verifier::machine::verify_machine_until;
 use robovec_ir::Function;
 
 pub use lowering::{Occupancy, MAX_STEPS};
@@ -80,8 +86,33 @@ pub fn lower(f: &Function, p: &Placement) -> Result<MachineProgram, MachineError
 /// # Errors
 /// As [`lower`].
 pub fn lower_measured(f: &Function, p: &Placement) -> Result<(MachineProgram, Occupancy), MachineError> {
-    let (m, occ) = lowering::lower(f, p)?;
-    let errs = verify_machine(f, &m);
+    lower_measured_until(f, p, &|| false)
+}
+
+/// [`lower`] that gives up when `stop` returns true (the caller's time limit, `-time-limit`).
+///
+/// # Errors
+/// [`MachineErrorKind::Stopped`] when `stop` returned true, else as [`lower`].
+pub fn lower_until(f: &Function, p: &Placement, stop: &dyn Fn() -> bool) -> Result<MachineProgram, MachineError> {
+    lower_measured_until(f, p, stop).map(|(m, _)| m)
+}
+
+/// [`lower_measured`] that gives up when `stop` returns true (the caller's time limit,
+/// `-time-limit`). `stop` is called once per value in each pass of the plan over the
+/// function, once per write, once per cycle with events while building the steps, and once
+/// per op and per cycle in the verifier's lowered check: a few indirect calls per op, so a
+/// hook that reads the clock only every so many calls costs nothing measurable.
+///
+/// # Errors
+/// [`MachineErrorKind::Stopped`] when `stop` returned true (nothing else returns it), else
+/// as [`lower`].
+pub fn lower_measured_until(
+    f: &Function,
+    p: &Placement,
+    stop: &dyn Fn() -> bool,
+) -> Result<(MachineProgram, Occupancy), MachineError> {
+    let (m, occ) = lowering::lower(f, p, stop)?;
+    let errs = verify_machine_until(f, &m, stop).ok_or_else(MachineError::stopped)?;
     if let Some(e) = errs.first() {
         return Err(MachineError::new(
             MachineErrorKind::Unverified,

@@ -63,9 +63,21 @@ pub(super) type Read = Result<usize, Option<i64>>;
 pub(super) struct Run<'a> {
     pub f: &'a Function,
     pub p: &'a Placement,
+    /// The caller's hook, called once per value, write or cycle bucket of the long loops:
+    /// true stops the lowering with [`K::Stopped`].
+    pub stop: &'a dyn Fn() -> bool,
 }
 
 impl Run<'_> {
+    /// `Err(Stopped)` when the caller's hook says stop (one call).
+    pub fn poll(&self) -> Result<(), SimError> {
+        if (self.stop)() {
+            Err(SimError::stopped())
+        } else {
+            Ok(())
+        }
+    }
+
     pub fn name(&self, k: Key) -> String {
         match k {
             Key::Value(v) => format!("%{}", self.f.name_of(v)),
@@ -235,6 +247,7 @@ impl Run<'_> {
     pub fn derive(&self) -> Result<Plan, SimError> {
         let r = self;
         let (f, p) = (self.f, self.p);
+        r.poll()?;
         r.check_structure()?;
         let n = f.values.len();
         let issue = |v: Value| r.issue(v);
@@ -243,6 +256,7 @@ impl Run<'_> {
         let mut arrival: Vec<Option<u32>> = vec![None; n];
         let mut cycles = 0u32;
         for &v in &f.body {
+            r.poll()?;
             let Some(kind) = f.op_kind(v) else { continue };
             let is = issue(v);
             let a = is.cycle.checked_add(p.latency(kind)).filter(|&a| a <= MAX_CYCLES).ok_or_else(|| {
@@ -287,6 +301,7 @@ impl Run<'_> {
         // a cycle ≤ c (the first such write on a tie).
         let mut reads: Vec<Vec<(Key, Read)>> = vec![Vec::new(); n];
         for &v in &f.body {
+            r.poll()?;
             if f.op_kind(v).is_none() {
                 continue;
             }
@@ -317,6 +332,7 @@ impl Run<'_> {
         let mut buf_of_value: HashMap<Value, usize> = HashMap::new();
         let mut buf_of_write: Vec<Option<usize>> = vec![None; p.writes.len()];
         for (i, w) in p.writes.iter().enumerate() {
+            r.poll()?;
             let Some(addr) = w.buffer_addr else { continue };
             let is = issue(w.value);
             let arr = arrival[w.value.index()].expect("ops arrive");
@@ -355,6 +371,7 @@ impl Run<'_> {
             buckets.entry(w.cycle).or_default().writes.push(i);
         }
         for &v in &f.body {
+            r.poll()?;
             if f.op_kind(v).is_some() {
                 buckets.entry(issue(v).cycle).or_default().issues.push(v);
                 let a = arrival[v.index()].expect("ops arrive");

@@ -13,9 +13,9 @@ use robovec_ir::placement::{Issue, Load, Pe, PeArray, Placement, Write};
 use robovec_ir::text::parse;
 use robovec_ir::{Function, Operand, Value};
 
-use super::{lower, MachineErrorKind};
+use super::{lower, lower_measured, lower_measured_until, MachineError, MachineErrorKind, When};
 use crate::encode::{encode, through_images, EncodeError, Layout};
-use crate::exec::execute;
+use crate::exec::{execute, execute_until};
 
 use Pe::{Add, Mul};
 
@@ -116,8 +116,9 @@ fn a_lone_add_takes_12_cycles() {
 /// `%x = a·b` on mul0 at 0 (arrives 7): written directly into add0 at 7 (address 1) and,
 /// through mul0's buffer (address 0), into add1 at 9 (address 1). `%y = x + a` on add0 at 7,
 /// `%z = x − b` on add1 at 9.
-#[test]
-fn direct_and_indirect_writes() {
+/// `%x = a * b` on mul0 at 0, written directly into add0 at 7 and through mul0's buffer into
+/// add1 at 9; `%y = x + a` on add0 at 7, `%z = x − b` on add1 at 9.
+fn direct_and_indirect() -> (Function, Placement) {
     let f = func(
         "func @f { phase atomised input %a input %b %x = mul %a, %b %y = add %x, %a %z = sub %x, %b \
          output y = %y output z = %z }",
@@ -139,6 +140,12 @@ fn direct_and_indirect_writes() {
         buffer_words: vec![0, 0, 1],
         spans: Default::default(),
     };
+    (f, p)
+}
+
+#[test]
+fn direct_and_indirect_writes() {
+    let (f, p) = direct_and_indirect();
     let m = lower(&f, &p).unwrap();
     assert_eq!(m.cycles, 21);
     let (add0, add1, mul0) = (&m.pes[0].steps, &m.pes[1].steps, &m.pes[2].steps);
@@ -232,4 +239,49 @@ fn results_colliding_on_one_pe_are_rejected() {
     let e = lower(&f, &p).unwrap_err();
     assert_eq!(e.kind, MachineErrorKind::ResultCollision, "{e}");
     assert!(e.to_string().contains("cycle 12, add0, %x"), "{e}");
+}
+
+/// A `stop` hook that counts its calls and says stop at call `at` (and after).
+fn stop_at(at: u64) -> (std::rc::Rc<std::cell::Cell<u64>>, impl Fn() -> bool) {
+    let calls = std::rc::Rc::new(std::cell::Cell::new(0u64));
+    let c = calls.clone();
+    (calls, move || {
+        c.set(c.get() + 1);
+        c.get() >= at
+    })
+}
+
+#[test]
+fn a_stop_hook_returning_true_stops_the_lowering_wherever_it_is() {
+    let (f, p) = direct_and_indirect();
+    let (calls, never) = stop_at(u64::MAX);
+    let whole = lower_measured_until(&f, &p, &never).expect("lowers");
+    assert_eq!(whole, lower_measured(&f, &p).expect("lowers"), "the hook changes nothing when it says go on");
+    let n = calls.get();
+    // The plan (once, then per op in three loops and per write), the steps (per cycle with
+    // events: 0, 7, 9, 19, 21) and the verifier's lowered check (per op, then per cycle
+    // 0..=21) all call it.
+    assert_eq!(n, (1 + 3 * 3 + 2) + 5 + (3 + 22));
+    for at in 1..=n {
+        let (calls, stop) = stop_at(at);
+        let e = lower_measured_until(&f, &p, &stop).expect_err("stopped");
+        assert_eq!(e, MachineError::stopped(), "call {at}");
+        assert_eq!((e.kind, e.to_string()), (MachineErrorKind::Stopped, "stopped: time limit".to_string()));
+        assert_eq!(calls.get(), at, "stops at the first true");
+    }
+}
+
+#[test]
+fn a_stop_hook_returning_true_stops_the_execution_at_that_cycle() {
+    let (f, p) = direct_and_indirect();
+    let m = lower(&f, &p).unwrap();
+    let (calls, never) = stop_at(u64::MAX);
+    assert_eq!(execute_until::<f64>(&m, input, &never), execute::<f64>(&m, input));
+    assert_eq!(calls.get(), u64::from(m.cycles) + 1, "once per cycle 0..=cycles");
+    for at in 1..=u64::from(m.cycles) + 1 {
+        let (_, stop) = stop_at(at);
+        let e = execute_until::<f32>(&m, input, &stop).expect_err("stopped");
+        assert_eq!(e, MachineError::stopped().at(When::Cycle(at as u32 - 1)));
+        assert_eq!(e.to_string(), format!("cycle {}: stopped: time limit", at - 1));
+    }
 }

@@ -34,12 +34,12 @@ use robovec_ir::machine::{MachineOp, MachineProgram};
 use robovec_ir::placement::Placement;
 use robovec_ir::{Function, Module};
 
-use robovec_machine::exec::execute;
-use robovec_machine::lower::{lower_measured, Occupancy};
+use robovec_machine::exec::execute_until;
+use robovec_machine::lower::{lower_measured, lower_measured_until, Occupancy};
 pub use robovec_machine::lower::{MachineError as SimError, MachineErrorKind as SimErrorKind, When};
 
 use crate::params::ParamKind;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 
 /// What one simulated run computed and measured.
 #[derive(Clone, Debug, PartialEq)]
@@ -90,16 +90,18 @@ pub struct SimReport {
 /// `sim` object (issue 10 item 5).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct SimStats {
-    /// Placements (one per function) simulated.
+    /// Placements (one per function) simulated: those whose first seed completed
+    /// (`-time-limit` may stop `sim` before a function's, or before a function).
     pub placements: usize,
     /// Input sets (seeds `0..seeds`), each simulated in every precision: the number asked, or
-    /// the fewest simulated for one placement when `-time-limit` stopped `sim` between seeds.
+    /// the fewest simulated for one placement when `-time-limit` stopped `sim` between seeds;
+    /// 0 when no placement was simulated.
     pub seeds: u32,
     /// Precisions simulated and compared with the interpreter.
     pub precisions: Vec<&'static str>,
     /// True: every output equalled the interpreter's bit for bit (a mismatch fails the pass).
     pub bit_exact: bool,
-    /// One entry per function simulated.
+    /// One entry per function simulated (none for a function `-time-limit` left unsimulated).
     pub functions: Vec<SimFunctionStats>,
 }
 
@@ -119,9 +121,13 @@ pub struct SimFunctionStats {
 }
 
 impl std::fmt::Display for SimStats {
-    /// `sim: simulated N placements bit-exact in f32 and f64 (S seeds)`.
+    /// `sim: simulated N placements bit-exact in f32 and f64 (S seeds)`, or `sim: simulated
+    /// no placement` (`-time-limit` stopped it before any first seed completed).
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let plural = |n: usize, w: &str| if n == 1 { format!("{n} {w}") } else { format!("{n} {w}s") };
+        if self.placements == 0 {
+            return write!(f, "sim: simulated no placement");
+        }
         write!(
             f,
             "sim: simulated {} {} in {} ({})",
@@ -144,19 +150,20 @@ pub fn simulate<T: Float>(
     input: impl FnMut(&str) -> f64,
 ) -> Result<SimOutcome<T>, SimError> {
     let (m, occ) = lower_measured(f, p)?;
-    run(f, &m, &occ, input)
+    run(f, &m, &occ, input, &Ticker::default())
 }
 
 /// Executes lowered program `m` of `f` on `input` (called once per input, in `f.inputs`
-/// order) and gathers the figures.
+/// order) and gathers the figures; one tick of `ticker` per cycle.
 fn run<T: Float>(
     f: &Function,
     m: &MachineProgram,
     occ: &Occupancy,
     mut input: impl FnMut(&str) -> f64,
+    ticker: &Ticker,
 ) -> Result<SimOutcome<T>, SimError> {
     let values: HashMap<&str, f64> = f.inputs.iter().map(|&v| (f.name_of(v), input(f.name_of(v)))).collect();
-    let x = execute::<T>(m, |n| values.get(n).copied().unwrap_or(f64::NAN))?;
+    let x = execute_until::<T>(m, |n| values.get(n).copied().unwrap_or(f64::NAN), &|| ticker.tick())?;
     let mut issued_add = vec![0u32; m.cycles as usize];
     let mut issued_mul = vec![0u32; m.cycles as usize];
     for q in &m.pes {
@@ -199,32 +206,49 @@ pub fn verify_placement(f: &Function, seeds: &[u64]) -> Result<SimReport, SimErr
 /// # Errors
 /// As [`verify_placement`].
 pub fn verify_with(f: &Function, p: &Placement, seeds: &[u64]) -> Result<SimReport, SimError> {
-    verify_until(f, p, seeds, None)
+    verify_until(f, p, seeds, &Ticker::default())
 }
 
-/// [`verify_with`] that stops starting seeds once `deadline` is reached (`-time-limit`, issue
-/// 28): the first seed always runs; the report's `seeds` are those simulated.
+/// [`verify_with`] that stops when `ticker` says so (`-time-limit`, issue 28): it ticks once
+/// per value, write and cycle of the lowering ([`lower_measured_until`]) and per cycle of each
+/// simulated run, and reads the clock ([`Ticker::check`]) before each of a seed's steps (f64
+/// run, f64 interpreter, f32 run, f32 interpreter). A stop after the first seed completed
+/// drops the seed in progress: the report's `seeds` are those simulated.
 ///
 /// # Errors
-/// As [`verify_placement`].
-pub fn verify_until(
+/// As [`verify_placement`]; [`SimErrorKind::Stopped`] when `ticker` stopped the lowering or
+/// the first seed (nothing was checked).
+pub fn verify_until(f: &Function, p: &Placement, seeds: &[u64], ticker: &Ticker) -> Result<SimReport, SimError> {
+    let (m, occ) = lower_measured_until(f, p, &|| ticker.tick())?;
+    verify_lowered(f, &m, &occ, seeds, ticker)
+}
+
+/// The seeds of [`verify_until`] on `f`'s lowered program `m` (occupancy `occ`).
+///
+/// # Errors
+/// As [`verify_until`], the lowering apart.
+fn verify_lowered(
     f: &Function,
-    p: &Placement,
+    m: &MachineProgram,
+    occ: &Occupancy,
     seeds: &[u64],
-    deadline: Option<&crate::Deadline>,
+    ticker: &Ticker,
 ) -> Result<SimReport, SimError> {
     let seeds: &[u64] = if seeds.is_empty() { &[0] } else { seeds };
-    let (m, occ) = lower_measured(f, p)?;
     let mut report: Option<SimReport> = None;
     for (i, &seed) in seeds.iter().enumerate() {
-        if i > 0 && deadline.is_some_and(crate::Deadline::reached) {
-            if let Some(r) = report.as_mut() {
-                r.seeds.truncate(i);
+        let both = compare::<f64>(f, m, occ, seed, "f64", ticker)
+            .and_then(|o| compare::<f32>(f, m, occ, seed, "f32", ticker).map(|_| o));
+        let o = match both {
+            Ok(o) => o,
+            Err(e) if e.kind == SimErrorKind::Stopped && i > 0 => {
+                if let Some(r) = report.as_mut() {
+                    r.seeds.truncate(i);
+                }
+                break;
             }
-            break;
-        }
-        let o = compare::<f64>(f, &m, &occ, seed, "f64")?;
-        compare::<f32>(f, &m, &occ, seed, "f32")?;
+            Err(e) => return Err(e),
+        };
         report.get_or_insert(SimReport {
             cycles: o.cycles,
             writes_direct: o.writes_direct,
@@ -246,9 +270,16 @@ fn compare<T: Float>(
     occ: &Occupancy,
     seed: u64,
     precision: &str,
+    ticker: &Ticker,
 ) -> Result<SimOutcome<T>, SimError> {
+    if ticker.check() {
+        return Err(SimError::stopped().at(When::Load));
+    }
     let input = |n: &str| pseudo_random_input(n, seed);
-    let sim = run::<T>(f, m, occ, input)?;
+    let sim = run::<T>(f, m, occ, input, ticker)?;
+    if ticker.check() {
+        return Err(SimError::stopped().at(When::End));
+    }
     let reference = eval::<T>(f, input);
     for (((name, s), (_, e)), o) in sim.outputs.iter().zip(&reference).zip(&f.outputs) {
         let (s, e) = (s.to_f64(), e.to_f64());
@@ -297,27 +328,52 @@ impl Pass for Sim {
         true
     }
 
-    /// `-time-limit`: once the limit is reached, `sim` starts no further seed (the first seed
-    /// of a function always runs) and no further function, with a note for each; the stats
-    /// then give the fewest seeds simulated and the placements simulated.
+    /// `-time-limit` stops `sim` wherever it is (the lowering, a simulated run, between the
+    /// steps of a seed: [`verify_until`]), with a note. A function stopped after its first
+    /// seed completed keeps the seeds simulated; one stopped before is not simulated (not
+    /// counted, no figures); no further function starts. The stats then give the placements
+    /// simulated and the fewest seeds simulated.
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let seeds: Vec<u64> = (0..self.seeds as u64).collect();
         let mut functions = Vec::new();
         let mut fewest = self.seeds;
+        let ticker = cx.ticker();
         for f in &m.functions {
             let fail = |message: String| PassError::Failed { pass: "sim".into(), message };
+            let fail_on = |e: SimError| fail(format!("@{}: {e}", f.name)).at(e.span);
             let p = f
                 .placement
                 .as_ref()
                 .ok_or_else(|| fail(format!("function @{} has no placement; run `place` first", f.name)))?;
-            if let Some(d) = cx.deadline.filter(crate::Deadline::reached) {
-                cx.note_stop("sim", &format!("before @{}: {}", f.name, d.reason()));
+            if ticker.check() {
+                cx.note_stop("sim", &format!("before @{}: {}", f.name, ticker.reason()));
                 break;
             }
-            let r = verify_until(f, p, &seeds, cx.deadline.as_ref())
-                .map_err(|e| fail(format!("@{}: {e}", f.name)).at(e.span))?;
+            let not_simulated = |stage: &str| {
+                format!(
+                    "in @{0} before its first seed completed ({stage}): {1}; @{0} not simulated",
+                    f.name,
+                    ticker.reason()
+                )
+            };
+            let (mach, occ) = match lower_measured_until(f, p, &|| ticker.tick()) {
+                Ok(x) => x,
+                Err(e) if e.kind == SimErrorKind::Stopped => {
+                    cx.note_stop("sim", &not_simulated("lowering"));
+                    break;
+                }
+                Err(e) => return Err(fail_on(e)),
+            };
+            let r = match verify_lowered(f, &mach, &occ, &seeds, &ticker) {
+                Ok(r) => r,
+                Err(e) if e.kind == SimErrorKind::Stopped => {
+                    cx.note_stop("sim", &not_simulated("seed 0"));
+                    break;
+                }
+                Err(e) => return Err(fail_on(e)),
+            };
             if r.seeds.len() < seeds.len() {
-                let why = cx.deadline.map(|d| d.reason()).unwrap_or_default();
+                let why = ticker.reason();
                 cx.note_stop("sim", &format!("after {} of {} seeds of @{}: {why}", r.seeds.len(), seeds.len(), f.name));
                 fewest = fewest.min(r.seeds.len() as u32);
             }
@@ -331,7 +387,7 @@ impl Pass for Sim {
         }
         cx.emit(SimStats {
             placements: functions.len(),
-            seeds: fewest,
+            seeds: if functions.is_empty() { 0 } else { fewest },
             precisions: vec!["f32", "f64"],
             bit_exact: true,
             functions,
@@ -349,9 +405,14 @@ impl crate::Artifact for SimStats {
         format!("{self}\n")
     }
 
+    /// The `sim` object of `function`'s report; none when `function` was not simulated
+    /// (`-time-limit`: the note in `stopped_early` says why).
     fn report(&self, function: &str) -> Option<crate::ReportEntry> {
         let mut s = self.clone();
         s.functions.retain(|x| x.function == function);
+        if s.functions.is_empty() {
+            return None;
+        }
         Some(crate::ReportEntry::new("sim", &s, crate::Merge::Last))
     }
 }

@@ -530,3 +530,114 @@ fn mutants_are_rejected_or_still_exact_and_never_panic() {
     }
     assert!(rejected > 400, "only {rejected} of 600 mutants rejected");
 }
+
+/// Two placed functions `@f` and `@g` (200 ops each, the naive placer's placements).
+fn two_placed() -> Module {
+    let functions = [("f", 7), ("g", 8)]
+        .map(|(name, seed)| {
+            let mut f = robovec_testkit::dag_gen::generate(200, seed);
+            f.name = name.into();
+            f.placement = Some(naive_placement(&f));
+            f
+        })
+        .into();
+    Module { functions }
+}
+
+/// Ticks `verify_until` takes on `f` for `seeds` with no limit, and on its lowering alone.
+fn ticks_of(f: &Function, seeds: &[u64]) -> (u64, u64) {
+    let t = Ticker::default();
+    verify_until(f, f.placement.as_ref().unwrap(), seeds, &t).expect("verifies");
+    let lowering = Ticker::default();
+    lower_measured_until(f, f.placement.as_ref().unwrap(), &|| lowering.tick()).expect("lowers");
+    (t.ticks(), lowering.ticks())
+}
+
+/// Runs `sim<seeds=3>` on `m` with every ticker stopping at tick `budget`: the notes, the
+/// stats line and the report objects of `@f` and `@g`.
+fn sim_with_budget(m: &mut Module, budget: u64) -> (Vec<String>, String, [Option<serde_json::Value>; 2]) {
+    let before = m.to_string();
+    let mut cx = PassContext { tick_budget: Some(budget), ..PassContext::default() };
+    Sim { seeds: 3 }.run(m, &mut cx).expect("sim is skippable: a stop is not an error");
+    assert_eq!(m.to_string(), before, "sim never changes the module");
+    assert!(robovec_ir::verifier::verify(m).is_ok());
+    let stats = cx.artifacts().next().expect("the stats");
+    let text = stats.stats_text(None);
+    let reports = ["f", "g"].map(|name| stats.report(name).map(|e| e.value));
+    (cx.stopped, text, reports)
+}
+
+#[test]
+fn verify_until_stops_in_the_lowering_in_the_first_seed_or_between_seeds() {
+    let m = two_placed();
+    let f = &m.functions[0];
+    let p = f.placement.as_ref().unwrap();
+    let (one_seed, lowering) = ticks_of(f, &[0]);
+    assert!(lowering > 1000 && one_seed > lowering, "{lowering} {one_seed}");
+    for budget in [1, lowering / 2, lowering, lowering + 1, one_seed - 1, one_seed] {
+        let e = verify_until(f, p, &[0, 1, 2], &Ticker::new(None, Some(budget))).expect_err("stopped");
+        assert_eq!((e.kind, e.message.as_str()), (SimErrorKind::Stopped, "stopped: time limit"), "{budget}");
+    }
+    // Stopped once the first seed completed: the seeds simulated are reported.
+    for (budget, done) in [(one_seed + 1, 1), (2 * one_seed - lowering, 1), (2 * one_seed - lowering + 1, 2)] {
+        let r = verify_until(f, p, &[0, 1, 2], &Ticker::new(None, Some(budget))).expect("the first seed completed");
+        assert_eq!(r.seeds, (0..done).collect::<Vec<u64>>(), "{budget}");
+        assert_eq!(r, verify_with(f, p, &r.seeds).unwrap());
+    }
+}
+
+#[test]
+fn time_limit_in_the_lowering_or_the_first_seed_leaves_the_function_unsimulated() {
+    let mut m = two_placed();
+    let (whole_f, _) = ticks_of(&m.functions[0], &[0, 1, 2]);
+    let (_, lowering_g) = ticks_of(&m.functions[1], &[0]);
+    // `sim` checks the clock before each function (1 tick), then lowers and simulates it.
+    let budget = 1 + whole_f + 1 + lowering_g / 2;
+    let (stopped, text, [f, g]) = sim_with_budget(&mut m, budget);
+    assert_eq!(
+        stopped,
+        [format!(
+            "sim stopped in @g before its first seed completed (lowering): tick budget of {budget} steps \
+             reached; @g not simulated"
+        )]
+    );
+    assert_eq!(text, "sim: simulated 1 placement bit-exact in f32 and f64 (3 seeds)\n");
+    let f = f.expect("@f simulated");
+    assert_eq!((f["placements"].as_u64(), f["seeds"].as_u64()), (Some(1), Some(3)));
+    assert_eq!(f["functions"][0]["function"], "f");
+    assert_eq!(g, None, "@g was not simulated: no `sim` object in its report");
+    // In `@f`'s first seed (its lowering is done): nothing simulated.
+    let (_, lowering_f) = ticks_of(&m.functions[0], &[0]);
+    let budget = 1 + lowering_f + 2;
+    let (stopped, text, reports) = sim_with_budget(&mut m, budget);
+    assert_eq!(
+        stopped,
+        [format!(
+            "sim stopped in @f before its first seed completed (seed 0): tick budget of {budget} steps \
+             reached; @f not simulated"
+        )]
+    );
+    assert_eq!(text, "sim: simulated no placement\n");
+    assert_eq!(reports, [None, None]);
+    // Without a limit both are simulated.
+    let (stopped, text, [f, g]) = sim_with_budget(&mut m, u64::MAX);
+    assert!(stopped.is_empty(), "{stopped:?}");
+    assert_eq!(text, "sim: simulated 2 placements bit-exact in f32 and f64 (3 seeds)\n");
+    assert!(f.is_some() && g.is_some());
+}
+
+#[test]
+fn time_limit_after_the_first_seed_keeps_the_seeds_simulated() {
+    let mut m = two_placed();
+    let (one_seed, _) = ticks_of(&m.functions[0], &[0]);
+    let budget = 1 + one_seed + 1;
+    let (stopped, text, [f, g]) = sim_with_budget(&mut m, budget);
+    let why = format!("tick budget of {budget} steps reached");
+    assert_eq!(
+        stopped,
+        [format!("sim stopped after 1 of 3 seeds of @f: {why}"), format!("sim stopped before @g: {why}")]
+    );
+    assert_eq!(text, "sim: simulated 1 placement bit-exact in f32 and f64 (1 seed)\n");
+    assert_eq!(f.expect("@f simulated")["seeds"].as_u64(), Some(1));
+    assert_eq!(g, None);
+}

@@ -39,6 +39,12 @@
 //!   `call` ops (the PEs have only `fp_add_sub` and `fp_mul`), targets with `writes` ≠ 2 (the
 //!   instruction word has two write ports), memories beyond the target (PE memory words, buffer
 //!   depth, instruction memory depth) and latencies below 2.
+//! - `-time-limit`: the pass is required (the output), so a limit reached before a function
+//!   starts or while its placement is lowered (the lowering and its verifier tick once per
+//!   value, write and cycle) ends the run with a time-limit error, nothing written. The
+//!   encoding, the design, Yosys and the estimate of a lowered function are not interrupted
+//!   (linear in the program's steps; Yosys only for designs of at most
+//!   [`AUTO_YOSYS_MAX_PES`] PEs unless `resources=yosys`).
 //!
 //! This file is the pass (its parameters, its report and artifact); the work — lowering,
 //! encoding, design, Verilog, estimate, files — is the machine crate's ([`robovec_machine::emit`]).
@@ -49,11 +55,13 @@ use serde::Serialize;
 
 use robovec_machine::design::build::Limits;
 use robovec_machine::design::Design;
-use robovec_machine::emit::{emit, DesignFile};
+use robovec_machine::emit::{emit_until, DesignFile};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
 use crate::params::{word_enum, ParamKind, Word};
-use crate::{Artifact, ArtifactFile, Member, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry};
+use crate::{
+    Artifact, ArtifactFile, Member, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry, Ticker,
+};
 
 /// The FPGA back end of `codegen`: `codegen<fpga;…>`, with its parameters.
 pub const BACK_END: Member = Member {
@@ -117,6 +125,9 @@ pub struct CodegenFpga {
     /// `resources=`.
     pub resources: Logic,
 }
+
+/// The pass's name in its time-limit errors.
+const PASS: &str = "codegen<fpga>";
 
 fn failed(message: String) -> PassError {
     PassError::Failed { pass: "codegen".into(), message }
@@ -235,10 +246,27 @@ impl CodegenFpga {
         limits: &Limits,
         model: &CostModel,
     ) -> Result<(Design, FpgaReport, Vec<DesignFile>), String> {
+        self.build_within(f, limits, model, &Ticker::default())
+    }
+
+    /// [`CodegenFpga::build`] whose lowering ticks `ticker` (once per value, write and cycle:
+    /// [`robovec_machine::lower::lower_measured_until`]) and gives up when it says stop
+    /// (`-time-limit`); the encoding, Yosys and the estimate after it are not interrupted.
+    ///
+    /// # Errors
+    /// As [`CodegenFpga::build`]; when `ticker` stopped the lowering (then
+    /// [`Ticker::stopped`]), the lowering's `stopped: time limit`.
+    pub fn build_within(
+        &self,
+        f: &robovec_ir::Function,
+        limits: &Limits,
+        model: &CostModel,
+        ticker: &Ticker,
+    ) -> Result<(Design, FpgaReport, Vec<DesignFile>), String> {
         let Some(p) = &f.placement else {
             return Err(format!("function @{} has no placement; run `place` before `codegen<fpga>`", f.name));
         };
-        let (d, r, files) = emit(f, p, limits, model, self.resources, self.format.as_str())?;
+        let (d, r, files) = emit_until(f, p, limits, model, self.resources, self.format.as_str(), &|| ticker.tick())?;
         let report = FpgaReport {
             out: self.out.display().to_string(),
             format: self.format.as_str(),
@@ -258,12 +286,23 @@ impl Pass for CodegenFpga {
         "codegen"
     }
 
+    /// `-time-limit` (a required pass: the output): the lowering of each function stops at
+    /// the limit, and a limit reached before a function starts stops the pass too; either
+    /// ends the run with [`PassError::TimeLimit`] (nothing written).
     fn run(&self, m: &mut robovec_ir::Module, cx: &mut PassContext) -> Result<(), PassError> {
         crate::require_phase("codegen", m, robovec_ir::Phase::Atomised)?;
         let (limits, model) = (Limits::of(&cx.target), cost_model(&cx.target));
+        let ticker = cx.ticker();
         let mut functions = Vec::new();
         for f in &m.functions {
-            let (_, report, files) = self.build(f, &limits, &model).map_err(failed)?;
+            if ticker.check() {
+                return Err(ticker.error(PASS, &format!("before @{} ({} functions done)", f.name, functions.len())));
+            }
+            let built = self.build_within(f, &limits, &model, &ticker);
+            if ticker.stopped() {
+                return Err(ticker.error(PASS, &format!("in @{} while lowering", f.name)));
+            }
+            let (_, report, files) = built.map_err(failed)?;
             if self.auto_skips_yosys(report.n_add + report.n_mul) {
                 cx.notes.push(format!(
                     "codegen<fpga> @{}: {} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway)",
@@ -275,5 +314,52 @@ impl Pass for CodegenFpga {
         }
         cx.emit(FpgaArtifact { functions, out: self.out.clone() });
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::place::{place_function, PlaceOptions};
+    use crate::{Instrumentation, PassContext, PassError, PassManager};
+
+    /// `@f`, 200 ops placed on 2 + 2 PEs.
+    fn placed() -> robovec_ir::Module {
+        let mut f = robovec_testkit::dag_gen::generate(200, 7);
+        f.name = "f".into();
+        f.placement = Some(place_function(&f, &PlaceOptions::with_pes(2)));
+        robovec_ir::Module { functions: vec![f] }
+    }
+
+    fn run(budget: Option<u64>) -> (Result<(), PassError>, usize) {
+        let pm = PassManager::new("codegen<fpga;out=unused;resources=estimate>", Instrumentation::default())
+            .expect("builds");
+        let mut m = placed();
+        let mut cx = PassContext { tick_budget: budget, ..PassContext::default() };
+        let ran = pm.run(&mut m, &mut cx, &mut Vec::new()).map(|_| ());
+        assert!(cx.stopped.is_empty(), "a required pass notes no stop: {:?}", cx.stopped);
+        (ran, cx.artifacts().count())
+    }
+
+    #[test]
+    fn time_limit_in_the_lowering_ends_the_run_saying_where() {
+        for (budget, expect) in [(1, "stopped before @f (0 functions done)"), (50, "stopped in @f while lowering")] {
+            match run(Some(budget)) {
+                (Err(PassError::TimeLimit { pass, message }), 0) => {
+                    assert_eq!(pass, "codegen<fpga>");
+                    assert_eq!(
+                        message,
+                        format!(
+                            "tick budget of {budget} steps reached: {expect}; the output needs it, so nothing is \
+                             written"
+                        )
+                    );
+                }
+                other => panic!("budget {budget}: {other:?}"),
+            }
+        }
+        // Without a limit: the design.
+        let (ran, artifacts) = run(None);
+        ran.expect("emits");
+        assert_eq!(artifacts, 1);
     }
 }
