@@ -280,6 +280,6 @@ fn time_limit_stops_check_with_a_note() {
     let note = err.lines().find(|l| l.starts_with("note: -check stopped after ")).unwrap_or_else(|| panic!("{err}"));
     assert!(note.ends_with(" of 10000000 samples of @invdyna: time limit of 1 s reached"), "{note}");
     let done: u64 = note["note: -check stopped after ".len()..].split(' ').next().unwrap().parse().unwrap();
-    assert!(done >= 256 && done < 10_000_000 && done % 256 == 0, "{note}");
+    assert!((256..10_000_000).contains(&done) && done.is_multiple_of(256), "{note}");
     assert!(out.exists(), "the output is written");
 }

@@ -23,8 +23,10 @@ use robovec_ir::{Module, Phase};
 
 use crate::params::ParamKind;
 use crate::place::{
-    cycles, lower_bound, ops_per_side, tight_lower_bound, try_place_function, PlaceOptions, Priority, Select,
+    cycles, lower_bound, ops_per_side, tight_lower_bound, try_place_function_within, PlaceError, PlaceOptions,
+    Priority, Select,
 };
+use crate::sim::{SimError, SimErrorKind};
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// min / mean / max of words over the PEs of one type.
@@ -272,7 +274,9 @@ impl Pass for Sweep {
                     }
                     done += 1;
                     let mut o = PlaceOptions::with_pes(n);
-                    o.deadline = cx.deadline;
+                    // A configuration the limit reaches is dropped (its placement or its
+                    // simulation stops inside): sweep is skippable, so no grace.
+                    (o.deadline, o.grace, o.tick_budget) = (cx.deadline, cx.deadline, cx.tick_budget);
                     o.arch.lat = cx.latencies;
                     o.arch.writes = cx.target.writes;
                     o.priority = priority;
@@ -282,15 +286,38 @@ impl Pass for Sweep {
                         // The seed's algorithm alone: no restarts or search either.
                         (o.restarts, o.search) = (0, 0);
                     }
-                    let p = try_place_function(f, &o)
-                        .map_err(|e| PassError::Failed { pass: "sweep".into(), message: e })?;
-                    let mut placed = f.clone();
-                    placed.placement = Some(p);
-                    crate::sim::verify_placement(&placed, &[1]).map_err(|e| PassError::Failed {
-                        pass: "sweep".into(),
-                        message: format!("@{} N={n} {pname}/{sname}: simulation failed: {e}", f.name),
-                    })?;
-                    let p = placed.placement.as_ref().expect("just set");
+                    let ticker = cx.ticker();
+                    let verified = match try_place_function_within(f, &o) {
+                        Ok((p, _)) => crate::sim::verify_until(f, &p, &[1], &ticker).map(|_| p),
+                        Err(PlaceError::Stopped) => Err(SimError::stopped()),
+                        Err(PlaceError::Stuck(e)) => {
+                            return Err(PassError::Failed { pass: "sweep".into(), message: e })
+                        }
+                    };
+                    let p = match verified {
+                        Ok(p) => p,
+                        Err(e) if e.kind == SimErrorKind::Stopped => {
+                            task.finish();
+                            let what = format!(
+                                "in N={n} {pname}/{sname} of @{} ({} of {total} configurations done, that one dropped): {}",
+                                f.name,
+                                done - 1,
+                                ticker.reason()
+                            );
+                            cx.note_stop("sweep", &what);
+                            fit.push(fit_row(&f.name, &cx.target, cp_now, &rows));
+                            cx.emit(SweepTable { rows });
+                            cx.emit(SweepFit { rows: fit });
+                            return Ok(());
+                        }
+                        Err(e) => {
+                            return Err(PassError::Failed {
+                                pass: "sweep".into(),
+                                message: format!("@{} N={n} {pname}/{sname}: simulation failed: {e}", f.name),
+                            })
+                        }
+                    };
+                    let p = &p;
                     let c = cycles(f, p);
                     let (_, cp) = compute_timing(f, &o.arch.lat);
                     let side = |k: u64, lat: u32| if k == 0 { 0 } else { (k.div_ceil(n as u64) - 1) as u32 + lat };

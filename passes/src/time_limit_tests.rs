@@ -224,3 +224,45 @@ fn required_passes_stopped_inside_end_the_run_saying_where() {
         }
     }
 }
+
+#[test]
+fn place_stopped_in_its_first_schedule_ends_the_run_and_after_it_keeps_the_best() {
+    let text = "place<pe=2;improve=4>";
+    match run_budget(text, &mut atomised(60), 5).0 {
+        Err(e @ PassError::TimeLimit { .. }) => {
+            let e = e.to_string();
+            assert!(e.contains("tick budget of 5 steps reached: stopped in @f in its first list schedule;"), "{e}");
+        }
+        other => panic!("{other:?}"),
+    }
+    // The limit reached, its grace not: the first schedule is made, no round of improvement.
+    let pm = PassManager::new(text, Instrumentation::default()).expect("builds");
+    let mut m = atomised(60);
+    let mut cx = PassContext { deadline: Some(reached_with_grace_left()), ..PassContext::default() };
+    pm.run(&mut m, &mut cx, &mut Vec::new()).expect("placed in the grace");
+    assert_eq!(
+        cx.stopped,
+        ["place stopped searching @f early (best schedule so far kept): time limit of 1000 s reached"]
+    );
+    assert!(verifier::verify(&m).is_ok() && m.functions[0].placement.is_some(), "{:?}", verifier::verify(&m));
+    crate::sim::verify_placement(&m.functions[0], &[1]).expect("the placement kept simulates bit for bit");
+}
+
+#[test]
+fn sweep_drops_the_configuration_the_limit_stops_inside() {
+    let table = |b: u64| {
+        let mut m = atomised(60);
+        let mut cx = PassContext { tick_budget: Some(b), ..PassContext::default() };
+        crate::Pass::run(&crate::sweep::Sweep { ns: vec![2] }, &mut m, &mut cx).expect("skippable");
+        let csv = cx.artifacts().filter_map(|a| a.csv()).next().unwrap_or_default();
+        (csv.lines().count().saturating_sub(1), cx.stopped)
+    };
+    assert_eq!(table(u64::MAX), (4, vec![]), "four configurations at N = 2");
+    let (rows, stopped) = table(5);
+    assert_eq!(rows, 0);
+    assert_eq!(
+        stopped,
+        ["sweep stopped in N=2 classical/preferential of @f (0 of 4 configurations done, that one dropped): \
+          tick budget of 5 steps reached"]
+    );
+}

@@ -74,9 +74,41 @@ pub struct PlaceOptions {
     /// Iterations of key-mutation search after the restarts, under the same condition (see
     /// [`search`]); at most about 1.2·10⁷ op schedulings in all. 0 = none.
     pub search: u32,
-    /// `-time-limit`: restarts and search stop once it is reached, keeping the best schedule
-    /// so far (`None`: no limit; the work caps above still apply).
+    /// `-time-limit`: rounds of improvement, restarts and search stop once it is reached
+    /// (inside a schedule too: that schedule is dropped), keeping the best schedule so far
+    /// (`None`: no limit; the work caps above still apply).
     pub deadline: Option<crate::Deadline>,
+    /// `-time-limit` for the first list schedule, which the placement needs (the limit's grace
+    /// in the `place` pass, [`crate::Deadline::grace`]): past it the placement fails with
+    /// [`PlaceError::Stopped`] (`None`: never).
+    pub grace: Option<crate::Deadline>,
+    /// Tests: every ticker of the placement stops at this tick
+    /// ([`crate::PassContext::tick_budget`]).
+    pub tick_budget: Option<u64>,
+}
+
+/// Why a placement has no result.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PlaceError {
+    /// Only with `buffer = false`: an operand can no longer reach any PE memory of its type.
+    Stuck(String),
+    /// [`PlaceOptions::grace`] (or the test budget) was reached in the first list schedule.
+    Stopped,
+}
+
+impl std::fmt::Display for PlaceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PlaceError::Stuck(m) => f.write_str(m),
+            PlaceError::Stopped => f.write_str("stopped in the first list schedule: time limit"),
+        }
+    }
+}
+
+impl From<String> for PlaceError {
+    fn from(m: String) -> PlaceError {
+        PlaceError::Stuck(m)
+    }
 }
 
 impl PlaceOptions {
@@ -106,23 +138,27 @@ fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
         restarts: p.u32("restarts")?,
         search: p.u32("search")?,
         deadline: None,
+        grace: None,
+        tick_budget: None,
     })
 }
 
 /// Places `f` (atomised, verified).
 ///
 /// # Errors
-/// Only with `buffer = false`: an operand that can no longer reach any PE memory of its type.
+/// Only with `buffer = false`: an operand that can no longer reach any PE memory of its type
+/// (and, with [`PlaceOptions::grace`] set, [`PlaceError::Stopped`]'s text).
 pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement, String> {
-    try_place_function_within(f, opts).map(|(p, _)| p)
+    try_place_function_within(f, opts).map(|(p, _)| p).map_err(|e| e.to_string())
 }
 
-/// [`try_place_function`] that also says whether restarts or search stopped at
+/// [`try_place_function`] that also says whether rounds, restarts or search stopped at
 /// `opts.deadline` (`true`: the placement is the best found by then).
 ///
 /// # Errors
-/// As [`try_place_function`].
-pub fn try_place_function_within(f: &Function, opts: &PlaceOptions) -> Result<(Placement, bool), String> {
+/// [`PlaceError::Stuck`] as [`try_place_function`]; [`PlaceError::Stopped`] when
+/// `opts.grace` stopped the first list schedule.
+pub fn try_place_function_within(f: &Function, opts: &PlaceOptions) -> Result<(Placement, bool), PlaceError> {
     try_place_function_progress(f, opts, &crate::progress::Progress::hidden())
 }
 
@@ -135,11 +171,18 @@ pub fn try_place_function_progress(
     f: &Function,
     opts: &PlaceOptions,
     progress: &crate::progress::Progress,
-) -> Result<(Placement, bool), String> {
+) -> Result<(Placement, bool), PlaceError> {
     let a = &opts.arch;
+    let required = crate::Ticker::new(opts.grace, opts.tick_budget);
     let dag = dag::OpDag::new(f);
     let seed = schedule::seed_keys(f, a, opts.priority);
-    let (best, cut) = improved(f, &dag, opts, &seed, 0)?;
+    if required.check() {
+        return Err(PlaceError::Stopped);
+    }
+    let (best, cut) = improved(f, &dag, opts, &seed, 0, &required)?;
+    if required.check() {
+        return Err(PlaceError::Stopped);
+    }
     if cut {
         return Ok((memory::build(f, a, &best), true));
     }
@@ -158,20 +201,24 @@ pub(crate) fn end(s: &schedule::Schedule) -> u32 {
     s.arrival.iter().copied().max().unwrap_or(0)
 }
 
-/// The list schedule for `keys` with feeding bonus `feed` (cycles, see [`feed::Feed`]), then up
-/// to `opts.improve` rounds of forward-backward improvement (kept while they shorten it); no
-/// round starts once `opts.deadline` is reached (`true`: rounds were cut).
+/// The list schedule for `keys` with feeding bonus `feed` (cycles, see [`feed::Feed`]; it
+/// ticks `first`, [`PlaceError::Stopped`] when that stops it), then up to `opts.improve`
+/// rounds of forward-backward improvement (kept while they shorten it); a round the
+/// `opts.deadline` reaches is dropped and none starts after (`true`: rounds were cut).
 pub(crate) fn improved(
     f: &Function,
     dag: &dag::OpDag,
     opts: &PlaceOptions,
     keys: &[dag::Key],
     feed: u32,
-) -> Result<(schedule::Schedule, bool), String> {
+    first: &crate::Ticker,
+) -> Result<(schedule::Schedule, bool), PlaceError> {
     let a = &opts.arch;
-    let mut best = schedule::schedule(f, dag, a, keys, opts.select, feed)?;
+    let mut best =
+        schedule::schedule_until(f, dag, a, keys, opts.select, feed, &|| first.tick())?.ok_or(PlaceError::Stopped)?;
+    let rounds = crate::Ticker::new(opts.deadline, opts.tick_budget);
     for _ in 0..opts.improve {
-        if opts.deadline.is_some_and(|d| d.reached()) {
+        if rounds.check() {
             return Ok((best, true));
         }
         // Backward pass: ops that arrived last go first in reverse time; then forward again in
@@ -181,7 +228,9 @@ pub(crate) fn improved(
         let r = schedule::backward_starts(f, dag, a.n_add, a.n_mul, &a.lat, &back, feed);
         let r_max = r.iter().copied().max().unwrap_or(0);
         let fwd: Vec<dag::Key> = (0..f.values.len()).map(|i| (r_max - r[i], keys[i].0, i as u32)).collect();
-        let s = schedule::schedule(f, dag, a, &fwd, opts.select, feed)?;
+        let Some(s) = schedule::schedule_until(f, dag, a, &fwd, opts.select, feed, &|| rounds.tick())? else {
+            return Ok((best, true));
+        };
         if end(&s) >= end(&best) {
             break;
         }
@@ -326,12 +375,22 @@ impl Pass for Place {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let lat = cx.latencies_for("place", &self.lat);
         let arch = PeArray { lat, writes: self.writes.unwrap_or(cx.target.writes), ..self.opts.arch };
-        let opts = PlaceOptions { deadline: cx.deadline, arch, ..self.opts };
+        // `-time-limit`: the first list schedule, which the placement needs, runs to the
+        // limit's grace (`cx.ticker()`: place is required); the improvement, restarts and
+        // search stop at the limit itself.
+        let ticker = cx.ticker();
+        let grace = cx.deadline.map(|d| d.grace());
+        let opts = PlaceOptions { deadline: cx.deadline, grace, tick_budget: cx.tick_budget, arch, ..self.opts };
         for f in &mut m.functions {
-            let (p, stopped) = try_place_function_progress(f, &opts, &cx.progress)
-                .map_err(|e| PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) })?;
-            if let (true, Some(d)) = (stopped, cx.deadline) {
-                let what = format!("searching @{} early (best schedule so far kept): {}", f.name, d.reason());
+            let (p, stopped) = try_place_function_progress(f, &opts, &cx.progress).map_err(|e| match e {
+                PlaceError::Stopped => ticker.error("place", &format!("in @{} in its first list schedule", f.name)),
+                PlaceError::Stuck(e) => {
+                    PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) }
+                }
+            })?;
+            if stopped {
+                let why = crate::Ticker::new(cx.deadline, cx.tick_budget).reason();
+                let what = format!("searching @{} early (best schedule so far kept): {why}", f.name);
                 cx.note_stop("place", &what);
             }
             f.placement = Some(p);

@@ -220,6 +220,23 @@ pub fn schedule(
     select: Select,
     feed: u32,
 ) -> Result<Schedule, String> {
+    schedule_until(f, dag, arch, keys, select, feed, &|| false).map(|s| s.expect("never stopped"))
+}
+
+/// [`schedule`] that calls `stop` once per op taken from a ready list and once per cycle
+/// (`-time-limit`, [`crate::Ticker::tick`]) and gives up when it says so: `Ok(None)`.
+///
+/// # Errors
+/// As [`schedule`].
+pub fn schedule_until(
+    f: &Function,
+    dag: &OpDag,
+    arch: &PeArray,
+    keys: &[Key],
+    select: Select,
+    feed: u32,
+    stop: &dyn Fn() -> bool,
+) -> Result<Option<Schedule>, String> {
     let n = f.values.len();
     let kind = |v: Value| f.op_kind(v).expect("op");
     let mut feed = Feed::new(dag, keys, feed, false);
@@ -255,6 +272,9 @@ pub fn schedule(
     let mut t: u32 = 0;
     let mut stalled_since: Option<u32> = None;
     while placed < dag.ops.len() {
+        if stop() {
+            return Ok(None);
+        }
         while let Some(&Reverse((c, v))) = arrivals.peek() {
             if c > t {
                 break;
@@ -276,6 +296,9 @@ pub fn schedule(
             free.extend_from_slice(&pes[ty]);
             deferred.clear();
             while !free.is_empty() {
+                if stop() {
+                    return Ok(None);
+                }
                 let Some(Reverse((k, v))) = ready[ty].pop() else { break };
                 if k != feed.key[v.index()] || ctx.issue[v.index()].is_some() {
                     continue; // stale entry (the key was lowered since)
@@ -344,7 +367,7 @@ pub fn schedule(
             }
         }
     }
-    Ok(Schedule { issue: ctx.issue, arrival: ctx.arrival, bookings: ctx.bookings })
+    Ok(Some(Schedule { issue: ctx.issue, arrival: ctx.arrival, bookings: ctx.bookings }))
 }
 
 /// Constant or value read by an op, for load bookkeeping.

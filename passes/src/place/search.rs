@@ -21,7 +21,7 @@ use robovec_ir::Function;
 
 use super::dag::{Key, OpDag};
 use super::schedule::{self, Schedule};
-use super::{end, improved, lower_bound, tight_lower_bound, PlaceOptions, Priority};
+use super::{end, improved, lower_bound, tight_lower_bound, PlaceError, PlaceOptions, Priority};
 
 /// Op schedulings allowed for restarts per placement (about a second of work).
 const RESTART_WORK: u64 = 1_000_000;
@@ -68,8 +68,10 @@ pub fn restarts_and_search(
     seed: Vec<Key>,
     mut best: Schedule,
     progress: &crate::progress::Progress,
-) -> Result<(Schedule, bool), String> {
+) -> Result<(Schedule, bool), PlaceError> {
     let out_of_time = || opts.deadline.is_some_and(|d| d.reached());
+    // A schedule the limit reaches is dropped (the best so far is kept).
+    let ticker = crate::Ticker::new(opts.deadline, opts.tick_budget);
     let a = &opts.arch;
     let (spec, tight) = (lower_bound(f, a) as u64, tight_lower_bound(f, a) as u64);
     let mut target = tight * 102 / 100;
@@ -109,7 +111,10 @@ pub fn restarts_and_search(
                 .collect()
         };
         // A cut improvement is seen by the next `out_of_time()`.
-        let (s, _) = improved(f, dag, opts, &keys, feed)?;
+        let (s, _) = match improved(f, dag, opts, &keys, feed, &ticker) {
+            Err(PlaceError::Stopped) => return Ok((best, true)),
+            r => r?,
+        };
         if end(&s) < end(&best) {
             best = s;
             plan = (keys, feed);
@@ -134,7 +139,10 @@ pub fn restarts_and_search(
                 k.0 = (k.0 as i64 + shift).max(0) as u32;
             }
         }
-        let (s, _) = improved(f, dag, opts, &keys, plan.1)?;
+        let (s, _) = match improved(f, dag, opts, &keys, plan.1, &ticker) {
+            Err(PlaceError::Stopped) => return Ok((best, true)),
+            r => r?,
+        };
         if score(&s, window) <= score(&best, window) {
             best = s;
             plan.0 = keys;
