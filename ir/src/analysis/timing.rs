@@ -11,7 +11,7 @@
 
 use crate::function::Function;
 use crate::latency::Latencies;
-use crate::syntax::Timing;
+use crate::syntax::{Def, Timing};
 use crate::Value;
 
 /// Critical path figures of a function (SPEC §4).
@@ -27,59 +27,72 @@ pub struct TimingSummary {
 /// inputs and trig variables) and the critical path. `f` must verify and be atomised
 /// (parsed-phase expressions are treated as ready at 0, i.e. ignored).
 pub fn compute_timing(f: &Function, lat: &Latencies) -> (Vec<Option<Timing>>, TimingSummary) {
-    let (s, sum) = sweep(f, lat);
-    let mut t: Vec<Option<Timing>> = vec![None; f.values.len()];
-    for &v in &f.body {
-        if f.op_kind(v).is_some() {
-            t[v.index()] = Some(s.timing(v));
-        }
-    }
-    (t, sum)
+    let mut table = Table { f, timing: vec![None; f.values.len()] };
+    let sum = sweep(&f.body, f.values.len(), &mut table, lat);
+    (table.timing, sum)
 }
 
 /// [`compute_timing`] written into `f` (`ValueData::timing` of every value: `None` for inputs
 /// and trig variables), without a table of every value's timing beside the function: 16
 /// bytes of work memory per value instead of ~90 for that table and a user graph (issue 10
-/// §3). Returns the critical path.
+/// §3). Each op's timing is written when the backward sweep finalises it, while its
+/// definition is in the cache (issue 28: one pass over the values less). Returns the critical
+/// path.
 pub fn annotate_timing(f: &mut Function, lat: &Latencies) -> TimingSummary {
-    let (s, sum) = sweep(f, lat);
-    for i in 0..f.values.len() {
-        let v = Value::with_number(i as u32);
-        let timing = f.op_kind(v).map(|_| s.timing(v));
-        f.value_mut(v).timing = timing;
+    for i in 0..f.inputs.len() {
+        let v = f.inputs[i];
+        f.value_mut(v).timing = None;
     }
+    let body = std::mem::take(&mut f.body);
+    let sum = sweep(&body, f.values.len(), f, lat);
+    f.body = body;
     sum
 }
 
-/// The four levels of every value, indexed by `Value::index()` (meaningful for ops).
-struct Levels {
-    asap: Vec<u32>,
-    asap_c: Vec<u32>,
-    alap: Vec<u32>,
-    alap_c: Vec<u32>,
+/// Where the sweeps read definitions and write each value's timing.
+trait Levels {
+    fn def(&self, v: Value) -> &Def;
+    fn set(&mut self, v: Value, t: Option<Timing>);
 }
 
-impl Levels {
-    fn timing(&self, v: Value) -> Timing {
-        let i = v.index();
-        let (asap, alap) = (self.asap[i], self.alap[i]);
-        Timing { asap, alap, asap_cycle: self.asap_c[i], alap_cycle: self.alap_c[i], mobility: alap - asap }
+/// [`compute_timing`]'s table beside the function.
+struct Table<'a> {
+    f: &'a Function,
+    timing: Vec<Option<Timing>>,
+}
+
+impl Levels for Table<'_> {
+    fn def(&self, v: Value) -> &Def {
+        &self.f.value(v).def
+    }
+    fn set(&mut self, v: Value, t: Option<Timing>) {
+        self.timing[v.index()] = t;
     }
 }
 
-/// The forward (ASAP) and backward (ALAP) sweeps in body order. The backward sweep needs no
-/// user lists: visiting ops in reverse body order (reverse topological), each op pushes its
-/// own bound to its operands, so an op's bound is final when it is visited. Work memory: four
-/// `u32` per value. Cost: O(values + operands).
-fn sweep(f: &Function, lat: &Latencies) -> (Levels, TimingSummary) {
-    let n = f.values.len();
+impl Levels for Function {
+    fn def(&self, v: Value) -> &Def {
+        &self.value(v).def
+    }
+    fn set(&mut self, v: Value, t: Option<Timing>) {
+        self.value_mut(v).timing = t;
+    }
+}
+
+/// The forward (ASAP) and backward (ALAP) sweeps over `body` (body order, topological), each
+/// body value's timing set when final. The backward sweep needs no user lists: visiting ops
+/// in reverse body order (reverse topological), each op pushes its own bound to its operands,
+/// so an op's bound is final when it is visited. Work memory: four `u32` per value (`n`
+/// values, indexed by `Value::index()`). Cost: O(values + operands).
+fn sweep(body: &[Value], n: usize, s: &mut impl Levels, lat: &Latencies) -> TimingSummary {
     let mut asap = vec![0u32; n];
     let mut asap_c = vec![0u32; n];
     let mut sum = TimingSummary::default();
-    for &v in &f.body {
-        let Some(kind) = f.op_kind(v) else { continue };
+    for &v in body {
+        let def = s.def(v);
+        let Some(kind) = def.op_kind() else { continue };
         let (mut a, mut c) = (0, 0);
-        f.value(v).def.for_each_value(|p| {
+        def.for_each_value(|p| {
             a = a.max(asap[p.index()]);
             c = c.max(asap_c[p.index()]);
         });
@@ -92,19 +105,24 @@ fn sweep(f: &Function, lat: &Latencies) -> (Levels, TimingSummary) {
     // after: its ALAP level.
     let mut alap = vec![u32::MAX; n];
     let mut alap_c = vec![u32::MAX; n];
-    for &v in f.body.iter().rev() {
-        let Some(kind) = f.op_kind(v) else { continue };
+    for &v in body.iter().rev() {
+        let def = s.def(v);
+        let Some(kind) = def.op_kind() else {
+            s.set(v, None);
+            continue;
+        };
         let l = sum.asap.min(alap[v.index()]);
         let lc = sum.asap_cycle.min(alap_c[v.index()]);
-        alap[v.index()] = l;
-        alap_c[v.index()] = lc;
         let lat_v = lat.of(kind);
-        f.value(v).def.for_each_value(|p| {
+        def.for_each_value(|p| {
             alap[p.index()] = alap[p.index()].min(l - 1);
             alap_c[p.index()] = alap_c[p.index()].min(lc - lat_v);
         });
+        let i = v.index();
+        let (a, ac) = (asap[i], asap_c[i]);
+        s.set(v, Some(Timing { asap: a, alap: l, asap_cycle: ac, alap_cycle: lc, mobility: l - a }));
     }
-    (Levels { asap, asap_c, alap, alap_c }, sum)
+    sum
 }
 
 #[cfg(test)]
