@@ -246,19 +246,6 @@ impl Function {
         Ok(v)
     }
 
-    /// Appends a definition named `name`, which the caller knows is new in this function (a
-    /// pass that makes names unique by construction): no lookup, one insertion into the name
-    /// index (one probe of a table that leaves the caches in large functions; issue 28).
-    /// A name already taken is a bug of the caller (checked in debug builds).
-    pub fn define_new(&mut self, name: String, def: Def, span: Span) -> Value {
-        debug_assert!(self.lookup(&name).is_none(), "define_new: `{name}` is taken");
-        let v = Value::with_number(self.values.len() as u32);
-        self.values.push(ValueData { name, def, timing: None, span });
-        self.names.insert(&self.values, v);
-        self.body.push(v);
-        v
-    }
-
     /// Appends a definition under a fresh name derived from `base` (see [`Function::fresh_name`]).
     pub fn define_fresh(&mut self, base: &str, def: Def, span: Span) -> Value {
         let name = self.fresh_name(base);

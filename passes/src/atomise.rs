@@ -112,7 +112,6 @@ fn atomise_within(mut src: Cow<'_, Function>, ticker: &Ticker) -> Option<Functio
         let nv = out.add_input(name.into_owned(), span).expect("input names are unique");
         map[v.index()] = Operand::Value(nv);
     }
-    let unique = !src.values.iter().any(|d| d.name.contains('.'));
     for i in 0..src.body.len() {
         if ticker.tick() {
             return None;
@@ -129,9 +128,6 @@ fn atomise_within(mut src: Cow<'_, Function>, ticker: &Ticker) -> Option<Functio
                 let Operand::Value(a) = map[a.index()] else { unreachable!("inputs map to inputs") };
                 Operand::Value(out.define(name.into_owned(), Def::Trig(*t, a), span).expect("unique name"))
             }
-            Def::Binary(op, a, b) if unique => {
-                Operand::Value(out.define_new(name.into_owned(), Def::Binary(*op, m(a), m(b)), span))
-            }
             Def::Binary(op, a, b) => {
                 let def = Def::Binary(*op, m(a), m(b));
                 Operand::Value(out.define(name.into_owned(), def, span).expect("unique name"))
@@ -141,7 +137,7 @@ fn atomise_within(mut src: Cow<'_, Function>, ticker: &Ticker) -> Option<Functio
                 Operand::Value(out.define(name.into_owned(), def, span).expect("unique name"))
             }
             Def::Expr(e) => {
-                let mut em = Emitter { out: &mut out, root: name.into_owned(), span, next: 1, map: &map, unique };
+                let mut em = Emitter { out: &mut out, root: name.into_owned(), span, next: 1, map: &map };
                 em.emit(e, true)
             }
         };
@@ -171,22 +167,10 @@ struct Emitter<'a> {
     span: Span,
     next: u32,
     map: &'a [Operand],
-    /// No name of the source holds a `.`: the source's names (unique, verified) and the
-    /// `ROOT.k` names made here cannot meet, so no name is looked up.
-    unique: bool,
 }
 
 impl Emitter<'_> {
     fn define(&mut self, top: bool, def: Def) -> Operand {
-        if self.unique {
-            let name = if top {
-                std::mem::take(&mut self.root)
-            } else {
-                self.next += 1;
-                format!("{}.{}", self.root, self.next - 1)
-            };
-            return Operand::Value(self.out.define_new(name, def, self.span));
-        }
         let name = if top {
             std::mem::take(&mut self.root)
         } else {
