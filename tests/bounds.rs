@@ -96,8 +96,11 @@ fn a_bad_time_limit_is_a_usage_error() {
         assert_eq!(o.status.code(), Some(2), "-time-limit={bad}: {err}");
         assert!(err.contains("time-limit"), "{err}");
     }
-    let o = opt(&[input.to_str().unwrap(), "-passes=atomise", "-time-limit=30", "-o", "-"]);
-    assert!(o.status.success() && String::from_utf8_lossy(&o.stderr).is_empty());
+    // Any positive number (issue 29: 1e20 was refused): one beyond the clock is no limit.
+    for good in ["30", "1e20", "1.7e308"] {
+        let o = opt(&[input.to_str().unwrap(), "-passes=atomise,balance", &format!("-time-limit={good}"), "-o", "-"]);
+        assert!(o.status.success() && String::from_utf8_lossy(&o.stderr).is_empty(), "-time-limit={good}");
+    }
 }
 
 /// A limit already reached when `place` and `sweep` start: `place`, which the output needs,
