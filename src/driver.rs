@@ -24,7 +24,6 @@ use robovec_passes::{
 };
 
 use crate::diagnostics::SourceFile;
-use crate::eval::evaluate;
 use crate::options::{output_failure, select};
 pub use crate::options::{Failure, Options};
 use crate::output::OutputSet;
@@ -246,6 +245,11 @@ pub fn run_with(
     // Only the functions the run uses are built (a URDF's `-function=invdyna` skips `dirdyna`).
     let front = FrontOptions { functions: opts.function.clone().map(|f| vec![f]), deadline, ..opts.front.clone() };
     let (loaded, src) = load_with(&opts.input, &front)?;
+    let eval_inputs = eval_inputs.map(|given| crate::eval::EvalInputs {
+        given,
+        defaults: loaded.input_defaults,
+        defaults_source: loaded.defaults_source,
+    });
     let mut module = loaded.module;
     crate::preflight::check_functions(opts, &module)?;
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
@@ -352,16 +356,39 @@ fn report_json(
 fn eval_json(
     opts: &Options,
     module: &Module,
-    given: &BTreeMap<String, f64>,
+    given: &crate::eval::EvalInputs,
     stderr: &mut dyn Write,
 ) -> Result<String, Failure> {
     let f = select(module, &opts.function, "-eval")?;
-    for name in given.keys() {
+    for name in given.given.keys() {
         if !f.inputs.iter().any(|&v| f.name_of(v) == name) {
             writeln!(stderr, "warning: `{name}` is not an input of @{}; ignored", f.name).map_err(stderr_failure)?;
         }
     }
-    let r = evaluate(f, given, opts.eval_f32);
+    // Inputs not given are named (issue 29: they were silently random, gravity too).
+    let missing = crate::eval::not_given(f, given);
+    let first = |names: &[String]| {
+        let shown: Vec<&str> = names.iter().take(6).map(String::as_str).collect();
+        let more = names.len().saturating_sub(shown.len());
+        shown.join(", ") + &if more > 0 { format!(" and {more} more") } else { String::new() }
+    };
+    let file = opts.eval.as_deref().map_or(String::new(), |p| p.display().to_string());
+    if !missing.defaulted.is_empty() {
+        let (n, source) = (missing.defaulted.len(), given.defaults_source);
+        writeln!(stderr, "note: {n} inputs of @{} not in {file} take {source}: {}", f.name, first(&missing.defaulted))
+            .map_err(stderr_failure)?;
+    }
+    if !missing.random.is_empty() {
+        writeln!(
+            stderr,
+            "warning: {} inputs of @{} not in {file} get pseudo-random values in [-1, 1] (seed 0): {}",
+            missing.random.len(),
+            f.name,
+            first(&missing.random)
+        )
+        .map_err(stderr_failure)?;
+    }
+    let r = crate::eval::evaluate_with(f, &given.given, &given.defaults, opts.eval_f32);
     for c in &r.callback_standins {
         writeln!(
             stderr,
@@ -415,7 +442,7 @@ fn write_outputs(
     pm: &PassManager,
     module: &Module,
     ran: &Ran,
-    eval_inputs: Option<&BTreeMap<String, f64>>,
+    eval_inputs: Option<&crate::eval::EvalInputs>,
     terminal: Terminal,
     mut out: OutputSet,
     stdout: &mut dyn Write,

@@ -116,13 +116,48 @@ fn eval_uses_given_inputs_and_reports_all_outputs() {
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["inputs"]["q[4]"], 0.25);
     assert_eq!(j["inputs"]["dpt[3][2]"], 3.5);
-    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    // The inputs not given are named, with how many (issue 29: they were silently random).
+    let e = stderr(&o);
+    let w: Vec<&str> = e.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(w.len(), 1, "{e}");
+    let given = j["inputs"].as_object().unwrap().len() - 2;
+    let expect = format!("warning: {given} inputs of @dirdyna not in {} get pseudo-random values", inputs.display());
+    assert!(w[0].starts_with(&expect) && w[0].contains(" in [-1, 1] (seed 0): q["), "{}", w[0]);
+    assert!(w[0].ends_with(&format!(" and {} more", given - 6)), "{}", w[0]);
     assert!(j["outputs"]["M[1][1]"].is_number() && j["outputs"]["c[17]"].is_number());
     // Same numbers before atomise (the parsed IR is evaluated as written); JSON numbers compare
     // as f64, so a zero whose sign `0 - t` changed still compares equal.
     let o2 = opt(&[&segway(), "-passes=", &format!("-eval={}", inputs.display())]);
     let j2: serde_json::Value = serde_json::from_slice(&o2.stdout).unwrap();
     assert_eq!(j, j2);
+}
+
+/// `-eval` on a URDF: inputs not given take the model's parameters and Pinocchio's gravity
+/// (issue 29: gravity was silently random), and a note says so; the others are named.
+#[test]
+fn eval_on_a_urdf_takes_the_models_parameters_and_pinocchios_gravity() {
+    let d = tmp("eval_urdf");
+    let inputs = d.join("in.json");
+    std::fs::write(&inputs, r#"{"q[1]": 0.5, "q[2]": -0.25, "q[3]": 1.0}"#).unwrap();
+    let arm = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/three_link_arm/three_link_arm.urdf");
+    let o =
+        opt(&[arm.to_str().unwrap(), "-function=invdyna", "-passes=atomise", &format!("-eval={}", inputs.display())]);
+    let e = stderr(&o);
+    assert!(o.status.success(), "{e}");
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((j["inputs"]["g[1]"].as_f64(), j["inputs"]["g[2]"].as_f64()), (Some(0.0), Some(0.0)));
+    assert_eq!(j["inputs"]["g[3]"].as_f64(), Some(-9.81));
+    let note = e.lines().find(|l| l.starts_with("note: ")).unwrap_or_else(|| panic!("{e}"));
+    assert!(
+        note.contains("take the URDF's parameters and Pinocchio's gravity (0, 0, -9.81): g[1], g[2], g[3]"),
+        "{note}"
+    );
+    let warn = e.lines().find(|l| l.starts_with("warning: ")).unwrap_or_else(|| panic!("{e}"));
+    assert!(
+        warn.starts_with("warning: 6 inputs of @invdyna not in ")
+            && warn.ends_with("qd[1], qdd[1], qd[2], qdd[2], qd[3], qdd[3]"),
+        "{warn}"
+    );
     // An unknown input name is reported, not silently used.
     std::fs::write(&inputs, r#"{"q[99]": 1.0}"#).unwrap();
     let o = opt(&[&segway(), "-passes=atomise", &format!("-eval={}", inputs.display())]);

@@ -46,11 +46,19 @@ pub struct Loaded {
     /// Canonical parameter name (`m[2]`, `dpt[1][3]`) → value, when the input states them
     /// (a URDF does; a Robotran file does not: its parameters live in the user's `MbsData`).
     pub params: Option<BTreeMap<String, f64>>,
+    /// Values the input's own conventions give its functions' inputs, for `-eval`'s inputs
+    /// not given (issue 29): a URDF's model parameters and Pinocchio's gravity
+    /// `g = (0, 0, −9.81)`; empty for a Robotran file, whose values live in the user's
+    /// `MbsData`.
+    pub input_defaults: BTreeMap<String, f64>,
+    /// What [`Loaded::input_defaults`] are, for messages (`the URDF's parameters and
+    /// Pinocchio's gravity (0, 0, -9.81)`); empty when there are none.
+    pub defaults_source: &'static str,
 }
 
 impl From<Module> for Loaded {
     fn from(module: Module) -> Loaded {
-        Loaded { module, params: None }
+        Loaded { module, params: None, input_defaults: BTreeMap::new(), defaults_source: "" }
     }
 }
 

@@ -79,7 +79,12 @@ impl FrontEnd for Urdf {
             vec![FrontError::new(span, stop.to_string(), "reached here")
                 .note("-time-limit covers loading too: nothing is written without a complete module")]
         })?;
-        Ok(Loaded { module: g.module, params: g.params })
+        // `-eval`'s values for inputs not given: the model's own, and gravity as Pinocchio's
+        // `Model::gravity` (−9.81 m/s² along z).
+        let mut input_defaults = g.params.clone().unwrap_or_default();
+        input_defaults.extend([("g[1]".to_string(), 0.0), ("g[2]".to_string(), 0.0), ("g[3]".to_string(), -9.81)]);
+        let defaults_source = "the URDF's parameters and Pinocchio's gravity (0, 0, -9.81)";
+        Ok(Loaded { module: g.module, params: g.params, input_defaults, defaults_source })
     }
 }
 
