@@ -50,7 +50,14 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     .filter_map(|(flag, p)| p.map(|p| (flag, p)))
     .chain(companions.iter().map(|p| ("-o's companion", p.as_path())))
     .collect();
-    for (_, p) in &files {
+    for (flag, p) in &files {
+        // A path ending in `/` names a folder (issue 29: `-o nope/` wrote a file `nope`).
+        if p.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
+            return Err(Failure::Usage(format!(
+                "error: {flag} `{}` names a folder (it ends in `/`); {flag} writes a file\n",
+                p.display()
+            )));
+        }
         output::check_file(p).map_err(output_failure)?;
     }
     for (i, (flag_a, a)) in files.iter().enumerate() {

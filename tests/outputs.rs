@@ -288,6 +288,19 @@ fn usage_errors_come_before_any_work() {
         assert!(!dumps.exists(), "{extra:?}: no pass ran, no dump was written");
         assert_eq!(entries(&d), Vec::<String>::new(), "{extra:?}: no file written");
     }
+    // A path ending in `/` names a folder, never a file (issue 29: `-o nope/` wrote `nope`).
+    for flag in ["-o", "-report"] {
+        let nope = format!("{}/", d.join("nope").display());
+        let args: Vec<String> = if flag == "-o" {
+            vec![pendulum(), "-passes=atomise".into(), "-o".into(), nope.clone()]
+        } else {
+            vec![pendulum(), "-passes=atomise".into(), format!("-report={nope}"), "-o".into(), s(&out).into()]
+        };
+        let o = Command::new(BIN).args(&args).output().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{flag}: {}", stderr(&o));
+        assert!(stderr(&o).contains(&format!("{flag} `{nope}` names a folder (it ends in `/`)")), "{}", stderr(&o));
+        assert_eq!(entries(&d), Vec::<String>::new(), "{flag}: no file written");
+    }
     // A folder given as an output file, and a dump folder that is a file.
     fs::create_dir(d.join("adir")).unwrap();
     let o = opt(&[&pendulum(), "-passes=atomise", &dump, "-o", s(&d.join("adir"))]);
