@@ -39,13 +39,22 @@ impl SourceFile {
     }
 
     /// Renders diagnostics (no colour), each ending in a blank line; long lines and messages
-    /// are shortened (see the module doc).
+    /// are shortened (see the module doc). At most [`MAX_SHOWN`] are shown, then one line
+    /// `error: … and N more errors not shown (fix the first ones: later ones often follow
+    /// from them)` (issue 29: one swapped line of a Python file gave 49 KB of cascading errors).
     pub fn render(&self, diags: &[Diagnostic<()>]) -> String {
         let config = Config::default();
         // Line starts are computed once for all the diagnostics.
         let file = SimpleFile::new(self.name.as_str(), self.text.as_str());
+        let more = diags.len().saturating_sub(MAX_SHOWN);
+        let tail = (more > 0).then(|| {
+            format!(
+                "error: … and {more} more errors not shown (fix the first ones: later ones often follow from them)\n"
+            )
+        });
         diags
             .iter()
+            .take(MAX_SHOWN)
             .map(|d| {
                 let d = shorten_messages(d);
                 let rendered = match Windowed::new(&file, &d) {
@@ -54,9 +63,13 @@ impl SourceFile {
                 };
                 rendered.unwrap_or_else(|e| format!("error: {}\n(could not render: {e})\n", d.message))
             })
+            .chain(tail)
             .collect()
     }
 }
+
+/// Diagnostics [`SourceFile::render`] shows at most.
+pub const MAX_SHOWN: usize = 20;
 
 /// `s` cut in the middle to at most about `max` characters.
 fn shorten(s: &str, max: usize) -> String {

@@ -286,3 +286,27 @@ fn time_limit_stops_check_with_a_note() {
     assert!((256..10_000_000).contains(&done) && done.is_multiple_of(256), "{note}");
     assert!(out.exists(), "the output is written");
 }
+
+/// Cascading parse errors are capped (issue 29: one swapped line of a `.py` file gave 49 KB of
+/// errors): the first 20 are shown, then how many more there are.
+#[test]
+fn parse_errors_are_capped_with_a_count_of_the_rest() {
+    let d = tmp("error_cap");
+    let py = d.join("bad.py");
+    let mut t = String::from("import numpy as np\n\ndef dirdyna(M, c, s, tsim):\n  q = s.q\n");
+    for k in 1..=60 {
+        t += &format!("  T{k} = q[1] +* q[2]\n");
+    }
+    std::fs::write(&py, t).unwrap();
+    let o = opt(&[py.to_str().unwrap(), "-passes=atomise"]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    let shown = e.lines().filter(|l| l.starts_with("error")).count();
+    assert_eq!(shown, 21, "20 diagnostics and the count: {e}");
+    assert!(
+        e.trim_end()
+            .ends_with("error: … and 40 more errors not shown (fix the first ones: later ones often follow from them)"),
+        "{e}"
+    );
+    assert!(e.contains("bad.py:5:") && !e.contains("bad.py:25:"), "the first ones, located: {e}");
+}
