@@ -70,6 +70,15 @@ pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile
         }
     }
     let src = SourceFile::from_bytes(name, &bytes);
+    if let (true, Err(e)) = (fe.requires_utf8(), std::str::from_utf8(&bytes)) {
+        let at = e.valid_up_to();
+        let d = codespan_reporting::diagnostic::Diagnostic::error()
+            .with_message(format!("invalid UTF-8 (byte 0x{:02x}): a {} file is read as UTF-8", bytes[at], fe.name()))
+            .with_labels(
+                vec![codespan_reporting::diagnostic::Label::primary((), at..at + 1).with_message("not UTF-8")],
+            );
+        return Err(Failure::Input(src.render(&[d])));
+    }
     // The text is the one copy of the input kept (for diagnostics and the parse).
     drop(bytes);
     let loaded = fe

@@ -244,3 +244,23 @@ fn function_builds_only_the_function_asked_for() {
     assert!(stderr(&o).contains("no function `sensor_1` in the input; functions: invdyna, dirdyna"), "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+/// A URDF is XML, read as UTF-8: an invalid byte is refused at its line and column (issue 29:
+/// it was read as `?` and accepted), with exit 1 and nothing written.
+#[test]
+fn a_urdf_with_invalid_utf8_is_refused_where_the_byte_is() {
+    let d = tmp("bad_utf8");
+    let text = std::fs::read(path("examples/three_link_arm/three_link_arm.urdf")).unwrap();
+    let at = text.windows(6).position(|w| w == b"name=\"").unwrap() + 6;
+    let bad = d.join("bad.urdf");
+    std::fs::write(&bad, [&text[..at], b"\xff", &text[at..]].concat()).unwrap();
+    let out = d.join("out.rvir");
+    let o = opt(&[bad.to_str().unwrap(), "-passes=atomise", "-o", out.to_str().unwrap()]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("error: invalid UTF-8 (byte 0xff): a URDF file is read as UTF-8"), "{e}");
+    let line = text[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+    let col = at - text[..at].iter().rposition(|&b| b == b'\n').map_or(0, |k| k + 1) + 1;
+    assert!(e.contains(&format!("bad.urdf:{line}:{col}")), "{e}");
+    assert!(!out.exists());
+}

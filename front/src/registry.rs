@@ -93,6 +93,13 @@ pub trait FrontEnd: Sync {
     fn no_function_message(&self) -> &'static str {
         "expected at least one function"
     }
+
+    /// True when the input must be valid UTF-8 (XML: a URDF): the driver then refuses one
+    /// that is not, at its first invalid byte, instead of reading each such byte as `?` as it
+    /// does for Robotran files (issue 29: a URDF with invalid UTF-8 was accepted silently).
+    fn requires_utf8(&self) -> bool {
+        false
+    }
 }
 
 /// A Robotran output file (C with its companion `.h`, Matlab or Python).

@@ -41,6 +41,10 @@ impl FrontEnd for Urdf {
         Some(&robovec_dynamics::FUNCTION_NAMES)
     }
 
+    fn requires_utf8(&self) -> bool {
+        true
+    }
+
     fn load(&self, _: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
         let robot = parse(text).map_err(|e| vec![e])?;
         if !robot.joints.iter().any(|j| j.kind != JointKind::Fixed) {
