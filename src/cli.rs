@@ -140,6 +140,26 @@ fn parse_time_limit(s: &str) -> Result<f64, String> {
     }
 }
 
+/// Says what clap's parse error `e` says, for every binary: `--help` and `--version` on
+/// stdout, errors on stderr. Returns the exit status: clap's, or 1 when stdout cannot be
+/// written (a closed pipe, a full disk; issue 29: `robovec-gen --help > /dev/full` was exit 0).
+pub fn report_parse_error(e: &clap::Error) -> i32 {
+    use std::io::Write;
+    let text = e.render().to_string();
+    if e.use_stderr() {
+        let _ = std::io::stderr().lock().write_all(text.as_bytes());
+        return e.exit_code();
+    }
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => e.exit_code(),
+        Err(err) => {
+            let _ = writeln!(std::io::stderr().lock(), "error: cannot write to stdout: {err}");
+            1
+        }
+    }
+}
+
 /// Maps LLVM single-dash long flags (`-passes=x`) to clap's `--passes=x`.
 pub fn normalise_args(args: impl IntoIterator<Item = String>) -> Vec<String> {
     args.into_iter()

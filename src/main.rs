@@ -39,15 +39,8 @@ fn to_stderr(text: &str) {
 fn run() -> i32 {
     let cli = match Cli::try_parse_from(normalise_args(std::env::args())) {
         Ok(c) => c,
-        Err(e) => {
-            let text = e.render().to_string();
-            if e.use_stderr() {
-                to_stderr(&text);
-                return e.exit_code();
-            }
-            // --help and --version.
-            return to_stdout(&text, e.exit_code());
-        }
+        // --help and --version (stdout), or a usage error (stderr).
+        Err(e) => return robovec::cli::report_parse_error(&e),
     };
     if let Some(listing) = cli.print_passes {
         return to_stdout(&listing.render(), 0);

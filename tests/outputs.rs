@@ -195,6 +195,14 @@ fn a_full_disk_is_exit_1_with_one_line() {
         assert_one_line_exit_1(o.status.code(), &stderr(&o), &format!("{args:?} > /dev/full"));
         assert!(stderr(&o).contains("No space left"), "{}", stderr(&o));
     }
+    // --help and --version of both binaries too (issue 29: robovec-gen's were exit 0).
+    for bin in [BIN, env!("CARGO_BIN_EXE_robovec-gen")] {
+        for flag in ["--help", "--version"] {
+            let o = Command::new(bin).arg(flag).stdout(Stdio::from(full())).output().unwrap();
+            assert_one_line_exit_1(o.status.code(), &stderr(&o), &format!("{bin} {flag} > /dev/full"));
+            assert!(stderr(&o).contains("cannot write to stdout: No space left"), "{}", stderr(&o));
+        }
+    }
     // stderr on a full disk: exit 1 (nothing can be said) and no output file.
     let d = tmp("full");
     let out = d.join("out.rvir");

@@ -146,7 +146,11 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
     robovec::allocator::configure();
-    let args = Args::parse();
+    let args = match Args::try_parse() {
+        Ok(a) => a,
+        // --help and --version (stdout: a failed write is exit 1), or a usage error.
+        Err(e) => return ExitCode::from(robovec::cli::report_parse_error(&e) as u8),
+    };
     if args.study.study {
         return study(&args);
     }
