@@ -133,6 +133,19 @@ fn placed_designs_simulate_in_iverilog_bit_for_bit_like_the_binary32_evaluation(
     }
 }
 
+/// `simulate` runs from a folder whose name holds a `"`, a space and a `$` (issue 29: iverilog
+/// quoted the sources' paths in its `line directives and failed with a syntax error).
+#[test]
+fn simulate_works_whatever_its_folder_is_named() {
+    tool("iverilog");
+    let d = tmp("quoted");
+    let none = d.join("none.json");
+    std::fs::write(&none, "{}").unwrap();
+    let dir = d.join("we\"ird $dir");
+    let eval = emit(PENDULUM, 2, &dir, "", &none);
+    same_outputs("pendulum in a quoted folder", &eval, &simulate(&dir, &none));
+}
+
 #[test]
 fn mif_only_designs_simulate_too_and_unknown_inputs_are_refused() {
     let d = tmp("mif");

@@ -166,8 +166,14 @@ def main(argv):
             for key in ("data", "out"):
                 with open(os.path.join(tmp, pe["memories"][key]["file"] + ".hex"), "w") as f:
                     f.write("".join("%08x\n" % w for w in images[pe["slot"]][key]))
-        sources = [os.path.join(HERE, "hdl", n) for n in man["hdl"]] + [os.path.join(HERE, "hdl", "testbench.v")]
-        r = subprocess.run(["iverilog", "-g2005", "-o", os.path.join(tmp, "sim.vvp")] + sources,
+        # The sources are compiled from copies in the temporary folder, under their own names:
+        # iverilog quotes each path in its `line directives, so a folder name holding `"`
+        # (or other characters it does not escape) broke the compilation.
+        sources = []
+        for n in list(man["hdl"]) + ["testbench.v"]:
+            shutil.copy(os.path.join(HERE, "hdl", n), os.path.join(tmp, "src-" + os.path.basename(n)))
+            sources.append("src-" + os.path.basename(n))
+        r = subprocess.run(["iverilog", "-g2005", "-o", "sim.vvp"] + sources,
                            cwd=tmp, capture_output=True, text=True)
         if r.returncode != 0:
             fail("iverilog failed:\n" + r.stderr)
