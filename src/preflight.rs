@@ -50,16 +50,6 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     .filter_map(|(flag, p)| p.map(|p| (flag, p)))
     .chain(companions.iter().map(|p| ("-o's companion", p.as_path())))
     .collect();
-    for (flag, p) in &files {
-        // A path ending in `/` names a folder (issue 29: `-o nope/` wrote a file `nope`).
-        if p.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
-            return Err(Failure::Usage(format!(
-                "error: {flag} `{}` names a folder (it ends in `/`); {flag} writes a file\n",
-                p.display()
-            )));
-        }
-        output::check_file(p).map_err(output_failure)?;
-    }
     for (i, (flag_a, a)) in files.iter().enumerate() {
         for (flag_b, b) in &files[i + 1..] {
             if let (Some(x), Some(y)) = (output::identity(a), output::identity(b)) {
@@ -73,31 +63,61 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
             }
         }
     }
-    let folders =
-        pass_paths(pm, |k| matches!(k, ParamKind::OutputFolder)).into_iter().map(|(_, _, d)| PathBuf::from(d));
-    for d in opts.instr.dump_dir.iter().cloned().chain(folders) {
-        output::check_folder(&d).map_err(output_failure)?;
+    // Every folder the run writes, named for messages.
+    let folders: Vec<(String, PathBuf)> = opts
+        .instr
+        .dump_dir
+        .iter()
+        .map(|d| ("-dump-dir".to_string(), d.clone()))
+        .chain(
+            pass_paths(pm, |k| matches!(k, ParamKind::OutputFolder))
+                .into_iter()
+                .map(|(pass, key, d)| (format!("pass `{pass}`'s {key}="), PathBuf::from(d))),
+        )
+        .chain(opts.report_dir.iter().map(|d| ("-report-dir".to_string(), d.clone())))
+        .collect();
+    for (flag, d) in &folders {
+        if flag != "-report-dir" {
+            output::check_folder(d).map_err(output_failure)?;
+        }
+    }
+    // No output inside another's folder (issue 29: `-report=DIR/manifest.json` beside
+    // `codegen<fpga;out=DIR>`, or `-o dd/001-atomise.after.rvir` with `-dump-dir=dd`, replaced
+    // one output by another; a pass folder inside `-report-dir` failed only after the work).
+    let inside_folder = |p: &Path, dir: &Path| -> bool { resolved(p).starts_with(resolved(dir)) };
+    for (flag, p) in &files {
+        if let Some((dflag, d)) = folders.iter().find(|(_, d)| inside_folder(p, d)) {
+            return Err(Failure::Usage(format!(
+                "error: {flag} `{}` is inside {dflag} `{}`; choose another path\n",
+                p.display(),
+                d.display()
+            )));
+        }
+    }
+    for (i, (fa, a)) in folders.iter().enumerate() {
+        for (j, (fb, b)) in folders.iter().enumerate() {
+            if i != j && inside_folder(a, b) && (resolved(a) != resolved(b) || i < j) {
+                let what = if resolved(a) == resolved(b) { "is the same folder as" } else { "is inside" };
+                return Err(Failure::Usage(format!(
+                    "error: {fa} `{}` {what} {fb} `{}`; choose another path\n",
+                    a.display(),
+                    b.display()
+                )));
+            }
+        }
+    }
+    for (flag, p) in &files {
+        // A path ending in `/` names a folder (issue 29: `-o nope/` wrote a file `nope`).
+        if p.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
+            return Err(Failure::Usage(format!(
+                "error: {flag} `{}` names a folder (it ends in `/`); {flag} writes a file\n",
+                p.display()
+            )));
+        }
+        output::check_file(p).map_err(output_failure)?;
     }
     if let Some(dir) = &opts.report_dir {
         output::check_replaceable_folder(dir).map_err(output_failure)?;
-        // The folder is replaced whole: no other output may go inside it.
-        let inside = |p: &Path| {
-            let parent = p.parent().filter(|q| !q.as_os_str().is_empty()).unwrap_or(Path::new("."));
-            match (std::fs::canonicalize(parent), std::fs::canonicalize(dir)) {
-                (Ok(a), Ok(b)) => a.starts_with(b),
-                _ => parent.starts_with(dir),
-            }
-        };
-        // A dump folder counts by a file inside it.
-        let dumps: Vec<(&str, PathBuf)> = opts.instr.dump_dir.iter().map(|d| ("-dump-dir", d.join("dump"))).collect();
-        let mut all = files.iter().map(|&(f, p)| (f, p.to_path_buf())).chain(dumps);
-        if let Some((flag, p)) = all.find(|(_, p)| inside(p)) {
-            return Err(Failure::Usage(format!(
-                "error: {flag} `{}` is inside -report-dir `{}`, which is replaced as a whole; choose another path\n",
-                p.display(),
-                dir.display()
-            )));
-        }
     }
     check_pass_files(pm)?;
     // `-pareto`'s pipelines: every name, parameter and file they read, before any work too.
@@ -108,6 +128,35 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// `p` made absolute with `..` and symlinks resolved as far as the path exists, and `.` and
+/// `..` of the part that does not exist resolved as written, so that two spellings of one
+/// place compare equal.
+fn resolved(p: &Path) -> PathBuf {
+    use std::path::Component;
+    let abs = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let mut acc = PathBuf::new();
+    let mut exists = true;
+    for c in abs.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if !exists => {
+                acc.pop();
+            }
+            _ => {
+                acc.push(c);
+                if exists {
+                    // Symlinks and `..` resolved as the file system has them.
+                    match std::fs::canonicalize(&acc) {
+                        Ok(real) => acc = real,
+                        Err(_) => exists = false,
+                    }
+                }
+            }
+        }
+    }
+    acc
 }
 
 /// The file `-o` writes a back end's code to, when the pipeline ends in one and `-o` names a

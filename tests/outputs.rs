@@ -337,3 +337,72 @@ fn an_empty_or_comment_only_rvir_is_bad_input() {
         assert!(!d.join("r.json").exists());
     }
 }
+
+/// Every output is known before any work, and none goes inside another's folder (issue 29:
+/// such runs replaced one output by another with exit 0, or failed only after all the work
+/// blaming a temporary file): usage error, exit 2, nothing written, naming both.
+#[test]
+fn an_output_inside_another_outputs_folder_is_a_usage_error_naming_both() {
+    let d = tmp("nested");
+    let fpga = d.join("fpga");
+    let dd = d.join("dd");
+    let place = "-passes=atomise,place<pe=2>";
+    let with_fpga = format!("{place},codegen<fpga;out={}>", fpga.display());
+    let cases: Vec<(Vec<String>, String)> = vec![
+        (
+            vec![
+                with_fpga.clone(),
+                format!("-report={}", fpga.join("manifest.json").display()),
+                "-o".into(),
+                "-".into(),
+            ],
+            format!(
+                "-report `{}` is inside pass `codegen`'s out= `{}`",
+                fpga.join("manifest.json").display(),
+                fpga.display()
+            ),
+        ),
+        (
+            vec![with_fpga.clone(), "-o".into(), fpga.join("simulate").display().to_string()],
+            format!("-o `{}` is inside pass `codegen`'s out= `{}`", fpga.join("simulate").display(), fpga.display()),
+        ),
+        (
+            vec![
+                place.into(),
+                format!("-dump-dir={}", dd.display()),
+                "-o".into(),
+                dd.join("001-atomise.after.rvir").display().to_string(),
+            ],
+            format!("-o `{}` is inside -dump-dir `{}`", dd.join("001-atomise.after.rvir").display(), dd.display()),
+        ),
+        (
+            vec![
+                format!("{place},codegen<fpga;out={}>", d.join("rep/fpga").display()),
+                format!("-report-dir={}", d.join("rep").display()),
+                "-o".into(),
+                "-".into(),
+            ],
+            format!(
+                "pass `codegen`'s out= `{}` is inside -report-dir `{}`",
+                d.join("rep/fpga").display(),
+                d.join("rep").display()
+            ),
+        ),
+        (
+            vec![with_fpga.clone(), format!("-dump-dir={}", d.join("x/../fpga").display()), "-o".into(), "-".into()],
+            format!(
+                "-dump-dir `{}` is the same folder as pass `codegen`'s out= `{}`",
+                d.join("x/../fpga").display(),
+                fpga.display()
+            ),
+        ),
+    ];
+    for (extra, needle) in cases {
+        let mut args = vec![pendulum()];
+        args.extend(extra.iter().cloned());
+        let o = Command::new(BIN).args(&args).output().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(&needle), "{extra:?}: {}", stderr(&o));
+        assert_eq!(entries(&d), Vec::<String>::new(), "{extra:?}: nothing written");
+    }
+}
