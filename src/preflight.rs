@@ -52,7 +52,7 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     .collect();
     for (i, (flag_a, a)) in files.iter().enumerate() {
         for (flag_b, b) in &files[i + 1..] {
-            if let (Some(x), Some(y)) = (output::identity(a), output::identity(b)) {
+            if let (Some(x), Some(y)) = (same_file_key(a), same_file_key(b)) {
                 if x == y {
                     return Err(Failure::Usage(format!(
                         "error: {flag_a} `{}` and {flag_b} `{}` are the same file\n",
@@ -128,6 +128,20 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// What tells two outputs on one file apart: the file a regular output finally goes to
+/// ([`output::identity`]), or a FIFO itself (issue 29: one FIFO given to `-report` and `-o`
+/// lost one of them); `None` for character devices (`/dev/null` may take any number).
+fn same_file_key(p: &Path) -> Option<PathBuf> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if std::fs::metadata(p).is_ok_and(|m| m.file_type().is_fifo()) {
+            return Some(resolved(p));
+        }
+    }
+    output::identity(p)
 }
 
 /// `p` made absolute with `..` and symlinks resolved as far as the path exists, and `.` and

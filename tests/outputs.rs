@@ -145,6 +145,10 @@ fn a_fifo_is_written_directly() {
     assert!(fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo(), "still a FIFO");
     assert!(fs::read_to_string(&got).unwrap().contains("func @invdyna"));
     assert_eq!(entries(&d), ["fifo", "got"]);
+    // One FIFO for two outputs is refused before any work (issue 29: one of them was lost).
+    let o = opt(&[&pendulum(), "-passes=atomise", &format!("-report={}", s(&fifo)), "-o", s(&fifo)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("are the same file"), "{}", stderr(&o));
 }
 
 /// Runs `cmd` (a shell command using `$BIN`, `$IN`) with stdout into a pipe whose reader has
