@@ -95,11 +95,29 @@ pub fn run(e: &Export, stdout: &mut dyn Write) -> Result<(), Failure> {
             "error: --params-out: with --fold-params no parameter is left as an input\n".into(),
         ));
     }
+    // The outputs are distinct files, checked before any work (issue 29: `-o x.c --params-out
+    // x.h` replaced the header with the JSON).
+    let h_path = c_path.with_extension("h");
+    let outputs: Vec<(&str, &Path)> = [("-o", Some(c_path.as_path())), ("-o's header", Some(h_path.as_path()))]
+        .into_iter()
+        .chain([("--params-out", e.params_out.as_deref())])
+        .filter_map(|(flag, p)| p.map(|p| (flag, p)))
+        .collect();
+    for (i, (fa, a)) in outputs.iter().enumerate() {
+        if let Some((fb, b)) =
+            outputs[i + 1..].iter().find(|(_, b)| crate::preflight::resolved(a) == crate::preflight::resolved(b))
+        {
+            return Err(Failure::Usage(format!(
+                "error: {fa} `{}` and {fb} `{}` are the same file\n",
+                a.display(),
+                b.display()
+            )));
+        }
+    }
     let (module, params, project) = equations(&e.source, front)?;
     let Some(f) = module.function(&e.function) else {
         return Err(Failure::Usage(format!("error: --function {}: expected invdyna or dirdyna\n", e.function)));
     };
-    let h_path = c_path.with_extension("h");
     let header = file_name(&h_path);
     let source = match &e.source {
         Source::Topology { topology, dof, seed } => {

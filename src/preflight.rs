@@ -147,7 +147,7 @@ fn same_file_key(p: &Path) -> Option<PathBuf> {
 /// `p` made absolute with `..` and symlinks resolved as far as the path exists, and `.` and
 /// `..` of the part that does not exist resolved as written, so that two spellings of one
 /// place compare equal.
-fn resolved(p: &Path) -> PathBuf {
+pub(crate) fn resolved(p: &Path) -> PathBuf {
     use std::path::Component;
     let abs = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
     let mut acc = PathBuf::new();

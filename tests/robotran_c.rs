@@ -331,3 +331,31 @@ fn written_c_compiles_and_runs_bit_exact() {
         }
     }
 }
+
+/// robovec-gen's outputs are distinct files, checked before any work (issue 29: `-o x.c
+/// --params-out x.h` replaced the header that `x.c` includes with the JSON, exit 0).
+#[test]
+fn robovec_gen_refuses_two_outputs_on_one_file() {
+    let d = crate::common::tmp("gen_collide");
+    let c = d.join("x.c");
+    for other in [d.join("x.h"), d.join("sub/../x.c")] {
+        let o = gen(&[
+            "--topology",
+            "serial",
+            "--dof",
+            "3",
+            "--format",
+            "c",
+            "--function",
+            "dirdyna",
+            "-o",
+            c.to_str().unwrap(),
+            "--params-out",
+            other.to_str().unwrap(),
+        ]);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(e.contains(&format!("--params-out `{}` are the same file", other.display())), "{e}");
+        assert!(std::fs::read_dir(&d).unwrap().next().is_none(), "nothing written: {e}");
+    }
+}
