@@ -264,3 +264,26 @@ fn a_urdf_with_invalid_utf8_is_refused_where_the_byte_is() {
     assert!(e.contains(&format!("bad.urdf:{line}:{col}")), "{e}");
     assert!(!out.exists());
 }
+
+/// A name holding a line break comes back from robovec-gen as a character reference, so a
+/// reader gets the same name (issue 29: it came back as a raw newline, which XML readers turn
+/// into a space).
+#[test]
+fn robovec_gen_writes_line_breaks_in_names_as_character_references() {
+    let d = tmp("newline_names");
+    let text = std::fs::read_to_string(path("examples/three_link_arm/three_link_arm.urdf")).unwrap();
+    let text = text
+        .replace("<robot name=\"three_link_arm\">", "<robot name=\"three&#10;arm\">")
+        .replace("\"base\"", "\"base&#10;x\"");
+    let input = d.join("nl.urdf");
+    std::fs::write(&input, &text).unwrap();
+    let out = d.join("out.urdf");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_robovec-gen"))
+        .args(["--urdf", input.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let back = std::fs::read_to_string(&out).unwrap();
+    assert!(back.contains("<robot name=\"three&#10;arm\">") && back.contains("<link name=\"base&#10;x\">"), "{back}");
+    assert!(back.contains("<parent link=\"base&#10;x\"/>"), "{back}");
+}

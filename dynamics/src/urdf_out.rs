@@ -73,8 +73,22 @@ fn triple(v: [f64; 3]) -> String {
     format!("{:?} {:?} {:?}", v[0], v[1], v[2])
 }
 
+/// `s` as an XML attribute value: markup characters escaped, and tab, newline and carriage
+/// return as character references, which XML keeps in attribute values (written as they are,
+/// a reader normalises them to spaces; issue 29: a name with a newline came back changed).
 fn xml_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\t' | '\n' | '\r' => out.push_str(&format!("&#{};", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -92,6 +106,11 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn attribute_values_keep_markup_and_line_breaks() {
+        assert_eq!(xml_escape("a<b>&\"c\"\nd\te\r"), "a&lt;b&gt;&amp;&quot;c&quot;&#10;d&#9;e&#13;");
     }
 
     #[test]
