@@ -372,3 +372,30 @@ fn memories_beyond_the_target_are_diagnostics_with_the_figures_and_nothing_is_wr
     assert!(stderr(&o).contains("3 write port(s)"), "{}", stderr(&o));
     assert!(!dir.exists(), "nothing written");
 }
+
+/// A placement the machine model rejects is located at its line, as `sim` locates it
+/// (issue 29: `codegen<fpga>` said where in none of 22 corrupted placements).
+#[test]
+fn a_corrupted_placement_is_located_at_its_line() {
+    let d = tmp("located");
+    let placed = d.join("placed.rvir");
+    let o = opt(&[PENDULUM, "-passes=atomise,place<pe=2>", "-o", placed.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Load the second input of add0 at the first one's address: two loads of one address.
+    let text = std::fs::read_to_string(&placed).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let k = lines.iter().position(|l| l.trim_start().starts_with("load add0 1 ")).expect("a second load into add0");
+    lines[k] = lines[k].replacen("load add0 1 ", "load add0 0 ", 1);
+    let bad = d.join("bad.rvir");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    let out = d.join("fpga");
+    let pass = format!("-passes=codegen<fpga;out={};resources=estimate>", out.display());
+    for passes in ["-passes=sim".to_string(), pass] {
+        let o = opt(&[bad.to_str().unwrap(), &passes, "-o", "/dev/null"]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{passes}: {e}");
+        assert!(e.contains(&format!("bad.rvir:{}:5", k + 1)), "{passes}: located at the load: {e}");
+        assert!(e.contains("is written twice in one cycle"), "{e}");
+    }
+    assert!(!out.exists(), "nothing written");
+}

@@ -8,7 +8,7 @@ use serde::Serialize;
 use robovec_ir::placement::Placement;
 use robovec_ir::Function;
 
-use crate::design::build::{from_placement_until, Limits};
+use crate::design::build::{from_placement_until, DesignError, Limits};
 use crate::design::images::Image;
 use crate::design::{Design, HDL_LIBRARY, SIMULATE};
 use crate::resources::{self, CostModel, Logic, Resources};
@@ -152,7 +152,7 @@ pub fn emit(
     logic: Logic,
     format: &str,
 ) -> Result<(Design, Resources, Vec<DesignFile>), String> {
-    emit_until(f, p, limits, model, logic, format, &|| false)
+    emit_until(f, p, limits, model, logic, format, &|| false).map_err(|e| e.message)
 }
 
 /// [`emit`] whose lowering gives up when `stop` returns true ([`from_placement_until`]; the
@@ -169,9 +169,11 @@ pub fn emit_until(
     logic: Logic,
     format: &str,
     stop: &dyn Fn() -> bool,
-) -> Result<(Design, Resources, Vec<DesignFile>), String> {
-    let d = from_placement_until(f, p, limits, stop)
-        .map_err(|e| format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target))?;
+) -> Result<(Design, Resources, Vec<DesignFile>), DesignError> {
+    let d = from_placement_until(f, p, limits, stop).map_err(|e| DesignError {
+        message: format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target),
+        span: e.span,
+    })?;
     let cells =
         match logic {
             _ if logic.skips_yosys(d.n_add + d.n_mul) => None,

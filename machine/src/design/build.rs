@@ -7,6 +7,7 @@ use robovec_ir::machine::{MachineOp, MachineProgram, Word};
 use robovec_ir::placement::{PeArray, Placement};
 use robovec_ir::syntax::TrigFn;
 use robovec_ir::Function;
+use robovec_ir::Span;
 
 use super::images::Image;
 use super::{addr_bits, Design, LoadWord, OutputWord, PeImages, Source, Widths};
@@ -151,7 +152,36 @@ pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
 /// not have (`div`, `call`), `writes` ≠ 2, a latency below 2, a memory beyond the target, or a
 /// placement the machine model rejects.
 pub fn from_placement(f: &Function, p: &Placement, limits: &Limits) -> Result<Design, String> {
-    from_placement_until(f, p, limits, &|| false)
+    from_placement_until(f, p, limits, &|| false).map_err(|e| e.message)
+}
+
+/// Why a design cannot be made: the message, and where in the source it comes from when the
+/// lowering located it (the value or placement line; [`Span::DUMMY`] otherwise), so that
+/// `codegen<fpga>` reports `file:line:col` as `sim` does (issue 29).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DesignError {
+    /// One line per problem.
+    pub message: String,
+    /// The source span, [`Span::DUMMY`] when unknown.
+    pub span: Span,
+}
+
+impl From<String> for DesignError {
+    fn from(message: String) -> DesignError {
+        DesignError { message, span: Span::DUMMY }
+    }
+}
+
+impl From<&str> for DesignError {
+    fn from(message: &str) -> DesignError {
+        message.to_string().into()
+    }
+}
+
+impl std::fmt::Display for DesignError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
 }
 
 /// [`from_placement`] whose lowering gives up when `stop` returns true
@@ -165,13 +195,14 @@ pub fn from_placement_until(
     p: &Placement,
     limits: &Limits,
     stop: &dyn Fn() -> bool,
-) -> Result<Design, String> {
-    let m = crate::lower::lower_until(f, p, stop).map_err(|e| format!("the placement cannot be lowered: {e}"))?;
+) -> Result<Design, DesignError> {
+    let m = crate::lower::lower_until(f, p, stop)
+        .map_err(|e| DesignError { message: format!("the placement cannot be lowered: {e}"), span: e.span })?;
     let found = problems(&m, limits);
     if !found.is_empty() {
-        return Err(found.join("\n"));
+        return Err(found.join("\n").into());
     }
-    from_program(f, &m, limits)
+    Ok(from_program(f, &m, limits)?)
 }
 
 /// The design of machine program `m` of `f`.

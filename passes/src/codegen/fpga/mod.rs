@@ -53,7 +53,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use robovec_machine::design::build::Limits;
+use robovec_machine::design::build::{DesignError, Limits};
 use robovec_machine::design::Design;
 use robovec_machine::emit::{emit_until, DesignFile};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
@@ -246,7 +246,7 @@ impl CodegenFpga {
         limits: &Limits,
         model: &CostModel,
     ) -> Result<(Design, FpgaReport, Vec<DesignFile>), String> {
-        self.build_within(f, limits, model, &Ticker::default())
+        self.build_within(f, limits, model, &Ticker::default()).map_err(|e| e.message)
     }
 
     /// [`CodegenFpga::build`] whose lowering ticks `ticker` (once per value, write and cycle:
@@ -262,9 +262,9 @@ impl CodegenFpga {
         limits: &Limits,
         model: &CostModel,
         ticker: &Ticker,
-    ) -> Result<(Design, FpgaReport, Vec<DesignFile>), String> {
+    ) -> Result<(Design, FpgaReport, Vec<DesignFile>), DesignError> {
         let Some(p) = &f.placement else {
-            return Err(format!("function @{} has no placement; run `place` before `codegen<fpga>`", f.name));
+            return Err(format!("function @{} has no placement; run `place` before `codegen<fpga>`", f.name).into());
         };
         let (d, r, files) = emit_until(f, p, limits, model, self.resources, self.format.as_str(), &|| ticker.tick())?;
         let report = FpgaReport {
@@ -302,7 +302,11 @@ impl Pass for CodegenFpga {
             if ticker.stopped() {
                 return Err(ticker.error(PASS, &format!("in @{} while lowering", f.name)));
             }
-            let (_, report, files) = built.map_err(failed)?;
+            // Located at the value or placement line the lowering names, as `sim` does.
+            let (_, report, files) = built.map_err(|e| match e.span {
+                s if s == robovec_ir::Span::DUMMY => failed(e.message),
+                s => failed(e.message).at(s),
+            })?;
             if self.auto_skips_yosys(report.n_add + report.n_mul) {
                 cx.notes.push(format!(
                     "codegen<fpga> @{}: {} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway)",
