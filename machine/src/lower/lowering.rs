@@ -31,14 +31,14 @@ pub const MAX_STEPS: u64 = 16 << 20;
 /// time and last read. Errors name the old event when it is still needed or was written in
 /// the same cycle.
 fn occupy(
-    words: &mut HashMap<(usize, u32), usize>,
+    words: &mut Words,
     at: (usize, u32),
     new: usize,
     now: i64,
     start: impl Fn(usize) -> i64,
     last: impl Fn(usize) -> Option<i64>,
 ) -> Result<(), (usize, Option<i64>)> {
-    if let Some(&old) = words.get(&at) {
+    if let Some(old) = words.get(at.0, at.1) {
         if start(old) == now {
             return Err((old, None));
         }
@@ -46,8 +46,47 @@ fn occupy(
             return Err((old, Some(r)));
         }
     }
-    words.insert(at, new);
+    words.set(at.0, at.1, new);
     Ok(())
+}
+
+/// What each word of every PE memory (or buffer) holds: an event index, dense by slot and
+/// address (addresses are checked against the reported sizes before they are set).
+struct Words {
+    /// First word of each slot in `held`.
+    base: Vec<usize>,
+    held: Vec<u32>,
+}
+
+impl Words {
+    const EMPTY: u32 = u32::MAX;
+
+    fn new(words: &[u32]) -> Self {
+        let mut base = Vec::with_capacity(words.len() + 1);
+        let mut total = 0usize;
+        for &w in words {
+            base.push(total);
+            total += w as usize;
+        }
+        base.push(total);
+        Words { base, held: vec![Self::EMPTY; total] }
+    }
+
+    fn index(&self, slot: usize, addr: u32) -> Option<usize> {
+        let i = self.base.get(slot)? + addr as usize;
+        (i < *self.base.get(slot + 1)?).then_some(i)
+    }
+
+    /// The event word `addr` of `slot` holds (`None`: nothing yet, or no such word).
+    fn get(&self, slot: usize, addr: u32) -> Option<usize> {
+        let h = self.held[self.index(slot, addr)?];
+        (h != Self::EMPTY).then_some(h as usize)
+    }
+
+    fn set(&mut self, slot: usize, addr: u32, event: usize) {
+        let i = self.index(slot, addr).expect("address checked against the reported size");
+        self.held[i] = event as u32;
+    }
 }
 
 fn reuse_error(what: &str, addr: u32, old: String, new: String, read: Option<i64>) -> SimError {
@@ -123,8 +162,8 @@ pub(super) fn lower(
         .collect();
     let mut issue_of: Vec<Option<(usize, u32)>> = vec![None; n];
 
-    let mut mem: HashMap<(usize, u32), usize> = HashMap::new();
-    let mut buf: HashMap<(usize, u32), usize> = HashMap::new();
+    let mut mem = Words::new(&p.pe_words);
+    let mut buf = Words::new(&p.buffer_words);
     let word = |k: Key| -> Word {
         match k {
             Key::Const(b) => Word::Const(f64::from_bits(b)),
@@ -180,7 +219,7 @@ pub(super) fn lower(
     // The placement line of memory event `e` (a load, then the writes).
     let mem_span = |e: usize| if e < n_loads { p.spans.load(e) } else { p.spans.write(e - n_loads) };
     // Writes one PE memory word: bounds, reuse.
-    let store = |mem: &mut HashMap<(usize, u32), usize>, e: usize, now: i64, when: When| -> Result<(), SimError> {
+    let store = |mem: &mut Words, e: usize, now: i64, when: When| -> Result<(), SimError> {
         let ev = &mem_ev[e];
         let words = p.pe_words[ev.slot];
         if ev.addr >= words {
@@ -210,14 +249,25 @@ pub(super) fn lower(
         pes[r.slot(l.pe)].init[l.addr as usize] = Some(word(Key::of(&l.operand)));
     }
 
-    for (&c, bucket) in &buckets {
+    // Per-PE state of the current cycle, marked with the cycle (+ 1) it belongs to, so that
+    // nothing is cleared between cycles: the result bus, write ports used, the buffer read, the
+    // op issued.
+    let mut bus: Vec<(u32, Value)> = vec![(0, Value::with_number(0)); n_pe];
+    let mut ports: Vec<(u32, u32)> = vec![(0, 0); n_pe];
+    let mut buf_reads: Vec<(u32, usize)> = vec![(0, 0); n_pe];
+    let mut busy: Vec<(u32, Value)> = vec![(0, Value::with_number(0)); n_pe];
+    for c in 0..=buckets.last {
+        if buckets.is_empty(c) {
+            continue;
+        }
         r.poll()?;
         let now = When::Cycle(c);
+        let mark = c + 1;
         // Results arriving now: one per PE (one result bus), captured when outputs.
-        let mut bus: HashMap<usize, Value> = HashMap::new();
-        for &v in &bucket.arrivals {
+        for &v in buckets.arrivals.at(c) {
             let pe = issue(v).pe;
-            if let Some(u) = bus.insert(r.slot(pe), v) {
+            let held = std::mem::replace(&mut bus[r.slot(pe)], (mark, v));
+            if let Some(u) = (held.0 == mark).then_some(held.1) {
                 return Err(SimError::new(
                     K::ResultCollision,
                     format!(
@@ -233,7 +283,7 @@ pub(super) fn lower(
             pes[r.slot(pe)].steps[c as usize].capture = capture_at[v.index()];
         }
         // Results arriving now enter their producer's buffer.
-        for &b in &bucket.entries {
+        for &b in buckets.entries.at(c) {
             let ev = &buf_ev[b];
             if !arch.buffer {
                 return Err(SimError::new(K::NoBuffer, "written indirectly, but the architecture has no buffers")
@@ -274,9 +324,7 @@ pub(super) fn lower(
         }
 
         // Writes into PE memories: direct (arrivals) and from buffers.
-        let mut ports: HashMap<usize, u32> = HashMap::new();
-        let mut buf_reads: HashMap<usize, usize> = HashMap::new();
-        for &wi in &bucket.writes {
+        for &wi in buckets.writes.at(c) {
             let w = &p.writes[wi];
             let v = w.value;
             let arr = arrival[v.index()].expect("ops arrive");
@@ -316,7 +364,7 @@ pub(super) fn lower(
                         .of(r.vname(v))
                         .src(p.spans.write(wi)));
                     }
-                    if let Some(&other) = buf_reads.get(&ev.slot) {
+                    if let Some(other) = (buf_reads[ev.slot].0 == mark).then_some(buf_reads[ev.slot].1) {
                         let o = &buf_ev[other];
                         if o.addr != ev.addr {
                             return Err(SimError::new(
@@ -337,8 +385,8 @@ pub(super) fn lower(
                             .src(p.spans.write(wi)));
                         }
                     }
-                    buf_reads.insert(ev.slot, b);
-                    if buf.get(&(ev.slot, ev.addr)) != Some(&b) {
+                    buf_reads[ev.slot] = (mark, b);
+                    if buf.get(ev.slot, ev.addr) != Some(b) {
                         return Err(SimError::new(
                             K::ReadMissing,
                             format!("address {} of the buffer of {} no longer holds it", ev.addr, ev.pe),
@@ -354,9 +402,12 @@ pub(super) fn lower(
             };
             let e = n_loads + wi;
             let slot = mem_ev[e].slot;
-            let used = ports.entry(slot).or_insert(0);
-            *used += 1;
-            if *used > arch.writes {
+            if ports[slot].0 != mark {
+                ports[slot] = (mark, 0);
+            }
+            ports[slot].1 += 1;
+            let used = ports[slot].1;
+            if used > arch.writes {
                 return Err(SimError::new(
                     K::WritePorts,
                     format!(
@@ -374,8 +425,7 @@ pub(super) fn lower(
         }
 
         // Ops issued now read their operands and enter the pipeline.
-        let mut busy: HashMap<usize, Value> = HashMap::new();
-        for &v in &bucket.issues {
+        for &v in buckets.issues.at(c) {
             let is = issue(v);
             let kind = f.op_kind(v).expect("issued values are ops");
             if !is.pe.accepts(kind) {
@@ -388,7 +438,8 @@ pub(super) fn lower(
                 .of(r.vname(v))
                 .src(p.spans.issue(v)));
             }
-            if let Some(&other) = busy.get(&r.slot(is.pe)) {
+            let held = busy[r.slot(is.pe)];
+            if let Some(other) = (held.0 == mark).then_some(held.1) {
                 return Err(SimError::new(
                     K::PeBusy,
                     format!("issued on {} in the same cycle as {}; one op per PE per cycle", is.pe, r.vname(other)),
@@ -398,9 +449,9 @@ pub(super) fn lower(
                 .of(r.vname(v))
                 .src(p.spans.issue(v)));
             }
-            busy.insert(r.slot(is.pe), v);
+            busy[r.slot(is.pe)] = (mark, v);
             let mut addrs: Vec<u32> = Vec::new();
-            for &(k, res) in &reads[v.index()] {
+            for &(k, res) in reads.of(v) {
                 if let Key::Value(u) = k {
                     if let Some(a) = arrival[u.index()].filter(|&a| a > c) {
                         return Err(SimError::new(
@@ -431,7 +482,7 @@ pub(super) fn lower(
                     Err(None) => return Err(missing("never written or loaded there".into())),
                     Err(Some(t)) => return Err(missing(format!("written there only at cycle {t}"))),
                     Ok(e) => {
-                        if mem.get(&(mem_ev[e].slot, mem_ev[e].addr)) != Some(&e) {
+                        if mem.get(mem_ev[e].slot, mem_ev[e].addr) != Some(e) {
                             return Err(missing(format!("overwritten at address {}", mem_ev[e].addr)));
                         }
                         addrs.push(mem_ev[e].addr);

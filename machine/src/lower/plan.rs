@@ -2,7 +2,7 @@
 //! cycles, every PE memory write (loads and `Write`s) with the reads that use it, every buffer
 //! entry with its reads, and the events of each cycle.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 
 use robovec_ir::placement::{Issue, Pe, Placement};
 use robovec_ir::syntax::{Def, OpKind, Operand};
@@ -43,17 +43,78 @@ pub(super) struct BufEvent {
     pub write: usize,
 }
 
-/// Events of one cycle, in the order they happen.
-#[derive(Default)]
-pub(super) struct Bucket {
-    /// Ops whose results arrive now, in body order.
-    pub arrivals: Vec<Value>,
-    /// Buffer entries (`BufEvent` indices) of results arriving now.
-    pub entries: Vec<usize>,
-    /// `Placement::writes` indices written into PE memories now.
-    pub writes: Vec<usize>,
-    /// Ops issued now, in body order.
-    pub issues: Vec<Value>,
+/// Items grouped by cycle, each cycle's in the order given (a stable counting sort):
+/// `items[start[c]..start[c + 1]]`. Flat arrays, so walking the cycles in order reads memory
+/// in order (a map of per-cycle vectors costs a cache miss per item on 600k-op programs).
+pub(super) struct ByCycle<T> {
+    start: Vec<u32>,
+    items: Vec<T>,
+}
+
+impl<T: Copy> ByCycle<T> {
+    /// Groups `pairs` (cycle, item) by cycle; every cycle is ≤ `last`.
+    fn new(last: u32, pairs: &[(u32, T)]) -> Self {
+        let mut start = vec![0u32; last as usize + 2];
+        for &(c, _) in pairs {
+            start[c as usize + 1] += 1;
+        }
+        for c in 0..=last as usize {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut items: Vec<Option<T>> = vec![None; pairs.len()];
+        for &(c, t) in pairs {
+            items[fill[c as usize] as usize] = Some(t);
+            fill[c as usize] += 1;
+        }
+        ByCycle { start, items: items.into_iter().map(|t| t.expect("every slot filled")).collect() }
+    }
+
+    /// The items of cycle `c` (empty past the last cycle).
+    pub fn at(&self, c: u32) -> &[T] {
+        match (self.start.get(c as usize), self.start.get(c as usize + 1)) {
+            (Some(&a), Some(&b)) => &self.items[a as usize..b as usize],
+            _ => &[],
+        }
+    }
+}
+
+/// Events per cycle, in the order they happen within a cycle.
+pub(super) struct Buckets {
+    /// The last cycle with an event.
+    pub last: u32,
+    /// Ops whose results arrive, in body order.
+    pub arrivals: ByCycle<Value>,
+    /// Buffer entries (`BufEvent` indices) of results arriving.
+    pub entries: ByCycle<usize>,
+    /// `Placement::writes` indices written into PE memories.
+    pub writes: ByCycle<usize>,
+    /// Ops issued, in body order.
+    pub issues: ByCycle<Value>,
+}
+
+impl Buckets {
+    /// True when nothing happens at cycle `c`.
+    pub fn is_empty(&self, c: u32) -> bool {
+        self.arrivals.at(c).is_empty()
+            && self.entries.at(c).is_empty()
+            && self.writes.at(c).is_empty()
+            && self.issues.at(c).is_empty()
+    }
+}
+
+/// Each op's operand reads, flat: op `v` reads `list[at[v].0..at[v].1]`, in operand order.
+pub(super) struct Reads {
+    at: Vec<(u32, u32)>,
+    list: Vec<(Key, Read)>,
+}
+
+impl Reads {
+    /// The reads of op `v`, in operand order (empty for a non-op).
+    pub fn of(&self, v: Value) -> &[(Key, Read)] {
+        let (a, b) = self.at[v.index()];
+        &self.list[a as usize..b as usize]
+    }
 }
 
 /// A read of an operand: the memory event it reads, or the first cycle the value is written
@@ -227,14 +288,14 @@ pub(super) struct Plan {
     pub n_loads: usize,
     /// PE memory writes.
     pub mem_ev: Vec<MemEvent>,
-    /// Each op's operand reads, by value index.
-    pub reads: Vec<Vec<(Key, Read)>>,
+    /// Each op's operand reads.
+    pub reads: Reads,
     /// Buffer entries.
     pub buf_ev: Vec<BufEvent>,
     /// The buffer entry each indirect write reads.
     pub buf_of_write: Vec<Option<usize>>,
     /// Events per cycle.
-    pub buckets: BTreeMap<u32, Bucket>,
+    pub buckets: Buckets,
 }
 
 impl Run<'_> {
@@ -292,14 +353,34 @@ impl Run<'_> {
                 last_read: None,
             }))
             .collect();
-        let mut by_key: HashMap<(usize, Key), Vec<usize>> = HashMap::new();
-        for (i, e) in mem_ev.iter().enumerate() {
-            by_key.entry((e.slot, e.key)).or_default().push(i);
+        // The events of each key, in event order: grouped by value index for op results and
+        // inputs (CSR, so the lookups below follow the body's locality), in a map for constants.
+        let mut val_start = vec![0u32; n + 1];
+        for e in &mem_ev {
+            if let Key::Value(v) = e.key {
+                val_start[v.index() + 1] += 1;
+            }
         }
+        for i in 0..n {
+            val_start[i + 1] += val_start[i];
+        }
+        let mut fill = val_start.clone();
+        let mut val_ev = vec![0u32; val_start[n] as usize];
+        let mut const_ev: HashMap<(usize, u64), Vec<u32>> = HashMap::new();
+        for (i, e) in mem_ev.iter().enumerate() {
+            match e.key {
+                Key::Value(v) => {
+                    val_ev[fill[v.index()] as usize] = i as u32;
+                    fill[v.index()] += 1;
+                }
+                Key::Const(b) => const_ev.entry((e.slot, b)).or_default().push(i as u32),
+            }
+        }
+        drop(fill);
 
         // Reads: an op on PE p at cycle c reads each operand from the latest write of it into p at
         // a cycle ≤ c (the first such write on a tie).
-        let mut reads: Vec<Vec<(Key, Read)>> = vec![Vec::new(); n];
+        let mut reads = Reads { at: vec![(0, 0); n], list: Vec::new() };
         for &v in &f.body {
             r.poll()?;
             if f.op_kind(v).is_none() {
@@ -307,12 +388,25 @@ impl Run<'_> {
             }
             let is = issue(v);
             let (slot, c) = (r.slot(is.pe), is.cycle as i64);
+            let from = reads.list.len() as u32;
             for k in r.operands(v) {
-                let list = by_key.get(&(slot, k)).map(Vec::as_slice).unwrap_or(&[]);
+                let list: &[u32] = match k {
+                    Key::Value(u) => &val_ev[val_start[u.index()] as usize..val_start[u.index() + 1] as usize],
+                    Key::Const(b) => const_ev.get(&(slot, b)).map_or(&[], Vec::as_slice),
+                };
                 let mut best: Option<usize> = None;
+                let mut first_later: Option<i64> = None;
                 for &e in list {
-                    if mem_ev[e].time <= c && !matches!(best, Some(b) if mem_ev[b].time >= mem_ev[e].time) {
-                        best = Some(e);
+                    let ev = &mem_ev[e as usize];
+                    if ev.slot != slot {
+                        continue;
+                    }
+                    if ev.time <= c {
+                        if !matches!(best, Some(b) if mem_ev[b].time >= ev.time) {
+                            best = Some(e as usize);
+                        }
+                    } else {
+                        first_later = Some(first_later.map_or(ev.time, |t| t.min(ev.time)));
                     }
                 }
                 let res = match best {
@@ -321,10 +415,11 @@ impl Run<'_> {
                         *lr = Some(lr.map_or(c, |x| x.max(c)));
                         Ok(e)
                     }
-                    None => Err(list.iter().map(|&e| mem_ev[e].time).min()),
+                    None => Err(first_later),
                 };
-                reads[v.index()].push((k, res));
+                reads.list.push((k, res));
             }
+            reads.at[v.index()] = (from, reads.list.len() as u32);
         }
 
         // Buffer entries: one per indirect-written value, at its producer's buffer, from arrival.
@@ -363,21 +458,38 @@ impl Run<'_> {
         }
 
         // The schedule, cycle by cycle.
-        let mut buckets: BTreeMap<u32, Bucket> = BTreeMap::new();
-        for (i, b) in buf_ev.iter().enumerate() {
-            buckets.entry(b.arrival).or_default().entries.push(i);
-        }
+        let mut last = cycles;
         for (i, w) in p.writes.iter().enumerate() {
-            buckets.entry(w.cycle).or_default().writes.push(i);
+            if w.cycle > MAX_CYCLES {
+                return Err(SimError::new(
+                    K::Malformed,
+                    format!("written after cycle {MAX_CYCLES}, too late to lower"),
+                )
+                .at(When::Cycle(w.cycle))
+                .on(w.pe)
+                .of(r.vname(w.value))
+                .src(p.spans.write(i)));
+            }
+            last = last.max(w.cycle);
         }
+        let mut issued: Vec<(u32, Value)> = Vec::new();
+        let mut arriving: Vec<(u32, Value)> = Vec::new();
         for &v in &f.body {
             r.poll()?;
             if f.op_kind(v).is_some() {
-                buckets.entry(issue(v).cycle).or_default().issues.push(v);
-                let a = arrival[v.index()].expect("ops arrive");
-                buckets.entry(a).or_default().arrivals.push(v);
+                issued.push((issue(v).cycle, v));
+                arriving.push((arrival[v.index()].expect("ops arrive"), v));
             }
         }
+        let entries: Vec<(u32, usize)> = buf_ev.iter().enumerate().map(|(i, b)| (b.arrival, i)).collect();
+        let writes: Vec<(u32, usize)> = p.writes.iter().enumerate().map(|(i, w)| (w.cycle, i)).collect();
+        let buckets = Buckets {
+            last,
+            arrivals: ByCycle::new(last, &arriving),
+            entries: ByCycle::new(last, &entries),
+            writes: ByCycle::new(last, &writes),
+            issues: ByCycle::new(last, &issued),
+        };
         Ok(Plan { arrival, cycles, n_loads, mem_ev, reads, buf_ev, buf_of_write, buckets })
     }
 }
