@@ -200,7 +200,8 @@ pub struct OutputLoc {
 pub struct MachineProgram {
     /// PE counts, latencies (cycles), write ports, buffers.
     pub arch: PeArray,
-    /// Largest arrival cycle (0 without ops); steps cover `0..=cycles`.
+    /// Last cycle with an event: the largest arrival (0 without ops), or a later write from a
+    /// buffer; steps cover `0..=cycles`.
     pub cycles: u32,
     /// Words of each PE memory (addresses `0..pe_words`), by slot.
     pub pe_words: Vec<u32>,

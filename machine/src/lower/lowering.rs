@@ -134,7 +134,9 @@ pub(super) fn lower(
     stop: &dyn Fn() -> bool,
 ) -> Result<(MachineProgram, Occupancy), SimError> {
     let r = Run { f, p, stop };
-    let Plan { arrival, cycles, n_loads, mem_ev, reads, buf_ev, buf_of_write, buckets } = r.derive()?;
+    let Plan { arrival, n_loads, mem_ev, reads, buf_ev, buf_of_write, buckets } = r.derive()?;
+    // The program runs until its last event: the last arrival, or a later write from a buffer.
+    let cycles = buckets.last;
     let n = f.values.len();
     let arch = p.arch;
     let n_pe = arch.n_pe();

@@ -282,8 +282,6 @@ impl Run<'_> {
 pub(super) struct Plan {
     /// Arrival cycle of every op, by value index.
     pub arrival: Vec<Option<u32>>,
-    /// Largest arrival (0 without ops).
-    pub cycles: u32,
     /// Number of loads.
     pub n_loads: usize,
     /// PE memory writes.
@@ -490,6 +488,6 @@ impl Run<'_> {
             writes: ByCycle::new(last, &writes),
             issues: ByCycle::new(last, &issued),
         };
-        Ok(Plan { arrival, cycles, n_loads, mem_ev, reads, buf_ev, buf_of_write, buckets })
+        Ok(Plan { arrival, n_loads, mem_ev, reads, buf_ev, buf_of_write, buckets })
     }
 }

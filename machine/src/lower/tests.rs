@@ -285,3 +285,32 @@ fn a_stop_hook_returning_true_stops_the_execution_at_that_cycle() {
         assert_eq!(e.to_string(), format!("cycle {}: stopped: time limit", at - 1));
     }
 }
+
+/// A write from a buffer after the last arrival (useless, but legal) lengthens the program to
+/// its cycle instead of indexing past the steps (it panicked), and the run still computes.
+#[test]
+fn a_buffer_write_after_the_last_arrival_lengthens_the_program() {
+    let (f, mut p) = direct_and_indirect();
+    p.pe_words[0] = 3;
+    p.writes.push(Write { value: v(&f, "x"), pe: Add(0), addr: 2, cycle: 90, buffer_addr: Some(0) });
+    let m = lower(&f, &p).unwrap();
+    assert_eq!(m.cycles, 90);
+    assert!(m.pes.iter().all(|q| q.steps.len() == 91));
+    assert_eq!(m.pes[0].steps[90].writes, vec![MemWrite { addr: 2, src: Source::Buffer(2) }]);
+    assert_eq!(m.pes[2].steps[90].buffer.read, Some(0));
+    let x = execute::<f64>(&m, input).unwrap();
+    assert_eq!(x.cycles, 90);
+    let (a, b) = (input("a"), input("b"));
+    assert_eq!(x.outputs, vec![("y".to_string(), a * b + a), ("z".to_string(), a * b - b)]);
+    assert_eq!(round_trip(&m), m);
+}
+
+/// A write past the lowering's cycle bound is refused with a located error, not allocated.
+#[test]
+fn a_write_past_the_cycle_bound_is_refused() {
+    let (f, mut p) = direct_and_indirect();
+    p.writes[1].cycle = u32::MAX;
+    let e = lower(&f, &p).unwrap_err();
+    assert_eq!(e.kind, MachineErrorKind::Malformed, "{e}");
+    assert!(e.to_string().contains("too late to lower"), "{e}");
+}
