@@ -12,8 +12,9 @@ pub type Key = (u32, u32, u32);
 pub struct OpDag {
     /// Ops in body (topological) order.
     pub ops: Vec<Value>,
-    /// True for ops of the MULTI side.
-    mul: Vec<bool>,
+    /// The kind of each op (`None` for other values): a byte per value, so the schedulers'
+    /// random accesses do not touch the function's value table.
+    kind: Vec<Option<OpKind>>,
     /// `operands[operand_at[i]..operand_at[i + 1]]`: op operands of value i by position, `None`
     /// for initial data (inputs, trig variables, constants).
     operand_at: Vec<u32>,
@@ -35,7 +36,7 @@ impl OpDag {
         };
         let mut dag = OpDag {
             ops: Vec::new(),
-            mul: vec![false; n],
+            kind: vec![None; n],
             operand_at: Vec::with_capacity(n + 1),
             operands: Vec::new(),
             user_at: Vec::new(),
@@ -47,7 +48,7 @@ impl OpDag {
             dag.operand_at.push(dag.operands.len() as u32);
             let v = Value::with_number(i as u32);
             let Some(k) = f.op_kind(v) else { continue };
-            dag.mul[i] = k == OpKind::Mul;
+            dag.kind[i] = Some(k);
             let start = dag.operands.len();
             match &val.def {
                 robovec_ir::Def::Binary(_, a, b) => dag.operands.extend([is_op(a), is_op(b)]),
@@ -107,6 +108,14 @@ impl OpDag {
 
     /// True for an op of the MULTI side.
     pub fn is_mul(&self, v: Value) -> bool {
-        self.mul[v.index()]
+        self.kind[v.index()] == Some(OpKind::Mul)
+    }
+
+    /// The kind of op `v`.
+    ///
+    /// # Panics
+    /// When `v` is not an op.
+    pub fn kind(&self, v: Value) -> OpKind {
+        self.kind[v.index()].expect("an op")
     }
 }

@@ -238,7 +238,6 @@ pub fn schedule_until(
     stop: &dyn Fn() -> bool,
 ) -> Result<Option<Schedule>, String> {
     let n = f.values.len();
-    let kind = |v: Value| f.op_kind(v).expect("op");
     let mut feed = Feed::new(dag, keys, feed, false);
     let mut lowered = Vec::new();
     let mut pending = dag.n_distinct.clone();
@@ -328,7 +327,7 @@ pub fn schedule_until(
                     Some((_, i)) => {
                         let q = free.swap_remove(i);
                         ctx.commit(operands, &best_routes, q);
-                        let lat = arch.lat.of(kind(v));
+                        let lat = arch.lat.of(dag.kind(v));
                         ctx.issue[v.index()] = Some((q, t));
                         ctx.arrival[v.index()] = t + lat;
                         arrivals.push(Reverse((t + lat, v)));
@@ -413,7 +412,7 @@ pub fn backward_starts(
     let mut waiting: BinaryHeap<Reverse<(u32, Value)>> = BinaryHeap::new();
     for &v in &dag.ops {
         if pending[v.index()] == 0 {
-            waiting.push(Reverse((lat.of(f.op_kind(v).expect("op")), v)));
+            waiting.push(Reverse((lat.of(dag.kind(v)), v)));
         }
     }
     let mut ready: [BinaryHeap<Reverse<(Key, Value)>>; 2] = [BinaryHeap::new(), BinaryHeap::new()];
@@ -456,7 +455,7 @@ pub fn backward_starts(
                     earliest[a.index()] = earliest[a.index()].max(t + 1);
                     pending[a.index()] -= 1;
                     if pending[a.index()] == 0 {
-                        let k = f.op_kind(a).expect("op");
+                        let k = dag.kind(a);
                         waiting.push(Reverse((earliest[a.index()] + lat.of(k) - 1, a)));
                     }
                 }
