@@ -39,7 +39,7 @@ pub struct Function {
 /// per value, not two — issue 10 §3, memory of large functions). Derived from `values`, so
 /// ignored by `==`.
 #[derive(Clone, Debug, Default)]
-struct NameIndex(hashbrown::HashTable<Value>);
+struct NameIndex(hashbrown::HashTable<(u32, Value)>);
 
 impl PartialEq for NameIndex {
     fn eq(&self, _: &NameIndex) -> bool {
@@ -52,19 +52,51 @@ fn name_hash(name: &str) -> u64 {
     BuildHasherDefault::<rustc_hash::FxHasher>::default().hash_one(name)
 }
 
+/// The name index's hash of `name`, folded to 32 bits: stored beside each value, so that
+/// growing the table and most mismatches read no name (each name read is a cache miss on
+/// large functions: the value table and the strings are far apart; issue 28).
+fn short_hash(name: &str) -> u32 {
+    let h = name_hash(name);
+    (h ^ (h >> 32)) as u32
+}
+
+/// A stored short hash spread back over 64 bits (the table takes its bucket from the low bits
+/// and its tag from the high ones).
+fn spread(h: u32) -> u64 {
+    (h as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ h as u64
+}
+
 fn name_is(values: &[ValueData], v: Value, name: &str) -> bool {
     values.get(v.index()).is_some_and(|d| d.name == name)
 }
 
 impl NameIndex {
     fn get(&self, values: &[ValueData], name: &str) -> Option<Value> {
-        self.0.find(name_hash(name), |&v| name_is(values, v, name)).copied()
+        let h = short_hash(name);
+        self.0.find(spread(h), |&(eh, v)| eh == h && name_is(values, v, name)).map(|&(_, v)| v)
     }
 
     /// Indexes `v` under its name in `values` (the caller checked it is free).
     fn insert(&mut self, values: &[ValueData], v: Value) {
-        let h = name_hash(&values[v.index()].name);
-        self.0.insert_unique(h, v, |&x| values.get(x.index()).map_or(0, |d| name_hash(&d.name)));
+        let h = short_hash(&values[v.index()].name);
+        self.0.insert_unique(spread(h), (h, v), |&(eh, _)| spread(eh));
+    }
+
+    /// Indexes `next` (the value about to be pushed) under `name` when no value has that
+    /// name, with one hash and one probe; `Err(existing)` otherwise.
+    fn claim(&mut self, values: &[ValueData], name: &str, next: Value) -> Result<(), Value> {
+        let h = short_hash(name);
+        match self.0.entry(spread(h), |&(eh, v)| eh == h && name_is(values, v, name), |&(eh, _)| spread(eh)) {
+            hashbrown::hash_table::Entry::Occupied(e) => Err(e.get().1),
+            hashbrown::hash_table::Entry::Vacant(e) => {
+                e.insert((h, next));
+                Ok(())
+            }
+        }
+    }
+
+    fn reserve(&mut self, additional: usize) {
+        self.0.reserve(additional, |&(eh, _)| spread(eh));
     }
 
     fn build(values: &[ValueData]) -> NameIndex {
@@ -72,8 +104,9 @@ impl NameIndex {
         // As a map built by inserting every value in order: the last of equal names wins.
         for (i, d) in values.iter().enumerate() {
             let v = Value::with_number(i as u32);
-            match ix.0.find_mut(name_hash(&d.name), |&x| name_is(values, x, &d.name)) {
-                Some(slot) => *slot = v,
+            let h = short_hash(&d.name);
+            match ix.0.find_mut(spread(h), |&(eh, x)| eh == h && name_is(values, x, &d.name)) {
+                Some(slot) => slot.1 = v,
                 None => ix.insert(values, v),
             }
         }
@@ -195,7 +228,7 @@ impl Function {
     pub fn reserve(&mut self, values: usize, body: usize) {
         self.values.reserve_exact(values);
         self.body.reserve_exact(body);
-        self.names.0.reserve(values, |&x| self.values.get(x.index()).map_or(0, |d| name_hash(&d.name)));
+        self.names.reserve(values);
     }
 
     /// The value named `name` (without `%`).
@@ -217,12 +250,9 @@ impl Function {
     }
 
     fn push_value(&mut self, name: String, def: Def, span: Span) -> Result<Value, Value> {
-        if let Some(old) = self.lookup(&name) {
-            return Err(old);
-        }
         let v = Value::with_number(self.values.len() as u32);
+        self.names.claim(&self.values, &name, v)?;
         self.values.push(ValueData { name, def, timing: None, span });
-        self.names.insert(&self.values, v);
         Ok(v)
     }
 
