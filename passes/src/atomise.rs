@@ -172,7 +172,14 @@ struct Emitter<'a> {
 impl Emitter<'_> {
     fn define(&mut self, top: bool, def: Def) -> Operand {
         let name = if top {
-            std::mem::take(&mut self.root)
+            // The root name is free (sources and passes keep names unique per function) unless
+            // an inner name `root.k` of an earlier equation took it.
+            let root = std::mem::take(&mut self.root);
+            if self.out.lookup(&root).is_some() {
+                self.out.fresh_name(&root)
+            } else {
+                root
+            }
         } else {
             loop {
                 let n = format!("{}.{}", self.root, self.next);
@@ -182,8 +189,6 @@ impl Emitter<'_> {
                 }
             }
         };
-        // The root name is free: sources and passes keep names unique per function.
-        let name = if self.out.lookup(&name).is_some() { self.out.fresh_name(&name) } else { name };
         Operand::Value(self.out.define(name, def, self.span).expect("name is free"))
     }
 
