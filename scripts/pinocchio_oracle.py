@@ -11,9 +11,11 @@ URDF is a path, or `erd:REL` for a file of example-robot-data (`erd:ur_descripti
 found under the installed package's share folder. Builds the fixed-base model with
 `pinocchio.buildModelFromUrdf` and prints JSON on stdout:
   {"path", "joints": [names in Pinocchio's order], "gravity": [gx, gy, gz],
-   "states": [{"q": [...], "qd": [...], "qdd": [...], "tau": [...], "M": [[...]], "nle": [...]}]}
+   "states": [{"q": [...], "qd": [...], "qdd": [...], "tau": [...], "M": [[...]], "nle": [...],
+               "aba": [...]}]}
 where tau = rnea(q, qd, qdd), M = crba(q) (Pinocchio fills the upper triangle only: symmetrized
-here) and nle = nonLinearEffects(q, qd).
+here), nle = nonLinearEffects(q, qd) and aba = aba(q, qd, tau) (forward dynamics: qdd again, as
+Pinocchio's own algorithm computes it).
 with one angle (or length) per joint: a continuous joint's (cos, sin) pair is built from it.
 States are uniform: angles in [-pi, pi], lengths in [-0.2, 0.2], velocities and accelerations in [-2, 2].
 """
@@ -85,6 +87,7 @@ def main():
         upper = np.triu(pin.crba(model, data, q))
         mass = upper + np.triu(upper, 1).T
         nle = pin.nonLinearEffects(model, data, q, v)
+        aba = pin.aba(model, data, q, v, tau)
         out["states"].append({
             "q": coords,
             "qd": list(map(float, v)),
@@ -92,6 +95,7 @@ def main():
             "tau": list(map(float, tau)),
             "M": [list(map(float, row)) for row in mass],
             "nle": list(map(float, nle)),
+            "aba": list(map(float, aba)),
         })
     json.dump(out, sys.stdout)
 

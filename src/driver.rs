@@ -44,7 +44,7 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
 /// # Errors
 /// [`Failure::Usage`] for an extension no front end claims, or a requested function a front
 /// end that builds its functions cannot build (`no function `foo` in the input; functions:
-/// invdyna, dirdyna`, as `-function` against a loaded module); [`Failure::Input`] with codespan
+/// invdyna, dirdyna, fordyna`, as `-function` against a loaded module); [`Failure::Input`] with codespan
 /// diagnostics naming file, line and column (the time limit reached while loading among them).
 pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile), Failure> {
     let (bytes, name) = if input == "-" {

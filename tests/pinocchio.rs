@@ -1,6 +1,7 @@
 //! Numerical truth for the URDF front end (issue 14): robovec's generated inverse dynamics
 //! `Qq` against `pinocchio.rnea`, and its direct dynamics `M`, `c` against `pinocchio.crba`
-//! (symmetrized by the oracle) and `pinocchio.nonLinearEffects`, on random states, relative
+//! (symmetrized by the oracle) and `pinocchio.nonLinearEffects`, its forward dynamics `qdd`
+//! (`-function=fordyna`, from Pinocchio's `tau`) against `pinocchio.aba`, on random states, relative
 //! error ≤ 1e-10 (∞-norm of the difference over the ∞-norm of Pinocchio's values).
 //!
 //! Pinocchio (PyPI `pin`) and `example-robot-data` live in a virtual environment that `scripts/test.sh`
@@ -40,6 +41,7 @@ struct State {
     #[serde(rename = "M")]
     mass: Vec<Vec<f64>>,
     nle: Vec<f64>,
+    aba: Vec<f64>,
 }
 
 #[derive(serde::Deserialize)]
@@ -68,6 +70,8 @@ fn expected(function: &str, s: &State) -> BTreeMap<String, f64> {
     for i in 0..n {
         if function == "invdyna" {
             e.insert(format!("Qq[{}]", i + 1), s.tau[i]);
+        } else if function == "fordyna" {
+            e.insert(format!("qdd[{}]", i + 1), s.aba[i]);
         } else {
             e.insert(format!("c[{}]", i + 1), s.nle[i]);
             for j in 0..n {
@@ -78,7 +82,7 @@ fn expected(function: &str, s: &State) -> BTreeMap<String, f64> {
     e
 }
 
-/// Worst relative error of robovec's `Qq` (invdyna) and `M`, `c` (dirdyna), with symbolic
+/// Worst relative error of robovec's `Qq` (invdyna), `M`, `c` (dirdyna) and `qdd` (fordyna), with symbolic
 /// parameters given their values and with parameters folded, against Pinocchio over the
 /// oracle's states.
 fn compare(urdf: &str, dof: usize) -> f64 {
@@ -95,12 +99,17 @@ fn compare_on(urdf: &str, dof: usize, floating: bool) -> f64 {
     for fold in [false, true] {
         let (loaded, _) = robovec::driver::load_with(
             &o.path,
-            &FrontOptions { fold_params: fold, floating_base: floating, ..FrontOptions::default() },
+            &FrontOptions {
+                fold_params: fold,
+                floating_base: floating,
+                functions: Some(robovec_dynamics::FUNCTION_NAMES.iter().map(|s| s.to_string()).collect()),
+                ..FrontOptions::default()
+            },
         )
         .unwrap_or_else(|e| panic!("{}: {}", o.path, e.message()));
         assert_eq!(loaded.params.is_some(), !fold);
         let names: Vec<&str> = loaded.module.functions.iter().map(|f| f.name.as_str()).collect();
-        assert_eq!(names, ["invdyna", "dirdyna"]);
+        assert_eq!(names, ["invdyna", "dirdyna", "fordyna"]);
         for (f, s) in loaded.module.functions.iter().flat_map(|f| o.states.iter().map(move |s| (f, s))) {
             let want = expected(&f.name, s);
             assert_eq!(f.outputs.len(), want.len(), "{}: outputs", f.name);
@@ -112,6 +121,7 @@ fn compare_on(urdf: &str, dof: usize, floating: bool) -> f64 {
                 given.insert(format!("q[{}]", i + 1), s.q[i]);
                 given.insert(format!("qd[{}]", i + 1), s.qd[i]);
                 given.insert(format!("qdd[{}]", i + 1), s.qdd[i]);
+                given.insert(format!("Qq[{}]", i + 1), s.tau[i]);
             }
             // Every input must be given: no pseudo-random stand-in may enter the comparison.
             for &v in &f.inputs {
@@ -119,7 +129,7 @@ fn compare_on(urdf: &str, dof: usize, floating: bool) -> f64 {
             }
             let r = robovec::eval::evaluate(f, &given, false);
             // Per group (Qq, M, c): ∞-norm of the difference over Pinocchio's ∞-norm.
-            for group in ["Qq[", "M[", "c["] {
+            for group in ["Qq[", "M[", "c[", "qdd["] {
                 let keys: Vec<&String> = want.keys().filter(|k| k.starts_with(group)).collect();
                 if keys.is_empty() {
                     continue;

@@ -20,8 +20,10 @@
 //! algorithm ([`rnea`]), symbolic in the joint coordinates `q[i]`, `qd[i]`, `qdd[i]`, the
 //! gravity vector `g[1..3]` (Pinocchio's default is `g[3] = −9.81`) and the model parameters.
 //! `dirdyna`: direct dynamics `M[i][j]` (by CRBA, [`crba`]), `c[i]` (by RNEA) with
-//! `M qdd + c = Qq` ([`dirdyna`]). [`generate_with`] writes only the functions a [`Request`]
-//! names (`-function`) and stops at its deadline (`-time-limit`); the cost of each is linear
+//! `M qdd + c = Qq` ([`dirdyna`]). `fordyna`: forward dynamics `qdd[i]` from `q`, `qd`, `Qq`
+//! and `g` (Pinocchio's `aba`; CRBA, then the sparse `LᵀDL` factorisation, [`fordyna`]), written
+//! only when asked for. [`generate_with`] writes only the functions a [`Request`]
+//! names (`-function`; without it `invdyna` and `dirdyna`) and stops at its deadline (`-time-limit`); the cost of each is linear
 //! in the ops it writes, plus `dirdyna`'s `nq²` outputs (issue 28: no table of body pairs, no
 //! copy of a link's sums per child).
 //! `--floating-base` puts the robot on Robotran's floating base first
@@ -60,6 +62,7 @@
 
 pub mod crba;
 pub mod dirdyna;
+pub mod fordyna;
 pub mod frames;
 pub mod origins;
 pub mod rnea;
@@ -169,7 +172,7 @@ pub struct Generated {
 pub struct Request {
     /// Fold every parameter into the equations (`--fold-params`).
     pub fold: bool,
-    /// The functions to write, by name (`-function=NAME`); `None`: all of [`FUNCTION_NAMES`]. Names
+    /// The functions to write, by name (`-function=NAME`); `None`: `invdyna` and `dirdyna`. Names
     /// the generator does not write are ignored (the driver reports them against
     /// [`FUNCTION_NAMES`] before loading).
     pub functions: Option<Vec<String>>,
@@ -181,7 +184,10 @@ pub struct Request {
 impl Request {
     /// Whether function `name` is asked for.
     pub fn wants(&self, name: &str) -> bool {
-        self.functions.as_ref().is_none_or(|fs| fs.iter().any(|f| f == name))
+        match &self.functions {
+            Some(fs) => fs.iter().any(|f| f == name),
+            None => FUNCTIONS.iter().any(|&(f, _, by_default)| f == name && by_default),
+        }
     }
 }
 
@@ -208,7 +214,8 @@ pub enum Reached {
         /// Bodies of the robot.
         bodies: usize,
     },
-    /// A row of `M`'s outputs (`dirdyna`): `row` (1-based) of `rows` (`nq`).
+    /// A row of `M`: of its outputs (`dirdyna`) or of its factorisation and the substitutions
+    /// (`fordyna`): `row` (1-based) of `rows` (`nq`).
     Row {
         /// The row reached.
         row: usize,
@@ -229,16 +236,46 @@ impl std::fmt::Display for Stopped {
     }
 }
 
+/// The tree's parent array over the coordinates (Featherstone's `λ`, *Rigid Body Dynamics
+/// Algorithms* §6.5): entry `i` (coordinate `q[i]`, 1-based; entry 0 unused) is the coordinate
+/// of the nearest moving joint above joint `i`'s, 0 when there is none. Coordinates are
+/// numbered depth first, so `λ[i] < i`. Length `nq + 1`.
+pub fn coordinate_parents(model: &Model, layout: &Layout) -> Vec<usize> {
+    let robot = &model.robot;
+    let order = robot.dfs_joints();
+    let mut link_body = vec![0; robot.links.len()];
+    for (i, &j) in order.iter().enumerate() {
+        link_body[robot.joints[j].child] = i + 1;
+    }
+    // The coordinate of the nearest moving joint at or above each body (0: none).
+    let mut up = vec![0usize; order.len() + 1];
+    let mut lambda = vec![0usize; layout.q_index.iter().flatten().count() + 1];
+    for (i, &j) in order.iter().enumerate() {
+        let p = link_body[robot.joints[j].parent];
+        up[i + 1] = match layout.q_index[i] {
+            Some(qi) => {
+                lambda[qi] = up[p];
+                qi
+            }
+            None => up[p],
+        };
+    }
+    lambda
+}
+
 /// Writes one function's equations and outputs into the builder; [`Stopped`] at the deadline
 /// (the builder's, [`Builder::check`]).
 type Writer = fn(&Model, &Layout, &mut Builder) -> Result<(), Stopped>;
 
-/// The functions the generator writes, in module order (`-function=NAME` picks one): the
-/// one place that selects a formulation per function.
-const FUNCTIONS: [(&str, Writer); 2] = [("invdyna", rnea::invdyna), ("dirdyna", dirdyna::dirdyna)];
+/// The functions the generator writes, in module order (`-function=NAME` picks one), and
+/// whether it writes them without `-function` (Robotran's pair, `invdyna` and `dirdyna`;
+/// `fordyna` only when asked for): the one place that selects a formulation per function.
+const FUNCTIONS: [(&str, Writer, bool); 3] =
+    [("invdyna", rnea::invdyna, true), ("dirdyna", dirdyna::dirdyna, true), ("fordyna", fordyna::fordyna, false)];
 
-/// The names of the functions the generator writes, in module order: `invdyna`, `dirdyna`.
-pub const FUNCTION_NAMES: [&str; 2] = [FUNCTIONS[0].0, FUNCTIONS[1].0];
+/// The names of the functions the generator writes, in module order: `invdyna`, `dirdyna`,
+/// `fordyna`.
+pub const FUNCTION_NAMES: [&str; 3] = [FUNCTIONS[0].0, FUNCTIONS[1].0, FUNCTIONS[2].0];
 
 /// Generates `invdyna` and `dirdyna` for `model`; `fold` folds every parameter into the
 /// equations. [`generate_with`] with every function and no time limit.
@@ -285,7 +322,7 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
     let consts: FxHashMap<String, f64> =
         if request.fold { layout.nonzero().into_iter().collect() } else { FxHashMap::default() };
     let mut functions = Vec::new();
-    for (name, write) in FUNCTIONS.iter().filter(|(name, _)| request.wants(name)) {
+    for (name, write, _) in FUNCTIONS.iter().filter(|(name, _, _)| request.wants(name)) {
         let mut b = Builder::new(name, consts.clone());
         b.deadline = request.deadline;
         write(model, &layout, &mut b)?;

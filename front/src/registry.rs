@@ -83,7 +83,7 @@ pub trait FrontEnd: Sync {
     fn load(&self, path: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>>;
 
     /// The names of the functions this front end builds whatever its input (the URDF's
-    /// `invdyna`, `dirdyna`), so that a `-function` naming none of them is refused before any
+    /// `invdyna`, `dirdyna`, `fordyna`), so that a `-function` naming none of them is refused before any
     /// work; `None` (the default) for front ends whose functions are the input's.
     fn function_names(&self) -> Option<&'static [&'static str]> {
         None
