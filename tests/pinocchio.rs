@@ -195,6 +195,19 @@ fn topology_families_match_pinocchio_rnea_crba_nle() {
     }
 }
 
+/// A 60-joint serial chain, where `fordyna` is the articulated-body algorithm (the `LᵀDL`
+/// factorisation is cubic in a chain's depth; `robovec_dynamics::fordyna` keeps the fewer ops):
+/// its `qdd` against `pinocchio.aba`, with `Qq`, `M` and `c` as for the other robots.
+#[test]
+fn long_chain_forward_dynamics_by_the_aba_matches_pinocchio() {
+    use robovec_dynamics::topology::{build, Topology};
+    let robot = build(Topology::Serial, 60, 1);
+    let path = crate::common::tmp("long_chain").join("serial_60.urdf");
+    std::fs::write(&path, robovec_dynamics::urdf_out::write_urdf(&robot)).unwrap();
+    let e = compare(path.to_str().unwrap(), 60);
+    eprintln!("serial 60: worst relative error {e:e}");
+}
+
 /// Robotran's floating base (`--floating-base`: T1–T3, R1–R3 as `q[1..6]`) against Pinocchio's
 /// composite root joint PX PY PZ RX RY RZ: the three-link arm (its root link has a mass, which
 /// now moves), Solo-12, a quadruped (6 + 12 coordinates), and Talos, a humanoid (6 + 32).

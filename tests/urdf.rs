@@ -241,7 +241,11 @@ fn function_builds_only_the_function_asked_for() {
     let out = d.join("none.rvir");
     let o = opt(&[urdf, "-function=sensor_1", "-passes=atomise", "-o", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("no function `sensor_1` in the input; functions: invdyna, dirdyna, fordyna"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no function `sensor_1` in the input; functions: invdyna, dirdyna, fordyna"),
+        "{}",
+        stderr(&o)
+    );
     assert!(!out.exists());
 }
 

@@ -1,28 +1,30 @@
 //! Forward dynamics `qdd = M(q)⁻¹ (Qq − c(q, qd, g))` of a tree (Pinocchio's `aba`): inputs
 //! `q`, `qd`, the generalised forces `Qq` and `g`; outputs `qdd[1..nq]`.
 //!
-//! # Formulation: CRBA, then the sparse LᵀDL factorisation of `M`
-//! - `M` by the composite-rigid-body algorithm ([`super::crba`], as `dirdyna`), `c` by one RNEA
-//!   sweep with `qdd = 0` ([`super::rnea::sweep`]), the right-hand side `Qq − c`;
-//! - `M = Lᵀ D L` by Featherstone's factorisation for branched trees (R. Featherstone,
-//!   "Efficient factorization of the joint-space inertia matrix for branched kinematic trees",
-//!   *Int. J. Robotics Research* 24(6), 2005; *Rigid Body Dynamics Algorithms*, 2008, §6.5,
-//!   algorithm "LTDL"): `L` is unit lower triangular and has an entry `L[k][i]` only where
-//!   coordinate `i` is an ancestor of `k` in the tree (the parent array `λ` of
-//!   [`crate::coordinate_parents`]), so the factorisation writes no fill-in and costs
-//!   `Σₖ dₖ²/2` multiply–adds for a coordinate at depth `dₖ`; one division per coordinate
-//!   (`1/D[k]`, bound once);
-//! - `qdd = L⁻¹ D⁻¹ L⁻ᵀ (Qq − c)` by the two sparse substitutions of the same reference.
+//! # Formulation: the fewer ops of two, per robot
+//! 1. **CRBA + sparse `LᵀDL`** (this module): `M` by the composite-rigid-body algorithm
+//!    ([`super::crba`], as `dirdyna`), `c` by one RNEA sweep with `qdd = 0`
+//!    ([`super::rnea::sweep`]), the right-hand side `Qq − c`; `M = Lᵀ D L` by Featherstone's
+//!    factorisation for branched trees (R. Featherstone, "Efficient factorization of the
+//!    joint-space inertia matrix for branched kinematic trees", *Int. J. Robotics Research*
+//!    24(6), 2005; *Rigid Body Dynamics Algorithms*, 2008, §6.5, "LTDL"): `L` is unit lower
+//!    triangular and has an entry `L[k][i]` only where coordinate `i` is an ancestor of `k` (the
+//!    parent array `λ` of [`crate::coordinate_parents`]), so there is no fill-in; `Σₖ dₖ(dₖ−1)/2`
+//!    multiply–adds for coordinates at depth `dₖ`, one division per coordinate (`1/D[k]`, bound
+//!    once); then `qdd = L⁻¹ D⁻¹ L⁻ᵀ (Qq − c)` by the two sparse substitutions.
+//! 2. **The articulated-body algorithm** ([`crate::aba`]): linear in the bodies.
 //!
-//! # Why not the articulated-body algorithm (yet)
-//! ABA is O(n) in the coordinates where this is O(Σ dₖ²): on a long chain (depth = n) ABA wins
-//! and this formulation grows as n³/6 (a 2,000-joint chain would write billions of ops; the
-//! generator's deadline stops it). On the robots users bring (arms, legs and humanoids: depth
-//! at most about 8 below the base) the factorisation costs a few hundred ops on top of `M` and
-//! `c`, which `dirdyna` already writes, and reuses the CRBA whose op count the generator has
-//! been tuned on; ABA, which the issue allows by measurement, is the next formulation to
-//! measure against it. Counts (symbolic parameters, `-passes=atomise,cse -stats`) are in
-//! `docs/generator.md` ("Forward dynamics"): `fordyna` costs 5–40 % more ops than `dirdyna`.
+//! [`Formulation::Fewest`] (what `-function=fordyna` writes) keeps whichever has fewer ops. The
+//! factorisation grows as the cube of the tree's depth and the ABA linearly, but the ABA
+//! carries a 6 × 6 articulated inertia across every joint where the CRBA carries one force per
+//! column: measured (`-passes=atomise`, symbolic parameters, own frames: LTDL / ABA ops),
+//! three_link_arm 689 / 1 543, UR5 952 / 3 167, Panda 2 615 / 5 915, Solo-12 (floating base)
+//! 5 422 / 14 054, Talos (floating base) 21 141 / 41 774, TIAGo Pro 34 155 / 124 377, a 30-joint
+//! serial chain 24 712 / 38 243 — the factorisation on every robot users bring; the ABA from
+//! chains of about 40 joints: 60 joints 126 355 / 79 000, 120 joints 770 126 / 160 426, and a
+//! 2,000-joint chain 2.28 million ops (4.9 s), where the factorisation would be billions. The
+//! ABA is written first and the factorisation only when its updates alone (`Σₖ dₖ(dₖ − 1)`
+//! ops) cost fewer ops than the ABA, so the generation stays linear in the ops it keeps.
 //!
 //! The matrix `M` is never an output here: its entries are temporaries the factorisation
 //! overwrites in place, as `H` is in Featherstone's algorithm.
@@ -36,14 +38,14 @@ use super::rnea::{motions, sweep, Drive};
 use super::sym::{mul, sub, to_expr, Builder, Term, ZERO};
 use super::{coordinate_parents, Layout, Model, Reached, Stopped};
 
-/// `1 / D[k]`: `D[k]` bound as `D{k}`, its reciprocal as `iD{k}` (a number stays a number).
-fn reciprocal(b: &mut Builder, k: usize, d: Term) -> Term {
+/// `1 / d`: `d` bound as `d_name`, its reciprocal as `inv_name` (a number stays a number).
+pub(super) fn reciprocal(b: &mut Builder, d_name: &str, inv_name: &str, d: Term) -> Term {
     let d = match d {
         Term::C(x) => return Term::C(1.0 / x),
-        d => b.bind(&format!("D{k}"), d),
+        d => b.bind(d_name, d),
     };
     let e = Expr::Binary(BinOp::Div, Box::new(Expr::Operand(Operand::Const(1.0))), Box::new(to_expr(&d)));
-    let n = b.f.fresh_name(&format!("iD{k}"));
+    let n = b.f.fresh_name(inv_name);
     Term::V(b.f.define(n, Def::Expr(e), Span::DUMMY).expect("fresh"))
 }
 
@@ -59,12 +61,70 @@ fn ancestors(lambda: &[usize], k: usize) -> impl Iterator<Item = usize> + '_ {
     })
 }
 
-/// Writes `fordyna` (outputs `qdd[1..nq]`) into `b`.
+/// How `fordyna` is formed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Formulation {
+    /// Whichever of the two below writes fewer ops for this robot (the first on a tie).
+    Fewest,
+    /// CRBA, sparse `LᵀDL`, substitutions (this module).
+    Ltdl,
+    /// The articulated-body algorithm ([`crate::aba`]).
+    Aba,
+}
+
+/// Writes `fordyna` (outputs `qdd[1..nq]`) into `b`: [`Formulation::Fewest`].
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+    fordyna_with(model, layout, b, Formulation::Fewest)
+}
+
+/// Writes `fordyna` formed by `how` into `b`. [`Formulation::Fewest`] writes both into two
+/// builders and keeps the one whose function has fewer ops (twice the generation time).
 ///
 /// # Errors
 /// [`Stopped`] at the builder's deadline (checked per body of the recursions and per
 /// coordinate of the factorisation and the substitutions).
-pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+pub fn fordyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: Formulation) -> Result<(), Stopped> {
+    match how {
+        Formulation::Ltdl => ltdl(model, layout, b),
+        Formulation::Aba => crate::aba::fordyna(model, layout, b),
+        Formulation::Fewest => {
+            // The ABA first: its cost is linear in the bodies. The factorisation alone costs
+            // `Σₖ dₖ(dₖ − 1)` ops (a multiply and a subtraction per update) for coordinates at
+            // depth `dₖ`: the `LᵀDL` is written only when that is below the ABA's ops (on a long
+            // chain it is cubic, and writing it would cost more than the whole ABA).
+            let mut aba = b.fresh();
+            crate::aba::fordyna(model, layout, &mut aba)?;
+            let aba_ops = aba.live_ops();
+            if factorisation_ops(&coordinate_parents(model, layout)) < aba_ops {
+                ltdl(model, layout, b)?;
+                if b.live_ops() <= aba_ops {
+                    return Ok(());
+                }
+            }
+            *b = aba;
+            Ok(())
+        }
+    }
+}
+
+/// Ops of the `LᵀDL` factorisation's updates for the coordinate parents `lambda`: a multiply
+/// and a subtraction per pair (ancestor `i` of `k`, ancestor-or-self `j` of `i`), structural
+/// zeros not counted (a lower bound of what [`ltdl`] writes).
+fn factorisation_ops(lambda: &[usize]) -> u64 {
+    let mut depth = vec![0u64; lambda.len()];
+    let mut ops = 0;
+    for k in 1..lambda.len() {
+        depth[k] = depth[lambda[k]] + 1;
+        ops += depth[k] * (depth[k] - 1);
+    }
+    ops
+}
+
+/// `fordyna` by CRBA, `LᵀDL` and the substitutions.
+fn ltdl(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
     let nq = layout.q_index.iter().flatten().count();
     let drive = Drive::inputs(b, nq, false);
     let forces: Vec<Term> = (1..=nq).map(|i| b.input(&format!("Qq[{i}]"))).collect();
@@ -88,7 +148,7 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
     for k in (1..=nq).rev() {
         b.check_at(at(k))?;
         let d = h.remove(&(k, k)).unwrap_or(ZERO);
-        inv_d[k] = reciprocal(b, k, d);
+        inv_d[k] = reciprocal(b, &format!("D{k}"), &format!("iD{k}"), d);
         let anc: Vec<usize> = ancestors(k).collect();
         for (n, &i) in anc.iter().enumerate() {
             let hki = h.remove(&(k, i)).unwrap_or(ZERO);
@@ -146,17 +206,24 @@ mod tests {
 
     use robovec_ir::interp;
 
+    use super::{fordyna_with, Formulation};
     use crate::topology::{build, Topology};
-    use crate::{coordinate_parents, generate_with, Model, Request};
+    use crate::{coordinate_parents, Model};
 
     /// Worst `|M qdd + c − Qq|∞ / |Qq|∞` over a few states, `qdd` from `fordyna`, `M` and `c`
     /// from `dirdyna` (an independent use of the same CRBA and RNEA: the factorisation and the
     /// substitutions are what is checked), parameters at their values, all other inputs drawn.
-    fn residual(robot: &crate::robot::Robot) -> f64 {
-        let request = Request { functions: Some(vec!["dirdyna".into(), "fordyna".into()]), ..Request::default() };
-        let g = generate_with(&Model { robot: robot.clone() }, &request).expect("no deadline");
-        let params = g.params.expect("symbolic parameters");
-        let (dir, fd) = (g.module.function("dirdyna").unwrap(), g.module.function("fordyna").unwrap());
+    fn residual(robot: &crate::robot::Robot, how: Formulation) -> f64 {
+        // Both in the robot's own frames, parameters at their values.
+        let model = Model { robot: robot.clone() };
+        let layout = crate::Layout::of(&model.robot);
+        let params = layout.values.clone();
+        let mut b = crate::sym::Builder::new("fordyna", Default::default());
+        fordyna_with(&model, &layout, &mut b, how).expect("no deadline");
+        let fd = &b.finish();
+        let mut b = crate::sym::Builder::new("dirdyna", Default::default());
+        crate::dirdyna::dirdyna(&model, &layout, &mut b).expect("no deadline");
+        let dir = &b.finish();
         let nq = fd.outputs.len();
         let mut worst: f64 = 0.0;
         for seed in 1..=4u64 {
@@ -188,10 +255,16 @@ mod tests {
     /// between moving ones (coordinates whose parent is not the previous body).
     #[test]
     fn forward_dynamics_inverts_the_mass_matrix() {
+        for how in [Formulation::Ltdl, Formulation::Aba] {
+            forward_dynamics_inverts_the_mass_matrix_by(how);
+        }
+    }
+
+    fn forward_dynamics_inverts_the_mass_matrix_by(how: Formulation) {
         for t in Topology::ALL {
             let r = build(t, 9, 3);
-            let e = residual(&r);
-            assert!(e <= 1e-10, "{t}: residual {e:e}");
+            let e = residual(&r, how);
+            assert!(e <= 1e-10, "{how:?} {t}: residual {e:e}");
             // The base link gets a mass: a massless base turns with its first joint for free
             // (`M` singular), which no floating robot is.
             let mut massive = r.clone();
@@ -202,14 +275,14 @@ mod tests {
                 inertia: [[0.3, 0.01, -0.02], [0.01, 0.25, 0.03], [-0.02, 0.03, 0.2]],
             });
             let floating = massive.with_floating_base().unwrap();
-            let e = residual(&floating);
-            assert!(e <= 1e-10, "{t} floating: residual {e:e}");
+            let e = residual(&floating, how);
+            assert!(e <= 1e-10, "{how:?} {t} floating: residual {e:e}");
         }
         let mut with_fixed = build(Topology::SemiSerial, 8, 5);
         with_fixed.joints[2].kind = crate::robot::JointKind::Fixed;
         with_fixed.joints[5].kind = crate::robot::JointKind::Fixed;
-        let e = residual(&with_fixed);
-        assert!(e <= 1e-10, "fixed joints between moving ones: residual {e:e}");
+        let e = residual(&with_fixed, how);
+        assert!(e <= 1e-10, "{how:?} fixed joints between moving ones: residual {e:e}");
     }
 
     /// `λ` by hand on a chain with a fixed joint and on Robotran's floating base: the base's
@@ -224,5 +297,33 @@ mod tests {
         let floating = chain.with_floating_base().unwrap();
         let layout = crate::Layout::of(&floating);
         assert_eq!(coordinate_parents(&Model { robot: floating }, &layout), [0, 0, 1, 2, 3, 4, 5, 6, 7, 8]);
+    }
+
+    /// `Σ d(d − 1)` by hand: a chain of 4 (depths 1..4: 0 + 2 + 6 + 12) and a star of three
+    /// branches off coordinate 1 (depths 1, 2, 2, 2: 0 + 2 + 2 + 2).
+    #[test]
+    fn factorisation_ops_count_the_updates() {
+        assert_eq!(super::factorisation_ops(&[0, 0, 1, 2, 3]), 20);
+        assert_eq!(super::factorisation_ops(&[0, 0, 1, 1, 1]), 6);
+    }
+
+    /// The fewer ops win: the factorisation on a short chain (9 joints), the ABA on a long one
+    /// (60 joints: the factorisation grows as the cube of the depth, the ABA linearly), and
+    /// `Fewest` writes exactly the smaller of the two.
+    #[test]
+    fn the_formulation_with_fewer_ops_is_kept() {
+        let ops = |robot: &crate::robot::Robot, how: Formulation| {
+            let model = Model { robot: robot.clone() };
+            let layout = crate::Layout::of(&model.robot);
+            let mut b = crate::sym::Builder::new("fordyna", Default::default());
+            fordyna_with(&model, &layout, &mut b, how).expect("no deadline");
+            b.finish().op_counts().total
+        };
+        for (dof, ltdl_wins) in [(9, true), (60, false)] {
+            let r = build(Topology::Serial, dof, 1);
+            let (l, a, f) = (ops(&r, Formulation::Ltdl), ops(&r, Formulation::Aba), ops(&r, Formulation::Fewest));
+            assert_eq!(l < a, ltdl_wins, "serial {dof}: LTDL {l} ops, ABA {a}");
+            assert_eq!(f, l.min(a), "serial {dof}");
+        }
     }
 }

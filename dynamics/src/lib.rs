@@ -60,6 +60,7 @@
 
 #![deny(missing_docs)]
 
+pub mod aba;
 pub mod crba;
 pub mod dirdyna;
 pub mod fordyna;

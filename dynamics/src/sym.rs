@@ -375,6 +375,21 @@ impl Builder {
         Term::V(self.f.define(n, Def::Expr(e), Span::DUMMY).expect("fresh"))
     }
 
+    /// An empty builder for another function of the same name, folded constants and deadline
+    /// (a writer that tries two formulations writes the second into it).
+    pub fn fresh(&self) -> Builder {
+        Builder { f: Function::new(&self.f.name, Phase::Parsed), consts: self.consts.clone(), deadline: self.deadline }
+    }
+
+    /// The ops of what [`Builder::finish`] would keep (SPEC §3's count; a copy of the function
+    /// is pruned, this builder is unchanged).
+    pub fn live_ops(&self) -> u64 {
+        let mut f = self.f.clone();
+        let live = f.live_values(&[]);
+        f.retain(|_, v| live[v.index()]);
+        f.op_counts().total
+    }
+
     /// The finished function: what no output needs is dropped (Robotran writes only the
     /// equations its outputs read), inputs included; `equations` counts what is left. The
     /// names of values and outputs are indexed again ([`Function::retain`]).
