@@ -30,6 +30,32 @@ fn unknown_passes_and_parameters_are_usage_errors_listing_valid_ones() {
     assert_eq!(o.status.code(), Some(2));
 }
 
+/// Named pipelines (issue 31 item 3): `--print-passes` lists them with their expansion; inside a
+/// pipeline they run the passes they stand for (`-time-passes` names each, the IR is what the
+/// spelled-out pipeline writes); an unknown one is bad usage.
+#[test]
+fn named_pipelines_are_listed_and_expand_in_place() {
+    let o = opt(&["--print-passes"]);
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(s.contains("default<depth>  = atomise,cse,zero-removal,balance,cse"), "{s}");
+    assert!(s.contains("default<ops>    = atomise,cse,zero-removal,cse"), "{s}");
+    let d = tmp("named_pipelines");
+    let (a, b) = (d.join("named.rvir"), d.join("spelled.rvir"));
+    let o = opt(&[&segway(), "-passes=atomise,default<depth>,asap-alap", "-time-passes", "-o", a.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let log = stderr(&o);
+    for pass in ["atomise", "cse", "zero-removal", "balance", "asap-alap"] {
+        assert!(log.contains(&format!("  {pass}\n")), "{pass} in\n{log}");
+    }
+    let o =
+        opt(&[&segway(), "-passes=atomise,atomise,cse,zero-removal,balance,cse,asap-alap", "-o", b.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&a).unwrap(), std::fs::read_to_string(&b).unwrap());
+    let o = opt(&[&segway(), "-passes=atomise,default<O2>"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("`default<O2>` is no named pipeline; expected `default<depth>` or `default<ops>`"));
+}
+
 #[test]
 fn report_has_the_spec_fields_and_the_segway_figures() {
     let d = tmp("report");

@@ -6,6 +6,7 @@
 //! listing, the page and the code cannot disagree; the root test `tests/passes_reference.rs`
 //! fails when the committed page differs from [`markdown`].
 
+use crate::pipeline::NAMED;
 use crate::{ParamInfo, PassInfo, PASSES};
 
 /// The `--print-passes` listing: each pass and its parameters, one line each as
@@ -26,6 +27,10 @@ pub fn text() -> String {
                 s += &line(x);
             }
         }
+    }
+    s += "Named pipelines (usable anywhere in -passes=):\n";
+    for n in NAMED {
+        s += &format!("  {:<15} = {}\n      {}\n", n.name, n.expansion, n.doc);
     }
     s
 }
@@ -49,6 +54,12 @@ pub fn markdown() -> String {
     s += "| pass | what it does |\n|---|---|\n";
     for p in PASSES {
         s += &format!("| [`{}`](#{}) | {} |\n", p.name, p.name, cell(p.doc));
+    }
+    s += "\nNamed pipelines stand for a list of passes anywhere in a pipeline \
+          (`-passes=atomise,default<depth>,place<pe=16>`; LLVM's `default<O2>`):\n\n\
+          | pipeline | passes | what it is for |\n|---|---|---|\n";
+    for n in NAMED {
+        s += &format!("| `{}` | `{}` | {} |\n", n.name, n.expansion, cell(n.doc));
     }
     for p in PASSES {
         s += &format!("\n## `{}`\n\n{}\n", p.name, p.doc);
