@@ -52,6 +52,11 @@ fn run() -> i32 {
             return 2;
         }
     };
+    // A large input gets the allocator's settings for large runs (`robovec::allocator`); the
+    // size of stdin or of a file that cannot be read yet counts as small.
+    if let Ok(m) = std::fs::metadata(&opts.input) {
+        robovec::allocator::configure_for_input(m.len());
+    }
     use std::io::IsTerminal;
     let terminal =
         robovec::driver::Terminal { stdout: std::io::stdout().is_terminal(), stderr: std::io::stderr().is_terminal() };
