@@ -211,9 +211,9 @@ fn units_are_written_beside_dash_o_listed_and_link_beside_another_model() {
     // A second model: the same function unsplit, symbol `whole`, in its own file.
     run_ok(&[PENDULUM, "-passes=atomise,codegen<c;chunk=0;name=whole>", "-o", dir.join("other.c").to_str().unwrap()]);
     let driver = "#include <stdio.h>\n#include \"model.h\"\n#include \"other.h\"\n\
-                  int main(void) {\n  double in[PEND_INPUTS], a[PEND_OUTPUTS], b[WHOLE_OUTPUTS];\n  \
-                  for (int i = 0; i < PEND_INPUTS; i++) in[i] = 0.37 * i - 1.1;\n  pend(in, a);\n  whole(in, b);\n  \
-                  for (int j = 0; j < PEND_OUTPUTS; j++) printf(\"%a %a\\n\", a[j], b[j]);\n  return 0;\n}\n";
+                  int main(void) {\n  double in[pend_INPUTS], a[pend_OUTPUTS], b[whole_OUTPUTS];\n  \
+                  for (int i = 0; i < pend_INPUTS; i++) in[i] = 0.37 * i - 1.1;\n  pend(in, a);\n  whole(in, b);\n  \
+                  for (int j = 0; j < pend_OUTPUTS; j++) printf(\"%a %a\\n\", a[j], b[j]);\n  return 0;\n}\n";
     std::fs::write(dir.join("main.c"), driver).unwrap();
     let o = cc(
         &dir,

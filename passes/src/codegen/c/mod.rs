@@ -31,7 +31,7 @@ use std::path::Path;
 
 use robovec_ir::{Callee, Def, Function, Module};
 
-use super::names::is_c_identifier;
+use super::names::{free_name, is_c_identifier, is_reserved_symbol, reserved_symbol_reason, sanitise};
 use super::{CodegenArtifact, Interface};
 use crate::params::{word_enum, ParamKind};
 use crate::{GeneratedCode, Member, ParamInfo, Params, Pass, PassContext, PassError};
@@ -221,6 +221,9 @@ impl CodegenC {
             if !is_c_identifier(n) {
                 return Err(bad(format!("parameter `name` must be one C identifier, found `{n}`")));
             }
+            if let Some(why) = reserved_symbol_reason(n) {
+                return Err(bad(format!("parameter `name`: `{n}` cannot name generated C: it is {why}")));
+            }
         }
         if o.abi == Abi::Robotran {
             let clash = if o.batch > 1 {
@@ -256,14 +259,35 @@ impl CodegenC {
         }
     }
 
-    fn symbol(&self, f: &Function, several: bool) -> Result<String, PassError> {
-        match (&self.name, self.abi) {
-            (Some(n), Abi::Robotran) if several => Ok(format!("{n}_{}", robotran::symbol(f)?)),
-            (Some(n), _) if several => Ok(format!("{n}_{}", f.name)),
-            (Some(n), _) => Ok(n.clone()),
-            (None, Abi::Robotran) => robotran::symbol(f),
-            (None, Abi::Plain) => Ok(super::names::sanitise(&f.name)),
+    /// The symbol of each function of `m`, in order: Robotran's names for `abi=robotran`
+    /// (prefixed `NAME_` with `name=` and several functions), else `name=` or the function's
+    /// name sanitised; injective, and for `abi=plain` never [`is_reserved_symbol`] (a derived
+    /// symbol that would be is renamed, [`free_name`]), nor the size macro of another.
+    ///
+    /// # Errors
+    /// [`PassError::Failed`] for a function with no Robotran signature (`abi=robotran`).
+    fn symbols(&self, m: &Module) -> Result<Vec<String>, PassError> {
+        let several = m.functions.len() > 1;
+        let mut taken: HashSet<String> = HashSet::new();
+        let mut out = Vec::with_capacity(m.functions.len());
+        for f in &m.functions {
+            let wanted = match (&self.name, self.abi) {
+                (Some(n), Abi::Robotran) if several => format!("{n}_{}", robotran::symbol(f)?),
+                (Some(n), _) if several => format!("{n}_{}", sanitise(&f.name)),
+                (Some(n), _) => n.clone(),
+                (None, Abi::Robotran) => robotran::symbol(f)?,
+                (None, Abi::Plain) => sanitise(&f.name),
+            };
+            let symbol = match self.abi {
+                // Robotran's names are the drop-in's contract: kept as they are (the sensors share
+                // `mbs_sensor`, which dispatches on the sensor's number).
+                Abi::Robotran => wanted,
+                Abi::Plain => free_name(&wanted, &taken, is_reserved_symbol),
+            };
+            taken.extend([format!("{symbol}_INPUTS"), format!("{symbol}_OUTPUTS"), symbol.clone()]);
+            out.push(symbol);
         }
+        Ok(out)
     }
 
     /// The C file, its header and the interfaces, for every function of `m` (atomised), as
@@ -300,7 +324,6 @@ impl CodegenC {
         main: Option<&Path>,
         ticker: &crate::Ticker,
     ) -> Result<CodegenArtifact, PassError> {
-        let several = m.functions.len() > 1;
         let fused = m.functions.iter().any(has_fused);
         let callbacks = body::callbacks(m)?;
         let decls = if self.abi == Abi::Robotran {
@@ -308,7 +331,7 @@ impl CodegenC {
         } else {
             body::callback_decls(&callbacks, self.real())
         };
-        let symbols: Vec<String> = m.functions.iter().map(|f| self.symbol(f, several)).collect::<Result<_, _>>()?;
+        let symbols = self.symbols(m)?;
         // The file's global names, which no part may take.
         let taken: HashSet<String> = symbols.iter().cloned().chain(callbacks.iter().map(|k| k.base.clone())).collect();
         let mut emitted = Vec::with_capacity(m.functions.len());
@@ -389,14 +412,16 @@ impl CodegenC {
             interfaces.push(iface);
         }
         if self.abi == Abi::Robotran {
-            let (code, proto) =
-                robotran::sensor_dispatch(m, |f| self.symbol(f, several).expect("symbols checked above"));
+            let symbol_of = |f: &Function| {
+                let i = m.functions.iter().position(|g| std::ptr::eq(g, f)).expect("a function of m");
+                symbols[i].clone()
+            };
+            let (code, proto) = robotran::sensor_dispatch(m, symbol_of);
             files[0] += &code;
             h += &proto;
         }
-        let guard = symbols
-            .first()
-            .map_or("ROBOVEC_GENERATED_H".to_string(), |s| format!("ROBOVEC_GENERATED_{}_H", s.to_uppercase()));
+        // The first symbol as it is (case kept: `AB` and `ab` are two files' symbols, one guard each).
+        let guard = symbols.first().map_or("ROBOVEC_GENERATED_H".to_string(), |s| format!("ROBOVEC_{s}_H"));
         let units_note = if units > 1 {
             let list: Vec<String> = (0..units).map(base_name).collect();
             format!(

@@ -210,10 +210,8 @@ pub(crate) fn function(
     }
     let _ = writeln!(
         proto,
-        " */\n{sig};\n#define {}_INPUTS {}\n#define {}_OUTPUTS {}\n",
-        symbol.to_uppercase(),
+        " */\n{sig};\n#define {symbol}_INPUTS {}\n#define {symbol}_OUTPUTS {}\n",
         iface.inputs.len(),
-        symbol.to_uppercase(),
         iface.outputs.len()
     );
     Emitted { entry: s, parts, proto, iface }
