@@ -9,6 +9,7 @@ mod accuracy;
 mod architecture;
 mod artifacts;
 mod bounds;
+mod c_names;
 mod cli;
 mod codegen_c;
 mod corpus;

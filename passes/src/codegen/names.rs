@@ -405,6 +405,8 @@ const LIBC_FUNCTIONS: &[&str] = &[
     "free_sized",
     "free_aligned_sized",
     "memalignment",
+    "mkstemps",
+    "mkostemps",
 ];
 
 fn is_keyword(name: &str) -> bool {
@@ -462,9 +464,9 @@ pub fn reserved_symbol_reason(name: &str) -> Option<&'static str> {
         Some("reserved by the C standard (a leading `_` or a `__`)")
     } else if name.starts_with("robovec_") || name.starts_with("ROBOVEC_") {
         Some("reserved for robovec's own helpers and macros")
-    } else if is_math_function(name) {
+    } else if is_math_function(name) || name.strip_suffix("_r").is_some_and(is_math_function) {
         Some("a function or macro of <math.h>")
-    } else if LIBC_FUNCTIONS.contains(&name)
+    } else if [Some(name), name.strip_suffix("_r")].into_iter().flatten().any(|n| LIBC_FUNCTIONS.contains(&n))
         || ["str", "mem", "wcs", "is", "to", "atomic_"].iter().any(|p| lower_after(name, p))
     {
         Some("a function of the C library or a name the standard reserves for it")

@@ -1,0 +1,360 @@
+//! Issue 29 item 1: generated C links anywhere. Hostile names as IR value names and as `name=`,
+//! the system compiler's own header macros as value names, libc's functions as function names,
+//! and two generated files (both headers in one translation unit) linked into one program;
+//! compiled by `cc` in its default dialect and with `-std=c99`, with
+//! `-Werror=implicit-function-declaration`, and run: outputs equal `-eval` bit for bit.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::Command;
+
+use crate::common::{opt, stderr, tmp};
+
+/// The names the issue measured breaking the C, and a few more of the same kinds.
+const HOSTILE: &[&str] = &[
+    "_Atomic",
+    "_Generic",
+    "_Noreturn",
+    "_Alignas",
+    "_Static_assert",
+    "_Thread_local",
+    "__attribute__",
+    "_Pragma",
+    "__STDC__",
+    "__LINE__",
+    "FP_NAN",
+    "FP_ZERO",
+    "HUGE_VALL",
+    "math_errhandling",
+    "MATH_ERRNO",
+    "M_PI_2",
+    "M_SQRT2",
+    "M_LN2",
+    "asm",
+    "typeof",
+    "int",
+    "sin",
+    "cos",
+    "memcpy",
+    "fma",
+    "M_PI",
+    "restrict",
+    "robovec_sincos_inline",
+    "robovec_vec",
+    "in",
+    "out",
+    "live",
+    "AB_INPUTS",
+    "linux",
+    "unix",
+    "NULL",
+    "errno",
+    "bool",
+    "true",
+    "size_t",
+    "EDOM",
+    "INFINITY",
+    "main",
+];
+
+/// The dialects every file is compiled in: the compiler's default and C99.
+const DIALECTS: [&[&str]; 2] = [&[], &["-std=c99"]];
+
+/// A function whose inputs and temporaries carry `names` (`%NAME`), each temporary a distinct
+/// combination of the two inputs `a`, `b` and the previous one, with `sin`/`cos` trig values,
+/// and one output per temporary.
+fn hostile_ir(names: &[&str]) -> String {
+    let mut s = String::from("func @f {\n  input %a\n  input %b\n");
+    for (i, n) in names.iter().enumerate().filter(|(i, _)| i % 7 == 3) {
+        let _ = i;
+        s += &format!("  input %{n}\n");
+    }
+    s += "  %ts = sin %a\n  %tc = cos %b\n";
+    let mut prev = "ts".to_string();
+    for (i, n) in names.iter().enumerate() {
+        if i % 7 == 3 {
+            s += &format!("  %{n}.t = mul %{n}, %tc\n");
+            prev = format!("{n}.t");
+            continue;
+        }
+        let op = ["add", "mul", "sub"][i % 3];
+        s += &format!("  %{n} = {op} %{prev}, {}\n", if i % 2 == 0 { "%a" } else { "%b" });
+        prev = n.to_string();
+    }
+    s += &format!("  output o = %{prev}\n");
+    for (i, n) in names.iter().enumerate().filter(|(i, _)| i % 7 != 3) {
+        s += &format!("  output o{i} = %{n}\n");
+    }
+    s + "}\n"
+}
+
+/// `cc ARGS` in `dir`; panics with the compiler's messages when it fails.
+fn cc(dir: &Path, args: &[&str]) {
+    let o = Command::new("cc")
+        .current_dir(dir)
+        .args(["-O0", "-ffp-contract=off", "-Werror=implicit-function-declaration"])
+        .args(args)
+        .output()
+        .expect("a C compiler `cc` on PATH (scripts/test.sh installs gcc)");
+    assert!(o.status.success(), "cc {args:?} in {}:\n{}", dir.display(), String::from_utf8_lossy(&o.stderr));
+}
+
+/// `-eval` of `ir` (file in `dir`) on `inputs` (`extra`: `-function=…`): output name → value.
+fn eval(dir: &Path, ir: &Path, inputs: &BTreeMap<String, f64>, extra: &[&str]) -> BTreeMap<String, f64> {
+    let json = dir.join("inputs.json");
+    std::fs::write(&json, serde_json::to_string(inputs).unwrap()).unwrap();
+    let eval = format!("-eval={}", json.display());
+    let mut args = vec![ir.to_str().unwrap(), eval.as_str()];
+    args.extend(extra);
+    let o = opt(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    v["outputs"].as_object().unwrap().iter().map(|(k, x)| (k.clone(), x.as_f64().unwrap())).collect()
+}
+
+/// The inputs `codegen<c;abi=plain>` documents in the report, in argument order, and its outputs.
+fn interface(report: &Path) -> (Vec<String>, Vec<String>) {
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    let list = |k: &str| r["codegen"][k].as_array().unwrap().iter().map(|x| x.as_str().unwrap().to_string()).collect();
+    (list("inputs"), list("outputs"))
+}
+
+/// Writes `ir` as C with `options`, compiles it in both dialects with a driver that includes
+/// its header, runs it on the inputs and checks every output against `-eval`: bit for bit, or
+/// (`trig=inline`, robovec's own sin/cos, within an ulp of libm's) to 1e-12 relative.
+fn compiles_and_equals_eval(dir: &Path, ir_text: &str, options: &str, batch: usize) {
+    let exact = !options.contains("trig=inline");
+    let ir = dir.join("f.rvir");
+    std::fs::write(&ir, ir_text).unwrap();
+    let (c, report) = (dir.join("f.c"), dir.join("r.json"));
+    let o = opt(&[
+        ir.to_str().unwrap(),
+        &format!("-passes=atomise,codegen<c;{options}>"),
+        "-o",
+        c.to_str().unwrap(),
+        &format!("-report={}", report.display()),
+    ]);
+    assert!(o.status.success(), "{options}: {}", stderr(&o));
+    let (ins, outs) = interface(&report);
+    let inputs: BTreeMap<String, f64> =
+        ins.iter().enumerate().map(|(i, n)| (n.clone(), 0.1 + 0.37 * i as f64 - 0.9 * (i % 3) as f64)).collect();
+    let want = eval(dir, &ir, &inputs, &[]);
+    let symbol = "f";
+    let mut driver = format!(
+        "#include <stdio.h>\n#include \"f.h\"\nint main(void) {{\n  static double in[{symbol}_INPUTS * {batch}], out[{symbol}_OUTPUTS * {batch}];\n"
+    );
+    for (i, n) in ins.iter().enumerate() {
+        for l in 0..batch {
+            driver += &format!("  in[{}] = {:?};\n", i * batch + l, inputs[n]);
+        }
+    }
+    driver += &format!("  {symbol}(in, out);\n  for (int j = 0; j < {symbol}_OUTPUTS * {batch}; j++) printf(\"%.17g\\n\", out[j]);\n  return 0;\n}}\n");
+    std::fs::write(dir.join("main.c"), driver).unwrap();
+    for dialect in DIALECTS {
+        let mut args: Vec<&str> = dialect.to_vec();
+        args.extend(["-o", "run", "main.c", "f.c", "-lm"]);
+        cc(dir, &args);
+        let run = Command::new(dir.join("run")).output().unwrap();
+        let got: Vec<f64> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+        assert_eq!(got.len(), outs.len() * batch);
+        for (j, n) in outs.iter().enumerate() {
+            for l in 0..batch {
+                let (x, w) = (got[j * batch + l], want[n]);
+                let close = if exact { x.to_bits() == w.to_bits() } else { (x - w).abs() <= 1e-12 * w.abs().max(1.0) };
+                assert!(close, "{options} {dialect:?}: output {n} lane {l}: C {x} vs -eval {w}");
+            }
+        }
+    }
+}
+
+/// Every hostile name as an input and a temporary: the C compiles in both dialects and equals
+/// `-eval` bit for bit, one state with libm's sin/cos and four with the inline ones.
+#[test]
+fn hostile_value_names_compile_and_equal_eval() {
+    let dir = tmp("hostile_values");
+    let ir = hostile_ir(HOSTILE);
+    compiles_and_equals_eval(&dir, &ir, "abi=plain", 1);
+    compiles_and_equals_eval(&dir, &ir, "abi=plain;batch=4", 4);
+    compiles_and_equals_eval(&dir, &ir, "abi=plain;batch=4;trig=inline", 4);
+    compiles_and_equals_eval(&dir, &ir, "abi=plain;chunk=5", 1);
+}
+
+/// Every hostile name as `name=`: bad usage (exit 2) naming why, or, when it is a fine symbol,
+/// C that compiles and equals `-eval`. Every name of the list is reserved.
+#[test]
+fn hostile_symbols_are_refused_with_a_reason() {
+    let dir = tmp("hostile_symbols");
+    let ir = dir.join("f.rvir");
+    std::fs::write(&ir, hostile_ir(&["x", "y"])).unwrap();
+    for n in HOSTILE {
+        let o = opt(&[ir.to_str().unwrap(), &format!("-passes=atomise,codegen<c;name={n}>"), "-o", "/dev/null"]);
+        assert_eq!(o.status.code(), Some(2), "name={n}: {}", stderr(&o));
+        assert!(stderr(&o).contains(&format!("`{n}` cannot name generated C: it is")), "{n}: {}", stderr(&o));
+    }
+    let o = opt(&[ir.to_str().unwrap(), "-passes=atomise,codegen<c;name=robot_model>", "-o", "/dev/null"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// The compiler's own headers decide (not this test's list): every macro that `<math.h>`,
+/// `<string.h>`, `<stdlib.h>` and `<immintrin.h>` define or the compiler predefines in its
+/// default dialect and in C99, with a name the standard does not reserve, as a value name; the
+/// C compiles in both dialects, one state and batches (which include `<immintrin.h>`).
+#[test]
+fn the_system_headers_macros_are_never_value_names() {
+    let dir = tmp("header_macros");
+    let mut names: Vec<String> = Vec::new();
+    for dialect in DIALECTS {
+        let o = Command::new("cc")
+            .args(dialect)
+            .args(["-dM", "-E", "-x", "c", "-"])
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .and_then(|mut c| {
+                use std::io::Write;
+                c.stdin.take().unwrap().write_all(
+                    b"#include <math.h>\n#include <string.h>\n#include <stdlib.h>\n#include <immintrin.h>\n",
+                )?;
+                c.wait_with_output()
+            })
+            .expect("cc -dM -E");
+        assert!(o.status.success());
+        for line in String::from_utf8(o.stdout).unwrap().lines() {
+            let Some(rest) = line.strip_prefix("#define ") else { continue };
+            let name: String = rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+            if !name.starts_with('_') && !names.contains(&name) {
+                names.push(name);
+            }
+        }
+    }
+    assert!(names.len() > 50, "the headers define macros: {names:?}");
+    for n in ["M_PI", "FP_NAN", "HUGE_VALL", "NAN", "RAND_MAX"] {
+        assert!(names.iter().any(|m| m == n), "{n} among {names:?}");
+    }
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let ir = hostile_ir(&refs);
+    compiles_and_equals_eval(&dir, &ir, "abi=plain", 1);
+    compiles_and_equals_eval(&dir, &ir, "abi=plain;batch=4", 4);
+    compiles_and_equals_eval(&dir, &ir, "abi=plain;batch=4;trig=inline", 4);
+}
+
+/// Functions named like the C library's (every identifier that `<math.h>`, `<string.h>` and
+/// `<stdlib.h>` declare as a function, read from the preprocessed headers) and two IR names that
+/// sanitise alike (`@f[1]`, `@f_1`): the symbols are renamed, unique, and the file compiles
+/// with those headers forced in (`-include`), where a clash would be a conflicting declaration.
+#[test]
+fn functions_named_like_the_c_library_get_free_symbols() {
+    let dir = tmp("library_symbols");
+    let o = Command::new("cc")
+        .args(["-E", "-P", "-x", "c", "-"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .and_then(|mut c| {
+            use std::io::Write;
+            c.stdin.take().unwrap().write_all(b"#include <math.h>\n#include <string.h>\n#include <stdlib.h>\n")?;
+            c.wait_with_output()
+        })
+        .expect("cc -E");
+    let text = String::from_utf8(o.stdout).unwrap();
+    // `IDENT (` after a type or `*`: a declared function (attributes and macros' calls are
+    // identifiers followed by `((`, skipped).
+    let mut funcs: Vec<String> = Vec::new();
+    let bytes: Vec<char> = text.chars().collect();
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i].is_ascii_alphabetic() && (i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == '_'))
+        {
+            let start = i;
+            while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == '_') {
+                i += 1;
+            }
+            let name: String = bytes[start..i].iter().collect();
+            let mut j = i;
+            while j < bytes.len() && bytes[j] == ' ' {
+                j += 1;
+            }
+            let before: String = bytes[start.saturating_sub(2)..start].iter().collect();
+            if j + 1 < bytes.len()
+                && bytes[j] == '('
+                && bytes[j + 1] != '('
+                && (before.ends_with(' ') || before.ends_with('*'))
+                && !funcs.contains(&name)
+                && !["if", "sizeof", "return", "while", "for", "switch"].contains(&name.as_str())
+            {
+                funcs.push(name);
+            }
+        } else {
+            i += 1;
+        }
+    }
+    for f in ["sin", "memcpy", "malloc", "strlen", "qsort"] {
+        assert!(funcs.iter().any(|g| g == f), "{f} among {} functions", funcs.len());
+    }
+    let mut ir = String::new();
+    for name in funcs.iter().map(String::as_str).chain(["f[1]", "f_1"]) {
+        ir += &format!("func @{name} {{\n  input %a\n  %x = mul %a, %a\n  output o = %x\n}}\n");
+    }
+    std::fs::write(dir.join("m.rvir"), ir).unwrap();
+    let (m, c) = (dir.join("m.rvir").display().to_string(), dir.join("m.c").display().to_string());
+    let o = opt(&[&m, "-passes=atomise,codegen<c>", "-o", &c]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let h = std::fs::read_to_string(dir.join("m.h")).unwrap();
+    assert!(h.contains("void f_1(") && h.contains("void f_1_2("), "@f[1] and @f_1: two symbols");
+    for dialect in DIALECTS {
+        let mut args: Vec<&str> = dialect.to_vec();
+        args.extend([
+            "-include", "math.h", "-include", "string.h", "-include", "stdlib.h", "-include", "m.h", "-c", "m.c",
+        ]);
+        cc(&dir, &args);
+    }
+}
+
+/// Two generated files in one program: one module with `@AB` (3 inputs) and `@ab` (1 input),
+/// whose size macros stay distinct, written twice with `batch=4` (vector types and helpers in
+/// each file): with the inline sin/cos, and with libm's under `name=other`. Both headers in
+/// one translation unit, both objects linked; libm's file equals `-eval` bit for bit, the
+/// inline one to 1e-12.
+#[test]
+fn two_generated_files_include_and_link_together() {
+    let dir = tmp("two_files");
+    let ir = "func @AB {\n  input %a\n  input %b\n  input %c\n  %s = sin %a\n  %x = mul %s, %b\n  %y = add %x, %c\n  output y = %y\n}\n\
+              func @ab {\n  input %a\n  %k = cos %a\n  output k = %k\n}\n";
+    std::fs::write(dir.join("m.rvir"), ir).unwrap();
+    let p = |s: &str| dir.join(s).display().to_string();
+    for (out, options) in [("one.c", "codegen<c;batch=4;trig=inline>"), ("two.c", "codegen<c;batch=4;name=other>")] {
+        let o = opt(&[&p("m.rvir"), &format!("-passes=atomise,{options}"), "-o", &p(out)]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let h = std::fs::read_to_string(dir.join("one.h")).unwrap();
+    assert!(h.contains("#define AB_INPUTS 3") && h.contains("#define ab_INPUTS 1"), "{h}");
+    let driver = "#include <stdio.h>\n#include \"one.h\"\n#include \"two.h\"\n\
+        int main(void) {\n\
+          double in[AB_INPUTS * 4], y[AB_OUTPUTS * 4], k[ab_INPUTS * 4], k2[other_ab_OUTPUTS * 4], y2[other_AB_OUTPUTS * 4];\n\
+          for (int i = 0; i < AB_INPUTS * 4; i++) in[i] = 0.25 + 0.5 * i;\n\
+          AB(in, y); ab(in, k); other_AB(in, y2); other_ab(in, k2);\n\
+          for (int l = 0; l < 4; l++) printf(\"%.17g %.17g %.17g %.17g\\n\", y[l], y2[l], k[l], k2[l]);\n\
+          return (int)(sizeof in / sizeof in[0]) != 12 || (int)(sizeof k / sizeof k[0]) != 4;\n}\n";
+    std::fs::write(dir.join("main.c"), driver).unwrap();
+    for dialect in DIALECTS {
+        let mut args: Vec<&str> = dialect.to_vec();
+        args.extend(["-o", "run", "main.c", "one.c", "two.c", "-lm"]);
+        cc(&dir, &args);
+        let run = Command::new(dir.join("run")).output().unwrap();
+        assert!(run.status.success(), "the size macros size the arrays");
+        let text = String::from_utf8(run.stdout).unwrap();
+        assert_eq!(text.lines().count(), 4, "{text}");
+        for (l, line) in text.lines().enumerate() {
+            let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
+            let at = |i: usize| 0.25 + 0.5 * (i * 4 + l) as f64;
+            let inputs: BTreeMap<String, f64> =
+                [("a".to_string(), at(0)), ("b".into(), at(1)), ("c".into(), at(2))].into();
+            let y = eval(&dir, &dir.join("m.rvir"), &inputs, &["-function=AB"])["y"];
+            let k = eval(&dir, &dir.join("m.rvir"), &inputs, &["-function=ab"])["k"];
+            assert_eq!(v[1].to_bits(), y.to_bits(), "lane {l}: libm's file vs -eval: {line}");
+            assert_eq!(v[3].to_bits(), k.to_bits(), "lane {l}: libm's file vs -eval: {line}");
+            assert!((v[0] - y).abs() <= 1e-12 * y.abs().max(1.0), "lane {l}: inline {} vs {y}", v[0]);
+            assert!((v[2] - k).abs() <= 1e-12, "lane {l}: inline {} vs {k}", v[2]);
+        }
+    }
+}
