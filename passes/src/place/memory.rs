@@ -14,6 +14,7 @@ use robovec_ir::machine::Held;
 use robovec_ir::placement::{Issue, Load, Pe, PeArray, Placement, Write};
 use robovec_ir::{Function, Operand};
 
+use super::dag::{Node, OpDag};
 use super::schedule::{initial_operands, Schedule};
 
 /// The PE of a dense slot.
@@ -53,39 +54,44 @@ fn allocate(items: &[(u32, u32)]) -> (Vec<u32>, u32) {
     (addr, words)
 }
 
-/// Builds the placement of `f` from its schedule.
-pub fn build(f: &Function, arch: &PeArray, s: &Schedule) -> Placement {
+/// Builds the placement of `f` from its schedule `s` (indexed by the nodes of `dag`, built
+/// from `f`).
+pub fn build(f: &Function, dag: &OpDag, arch: &PeArray, s: &Schedule) -> Placement {
     let n_pe = arch.n_pe();
-    let n = f.values.len();
-    // Bookings of each value (compressed rows), to find the one an op reads on its PE.
+    let n = dag.len();
+    // Bookings of each node (compressed rows), to find the one an op reads on its PE.
     let mut at = vec![0u32; n + 1];
     for b in &s.bookings {
-        at[b.value.index() + 1] += 1;
+        at[b.node as usize + 1] += 1;
     }
     for i in 0..n {
         at[i + 1] += at[i];
     }
     let mut fill = at.clone();
-    let mut by_value = vec![0u32; s.bookings.len()];
+    let mut by_node = vec![0u32; s.bookings.len()];
     for (i, b) in s.bookings.iter().enumerate() {
-        by_value[fill[b.value.index()] as usize] = i as u32;
-        fill[b.value.index()] += 1;
+        by_node[fill[b.node as usize] as usize] = i as u32;
+        fill[b.node as usize] += 1;
     }
     // Last read cycle of each booking, and of each initial item loaded into each PE memory.
     let mut last_booking = vec![0u32; s.bookings.len()];
     let mut loads_wanted: Vec<Vec<Operand>> = vec![Vec::new(); n_pe];
     let mut load_index: Vec<HashMap<Held, usize>> = vec![HashMap::new(); n_pe];
     let mut last_load: Vec<Vec<u32>> = vec![Vec::new(); n_pe];
-    for &v in &f.body {
-        let Some((q, t)) = s.issue[v.index()] else { continue };
-        f.value(v).def.for_each_value(|a| {
-            if let Some(&i) = by_value[at[a.index()] as usize..at[a.index() + 1] as usize]
-                .iter()
-                .find(|&&i| s.bookings[i as usize].target == q)
-            {
+    // In node order (operands are near their users there), then the loads in body order.
+    for j in 0..n as Node {
+        let (q, t) = s.issue[j as usize];
+        for a in dag.distinct_operands(j) {
+            let row = &by_node[at[a as usize] as usize..at[a as usize + 1] as usize];
+            if let Some(&i) = row.iter().find(|&&i| s.bookings[i as usize].target == q as usize) {
                 last_booking[i as usize] = last_booking[i as usize].max(t);
             }
-        });
+        }
+    }
+    for &v in &f.body {
+        let Some(j) = dag.node(v) else { continue };
+        let (q, t) = s.issue[j as usize];
+        let q = q as usize;
         for o in initial_operands(f, v) {
             let i = *load_index[q].entry(Held::of(&o)).or_insert_with(|| {
                 loads_wanted[q].push(o);
@@ -102,18 +108,18 @@ pub fn build(f: &Function, arch: &PeArray, s: &Schedule) -> Placement {
     for (i, b) in s.bookings.iter().enumerate() {
         per_memory[b.target].push(i);
     }
-    // Buffers: one item per value that is read from its producer's buffer, from its arrival
-    // to its last buffer read.
+    // Buffers: one item per op that is read from its producer's buffer, from its arrival to
+    // its last buffer read.
     let mut buffer_end: Vec<Option<u32>> = vec![None; n];
     for b in s.bookings.iter().filter(|b| b.indirect) {
-        let e = buffer_end[b.value.index()].get_or_insert(b.cycle);
+        let e = buffer_end[b.node as usize].get_or_insert(b.cycle);
         *e = (*e).max(b.cycle);
     }
     let mut buffer_items: Vec<Vec<(usize, u32, u32)>> = vec![Vec::new(); n_pe];
-    for (v, end) in buffer_end.iter().enumerate() {
+    for (j, end) in buffer_end.iter().enumerate() {
         if let Some(end) = *end {
-            let (p, _) = s.issue[v].expect("issued");
-            buffer_items[p].push((v, s.arrival[v], end));
+            let p = s.issue[j].0 as usize;
+            buffer_items[p].push((j, s.arrival[j], end));
         }
     }
     let mut buffer_addr = vec![0u32; n];
@@ -122,8 +128,8 @@ pub fn build(f: &Function, arch: &PeArray, s: &Schedule) -> Placement {
         let spans: Vec<(u32, u32)> = items.iter().map(|&(_, a, b)| (a, b)).collect();
         let (addrs, words) = allocate(&spans);
         buffer_words[p] = words;
-        for (&(v, _, _), a) in items.iter().zip(addrs) {
-            buffer_addr[v] = a;
+        for (&(j, _, _), a) in items.iter().zip(addrs) {
+            buffer_addr[j] = a;
         }
     }
     for q in 0..n_pe {
@@ -137,12 +143,15 @@ pub fn build(f: &Function, arch: &PeArray, s: &Schedule) -> Placement {
         }
         for (&i, &addr) in per_memory[q].iter().zip(&addrs[loads_wanted[q].len()..]) {
             let b = &s.bookings[i];
-            let buffer_addr = b.indirect.then(|| buffer_addr[b.value.index()]);
-            writes.push(Write { value: b.value, pe, addr, cycle: b.cycle, buffer_addr });
+            let buffer_addr = b.indirect.then(|| buffer_addr[b.node as usize]);
+            writes.push(Write { value: dag.ops[b.node as usize], pe, addr, cycle: b.cycle, buffer_addr });
         }
     }
     writes.sort_unstable_by_key(|w| (w.cycle, w.pe, w.addr));
-    let issue = s.issue.iter().map(|x| x.map(|(q, cycle)| Issue { pe: pe_of(arch, q), cycle })).collect();
+    let mut issue = vec![None; f.values.len()];
+    for (&v, &(q, cycle)) in dag.ops.iter().zip(&s.issue) {
+        issue[v.index()] = Some(Issue { pe: pe_of(arch, q as usize), cycle });
+    }
     Placement { arch: *arch, issue, loads, writes, pe_words, buffer_words, spans: Default::default() }
 }
 

@@ -22,6 +22,7 @@ pub mod bound;
 pub mod dag;
 pub mod feed;
 pub mod memory;
+pub mod ready;
 pub mod report;
 pub mod schedule;
 pub mod search;
@@ -174,26 +175,29 @@ pub fn try_place_function_progress(
 ) -> Result<(Placement, bool), PlaceError> {
     let a = &opts.arch;
     let required = crate::Ticker::new(opts.grace, opts.tick_budget);
-    let dag = dag::OpDag::new(f);
     let seed = schedule::seed_keys(f, a, opts.priority);
+    // Nodes in the seed's priority order: the schedules take ops mostly in that order, and
+    // their per-op arrays are indexed by node (see `dag`).
+    let dag = dag::OpDag::ordered(f, &seed);
+    let seed = dag.gather(&seed);
     if required.check() {
         return Err(PlaceError::Stopped);
     }
-    let (best, cut) = improved(f, &dag, opts, &seed, 0, &required)?;
+    let (best, cut) = improved(&dag, opts, &seed, 0, &required)?;
     if required.check() {
         return Err(PlaceError::Stopped);
     }
     if cut {
-        return Ok((memory::build(f, a, &best), true));
+        return Ok((memory::build(f, &dag, a, &best), true));
     }
     let spec = lower_bound(f, a) as u64;
     // Within 2% of SPEC §4's bound (hence of the tight bound too): nothing to search for, and
     // the tight bound (O(n log n) but not free) is not computed.
     if (opts.restarts > 0 || opts.search > 0) && end(&best) as u64 * 100 > spec * 102 {
         let (best, stopped) = search::restarts_and_search(f, &dag, opts, seed, best, progress)?;
-        return Ok((memory::build(f, a, &best), stopped));
+        return Ok((memory::build(f, &dag, a, &best), stopped));
     }
-    Ok((memory::build(f, a, &best), false))
+    Ok((memory::build(f, &dag, a, &best), false))
 }
 
 /// Cycles of a schedule: the largest arrival.
@@ -201,12 +205,11 @@ pub(crate) fn end(s: &schedule::Schedule) -> u32 {
     s.arrival.iter().copied().max().unwrap_or(0)
 }
 
-/// The list schedule for `keys` with feeding bonus `feed` (cycles, see [`feed::Feed`]; it
-/// ticks `first`, [`PlaceError::Stopped`] when that stops it), then up to `opts.improve`
-/// rounds of forward-backward improvement (kept while they shorten it); a round the
-/// `opts.deadline` reaches is dropped and none starts after (`true`: rounds were cut).
+/// The list schedule for `keys` (indexed by node) with feeding bonus `feed` (cycles, see
+/// [`feed::Feed`]; it ticks `first`, [`PlaceError::Stopped`] when that stops it), then up to
+/// `opts.improve` rounds of forward-backward improvement (kept while they shorten it); a round
+/// the `opts.deadline` reaches is dropped and none starts after (`true`: rounds were cut).
 pub(crate) fn improved(
-    f: &Function,
     dag: &dag::OpDag,
     opts: &PlaceOptions,
     keys: &[dag::Key],
@@ -215,20 +218,21 @@ pub(crate) fn improved(
 ) -> Result<(schedule::Schedule, bool), PlaceError> {
     let a = &opts.arch;
     let mut best =
-        schedule::schedule_until(f, dag, a, keys, opts.select, feed, &|| first.tick())?.ok_or(PlaceError::Stopped)?;
+        schedule::schedule_until(dag, a, keys, opts.select, feed, &|| first.tick())?.ok_or(PlaceError::Stopped)?;
     let rounds = crate::Ticker::new(opts.deadline, opts.tick_budget);
     for _ in 0..opts.improve {
         if rounds.check() {
             return Ok((best, true));
         }
         // Backward pass: ops that arrived last go first in reverse time; then forward again in
-        // order of the backward (justified) start times.
+        // order of the backward (justified) start times; ties by value index.
         let t = end(&best);
-        let back: Vec<dag::Key> = (0..f.values.len()).map(|i| (t - best.arrival[i], keys[i].0, i as u32)).collect();
-        let r = schedule::backward_starts(f, dag, a.n_add, a.n_mul, &a.lat, &back, feed);
+        let tie = |j: usize| dag.ops[j].index() as u32;
+        let back: Vec<dag::Key> = (0..dag.len()).map(|j| (t - best.arrival[j], keys[j].0, tie(j))).collect();
+        let r = schedule::backward_starts(dag, a.n_add, a.n_mul, &a.lat, &back, feed);
         let r_max = r.iter().copied().max().unwrap_or(0);
-        let fwd: Vec<dag::Key> = (0..f.values.len()).map(|i| (r_max - r[i], keys[i].0, i as u32)).collect();
-        let Some(s) = schedule::schedule_until(f, dag, a, &fwd, opts.select, feed, &|| rounds.tick())? else {
+        let fwd: Vec<dag::Key> = (0..dag.len()).map(|j| (r_max - r[j], keys[j].0, tie(j))).collect();
+        let Some(s) = schedule::schedule_until(dag, a, &fwd, opts.select, feed, &|| rounds.tick())? else {
             return Ok((best, true));
         };
         if end(&s) >= end(&best) {

@@ -10,19 +10,22 @@
 //! find a cycle where we have an empty writing slot". Bookings are decided at compile time, so a
 //! booking in a past cycle is legal as long as that cycle's ports are still free.
 //!
-//! Cost: each op enters and leaves a binary heap once (plus rare deferrals), and each placement
-//! tries at most the free PEs of its type: O(n log n + n·N) for n ops and N PEs per type; idle
-//! cycles are skipped.
+//! Cost: each op enters and leaves the ready list ([`ReadyQueue`]) once (plus rare deferrals),
+//! and each placement tries at most the free PEs of its type: O(n log n + n·N) for n ops and N
+//! PEs per type; idle cycles are skipped. Every per-op array is indexed by [`Node`] (see
+//! [`OpDag`]: with nodes in priority order, the ops taken one after the other are neighbours in
+//! memory).
 
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
+use std::collections::{BinaryHeap, HashMap};
 
 use robovec_ir::analysis::compute_timing;
 use robovec_ir::placement::{Pe, PeArray};
 use robovec_ir::{Function, Operand, Value};
 
-use super::dag::{Key, OpDag};
+use super::dag::{Key, Node, OpDag, NO_NODE};
 use super::feed::Feed;
+use super::ready::ReadyQueue;
 use super::{Priority, Select};
 use robovec_ir::analysis::Latencies;
 
@@ -51,8 +54,8 @@ pub fn preference(left: Route, right: Route) -> u32 {
 /// A booked write of an op's result into a PE memory.
 #[derive(Clone, Copy, Debug)]
 pub struct Booking {
-    /// Producer op (value).
-    pub value: Value,
+    /// Producer op.
+    pub node: Node,
     /// Target memory (PE slot).
     pub target: usize,
     /// Write cycle.
@@ -61,11 +64,12 @@ pub struct Booking {
     pub indirect: bool,
 }
 
-/// The schedule: issues and bookings (addresses come later, see `memory.rs`).
+/// The schedule: issues and bookings (addresses come later, see `memory.rs`), indexed by
+/// [`Node`] of the [`OpDag`] it was made with.
 pub struct Schedule {
-    /// `(pe slot, issue cycle)` per value index, `None` for non-ops.
-    pub issue: Vec<Option<(usize, u32)>>,
-    /// Arrival cycle per value index (0 for non-ops).
+    /// `(pe slot, issue cycle)` per node.
+    pub issue: Vec<(u32, u32)>,
+    /// Arrival cycle (issue + latency) per node.
     pub arrival: Vec<u32>,
     /// Every write booked, in booking order.
     pub bookings: Vec<Booking>,
@@ -75,7 +79,7 @@ pub struct Schedule {
 struct Ports {
     /// `writes[slot][cycle]`: writes booked into that PE memory in that cycle.
     writes: Vec<Vec<u8>>,
-    /// `buffer_read[slot][cycle]`: value index + 1 read from that PE's buffer in that cycle (0 = free).
+    /// `buffer_read[slot][cycle]`: node + 1 read from that PE's buffer in that cycle (0 = free).
     buffer_read: Vec<Vec<u32>>,
 }
 
@@ -93,21 +97,52 @@ impl Ports {
         }
         v[c as usize] += 1;
     }
-    fn set_buffer(&mut self, slot: usize, c: u32, value: Value) {
+    fn set_buffer(&mut self, slot: usize, c: u32, j: Node) {
         let v = &mut self.buffer_read[slot];
         if v.len() <= c as usize {
             v.resize(c as usize + 1, 0);
         }
-        v[c as usize] = value.index() as u32 + 1;
+        v[c as usize] = j + 1;
     }
 }
 
+/// The PE memories each node's result has been written into: four inline per node (8 bytes,
+/// beside its neighbours'; most results go to one to three memories), the rest in a side table.
+struct Located {
+    inline: Vec<[u16; 4]>,
+    more: HashMap<Node, Vec<usize>>,
+}
+
+impl Located {
+    const EMPTY: u16 = u16::MAX;
+
+    fn new(n: usize) -> Located {
+        Located { inline: vec![[Self::EMPTY; 4]; n], more: HashMap::new() }
+    }
+
+    fn contains(&self, j: Node, q: usize) -> bool {
+        let row = &self.inline[j as usize];
+        row.contains(&(q as u16)) || (row[3] != Self::EMPTY && self.more.get(&j).is_some_and(|m| m.contains(&q)))
+    }
+
+    fn push(&mut self, j: Node, q: usize) {
+        let row = &mut self.inline[j as usize];
+        match row.iter_mut().find(|s| **s == Self::EMPTY) {
+            Some(s) => *s = q as u16,
+            None => self.more.entry(j).or_default().push(q),
+        }
+    }
+}
+
+/// Issue cycle of a node not issued yet.
+const UNISSUED: u32 = u32::MAX;
+
 struct Ctx<'a> {
     arch: &'a PeArray,
-    issue: Vec<Option<(usize, u32)>>,
+    /// `(pe slot, issue cycle)` per node, cycle [`UNISSUED`] before.
+    issue: Vec<(u32, u32)>,
     arrival: Vec<u32>,
-    /// Memories (PE slots) a value has been written into.
-    located: Vec<Vec<usize>>,
+    located: Located,
     ports: Ports,
     bookings: Vec<Booking>,
 }
@@ -117,17 +152,21 @@ struct Ctx<'a> {
 struct Planned {
     /// Write cycles into the target memory.
     writes: Vec<u32>,
-    /// `(producer slot, cycle, value)` buffer reads.
-    reads: Vec<(usize, u32, Value)>,
+    /// `(producer slot, cycle, node)` buffer reads.
+    reads: Vec<(usize, u32, Node)>,
 }
 
 impl Ctx<'_> {
-    /// Route of op operand `v` into memory `q` for an issue at `t`, on top of `planned`.
-    fn route(&self, v: Value, q: usize, t: u32, planned: &Planned) -> Option<Route> {
-        if self.located[v.index()].contains(&q) {
+    fn issued(&self, j: Node) -> bool {
+        self.issue[j as usize].1 != UNISSUED
+    }
+
+    /// Route of operand node `v` into memory `q` for an issue at `t`, on top of `planned`.
+    fn route(&self, v: Node, q: usize, t: u32, planned: &Planned) -> Option<Route> {
+        if self.located.contains(v, q) {
             return Some(Route::Pe);
         }
-        let a = self.arrival[v.index()];
+        let a = self.arrival[v as usize];
         let used =
             |c: u32| self.ports.writes_at(q, c) as u32 + planned.writes.iter().filter(|&&x| x == c).count() as u32;
         if used(a) < self.arch.writes {
@@ -136,8 +175,8 @@ impl Ctx<'_> {
         if !self.arch.buffer {
             return None;
         }
-        let (p, _) = self.issue[v.index()].expect("operand op was issued");
-        let tag = v.index() as u32 + 1;
+        let p = self.issue[v as usize].0 as usize;
+        let tag = v + 1;
         let buffer_free = |b: u32| {
             let booked = self.ports.buffer_at(p, b);
             (booked == 0 || booked == tag) && planned.reads.iter().all(|&(pp, bb, w)| pp != p || bb != b || w == v)
@@ -145,23 +184,23 @@ impl Ctx<'_> {
         (a..=t).find(|&b| used(b) < self.arch.writes && buffer_free(b)).map(Route::Indirect)
     }
 
-    /// Routes of the op operands `ops` of one op into `q` at `t`, written into `out`; false if
-    /// one cannot get there. `planned` is scratch space.
-    fn routes(&self, ops: &[Option<Value>], q: usize, t: u32, planned: &mut Planned, out: &mut Vec<Route>) -> bool {
+    /// Routes of the operands `ops` (nodes, [`NO_NODE`] for initial data) of one op into `q`
+    /// at `t`, written into `out`; false if one cannot get there. `planned` is scratch space.
+    fn routes(&self, ops: &[Node], q: usize, t: u32, planned: &mut Planned, out: &mut Vec<Route>) -> bool {
         out.clear();
         planned.writes.clear();
         planned.reads.clear();
-        for (i, &o) in ops.iter().enumerate() {
-            let Some(v) = o.filter(|v| !ops[..i].contains(&Some(*v))) else {
+        for (i, &v) in ops.iter().enumerate() {
+            if v == NO_NODE || ops[..i].contains(&v) {
                 out.push(Route::Pe); // initial data (loaded), or the same value as an earlier operand
                 continue;
-            };
+            }
             let Some(r) = self.route(v, q, t, planned) else { return false };
             match r {
-                Route::Direct => planned.writes.push(self.arrival[v.index()]),
+                Route::Direct => planned.writes.push(self.arrival[v as usize]),
                 Route::Indirect(b) => {
                     planned.writes.push(b);
-                    planned.reads.push((self.issue[v.index()].expect("issued").0, b, v));
+                    planned.reads.push((self.issue[v as usize].0 as usize, b, v));
                 }
                 Route::Pe => {}
             }
@@ -170,24 +209,26 @@ impl Ctx<'_> {
         true
     }
 
-    fn commit(&mut self, ops: &[Option<Value>], routes: &[Route], q: usize) {
-        for (&o, &r) in ops.iter().zip(routes) {
-            let Some(v) = o else { continue };
+    fn commit(&mut self, ops: &[Node], routes: &[Route], q: usize) {
+        for (&v, &r) in ops.iter().zip(routes) {
+            if v == NO_NODE {
+                continue;
+            }
             let (cycle, indirect) = match r {
                 Route::Pe => continue,
-                Route::Direct => (self.arrival[v.index()], false),
+                Route::Direct => (self.arrival[v as usize], false),
                 Route::Indirect(b) => (b, true),
             };
-            if self.located[v.index()].contains(&q) {
+            if self.located.contains(v, q) {
                 continue; // the same value twice in one op
             }
             self.ports.add_write(q, cycle);
             if indirect {
-                let (p, _) = self.issue[v.index()].expect("issued");
+                let p = self.issue[v as usize].0 as usize;
                 self.ports.set_buffer(p, cycle, v);
             }
-            self.located[v.index()].push(q);
-            self.bookings.push(Booking { value: v, target: q, cycle, indirect });
+            self.located.push(v, q);
+            self.bookings.push(Booking { node: v, target: q, cycle, indirect });
         }
     }
 }
@@ -206,21 +247,21 @@ pub fn seed_keys(f: &Function, arch: &PeArray, priority: Priority) -> Vec<Key> {
         .collect()
 }
 
-/// Schedules every op of `f` (atomised, verified) on `arch`, ready ops taken in increasing
-/// `keys` order (indexed by value index), with the feeding bonus `feed` in cycles (see
-/// [`Feed`]; 0 = the seed's static order).
+/// The two ready lists (ADD side, MULTI side) for `keys`.
+fn ready_lists(keys: &[Key]) -> [ReadyQueue; 2] {
+    let max_first = keys.iter().map(|k| k.0).max().unwrap_or(0);
+    let cap = keys.len() + 1024;
+    [ReadyQueue::new(max_first, cap), ReadyQueue::new(max_first, cap)]
+}
+
+/// Schedules every op of `dag` on `arch`, ready ops taken in increasing `keys` order (indexed
+/// by node; ties by node), with the feeding bonus `feed` in cycles (see [`Feed`]; 0 = the
+/// seed's static order).
 ///
 /// # Errors
 /// Only without buffers: an op whose operand can no longer reach any PE memory of its type.
-pub fn schedule(
-    f: &Function,
-    dag: &OpDag,
-    arch: &PeArray,
-    keys: &[Key],
-    select: Select,
-    feed: u32,
-) -> Result<Schedule, String> {
-    schedule_until(f, dag, arch, keys, select, feed, &|| false).map(|s| s.expect("never stopped"))
+pub fn schedule(dag: &OpDag, arch: &PeArray, keys: &[Key], select: Select, feed: u32) -> Result<Schedule, String> {
+    schedule_until(dag, arch, keys, select, feed, &|| false).map(|s| s.expect("never stopped"))
 }
 
 /// [`schedule`] that calls `stop` once per op taken from a ready list and once per cycle
@@ -229,7 +270,6 @@ pub fn schedule(
 /// # Errors
 /// As [`schedule`].
 pub fn schedule_until(
-    f: &Function,
     dag: &OpDag,
     arch: &PeArray,
     keys: &[Key],
@@ -237,25 +277,25 @@ pub fn schedule_until(
     feed: u32,
     stop: &dyn Fn() -> bool,
 ) -> Result<Option<Schedule>, String> {
-    let n = f.values.len();
+    let n = dag.len();
     let mut feed = Feed::new(dag, keys, feed, false);
     let mut lowered = Vec::new();
     let mut pending = dag.n_distinct.clone();
     let mut ctx = Ctx {
         arch,
-        issue: vec![None; n],
+        issue: vec![(0, UNISSUED); n],
         arrival: vec![0; n],
-        located: vec![Vec::new(); n],
+        located: Located::new(n),
         ports: Ports { writes: vec![Vec::new(); arch.n_pe()], buffer_read: vec![Vec::new(); arch.n_pe()] },
         bookings: Vec::new(),
     };
-    let mut ready: [BinaryHeap<Reverse<(Key, Value)>>; 2] = [BinaryHeap::new(), BinaryHeap::new()];
-    for &v in &dag.ops {
-        if pending[v.index()] == 0 {
-            ready[dag.is_mul(v) as usize].push(Reverse((feed.key[v.index()], v)));
+    let mut ready = ready_lists(keys);
+    for v in 0..n as Node {
+        if pending[v as usize] == 0 {
+            ready[dag.is_mul(v) as usize].push(feed.key[v as usize], v);
         }
     }
-    let mut arrivals: BinaryHeap<Reverse<(u32, Value)>> = BinaryHeap::new();
+    let mut arrivals: BinaryHeap<Reverse<(u32, Node)>> = BinaryHeap::new();
     let pes_of = |mul: bool| -> Vec<usize> {
         if mul {
             (0..arch.n_mul).map(|i| Pe::Mul(i).slot(arch.n_add)).collect()
@@ -270,7 +310,7 @@ pub fn schedule_until(
     let mut placed = 0usize;
     let mut t: u32 = 0;
     let mut stalled_since: Option<u32> = None;
-    while placed < dag.ops.len() {
+    while placed < n {
         if stop() {
             return Ok(None);
         }
@@ -280,9 +320,9 @@ pub fn schedule_until(
             }
             arrivals.pop();
             for &u in dag.users_of(v) {
-                pending[u.index()] -= 1;
-                if pending[u.index()] == 0 {
-                    ready[dag.is_mul(u) as usize].push(Reverse((feed.key[u.index()], u)));
+                pending[u as usize] -= 1;
+                if pending[u as usize] == 0 {
+                    ready[dag.is_mul(u) as usize].push(feed.key[u as usize], u);
                 }
             }
         }
@@ -298,8 +338,8 @@ pub fn schedule_until(
                 if stop() {
                     return Ok(None);
                 }
-                let Some(Reverse((k, v))) = ready[ty].pop() else { break };
-                if k != feed.key[v.index()] || ctx.issue[v.index()].is_some() {
+                let Some((k, v)) = ready[ty].pop() else { break };
+                if k != feed.key[v as usize] || ctx.issued(v) {
                     continue; // stale entry (the key was lowered since)
                 }
                 let operands = dag.operands_of(v);
@@ -328,23 +368,25 @@ pub fn schedule_until(
                         let q = free.swap_remove(i);
                         ctx.commit(operands, &best_routes, q);
                         let lat = arch.lat.of(dag.kind(v));
-                        ctx.issue[v.index()] = Some((q, t));
-                        ctx.arrival[v.index()] = t + lat;
+                        ctx.issue[v as usize] = (q as u32, t);
+                        ctx.arrival[v as usize] = t + lat;
                         arrivals.push(Reverse((t + lat, v)));
                         placed += 1;
                         progress = true;
-                        feed.issued(dag, |u| ctx.issue[u.index()].is_some(), v, &mut lowered);
+                        feed.issued(dag, |u| ctx.issued(u), v, &mut lowered);
                         for (k, u) in lowered.drain(..) {
-                            if pending[u.index()] == 0 {
-                                ready[dag.is_mul(u) as usize].push(Reverse((k, u)));
+                            if pending[u as usize] == 0 {
+                                ready[dag.is_mul(u) as usize].push(k, u);
                             }
                         }
                         free.sort_unstable();
                     }
-                    None => deferred.push(Reverse((k, v))),
+                    None => deferred.push((k, v)),
                 }
             }
-            ready[ty].extend(deferred.drain(..));
+            for (k, v) in deferred.drain(..) {
+                ready[ty].push(k, v);
+            }
         }
         if progress {
             stalled_since = None;
@@ -386,77 +428,65 @@ pub fn initial_operands(f: &Function, v: Value) -> Vec<Operand> {
 
 /// Backward ("right-justified") list schedule in the pure resource model of SPEC §5 (PEs and
 /// latencies, no memories): ops are issued in reverse time, an op as soon as all its users are,
-/// taken in increasing `keys` order. Returns each op's reverse issue cycle `r` (`s = T − r` is a
-/// forward start of a schedule that ends together for every sink), indexed by value index.
+/// taken in increasing `keys` order (indexed by node). Returns each op's reverse issue cycle
+/// `r` (`s = T − r` is a forward start of a schedule that ends together for every sink),
+/// indexed by node.
 ///
 /// Used by forward-backward improvement (Tormos & Lova 2001; "justification", Valls et al.
 /// 2005): scheduling forward again in decreasing `r` order packs the resources better than
 /// ALAP order when both PE types are saturated. `feed` is the feeding bonus in cycles (see
 /// [`Feed`]), applied in reverse time: an op that is the last unissued user of an op of the
 /// other type goes earlier. Cost: O(n log n).
-pub fn backward_starts(
-    f: &Function,
-    dag: &OpDag,
-    n_add: u32,
-    n_mul: u32,
-    lat: &Latencies,
-    keys: &[Key],
-    feed: u32,
-) -> Vec<u32> {
-    let n = f.values.len();
+pub fn backward_starts(dag: &OpDag, n_add: u32, n_mul: u32, lat: &Latencies, keys: &[Key], feed: u32) -> Vec<u32> {
+    let n = dag.len();
     let mut feed = Feed::new(dag, keys, feed, true);
     let (mut lowered, mut in_ready, mut placed) = (Vec::new(), vec![false; n], vec![false; n]);
-    let mut pending: Vec<u32> = (0..n).map(|i| dag.user_at[i + 1] - dag.user_at[i]).collect();
+    let mut pending: Vec<u32> = (0..n as Node).map(|j| dag.n_users(j)).collect();
     let mut earliest = vec![0u32; n]; // reverse ready time before the op's own latency
     let mut r = vec![0u32; n];
-    let mut waiting: BinaryHeap<Reverse<(u32, Value)>> = BinaryHeap::new();
-    for &v in &dag.ops {
-        if pending[v.index()] == 0 {
+    let mut waiting: BinaryHeap<Reverse<(u32, Node)>> = BinaryHeap::new();
+    for v in 0..n as Node {
+        if pending[v as usize] == 0 {
             waiting.push(Reverse((lat.of(dag.kind(v)), v)));
         }
     }
-    let mut ready: [BinaryHeap<Reverse<(Key, Value)>>; 2] = [BinaryHeap::new(), BinaryHeap::new()];
+    let mut ready = ready_lists(keys);
     let caps = [n_add as usize, n_mul as usize];
     let mut done = 0;
     let mut t = 0u32;
-    while done < dag.ops.len() {
+    while done < n {
         while let Some(&Reverse((c, v))) = waiting.peek() {
             if c > t {
                 break;
             }
             waiting.pop();
-            in_ready[v.index()] = true;
-            ready[dag.is_mul(v) as usize].push(Reverse((feed.key[v.index()], v)));
+            in_ready[v as usize] = true;
+            ready[dag.is_mul(v) as usize].push(feed.key[v as usize], v);
         }
         for ty in 0..2 {
             let mut issued = 0;
             while issued < caps[ty] {
-                let Some(Reverse((k, v))) = ready[ty].pop() else { break };
-                if k != feed.key[v.index()] || placed[v.index()] {
+                let Some((k, v)) = ready[ty].pop() else { break };
+                if k != feed.key[v as usize] || placed[v as usize] {
                     continue; // stale entry (the key was lowered since)
                 }
                 issued += 1;
-                r[v.index()] = t;
-                placed[v.index()] = true;
+                r[v as usize] = t;
+                placed[v as usize] = true;
                 done += 1;
-                feed.issued(dag, |u| placed[u.index()], v, &mut lowered);
+                feed.issued(dag, |u| placed[u as usize], v, &mut lowered);
                 for (k, u) in lowered.drain(..) {
-                    if in_ready[u.index()] {
-                        ready[dag.is_mul(u) as usize].push(Reverse((k, u)));
+                    if in_ready[u as usize] {
+                        ready[dag.is_mul(u) as usize].push(k, u);
                     }
                 }
                 // Operands: ready in reverse time once every user is placed, after their latency.
-                let row = dag.operands_of(v);
-                for (j, &o) in row.iter().enumerate() {
-                    let Some(a) = o else { continue };
-                    if row[..j].contains(&Some(a)) {
-                        continue;
-                    }
-                    earliest[a.index()] = earliest[a.index()].max(t + 1);
-                    pending[a.index()] -= 1;
-                    if pending[a.index()] == 0 {
+                for a in dag.distinct_operands(v) {
+                    earliest[a as usize] = earliest[a as usize].max(t + 1);
+                    pending[a as usize] -= 1;
+                    if pending[a as usize] == 0 {
                         let k = dag.kind(a);
-                        waiting.push(Reverse((earliest[a.index()] + lat.of(k) - 1, a)));
+                        waiting.push(Reverse((earliest[a as usize] + lat.of(k) - 1, a)));
                     }
                 }
             }

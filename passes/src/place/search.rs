@@ -55,7 +55,8 @@ impl Rng {
     }
 }
 
-/// Restarts, then key-mutation search, from the seed `keys` and their (improved) schedule
+/// Restarts, then key-mutation search, from the seed `keys` (indexed by node of `dag`) and
+/// their (improved) schedule
 /// `best`; returns the shortest schedule found, and `true` when `opts.deadline` stopped the
 /// work early (the schedule is then the best found by that time).
 ///
@@ -79,7 +80,7 @@ pub fn restarts_and_search(
         target = target.min(spec * 105 / 100);
     }
     let done = |s: &Schedule| end(s) as u64 <= target;
-    let per_run = dag.ops.len().max(1) as u64 * (1 + opts.improve as u64);
+    let per_run = dag.len().max(1) as u64 * (1 + opts.improve as u64);
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
     // The best plan so far: keys and feeding bonus.
     let mut plan = (seed.clone(), 0u32);
@@ -98,20 +99,25 @@ pub fn restarts_and_search(
         let feed = FEEDS[r as usize % FEEDS.len()];
         let keys = if r == 0 {
             let other = if opts.priority == Priority::Classical { Priority::Mobility } else { Priority::Classical };
-            schedule::seed_keys(f, a, other)
+            dag.gather(&schedule::seed_keys(f, a, other))
         } else if r < FEEDS.len() as u64 {
             seed.clone()
         } else {
+            // One draw per value (not per op), in value order: the sequence the placement
+            // figures were measured with.
             let amplitude = [8u64, 16, 32][(r as usize / FEEDS.len()) % 3];
-            seed.iter()
-                .map(|&(k0, k1, _)| {
-                    let x = rng.next();
-                    (k0.saturating_add((x % amplitude) as u32), k1, (x >> 40) as u32)
-                })
-                .collect()
+            let mut keys = seed.clone();
+            for i in 0..f.values.len() {
+                let x = rng.next();
+                if let Some(j) = dag.node(robovec_ir::Value::with_number(i as u32)) {
+                    let (k0, k1, _) = seed[j as usize];
+                    keys[j as usize] = (k0.saturating_add((x % amplitude) as u32), k1, (x >> 40) as u32);
+                }
+            }
+            keys
         };
         // A cut improvement is seen by the next `out_of_time()`.
-        let (s, _) = match improved(f, dag, opts, &keys, feed, &ticker) {
+        let (s, _) = match improved(dag, opts, &keys, feed, &ticker) {
             Err(PlaceError::Stopped) => return Ok((best, true)),
             r => r?,
         };
@@ -132,14 +138,17 @@ pub fn restarts_and_search(
             task.set(restarts + i);
         }
         let mut keys = plan.0.clone();
-        for k in keys.iter_mut() {
+        for i in 0..f.values.len() {
             let x = rng.next();
             if x.is_multiple_of(10) {
-                let shift = ((x >> 20) % 33) as i64 - 16;
-                k.0 = (k.0 as i64 + shift).max(0) as u32;
+                if let Some(j) = dag.node(robovec_ir::Value::with_number(i as u32)) {
+                    let k = &mut keys[j as usize];
+                    let shift = ((x >> 20) % 33) as i64 - 16;
+                    k.0 = (k.0 as i64 + shift).max(0) as u32;
+                }
             }
         }
-        let (s, _) = match improved(f, dag, opts, &keys, plan.1, &ticker) {
+        let (s, _) = match improved(dag, opts, &keys, plan.1, &ticker) {
             Err(PlaceError::Stopped) => return Ok((best, true)),
             r => r?,
         };
