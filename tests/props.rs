@@ -530,7 +530,13 @@ fn eval_g<T: Float>(g: &G, avail: &[String], env: &std::collections::HashMap<Str
 
 /// Everything but spans.
 fn same_function(a: &Function, b: &Function) -> bool {
-    let vals = |f: &Function| f.values.iter().map(|v| (v.name.clone(), v.def.clone(), v.timing)).collect::<Vec<_>>();
+    let vals = |f: &Function| {
+        f.values
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (v.name.clone(), v.def.clone(), f.timing(robovec_ir::Value::with_number(i as u32))))
+            .collect::<Vec<_>>()
+    };
     let outs = |f: &Function| f.outputs.iter().map(|o| (o.name.clone(), o.value)).collect::<Vec<_>>();
     a.name == b.name
         && a.phase == b.phase

@@ -12,8 +12,9 @@ fn assert_same(a: &Module, b: &Module, what: &str) {
     for (f, g) in a.functions.iter().zip(&b.functions) {
         assert_eq!((&f.name, f.phase, f.equations), (&g.name, g.phase, g.equations), "{what}");
         assert_eq!((&f.inputs, &f.body), (&g.inputs, &g.body), "{what} @{}", f.name);
-        for (x, y) in f.values.iter().zip(&g.values) {
-            assert_eq!((&x.name, &x.def, &x.timing), (&y.name, &y.def, &y.timing), "{what} @{}", f.name);
+        for (i, (x, y)) in f.values.iter().zip(&g.values).enumerate() {
+            let v = robovec_ir::Value::with_number(i as u32);
+            assert_eq!((&x.name, &x.def, f.timing(v)), (&y.name, &y.def, g.timing(v)), "{what} @{}", f.name);
         }
         let outs = |f: &robovec_ir::Function| f.outputs.iter().map(|o| (o.name.clone(), o.value)).collect::<Vec<_>>();
         assert_eq!(outs(f), outs(g), "{what} @{}", f.name);

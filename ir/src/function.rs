@@ -4,7 +4,7 @@
 use crate::count::{count_expr, OpCounts};
 use crate::entities::Value;
 use crate::span::Span;
-use crate::syntax::{Callee, Def, Expr, OpKind, Operand, Output, Phase, ValueData};
+use crate::syntax::{Callee, Def, Expr, OpKind, Operand, Output, Phase, Timing, ValueData};
 
 /// One Robotran function in SSA form (`dirdyna`, `invdyna`, `sensor_3`, …).
 ///
@@ -31,6 +31,8 @@ pub struct Function {
     pub span: Span,
     /// The placement on the PE architecture, when `place` made one (or the text had one).
     pub placement: Option<crate::placement::Placement>,
+    /// Schedule attributes by value index ([`Function::timing`]).
+    timings: Timings,
     names: NameIndex,
     outputs_by_name: OutputIndex,
 }
@@ -44,6 +46,26 @@ struct NameIndex(hashbrown::HashTable<(u32, Value)>);
 impl PartialEq for NameIndex {
     fn eq(&self, _: &NameIndex) -> bool {
         true
+    }
+}
+
+/// Schedule attributes by value index, beside the values rather than in them: an analysis
+/// writes them into a compact table, and the passes that never read them (all but `place`'s
+/// seed keys and the printer) do not carry 24 bytes per value through the caches (issue 28:
+/// `asap-alap` on 2.4M values streamed the whole value table twice). Shorter than `values`
+/// when the last values have none; `==` compares the attributes, not the table's length.
+#[derive(Clone, Debug, Default)]
+struct Timings(Vec<Option<Timing>>);
+
+impl Timings {
+    fn get(&self, i: usize) -> Option<Timing> {
+        self.0.get(i).copied().flatten()
+    }
+}
+
+impl PartialEq for Timings {
+    fn eq(&self, other: &Timings) -> bool {
+        (0..self.0.len().max(other.0.len())).all(|i| self.get(i) == other.get(i))
     }
 }
 
@@ -218,6 +240,7 @@ impl Function {
             outputs: Vec::new(),
             span: Span::DUMMY,
             placement: None,
+            timings: Timings::default(),
             names: NameIndex::default(),
             outputs_by_name: OutputIndex::default(),
         }
@@ -227,6 +250,30 @@ impl Function {
     /// holds its own values).
     pub fn value(&self, v: Value) -> &ValueData {
         &self.values[v.index()]
+    }
+
+    /// The schedule attributes of `v`, when an analysis wrote them (`asap-alap`, or the text's
+    /// `{asap=…}`).
+    pub fn timing(&self, v: Value) -> Option<Timing> {
+        self.timings.get(v.index())
+    }
+
+    /// Sets (or, with `None`, removes) the schedule attributes of `v`.
+    pub fn set_timing(&mut self, v: Value, t: Option<Timing>) {
+        let i = v.index();
+        if i >= self.timings.0.len() {
+            if t.is_none() {
+                return;
+            }
+            self.timings.0.resize(i + 1, None);
+        }
+        self.timings.0[i] = t;
+    }
+
+    /// Replaces every value's schedule attributes by `table` (indexed by value index; values
+    /// past its end have none).
+    pub fn set_timings(&mut self, table: Vec<Option<Timing>>) {
+        self.timings = Timings(table);
     }
 
     /// Mutable data of `v`; the name must not be changed through it (use [`Function::rename`]).
@@ -264,7 +311,7 @@ impl Function {
     fn push_value(&mut self, name: String, def: Def, span: Span) -> Result<Value, Value> {
         let v = Value::with_number(self.values.len() as u32);
         self.names.claim(&self.values, &name, v)?;
-        self.values.push(ValueData { name, def, timing: None, span });
+        self.values.push(ValueData { name, def, span });
         Ok(v)
     }
 
@@ -368,9 +415,7 @@ impl Function {
     /// Removes every schedule attribute and the placement (call after a change that
     /// invalidates them).
     pub fn clear_timing(&mut self) {
-        for d in &mut self.values {
-            d.timing = None;
-        }
+        self.timings = Timings::default();
         self.placement = None;
     }
 
@@ -397,9 +442,14 @@ impl Function {
         let mut slots: Vec<Option<ValueData>> = std::mem::take(&mut self.values).into_iter().map(Some).collect();
         let mut new_inputs = Vec::new();
         let mut new_body = Vec::new();
+        let mut new_timings = Vec::new();
         for v in kept {
             let nv = Value::with_number(new_values.len() as u32);
             map[v.index()] = Some(nv);
+            if let Some(t) = self.timings.get(v.index()) {
+                new_timings.resize(nv.index(), None);
+                new_timings.push(Some(t));
+            }
             let d = slots[v.index()].take().expect("inputs and body name each value once");
             if matches!(d.def, Def::Input) {
                 new_inputs.push(nv);
@@ -452,6 +502,7 @@ impl Function {
             }
         }
         self.values = new_values;
+        self.timings = Timings(new_timings);
         self.inputs = new_inputs;
         self.body = new_body;
         self.reindex_names();
@@ -617,7 +668,7 @@ mod tests {
         use std::mem::size_of;
         assert_eq!(size_of::<Expr>(), 24, "an expression node (a call boxes its callee and arguments)");
         assert_eq!(size_of::<Def>(), 40, "a definition (a call boxes its callee)");
-        assert_eq!(size_of::<ValueData>(), 96, "name 24 + definition 40 + timing 24 + span 8");
+        assert_eq!(size_of::<ValueData>(), 72, "name 24 + definition 40 + span 8 (timing beside: issue 28)");
     }
 
     #[test]

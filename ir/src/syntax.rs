@@ -118,15 +118,14 @@ pub struct Timing {
     pub mobility: u32,
 }
 
-/// One value of a function: its name, definition and where it came from.
+/// One value of a function: its name, definition and where it came from (72 bytes; its
+/// schedule attributes are beside the values, [`crate::Function::timing`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ValueData {
     /// Name in the text form without `%` (`AlF15`, `q[4]`, `frc[2][11].1`); unique in its function.
     pub name: String,
     /// The definition.
     pub def: Def,
-    /// Schedule attributes, when an analysis wrote them.
-    pub timing: Option<Timing>,
     /// Source span (Robotran or `.rvir` text), `Span::DUMMY` when a pass made it.
     pub span: Span,
 }

@@ -76,7 +76,7 @@ mod tests {
         .unwrap();
         AsapAlap { lat: LatencyOverride::default() }.run(&mut m, &mut PassContext::default()).unwrap();
         let f = &m.functions[0];
-        let t = |n: &str| f.value(f.lookup(n).unwrap()).timing.unwrap();
+        let t = |n: &str| f.timing(f.lookup(n).unwrap()).unwrap();
         let row = |n: &str| {
             let t = t(n);
             (t.asap, t.alap, t.asap_cycle, t.alap_cycle, t.mobility)

@@ -315,7 +315,7 @@ fn build(g: &Gen, n_ops: usize, seed: u64) -> Function {
         // once at the end (`define` would hash every name twice and grow the index 20 times).
         op_val.push(Value::with_number(f.values.len() as u32));
         f.body.push(Value::with_number(f.values.len() as u32));
-        f.values.push(ValueData { name, def, timing: None, span: Span::DUMMY });
+        f.values.push(ValueData { name, def, span: Span::DUMMY });
     }
     f.reindex_names();
     let mut i = 0;

@@ -11,8 +11,7 @@
 
 use crate::function::Function;
 use crate::latency::Latencies;
-use crate::syntax::{Def, Timing};
-use crate::Value;
+use crate::syntax::Timing;
 
 /// Critical path figures of a function (SPEC §4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -27,100 +26,58 @@ pub struct TimingSummary {
 /// inputs and trig variables) and the critical path. `f` must verify and be atomised
 /// (parsed-phase expressions are treated as ready at 0, i.e. ignored).
 pub fn compute_timing(f: &Function, lat: &Latencies) -> (Vec<Option<Timing>>, TimingSummary) {
-    let mut table = Table { f, timing: vec![None; f.values.len()] };
-    let sum = sweep(&f.body, f.values.len(), &mut table, lat);
-    (table.timing, sum)
+    let mut timing = vec![None; f.values.len()];
+    let sum = sweep(f, &mut timing, lat);
+    (timing, sum)
 }
 
-/// [`compute_timing`] written into `f` (`ValueData::timing` of every value: `None` for inputs
-/// and trig variables), without a table of every value's timing beside the function: 16
-/// bytes of work memory per value instead of ~90 for that table and a user graph (issue 10
-/// §3). Each op's timing is written when the backward sweep finalises it, while its
-/// definition is in the cache (issue 28: one pass over the values less). Returns the critical
-/// path.
+/// [`compute_timing`] written into `f` ([`Function::timing`] of every value: `None` for inputs
+/// and trig variables). The table is beside the values, so the sweeps stream the definitions
+/// and write 24 bytes per value in order (issue 28). Returns the critical path.
 pub fn annotate_timing(f: &mut Function, lat: &Latencies) -> TimingSummary {
-    for i in 0..f.inputs.len() {
-        let v = f.inputs[i];
-        f.value_mut(v).timing = None;
-    }
-    let body = std::mem::take(&mut f.body);
-    let sum = sweep(&body, f.values.len(), f, lat);
-    f.body = body;
+    let (table, sum) = compute_timing(f, lat);
+    f.set_timings(table);
     sum
 }
 
-/// Where the sweeps read definitions and write each value's timing.
-trait Levels {
-    fn def(&self, v: Value) -> &Def;
-    fn set(&mut self, v: Value, t: Option<Timing>);
-}
-
-/// [`compute_timing`]'s table beside the function.
-struct Table<'a> {
-    f: &'a Function,
-    timing: Vec<Option<Timing>>,
-}
-
-impl Levels for Table<'_> {
-    fn def(&self, v: Value) -> &Def {
-        &self.f.value(v).def
-    }
-    fn set(&mut self, v: Value, t: Option<Timing>) {
-        self.timing[v.index()] = t;
-    }
-}
-
-impl Levels for Function {
-    fn def(&self, v: Value) -> &Def {
-        &self.value(v).def
-    }
-    fn set(&mut self, v: Value, t: Option<Timing>) {
-        self.value_mut(v).timing = t;
-    }
-}
-
-/// The forward (ASAP) and backward (ALAP) sweeps over `body` (body order, topological), each
-/// body value's timing set when final. The backward sweep needs no user lists: visiting ops
-/// in reverse body order (reverse topological), each op pushes its own bound to its operands,
-/// so an op's bound is final when it is visited. Work memory: four `u32` per value (`n`
-/// values, indexed by `Value::index()`). Cost: O(values + operands).
-fn sweep(body: &[Value], n: usize, s: &mut impl Levels, lat: &Latencies) -> TimingSummary {
-    let mut asap = vec![0u32; n];
-    let mut asap_c = vec![0u32; n];
+/// The forward (ASAP) and backward (ALAP) sweeps over the body (body order, topological),
+/// into `timing` (indexed by value index, all `None` on entry). The backward sweep needs no
+/// user lists: visiting ops in reverse body order (reverse topological), each op pushes its
+/// own bound to its operands, so an op's bound is final when it is visited. The bounds live in
+/// the operands' own entries (ALAP fields, `u32::MAX` = none yet), so `timing` is the only
+/// work memory (fresh memory is page faults on large functions: issue 28). Cost:
+/// O(values + operands).
+fn sweep(f: &Function, timing: &mut [Option<Timing>], lat: &Latencies) -> TimingSummary {
     let mut sum = TimingSummary::default();
-    for &v in body {
-        let def = s.def(v);
+    let level = |t: &Option<Timing>| t.map_or((0, 0), |t| (t.asap, t.asap_cycle));
+    for &v in &f.body {
+        let def = &f.value(v).def;
         let Some(kind) = def.op_kind() else { continue };
         let (mut a, mut c) = (0, 0);
         def.for_each_value(|p| {
-            a = a.max(asap[p.index()]);
-            c = c.max(asap_c[p.index()]);
+            let (pa, pc) = level(&timing[p.index()]);
+            a = a.max(pa);
+            c = c.max(pc);
         });
-        asap[v.index()] = a + 1;
-        asap_c[v.index()] = c + lat.of(kind);
-        sum.asap = sum.asap.max(a + 1);
-        sum.asap_cycle = sum.asap_cycle.max(c + lat.of(kind));
+        let (a, c) = (a + 1, c + lat.of(kind));
+        timing[v.index()] = Some(Timing { asap: a, asap_cycle: c, alap: u32::MAX, alap_cycle: u32::MAX, mobility: 0 });
+        sum.asap = sum.asap.max(a);
+        sum.asap_cycle = sum.asap_cycle.max(c);
     }
-    // Before an op is visited: the smallest bound pushed by its op users (`u32::MAX`: none);
-    // after: its ALAP level.
-    let mut alap = vec![u32::MAX; n];
-    let mut alap_c = vec![u32::MAX; n];
-    for &v in body.iter().rev() {
-        let def = s.def(v);
-        let Some(kind) = def.op_kind() else {
-            s.set(v, None);
-            continue;
-        };
-        let l = sum.asap.min(alap[v.index()]);
-        let lc = sum.asap_cycle.min(alap_c[v.index()]);
-        let lat_v = lat.of(kind);
+    for &v in f.body.iter().rev() {
+        let def = &f.value(v).def;
+        let Some(kind) = def.op_kind() else { continue };
+        let t = timing[v.index()].as_mut().expect("ops have a level");
+        t.alap = t.alap.min(sum.asap);
+        t.alap_cycle = t.alap_cycle.min(sum.asap_cycle);
+        t.mobility = t.alap - t.asap;
+        let (l, lc, lat_v) = (t.alap, t.alap_cycle, lat.of(kind));
         def.for_each_value(|p| {
-            alap[p.index()] = alap[p.index()].min(l - 1);
-            alap_c[p.index()] = alap_c[p.index()].min(lc - lat_v);
+            if let Some(t) = timing[p.index()].as_mut() {
+                t.alap = t.alap.min(l - 1);
+                t.alap_cycle = t.alap_cycle.min(lc - lat_v);
+            }
         });
-        let i = v.index();
-        let (a, ac) = (asap[i], asap_c[i]);
-        s.set(v, Some(Timing { asap: a, alap: l, asap_cycle: ac, alap_cycle: lc, mobility: l - a }));
     }
     sum
 }
@@ -129,6 +86,7 @@ fn sweep(body: &[Value], n: usize, s: &mut impl Levels, lat: &Latencies) -> Timi
 mod tests {
     use super::*;
     use crate::analysis::DepGraph;
+    use crate::Value;
 
     /// The definition with user lists (`DepGraph`), as ALAP is stated in the module doc.
     fn by_user_lists(f: &Function, lat: &Latencies) -> Vec<Option<Timing>> {
@@ -171,7 +129,8 @@ mod tests {
         assert_eq!((sum.asap, sum.asap_cycle), (4, 7 + 30 + 12 + 7));
         let mut g = f.clone();
         assert_eq!(annotate_timing(&mut g, &lat), sum);
-        assert_eq!(g.values.iter().map(|d| d.timing).collect::<Vec<_>>(), t);
+        let annotated: Vec<_> = (0..g.values.len()).map(|i| g.timing(Value::with_number(i as u32))).collect();
+        assert_eq!(annotated, t);
         assert!(t[g.lookup("C").expect("trig").index()].is_none());
     }
 }

@@ -72,7 +72,7 @@ fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
                     RhsAst::Expr(e) => Def::Expr(expr(&func, e, errors)),
                 };
                 match func.define(name, def, name_span) {
-                    Ok(v) => func.value_mut(v).timing = timing,
+                    Ok(v) => func.set_timing(v, timing),
                     Err(_) => errors.push(redefined(name, name_span)),
                 }
             }

@@ -160,7 +160,7 @@ pub fn write_function(out: &mut impl Write, f: &Function) -> fmt::Result {
             }
             Def::Expr(e) => write_expr(out, f, e)?,
         }
-        if let Some(t) = &d.timing {
+        if let Some(t) = &f.timing(v) {
             write!(
                 out,
                 " {{asap={}, alap={}, asap_cycle={}, alap_cycle={}, mobility={}}}",

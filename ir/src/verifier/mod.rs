@@ -232,7 +232,7 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
                 }
             }
         }
-        if let Some(t) = &d.timing {
+        if let Some(t) = &f.timing(v) {
             if t.alap < t.asap || t.mobility != t.alap - t.asap || t.alap_cycle < t.asap_cycle {
                 local.push(format!("inconsistent timing {t:?}"));
             }

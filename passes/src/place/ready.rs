@@ -91,7 +91,7 @@ mod tests {
             x ^= x << 13;
             x ^= x >> 7;
             x ^= x << 17;
-            if x % 3 != 0 {
+            if !x.is_multiple_of(3) {
                 let k = ((x % 200) as u32, (x >> 8) as u32 % 5, step);
                 q.push(k, step);
                 reference.push((k, step));
