@@ -71,8 +71,14 @@ pub fn execute_until<T: Float>(
     let mut out: Vec<Vec<Option<T>>> =
         p.pes.iter().map(|q| q.output_init.iter().map(|w| w.as_ref().map(&mut value)).collect()).collect();
     let mut buf: Vec<Vec<Option<T>>> = p.buffer_words.iter().map(|&w| vec![None; w as usize]).collect();
-    // Results by (slot, arrival cycle).
-    let mut arriving: Vec<Option<T>> = vec![None; n_pe * span];
+    // Results in flight by (arrival cycle mod `ring`, slot): a result arrives at most the
+    // longest latency after its issue, so `ring` cycles of one word per PE hold them all (a
+    // table of every cycle was n_pe × cycles words: 42 MB of fresh memory per run at WALK-MAN
+    // × 64, read with a stride of a cycle per PE; issue 28). A cycle's row is cleared once the
+    // cycle is done.
+    let l = &p.arch.lat;
+    let ring = l.add.max(l.mul).max(l.div).max(l.call) as usize + 1;
+    let mut arriving: Vec<Option<T>> = vec![None; n_pe * ring];
     let mut bus: Vec<Option<T>> = vec![None; n_pe];
     let mut args: Vec<T> = Vec::new();
     for c in 0..span {
@@ -82,7 +88,7 @@ pub fn execute_until<T: Float>(
         }
         for (s, q) in p.pes.iter().enumerate() {
             let st = &q.steps[c];
-            let now = arriving[s * span + c];
+            let now = arriving[(c % ring) * n_pe + s];
             if let Some(a) = st.buffer.store {
                 let w = buf[s]
                     .get_mut(a as usize)
@@ -111,7 +117,7 @@ pub fn execute_until<T: Float>(
         for (s, q) in p.pes.iter().enumerate() {
             for w in &q.steps[c].writes {
                 let data = match w.src {
-                    Source::Result(t) if t < n_pe => arriving[t * span + c],
+                    Source::Result(t) if t < n_pe => arriving[(c % ring) * n_pe + t],
                     Source::Buffer(t) if t < n_pe => bus[t],
                     _ => None,
                 }
@@ -148,8 +154,9 @@ pub fn execute_until<T: Float>(
             if at >= span {
                 return Err(bad(when, s, format!("result arrives at cycle {at}, after the last cycle")));
             }
-            arriving[s * span + at] = Some(x);
+            arriving[(at % ring) * n_pe + s] = Some(x);
         }
+        arriving[(c % ring) * n_pe..(c % ring + 1) * n_pe].fill(None);
     }
     let mut outputs = Vec::with_capacity(p.outputs.len());
     for o in &p.outputs {

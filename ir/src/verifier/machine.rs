@@ -184,8 +184,13 @@ fn check(f: &Function, p: &MachineProgram, e: &mut Errs, stop: &dyn Fn() -> bool
         return Some(());
     }
 
-    // Provenance: which value each (slot, cycle) issue computes.
+    // Provenance: which value each (slot, cycle) issue computes; and the results arriving per
+    // (slot, cycle), found in the same walk (each op's step read once: in body order the steps
+    // are scattered over the program; issue 28), their violations reported after the
+    // provenance's.
     let mut issued_value: Vec<Vec<Option<Value>>> = vec![vec![None; steps]; n_pe];
+    let mut arriving: Vec<Vec<Option<Value>>> = vec![vec![None; steps]; n_pe];
+    let mut arrival_errs: Vec<String> = Vec::new();
     for &v in &f.body {
         if stop() {
             return None;
@@ -216,6 +221,18 @@ fn check(f: &Function, p: &MachineProgram, e: &mut Errs, stop: &dyn Fn() -> bool
                         }
                         if let Some(u) = issued_value[s][c as usize].replace(v) {
                             e.push(format!("cycle {c}, {pe}: issues both %{} and %{}", f.name_of(u), f.name_of(v)));
+                        }
+                        let at = c as usize + p.latency(&i.op) as usize;
+                        if at >= steps {
+                            let m =
+                                format!("%{} arrives at cycle {at}, after the last cycle {}", f.name_of(v), p.cycles);
+                            arrival_errs.push(m);
+                        } else if let Some(u) = arriving[s][at].replace(v) {
+                            arrival_errs.push(format!(
+                                "cycle {at}, {pe}: %{} and %{} arrive in one cycle (one result bus per PE)",
+                                f.name_of(u),
+                                f.name_of(v)
+                            ));
                         }
                     }
                 }
@@ -248,26 +265,8 @@ fn check(f: &Function, p: &MachineProgram, e: &mut Errs, stop: &dyn Fn() -> bool
     let mut mem: Vec<Vec<Option<Held>>> = p.pes.iter().map(|q| tags(&q.init, e)).collect();
     let mut out: Vec<Vec<Option<Held>>> = p.pes.iter().map(|q| tags(&q.output_init, e)).collect();
     let mut buf: Vec<Vec<Option<Held>>> = p.buffer_words.iter().map(|&w| vec![None; w as usize]).collect();
-
-    // Results arriving per (slot, cycle).
-    let mut arriving: Vec<Vec<Option<Value>>> = vec![vec![None; steps]; n_pe];
-    for &v in &f.body {
-        let (Some((s, c)), Some(_)) = (p.issue_of[v.index()], f.op_kind(v)) else { continue };
-        if s >= n_pe || c as usize >= steps {
-            continue;
-        }
-        let Some(i) = &p.pes[s].steps[c as usize].issue else { continue };
-        let at = c as usize + p.latency(&i.op) as usize;
-        if at >= steps {
-            e.push(format!("%{} arrives at cycle {at}, after the last cycle {}", f.name_of(v), p.cycles));
-        } else if let Some(u) = arriving[s][at].replace(v) {
-            e.push(format!(
-                "cycle {at}, {}: %{} and %{} arrive in one cycle (one result bus per PE)",
-                p.pes[s].pe,
-                f.name_of(u),
-                f.name_of(v)
-            ));
-        }
+    for m in arrival_errs {
+        e.push(m);
     }
 
     let mut bus: Vec<Option<Held>> = vec![None; n_pe];

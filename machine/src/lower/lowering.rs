@@ -214,6 +214,14 @@ pub(super) fn lower(
     for (s, q) in pes.iter_mut().enumerate() {
         q.output_init.resize(output_words[s] as usize, None);
     }
+    // Which values are captured outputs, a bit each: the arrivals test it before reading
+    // `capture_at` (8 bytes a value, read in cycle order; issue 28).
+    let mut is_output = vec![0u64; n.div_ceil(64)];
+    for (i, c) in capture_at.iter().enumerate() {
+        if c.is_some() {
+            is_output[i / 64] |= 1 << (i % 64);
+        }
+    }
     for (&k, &a) in &init_out {
         pes[0].output_init[a as usize] = Some(word(k));
     }
@@ -266,8 +274,7 @@ pub(super) fn lower(
         let now = When::Cycle(c);
         let mark = c + 1;
         // Results arriving now: one per PE (one result bus), captured when outputs.
-        for &v in buckets.arrivals.at(c) {
-            let pe = issue(v).pe;
+        for &(v, pe) in buckets.arrivals.at(c) {
             let held = std::mem::replace(&mut bus[r.slot(pe)], (mark, v));
             if let Some(u) = (held.0 == mark).then_some(held.1) {
                 return Err(SimError::new(
@@ -282,7 +289,9 @@ pub(super) fn lower(
                 .of(r.vname(v))
                 .src(p.spans.issue(v)));
             }
-            pes[r.slot(pe)].steps[c as usize].capture = capture_at[v.index()];
+            if is_output[v.index() / 64] >> (v.index() % 64) & 1 == 1 {
+                pes[r.slot(pe)].steps[c as usize].capture = capture_at[v.index()];
+            }
         }
         // Results arriving now enter their producer's buffer.
         for &b in buckets.entries.at(c) {
@@ -427,9 +436,9 @@ pub(super) fn lower(
         }
 
         // Ops issued now read their operands and enter the pipeline.
-        for &v in buckets.issues.at(c) {
-            let is = issue(v);
-            let kind = f.op_kind(v).expect("issued values are ops");
+        for item in buckets.issues.at(c) {
+            let (v, kind) = (item.value, item.kind);
+            let is = robovec_ir::placement::Issue { pe: item.pe, cycle: c };
             if !is.pe.accepts(kind) {
                 return Err(SimError::new(
                     K::WrongPeType,
@@ -453,9 +462,9 @@ pub(super) fn lower(
             }
             busy[r.slot(is.pe)] = (mark, v);
             let mut addrs: Vec<u32> = Vec::new();
-            for &(k, res) in reads.of(v) {
-                if let Key::Value(u) = k {
-                    if let Some(a) = arrival[u.index()].filter(|&a| a > c) {
+            for &(k, res, arrives) in reads.range(item.reads) {
+                if let Key::Value(_) = k {
+                    if let Some(a) = arrives.filter(|&a| a > c) {
                         return Err(SimError::new(
                             K::BeforeArrival,
                             format!(
@@ -491,13 +500,15 @@ pub(super) fn lower(
                     }
                 }
             }
-            let op = match &f.value(v).def {
-                Def::Binary(BinOp::Add, _, _) => MachineOp::Add,
-                Def::Binary(BinOp::Sub, _, _) => MachineOp::Sub,
-                Def::Binary(BinOp::Mul, _, _) => MachineOp::Mul,
-                Def::Binary(BinOp::Div, _, _) => MachineOp::Div,
-                Def::Call(callee, _) => MachineOp::Call(callee.clone()),
-                _ => unreachable!("ops are binary or calls"),
+            let op = match item.bin {
+                Some(BinOp::Add) => MachineOp::Add,
+                Some(BinOp::Sub) => MachineOp::Sub,
+                Some(BinOp::Mul) => MachineOp::Mul,
+                Some(BinOp::Div) => MachineOp::Div,
+                None => match &f.value(v).def {
+                    Def::Call(callee, _) => MachineOp::Call(callee.clone()),
+                    _ => unreachable!("ops are binary or calls"),
+                },
             };
             pes[r.slot(is.pe)].steps[c as usize].issue = Some(Instr { op, reads: addrs });
             issue_of[v.index()] = Some((r.slot(is.pe), c));

@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 
 use robovec_ir::placement::{Issue, Pe, Placement};
-use robovec_ir::syntax::{Def, OpKind, Operand};
+use robovec_ir::syntax::{BinOp, Def, OpKind, Operand};
 use robovec_ir::{Function, Value};
 
 use robovec_ir::machine::Held as Key;
@@ -29,6 +29,14 @@ pub(super) struct MemEvent {
     pub key: Key,
     /// Latest cycle an op reads this word (reads resolved statically, see `resolve`).
     pub last_read: Option<i64>,
+}
+
+/// A memory event as the reads search them: its write cycle, PE slot and index in `mem_ev`.
+#[derive(Clone, Copy)]
+struct EvRef {
+    time: i64,
+    slot: u32,
+    event: u32,
 }
 
 /// A value entering its producer's buffer at arrival and read back by indirect writes.
@@ -83,14 +91,30 @@ impl<T: Copy> ByCycle<T> {
 pub(super) struct Buckets {
     /// The last cycle with an event.
     pub last: u32,
-    /// Ops whose results arrive, in body order.
-    pub arrivals: ByCycle<Value>,
+    /// Ops whose results arrive, with their PE, in body order.
+    pub arrivals: ByCycle<(Value, Pe)>,
     /// Buffer entries (`BufEvent` indices) of results arriving.
     pub entries: ByCycle<usize>,
     /// `Placement::writes` indices written into PE memories.
     pub writes: ByCycle<usize>,
-    /// Ops issued, in body order.
-    pub issues: ByCycle<Value>,
+    /// Ops issued, in body order, with what the lowering needs of them (so that its walk in
+    /// cycle order reads them here rather than by value: issue 28).
+    pub issues: ByCycle<IssueItem>,
+}
+
+/// An op issued, as the lowering's cycle loop reads it.
+#[derive(Clone, Copy)]
+pub(super) struct IssueItem {
+    /// The op.
+    pub value: Value,
+    /// Its PE.
+    pub pe: Pe,
+    /// Its kind.
+    pub kind: OpKind,
+    /// Its operation when binary (`None`: a call).
+    pub bin: Option<BinOp>,
+    /// Its reads: `Reads::list[reads.0..reads.1]`.
+    pub reads: (u32, u32),
 }
 
 impl Buckets {
@@ -103,17 +127,17 @@ impl Buckets {
     }
 }
 
-/// Each op's operand reads, flat: op `v` reads `list[at[v].0..at[v].1]`, in operand order.
+/// Each op's operand reads, flat: op `v` reads `list[at[v].0..at[v].1]`, in operand order,
+/// each with the operand's arrival cycle when it is an op.
 pub(super) struct Reads {
     at: Vec<(u32, u32)>,
-    list: Vec<(Key, Read)>,
+    list: Vec<(Key, Read, Option<u32>)>,
 }
 
 impl Reads {
-    /// The reads of op `v`, in operand order (empty for a non-op).
-    pub fn of(&self, v: Value) -> &[(Key, Read)] {
-        let (a, b) = self.at[v.index()];
-        &self.list[a as usize..b as usize]
+    /// The reads `range` of an op ([`IssueItem::reads`]).
+    pub fn range(&self, range: (u32, u32)) -> &[(Key, Read, Option<u32>)] {
+        &self.list[range.0 as usize..range.1 as usize]
     }
 }
 
@@ -267,15 +291,6 @@ impl Run<'_> {
         }
         Ok(())
     }
-
-    /// Operand keys an op reads, in operand order (a call reads all its arguments).
-    fn operands(&self, v: Value) -> Vec<Key> {
-        match &self.f.value(v).def {
-            Def::Binary(_, a, b) => vec![key_of(a), key_of(b)],
-            Def::Call(_, args) => args.iter().map(key_of).collect(),
-            _ => Vec::new(),
-        }
-    }
 }
 
 /// What [`derive`] finds; indices of `mem_ev` are loads (`0..n_loads`), then `Placement::writes`.
@@ -353,6 +368,9 @@ impl Run<'_> {
             .collect();
         // The events of each key, in event order: grouped by value index for op results and
         // inputs (CSR, so the lookups below follow the body's locality), in a map for constants.
+        // Each entry carries what finding a read compares (time, slot), and the latest read of
+        // a value's events is kept beside the entries, so the reads never touch `mem_ev`
+        // (in cycle order: scattered against the body's order on large functions; issue 28).
         let mut val_start = vec![0u32; n + 1];
         for e in &mem_ev {
             if let Key::Value(v) = e.key {
@@ -363,62 +381,88 @@ impl Run<'_> {
             val_start[i + 1] += val_start[i];
         }
         let mut fill = val_start.clone();
-        let mut val_ev = vec![0u32; val_start[n] as usize];
-        let mut const_ev: HashMap<(usize, u64), Vec<u32>> = HashMap::new();
+        let mut val_ev = vec![EvRef { time: 0, slot: 0, event: 0 }; val_start[n] as usize];
+        let mut const_ev: HashMap<(usize, u64), Vec<EvRef>> = HashMap::new();
         for (i, e) in mem_ev.iter().enumerate() {
+            let entry = EvRef { time: e.time, slot: e.slot as u32, event: i as u32 };
             match e.key {
                 Key::Value(v) => {
-                    val_ev[fill[v.index()] as usize] = i as u32;
+                    val_ev[fill[v.index()] as usize] = entry;
                     fill[v.index()] += 1;
                 }
-                Key::Const(b) => const_ev.entry((e.slot, b)).or_default().push(i as u32),
+                Key::Const(b) => const_ev.entry((e.slot, b)).or_default().push(entry),
             }
         }
         drop(fill);
+        // Latest read of each entry of `val_ev` (`i64::MIN`: none).
+        let mut val_last = vec![i64::MIN; val_ev.len()];
 
         // Reads: an op on PE p at cycle c reads each operand from the latest write of it into p at
         // a cycle ≤ c (the first such write on a tie).
         let mut reads = Reads { at: vec![(0, 0); n], list: Vec::new() };
+        let mut keys: Vec<Key> = Vec::new();
         for &v in &f.body {
             r.poll()?;
-            if f.op_kind(v).is_none() {
-                continue;
+            keys.clear();
+            match &f.value(v).def {
+                Def::Binary(_, a, b) => keys.extend([key_of(a), key_of(b)]),
+                Def::Call(_, args) => keys.extend(args.iter().map(key_of)),
+                _ => continue,
             }
             let is = issue(v);
             let (slot, c) = (r.slot(is.pe), is.cycle as i64);
             let from = reads.list.len() as u32;
-            for k in r.operands(v) {
-                let list: &[u32] = match k {
-                    Key::Value(u) => &val_ev[val_start[u.index()] as usize..val_start[u.index() + 1] as usize],
-                    Key::Const(b) => const_ev.get(&(slot, b)).map_or(&[], Vec::as_slice),
+            for &k in &keys {
+                let (base, list): (usize, &[EvRef]) = match k {
+                    Key::Value(u) => {
+                        let (a, b) = (val_start[u.index()] as usize, val_start[u.index() + 1] as usize);
+                        (a, &val_ev[a..b])
+                    }
+                    Key::Const(b) => (0, const_ev.get(&(slot, b)).map_or(&[], Vec::as_slice)),
                 };
-                let mut best: Option<usize> = None;
+                // (time, position in `list`) of the read write.
+                let mut best: Option<(i64, usize)> = None;
                 let mut first_later: Option<i64> = None;
-                for &e in list {
-                    let ev = &mem_ev[e as usize];
-                    if ev.slot != slot {
+                for (i, ev) in list.iter().enumerate() {
+                    if ev.slot as usize != slot {
                         continue;
                     }
                     if ev.time <= c {
-                        if !matches!(best, Some(b) if mem_ev[b].time >= ev.time) {
-                            best = Some(e as usize);
+                        if !matches!(best, Some((t, _)) if t >= ev.time) {
+                            best = Some((ev.time, i));
                         }
                     } else {
                         first_later = Some(first_later.map_or(ev.time, |t| t.min(ev.time)));
                     }
                 }
                 let res = match best {
-                    Some(e) => {
-                        let lr = &mut mem_ev[e].last_read;
-                        *lr = Some(lr.map_or(c, |x| x.max(c)));
+                    Some((_, i)) => {
+                        let e = list[i].event as usize;
+                        if let Key::Value(_) = k {
+                            let last = &mut val_last[base + i];
+                            *last = (*last).max(c);
+                        } else {
+                            let lr = &mut mem_ev[e].last_read;
+                            *lr = Some(lr.map_or(c, |x| x.max(c)));
+                        }
                         Ok(e)
                     }
                     None => Err(first_later),
                 };
-                reads.list.push((k, res));
+                let arrives = match k {
+                    Key::Value(u) => arrival[u.index()],
+                    Key::Const(_) => None,
+                };
+                reads.list.push((k, res, arrives));
             }
             reads.at[v.index()] = (from, reads.list.len() as u32);
         }
+        for (ev, &last) in val_ev.iter().zip(&val_last) {
+            if last != i64::MIN {
+                mem_ev[ev.event as usize].last_read = Some(last);
+            }
+        }
+        drop((val_ev, val_last));
 
         // Buffer entries: one per indirect-written value, at its producer's buffer, from arrival.
         let mut buf_ev: Vec<BufEvent> = Vec::new();
@@ -470,13 +514,20 @@ impl Run<'_> {
             }
             last = last.max(w.cycle);
         }
-        let mut issued: Vec<(u32, Value)> = Vec::new();
-        let mut arriving: Vec<(u32, Value)> = Vec::new();
+        let mut issued: Vec<(u32, IssueItem)> = Vec::new();
+        let mut arriving: Vec<(u32, (Value, Pe))> = Vec::new();
         for &v in &f.body {
             r.poll()?;
-            if f.op_kind(v).is_some() {
-                issued.push((issue(v).cycle, v));
-                arriving.push((arrival[v.index()].expect("ops arrive"), v));
+            let def = &f.value(v).def;
+            if let Some(kind) = def.op_kind() {
+                let is = issue(v);
+                let bin = match def {
+                    Def::Binary(op, _, _) => Some(*op),
+                    _ => None,
+                };
+                let item = IssueItem { value: v, pe: is.pe, kind, bin, reads: reads.at[v.index()] };
+                issued.push((is.cycle, item));
+                arriving.push((arrival[v.index()].expect("ops arrive"), (v, is.pe)));
             }
         }
         let entries: Vec<(u32, usize)> = buf_ev.iter().enumerate().map(|(i, b)| (b.arrival, i)).collect();
