@@ -53,6 +53,15 @@
 use crate::placement::{Pe, PeArray};
 use crate::syntax::{Callee, Operand, TrigFn};
 use crate::Value;
+use smallvec::SmallVec;
+
+/// An instruction's read addresses, inline up to two (the binary ops; a call with more spills
+/// to the heap).
+pub type ReadAddrs = SmallVec<[u32; 2]>;
+
+/// A step's PE-memory writes, inline up to two (the seed's two write ports; more ports spill to
+/// the heap).
+pub type StepWrites = SmallVec<[MemWrite; 2]>;
 
 /// What a memory word holds: a value of the function or a constant, by its `f64` bits (`0.0`
 /// and `-0.0` differ). The one memory-word key of the placer, the lowering and the verifier.
@@ -127,7 +136,7 @@ pub struct Instr {
     /// The op.
     pub op: MachineOp,
     /// Read addresses (words of this PE's memory).
-    pub reads: Vec<u32>,
+    pub reads: ReadAddrs,
 }
 
 /// Where a PE-memory write takes its data (the crossbar select).
@@ -163,7 +172,7 @@ pub struct Step {
     /// The instruction issued, if any.
     pub issue: Option<Instr>,
     /// Writes into this PE's memory, in write-port order (at most `arch.writes`).
-    pub writes: Vec<MemWrite>,
+    pub writes: StepWrites,
     /// The buffer's instruction.
     pub buffer: BufferOp,
     /// Capture the result arriving now on this PE at this output-memory address.

@@ -50,7 +50,7 @@
 //! `encode` accepts; it rejects words with bits set outside their fields, a select beyond
 //! `2·n_pe`, a write enable without a select (or the reverse), or a sub bit on a MULTI PE.
 
-use robovec_ir::machine::{BufferOp, Instr, MachineOp, MachineProgram, MemWrite, Source, Step};
+use robovec_ir::machine::{BufferOp, Instr, MachineOp, MachineProgram, MemWrite, Source, Step, StepWrites};
 
 /// Field widths of the four image words, bits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -330,14 +330,14 @@ pub fn decode_step(l: &Layout, slot: usize, cycle: usize, words: [u64; 4]) -> Re
             (false, false) => MachineOp::Mul,
             (false, true) => return Err(err("instruction", "sub bit set on a MULTI PE".into())),
         };
-        Some(Instr { op, reads: vec![get(instr, 0, aw) as u32, get(instr, aw, aw) as u32] })
+        Some(Instr { op, reads: [get(instr, 0, aw) as u32, get(instr, aw, aw) as u32].into() })
     } else {
         if get(instr, 0, 2 * aw) != 0 || bit(instr, 4 * aw + 3) {
             return Err(err("instruction", "read addresses or sub bit without issue valid".into()));
         }
         None
     };
-    let mut writes = Vec::new();
+    let mut writes = StepWrites::new();
     for p in 0..2u32 {
         let we = bit(instr, 4 * aw + p);
         let addr = get(instr, (2 + p) * aw, aw) as u32;
@@ -468,8 +468,11 @@ mod tests {
     fn every_field_round_trips() {
         let l = layout(4, 2);
         let step = Step {
-            issue: Some(Instr { op: MachineOp::Sub, reads: vec![2047, 5] }),
-            writes: vec![MemWrite { addr: 7, src: Source::Buffer(3) }, MemWrite { addr: 2046, src: Source::Result(0) }],
+            issue: Some(Instr { op: MachineOp::Sub, reads: [2047, 5].into() }),
+            writes: StepWrites::from_vec(vec![
+                MemWrite { addr: 7, src: Source::Buffer(3) },
+                MemWrite { addr: 2046, src: Source::Result(0) },
+            ]),
             buffer: BufferOp { store: Some(15), read: Some(9) },
             capture: Some(6),
         };
@@ -480,7 +483,7 @@ mod tests {
         assert_eq!(w, [instr, 8 | (1 << 4), 15 | (9 << 4) | (0b11 << 8), 6 | (1 << 3)]);
         assert_eq!(decode_step(&l, 1, 3, w).unwrap(), step);
         // A MULTI PE (slot 2) decodes the same valid bit as a mul.
-        let mul = Step { issue: Some(Instr { op: MachineOp::Mul, reads: vec![1, 2] }), ..Step::default() };
+        let mul = Step { issue: Some(Instr { op: MachineOp::Mul, reads: [1, 2].into() }), ..Step::default() };
         let w = encode_step(&l, 2, 0, &mul).unwrap();
         assert_eq!(decode_step(&l, 2, 0, w).unwrap(), mul);
         assert_eq!(encode_step(&l, 0, 0, &Step::default()).unwrap(), [0; 4]);
@@ -489,15 +492,15 @@ mod tests {
     #[test]
     fn encode_and_decode_reject_what_the_words_cannot_hold() {
         let l = layout(2, 1);
-        let too_far = Step { issue: Some(Instr { op: MachineOp::Add, reads: vec![2048, 0] }), ..Step::default() };
+        let too_far = Step { issue: Some(Instr { op: MachineOp::Add, reads: [2048, 0].into() }), ..Step::default() };
         assert!(matches!(
             encode_step(&l, 0, 4, &too_far),
             Err(EncodeError::FieldOverflow { what: "read address", value: 2048, bits: 11, .. })
         ));
         let w = MemWrite { addr: 0, src: Source::Result(0) };
-        let three = Step { writes: vec![w, w, w], ..Step::default() };
+        let three = Step { writes: StepWrites::from_vec(vec![w, w, w]), ..Step::default() };
         assert!(matches!(encode_step(&l, 0, 0, &three), Err(EncodeError::TooManyWrites { writes: 3, .. })));
-        let call = Step { issue: Some(Instr { op: MachineOp::Div, reads: vec![0, 0] }), ..Step::default() };
+        let call = Step { issue: Some(Instr { op: MachineOp::Div, reads: [0, 0].into() }), ..Step::default() };
         assert!(matches!(encode_step(&l, 0, 0, &call), Err(EncodeError::NoUnit { .. })));
         // Decode: a bit beyond the 48 used, a sub bit on a MULTI PE, a select beyond 2·n_pe,
         // a write enable without a select.
@@ -521,10 +524,15 @@ mod tests {
             Just(MachineOp::Mul).boxed()
         };
         let issue =
-            proptest::option::of((op, addr.clone(), addr).prop_map(|(op, a, b)| Instr { op, reads: vec![a, b] }));
+            proptest::option::of((op, addr.clone(), addr).prop_map(|(op, a, b)| Instr { op, reads: [a, b].into() }));
         let small = || proptest::option::of(0u32..16);
         (issue, proptest::collection::vec(write, 0..=2), small(), small(), proptest::option::of(0u32..8)).prop_map(
-            |(issue, writes, store, read, capture)| Step { issue, writes, buffer: BufferOp { store, read }, capture },
+            |(issue, writes, store, read, capture)| Step {
+                issue,
+                writes: writes.into(),
+                buffer: BufferOp { store, read },
+                capture,
+            },
         )
     }
 

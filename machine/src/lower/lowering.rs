@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 
 use robovec_ir::machine::{
-    Held as Key, Instr, MachineOp, MachineProgram, MemWrite, OutputLoc, PeProgram, Source, Step, Word,
+    Held as Key, Instr, MachineOp, MachineProgram, MemWrite, OutputLoc, PeProgram, ReadAddrs, Source, Step, Word,
 };
 use robovec_ir::placement::Placement;
 use robovec_ir::syntax::{BinOp, Def, Operand};
@@ -107,8 +107,14 @@ fn reuse_error(what: &str, addr: u32, old: String, new: String, read: Option<i64
 }
 
 /// Largest number of words live at once per slot; `items` are `(slot, start, end)`, inclusive.
-fn peak(n: usize, items: impl Iterator<Item = (usize, i64, i64)>) -> Vec<u32> {
-    let mut ev: Vec<Vec<(i64, i32)>> = vec![Vec::new(); n];
+/// Each slot's start/end events are sorted once, in a vector sized from a first count (no
+/// growth).
+fn peak(n: usize, items: impl Iterator<Item = (usize, i64, i64)> + Clone) -> Vec<u32> {
+    let mut count = vec![0usize; n];
+    for (s, _, _) in items.clone() {
+        count[s] += 2;
+    }
+    let mut ev: Vec<Vec<(i64, i32)>> = count.into_iter().map(Vec::with_capacity).collect();
     for (s, a, b) in items {
         ev[s].push((a, 1));
         ev[s].push((b + 1, -1));
@@ -461,7 +467,7 @@ pub(super) fn lower(
                 .src(p.spans.issue(v)));
             }
             busy[r.slot(is.pe)] = (mark, v);
-            let mut addrs: Vec<u32> = Vec::new();
+            let mut addrs = ReadAddrs::new();
             for &(k, res, arrives) in reads.range(item.reads) {
                 if let Key::Value(_) = k {
                     if let Some(a) = arrives.filter(|&a| a > c) {

@@ -465,26 +465,31 @@ impl Run<'_> {
         drop((val_ev, val_last));
 
         // Buffer entries: one per indirect-written value, at its producer's buffer, from arrival.
-        let mut buf_ev: Vec<BufEvent> = Vec::new();
-        let mut buf_of_value: HashMap<Value, usize> = HashMap::new();
+        let mut buf_ev: Vec<BufEvent> = Vec::with_capacity(p.writes.len());
+        // The buffer entry of each value (`usize::MAX`: none yet), by `Value::index()`.
+        let mut buf_of_value: Vec<usize> = vec![usize::MAX; n];
         let mut buf_of_write: Vec<Option<usize>> = vec![None; p.writes.len()];
         for (i, w) in p.writes.iter().enumerate() {
             r.poll()?;
             let Some(addr) = w.buffer_addr else { continue };
             let is = issue(w.value);
             let arr = arrival[w.value.index()].expect("ops arrive");
-            let b = *buf_of_value.entry(w.value).or_insert_with(|| {
-                buf_ev.push(BufEvent {
-                    slot: r.slot(is.pe),
-                    pe: is.pe,
-                    addr,
-                    value: w.value,
-                    arrival: arr,
-                    last_read: 0,
-                    write: i,
-                });
-                buf_ev.len() - 1
-            });
+            let b = match buf_of_value[w.value.index()] {
+                usize::MAX => {
+                    buf_ev.push(BufEvent {
+                        slot: r.slot(is.pe),
+                        pe: is.pe,
+                        addr,
+                        value: w.value,
+                        arrival: arr,
+                        last_read: 0,
+                        write: i,
+                    });
+                    buf_of_value[w.value.index()] = buf_ev.len() - 1;
+                    buf_ev.len() - 1
+                }
+                b => b,
+            };
             if buf_ev[b].addr != addr {
                 return Err(SimError::new(
                     K::BufferEntries,
@@ -514,8 +519,8 @@ impl Run<'_> {
             }
             last = last.max(w.cycle);
         }
-        let mut issued: Vec<(u32, IssueItem)> = Vec::new();
-        let mut arriving: Vec<(u32, (Value, Pe))> = Vec::new();
+        let mut issued: Vec<(u32, IssueItem)> = Vec::with_capacity(f.body.len());
+        let mut arriving: Vec<(u32, (Value, Pe))> = Vec::with_capacity(f.body.len());
         for &v in &f.body {
             r.poll()?;
             let def = &f.value(v).def;

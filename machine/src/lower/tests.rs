@@ -56,7 +56,7 @@ fn idle(pe: Pe, init: Vec<Option<Word>>, cycles: u32) -> PeProgram {
 }
 
 fn issue(op: MachineOp, a: u32, b: u32) -> Option<Instr> {
-    Some(Instr { op, reads: vec![a, b] })
+    Some(Instr { op, reads: [a, b].into() })
 }
 
 /// DE10-Nano words: 2048-word PE memories and buffers, 52-bit instructions (seed §1.3.1).
@@ -152,9 +152,9 @@ fn direct_and_indirect_writes() {
     assert_eq!(mul0[0].issue, issue(MachineOp::Mul, 0, 1));
     assert_eq!(mul0[7].buffer, BufferOp { store: Some(0), read: None });
     assert_eq!(mul0[9].buffer, BufferOp { store: None, read: Some(0) });
-    assert_eq!(add0[7].writes, vec![MemWrite { addr: 1, src: Source::Result(2) }]);
+    assert_eq!(add0[7].writes[..], [MemWrite { addr: 1, src: Source::Result(2) }]);
     assert_eq!(add0[7].issue, issue(MachineOp::Add, 1, 0));
-    assert_eq!(add1[9].writes, vec![MemWrite { addr: 1, src: Source::Buffer(2) }]);
+    assert_eq!(add1[9].writes[..], [MemWrite { addr: 1, src: Source::Buffer(2) }]);
     assert_eq!(add1[9].issue, issue(MachineOp::Sub, 1, 0));
     assert_eq!((add0[19].capture, add1[21].capture), (Some(0), Some(0)));
     let busy = m.pes.iter().flat_map(|q| &q.steps).filter(|s| **s != Step::default()).count();
@@ -296,7 +296,7 @@ fn a_buffer_write_after_the_last_arrival_lengthens_the_program() {
     let m = lower(&f, &p).unwrap();
     assert_eq!(m.cycles, 90);
     assert!(m.pes.iter().all(|q| q.steps.len() == 91));
-    assert_eq!(m.pes[0].steps[90].writes, vec![MemWrite { addr: 2, src: Source::Buffer(2) }]);
+    assert_eq!(m.pes[0].steps[90].writes[..], [MemWrite { addr: 2, src: Source::Buffer(2) }]);
     assert_eq!(m.pes[2].steps[90].buffer.read, Some(0));
     let x = execute::<f64>(&m, input).unwrap();
     assert_eq!(x.cycles, 90);

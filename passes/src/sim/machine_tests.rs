@@ -82,7 +82,7 @@ fn the_lowered_verifier_finds_broken_programs() {
     let mut bad = m.clone();
     bad.arch.writes = 1;
     let w = MemWrite { addr: 0, src: Source::Result(0) };
-    bad.pes[0].steps[0].writes = vec![w, w];
+    bad.pes[0].steps[0].writes = [w, w].into();
     fails(&bad, "2 writes, 1 write ports");
 }
 
