@@ -20,6 +20,11 @@ pub type Node = u32;
 /// In an operand row: initial data (an input, a trig variable or a constant), not an op.
 pub const NO_NODE: Node = Node::MAX;
 
+/// The distinct ops of an operand row, in operand order (initial data, [`NO_NODE`], skipped).
+fn distinct(row: &[Node]) -> impl Iterator<Item = Node> + '_ {
+    row.iter().enumerate().filter(move |&(i, &a)| a != NO_NODE && !row[..i].contains(&a)).map(|(_, &a)| a)
+}
+
 /// The dependence structure the list schedulers need, built once per placement and shared by
 /// every forward and backward pass (compressed rows, no per-op allocation). Indexed by
 /// [`Node`].
@@ -84,12 +89,9 @@ impl OpDag {
                 robovec_ir::Def::Call(_, args) => operands.extend(args.iter().map(node)),
                 _ => {}
             }
-            for i in start..operands.len() {
-                let a = operands[i];
-                if a != NO_NODE && !operands[start..i].contains(&a) {
-                    n_distinct[j] += 1;
-                    n_users[a as usize] += 1;
-                }
+            for a in distinct(&operands[start..]) {
+                n_distinct[j] += 1;
+                n_users[a as usize] += 1;
             }
         }
         operand_at.push(operands.len() as u32);
@@ -103,12 +105,9 @@ impl OpDag {
         let user_at = n_users.clone();
         let mut users = vec![0; at as usize];
         for j in 0..n {
-            let row = &operands[operand_at[j] as usize..operand_at[j + 1] as usize];
-            for (i, &a) in row.iter().enumerate() {
-                if a != NO_NODE && !row[..i].contains(&a) {
-                    users[n_users[a as usize] as usize] = j as Node;
-                    n_users[a as usize] += 1;
-                }
+            for a in distinct(&operands[operand_at[j] as usize..operand_at[j + 1] as usize]) {
+                users[n_users[a as usize] as usize] = j as Node;
+                n_users[a as usize] += 1;
             }
         }
         OpDag { ops, node_of, kind, operand_at, operands, user_at, users, n_distinct }
@@ -151,8 +150,7 @@ impl OpDag {
 
     /// Distinct op operands of node `j`, in operand order.
     pub fn distinct_operands(&self, j: Node) -> impl Iterator<Item = Node> + '_ {
-        let row = self.operands_of(j);
-        row.iter().enumerate().filter(move |&(i, &a)| a != NO_NODE && !row[..i].contains(&a)).map(|(_, &a)| a)
+        distinct(self.operands_of(j))
     }
 
     /// True for an op of the MULTI side.
