@@ -42,18 +42,13 @@ ROBOTS = [
     ("tiago_pro", "tiago_pro_description/robots/tiago_pro.urdf", True),
 ]
 
-# As `CXX_FLAGS` of `benches/pinocchio/side.rs` (Pinocchio's variant of 25 joint types needs
-# the larger MPL limits), at -O1: the exporter runs once per robot.
-CXX_FLAGS = [
-    "-O1",
-    "-DNDEBUG",
-    "-Wno-deprecated-declarations",
-    "-std=c++17",
-    "-DBOOST_MPL_LIMIT_LIST_SIZE=30",
-    "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
-    "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS",
-    "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
-]
+
+def cxx_flags():
+    """-O1 (the exporter runs once per robot), then the bench's shared Pinocchio flags."""
+    with open(os.path.join(HERE, "pinocchio_cxx_flags.txt")) as f:
+        shared = [l.strip() for l in f if l.strip() and not l.strip().startswith("#")]
+    return ["-O1"] + shared
+
 
 STATEMENT = re.compile(r"\s*[vy]\[\d+\]\s*=\s*(.*);\s*$")
 TOKEN = re.compile(r"[A-Za-z_]\w*\[\d+\]|\d+\.?\d*(?:e[-+]?\d+)?|[-+*/()]|\w+")
@@ -89,14 +84,15 @@ def exporter(python):
         if not os.path.exists(os.path.join(prefix, h)):
             sys.exit(f"{h} missing under {prefix}: {python} -m pip install pin cmeel-eigen cmeel-cppad cmeel-cppadcodegen example-robot-data")
     src = os.path.join(HERE, "cg_export.cpp")
-    key = hashlib.sha256((open(src).read() + " ".join(CXX_FLAGS) + prefix).encode()).hexdigest()[:16]
+    flags = cxx_flags()
+    key = hashlib.sha256((open(src).read() + " ".join(flags) + prefix).encode()).hexdigest()[:16]
     exe = os.path.join(WORK, f"cg_export-{key}")
     if not os.path.exists(exe):
         os.makedirs(WORK, exist_ok=True)
         print(f"compiling {src} (several minutes; cached as {exe})", file=sys.stderr)
         lib = os.path.join(prefix, "lib")
         inc = [f"-I{os.path.join(prefix, 'include')}", f"-I{os.path.join(prefix, 'include', 'eigen3')}"]
-        run(["g++", *CXX_FLAGS, *inc, src, "-o", exe + ".tmp", f"-L{lib}", f"-Wl,-rpath,{lib}",
+        run(["g++", *flags, *inc, src, "-o", exe + ".tmp", f"-L{lib}", f"-Wl,-rpath,{lib}",
              "-lcppad_lib", "-lboost_serialization", "-ldl"])
         os.replace(exe + ".tmp", exe)
     return prefix, exe

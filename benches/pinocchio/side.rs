@@ -7,18 +7,12 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// Flags of the C++ harness (Pinocchio header-only: its `double` and `long double` instances are
-/// compiled here, for this CPU; the Boost limits are those of Pinocchio's CMake config).
-const CXX_FLAGS: &[&str] = &[
-    "-O3",
-    "-march=native",
-    "-DNDEBUG",
-    "-Wno-deprecated-declarations",
-    "-std=c++17",
-    "-DBOOST_MPL_LIMIT_LIST_SIZE=30",
-    "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
-    "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS",
-    "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
-];
+/// compiled here, for this CPU): optimisation, then the flags shared with `cg_ops.py`
+/// (`pinocchio_cxx_flags.txt`).
+fn cxx_flags() -> Vec<&'static str> {
+    let shared = include_str!("pinocchio_cxx_flags.txt").lines().map(str::trim);
+    ["-O3", "-march=native"].into_iter().chain(shared.filter(|l| !l.is_empty() && !l.starts_with('#'))).collect()
+}
 
 /// Flags of robovec's generated C (the `native` set of `cargo bench --bench codegen_c`; no
 /// contraction, so the values are `-eval`'s).
@@ -66,14 +60,14 @@ impl Env {
         let src = root.join("benches/pinocchio/harness.cpp");
         let text = std::fs::read(&src).unwrap();
         let mut h = std::collections::hash_map::DefaultHasher::new();
-        (text, CXX_FLAGS, &prefix).hash(&mut h);
+        (text, cxx_flags(), &prefix).hash(&mut h);
         let harness = work.join(format!("harness-{:016x}.o", h.finish()));
         if !harness.exists() {
             eprintln!("compiling {} (about 3 min; cached as {})", src.display(), harness.display());
             let tmp = harness.with_extension("tmp.o");
             let inc = |p: &str| format!("-I{}", prefix.join(p).display());
             run(Command::new("g++")
-                .args(CXX_FLAGS)
+                .args(cxx_flags())
                 .args([inc("include"), inc("include/eigen3")])
                 .arg("-c")
                 .arg(&src)
