@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
 """Pinocchio reference values for robovec's URDF front end (issue 14).
 
-Usage: pinocchio_oracle.py URDF STATES SEED [floating]
+Usage: pinocchio_oracle.py URDF STATES SEED [fixed|floating|freeflyer]
 
 With `floating`, the model is on Robotran's floating base: root joint
 `JointModelComposite([PX, PY, PZ, RX, RY, RZ])` (robovec's `--floating-base`, T1-T3 then R1-R3),
 whose six coordinates are plain lengths and angles, so q, qd, qdd map one to one.
+With `freeflyer`, the root joint is `JointModelFreeFlyer()` (robovec's `--free-flyer`): q starts
+with the base position (uniform in [-1, 1]) and a random unit quaternion (x, y, z, w), seven
+coordinates for the base's six velocities.
 
 URDF is a path, or `erd:REL` for a file of example-robot-data (`erd:ur_description/urdf/ur5_robot.urdf`),
 found under the installed package's share folder. Builds the fixed-base model with
@@ -41,11 +44,14 @@ def locate(spec):
     sys.exit(f"example-robot-data file {rel} not found under {sys.prefix}")
 
 
-def build_model(path, floating):
-    """Pinocchio's model of the URDF at `path`: fixed base, or (`floating`) on the root joint
-    JointModelComposite([PX, PY, PZ, RX, RY, RZ]), the layout of robovec's --floating-base."""
-    if not floating:
+def build_model(path, base):
+    """Pinocchio's model of the URDF at `path`: fixed base, on the root joint
+    JointModelComposite([PX, PY, PZ, RX, RY, RZ]) (`floating`, the layout of robovec's
+    --floating-base) or on JointModelFreeFlyer (`freeflyer`, robovec's --free-flyer)."""
+    if base == "fixed":
         return pin.buildModelFromUrdf(path)
+    if base == "freeflyer":
+        return pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())
     root = pin.JointModelComposite()
     for j in (pin.JointModelPX(), pin.JointModelPY(), pin.JointModelPZ(),
               pin.JointModelRX(), pin.JointModelRY(), pin.JointModelRZ()):
@@ -56,8 +62,11 @@ def build_model(path, floating):
 def main():
     path = locate(sys.argv[1])
     n, seed = int(sys.argv[2]), int(sys.argv[3])
-    floating = len(sys.argv) > 4 and sys.argv[4] == "floating"
-    model = build_model(path, floating)
+    base = sys.argv[4] if len(sys.argv) > 4 else "fixed"
+    if base not in ("fixed", "floating", "freeflyer"):
+        sys.exit(f"unknown base {base}: expected fixed, floating or freeflyer")
+    floating = base == "floating"
+    model = build_model(path, base)
     data = model.createData()
     rng = np.random.default_rng(seed)
     joints = list(model.joints)[1:]
@@ -68,6 +77,12 @@ def main():
         a = rng.uniform(-2.0, 2.0, model.nv)
         coords = []
         for j in joints:
+            if base == "freeflyer" and j.id == 1:
+                quat = rng.normal(size=4)
+                x = np.concatenate([rng.uniform(-1.0, 1.0, 3), quat / np.linalg.norm(quat)])
+                coords.extend(map(float, x))
+                q[j.idx_q:j.idx_q + 7] = x
+                continue
             if floating and j.id == 1:
                 x = np.concatenate([rng.uniform(-0.2, 0.2, 3), rng.uniform(-math.pi, math.pi, 3)])
                 coords.extend(map(float, x))

@@ -117,8 +117,19 @@ pub struct Cli {
     pub fold_params: bool,
     /// URDF input: put the robot on Robotran's floating base (`T1`–`T3` translations along x,
     /// y, z, then `R1`–`R3` rotations about x, y, z: `q[1..6]`; the URDF's joints follow).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "free_flyer")]
     pub floating_base: bool,
+    /// URDF input: put the robot on Pinocchio's free-flyer base (`JointModelFreeFlyer`): `q[1..3]`
+    /// the base position in the world, `q[4..7]` its unit quaternion (x, y, z, w), `qd[1..6]`,
+    /// `qdd[1..6]`, `Qq[1..6]` its velocity, acceleration and force in the base frame (linear,
+    /// then angular); the URDF's joints follow (`q[8]`, `qd[7]`). The quaternion is not
+    /// normalised by the equations (as in Pinocchio).
+    #[arg(long)]
+    pub free_flyer: bool,
+    /// URDF input: the gravity vector `x,y,z` (m/s², world frame), written into the equations
+    /// as numbers instead of the inputs `g[1..3]` (Pinocchio's default is `0,0,-9.81`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_gravity, allow_hyphen_values = true)]
+    pub gravity: Option<[f64; 3]>,
     /// URDF input: write the values of the parameters kept as inputs to FILE, the JSON object
     /// (`{"m[1]": 2.5, …}`) that `specialize<params=FILE>` and `-eval` read.
     #[arg(long, value_name = "FILE")]
@@ -157,6 +168,16 @@ pub fn report_parse_error(e: &clap::Error) -> i32 {
             let _ = writeln!(std::io::stderr().lock(), "error: cannot write to stdout: {err}");
             1
         }
+    }
+}
+
+/// `-gravity=x,y,z`: three finite numbers (m/s²) separated by commas.
+fn parse_gravity(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let numbers: Vec<f64> = parts.iter().filter_map(|p| p.trim().parse::<f64>().ok()).filter(|x| x.is_finite()).collect();
+    match <[f64; 3]>::try_from(numbers) {
+        Ok(g) if parts.len() == 3 => Ok(g),
+        _ => Err(format!("expected three finite numbers `x,y,z` (m/s²), such as `0,0,-9.81`; got `{s}`")),
     }
 }
 
@@ -245,6 +266,8 @@ impl Cli {
             front: robovec_front::FrontOptions {
                 fold_params: self.fold_params,
                 floating_base: self.floating_base,
+                free_flyer: self.free_flyer,
+                gravity: self.gravity,
                 ..robovec_front::FrontOptions::default()
             },
             params_out: self.params_out,

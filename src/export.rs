@@ -68,7 +68,7 @@ pub fn run(e: &Export, stdout: &mut dyn Write) -> Result<(), Failure> {
         fold_params: e.fold_params,
         floating_base: e.floating_base,
         functions: Some(vec![e.function.clone()]),
-        deadline: None,
+        ..FrontOptions::default()
     };
     if e.format == Format::Urdf {
         if e.fold_params || e.params_out.is_some() {
@@ -177,7 +177,7 @@ fn equations(source: &Source, front: FrontOptions) -> Result<Equations, Failure>
         Source::Topology { topology, dof, seed } => {
             let robot = robot(source, front.floating_base)?;
             let request =
-                robovec_dynamics::Request { fold: front.fold_params, functions: front.functions, deadline: None };
+                robovec_dynamics::Request { fold: front.fold_params, functions: front.functions, ..Default::default() };
             let g = robovec_dynamics::generate_with(&robovec_dynamics::Model { robot }, &request)
                 .expect("no deadline, no stop");
             Ok((g.module, g.params, format!("{}{dof}_seed{seed}", topology.name().replace('-', "_"))))

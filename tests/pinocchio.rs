@@ -52,8 +52,28 @@ struct Oracle {
     states: Vec<State>,
 }
 
-fn oracle(py: &PathBuf, urdf: &str, states: usize, seed: u64, floating: bool) -> Oracle {
-    let base = if floating { "floating" } else { "fixed" };
+/// The robot's base: fixed, Robotran's six-joint floating base (`--floating-base`, Pinocchio's
+/// composite root joint) or Pinocchio's free flyer (`--free-flyer`, `JointModelFreeFlyer`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Base {
+    Fixed,
+    Floating,
+    FreeFlyer,
+}
+
+impl Base {
+    /// The oracle script's word.
+    fn word(self) -> &'static str {
+        match self {
+            Base::Fixed => "fixed",
+            Base::Floating => "floating",
+            Base::FreeFlyer => "freeflyer",
+        }
+    }
+}
+
+fn oracle(py: &PathBuf, urdf: &str, states: usize, seed: u64, base: Base) -> Oracle {
+    let base = base.word();
     let out = Command::new(py)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .args(["scripts/pinocchio_oracle.py", urdf, &states.to_string(), &seed.to_string(), base])
@@ -65,7 +85,7 @@ fn oracle(py: &PathBuf, urdf: &str, states: usize, seed: u64, floating: bool) ->
 
 /// Pinocchio's values of `function`'s outputs in state `s`, by output name.
 fn expected(function: &str, s: &State) -> BTreeMap<String, f64> {
-    let n = s.q.len();
+    let n = s.qd.len();
     let mut e = BTreeMap::new();
     for i in 0..n {
         if function == "invdyna" {
@@ -86,14 +106,15 @@ fn expected(function: &str, s: &State) -> BTreeMap<String, f64> {
 /// parameters given their values and with parameters folded, against Pinocchio over the
 /// oracle's states.
 fn compare(urdf: &str, dof: usize) -> f64 {
-    compare_on(urdf, dof, false)
+    compare_on(urdf, dof, Base::Fixed)
 }
 
-/// [`compare`] on a fixed or (`floating`) Robotran floating base: `dof` counts the base's six
-/// coordinates, which Pinocchio holds in one composite root joint.
-fn compare_on(urdf: &str, dof: usize, floating: bool) -> f64 {
+/// [`compare`] on `base`: `dof` counts the velocity coordinates, the base's six included (which
+/// Pinocchio holds in one root joint); with the free flyer `q` has one more (the quaternion).
+fn compare_on(urdf: &str, dof: usize, base: Base) -> f64 {
     let Some(py) = python() else { return 0.0 };
-    let o = oracle(&py, urdf, 8, 7, floating);
+    let o = oracle(&py, urdf, 8, 7, base);
+    let floating = base != Base::Fixed;
     assert_eq!(o.joints.len() + if floating { 5 } else { 0 }, dof, "{}: joints {:?}", o.path, o.joints);
     let mut worst: f64 = 0.0;
     for fold in [false, true] {
@@ -101,7 +122,8 @@ fn compare_on(urdf: &str, dof: usize, floating: bool) -> f64 {
             &o.path,
             &FrontOptions {
                 fold_params: fold,
-                floating_base: floating,
+                floating_base: base == Base::Floating,
+                free_flyer: base == Base::FreeFlyer,
                 functions: Some(robovec_dynamics::FUNCTION_NAMES.iter().map(|s| s.to_string()).collect()),
                 ..FrontOptions::default()
             },
@@ -117,8 +139,11 @@ fn compare_on(urdf: &str, dof: usize, floating: bool) -> f64 {
             for (k, g) in o.gravity.iter().enumerate() {
                 given.insert(format!("g[{}]", k + 1), *g);
             }
+            assert_eq!(s.q.len(), dof + usize::from(base == Base::FreeFlyer), "configuration coordinates");
+            for (i, q) in s.q.iter().enumerate() {
+                given.insert(format!("q[{}]", i + 1), *q);
+            }
             for i in 0..dof {
-                given.insert(format!("q[{}]", i + 1), s.q[i]);
                 given.insert(format!("qd[{}]", i + 1), s.qd[i]);
                 given.insert(format!("qdd[{}]", i + 1), s.qdd[i]);
                 given.insert(format!("Qq[{}]", i + 1), s.tau[i]);
@@ -213,12 +238,39 @@ fn long_chain_forward_dynamics_by_the_aba_matches_pinocchio() {
 /// now moves), Solo-12, a quadruped (6 + 12 coordinates), and Talos, a humanoid (6 + 32).
 #[test]
 fn floating_base_matches_pinocchio_composite_root_joint() {
-    let e = compare_on("examples/three_link_arm/three_link_arm.urdf", 3 + 6, true);
+    let e = compare_on("examples/three_link_arm/three_link_arm.urdf", 3 + 6, Base::Floating);
     eprintln!("three_link_arm floating: worst relative error {e:e}");
-    let e = compare_on("erd:solo_description/robots/solo12.urdf", 12 + 6, true);
+    let e = compare_on("erd:solo_description/robots/solo12.urdf", 12 + 6, Base::Floating);
     eprintln!("solo12 floating: worst relative error {e:e}");
-    let e = compare_on("erd:talos_data/robots/talos_reduced.urdf", 32 + 6, true);
+    let e = compare_on("erd:talos_data/robots/talos_reduced.urdf", 32 + 6, Base::Floating);
     eprintln!("talos floating: worst relative error {e:e}");
+}
+
+/// Pinocchio's free flyer (`--free-flyer`: position and unit quaternion as `q[1..7]`, the base's
+/// velocity in its frame as `qd[1..6]`) against `buildModelFromUrdf(path, JointModelFreeFlyer())`
+/// at random states with random unit quaternions: the three-link arm (its root link's mass now
+/// moves), UR5 and Panda set free (arms without a floating base in practice, but the same
+/// equations), Solo-12 (6 + 12 velocity coordinates) and Talos (6 + 32): `Qq` (`rnea`), `M`,
+/// `c` (`crba`, `nonLinearEffects`) and `qdd` (`aba`) within 1e-10.
+#[test]
+fn free_flyer_matches_pinocchio_free_flyer_root_joint() {
+    for (urdf, joints) in [
+        ("examples/three_link_arm/three_link_arm.urdf", 3),
+        ("erd:ur_description/urdf/ur5_robot.urdf", 6),
+        ("erd:panda_description/urdf/panda.urdf", 9),
+        ("erd:solo_description/robots/solo12.urdf", 12),
+        ("erd:talos_data/robots/talos_reduced.urdf", 32),
+    ] {
+        let e = compare_on(urdf, joints + 6, Base::FreeFlyer);
+        eprintln!("{urdf} free flyer: worst relative error {e:e}");
+    }
+}
+
+/// TIAGo Pro on the free flyer (6 + 33 velocity coordinates; see the test below).
+#[test]
+fn mobile_manipulator_matches_pinocchio_free_flyer() {
+    let e = compare_on("erd:tiago_pro_description/robots/tiago_pro.urdf", 33 + 6, Base::FreeFlyer);
+    eprintln!("tiago_pro free flyer: worst relative error {e:e}");
 }
 
 /// A mobile manipulator: PAL's TIAGo Pro (example-robot-data; omnidirectional base on four
@@ -227,7 +279,7 @@ fn floating_base_matches_pinocchio_composite_root_joint() {
 /// root joint. (The older TIAGo's URDF is refused: see docs/generator.md, an inertia tensor no body has.)
 #[test]
 fn mobile_manipulator_matches_pinocchio_composite_root_joint() {
-    let e = compare_on("erd:tiago_pro_description/robots/tiago_pro.urdf", 33 + 6, true);
+    let e = compare_on("erd:tiago_pro_description/robots/tiago_pro.urdf", 33 + 6, Base::Floating);
     eprintln!("tiago_pro floating: worst relative error {e:e}");
 }
 

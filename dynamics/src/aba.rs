@@ -180,6 +180,40 @@ struct Link {
     s: Option<(V3, V3)>,
     /// The joint's coordinate.
     qi: Option<usize>,
+    /// A free flyer (six coordinates from `qi`, `S` the identity; `s` is `None`).
+    free: bool,
+}
+
+/// `x` with `A x = r` for a symmetric positive-definite 6 × 6 `A` (only `a[i][j]`, `i ≤ j`, is
+/// read) by `LDLᵀ` and the two substitutions: `n³/6` multiply–adds, one reciprocal per pivot,
+/// 6 of them. Temporaries `{name}L{i}_{j}`, `{name}D{i}`, `{name}Y{i}` (1-based).
+fn solve6(b: &mut Builder, name: &str, a: &[[Term; 6]; 6], r: [Term; 6]) -> [Term; 6] {
+    // l[i][j] (j < i) of the unit lower L, and D.
+    let mut l: [[Term; 6]; 6] = Default::default();
+    let mut inv_d: [Term; 6] = Default::default();
+    let mut dl: [[Term; 6]; 6] = Default::default(); // L[i][k]·D[k], k < i
+    for i in 0..6 {
+        for j in 0..i {
+            // (A[j][i] − Σ_{k<j} L[i][k]·D[k]·L[j][k]) / D[j].
+            let t = (0..j).fold(a[j][i].clone(), |t, k| sub(t, mul(dl[i][k].clone(), l[j][k].clone())));
+            dl[i][j] = b.bind(&format!("{name}E{}_{}", i + 1, j + 1), t);
+            l[i][j] = b.bind(&format!("{name}L{}_{}", i + 1, j + 1), mul(dl[i][j].clone(), inv_d[j].clone()));
+        }
+        let d = (0..i).fold(a[i][i].clone(), |t, k| sub(t, mul(dl[i][k].clone(), l[i][k].clone())));
+        inv_d[i] = super::fordyna::reciprocal(b, &format!("{name}D{}", i + 1), &format!("i{name}D{}", i + 1), d);
+    }
+    // L y = r, then Lᵀ x = D⁻¹ y.
+    let mut y: [Term; 6] = Default::default();
+    for i in 0..6 {
+        let t = (0..i).fold(r[i].clone(), |t, k| sub(t, mul(l[i][k].clone(), y[k].clone())));
+        y[i] = b.bind(&format!("{name}Y{}", i + 1), t);
+    }
+    let mut x: [Term; 6] = Default::default();
+    for i in (0..6).rev() {
+        let t = (i + 1..6).fold(mul(y[i].clone(), inv_d[i].clone()), |t, k| sub(t, mul(l[k][i].clone(), x[k].clone())));
+        x[i] = b.bind(&format!("{name}X{}", i + 1), t);
+    }
+    x
 }
 
 /// Writes `fordyna` by the ABA into `b` (outputs `qdd[1..nq]`).
@@ -188,7 +222,7 @@ struct Link {
 /// [`Stopped`] at the builder's deadline (checked per body of each of the three passes).
 pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
     let robot = &model.robot;
-    let nq = layout.q_index.iter().flatten().count();
+    let nq = layout.nv;
     let drive = Drive::inputs(b, nq, false);
     let forces: Vec<Term> = (1..=nq).map(|i| b.input(&format!("Qq[{i}]"))).collect();
     let motions: Vec<Motion> = motions(model, layout, b);
@@ -202,7 +236,7 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
         std::iter::once(0).chain(order.iter().map(|&j| link_body[robot.joints[j].parent])).collect();
     let mut moves = vec![false; nb + 1];
     for i in 0..nb {
-        moves[i + 1] = moves[parent[i + 1]] || layout.q_index[i].is_some();
+        moves[i + 1] = moves[parent[i + 1]] || layout.v_index[i].is_some();
     }
 
     // Pass 1: joints, velocities and velocity terms, rigid inertias.
@@ -221,18 +255,19 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
         let p = parent[body];
         let ro = numeric(&joint.origin.rot);
         let d0: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
-        let qd = layout.q_index[i].map_or(ZERO, |qi| drive.qd[qi - 1].clone());
+        let qd = layout.v_index[i].map_or(ZERO, |qi| drive.qd[qi - 1].clone());
         // The parent's `OM × (OM × d)` in the joint frame, then the joint's own terms.
         let om_j = matvec(&ro, &om[p], true);
         let centripetal = matvec(&ro, &cross(&om[p], &cross(&om[p], &d0)), true);
         let m = &motions[body];
-        let (link, om_b, c) = match (joint.kind, &m.rot, &m.shift, layout.q_index[i]) {
+        let (link, om_b, c) = match (joint.kind, &m.rot, &m.shift, layout.v_index[i]) {
             (JointKind::Revolute, Some(r), _, Some(qi)) => {
                 let om_r = matvec(r, &om_j, true);
                 let axis = joint.axis.map(Term::C);
                 let sq = vscale(&axis, &qd);
                 let c = (cross(&om_r, &sq), matvec(r, &centripetal, true));
-                let link = Link { p: mm(&ro, r, false, false), d: d0, s: Some((axis, zero3())), qi: Some(qi) };
+                let link =
+                    Link { p: mm(&ro, r, false, false), d: d0, s: Some((axis, zero3())), qi: Some(qi), free: false };
                 (link, vadd(&om_r, &sq), c)
             }
             (JointKind::Prismatic, _, Some(shift), Some(qi)) => {
@@ -241,10 +276,20 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
                 let cor = cross(&om_j, &sq);
                 let lin = vadd(&vadd(&centripetal, &cross(&om_j, &cross(&om_j, shift))), &vadd(&cor, &cor));
                 let d = vadd(&d0, &matvec(&ro, shift, false));
-                let link = Link { p: ro, d, s: Some((zero3(), axis)), qi: Some(qi) };
+                let link = Link { p: ro, d, s: Some((zero3(), axis)), qi: Some(qi), free: false };
                 (link, om_j, (zero3(), lin))
             }
-            _ => (Link { p: ro, d: d0, s: None, qi: None }, om_j, (zero3(), centripetal)),
+            (JointKind::FreeFlyer, _, _, Some(qi)) => {
+                // From the fixed world (`om_j`, `centripetal` are 0): the base's angular velocity
+                // `w` and the `w × v` of its classical acceleration (see `crate::rnea`).
+                let r = m.free.clone().expect("a free flyer's motion");
+                let at = |k: usize| drive.qd[qi - 1 + k].clone();
+                let (v, w) = ([0, 1, 2].map(at), [3, 4, 5].map(at));
+                let c = (zero3(), vadd(&matvec(&r, &centripetal, true), &cross(&w, &v)));
+                let link = Link { p: r.clone(), d: d0, s: None, qi: Some(qi), free: true };
+                (link, vadd(&matvec(&r, &om_j, true), &w), c)
+            }
+            _ => (Link { p: ro, d: d0, s: None, qi: None, free: false }, om_j, (zero3(), centripetal)),
         };
         om[body] = bind3(b, "AOM", body, om_b);
         bias[body] = (bind3(b, "CW", body, c.0), bind3(b, "CA", body, c.1));
@@ -270,6 +315,7 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
 
     // Pass 2: articulated inertias, leaves to root.
     let mut u_of: Vec<Option<(V3, V3, Term, Term)>> = (0..=nb).map(|_| None).collect();
+    let mut free_root: Option<(Inertia, V3, V3)> = None;
     let mut children = vec![0usize; nb + 1];
     for body in (1..=nb).rev() {
         if !moves[body] {
@@ -280,6 +326,12 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
         let inertia = std::mem::take(&mut ia[body]).bind(b, "IA", body);
         let (pn, pf) = std::mem::take(&mut pa[body]);
         let (pn, pf) = (bind3(b, "PAN", body, pn), bind3(b, "PAF", body, pf));
+        if link.free {
+            // The root's articulated inertia and bias force, solved in pass 3 (the world above
+            // does not move).
+            free_root = Some((inertia, pn, pf));
+            continue;
+        }
         let (ia_a, pa_a) = match (&link.s, link.qi) {
             (Some((sw, sa)), Some(qi)) => {
                 let (uw, ua) = inertia.apply(sw, sa);
@@ -331,6 +383,28 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
         let w = vadd(&matvec(&link.p, wp, true), &bias[body].0);
         let a = vadd(&matvec(&link.p, &vsub(ap, &cross(&link.d, wp)), true), &bias[body].1);
         let (w, a) = (bind3(b, "AW", body, w), bind3(b, "AA", body, a));
+        if let (true, Some(qi), Some((ia, pn, pf))) = (link.free, link.qi, free_root.take()) {
+            // `I (A' + qdd) + p = τ` for the base's (linear, angular) `qdd`: the 6 × 6 system
+            // `[[M, Hᵀ], [H, J]] (a, w) = τ − p − I A'`.
+            let (iw, ia_) = ia.apply(&w, &a);
+            let rhs: [Term; 6] = std::array::from_fn(|k| {
+                let (p, i) = if k < 3 { (&pf[k], &ia_[k]) } else { (&pn[k - 3], &iw[k - 3]) };
+                sub(forces[qi - 1 + k].clone(), add(p.clone(), i.clone()))
+            });
+            let e = |r: usize, c: usize| match (r < 3, c < 3) {
+                (true, true) => ia.m[r][c].clone(),
+                (true, false) => ia.h[c - 3][r].clone(),
+                (false, true) => ia.h[r - 3][c].clone(),
+                (false, false) => ia.j[r - 3][c - 3].clone(),
+            };
+            let x = solve6(b, "FB", &std::array::from_fn(|r| std::array::from_fn(|c| e(r, c))), rhs);
+            for (k, t) in x.iter().enumerate() {
+                qdd[qi - 1 + k] = b.bind(&format!("QDD{}", qi + k), t.clone());
+            }
+            let (lin, ang): (V3, V3) = ([0, 1, 2].map(|k| qdd[qi - 1 + k].clone()), [3, 4, 5].map(|k| qdd[qi - 1 + k].clone()));
+            acc[body] = (vadd(&w, &ang), vadd(&a, &lin));
+            continue;
+        }
         acc[body] = match (&link.s, &u_of[body], link.qi) {
             (Some((sw, sa)), Some((uw, ua, u, inv)), Some(qi)) => {
                 let x = mul(sub(u.clone(), add(vdot(uw, &w), vdot(ua, &a))), inv.clone());

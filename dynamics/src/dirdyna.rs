@@ -75,7 +75,7 @@ pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
 /// # Errors
 /// [`Stopped`] at the builder's deadline (checked per body and per row of `M`).
 pub fn dirdyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: MassMatrix) -> Result<(), Stopped> {
-    let nq = layout.q_index.iter().flatten().count();
+    let nq = layout.nv;
     // `c`'s inputs first (gravity, rates), then the trig variables.
     let drive = Drive::inputs(b, nq, false);
     let motions = motions(model, layout, b);
@@ -150,7 +150,7 @@ mod tests {
         let model = Model { robot: robot.clone() };
         let layout = Layout::of(&model.robot);
         let mut given: BTreeMap<String, f64> = layout.nonzero();
-        let nq = layout.q_index.iter().flatten().count();
+        let nq = layout.nv;
         for i in 1..=nq {
             given.insert(format!("q[{i}]"), (i as f64 * 0.7).sin() * 3.0);
         }

@@ -125,7 +125,7 @@ fn factorisation_ops(lambda: &[usize]) -> u64 {
 
 /// `fordyna` by CRBA, `LᵀDL` and the substitutions.
 fn ltdl(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
-    let nq = layout.q_index.iter().flatten().count();
+    let nq = layout.nv;
     let drive = Drive::inputs(b, nq, false);
     let forces: Vec<Term> = (1..=nq).map(|i| b.input(&format!("Qq[{i}]"))).collect();
     let motions = motions(model, layout, b);

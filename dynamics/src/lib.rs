@@ -83,7 +83,7 @@ use robovec_ir::Module;
 use robovec_passes::Deadline;
 use rustc_hash::FxHashMap;
 
-use robot::{JointKind, Robot};
+use robot::Robot;
 use sym::{Builder, Term, ZERO};
 
 /// A robot to generate equations for.
@@ -96,9 +96,18 @@ pub struct Model {
 /// The numbering and parameter values of a model (see the module doc).
 #[derive(Clone, Debug)]
 pub struct Layout {
-    /// For each joint of the depth-first walk, its coordinate index `i` of `q[i]` (1-based), or
-    /// `None` for a fixed joint.
+    /// For each joint of the depth-first walk, the index `i` (1-based) of its first velocity
+    /// coordinate — `qd[i]`, `qdd[i]`, `Qq[i]`, row and column `i` of `M` — or `None` for a fixed
+    /// joint. A free flyer has six from there ([`robot::JointKind::nv`]).
+    pub v_index: Vec<Option<usize>>,
+    /// For each joint of the walk, the index (1-based) of its first configuration coordinate
+    /// `q[i]`, or `None` for a fixed joint (a free flyer has seven; `v_index` plus one for every
+    /// joint after it).
     pub q_index: Vec<Option<usize>>,
+    /// Velocity coordinates, `nv`.
+    pub nv: usize,
+    /// Configuration coordinates, `nq` (`nv`, plus one with a free flyer).
+    pub nq: usize,
     /// Every parameter (canonical name) → value, zeros included.
     pub values: BTreeMap<String, f64>,
 }
@@ -107,19 +116,18 @@ impl Layout {
     /// The numbering and parameters of `robot`.
     pub fn of(robot: &Robot) -> Layout {
         let order = robot.dfs_joints();
+        let mut v_index = Vec::with_capacity(order.len());
         let mut q_index = Vec::with_capacity(order.len());
-        let mut nq = 0;
+        let (mut nv, mut nq) = (0, 0);
         let mut values = BTreeMap::new();
         for (i, &j) in order.iter().enumerate() {
             let body = i + 1;
             let joint = &robot.joints[j];
-            q_index.push(match joint.kind {
-                JointKind::Fixed => None,
-                _ => {
-                    nq += 1;
-                    Some(nq)
-                }
-            });
+            let kind = joint.kind;
+            v_index.push((kind.nv() > 0).then_some(nv + 1));
+            q_index.push((kind.nq() > 0).then_some(nq + 1));
+            nv += kind.nv();
+            nq += kind.nq();
             for (k, x) in joint.origin.xyz.iter().enumerate() {
                 values.insert(format!("dpt[{}][{body}]", k + 1), *x);
             }
@@ -135,7 +143,7 @@ impl Layout {
                 }
             }
         }
-        Layout { q_index, values }
+        Layout { v_index, q_index, nv, nq, values }
     }
 
     /// `In[k][b]` for row `r`, column `c` (0-based) of body `b`'s tensor: the upper entry's name.
@@ -173,6 +181,9 @@ pub struct Generated {
 pub struct Request {
     /// Fold every parameter into the equations (`--fold-params`).
     pub fold: bool,
+    /// The gravity vector as numbers (m/s², world frame; `-gravity=x,y,z`) instead of the
+    /// inputs `g[1..3]`.
+    pub gravity: Option<[f64; 3]>,
     /// The functions to write, by name (`-function=NAME`); `None`: `invdyna` and `dirdyna`. Names
     /// the generator does not write are ignored (the driver reports them against
     /// [`FUNCTION_NAMES`] before loading).
@@ -238,9 +249,11 @@ impl std::fmt::Display for Stopped {
 }
 
 /// The tree's parent array over the coordinates (Featherstone's `λ`, *Rigid Body Dynamics
-/// Algorithms* §6.5): entry `i` (coordinate `q[i]`, 1-based; entry 0 unused) is the coordinate
-/// of the nearest moving joint above joint `i`'s, 0 when there is none. Coordinates are
-/// numbered depth first, so `λ[i] < i`. Length `nq + 1`.
+/// Algorithms* §6.5): entry `i` (velocity coordinate `qd[i]`, 1-based; entry 0 unused) is the
+/// coordinate of the nearest moving joint above joint `i`'s, 0 when there is none; a free
+/// flyer's six coordinates are a chain (`λ[i + k] = i + k − 1`; its block of `M` is dense) and
+/// the joints below it hang from its last. Coordinates are numbered depth first, so `λ[i] < i`.
+/// Length `nv + 1`.
 pub fn coordinate_parents(model: &Model, layout: &Layout) -> Vec<usize> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
@@ -250,13 +263,17 @@ pub fn coordinate_parents(model: &Model, layout: &Layout) -> Vec<usize> {
     }
     // The coordinate of the nearest moving joint at or above each body (0: none).
     let mut up = vec![0usize; order.len() + 1];
-    let mut lambda = vec![0usize; layout.q_index.iter().flatten().count() + 1];
+    let mut lambda = vec![0usize; layout.nv + 1];
     for (i, &j) in order.iter().enumerate() {
         let p = link_body[robot.joints[j].parent];
-        up[i + 1] = match layout.q_index[i] {
+        up[i + 1] = match layout.v_index[i] {
             Some(qi) => {
                 lambda[qi] = up[p];
-                qi
+                let last = qi + robot.joints[j].kind.nv() - 1;
+                for k in qi + 1..=last {
+                    lambda[k] = k - 1;
+                }
+                last
             }
             None => up[p],
         };
@@ -322,6 +339,11 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
     let layout = Layout::of(&model.robot);
     let consts: FxHashMap<String, f64> =
         if request.fold { layout.nonzero().into_iter().collect() } else { FxHashMap::default() };
+    // `-gravity`: the inputs `g[1..3]` folded to numbers as the parameters are.
+    let consts: FxHashMap<String, f64> = consts
+        .into_iter()
+        .chain(request.gravity.iter().flat_map(|g| (0..3).map(|k| (format!("g[{}]", k + 1), g[k]))))
+        .collect();
     let mut functions = Vec::new();
     for (name, write, _) in FUNCTIONS.iter().filter(|(name, _, _)| request.wants(name)) {
         let mut b = Builder::new(name, consts.clone());

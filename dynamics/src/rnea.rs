@@ -87,6 +87,38 @@ pub struct Motion {
     pub(super) rot: Option<M3>,
     /// `axis·q` of a prismatic joint.
     pub(super) shift: Option<V3>,
+    /// A free flyer's rotation `R(quat)` (base → world; [`quaternion_rotation`]). Its
+    /// translation enters no dynamics; `rot` and `shift` are `None`.
+    pub(super) free: Option<M3>,
+}
+
+/// The rotation (child → parent) of the unit quaternion `(x, y, z, w)`, as Eigen's
+/// `Quaternion::toRotationMatrix` (what Pinocchio's free flyer uses) writes it, with
+/// `t = 2·(x, y, z)`: `R = [[1 − (tyy + tzz), txy − twz, txz + twy], [txy + twz, 1 − (txx + tzz),
+/// tyz − twx], [txz − twy, tyz + twx, 1 − (txx + tyy)]]` (`tyy = ty·y`, `twz = tz·w`, …).
+/// For a quaternion that is not of unit norm this is not a rotation, as in Pinocchio:
+/// normalising is the caller's job. Every entry bound once as `RQ{r}{c}{body}`.
+fn quaternion_rotation(b: &mut Builder, body: usize, quat: [Term; 4]) -> M3 {
+    let [x, y, z, w] = quat;
+    let t = [x.clone(), y.clone(), z.clone()].map(|c| mul(Term::C(2.0), c));
+    let t: [Term; 3] = [0, 1, 2].map(|k| b.bind(&format!("TQ{}{body}", k + 1), t[k].clone()));
+    let p = |a: &Term, c: &Term| mul(a.clone(), c.clone());
+    let (txx, tyy, tzz) = (p(&t[0], &x), p(&t[1], &y), p(&t[2], &z));
+    let (txy, txz, tyz) = (p(&t[1], &x), p(&t[2], &x), p(&t[2], &y));
+    let (twx, twy, twz) = (p(&t[0], &w), p(&t[1], &w), p(&t[2], &w));
+    let one = || Term::C(1.0);
+    let r = [
+        [sub(one(), add(tyy.clone(), tzz.clone())), sub(txy.clone(), twz.clone()), add(txz.clone(), twy.clone())],
+        [add(txy, twz), sub(one(), add(txx.clone(), tzz)), sub(tyz.clone(), twx.clone())],
+        [sub(txz, twy), add(tyz, twx), sub(one(), add(txx, tyy))],
+    ];
+    let mut out: M3 = Default::default();
+    for (i, row) in r.into_iter().enumerate() {
+        for (j, e) in row.into_iter().enumerate() {
+            out[i][j] = b.bind(&format!("RQ{}{}{body}", i + 1, j + 1), e);
+        }
+    }
+    out
 }
 
 /// What drives one RNEA sweep: joint rates and accelerations per coordinate (index `i − 1` for
@@ -120,7 +152,7 @@ pub fn motions(model: &Model, layout: &Layout, b: &mut Builder) -> Vec<Motion> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
     let mut motions: Vec<Motion> = Vec::with_capacity(order.len() + 1);
-    motions.push(Motion { rot: None, shift: None });
+    motions.push(Motion { rot: None, shift: None, free: None });
     for (i, &j) in order.iter().enumerate() {
         let joint = &robot.joints[j];
         let motion = match (joint.kind, layout.q_index[i]) {
@@ -137,13 +169,18 @@ pub fn motions(model: &Model, layout: &Layout, b: &mut Builder) -> Vec<Motion> {
                     c = b.bind(&format!("CQ{qi}"), c2);
                     s = b.bind(&format!("SQ{qi}"), s2);
                 }
-                Motion { rot: Some(axis_rotation(&joint.axis, &c, &s)), shift: None }
+                Motion { rot: Some(axis_rotation(&joint.axis, &c, &s)), shift: None, free: None }
             }
             (JointKind::Prismatic, Some(qi)) => {
                 let q = b.input(&format!("q[{qi}]"));
-                Motion { rot: None, shift: Some(scale(&joint.axis, &q)) }
+                Motion { rot: None, shift: Some(scale(&joint.axis, &q)), free: None }
             }
-            _ => Motion { rot: None, shift: None },
+            (JointKind::FreeFlyer, Some(qi)) => {
+                // q[qi..qi + 2]: the position, which no dynamics reads; then x, y, z, w.
+                let quat = [3, 4, 5, 6].map(|k| b.input(&format!("q[{}]", qi + k)));
+                Motion { rot: None, shift: None, free: Some(quaternion_rotation(b, i + 1, quat)) }
+            }
+            _ => Motion { rot: None, shift: None, free: None },
         };
         motions.push(motion);
     }
@@ -155,7 +192,7 @@ pub fn motions(model: &Model, layout: &Layout, b: &mut Builder) -> Vec<Motion> {
 /// # Errors
 /// [`Stopped`] at the builder's deadline.
 pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
-    let nq = layout.q_index.iter().flatten().count();
+    let nq = layout.nv;
     let drive = Drive::inputs(b, nq, true);
     let motions = motions(model, layout, b);
     for (qi, t) in sweep(model, layout, b, &motions, &drive)? {
@@ -232,12 +269,23 @@ pub fn sweep(
         let omp_j = matvec(&ro, &omp[p], true);
         let mut al_j = matvec(&ro, &acc, true);
         let m = &motions[body];
-        let (qd, qdd) = match layout.q_index[i] {
+        let (qd, qdd) = match layout.v_index[i] {
             Some(qi) => (drive.qd[qi - 1].clone(), drive.qdd[qi - 1].clone()),
             None => (ZERO, ZERO),
         };
-        let (om_b, omp_b, al_b) = match (&m.rot, &m.shift) {
-            (Some(r), _) => {
+        let (om_b, omp_b, al_b) = match (&m.rot, &m.shift, &m.free) {
+            (_, _, Some(r)) => {
+                // A free flyer from the fixed world (`om_j`, `omp_j` are 0): the base's own
+                // velocity (linear `v`, angular `w`) and its derivative in its frame, so the
+                // classical acceleration of its origin is `v' + w × v`.
+                let qi = layout.v_index[i].expect("a free flyer has coordinates");
+                let at = |x: &[Term], k: usize| x[qi - 1 + k].clone();
+                let (v, w) = ([0, 1, 2].map(|k| at(&drive.qd, k)), [3, 4, 5].map(|k| at(&drive.qd, k)));
+                let (vp, wp) = ([0, 1, 2].map(|k| at(&drive.qdd, k)), [3, 4, 5].map(|k| at(&drive.qdd, k)));
+                let al_b = vadd(&matvec(r, &al_j, true), &vadd(&vp, &cross(&w, &v)));
+                (vadd(&matvec(r, &om_j, true), &w), vadd(&matvec(r, &omp_j, true), &wp), al_b)
+            }
+            (Some(r), _, _) => {
                 let om_j = bind3(b, "ROM", body, om_j);
                 let al_j = bind3(b, "RALPHA", body, al_j);
                 let om_r = matvec(r, &om_j, true);
@@ -247,7 +295,7 @@ pub fn sweep(
                 let omp_b = vadd(&vadd(&omp_r, &scale(&joint.axis, &qdd)), &cross(&om_r, &sq));
                 (om_b, omp_b, matvec(r, &al_j, true))
             }
-            (None, Some(shift)) => {
+            (None, Some(shift), _) => {
                 let om_j = bind3(b, "ROM", body, om_j);
                 let omp_j = bind3(b, "ROMp", body, omp_j);
                 al_j = vadd(&al_j, &vadd(&cross(&omp_j, shift), &cross(&om_j, &cross(&om_j, shift))));
@@ -256,7 +304,7 @@ pub fn sweep(
                 let al_b = vadd(&vadd(&al_j, &scale(&joint.axis, &qdd)), &vadd(&cor, &cor));
                 (om_j, omp_j, al_b)
             }
-            (None, None) => (om_j, omp_j, al_j),
+            (None, None, None) => (om_j, omp_j, al_j),
         };
         om[body] = bind3(b, "OM", body, om_b);
         omp[body] = bind3(b, "OMp", body, omp_b);
@@ -267,7 +315,7 @@ pub fn sweep(
     let mut moves = vec![false; nb + 1];
     for (i, &j) in order.iter().enumerate() {
         let p = body_of_link(robot.joints[j].parent);
-        moves[i + 1] = moves[p] || layout.q_index[i].is_some();
+        moves[i + 1] = moves[p] || layout.v_index[i].is_some();
     }
     // Backward dynamics.
     let mut fq: Vec<V3> = vec![[ZERO, ZERO, ZERO]; nb + 1];
@@ -292,12 +340,15 @@ pub fn sweep(
         let f_tot = bind3(b, "Fq", body, vadd(&fs, &fq[body]));
         let c_tot = bind3(b, "Cq", body, vadd(&cs, &cq[body]));
         let m = &motions[body];
-        let tau = match (joint.kind, layout.q_index[i]) {
-            (JointKind::Prismatic, Some(qi)) => Some((qi, dot(&joint.axis, &f_tot))),
-            (JointKind::Revolute, Some(qi)) => Some((qi, dot(&joint.axis, &c_tot))),
-            _ => None,
-        };
-        torque.extend(tau);
+        match (joint.kind, layout.v_index[i]) {
+            (JointKind::Prismatic, Some(qi)) => torque.push((qi, dot(&joint.axis, &f_tot))),
+            (JointKind::Revolute, Some(qi)) => torque.push((qi, dot(&joint.axis, &c_tot))),
+            // The base's spatial force in its frame: force, then moment about its origin.
+            (JointKind::FreeFlyer, Some(qi)) => {
+                torque.extend(f_tot.iter().chain(&c_tot).enumerate().map(|(k, t)| (qi + k, t.clone())))
+            }
+            _ => {}
+        }
         // Into the parent's frame, about its origin.
         let p = body_of_link(joint.parent);
         if !moves[p] {

@@ -84,6 +84,31 @@ pub enum JointKind {
     Prismatic,
     /// `fixed`: no degree of freedom.
     Fixed,
+    /// Pinocchio's `JointModelFreeFlyer` (the root joint of `--free-flyer`,
+    /// [`Robot::with_free_flyer`]): the child's pose in the parent (the world) as 7 configuration
+    /// coordinates — position (m), then the unit quaternion `(x, y, z, w)` — and its velocity as 6
+    /// — linear (m/s), then angular (rad/s), both in the child's frame. Only as the root joint,
+    /// from a fixed world; `axis` and `origin` are unused (identity).
+    FreeFlyer,
+}
+
+impl JointKind {
+    /// Velocity coordinates (`qd`, `qdd`, `Qq`, rows of `M`) of the joint: 0, 1 or 6.
+    pub fn nv(self) -> usize {
+        match self {
+            JointKind::Fixed => 0,
+            JointKind::Revolute | JointKind::Prismatic => 1,
+            JointKind::FreeFlyer => 6,
+        }
+    }
+
+    /// Configuration coordinates (`q`) of the joint: 0, 1 or 7.
+    pub fn nq(self) -> usize {
+        match self {
+            JointKind::FreeFlyer => 7,
+            k => k.nv(),
+        }
+    }
 }
 
 /// One joint of the tree.
@@ -152,7 +177,11 @@ impl Robot {
         in_segment[self.root] = true;
         for j in self.dfs_joints() {
             let jo = &self.joints[j];
-            let plain = jo.origin.xyz == [0.0; 3] && jo.origin.rot == Origin::IDENTITY.rot;
+            // A free flyer's child is no part of it: the base's velocity is in its own frame,
+            // whose six coordinates the CRBA writes as one block, not by projection.
+            let plain = jo.origin.xyz == [0.0; 3]
+                && jo.origin.rot == Origin::IDENTITY.rot
+                && jo.kind != JointKind::FreeFlyer;
             in_segment[jo.child] =
                 in_segment[jo.parent] && plain && !(jo.kind == JointKind::Prismatic && revolute_above[jo.parent]);
             revolute_above[jo.child] = revolute_above[jo.parent] || jo.kind == JointKind::Revolute;
@@ -237,6 +266,50 @@ impl Robot {
             });
             parent = child;
         }
+        Ok(self)
+    }
+}
+
+/// The name of the free flyer's joint (Pinocchio's `root_joint`) and of the fixed link above it
+/// (Pinocchio's `universe`), [`Robot::with_free_flyer`].
+pub const FREE_FLYER: [&str; 2] = ["root_joint", "universe"];
+
+impl Robot {
+    /// `self` on Pinocchio's free-flyer base (`JointModelFreeFlyer`, `--free-flyer`): a new fixed
+    /// root link `universe` and the joint `root_joint` of kind [`JointKind::FreeFlyer`] from it
+    /// to the old root, whose mass now counts. The joint is body 1 and takes `q[1..7]` (position,
+    /// quaternion `x, y, z, w`) and `qd[1..6]`, `qdd[1..6]`, `Qq[1..6]` (linear, then angular, in
+    /// the base frame); the URDF's moving joints follow from `q[8]` and `qd[7]`. Pinocchio's model
+    /// is `buildModelFromUrdf(path, JointModelFreeFlyer())`, with the same numbering.
+    ///
+    /// # Errors
+    /// The name and the element of the first URDF joint or link, in the file's order, whose name
+    /// is `root_joint` (a joint) or `universe` (a link).
+    pub fn with_free_flyer(mut self) -> Result<Robot, (String, Span)> {
+        let clash = self
+            .joints
+            .iter()
+            .filter(|j| j.name == FREE_FLYER[0])
+            .map(|j| (&j.name, j.span))
+            .chain(self.links.iter().filter(|l| l.name == FREE_FLYER[1]).map(|l| (&l.name, l.span)))
+            .min_by_key(|(_, span)| span.start);
+        if let Some((name, span)) = clash {
+            return Err((name.clone(), span));
+        }
+        let old_root = self.root;
+        let span = self.links[old_root].span;
+        self.links.push(Link { name: FREE_FLYER[1].into(), inertial: None, span });
+        self.root = self.links.len() - 1;
+        self.joints.push(Joint {
+            name: FREE_FLYER[0].into(),
+            kind: JointKind::FreeFlyer,
+            parent: self.root,
+            child: old_root,
+            origin: Origin::IDENTITY,
+            axis: [0.0; 3],
+            offset: 0.0,
+            span,
+        });
         Ok(self)
     }
 }

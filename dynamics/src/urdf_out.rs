@@ -41,12 +41,15 @@ pub fn write_urdf(robot: &Robot) -> String {
             JointKind::Revolute => "continuous",
             JointKind::Prismatic => "prismatic",
             JointKind::Fixed => "fixed",
+            // URDF's spelling of a six-degree-of-freedom joint (robovec reads the URDF back
+            // without it and adds it with `--free-flyer`).
+            JointKind::FreeFlyer => "floating",
         };
         let _ = writeln!(s, "  <joint name=\"{}\" type=\"{kind}\">", xml_escape(&j.name));
         let _ = writeln!(s, "    <parent link=\"{}\"/>", xml_escape(&robot.links[j.parent].name));
         let _ = writeln!(s, "    <child link=\"{}\"/>", xml_escape(&robot.links[j.child].name));
         let _ = writeln!(s, "    <origin xyz=\"{}\" rpy=\"{}\"/>", triple(j.origin.xyz), triple(rpy(&j.origin)));
-        if j.kind != JointKind::Fixed {
+        if matches!(j.kind, JointKind::Revolute | JointKind::Prismatic) {
             let _ = writeln!(s, "    <axis xyz=\"{}\"/>", triple(j.axis));
         }
         if j.kind == JointKind::Prismatic {

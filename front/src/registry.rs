@@ -28,6 +28,13 @@ pub struct FrontOptions {
     /// `R1`–`R3` before the root link, `q[1..6]`; see `robovec_dynamics::robot::Robot::with_floating_base`).
     /// Front ends of fixed equations (Robotran files, IR) ignore it.
     pub floating_base: bool,
+    /// `--free-flyer`: put the robot on Pinocchio's free-flyer base (`q[1..7]` position and
+    /// quaternion, `qd[1..6]` the base's velocity in its frame; see
+    /// `robovec_dynamics::robot::Robot::with_free_flyer`). Front ends of fixed equations ignore it.
+    pub free_flyer: bool,
+    /// `-gravity=x,y,z`: the gravity vector written into generated equations as numbers
+    /// (m/s², world frame) instead of the inputs `g[1..3]`. Front ends of fixed equations ignore it.
+    pub gravity: Option<[f64; 3]>,
     /// `-function=NAME`: the functions the run will use; `None`: all. A front end that builds
     /// its functions (the URDF's generator) builds only these (issue 28: `-function=invdyna`
     /// does not build `dirdyna`); front ends that read their functions ignore it.

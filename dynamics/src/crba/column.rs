@@ -111,10 +111,18 @@ impl Tree<'_> {
             }
             return Ok(false);
         }
-        if let Some(qi) = self.layout.q_index[at - 1] {
+        if let Some(qi) = self.layout.v_index[at - 1] {
             let jo = &self.robot.joints[self.order[at - 1]];
-            let t = if jo.kind == JointKind::Revolute { dot(&jo.axis, &col.n) } else { dot(&jo.axis, &col.f) };
-            upper.push(((qi, qj), bind_entry(b, qi, qj, t)));
+            match jo.kind {
+                // A free flyer's six rows: the force, then the moment, in the base frame.
+                JointKind::FreeFlyer => {
+                    for (k, t) in col.f.iter().chain(&col.n).enumerate() {
+                        upper.push(((qi + k, qj), bind_entry(b, qi + k, qj, t.clone())));
+                    }
+                }
+                JointKind::Revolute => upper.push(((qi, qj), bind_entry(b, qi, qj, dot(&jo.axis, &col.n)))),
+                _ => upper.push(((qi, qj), bind_entry(b, qi, qj, dot(&jo.axis, &col.f)))),
+            }
         }
         let p = self.parent[at];
         if !self.moves[p] {
@@ -189,7 +197,7 @@ impl Tree<'_> {
         }
         let mut out = Vec::new();
         for (idx, &bi) in path.iter().enumerate() {
-            let Some(qi) = self.layout.q_index[bi - 1] else { continue };
+            let Some(qi) = self.layout.v_index[bi - 1] else { continue };
             let jo = &self.robot.joints[self.order[bi - 1]];
             let w = cache.entry((at, bi)).or_insert_with(|| {
                 let mut w: V3 = jo.axis.map(Term::C);

@@ -82,8 +82,9 @@ mod composite;
 mod tests;
 mod tree;
 
-use super::rnea::{numeric, Motion, M3, SUM_CHUNK, V3};
-use super::sym::{Builder, Term};
+use super::rnea::{cross, numeric, Motion, M3, SUM_CHUNK, V3};
+use super::robot::JointKind;
+use super::sym::{mul, Builder, Term, ZERO};
 use super::{Layout, Model, Stopped};
 pub(crate) use column::bind_entry;
 use column::merged_rotation;
@@ -117,7 +118,7 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
         std::iter::once(0).chain(order.iter().map(|&j| link_body[robot.joints[j].parent])).collect();
     let mut moves = vec![false; nb + 1];
     for i in 0..nb {
-        moves[i + 1] = moves[parent[i + 1]] || layout.q_index[i].is_some();
+        moves[i + 1] = moves[parent[i + 1]] || layout.v_index[i].is_some();
     }
     let ro: Vec<M3> =
         std::iter::once(M3::default()).chain(order.iter().map(|&j| numeric(&robot.joints[j].origin.rot))).collect();
@@ -132,7 +133,7 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
         std::iter::once(true).chain(order.iter().map(|&j| segment_of_link[robot.joints[j].child])).collect();
     let mut segment_moving = vec![0usize; nb + 1];
     for body in 1..=nb {
-        segment_moving[body] = segment_moving[parent[body]] + usize::from(layout.q_index[body - 1].is_some());
+        segment_moving[body] = segment_moving[parent[body]] + usize::from(layout.v_index[body - 1].is_some());
     }
     let tree = Tree { robot, layout, motions, order, parent, moves, ro, merged, in_segment, segment_moving };
     let waits = tree.waits();
@@ -170,7 +171,14 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
                 comp[p] = comp[p].bind(b, format_args!("{p}_{}", children[p] / SUM_CHUNK));
             }
         }
-        if let Some(qj) = layout.q_index[body - 1] {
+        let kind = robot.joints[tree.order[body - 1]].kind;
+        if let (JointKind::FreeFlyer, Some(qj)) = (kind, layout.v_index[body - 1]) {
+            // The base's six columns: the whole robot's composite about the base origin, in the
+            // base frame (the world above does not move: nothing to carry). Columns waiting for
+            // this body's go up first.
+            tree.finish(b, &mut projections, &mut pending, &mut upper)?;
+            upper.extend(free_flyer_block(b, qj, &c));
+        } else if let Some(qj) = layout.v_index[body - 1] {
             // A column waiting for this body's (its child's, one step up already) goes up with it:
             // a body waits only for its parent, which is the next body this loop forms.
             debug_assert!(pending.iter().all(|o| o.at() == body), "a waiting column is at its parent");
@@ -185,4 +193,29 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, motions: &[M
     }
     debug_assert!(pending.is_empty(), "the root waits for no column");
     Ok(upper)
+}
+
+/// The upper triangle of a free flyer's 6 × 6 block of `M` (coordinates `qj..qj + 5`: linear,
+/// then angular, in the base frame) from the composite `c = (m, h, J)` of everything it
+/// carries: a unit linear acceleration `e_b` needs the force `m e_b` (and the moment
+/// `h × e_b`), a unit angular one the force `e_b × h` and the moment `J e_b`; so
+/// `M = [[m 1, −[h]×], [[h]×, J]]` (Featherstone 2008, §2.13), each entry bound as
+/// [`bind_entry`].
+fn free_flyer_block(b: &mut Builder, qj: usize, c: &Composite) -> Entries {
+    let mut out = Vec::with_capacity(21);
+    for col in 0..6 {
+        let mut e: V3 = [ZERO, ZERO, ZERO];
+        e[col % 3] = Term::C(1.0);
+        // The force and moment of this column's unit acceleration.
+        let (f, n): (V3, V3) = if col < 3 {
+            (e.clone().map(|x| mul(c.m.clone(), x)), cross(&c.h, &e))
+        } else {
+            (cross(&e, &c.h), c.j[col - 3].clone())
+        };
+        for (row, t) in f.into_iter().chain(n).enumerate().take(col + 1) {
+            let (i, j) = (qj + row, qj + col);
+            out.push(((i, j), bind_entry(b, i, j, t)));
+        }
+    }
+    out
 }

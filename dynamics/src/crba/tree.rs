@@ -47,7 +47,8 @@ impl Tree<'_> {
             waits[body] = p > 0
                 && p + 1 == body
                 && self.moves[p]
-                && self.layout.q_index[p - 1].is_some()
+                && self.layout.v_index[p - 1].is_some()
+                && self.robot.joints[self.order[p - 1]].kind != crate::robot::JointKind::FreeFlyer
                 && walk[body] >= PAIR_WALK
                 && !dense[body];
         }

@@ -60,10 +60,16 @@ impl FrontEnd for Urdf {
                 vec![FrontError::new(span, format!("`{name}` is a name of robovec's floating base"), "this element")
                     .note("rename this URDF joint or link to use --floating-base")]
             })?
+        } else if opts.free_flyer {
+            robot.with_free_flyer().map_err(|(name, span)| {
+                vec![FrontError::new(span, format!("`{name}` is a name of robovec's free flyer"), "this element")
+                    .note("rename this URDF joint or link to use --free-flyer")]
+            })?
         } else {
             robot
         };
         let request = robovec_dynamics::Request {
+            gravity: opts.gravity,
             fold: opts.fold_params,
             functions: opts.functions.clone(),
             deadline: opts.deadline,
@@ -85,6 +91,7 @@ impl FrontEnd for Urdf {
         })?;
         // `-eval`'s values for inputs not given: the model's own, and gravity as Pinocchio's
         // `Model::gravity` (−9.81 m/s² along z).
+        // (With -gravity, no function has the inputs `g[k]`.)
         let mut input_defaults = g.params.clone().unwrap_or_default();
         input_defaults.extend([("g[1]".to_string(), 0.0), ("g[2]".to_string(), 0.0), ("g[3]".to_string(), -9.81)]);
         let defaults_source = "the URDF's parameters and Pinocchio's gravity (0, 0, -9.81)";
