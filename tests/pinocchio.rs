@@ -231,6 +231,9 @@ fn long_chain_forward_dynamics_by_the_aba_matches_pinocchio() {
     std::fs::write(&path, robovec_dynamics::urdf_out::write_urdf(&robot)).unwrap();
     let e = compare(path.to_str().unwrap(), 60);
     eprintln!("serial 60: worst relative error {e:e}");
+    // On the free flyer: the ABA's 6 × 6 solve at the root.
+    let e = compare_on(path.to_str().unwrap(), 60 + 6, Base::FreeFlyer);
+    eprintln!("serial 60 free flyer: worst relative error {e:e}");
 }
 
 /// Robotran's floating base (`--floating-base`: T1–T3, R1–R3 as `q[1..6]`) against Pinocchio's

@@ -291,3 +291,71 @@ fn robovec_gen_writes_line_breaks_in_names_as_character_references() {
     assert!(back.contains("<robot name=\"three&#10;arm\">") && back.contains("<link name=\"base&#10;x\">"), "{back}");
     assert!(back.contains("<parent link=\"base&#10;x\"/>"), "{back}");
 }
+
+/// `--free-flyer` and `-gravity` from the command line: the free flyer's numbering (seven
+/// configuration coordinates, six velocity ones, the URDF's joints after), `-gravity` writing
+/// the numbers where the inputs `g[k]` were (the same `Qq` as those inputs given the same
+/// values), and the diagnostics: `--free-flyer` with `--floating-base` and a malformed
+/// `-gravity` exit 2, a URDF joint named `root_joint` exits 1 at that joint.
+#[test]
+fn free_flyer_and_gravity_options() {
+    let arm = path("examples/three_link_arm/three_link_arm.urdf");
+    let load = |gravity: Option<[f64; 3]>| {
+        let opts = FrontOptions { free_flyer: true, gravity, fold_params: true, ..FrontOptions::default() };
+        robovec::driver::load_with(&arm, &opts).expect("URDF loads").0
+    };
+    let (inputs, folded) = (load(None), load(Some([0.5, -1.0, -9.81])));
+    let names = |m: &robovec_front::Loaded| -> Vec<String> {
+        let f = &m.module.functions[0];
+        f.inputs.iter().map(|&v| f.name_of(v).to_string()).collect()
+    };
+    let with_g = names(&inputs);
+    for k in 1..=3 {
+        assert!(with_g.contains(&format!("g[{k}]")), "{with_g:?}");
+    }
+    // The quaternion and the base's six rates are inputs; the position enters no dynamics.
+    for name in ["q[4]", "q[7]", "q[8]", "q[10]", "qd[1]", "qd[6]", "qd[9]", "qdd[9]"] {
+        assert!(with_g.contains(&name.to_string()), "{name} in {with_g:?}");
+    }
+    assert!(!with_g.iter().any(|n| n == "q[1]" || n == "q[11]" || n == "qd[10]"), "{with_g:?}");
+    assert!(!names(&folded).iter().any(|n| n.starts_with("g[")), "{:?}", names(&folded));
+    let f = &inputs.module.functions[0];
+    assert_eq!(f.outputs.len(), 9, "Qq[1..9]");
+    let mut rng = robovec_ir::rng::SplitMix64::new(3);
+    let mut given: BTreeMap<String, f64> = [("g[1]", 0.5), ("g[2]", -1.0), ("g[3]", -9.81)]
+        .into_iter()
+        .map(|(k, x)| (k.to_string(), x))
+        .collect();
+    for i in 1..=10 {
+        given.insert(format!("q[{i}]"), 2.0 * rng.unit() - 1.0);
+    }
+    for i in 1..=9 {
+        given.insert(format!("qd[{i}]"), 2.0 * rng.unit() - 1.0);
+        given.insert(format!("qdd[{i}]"), 2.0 * rng.unit() - 1.0);
+    }
+    let a = robovec::eval::evaluate(f, &given, false).outputs;
+    let b = robovec::eval::evaluate(&folded.module.functions[0], &given, false).outputs;
+    assert_eq!(a, b, "-gravity writes the numbers the inputs would carry");
+
+    let o = opt(&[&arm, "--free-flyer", "--floating-base", "-passes=atomise"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--free-flyer") && stderr(&o).contains("--floating-base"), "{}", stderr(&o));
+    for bad in ["-gravity=0,-9.81", "-gravity=0,0,x", "-gravity=0,0,inf"] {
+        let o = opt(&[&arm, bad, "-passes=atomise"]);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
+        assert!(stderr(&o).contains("expected three finite numbers"), "{bad}: {}", stderr(&o));
+    }
+    let o = opt(&[&arm, "--free-flyer", "-gravity=0,0,-1.62", "-passes=atomise", "-o", "/dev/null"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let d = tmp("free_flyer_clash");
+    let clash = d.join("clash.urdf");
+    std::fs::write(
+        &clash,
+        "<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"b\"/>\n  <joint name=\"root_joint\" type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/></joint>\n</robot>\n",
+    )
+    .unwrap();
+    let o = opt(&[clash.to_str().unwrap(), "--free-flyer", "-passes=atomise"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("`root_joint` is a name of robovec's free flyer") && e.contains("clash.urdf:4:3"), "{e}");
+}

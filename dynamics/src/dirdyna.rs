@@ -150,8 +150,7 @@ mod tests {
         let model = Model { robot: robot.clone() };
         let layout = Layout::of(&model.robot);
         let mut given: BTreeMap<String, f64> = layout.nonzero();
-        let nq = layout.nv;
-        for i in 1..=nq {
+        for i in 1..=layout.nq {
             given.insert(format!("q[{i}]"), (i as f64 * 0.7).sin() * 3.0);
         }
         let mut b = Builder::new("dirdyna", Default::default());
@@ -173,7 +172,8 @@ mod tests {
     }
 
     /// CRBA's `M` against the unit-acceleration RNEA's (an independent recursion) on every
-    /// topology family, on Robotran's floating base (the CRBA's root-segment projection) and on
+    /// topology family, on Robotran's floating base (the CRBA's root-segment projection), on the
+    /// free flyer (its 6 × 6 block from the whole robot's composite) and on
     /// a chain of dense URDF rotations (merged rotations), that chain also in the frames of
     /// `crate::frames`, and the families with the origins of `crate::origins` (the
     /// same `M`: the coordinates keep their meaning): equal to 1e-12.
@@ -192,6 +192,9 @@ mod tests {
         assert_close("floating base", &crba, &unit, 11);
         let slid = crate::origins::slide(&floating).expect("the chain above the base slides");
         assert_close("floating base, slid", &mass_matrix(&slid, MassMatrix::Crba), &crba, 11);
+        let free = build(Topology::SemiSerial, 5, 2).with_free_flyer().unwrap();
+        let (crba, unit) = (mass_matrix(&free, MassMatrix::Crba), mass_matrix(&free, MassMatrix::UnitAcceleration));
+        assert_close("free flyer", &crba, &unit, 11);
         let mut dense = build(Topology::Serial, 7, 5);
         for (i, j) in dense.joints.iter_mut().enumerate() {
             let x = i as f64;

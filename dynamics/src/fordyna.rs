@@ -225,11 +225,17 @@ mod tests {
         crate::dirdyna::dirdyna(&model, &layout, &mut b).expect("no deadline");
         let dir = &b.finish();
         let nq = fd.outputs.len();
+        assert_eq!(nq, layout.nv);
         let mut worst: f64 = 0.0;
         for seed in 1..=4u64 {
             let mut given: BTreeMap<String, f64> = params.clone();
+            // (A free flyer's quaternion is drawn too, not of unit norm: `M qdd + c = Qq`
+            // holds for any `R`.)
+            for i in 1..=layout.nq {
+                given.insert(format!("q[{i}]"), 3.0 * interp::pseudo_random_input(&format!("q[{i}]"), seed));
+            }
             for i in 1..=nq {
-                for v in ["q", "qd", "Qq"] {
+                for v in ["qd", "Qq"] {
                     let name = format!("{v}[{i}]");
                     given.insert(name.clone(), 3.0 * interp::pseudo_random_input(&name, seed));
                 }
@@ -251,7 +257,8 @@ mod tests {
     }
 
     /// `M qdd + c = Qq` to 1e-10 on every topology family (chains, branches, stars), on
-    /// Robotran's floating base (a dense 6 × 6 block above every branch) and with joints fixed
+    /// Robotran's floating base (a dense 6 × 6 block above every branch), on the free flyer (the
+    /// same block, the ABA's 6 × 6 root solve) and with joints fixed
     /// between moving ones (coordinates whose parent is not the previous body).
     #[test]
     fn forward_dynamics_inverts_the_mass_matrix() {
@@ -274,9 +281,12 @@ mod tests {
                 com: [0.05, -0.02, 0.1],
                 inertia: [[0.3, 0.01, -0.02], [0.01, 0.25, 0.03], [-0.02, 0.03, 0.2]],
             });
-            let floating = massive.with_floating_base().unwrap();
+            let floating = massive.clone().with_floating_base().unwrap();
             let e = residual(&floating, how);
             assert!(e <= 1e-10, "{how:?} {t} floating: residual {e:e}");
+            let free = massive.with_free_flyer().unwrap();
+            let e = residual(&free, how);
+            assert!(e <= 1e-10, "{how:?} {t} free flyer: residual {e:e}");
         }
         let mut with_fixed = build(Topology::SemiSerial, 8, 5);
         with_fixed.joints[2].kind = crate::robot::JointKind::Fixed;
@@ -285,8 +295,8 @@ mod tests {
         assert!(e <= 1e-10, "{how:?} fixed joints between moving ones: residual {e:e}");
     }
 
-    /// `λ` by hand on a chain with a fixed joint and on Robotran's floating base: the base's
-    /// six coordinates are a chain and its children hang from `R3` (coordinate 6).
+    /// `λ` by hand on a chain with a fixed joint, on Robotran's floating base and on the free
+    /// flyer: the base's six coordinates are a chain and its children hang from coordinate 6.
     #[test]
     fn coordinate_parents_follow_the_tree() {
         let mut chain = build(Topology::Serial, 4, 1);
@@ -294,9 +304,16 @@ mod tests {
         let layout = crate::Layout::of(&chain);
         // Joints 1, 3, 4 move: coordinates 1, 2, 3, each the child of the one before.
         assert_eq!(coordinate_parents(&Model { robot: chain.clone() }, &layout), [0, 0, 1, 2]);
-        let floating = chain.with_floating_base().unwrap();
+        let floating = chain.clone().with_floating_base().unwrap();
         let layout = crate::Layout::of(&floating);
         assert_eq!(coordinate_parents(&Model { robot: floating }, &layout), [0, 0, 1, 2, 3, 4, 5, 6, 7, 8]);
+        // The free flyer: one joint, six coordinates in a chain; seven configuration ones.
+        let free = chain.with_free_flyer().unwrap();
+        let layout = crate::Layout::of(&free);
+        assert_eq!((layout.nv, layout.nq), (9, 10));
+        assert_eq!(layout.v_index, [Some(1), Some(7), None, Some(8), Some(9)]);
+        assert_eq!(layout.q_index, [Some(1), Some(8), None, Some(9), Some(10)]);
+        assert_eq!(coordinate_parents(&Model { robot: free }, &layout), [0, 0, 1, 2, 3, 4, 5, 6, 7, 8]);
     }
 
     /// `Σ d(d − 1)` by hand: a chain of 4 (depths 1..4: 0 + 2 + 6 + 12) and a star of three

@@ -270,8 +270,8 @@ pub fn coordinate_parents(model: &Model, layout: &Layout) -> Vec<usize> {
             Some(qi) => {
                 lambda[qi] = up[p];
                 let last = qi + robot.joints[j].kind.nv() - 1;
-                for k in qi + 1..=last {
-                    lambda[k] = k - 1;
+                for (k, l) in lambda.iter_mut().enumerate().take(last + 1).skip(qi + 1) {
+                    *l = k - 1;
                 }
                 last
             }
