@@ -47,7 +47,10 @@ def locate(spec):
 def build_model(path, base):
     """Pinocchio's model of the URDF at `path`: fixed base, on the root joint
     JointModelComposite([PX, PY, PZ, RX, RY, RZ]) (`floating`, the layout of robovec's
-    --floating-base) or on JointModelFreeFlyer (`freeflyer`, robovec's --free-flyer)."""
+    --floating-base) or on JointModelFreeFlyer (`freeflyer`, robovec's --free-flyer). A bool
+    `base` is the bench's older spelling (True: `floating`)."""
+    if isinstance(base, bool):
+        base = "floating" if base else "fixed"
     if base == "fixed":
         return pin.buildModelFromUrdf(path)
     if base == "freeflyer":
