@@ -122,6 +122,40 @@ fn quaternion_rotation(b: &mut Builder, body: usize, quat: [Term; 4]) -> M3 {
     out
 }
 
+/// `U = [ω̇]× + [ω]×[ω]×` of a body (Khalil & Kleinfinger's customised Newton–Euler: W. Khalil,
+/// E. Dombre, *Modeling, Identification and Control of Robots*, 2002, §9.5): `U·v = ω̇ × v + ω ×
+/// (ω × v)`, the acceleration of a point at `v` relative to the origin's, for every child's
+/// joint origin and the centre of mass (or first moment) alike. `[ω]×² = ω ωᵀ − |ω|² I`: the six
+/// products `ωᵢωⱼ` (bound as `WW{i}{j}{body}`), three sums on the diagonal, six off it — 15 ops
+/// once per body where each `ω̇ × v + ω × (ω × v)` costs 33; entries bound as `U{r}{c}{body}`.
+fn acceleration_matrix(b: &mut Builder, body: usize, w: &V3, wp: &V3) -> M3 {
+    let mut ww: M3 = Default::default();
+    for i in 0..3 {
+        for j in i..3 {
+            ww[i][j] = b.bind(&format!("WW{}{}{body}", i + 1, j + 1), mul(w[i].clone(), w[j].clone()));
+            ww[j][i] = ww[i][j].clone();
+        }
+    }
+    let wpx = [[ZERO, neg(wp[2].clone()), wp[1].clone()], [wp[2].clone(), ZERO, neg(wp[0].clone())], [
+        neg(wp[1].clone()),
+        wp[0].clone(),
+        ZERO,
+    ]];
+    let mut out: M3 = Default::default();
+    for r in 0..3 {
+        for c in 0..3 {
+            let t = if r == c {
+                let (x, y) = ((r + 1) % 3, (r + 2) % 3);
+                neg(add(ww[x][x].clone(), ww[y][y].clone()))
+            } else {
+                add(ww[r][c].clone(), wpx[r][c].clone())
+            };
+            out[r][c] = b.bind(&format!("U{}{}{body}", r + 1, c + 1), t);
+        }
+    }
+    out
+}
+
 /// What drives one RNEA sweep: joint rates and accelerations per coordinate (index `i − 1` for
 /// `q[i]`) and the gravity vector `g`, as terms (inputs, or constants such as 0 and 1).
 pub struct Drive {
@@ -245,6 +279,8 @@ pub fn sweep(
     // Per body (1-based index = position in `order` + 1): kinematics in its frame.
     let g: V3 = drive.g.clone().map(neg);
     let mut om: Vec<V3> = vec![Default::default(); nb + 1];
+    // `U = [ω̇]× + [ω]×²` per body ([`acceleration_matrix`]); 0 for the fixed base.
+    let mut u: Vec<M3> = vec![Default::default(); nb + 1];
     let mut omp: Vec<V3> = vec![Default::default(); nb + 1];
     let mut alpha: Vec<V3> = vec![Default::default(); nb + 1];
     om[0] = [ZERO, ZERO, ZERO];
@@ -265,7 +301,7 @@ pub fn sweep(
         let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
         let ro = numeric(&joint.origin.rot);
         // Parent quantities at the joint origin, in the joint frame.
-        let acc = vadd(&alpha[p], &vadd(&cross(&omp[p], &d), &cross(&om[p], &cross(&om[p], &d))));
+        let acc = vadd(&alpha[p], &matvec(&u[p], &d, false));
         let om_j = matvec(&ro, &om[p], true);
         let omp_j = matvec(&ro, &omp[p], true);
         let mut al_j = matvec(&ro, &acc, true);
@@ -309,6 +345,7 @@ pub fn sweep(
         };
         om[body] = bind3(b, "OM", body, om_b);
         omp[body] = bind3(b, "OMp", body, omp_b);
+        u[body] = acceleration_matrix(b, body, &om[body], &omp[body]);
         alpha[body] = bind3(b, "ALPHA", body, al_b);
     }
     // Which bodies move: those with a moving joint on their path from the root. The others
@@ -355,17 +392,14 @@ pub fn sweep(
                 // `f = m α + ω̇ × h + ω × (ω × h)`, `n = J ω̇ + ω × (J ω) + h × α`.
                 Some(c) => {
                     let c = Composite::body(mass, l, inn).add(c).bind(b, format_args!("L{body}"));
-                    let fs = vadd(
-                        &a.clone().map(|x| mul(c.m.clone(), x)),
-                        &vadd(&cross(wp, &c.h), &cross(w, &cross(w, &c.h))),
-                    );
+                    let fs = vadd(&a.clone().map(|x| mul(c.m.clone(), x)), &matvec(&u[body], &c.h, false));
                     let fs = bind3(b, "Fs", body, fs);
                     let jw = matvec(&c.j, w, false);
                     let cs = vadd(&vadd(&matvec(&c.j, wp, false), &cross(w, &jw)), &cross(&c.h, a));
                     (fs, cs)
                 }
                 None => {
-                    let acc_c = vadd(a, &vadd(&cross(wp, &l), &cross(w, &cross(w, &l))));
+                    let acc_c = vadd(a, &matvec(&u[body], &l, false));
                     let fs = bind3(b, "Fs", body, acc_c.map(|x| mul(mass.clone(), x)));
                     let iw = matvec(&inn, w, false);
                     let cs = vadd(&vadd(&matvec(&inn, wp, false), &cross(w, &iw)), &cross(&l, &fs));
