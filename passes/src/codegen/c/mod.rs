@@ -329,7 +329,9 @@ impl CodegenC {
     ///
     /// # Errors
     /// [`PassError::Failed`] when a function cannot be written in this ABI (an unknown
-    /// Robotran function kind for `abi=robotran`, a callback used with two arities).
+    /// Robotran function kind for `abi=robotran`; for `abi=pinocchio` a function other than the
+    /// URDF generator's or an input or output with no place in Pinocchio's signatures,
+    /// [`pinocchio`]; a callback used with two arities).
     pub fn emit_as(&self, m: &Module, main: Option<&Path>) -> Result<CodegenArtifact, PassError> {
         self.emit_within(m, main, &crate::Ticker::default())
     }
