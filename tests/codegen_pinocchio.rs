@@ -67,7 +67,15 @@ const FUNCTIONS: &[(&str, &[&str], &str)] = &[
 /// Emits `m` with `o` (name `model`) into `dir`, checks the header's sizes against `nq`, `nv`,
 /// compiles it with a driver that calls every function on `states` (in calls of `o.batch`
 /// lanes, outputs pre-filled with NaN) and returns each state's results.
-fn run_c(dir: &Path, m: &Module, o: &CodegenC, nq: usize, nv: usize, states: &[StateIn], flags: &[&str]) -> Vec<Results> {
+fn run_c(
+    dir: &Path,
+    m: &Module,
+    o: &CodegenC,
+    nq: usize,
+    nv: usize,
+    states: &[StateIn],
+    flags: &[&str],
+) -> Vec<Results> {
     let w = o.batch as usize;
     assert_eq!(states.len() % w, 0);
     let art = o.emit(m).unwrap_or_else(|e| panic!("emit: {e}"));
@@ -223,9 +231,12 @@ fn against_pinocchio(py: &Path, label: &str, urdf: &str, continuous: bool) -> f6
         let got = run_c(&dir, &m, &co, nv, nv, &states, &["-O1"]);
         for (k, (r, s)) in got.iter().zip(&o.states).enumerate() {
             let mass: Vec<f64> = s.mass.iter().flatten().copied().collect();
-            for (what, g, want) in
-                [("tau", &r["tau"], &s.tau), ("M", &r["M"], &mass), ("nle", &r["nle"], &s.nle), ("qdd", &r["qdd"], &s.aba)]
-            {
+            for (what, g, want) in [
+                ("tau", &r["tau"], &s.tau),
+                ("M", &r["M"], &mass),
+                ("nle", &r["nle"], &s.nle),
+                ("qdd", &r["qdd"], &s.aba),
+            ] {
                 let e = rel(g, want);
                 assert!(
                     e <= 1e-10,
@@ -296,12 +307,14 @@ fn interpreted(m: &Module, s: &StateIn, nv: usize) -> Results {
         robovec::eval::evaluate(f, &given, false).outputs
     };
     let (inv, dir, fwd) = (out("invdyna"), out("dirdyna"), out("fordyna"));
-    let list = |o: &BTreeMap<String, f64>, base: &str| -> Vec<f64> {
-        (1..=nv).map(|k| o[&format!("{base}[{k}]")]).collect()
-    };
+    let list =
+        |o: &BTreeMap<String, f64>, base: &str| -> Vec<f64> { (1..=nv).map(|k| o[&format!("{base}[{k}]")]).collect() };
     let mut r = Results::new();
     r.insert("tau", list(&inv, "Qq"));
-    r.insert("M", (1..=nv).flat_map(|i| (1..=nv).map(move |j| (i, j))).map(|(i, j)| dir[&format!("M[{i}][{j}]")]).collect());
+    r.insert(
+        "M",
+        (1..=nv).flat_map(|i| (1..=nv).map(move |j| (i, j))).map(|(i, j)| dir[&format!("M[{i}][{j}]")]).collect(),
+    );
     r.insert("nle", list(&dir, "c"));
     r.insert("qdd", list(&fwd, "qdd"));
     r
@@ -391,7 +404,10 @@ fn dash_o_writes_pinocchios_signatures_and_the_report() {
     assert_eq!(r["codegen"]["inputs"], serde_json::json!(["q[1]", "q[2]", "q[3]"]));
     assert_eq!(r["codegen"]["outputs"].as_array().unwrap().len(), 9);
     // The C file compiles as C99 with every warning.
-    let cc = Command::new("cc").current_dir(&dir).args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-Wno-unknown-pragmas", "-c", "arm.c"]).output();
+    let cc = Command::new("cc")
+        .current_dir(&dir)
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-Wno-unknown-pragmas", "-c", "arm.c"])
+        .output();
     let cc = cc.expect("cc");
     assert!(cc.status.success(), "{}", String::from_utf8_lossy(&cc.stderr));
     // Default prefix `model`; the forward dynamics as `model_aba`.
@@ -430,8 +446,11 @@ fn what_has_no_place_in_pinocchios_signature_is_refused() {
     std::fs::write(&ir, "func @sensor_1 {\n  input %q[1]\n  %x = %q[1] * %q[1]\n  output sens.P[1] = %x\n}\n").unwrap();
     check(&[ir.to_str().unwrap(), pin], 1, &["@sensor_1: abi=pinocchio writes the URDF generator's @invdyna"]);
     let ir = dir.join("g.rvir");
-    std::fs::write(&ir, "func @invdyna {\n  input %q[1]\n  input %tsim\n  %x = %q[1] * %tsim\n  output Qq[1] = %x\n}\n")
-        .unwrap();
+    std::fs::write(
+        &ir,
+        "func @invdyna {\n  input %q[1]\n  input %tsim\n  %x = %q[1] * %tsim\n  output Qq[1] = %x\n}\n",
+    )
+    .unwrap();
     check(&[ir.to_str().unwrap(), pin], 1, &["input `tsim` has no place in Pinocchio's signature"]);
     check(
         &[ARM, "--fold-params", "-function=dirdyna", "-passes=atomise,dce<outputs=M[1][1],c>,codegen<c;abi=pinocchio>"],

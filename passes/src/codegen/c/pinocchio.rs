@@ -144,8 +144,7 @@ fn algorithms(f: &Function) -> Result<Vec<(Algo, &'static [&'static str])>, Pass
 /// index and largest velocity index.
 fn check(f: &Function) -> Result<(usize, usize), PassError> {
     let algos = algorithms(f)?;
-    let allowed: Vec<&str> =
-        algos.iter().flat_map(|(a, _)| a.arrays().0.iter().map(|x| x.1)).chain(["g"]).collect();
+    let allowed: Vec<&str> = algos.iter().flat_map(|(a, _)| a.arrays().0.iter().map(|x| x.1)).chain(["g"]).collect();
     let (mut nq, mut nv) = (0, 0);
     let mut params = Vec::new();
     for &v in &f.inputs {
@@ -160,15 +159,13 @@ fn check(f: &Function) -> Result<(usize, usize), PassError> {
                     nv = nv.max(idx[0]);
                 }
             }
-            _ => {
-                return Err(failed(
-                    f,
-                    format!(
-                        "input `{n}` has no place in Pinocchio's signature (abi=pinocchio reads {} and gravity g[1..3])",
-                        allowed[..allowed.len() - 1].join(", ")
-                    ),
-                ))
-            }
+            _ => return Err(failed(
+                f,
+                format!(
+                    "input `{n}` has no place in Pinocchio's signature (abi=pinocchio reads {} and gravity g[1..3])",
+                    allowed[..allowed.len() - 1].join(", ")
+                ),
+            )),
         }
     }
     if !params.is_empty() {
@@ -277,9 +274,10 @@ pub(crate) fn emit(
             inputs.push(if base == "g" {
                 Source::Const(GRAVITY[idx[0] - 1])
             } else {
-                let p = ins.iter().position(|x| x.1 == base).ok_or_else(|| {
-                    failed(f, format!("{symbol} takes no `{base}`, but its outputs read `{n}`"))
-                })?;
+                let p = ins
+                    .iter()
+                    .position(|x| x.1 == base)
+                    .ok_or_else(|| failed(f, format!("{symbol} takes no `{base}`, but its outputs read `{n}`")))?;
                 Source::Elem(p, idx[0] - 1)
             });
         }
@@ -305,8 +303,11 @@ pub(crate) fn emit(
             outputs.push(dest);
         }
         if let Some(e) = covered.iter().position(|c| !c) {
-            let missing =
-                if *a == Algo::Crba { format!("M[{}][{}]", e / nv + 1, e % nv + 1) } else { format!("{out_ir}[{}]", e + 1) };
+            let missing = if *a == Algo::Crba {
+                format!("M[{}][{}]", e / nv + 1, e % nv + 1)
+            } else {
+                format!("{out_ir}[{}]", e + 1)
+            };
             return Err(failed(
                 f,
                 format!(

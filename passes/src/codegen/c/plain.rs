@@ -51,12 +51,8 @@ pub(crate) fn function(
         inputs: (0..iface.inputs.len()).map(|i| Source::Elem(0, i)).collect(),
         outputs: (0..f.outputs.len()).map(|j| vec![(1, j)]).collect(),
     };
-    let comment = format!(
-        "@{}: {} inputs, {} outputs (order: see the header)",
-        f.name,
-        iface.inputs.len(),
-        iface.outputs.len()
-    );
+    let comment =
+        format!("@{}: {} inputs, {} outputs (order: see the header)", f.name, iface.inputs.len(), iface.outputs.len());
     let (s, parts) = arrays(o, f, symbol, taken, ticker, &layout, &comment);
     let real = o.real();
     let w = o.batch as usize;
@@ -229,10 +225,8 @@ pub(crate) fn arrays(
             }
         }
     };
-    let mut s = format!(
-        "/* {comment}{}. */\n",
-        if split { format!("; {} parts", plan.parts()) } else { String::new() }
-    );
+    let mut s =
+        format!("/* {comment}{}. */\n", if split { format!("; {} parts", plan.parts()) } else { String::new() });
     let mut parts = Vec::new();
     if split {
         let prefix = part_prefix(symbol, plan.parts(), taken);
