@@ -16,6 +16,8 @@ found under the installed package's share folder. Builds the fixed-base model wi
   {"path", "joints": [names in Pinocchio's order], "gravity": [gx, gy, gz],
    "states": [{"q": [...], "qd": [...], "qdd": [...], "tau": [...], "M": [[...]], "nle": [...],
                "aba": [...]}]}
+(q: one coordinate per joint, robovec's q[1..]; q_pinocchio: Pinocchio's own configuration vector,
+nq long: a continuous joint's (cos, sin))
 where tau = rnea(q, qd, qdd), M = crba(q) (Pinocchio fills the upper triangle only: symmetrized
 here), nle = nonLinearEffects(q, qd) and aba = aba(q, qd, tau) (forward dynamics: qdd again, as
 Pinocchio's own algorithm computes it).
@@ -108,6 +110,7 @@ def main():
         aba = pin.aba(model, data, q, v, tau)
         out["states"].append({
             "q": coords,
+            "q_pinocchio": list(map(float, q)),
             "qd": list(map(float, v)),
             "qdd": list(map(float, a)),
             "tau": list(map(float, tau)),

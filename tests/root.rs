@@ -12,6 +12,7 @@ mod bounds;
 mod c_names;
 mod cli;
 mod codegen_c;
+mod codegen_pinocchio;
 mod corpus;
 mod cse;
 mod diagnostics;

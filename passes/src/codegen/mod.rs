@@ -40,9 +40,9 @@ pub struct Interface {
     /// Function name in the IR (`dirdyna`).
     #[serde(skip)]
     pub function: String,
-    /// The C symbol (`dirdyna`, `mbs_dirdyna`).
+    /// The C symbol (`dirdyna`, `mbs_dirdyna`, `model_crba`).
     pub symbol: String,
-    /// `plain` or `robotran` (the report writes the word).
+    /// `plain`, `robotran` or `pinocchio` (the report writes the word).
     pub abi: Abi,
     /// `f64` or `f32`.
     pub precision: Precision,
@@ -51,7 +51,9 @@ pub struct Interface {
     /// `libm`, `input` or `inline`.
     pub trig: Trig,
     /// Canonical input names (SPEC §2), in argument order: `in[i]` (or `in[i*W + lane]`) is
-    /// input `i`. With `trig=input` the trig values (`S4`, `C4`) follow the IR's inputs.
+    /// input `i`. With `trig=input` the trig values (`S4`, `C4`) follow the IR's inputs. With
+    /// `abi=pinocchio`, the elements of the input arrays in order (`q[1]`…`q[nq]`, `qd[1]`…),
+    /// outputs likewise (`M[1][1]`, `M[1][2]`, …).
     pub inputs: Vec<String>,
     /// Canonical output names, in result order.
     pub outputs: Vec<String>,
@@ -135,6 +137,12 @@ mod tests {
         assert!(twice.contains("given twice"), "{twice}");
         let bad = build("codegen<c;abi=robotran;batch=8>").unwrap_err().to_string();
         assert!(bad.contains("`abi=robotran` cannot go with `batch=8`"), "{bad}");
+        let pinocchio = build("codegen<c;abi=pinocchio;batch=4;trig=inline>").unwrap();
+        assert!(pinocchio.contains("abi: Pinocchio") && pinocchio.contains("batch: 4"), "{pinocchio}");
+        for (bad, why) in [("precision=f32", "doubles"), ("trig=input", "no sin/cos")] {
+            let e = build(&format!("codegen<c;abi=pinocchio;{bad}>")).unwrap_err().to_string();
+            assert!(e.contains(&format!("`abi=pinocchio` cannot go with `{bad}`")) && e.contains(why), "{e}");
+        }
         let verilog = build("codegen<back-end=verilog>").unwrap_err().to_string();
         assert_eq!(verilog, "pass `codegen`: parameter `back-end` must be `c` or `fpga`, found `verilog`");
     }

@@ -101,7 +101,7 @@ fn word_parameters_are_read_as_their_enums() {
         }
         assert_eq!(T::from_word("x"), None);
     }
-    round_trip(&[Abi::Plain, Abi::Robotran]);
+    round_trip(&[Abi::Plain, Abi::Robotran, Abi::Pinocchio]);
     round_trip(&[Precision::F64, Precision::F32]);
     round_trip(&[Trig::Libm, Trig::Input, Trig::Inline]);
     round_trip(&[Format::Both, Format::Mif, Format::Hex]);

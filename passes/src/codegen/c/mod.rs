@@ -1,4 +1,4 @@
-//! `codegen<c;abi=plain|robotran;precision=f64|f32;batch=1|2|4|8|16;trig=libm|input|inline;name=…>`:
+//! `codegen<c;abi=plain|robotran|pinocchio;precision=f64|f32;batch=1|2|4|8|16;trig=libm|input|inline;name=…>`:
 //! the functions as C (issue 11, SPEC §8).
 //!
 //! Every IR operation becomes one C statement, in the IR's order, so that the compiled code
@@ -15,11 +15,14 @@
 //!
 //! ABIs: `plain` ([`plain`]) is `void NAME(const REAL *restrict in, REAL *restrict out)`;
 //! `robotran` ([`robotran`]) has the signature and `MbsData` field access of the Robotran
-//! function the IR came from, a drop-in replacement of its file.
+//! function the IR came from, a drop-in replacement of its file; `pinocchio` ([`pinocchio`])
+//! has the signatures of Pinocchio's algorithms for the URDF generator's functions
+//! (`NAME_rnea(q, v, a, tau)`, `NAME_crba(q, M)`, `NAME_nle(q, v, nle)`, `NAME_aba(q, v, tau, qdd)`).
 
 mod body;
 mod native;
 pub use body::split_callee;
+pub mod pinocchio;
 pub mod plain;
 pub mod robotran;
 mod split;
@@ -44,11 +47,13 @@ pub const BACK_END: Member = Member {
     build: |p| Ok(Box::new(CodegenC::from_params(p)?)),
 };
 
-/// `abi=plain|robotran`.
+/// `abi=plain|robotran|pinocchio`.
 pub const ABI: ParamInfo = ParamInfo {
     name: "abi",
     kind: ParamKind::Choice { choices: Abi::WORDS, default: Abi::Plain.as_str() },
-    doc: "C: `plain` (in/out arrays) or `robotran` (drop-in, Robotran's signature and MbsData)",
+    doc: "C: `plain` (in/out arrays), `robotran` (drop-in, Robotran's signature and MbsData) or `pinocchio` \
+          (URDF dynamics as `NAME_rnea(q, v, a, tau)`, `NAME_crba(q, M)`, `NAME_nle(q, v, nle)`, \
+          `NAME_aba(q, v, tau, qdd)` over Pinocchio's vectors, gravity (0, 0, -9.81) folded; parameters folded first)",
 };
 /// `precision=f64|f32`.
 pub const PRECISION: ParamInfo = ParamInfo {
@@ -60,7 +65,7 @@ pub const PRECISION: ParamInfo = ParamInfo {
 pub const BATCH: ParamInfo = ParamInfo {
     name: "batch",
     kind: ParamKind::U32Set { default: 1, allowed: &[1, 2, 4, 8, 16] },
-    doc: "C: states per call, lanes (`in[i*W + lane]`); plain ABI only",
+    doc: "C: states per call, lanes (`in[i*W + lane]`; every array likewise with `abi=pinocchio`); not with `abi=robotran`",
 };
 /// `trig=libm|input|inline`.
 pub const TRIG: ParamInfo = ParamInfo {
@@ -73,7 +78,8 @@ pub const TRIG: ParamInfo = ParamInfo {
 pub const NAME: ParamInfo = ParamInfo {
     name: "name",
     kind: ParamKind::Names,
-    doc: "C: symbol of the function (a prefix `NAME_function` with several functions)",
+    doc: "C: symbol of the function (a prefix `NAME_function` with several functions; with `abi=pinocchio` \
+          always the prefix of `NAME_rnea`…, default `model`)",
 };
 
 /// The default of `chunk=`: statements per part (see the module doc for the measurements).
@@ -105,6 +111,9 @@ word_enum! {
         /// `robotran` ([`robotran`]): the signature and `MbsData` field access of the Robotran
         /// function the IR came from, a drop-in replacement of its file.
         Robotran = "robotran",
+        /// `pinocchio` ([`pinocchio`]): the URDF generator's functions with the signatures of
+        /// Pinocchio's `rnea`, `crba`, `nonLinearEffects` and `aba` over its vectors.
+        Pinocchio = "pinocchio",
     }
 }
 
@@ -199,8 +208,9 @@ impl CodegenC {
     /// # Errors
     /// [`PassError::BadParameter`] for options that cannot go together (`abi=robotran` with
     /// `batch>1`, `precision=f32`, `trig=input` or `trig=inline`: Robotran's signature is one state of
-    /// `double`s that computes its own trig; `units>1` with `chunk=0`) and for a `name` that is
-    /// not one C identifier.
+    /// `double`s that computes its own trig; `abi=pinocchio` with `precision=f32` or `trig=input`:
+    /// Pinocchio's vectors are doubles and its signatures take no sin/cos; `units>1` with
+    /// `chunk=0`) and for a `name` that is not one C identifier.
     pub fn from_params(p: &Params) -> Result<CodegenC, PassError> {
         let o = CodegenC {
             abi: p.word("abi")?,
@@ -242,6 +252,18 @@ impl CodegenC {
                 )));
             }
         }
+        if o.abi == Abi::Pinocchio {
+            let clash = if o.f32() {
+                Some(("precision=f32", "Pinocchio's vectors are doubles"))
+            } else if o.trig == Trig::Input {
+                Some(("trig=input", "Pinocchio's signatures take no sin/cos"))
+            } else {
+                None
+            };
+            if let Some((c, why)) = clash {
+                return Err(bad(format!("`abi=pinocchio` cannot go with `{c}`: {why} (use `abi=plain`)")));
+            }
+        }
         Ok(o)
     }
 
@@ -276,13 +298,13 @@ impl CodegenC {
                 (Some(n), _) if several => format!("{n}_{}", sanitise(&f.name)),
                 (Some(n), _) => n.clone(),
                 (None, Abi::Robotran) => robotran::symbol(f)?,
-                (None, Abi::Plain) => sanitise(&f.name),
+                (None, _) => sanitise(&f.name),
             };
             let symbol = match self.abi {
                 // Robotran's names are the drop-in's contract: kept as they are (the sensors share
                 // `mbs_sensor`, which dispatches on the sensor's number).
                 Abi::Robotran => wanted,
-                Abi::Plain => free_name(&wanted, &taken, is_reserved_symbol),
+                Abi::Plain | Abi::Pinocchio => free_name(&wanted, &taken, is_reserved_symbol),
             };
             taken.extend([format!("{symbol}_INPUTS"), format!("{symbol}_OUTPUTS"), symbol.clone()]);
             out.push(symbol);
@@ -307,7 +329,9 @@ impl CodegenC {
     ///
     /// # Errors
     /// [`PassError::Failed`] when a function cannot be written in this ABI (an unknown
-    /// Robotran function kind for `abi=robotran`, a callback used with two arities).
+    /// Robotran function kind for `abi=robotran`; for `abi=pinocchio` a function other than the
+    /// URDF generator's or an input or output with no place in Pinocchio's signatures,
+    /// [`pinocchio`]; a callback used with two arities).
     pub fn emit_as(&self, m: &Module, main: Option<&Path>) -> Result<CodegenArtifact, PassError> {
         self.emit_within(m, main, &crate::Ticker::default())
     }
@@ -331,20 +355,26 @@ impl CodegenC {
         } else {
             body::callback_decls(&callbacks, self.real())
         };
-        let symbols = self.symbols(m)?;
-        // The file's global names, which no part may take.
-        let taken: HashSet<String> = symbols.iter().cloned().chain(callbacks.iter().map(|k| k.base.clone())).collect();
-        let mut emitted = Vec::with_capacity(m.functions.len());
-        for (f, symbol) in m.functions.iter().zip(&symbols) {
-            emitted.push(if self.abi == Abi::Robotran {
-                robotran::function(self, f, symbol, &taken, ticker)?
-            } else {
-                plain::function(self, f, symbol, &taken, ticker)
-            });
-            if ticker.stopped() {
-                return Err(ticker.error("codegen", &format!("writing @{}", f.name)));
+        let (symbols, emitted, preface) = if self.abi == Abi::Pinocchio {
+            pinocchio::emit(self, m, ticker)?
+        } else {
+            let symbols = self.symbols(m)?;
+            // The file's global names, which no part may take.
+            let taken: HashSet<String> =
+                symbols.iter().cloned().chain(callbacks.iter().map(|k| k.base.clone())).collect();
+            let mut emitted = Vec::with_capacity(m.functions.len());
+            for (f, symbol) in m.functions.iter().zip(&symbols) {
+                emitted.push(if self.abi == Abi::Robotran {
+                    robotran::function(self, f, symbol, &taken, ticker)?
+                } else {
+                    plain::function(self, f, symbol, &taken, ticker)
+                });
+                if ticker.stopped() {
+                    return Err(ticker.error("codegen", &format!("writing @{}", f.name)));
+                }
             }
-        }
+            (symbols, emitted, String::new())
+        };
         let units = self.units as usize;
         let unit_of = unit_assignment(&emitted, units);
         let file_names: Vec<String> = match main {
@@ -396,7 +426,7 @@ impl CodegenC {
                 f.push('\n');
             }
         }
-        let mut h = String::new();
+        let mut h = preface;
         let mut interfaces = Vec::new();
         for (e, units_of) in emitted.into_iter().zip(&unit_of) {
             for (p, &u) in e.parts.iter().zip(units_of) {
@@ -505,8 +535,16 @@ impl CodegenC {
         if self.abi == Abi::Robotran {
             s += "#include \"mbs_data.h\"\n\n";
         }
+        // Pinocchio's callers are C++.
+        let cpp = self.abi == Abi::Pinocchio;
+        if cpp {
+            s += "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
+        }
         s += prototypes;
         s += callback_decls;
+        if cpp {
+            s += "#ifdef __cplusplus\n}\n#endif\n\n";
+        }
         s += "#endif\n";
         s
     }

@@ -46,7 +46,77 @@ pub(crate) fn function(
     ticker: &crate::Ticker,
 ) -> Emitted {
     let iface = interface(o, f, symbol);
-    let mut reserved: Vec<&str> = RESERVED.to_vec();
+    let layout = Layout {
+        params: vec![("in", false), ("out", true)],
+        inputs: (0..iface.inputs.len()).map(|i| Source::Elem(0, i)).collect(),
+        outputs: (0..f.outputs.len()).map(|j| vec![(1, j)]).collect(),
+    };
+    let comment =
+        format!("@{}: {} inputs, {} outputs (order: see the header)", f.name, iface.inputs.len(), iface.outputs.len());
+    let (s, parts) = arrays(o, f, symbol, taken, ticker, &layout, &comment);
+    let real = o.real();
+    let w = o.batch as usize;
+    let sig = format!("void {symbol}(const {real} *restrict in, {real} *restrict out)");
+    let mut proto = format!("/* @{} as {symbol}", f.name);
+    if w > 1 {
+        let _ = write!(proto, ", {w} states per call (lane l of element i at [i*{w} + l])");
+    }
+    proto += ".\n * Inputs:";
+    for (i, n) in iface.inputs.iter().enumerate() {
+        let _ = write!(proto, "{}in[{i}] {n}", if i % 8 == 0 { "\n *   " } else { ", " });
+    }
+    proto += "\n * Outputs:";
+    for (j, n) in iface.outputs.iter().enumerate() {
+        let _ = write!(proto, "{}out[{j}] {n}", if j % 8 == 0 { "\n *   " } else { ", " });
+    }
+    let _ = writeln!(
+        proto,
+        " */\n{sig};\n#define {symbol}_INPUTS {}\n#define {symbol}_OUTPUTS {}\n",
+        iface.inputs.len(),
+        iface.outputs.len()
+    );
+    Emitted { entry: s, parts, proto, iface }
+}
+
+/// Where the generated code reads one input of a function written by [`arrays`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Source {
+    /// Element `.1` of parameter `.0` (an input array of [`Layout::params`]).
+    Elem(usize, usize),
+    /// A constant written into the code (`abi=pinocchio`'s gravity).
+    Const(f64),
+}
+
+/// The array parameters of a function written by [`arrays`] and where each input and output
+/// lives in them: the plain ABI's `in`/`out`, or Pinocchio's `q`, `v`, `a`, `tau`, `M`, ….
+pub(crate) struct Layout<'a> {
+    /// The parameters in order: C name, true for an output array (`REAL *restrict`; an input
+    /// array is `const REAL *restrict`).
+    pub params: Vec<(&'a str, bool)>,
+    /// Per input of the function ([`input_values`] order): where it is read.
+    pub inputs: Vec<Source>,
+    /// Per output of the function: the `(parameter, element)` it is written to, one or more (a
+    /// mass matrix's mirrored triangle).
+    pub outputs: Vec<Vec<(usize, usize)>>,
+}
+
+/// `f` as `symbol` over the arrays of `layout`: the definition of the entry point, opening with
+/// `/* {comment}. */` (split into parts of at most `o.chunk` statements when it has more; part
+/// names avoid `taken`, the file's other global names), and its parts. Element `e` of a
+/// parameter is `p[e]`, with `batch=W` lane `l` of it is `p[e*W + l]` (`memcpy`, no alignment
+/// assumed). Inputs are read just before their first use and outputs written right after the
+/// statement that computes them (the module doc); outputs that are inputs or constants come last.
+pub(crate) fn arrays(
+    o: &CodegenC,
+    f: &Function,
+    symbol: &str,
+    taken: &HashSet<String>,
+    ticker: &crate::Ticker,
+    layout: &Layout,
+    comment: &str,
+) -> (String, Vec<Part>) {
+    let mut reserved: Vec<&str> = layout.params.iter().map(|p| p.0).collect();
+    reserved.extend(RESERVED);
     reserved.push(symbol);
     let callee_names = super::body::callee_names(f);
     reserved.extend(callee_names.iter().map(String::as_str));
@@ -56,12 +126,14 @@ pub(crate) fn function(
     let plan = Plan::new(f, &order, &attached, o.chunk as usize, &[], &[]);
     let real = o.real();
     let w = o.batch as usize;
-    let params = format!("const {real} *restrict in, {real} *restrict out");
+    let params: Vec<String> = layout
+        .params
+        .iter()
+        .map(|&(p, out)| if out { format!("{real} *restrict {p}") } else { format!("const {real} *restrict {p}") })
+        .collect();
+    let params = params.join(", ");
     let sig = format!("void {symbol}({params})");
     let ty = b.value_type();
-    // Inputs are read just before their first use and outputs written right after their value
-    // is computed (`in` and `out` are `restrict`: nothing aliases), which keeps the compiler's
-    // live ranges short (see the module doc). Outputs that are inputs or constants come last.
     let inputs = input_values(f, o.trig == super::Trig::Input);
     let mut input_at: Vec<Option<usize>> = vec![None; f.values.len()];
     for (i, &v) in inputs.iter().enumerate() {
@@ -77,7 +149,7 @@ pub(crate) fn function(
     }
     let split = plan.parts() > 1;
     // A batch: one pass of the body per chunk of ROBOVEC_VL lanes, at offset `at` in a block
-    // (a part gets `in` and `out` at the chunk already).
+    // (a part gets its arrays at the chunk already).
     let at = if split { "" } else { " + robovec_chunk * ROBOVEC_VL" };
     // Part k has read value v when read[v] == k + 1.
     let mut read = vec![0u32; f.values.len()];
@@ -88,10 +160,17 @@ pub(crate) fn function(
         let n = &names[v.index()];
         if let Some(i) = input_at[v.index()] {
             read[v.index()] = k as u32 + 1;
-            if w > 1 {
-                let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, in + {}{at}, sizeof {n});", i * w);
-            } else {
-                let _ = writeln!(s, "  const {ty} {n} = in[{i}];");
+            match layout.inputs[i] {
+                Source::Elem(p, e) if w > 1 => {
+                    let p = layout.params[p].0;
+                    let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, {p} + {}{at}, sizeof {n});", e * w);
+                }
+                Source::Elem(p, e) => {
+                    let _ = writeln!(s, "  const {ty} {n} = {}[{e}];", layout.params[p].0);
+                }
+                Source::Const(c) => {
+                    let _ = writeln!(s, "  const {ty} {n} = {};", b.operand_value(&Operand::Const(c)));
+                }
             }
         } else if plan.reads_live(v, k) {
             read[v.index()] = k as u32 + 1;
@@ -100,17 +179,20 @@ pub(crate) fn function(
     };
     let store = |s: &mut String, j: usize, x: &Operand| {
         let e = b.operand_value(x);
-        if w > 1 {
-            match x {
-                Operand::Value(_) => {
-                    let _ = writeln!(s, "  memcpy(out + {}{at}, &{e}, sizeof {e});", j * w);
+        for &(p, el) in &layout.outputs[j] {
+            let p = layout.params[p].0;
+            if w > 1 {
+                match x {
+                    Operand::Value(_) => {
+                        let _ = writeln!(s, "  memcpy({p} + {}{at}, &{e}, sizeof {e});", el * w);
+                    }
+                    Operand::Const(_) => {
+                        let _ = writeln!(s, "  {{ const {ty} k = {e}; memcpy({p} + {}{at}, &k, sizeof k); }}", el * w);
+                    }
                 }
-                Operand::Const(_) => {
-                    let _ = writeln!(s, "  {{ const {ty} k = {e}; memcpy(out + {}{at}, &k, sizeof k); }}", j * w);
-                }
+            } else {
+                let _ = writeln!(s, "  {p}[{el}] = {e};");
             }
-        } else {
-            let _ = writeln!(s, "  out[{j}] = {e};");
         }
     };
     // The statements of part k (all of them when not split), then in the last part the
@@ -143,13 +225,8 @@ pub(crate) fn function(
             }
         }
     };
-    let mut s = format!(
-        "/* @{}: {} inputs, {} outputs (order: see the header){}. */\n",
-        f.name,
-        iface.inputs.len(),
-        iface.outputs.len(),
-        if split { format!("; {} parts", plan.parts()) } else { String::new() }
-    );
+    let mut s =
+        format!("/* {comment}{}. */\n", if split { format!("; {} parts", plan.parts()) } else { String::new() });
     let mut parts = Vec::new();
     if split {
         let prefix = part_prefix(symbol, plan.parts(), taken);
@@ -174,9 +251,12 @@ pub(crate) fn function(
         );
         let (indent, args) = if w > 1 {
             s += super::body::CHUNK_LOOP;
-            ("    ", "in + robovec_chunk * ROBOVEC_VL, out + robovec_chunk * ROBOVEC_VL, live")
+            let a: Vec<String> =
+                layout.params.iter().map(|p| format!("{} + robovec_chunk * ROBOVEC_VL", p.0)).collect();
+            ("    ", a.join(", ") + ", live")
         } else {
-            ("  ", "in, out, live")
+            let a: Vec<&str> = layout.params.iter().map(|p| p.0).collect();
+            ("  ", a.join(", ") + ", live")
         };
         for k in 0..plan.parts() {
             let _ = writeln!(s, "{indent}{}({args});", part_name(&prefix, k));
@@ -196,23 +276,5 @@ pub(crate) fn function(
         }
         s += "}\n\n";
     }
-    let mut proto = format!("/* @{} as {symbol}", f.name);
-    if w > 1 {
-        let _ = write!(proto, ", {w} states per call (lane l of element i at [i*{w} + l])");
-    }
-    proto += ".\n * Inputs:";
-    for (i, n) in iface.inputs.iter().enumerate() {
-        let _ = write!(proto, "{}in[{i}] {n}", if i % 8 == 0 { "\n *   " } else { ", " });
-    }
-    proto += "\n * Outputs:";
-    for (j, n) in iface.outputs.iter().enumerate() {
-        let _ = write!(proto, "{}out[{j}] {n}", if j % 8 == 0 { "\n *   " } else { ", " });
-    }
-    let _ = writeln!(
-        proto,
-        " */\n{sig};\n#define {symbol}_INPUTS {}\n#define {symbol}_OUTPUTS {}\n",
-        iface.inputs.len(),
-        iface.outputs.len()
-    );
-    Emitted { entry: s, parts, proto, iface }
+    (s, parts)
 }

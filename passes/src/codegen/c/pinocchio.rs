@@ -1,0 +1,371 @@
+//! `abi=pinocchio`: the URDF generator's functions with the signatures of Pinocchio's
+//! algorithms, so that a program written against Pinocchio's vectors calls robovec's C
+//! without reshuffling them (issue 30):
+//!
+//! | IR function | C function | Pinocchio |
+//! |---|---|---|
+//! | `invdyna` | `void NAME_rnea(const double *q, const double *v, const double *a, double *tau)` | `rnea(model, data, q, v, a)` |
+//! | `dirdyna`'s `M` | `void NAME_crba(const double *q, double *M)` | `crba(model, data, q)`, both triangles |
+//! | `dirdyna`'s `c` | `void NAME_nle(const double *q, const double *v, double *nle)` | `nonLinearEffects(model, data, q, v)` |
+//! | `fordyna` | `void NAME_aba(const double *q, const double *v, const double *tau, double *qdd)` | `aba(model, data, q, v, tau)` |
+//!
+//! `dirdyna` gives two functions, each the backward slice of its outputs (the mass matrix
+//! depends on `q` only, so `NAME_crba` takes no velocity). `fordyna` exists when the URDF is
+//! loaded with `-function=fordyna`.
+//!
+//! # Index convention
+//! Arrays are 0-based and map by name and index, never by position in the IR's input list:
+//! input `q[i]` is `q[i-1]`, `qd[i]` is `v[i-1]`, `qdd[i]` is `a[i-1]`, `Qq[i]` (an input of
+//! `fordyna`) is `tau[i-1]`; outputs `Qq[i]` are `tau[i-1]`, `c[i]` are `nle[i-1]`, `qdd[i]` are
+//! `qdd[i-1]`, and `M[i][j]` is `M[(i-1)*nv + (j-1)]`: row-major with both triangles (the same
+//! array as Pinocchio's column-major `data.M` once symmetrised, since `M` is symmetric). When
+//! the IR has one triangle only, each entry is written to its mirror too; an entry missing in
+//! both is an error. `nv` is the largest velocity index of the module (`qd`, `qdd`, `Qq`, `c`,
+//! `M`) and `nq` the largest `q` index, at least `nv` (Pinocchio's free-flyer has `nq = nv + 1`):
+//! the header defines `NAME_NQ` and `NAME_NV`. A joint Pinocchio holds as `(cos θ, sin θ)` (a
+//! URDF `continuous` joint, `nq = 2` for it) is one angle `q[i]` to robovec's generator: such a
+//! model's `q` is not Pinocchio's (convert, or write the joint as `revolute` with limits).
+//!
+//! # Gravity and parameters
+//! Inputs `g[1..3]` (the generator's gravity) are folded into the code as Pinocchio's default
+//! `model.gravity`, (0, 0, −9.81) m/s²: constants the function reads, so the C computes bit for
+//! bit what `-eval` computes with those values of `g`. A model written with its gravity as
+//! constants has no `g` input, and nothing is folded. Model parameters (`m`, `l`, `In`, `dpt`)
+//! must be folded before: `--fold-params` on the URDF, or `specialize<params=FILE>`; an input
+//! that is not `q`, `qd`, `qdd`, `Qq` or `g` is an error naming it.
+//!
+//! # Options
+//! `name=NAME` is the prefix of the symbols (default `model`, Pinocchio's name for the model
+//! argument: `model_rnea`); `batch=W` takes W states per call, lane-contiguous as in the plain
+//! ABI: element `k` of lane `l` of every array is `p[k*W + l]` (`M`'s element `(i-1)*nv + (j-1)`
+//! likewise). `trig=libm` and `trig=inline` as for the other ABIs; `chunk=` and `units=` too.
+//! `precision=f32` and `trig=input` are refused ([`super::CodegenC::from_params`]): Pinocchio's
+//! vectors are doubles and its signatures take no sin/cos.
+//!
+//! The header declares the functions without `restrict` (the definitions have it: an output
+//! array may not overlap an input) inside `extern "C"` for C++ callers, with the include guard
+//! `ROBOVEC_NAME_<first function>_H`.
+
+use std::collections::HashSet;
+use std::fmt::Write as _;
+
+use robovec_ir::{Function, Module};
+
+use super::plain::{arrays, Layout, Source};
+use super::{CodegenC, Emitted};
+use crate::codegen::names::reserved_symbol_reason;
+use crate::codegen::Interface;
+use crate::PassError;
+
+/// The prefix of the symbols without `name=`: `model_rnea`, `model_crba`, ….
+pub const DEFAULT_NAME: &str = "model";
+
+/// Pinocchio's default gravity (`model.gravity.linear()`), m/s²: what `g[1..3]` become.
+pub const GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+
+/// The model parameters the URDF generator leaves as inputs without `--fold-params`.
+const PARAMETERS: &[&str] = &["m", "l", "In", "dpt"];
+
+/// One of the C functions: Pinocchio's algorithm.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Algo {
+    Rnea,
+    Crba,
+    Nle,
+    Aba,
+}
+
+impl Algo {
+    /// The suffix of the symbol.
+    fn suffix(self) -> &'static str {
+        match self {
+            Algo::Rnea => "rnea",
+            Algo::Crba => "crba",
+            Algo::Nle => "nle",
+            Algo::Aba => "aba",
+        }
+    }
+
+    /// Input arrays `(C name, the IR's array)`, then the output array `(C name, the IR's array)`.
+    fn arrays(self) -> (&'static [(&'static str, &'static str)], (&'static str, &'static str)) {
+        match self {
+            Algo::Rnea => (&[("q", "q"), ("v", "qd"), ("a", "qdd")], ("tau", "Qq")),
+            Algo::Crba => (&[("q", "q")], ("M", "M")),
+            Algo::Nle => (&[("q", "q"), ("v", "qd")], ("nle", "c")),
+            Algo::Aba => (&[("q", "q"), ("v", "qd"), ("tau", "Qq")], ("qdd", "qdd")),
+        }
+    }
+
+    /// Pinocchio's call it replaces.
+    fn pinocchio(self) -> &'static str {
+        match self {
+            Algo::Rnea => "tau = rnea(model, data, q, v, a)",
+            Algo::Crba => "M = crba(model, data, q), both triangles, row-major",
+            Algo::Nle => "nle = nonLinearEffects(model, data, q, v)",
+            Algo::Aba => "qdd = aba(model, data, q, v, tau)",
+        }
+    }
+}
+
+/// `M[2][3]` → (`M`, [2, 3]); `None` when the name is not `base[i]…` with 1-based integers.
+fn indexed(name: &str) -> Option<(&str, Vec<usize>)> {
+    let i = name.find('[')?;
+    let mut idx = Vec::new();
+    let mut rest = &name[i..];
+    while let Some(r) = rest.strip_prefix('[') {
+        let end = r.find(']')?;
+        idx.push(r[..end].parse::<usize>().ok().filter(|&k| k >= 1)?);
+        rest = &r[end + 1..];
+    }
+    rest.is_empty().then_some((&name[..i], idx))
+}
+
+fn failed(f: &Function, message: String) -> PassError {
+    PassError::Failed { pass: "codegen".into(), message: format!("@{}: {message}", f.name) }
+}
+
+/// The C functions of `f` (with the IR's outputs each keeps), or the error for a function that
+/// is not one of the generator's.
+fn algorithms(f: &Function) -> Result<Vec<(Algo, &'static [&'static str])>, PassError> {
+    match f.name.as_str() {
+        "invdyna" => Ok(vec![(Algo::Rnea, &["Qq"])]),
+        "dirdyna" => Ok(vec![(Algo::Crba, &["M"]), (Algo::Nle, &["c"])]),
+        "fordyna" => Ok(vec![(Algo::Aba, &["qdd"])]),
+        _ => Err(failed(
+            f,
+            "abi=pinocchio writes the URDF generator's @invdyna (NAME_rnea), @dirdyna (NAME_crba, NAME_nle) and \
+             @fordyna (NAME_aba); this function is none of them (use abi=plain)"
+                .into(),
+        )),
+    }
+}
+
+/// Checks the inputs and outputs of `f` against its algorithms and returns its largest `q`
+/// index and largest velocity index.
+fn check(f: &Function) -> Result<(usize, usize), PassError> {
+    let algos = algorithms(f)?;
+    let allowed: Vec<&str> = algos.iter().flat_map(|(a, _)| a.arrays().0.iter().map(|x| x.1)).chain(["g"]).collect();
+    let (mut nq, mut nv) = (0, 0);
+    let mut params = Vec::new();
+    for &v in &f.inputs {
+        let n = f.name_of(v);
+        match indexed(n) {
+            Some((base, _)) if PARAMETERS.contains(&base) => params.push(n.to_string()),
+            Some(("g", idx)) if idx.len() == 1 && idx[0] <= 3 => {}
+            Some((base, idx)) if idx.len() == 1 && allowed.contains(&base) => {
+                if base == "q" {
+                    nq = nq.max(idx[0]);
+                } else {
+                    nv = nv.max(idx[0]);
+                }
+            }
+            _ => return Err(failed(
+                f,
+                format!(
+                    "input `{n}` has no place in Pinocchio's signature (abi=pinocchio reads {} and gravity g[1..3])",
+                    allowed[..allowed.len() - 1].join(", ")
+                ),
+            )),
+        }
+    }
+    if !params.is_empty() {
+        let more = if params.len() > 4 { format!(", … ({} in all)", params.len()) } else { String::new() };
+        params.truncate(4);
+        return Err(failed(
+            f,
+            format!(
+                "model parameters are inputs ({}{more}); Pinocchio's functions take the state only: load the URDF \
+                 with --fold-params, or fold them with specialize<params=FILE>",
+                params.join(", ")
+            ),
+        ));
+    }
+    let outs: Vec<&str> = algos.iter().flat_map(|(_, o)| o.iter().copied()).collect();
+    for o in &f.outputs {
+        match indexed(&o.name) {
+            Some(("M", idx)) if idx.len() == 2 && outs.contains(&"M") => nv = nv.max(idx[0]).max(idx[1]),
+            Some((base, idx)) if idx.len() == 1 && outs.contains(&base) => nv = nv.max(idx[0]),
+            _ => {
+                return Err(failed(
+                    f,
+                    format!("output `{}` has no place in Pinocchio's signature (abi=pinocchio writes {})", o.name, {
+                        let list: Vec<String> =
+                            outs.iter().map(|b| if *b == "M" { "M[i][j]".into() } else { format!("{b}[i]") }).collect();
+                        list.join(", ")
+                    }),
+                ))
+            }
+        }
+    }
+    Ok((nq, nv))
+}
+
+/// `f` with only the outputs of `keep` (arrays) and what they need: the backward slice, unused
+/// inputs dropped.
+fn slice(f: &Function, keep: &[&str]) -> Function {
+    let mut g = f.clone();
+    g.outputs.retain(|o| indexed(&o.name).is_some_and(|(b, _)| keep.contains(&b)));
+    let live = g.live_values(&[]);
+    g.retain(|_, v| live[v.index()]);
+    g
+}
+
+/// The symbols' prefix: `name=` or [`DEFAULT_NAME`], checked so that every symbol is free.
+fn prefix(o: &CodegenC) -> Result<String, PassError> {
+    let n = o.name.clone().unwrap_or_else(|| DEFAULT_NAME.to_string());
+    for s in [Algo::Rnea, Algo::Crba, Algo::Nle, Algo::Aba].map(|a| format!("{n}_{}", a.suffix())) {
+        if let Some(why) = reserved_symbol_reason(&s) {
+            return Err(PassError::BadParameter {
+                pass: "codegen".into(),
+                message: format!("parameter `name`: abi=pinocchio's symbol `{s}` cannot name generated C: it is {why}"),
+            });
+        }
+    }
+    Ok(n)
+}
+
+/// Every C function of `m` (atomised URDF dynamics) as [`Emitted`], with its symbol, and the
+/// header's preamble (`NAME_NQ`, `NAME_NV`).
+///
+/// # Errors
+/// [`PassError::Failed`] for a function that is not `invdyna`, `dirdyna` or `fordyna`, an
+/// input or output with no place in Pinocchio's signature (model parameters among them: the
+/// message says how to fold them), or a mass matrix entry missing in both triangles;
+/// [`PassError::BadParameter`] for a `name=` whose symbols would be reserved.
+pub(crate) fn emit(
+    o: &CodegenC,
+    m: &Module,
+    ticker: &crate::Ticker,
+) -> Result<(Vec<String>, Vec<Emitted>, String), PassError> {
+    let name = prefix(o)?;
+    let (mut nq, mut nv) = (0, 0);
+    for f in &m.functions {
+        let (q, v) = check(f)?;
+        nq = nq.max(q);
+        nv = nv.max(v);
+    }
+    nq = nq.max(nv);
+    let mut jobs: Vec<(Algo, Function)> = Vec::new();
+    for f in &m.functions {
+        for (a, keep) in algorithms(f)? {
+            // invdyna and fordyna have only their own outputs: no copy.
+            jobs.push((a, if a == Algo::Crba || a == Algo::Nle { slice(f, keep) } else { f.clone() }));
+        }
+    }
+    let mut seen = HashSet::new();
+    for (a, f) in &jobs {
+        if !seen.insert(*a) {
+            return Err(failed(f, format!("two functions of the module would be {name}_{}", a.suffix())));
+        }
+    }
+    let symbols: Vec<String> = jobs.iter().map(|(a, _)| format!("{name}_{}", a.suffix())).collect();
+    let taken: HashSet<String> = symbols.iter().cloned().collect();
+    let w = o.batch as usize;
+    let mut emitted = Vec::with_capacity(jobs.len());
+    for ((a, f), symbol) in jobs.iter().zip(&symbols) {
+        let (ins, (out_c, out_ir)) = a.arrays();
+        let mut params: Vec<(&str, bool)> = ins.iter().map(|x| (x.0, false)).collect();
+        params.push((out_c, true));
+        let out_param = params.len() - 1;
+        let mut inputs = Vec::with_capacity(f.inputs.len());
+        for &v in &f.inputs {
+            let n = f.name_of(v);
+            let (base, idx) = indexed(n).expect("checked");
+            inputs.push(if base == "g" {
+                Source::Const(GRAVITY[idx[0] - 1])
+            } else {
+                let p = ins
+                    .iter()
+                    .position(|x| x.1 == base)
+                    .ok_or_else(|| failed(f, format!("{symbol} takes no `{base}`, but its outputs read `{n}`")))?;
+                Source::Elem(p, idx[0] - 1)
+            });
+        }
+        // Outputs: one element each, M mirrored where the IR has one triangle only.
+        let mut outputs = Vec::with_capacity(f.outputs.len());
+        let mut covered = vec![false; if *a == Algo::Crba { nv * nv } else { nv }];
+        let present: HashSet<&str> = f.outputs.iter().map(|x| x.name.as_str()).collect();
+        for x in &f.outputs {
+            let (_, idx) = indexed(&x.name).expect("checked");
+            let mut dest = Vec::with_capacity(2);
+            if *a == Algo::Crba {
+                let (i, j) = (idx[0] - 1, idx[1] - 1);
+                dest.push((out_param, i * nv + j));
+                if i != j && !present.contains(format!("M[{}][{}]", j + 1, i + 1).as_str()) {
+                    dest.push((out_param, j * nv + i));
+                }
+            } else {
+                dest.push((out_param, idx[0] - 1));
+            }
+            for &(_, e) in &dest {
+                covered[e] = true;
+            }
+            outputs.push(dest);
+        }
+        if let Some(e) = covered.iter().position(|c| !c) {
+            let missing = if *a == Algo::Crba {
+                format!("M[{}][{}]", e / nv + 1, e % nv + 1)
+            } else {
+                format!("{out_ir}[{}]", e + 1)
+            };
+            return Err(failed(
+                f,
+                format!(
+                    "{symbol} writes {out_c}[0..{}) but the function has no output {missing} (nv = {nv}; was it removed by dce?)",
+                    covered.len()
+                ),
+            ));
+        }
+        let layout = Layout { params, inputs, outputs };
+        let comment = format!("@{} as {symbol}: Pinocchio's {}", f.name, a.pinocchio());
+        let (entry, parts) = arrays(o, f, symbol, &taken, ticker, &layout, &comment);
+        if ticker.stopped() {
+            return Err(ticker.error("codegen", &format!("writing {symbol}")));
+        }
+        // The interface: the arrays' elements in argument order.
+        let mut in_names = Vec::new();
+        for &(_, base) in ins {
+            let n = if base == "q" { nq } else { nv };
+            in_names.extend((1..=n).map(|k| format!("{base}[{k}]")));
+        }
+        let out_names: Vec<String> = if *a == Algo::Crba {
+            (1..=nv).flat_map(|i| (1..=nv).map(move |j| format!("M[{i}][{j}]"))).collect()
+        } else {
+            (1..=nv).map(|k| format!("{out_ir}[{k}]")).collect()
+        };
+        let iface = Interface { inputs: in_names, outputs: out_names, ..super::interface(o, f, symbol) };
+        let mut proto = format!("/* @{} as {symbol}: Pinocchio's {}.\n *", f.name, a.pinocchio());
+        for &(c, base) in ins {
+            let n = if base == "q" { "NQ" } else { "NV" };
+            let _ = write!(proto, " {c}[0..{name}_{n}) = {base}[1..],");
+        }
+        let size = if *a == Algo::Crba { format!("{name}_NV*{name}_NV") } else { format!("{name}_NV") };
+        let _ = write!(proto, " {out_c}[0..{size}) = {out_ir}");
+        if *a == Algo::Crba {
+            proto += "[i+1][j+1] at i*NV + j";
+        } else {
+            proto += "[1..]";
+        }
+        if w > 1 {
+            let _ = write!(proto, ";\n * {w} states per call: lane l of element k of every array at [k*{w} + l]");
+        }
+        let args: Vec<String> = layout
+            .params
+            .iter()
+            .map(|&(p, out)| if out { format!("double *{p}") } else { format!("const double *{p}") })
+            .collect();
+        let _ = writeln!(proto, ". */\nvoid {symbol}({});\n", args.join(", "));
+        emitted.push(Emitted { entry, parts, proto, iface });
+    }
+    let gravity = if m.functions.iter().any(|f| f.inputs.iter().any(|&v| f.name_of(v).starts_with("g["))) {
+        "; gravity folded as Pinocchio's default (0, 0, -9.81)"
+    } else {
+        ""
+    };
+    let preface = format!(
+        "/* Pinocchio's vectors (0-based): q has NQ elements, v, a, tau, nle, qdd NV, M NV*NV (row-major, both\n \
+         * triangles){gravity}. The output array must not overlap an input. */\n\
+         #define {name}_NQ {nq}\n#define {name}_NV {nv}\n\n"
+    );
+    Ok((symbols, emitted, preface))
+}
