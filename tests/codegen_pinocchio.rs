@@ -41,10 +41,16 @@ type Results = BTreeMap<&'static str, Vec<f64>>;
 /// Every function of the URDF at `path` (invdyna, dirdyna, fordyna), parameters folded, after
 /// `pipeline`.
 fn load(path: &str, pipeline: &str) -> Module {
+    load_on(path, pipeline, false)
+}
+
+/// [`load`], on Pinocchio's free flyer when `free_flyer`.
+fn load_on(path: &str, pipeline: &str, free_flyer: bool) -> Module {
     let (loaded, _) = robovec::driver::load_with(
         path,
         &FrontOptions {
             fold_params: true,
+            free_flyer,
             functions: Some(robovec_dynamics::FUNCTION_NAMES.iter().map(|s| s.to_string()).collect()),
             ..FrontOptions::default()
         },
@@ -199,9 +205,16 @@ struct Oracle {
 /// angle (the oracle's `q`); otherwise the C gets Pinocchio's configuration vector itself.
 /// Returns the worst relative error.
 fn against_pinocchio(py: &Path, label: &str, urdf: &str, continuous: bool) -> f64 {
+    against_pinocchio_on(py, label, urdf, continuous, false)
+}
+
+/// [`against_pinocchio`], on the free flyer (`--free-flyer`, `JointModelFreeFlyer`) when
+/// `free_flyer`: `q` has `nv + 1` entries (position, quaternion x y z w, joints).
+fn against_pinocchio_on(py: &Path, label: &str, urdf: &str, continuous: bool, free_flyer: bool) -> f64 {
+    let base = if free_flyer { "freeflyer" } else { "fixed" };
     let out = Command::new(py)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["scripts/pinocchio_oracle.py", urdf, "8", "11"])
+        .args(["scripts/pinocchio_oracle.py", urdf, "8", "11", base])
         .output()
         .expect("run the oracle script");
     assert!(out.status.success(), "oracle failed on {urdf}: {}", String::from_utf8_lossy(&out.stderr));
@@ -223,12 +236,14 @@ fn against_pinocchio(py: &Path, label: &str, urdf: &str, continuous: bool) -> f6
             StateIn { q, v: s.qd.clone(), a: s.qdd.clone(), tau: s.tau.clone() }
         })
         .collect();
-    let m = load(&o.path, "atomise,cse");
+    let m = load_on(&o.path, "atomise,cse", free_flyer);
+    let nq = states[0].q.len();
+    assert_eq!(nq, nv + usize::from(free_flyer), "{label}: configuration coordinates");
     let mut worst: f64 = 0.0;
     for batch in [1, 4] {
         let dir = tmp(&format!("pinocchio_{label}_{batch}"));
         let co = CodegenC { abi: Abi::Pinocchio, batch, ..CodegenC::default() };
-        let got = run_c(&dir, &m, &co, nv, nv, &states, &["-O1"]);
+        let got = run_c(&dir, &m, &co, nq, nv, &states, &["-O1"]);
         for (k, (r, s)) in got.iter().zip(&o.states).enumerate() {
             let mass: Vec<f64> = s.mass.iter().flatten().copied().collect();
             for (what, g, want) in [
@@ -258,6 +273,11 @@ fn pinocchio_abi_c_called_with_pinocchios_vectors_matches_pinocchio() {
     eprintln!("ur5: worst relative error {e:e}");
     let e = against_pinocchio(&py, "panda", "erd:panda_description/urdf/panda.urdf", false);
     eprintln!("panda: worst relative error {e:e}");
+    // The free flyer: Pinocchio's q (position, unit quaternion x y z w, joints) as it is.
+    let e = against_pinocchio_on(&py, "solo12_ff", "erd:solo_description/robots/solo12.urdf", false, true);
+    eprintln!("solo12 free flyer: worst relative error {e:e}");
+    let e = against_pinocchio_on(&py, "talos_ff", "erd:talos_data/robots/talos_reduced.urdf", false, true);
+    eprintln!("talos free flyer: worst relative error {e:e}");
     use robovec_dynamics::topology::{build, Topology};
     let dir = tmp("topology");
     for t in Topology::ALL {
