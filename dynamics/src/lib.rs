@@ -65,6 +65,7 @@ pub mod crba;
 pub mod dirdyna;
 pub mod fordyna;
 pub mod frames;
+pub mod lump;
 pub mod origins;
 pub mod rnea;
 pub mod robot;
@@ -317,7 +318,20 @@ pub fn generate(model: &Model, fold: bool) -> Generated {
 /// # Errors
 /// [`Stopped`] once `request.deadline` is reached (checked per body and per row of outputs).
 pub fn generate_with(model: &Model, request: &Request) -> Result<Generated, Stopped> {
-    let mut robots = vec![model.robot.clone()];
+    // Links on fixed joints merged into their parents ([`lump`]); a stop names the body of the
+    // robot as given.
+    let (own, body_of) = match lump::contract_fixed(&model.robot) {
+        Some((robot, body_of)) => (robot, Some(body_of)),
+        None => (model.robot.clone(), None),
+    };
+    let bodies = model.robot.joints.len();
+    let renumber = |mut stop: Stopped| {
+        if let (Reached::Body { body, .. }, Some(map)) = (stop.at, &body_of) {
+            stop.at = Reached::Body { body: map.get(body).copied().unwrap_or(body), bodies };
+        }
+        stop
+    };
+    let mut robots = vec![own];
     robots.extend(frames::reframe(&model.robot));
     for i in 0..robots.len() {
         robots.extend(origins::slide(&robots[i]));
@@ -325,7 +339,7 @@ pub fn generate_with(model: &Model, request: &Request) -> Result<Generated, Stop
     let ops = |g: &Generated| g.module.functions.iter().map(|f| f.op_counts().total).sum::<u64>();
     let mut best: Option<(u64, Generated)> = None;
     for robot in robots {
-        let g = generate_in_frames(&Model { robot }, request)?;
+        let g = generate_in_frames(&Model { robot }, request).map_err(renumber)?;
         let n = ops(&g);
         if best.as_ref().is_none_or(|(m, _)| n < *m) {
             best = Some((n, g));

@@ -23,7 +23,6 @@ use robovec_ir::TrigFn;
 
 use super::robot::{snap, JointKind};
 use super::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
-use super::crba::Composite;
 use super::{Layout, Model, Stopped};
 
 /// A 3-vector of terms.
@@ -360,9 +359,6 @@ pub fn sweep(
     let mut cq: Vec<V3> = vec![[ZERO, ZERO, ZERO]; nb + 1];
     let mut children = vec![0usize; nb + 1];
     let mut torque: Vec<(usize, Term)> = Vec::new();
-    // Per body, the mass properties of the links fixed to it (`Composite`, in its frame), as
-    // Pinocchio's URDF reader merges them: a link on a fixed joint costs no force of its own.
-    let mut lumped: Vec<Option<Composite>> = vec![None; nb + 1];
     for i in (0..nb).rev() {
         let body = i + 1;
         if !moves[body] {
@@ -375,39 +371,12 @@ pub fn sweep(
         let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
         let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
         let (w, wp, a) = (&om[body], &omp[body], &alpha[body]);
-        let (f_tot, c_tot) = if joint.kind == JointKind::Fixed && moves[p] {
-            // Rigidly attached to its parent: its mass properties (and those lumped into it)
-            // join the parent's; only its children's forces pass through it.
-            let own = Composite::body(mass, l, inn).add(lumped[body].take().unwrap_or_else(Composite::zero));
-            if !own.is_zero() {
-                let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
-                let moved = own.moved(b, &format!("F{body}"), Some(&numeric(&joint.origin.rot)), Some(&d));
-                let bound = moved.bind(b, format_args!("F{body}"));
-                lumped[p] = Some(lumped[p].take().unwrap_or_else(Composite::zero).add(bound));
-            }
-            (bind3(b, "Fq", body, std::mem::take(&mut fq[body])), bind3(b, "Cq", body, std::mem::take(&mut cq[body])))
-        } else {
-            let (fs, cs) = match lumped[body].take() {
-                // With links lumped in: the force of the composite `(m, h, J)` about the origin,
-                // `f = m α + ω̇ × h + ω × (ω × h)`, `n = J ω̇ + ω × (J ω) + h × α`.
-                Some(c) => {
-                    let c = Composite::body(mass, l, inn).add(c).bind(b, format_args!("L{body}"));
-                    let fs = vadd(&a.clone().map(|x| mul(c.m.clone(), x)), &matvec(&u[body], &c.h, false));
-                    let fs = bind3(b, "Fs", body, fs);
-                    let jw = matvec(&c.j, w, false);
-                    let cs = vadd(&vadd(&matvec(&c.j, wp, false), &cross(w, &jw)), &cross(&c.h, a));
-                    (fs, cs)
-                }
-                None => {
-                    let acc_c = vadd(a, &matvec(&u[body], &l, false));
-                    let fs = bind3(b, "Fs", body, acc_c.map(|x| mul(mass.clone(), x)));
-                    let iw = matvec(&inn, w, false);
-                    let cs = vadd(&vadd(&matvec(&inn, wp, false), &cross(w, &iw)), &cross(&l, &fs));
-                    (fs, cs)
-                }
-            };
-            (bind3(b, "Fq", body, vadd(&fs, &fq[body])), bind3(b, "Cq", body, vadd(&cs, &cq[body])))
-        };
+        let acc_c = vadd(a, &matvec(&u[body], &l, false));
+        let fs = bind3(b, "Fs", body, acc_c.map(|x| mul(mass.clone(), x)));
+        let iw = matvec(&inn, w, false);
+        let cs = vadd(&vadd(&matvec(&inn, wp, false), &cross(w, &iw)), &cross(&l, &fs));
+        let f_tot = bind3(b, "Fq", body, vadd(&fs, &fq[body]));
+        let c_tot = bind3(b, "Cq", body, vadd(&cs, &cq[body]));
         let m = &motions[body];
         match (joint.kind, layout.v_index[i]) {
             (JointKind::Prismatic, Some(qi)) => torque.push((qi, dot(&joint.axis, &f_tot))),

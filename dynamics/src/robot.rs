@@ -129,6 +129,10 @@ pub struct Joint {
     /// A revolute joint turns its child by `q + offset` (radians): 0 as read from a URDF; set
     /// by the generator's choice of body frames ([`crate::frames`]).
     pub offset: f64,
+    /// Where the joint goes among its parent link's children: by `(rank, name)`. 0 as read from
+    /// a URDF (urdfdom's name order); [`crate::lump::contract_fixed`] sets every joint's to its
+    /// place in the original walk, so that joints moved up past a removed fixed joint keep it.
+    pub rank: usize,
     /// The `<joint>` element.
     pub span: Span,
 }
@@ -162,7 +166,7 @@ impl Robot {
     /// so `pinocchio.buildModelFromUrdf`) visits them, since it keeps joints in a sorted map.
     pub fn children(&self, l: usize) -> Vec<usize> {
         let mut c: Vec<usize> = (0..self.joints.len()).filter(|&j| self.joints[j].parent == l).collect();
-        c.sort_by(|&a, &b| self.joints[a].name.as_bytes().cmp(self.joints[b].name.as_bytes()));
+        c.sort_by(|&a, &b| self.joint_order(a, b));
         c
     }
 
@@ -189,6 +193,12 @@ impl Robot {
         in_segment
     }
 
+    /// The order of two sibling joints: by [`Joint::rank`], then by name (byte order).
+    fn joint_order(&self, a: usize, b: usize) -> std::cmp::Ordering {
+        let (a, b) = (&self.joints[a], &self.joints[b]);
+        a.rank.cmp(&b.rank).then_with(|| a.name.as_bytes().cmp(b.name.as_bytes()))
+    }
+
     /// Every joint in depth-first pre-order from the root, children by [`Robot::children`]:
     /// Pinocchio's joint order once the fixed joints are left out. Cost: O(joints · log joints).
     pub fn dfs_joints(&self) -> Vec<usize> {
@@ -197,7 +207,7 @@ impl Robot {
             children[joint.parent].push(j);
         }
         for c in &mut children {
-            c.sort_by(|&a, &b| self.joints[a].name.as_bytes().cmp(self.joints[b].name.as_bytes()));
+            c.sort_by(|&a, &b| self.joint_order(a, b));
         }
         let mut out = Vec::with_capacity(self.joints.len());
         let mut stack: Vec<usize> = children[self.root].iter().rev().copied().collect();
@@ -262,6 +272,7 @@ impl Robot {
                 origin: Origin::IDENTITY,
                 axis,
                 offset: 0.0,
+                rank: 0,
                 span,
             });
             parent = child;
@@ -308,6 +319,7 @@ impl Robot {
             origin: Origin::IDENTITY,
             axis: [0.0; 3],
             offset: 0.0,
+            rank: 0,
             span,
         });
         Ok(self)

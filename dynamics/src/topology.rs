@@ -171,6 +171,7 @@ pub fn build(topology: Topology, dof: usize, seed: u64) -> Robot {
                 origin: Origin { xyz, rot: Origin::IDENTITY.rot },
                 axis,
                 offset: 0.0,
+                rank: 0,
                 span: Span::DUMMY,
             });
             parent = child;

@@ -11,25 +11,20 @@ const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 
 /// A composite rigid body in one frame: mass, first moment and rotational inertia about the
 /// frame origin (see the module doc).
 #[derive(Clone, Default)]
-pub(crate) struct Composite {
-    pub(crate) m: Term,
-    pub(crate) h: V3,
-    pub(crate) j: M3,
+pub(super) struct Composite {
+    pub(super) m: Term,
+    pub(super) h: V3,
+    pub(super) j: M3,
 }
 
 impl Composite {
-    pub(crate) fn zero() -> Composite {
+    pub(super) fn zero() -> Composite {
         Composite { m: ZERO, h: [ZERO, ZERO, ZERO], j: Default::default() }
-    }
-
-    /// Whether every entry is the structural zero (massless links only).
-    pub(crate) fn is_zero(&self) -> bool {
-        self.m == ZERO && self.h.iter().chain(self.j.iter().flatten()).all(|t| *t == ZERO)
     }
 
     /// One body: mass `m`, centre of mass `l`, inertia `inn` about the centre of mass:
     /// `(m, m l, In + m (|l|² I − l lᵀ))`.
-    pub(crate) fn body(m: Term, l: V3, inn: M3) -> Composite {
+    pub(super) fn body(m: Term, l: V3, inn: M3) -> Composite {
         let mut j: M3 = Default::default();
         for a in 0..3 {
             for c in a..3 {
@@ -48,7 +43,7 @@ impl Composite {
 
     /// `self + o`, taking both: no copy of `self`, which as a link's composite grows by one
     /// child at a time (a copy per child would cost the square of its children).
-    pub(crate) fn add(self, o: Composite) -> Composite {
+    pub(super) fn add(self, o: Composite) -> Composite {
         let Composite { m, h, j } = self;
         let [h0, h1, h2] = h;
         let [o0, o1, o2] = o.h;
@@ -64,7 +59,7 @@ impl Composite {
     /// Rotated by `r` (child → parent), then shifted by `t` (the child origin in the parent).
     /// A rotation about a coordinate axis ([`axis_turn`]) turns `J` by [`turned`], its
     /// temporaries named after `tag` (`"2"` for body 2's joint, `"O2"` for its origin).
-    pub(crate) fn moved(&self, b: &mut Builder, tag: &str, r: Option<&M3>, t: Option<&V3>) -> Composite {
+    pub(super) fn moved(&self, b: &mut Builder, tag: &str, r: Option<&M3>, t: Option<&V3>) -> Composite {
         let (h, j) = match (r, r.and_then(axis_turn)) {
             (Some(r), Some(turn)) => (matvec(r, &self.h, false), turned(b, tag, &self.j, &turn)),
             (Some(r), None) => {
@@ -108,7 +103,7 @@ impl Composite {
 
     /// Every entry bound as a temporary: `MC{body}`, `HC{k}{body}`, `JC{r}{c}{body}` (`body`
     /// is any tag: `12`, or `12_3` for the third partial sum of body 12's children).
-    pub(crate) fn bind(&self, b: &mut Builder, body: impl std::fmt::Display) -> Composite {
+    pub(super) fn bind(&self, b: &mut Builder, body: impl std::fmt::Display) -> Composite {
         let m = b.bind(&format!("MC{body}"), self.m.clone());
         let h = bind3(b, "HC", &body, self.h.clone());
         let mut j: M3 = Default::default();

@@ -88,7 +88,7 @@ use super::sym::{mul, Builder, Term, ZERO};
 use super::{Layout, Model, Stopped};
 pub(crate) use column::bind_entry;
 use column::merged_rotation;
-pub(crate) use composite::Composite;
+use composite::Composite;
 use rustc_hash::FxHashMap;
 use tree::Tree;
 

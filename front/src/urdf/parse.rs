@@ -219,6 +219,7 @@ pub fn parse(text: &str) -> Result<Robot, FrontError> {
             origin: origin(j)?,
             axis,
             offset: 0.0,
+            rank: 0,
             span: span_of(j.range()),
         });
     }
