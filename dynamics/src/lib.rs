@@ -11,7 +11,8 @@
 //!
 //! # Main modules
 //! [`robot`] (the model), [`sym`] (the expression builder), [`rnea`], [`crba`] and [`dirdyna`]
-//! (the formulations), [`frames`] and [`origins`] (the body frames the generator may choose),
+//! (the formulations), [`lump`] (fixed joints contracted), [`frames`] and [`origins`] (the body
+//! frames the generator may choose),
 //! [`topology`] (the study's robot families), [`urdf_out`] and [`robotran_c`] (the writers of
 //! `robovec-gen`), [`study`] (the thesis's study: cases, one case's run, the table).
 //!
@@ -36,10 +37,19 @@
 //! and map the velocities through the Cardan rates (`ω = E(q) qd[4..6]`, linear velocity
 //! rotated to the world frame).
 //!
+//! `--free-flyer` puts it on Pinocchio's free flyer instead ([`robot::Robot::with_free_flyer`]):
+//! `q[1..7]` the base position and unit quaternion `(x, y, z, w)` (not normalised by the
+//! equations: the caller's job, as in Pinocchio), `qd[1..6]`, `qdd[1..6]`, `Qq[1..6]` the base's
+//! velocity, acceleration and force in its frame (linear, then angular); the joints follow from
+//! `q[8]`, `qd[7]` ([`Layout::q_index`], [`Layout::v_index`]). `-gravity=x,y,z`
+//! ([`Request::gravity`]) writes `g` as numbers.
+//!
 //! # Numbering (Pinocchio's)
 //! Joints are numbered depth first from the root link, the joints leaving a link taken in
 //! byte order of their names (urdfdom's sorted map, which `pinocchio.buildModelFromUrdf`
-//! walks). Body `b` is the child link of the `b`-th joint of that walk (fixed joints included);
+//! walks). Links on fixed joints are first merged into the link they hang from ([`lump`], as
+//! Pinocchio's reader does; the walk keeps its order). Body `b` is the child link of the `b`-th
+//! joint of that walk;
 //! the moving (revolute, continuous, prismatic) joints are numbered `q[1..nq]` in the same walk,
 //! so `q[i]`, `qd[i]`, `qdd[i]` and `Qq[i]` are Pinocchio's entry `i − 1` of a fixed-base model.
 //!
