@@ -126,6 +126,11 @@ pub struct Cli {
     /// normalised by the equations (as in Pinocchio).
     #[arg(long)]
     pub free_flyer: bool,
+    /// URDF input: a continuous joint's configuration, one angle `q[i]` (`angle`, Robotran's)
+    /// or Pinocchio's pair `q[i] = cos θ`, `q[i+1] = sin θ` (`cos-sin`, what
+    /// `codegen<c;abi=pinocchio>` callers pass; not normalised by the equations).
+    #[arg(long, value_name = "angle|cos-sin", default_value = "angle")]
+    pub continuous: ContinuousJoint,
     /// URDF input: the gravity vector `x,y,z` (m/s², world frame), written into the equations
     /// as numbers instead of the inputs `g[1..3]` (Pinocchio's default is `0,0,-9.81`).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_gravity, allow_hyphen_values = true)]
@@ -202,6 +207,15 @@ pub fn normalise_args(args: impl IntoIterator<Item = String>) -> Vec<String> {
         .collect()
 }
 
+/// `--continuous=angle|cos-sin`: how a URDF continuous joint's configuration is written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ContinuousJoint {
+    /// One angle `q[i]` (Robotran's convention).
+    Angle,
+    /// Pinocchio's `(cos θ, sin θ)` pair `q[i]`, `q[i+1]`.
+    CosSin,
+}
+
 /// The formats of `--print-passes` (both read from the registry: [`robovec_passes::reference`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum PassListing {
@@ -267,6 +281,7 @@ impl Cli {
                 fold_params: self.fold_params,
                 floating_base: self.floating_base,
                 free_flyer: self.free_flyer,
+                continuous_cos_sin: self.continuous == ContinuousJoint::CosSin,
                 gravity: self.gravity,
                 ..robovec_front::FrontOptions::default()
             },

@@ -41,16 +41,18 @@ type Results = BTreeMap<&'static str, Vec<f64>>;
 /// Every function of the URDF at `path` (invdyna, dirdyna, fordyna), parameters folded, after
 /// `pipeline`.
 fn load(path: &str, pipeline: &str) -> Module {
-    load_on(path, pipeline, false)
+    load_on(path, pipeline, false, false)
 }
 
-/// [`load`], on Pinocchio's free flyer when `free_flyer`.
-fn load_on(path: &str, pipeline: &str, free_flyer: bool) -> Module {
+/// [`load`], on Pinocchio's free flyer when `free_flyer`, continuous joints as Pinocchio's
+/// `(cos, sin)` pairs when `cos_sin` (`--continuous=cos-sin`).
+fn load_on(path: &str, pipeline: &str, free_flyer: bool, cos_sin: bool) -> Module {
     let (loaded, _) = robovec::driver::load_with(
         path,
         &FrontOptions {
             fold_params: true,
             free_flyer,
+            continuous_cos_sin: cos_sin,
             functions: Some(robovec_dynamics::FUNCTION_NAMES.iter().map(|s| s.to_string()).collect()),
             ..FrontOptions::default()
         },
@@ -201,8 +203,8 @@ struct Oracle {
 
 /// The `abi=pinocchio` C of the URDF `urdf` (a path or `erd:…`) called with Pinocchio's vectors
 /// against Pinocchio's results, one state per call and `batch=4`; `continuous`: the model has
-/// continuous joints, whose Pinocchio configuration is (cos θ, sin θ): robovec's C takes the
-/// angle (the oracle's `q`); otherwise the C gets Pinocchio's configuration vector itself.
+/// continuous joints, whose Pinocchio configuration is (cos θ, sin θ), and is loaded with
+/// `--continuous=cos-sin`; either way the C gets Pinocchio's configuration vector itself.
 /// Returns the worst relative error.
 fn against_pinocchio(py: &Path, label: &str, urdf: &str, continuous: bool) -> f64 {
     against_pinocchio_on(py, label, urdf, continuous, false)
@@ -225,20 +227,18 @@ fn against_pinocchio_on(py: &Path, label: &str, urdf: &str, continuous: bool, fr
         .states
         .iter()
         .map(|s| {
-            // Pinocchio's own configuration vector, unless continuous joints make it (cos, sin).
-            let q = if continuous {
+            // Pinocchio's own configuration vector: with continuous joints, their (cos, sin)
+            // pairs (the model loaded with --continuous=cos-sin).
+            if continuous {
                 assert!(s.q_pinocchio.len() > s.q.len(), "{label}: continuous joints");
-                s.q.clone()
             } else {
                 assert_eq!(s.q_pinocchio, s.q, "{label}: Pinocchio's q is one coordinate per joint");
-                s.q_pinocchio.clone()
-            };
-            StateIn { q, v: s.qd.clone(), a: s.qdd.clone(), tau: s.tau.clone() }
+            }
+            StateIn { q: s.q_pinocchio.clone(), v: s.qd.clone(), a: s.qdd.clone(), tau: s.tau.clone() }
         })
         .collect();
-    let m = load_on(&o.path, "atomise,cse", free_flyer);
+    let m = load_on(&o.path, "atomise,cse", free_flyer, continuous);
     let nq = states[0].q.len();
-    assert_eq!(nq, nv + usize::from(free_flyer), "{label}: configuration coordinates");
     let mut worst: f64 = 0.0;
     for batch in [1, 4] {
         let dir = tmp(&format!("pinocchio_{label}_{batch}"));

@@ -35,6 +35,8 @@ pub(crate) fn python() -> Option<PathBuf> {
 #[derive(serde::Deserialize)]
 struct State {
     q: Vec<f64>,
+    /// Pinocchio's own configuration vector (a continuous joint's `(cos, sin)`).
+    q_pinocchio: Vec<f64>,
     qd: Vec<f64>,
     qdd: Vec<f64>,
     tau: Vec<f64>,
@@ -112,6 +114,12 @@ fn compare(urdf: &str, dof: usize) -> f64 {
 /// [`compare`] on `base`: `dof` counts the velocity coordinates, the base's six included (which
 /// Pinocchio holds in one root joint); with the free flyer `q` has one more (the quaternion).
 fn compare_on(urdf: &str, dof: usize, base: Base) -> f64 {
+    compare_with(urdf, dof, base, false)
+}
+
+/// [`compare_on`]; `cos_sin`: loaded with `--continuous=cos-sin` and given Pinocchio's own
+/// configuration vector.
+fn compare_with(urdf: &str, dof: usize, base: Base, cos_sin: bool) -> f64 {
     let Some(py) = python() else { return 0.0 };
     let o = oracle(&py, urdf, 8, 7, base);
     let floating = base != Base::Fixed;
@@ -124,6 +132,7 @@ fn compare_on(urdf: &str, dof: usize, base: Base) -> f64 {
                 fold_params: fold,
                 floating_base: base == Base::Floating,
                 free_flyer: base == Base::FreeFlyer,
+                continuous_cos_sin: cos_sin,
                 functions: Some(robovec_dynamics::FUNCTION_NAMES.iter().map(|s| s.to_string()).collect()),
                 ..FrontOptions::default()
             },
@@ -140,7 +149,8 @@ fn compare_on(urdf: &str, dof: usize, base: Base) -> f64 {
                 given.insert(format!("g[{}]", k + 1), *g);
             }
             assert_eq!(s.q.len(), dof + usize::from(base == Base::FreeFlyer), "configuration coordinates");
-            for (i, q) in s.q.iter().enumerate() {
+            let q = if cos_sin { &s.q_pinocchio } else { &s.q };
+            for (i, q) in q.iter().enumerate() {
                 given.insert(format!("q[{}]", i + 1), *q);
             }
             for i in 0..dof {
@@ -269,11 +279,28 @@ fn free_flyer_matches_pinocchio_free_flyer_root_joint() {
     }
 }
 
-/// TIAGo Pro on the free flyer (6 + 33 velocity coordinates; see the test below).
+/// TIAGo Pro on the free flyer (6 + 33 velocity coordinates; see the test below), with its
+/// wheels' configuration as angles and as Pinocchio's `(cos, sin)` pairs (`--continuous=cos-sin`:
+/// Pinocchio's `q` itself, 4 + 1 entries longer than `qd`).
 #[test]
 fn mobile_manipulator_matches_pinocchio_free_flyer() {
     let e = compare_on("erd:tiago_pro_description/robots/tiago_pro.urdf", 33 + 6, Base::FreeFlyer);
     eprintln!("tiago_pro free flyer: worst relative error {e:e}");
+    let e = compare_with("erd:tiago_pro_description/robots/tiago_pro.urdf", 33 + 6, Base::FreeFlyer, true);
+    eprintln!("tiago_pro free flyer, cos-sin: worst relative error {e:e}");
+}
+
+/// `--continuous=cos-sin` on a fixed base: the three-link arm (one continuous joint) and a
+/// serial chain whose joints are all continuous, given Pinocchio's `q` as it is.
+#[test]
+fn continuous_joints_as_pinocchios_cos_sin_pairs() {
+    let e = compare_with("examples/three_link_arm/three_link_arm.urdf", 3, Base::Fixed, true);
+    eprintln!("three_link_arm cos-sin: worst relative error {e:e}");
+    let robot = robovec_dynamics::topology::build(robovec_dynamics::topology::Topology::Serial, 9, 1);
+    let path = crate::common::tmp("cos_sin").join("serial_9.urdf");
+    std::fs::write(&path, robovec_dynamics::urdf_out::write_urdf(&robot)).unwrap();
+    let e = compare_with(path.to_str().unwrap(), 9, Base::Fixed, true);
+    eprintln!("serial 9 cos-sin: worst relative error {e:e}");
 }
 
 /// A mobile manipulator: PAL's TIAGo Pro (example-robot-data; omnidirectional base on four

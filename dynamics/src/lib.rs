@@ -117,7 +117,8 @@ pub struct Layout {
     pub q_index: Vec<Option<usize>>,
     /// Velocity coordinates, `nv`.
     pub nv: usize,
-    /// Configuration coordinates, `nq` (`nv`, plus one with a free flyer).
+    /// Configuration coordinates, `nq` (`nv`, plus one with a free flyer and one per continuous
+    /// joint under [`robot::Robot::cos_sin`]).
     pub nq: usize,
     /// Every parameter (canonical name) → value, zeros included.
     pub values: BTreeMap<String, f64>,
@@ -135,10 +136,11 @@ impl Layout {
             let body = i + 1;
             let joint = &robot.joints[j];
             let kind = joint.kind;
+            let kq = if robot.cos_sin && joint.continuous { 2 } else { kind.nq() };
             v_index.push((kind.nv() > 0).then_some(nv + 1));
-            q_index.push((kind.nq() > 0).then_some(nq + 1));
+            q_index.push((kq > 0).then_some(nq + 1));
             nv += kind.nv();
-            nq += kind.nq();
+            nq += kq;
             for (k, x) in joint.origin.xyz.iter().enumerate() {
                 values.insert(format!("dpt[{}][{body}]", k + 1), *x);
             }

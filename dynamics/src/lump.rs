@@ -139,7 +139,8 @@ pub fn contract_fixed(robot: &Robot) -> Option<(Robot, Vec<usize>)> {
         });
         body_of.push(rank + 1);
     }
-    let contracted = Robot { name: robot.name.clone(), links, joints, root: new_index[robot.root] };
+    let contracted =
+        Robot { name: robot.name.clone(), links, joints, root: new_index[robot.root], cos_sin: robot.cos_sin };
     Some((contracted, body_of))
 }
 

@@ -191,9 +191,13 @@ pub fn motions(model: &Model, layout: &Layout, b: &mut Builder) -> Vec<Motion> {
         let joint = &robot.joints[j];
         let motion = match (joint.kind, layout.q_index[i]) {
             (JointKind::Revolute, Some(qi)) => {
-                let q = b.input(&format!("q[{qi}]"));
-                let mut c = b.trig(&format!("C{qi}"), TrigFn::Cos, q.clone());
-                let mut s = b.trig(&format!("S{qi}"), TrigFn::Sin, q);
+                let (mut c, mut s) = if robot.cos_sin && joint.continuous {
+                    // Pinocchio's (cos, sin) pair of a continuous joint: the trig variables.
+                    (b.input(&format!("q[{qi}]")), b.input(&format!("q[{}]", qi + 1)))
+                } else {
+                    let q = b.input(&format!("q[{qi}]"));
+                    (b.trig(&format!("C{qi}"), TrigFn::Cos, q.clone()), b.trig(&format!("S{qi}"), TrigFn::Sin, q))
+                };
                 if joint.offset != 0.0 {
                     // cos and sin of q + offset (`crate::frames`), bound as CQ, SQ.
                     let (so, co) = joint.offset.sin_cos();

@@ -133,6 +133,9 @@ pub struct Joint {
     /// a URDF (urdfdom's name order); [`crate::lump::contract_fixed`] sets every joint's to its
     /// place in the original walk, so that joints moved up past a removed fixed joint keep it.
     pub rank: usize,
+    /// A URDF `continuous` joint (a [`JointKind::Revolute`] without limits): with
+    /// [`Robot::cos_sin`], its configuration is Pinocchio's `(cos q, sin q)` pair.
+    pub continuous: bool,
     /// The `<joint>` element.
     pub span: Span,
 }
@@ -159,6 +162,12 @@ pub struct Robot {
     pub joints: Vec<Joint>,
     /// The root link (child of no joint).
     pub root: usize,
+    /// `--continuous=cos-sin`: every [`Joint::continuous`] joint takes two configuration
+    /// coordinates, `q[i] = cos θ` and `q[i + 1] = sin θ`, as Pinocchio's
+    /// `JointModelRevoluteUnbounded` (`nq = 2`, `nv = 1`), instead of the angle `θ`; the
+    /// equations read them as the trig variables (no `sin`/`cos` call). Not normalised: the
+    /// caller's job, as in Pinocchio.
+    pub cos_sin: bool,
 }
 
 impl Robot {
@@ -273,6 +282,7 @@ impl Robot {
                 axis,
                 offset: 0.0,
                 rank: 0,
+                continuous: false,
                 span,
             });
             parent = child;
@@ -320,6 +330,7 @@ impl Robot {
             axis: [0.0; 3],
             offset: 0.0,
             rank: 0,
+            continuous: false,
             span,
         });
         Ok(self)

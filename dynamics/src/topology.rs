@@ -172,12 +172,13 @@ pub fn build(topology: Topology, dof: usize, seed: u64) -> Robot {
                 axis,
                 offset: 0.0,
                 rank: 0,
+                continuous: false,
                 span: Span::DUMMY,
             });
             parent = child;
         }
     }
-    Robot { name: format!("{topology}_{dof}dof_seed{seed}"), links, joints, root: 0 }
+    Robot { name: format!("{topology}_{dof}dof_seed{seed}"), links, joints, root: 0, cos_sin: false }
 }
 
 #[cfg(test)]

@@ -32,6 +32,10 @@ pub struct FrontOptions {
     /// quaternion, `qd[1..6]` the base's velocity in its frame; see
     /// `robovec_dynamics::robot::Robot::with_free_flyer`). Front ends of fixed equations ignore it.
     pub free_flyer: bool,
+    /// `--continuous=cos-sin`: a URDF continuous joint's configuration as Pinocchio's
+    /// `(cos θ, sin θ)` pair (`robovec_dynamics::robot::Robot::cos_sin`). Front ends of fixed
+    /// equations ignore it.
+    pub continuous_cos_sin: bool,
     /// `-gravity=x,y,z`: the gravity vector written into generated equations as numbers
     /// (m/s², world frame) instead of the inputs `g[1..3]`. Front ends of fixed equations ignore it.
     pub gravity: Option<[f64; 3]>,

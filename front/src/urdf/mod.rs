@@ -55,6 +55,8 @@ impl FrontEnd for Urdf {
             )
             .note("expected at least one revolute, continuous or prismatic joint")]);
         }
+        let mut robot = robot;
+        robot.cos_sin = opts.continuous_cos_sin;
         let robot = if opts.floating_base {
             robot.with_floating_base().map_err(|(name, span)| {
                 vec![FrontError::new(span, format!("`{name}` is a name of robovec's floating base"), "this element")

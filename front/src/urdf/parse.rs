@@ -220,6 +220,7 @@ pub fn parse(text: &str) -> Result<Robot, FrontError> {
             axis,
             offset: 0.0,
             rank: 0,
+            continuous: ty.value() == "continuous",
             span: span_of(j.range()),
         });
     }
@@ -246,7 +247,7 @@ pub fn parse(text: &str) -> Result<Robot, FrontError> {
             .note("a URDF is one tree: connect every link to the root by a joint"))
         }
     };
-    let robot = Robot { name, links, joints, root };
+    let robot = Robot { name, links, joints, root, cos_sin: false };
     // A loop not through the root leaves its links unreachable from it.
     let seen = robot.dfs_joints();
     if seen.len() != robot.joints.len() {

@@ -23,8 +23,9 @@
 //! both is an error. `nv` is the largest velocity index of the module (`qd`, `qdd`, `Qq`, `c`,
 //! `M`) and `nq` the largest `q` index, at least `nv` (Pinocchio's free-flyer has `nq = nv + 1`):
 //! the header defines `NAME_NQ` and `NAME_NV`. A joint Pinocchio holds as `(cos θ, sin θ)` (a
-//! URDF `continuous` joint, `nq = 2` for it) is one angle `q[i]` to robovec's generator: such a
-//! model's `q` is not Pinocchio's (convert, or write the joint as `revolute` with limits).
+//! URDF `continuous` joint, `nq = 2` for it) takes that pair when the URDF is loaded with
+//! `--continuous=cos-sin`; without it, it is one angle `q[i]` and the model's `q` is not
+//! Pinocchio's.
 //!
 //! # Gravity and parameters
 //! Inputs `g[1..3]` (the generator's gravity) are folded into the code as Pinocchio's default
