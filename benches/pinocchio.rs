@@ -218,6 +218,9 @@ impl Baseline {
     }
 }
 
+/// One contestant's median ns in one run and its median paired ratio against each [`Baseline`].
+type RunFigures = (f64, [Option<f64>; 2]);
+
 fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -> (usize, Vec<Figures>) {
     let work = env.work.join(robot.name);
     std::fs::create_dir_all(&work).unwrap();
@@ -356,7 +359,7 @@ fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -
     let exe = env.link(&work, &sources);
     let mut names: BTreeMap<usize, (usize, String)> = BTreeMap::new();
     // Per contestant, per run: median ns and median paired ratio against each baseline.
-    let mut per_run: BTreeMap<usize, Vec<(f64, [Option<f64>; 2])>> = BTreeMap::new();
+    let mut per_run: BTreeMap<usize, Vec<RunFigures>> = BTreeMap::new();
     for r in 0..runs {
         let values = work.join("values.bin");
         let out = run(Command::new(&exe)
@@ -438,10 +441,8 @@ fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -
 /// contestant.
 fn summary_row(robot: &str, nv: usize, g: usize, baseline: Baseline, figs: &[Figures], mhz: f64) -> Option<String> {
     let mine: Vec<&Figures> = figs.iter().filter(|f| f.group == g).collect();
-    let base = mine
-        .iter()
-        .filter(|f| f.name.starts_with(baseline.prefix()))
-        .min_by(|a, b| a.ns.0.total_cmp(&b.ns.0))?;
+    let base =
+        mine.iter().filter(|f| f.name.starts_with(baseline.prefix())).min_by(|a, b| a.ns.0.total_cmp(&b.ns.0))?;
     let k = baseline as usize;
     let mut row = format!(
         "| {robot} | {nv} | {} | {} `{}` | {:.0} ({:.0} cycles) |",
