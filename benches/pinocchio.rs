@@ -1,38 +1,51 @@
-//! robovec's generated C against Pinocchio's C++ (issue 14), side by side in one process.
+//! robovec's generated C against Pinocchio's C++ (issue 14) and against Pinocchio's own code
+//! generator, CppADCodeGen (issue 30), side by side in one process.
 //!
-//! `cargo bench --bench pinocchio -- [ROBOT…] [--reps=N] [--runs=K]`
+//! `cargo bench --bench pinocchio -- [ROBOT…] [--reps=N] [--runs=K] [--base=composite|free-flyer]`
 //!
-//! Robots (default: all): `ur5`, `panda` (fixed base), `solo12`, `talos`, `tiago_pro` (Robotran's
-//! floating base, Pinocchio's composite root joint PX PY PZ RX RY RZ), `serial30` (the 30-dof
+//! Robots (default: all): `ur5`, `panda` (fixed base), `solo12`, `talos`, `tiago_pro` (floating
+//! base: `--base=composite`, the default, is Robotran's six-joint base, robovec's
+//! `--floating-base`, and Pinocchio's composite root joint PX PY PZ RX RY RZ; `--base=free-flyer`
+//! is Pinocchio's `JointModelFreeFlyer` and robovec's `--free-flyer`), `serial30` (the 30-dof
 //! serial topology family robot, `robovec_dynamics::topology`, seed 1) — the robots of
 //! `tests/pinocchio.rs`. For each robot it
 //! 1. runs `benches/pinocchio/export_model.py` with the venv's Python: Pinocchio's model built as
-//!    the oracle builds it, saved with `saveToText`, and 64 random states (the oracle's
-//!    distribution) shared by both sides;
-//! 2. writes robovec's C with `robovec-opt URDF -function=F --fold-params [--floating-base]
-//!    -passes=PIPELINE,codegen<c;abi=plain;…>` for [`VARIANTS`] of three functions: `invdyna`
-//!    (against `pinocchio::rnea`), `dirdyna` cut by `dce<outputs=…>` to the upper triangle of
-//!    `M` (against `pinocchio::crba`, which fills the upper triangle only) and to that and `c`
-//!    (against `crba` then `nonLinearEffects`): both sides compute and store the same entries
-//!    (Robotran's `M[j][i] = M[i][j]` copies of the lower triangle are 0 ops but 1.9× the
-//!    stores: 13% of `M`'s time on TIAGo Pro at `batch=8`);
-//! 3. builds one binary: `benches/pinocchio/harness.cpp` (Pinocchio header-only, instantiated
+//!    the oracle builds it (or on the free-flyer), saved with `saveToText`, and 64 random states
+//!    (the oracle's distribution; a free-flyer's quaternion uniform on the sphere) shared by all;
+//! 2. runs `benches/pinocchio/cg_sources.py`: CppADCodeGen's C of `rnea`, `crba` (the upper
+//!    triangle of `M`) and `aba` for that model (`cg_export.cpp`, compiled once and cached in
+//!    `target/pinocchio_bench/cg_export-HASH`, 5–9 min; the sources rewritten only when the model
+//!    changes), each compiled twice as its own object ([`CG_BUILDS`]: `-O3 -march=native` and
+//!    `-Ofast -march=native`, Pinocchio's default), its function renamed per build;
+//! 3. writes robovec's C with `robovec-opt URDF -function=F --fold-params [--floating-base |
+//!    --free-flyer] -passes=PIPELINE,codegen<c;abi=plain;…>` for [`VARIANTS`] of four functions:
+//!    `invdyna` (against `pinocchio::rnea`), `dirdyna` cut by `dce<outputs=…>` to the upper
+//!    triangle of `M` (against `pinocchio::crba`, which fills the upper triangle only) and to that
+//!    and `c` (against `crba` then `nonLinearEffects`): both sides compute and store the same
+//!    entries (Robotran's `M[j][i] = M[i][j]` copies of the lower triangle are 0 ops but 1.9× the
+//!    stores: 13% of `M`'s time on TIAGo Pro at `batch=8`), and `fordyna` (against
+//!    `pinocchio::aba`, from the `tau` of the reference inverse dynamics of each state);
+//! 4. builds one binary: `benches/pinocchio/harness.cpp` (Pinocchio header-only, instantiated
 //!    for `double` and `long double`, `g++ -O3 -march=native -DNDEBUG`; compiled once and cached
-//!    in `target/pinocchio_bench/` under the hash of its source and flags: ~3 min), robovec's C
-//!    (`cc -O3 -march=native -ffp-contract=off`) and the table of inputs and maps `table.c`;
-//! 4. runs it `runs` times (default 5, `reps` default 101): each rep times every contestant of a function once,
-//!    alternating, the order rotated each rep, ~0.3 ms per sample cycling over the 64 states; the
-//!    ratio is built from **paired** samples (Pinocchio's ns over robovec's in the same rep; for
-//!    `crba` the faster of Pinocchio's LOCAL and WORLD conventions in that run), median per run,
-//!    then median over the runs;
-//! 5. measures bits of error (`robovec_ir::numerics::bits_f64`, Herbie's ordinal distance, the
+//!    in `target/pinocchio_bench/` under the hash of its source and flags: 3–9 min), CG's objects,
+//!    robovec's C (`cc -O3 -march=native -ffp-contract=off`) and the table of inputs and maps
+//!    `table.c`;
+//! 5. runs it `runs` times (default 5, `reps` default 101): each rep times every contestant of a
+//!    function once, alternating, the order rotated each rep, ~0.3 ms per sample cycling over the
+//!    64 states; the ratios are built from **paired** samples against two baselines (the
+//!    baseline's ns over the contestant's in the same rep): Pinocchio's run-time algorithm (for
+//!    `crba` and `aba` the faster of the LOCAL and WORLD conventions in that run) and CG (the
+//!    faster of its two builds in that run), median per run, then median over the runs;
+//! 6. measures bits of error (`robovec_ir::numerics::bits_f64`, Herbie's ordinal distance, the
 //!    `accuracy` pass's metric) of every contestant's f64 values on the 64 states against
 //!    Pinocchio evaluated on `long double` (64-bit significand) from the exact coordinates;
-//!    for `M` only the upper triangle counts (the lower one is a copy on both sides).
+//!    for `M` only the upper triangle counts (the lower one is a copy on every side).
 //!
-//! Prints a Markdown table and writes it to `target/pinocchio_bench/table.md`. Needs `cc`, `g++`
-//! and the Pinocchio venv at `target/pinocchio-venv` (or `ROBOVEC_PINOCCHIO_PYTHON`) with
-//! `cmeel-eigen` for Eigen's headers; fails with the commands to create it otherwise.
+//! Prints a Markdown table (per function one row against Pinocchio's run-time algorithm and,
+//! where CG has the function, one against CG) and writes it to `target/pinocchio_bench/table.md`.
+//! Needs `cc`, `g++` and the Pinocchio venv at `target/pinocchio-venv` (or
+//! `ROBOVEC_PINOCCHIO_PYTHON`) with `cmeel-eigen`, `cmeel-cppad` and `cmeel-cppadcodegen`; fails
+//! with the commands to create it otherwise.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -71,12 +84,59 @@ const VARIANTS: [(&str, &str, u32, &str); 6] = [
 /// The variants whose bits of error the summary shows: without and with fused multiply-adds.
 const BITS_OF: [&str; 2] = ["1 state, trig=libm", "batch=8, trig=inline, fma"];
 
-/// The three comparisons: label, robovec function, outputs kept (`dce`), Pinocchio's side.
-const GROUPS: [(&str, &str, Keep, &str); 3] = [
-    ("inverse dynamics", "invdyna", Keep::All, "rnea"),
-    ("mass matrix", "dirdyna", Keep::UpperM, "crba"),
-    ("M and c", "dirdyna", Keep::UpperMAndC, "crba + nonLinearEffects"),
+/// The four comparisons (the harness's groups, in its order): label, robovec function, outputs
+/// kept (`dce`), Pinocchio's side, CppADCodeGen's function (`cg_export.cpp`; none computes `M`
+/// and `c` together).
+const GROUPS: [(&str, &str, Keep, &str, Option<&str>); 4] = [
+    ("inverse dynamics", "invdyna", Keep::All, "rnea", Some("rnea")),
+    ("mass matrix", "dirdyna", Keep::UpperM, "crba", Some("crba")),
+    ("M and c", "dirdyna", Keep::UpperMAndC, "crba + nonLinearEffects", None),
+    ("forward dynamics", "fordyna", Keep::All, "aba", Some("aba")),
 ];
+
+/// CppADCodeGen's builds of each of its functions: label, `cc` flags. `-Ofast` is Pinocchio's
+/// default (`CodeGenBase::compileLib`), here with `-march=native` as every contestant; `-O3
+/// -march=native` is robovec's optimisation level (GCC contracts multiply-adds in both, as in
+/// Pinocchio's C++; `-Ofast` also reassociates). The objects are linked without `-Ofast`, so no
+/// flush-to-zero start-up code enters the process.
+const CG_BUILDS: [(&str, &[&str]); 2] = [("O3", &["-O3", "-march=native"]), ("Ofast", &["-Ofast", "-march=native"])];
+
+/// The root joint of the floating robots: one switch for both sides.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Base {
+    /// Robotran's six-joint base, robovec's `--floating-base`; Pinocchio's root joint
+    /// `JointModelComposite(PX PY PZ RX RY RZ)`.
+    Composite,
+    /// Pinocchio's `JointModelFreeFlyer` (position, unit quaternion x y z w; the base's velocity in
+    /// its own frame), robovec's `--free-flyer` (`q[1..nv+1]`, `qd[1..nv]`).
+    FreeFlyer,
+}
+
+impl Base {
+    fn parse(s: &str) -> Base {
+        match s {
+            "composite" => Base::Composite,
+            "free-flyer" => Base::FreeFlyer,
+            _ => panic!("--base={s}: composite or free-flyer"),
+        }
+    }
+
+    /// `export_model.py`'s base argument.
+    fn export_arg(self) -> &'static str {
+        match self {
+            Base::Composite => "floating",
+            Base::FreeFlyer => "free-flyer",
+        }
+    }
+
+    /// robovec-opt's flag.
+    fn robovec_flag(self) -> &'static str {
+        match self {
+            Base::Composite => "--floating-base",
+            Base::FreeFlyer => "--free-flyer",
+        }
+    }
+}
 
 /// The outputs of robovec's function a comparison keeps.
 #[derive(Clone, Copy)]
@@ -124,12 +184,44 @@ struct Figures {
     group: usize,
     /// Median ns per state over the runs (each run's median), and its min–max.
     ns: (f64, f64, f64),
-    /// Median over runs of the median paired ratio Pinocchio / this (1 for Pinocchio's best).
-    ratio: f64,
+    /// Median over runs of the median paired ratio baseline / this, per [`Baseline`] (1 for the
+    /// baseline's best; `None`: the function has no such baseline).
+    ratio: [Option<f64>; 2],
     errors: side::Errors,
 }
 
-fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Vec<Figures>) {
+/// What robovec is compared with: Pinocchio's run-time C++ algorithms, or its CppADCodeGen C.
+/// A function's baseline in a run is the faster of that side's contestants (`crba`'s LOCAL and
+/// WORLD conventions, CG's two builds).
+#[derive(Clone, Copy)]
+enum Baseline {
+    Pinocchio,
+    Cg,
+}
+
+impl Baseline {
+    const ALL: [Baseline; 2] = [Baseline::Pinocchio, Baseline::Cg];
+
+    /// The contestant-name prefix of this side.
+    fn prefix(self) -> &'static str {
+        match self {
+            Baseline::Pinocchio => "pinocchio ",
+            Baseline::Cg => "cg ",
+        }
+    }
+
+    fn label(self) -> &'static str {
+        match self {
+            Baseline::Pinocchio => "Pinocchio",
+            Baseline::Cg => "CG",
+        }
+    }
+}
+
+/// One contestant's median ns in one run and its median paired ratio against each [`Baseline`].
+type RunFigures = (f64, [Option<f64>; 2]);
+
+fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -> (usize, Vec<Figures>) {
     let work = env.work.join(robot.name);
     std::fs::create_dir_all(&work).unwrap();
     eprintln!("== {}", robot.name);
@@ -146,20 +238,48 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
     export.arg(env.root.join("benches/pinocchio/export_model.py")).arg(&urdf_spec).arg(&work);
     export.args([NSETS.to_string(), "1".into()]);
     if robot.floating {
-        export.arg("floating");
+        export.arg(base.export_arg());
     }
     let info: serde_json::Value = serde_json::from_str(&run(&mut export)).expect("export_model.py's JSON");
     let urdf = info["path"].as_str().unwrap().to_string();
     let states: States = read_states(&work.join("states.txt"));
     assert_eq!(states.x.len(), NSETS);
+    assert_eq!(states.free_flyer, robot.floating && base == Base::FreeFlyer);
     let nv = states.nv;
+
+    // CppADCodeGen's C (`cg_sources.py`: its exporter compiled once, its sources written once per
+    // model), one copy per (function, build) with the function renamed and the flags in a comment.
+    let cg: serde_json::Value = serde_json::from_str(&run(Command::new(&env.python)
+        .arg(env.root.join("benches/pinocchio/cg_sources.py"))
+        .arg(work.join("model.txt"))
+        .arg(work.join("cg"))))
+    .expect("cg_sources.py's JSON");
+    assert_eq!(cg["nv"].as_u64(), Some(nv as u64));
+    let mut sources: Vec<(std::path::PathBuf, &[&str])> = Vec::new();
+    let mut cg_decls = String::new();
+    let mut cg_entries = Vec::new();
+    for (g, (.., cg_fn)) in GROUPS.iter().enumerate() {
+        let Some(f) = cg_fn else { continue };
+        let text = std::fs::read_to_string(cg[f].as_str().unwrap()).unwrap();
+        for (tag, flags) in CG_BUILDS {
+            let symbol = format!("cg_{f}_{tag}");
+            let src = work.join(format!("{symbol}.c"));
+            let head = format!("/* cc {} */\n#define cg_{f}_forward_zero {symbol}\n", flags.join(" "));
+            side::write_if_changed(&src, (head + &text).as_bytes());
+            sources.push((src, flags));
+            let _ = writeln!(
+                cg_decls,
+                "void {symbol}(double const *const *in, double *const *out, struct LangCAtomicFun atomic);"
+            );
+            cg_entries.push(format!("  {{\"{f} -{tag}\", {symbol}, {g}}},"));
+        }
+    }
 
     // robovec's C, one file per (function, variant).
     let mut columns: Vec<String> = Vec::new();
     let mut entries = Vec::new();
     let mut decls = String::new();
-    let mut sources = Vec::new();
-    for (g, (_, function, keep, _)) in GROUPS.iter().enumerate() {
+    for (g, (_, function, keep, ..)) in GROUPS.iter().enumerate() {
         let (prefix, short) = keep.dce(nv);
         for (v, (label, pipeline, batch, trig)) in VARIANTS.iter().enumerate() {
             let i = g * VARIANTS.len() + v;
@@ -168,7 +288,7 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
             let mut cmd = Command::new(env!("CARGO_BIN_EXE_robovec-opt"));
             cmd.arg(&urdf).arg(format!("-function={function}")).arg("--fold-params");
             if robot.floating {
-                cmd.arg("--floating-base");
+                cmd.arg(base.robovec_flag());
             }
             let full = pipeline.replacen("atomise,", &format!("atomise,{prefix}"), 1);
             cmd.arg(format!("-passes={full},codegen<c;abi=plain;batch={batch};trig={trig};name=rv{i}>"));
@@ -176,16 +296,20 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
             run(cmd.arg("-o").arg(&fresh).arg(format!("-report={}", report.display())));
             let src = work.join(format!("rv{i}.c"));
             side::write_if_changed(&src, &std::fs::read(&fresh).unwrap());
-            sources.push(src);
+            sources.push((src, side::C_FLAGS));
             let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
             let list = |k: &str| -> Vec<String> {
                 j["codegen"][k].as_array().unwrap().iter().map(|x| x.as_str().unwrap().to_string()).collect()
             };
             let (ins, outs) = (list("inputs"), list("outputs"));
             let symbol = j["codegen"]["symbol"].as_str().unwrap().to_string();
+            // The forward dynamics' `Qq[i]`: the harness's `tau[i − 1]`, map `−i`.
             let in_map: Vec<String> = ins
                 .iter()
                 .map(|n| {
+                    if let Some(i) = n.strip_prefix("Qq[").and_then(|r| r.strip_suffix(']')) {
+                        return format!("-{i}");
+                    }
                     if !columns.contains(n) {
                         columns.push(n.clone());
                     }
@@ -220,14 +344,22 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
     table += "};\n";
     table += &decls;
     let _ = writeln!(table, "const RvVariant RV_VARIANTS[] = {{\n{}\n}};", entries.join("\n"));
+    // CppADCodeGen's functions and their signature (its `cg_F_forward_zero.c`'s types).
+    table += "typedef struct Array { void *data; unsigned long size; int sparse; const unsigned long *idx; unsigned long nnz; } Array;\n";
+    table += "struct LangCAtomicFun { void *libModel;\n  int (*forward)(void *libModel, int atomicIndex, int q, int p, const Array tx[], Array *ty);\n  int (*reverse)(void *libModel, int atomicIndex, int p, const Array tx[], Array *px, const Array py[]); };\n";
+    table += "typedef void (*cg_fn)(double const *const *in, double *const *out, struct LangCAtomicFun atomic);\n";
+    table += "typedef struct { const char *label; cg_fn fn; int group; } CgVariant;\n";
+    table += &cg_decls;
+    let _ = writeln!(table, "const int CG_NVARIANTS = {};", cg_entries.len());
+    let _ = writeln!(table, "const CgVariant CG_VARIANTS[] = {{\n{}\n}};", cg_entries.join("\n"));
     let table_c = work.join("table.c");
     side::write_if_changed(&table_c, table.as_bytes());
-    sources.push(table_c);
+    sources.push((table_c, side::C_FLAGS));
 
     let exe = env.link(&work, &sources);
     let mut names: BTreeMap<usize, (usize, String)> = BTreeMap::new();
-    // Per contestant, per run: median ns and median paired ratio.
-    let mut per_run: BTreeMap<usize, Vec<(f64, f64)>> = BTreeMap::new();
+    // Per contestant, per run: median ns and median paired ratio against each baseline.
+    let mut per_run: BTreeMap<usize, Vec<RunFigures>> = BTreeMap::new();
     for r in 0..runs {
         let values = work.join("values.bin");
         let out = run(Command::new(&exe)
@@ -248,15 +380,22 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
         }
         for (g, ..) in GROUPS.iter().enumerate() {
             let members: Vec<usize> = names.iter().filter(|(_, (gg, _))| *gg == g).map(|(c, _)| *c).collect();
-            // Pinocchio's baseline in this run: its fastest algorithm (median) for the group.
-            let base = *members
-                .iter()
-                .filter(|c| names[c].1.starts_with("pinocchio"))
-                .min_by(|a, b| side::median(&times[a]).total_cmp(&side::median(&times[b])))
-                .unwrap();
+            // Each side's baseline in this run: its fastest contestant (median) for the group.
+            let bases = Baseline::ALL.map(|b| {
+                members
+                    .iter()
+                    .copied()
+                    .filter(|c| names[c].1.starts_with(b.prefix()))
+                    .min_by(|x, y| side::median(&times[x]).total_cmp(&side::median(&times[y])))
+            });
+            assert!(bases[0].is_some(), "{}: no Pinocchio contestant for group {g}", robot.name);
             for &c in &members {
-                let paired: Vec<f64> = times[&base].iter().zip(&times[&c]).map(|(b, x)| b / x).collect();
-                per_run.entry(c).or_default().push((side::median(&times[&c]), side::median(&paired)));
+                let ratio = bases.map(|b| {
+                    let b = b?;
+                    let paired: Vec<f64> = times[&b].iter().zip(&times[&c]).map(|(b, x)| b / x).collect();
+                    Some(side::median(&paired))
+                });
+                per_run.entry(c).or_default().push((side::median(&times[&c]), ratio));
             }
         }
         eprintln!("   run {} of {runs} done", r + 1);
@@ -267,7 +406,10 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
         .map(|(c, (g, name))| {
             let runs = &per_run[c];
             let ns: Vec<f64> = runs.iter().map(|r| r.0).collect();
-            let ratios: Vec<f64> = runs.iter().map(|r| r.1).collect();
+            let ratio = [0, 1].map(|k| {
+                let ratios: Option<Vec<f64>> = runs.iter().map(|r| r.1[k]).collect();
+                ratios.map(|r| side::median(&r))
+            });
             Figures {
                 name: name.clone(),
                 group: *g,
@@ -276,7 +418,7 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
                     ns.iter().copied().fold(f64::INFINITY, f64::min),
                     ns.iter().copied().fold(0.0, f64::max),
                 ),
-                ratio: side::median(&ratios),
+                ratio,
                 errors: errors[c],
             }
         })
@@ -294,41 +436,45 @@ fn bench_robot(env: &Env, robot: &Robot, (reps, runs): (u32, u32)) -> (usize, Ve
     (nv, figures)
 }
 
-/// One row of the summary: Pinocchio's fastest algorithm against each robovec variant.
-fn summary_row(robot: &str, nv: usize, g: usize, figs: &[Figures], mhz: f64) -> String {
+/// One row of the summary: a side's fastest contestant (Pinocchio's run-time algorithm or
+/// CppADCodeGen's build) against each robovec variant; `None` when the function has no such
+/// contestant.
+fn summary_row(robot: &str, nv: usize, g: usize, baseline: Baseline, figs: &[Figures], mhz: f64) -> Option<String> {
     let mine: Vec<&Figures> = figs.iter().filter(|f| f.group == g).collect();
-    let pin = mine
-        .iter()
-        .filter(|f| f.name.starts_with("pinocchio"))
-        .min_by(|a, b| a.ns.0.total_cmp(&b.ns.0))
-        .expect("a Pinocchio contestant");
+    let base =
+        mine.iter().filter(|f| f.name.starts_with(baseline.prefix())).min_by(|a, b| a.ns.0.total_cmp(&b.ns.0))?;
+    let k = baseline as usize;
     let mut row = format!(
-        "| {robot} | {nv} | {} (`{}`) | {:.0} ({:.0} cycles) |",
+        "| {robot} | {nv} | {} | {} `{}` | {:.0} ({:.0} cycles) |",
         GROUPS[g].0,
-        pin.name.trim_start_matches("pinocchio "),
-        pin.ns.0,
-        pin.ns.0 * mhz / 1e3
+        baseline.label(),
+        base.name.trim_start_matches(baseline.prefix()),
+        base.ns.0,
+        base.ns.0 * mhz / 1e3
     );
     let variant = |label: &str| {
         mine.iter().find(|f| f.name.starts_with("robovec") && f.name.ends_with(label)).expect("each variant")
     };
     for (label, ..) in VARIANTS {
         let f = variant(label);
-        let _ = write!(row, " {:.0} ({:.1}×) |", f.ns.0, f.ratio);
+        let _ = write!(row, " {:.0} ({:.1}×) |", f.ns.0, f.ratio[k].expect("a ratio against the baseline"));
     }
-    let _ = write!(row, " {:.2} / {:.0} |", pin.errors.mean_bits, pin.errors.max_bits);
+    let _ = write!(row, " {:.2} / {:.0} |", base.errors.mean_bits, base.errors.max_bits);
     for label in BITS_OF {
         let e = &variant(label).errors;
         let _ = write!(row, " {:.2} / {:.0} |", e.mean_bits, e.max_bits);
     }
-    row
+    Some(row)
 }
 
 fn main() {
     let mut wanted = Vec::new();
     let (mut reps, mut runs) = (101, 5);
+    let mut base = Base::Composite;
     for a in std::env::args().skip(1) {
-        if let Some(r) = a.strip_prefix("--reps=") {
+        if let Some(b) = a.strip_prefix("--base=") {
+            base = Base::parse(b);
+        } else if let Some(r) = a.strip_prefix("--reps=") {
             reps = r.parse().expect("--reps=N");
         } else if let Some(r) = a.strip_prefix("--runs=") {
             runs = r.parse().expect("--runs=N");
@@ -347,14 +493,18 @@ fn main() {
     let (cpu, mhz) = side::clock();
     let mut summary = format!(
         "{cpu} at {mhz} MHz (cycles = ns × that clock); load average before: {}; {runs} runs × {reps} reps, medians; \
-         (×) = Pinocchio's ns ÷ robovec's, paired per rep\n\n",
-        load.trim()
+         floating base: {}; (×) = the row's baseline's ns ÷ robovec's, paired per rep\n\n",
+        load.trim(),
+        match base {
+            Base::Composite => "composite (PX PY PZ RX RY RZ)",
+            Base::FreeFlyer => "free-flyer",
+        }
     );
-    summary += "| robot | dof | function (Pinocchio's fastest) | Pinocchio ns/state |";
+    summary += "| robot | dof | function | baseline (its fastest) | baseline ns/state |";
     for (label, ..) in VARIANTS {
         let _ = write!(summary, " robovec {label} |");
     }
-    summary += " bits of error mean / max: Pinocchio |";
+    summary += " bits of error mean / max: baseline |";
     for label in BITS_OF {
         let _ = write!(summary, " robovec {label} |");
     }
@@ -363,29 +513,35 @@ fn main() {
     summary += &"---|".repeat(1 + BITS_OF.len());
     summary += "\n";
     let mut detail = format!(
-        "| robot | dof | function | contestant | ns/state median over {runs} runs (min–max) | Pinocchio ÷ this (paired) | bits of error mean / max | worst relative error |\n|---|---:|---|---|---:|---:|---|---:|\n"
+        "| robot | dof | function | contestant | ns/state median over {runs} runs (min–max) | Pinocchio ÷ this (paired) | CG ÷ this (paired) | bits of error mean / max | worst relative error |\n|---|---:|---|---|---:|---:|---:|---|---:|\n"
     );
     for robot in ROBOTS.iter().filter(|r| wanted.is_empty() || wanted.iter().any(|w| w == r.name)) {
-        let (nv, figs) = bench_robot(&env, robot, (reps, runs));
+        let (nv, figs) = bench_robot(&env, robot, base, (reps, runs));
         for f in &figs {
+            let ratio = |k: usize| f.ratio[k].map_or("–".to_string(), |r| format!("{r:.2}×"));
             let _ = writeln!(
                 detail,
-                "| {} | {nv} | {} | {} | {:.1} ({:.1}–{:.1}) | {:.2}× | {:.2} / {:.0} | {:.1e} |",
+                "| {} | {nv} | {} | {} | {:.1} ({:.1}–{:.1}) | {} | {} | {:.2} / {:.0} | {:.1e} |",
                 robot.name,
                 GROUPS[f.group].0,
                 f.name,
                 f.ns.0,
                 f.ns.1,
                 f.ns.2,
-                f.ratio,
+                ratio(0),
+                ratio(1),
                 f.errors.mean_bits,
                 f.errors.max_bits,
                 f.errors.relative
             );
         }
         for g in 0..GROUPS.len() {
-            summary += &summary_row(robot.name, nv, g, &figs, mhz);
-            summary.push('\n');
+            for baseline in Baseline::ALL {
+                if let Some(row) = summary_row(robot.name, nv, g, baseline, &figs, mhz) {
+                    summary += &row;
+                    summary.push('\n');
+                }
+            }
         }
     }
     let out = format!("{summary}\nEvery contestant:\n\n{detail}");

@@ -7,7 +7,8 @@
 #   generated Verilog;
 # - Pinocchio and example-robot-data from PyPI, in the virtual environment
 #   `target/pinocchio-venv` (about 50 s; kept across runs): the numerical oracle of the URDF
-#   front end's tests.
+#   front end's tests (with Eigen's, CppAD's and CppADCodeGen's headers for
+#   `cargo bench --bench pinocchio`).
 # Debian packages come from `apt-get` (as root, or through `sudo`). Then it runs
 # `cargo test --workspace --locked` with the arguments given (`scripts/test.sh -p robovec-ir`).
 # The tests read the Robotran corpus from `../shared` beside the repository and fail without it.
@@ -53,7 +54,7 @@ done
 venv=target/pinocchio-venv
 venv_ready() {
     "$venv/bin/python" -c "import pinocchio" >/dev/null 2>&1 \
-        && "$venv/bin/pip" show -q example-robot-data cmeel-eigen >/dev/null 2>&1
+        && "$venv/bin/pip" show -q example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen >/dev/null 2>&1
 }
 if ! venv_ready; then
     if ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
@@ -62,7 +63,7 @@ if ! venv_ready; then
     echo "installing pin and example-robot-data into $venv" >&2
     rm -rf "$venv"
     python3 -m venv "$venv"
-    "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen
+    "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen
     venv_ready || { echo "pinocchio and example-robot-data did not install into $venv" >&2; exit 1; }
 fi
 

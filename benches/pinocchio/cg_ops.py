@@ -11,9 +11,9 @@ and a release `robovec-opt` (`cargo build --release`).
 For each robot:
 1. `export_model.py` builds Pinocchio's model the oracle's way (fixed base, or the composite
    root joint PX PY PZ RX RY RZ of robovec's `--floating-base`) and saves it;
-2. `cg_export` (`cg_export.cpp`, compiled once with `g++` and cached in
-   `target/pinocchio_bench/` under the hash of its source) writes CppADCodeGen's C of `rnea`,
-   `crba` and `aba`;
+2. `cg_sources.py`'s helpers (shared with the bench's CG contestants) compile `cg_export.cpp`
+   once (cached in `target/pinocchio_bench/` under the hash of its source and flags) and write
+   CppADCodeGen's C of `rnea`, `crba` and `aba`;
 3. robovec writes `invdyna`, `dirdyna` cut to the upper triangle of `M` (what `crba` fills) and
    `fordyna` with `-passes=atomise,cse --fold-params`, and `-stats` gives their ops.
 
@@ -22,15 +22,11 @@ Ops are the binary `+ - * /` of the generated statements: CppADCodeGen's are cou
 counted as written), robovec's are `-stats`' `ops` (add, sub, mul, div; its trig values are
 inputs, as CG's `sin`/`cos` calls are not counted). Prints a Markdown table with robovec / CG.
 """
-import hashlib
 import os
 import re
-import subprocess
 import sys
 
-ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-HERE = os.path.join(ROOT, "benches", "pinocchio")
-WORK = os.path.join(ROOT, "target", "pinocchio_bench")
+from cg_sources import ROOT, HERE, WORK, exporter, export, run
 
 # name, example-robot-data file, floating base: the robots of `benches/pinocchio.rs` that
 # example-robot-data holds.
@@ -41,13 +37,6 @@ ROBOTS = [
     ("talos", "talos_data/robots/talos_reduced.urdf", True),
     ("tiago_pro", "tiago_pro_description/robots/tiago_pro.urdf", True),
 ]
-
-
-def cxx_flags():
-    """-O1 (the exporter runs once per robot), then the bench's shared Pinocchio flags."""
-    with open(os.path.join(HERE, "pinocchio_cxx_flags.txt")) as f:
-        shared = [l.strip() for l in f if l.strip() and not l.strip().startswith("#")]
-    return ["-O1"] + shared
 
 
 STATEMENT = re.compile(r"\s*[vy]\[\d+\]\s*=\s*(.*);\s*$")
@@ -68,34 +57,6 @@ def cg_ops(path):
                     n += 1
                 prev = t
     return n
-
-
-def run(cmd, **kw):
-    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
-    if r.returncode != 0:
-        sys.exit(f"failed: {' '.join(cmd)}\n{r.stdout}{r.stderr}")
-    return r.stdout + r.stderr
-
-
-def exporter(python):
-    prefix = run([python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"]).strip()
-    prefix = os.path.join(prefix, "cmeel.prefix")
-    for h in ["include/pinocchio/codegen/cppadcg-algo.hpp", "include/cppad/cg.hpp", "include/eigen3/Eigen/Core"]:
-        if not os.path.exists(os.path.join(prefix, h)):
-            sys.exit(f"{h} missing under {prefix}: {python} -m pip install pin cmeel-eigen cmeel-cppad cmeel-cppadcodegen example-robot-data")
-    src = os.path.join(HERE, "cg_export.cpp")
-    flags = cxx_flags()
-    key = hashlib.sha256((open(src).read() + " ".join(flags) + prefix).encode()).hexdigest()[:16]
-    exe = os.path.join(WORK, f"cg_export-{key}")
-    if not os.path.exists(exe):
-        os.makedirs(WORK, exist_ok=True)
-        print(f"compiling {src} (several minutes; cached as {exe})", file=sys.stderr)
-        lib = os.path.join(prefix, "lib")
-        inc = [f"-I{os.path.join(prefix, 'include')}", f"-I{os.path.join(prefix, 'include', 'eigen3')}"]
-        run(["g++", *flags, *inc, src, "-o", exe + ".tmp", f"-L{lib}", f"-Wl,-rpath,{lib}",
-             "-lcppad_lib", "-lboost_serialization", "-ldl"])
-        os.replace(exe + ".tmp", exe)
-    return prefix, exe
 
 
 def robovec_ops(opt, urdf, floating, function, passes):
@@ -131,7 +92,7 @@ def main():
     for name, rel, floating in robots:
         out = os.path.join(WORK, "cg", name)
         run([python, os.path.join(HERE, "export_model.py"), f"erd:{rel}", out, "1", "1"] + (["floating"] if floating else []))
-        nv = int(re.search(r"nv (\d+)", run([exe, os.path.join(out, "model.txt"), out])).group(1))
+        _, nv, cg = export(exe, os.path.join(out, "model.txt"), out)
         upper = ",".join(f"M[{i}][{j}]" for i in range(1, nv + 1) for j in range(i, nv + 1))
         urdf = os.path.join(erd, rel)
         rows = [
@@ -139,10 +100,10 @@ def main():
             ("crba", "dirdyna", f"atomise,cse,dce<outputs={upper}>"),
             ("aba", "fordyna", "atomise,cse"),
         ]
-        for cg, function, passes in rows:
-            c = cg_ops(os.path.join(out, cg, f"cg_{cg}_forward_zero.c"))
+        for name_cg, function, passes in rows:
+            c = cg_ops(cg[name_cg])
             r = robovec_ops(opt, urdf, floating, function, passes)
-            print(f"| {name} | {cg} / {function} | {c} | {r} | {r / c:.2f}× |", flush=True)
+            print(f"| {name} | {name_cg} / {function} | {c} | {r} | {r / c:.2f}× |", flush=True)
 
 
 if __name__ == "__main__":

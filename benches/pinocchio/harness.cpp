@@ -1,5 +1,6 @@
-// Timing and value harness of `cargo bench --bench pinocchio` (issue 14): Pinocchio's C++ `rnea`,
-// `crba` and `crba` + `nonLinearEffects` against robovec's generated C, on the same states.
+// Timing and value harness of `cargo bench --bench pinocchio` (issues 14, 30): Pinocchio's C++
+// `rnea`, `crba`, `crba` + `nonLinearEffects` and `aba` against Pinocchio's CppADCodeGen C (`rnea`,
+// `crba`, `aba`) and robovec's generated C, on the same states.
 //
 //   harness MODEL.txt STATES.txt VALUES.bin REPS
 //
@@ -7,10 +8,18 @@
 // script). robovec's side is linked in from `table.c` (written by the bench): `RV_SETS` holds every
 // robovec input of every state (`RV_NCOLS` columns), `RV_VARIANTS` the generated functions with
 // their group (0: inverse dynamics vs `rnea`; 1: `M` vs `crba`; 2: `M`, `c` vs `crba` +
-// `nonLinearEffects`), lanes per call, and maps: input k reads column `in_map[k]`, output k is entry
-// `out_map[k]` of the group's layout (0: `tau[i]`; 1: `M[i][j]` at `i*nv + j`; 2: that, then
-// `c[i]` at `nv*nv + i`; robovec's `M` is the upper triangle, as `crba`'s, and both are
-// mirrored into the lower one).
+// `nonLinearEffects`; 3: forward dynamics vs `aba`), lanes per call, and maps: input k reads column
+// `in_map[k]` (a negative `-1 - i`: the generalised force `tau[i]` of the state, the ABA's input,
+// computed here), output k is entry `out_map[k]` of the group's layout (0: `tau[i]`; 1: `M[i][j]`
+// at `i*nv + j`; 2: that, then `c[i]` at `nv*nv + i`; 3: `qdd[i]`; robovec's `M` is the upper
+// triangle, as `crba`'s, and both are mirrored into the lower one). `CG_VARIANTS` (also in
+// `table.c`) are CppADCodeGen's functions, each compiled on its own (`cg_F_forward_zero` renamed
+// per build): group 0 reads (q, v, a), 1 q, 3 (q, v, tau) in Pinocchio's layout, one state per call;
+// group 1's output is the upper triangle of `M` row by row (`M(i, j)`, `j >= i`).
+//
+// The ABA's input `tau` of a state is the reference inverse dynamics of that state (below) rounded
+// to double, the same for every contestant; its reference is the `long double` ABA from it, so
+// `qdd` is close to the state's accelerations.
 //
 // Prints `contestant\tINDEX\tGROUP\tNAME` per contestant, then `time\tINDEX\tREP\tNS_PER_STATE` for
 // every rep: in each rep every contestant of a group is timed once, the group's order rotated by
@@ -18,6 +27,7 @@
 // lanes takes W consecutive states). Writes VALUES.bin, native f64: per group, the reference
 // (Pinocchio on `long double`, its 64-bit significand, rounded to f64 once), then each
 // contestant's values in index order, each block `nsets x group size`.
+#include "pinocchio/algorithm/aba.hpp"
 #include "pinocchio/algorithm/crba.hpp"
 #include "pinocchio/algorithm/joint-configuration.hpp"
 #include "pinocchio/algorithm/rnea.hpp"
@@ -49,6 +59,28 @@ typedef struct {
 extern const int RV_NSETS, RV_NCOLS, RV_NVARIANTS;
 extern const double RV_SETS[];
 extern const RvVariant RV_VARIANTS[];
+
+// CppADCodeGen's function (its `cg_F_forward_zero.c`); no atomic functions are used.
+typedef struct Array {
+  void *data;
+  unsigned long size;
+  int sparse;
+  const unsigned long *idx;
+  unsigned long nnz;
+} Array;
+struct LangCAtomicFun {
+  void *libModel;
+  int (*forward)(void *libModel, int atomicIndex, int q, int p, const Array tx[], Array *ty);
+  int (*reverse)(void *libModel, int atomicIndex, int p, const Array tx[], Array *px, const Array py[]);
+};
+typedef void (*cg_fn)(double const *const *in, double *const *out, struct LangCAtomicFun atomic);
+typedef struct {
+  const char *label;
+  cg_fn fn;
+  int group;
+} CgVariant;
+extern const int CG_NVARIANTS;
+extern const CgVariant CG_VARIANTS[];
 }
 
 typedef Eigen::Matrix<long double, Eigen::Dynamic, 1> VecL;
@@ -101,18 +133,23 @@ int main(int argc, char **argv) {
     return 1;
   }
   const int reps = std::atoi(argv[4]);
-  const int sizes[3] = {nv, nv * nv, nv * nv + nv};
+  const int ngroups = 4;
+  const int sizes[ngroups] = {nv, nv * nv, nv * nv + nv, nv};
 
   // The reference: Pinocchio on long double, each configuration rebuilt from the exact
-  // coordinates (a continuous joint's cos, sin in long double, not Pinocchio's rounded doubles).
+  // coordinates (a continuous joint's cos, sin in long double, not Pinocchio's rounded doubles;
+  // a free-flyer's position and quaternion are the inputs' doubles, as every contestant's).
   pinocchio::ModelTpl<long double> model_l = model.cast<long double>();
   pinocchio::DataTpl<long double> data_l(model_l);
-  std::vector<std::vector<double>> ref(3, std::vector<double>());
-  for (int gi = 0; gi < 3; gi++) ref[gi].resize((size_t)n * sizes[gi]);
+  std::vector<std::vector<double>> ref(ngroups, std::vector<double>());
+  for (int gi = 0; gi < ngroups; gi++) ref[gi].resize((size_t)n * sizes[gi]);
+  // The ABA's input: the reference `tau` rounded to double.
+  std::vector<Eigen::VectorXd> tau_d(n, Eigen::VectorXd(nv));
   for (int s = 0; s < n; s++) {
     VecL ql = q[s].cast<long double>();
     for (int i = 0; i < nv; i++) {
       long double xi = x[s][i];
+      if (kind[i] == 2) continue;  // the free-flyer's configuration is q[0..7] itself
       if (kind[i] == 1) {
         ql[idx_q[i]] = std::cos(xi);
         ql[idx_q[i] + 1] = std::sin(xi);
@@ -124,8 +161,11 @@ int main(int argc, char **argv) {
     VecL tau = pinocchio::rnea(model_l, data_l, ql, vl, al);
     MatL m = pinocchio::crba(model_l, data_l, ql);
     VecL nle = pinocchio::nonLinearEffects(model_l, data_l, ql, vl);
+    for (int i = 0; i < nv; i++) tau_d[s][i] = (double)tau[i];
+    VecL ddq = pinocchio::aba(model_l, data_l, ql, vl, VecL(tau_d[s].cast<long double>()));
     for (int i = 0; i < nv; i++) {
       ref[0][(size_t)s * sizes[0] + i] = (double)tau[i];
+      ref[3][(size_t)s * sizes[3] + i] = (double)ddq[i];
       ref[2][(size_t)s * sizes[2] + nv * nv + i] = (double)nle[i];
       for (int j = 0; j < nv; j++) {
         double mij = (double)(i <= j ? m(i, j) : m(j, i));
@@ -135,7 +175,7 @@ int main(int argc, char **argv) {
     }
   }
 
-  // Contestants: Pinocchio's algorithms, then robovec's variants.
+  // Contestants: Pinocchio's algorithms, then CppADCodeGen's functions, then robovec's variants.
   std::vector<Contestant> cs;
   volatile double sink = 0;
   auto mirror = [nv](const Eigen::MatrixXd &m, double *out) {
@@ -163,6 +203,63 @@ int main(int argc, char **argv) {
                     for (int i = 0; i < nv; i++) out[nv * nv + i] = c[i];
                   }});
   }
+  for (int world = 0; world < 2; world++) {
+    pinocchio::Convention conv = world ? pinocchio::Convention::WORLD : pinocchio::Convention::LOCAL;
+    cs.push_back({std::string("pinocchio aba ") + (world ? "WORLD" : "LOCAL"), 3, 1,
+                  [&, conv](int k) { pinocchio::aba(model, data, q[k], v[k], tau_d[k], conv); },
+                  [&, conv](int s, double *out) {
+                    Eigen::VectorXd d = pinocchio::aba(model, data, q[s], v[s], tau_d[s], conv);
+                    for (int i = 0; i < nv; i++) out[i] = d[i];
+                  }});
+  }
+  // CppADCodeGen: each state's input vector packed once per group, one call per state.
+  const struct LangCAtomicFun no_atomic = {nullptr, nullptr, nullptr};
+  std::vector<std::vector<double>> cg_in(ngroups);
+  std::vector<int> cg_n_in(ngroups, 0), cg_n_out(ngroups, 0);
+  cg_n_in[0] = cg_n_in[3] = nq + 2 * nv;
+  cg_n_in[1] = nq;
+  cg_n_out[0] = cg_n_out[3] = nv;
+  cg_n_out[1] = nv * (nv + 1) / 2;
+  for (int gi : {0, 1, 3}) {
+    cg_in[gi].resize((size_t)n * cg_n_in[gi]);
+    for (int s = 0; s < n; s++) {
+      double *x = cg_in[gi].data() + (size_t)s * cg_n_in[gi];
+      for (int i = 0; i < nq; i++) x[i] = q[s][i];
+      if (gi == 1) continue;
+      for (int i = 0; i < nv; i++) {
+        x[nq + i] = v[s][i];
+        x[nq + nv + i] = gi == 0 ? a[s][i] : tau_d[s][i];
+      }
+    }
+  }
+  std::vector<std::vector<double>> cg_out(CG_NVARIANTS);
+  for (int ci = 0; ci < CG_NVARIANTS; ci++) {
+    const int gi = CG_VARIANTS[ci].group;
+    if (gi != 0 && gi != 1 && gi != 3) {
+      std::fprintf(stderr, "CppADCodeGen variant %s: group %d\n", CG_VARIANTS[ci].label, gi);
+      return 1;
+    }
+    cg_out[ci].resize(cg_n_out[gi]);
+    cs.push_back({std::string("cg ") + CG_VARIANTS[ci].label, gi, 1,
+                  [&, ci, gi](int k) {
+                    const double *ins[1] = {cg_in[gi].data() + (size_t)k * cg_n_in[gi]};
+                    double *outs[1] = {cg_out[ci].data()};
+                    CG_VARIANTS[ci].fn(ins, outs, no_atomic);
+                  },
+                  [&, ci, gi, nv](int s, double *out) {
+                    const double *ins[1] = {cg_in[gi].data() + (size_t)s * cg_n_in[gi]};
+                    std::vector<double> o(cg_n_out[gi]);
+                    double *outs[1] = {o.data()};
+                    CG_VARIANTS[ci].fn(ins, outs, no_atomic);
+                    if (gi != 1) {
+                      for (int i = 0; i < nv; i++) out[i] = o[i];
+                      return;
+                    }
+                    int k = 0;
+                    for (int i = 0; i < nv; i++)
+                      for (int j = i; j < nv; j++) out[i * nv + j] = out[j * nv + i] = o[k++];
+                  }});
+  }
   // robovec: inputs packed once per variant, lane-contiguous (`in[i*W + lane]`).
   std::vector<std::vector<double>> packed(RV_NVARIANTS), outbuf(RV_NVARIANTS);
   for (int vi = 0; vi < RV_NVARIANTS; vi++) {
@@ -176,8 +273,11 @@ int main(int argc, char **argv) {
     outbuf[vi].resize((size_t)rv.n_out * w);
     for (int b = 0; b < n / w; b++)
       for (int lane = 0; lane < w; lane++)
-        for (int i = 0; i < rv.n_in; i++)
-          packed[vi][((size_t)b * rv.n_in + i) * w + lane] = RV_SETS[(size_t)(b * w + lane) * RV_NCOLS + rv.in_map[i]];
+        for (int i = 0; i < rv.n_in; i++) {
+          const int s = b * w + lane, m = rv.in_map[i];
+          packed[vi][((size_t)b * rv.n_in + i) * w + lane] =
+              m >= 0 ? RV_SETS[(size_t)s * RV_NCOLS + m] : tau_d[s][-1 - m];
+        }
     cs.push_back({std::string("robovec ") + rv.label, rv.group, w,
                   [&, vi](int k) {
                     const RvVariant &r = RV_VARIANTS[vi];
@@ -191,7 +291,7 @@ int main(int argc, char **argv) {
                     for (int k = 0; k < r.n_out; k++)
                       if (r.out_map[k] >= 0) out[r.out_map[k]] = o[(size_t)k * r.batch + lane];
                     // robovec's M is the upper triangle, as crba's: mirrored like crba's.
-                    if (r.group != 0)
+                    if (r.group == 1 || r.group == 2)
                       for (int i = 0; i < nv; i++)
                         for (int j = 0; j < i; j++) out[i * nv + j] = out[j * nv + i];
                   }});
@@ -200,7 +300,7 @@ int main(int argc, char **argv) {
   // Values.
   {
     std::ofstream f(argv[3], std::ios::binary);
-    for (int gi = 0; gi < 3; gi++) {
+    for (int gi = 0; gi < ngroups; gi++) {
       f.write((const char *)ref[gi].data(), ref[gi].size() * sizeof(double));
       for (size_t c = 0; c < cs.size(); c++) {
         if (cs[c].group != gi) continue;
@@ -227,7 +327,7 @@ int main(int argc, char **argv) {
     calls[c] = std::max(1L, (long)(3e5 / per));
   }
   for (int rep = 0; rep < reps; rep++) {
-    for (int gi = 0; gi < 3; gi++) {
+    for (int gi = 0; gi < ngroups; gi++) {
       std::vector<size_t> members;
       for (size_t c = 0; c < cs.size(); c++)
         if (cs[c].group == gi) members.push_back(c);

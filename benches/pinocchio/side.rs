@@ -16,11 +16,12 @@ fn cxx_flags() -> Vec<&'static str> {
 
 /// Flags of robovec's generated C (the `native` set of `cargo bench --bench codegen_c`; no
 /// contraction, so the values are `-eval`'s).
-const C_FLAGS: &[&str] = &["-O3", "-march=native", "-ffp-contract=off", "-Wno-psabi"];
+pub const C_FLAGS: &[&str] = &["-O3", "-march=native", "-ffp-contract=off", "-Wno-psabi"];
 
-/// How to create the environment (the commands of `scripts/test.sh`, plus Eigen's headers).
+/// How to create the environment (the commands of `scripts/test.sh`: Pinocchio, its robots,
+/// Eigen's, CppAD's and CppADCodeGen's headers).
 const HOW: &str = "python3 -m venv target/pinocchio-venv && \
-    target/pinocchio-venv/bin/pip install pin example-robot-data cmeel-eigen";
+    target/pinocchio-venv/bin/pip install pin example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen";
 
 /// The Pinocchio environment and the bench's work folder.
 pub struct Env {
@@ -48,7 +49,12 @@ impl Env {
         let purelib =
             run(Command::new(&python).args(["-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"]));
         let prefix = PathBuf::from(purelib.trim()).join("cmeel.prefix");
-        for h in ["include/pinocchio/algorithm/rnea.hpp", "include/eigen3/Eigen/Core", "include/boost/version.hpp"] {
+        for h in [
+            "include/pinocchio/algorithm/rnea.hpp",
+            "include/eigen3/Eigen/Core",
+            "include/boost/version.hpp",
+            "include/cppad/cg.hpp",
+        ] {
             assert!(
                 prefix.join(h).exists(),
                 "{} is missing; create the environment with: {HOW}",
@@ -78,18 +84,19 @@ impl Env {
         Env { root, python, prefix, work, harness }
     }
 
-    /// Compiles `sources` (C, in `dir`) two at a time when newer than their objects, links them
-    /// with the harness, returns the executable.
-    pub fn link(&self, dir: &Path, sources: &[PathBuf]) -> PathBuf {
-        let objs: Vec<PathBuf> = sources.iter().map(|s| s.with_extension("o")).collect();
-        let stale: Vec<(&PathBuf, &PathBuf)> = sources.iter().zip(&objs).filter(|(s, o)| !newer(o, s)).collect();
+    /// Compiles `sources` (C, in `dir`, each with its flags) two at a time when newer than their
+    /// objects, links them with the harness, returns the executable. A source's flags must be
+    /// part of its text (a comment will do) for a change of flags to rebuild it.
+    pub fn link(&self, dir: &Path, sources: &[(PathBuf, &[&str])]) -> PathBuf {
+        let objs: Vec<PathBuf> = sources.iter().map(|s| s.0.with_extension("o")).collect();
+        let stale: Vec<(&(PathBuf, &[&str]), &PathBuf)> =
+            sources.iter().zip(&objs).filter(|((s, _), o)| !newer(o, s)).collect();
         let t0 = std::time::Instant::now();
         for pair in stale.chunks(2) {
             let children: Vec<_> = pair
                 .iter()
-                .map(|(s, o)| {
-                    let c =
-                        Command::new("cc").args(C_FLAGS).arg("-c").arg(s).arg("-o").arg(o).spawn().expect("cc runs");
+                .map(|((s, flags), o)| {
+                    let c = Command::new("cc").args(*flags).arg("-c").arg(s).arg("-o").arg(o).spawn().expect("cc runs");
                     (s, c)
                 })
                 .collect();
@@ -152,12 +159,15 @@ pub fn clock() -> (String, f64) {
     )
 }
 
-/// The states of `export_model.py`'s `states.txt`: per state the robovec coordinates `x`
-/// (`q[1..nv]`), velocities `v` and accelerations `a`; gravity `g`.
+/// The states of `export_model.py`'s `states.txt`: per state the coordinates `x` (one per
+/// velocity), Pinocchio's configuration `q`, velocities `v` and accelerations `a`; gravity `g`;
+/// whether the root joint is Pinocchio's free-flyer (a layout of kind 2).
 pub struct States {
     pub nv: usize,
     pub g: [f64; 3],
+    pub free_flyer: bool,
     pub x: Vec<Vec<f64>>,
+    pub q: Vec<Vec<f64>>,
     pub v: Vec<Vec<f64>>,
     pub a: Vec<Vec<f64>>,
 }
@@ -171,27 +181,37 @@ pub fn read_states(path: &Path) -> States {
     let mut w = text.split_whitespace().skip(3);
     let mut num = || -> f64 { w.next().expect("states.txt truncated").parse().unwrap() };
     let g = [num(), num(), num()];
-    for _ in 0..2 * nv {
+    let mut free_flyer = false;
+    for _ in 0..nv {
         num();
+        free_flyer |= num() == 2.0;
     }
-    let mut s = States { nv, g, x: vec![], v: vec![], a: vec![] };
+    let mut s = States { nv, g, free_flyer, x: vec![], q: vec![], v: vec![], a: vec![] };
     for _ in 0..n {
         let mut take = |k: usize| (0..k).map(|_| num()).collect::<Vec<f64>>();
         s.x.push(take(nv));
-        take(nq);
+        s.q.push(take(nq));
         s.v.push(take(nv));
         s.a.push(take(nv));
     }
     s
 }
 
-/// Value of robovec input `name` in state `s`: `q[i]`, `qd[i]`, `qdd[i]` the state's coordinate,
-/// velocity, acceleration `i − 1`; `g[k]` gravity; `S4`/`C4` (`trig=input`) sin/cos of `q[4]`.
+/// Value of robovec input `name` in state `s`: `q[i]` the state's coordinate `i − 1` (on a
+/// free-flyer `q[1..7]` are Pinocchio's `q[0..7]`, base position and quaternion, and `q[i]`,
+/// `i > 7`, the joint coordinate `i − 2`), `qd[i]`, `qdd[i]` its velocity, acceleration `i − 1`;
+/// `g[k]` gravity; `S4`/`C4` (`trig=input`) sin/cos of `q[4]`. (The generalised forces `Qq[i]`
+/// of the forward dynamics are the harness's: see `harness.cpp`.)
 pub fn robovec_inputs(name: &str, st: &States, s: usize) -> f64 {
     let index = |p: &str| -> Option<usize> { name.strip_prefix(p)?.strip_suffix(']')?.parse().ok() };
     let trig = |p: char| -> Option<usize> { name.strip_prefix(p)?.parse().ok() };
+    let coordinate = |i: usize| match (st.free_flyer, i) {
+        (true, 1..=7) => st.q[s][i - 1],
+        (true, _) => st.x[s][i - 2],
+        (false, _) => st.x[s][i - 1],
+    };
     if let Some(i) = index("q[") {
-        st.x[s][i - 1]
+        coordinate(i)
     } else if let Some(i) = index("qd[") {
         st.v[s][i - 1]
     } else if let Some(i) = index("qdd[") {
@@ -199,22 +219,23 @@ pub fn robovec_inputs(name: &str, st: &States, s: usize) -> f64 {
     } else if let Some(k) = index("g[") {
         st.g[k - 1]
     } else if let Some(i) = trig('S') {
-        st.x[s][i - 1].sin()
+        coordinate(i).sin()
     } else if let Some(i) = trig('C') {
-        st.x[s][i - 1].cos()
+        coordinate(i).cos()
     } else {
         panic!("robovec input {name}: no value in the shared states")
     }
 }
 
 /// Slot of robovec output `name` in the harness's layout of group `g` (0: `Qq[i]` → `i − 1`;
-/// 1, 2: `M[i][j]` → `(i − 1)·nv + j − 1`; 2: `c[i]` → `nv² + i − 1`).
+/// 1, 2: `M[i][j]` → `(i − 1)·nv + j − 1`; 2: `c[i]` → `nv² + i − 1`; 3: `qdd[i]` → `i − 1`).
 pub fn output_slot(name: &str, g: usize, nv: usize) -> usize {
     let idx: Vec<usize> = name.split('[').skip(1).filter_map(|p| p.trim_end_matches(']').parse().ok()).collect();
     match (name.split('[').next().unwrap(), g, idx.as_slice()) {
         ("Qq", 0, [i]) => i - 1,
         ("M", 1 | 2, [i, j]) => (i - 1) * nv + j - 1,
         ("c", 2, [i]) => nv * nv + i - 1,
+        ("qdd", 3, [i]) => i - 1,
         _ => panic!("robovec output {name} in group {g}"),
     }
 }
@@ -240,8 +261,8 @@ pub fn errors(
 ) -> BTreeMap<usize, Errors> {
     let bytes = std::fs::read(path).unwrap();
     let vals: Vec<f64> = bytes.chunks_exact(8).map(|c| f64::from_ne_bytes(c.try_into().unwrap())).collect();
-    let sizes = [nv, nv * nv, nv * nv + nv];
-    let counted = |g: usize, k: usize| g == 0 || k >= nv * nv || k / nv <= k % nv;
+    let sizes = [nv, nv * nv, nv * nv + nv, nv];
+    let counted = |g: usize, k: usize| g == 0 || g == 3 || k >= nv * nv || k / nv <= k % nv;
     let mut at = 0;
     let mut out = BTreeMap::new();
     for (g, &size) in sizes.iter().enumerate() {
