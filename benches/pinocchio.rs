@@ -4,9 +4,9 @@
 //! `cargo bench --bench pinocchio -- [ROBOT…] [--reps=N] [--runs=K] [--base=composite|free-flyer]`
 //!
 //! Robots (default: all): `ur5`, `panda` (fixed base), `solo12`, `talos`, `tiago_pro` (floating
-//! base: `--base=composite`, the default, is Robotran's six-joint base, robovec's
-//! `--floating-base`, and Pinocchio's composite root joint PX PY PZ RX RY RZ; `--base=free-flyer`
-//! is Pinocchio's `JointModelFreeFlyer` and robovec's `--free-flyer`), `serial30` (the 30-dof
+//! base: `--base=free-flyer`, the default, is Pinocchio's `JointModelFreeFlyer` and robovec's
+//! `--free-flyer`; `--base=composite` is Robotran's six-joint base, robovec's
+//! `--floating-base`, and Pinocchio's composite root joint PX PY PZ RX RY RZ), `serial30` (the 30-dof
 //! serial topology family robot, `robovec_dynamics::topology`, seed 1) — the robots of
 //! `tests/pinocchio.rs`. For each robot it
 //! 1. runs `benches/pinocchio/export_model.py` with the venv's Python: Pinocchio's model built as
@@ -470,7 +470,7 @@ fn summary_row(robot: &str, nv: usize, g: usize, baseline: Baseline, figs: &[Fig
 fn main() {
     let mut wanted = Vec::new();
     let (mut reps, mut runs) = (101, 5);
-    let mut base = Base::Composite;
+    let mut base = Base::FreeFlyer;
     for a in std::env::args().skip(1) {
         if let Some(b) = a.strip_prefix("--base=") {
             base = Base::parse(b);

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Operations of Pinocchio's CppADCodeGen output against robovec's, per robot (issue 30).
 
-Usage: cg_ops.py [ROBOT ...] [--robovec-opt PATH]
+Usage: cg_ops.py [ROBOT ...] [--robovec-opt PATH] [--base=free-flyer|composite]
 
 ROBOT is a name of the bench's list below (default: all of them). Needs the Pinocchio venv of
 `cargo bench --bench pinocchio` (`target/pinocchio-venv`, or ROBOVEC_PINOCCHIO_PYTHON) with
@@ -9,13 +9,15 @@ ROBOT is a name of the bench's list below (default: all of them). Needs the Pino
 and a release `robovec-opt` (`cargo build --release`).
 
 For each robot:
-1. `export_model.py` builds Pinocchio's model the oracle's way (fixed base, or the composite
+1. `export_model.py` builds Pinocchio's model the oracle's way (fixed base; a floating robot on
+   `JointModelFreeFlyer`, robovec's `--free-flyer`, by default, or with `--base=composite` on the
    root joint PX PY PZ RX RY RZ of robovec's `--floating-base`) and saves it;
 2. `cg_sources.py`'s helpers (shared with the bench's CG contestants) compile `cg_export.cpp`
    once (cached in `target/pinocchio_bench/` under the hash of its source and flags) and write
    CppADCodeGen's C of `rnea`, `crba` and `aba`;
 3. robovec writes `invdyna`, `dirdyna` cut to the upper triangle of `M` (what `crba` fills) and
-   `fordyna` with `-passes=atomise,cse --fold-params`, and `-stats` gives their ops.
+   `fordyna` with `-passes=atomise,cse --fold-params -gravity=0,0,-9.81` (CG's tape holds the
+   model's gravity as constants too), and `-stats` gives their ops.
 
 Ops are the binary `+ - * /` of the generated statements: CppADCodeGen's are counted in its
 `cg_F_forward_zero.c` (unary minus and `sin`/`cos` calls not counted, `0 - x` and `-1 * x`
@@ -59,10 +61,11 @@ def cg_ops(path):
     return n
 
 
-def robovec_ops(opt, urdf, floating, function, passes):
-    args = [opt, urdf, f"-function={function}", "--fold-params", f"-passes={passes}", "-stats", "-o", os.devnull]
-    if floating:
-        args.append("--floating-base")
+def robovec_ops(opt, urdf, base_flag, function, passes):
+    args = [opt, urdf, f"-function={function}", "--fold-params", "-gravity=0,0,-9.81", f"-passes={passes}", "-stats",
+            "-o", os.devnull]
+    if base_flag:
+        args.append(base_flag)
     out = run(args)
     counts = re.findall(r"ops (\d+) \(", out)
     if not counts:
@@ -73,6 +76,13 @@ def robovec_ops(opt, urdf, floating, function, passes):
 def main():
     args = sys.argv[1:]
     opt = os.path.join(ROOT, "target", "release", "robovec-opt")
+    base = "free-flyer"
+    for a in list(args):
+        if a.startswith("--base="):
+            base = a.split("=", 1)[1]
+            args.remove(a)
+    if base not in ("free-flyer", "composite"):
+        sys.exit(f"--base={base}: free-flyer or composite")
     if "--robovec-opt" in args:
         i = args.index("--robovec-opt")
         opt = args[i + 1]
@@ -91,7 +101,7 @@ def main():
     print("|---|---|---:|---:|---:|")
     for name, rel, floating in robots:
         out = os.path.join(WORK, "cg", name)
-        run([python, os.path.join(HERE, "export_model.py"), f"erd:{rel}", out, "1", "1"] + (["floating"] if floating else []))
+        run([python, os.path.join(HERE, "export_model.py"), f"erd:{rel}", out, "1", "1"] + ([{"free-flyer": "free-flyer", "composite": "floating"}[base]] if floating else []))
         _, nv, cg = export(exe, os.path.join(out, "model.txt"), out)
         upper = ",".join(f"M[{i}][{j}]" for i in range(1, nv + 1) for j in range(i, nv + 1))
         urdf = os.path.join(erd, rel)
@@ -102,7 +112,8 @@ def main():
         ]
         for name_cg, function, passes in rows:
             c = cg_ops(cg[name_cg])
-            r = robovec_ops(opt, urdf, floating, function, passes)
+            flag = {"free-flyer": "--free-flyer", "composite": "--floating-base"}[base] if floating else None
+            r = robovec_ops(opt, urdf, flag, function, passes)
             print(f"| {name} | {name_cg} / {function} | {c} | {r} | {r / c:.2f}× |", flush=True)
 
 
