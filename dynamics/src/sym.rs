@@ -390,6 +390,19 @@ impl Builder {
         f.op_counts().total
     }
 
+    /// The ops of what [`Builder::finish`] would keep once atomised and its repeated ops merged
+    /// (`-passes=atomise,cse`, what every pipeline of a user starts with): the count to compare
+    /// two formulations by, since one may repeat more terms than the other (the ABA's articulated
+    /// inertias, built entry by entry, repeat many). Cost: linear in the ops.
+    pub fn ops_after_cse(&self) -> u64 {
+        let mut f = self.f.clone();
+        let live = f.live_values(&[]);
+        f.retain(|_, v| live[v.index()]);
+        let mut f = robovec_passes::atomise::atomise_owned(f);
+        robovec_passes::cse::cse_function(&mut f);
+        f.op_counts().total
+    }
+
     /// The finished function: what no output needs is dropped (Robotran writes only the
     /// equations its outputs read), inputs included; `equations` counts what is left. The
     /// names of values and outputs are indexed again ([`Function::retain`]).
