@@ -17,7 +17,7 @@
 //!    `target/pinocchio_bench/cg_export-HASH`, 5–9 min; the sources rewritten only when the model
 //!    changes), each compiled twice as its own object ([`CG_BUILDS`]: `-O3 -march=native` and
 //!    `-Ofast -march=native`, Pinocchio's default), its function renamed per build;
-//! 3. writes robovec's C with `robovec-opt URDF -function=F --fold-params [--floating-base |
+//! 3. writes robovec's C with `robovec-opt URDF -function=F --fold-params -gravity=G [--floating-base |
 //!    --free-flyer] -passes=PIPELINE,codegen<c;abi=plain;…>` for [`VARIANTS`] of four functions:
 //!    `invdyna` (against `pinocchio::rnea`), `dirdyna` cut by `dce<outputs=…>` to the upper
 //!    triangle of `M` (against `pinocchio::crba`, which fills the upper triangle only) and to that
@@ -287,6 +287,10 @@ fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -
             let fresh = work.join(format!("rv{i}.new.c"));
             let mut cmd = Command::new(env!("CARGO_BIN_EXE_robovec-opt"));
             cmd.arg(&urdf).arg(format!("-function={function}")).arg("--fold-params");
+            // The model's gravity written into the equations as numbers, as CppADCodeGen's tape
+            // holds Pinocchio's `model.gravity` (the states' `g`, Pinocchio's default).
+            let [gx, gy, gz] = states.g;
+            cmd.arg(format!("-gravity={gx:?},{gy:?},{gz:?}"));
             if robot.floating {
                 cmd.arg(base.robovec_flag());
             }
