@@ -74,7 +74,7 @@ const NSETS: usize = 64;
 /// faster at `batch=8` on a Zen 3).
 const VARIANTS: [(&str, &str, u32, &str); 6] = [
     ("1 state, trig=libm", "atomise,cse", 1, "libm"),
-    ("1 state, trig=inline, fma", "atomise,cse,zero-removal,contract", 1, "inline"),
+    ("1 state, trig=inline, fma", "atomise,cse,zero-removal,contract,schedule-cpu", 1, "inline"),
     ("batch=4, trig=inline, fma", "atomise,cse,zero-removal,contract,schedule-cpu", 4, "inline"),
     ("batch=8, trig=inline", "atomise,cse,zero-removal,schedule-cpu", 8, "inline"),
     ("batch=8, trig=inline, fma", "atomise,cse,zero-removal,contract,schedule-cpu", 8, "inline"),
