@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """Pinocchio reference values for robovec's URDF front end (issue 14).
 
-Usage: pinocchio_oracle.py URDF STATES SEED [fixed|floating|freeflyer]
+Usage: pinocchio_oracle.py URDF STATES SEED [fixed|floating|free-flyer]
 
 With `floating`, the model is on Robotran's floating base: root joint
 `JointModelComposite([PX, PY, PZ, RX, RY, RZ])` (robovec's `--floating-base`, T1-T3 then R1-R3),
 whose six coordinates are plain lengths and angles, so q, qd, qdd map one to one.
-With `freeflyer`, the root joint is `JointModelFreeFlyer()` (robovec's `--free-flyer`): q starts
+With `free-flyer`, the root joint is `JointModelFreeFlyer()` (robovec's `--free-flyer`): q starts
 with the base position (uniform in [-1, 1]) and a random unit quaternion (x, y, z, w), seven
 coordinates for the base's six velocities.
 
@@ -49,13 +49,10 @@ def locate(spec):
 def build_model(path, base):
     """Pinocchio's model of the URDF at `path`: fixed base, on the root joint
     JointModelComposite([PX, PY, PZ, RX, RY, RZ]) (`floating`, the layout of robovec's
-    --floating-base) or on JointModelFreeFlyer (`freeflyer`, robovec's --free-flyer). A bool
-    `base` is the bench's older spelling (True: `floating`)."""
-    if isinstance(base, bool):
-        base = "floating" if base else "fixed"
+    --floating-base) or on JointModelFreeFlyer (`free-flyer`, robovec's --free-flyer)."""
     if base == "fixed":
         return pin.buildModelFromUrdf(path)
-    if base == "freeflyer":
+    if base == "free-flyer":
         return pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())
     root = pin.JointModelComposite()
     for j in (pin.JointModelPX(), pin.JointModelPY(), pin.JointModelPZ(),
@@ -68,8 +65,8 @@ def main():
     path = locate(sys.argv[1])
     n, seed = int(sys.argv[2]), int(sys.argv[3])
     base = sys.argv[4] if len(sys.argv) > 4 else "fixed"
-    if base not in ("fixed", "floating", "freeflyer"):
-        sys.exit(f"unknown base {base}: expected fixed, floating or freeflyer")
+    if base not in ("fixed", "floating", "free-flyer"):
+        sys.exit(f"unknown base {base}: expected fixed, floating or free-flyer")
     floating = base == "floating"
     model = build_model(path, base)
     data = model.createData()
@@ -82,7 +79,7 @@ def main():
         a = rng.uniform(-2.0, 2.0, model.nv)
         coords = []
         for j in joints:
-            if base == "freeflyer" and j.id == 1:
+            if base == "free-flyer" and j.id == 1:
                 quat = rng.normal(size=4)
                 x = np.concatenate([rng.uniform(-1.0, 1.0, 3), quat / np.linalg.norm(quat)])
                 coords.extend(map(float, x))

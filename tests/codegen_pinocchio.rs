@@ -25,6 +25,7 @@ use robovec_passes::codegen::literal::hex;
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
 use crate::common::{opt, stderr, tmp};
+use crate::pinocchio::{oracle, Base};
 
 /// One state in Pinocchio's vectors (`q` nq long, the others nv long).
 #[derive(Clone, Debug)]
@@ -181,26 +182,6 @@ fn rel(got: &[f64], want: &[f64]) -> f64 {
     }
 }
 
-#[derive(serde::Deserialize)]
-struct OracleState {
-    q: Vec<f64>,
-    q_pinocchio: Vec<f64>,
-    qd: Vec<f64>,
-    qdd: Vec<f64>,
-    tau: Vec<f64>,
-    #[serde(rename = "M")]
-    mass: Vec<Vec<f64>>,
-    nle: Vec<f64>,
-    aba: Vec<f64>,
-}
-
-#[derive(serde::Deserialize)]
-struct Oracle {
-    path: String,
-    gravity: Vec<f64>,
-    states: Vec<OracleState>,
-}
-
 /// The `abi=pinocchio` C of the URDF `urdf` (a path or `erd:…`) called with Pinocchio's vectors
 /// against Pinocchio's results, one state per call and `batch=4`; `continuous`: the model has
 /// continuous joints, whose Pinocchio configuration is (cos θ, sin θ), and is loaded with
@@ -213,14 +194,8 @@ fn against_pinocchio(py: &Path, label: &str, urdf: &str, continuous: bool) -> f6
 /// [`against_pinocchio`], on the free flyer (`--free-flyer`, `JointModelFreeFlyer`) when
 /// `free_flyer`: `q` has `nv + 1` entries (position, quaternion x y z w, joints).
 fn against_pinocchio_on(py: &Path, label: &str, urdf: &str, continuous: bool, free_flyer: bool) -> f64 {
-    let base = if free_flyer { "freeflyer" } else { "fixed" };
-    let out = Command::new(py)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["scripts/pinocchio_oracle.py", urdf, "8", "11", base])
-        .output()
-        .expect("run the oracle script");
-    assert!(out.status.success(), "oracle failed on {urdf}: {}", String::from_utf8_lossy(&out.stderr));
-    let o: Oracle = serde_json::from_slice(&out.stdout).expect("oracle JSON");
+    let base = if free_flyer { Base::FreeFlyer } else { Base::Fixed };
+    let o = oracle(py, urdf, 8, 11, base);
     assert_eq!(o.gravity, GRAVITY, "Pinocchio's default gravity is what abi=pinocchio folds");
     let nv = o.states[0].qd.len();
     let states: Vec<StateIn> = o

@@ -10,7 +10,7 @@
 //! (`CI` set) a missing environment fails the test; elsewhere it is skipped with a note.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use robovec_front::FrontOptions;
@@ -32,26 +32,29 @@ pub(crate) fn python() -> Option<PathBuf> {
     None
 }
 
+/// One state of `scripts/pinocchio_oracle.py`'s JSON: robovec's coordinates `q` (one angle per
+/// joint), Pinocchio's own configuration vector, and Pinocchio's results.
 #[derive(serde::Deserialize)]
-struct State {
-    q: Vec<f64>,
+pub(crate) struct State {
+    pub(crate) q: Vec<f64>,
     /// Pinocchio's own configuration vector (a continuous joint's `(cos, sin)`).
-    q_pinocchio: Vec<f64>,
-    qd: Vec<f64>,
-    qdd: Vec<f64>,
-    tau: Vec<f64>,
+    pub(crate) q_pinocchio: Vec<f64>,
+    pub(crate) qd: Vec<f64>,
+    pub(crate) qdd: Vec<f64>,
+    pub(crate) tau: Vec<f64>,
     #[serde(rename = "M")]
-    mass: Vec<Vec<f64>>,
-    nle: Vec<f64>,
-    aba: Vec<f64>,
+    pub(crate) mass: Vec<Vec<f64>>,
+    pub(crate) nle: Vec<f64>,
+    pub(crate) aba: Vec<f64>,
 }
 
+/// `scripts/pinocchio_oracle.py`'s JSON.
 #[derive(serde::Deserialize)]
-struct Oracle {
-    path: String,
+pub(crate) struct Oracle {
+    pub(crate) path: String,
     joints: Vec<String>,
-    gravity: Vec<f64>,
-    states: Vec<State>,
+    pub(crate) gravity: Vec<f64>,
+    pub(crate) states: Vec<State>,
 }
 
 /// The robot's base: fixed, Robotran's six-joint floating base (`--floating-base`, Pinocchio's
@@ -69,12 +72,14 @@ impl Base {
         match self {
             Base::Fixed => "fixed",
             Base::Floating => "floating",
-            Base::FreeFlyer => "freeflyer",
+            Base::FreeFlyer => "free-flyer",
         }
     }
 }
 
-fn oracle(py: &PathBuf, urdf: &str, states: usize, seed: u64, base: Base) -> Oracle {
+/// Runs the oracle script on `urdf` (a path or `erd:…`): `states` random states from `seed`, on
+/// `base`.
+pub(crate) fn oracle(py: &Path, urdf: &str, states: usize, seed: u64, base: Base) -> Oracle {
     let base = base.word();
     let out = Command::new(py)
         .current_dir(env!("CARGO_MANIFEST_DIR"))

@@ -46,7 +46,7 @@ def main():
         sys.exit(f"base {base}: one of fixed, floating, free-flyer")
     free_flyer = base == "free-flyer"
     floating = base != "fixed"
-    model = pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer()) if free_flyer else build_model(path, floating)
+    model = build_model(path, base)
     os.makedirs(out_dir, exist_ok=True)
     model.saveToText(os.path.join(out_dir, "model.txt"))
 
