@@ -48,7 +48,7 @@ type Vec3 = [f64; 3];
 
 const IDENTITY: Mat = Origin::IDENTITY.rot;
 
-fn mat_mul(a: &Mat, b: &Mat) -> Mat {
+pub(super) fn mat_mul(a: &Mat, b: &Mat) -> Mat {
     let mut c = [[0.0; 3]; 3];
     for (i, row) in c.iter_mut().enumerate() {
         for (j, x) in row.iter_mut().enumerate() {
@@ -76,7 +76,7 @@ fn rot_x(t: f64) -> Mat {
     [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]
 }
 
-fn snapped(m: &Mat) -> Mat {
+pub(super) fn snapped(m: &Mat) -> Mat {
     m.map(|row| row.map(snap))
 }
 

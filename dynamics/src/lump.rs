@@ -18,30 +18,14 @@
 //! centre of mass and inertia are theirs together (in its frame), and `dpt` is the composed
 //! joint origin. Their values come with them (`-params-out`).
 
-use super::robot::{rotate_tensor, snap, Inertial, Joint, JointKind, Link, Origin, Robot};
-
-type Mat = [[f64; 3]; 3];
-
-fn mat_mul(a: &Mat, b: &Mat) -> Mat {
-    [0, 1, 2].map(|i| [0, 1, 2].map(|j| snap((0..3).map(|k| a[i][k] * b[k][j]).sum())))
-}
-
-fn mat_vec(a: &Mat, v: &[f64; 3]) -> [f64; 3] {
-    [0, 1, 2].map(|i| (0..3).map(|k| a[i][k] * v[k]).sum())
-}
+use super::frames::{mat_mul, mat_vec, snapped, tidy};
+use super::robot::{rotate_tensor, Inertial, Joint, JointKind, Link, Origin, Robot};
 
 /// `a ∘ b`: the transform `b` (child in `a`'s child frame) seen from `a`'s parent.
 fn compose(a: &Origin, b: &Origin) -> Origin {
     let t = mat_vec(&a.rot, &b.xyz);
-    let xyz = [0, 1, 2].map(|k| {
-        let x = a.xyz[k] + t[k];
-        if x.abs() < 1e-15 {
-            0.0
-        } else {
-            x
-        }
-    });
-    Origin { xyz, rot: mat_mul(&a.rot, &b.rot) }
+    let xyz = [0, 1, 2].map(|k| tidy(a.xyz[k] + t[k]));
+    Origin { xyz, rot: snapped(&mat_mul(&a.rot, &b.rot)) }
 }
 
 /// Several rigid bodies' mass properties, each given in a frame placed by an [`Origin`] in the
@@ -49,7 +33,7 @@ fn compose(a: &Origin, b: &Origin) -> Origin {
 /// `None` when the total is massless with no inertia.
 fn combine(parts: &[(Origin, Inertial)]) -> Option<Inertial> {
     let mass: f64 = parts.iter().map(|(_, i)| i.mass).sum();
-    let placed: Vec<(f64, [f64; 3], Mat)> = parts
+    let placed: Vec<(f64, [f64; 3], [[f64; 3]; 3])> = parts
         .iter()
         .map(|(o, i)| {
             let c = mat_vec(&o.rot, &i.com);

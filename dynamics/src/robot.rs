@@ -192,9 +192,8 @@ impl Robot {
             let jo = &self.joints[j];
             // A free flyer's child is no part of it: the base's velocity is in its own frame,
             // whose six coordinates the CRBA writes as one block, not by projection.
-            let plain = jo.origin.xyz == [0.0; 3]
-                && jo.origin.rot == Origin::IDENTITY.rot
-                && jo.kind != JointKind::FreeFlyer;
+            let plain =
+                jo.origin.xyz == [0.0; 3] && jo.origin.rot == Origin::IDENTITY.rot && jo.kind != JointKind::FreeFlyer;
             in_segment[jo.child] =
                 in_segment[jo.parent] && plain && !(jo.kind == JointKind::Prismatic && revolute_above[jo.parent]);
             revolute_above[jo.child] = revolute_above[jo.parent] || jo.kind == JointKind::Revolute;
@@ -228,6 +227,20 @@ impl Robot {
     }
 }
 
+impl Robot {
+    /// The name and element of the first joint (named as `joint` accepts) or link (as `link`
+    /// accepts) in the file's order: a name a base the generator adds would clash with.
+    fn first_named(&self, joint: impl Fn(&str) -> bool, link: impl Fn(&str) -> bool) -> Option<(String, Span)> {
+        self.joints
+            .iter()
+            .filter(|j| joint(&j.name))
+            .map(|j| (&j.name, j.span))
+            .chain(self.links.iter().filter(|l| link(&l.name)).map(|l| (&l.name, l.span)))
+            .min_by_key(|(_, span)| span.start)
+            .map(|(name, span)| (name.clone(), span))
+    }
+}
+
 /// The names of Robotran's six floating-base joints, in chain order (`q[1..6]`).
 pub const FLOATING_BASE: [&str; 6] = ["T1", "T2", "T3", "R1", "R2", "R3"];
 
@@ -248,15 +261,9 @@ impl Robot {
             .flat_map(|j| [j.to_string(), format!("{j}_link")])
             .chain(["world".to_string()])
             .collect();
-        let clash = self
-            .joints
-            .iter()
-            .map(|j| (&j.name, j.span))
-            .chain(self.links.iter().map(|l| (&l.name, l.span)))
-            .filter(|(n, _)| reserved.contains(n))
-            .min_by_key(|(_, span)| span.start);
-        if let Some((name, span)) = clash {
-            return Err((name.clone(), span));
+        if let Some(clash) = self.first_named(|n| reserved.iter().any(|r| r == n), |n| reserved.iter().any(|r| r == n))
+        {
+            return Err(clash);
         }
         let old_root = self.root;
         let span = self.links[old_root].span;
@@ -307,15 +314,8 @@ impl Robot {
     /// The name and the element of the first URDF joint or link, in the file's order, whose name
     /// is `root_joint` (a joint) or `universe` (a link).
     pub fn with_free_flyer(mut self) -> Result<Robot, (String, Span)> {
-        let clash = self
-            .joints
-            .iter()
-            .filter(|j| j.name == FREE_FLYER[0])
-            .map(|j| (&j.name, j.span))
-            .chain(self.links.iter().filter(|l| l.name == FREE_FLYER[1]).map(|l| (&l.name, l.span)))
-            .min_by_key(|(_, span)| span.start);
-        if let Some((name, span)) = clash {
-            return Err((name.clone(), span));
+        if let Some(clash) = self.first_named(|n| n == FREE_FLYER[0], |n| n == FREE_FLYER[1]) {
+            return Err(clash);
         }
         let old_root = self.root;
         let span = self.links[old_root].span;

@@ -381,19 +381,11 @@ impl Builder {
         Builder { f: Function::new(&self.f.name, Phase::Parsed), consts: self.consts.clone(), deadline: self.deadline }
     }
 
-    /// The ops of what [`Builder::finish`] would keep (SPEC §3's count; a copy of the function
-    /// is pruned, this builder is unchanged).
-    pub fn live_ops(&self) -> u64 {
-        let mut f = self.f.clone();
-        let live = f.live_values(&[]);
-        f.retain(|_, v| live[v.index()]);
-        f.op_counts().total
-    }
-
     /// The ops of what [`Builder::finish`] would keep once atomised and its repeated ops merged
     /// (`-passes=atomise,cse`, what every pipeline of a user starts with): the count to compare
     /// two formulations by, since one may repeat more terms than the other (the ABA's articulated
-    /// inertias, built entry by entry, repeat many). Cost: linear in the ops.
+    /// inertias, built entry by entry, repeat many). A copy of the function is pruned, this
+    /// builder is unchanged. Cost: linear in the ops.
     pub fn ops_after_cse(&self) -> u64 {
         let mut f = self.f.clone();
         let live = f.live_values(&[]);
