@@ -1,7 +1,9 @@
 //! `trig=inline` (`passes/src/codegen/c/trig.rs`): the emitted sin/cos, compiled
-//! (`cc -O1 -ffp-contract=off`, one program, for a generic target and with `-march=native`), against a reference computed here in exact
+//! (`cc -O1 -ffp-contract=off`, one program, for a generic target and with `-march=native`, and at
+//! `-O2 -march=native`), against a reference computed here in exact
 //! integer arithmetic (the reduction) and double-double (the series) — accurate to about
-//! 2^−100, far beyond the ulp being measured; batched lanes equal `batch=1` bit for bit;
+//! 2^−100, far beyond the ulp being measured; batched lanes equal `batch=1` bit for bit, and
+//! one state's block of coordinates (`robovec_sincos_n`) equals one call per coordinate;
 //! libm's exact results beyond the range and on NaN/±∞; `sin(±0) = ±0`.
 
 use std::process::{Command, Stdio};
@@ -259,6 +261,11 @@ const IR: &str = "func @sc {\n  phase atomised\n  input %q[1]\n  input %q[2]\n  
                   %C1 = cos %q[1]\n  %S2 = sin %q[2]\n  %C3 = cos %q[3]\n  output s = %S1\n  output c = %C1\n  \
                   output s2 = %S2\n  output c3 = %C3\n}\n";
 
+/// The sin and cos of `q[1]` only (one coordinate: no block, one `robovec_sincos_inline` call), the
+/// outputs of [`IR`] with all three inputs equal.
+const IR_ONE: &str = "func @sc {\n  phase atomised\n  input %q[1]\n  %S1 = sin %q[1]\n  %C1 = cos %q[1]\n  \
+                      output s = %S1\n  output c = %C1\n  output s2 = %S1\n  output c3 = %C1\n}\n";
+
 /// The C driver of symbol `sym`: reads a count and that many reals, writes the 4 outputs of each.
 fn driver(sym: &str, real: &str, w: u32) -> String {
     format!(
@@ -273,10 +280,12 @@ fn driver(sym: &str, real: &str, w: u32) -> String {
 }
 
 /// Compiled for a generic target (no FMA: the polynomials as products and sums) and for the
-/// host's own (`-march=native`: with FMA where the host has it, `ROBOVEC_MADD` fuses them).
+/// host's own (`-march=native`: with FMA where the host has it, `ROBOVEC_MADD` fuses them), at
+/// -O1 and -O2 (where the block's loop is vectorised).
 #[test]
 fn inline_sin_cos_are_within_one_ulp_and_lanes_equal_the_scalar_code() {
-    for (k, flags) in [&["-O1"][..], &["-O1", "-march=native"]].into_iter().enumerate() {
+    // -O2: the block's loop vectorised (GCC 12+, Clang), whose lanes must give the same bits.
+    for (k, flags) in [&["-O1"][..], &["-O1", "-march=native"], &["-O2", "-march=native"]].into_iter().enumerate() {
         check_inline_sin_cos(&format!("trig_inline_{k}"), flags);
     }
 }
@@ -285,24 +294,49 @@ fn inline_sin_cos_are_within_one_ulp_and_lanes_equal_the_scalar_code() {
 fn check_inline_sin_cos(dir: &str, flags: &[&str]) {
     let dir = tmp(dir);
     let m = robovec_ir::text::parse(IR).unwrap_or_else(|e| panic!("{e:?}"));
-    // (symbol, f32, batch): the scalar form and a batch in each precision.
-    let forms = [("d1", false, 1), ("d4", false, 4), ("s1", true, 1), ("s8", true, 8)];
+    let m_one = robovec_ir::text::parse(IR_ONE).unwrap_or_else(|e| panic!("{e:?}"));
+    // (symbol, f32, batch, one coordinate): per precision one state with a block of three
+    // coordinates, a batch, and one state with one coordinate (one call, no block).
+    let forms = [
+        ("d1", false, 1, false),
+        ("d4", false, 4, false),
+        ("d1one", false, 1, true),
+        ("s1", true, 1, false),
+        ("s8", true, 8, false),
+        ("s1one", true, 1, true),
+    ];
     let mut main = String::from("#include <stdio.h>\n");
     let mut files = vec!["main.c".to_string()];
-    for (sym, f32, w) in forms {
+    for (sym, f32, w, one) in forms {
         let precision = if f32 { Precision::F32 } else { Precision::F64 };
         let o = CodegenC { precision, batch: w, trig: Trig::Inline, name: Some(sym.into()), ..CodegenC::default() };
-        let art = o.emit(&m).unwrap();
-        assert_eq!(art.interfaces[0].inputs, ["q[1]", "q[2]", "q[3]"]);
+        let art = o.emit(if one { &m_one } else { &m }).unwrap();
+        assert_eq!(art.interfaces[0].inputs, if one { &["q[1]"][..] } else { &["q[1]", "q[2]", "q[3]"][..] });
         assert_eq!(art.interfaces[0].trig, Trig::Inline);
         let c = &art.code.main;
-        assert!(c.contains("robovec_sincos_inline(q_1, &S1, &C1);"), "{c}");
-        assert!(c.contains("robovec_sin_inline(q_2)") && c.contains("robovec_cos_inline(q_3)"), "{c}");
+        let (real, n) = if f32 { ("float", 16) } else { ("double", 8) };
+        match (w, one) {
+            (1, false) => {
+                let zeros = vec![if f32 { "0x0p+0f" } else { "0x0p+0" }; n - 3].join(", ");
+                let block = format!(
+                    "  const {real} robovec_ta[{n}] = {{q_1, q_2, q_3, {zeros}}};\n  {real} robovec_ts[{n}], robovec_tc[{n}];\n  \
+                     robovec_sincos_n(robovec_ta, robovec_ts, robovec_tc, {n});\n  const {real} S1 = robovec_ts[0];\n  \
+                     const {real} C1 = robovec_tc[0];\n  const {real} S2 = robovec_ts[1];\n  const {real} C3 = robovec_tc[2];\n"
+                );
+                assert!(c.contains(&block), "{block}\n{c}");
+                assert!(!c.contains("robovec_sincos_inline(q_"), "{c}");
+            }
+            (1, true) => assert!(c.contains("  robovec_sincos_inline(q_1, &S1, &C1);\n"), "{c}"),
+            _ => {
+                assert!(c.contains("robovec_sincos_inline(q_1, &S1, &C1);"), "{c}");
+                assert!(c.contains("robovec_sin_inline(q_2)") && c.contains("robovec_cos_inline(q_3)"), "{c}");
+            }
+        }
         std::fs::write(dir.join(format!("{sym}.c")), c).unwrap();
         files.push(format!("{sym}.c"));
         main += &driver(sym, o.real(), w);
     }
-    main += "int main(void) { return run_d1() || run_d4() || run_s1() || run_s8(); }\n";
+    main += "int main(void) { return run_d1() || run_d4() || run_d1one() || run_s1() || run_s8() || run_s1one(); }\n";
     std::fs::write(dir.join("main.c"), main).unwrap();
     let exe = super::cc(&dir, &files, flags);
 
@@ -313,7 +347,7 @@ fn check_inline_sin_cos(dir: &str, flags: &[&str]) {
     let all = |sets: &[(&str, Vec<f64>)]| -> Vec<f64> { sets.iter().flat_map(|(_, v)| v.iter().copied()).collect() };
     let (x64, x32) = (all(&args64), all(&args32));
     let mut input = Vec::new();
-    for (xs, f32) in [(&x64, false), (&x64, false), (&x32, true), (&x32, true)] {
+    for (xs, f32) in [(&x64, false), (&x64, false), (&x64, false), (&x32, true), (&x32, true), (&x32, true)] {
         input.extend((xs.len() as u64).to_le_bytes());
         for &x in xs {
             if f32 {
@@ -330,8 +364,8 @@ fn check_inline_sin_cos(dir: &str, flags: &[&str]) {
     writer.join().unwrap();
     assert!(out.status.success(), "{} exited with {:?}", exe.display(), out.status);
     let bytes = out.stdout;
-    assert_eq!(bytes.len(), x64.len() * 4 * 8 * 2 + x32.len() * 4 * 4 * 2, "outputs written");
-    let (b64, b32) = bytes.split_at(x64.len() * 4 * 8 * 2);
+    assert_eq!(bytes.len(), x64.len() * 4 * 8 * 3 + x32.len() * 4 * 4 * 3, "outputs written");
+    let (b64, b32) = bytes.split_at(x64.len() * 4 * 8 * 3);
     let read64: Vec<u64> = b64.chunks(8).map(|c| u64::from_le_bytes(c.try_into().unwrap())).collect();
     let read32: Vec<u64> = b32.chunks(4).map(|c| u64::from(u32::from_le_bytes(c.try_into().unwrap()))).collect();
     let as_f = |b: u64, f32: bool| if f32 { f64::from(f32::from_bits(b as u32)) } else { f64::from_bits(b) };
@@ -341,11 +375,14 @@ fn check_inline_sin_cos(dir: &str, flags: &[&str]) {
         [(false, &x64, &args64, &read64, c64.limit()), (true, &x32, &args32, &read32, c32.limit())]
     {
         let n = xs.len();
-        let (scalar, batch) = got.split_at(4 * n);
+        let (scalar, rest) = got.split_at(4 * n);
+        let (batch, one) = rest.split_at(4 * n);
         let label = if f32 { "f32" } else { "f64" };
-        // Lanes of the batch equal the scalar code bit for bit; the single sin/cos equal the fused.
+        // Lanes of the batch and one call per coordinate equal the block bit for bit; the
+        // single sin/cos equal the fused.
         for i in 0..n {
             assert_eq!(&scalar[4 * i..4 * i + 4], &batch[4 * i..4 * i + 4], "{label} x = {:e}: batch ≠ scalar", xs[i]);
+            assert_eq!(&scalar[4 * i..4 * i + 4], &one[4 * i..4 * i + 4], "{label} x = {:e}: block ≠ one call", xs[i]);
             let r = &scalar[4 * i..4 * i + 4];
             assert_eq!((r[0], r[1]), (r[2], r[3]), "{label} x = {:e}: sin/cos alone ≠ fused", xs[i]);
         }

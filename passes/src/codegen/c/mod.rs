@@ -10,7 +10,8 @@
 //! coordinates are inputs (after the IR's inputs); with `trig=libm` they are computed (per lane).
 //! With `trig=inline` they are computed by robovec's own branch-free sin/cos, written into the
 //! file ([`trig`]: vectorised over the lanes, one reduction for the sin and cos of one
-//! coordinate, within 1 ulp): that code is **not** bit-exact with the interpreter, whose
+//! coordinate, within 1 ulp; one state's input coordinates in one block, a loop the C compiler
+//! vectorises, `body::TrigBlock`): that code is **not** bit-exact with the interpreter, whose
 //! sin/cos are libm's.
 //!
 //! ABIs: `plain` ([`plain`]) is `void NAME(const REAL *restrict in, REAL *restrict out)`;

@@ -482,7 +482,10 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
              static inline {real} robovec_real({u} i) {{ {real} x; memcpy(&x, &i, sizeof x); return x; }}"
         );
     }
-    let _ = writeln!(s, "static inline void robovec_sincos_inline({v} x, {v} *sin_out, {v} *cos_out)\n{{");
+    // The scalar form's reduction and polynomials are a branch-free kernel, so that a loop of
+    // them vectorises (`robovec_sincos_n`); the vector form tests its lanes' range inside.
+    let kernel = if vector { "robovec_sincos_inline" } else { "robovec_sincos_kernel" };
+    let _ = writeln!(s, "static inline void {kernel}({v} x, {v} *sin_out, {v} *cos_out)\n{{");
     let _ = writeln!(
         s,
         "  /* k = round(x*2/pi): adding 1.5*2^{} rounds to an integer, whose low bits are t's. */\n  \
@@ -558,20 +561,47 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
             mask(&in_range),
             elem = if f32 { "unsigned int" } else { "unsigned long long" },
         );
-    } else {
+    }
+    let _ = writeln!(s, "  *sin_out = s;\n  *cos_out = c;\n}}");
+    if !vector {
+        let far = format!("!(x[i] * x[i] <= {})", lit(l * l));
         let _ = writeln!(
             s,
-            "  /* |x| > L or NaN (rare): libm (x*x <= L^2 is |x| <= L exactly, false for NaN). */\n  \
-             if (__builtin_expect(!({in_range}), 0)) {{ s = sin{sfx}(x); c = cos{sfx}(x); }}"
+            "static inline void robovec_sincos_inline({v} x, {v} *sin_out, {v} *cos_out)\n{{\n  \
+             robovec_sincos_kernel(x, sin_out, cos_out);\n  \
+             /* |x| > L or NaN (rare): libm (x*x <= L^2 is |x| <= L exactly, false for NaN). */\n  \
+             if (__builtin_expect(!({in_range}), 0)) {{ *sin_out = sin{sfx}(x); *cos_out = cos{sfx}(x); }}\n}}\n\
+             /* The sin and cos of the n arguments x (one state's coordinates): the kernel's loop has no branch, so\n \
+             * the compiler vectorises it (-O3; -O2 of GCC 12+ and Clang too, n being a multiple of the lanes: callers\n \
+             * pad it to {pad}); then the arguments beyond L or NaN (rare) take libm. The same bits as\n \
+             * robovec_sincos_inline per argument. */\n\
+             static inline void robovec_sincos_n(const {v} *restrict x, {v} *restrict sin_out, {v} *restrict cos_out, int n)\n{{\n  \
+             int i, far = 0;\n  \
+             for (i = 0; i < n; i++) robovec_sincos_kernel(x[i], &sin_out[i], &cos_out[i]);\n  \
+             for (i = 0; i < n; i++) far |= {far};\n  \
+             if (__builtin_expect(far, 0))\n    \
+             for (i = 0; i < n; i++)\n      \
+             if ({far}) {{ sin_out[i] = sin{sfx}(x[i]); cos_out[i] = cos{sfx}(x[i]); }}\n}}",
+            pad = block_pad(f32),
         );
     }
     let _ = writeln!(
         s,
-        "  *sin_out = s;\n  *cos_out = c;\n}}\n\
-         static inline {v} robovec_sin_inline({v} x) {{ {v} s, c; robovec_sincos_inline(x, &s, &c); return s; }}\n\
+        "static inline {v} robovec_sin_inline({v} x) {{ {v} s, c; robovec_sincos_inline(x, &s, &c); return s; }}\n\
          static inline {v} robovec_cos_inline({v} x) {{ {v} s, c; robovec_sincos_inline(x, &s, &c); return c; }}\n"
     );
     s
+}
+
+/// `trig=inline`, one state: the length of the argument array of `robovec_sincos_n` is a
+/// multiple of this (64 bytes: the lanes of the widest vector, AVX-512), so that every vector
+/// width divides it and the loop needs no scalar remainder.
+pub(crate) fn block_pad(f32: bool) -> usize {
+    if f32 {
+        16
+    } else {
+        8
+    }
 }
 
 #[cfg(test)]
