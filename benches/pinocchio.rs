@@ -60,8 +60,9 @@ use side::{read_states, robovec_inputs, run, Env, States};
 const NSETS: usize = 64;
 
 /// robovec's variants of each function: label, pipeline before `codegen`, lanes, `trig`. One
-/// state without `schedule-cpu` (it does not help one state: docs/codegen-c.md "Speed of the generated C");
-/// batches of 4 (one AVX2 vector of doubles) and 8 (one AVX-512 vector: the fastest width per
+/// state with `trig=libm` as the plain baseline, and with `trig=inline`, `contract` and
+/// `schedule-cpu` (its greedy order cuts the register spills of one long function: Solo-12's
+/// `rnea` 1.43 → 1.59× CG, docs/benchmarks.md "Timed against CppADCodeGen", run 3); batches of 4 (one AVX2 vector of doubles) and 8 (one AVX-512 vector: the fastest width per
 /// state where the machine has AVX-512, 4 where it has AVX2 only: 8 and 16 lanes were 5–45 %
 /// slower per state on TIAGo Pro and serial30 on a Zen 3). `trig=libm` and `trig=inline`
 /// compute sin/cos, like for like with Pinocchio; `trig=input` takes them as inputs (the
