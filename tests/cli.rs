@@ -37,18 +37,18 @@ fn unknown_passes_and_parameters_are_usage_errors_listing_valid_ones() {
 fn named_pipelines_are_listed_and_expand_in_place() {
     let o = opt(&["--print-passes"]);
     let s = String::from_utf8_lossy(&o.stdout);
-    assert!(s.contains("default<depth>  = atomise,cse,zero-removal,balance,cse"), "{s}");
+    assert!(s.contains("default<depth>  = atomise,cse,zero-removal,balance,cse,recurrence,cse"), "{s}");
     assert!(s.contains("default<ops>    = atomise,cse,zero-removal,cse"), "{s}");
     let d = tmp("named_pipelines");
     let (a, b) = (d.join("named.rvir"), d.join("spelled.rvir"));
     let o = opt(&[&segway(), "-passes=atomise,default<depth>,asap-alap", "-time-passes", "-o", a.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let log = stderr(&o);
-    for pass in ["atomise", "cse", "zero-removal", "balance", "asap-alap"] {
+    for pass in ["atomise", "cse", "zero-removal", "balance", "recurrence", "asap-alap"] {
         assert!(log.contains(&format!("  {pass}\n")), "{pass} in\n{log}");
     }
     let o =
-        opt(&[&segway(), "-passes=atomise,atomise,cse,zero-removal,balance,cse,asap-alap", "-o", b.to_str().unwrap()]);
+        opt(&[&segway(), "-passes=atomise,atomise,cse,zero-removal,balance,cse,recurrence,cse,asap-alap", "-o", b.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(std::fs::read_to_string(&a).unwrap(), std::fs::read_to_string(&b).unwrap());
     let o = opt(&[&segway(), "-passes=atomise,default<O2>"]);

@@ -32,6 +32,7 @@ mod pinocchio;
 mod placement;
 mod placement_verify;
 mod props;
+mod recurrence;
 mod report_dir;
 mod robotran_c;
 mod roundtrip;

@@ -19,6 +19,7 @@ pub mod inline;
 pub mod manager;
 pub mod params;
 pub mod pipeline;
+pub mod recurrence;
 pub mod place;
 pub mod progress;
 pub mod reference;
@@ -372,6 +373,7 @@ pub const PASSES: &[PassInfo] = &[
     tree_height::balance::INFO,
     inline::INFO,
     tree_height::distribute::INFO,
+    recurrence::INFO,
     specialize::INFO,
     eqsat::INFO,
     cse::INFO,

@@ -46,16 +46,19 @@ pub struct NamedPipeline {
 
 /// The named pipelines (issue 31 item 3), chosen by measurement on the public corpus's
 /// `dirdyna` and `invdyna` files (`-stats`; coman, Frank_segway, Jeep, m454): `balance` after
-/// `zero-removal` gives the shortest critical path of the passes robovec has (coman 181 → 72
-/// ops, Jeep 81 → 46, Segway 65 → 35) at no op cost, and a last `cse` merges the sums that
-/// balanced trees share (Jeep 8 183 → 8 168 ops, m454 608 → 592); without `balance`, `cse`
-/// before `zero-removal` gives fewer ops than after (Jeep 8 181 against 8 289).
+/// `zero-removal` shortens every sum (coman 2057 → 744 cycles, Jeep 897 → 467, Segway 720 →
+/// 350) at no op cost, and a `cse` after it merges the sums that balanced trees share (Jeep
+/// 8 183 → 8 168 ops, m454 608 → 592); `recurrence` then restructures the chains through the
+/// bodies (coman 744 → 480, Jeep 467 → 327, Segway 350 → 248, WALK-MAN 831 → 528: 0.23–0.54×
+/// `atomise`'s critical path on every file, 1.15–1.27× its ops; `scripts/depth_corpus.sh`).
+/// Without reassociation, `cse` before `zero-removal` gives fewer ops than after (Jeep 8 181
+/// against 8 289).
 pub const NAMED: &[NamedPipeline] = &[
     NamedPipeline {
         name: "default<depth>",
-        expansion: "atomise,cse,zero-removal,balance,cse",
-        doc: "the shortest critical path (for place and codegen<fpga>): tree-height reduction of every sum \
-              and product, shared terms merged",
+        expansion: "atomise,cse,zero-removal,balance,cse,recurrence,cse",
+        doc: "the shortest critical path within 1.5x the ops (for place and codegen<fpga>): tree-height \
+              reduction of every sum and product, then of the chains through the bodies",
     },
     NamedPipeline {
         name: "default<ops>",
@@ -180,7 +183,10 @@ mod tests {
     #[test]
     fn named_pipelines_expand_in_place() {
         let names = |t: &str| parse_pipeline(t).unwrap().iter().map(ToString::to_string).collect::<Vec<_>>();
-        assert_eq!(names("default<depth>"), ["atomise", "cse", "zero-removal", "balance", "cse"]);
+        assert_eq!(
+            names("default<depth>"),
+            ["atomise", "cse", "zero-removal", "balance", "cse", "recurrence", "cse"]
+        );
         assert_eq!(
             names("atomise,default<ops>,place<pe=16>"),
             ["atomise", "atomise", "cse", "zero-removal", "cse", "place<pe=16>"]

@@ -1,0 +1,480 @@
+//! `recurrence<rounds=64;max-terms=4;slack=0;max-slack=48;pe=0;max-growth=1.5;lat-*>`: restructures the chains of
+//! linear maps that tree-height reduction of single sums cannot see across (issue 31 item 1):
+//! each body's velocity, acceleration and force in a Robotran file is its parent's (or
+//! children's) rotated and added to, `x_k = A_k·x_{k−1} + b_k`, a chain as long as the tree is
+//! deep, and the three sweeps (velocities, then the accelerations that read their squares, then
+//! the backward force sweep) run one after the other.
+//!
+//! Phase: atomised → atomised. **Back-substitution into linear forms** (Kogge and Stone's
+//! recursive doubling read on a DAG; Kuck's tree-height reduction with distribution; Brent,
+//! Kuck and Maruyama, IEEE TC C-22, 1973): every critical value (slack ≤ `slack` cycles after
+//! `balance`) is written as a [`forms::Form`] `Σ ± c_i·p_i` over *pivots* `p_i`, values that are
+//! late, with coefficients `c_i` that are early: a sum adds its operands' forms (terms of the
+//! same pivot collected, their coefficients added), a product scales the later operand's form
+//! by the earlier operand, a coefficient that is not earlier than its pivot is multiplied out
+//! (the product becomes a pivot), and a form of more than `max-terms` terms merges its two
+//! earliest terms. Each value is then made from whichever is ready first: its own op on its
+//! operands, or its form (one product per term, then the two-earliest-first sum). So a force
+//! at the root waits for the latest acceleration only through one product and a few adds, and
+//! the coefficients — products of the rotations along the path — are computed while the
+//! accelerations are.
+//!
+//! Rounds: a round restructures the values with at most `slack` cycles of slack, balances, and
+//! is kept when the critical path got shorter (with `pe=N`: when max(critical path, the
+//! resource bound of N ADD + N MULTI PEs) got lower) within `max-growth` × the input's ops.
+//! A round that gains nothing widens the slack (to the smaller latency, then doubling, up to
+//! `max-slack`) and the next tries again; a round over the ops budget is retried on the values
+//! ready in the last half of the critical path, then the last quarter, … (4 times); rounds
+//! stop there, at `max-slack`, or after `rounds`. The output is balanced (`balance` ran last); a function no round shortened
+//! is left as it was.
+//!
+//! Measured on the public corpus's `dirdyna` and `invdyna` files after
+//! `cse,zero-removal,balance,cse` (`scripts/depth_corpus.sh`, docs/rewrites.md): critical path
+//! 0.23–0.54× `atomise`'s (coman `dirdyna` 744 → 480 cycles, WALK-MAN 831 → 528, Segway 350 →
+//! 248) for 1.15–1.27× `atomise`'s ops, f32 mean bits of error within ±0.05.
+//!
+//! Exact in real arithmetic (distributivity, associativity, commutativity); in floating point
+//! it changes rounding as reassociation and distribution do, and the magnitude bound of
+//! `balance` applies to the result (`accuracy` and `-check` measure it). Cost per round:
+//! O(values · max-terms²) plus two `balance` rewrites.
+
+mod forms;
+#[cfg(test)]
+mod tests;
+
+use robovec_ir::analysis::{compute_timing, Latencies};
+use robovec_ir::{BinOp, Def, Function, Module, Operand, Phase, Timing, Value};
+
+use crate::params::ParamKind;
+use crate::tree_height::{rewrite_within, Shape};
+use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use forms::{Builder, Form, Signed};
+
+/// Registry entry.
+pub const INFO: PassInfo = PassInfo {
+    name: "recurrence",
+    doc: "restructure chains of linear maps (velocity, acceleration, force recurrences) by back-substitution \
+          into linear forms over late values, within an ops budget",
+    params: &[
+        ParamInfo {
+            name: "rounds",
+            kind: ParamKind::U32 { default: 64, min: 0, max: 1000 },
+            doc: "rounds of (balance, restructure the critical values, balance)",
+        },
+        ParamInfo {
+            name: "max-terms",
+            kind: ParamKind::U32 { default: 4, min: 1, max: 64 },
+            doc: "largest number of terms of a linear form",
+        },
+        ParamInfo {
+            name: "slack",
+            kind: ParamKind::U32 { default: 0, min: 0, max: 1_000_000 },
+            doc: "restructure values with at most this slack after balance, cycles (0: the critical paths)",
+        },
+        ParamInfo {
+            name: "max-slack",
+            kind: ParamKind::U32 { default: 48, min: 0, max: 1_000_000 },
+            doc: "when a round gains nothing, widen the slack (to the smaller latency, then doubling) up to this, cycles",
+        },
+        ParamInfo {
+            name: "pe",
+            kind: ParamKind::U32 { default: 0, min: 0, max: 1_000_000 },
+            doc: "N of the PE array to place on (N ADD + N MULTI): keep a round only if it lowers max(critical path, \
+                  ⌈add-side ops / N⌉, ⌈muls / N⌉); 0: the critical path alone",
+        },
+        ParamInfo {
+            name: "max-growth",
+            kind: ParamKind::F64 { default: 1.5, min: 1.0, max: 100.0 },
+            doc: "largest ops / input ops",
+        },
+        crate::params::LAT_ADD,
+        crate::params::LAT_MUL,
+        crate::params::LAT_DIV,
+        crate::params::LAT_CALL,
+    ],
+    build: |p: &Params| {
+        Ok(Box::new(Recurrence {
+            rounds: p.u32("rounds")?,
+            max_terms: p.u32("max-terms")?,
+            slack: p.u32("slack")?,
+            max_slack: p.u32("max-slack")?,
+            pe: p.u32("pe")?,
+            max_growth: p.f64("max-growth")?,
+            lat: p.latencies()?,
+            given: p.latency_override()?,
+        }))
+    },
+};
+
+/// The `recurrence` pass.
+#[derive(Clone, Debug)]
+pub struct Recurrence {
+    /// Rounds at most.
+    pub rounds: u32,
+    /// Largest number of terms of a form.
+    pub max_terms: u32,
+    /// Largest slack of a restructured value after `balance` in the first round, cycles.
+    pub slack: u32,
+    /// Largest slack the rounds widen to when one gains nothing, cycles.
+    pub max_slack: u32,
+    /// N of the PE array the result is placed on; 0: unbounded (the critical path alone).
+    pub pe: u32,
+    /// Largest ops / input ops.
+    pub max_growth: f64,
+    /// Latencies, cycles (replaced at run time by the pipeline's with `given` applied).
+    pub lat: Latencies,
+    /// Latencies given on the pass.
+    pub given: crate::LatencyOverride,
+}
+
+impl Default for Recurrence {
+    fn default() -> Self {
+        Recurrence {
+            rounds: 64,
+            max_terms: 4,
+            slack: 0,
+            max_slack: 48,
+            pe: 0,
+            max_growth: 1.5,
+            lat: Latencies::default(),
+            given: crate::LatencyOverride::default(),
+        }
+    }
+}
+
+impl Pass for Recurrence {
+    fn name(&self) -> &'static str {
+        "recurrence"
+    }
+
+    fn requires(&self) -> Option<Phase> {
+        Some(Phase::Atomised)
+    }
+
+    fn at_time_limit(&self) -> AtTimeLimit {
+        AtTimeLimit::Skip
+    }
+
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        let opts = Recurrence { lat: cx.latencies_for("recurrence", &self.given), ..self.clone() };
+        let ticker = cx.ticker();
+        let mut parts = Vec::new();
+        for f in &mut m.functions {
+            if ticker.stopped() {
+                break;
+            }
+            let (g, s, stopped) = restructure_within(f, &opts, &ticker);
+            *f = g;
+            if stopped {
+                let why = ticker.reason();
+                cx.note_stop("recurrence", &format!("in @{} after {} rounds (kept): {why}", f.name, s.rounds));
+            }
+            parts.push(format!(
+                "@{}: {} rounds, ops {} -> {}, balanced critical path {} -> {} cycles",
+                f.name, s.rounds, s.ops.0, s.ops.1, s.cp.0, s.cp.1
+            ));
+        }
+        cx.notes.push(format!("recurrence: {}", parts.join("; ")));
+        Ok(())
+    }
+}
+
+/// What the restructuring did to one function.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RecurrenceStats {
+    /// Rounds kept.
+    pub rounds: u32,
+    /// Ops before and after.
+    pub ops: (u64, u64),
+    /// Critical path after `balance` before, and of the result (cycles).
+    pub cp: (u32, u32),
+}
+
+/// Restructures `f` (atomised, verified) as [`Recurrence`] says; the result is balanced.
+pub fn restructure_function(f: &Function, opts: &Recurrence) -> (Function, RecurrenceStats) {
+    let (g, s, _) = restructure_within(f, opts, &Ticker::default());
+    (g, s)
+}
+
+/// [`restructure_function`] that stops when `ticker` says so (`-time-limit`): the rounds done
+/// are kept; the flag is true when it stopped.
+pub fn restructure_within(f: &Function, opts: &Recurrence, ticker: &Ticker) -> (Function, RecurrenceStats, bool) {
+    let ops0 = f.op_counts().total;
+    let budget = (ops0 as f64 * opts.max_growth).floor() as u64;
+    let Some((mut cur, _)) = rewrite_within(f, Shape::Balance, &opts.lat, ticker) else {
+        return (f.clone(), RecurrenceStats { ops: (ops0, ops0), ..Default::default() }, true);
+    };
+    let (mut timing, sum) = compute_timing(&cur, &opts.lat);
+    let mut cp = sum.asap_cycle;
+    let mut stats = RecurrenceStats { rounds: 0, ops: (ops0, cur.op_counts().total), cp: (cp, cp) };
+    let mut slack = opts.slack;
+    let mut best = bound(&cur, cp, opts.pe);
+    // Over the budget, a round restructures only the values ready after cp·(1 − 2^−halving):
+    // the end of the critical paths, where the latest terms are.
+    let mut halving = 0u32;
+    for _ in 0..opts.rounds {
+        if ticker.check() {
+            break;
+        }
+        let from = cp - (cp >> halving.min(31));
+        let Some(g) = round(&cur, &timing, (slack, from), opts, ticker) else { break };
+        let Some((g, _)) = rewrite_within(&g, Shape::Balance, &opts.lat, ticker) else { break };
+        let (t, s) = compute_timing(&g, &opts.lat);
+        let ops = g.op_counts().total;
+        if ops > budget {
+            if halving >= MAX_HALVING {
+                break;
+            }
+            halving += 1;
+            continue;
+        }
+        let b = bound(&g, s.asap_cycle, opts.pe);
+        if b >= best {
+            // Nothing shorter from the critical values alone: widen to the near-critical ones.
+            if slack >= opts.max_slack {
+                break;
+            }
+            slack = opts.max_slack.min(if slack == 0 { opts.lat.mul.min(opts.lat.add).max(1) } else { 2 * slack });
+            continue;
+        }
+        (cur, timing, cp, best) = (g, t, s.asap_cycle, b);
+        stats.rounds += 1;
+        stats.ops.1 = ops;
+    }
+    if stats.rounds == 0 {
+        // Nothing kept: the function as it was, not its balanced form.
+        return (f.clone(), RecurrenceStats { ops: (ops0, ops0), cp: (cp, cp), rounds: 0 }, ticker.stopped());
+    }
+    stats.cp.1 = cp;
+    (cur, stats, ticker.stopped())
+}
+
+/// Rounds over the budget retry on the last half, quarter, … of the critical path, this many
+/// times.
+const MAX_HALVING: u32 = 4;
+
+/// What a round must lower (cycles): the critical path, and with `pe` = N > 0 the resource
+/// bound of N ADD + N MULTI pipelined PEs (one op issued per PE per cycle: ⌈add-side ops / N⌉,
+/// ⌈muls / N⌉; seed §1.2), below which no placement goes.
+fn bound(g: &Function, cp: u32, pe: u32) -> u64 {
+    if pe == 0 {
+        return cp as u64;
+    }
+    let c = g.op_counts();
+    let add_side = c.add + c.sub + c.div + c.call;
+    (cp as u64).max(add_side.div_ceil(pe as u64)).max(c.mul.div_ceil(pe as u64))
+}
+
+/// How a critical value is made when something needs it as a value.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Make {
+    /// Its own op on its operands' values.
+    Op,
+    /// Its form.
+    Form,
+}
+
+/// One restructuring of `f` (balanced, `timing` its timing): the values with at most `slack`
+/// cycles of slack that are ready at `from` or later.
+fn round(
+    f: &Function,
+    timing: &[Option<Timing>],
+    (slack, from): (u32, u32),
+    opts: &Recurrence,
+    ticker: &Ticker,
+) -> Option<Function> {
+    let lat = opts.lat;
+    let n = f.values.len();
+    let critical = |v: Value| -> bool {
+        matches!(f.value(v).def, Def::Binary(BinOp::Add | BinOp::Sub | BinOp::Mul, _, _))
+            && timing[v.index()].is_some_and(|t| t.alap_cycle - t.asap_cycle <= slack && t.asap_cycle >= from)
+    };
+    let mut b = Builder::new(&f.name, lat);
+    b.out.equations = f.equations;
+    b.out.span = f.span;
+    let mut r = Round {
+        f,
+        b,
+        made: vec![None; n],
+        forms: vec![None; n],
+        make: vec![Make::Op; n],
+        est: vec![0; n],
+        max_terms: opts.max_terms as usize,
+    };
+    for &v in &f.inputs {
+        let d = f.value(v);
+        let x = r.b.input(&d.name, d.span);
+        r.made[v.index()] = Some(Signed::plus(Operand::Value(x)));
+    }
+    for &v in &f.body {
+        if ticker.tick() {
+            return None;
+        }
+        if critical(v) {
+            r.restructure(v);
+        } else {
+            let s = r.value_of(v);
+            r.est[v.index()] = r.b.t(s.op);
+        }
+    }
+    let mut outs = Vec::with_capacity(f.outputs.len());
+    for o in &f.outputs {
+        let op = match o.value {
+            Operand::Value(v) => {
+                let s = r.value_of(v);
+                r.b.plain(s, &o.name, o.span)
+            }
+            c => c,
+        };
+        outs.push((o.name.clone(), op, o.span));
+    }
+    let mut out = r.b.out;
+    for (name, op, span) in outs {
+        out.set_output(name, op, span);
+    }
+    let live = out.live_values(&[]);
+    out.retain(|g, v| live[v.index()] || matches!(g.value(v).def, Def::Input));
+    Some(out)
+}
+
+struct Round<'a> {
+    f: &'a Function,
+    b: Builder,
+    /// The value of each original value in the new function, once made.
+    made: Vec<Option<Signed>>,
+    /// The form of each critical value.
+    forms: Vec<Option<Form>>,
+    make: Vec<Make>,
+    /// Ready time of each original value as it will be made (cycles).
+    est: Vec<u32>,
+    max_terms: usize,
+}
+
+impl Round<'_> {
+    fn est_of(&self, o: Operand) -> u32 {
+        match o {
+            Operand::Value(v) => self.est[v.index()],
+            Operand::Const(_) => 0,
+        }
+    }
+
+    fn form_of(&mut self, o: Operand) -> Form {
+        match o {
+            Operand::Value(v) => match &self.forms[v.index()] {
+                Some(fm) => fm.clone(),
+                None => Form::scalar(self.value_of(v)),
+            },
+            c => Form::scalar(Signed::plus(c)),
+        }
+    }
+
+    fn operand(&mut self, o: Operand) -> Signed {
+        match o {
+            Operand::Value(v) => self.value_of(v),
+            c => Signed::plus(c),
+        }
+    }
+
+    /// Writes the critical value `v`'s form and chooses how `v` is made.
+    fn restructure(&mut self, v: Value) {
+        let d = self.f.value(v);
+        let Def::Binary(op, a, c) = d.def else { unreachable!("critical values are add, sub, mul") };
+        let (name, span) = (d.name.as_str(), d.span);
+        let form = match op {
+            BinOp::Add | BinOp::Sub => {
+                let (fa, fc) = (self.form_of(a), self.form_of(c));
+                self.b.add_forms(fa, &fc, op == BinOp::Sub, name, span)
+            }
+            _ => {
+                // Scale the later operand's form by the earlier operand's value.
+                let (early, late) = if self.est_of(a) <= self.est_of(c) { (a, c) } else { (c, a) };
+                let s = self.operand(early);
+                let fl = self.form_of(late);
+                self.b.scale(&fl, s, name, span)
+            }
+        };
+        let form = self.b.tidy(form, self.max_terms, name, span);
+        let by_form = self.b.form_time(&form);
+        let by_op = self.est_of(a).max(self.est_of(c)) + self.b.lat.of(op.kind());
+        let i = v.index();
+        (self.make[i], self.est[i]) = if by_form < by_op { (Make::Form, by_form) } else { (Make::Op, by_op) };
+        // A plain sum of values that its form does not make earlier is a pivot itself: its
+        // consumers would only have more terms to scale.
+        let plain = form.terms.iter().all(|t| t.coef == Operand::Const(1.0));
+        self.forms[i] = if plain && form.terms.len() > 1 && by_form >= by_op { None } else { Some(form) };
+    }
+
+    /// The value of original value `v` in the new function, made on first use (iteratively:
+    /// chains of critical values made by their ops are as long as the function).
+    fn value_of(&mut self, v: Value) -> Signed {
+        let mut stack = vec![v];
+        while let Some(&x) = stack.last() {
+            if self.made[x.index()].is_some() {
+                stack.pop();
+                continue;
+            }
+            let d = self.f.value(x);
+            if self.forms[x.index()].is_some() && self.make[x.index()] == Make::Form {
+                let fm = self.forms[x.index()].take().expect("checked");
+                let s = self.b.materialise(&fm, &d.name, d.span);
+                self.forms[x.index()] = Some(fm);
+                self.made[x.index()] = Some(s);
+                stack.pop();
+                continue;
+            }
+            let mut pending = false;
+            d.def.for_each_value(|a| {
+                if self.made[a.index()].is_none() {
+                    stack.push(a);
+                    pending = true;
+                }
+            });
+            if !pending {
+                let s = self.op_of(x);
+                self.made[x.index()] = Some(s);
+            }
+        }
+        self.made[v.index()].expect("made above")
+    }
+
+    /// `v`'s own op on its operands' values (which are made).
+    fn op_of(&mut self, v: Value) -> Signed {
+        let d = self.f.value(v);
+        let (name, span) = (d.name.as_str(), d.span);
+        match &d.def {
+            Def::Binary(op, a, c) => {
+                let (x, y) = (self.operand_made(*a), self.operand_made(*c));
+                match op {
+                    BinOp::Add => self.b.add(x, y, name, span),
+                    BinOp::Sub => self.b.add(x, y.negated(), name, span),
+                    BinOp::Mul => self.b.mul(x, y, name, span),
+                    BinOp::Div => Signed { neg: x.neg ^ y.neg, op: self.b.bin(BinOp::Div, x.op, y.op, name, span) },
+                }
+            }
+            Def::Trig(t, a) => {
+                let Some(Signed { op: Operand::Value(x), neg: false }) = self.made[a.index()] else {
+                    unreachable!("trig reads an input")
+                };
+                let ready = 0;
+                Signed::plus(Operand::Value(self.b.define(name, Def::Trig(*t, x), span, ready)))
+            }
+            Def::Call(c, args) => {
+                let mut ops = Vec::with_capacity(args.len());
+                for &o in args {
+                    let s = self.operand_made(o);
+                    ops.push(self.b.plain(s, name, span));
+                }
+                let ready = ops.iter().map(|&o| self.b.t(o)).max().unwrap_or(0) + self.b.lat.call;
+                Signed::plus(Operand::Value(self.b.define(name, Def::Call(c.clone(), ops), span, ready)))
+            }
+            Def::Input | Def::Expr(_) => unreachable!("atomised bodies hold ops and trig variables"),
+        }
+    }
+
+    fn operand_made(&self, o: Operand) -> Signed {
+        match o {
+            Operand::Value(x) => self.made[x.index()].expect("operands are made first"),
+            c => Signed::plus(c),
+        }
+    }
+}
