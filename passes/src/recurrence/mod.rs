@@ -30,8 +30,8 @@
 //!
 //! Measured on the public corpus's `dirdyna` and `invdyna` files after
 //! `cse,zero-removal,balance,cse` (`scripts/depth_corpus.sh`, docs/rewrites.md): critical path
-//! 0.23–0.54× `atomise`'s (coman `dirdyna` 744 → 480 cycles, WALK-MAN 831 → 528, Segway 350 →
-//! 248) for 1.15–1.27× `atomise`'s ops, f32 mean bits of error within ±0.05.
+//! 0.23–0.54× `atomise`'s (coman `dirdyna` 744 → 475 cycles, WALK-MAN 831 → 506, Segway 350 →
+//! 246) for 0.83–1.32× `atomise`'s ops, f32 mean bits of error within ±0.06.
 //!
 //! Exact in real arithmetic (distributivity, associativity, commutativity); in floating point
 //! it changes rounding as reassociation and distribution do, and the magnitude bound of
