@@ -179,7 +179,8 @@ pub fn report_parse_error(e: &clap::Error) -> i32 {
 /// `-gravity=x,y,z`: three finite numbers (m/s²) separated by commas.
 fn parse_gravity(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').collect();
-    let numbers: Vec<f64> = parts.iter().filter_map(|p| p.trim().parse::<f64>().ok()).filter(|x| x.is_finite()).collect();
+    let numbers: Vec<f64> =
+        parts.iter().filter_map(|p| p.trim().parse::<f64>().ok()).filter(|x| x.is_finite()).collect();
     match <[f64; 3]>::try_from(numbers) {
         Ok(g) if parts.len() == 3 => Ok(g),
         _ => Err(format!("expected three finite numbers `x,y,z` (m/s²), such as `0,0,-9.81`; got `{s}`")),

@@ -47,8 +47,12 @@ fn named_pipelines_are_listed_and_expand_in_place() {
     for pass in ["atomise", "cse", "zero-removal", "balance", "recurrence", "asap-alap"] {
         assert!(log.contains(&format!("  {pass}\n")), "{pass} in\n{log}");
     }
-    let o =
-        opt(&[&segway(), "-passes=atomise,atomise,cse,zero-removal,balance,cse,recurrence,cse,asap-alap", "-o", b.to_str().unwrap()]);
+    let o = opt(&[
+        &segway(),
+        "-passes=atomise,atomise,cse,zero-removal,balance,cse,recurrence,cse,asap-alap",
+        "-o",
+        b.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(std::fs::read_to_string(&a).unwrap(), std::fs::read_to_string(&b).unwrap());
     let o = opt(&[&segway(), "-passes=atomise,default<O2>"]);

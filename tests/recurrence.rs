@@ -56,7 +56,7 @@ fn chain(seed: u64, steps: usize) -> Function {
     let mut rng = SplitMix64::new(seed);
     let mut inputs: Vec<String> = ["x0_0", "x0_1", "x0_2"].iter().map(|n| format!("input %{n}")).collect();
     let mut body = String::new();
-    let quadratic = rng.next_u64() % 2 == 0;
+    let quadratic = rng.next_u64().is_multiple_of(2);
     let mut axes = Vec::new();
     let mut x = ["x0_0".to_string(), "x0_1".into(), "x0_2".into()];
     let mut xs = Vec::new();
@@ -68,8 +68,18 @@ fn chain(seed: u64, steps: usize) -> Function {
         out[axis] = src[axis].clone();
         out[i] = format!("{dst}_{i}.r");
         out[j] = format!("{dst}_{j}.r");
-        *body += &format!("%{d}.a = mul %{}, %C{k}\n%{d}.b = mul %{}, %S{k}\n%{d} = {plus} %{d}.a, %{d}.b\n", src[i], src[j], d = out[i]);
-        *body += &format!("%{d}.a = mul %{}, %C{k}\n%{d}.b = mul %{}, %S{k}\n%{d} = {minus} %{d}.a, %{d}.b\n", src[j], src[i], d = out[j]);
+        *body += &format!(
+            "%{d}.a = mul %{}, %C{k}\n%{d}.b = mul %{}, %S{k}\n%{d} = {plus} %{d}.a, %{d}.b\n",
+            src[i],
+            src[j],
+            d = out[i]
+        );
+        *body += &format!(
+            "%{d}.a = mul %{}, %C{k}\n%{d}.b = mul %{}, %S{k}\n%{d} = {minus} %{d}.a, %{d}.b\n",
+            src[j],
+            src[i],
+            d = out[j]
+        );
         out
     };
     for k in 1..=steps {

@@ -322,10 +322,8 @@ fn free_flyer_and_gravity_options() {
     let f = &inputs.module.functions[0];
     assert_eq!(f.outputs.len(), 9, "Qq[1..9]");
     let mut rng = robovec_ir::rng::SplitMix64::new(3);
-    let mut given: BTreeMap<String, f64> = [("g[1]", 0.5), ("g[2]", -1.0), ("g[3]", -9.81)]
-        .into_iter()
-        .map(|(k, x)| (k.to_string(), x))
-        .collect();
+    let mut given: BTreeMap<String, f64> =
+        [("g[1]", 0.5), ("g[2]", -1.0), ("g[3]", -9.81)].into_iter().map(|(k, x)| (k.to_string(), x)).collect();
     for i in 1..=10 {
         given.insert(format!("q[{i}]"), 2.0 * rng.unit() - 1.0);
     }

@@ -401,7 +401,8 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
             for (k, t) in x.iter().enumerate() {
                 qdd[qi - 1 + k] = b.bind(&format!("QDD{}", qi + k), t.clone());
             }
-            let (lin, ang): (V3, V3) = ([0, 1, 2].map(|k| qdd[qi - 1 + k].clone()), [3, 4, 5].map(|k| qdd[qi - 1 + k].clone()));
+            let (lin, ang): (V3, V3) =
+                ([0, 1, 2].map(|k| qdd[qi - 1 + k].clone()), [3, 4, 5].map(|k| qdd[qi - 1 + k].clone()));
             acc[body] = (vadd(&w, &ang), vadd(&a, &lin));
             continue;
         }

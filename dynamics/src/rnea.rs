@@ -135,11 +135,11 @@ fn acceleration_matrix(b: &mut Builder, body: usize, w: &V3, wp: &V3) -> M3 {
             ww[j][i] = ww[i][j].clone();
         }
     }
-    let wpx = [[ZERO, neg(wp[2].clone()), wp[1].clone()], [wp[2].clone(), ZERO, neg(wp[0].clone())], [
-        neg(wp[1].clone()),
-        wp[0].clone(),
-        ZERO,
-    ]];
+    let wpx = [
+        [ZERO, neg(wp[2].clone()), wp[1].clone()],
+        [wp[2].clone(), ZERO, neg(wp[0].clone())],
+        [neg(wp[1].clone()), wp[0].clone(), ZERO],
+    ];
     let mut out: M3 = Default::default();
     for r in 0..3 {
         for c in 0..3 {

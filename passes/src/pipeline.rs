@@ -183,10 +183,7 @@ mod tests {
     #[test]
     fn named_pipelines_expand_in_place() {
         let names = |t: &str| parse_pipeline(t).unwrap().iter().map(ToString::to_string).collect::<Vec<_>>();
-        assert_eq!(
-            names("default<depth>"),
-            ["atomise", "cse", "zero-removal", "balance", "cse", "recurrence", "cse"]
-        );
+        assert_eq!(names("default<depth>"), ["atomise", "cse", "zero-removal", "balance", "cse", "recurrence", "cse"]);
         assert_eq!(
             names("atomise,default<ops>,place<pe=16>"),
             ["atomise", "atomise", "cse", "zero-removal", "cse", "place<pe=16>"]

@@ -160,7 +160,10 @@ fn rebuilding_rewrites_stopped_inside_keep_the_function_as_it_was() {
         let (ran, stopped) = run_budget(text, &mut m, u64::MAX);
         ran.unwrap_or_else(|e| panic!("{text}: {e}"));
         assert!(stopped.is_empty(), "{text}: {stopped:?}");
-        assert!(text == "inline" || text == "distribute" || text == "recurrence" || m.to_string() != before, "{text} changed nothing");
+        assert!(
+            text == "inline" || text == "distribute" || text == "recurrence" || m.to_string() != before,
+            "{text} changed nothing"
+        );
     }
 }
 

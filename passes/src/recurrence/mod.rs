@@ -74,7 +74,8 @@ pub const INFO: PassInfo = PassInfo {
         ParamInfo {
             name: "max-slack",
             kind: ParamKind::U32 { default: 48, min: 0, max: 1_000_000 },
-            doc: "when a round gains nothing, widen the slack (to the smaller latency, then doubling) up to this, cycles",
+            doc:
+                "when a round gains nothing, widen the slack (to the smaller latency, then doubling) up to this, cycles",
         },
         ParamInfo {
             name: "pe",

@@ -450,7 +450,7 @@ impl TrigBlock {
             .args
             .iter()
             .map(|a| body.names[a.index()].as_str())
-            .chain(std::iter::repeat(zero.as_str()).take(n - self.args.len()))
+            .chain(std::iter::repeat_n(zero.as_str(), n - self.args.len()))
             .collect();
         let _ = writeln!(
             s,

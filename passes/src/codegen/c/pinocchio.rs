@@ -160,13 +160,15 @@ fn check(f: &Function) -> Result<(usize, usize), PassError> {
                     nv = nv.max(idx[0]);
                 }
             }
-            _ => return Err(failed(
-                f,
-                format!(
+            _ => {
+                return Err(failed(
+                    f,
+                    format!(
                     "input `{n}` has no place in Pinocchio's signature (abi=pinocchio reads {} and gravity g[1..3])",
                     allowed[..allowed.len() - 1].join(", ")
                 ),
-            )),
+                ))
+            }
         }
     }
     if !params.is_empty() {
