@@ -144,13 +144,8 @@ impl Builder {
             BinOp::Add | BinOp::Mul if key_order(a) > key_order(b) => (b, a),
             _ => (a, b),
         };
-        if let (Operand::Const(x), Operand::Const(y), BinOp::Add | BinOp::Sub | BinOp::Mul) = (a, b, op) {
-            let z = match op {
-                BinOp::Add => x + y,
-                BinOp::Sub => x - y,
-                _ => x * y,
-            };
-            if z.is_finite() {
+        if let (Operand::Const(x), Operand::Const(y)) = (a, b) {
+            if let Some(z) = fold_exactly(op, x, y) {
                 return Operand::Const(z);
             }
         }
@@ -334,4 +329,24 @@ fn stem(base: &str) -> &str {
         s = &s[..i];
     }
     s
+}
+
+/// `x op y` when it is exact in binary64 and a binary32 number too, so that folding it changes
+/// no rounding in either format (a folded inexact constant would be one rounding that the
+/// function's depth no longer counts); `None` otherwise (the op is written).
+fn fold_exactly(op: BinOp, x: f64, y: f64) -> Option<f64> {
+    let (z, exact) = match op {
+        BinOp::Mul => {
+            let z = x * y;
+            (z, x.mul_add(y, -z) == 0.0)
+        }
+        BinOp::Add | BinOp::Sub => {
+            let y = if op == BinOp::Sub { -y } else { y };
+            let z = x + y;
+            let yv = z - x;
+            (z, (x - (z - yv)) + (y - yv) == 0.0)
+        }
+        BinOp::Div => return None,
+    };
+    (exact && z.is_finite() && (z as f32) as f64 == z).then_some(z)
 }

@@ -22,11 +22,14 @@
 //! Rounds: a round restructures the values with at most `slack` cycles of slack, balances, and
 //! is kept when the critical path got shorter (with `pe=N`: when max(critical path, the
 //! resource bound of N ADD + N MULTI PEs) got lower) within `max-growth` × the input's ops.
-//! A round that gains nothing widens the slack (to the smaller latency, then doubling, up to
-//! `max-slack`) and the next tries again; a round over the ops budget is retried on the values
-//! ready in the last half of the critical path, then the last quarter, … (4 times); rounds
-//! stop there, at `max-slack`, or after `rounds`. The output is balanced (`balance` ran last); a function no round shortened
-//! is left as it was.
+//! A round that gains nothing, or goes over the ops budget, is retried on the values ready in
+//! the last half of the critical path, then the last quarter, … (4 times): the values at the
+//! cut become the pivots and the coefficients after it start at 0 beside the part before it
+//! (one level of recursive doubling: a chain restructured from its start has coefficients as
+//! late as its values). Then a round that gains nothing widens the slack (to the smaller
+//! latency, then doubling, up to `max-slack`); rounds stop at the budget after the last
+//! halving, at `max-slack`, or after `rounds`. The output is balanced (`balance` ran last); a
+//! function no round shortened is left as it was.
 //!
 //! Measured on the public corpus's `dirdyna` and `invdyna` files after
 //! `cse,zero-removal,balance,cse` (`scripts/depth_corpus.sh`, docs/rewrites.md): critical path
@@ -210,8 +213,8 @@ pub fn restructure_within(f: &Function, opts: &Recurrence, ticker: &Ticker) -> (
     let mut stats = RecurrenceStats { rounds: 0, ops: (ops0, cur.op_counts().total), cp: (cp, cp) };
     let mut slack = opts.slack;
     let mut best = bound(&cur, cp, opts.pe);
-    // Over the budget, a round restructures only the values ready after cp·(1 − 2^−halving):
-    // the end of the critical paths, where the latest terms are.
+    // After a round over the budget or without gain, a round restructures only the values ready
+    // after cp·(1 − 2^−halving): the end of the critical paths, where the latest terms are.
     let mut halving = 0u32;
     for _ in 0..opts.rounds {
         if ticker.check() {
@@ -231,11 +234,18 @@ pub fn restructure_within(f: &Function, opts: &Recurrence, ticker: &Ticker) -> (
         }
         let b = bound(&g, s.asap_cycle, opts.pe);
         if b >= best {
-            // Nothing shorter from the critical values alone: widen to the near-critical ones.
+            // Nothing shorter: restructure only the end of the critical paths (the values before
+            // it become the pivots, the coefficients after it start early), then widen to the
+            // near-critical values.
+            if halving < MAX_HALVING {
+                halving += 1;
+                continue;
+            }
             if slack >= opts.max_slack {
                 break;
             }
             slack = opts.max_slack.min(if slack == 0 { opts.lat.mul.min(opts.lat.add).max(1) } else { 2 * slack });
+            halving = 0;
             continue;
         }
         (cur, timing, cp, best) = (g, t, s.asap_cycle, b);

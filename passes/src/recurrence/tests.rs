@@ -113,3 +113,33 @@ fn the_ops_budget_holds_and_a_round_over_it_retries_on_the_end_of_the_critical_p
     let (g, s) = restructure_function(&f, &Recurrence { max_growth: 1.0, ..Recurrence::default() });
     assert_eq!((s.rounds, g.to_string()), (0, f.to_string()));
 }
+
+#[test]
+fn a_chain_from_the_inputs_is_cut_where_its_coefficients_can_start_early() {
+    // Eight rotations of (x, y) from the inputs: every step's coefficient chain would be as long
+    // as the step chain itself, so restructuring from the start gains nothing. Restructuring
+    // only the second half makes the values at the half-way point the pivots, and the second
+    // half's coefficients (products of its rotations) start at 0 beside the first half: about
+    // half the chain plus one product and the adds.
+    let mut src = String::from("func @f { phase atomised input %x0 input %y0");
+    for k in 1..=8 {
+        src += &format!(" input %c{k} input %s{k}");
+    }
+    for k in 1..=8 {
+        let j = k - 1;
+        src += &format!(
+            " %x{k}.a = mul %x{j}, %c{k} %x{k}.b = mul %y{j}, %s{k} %x{k} = sub %x{k}.a, %x{k}.b \
+              %y{k}.a = mul %x{j}, %s{k} %y{k}.b = mul %y{j}, %c{k} %y{k} = add %y{k}.a, %y{k}.b"
+        );
+    }
+    src += " output x = %x8 output y = %y8 }";
+    let f = parse(&src).unwrap().functions.remove(0);
+    assert_eq!(cp(&f), 8 * 19);
+    let (g, s) = restructure_function(&f, &Recurrence::default());
+    assert!(verifier::verify_function(&g).is_empty(), "{g}");
+    assert!(cp(&g) * 100 <= 85 * cp(&f), "{} -> {}", cp(&f), cp(&g));
+    assert!(g.op_counts().total as f64 <= 1.5 * s.ops.0 as f64);
+    for seed in 0..4 {
+        close(&f, &g, seed);
+    }
+}
