@@ -49,7 +49,7 @@ pub struct NamedPipeline {
 /// `zero-removal` shortens every sum (coman 2057 → 744 cycles, Jeep 897 → 467, Segway 720 →
 /// 350) at no op cost, and a `cse` after it merges the sums that balanced trees share (Jeep
 /// 8 183 → 8 168 ops, m454 608 → 592); `recurrence` then restructures the chains through the
-/// bodies (coman 744 → 475, Jeep 467 → 327, Segway 350 → 246, WALK-MAN 831 → 506: 0.23–0.54×
+/// bodies (coman 744 → 475, Jeep 467 → 327, Segway 350 → 246, WALK-MAN 831 → 508: 0.23–0.54×
 /// `atomise`'s critical path on every file, 0.83–1.32× its ops; `scripts/depth_corpus.sh`).
 /// Without reassociation, `cse` before `zero-removal` gives fewer ops than after (Jeep 8 181
 /// against 8 289).

@@ -33,7 +33,7 @@
 //!
 //! Measured on the public corpus's `dirdyna` and `invdyna` files after
 //! `cse,zero-removal,balance,cse` (`scripts/depth_corpus.sh`, docs/rewrites.md): critical path
-//! 0.23–0.54× `atomise`'s (coman `dirdyna` 744 → 475 cycles, WALK-MAN 831 → 506, Segway 350 →
+//! 0.23–0.54× `atomise`'s (coman `dirdyna` 744 → 475 cycles, WALK-MAN 831 → 508, Segway 350 →
 //! 246) for 0.83–1.32× `atomise`'s ops, f32 mean bits of error within ±0.06.
 //!
 //! Exact in real arithmetic (distributivity, associativity, commutativity); in floating point
