@@ -12,11 +12,12 @@
 //! `−(a·b)`), as `zero-removal` and `balance` do; a sign reaches an op only at an output or a
 //! call ([`Builder::plain`]).
 
-use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::HashMap;
 
 use robovec_ir::analysis::Latencies;
 use robovec_ir::{BinOp, Def, Function, Operand, Phase, Span, Value};
+
+use crate::tree_height::shape::{greedy, root_time, BNode};
 
 /// An operand of the new function with a sign the consumers absorb: the value is `−op` when
 /// `neg`. Constants carry their sign in the constant (`neg` is false).
@@ -209,13 +210,8 @@ impl Builder {
 
     /// Ready time of the form's sum built two-earliest-first (Golumbic 1976), without making it.
     pub fn form_time(&self, f: &Form) -> u32 {
-        let mut heap: BinaryHeap<Reverse<u32>> = f.terms.iter().map(|t| Reverse(self.term_time(t))).collect();
-        while heap.len() > 1 {
-            let Reverse(_) = heap.pop().expect("two entries");
-            let Reverse(b) = heap.pop().expect("two entries");
-            heap.push(Reverse(b + self.lat.add));
-        }
-        heap.pop().map_or(0, |Reverse(t)| t)
+        let ready: Vec<u32> = f.terms.iter().map(|t| self.term_time(t)).collect();
+        root_time(&greedy(&ready, self.lat.add), &ready, self.lat.add)
     }
 
     fn term_value(&mut self, t: &Term, base: &str, span: Span) -> Signed {
@@ -228,22 +224,17 @@ impl Builder {
         self.sum(items, base, span)
     }
 
-    /// The two-earliest-first sum of `items` (zero when empty).
+    /// The two-earliest-first sum of `items` (zero when empty): `balance`'s tree
+    /// ([`greedy`]) over their ready times.
     pub fn sum(&mut self, items: Vec<Signed>, base: &str, span: Span) -> Signed {
-        let mut heap: BinaryHeap<Reverse<(u32, usize)>> = BinaryHeap::new();
-        let mut slots: Vec<Signed> = Vec::with_capacity(2 * items.len());
-        for s in items {
-            heap.push(Reverse((self.t(s.op), slots.len())));
-            slots.push(s);
+        let ready: Vec<u32> = items.iter().map(|s| self.t(s.op)).collect();
+        let mut made = items;
+        for node in greedy(&ready, self.lat.add).into_iter().skip(ready.len()) {
+            let BNode::Pair(a, b) = node else { unreachable!("the terms come first") };
+            let s = self.add(made[a as usize], made[b as usize], base, span);
+            made.push(s);
         }
-        while heap.len() > 1 {
-            let Reverse((_, i)) = heap.pop().expect("two entries");
-            let Reverse((_, j)) = heap.pop().expect("two entries");
-            let s = self.add(slots[i], slots[j], base, span);
-            heap.push(Reverse((self.t(s.op), slots.len())));
-            slots.push(s);
-        }
-        heap.pop().map_or(Signed::plus(Operand::Const(0.0)), |Reverse((_, i))| slots[i])
+        made.pop().unwrap_or(Signed::plus(Operand::Const(0.0)))
     }
 
     /// `a ± b`, like terms (same pivot, both coefficients not constants) collected.

@@ -97,18 +97,7 @@ pub const INFO: PassInfo = PassInfo {
         crate::params::LAT_DIV,
         crate::params::LAT_CALL,
     ],
-    build: |p: &Params| {
-        Ok(Box::new(Recurrence {
-            rounds: p.u32("rounds")?,
-            max_terms: p.u32("max-terms")?,
-            slack: p.u32("slack")?,
-            max_slack: p.u32("max-slack")?,
-            pe: p.u32("pe")?,
-            max_growth: p.f64("max-growth")?,
-            lat: p.latencies()?,
-            given: p.latency_override()?,
-        }))
-    },
+    build: |p: &Params| Ok(Box::new(Recurrence::from_params(p)?)),
 };
 
 /// The `recurrence` pass.
@@ -132,18 +121,29 @@ pub struct Recurrence {
     pub given: crate::LatencyOverride,
 }
 
+impl Recurrence {
+    /// The pass with checked parameters `p`.
+    ///
+    /// # Errors
+    /// A parameter of the wrong kind ([`PassError::BadParameter`]).
+    pub fn from_params(p: &Params) -> Result<Recurrence, PassError> {
+        Ok(Recurrence {
+            rounds: p.u32("rounds")?,
+            max_terms: p.u32("max-terms")?,
+            slack: p.u32("slack")?,
+            max_slack: p.u32("max-slack")?,
+            pe: p.u32("pe")?,
+            max_growth: p.f64("max-growth")?,
+            lat: p.latencies()?,
+            given: p.latency_override()?,
+        })
+    }
+}
+
 impl Default for Recurrence {
+    /// The defaults [`INFO`] declares (the ones `--print-passes` lists).
     fn default() -> Self {
-        Recurrence {
-            rounds: 64,
-            max_terms: 4,
-            slack: 0,
-            max_slack: 48,
-            pe: 0,
-            max_growth: 1.5,
-            lat: Latencies::default(),
-            given: crate::LatencyOverride::default(),
-        }
+        Recurrence::from_params(&Params::defaults(&INFO)).expect("the declared defaults are valid")
     }
 }
 
