@@ -135,6 +135,12 @@ pub struct Cli {
     /// as numbers instead of the inputs `g[1..3]` (Pinocchio's default is `0,0,-9.81`).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_gravity, allow_hyphen_values = true)]
     pub gravity: Option<[f64; 3]>,
+    /// URDF input: the generator's formulation. `ops` (the default): the fewest ops, body-frame
+    /// recursive Newton–Euler, CRBA, LᵀDL or ABA. `depth`: the shortest critical path, every
+    /// recursion of `invdyna` and of `dirdyna`'s `c` written in the world frame as a parallel
+    /// prefix along the tree's chains (its `M` by the CRBA; no `fordyna`). See docs/rewrites.md.
+    #[arg(long, value_name = "ops|depth", default_value = "ops")]
+    pub formulation: FormulationArg,
     /// URDF input: write the values of the parameters kept as inputs to FILE, the JSON object
     /// (`{"m[1]": 2.5, …}`) that `specialize<params=FILE>` and `-eval` read.
     #[arg(long, value_name = "FILE")]
@@ -217,6 +223,24 @@ pub enum ContinuousJoint {
     CosSin,
 }
 
+/// `--formulation`: the symbolic generator's formulation (`robovec_dynamics::Formulation`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FormulationArg {
+    /// The fewest ops (body-frame RNEA, CRBA, LᵀDL or ABA).
+    Ops,
+    /// The shortest critical path (world-frame parallel prefixes, `robovec_dynamics::depth`).
+    Depth,
+}
+
+impl From<FormulationArg> for robovec_dynamics::Formulation {
+    fn from(f: FormulationArg) -> robovec_dynamics::Formulation {
+        match f {
+            FormulationArg::Ops => robovec_dynamics::Formulation::Ops,
+            FormulationArg::Depth => robovec_dynamics::Formulation::Depth,
+        }
+    }
+}
+
 /// The formats of `--print-passes` (both read from the registry: [`robovec_passes::reference`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum PassListing {
@@ -284,6 +308,7 @@ impl Cli {
                 free_flyer: self.free_flyer,
                 continuous_cos_sin: self.continuous == ContinuousJoint::CosSin,
                 gravity: self.gravity,
+                formulation: self.formulation.into(),
                 ..robovec_front::FrontOptions::default()
             },
             params_out: self.params_out,

@@ -357,3 +357,79 @@ fn free_flyer_and_gravity_options() {
     let e = stderr(&o);
     assert!(e.contains("`root_joint` is a name of robovec's free flyer") && e.contains("clash.urdf:4:3"), "{e}");
 }
+
+/// Issue 31 item 4: `--formulation=depth` writes the same `invdyna` and `dirdyna` as the default
+/// formulation (to 1e-10 of the outputs' largest magnitude, at random states with the URDF's
+/// parameters given: the rigorous rounding bound is checked in `robovec_dynamics::depth`'s unit
+/// tests) on the examples and a branched study robot, fixed, on the floating base and on the
+/// free flyer; a shorter critical path on a 30-dof chain; `fordyna` refused with exit 1.
+#[test]
+fn depth_formulation_agrees_with_the_default_one() {
+    use robovec_dynamics::topology::{build, Topology};
+    use robovec_dynamics::Formulation;
+    let d = tmp("depth_formulation");
+    let semi = d.join("semi.urdf");
+    std::fs::write(&semi, robovec_dynamics::urdf_out::write_urdf(&build(Topology::SemiSerial, 12, 2))).unwrap();
+    let serial = d.join("serial.urdf");
+    std::fs::write(&serial, robovec_dynamics::urdf_out::write_urdf(&build(Topology::Serial, 30, 1))).unwrap();
+    let urdfs = [path(URDF), path("examples/three_link_arm/three_link_arm.urdf"), semi.to_str().unwrap().to_string()];
+    for urdf in &urdfs {
+        for (floating_base, free_flyer) in [(false, false), (true, false), (false, true)] {
+            let load = |formulation| {
+                let opts = FrontOptions { floating_base, free_flyer, formulation, ..FrontOptions::default() };
+                robovec::driver::load_with(urdf, &opts).expect("URDF loads").0
+            };
+            let (ops, depth) = (load(Formulation::Ops), load(Formulation::Depth));
+            let mut rng = robovec_ir::rng::SplitMix64::new(7);
+            for _ in 0..4 {
+                let mut given: BTreeMap<String, f64> = ops.params.clone().unwrap_or_default();
+                given.extend(depth.params.clone().unwrap_or_default());
+                for k in 1..=3 {
+                    given.insert(format!("g[{k}]"), 20.0 * rng.unit() - 10.0);
+                }
+                for i in 1..=40 {
+                    for v in ["q", "qd", "qdd"] {
+                        given.insert(format!("{v}[{i}]"), 4.0 * rng.unit() - 2.0);
+                    }
+                }
+                if free_flyer {
+                    // A unit quaternion q[4..7]: both formulations assume a rotation.
+                    let n = (4..=7).map(|i| given[&format!("q[{i}]")].powi(2)).sum::<f64>().sqrt();
+                    (4..=7).for_each(|i| *given.get_mut(&format!("q[{i}]")).unwrap() /= n);
+                }
+                for (a, b) in ops.module.functions.iter().zip(&depth.module.functions) {
+                    assert_eq!(a.name, b.name);
+                    let x = robovec::eval::evaluate(a, &given, false).outputs;
+                    let y = robovec::eval::evaluate(b, &given, false).outputs;
+                    assert_eq!(x.len(), y.len(), "{urdf} {}", a.name);
+                    let norm = x.values().fold(1.0f64, |m, v| m.max(v.abs()));
+                    for (k, v) in &x {
+                        assert!(
+                            (v - y[k]).abs() <= 1e-10 * norm,
+                            "{urdf} floating {floating_base} free flyer {free_flyer} {k}: {v} vs {}",
+                            y[k]
+                        );
+                    }
+                }
+            }
+        }
+    }
+    // The critical path of `atomise` (cycles, from -stats): shorter with the depth formulation.
+    let cycles = |formulation: &str| {
+        let o = opt(&[serial.to_str().unwrap(), "-function=invdyna", formulation, "-passes=atomise", "-stats"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let s = stderr(&o);
+        let at = s.find(" cycles").expect("-stats line");
+        s[..at].rsplit(' ').next().unwrap().parse::<u32>().unwrap()
+    };
+    let (by_ops, by_depth) = (cycles("--formulation=ops"), cycles("--formulation=depth"));
+    assert!(2 * by_depth < by_ops, "30-dof chain: {by_ops} cycles by ops, {by_depth} by depth");
+    // fordyna has no depth formulation: a diagnostic, exit 1, nothing written.
+    let out = d.join("fd.rvir");
+    let o = opt(&[URDF, "--formulation=depth", "-function=fordyna", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--formulation=depth does not write @fordyna"), "{}", stderr(&o));
+    assert!(!out.exists());
+    let o = opt(&[URDF, "--formulation=fast", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

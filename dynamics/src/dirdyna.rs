@@ -75,6 +75,25 @@ pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
 /// # Errors
 /// [`Stopped`] at the builder's deadline (checked per body and per row of `M`).
 pub fn dirdyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: MassMatrix) -> Result<(), Stopped> {
+    dirdyna_by(model, layout, b, how, sweep)
+}
+
+/// One sweep giving the joint forces `(i, Q_i)` ([`super::rnea::sweep`], or the world-frame
+/// parallel-prefix sweep of [`super::depth`]).
+pub type Sweep = fn(&Model, &Layout, &mut Builder, &[Motion], &Drive) -> Result<Vec<(usize, Term)>, Stopped>;
+
+/// [`dirdyna_with`] with `c` written by `c_by` (the depth-optimised formulation's sweep,
+/// [`super::depth::dirdyna`]).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per body and per row of `M`).
+pub fn dirdyna_by(
+    model: &Model,
+    layout: &Layout,
+    b: &mut Builder,
+    how: MassMatrix,
+    c_by: Sweep,
+) -> Result<(), Stopped> {
     let nq = layout.nv;
     // `c`'s inputs first (gravity, rates), then the trig variables.
     let drive = Drive::inputs(b, nq, false);
@@ -88,7 +107,7 @@ pub fn dirdyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: MassMa
         upper.insert((i - 1, j - 1), t);
     }
     let mut c = vec![ZERO; nq];
-    for (qi, t) in sweep(model, layout, b, &motions, &drive)? {
+    for (qi, t) in c_by(model, layout, b, &motions, &drive)? {
         c[qi - 1] = t;
     }
     // `nq²` names: each made of its row's `M[i]` and its column's `[j]`, formatted once.

@@ -11,7 +11,7 @@
 //!
 //! # Main modules
 //! [`robot`] (the model), [`sym`] (the expression builder), [`rnea`], [`crba`] and [`dirdyna`]
-//! (the formulations), [`lump`] (fixed joints contracted), [`frames`] and [`origins`] (the body
+//! (the formulations), [`depth`] (the depth-optimised formulation of `--formulation=depth`), [`lump`] (fixed joints contracted), [`frames`] and [`origins`] (the body
 //! frames the generator may choose),
 //! [`topology`] (the study's robot families), [`urdf_out`] and [`robotran_c`] (the writers of
 //! `robovec-gen`), [`study`] (the thesis's study: cases, one case's run, the table).
@@ -72,6 +72,7 @@
 
 pub mod aba;
 pub mod crba;
+pub mod depth;
 pub mod dirdyna;
 pub mod fordyna;
 pub mod frames;
@@ -204,6 +205,30 @@ pub struct Request {
     /// `-time-limit`: checked once per body of every recursion and per row of `M`'s outputs
     /// (see [`Stopped`]).
     pub deadline: Option<Deadline>,
+    /// `--formulation`: the fewest ops (today's, the default) or the shortest dependence depth
+    /// ([`depth`]).
+    pub formulation: Formulation,
+}
+
+/// Which formulation the generator writes (`--formulation=ops|depth`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Formulation {
+    /// The fewest ops: body-frame RNEA, CRBA, LᵀDL or ABA ([`rnea`], [`crba`], [`fordyna`]).
+    #[default]
+    Ops,
+    /// The shortest critical path: the world-frame parallel-prefix sweep of [`depth`]
+    /// (`invdyna`, and `dirdyna`'s `c`); no `fordyna`.
+    Depth,
+}
+
+impl Formulation {
+    /// The command-line word: `ops`, `depth`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Formulation::Ops => "ops",
+            Formulation::Depth => "depth",
+        }
+    }
 }
 
 impl Request {
@@ -211,8 +236,14 @@ impl Request {
     pub fn wants(&self, name: &str) -> bool {
         match &self.functions {
             Some(fs) => fs.iter().any(|f| f == name),
-            None => FUNCTIONS.iter().any(|&(f, _, by_default)| f == name && by_default),
+            None => FUNCTIONS.iter().any(|&(f, _, _, by_default)| f == name && by_default),
         }
+    }
+
+    /// The functions asked for that [`Request::formulation`] does not write (`fordyna` under
+    /// [`Formulation::Depth`]), in module order: the front end reports them before generating.
+    pub fn unsupported(&self) -> Vec<&'static str> {
+        FUNCTIONS.iter().filter(|f| self.wants(f.0) && writer(f, self.formulation).is_none()).map(|f| f.0).collect()
     }
 }
 
@@ -298,11 +329,23 @@ pub fn coordinate_parents(model: &Model, layout: &Layout) -> Vec<usize> {
 /// (the builder's, [`Builder::check`]).
 type Writer = fn(&Model, &Layout, &mut Builder) -> Result<(), Stopped>;
 
-/// The functions the generator writes, in module order (`-function=NAME` picks one), and
-/// whether it writes them without `-function` (Robotran's pair, `invdyna` and `dirdyna`;
-/// `fordyna` only when asked for): the one place that selects a formulation per function.
-const FUNCTIONS: [(&str, Writer, bool); 3] =
-    [("invdyna", rnea::invdyna, true), ("dirdyna", dirdyna::dirdyna, true), ("fordyna", fordyna::fordyna, false)];
+/// The functions the generator writes, in module order (`-function=NAME` picks one), their
+/// writers under [`Formulation::Ops`] and [`Formulation::Depth`] (`None`: none), and whether it
+/// writes them without `-function` (Robotran's pair, `invdyna` and `dirdyna`; `fordyna` only
+/// when asked for): the one place that selects a formulation per function.
+const FUNCTIONS: [(&str, Writer, Option<Writer>, bool); 3] = [
+    ("invdyna", rnea::invdyna, Some(depth::invdyna), true),
+    ("dirdyna", dirdyna::dirdyna, Some(depth::dirdyna), true),
+    ("fordyna", fordyna::fordyna, None, false),
+];
+
+/// The writer of function entry `f` under `formulation`.
+fn writer(f: &(&str, Writer, Option<Writer>, bool), formulation: Formulation) -> Option<Writer> {
+    match formulation {
+        Formulation::Ops => Some(f.1),
+        Formulation::Depth => f.2,
+    }
+}
 
 /// The names of the functions the generator writes, in module order: `invdyna`, `dirdyna`,
 /// `fordyna`.
@@ -371,7 +414,10 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
         .chain(request.gravity.iter().flat_map(|g| (0..3).map(|k| (format!("g[{}]", k + 1), g[k]))))
         .collect();
     let mut functions = Vec::new();
-    for (name, write, _) in FUNCTIONS.iter().filter(|(name, _, _)| request.wants(name)) {
+    // (A function the formulation does not write is left out: the front end reports it first,
+    // `Request::unsupported`.)
+    for f in FUNCTIONS.iter().filter(|f| request.wants(f.0)) {
+        let (name, Some(write)) = (f.0, writer(f, request.formulation)) else { continue };
         let mut b = Builder::new(name, consts.clone());
         b.deadline = request.deadline;
         write(model, &layout, &mut b)?;

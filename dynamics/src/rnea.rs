@@ -127,7 +127,7 @@ fn quaternion_rotation(b: &mut Builder, body: usize, quat: [Term; 4]) -> M3 {
 /// joint origin and the centre of mass (or first moment) alike. `[ω]×² = ω ωᵀ − |ω|² I`: the six
 /// products `ωᵢωⱼ` (bound as `WW{i}{j}{body}`), three sums on the diagonal, six off it — 15 ops
 /// once per body where each `ω̇ × v + ω × (ω × v)` costs 33; entries bound as `U{r}{c}{body}`.
-fn acceleration_matrix(b: &mut Builder, body: usize, w: &V3, wp: &V3) -> M3 {
+pub(super) fn acceleration_matrix(b: &mut Builder, body: usize, w: &V3, wp: &V3) -> M3 {
     let mut ww: M3 = Default::default();
     for i in 0..3 {
         for j in i..3 {

@@ -39,6 +39,10 @@ pub struct FrontOptions {
     /// `-gravity=x,y,z`: the gravity vector written into generated equations as numbers
     /// (m/s², world frame) instead of the inputs `g[1..3]`. Front ends of fixed equations ignore it.
     pub gravity: Option<[f64; 3]>,
+    /// `--formulation=ops|depth`: the generator's formulation, the fewest ops (the default) or
+    /// the shortest critical path (`robovec_dynamics::depth`). Front ends of fixed equations
+    /// ignore it.
+    pub formulation: robovec_dynamics::Formulation,
     /// `-function=NAME`: the functions the run will use; `None`: all. A front end that builds
     /// its functions (the URDF's generator) builds only these (issue 28: `-function=invdyna`
     /// does not build `dirdyna`); front ends that read their functions ignore it.

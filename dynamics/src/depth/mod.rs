@@ -1,0 +1,77 @@
+//! The depth-optimised formulation (`--formulation=depth`, issue 31 item 4): the same inverse
+//! dynamics as the body-frame recursive Newton–Euler algorithm ([`crate::rnea`]), written so
+//! that the dependence depth grows with the logarithm of the tree's depth instead of linearly.
+//!
+//! # Why
+//! The body-frame RNEA is a chain of recurrences as long as the tree is deep (`R_k = R_{k−1}·A_k`,
+//! `ω_k = A_kᵀ ω_{k−1} + qd_k e_k`, …, and the backward force sweep). The `recurrence` pass of
+//! `default<depth>` restructures those chains after the fact; this formulation writes them as
+//! parallel prefixes from the start (R. E. Ladner, M. J. Fischer, "Parallel prefix computation",
+//! *J. ACM* 27(4), 1980; R. P. Brent, H. T. Kung, "A regular layout for parallel adders", *IEEE
+//! Trans. Computers* C-31(3), 1982), along the heavy chains of the tree ([`scan`]).
+//!
+//! # Formulation (world frame, every quantity of body `b` with parent `p`)
+//! - joint rotation child → parent `E_b = R_origin·R_axis(q_b)` (a constant for prismatic and
+//!   fixed joints, the quaternion's for a free flyer) and the child origin in the parent frame
+//!   `t_b = d_b (+ R_origin·axis·q_b` prismatic);
+//! - orientations `R_b = E_{c₁}⋯E_{c_i}` along a chain `c₁ … c_m`: a Brent–Kung prefix of the
+//!   3 × 3 products, times the head's parent's `R_p` (one product, so the late `R_p` is one
+//!   product deep); axes `z_b = R_b·axis`, origin steps `r_b = R_p·t_b`;
+//! - `ω_b = ω_p + z_b qd_b`, `ω̇_b = ω̇_p + z_b qdd_b + ω_p × z_b qd_b`,
+//!   `a_b = a_p + U_p r_b` (`U = [ω̇]× + [ω]×²`; prismatic: `+ z_b qdd_b + 2 ω_p × z_b qd_b`),
+//!   `a_0 = −g`, and the origins `o_b = o_p + r_b`: each a sum over the ancestors, written as
+//!   Sklansky prefix sums along the chain, the head's parent's value added after the network;
+//! - per body: the force `F_b = m_b (a_b + U_b ρ_b)` at the centre of mass `c_b = o_b + ρ_b`,
+//!   `ρ_b = R_b l_b`, and its moment about the world origin `Mo_b = R_b (In ω̇ᵇ + ωᵇ × In ωᵇ) +
+//!   c_b × F_b` (`ωᵇ = R_bᵀ ω_b`, Euler's equation in the body frame, where `In` is given);
+//! - the wrench of a subtree about the world origin, `Fq_k = Σ_{j ∈ subtree(k)} F_j`,
+//!   `Mq_k = Σ Mo_j`: Sklansky suffix sums along each chain, the light children's totals added
+//!   to their parent's term;
+//! - the joint force is the wrench projected on the joint's Plücker axis `(z_k, o_k × z_k)`:
+//!   `Q_k = z_k·Mq_k − (z_k × o_k)·Fq_k` (revolute), `z_k·Fq_k` (prismatic); a free flyer's is
+//!   `(R_kᵀ Fq_k, R_kᵀ (Mq_k − o_k × Fq_k))`.
+//!
+//! In exact arithmetic (and with `cos² + sin² = 1`) this is the body-frame RNEA's `Qq`; the tests
+//! compare both under the rigorous error budget of `robovec_ir::numerics::budget`.
+//!
+//! Every recursion is a prefix over at most `log₂ n` chains on any path from the root, so the
+//! depth is `O(log² n)` on any tree and `O(log n)` on a chain or a tree of few branches.
+//! `dirdyna` writes `c` by this sweep (`qdd = 0`) and `M` by today's CRBA ([`crate::crba`]), whose
+//! composite inertias stay a backward recurrence; `fordyna` has no depth formulation.
+//!
+//! # Measured
+//! See `docs/rewrites.md`, "A depth-optimised formulation (issue 31 item 4)".
+
+pub mod scan;
+pub mod sweep;
+
+#[cfg(test)]
+mod tests;
+
+use crate::dirdyna::{dirdyna_by, MassMatrix};
+use crate::rnea::{motions, Drive};
+use crate::sym::Builder;
+use crate::{Layout, Model, Stopped};
+
+/// Writes `invdyna` (outputs `Qq[1..nv]`) by the world-frame parallel-prefix sweep
+/// ([`sweep::sweep`]).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+    let drive = Drive::inputs(b, layout.nv, true);
+    let motions = motions(model, layout, b);
+    for (qi, t) in sweep::sweep(model, layout, b, &motions, &drive)? {
+        b.output(&format!("Qq[{qi}]"), &format!("Qq{qi}"), t);
+    }
+    Ok(())
+}
+
+/// Writes `dirdyna` (outputs `M[i][j]`, then `c[i]`): `c` by [`sweep::sweep`] with `qdd = 0`,
+/// `M` by the CRBA ([`crate::crba`]).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+    dirdyna_by(model, layout, b, MassMatrix::Crba, sweep::sweep)
+}
