@@ -75,39 +75,40 @@ pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
 /// # Errors
 /// [`Stopped`] at the builder's deadline (checked per body and per row of `M`).
 pub fn dirdyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: MassMatrix) -> Result<(), Stopped> {
-    dirdyna_by(model, layout, b, how, sweep)
+    let nq = layout.nv;
+    let mut parts = |b: &mut Builder, motions: &[Motion], drive: &Drive| {
+        let entries = match how {
+            MassMatrix::Crba => crba::mass_matrix(model, layout, b, motions)?,
+            MassMatrix::UnitAcceleration => unit_acceleration(model, layout, b, motions, nq)?,
+        };
+        Ok((entries, sweep(model, layout, b, motions, drive)?))
+    };
+    dirdyna_by(model, layout, b, &mut parts)
 }
 
-/// One sweep giving the joint forces `(i, Q_i)` ([`super::rnea::sweep`], or the world-frame
-/// parallel-prefix sweep of [`super::depth`]).
-pub type Sweep = fn(&Model, &Layout, &mut Builder, &[Motion], &Drive) -> Result<Vec<(usize, Term)>, Stopped>;
+/// What writes `M` and `c` of [`dirdyna_by`]: given the builder, the joint motions and `c`'s
+/// drive (`qdd = 0`), the upper triangle of `M` ([`crba::Entries`]) and the joint forces
+/// `(i, c_i)`, sorted by `i`.
+pub type Parts<'a> =
+    dyn FnMut(&mut Builder, &[Motion], &Drive) -> Result<(crba::Entries, Vec<(usize, Term)>), Stopped> + 'a;
 
-/// [`dirdyna_with`] with `c` written by `c_by` (the depth-optimised formulation's sweep,
-/// [`super::depth::dirdyna`]).
+/// `dirdyna`'s inputs, statements and outputs in Robotran's layout, with `M` and `c` written by
+/// `parts` (the CRBA and the RNEA, or the depth-optimised formulation's, [`super::depth`]).
 ///
 /// # Errors
 /// [`Stopped`] at the builder's deadline (checked per body and per row of `M`).
-pub fn dirdyna_by(
-    model: &Model,
-    layout: &Layout,
-    b: &mut Builder,
-    how: MassMatrix,
-    c_by: Sweep,
-) -> Result<(), Stopped> {
+pub fn dirdyna_by(model: &Model, layout: &Layout, b: &mut Builder, parts: &mut Parts<'_>) -> Result<(), Stopped> {
     let nq = layout.nv;
     // `c`'s inputs first (gravity, rates), then the trig variables.
     let drive = Drive::inputs(b, nq, false);
     let motions = motions(model, layout, b);
     let mut upper: FxHashMap<(usize, usize), Term> = FxHashMap::default();
-    let entries = match how {
-        MassMatrix::Crba => crba::mass_matrix(model, layout, b, &motions)?,
-        MassMatrix::UnitAcceleration => unit_acceleration(model, layout, b, &motions, nq)?,
-    };
+    let (entries, forces) = parts(b, &motions, &drive)?;
     for ((i, j), t) in entries {
         upper.insert((i - 1, j - 1), t);
     }
     let mut c = vec![ZERO; nq];
-    for (qi, t) in c_by(model, layout, b, &motions, &drive)? {
+    for (qi, t) in forces {
         c[qi - 1] = t;
     }
     // `nq²` names: each made of its row's `M[i]` and its column's `[j]`, formatted once.

@@ -36,22 +36,30 @@
 //!
 //! Every recursion is a prefix over at most `log₂ n` chains on any path from the root, so the
 //! depth is `O(log² n)` on any tree and `O(log n)` on a chain or a tree of few branches.
-//! `dirdyna` writes `c` by this sweep (`qdd = 0`) and `M` by today's CRBA ([`crate::crba`]), whose
-//! composite inertias stay a backward recurrence; `fordyna` has no depth formulation.
+//! `dirdyna` writes `c` by this sweep (`qdd = 0`) and `M` by the composite-rigid-body algorithm
+//! in the world frame ([`composite`]: a subtree's inertia about the world origin is a suffix sum
+//! of its bodies', each entry one projection on two Plücker axes), both on one set of
+//! kinematics ([`frames`]). `fordyna` has no depth formulation (`--formulation=depth
+//! -function=fordyna` is refused: [`crate::Request::unsupported`]).
+//!
+//! The frames of [`crate::frames`] and [`crate::origins`] are still chosen by the fewest ops.
 //!
 //! # Measured
 //! See `docs/rewrites.md`, "A depth-optimised formulation (issue 31 item 4)".
 
+pub mod composite;
+pub mod frames;
 pub mod scan;
 pub mod sweep;
 
 #[cfg(test)]
 mod tests;
 
-use crate::dirdyna::{dirdyna_by, MassMatrix};
-use crate::rnea::{motions, Drive};
+use crate::dirdyna::dirdyna_by;
+use crate::rnea::{motions, Drive, Motion};
 use crate::sym::Builder;
 use crate::{Layout, Model, Stopped};
+use frames::Frames;
 
 /// Writes `invdyna` (outputs `Qq[1..nv]`) by the world-frame parallel-prefix sweep
 /// ([`sweep::sweep`]).
@@ -67,11 +75,17 @@ pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
     Ok(())
 }
 
-/// Writes `dirdyna` (outputs `M[i][j]`, then `c[i]`): `c` by [`sweep::sweep`] with `qdd = 0`,
-/// `M` by the CRBA ([`crate::crba`]).
+/// Writes `dirdyna` (outputs `M[i][j]`, then `c[i]`): `M` by world-frame composite inertias
+/// ([`composite::mass_matrix`]), `c` by [`sweep::sweep_in`] with `qdd = 0`, both on one set of
+/// world-frame kinematics ([`frames::Frames`]).
 ///
 /// # Errors
 /// [`Stopped`] at the builder's deadline.
 pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
-    dirdyna_by(model, layout, b, MassMatrix::Crba, sweep::sweep)
+    let mut parts = |b: &mut Builder, motions: &[Motion], drive: &Drive| {
+        let frames = Frames::of(model, layout, b, motions)?;
+        let entries = composite::mass_matrix(model, layout, b, &frames)?;
+        Ok((entries, sweep::sweep_in(model, layout, b, &frames, drive)?))
+    };
+    dirdyna_by(model, layout, b, &mut parts)
 }

@@ -2,77 +2,12 @@
 //! ([`crate::rnea::sweep`]) written as a parallel prefix along the tree's heavy chains
 //! ([`super::scan`]). The formulas are in the module doc of [`super`].
 
-use super::scan::{heavy_chains, prefix, suffix, Network};
-use crate::rnea::{acceleration_matrix, cross, matvec, numeric, vadd, Drive, Motion, M3, V3};
+use super::frames::{bind_v3, vdot, vector_prefix, vscale, Frames, SUMS};
+use super::scan::suffix;
+use crate::rnea::{acceleration_matrix, cross, matvec, vadd, Drive, Motion, M3, V3};
 use crate::robot::JointKind;
-use crate::sym::{mul, neg, sub, sum, Builder, Term, ZERO};
+use crate::sym::{mul, neg, sub, Builder, Term, ZERO};
 use crate::{Layout, Model, Stopped};
-
-/// The network of the rotation prefixes (3 × 3 products, 45 ops each when dense): the fewer
-/// products.
-const ROTATIONS: Network = Network::BrentKung;
-/// The network of the vector prefixes and suffixes (3 adds each): the shallower.
-const SUMS: Network = Network::Sklansky;
-
-/// `a·c` of two 3 × 3 matrices (entries summed left to right).
-fn matmul(a: &M3, c: &M3) -> M3 {
-    [0, 1, 2].map(|i| [0, 1, 2].map(|j| sum((0..3).map(|k| mul(a[i][k].clone(), c[k][j].clone())))))
-}
-
-/// `m·k` for a numeric vector `k` (a joint axis).
-fn matvec_num(m: &M3, k: &[f64; 3]) -> V3 {
-    [0, 1, 2].map(|r| sum((0..3).map(|c| mul(m[r][c].clone(), Term::C(k[c])))))
-}
-
-/// `v·s`, entry by entry.
-fn vscale(v: &V3, s: &Term) -> V3 {
-    v.clone().map(|x| mul(x, s.clone()))
-}
-
-/// `a·c` for two vectors of terms.
-fn vdot(a: &V3, c: &V3) -> Term {
-    sum((0..3).map(|k| mul(a[k].clone(), c[k].clone())))
-}
-
-/// Binds the entries of `m` as `{name}{r}{c}_{n}`.
-fn bind_m3(b: &mut Builder, name: &str, n: impl std::fmt::Display, m: M3) -> M3 {
-    let mut out: M3 = Default::default();
-    for (r, row) in m.into_iter().enumerate() {
-        for (c, e) in row.into_iter().enumerate() {
-            out[r][c] = b.bind(&format!("{name}{}{}_{n}", r + 1, c + 1), e);
-        }
-    }
-    out
-}
-
-/// Binds the entries of `v` as `{name}{k}_{n}`.
-fn bind_v3(b: &mut Builder, name: &str, n: impl std::fmt::Display, v: V3) -> V3 {
-    let [x, y, z] = v;
-    [b.bind(&format!("{name}1_{n}"), x), b.bind(&format!("{name}2_{n}"), y), b.bind(&format!("{name}3_{n}"), z)]
-}
-
-/// Prefix sums along one chain: `start + t₁ + ⋯ + t_i` for every `i`, bound as
-/// `{name}{k}_{body}`. An early `start` (the base's value, an input or 0) joins the first term;
-/// a late one (the chain head's parent's) is added to every prefix, one add after the network.
-fn vector_prefix(b: &mut Builder, name: &str, bodies: &[usize], start: &V3, late: bool, mut terms: Vec<V3>) -> Vec<V3> {
-    if !late {
-        terms[0] = vadd(start, &terms[0]);
-    }
-    let mut n = 0usize;
-    let inner = format!("{name}s");
-    let mut op = |x: &V3, y: &V3| {
-        n += 1;
-        bind_v3(b, &inner, format_args!("{}_{n}", bodies[0]), vadd(x, y))
-    };
-    let sums = prefix(&terms, SUMS, &mut op);
-    sums.into_iter()
-        .zip(bodies)
-        .map(|(s, &body)| {
-            let s = if late { vadd(start, &s) } else { s };
-            bind_v3(b, name, body, s)
-        })
-        .collect()
-}
 
 /// The joint forces `(i, Q_i)` of one sweep driven by `drive`, sorted by `i` (terms, not yet
 /// bound): the same values as [`crate::rnea::sweep`] in exact arithmetic. Cost: linear in the
@@ -87,52 +22,32 @@ pub fn sweep(
     motions: &[Motion],
     drive: &Drive,
 ) -> Result<Vec<(usize, Term)>, Stopped> {
+    let frames = Frames::of(model, layout, b, motions)?;
+    sweep_in(model, layout, b, &frames, drive)
+}
+
+/// [`sweep`] in kinematics already written ([`Frames::of`]; `dirdyna` shares them with `M`).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per body, forward and backward).
+pub fn sweep_in(
+    model: &Model,
+    layout: &Layout,
+    b: &mut Builder,
+    frames: &Frames,
+    drive: &Drive,
+) -> Result<Vec<(usize, Term)>, Stopped> {
     let robot = &model.robot;
-    let order = robot.dfs_joints();
+    let Frames { order, parent, moves, chains, rw, z, r: t, o, .. } = frames;
     let nb = order.len();
-    let mut link_body = vec![0; robot.links.len()];
-    for (i, &j) in order.iter().enumerate() {
-        link_body[robot.joints[j].child] = i + 1;
-    }
-    let mut parent = vec![0usize; nb + 1];
-    let mut moves = vec![false; nb + 1];
-    for (i, &j) in order.iter().enumerate() {
-        parent[i + 1] = link_body[robot.joints[j].parent];
-        moves[i + 1] = moves[parent[i + 1]] || layout.v_index[i].is_some();
-    }
-    let (chains, _) = heavy_chains(&parent);
-    let identity = numeric(&[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
     let zero3 = || [ZERO, ZERO, ZERO];
-    // Per body (index 0: the base), in the world frame: rotation body → world, joint axis,
-    // origin, the vector from the parent's origin, ω, ω̇, the origin's acceleration minus
+    // Per body (index 0: the base), in the world frame: ω, ω̇, the origin's acceleration minus
     // gravity, U = [ω̇]× + [ω]×².
-    let mut rw: Vec<M3> = vec![identity.clone(); nb + 1];
-    let mut z: Vec<V3> = vec![zero3(); nb + 1];
-    let mut o: Vec<V3> = vec![zero3(); nb + 1];
     let mut om: Vec<V3> = vec![zero3(); nb + 1];
     let mut omp: Vec<V3> = vec![zero3(); nb + 1];
     let mut alpha: Vec<V3> = vec![zero3(); nb + 1];
     let mut u: Vec<M3> = vec![Default::default(); nb + 1];
     alpha[0] = drive.g.clone().map(neg);
-    // The joint's rotation child → parent `E` and the child origin in the parent frame `t`.
-    let mut e: Vec<M3> = vec![identity.clone(); nb + 1];
-    let mut t: Vec<V3> = vec![zero3(); nb + 1];
-    for (i, &j) in order.iter().enumerate() {
-        let body = i + 1;
-        let joint = &robot.joints[j];
-        let ro = numeric(&joint.origin.rot);
-        let d: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("dpt[{k}][{body}]")));
-        let m = &motions[body];
-        e[body] = match (&m.rot, &m.free) {
-            (_, Some(r)) => r.clone(),
-            (Some(r), _) => matmul(&ro, r),
-            _ => ro.clone(),
-        };
-        t[body] = match &m.shift {
-            Some(s) => vadd(&d, &matvec(&ro, s, false)),
-            None => d,
-        };
-    }
     let rates = |i: usize| match layout.v_index[i] {
         Some(qi) => (drive.qd[qi - 1].clone(), drive.qdd[qi - 1].clone()),
         None => (ZERO, ZERO),
@@ -145,32 +60,15 @@ pub fn sweep(
         (part(&drive.qd, 0), part(&drive.qd, 3), part(&drive.qdd, 0), part(&drive.qdd, 3))
     };
     // Forward: chain by chain, each from its head's parent (an earlier chain, or the base).
-    let mut rn = 0usize;
-    for chain in &chains {
+    for chain in chains {
         let p = parent[chain[0]];
         let late = p != 0;
-        let es: Vec<M3> = chain.iter().map(|&c| e[c].clone()).collect();
-        let mut op = |x: &M3, y: &M3| {
-            rn += 1;
-            bind_m3(b, "PR", rn, matmul(x, y))
-        };
-        let local = prefix(&es, ROTATIONS, &mut op);
-        for (&body, l) in chain.iter().zip(local) {
-            b.check(body, nb)?;
-            let r = if late { matmul(&rw[p], &l) } else { l };
-            rw[body] = bind_m3(b, "RW", body, r);
-        }
-        // Axes, and the vectors from each parent's origin.
         let mut w_terms = Vec::with_capacity(chain.len());
-        for (k, &body) in chain.iter().enumerate() {
+        for &body in chain {
+            b.check(body, nb)?;
             let i = body - 1;
-            let pb = if k == 0 { p } else { chain[k - 1] };
-            let joint = &robot.joints[order[i]];
-            z[body] = bind_v3(b, "Z", body, matvec_num(&rw[body], &joint.axis));
-            let r = matvec(&rw[pb], &t[body], false);
-            t[body] = bind_v3(b, "RD", body, r);
             let (qd, _) = rates(i);
-            w_terms.push(match joint.kind {
+            w_terms.push(match robot.joints[order[i]].kind {
                 JointKind::Revolute => bind_v3(b, "WZ", body, vscale(&z[body], &qd)),
                 JointKind::FreeFlyer => matvec(&rw[body], &free(i).1, false),
                 _ => zero3(),
@@ -217,10 +115,8 @@ pub fn sweep(
             a_terms.push(a);
         }
         let alphas = vector_prefix(b, "ALPHA", chain, &alpha[p], late, a_terms);
-        let origins = vector_prefix(b, "O", chain, &o[p], late, chain.iter().map(|&c| t[c].clone()).collect());
-        for ((&body, a), x) in chain.iter().zip(alphas).zip(origins) {
+        for (&body, a) in chain.iter().zip(alphas) {
             alpha[body] = a;
-            o[body] = x;
         }
     }
     // Backward: each body's inertial force `F` and its moment about the world origin `Mo`,
@@ -286,8 +182,7 @@ pub fn sweep(
         let Some(qi) = layout.v_index[i] else { continue };
         match robot.joints[j].kind {
             JointKind::Revolute => {
-                let zo = bind_v3(b, "ZO", body, cross(&z[body], &o[body]));
-                torque.push((qi, sub(vdot(&z[body], &ms[body]), vdot(&zo, &fs[body]))));
+                torque.push((qi, sub(vdot(&z[body], &ms[body]), vdot(&frames.zo[body], &fs[body]))));
             }
             JointKind::Prismatic => torque.push((qi, vdot(&z[body], &fs[body]))),
             JointKind::FreeFlyer => {

@@ -113,7 +113,7 @@ fn eval_with_bound(f: &Function, given: &BTreeMap<String, f64>, inexact: &[Strin
 }
 
 /// The largest `|depth − rnea| / tolerance` over four states and every output of `invdyna`
-/// and of `dirdyna`'s `c`. Tolerance: the sum of both running error bounds
+/// and `dirdyna` (`M` by the CRBA against the world-frame composites, `c`). Tolerance: the sum of both running error bounds
 /// ([`eval_with_bound`]), plus `10⁻³` of it for the terms of second order in `u`. Derivation:
 /// both formulations are the same polynomial wherever `cos² + sin² = 1` (and the quaternion has
 /// unit norm), so at the exact unit point nearest the inputs they have one exact value, from
@@ -133,7 +133,7 @@ fn worst_ratio(robot: &Robot) -> f64 {
     let mut worst: f64 = 0.0;
     let pairs: [(&str, Writer, Writer, &str); 2] = [
         ("invdyna", crate::rnea::invdyna, super::invdyna, "Qq["),
-        ("dirdyna", crate::dirdyna::dirdyna, super::dirdyna, "c["),
+        ("dirdyna", crate::dirdyna::dirdyna, super::dirdyna, ""),
     ];
     for (name, ops, depth, prefix) in pairs {
         let (f0, f1) = (function(&robot, name, ops), function(&robot, name, depth));
@@ -165,8 +165,8 @@ fn massive_base(mut r: Robot) -> Robot {
     r
 }
 
-/// `Qq` and `c` of the depth formulation equal the body-frame RNEA's within the derived
-/// tolerance on every topology family (chains, branches, many short chains, a star), on
+/// `Qq`, `M` and `c` of the depth formulation equal the body-frame RNEA's and CRBA's within
+/// the derived tolerance on every topology family (chains, branches, many short chains, a star), on
 /// Robotran's floating base (prismatic joints), on the free flyer, with fixed joints between
 /// moving ones and on a chain of dense URDF rotations with oblique axes.
 #[test]
