@@ -115,6 +115,7 @@ fn corpus_eqsat_is_valid_no_slower_within_budget_close_and_simulates() {
     let (mut funcs, mut sampled_n, mut outputs, mut via_running) = (0, 0, 0, 0);
     let mut te = 0.0;
     let (mut cp_sum, mut cp_new_sum, mut worst) = (0u64, 0u64, (0.0f64, String::new()));
+    let (mut critical_from, mut critical_sum) = (0u64, 0u64);
     for p in corpus_files().into_iter().filter(|p| !is_loop_file(p)) {
         let (m, _) = robovec::driver::load(p.to_str().unwrap()).unwrap_or_else(|f| panic!("{}", f.message()));
         // Sensor files repeat one prefix in every function: every third function is enough.
@@ -167,6 +168,20 @@ fn corpus_eqsat_is_valid_no_slower_within_budget_close_and_simulates() {
                 assert!(verifier::verify_function(&h).is_empty(), "{name}: budget 1");
                 assert!(h.op_counts().total <= a.op_counts().total + st1.windows_replaced as u64, "{name}: budget 1");
                 assert!(compute_timing(&h, &lat).1.asap_cycle <= cp0, "{name}: budget 1 critical path");
+                // Critical windows: overlapping, across shared values; each replaced window adds
+                // at most `budget` ops net, and no root gets later.
+                let mut c = a.clone();
+                let oc = EqsatOptions { critical: true, slack: 12, budget: 2, ..opts.clone() };
+                let sc = eqsat_function(&mut c, &oc, &rules0);
+                assert!(verifier::verify_function(&c).is_empty(), "{name}: critical windows");
+                assert!(
+                    c.op_counts().total <= a.op_counts().total + 2 * sc.windows_replaced as u64,
+                    "{name}: critical windows over budget: {sc}"
+                );
+                let cpc = compute_timing(&c, &lat).1.asap_cycle;
+                assert!(cpc <= cp0 && sc.cp_after == cpc, "{name}: critical windows {cp0} -> {cpc}");
+                critical_sum += cpc as u64;
+                critical_from += cp0 as u64;
             }
             funcs += 1;
             sampled_n += s as usize;
@@ -176,9 +191,11 @@ fn corpus_eqsat_is_valid_no_slower_within_budget_close_and_simulates() {
     }
     assert!(funcs >= 30, "only {funcs} functions");
     assert!(cp_new_sum < cp_sum * 9 / 10, "eqsat should shorten critical paths: {cp_sum} -> {cp_new_sum}");
+    assert!(critical_sum < critical_from, "critical windows shortened nothing: {critical_from} -> {critical_sum}");
     println!(
         "{funcs} functions ({sampled_n} sampled), {outputs} outputs checked ({via_running} by the running bound); \
-         critical paths {cp_sum} -> {cp_new_sum} cycles; worst |new - old| / bound {:.3} at {}; eqsat + checks {te:.2} s",
+         critical paths {cp_sum} -> {cp_new_sum} cycles (critical windows on the small ones: \
+         {critical_from} -> {critical_sum}); worst |new - old| / bound {:.3} at {}; eqsat + checks {te:.2} s",
         worst.0, worst.1
     );
 }

@@ -108,6 +108,15 @@ fn every_registered_pass_keeps_the_numbers_on_random_dags() {
     }
 }
 
+#[test]
+fn eqsat_critical_windows_keep_the_numbers_on_random_dags() {
+    // Not a registry default: the overlapping windows across shared values, with extra ops.
+    for seed in 0..24 {
+        run_case(seed, "atomise,eqsat<scope=critical;slack=12;budget=4>")
+            .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+    }
+}
+
 fn pipeline_strategy() -> impl Strategy<Value = String> {
     let names = checked_passes();
     prop::collection::vec(0..names.len(), 1..4)

@@ -4,12 +4,14 @@
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
-use egg::{Extractor, Id, RecExpr, Runner, StopReason};
+use egg::{Extractor, Id, Language, RecExpr, Runner, StopReason};
 use robovec_ir::analysis::compute_timing;
 use robovec_ir::{BinOp, Def, Function, Operand, Span, Value};
 
+use super::critical::find_critical_windows;
 use super::extract::{count_ops, pareto_extract, ReadyCost};
-use super::lang::{leaf_index, Arith, ConstantFold, Rewrite};
+use super::lang::{leaf_index, leaf_symbol, Arith, ConstantFold, Rewrite};
+use super::stats::EqsatStats;
 use super::window::{find_windows, Window};
 use super::EqsatOptions;
 use crate::Deadline;
@@ -28,97 +30,6 @@ pub const WORK_ENODES: u64 = 3_000_000;
 /// Least budget left for another window to be saturated, e-nodes.
 pub const MIN_WINDOW_WORK: u64 = 1_000;
 
-/// How the egg runs of a function stopped (egg `StopReason`), in windows.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-pub struct StopCounts {
-    /// No rule could add anything.
-    pub saturated: u32,
-    /// `iters` reached.
-    pub iteration_limit: u32,
-    /// `nodes` reached.
-    pub node_limit: u32,
-    /// `time-ms` reached.
-    pub time_limit: u32,
-    /// Any other reason.
-    pub other: u32,
-}
-
-/// What `eqsat` did to one function (printed by `-stats`).
-#[derive(Clone, Debug, Default, serde::Serialize)]
-pub struct EqsatStats {
-    /// Function name.
-    pub function: String,
-    /// Windows saturated, windows.
-    pub windows_tried: u32,
-    /// Windows replaced by their extracted form, windows.
-    pub windows_replaced: u32,
-    /// Windows where egg's lexicographic extraction was over the op budget and the Pareto
-    /// extraction within the budget was used, windows.
-    pub budget_fallbacks: u32,
-    /// Stop reasons of the runs.
-    pub stops: StopCounts,
-    /// Total wall time of saturation + extraction, milliseconds.
-    pub total_ms: f64,
-    /// Mean wall time per window, milliseconds.
-    pub mean_ms: f64,
-    /// Largest wall time of one window, milliseconds.
-    pub max_ms: f64,
-    /// Largest e-graph of a window, e-nodes.
-    pub max_enodes: usize,
-    /// Ops before / after, ops.
-    pub ops_before: u64,
-    /// Ops after, ops.
-    pub ops_after: u64,
-    /// Critical path (largest ASAPCycle, SPEC §4) before, cycles.
-    pub cp_before: u32,
-    /// Critical path after, cycles.
-    pub cp_after: u32,
-    /// Windows found in the function, windows (`windows_tried` is smaller when the run
-    /// stopped early).
-    pub windows_total: u32,
-    /// E-nodes of all the windows' e-graphs together, e-nodes (about at most the work budget,
-    /// [`WORK_ENODES`] by default: egg checks its node limit between rules).
-    pub enodes_total: u64,
-    /// Why the run stopped before trying every window (the `-time-limit` or the work budget
-    /// reached); the windows not tried are kept unchanged.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub stopped_early: Option<String>,
-}
-
-impl std::fmt::Display for EqsatStats {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let s = &self.stops;
-        write!(
-            f,
-            "@{}: eqsat: windows {} tried, {} replaced ({} within budget by Pareto extraction); stop reasons: \
-             saturated {}, iteration limit {}, node limit {}, time limit {}, other {}; time {:.1} ms total, \
-             {:.3} ms mean / {:.3} ms max per window; largest e-graph {} e-nodes; ops {} -> {}; critical path \
-             {} -> {} cycles",
-            self.function,
-            self.windows_tried,
-            self.windows_replaced,
-            self.budget_fallbacks,
-            s.saturated,
-            s.iteration_limit,
-            s.node_limit,
-            s.time_limit,
-            s.other,
-            self.total_ms,
-            self.mean_ms,
-            self.max_ms,
-            self.max_enodes,
-            self.ops_before,
-            self.ops_after,
-            self.cp_before,
-            self.cp_after
-        )?;
-        if let Some(why) = &self.stopped_early {
-            write!(f, "; stopped after {} of {} windows: {why}", self.windows_tried, self.windows_total)?;
-        }
-        Ok(())
-    }
-}
-
 /// Rewrites `f` (atomised, verified) window by window; see the module doc of `eqsat`.
 pub fn eqsat_function(f: &mut Function, o: &EqsatOptions, rules: &[Rewrite]) -> EqsatStats {
     eqsat_function_within(f, o, rules, None)
@@ -134,20 +45,56 @@ pub fn eqsat_function_within(
     rules: &[Rewrite],
     deadline: Option<Deadline>,
 ) -> EqsatStats {
+    let mut st = one_run(f, o, rules, deadline, 0);
+    if !o.critical {
+        return st;
+    }
+    // Critical windows: another round while the last one shortened the critical path (its
+    // windows made other values critical), within the rounds, the work budget and the deadline.
+    let mut rounds = 1;
+    let mut last = st.cp_after;
+    while rounds < o.rounds && st.stopped_early.is_none() && last < st.cp_before_round {
+        let r = one_run(f, o, rules, deadline, st.enodes_total);
+        st.cp_before_round = last;
+        last = r.cp_after;
+        st.absorb(r);
+        rounds += 1;
+    }
+    st.rounds = rounds;
+    st
+}
+
+/// One run over the windows of `f` (see [`eqsat_function_within`]), after earlier runs of the
+/// same function spent `spent` e-nodes of the work budget.
+fn one_run(
+    f: &mut Function,
+    o: &EqsatOptions,
+    rules: &[Rewrite],
+    deadline: Option<Deadline>,
+    spent: u64,
+) -> EqsatStats {
+    let work = o.work_enodes.saturating_sub(spent);
     let mut st = EqsatStats {
+        rounds: 1,
         function: f.name.clone(),
         ops_before: f.op_counts().total,
         cp_before: compute_timing(f, &o.lat).1.asap_cycle,
         ..EqsatStats::default()
     };
-    let windows = find_windows(f, o.window);
+    let windows = if o.critical {
+        find_critical_windows(f, o.window, &compute_timing(f, &o.lat).0, o.slack)
+    } else {
+        find_windows(f, o.window)
+    };
     st.windows_total = windows.len() as u32;
     let n = f.values.len();
     let mut at_root: Vec<Option<usize>> = vec![None; n];
     let mut inside = vec![false; n];
     for (i, w) in windows.iter().enumerate() {
         at_root[w.root.index()] = Some(i);
-        w.interior.iter().for_each(|v| inside[v.index()] = true);
+        if !o.critical {
+            w.interior.iter().for_each(|v| inside[v.index()] = true);
+        }
     }
     let mut ready = vec![0u32; n];
     let mut plans: Vec<Option<RecExpr<Arith>>> = vec![None; windows.len()];
@@ -161,7 +108,7 @@ pub fn eqsat_function_within(
             if st.stopped_early.is_none() {
                 if let Some(d) = deadline.filter(|d| d.reached()) {
                     st.stopped_early = Some(d.reason());
-                } else if o.work_enodes.saturating_sub(st.enodes_total) < MIN_WINDOW_WORK {
+                } else if work.saturating_sub(st.enodes_total) < MIN_WINDOW_WORK {
                     let b = o.work_enodes;
                     st.stopped_early = Some(format!("work budget of {b} e-nodes per function reached"));
                 }
@@ -173,12 +120,19 @@ pub fn eqsat_function_within(
                 continue;
             }
             let limits = Limits {
-                nodes: (o.nodes as u64).min(o.work_enodes.saturating_sub(st.enodes_total)) as usize,
+                nodes: (o.nodes as u64).min(work.saturating_sub(st.enodes_total)) as usize,
                 time: deadline
                     .map_or(Duration::from_millis(o.time_ms), |d| d.time_left().min(Duration::from_millis(o.time_ms))),
             };
+            // A critical window's interior values may have been rewritten already: the root
+            // as it is now is its op on its operands as they are.
+            let now = o.critical.then(|| {
+                let mut r = 0;
+                f.value(v).def.for_each_value(|p| r = r.max(ready[p.index()]));
+                r + f.op_kind(v).map_or(0, |k| o.lat.of(k))
+            });
             let t0 = Instant::now();
-            let (r, plan) = saturate(w, &leaf_ready, o, limits, rules, &mut st);
+            let (r, plan) = saturate(w, &leaf_ready, now, o, limits, rules, &mut st);
             let dt = t0.elapsed().as_secs_f64() * 1e3;
             st.windows_tried += 1;
             st.total_ms += dt;
@@ -196,9 +150,15 @@ pub fn eqsat_function_within(
         ready[v.index()] = r + o.lat.of(kind);
     }
     st.mean_ms = if st.windows_tried > 0 { st.total_ms / st.windows_tried as f64 } else { 0.0 };
-    rebuild(f, &windows, &plans);
+    rebuild(f, &windows, &plans, !o.critical);
+    if o.critical {
+        // Interior values read only by replaced roots are dead now.
+        let live = f.live_values(&[]);
+        f.retain(|g, v| live[v.index()] || matches!(g.value(v).def, Def::Input));
+    }
     st.ops_after = f.op_counts().total;
     st.cp_after = compute_timing(f, &o.lat).1.asap_cycle;
+    st.cp_before_round = st.cp_before;
     st
 }
 
@@ -213,19 +173,33 @@ struct Limits {
 fn saturate(
     w: &Window,
     leaf_ready: &[u32],
+    now: Option<u32>,
     o: &EqsatOptions,
     limits: Limits,
     rules: &[Rewrite],
     st: &mut EqsatStats,
 ) -> (u32, Option<RecExpr<Arith>>) {
     let cf = ReadyCost { leaf_ready, lat_add: o.lat.add, lat_mul: o.lat.mul };
-    let (orig_ready, _) = cf.expr_cost(&w.expr);
-    let runner: Runner<Arith, ConstantFold> = Runner::default()
-        .with_iter_limit(o.iters)
-        .with_node_limit(limits.nodes)
-        .with_time_limit(limits.time)
-        .with_expr(&w.expr)
-        .run(rules);
+    let orig_ready = now.unwrap_or_else(|| cf.expr_cost(&w.expr).0);
+    let mut runner: Runner<Arith, ConstantFold> =
+        Runner::default().with_iter_limit(o.iters).with_node_limit(limits.nodes).with_time_limit(limits.time);
+    if w.aliases.is_empty() {
+        runner = runner.with_expr(&w.expr);
+    } else {
+        // The expression node by node, then each shared interior node unioned with its leaf.
+        let mut ids: Vec<Id> = Vec::with_capacity(w.expr.as_ref().len());
+        for node in w.expr.as_ref() {
+            let id = runner.egraph.add(node.clone().map_children(|c| ids[usize::from(c)]));
+            ids.push(id);
+        }
+        for &(i, k) in &w.aliases {
+            let leaf = runner.egraph.add(Arith::Leaf(leaf_symbol(k)));
+            runner.egraph.union(ids[i], leaf);
+        }
+        runner.egraph.rebuild();
+        runner.roots.push(*ids.last().expect("non-empty window"));
+    }
+    let runner = runner.run(rules);
     st.enodes_total += runner.egraph.total_number_of_nodes() as u64;
     match &runner.stop_reason {
         Some(StopReason::Saturated) => st.stops.saturated += 1,
@@ -236,7 +210,7 @@ fn saturate(
     }
     st.max_enodes = st.max_enodes.max(runner.egraph.total_number_of_nodes());
     let root: Id = runner.roots[0];
-    let limit = w.ops + o.budget;
+    let limit = w.freed + o.budget;
     let (_, mut best) = Extractor::new(&runner.egraph, cf.clone()).find_best(root);
     if count_ops(&best) > limit {
         match pareto_extract(&runner.egraph, root, &cf, limit, 64) {
@@ -249,7 +223,7 @@ fn saturate(
     }
     let (new_ready, _) = cf.expr_cost(&best);
     let new_ops = count_ops(&best);
-    let better = new_ready < orig_ready || new_ops < w.ops;
+    let better = new_ready < orig_ready || new_ops < w.freed;
     if new_ready <= orig_ready && new_ops <= limit && better {
         (new_ready, Some(best))
     } else {
@@ -260,13 +234,15 @@ fn saturate(
 /// Replaces every planned window: new ops go just before the root (all leaves precede it),
 /// interior values disappear, and a root whose new form is a leaf or a constant is replaced by
 /// it in every use.
-fn rebuild(f: &mut Function, windows: &[Window], plans: &[Option<RecExpr<Arith>>]) {
+fn rebuild(f: &mut Function, windows: &[Window], plans: &[Option<RecExpr<Arith>>], drop_interior: bool) {
     let n = f.values.len();
     let mut dropped = vec![false; n];
     let mut plan_at: Vec<Option<usize>> = vec![None; n];
     for (i, w) in windows.iter().enumerate() {
         if plans[i].is_some() {
-            w.interior.iter().for_each(|v| dropped[v.index()] = true);
+            if drop_interior {
+                w.interior.iter().for_each(|v| dropped[v.index()] = true);
+            }
             plan_at[w.root.index()] = Some(i);
         }
     }

@@ -331,3 +331,38 @@ fn a_reached_deadline_tries_no_window_and_keeps_the_function() {
     assert!(robovec_ir::verifier::verify_function(&m.functions[0]).is_empty());
     assert_eq!(m.to_string(), before, "no window tried, nothing rewritten");
 }
+
+/// Running sums `s_k = s_{k−1} + x_{k+2}` over six inputs, every sum an output: a chain of
+/// shared values, so cluster windows hold one op each.
+fn running_sums() -> Module {
+    func(
+        "func @f { phase atomised input %x1 input %x2 input %x3 input %x4 input %x5 input %x6 \
+         %s1 = add %x1, %x2 %s2 = add %s1, %x3 %s3 = add %s2, %x4 %s4 = add %s3, %x5 %s5 = add %s4, %x6 \
+         output o1 = %s1 output o2 = %s2 output o3 = %s3 output o4 = %s4 output o5 = %s5 }",
+    )
+}
+
+#[test]
+fn critical_windows_reach_across_shared_values() {
+    // Cluster windows: every sum is an output, so no window has two ops; the chain stays
+    // 5 adds deep (60 cycles).
+    let s = run(&mut running_sums(), &EqsatOptions::default());
+    assert_eq!((s.windows_total, s.cp_after), (0, 60), "{s}");
+    // Critical windows (slack 0: every sum), one extra op each. In body order: s3's window
+    // reads s1 (ready 12) and x3, x4: s1 + (x3 + x4) is ready at 24 instead of 36, 2 ops for the
+    // 1 freed. s4 is then 24 + 12 = 36, which no term beats. s5 = s3 + (x5 + x6) is ready at
+    // 36 instead of 48. Critical path 60 -> 36 cycles, ops 5 -> 7.
+    let o = EqsatOptions { critical: true, budget: 1, ..EqsatOptions::default() };
+    let mut m = running_sums();
+    let s = run(&mut m, &o);
+    assert_eq!((s.cp_before, s.cp_after), (60, 36), "{s}");
+    assert_eq!((s.ops_before, s.ops_after), (5, 7), "{s}");
+    let f = &m.functions[0];
+    let input = |name: &str| (name[1..].parse::<f64>().unwrap()).powi(2);
+    let out = robovec_ir::interp::eval::<f64>(f, input);
+    let expect = [5.0, 14.0, 30.0, 55.0, 91.0];
+    assert_eq!(out.iter().map(|(_, y)| *y).collect::<Vec<_>>(), expect, "{f}");
+    // Without the extra op, no rewrite fits: every window needs 2 ops where it frees 1.
+    let s0 = run(&mut running_sums(), &EqsatOptions { critical: true, ..EqsatOptions::default() });
+    assert_eq!((s0.cp_after, s0.ops_after), (60, 5), "{s0}");
+}

@@ -42,11 +42,20 @@ pub struct Window {
     pub expr: RecExpr<Arith>,
     /// Ops of the window as written (interior + root), ops.
     pub ops: u32,
+    /// Ops that disappear when the window is replaced (ops): all of [`Window::ops`] for a
+    /// cluster window; for a critical window ([`super::critical::find_critical_windows`]) the root and the
+    /// interior values read only inside the window.
+    pub freed: u32,
+    /// Shared interior values of a critical window that are also leaves: (index of the
+    /// interior node in [`Window::expr`], leaf index). Saturation unions the two, so that
+    /// extraction may read the value as it is already computed (no op, its own ready time)
+    /// instead of recomputing it. Empty for a cluster window.
+    pub aliases: Vec<(usize, usize)>,
     /// Leaf occurrences (value and constant), at most the `cap` of [`find_windows`].
     pub size: u32,
 }
 
-fn arith(f: &Function, v: Value) -> Option<(BinOp, Operand, Operand)> {
+pub(super) fn arith(f: &Function, v: Value) -> Option<(BinOp, Operand, Operand)> {
     match f.value(v).def {
         Def::Binary(op @ (BinOp::Add | BinOp::Sub | BinOp::Mul), a, b) => Some((op, a, b)),
         _ => None,
@@ -54,7 +63,7 @@ fn arith(f: &Function, v: Value) -> Option<(BinOp, Operand, Operand)> {
 }
 
 /// A node of a tree: an operand leaf or an op (value, operator, operand nodes).
-enum TNode {
+pub(super) enum TNode {
     Leaf(Operand),
     Op(Value, BinOp, usize, usize),
 }
@@ -150,8 +159,22 @@ fn split(nodes: &[TNode], cap: usize) -> Vec<bool> {
 
 /// The window rooted at tree node `top`, stopping at other cut nodes (which become leaves).
 fn emit(nodes: &[TNode], cut: &[bool], top: usize) -> Window {
+    emit_with_ids(nodes, cut, top).0
+}
+
+/// [`emit`], also returning each tree node's index in the window's expression.
+pub(super) fn emit_with_ids(nodes: &[TNode], cut: &[bool], top: usize) -> (Window, Vec<Option<egg::Id>>) {
     let TNode::Op(root, ..) = nodes[top] else { unreachable!("windows are rooted at ops") };
-    let mut w = Window { root, interior: Vec::new(), leaves: Vec::new(), expr: RecExpr::default(), ops: 0, size: 0 };
+    let mut w = Window {
+        root,
+        interior: Vec::new(),
+        leaves: Vec::new(),
+        expr: RecExpr::default(),
+        ops: 0,
+        freed: 0,
+        aliases: Vec::new(),
+        size: 0,
+    };
     // Post-order with an explicit stack; `ids[i]` is node i's id in `expr`.
     let mut ids = vec![None; nodes.len()];
     let mut stack = vec![(top, false)];
@@ -170,6 +193,7 @@ fn emit(nodes: &[TNode], cut: &[bool], top: usize) -> Window {
                     _ => Arith::Mul([x, y]),
                 }));
                 w.ops += 1;
+                w.freed += 1;
                 if i != top {
                     w.interior.push(*v);
                 }
@@ -188,5 +212,5 @@ fn emit(nodes: &[TNode], cut: &[bool], top: usize) -> Window {
             }
         }
     }
-    w
+    (w, ids)
 }
