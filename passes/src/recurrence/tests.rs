@@ -143,3 +143,16 @@ fn a_chain_from_the_inputs_is_cut_where_its_coefficients_can_start_early() {
         close(&f, &g, seed);
     }
 }
+
+#[test]
+fn the_placement_bound_divides_the_resource_bound_by_the_fill() {
+    // CHAIN has 10 adds (7 in the sum L, one per step) and 3 muls, critical path 93 cycles.
+    let f = parse(CHAIN).unwrap().functions.remove(0);
+    assert_eq!((f.op_counts().add, f.op_counts().mul), (10, 3));
+    assert_eq!(super::bound(&f, 93, 0, 0.5), 93, "pe = 0: the critical path alone");
+    assert_eq!(super::bound(&f, 93, 1, 1.0), 93, "10 add slots on 1 PE: under the path");
+    assert_eq!(super::bound(&f, 5, 1, 1.0), 10, "the resource bound: 10 adds on 1 ADD PE");
+    assert_eq!(super::bound(&f, 4, 2, 1.0), 5, "⌈10 / 2⌉ = 5");
+    assert_eq!(super::bound(&f, 5, 1, 0.9), 12, "10 / 0.9 = 11.1, rounded up");
+    assert_eq!(super::bound(&f, 5, 2, 0.4), 13, "⌈10 / 2⌉ / 0.4 = 12.5, rounded up");
+}
