@@ -32,7 +32,9 @@
 //!   `(R_kᵀ Fq_k, R_kᵀ (Mq_k − o_k × Fq_k))`.
 //!
 //! In exact arithmetic (and with `cos² + sin² = 1`) this is the body-frame RNEA's `Qq`; the tests
-//! compare both under the rigorous error budget of `robovec_ir::numerics::budget`.
+//! compare both within the sum of their running error bounds (Wilkinson's running error
+//! analysis, Higham, *Accuracy and Stability of Numerical Algorithms*, §3.3), evaluated at each
+//! state.
 //!
 //! Every recursion is a prefix over at most `log₂ n` chains on any path from the root, so the
 //! depth is `O(log² n)` on any tree and `O(log n)` on a chain or a tree of few branches.
