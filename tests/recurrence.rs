@@ -27,7 +27,9 @@ fn recurrence_on_the_corpus_is_shorter_within_budget_and_bound_and_simulates() {
         let mut r = run(&format!("{BEFORE},recurrence"), &f);
         assert!(verifier::verify_function(&r).is_empty(), "{name}");
         assert!(cp(&r) <= cp(&b), "{name}: recurrence made it longer: {} > {}", cp(&r), cp(&b));
-        assert!(r.op_counts().total as f64 <= 1.5 * b.op_counts().total as f64, "{name}: ops budget");
+        // The budget: 1.5× the ops as first atomised (`budget-of=atomised`, the goal).
+        let atomised = run("atomise", &f).op_counts().total;
+        assert!(r.op_counts().total as f64 <= 1.5 * atomised as f64, "{name}: ops budget");
         shorter += (cp(&r) < cp(&b)) as u32;
         if name.contains("dyna") || name.contains("accelred") {
             // Every dynamics file has chains through its bodies to restructure.
@@ -161,4 +163,25 @@ fn check_accepts_default_depth_on_the_segway() {
     let o = crate::common::opt(&[p.to_str().unwrap(), "-passes=atomise,default<depth>", "-check", "-o", "/dev/null"]);
     assert!(o.status.success(), "{}", crate::common::stderr(&o));
     assert!(crate::common::stderr(&o).contains("check passed"), "{}", crate::common::stderr(&o));
+}
+
+/// `default<depth>`'s ops budget is 1.5× the ops of the function as the pipeline first had it
+/// atomised (before `cse` and `zero-removal` removed any), the ops goal; with
+/// `budget-of=input` it is 1.5× the ops `recurrence` receives, which is smaller.
+#[test]
+fn the_ops_budget_is_stated_against_the_atomised_function() {
+    let p = crate::common::corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c");
+    let (m, _) = robovec::driver::load(p.to_str().unwrap()).unwrap_or_else(|f| panic!("{}", f.message()));
+    let atomised = run("atomise", &m.functions[0]);
+    let before = run("cse,zero-removal,balance,cse", &atomised);
+    let (a, b) = (atomised.op_counts().total, before.op_counts().total);
+    assert!(b < a, "cse and zero-removal remove ops: {a} -> {b}");
+    let of_atomised = run("cse,zero-removal,balance,cse,recurrence,cse", &atomised);
+    let of_input = run("cse,zero-removal,balance,cse,recurrence<budget-of=input>,cse", &atomised);
+    let (oa, oi) = (of_atomised.op_counts().total, of_input.op_counts().total);
+    assert!(oa as f64 <= 1.5 * a as f64, "{oa} ops against {a} atomised");
+    assert!(oi as f64 <= 1.5 * b as f64, "{oi} ops against {b} after cse");
+    assert!(cp(&of_atomised) <= cp(&of_input), "{} against {}", cp(&of_atomised), cp(&of_input));
+    // The larger budget is used: past 1.5× what recurrence received.
+    assert!(oa as f64 > 1.5 * b as f64, "{oa} ops, {b} received");
 }

@@ -215,6 +215,11 @@ pub struct PassContext {
     /// Index in the pipeline of the pass running now (set by the manager; `None` outside a
     /// pipeline), recorded with every artifact.
     pub pass_index: Option<usize>,
+    /// Ops of each function (by name) when the pipeline first had it atomised: after the
+    /// pass that atomised it, or at the start when the input was atomised already (set by the
+    /// manager). The baseline of ops budgets stated against the atomised equations (issue 31:
+    /// `default<depth>` within 1.5× `atomise`'s ops; `recurrence<budget-of=atomised>`).
+    pub atomised_ops: std::collections::HashMap<String, u64>,
     /// Where long loops report progress (samples, sweep configurations, search iterations):
     /// hidden by default; the driver plugs a display in when stderr is a terminal (see
     /// [`progress`]). Passes never write to the terminal themselves.

@@ -196,6 +196,7 @@ impl PassManager {
             cx.original = Some(m.clone());
         }
         let mut records = Vec::new();
+        note_atomised_ops(m, cx);
         for (i, (spec, pass)) in self.passes.iter().enumerate() {
             let name = pass.name();
             if let Some(d) = cx.deadline.filter(crate::Deadline::reached) {
@@ -239,6 +240,7 @@ impl PassManager {
                 m.functions.iter_mut().for_each(|f| f.clear_timing());
             }
             records.push(PassRecord { name: spec.to_string(), wall_ms, ops_before, ops_after: module_ops(m) });
+            note_atomised_ops(m, cx);
             if self.instr.print_after.selects(name) {
                 write!(log, "*** IR Dump After {spec} ***\n{m}").map_err(PassError::Log)?;
             }
@@ -286,4 +288,13 @@ fn verify_named(m: &Module, pass: &str) -> Result<(), PassError> {
         errors: errs.iter().map(|e| format!("  {e}")).collect::<Vec<_>>().join("\n"),
         list: errs,
     })
+}
+
+/// Records in [`PassContext::atomised_ops`] the ops of every atomised function not recorded yet.
+fn note_atomised_ops(m: &Module, cx: &mut PassContext) {
+    for f in m.functions.iter().filter(|f| f.phase == robovec_ir::Phase::Atomised) {
+        if !cx.atomised_ops.contains_key(&f.name) {
+            cx.atomised_ops.insert(f.name.clone(), f.op_counts().total);
+        }
+    }
 }

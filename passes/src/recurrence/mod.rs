@@ -21,7 +21,10 @@
 //!
 //! Rounds: a round restructures the values with at most `slack` cycles of slack, balances, and
 //! is kept when the critical path got shorter (with `pe=N`: when max(critical path, the
-//! resource bound of N ADD + N MULTI PEs ÷ `fill`) got lower) within `max-growth` × the input's ops.
+//! resource bound of N ADD + N MULTI PEs ÷ `fill`) got lower) within `max-growth` × the ops of the function as the pipeline first had it
+//! atomised (`budget-of=atomised`: before `cse` and `zero-removal` removed any, so that
+//! `default<depth>` keeps the issue's goal of 1.5× `atomise`'s ops; the pass's input's when
+//! larger, or with `budget-of=input`).
 //! A round that gains nothing, or goes over the ops budget, is retried on the values ready in
 //! the last half of the critical path, then the last quarter, … (4 times): the values at the
 //! cut become the pivots and the coefficients after it start at 0 beside the part before it
@@ -33,8 +36,8 @@
 //!
 //! Measured on the public corpus's `dirdyna` and `invdyna` files after
 //! `cse,zero-removal,balance,cse` (`scripts/depth_corpus.sh`, docs/rewrites.md): critical path
-//! 0.23–0.54× `atomise`'s (coman `dirdyna` 744 → 475 cycles, WALK-MAN 831 → 508, Segway 350 →
-//! 246) for 0.83–1.32× `atomise`'s ops, f32 mean bits of error within ±0.06.
+//! 0.22–0.51× `atomise`'s (coman `dirdyna` 744 → 461 cycles, WALK-MAN 831 → 499, Segway 350 →
+//! 241) for 0.83–1.50× `atomise`'s ops.
 //!
 //! Exact in real arithmetic (distributivity, associativity, commutativity); in floating point
 //! it changes rounding as reassociation and distribution do, and the magnitude bound of
@@ -95,7 +98,13 @@ pub const INFO: PassInfo = PassInfo {
         ParamInfo {
             name: "max-growth",
             kind: ParamKind::F64 { default: 1.5, min: 1.0, max: 100.0 },
-            doc: "largest ops / input ops",
+            doc: "largest ops / the ops of `budget-of`",
+        },
+        ParamInfo {
+            name: "budget-of",
+            kind: ParamKind::Choice { choices: &["atomised", "input"], default: "atomised" },
+            doc: "the ops max-growth multiplies: the function's when the pipeline first had it atomised (before cse \
+                  and zero-removal removed any), or the pass's input's (the larger of the two is used)",
         },
         crate::params::LAT_ADD,
         crate::params::LAT_MUL,
@@ -121,8 +130,12 @@ pub struct Recurrence {
     /// With `pe` = N > 0: the share of issue slots a placement fills (the resource bound is
     /// divided by it; 1: the bare bound).
     pub fill: f64,
-    /// Largest ops / input ops.
+    /// Largest ops / the ops of the budget's baseline ([`Recurrence::budget_of_atomised`]).
     pub max_growth: f64,
+    /// The budget is `max_growth` × the ops of the function when the pipeline first had it
+    /// atomised ([`crate::PassContext::atomised_ops`]), when larger than its input's; false:
+    /// × the input's.
+    pub budget_of_atomised: bool,
     /// Latencies, cycles (replaced at run time by the pipeline's with `given` applied).
     pub lat: Latencies,
     /// Latencies given on the pass.
@@ -143,6 +156,7 @@ impl Recurrence {
             pe: p.u32("pe")?,
             fill: p.f64("fill")?,
             max_growth: p.f64("max-growth")?,
+            budget_of_atomised: p.choice("budget-of")? == "atomised",
             lat: p.latencies()?,
             given: p.latency_override()?,
         })
@@ -177,7 +191,11 @@ impl Pass for Recurrence {
             if ticker.stopped() {
                 break;
             }
-            let (g, s, stopped) = restructure_within(f, &opts, &ticker);
+            let base = match cx.atomised_ops.get(&f.name) {
+                Some(&a) if opts.budget_of_atomised => a.max(f.op_counts().total),
+                _ => f.op_counts().total,
+            };
+            let (g, s, stopped) = restructure_within(f, &opts, base, &ticker);
             *f = g;
             if stopped {
                 let why = ticker.reason();
@@ -204,17 +222,23 @@ pub struct RecurrenceStats {
     pub cp: (u32, u32),
 }
 
-/// Restructures `f` (atomised, verified) as [`Recurrence`] says; the result is balanced.
+/// Restructures `f` (atomised, verified) as [`Recurrence`] says, within `max_growth` × its
+/// own ops; the result is balanced.
 pub fn restructure_function(f: &Function, opts: &Recurrence) -> (Function, RecurrenceStats) {
-    let (g, s, _) = restructure_within(f, opts, &Ticker::default());
+    let (g, s, _) = restructure_within(f, opts, f.op_counts().total, &Ticker::default());
     (g, s)
 }
 
-/// [`restructure_function`] that stops when `ticker` says so (`-time-limit`): the rounds done
-/// are kept; the flag is true when it stopped.
-pub fn restructure_within(f: &Function, opts: &Recurrence, ticker: &Ticker) -> (Function, RecurrenceStats, bool) {
+/// [`restructure_function`] with the ops budget `max_growth` × `base` (ops), that stops when
+/// `ticker` says so (`-time-limit`): the rounds done are kept; the flag is true when it stopped.
+pub fn restructure_within(
+    f: &Function,
+    opts: &Recurrence,
+    base: u64,
+    ticker: &Ticker,
+) -> (Function, RecurrenceStats, bool) {
     let ops0 = f.op_counts().total;
-    let budget = (ops0 as f64 * opts.max_growth).floor() as u64;
+    let budget = (base as f64 * opts.max_growth).floor() as u64;
     let Some((mut cur, _)) = rewrite_within(f, Shape::Balance, &opts.lat, ticker) else {
         return (f.clone(), RecurrenceStats { ops: (ops0, ops0), ..Default::default() }, true);
     };
@@ -226,6 +250,9 @@ pub fn restructure_within(f: &Function, opts: &Recurrence, ticker: &Ticker) -> (
     // After a round over the budget or without gain, a round restructures only the values ready
     // after cp·(1 − 2^−halving): the end of the critical paths, where the latest terms are.
     let mut halving = 0u32;
+    // With pe = N: the balanced input and states after kept rounds (round count, function),
+    // thinned to at most 2·SNAPSHOTS, placed at the end.
+    let mut snapshots: Vec<(u32, Function)> = if opts.pe > 0 { vec![(0, cur.clone())] } else { Vec::new() };
     for _ in 0..opts.rounds {
         if ticker.check() {
             break;
@@ -261,6 +288,17 @@ pub fn restructure_within(f: &Function, opts: &Recurrence, ticker: &Ticker) -> (
         (cur, timing, cp, best) = (g, t, s.asap_cycle, b);
         stats.rounds += 1;
         stats.ops.1 = ops;
+        if opts.pe > 0 {
+            snapshots.push((stats.rounds, cur.clone()));
+            thin(&mut snapshots);
+        }
+    }
+    if opts.pe > 0 && stats.rounds > 0 && !ticker.check() {
+        // The bound is a model: place the states kept along the way and return the fastest.
+        if let Some((rounds, g)) = fastest_placed(snapshots, opts, ticker) {
+            (cp, stats.rounds, stats.ops.1) = (compute_timing(&g, &opts.lat).1.asap_cycle, rounds, g.op_counts().total);
+            cur = g;
+        }
     }
     if stats.rounds == 0 {
         // Nothing kept: the function as it was, not its balanced form.
@@ -268,6 +306,42 @@ pub fn restructure_within(f: &Function, opts: &Recurrence, ticker: &Ticker) -> (
     }
     stats.cp.1 = cp;
     (cur, stats, ticker.stopped())
+}
+
+/// States kept for [`fastest_placed`], at most twice this many.
+const SNAPSHOTS: usize = 4;
+
+/// Drops every other state but the first and the last once there are more than
+/// 2·[`SNAPSHOTS`]: the states left are spread over the rounds.
+fn thin(snapshots: &mut Vec<(u32, Function)>) {
+    if snapshots.len() <= 2 * SNAPSHOTS {
+        return;
+    }
+    let last = snapshots.len() - 1;
+    let mut i = 0;
+    snapshots.retain(|_| {
+        i += 1;
+        i == 1 || i - 1 == last || (i - 1) % 2 == 0
+    });
+}
+
+/// The state with the fewest placed cycles on N ADD + N MULTI PEs (list scheduling with
+/// `place`'s defaults, no improvement rounds, restarts or search; ties to the later state,
+/// which has the shorter critical path), with its round count; `None` when the ticker stops.
+fn fastest_placed(snapshots: Vec<(u32, Function)>, opts: &Recurrence, ticker: &Ticker) -> Option<(u32, Function)> {
+    let mut po = crate::place::PlaceOptions::with_pes(opts.pe);
+    (po.arch.lat, po.improve, po.restarts, po.search) = (opts.lat, 0, 0, 0);
+    let mut best: Option<(u32, u32, Function)> = None;
+    for (rounds, g) in snapshots {
+        if ticker.check() {
+            return None;
+        }
+        let placed = crate::place::cycles(&g, &crate::place::place_function(&g, &po));
+        if best.as_ref().is_none_or(|b| placed <= b.0) {
+            best = Some((placed, rounds, g));
+        }
+    }
+    best.map(|(_, r, g)| (r, g))
 }
 
 /// Rounds over the budget retry on the last half, quarter, … of the critical path, this many

@@ -156,3 +156,42 @@ fn the_placement_bound_divides_the_resource_bound_by_the_fill() {
     assert_eq!(super::bound(&f, 5, 1, 0.9), 12, "10 / 0.9 = 11.1, rounded up");
     assert_eq!(super::bound(&f, 5, 2, 0.4), 13, "⌈10 / 2⌉ / 0.4 = 12.5, rounded up");
 }
+
+#[test]
+fn thinning_keeps_the_first_the_last_and_every_other_state() {
+    let f = parse(CHAIN).unwrap().functions.remove(0);
+    let mut s: Vec<(u32, Function)> = (0..8).map(|r| (r, f.clone())).collect();
+    super::thin(&mut s);
+    assert_eq!(s.len(), 8, "at most 2·SNAPSHOTS: nothing dropped");
+    s.push((8, f.clone()));
+    super::thin(&mut s);
+    assert_eq!(s.iter().map(|x| x.0).collect::<Vec<_>>(), [0, 2, 4, 6, 8]);
+    s.extend((9..13).map(|r| (r, f.clone())));
+    super::thin(&mut s);
+    assert_eq!(s.iter().map(|x| x.0).collect::<Vec<_>>(), [0, 4, 8, 10, 12]);
+}
+
+#[test]
+fn with_pe_the_result_places_no_slower_than_the_balanced_input() {
+    // The affine chain on 1 PE of each kind, where the ops as much as the path bound the
+    // placement: the state returned is the fastest placed of those the rounds kept, the
+    // balanced input among them.
+    let f = parse(CHAIN).unwrap().functions.remove(0);
+    let po = {
+        let mut o = crate::place::PlaceOptions::with_pes(1);
+        (o.improve, o.restarts, o.search) = (0, 0, 0);
+        o
+    };
+    let placed = |g: &Function| crate::place::cycles(g, &crate::place::place_function(g, &po));
+    let (b, _) = crate::tree_height::rewrite_within(
+        &f,
+        crate::tree_height::Shape::Balance,
+        &Latencies::default(),
+        &crate::Ticker::default(),
+    )
+    .unwrap();
+    let (g, _) = restructure_function(&f, &Recurrence { pe: 1, ..Recurrence::default() });
+    assert!(verifier::verify_function(&g).is_empty(), "{g}");
+    assert!(placed(&g) <= placed(&b), "{} placed against {} balanced", placed(&g), placed(&b));
+    close(&f, &g, 3);
+}
