@@ -31,7 +31,9 @@
 //! (one level of recursive doubling: a chain restructured from its start has coefficients as
 //! late as its values). Then a round that gains nothing widens the slack (to the smaller
 //! latency, then doubling, up to `max-slack`); rounds stop at the budget after the last
-//! halving, at `max-slack`, or after `rounds`. The output is balanced (`balance` ran last); a
+//! halving, at `max-slack`, or after `rounds`. With `pe=N` the balanced input and up to eight
+//! states kept along the rounds are placed (list scheduling, `place`'s defaults without
+//! improvement) and the fastest placed is returned: the bound is a model of the placement. The output is balanced (`balance` ran last); a
 //! function no round shortened is left as it was.
 //!
 //! Measured on the public corpus's `dirdyna` and `invdyna` files after
