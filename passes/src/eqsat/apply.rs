@@ -49,18 +49,14 @@ pub fn eqsat_function_within(
     if !o.critical {
         return st;
     }
-    // Critical windows: another round while the last one shortened the critical path (its
+    // Critical windows: another run while the last one shortened the critical path (its
     // windows made other values critical), within the rounds, the work budget and the deadline.
-    let mut rounds = 1;
-    let mut last = st.cp_after;
-    while rounds < o.rounds && st.stopped_early.is_none() && last < st.cp_before_round {
+    let mut before = st.cp_before;
+    while st.rounds < o.rounds && st.stopped_early.is_none() && st.cp_after < before {
+        before = st.cp_after;
         let r = one_run(f, o, rules, deadline, st.enodes_total);
-        st.cp_before_round = last;
-        last = r.cp_after;
         st.absorb(r);
-        rounds += 1;
     }
-    st.rounds = rounds;
     st
 }
 
@@ -158,7 +154,6 @@ fn one_run(
     }
     st.ops_after = f.op_counts().total;
     st.cp_after = compute_timing(f, &o.lat).1.asap_cycle;
-    st.cp_before_round = st.cp_before;
     st
 }
 

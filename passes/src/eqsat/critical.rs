@@ -3,7 +3,7 @@
 
 use robovec_ir::{Function, Operand, Value};
 
-use super::window::{arith, emit_with_ids, TNode, Window};
+use super::window::{arith, emit_with_ids, tree, TNode, Window};
 
 /// The critical windows of `f` (atomised, verified; `timing` its timing): one per `add`/`sub`/`mul`
 /// value with at most `slack` cycles of slack (ALAPCycle − ASAPCycle, SPEC §4), in body order. A
@@ -76,29 +76,7 @@ pub fn find_critical_windows(
             continue;
         }
         // The tree: expanded values are ops (repeated where the window reads them twice).
-        let mut nodes: Vec<TNode> = Vec::new();
-        let mut stack: Vec<(Operand, Option<(usize, bool)>)> = vec![(Operand::Value(r), None)];
-        let mut parent_slot: Vec<Option<(usize, bool)>> = Vec::new();
-        while let Some((o, slot)) = stack.pop() {
-            let i = nodes.len();
-            match o {
-                Operand::Value(v) if expanded.contains(&v) && nodes.len() < 4 * cap => {
-                    let (op, a, b) = arith(f, v).expect("tree ops are arith");
-                    nodes.push(TNode::Op(v, op, usize::MAX, usize::MAX));
-                    stack.push((b, Some((i, false))));
-                    stack.push((a, Some((i, true))));
-                }
-                o => nodes.push(TNode::Leaf(o)),
-            }
-            parent_slot.push(slot);
-        }
-        for (i, slot) in parent_slot.iter().enumerate() {
-            if let Some((p, left)) = *slot {
-                if let TNode::Op(_, _, a, b) = &mut nodes[p] {
-                    *(if left { a } else { b }) = i;
-                }
-            }
-        }
+        let nodes = tree(f, r, |v, len| expanded.contains(&v) && len < 4 * cap);
         let cut = vec![false; nodes.len()];
         let (mut w, ids) = emit_with_ids(&nodes, &cut, 0);
         // Ops freed: the root, and (in reverse body order, users first) each expanded value

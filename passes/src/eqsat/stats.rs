@@ -54,9 +54,6 @@ pub struct EqsatStats {
     pub enodes_total: u64,
     /// Runs over the windows (`rounds`; 1 for cluster windows).
     pub rounds: u32,
-    /// Critical path before the last run, cycles (the rounds stop when a run gains nothing).
-    #[serde(skip)]
-    pub cp_before_round: u32,
     /// Why the run stopped before trying every window (the `-time-limit` or the work budget
     /// reached); the windows not tried are kept unchanged.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -101,9 +98,10 @@ impl std::fmt::Display for EqsatStats {
 }
 
 impl EqsatStats {
-    /// Adds the counts of a later run `r` of the same function: its windows, stops, times and
-    /// e-nodes; the ops and the critical path after it; its stop reason.
+    /// Adds the counts of a later run `r` of the same function: its runs, windows, stops, times
+    /// and e-nodes; the ops and the critical path after it; its stop reason.
     pub(super) fn absorb(&mut self, r: EqsatStats) {
+        self.rounds += r.rounds;
         self.windows_total += r.windows_total;
         self.windows_tried += r.windows_tried;
         self.windows_replaced += r.windows_replaced;

@@ -95,30 +95,7 @@ pub fn find_windows(f: &Function, cap: usize) -> Vec<Window> {
         if arith(f, r).is_none() || interior(r) {
             continue;
         }
-        // Pre-order over the tree with an explicit stack (cascades can be thousands deep).
-        let mut nodes: Vec<TNode> = Vec::new();
-        let mut stack: Vec<(Operand, Option<(usize, bool)>)> = vec![(Operand::Value(r), None)];
-        let mut parent_slot: Vec<Option<(usize, bool)>> = Vec::new();
-        while let Some((o, slot)) = stack.pop() {
-            let i = nodes.len();
-            match o {
-                Operand::Value(v) if v == r || interior(v) => {
-                    let (op, a, b) = arith(f, v).expect("tree ops are arith");
-                    nodes.push(TNode::Op(v, op, usize::MAX, usize::MAX));
-                    stack.push((b, Some((i, false))));
-                    stack.push((a, Some((i, true))));
-                }
-                o => nodes.push(TNode::Leaf(o)),
-            }
-            parent_slot.push(slot);
-        }
-        for (i, slot) in parent_slot.iter().enumerate() {
-            if let Some((p, left)) = *slot {
-                if let TNode::Op(_, _, a, b) = &mut nodes[p] {
-                    *(if left { a } else { b }) = i;
-                }
-            }
-        }
+        let nodes = tree(f, r, |v, _| interior(v));
         let cut = split(&nodes, cap);
         let mut here: Vec<Window> = (0..nodes.len()).filter(|&i| cut[i]).map(|i| emit(&nodes, &cut, i)).collect();
         here.retain(|w| w.ops >= 2 || w.expr.as_ref().iter().any(|n| matches!(n, Arith::Num(_))));
@@ -130,6 +107,36 @@ pub fn find_windows(f: &Function, cap: usize) -> Vec<Window> {
     }
     out.sort_by_key(|w| pos[w.root.index()]);
     out
+}
+
+/// The tree rooted at `r` in pre-order (node 0 the root): an `add`/`sub`/`mul` value `v` is an
+/// op node when `expand(v, nodes so far)` says so (the root always is), every other operand a
+/// leaf; a value read twice is walked twice. Explicit stack: cascades can be thousands deep.
+pub(super) fn tree(f: &Function, r: Value, mut expand: impl FnMut(Value, usize) -> bool) -> Vec<TNode> {
+    let mut nodes: Vec<TNode> = Vec::new();
+    let mut stack: Vec<(Operand, Option<(usize, bool)>)> = vec![(Operand::Value(r), None)];
+    let mut parent_slot: Vec<Option<(usize, bool)>> = Vec::new();
+    while let Some((o, slot)) = stack.pop() {
+        let i = nodes.len();
+        match o {
+            Operand::Value(v) if arith(f, v).is_some() && (v == r || expand(v, i)) => {
+                let (op, a, b) = arith(f, v).expect("checked");
+                nodes.push(TNode::Op(v, op, usize::MAX, usize::MAX));
+                stack.push((b, Some((i, false))));
+                stack.push((a, Some((i, true))));
+            }
+            o => nodes.push(TNode::Leaf(o)),
+        }
+        parent_slot.push(slot);
+    }
+    for (i, slot) in parent_slot.iter().enumerate() {
+        if let Some((p, left)) = *slot {
+            if let TNode::Op(_, _, a, b) = &mut nodes[p] {
+                *(if left { a } else { b }) = i;
+            }
+        }
+    }
+    nodes
 }
 
 /// Cuts a tree (node 0 = root) into windows of at most `cap` leaf occurrences, top-down: each

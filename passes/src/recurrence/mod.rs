@@ -90,7 +90,8 @@ pub const INFO: PassInfo = PassInfo {
             name: "pe",
             kind: ParamKind::U32 { default: 0, min: 0, max: 1_000_000 },
             doc: "N of the PE array to place on (N ADD + N MULTI): keep a round only if it lowers max(critical path, \
-                  ⌈add-side ops / N⌉, ⌈muls / N⌉); 0: the critical path alone",
+                  max(⌈add-side ops / N⌉, ⌈muls / N⌉) / fill), then return the fastest placed of the kept states; \
+                  0: the critical path alone",
         },
         ParamInfo {
             name: "fill",
