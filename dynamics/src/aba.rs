@@ -228,16 +228,8 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
     let motions: Vec<Motion> = motions(model, layout, b);
     let order = robot.dfs_joints();
     let nb = order.len();
-    let mut link_body = vec![0; robot.links.len()];
-    for (i, &j) in order.iter().enumerate() {
-        link_body[robot.joints[j].child] = i + 1;
-    }
-    let parent: Vec<usize> =
-        std::iter::once(0).chain(order.iter().map(|&j| link_body[robot.joints[j].parent])).collect();
-    let mut moves = vec![false; nb + 1];
-    for i in 0..nb {
-        moves[i + 1] = moves[parent[i + 1]] || layout.v_index[i].is_some();
-    }
+    let parent = robot.body_parents(&order);
+    let moves = layout.moving_bodies(&parent);
 
     // Pass 1: joints, velocities and velocity terms, rigid inertias.
     let zero3 = || [ZERO, ZERO, ZERO];

@@ -126,6 +126,17 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// Whether each body moves: a moving joint lies on its path from the root (`parent` from
+    /// [`Robot::body_parents`]; length `parent.len()`, entry 0 the base's, false). The others
+    /// are fixed to the base and bear no joint force.
+    pub fn moving_bodies(&self, parent: &[usize]) -> Vec<bool> {
+        let mut moves = vec![false; parent.len()];
+        for i in 1..parent.len() {
+            moves[i] = moves[parent[i]] || self.v_index[i - 1].is_some();
+        }
+        moves
+    }
+
     /// The numbering and parameters of `robot`.
     pub fn of(robot: &Robot) -> Layout {
         let order = robot.dfs_joints();
@@ -301,10 +312,7 @@ impl std::fmt::Display for Stopped {
 pub fn coordinate_parents(model: &Model, layout: &Layout) -> Vec<usize> {
     let robot = &model.robot;
     let order = robot.dfs_joints();
-    let mut link_body = vec![0; robot.links.len()];
-    for (i, &j) in order.iter().enumerate() {
-        link_body[robot.joints[j].child] = i + 1;
-    }
+    let link_body = robot.link_bodies(&order);
     // The coordinate of the nearest moving joint at or above each body (0: none).
     let mut up = vec![0usize; order.len() + 1];
     let mut lambda = vec![0usize; layout.nv + 1];

@@ -290,10 +290,7 @@ pub fn sweep(
     omp[0] = [ZERO, ZERO, ZERO];
     alpha[0] = g;
     // Body of each link (0: the root, the base).
-    let mut link_body = vec![0; robot.links.len()];
-    for (i, &j) in order.iter().enumerate() {
-        link_body[robot.joints[j].child] = i + 1;
-    }
+    let link_body = robot.link_bodies(&order);
     let body_of_link = |l: usize| link_body[l];
     // Forward kinematics.
     for (i, &j) in order.iter().enumerate() {
@@ -353,11 +350,7 @@ pub fn sweep(
     }
     // Which bodies move: those with a moving joint on their path from the root. The others
     // (fixed to the base) bear no joint torque.
-    let mut moves = vec![false; nb + 1];
-    for (i, &j) in order.iter().enumerate() {
-        let p = body_of_link(robot.joints[j].parent);
-        moves[i + 1] = moves[p] || layout.v_index[i].is_some();
-    }
+    let moves = layout.moving_bodies(&robot.body_parents(&order));
     // Backward dynamics.
     let mut fq: Vec<V3> = vec![[ZERO, ZERO, ZERO]; nb + 1];
     let mut cq: Vec<V3> = vec![[ZERO, ZERO, ZERO]; nb + 1];

@@ -225,6 +225,24 @@ impl Robot {
         }
         out
     }
+
+    /// The body of every link (length: the links) for the depth-first joint order `order`
+    /// ([`Robot::dfs_joints`]): body `i + 1` is the child link of `order[i]`, body 0 the root
+    /// link (the base).
+    pub fn link_bodies(&self, order: &[usize]) -> Vec<usize> {
+        let mut link_body = vec![0; self.links.len()];
+        for (i, &j) in order.iter().enumerate() {
+            link_body[self.joints[j].child] = i + 1;
+        }
+        link_body
+    }
+
+    /// The parent body of every body of `order` ([`Robot::link_bodies`]'s numbering; length
+    /// `order.len() + 1`, entry 0 the base's, 0).
+    pub fn body_parents(&self, order: &[usize]) -> Vec<usize> {
+        let link_body = self.link_bodies(order);
+        std::iter::once(0).chain(order.iter().map(|&j| link_body[self.joints[j].parent])).collect()
+    }
 }
 
 impl Robot {

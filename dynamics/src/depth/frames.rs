@@ -113,16 +113,8 @@ impl Frames {
         let robot = &model.robot;
         let order = robot.dfs_joints();
         let nb = order.len();
-        let mut link_body = vec![0; robot.links.len()];
-        for (i, &j) in order.iter().enumerate() {
-            link_body[robot.joints[j].child] = i + 1;
-        }
-        let mut parent = vec![0usize; nb + 1];
-        let mut moves = vec![false; nb + 1];
-        for (i, &j) in order.iter().enumerate() {
-            parent[i + 1] = link_body[robot.joints[j].parent];
-            moves[i + 1] = moves[parent[i + 1]] || layout.v_index[i].is_some();
-        }
+        let parent = robot.body_parents(&order);
+        let moves = layout.moving_bodies(&parent);
         let (chains, _) = heavy_chains(&parent);
         let identity = numeric(&[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
         let zero3 = || [ZERO, ZERO, ZERO];
