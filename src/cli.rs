@@ -137,8 +137,9 @@ pub struct Cli {
     pub gravity: Option<[f64; 3]>,
     /// URDF input: the generator's formulation. `ops` (the default): the fewest ops, body-frame
     /// recursive Newton–Euler, CRBA, LᵀDL or ABA. `depth`: the shortest critical path, every
-    /// recursion of `invdyna` and of `dirdyna`'s `c` written in the world frame as a parallel
-    /// prefix along the tree's chains (its `M` by the CRBA; no `fordyna`). See docs/rewrites.md.
+    /// recursion of `invdyna` and of `dirdyna` (`M` by world-frame composite inertias, `c`)
+    /// written in the world frame as a parallel prefix along the tree's chains (no `fordyna`).
+    /// See docs/rewrites.md.
     #[arg(long, value_name = "ops|depth", default_value = "ops")]
     pub formulation: FormulationArg,
     /// URDF input: write the values of the parameters kept as inputs to FILE, the JSON object

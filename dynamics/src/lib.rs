@@ -227,8 +227,8 @@ pub enum Formulation {
     /// The fewest ops: body-frame RNEA, CRBA, LᵀDL or ABA ([`rnea`], [`crba`], [`fordyna`]).
     #[default]
     Ops,
-    /// The shortest critical path: the world-frame parallel-prefix sweep of [`depth`]
-    /// (`invdyna`, and `dirdyna`'s `c`); no `fordyna`.
+    /// The shortest critical path: the world-frame parallel prefixes of [`depth`] (`invdyna`,
+    /// and `dirdyna`'s `M` and `c`); no `fordyna`.
     Depth,
 }
 
