@@ -15,6 +15,7 @@ mod codegen_c;
 mod codegen_pinocchio;
 mod corpus;
 mod cse;
+mod depth_bound;
 mod diagnostics;
 mod eqsat;
 mod error_reference;

@@ -14,6 +14,7 @@ pub mod codegen;
 pub mod contract;
 pub mod cse;
 pub mod dce;
+pub mod depth_bound;
 pub mod eqsat;
 pub mod inline;
 pub mod manager;
@@ -379,6 +380,7 @@ pub const PASSES: &[PassInfo] = &[
     inline::INFO,
     tree_height::distribute::INFO,
     recurrence::INFO,
+    depth_bound::INFO,
     specialize::INFO,
     eqsat::INFO,
     cse::INFO,
