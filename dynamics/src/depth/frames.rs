@@ -8,9 +8,12 @@ use crate::robot::JointKind;
 use crate::sym::{mul, sum, Builder, Term, ZERO};
 use crate::{Layout, Model, Stopped};
 
-/// The network of the rotation prefixes (3 × 3 products, 45 ops each when dense): the fewer
-/// products.
-pub(super) const ROTATIONS: Network = Network::BrentKung;
+/// The network of the rotation prefixes (3 × 3 products, 45 ops each when dense):
+/// Ladner–Fischer's `P₁`, one level of pairing around Sklansky. Measured on the study robots
+/// (`scripts/depth_formulation.sh`): as short as Sklansky (a 130-joint chain's `invdyna` 715
+/// cycles after `atomise`, Brent–Kung's 796) for fewer products (41 596 ops against Sklansky's
+/// 46 886 and Brent–Kung's 38 410); `P₂` is 746 cycles again (docs/rewrites.md).
+pub(super) const ROTATIONS: Network = Network::LadnerFischer(1);
 /// The network of the vector prefixes and suffixes (3 adds each): the shallower.
 pub(super) const SUMS: Network = Network::Sklansky;
 
@@ -104,7 +107,7 @@ pub struct Frames {
 }
 
 impl Frames {
-    /// Writes the orientations (Brent–Kung prefixes of the joint rotations, times the chain
+    /// Writes the orientations (Ladner–Fischer prefixes of the joint rotations, times the chain
     /// head's parent's), axes, steps and origins (Sklansky prefix sums) of every body into `b`.
     ///
     /// # Errors

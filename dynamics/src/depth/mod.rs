@@ -14,7 +14,7 @@
 //! - joint rotation child → parent `E_b = R_origin·R_axis(q_b)` (a constant for prismatic and
 //!   fixed joints, the quaternion's for a free flyer) and the child origin in the parent frame
 //!   `t_b = d_b (+ R_origin·axis·q_b` prismatic);
-//! - orientations `R_b = E_{c₁}⋯E_{c_i}` along a chain `c₁ … c_m`: a Brent–Kung prefix of the
+//! - orientations `R_b = E_{c₁}⋯E_{c_i}` along a chain `c₁ … c_m`: a Ladner–Fischer (`P₁`) prefix of the
 //!   3 × 3 products, times the head's parent's `R_p` (one product, so the late `R_p` is one
 //!   product deep); axes `z_b = R_b·axis`, origin steps `r_b = R_p·t_b`;
 //! - `ω_b = ω_p + z_b qd_b`, `ω̇_b = ω̇_p + z_b qdd_b + ω_p × z_b qd_b`,

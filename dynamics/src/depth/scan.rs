@@ -7,7 +7,11 @@
 //! parallel adders", *IEEE Trans. Computers* C-31(3), 1982). Two networks are written here:
 //! - [`Network::Sklansky`] (Ladner–Fischer's `P₀`, J. Sklansky 1960): depth `⌈log₂ m⌉`,
 //!   `⌊m/2⌋·⌈log₂ m⌉` operations at most;
-//! - [`Network::BrentKung`]: depth `2⌈log₂ m⌉ − 1` at most, fewer than `2m` operations.
+//! - [`Network::BrentKung`]: depth `2⌈log₂ m⌉ − 1` at most, fewer than `2m` operations;
+//! - [`Network::LadnerFischer`]`(k)` (Ladner–Fischer's `P_k`): `k` levels of Brent–Kung's
+//!   pairing around a Sklansky network over the `m / 2^k` pairs' products: depth `⌈log₂ m⌉ + k`
+//!   at most, about `m·(2 − 2^{1−k}) + (m / 2^{k+1})·log₂(m / 2^k)` operations — Sklansky's
+//!   depth within `k` levels for a fraction of its operations (`k = 0` is Sklansky).
 //!
 //! The operation is never assumed commutative: `op(a, b)` is `a ∘ b` with `a` the earlier range
 //! (3 × 3 rotation products compose in order).
@@ -24,6 +28,8 @@ pub enum Network {
     Sklansky,
     /// Depth `2⌈log₂ m⌉ − 1` at most, fewer than `2m` operations.
     BrentKung,
+    /// `k` Brent–Kung levels, then Sklansky: depth `⌈log₂ m⌉ + k` at most.
+    LadnerFischer(u32),
 }
 
 /// The inclusive prefixes `x₁ ∘ ⋯ ∘ x_i` of `xs` (`i = 1..m`, same length as `xs`) by network
@@ -31,8 +37,9 @@ pub enum Network {
 /// the module doc, recursion depth `log₂ m`.
 pub fn prefix<T: Clone>(xs: &[T], net: Network, op: &mut dyn FnMut(&T, &T) -> T) -> Vec<T> {
     match net {
-        Network::Sklansky => sklansky(xs, op),
-        Network::BrentKung => brent_kung(xs, op),
+        Network::Sklansky | Network::LadnerFischer(0) => sklansky(xs, op),
+        Network::BrentKung => brent_kung(xs, Network::BrentKung, op),
+        Network::LadnerFischer(k) => brent_kung(xs, Network::LadnerFischer(k - 1), op),
     }
 }
 
@@ -59,13 +66,15 @@ fn sklansky<T: Clone>(xs: &[T], op: &mut dyn FnMut(&T, &T) -> T) -> Vec<T> {
     out
 }
 
-fn brent_kung<T: Clone>(xs: &[T], op: &mut dyn FnMut(&T, &T) -> T) -> Vec<T> {
+/// One level of Brent–Kung's pairing: the pairs' products, their prefixes by `inner`, then the
+/// even positions fixed up.
+fn brent_kung<T: Clone>(xs: &[T], inner: Network, op: &mut dyn FnMut(&T, &T) -> T) -> Vec<T> {
     let m = xs.len();
     if m <= 1 {
         return xs.to_vec();
     }
     let pairs: Vec<T> = (0..m / 2).map(|k| op(&xs[2 * k], &xs[2 * k + 1])).collect();
-    let ps = brent_kung(&pairs, op);
+    let ps = prefix(&pairs, inner, op);
     (0..m)
         .map(|i| match i {
             0 => xs[0].clone(),
@@ -118,14 +127,17 @@ pub fn heavy_chains(parent: &[usize]) -> (Vec<Vec<usize>>, Vec<bool>) {
 mod tests {
     use super::*;
 
-    /// Prefixes of strings under concatenation (associative, not commutative), and the depth
-    /// and the operations of both networks counted by hand for 8 and 5 elements.
+    /// Prefixes of strings under concatenation (associative, not commutative), within each
+    /// network's depth and operation bounds for 0–39 elements; and the depth and operations of
+    /// 16 elements counted by hand: Sklansky 4 levels of 8 (32), Brent–Kung 8 pairs, 11 ops for
+    /// the 8 pairs' prefixes (depth 4) and 7 fix-ups (26 ops, depth 6), `P₁` 8 pairs, Sklansky
+    /// over them (12 ops, depth 3) and 7 fix-ups (27 ops, depth 5).
     #[test]
     fn networks_give_the_prefixes_in_order_at_their_depth() {
         for m in 0..40usize {
             let xs: Vec<(String, u32)> = (0..m).map(|i| (char::from(b'a' + (i % 26) as u8).to_string(), 0)).collect();
             let want: Vec<String> = (1..=m).map(|i| xs[..i].iter().map(|x| x.0.as_str()).collect()).collect();
-            for net in [Network::Sklansky, Network::BrentKung] {
+            for net in [Network::Sklansky, Network::BrentKung, Network::LadnerFischer(1), Network::LadnerFischer(2)] {
                 let mut ops = 0;
                 let mut op = |a: &(String, u32), b: &(String, u32)| {
                     ops += 1;
@@ -144,6 +156,12 @@ mod tests {
                         assert!(depth <= (2 * lg).saturating_sub(1), "{net:?} {m}: depth {depth}");
                         assert!(ops < 2 * m.max(1), "{net:?} {m}: {ops} ops");
                     }
+                    Network::LadnerFischer(k) => {
+                        assert!(depth <= lg + k, "{net:?} {m}: depth {depth}");
+                        // k pairing levels (< 2m ops together), then Sklansky over ⌊m/2^k⌋.
+                        let rest = m >> k;
+                        assert!(ops < 2 * m.max(1) + (rest / 2) * lg as usize, "{net:?} {m}: {ops} ops");
+                    }
                 }
                 let mut op = |a: &(String, u32), b: &(String, u32)| (format!("{}{}", a.0, b.0), 0);
                 let suf = suffix(&xs, net, &mut op);
@@ -151,6 +169,24 @@ mod tests {
                     assert_eq!(s.0, xs[i..].iter().map(|x| x.0.as_str()).collect::<String>());
                 }
             }
+        }
+    }
+
+    #[test]
+    fn networks_of_sixteen_counted_by_hand() {
+        let xs: Vec<u32> = vec![0; 16];
+        for (net, want) in [
+            (Network::Sklansky, (4, 32)),
+            (Network::BrentKung, (6, 26)),
+            (Network::LadnerFischer(1), (5, 27)),
+            (Network::LadnerFischer(2), (6, 26)),
+        ] {
+            let mut ops = 0;
+            let got = prefix(&xs, net, &mut |a: &u32, b: &u32| {
+                ops += 1;
+                a.max(b) + 1
+            });
+            assert_eq!((*got.iter().max().unwrap(), ops), want, "{net:?}");
         }
     }
 
