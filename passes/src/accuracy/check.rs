@@ -232,7 +232,7 @@ pub fn check_function_until(
 /// Passes that never change a computed value (no reassociation, no rewriting of arithmetic):
 /// a pipeline of these is checked bit for bit, by `-check` and by the fuzzing and property tests.
 /// Any other registered pass gets the budget check.
-pub const BIT_EXACT: &[&str] = &["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy"];
+pub const BIT_EXACT: &[&str] = &["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy", "depth-bound"];
 
 /// True when every pass of `pipeline` (comma-separated, parameters allowed) is in
 /// [`BIT_EXACT`].
