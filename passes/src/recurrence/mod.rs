@@ -31,8 +31,8 @@
 //! (one level of recursive doubling: a chain restructured from its start has coefficients as
 //! late as its values). Then a round that gains nothing widens the slack (to the smaller
 //! latency, then doubling, up to `max-slack`); rounds stop at the budget after the last
-//! halving, at `max-slack`, or after `rounds`. With `pe=N` the balanced input and up to eight
-//! states kept along the rounds are placed (list scheduling, `place`'s defaults without
+//! halving, at `max-slack`, or after `rounds`. With `pe=N` the balanced input, the states of
+//! the last six kept rounds and up to eight earlier ones are placed (list scheduling, `place`'s defaults without
 //! improvement) and the fastest placed is returned: the bound is a model of the placement. The output is balanced (`balance` ran last); a
 //! function no round shortened is left as it was.
 //!
@@ -254,7 +254,7 @@ pub fn restructure_within(
     // after cp·(1 − 2^−halving): the end of the critical paths, where the latest terms are.
     let mut halving = 0u32;
     // With pe = N: the balanced input and states after kept rounds (round count, function),
-    // thinned to at most 2·SNAPSHOTS, placed at the end.
+    // the last TAIL of them and at most 2·SNAPSHOTS before, placed at the end.
     let mut snapshots: Vec<(u32, Function)> = if opts.pe > 0 { vec![(0, cur.clone())] } else { Vec::new() };
     for _ in 0..opts.rounds {
         if ticker.check() {
@@ -311,20 +311,27 @@ pub fn restructure_within(
     (cur, stats, ticker.stopped())
 }
 
-/// States kept for [`fastest_placed`], at most twice this many.
+/// States kept for [`fastest_placed`] before the last [`TAIL`]: at most twice this many.
 const SNAPSHOTS: usize = 4;
 
-/// Drops every other state but the first and the last once there are more than
-/// 2·[`SNAPSHOTS`]: the states left are spread over the rounds.
+/// The last states kept, all of them: where the critical path nears what N PEs can issue, list
+/// scheduling falls behind the path before the resource bound says so (Jeep `dirdyna` at N = 32:
+/// the states of the last rounds, 320 / 315 / 313 / 308-cycle paths, place in 320 / 326 / 345 /
+/// 347 cycles), so the fastest placed is among the last few.
+const TAIL: usize = 6;
+
+/// Keeps the last [`TAIL`] states, and drops every other state but the first before them once
+/// there are more than 2·[`SNAPSHOTS`] there: the earlier states left are spread over the rounds.
 fn thin(snapshots: &mut Vec<(u32, Function)>) {
-    if snapshots.len() <= 2 * SNAPSHOTS {
+    let head = snapshots.len().saturating_sub(TAIL);
+    if head <= 2 * SNAPSHOTS {
         return;
     }
-    let last = snapshots.len() - 1;
     let mut i = 0;
     snapshots.retain(|_| {
+        let k = i;
         i += 1;
-        i == 1 || i - 1 == last || (i - 1) % 2 == 0
+        k >= head || k % 2 == 0
     });
 }
 

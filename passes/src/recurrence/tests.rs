@@ -158,17 +158,25 @@ fn the_placement_bound_divides_the_resource_bound_by_the_fill() {
 }
 
 #[test]
-fn thinning_keeps_the_first_the_last_and_every_other_state() {
+fn thinning_keeps_the_last_states_the_first_and_every_other_before() {
+    // As the rounds push them: the last TAIL = 6 states stay, and once more than 2·SNAPSHOTS = 8
+    // precede them, every other of those goes (the first stays).
     let f = parse(CHAIN).unwrap().functions.remove(0);
-    let mut s: Vec<(u32, Function)> = (0..8).map(|r| (r, f.clone())).collect();
-    super::thin(&mut s);
-    assert_eq!(s.len(), 8, "at most 2·SNAPSHOTS: nothing dropped");
-    s.push((8, f.clone()));
-    super::thin(&mut s);
-    assert_eq!(s.iter().map(|x| x.0).collect::<Vec<_>>(), [0, 2, 4, 6, 8]);
-    s.extend((9..13).map(|r| (r, f.clone())));
-    super::thin(&mut s);
-    assert_eq!(s.iter().map(|x| x.0).collect::<Vec<_>>(), [0, 4, 8, 10, 12]);
+    let mut s: Vec<(u32, Function)> = Vec::new();
+    let rounds = |s: &Vec<(u32, Function)>| s.iter().map(|x| x.0).collect::<Vec<_>>();
+    for r in 0..15 {
+        s.push((r, f.clone()));
+        super::thin(&mut s);
+        if r == 13 {
+            assert_eq!(s.len(), 14, "8 + 6: nothing dropped");
+        }
+    }
+    assert_eq!(rounds(&s), [0, 2, 4, 6, 8, 9, 10, 11, 12, 13, 14]);
+    for r in 15..19 {
+        s.push((r, f.clone()));
+        super::thin(&mut s);
+    }
+    assert_eq!(rounds(&s), [0, 4, 8, 10, 12, 13, 14, 15, 16, 17, 18]);
 }
 
 #[test]
