@@ -84,10 +84,14 @@ impl Pass for DepthBound {
         let lat = cx.latencies_for("depth-bound", &self.lat);
         let ticker = cx.ticker();
         let mut functions = Vec::new();
+        let mut noted = false;
         for f in &m.functions {
+            // After a stop, the functions left expand nothing: their bounds are 0, with 0 outputs
+            // expanded.
             let b = bound_function(f, &lat, self.max_terms, || ticker.check());
-            if ticker.stopped() {
+            if ticker.stopped() && !noted {
                 cx.note_stop("depth-bound", &format!("while expanding @{}: {}", f.name, ticker.reason()));
+                noted = true;
             }
             functions.push(b);
         }

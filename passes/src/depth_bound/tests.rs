@@ -107,3 +107,19 @@ fn the_bound_is_the_same_before_and_after_rewrites() {
     assert_eq!(before.binding, after.binding);
     assert!(after.critical_path_cycles >= after.lower_bound_cycles);
 }
+
+#[test]
+fn a_stopped_expansion_bounds_the_outputs_it_reached() {
+    // Stopped before the third body value: `p` (made from the first two) is expanded, `o` is not.
+    let text = "func @f { phase atomised input %a input %b input %c \
+                %x = add %a, %b %p = mul %x, %c %o = add %p, %a output p = %p output o = %o }";
+    let m = parse(text).unwrap();
+    let mut asked = 0;
+    let b = bound_function(&m.functions[0], &lat(), 4096, || {
+        asked += 1;
+        asked > 2
+    });
+    assert_eq!((b.outputs, b.outputs_expanded), (2, 1));
+    // p = ac + bc: 2 monomials of degree 2, no variable alone: N(12) = 2 → 12, degree 2 → 7.
+    assert_eq!((b.binding.as_ref().unwrap().output.as_str(), b.lower_bound_cycles), ("p", 12));
+}
