@@ -6,8 +6,7 @@
 # Usage (from the repository, after `cargo build --release`): scripts/depth_bound.sh > out.txt
 set -u
 cd "$(dirname "$0")/.."
-for f in ../shared/corpus/robotran/c/*.c ../shared/corpus/robotran/matlab/*.m ../shared/corpus/robotran/python/*.py; do
-  case "$f" in *accelred*|*invdynared*) continue;; *dyna*) ;; *) continue;; esac
+for f in $(scripts/dyna_files.sh); do
   for p in 'atomise,depth-bound' 'atomise,default<depth>,depth-bound'; do
     ./target/release/robovec-opt "$f" -passes="$p" -o /dev/null 2>&1 | grep '^depth-bound' | sed "s|^|$(basename "$f") $p: |"
   done

@@ -8,7 +8,6 @@
 set -u
 cd "$(dirname "$0")/.."
 P='atomise,place<pe=16>;atomise,cse,zero-removal,balance,cse,place<pe=16>;atomise,cse,zero-removal,balance,cse,recurrence,cse,place<pe=16>'
-for f in ../shared/corpus/robotran/c/*.c ../shared/corpus/robotran/matlab/*.m ../shared/corpus/robotran/python/*.py; do
-  case "$f" in *accelred*|*invdynared*) continue;; *dyna*) ;; *) continue;; esac
+for f in $(scripts/dyna_files.sh); do
   ./target/release/robovec-opt "$f" -pareto="$P" -pareto-samples=100 -o /dev/null 2>&1 | sed "s|^@|$(basename "$f") @|"
 done

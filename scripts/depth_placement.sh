@@ -11,8 +11,7 @@ cd "$(dirname "$0")/.."
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "file | N | placed | critical path | tight bound | placed / path | placed / tight bound | default<depth> path | ops"
-for f in ../shared/corpus/robotran/c/*.c ../shared/corpus/robotran/matlab/*.m ../shared/corpus/robotran/python/*.py; do
-  case "$f" in *accelred*|*invdynared*) continue;; *dyna*) ;; *) continue;; esac
+for f in $(scripts/dyna_files.sh); do
   d=$(./target/release/robovec-opt "$f" -passes='atomise,default<depth>' -stats -o /dev/null 2>&1 \
     | sed -n 's/.*critical path [0-9]* ops \/ \([0-9]*\) cycles.*/\1/p' | tail -1)
   for n in 16 32; do
