@@ -106,11 +106,7 @@ impl Expansion {
 }
 
 fn constant(c: f64) -> Poly {
-    if c == 0.0 {
-        Vec::new()
-    } else {
-        vec![(Box::default(), Coef::constant(c))]
-    }
+    constant_or_empty(Coef::constant(c))
 }
 
 /// The inputs read, through any chain of values, by a trig variable or a call: by value index.
@@ -199,6 +195,7 @@ pub fn expand(f: &Function, max_terms: usize, mut stop: impl FnMut() -> bool) ->
     ex
 }
 
+/// A polynomial without x-variable: the coefficient `c`, or none when it is zero.
 fn constant_or_empty(c: Coef) -> Poly {
     if c.is_zero() {
         Vec::new()

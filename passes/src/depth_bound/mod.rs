@@ -84,14 +84,13 @@ impl Pass for DepthBound {
         let lat = cx.latencies_for("depth-bound", &self.lat);
         let ticker = cx.ticker();
         let mut functions = Vec::new();
-        let mut noted = false;
         for f in &m.functions {
             // After a stop, the functions left expand nothing: their bounds are 0, with 0 outputs
-            // expanded.
+            // expanded. The note names the function the stop came in.
+            let stopped_before = ticker.stopped();
             let b = bound_function(f, &lat, self.max_terms, || ticker.check());
-            if ticker.stopped() && !noted {
+            if ticker.stopped() && !stopped_before {
                 cx.note_stop("depth-bound", &format!("while expanding @{}: {}", f.name, ticker.reason()));
-                noted = true;
             }
             functions.push(b);
         }
@@ -167,20 +166,26 @@ pub fn bound_function(f: &Function, lat: &Latencies, max_terms: usize, stop: imp
 /// The bound of one expanded output.
 pub fn output_bound(name: &str, p: &expand::Poly, lat: &Latencies) -> OutputBound {
     let degree = p.iter().map(|(m, _)| m.len() as u32).max().unwrap_or(0);
-    let mut vars: Vec<u32> = p.iter().flat_map(|(m, _)| m.iter().copied()).collect();
-    vars.sort_unstable();
-    vars.dedup();
+    // Per x-variable: the monomials that hold it, and whether one of them is the variable alone
+    // (one pass over the monomials; a monomial is sorted, so repeats are neighbours).
+    let mut holding: std::collections::HashMap<u32, (u32, bool)> = std::collections::HashMap::new();
+    for (m, _) in p {
+        for (k, &y) in m.iter().enumerate() {
+            if k == 0 || m[k - 1] != y {
+                let e = holding.entry(y).or_default();
+                e.0 += 1;
+                e.1 |= m.len() == 1;
+            }
+        }
+    }
     // An x-variable whose only monomial is itself.
-    let sum_root = vars.iter().any(|&y| {
-        let mut with_y = p.iter().filter(|(m, _)| m.contains(&y));
-        matches!((with_y.next(), with_y.next()), (Some((m, _)), None) if **m == [y])
-    });
+    let sum_root = holding.values().any(|&(n, alone)| n == 1 && alone);
     let monomials = p.len() as u64;
     OutputBound {
         output: name.to_string(),
         monomials,
         degree,
-        variables: vars.len() as u32,
+        variables: holding.len() as u32,
         sum_root,
         lower_bound_cycles: count::min_cycles(monomials, degree, sum_root, lat.add, lat.mul),
     }
