@@ -138,7 +138,8 @@ pub struct Cli {
     /// URDF input: the generator's formulation. `ops` (the default): the fewest ops, body-frame
     /// recursive Newton–Euler, CRBA, LᵀDL or ABA. `depth`: the shortest critical path, every
     /// recursion of `invdyna` and of `dirdyna` (`M` by world-frame composite inertias, `c`)
-    /// written in the world frame as a parallel prefix along the tree's chains (no `fordyna`).
+    /// written in the world frame as a parallel prefix along the tree's chains; `fordyna` solves
+    /// with those `M` and `c` by the sparse LᵀDL (the ABA on long chains).
     /// See docs/rewrites.md.
     #[arg(long, value_name = "ops|depth", default_value = "ops")]
     pub formulation: FormulationArg,

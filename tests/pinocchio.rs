@@ -128,8 +128,7 @@ fn compare_with(urdf: &str, dof: usize, base: Base, cos_sin: bool) -> f64 {
     compare_formulation(urdf, dof, base, cos_sin, robovec_dynamics::Formulation::Ops)
 }
 
-/// [`compare_with`] for the generator's `formulation` (`--formulation=depth` writes `invdyna` and
-/// `dirdyna`, no `fordyna`).
+/// [`compare_with`] for the generator's `formulation`.
 fn compare_formulation(
     urdf: &str,
     dof: usize,
@@ -138,12 +137,7 @@ fn compare_formulation(
     formulation: robovec_dynamics::Formulation,
 ) -> f64 {
     let Some(py) = python() else { return 0.0 };
-    let depth = formulation == robovec_dynamics::Formulation::Depth;
-    let functions: Vec<String> = robovec_dynamics::FUNCTION_NAMES
-        .iter()
-        .filter(|&&f| !(depth && f == "fordyna"))
-        .map(|s| s.to_string())
-        .collect();
+    let functions: Vec<String> = robovec_dynamics::FUNCTION_NAMES.iter().map(|s| s.to_string()).collect();
     let o = oracle(&py, urdf, 8, 7, base);
     let floating = base != Base::Fixed;
     assert_eq!(o.joints.len() + if floating { 5 } else { 0 }, dof, "{}: joints {:?}", o.path, o.joints);
@@ -270,11 +264,11 @@ fn long_chain_forward_dynamics_by_the_aba_matches_pinocchio() {
     eprintln!("serial 60 free flyer: worst relative error {e:e}");
 }
 
-/// `--formulation=depth` (world-frame parallel-prefix Newton–Euler and CRBA): `Qq`, `M` and `c`
+/// `--formulation=depth` (world-frame parallel-prefix Newton–Euler and CRBA): `Qq`, `M`, `c` and `qdd`
 /// within 1e-10 of Pinocchio's on a serial chain deep enough for several prefix levels, a
 /// branched robot (Panda's fingers), Solo-12 on the free flyer and Talos on the floating base.
 #[test]
-fn depth_formulation_matches_pinocchio_rnea_crba_nle() {
+fn depth_formulation_matches_pinocchio_rnea_crba_nle_aba() {
     use robovec_dynamics::topology::{build, Topology};
     use robovec_dynamics::Formulation::Depth;
     let robot = build(Topology::Serial, 23, 1);

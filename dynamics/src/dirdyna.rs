@@ -89,8 +89,10 @@ pub fn dirdyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: MassMa
 /// What writes `M` and `c` of [`dirdyna_by`]: given the builder, the joint motions and `c`'s
 /// drive (`qdd = 0`), the upper triangle of `M` ([`crba::Entries`]) and the joint forces
 /// `(i, c_i)`, sorted by `i`.
-pub type Parts<'a> =
-    dyn FnMut(&mut Builder, &[Motion], &Drive) -> Result<(crba::Entries, Vec<(usize, Term)>), Stopped> + 'a;
+pub type Parts<'a> = dyn FnMut(&mut Builder, &[Motion], &Drive) -> Parted + 'a;
+
+/// What a [`Parts`] returns: the upper triangle of `M` and the joint forces `(i, c_i)`.
+pub type Parted = Result<(crba::Entries, Vec<(usize, Term)>), Stopped>;
 
 /// `dirdyna`'s inputs, statements and outputs in Robotran's layout, with `M` and `c` written by
 /// `parts` (the CRBA and the RNEA, or the depth-optimised formulation's, [`super::depth`]).

@@ -38,7 +38,8 @@ use rustc_hash::FxHashMap;
 use robovec_ir::{BinOp, Def, Expr, Operand, Span};
 
 use super::crba;
-use super::rnea::{motions, sweep, Drive};
+use super::dirdyna::{Parted, Parts};
+use super::rnea::{motions, sweep, Drive, Motion};
 use super::sym::{mul, sub, to_expr, Builder, Term, ZERO};
 use super::{coordinate_parents, Layout, Model, Reached, Stopped};
 
@@ -92,26 +93,53 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
 /// coordinate of the factorisation and the substitutions).
 pub fn fordyna_with(model: &Model, layout: &Layout, b: &mut Builder, how: Formulation) -> Result<(), Stopped> {
     match how {
-        Formulation::Ltdl => ltdl(model, layout, b),
+        Formulation::Ltdl => ltdl_by(model, layout, b, &mut crba_rnea(model, layout)),
         Formulation::Aba => crate::aba::fordyna(model, layout, b),
-        Formulation::Fewest => {
-            // The ABA first: its cost is linear in the bodies. The factorisation alone costs
-            // `Σₖ dₖ(dₖ − 1)` ops (a multiply and a subtraction per update) for coordinates at
-            // depth `dₖ`: the `LᵀDL` is written only when that is below the ABA's ops (on a long
-            // chain it is cubic, and writing it would cost more than the whole ABA).
-            let mut aba = b.fresh();
-            crate::aba::fordyna(model, layout, &mut aba)?;
-            let aba_ops = aba.ops_after_cse();
-            if factorisation_ops(&coordinate_parents(model, layout)) < aba_ops {
-                ltdl(model, layout, b)?;
-                if b.ops_after_cse() <= aba_ops {
-                    return Ok(());
-                }
-            }
-            *b = aba;
-            Ok(())
+        Formulation::Fewest => ltdl_or_aba(model, layout, b, &mut crba_rnea(model, layout), true),
+    }
+}
+
+/// `M` by the CRBA and `c` by the RNEA in the body frames: [`ltdl_by`]'s parts for the fewest
+/// ops.
+fn crba_rnea<'a>(model: &'a Model, layout: &'a Layout) -> impl FnMut(&mut Builder, &[Motion], &Drive) -> Parted + 'a {
+    move |b: &mut Builder, motions: &[Motion], drive: &Drive| {
+        Ok((crba::mass_matrix(model, layout, b, motions)?, sweep(model, layout, b, motions, drive)?))
+    }
+}
+
+/// The `LᵀDL` on the `M` and `c` that `parts` writes ([`ltdl_by`]), or the ABA when that has
+/// fewer ops.
+///
+/// The ABA is written first: its cost is linear in the bodies. The factorisation alone costs
+/// `Σₖ dₖ(dₖ − 1)` ops (a multiply and a subtraction per update) for coordinates at depth
+/// `dₖ`: the `LᵀDL` is written only when that is below the ABA's ops (on a long chain it is
+/// cubic, and writing it would cost more than the whole ABA). With `whole`, it is kept only when
+/// the whole function also has no more ops than the ABA (the fewest ops); without, whenever its
+/// updates cost fewer ops than the ABA (the depth formulation, whose `c` takes more ops for a
+/// shorter path: [`crate::depth::fordyna`]).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub(crate) fn ltdl_or_aba(
+    model: &Model,
+    layout: &Layout,
+    b: &mut Builder,
+    parts: &mut Parts<'_>,
+    whole: bool,
+) -> Result<(), Stopped> {
+    let mut aba = b.fresh();
+    crate::aba::fordyna(model, layout, &mut aba)?;
+    let aba_ops = aba.ops_after_cse();
+    if factorisation_ops(&coordinate_parents(model, layout)) < aba_ops {
+        let mut by_ltdl = b.fresh();
+        ltdl_by(model, layout, &mut by_ltdl, parts)?;
+        if !whole || by_ltdl.ops_after_cse() <= aba_ops {
+            *b = by_ltdl;
+            return Ok(());
         }
     }
+    *b = aba;
+    Ok(())
 }
 
 /// Ops of the `LᵀDL` factorisation's updates for the coordinate parents `lambda`: a multiply
@@ -127,20 +155,27 @@ fn factorisation_ops(lambda: &[usize]) -> u64 {
     ops
 }
 
-/// `fordyna` by CRBA, `LᵀDL` and the substitutions.
-fn ltdl(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+/// `fordyna`'s inputs (`q`, `qd`, `g`, then `Qq`), `M` and `c` written by `parts` (the CRBA and
+/// the RNEA, or the depth formulation's, [`crate::depth`]), `M`'s `LᵀDL` factorisation, the
+/// substitutions, and the outputs `qdd[1..nq]`.
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per body and per row of the factorisation
+/// and of the substitutions).
+pub(crate) fn ltdl_by(model: &Model, layout: &Layout, b: &mut Builder, parts: &mut Parts<'_>) -> Result<(), Stopped> {
     let nq = layout.nv;
     let drive = Drive::inputs(b, nq, false);
     let forces: Vec<Term> = (1..=nq).map(|i| b.input(&format!("Qq[{i}]"))).collect();
     let motions = motions(model, layout, b);
     let lambda = coordinate_parents(model, layout);
+    let (entries, c) = parts(b, &motions, &drive)?;
     // `H[k][i]` for `i` an ancestor of `k` or `k` itself (1-based), from `M`'s upper triangle.
     let mut h: FxHashMap<(usize, usize), Term> = FxHashMap::default();
-    for ((i, j), t) in crba::mass_matrix(model, layout, b, &motions)? {
+    for ((i, j), t) in entries {
         h.insert((j, i), t);
     }
     let mut x = forces;
-    for (qi, t) in sweep(model, layout, b, &motions, &drive)? {
+    for (qi, t) in c {
         let r = sub(std::mem::take(&mut x[qi - 1]), t);
         x[qi - 1] = b.bind(&format!("QC{qi}"), r);
     }
@@ -217,13 +252,17 @@ mod tests {
     /// Worst `|M qdd + c − Qq|∞ / |Qq|∞` over a few states, `qdd` from `fordyna`, `M` and `c`
     /// from `dirdyna` (an independent use of the same CRBA and RNEA: the factorisation and the
     /// substitutions are what is checked), parameters at their values, all other inputs drawn.
-    fn residual(robot: &crate::robot::Robot, how: Formulation) -> f64 {
+    fn residual(robot: &crate::robot::Robot, how: How) -> f64 {
         // Both in the robot's own frames, parameters at their values.
         let model = Model { robot: robot.clone() };
         let layout = crate::Layout::of(&model.robot);
         let params = layout.values.clone();
         let mut b = crate::sym::Builder::new("fordyna", Default::default());
-        fordyna_with(&model, &layout, &mut b, how).expect("no deadline");
+        match how {
+            How::Ops(how) => fordyna_with(&model, &layout, &mut b, how),
+            How::Depth => crate::depth::fordyna(&model, &layout, &mut b),
+        }
+        .expect("no deadline");
         let fd = &b.finish();
         let mut b = crate::sym::Builder::new("dirdyna", Default::default());
         crate::dirdyna::dirdyna(&model, &layout, &mut b).expect("no deadline");
@@ -233,10 +272,15 @@ mod tests {
         let mut worst: f64 = 0.0;
         for seed in 1..=4u64 {
             let mut given: BTreeMap<String, f64> = params.clone();
-            // (A free flyer's quaternion is drawn too, not of unit norm: `M qdd + c = Qq`
-            // holds for any `R`.)
+            // (A free flyer's quaternion is drawn too, not of unit norm for the fewest-ops
+            // formulation, where `M qdd + c = Qq` holds for any `R`; the depth formulation's
+            // world-frame `M` and `c` assume a rotation, so there it is normalised.)
             for i in 1..=layout.nq {
                 given.insert(format!("q[{i}]"), 3.0 * interp::pseudo_random_input(&format!("q[{i}]"), seed));
+            }
+            if matches!(how, How::Depth) && layout.nq > layout.nv {
+                let n = (4..=7).map(|i| given[&format!("q[{i}]")].powi(2)).sum::<f64>().sqrt();
+                (4..=7).for_each(|i| *given.get_mut(&format!("q[{i}]")).expect("drawn") /= n);
             }
             for i in 1..=nq {
                 for v in ["qd", "Qq"] {
@@ -260,18 +304,29 @@ mod tests {
         worst
     }
 
+    /// Which `fordyna` [`residual`] checks.
+    #[derive(Clone, Copy, Debug)]
+    enum How {
+        /// The fewest-ops formulation's, formed so.
+        Ops(Formulation),
+        /// The depth formulation's ([`crate::depth::fordyna`]: its `M` and `c`, then `LᵀDL`).
+        Depth,
+    }
+
     /// `M qdd + c = Qq` to 1e-10 on every topology family (chains, branches, stars), on
     /// Robotran's floating base (a dense 6 × 6 block above every branch), on the free flyer (the
     /// same block, the ABA's 6 × 6 root solve) and with joints fixed
-    /// between moving ones (coordinates whose parent is not the previous body).
+    /// between moving ones (coordinates whose parent is not the previous body); for the depth
+    /// formulation's `fordyna` too, whose `M` and `c` are not the ones it is checked against
+    /// (world-frame prefixes there, the body-frame CRBA and RNEA here).
     #[test]
     fn forward_dynamics_inverts_the_mass_matrix() {
-        for how in [Formulation::Ltdl, Formulation::Aba] {
+        for how in [How::Ops(Formulation::Ltdl), How::Ops(Formulation::Aba), How::Depth] {
             forward_dynamics_inverts_the_mass_matrix_by(how);
         }
     }
 
-    fn forward_dynamics_inverts_the_mass_matrix_by(how: Formulation) {
+    fn forward_dynamics_inverts_the_mass_matrix_by(how: How) {
         for t in Topology::ALL {
             let r = build(t, 9, 3);
             let e = residual(&r, how);

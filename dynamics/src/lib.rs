@@ -228,7 +228,7 @@ pub enum Formulation {
     #[default]
     Ops,
     /// The shortest critical path: the world-frame parallel prefixes of [`depth`] (`invdyna`,
-    /// and `dirdyna`'s `M` and `c`); no `fordyna`.
+    /// and `dirdyna`'s `M` and `c`; `fordyna` factorises those `M` and `c`).
     Depth,
 }
 
@@ -249,12 +249,6 @@ impl Request {
             Some(fs) => fs.iter().any(|f| f == name),
             None => FUNCTIONS.iter().any(|&(f, _, _, by_default)| f == name && by_default),
         }
-    }
-
-    /// The functions asked for that [`Request::formulation`] does not write (`fordyna` under
-    /// [`Formulation::Depth`]), in module order: the front end reports them before generating.
-    pub fn unsupported(&self) -> Vec<&'static str> {
-        FUNCTIONS.iter().filter(|f| self.wants(f.0) && writer(f, self.formulation).is_none()).map(|f| f.0).collect()
     }
 }
 
@@ -338,19 +332,19 @@ pub fn coordinate_parents(model: &Model, layout: &Layout) -> Vec<usize> {
 type Writer = fn(&Model, &Layout, &mut Builder) -> Result<(), Stopped>;
 
 /// The functions the generator writes, in module order (`-function=NAME` picks one), their
-/// writers under [`Formulation::Ops`] and [`Formulation::Depth`] (`None`: none), and whether it
+/// writers under [`Formulation::Ops`] and [`Formulation::Depth`], and whether it
 /// writes them without `-function` (Robotran's pair, `invdyna` and `dirdyna`; `fordyna` only
 /// when asked for): the one place that selects a formulation per function.
-const FUNCTIONS: [(&str, Writer, Option<Writer>, bool); 3] = [
-    ("invdyna", rnea::invdyna, Some(depth::invdyna), true),
-    ("dirdyna", dirdyna::dirdyna, Some(depth::dirdyna), true),
-    ("fordyna", fordyna::fordyna, None, false),
+const FUNCTIONS: [(&str, Writer, Writer, bool); 3] = [
+    ("invdyna", rnea::invdyna, depth::invdyna, true),
+    ("dirdyna", dirdyna::dirdyna, depth::dirdyna, true),
+    ("fordyna", fordyna::fordyna, depth::fordyna, false),
 ];
 
 /// The writer of function entry `f` under `formulation`.
-fn writer(f: &(&str, Writer, Option<Writer>, bool), formulation: Formulation) -> Option<Writer> {
+fn writer(f: &(&str, Writer, Writer, bool), formulation: Formulation) -> Writer {
     match formulation {
-        Formulation::Ops => Some(f.1),
+        Formulation::Ops => f.1,
         Formulation::Depth => f.2,
     }
 }
@@ -422,10 +416,8 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
         .chain(request.gravity.iter().flat_map(|g| (0..3).map(|k| (format!("g[{}]", k + 1), g[k]))))
         .collect();
     let mut functions = Vec::new();
-    // (A function the formulation does not write is left out: the front end reports it first,
-    // `Request::unsupported`.)
     for f in FUNCTIONS.iter().filter(|f| request.wants(f.0)) {
-        let (name, Some(write)) = (f.0, writer(f, request.formulation)) else { continue };
+        let (name, write) = (f.0, writer(f, request.formulation));
         let mut b = Builder::new(name, consts.clone());
         b.deadline = request.deadline;
         write(model, &layout, &mut b)?;

@@ -1,5 +1,6 @@
 //! Any bytes → the URDF front end (through the front-end registry, symbolic and folded
-//! parameters, fixed and floating base) returns (Ok or errors), never panics; when it returns a module, that module
+//! parameters, fixed and floating base, and every function of the depth formulation, `fordyna`
+//! included) returns (Ok or errors), never panics; when it returns a module, that module
 //! verifies, atomises, and the atomised module verifies.
 #![no_main]
 
@@ -11,8 +12,14 @@ use robovec_front::{check_accepted, front_end_for, FrontOptions};
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
     let fe = front_end_for("robot.urdf").expect("the URDF front end is registered");
-    for (fold_params, floating_base) in [(false, false), (true, false), (false, true)] {
-        let opts = FrontOptions { fold_params, floating_base, ..FrontOptions::default() };
+    let every = Some(robovec_dynamics::FUNCTION_NAMES.map(String::from).to_vec());
+    let depth = robovec_dynamics::Formulation::Depth;
+    for opts in [
+        FrontOptions::default(),
+        FrontOptions { fold_params: true, ..FrontOptions::default() },
+        FrontOptions { floating_base: true, ..FrontOptions::default() },
+        FrontOptions { formulation: depth, functions: every, ..FrontOptions::default() },
+    ] {
         let Ok(loaded) = fe.load(Path::new("robot.urdf"), text, &opts) else { return };
         if let Err(e) = check_accepted(&loaded.module) {
             panic!("{e}");

@@ -77,14 +77,6 @@ impl FrontEnd for Urdf {
             deadline: opts.deadline,
             formulation: opts.formulation,
         };
-        if let Some(name) = request.unsupported().first() {
-            return Err(vec![FrontError::new(
-                robot.links[robot.root].span,
-                format!("--formulation={} does not write @{name}", opts.formulation.name()),
-                "robot read here",
-            )
-            .note("the depth formulation writes invdyna and dirdyna; use --formulation=ops for fordyna")]);
-        }
         let model = robovec_dynamics::Model { robot };
         let g = robovec_dynamics::generate_with(&model, &request).map_err(|stop| {
             // The joint of the body reached (the root link for a row of M's outputs).
