@@ -28,7 +28,7 @@
 //! triangles of the symmetric `J`, `M` are formed).
 
 use super::rnea::{cross, matvec, motions, numeric, vadd, Drive, Motion, M3, SUM_CHUNK, V3};
-use super::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
+use super::sym::{add, mul, neg, reciprocal, sub, sum, Builder, Term, ZERO};
 use super::{robot::JointKind, Layout, Model, Stopped};
 
 fn vsub(a: &V3, b: &V3) -> V3 {
@@ -200,7 +200,7 @@ fn solve6(b: &mut Builder, name: &str, a: &[[Term; 6]; 6], r: [Term; 6]) -> [Ter
             l[i][j] = b.bind(&format!("{name}L{}_{}", i + 1, j + 1), mul(dl[i][j].clone(), inv_d[j].clone()));
         }
         let d = (0..i).fold(a[i][i].clone(), |t, k| sub(t, mul(dl[i][k].clone(), l[i][k].clone())));
-        inv_d[i] = super::fordyna::reciprocal(b, &format!("{name}D{}", i + 1), &format!("i{name}D{}", i + 1), d);
+        inv_d[i] = reciprocal(b, &format!("{name}D{}", i + 1), &format!("i{name}D{}", i + 1), d);
     }
     // L y = r, then Lᵀ x = D⁻¹ y.
     let mut y: [Term; 6] = Default::default();
@@ -329,7 +329,7 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
                 let (uw, ua) = inertia.apply(sw, sa);
                 let (uw, ua) = (bind3(b, "UW", body, uw), bind3(b, "UA", body, ua));
                 let d = add(vdot(sw, &uw), vdot(sa, &ua));
-                let inv = super::fordyna::reciprocal(b, &format!("AD{body}"), &format!("iAD{body}"), d);
+                let inv = reciprocal(b, &format!("AD{body}"), &format!("iAD{body}"), d);
                 let u = sub(forces[qi - 1].clone(), add(vdot(sw, &pn), vdot(sa, &pf)));
                 let u = b.bind(&format!("AU{body}"), u);
                 let ia_a = inertia.minus_outer(&uw, &ua, &inv);

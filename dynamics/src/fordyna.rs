@@ -35,24 +35,11 @@
 
 use rustc_hash::FxHashMap;
 
-use robovec_ir::{BinOp, Def, Expr, Operand, Span};
-
 use super::crba;
 use super::dirdyna::{Parted, Parts};
 use super::rnea::{motions, sweep, Drive, Motion};
-use super::sym::{mul, sub, to_expr, Builder, Term, ZERO};
+use super::sym::{mul, reciprocal, sub, Builder, Term, ZERO};
 use super::{coordinate_parents, Layout, Model, Reached, Stopped};
-
-/// `1 / d`: `d` bound as `d_name`, its reciprocal as `inv_name` (a number stays a number).
-pub(super) fn reciprocal(b: &mut Builder, d_name: &str, inv_name: &str, d: Term) -> Term {
-    let d = match d {
-        Term::C(x) => return Term::C(1.0 / x),
-        d => b.bind(d_name, d),
-    };
-    let e = Expr::Binary(BinOp::Div, Box::new(Expr::Operand(Operand::Const(1.0))), Box::new(to_expr(&d)));
-    let n = b.f.fresh_name(inv_name);
-    Term::V(b.f.define(n, Def::Expr(e), Span::DUMMY).expect("fresh"))
-}
 
 /// The ancestors of coordinate `k` in `λ`, nearest first.
 fn ancestors(lambda: &[usize], k: usize) -> impl Iterator<Item = usize> + '_ {

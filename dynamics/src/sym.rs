@@ -407,6 +407,17 @@ impl Builder {
     }
 }
 
+/// `1 / d`: `d` bound as `d_name`, its reciprocal as `inv_name` (a number stays a number).
+pub(crate) fn reciprocal(b: &mut Builder, d_name: &str, inv_name: &str, d: Term) -> Term {
+    let d = match d {
+        Term::C(x) => return Term::C(1.0 / x),
+        d => b.bind(d_name, d),
+    };
+    let e = Expr::Binary(BinOp::Div, Box::new(Expr::Operand(Operand::Const(1.0))), Box::new(to_expr(&d)));
+    let n = b.f.fresh_name(inv_name);
+    Term::V(b.f.define(n, Def::Expr(e), Span::DUMMY).expect("fresh"))
+}
+
 /// The parsed-IR expression of `t` (constants non-negative, minus as [`Expr::Neg`]).
 pub fn to_expr(t: &Term) -> Expr {
     let bin = |op, a: &Term, b: &Term| Expr::Binary(op, Box::new(to_expr(a)), Box::new(to_expr(b)));
