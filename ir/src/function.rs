@@ -228,6 +228,21 @@ impl Function {
         live
     }
 
+    /// How many times each value is read (indexed by `Value::index()`): once per operand of a
+    /// body value that names it, and once per output that is it. Cost: O(values + operands).
+    pub fn use_counts(&self) -> Vec<u32> {
+        let mut uses = vec![0u32; self.values.len()];
+        for &v in &self.body {
+            self.value(v).def.for_each_value(|a| uses[a.index()] += 1);
+        }
+        for o in &self.outputs {
+            if let Operand::Value(v) = o.value {
+                uses[v.index()] += 1;
+            }
+        }
+        uses
+    }
+
     /// An empty function in `phase`.
     pub fn new(name: impl Into<String>, phase: Phase) -> Function {
         Function {

@@ -139,16 +139,9 @@ pub fn expand(f: &Function, max_terms: usize, mut stop: impl FnMut() -> bool) ->
         };
         polys[v.index()] = Some(Rc::new(p));
     }
-    // Reads left of each value: its polynomial is dropped after the last (outputs keep theirs).
-    let mut reads = vec![0u32; f.values.len()];
-    for &v in &f.body {
-        f.value(v).def.for_each_value(|x| reads[x.index()] += 1);
-    }
-    for o in &f.outputs {
-        if let Operand::Value(v) = o.value {
-            reads[v.index()] = u32::MAX;
-        }
-    }
+    // Reads left of each value: its polynomial is dropped after the last. An output's read is
+    // never done, so outputs keep theirs.
+    let mut reads = f.use_counts();
     let mut ex = Expansion { variables, polys };
     for &v in &f.body {
         if stop() {
@@ -183,12 +176,9 @@ pub fn expand(f: &Function, max_terms: usize, mut stop: impl FnMut() -> bool) ->
         };
         ex.polys[v.index()] = p.filter(|p| p.len() <= max_terms && p.iter().all(|(_, c)| c.is_finite())).map(Rc::new);
         f.value(v).def.for_each_value(|x| {
-            let r = &mut reads[x.index()];
-            if *r != u32::MAX {
-                *r -= 1;
-                if *r == 0 {
-                    ex.polys[x.index()] = None;
-                }
+            reads[x.index()] -= 1;
+            if reads[x.index()] == 0 {
+                ex.polys[x.index()] = None;
             }
         });
     }

@@ -22,15 +22,7 @@ pub fn find_critical_windows(
 ) -> Vec<Window> {
     let cap = cap.max(2);
     let n = f.values.len();
-    let mut uses = vec![0u32; n];
-    for &v in &f.body {
-        f.value(v).def.for_each_value(|a| uses[a.index()] += 1);
-    }
-    for o in &f.outputs {
-        if let Operand::Value(v) = o.value {
-            uses[v.index()] += 1;
-        }
-    }
+    let uses = f.use_counts();
     let mut pos = vec![0usize; n];
     for (i, &v) in f.body.iter().enumerate() {
         pos[v.index()] = i;
