@@ -104,11 +104,12 @@ fn variants(params_json: &Path, dce_outputs: &str, quick: bool, core: bool) -> V
     let spec = format!("atomise,specialize<params={}>,schedule-cpu", params_json.display());
     out.push(v("specialize(params),schedule-cpu", &spec, "f64", 1, "libm"));
     out.push(v("specialize(params),schedule-cpu batch=8 f64 trig=input", &spec, "f64", 8, "input"));
-    // Issue 31: the named pipeline of fewest ops, alone, with fused multiply-adds and robovec's
-    // own sin/cos, and batched.
+    // Issue 31: the named pipeline of fewest ops (`schedule-cpu` last), alone, with fused
+    // multiply-adds and robovec's own sin/cos, and batched; and without its `schedule-cpu`.
+    out.push(v("atomise,cse,zero-removal,cse", "atomise,cse,zero-removal,cse", "f64", 1, "libm"));
     out.push(v("default<ops>", "default<ops>", "f64", 1, "libm"));
     out.push(v("default<ops>,contract trig=inline", "default<ops>,contract", "f64", 1, "inline"));
-    out.push(v("default<ops>,schedule-cpu batch=8 f64 trig=input", "default<ops>,schedule-cpu", "f64", 8, "input"));
+    out.push(v("default<ops> batch=8 f64 trig=input", "default<ops>", "f64", 8, "input"));
     let dce = format!("atomise,dce<outputs={dce_outputs}>,schedule-cpu");
     out.push(v(&format!("dce<outputs={dce_outputs}>,schedule-cpu"), &dce, "f64", 1, "libm"));
     if core {

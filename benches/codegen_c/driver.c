@@ -36,13 +36,14 @@ typedef struct {
     int base;           /* variant to pair against (-1: none) */
 } Variant;
 
+#include "model.inc"
+
+/* After model.inc, which defines ROBOTRAN_KIND. */
 #if ROBOTRAN_KIND == 0
 void robotran_fn(double **M, double *c, MbsData *s, double tsim);
 #else
 void robotran_fn(double *Qq, MbsData *s, double tsim);
 #endif
-
-#include "model.inc"
 
 static double now_ns(void) {
     struct timespec t;
