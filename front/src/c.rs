@@ -364,7 +364,7 @@ fn body<'s>(
                 let span = Span::new(t.0, toks[i + 2].2);
                 let cs = cases.get_or_insert_with(Vec::new);
                 if let Some(prev) = cs.iter().find(|c| c.label == label) {
-                    let line = scan::line_of(src, prev.span.start as usize);
+                    let line = robovec_ir::span::line_of(src, prev.span.start as usize);
                     errors.push(
                         FrontError::new(span, format!("`case {label}` appears twice"), "second case")
                             .note(format!("first `case {label}:` at line {line}")),
@@ -421,7 +421,7 @@ fn body<'s>(
                     continue;
                 }
                 if let Some(r) = *returned {
-                    let line = scan::line_of(src, r.start as usize);
+                    let line = robovec_ir::span::line_of(src, r.start as usize);
                     errors.push(
                         FrontError::new(
                             scan::span_of(stmt, t.0),

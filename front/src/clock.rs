@@ -75,7 +75,7 @@ impl<'d> Clock<'d> {
     pub fn error(&self, src: &str) -> Option<FrontError> {
         let at = self.stopped_at.get()?.min(src.len());
         let seconds = self.deadline.map_or(0.0, |d| d.seconds);
-        let line = crate::scan::line_of(src, at);
+        let line = robovec_ir::span::line_of(src, at);
         let lines = src.bytes().filter(|&b| b == b'\n').count() + usize::from(!src.is_empty() && !src.ends_with('\n'));
         let start = src[..at].rfind('\n').map_or(0, |k| k + 1);
         let end = src[at..].find('\n').map_or(src.len(), |k| at + k);

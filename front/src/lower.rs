@@ -46,8 +46,8 @@ use robovec_ir::{Callee, Def, Expr as IrExpr, Function, Module, Operand, Phase, 
 use super::ast::{Expr, FuncAst, Ref, Stmt, Suffix};
 use super::clock::Clock;
 use super::error::FrontError;
-use super::scan::line_of;
 use super::{sensor, Language};
+use robovec_ir::span::line_of;
 
 /// Arrays of `MbsData` that Robotran code reads without the `s->` prefix.
 const INPUT_ARRAYS: &[&str] = &["q", "qd", "qdd", "dpt", "l", "m", "In", "g", "frc", "trq", "lrod", "Qq"];

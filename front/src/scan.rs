@@ -9,11 +9,7 @@ use super::lexer::{Spanned, Tok};
 use super::stmt::parse_stmt;
 use super::Language;
 
-/// 1-based line of byte `offset` in `src`.
-pub fn line_of(src: &str, offset: usize) -> usize {
-    let offset = offset.min(src.len());
-    1 + src.as_bytes()[..offset].iter().filter(|&&b| b == b'\n').count()
-}
+use robovec_ir::span::line_of;
 
 /// Words that start control flow in any of the three languages.
 pub fn control_kind(word: &str) -> Option<&'static str> {

@@ -32,6 +32,13 @@ impl Span {
     }
 }
 
+/// 1-based line of byte `offset` in `src` (offsets past the end count as the end). Cost: one
+/// pass over the bytes before `offset`.
+pub fn line_of(src: &str, offset: usize) -> usize {
+    let offset = offset.min(src.len());
+    1 + src.as_bytes()[..offset].iter().filter(|&&b| b == b'\n').count()
+}
+
 /// 1-based line and column of a byte offset in `src` (column counts chars).
 pub fn line_col(src: &str, offset: usize) -> (usize, usize) {
     let offset = offset.min(src.len());

@@ -21,8 +21,9 @@
 //! (`NAME_rnea(q, v, a, tau)`, `NAME_crba(q, M)`, `NAME_nle(q, v, nle)`, `NAME_aba(q, v, tau, qdd)`).
 
 mod body;
+mod callbacks;
 mod native;
-pub use body::split_callee;
+pub use callbacks::split_callee;
 pub mod pinocchio;
 pub mod plain;
 pub mod robotran;
@@ -350,11 +351,11 @@ impl CodegenC {
         ticker: &crate::Ticker,
     ) -> Result<CodegenArtifact, PassError> {
         let fused = m.functions.iter().any(has_fused);
-        let callbacks = body::callbacks(m)?;
+        let callbacks = callbacks::callbacks(m)?;
         let decls = if self.abi == Abi::Robotran {
             native::prototypes(m)?
         } else {
-            body::callback_decls(&callbacks, self.real())
+            callbacks::callback_decls(&callbacks, self.real())
         };
         let (symbols, emitted, preface) = if self.abi == Abi::Pinocchio {
             pinocchio::emit(self, m, ticker)?

@@ -24,7 +24,8 @@ use std::fmt::Write as _;
 
 use robovec_ir::{Def, Function, Module, Operand, Value};
 
-use super::body::{split_callee, Body};
+use super::body::{Body, Native};
+use super::callbacks::split_callee;
 use super::is_intrinsic;
 use crate::PassError;
 
@@ -118,15 +119,6 @@ fn unknown(f: &Function, base: &str) -> PassError {
              user_LinkForces, user_call_ExtForces, user_call_LinkForces); use abi=plain"
         ),
     )
-}
-
-/// The native form of a function's user callbacks ([`statements`]).
-pub(crate) struct Native {
-    /// Value index → its C statements (declaration of the value included).
-    pub statements: HashMap<usize, String>,
-    /// A later element of a vector callback instance → the instance's first element, whose
-    /// statements make the native call that this element reads.
-    pub lead: HashMap<usize, Value>,
 }
 
 /// The C statements of every user callback of `f` with the native signatures.

@@ -118,7 +118,7 @@ pub(crate) fn arrays(
     let mut reserved: Vec<&str> = layout.params.iter().map(|p| p.0).collect();
     reserved.extend(RESERVED);
     reserved.push(symbol);
-    let callee_names = super::body::callee_names(f);
+    let callee_names = super::callbacks::callee_names(f);
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
     let b = Body::new(o, f, &names, None, ticker);

@@ -162,7 +162,7 @@ pub(crate) fn function(
     };
     let mut reserved: Vec<&str> = vec!["s", "tsim", "sens", "isens", "live", symbol];
     reserved.extend(&outs);
-    let callee_names = super::body::callee_names(f);
+    let callee_names = super::callbacks::callee_names(f);
     reserved.extend(callee_names.iter().map(String::as_str));
     let names = c_names(f, &reserved);
     let native = super::native::statements(&Body::new(o, f, &names, None, ticker))?;
