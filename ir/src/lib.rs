@@ -44,6 +44,7 @@ pub mod placement;
 pub mod rng;
 pub mod span;
 pub mod syntax;
+mod syntax_impl;
 pub mod text;
 pub mod verifier;
 
