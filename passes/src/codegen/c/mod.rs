@@ -353,7 +353,7 @@ impl CodegenC {
         let fused = m.functions.iter().any(has_fused);
         let callbacks = callbacks::callbacks(m)?;
         let decls = if self.abi == Abi::Robotran {
-            native::prototypes(m)?
+            native::prototypes(m, &callbacks)?
         } else {
             callbacks::callback_decls(&callbacks, self.real())
         };

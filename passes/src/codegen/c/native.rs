@@ -25,7 +25,7 @@ use std::fmt::Write as _;
 use robovec_ir::{Def, Function, Module, Operand, Value};
 
 use super::body::{Body, Native};
-use super::callbacks::split_callee;
+use super::callbacks::{callee_names, split_callee, Callback};
 use super::is_intrinsic;
 use crate::PassError;
 
@@ -74,27 +74,17 @@ fn fail(f: &Function, message: String) -> PassError {
     PassError::Failed { pass: "codegen".into(), message: format!("@{}: {message}", f.name) }
 }
 
-/// The native prototypes of the callbacks `m` calls, guarded (empty without callbacks).
+/// The native prototypes of the callbacks `cbs` (`m`'s, [`super::callbacks::callbacks`]),
+/// guarded (empty without callbacks).
 ///
 /// # Errors
-/// [`PassError::Failed`] for a callback with no known native signature.
-pub(crate) fn prototypes(m: &Module) -> Result<String, PassError> {
-    let mut bases: Vec<String> = Vec::new();
-    for f in &m.functions {
-        for &v in &f.body {
-            if let Def::Call(c, args) = &f.value(v).def {
-                if is_intrinsic(c, args.len()) {
-                    continue;
-                }
-                let (base, _) = split_callee(c)?;
-                if Shape::of(&base).is_none() {
-                    return Err(unknown(f, &base));
-                }
-                if !bases.contains(&base) {
-                    bases.push(base);
-                }
-            }
-        }
+/// [`PassError::Failed`] for a callback with no known native signature, naming the first
+/// function of `m` that calls it.
+pub(crate) fn prototypes(m: &Module, cbs: &[Callback]) -> Result<String, PassError> {
+    let bases: Vec<&str> = cbs.iter().map(|k| k.base.as_str()).collect();
+    if let Some(&base) = bases.iter().find(|b| Shape::of(b).is_none()) {
+        let caller = m.functions.iter().find(|f| callee_names(f).iter().any(|n| n == base)).unwrap_or(&m.functions[0]);
+        return Err(unknown(caller, base));
     }
     if bases.is_empty() {
         return Ok(String::new());
