@@ -108,6 +108,7 @@ fn variants(params_json: &Path, dce_outputs: &str, quick: bool, core: bool) -> V
     // multiply-adds and robovec's own sin/cos, and batched; and without its `schedule-cpu`.
     out.push(v("atomise,cse,zero-removal,cse", "atomise,cse,zero-removal,cse", "f64", 1, "libm"));
     out.push(v("default<ops>", "default<ops>", "f64", 1, "libm"));
+    out.push(v("default<ops> trig=inline", "default<ops>", "f64", 1, "inline"));
     out.push(v("default<ops>,contract trig=inline", "default<ops>,contract", "f64", 1, "inline"));
     out.push(v("default<ops> batch=8 f64 trig=input", "default<ops>", "f64", 8, "input"));
     let dce = format!("atomise,dce<outputs={dce_outputs}>,schedule-cpu");
