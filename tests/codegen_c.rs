@@ -485,6 +485,22 @@ fn robotran_drop_in_equals_the_interpreter_bit_for_bit_on_every_c_corpus_file() 
     }
 }
 
+/// The drop-in with `trig=inline` (robovec's own sin/cos in place of libm's, the one-state gain
+/// docs/benchmarks.md measures): every output of every C corpus file within a small relative
+/// error of the interpreter's, with Robotran's signatures, `MbsData` fields and native callbacks,
+/// and split into parts (`default<ops>` then a small `chunk`, so that the trig block and the
+/// parts meet).
+#[test]
+fn robotran_drop_in_with_inline_trig_agrees_with_the_interpreter() {
+    let cases = corpus_cases("default<ops>", true);
+    for (k, chunk) in [0, 500].into_iter().enumerate() {
+        let o = CodegenC { abi: Abi::Robotran, trig: Trig::Inline, chunk, ..CodegenC::default() };
+        let (n, worst) = check_plain_tol::<f64>(&tmp(&format!("robotran_inline_{k}")), &cases, &o, 7, &[], Some(1e-12));
+        eprintln!("abi=robotran trig=inline chunk={chunk}: {n} outputs, largest relative difference {worst:e}");
+        assert!(n > 3_000, "only {n} outputs compared");
+    }
+}
+
 /// Small corpus files (callbacks, sqrt, sensors, trig) and random DAGs, for the batched forms.
 fn batch_cases() -> Vec<Case> {
     let mut cases: Vec<Case> = corpus_cases("atomise,zero-removal,balance", true)
@@ -605,9 +621,7 @@ const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";
 
 #[test]
 fn options_that_cannot_go_together_are_bad_usage() {
-    for bad in
-        ["abi=robotran;batch=4", "abi=robotran;precision=f32", "abi=robotran;trig=input", "abi=robotran;trig=inline"]
-    {
+    for bad in ["abi=robotran;batch=4", "abi=robotran;precision=f32", "abi=robotran;trig=input"] {
         let o = crate::common::opt(&[PENDULUM, &format!("-passes=atomise,codegen<c;{bad}>")]);
         let err = crate::common::stderr(&o);
         assert_eq!(o.status.code(), Some(2), "{bad}: {err}");

@@ -242,15 +242,15 @@ impl CodegenC {
                 Some(format!("batch={}", o.batch))
             } else if o.f32() {
                 Some("precision=f32".into())
-            } else if o.trig != Trig::Libm {
-                Some(format!("trig={}", o.trig.as_str()))
+            } else if o.trig == Trig::Input {
+                Some("trig=input".into())
             } else {
                 None
             };
             if let Some(c) = clash {
                 return Err(bad(format!(
                     "`abi=robotran` cannot go with `{c}`: Robotran's signature takes one state of doubles \
-                     and computes its own sin/cos (use `abi=plain`)"
+                     and no sin/cos (use `abi=plain`)"
                 )));
             }
         }
