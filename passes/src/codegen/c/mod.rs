@@ -154,6 +154,12 @@ pub const SLP_GUARD: &str =
     #if defined(__GNUC__) && !defined(__clang__) && __GNUC__ == 12 && defined(__FMA__)\n\
     #pragma GCC optimize (\"no-tree-slp-vectorize\")\n#endif\n";
 
+/// C's own switch for contraction, for the compilers that honour it (Clang, and the C99 ones
+/// that follow the standard): GCC ignores `#pragma STDC FP_CONTRACT` and says so under `-Wall`
+/// (`-Wunknown-pragmas`), which `-Werror` builds of the user's project would turn into an error,
+/// so GCC does not see it (it needs `-ffp-contract=off`, as the file's opening comment says).
+pub const STDC_GUARD: &str = "#if !defined(__GNUC__) || defined(__clang__)\n#pragma STDC FP_CONTRACT OFF\n#endif\n";
+
 /// The C back end's options.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CodegenC {
@@ -491,7 +497,7 @@ impl CodegenC {
              * floating-point contraction it computes bit for bit what robovec's interpreter computes{}.\n \
              {}* Compile with -ffp-contract=off (GCC contracts a*b+c into an FMA under -march=native),\n \
              * e.g. cc -O2 -ffp-contract=off -c model.c; link with -lm. */\n\
-             #pragma STDC FP_CONTRACT OFF\n{SLP_GUARD}#include <math.h>\n#include <string.h>\n\n",
+             {STDC_GUARD}{SLP_GUARD}#include <math.h>\n#include <string.h>\n\n",
             self.options_text(),
             if self.trig == Trig::Inline {
                 ",\n * except sin/cos: with trig=inline they are robovec's own (below), within 1 ulp but not libm's bits;\n \
