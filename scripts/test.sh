@@ -2,7 +2,8 @@
 # The test command (README "The two commands"; `.ci/run` calls it too, so the two cannot drift).
 #
 # On a fresh machine it first installs what the tests run besides Rust:
-# - a C compiler (gcc): the C back end's tests compile and execute generated C;
+# - the C compilers GCC and Clang: the C back end's tests compile and execute generated C, and
+#   check that it builds warning-free under both;
 # - Icarus Verilog, Verilator and Yosys: `codegen<fpga>`'s tests simulate, lint and size the
 #   generated Verilog;
 # - Pinocchio and example-robot-data from PyPI, in the virtual environment
@@ -41,13 +42,13 @@ fi
 command -v cc >/dev/null 2>&1 || apt_install gcc libc6-dev
 
 missing=()
-for tool in iverilog:iverilog vvp:iverilog verilator:verilator yosys:yosys; do
+for tool in gcc:gcc clang:clang iverilog:iverilog vvp:iverilog verilator:verilator yosys:yosys; do
     command -v "${tool%%:*}" >/dev/null 2>&1 || missing+=("${tool##*:}")
 done
 if [ ${#missing[@]} -gt 0 ]; then
     apt_install $(printf '%s\n' "${missing[@]}" | sort -u)
 fi
-for tool in cc iverilog vvp verilator yosys; do
+for tool in cc gcc clang iverilog vvp verilator yosys; do
     command -v "$tool" >/dev/null 2>&1 || { echo "$tool not found after installing it" >&2; exit 1; }
 done
 

@@ -21,6 +21,7 @@ use crate::common::{corpus_files, is_loop_file, tmp};
 
 mod split;
 mod trig;
+mod warnings;
 
 /// A module to test, with a label for messages.
 pub struct Case {
@@ -56,9 +57,14 @@ fn corpus_cases(pipeline: &str, only_c: bool) -> Vec<Case> {
 /// `-DROBOVEC_VBYTES=` vector width) into `dir/run`.
 fn cc(dir: &Path, files: &[String], flags: &[&str]) -> PathBuf {
     let exe = dir.join("run");
-    let mut cmd = Command::new("cc");
-    cmd.current_dir(dir).args(flags).args(["-ffp-contract=off", "-w", "-o"]).arg(&exe).args(files).arg("-lm");
-    let o = cmd.output().expect("a C compiler `cc` on PATH (scripts/test.sh installs gcc)");
+    // `cc=NAME` among the flags picks the compiler (`warnings.rs` runs the checks under Clang).
+    let compiler = flags.iter().find_map(|f| f.strip_prefix("cc=")).unwrap_or("cc");
+    let flags: Vec<&str> = flags.iter().copied().filter(|f| !f.starts_with("cc=")).collect();
+    let mut cmd = Command::new(compiler);
+    cmd.current_dir(dir).args(&flags).args(["-ffp-contract=off", "-w", "-o"]).arg(&exe).args(files).arg("-lm");
+    let o = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("C compiler `{compiler}` ({e}): scripts/test.sh installs gcc and clang"));
     assert!(o.status.success(), "cc failed in {}:\n{}", dir.display(), String::from_utf8_lossy(&o.stderr));
     exe
 }

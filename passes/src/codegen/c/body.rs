@@ -97,6 +97,10 @@ pub(crate) struct Body<'a> {
     /// `-time-limit`: one tick per statement written; once it says stop, no more statements
     /// are written and the caller fails with [`crate::PassError::TimeLimit`].
     ticker: &'a crate::Ticker,
+    /// By value index: no op reads the value and no output is it (a value Robotran computes and
+    /// never uses, before `dce`). Its statement is followed by `(void)NAME;`, so that
+    /// `-Wall -Werror` builds pass (`-Wunused-variable`).
+    unused: Vec<bool>,
 }
 
 impl<'a> Body<'a> {
@@ -111,7 +115,8 @@ impl<'a> Body<'a> {
     ) -> Body<'a> {
         let fused = if o.trig == Trig::Inline { fused_trig(f) } else { HashMap::new() };
         let block = if o.trig == Trig::Inline && o.batch == 1 { TrigBlock::of(f) } else { None };
-        Body { o, f, names, native, fused, block, ticker }
+        let unused = f.use_counts().iter().map(|&n| n == 0).collect();
+        Body { o, f, names, native, fused, block, ticker, unused }
     }
 
     /// The values that have a statement, in the order they are written, and for each whether
@@ -225,6 +230,7 @@ impl<'a> Body<'a> {
                 if b.members.last() == Some(&v) {
                     b.write(self, s);
                     for &w in &waiting {
+                        self.mark_unused(s, w);
                         after(s, w);
                     }
                 }
@@ -315,7 +321,16 @@ impl<'a> Body<'a> {
                     }
                 }
             }
+            self.mark_unused(s, v);
             after(s, v);
+        }
+    }
+
+    /// `(void)NAME;` after the statement of a value nothing reads ([`Body::unused`]); the
+    /// second of a fused sin/cos pair is declared with its partner, whose statement says so.
+    fn mark_unused(&self, s: &mut String, v: Value) {
+        if self.unused[v.index()] && self.fused.get(&v.index()).is_none_or(|&(_, leads)| leads) {
+            let _ = writeln!(s, "  (void){};", self.names[v.index()]);
         }
     }
 }

@@ -266,7 +266,8 @@ pub(crate) fn arrays(
         }
         s += "}\n\n";
     } else {
-        let _ = write!(s, "{sig}\n{{\n");
+        // `in` goes unread in a function of constants (as car43's `link3D`).
+        let _ = write!(s, "{sig}\n{{\n{}", super::split::void_params(&sig));
         if w > 1 {
             s += super::body::CHUNK_LOOP;
         }

@@ -214,7 +214,8 @@ pub(crate) fn function(
     let plan = Plan::new(f, &order, &attached, o.chunk as usize, &f.inputs, &end_uses);
     let iface = interface(o, f, symbol);
     if plan.parts() == 1 {
-        let mut s = format!("/* @{} */\n{sig}\n{{\n", f.name);
+        // `tsim`, `s` or an output array may go unread (as in Robotran's own file).
+        let mut s = format!("/* @{} */\n{sig}\n{{\n{}", f.name, super::split::void_params(&sig));
         for (&v, a) in f.inputs.iter().zip(&access) {
             let _ = writeln!(s, "  const double {} = {a};", names[v.index()]);
         }

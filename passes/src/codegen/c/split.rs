@@ -207,6 +207,26 @@ pub(crate) fn part_name(prefix: &str, k: usize) -> String {
     format!("{prefix}{}", k + 1)
 }
 
+/// `(void)p;` for every parameter of the C function signature `sig` (`… NAME(T *restrict a,
+/// T b)`), one line, indented: a function that reads none of some parameter (a part that
+/// writes no output, a Robotran function that never reads `tsim`) is then warning-free under
+/// `-Wextra` (`-Wunused-parameter`). Empty for `(void)` or no parameters.
+pub(crate) fn void_params(sig: &str) -> String {
+    let (Some(open), Some(close)) = (sig.find('('), sig.rfind(')')) else { return String::new() };
+    let names: Vec<&str> = sig[open + 1..close]
+        .split(',')
+        .filter_map(|p| {
+            let name = p.trim().rsplit(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).next()?;
+            (!name.is_empty() && p.trim() != "void").then_some(name)
+        })
+        .collect();
+    if names.is_empty() {
+        return String::new();
+    }
+    let casts: Vec<String> = names.iter().map(|n| format!("(void){n};")).collect();
+    format!("  {}\n", casts.join(" "))
+}
+
 /// One part of a split function, without storage class: the file assembler makes it `static`
 /// in the file of its entry point and external in another unit (`units=K`).
 #[derive(Clone, Debug)]
@@ -230,6 +250,19 @@ mod tests {
         let attached = vec![false; order.len()];
         let p = Plan::new(&f, &order, &attached, chunk, &[], &[]);
         (f, p)
+    }
+
+    #[test]
+    fn void_params_names_every_parameter() {
+        assert_eq!(
+            void_params(
+                "ROBOVEC_NOINLINE void f_part1(double **M, double *c, MbsData *s, double tsim, double *restrict live)"
+            ),
+            "  (void)M; (void)c; (void)s; (void)tsim; (void)live;\n"
+        );
+        assert_eq!(void_params("void g(const float *restrict in, float *restrict out)"), "  (void)in; (void)out;\n");
+        assert_eq!(void_params("void h(void)"), "");
+        assert_eq!(void_params("void h()"), "");
     }
 
     fn value(f: &Function, name: &str) -> Value {
