@@ -50,11 +50,10 @@ fn every_configuration_compiles_warning_free_under_gcc_and_clang() {
         ("abi=robotran trig=inline", CodegenC { abi: Abi::Robotran, trig: Trig::Inline, ..CodegenC::default() }),
     ];
     let mut compiled = 0;
-    for (pipeline, cases) in
-        [("default<ops>", warning_cases()), ("default<ops>,contract", warning_cases())].map(|(p, cs)| {
-            (p, cs.into_iter().map(|c| Case { label: c.label, m: run_pipeline(c.m, p) }).collect::<Vec<_>>())
-        })
-    {
+    let atomised = warning_cases();
+    for pipeline in ["default<ops>", "default<ops>,contract"] {
+        let cases: Vec<Case> =
+            atomised.iter().map(|c| Case { label: c.label.clone(), m: run_pipeline(c.m.clone(), pipeline) }).collect();
         for (label, o) in &configs {
             for case in &cases {
                 let art = o.emit(&case.m).unwrap_or_else(|e| panic!("{} {label}: {e}", case.label));

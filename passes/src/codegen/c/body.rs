@@ -20,6 +20,8 @@ use robovec_ir::Intrinsic;
 /// compiler into pieces, which at `-O2` without `-march` made coman's `batch=8` file take
 /// 35 min and 5 GB of GCC (issue 11); `-DROBOVEC_VBYTES=N` chooses the width by hand.
 /// Every lane computes the same operations either way, so results are bit-identical.
+///
+/// The helpers are marked `ROBOVEC_UNUSED` ([`super::UNUSED_HELPERS`] defines it before them).
 pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
     let sfx = if f32 { "f" } else { "" };
     let size = if f32 { 4 } else { 8 };
@@ -39,12 +41,12 @@ pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
          /* The bytes of one robovec_vec, for the preprocessor (intrinsics of that width). */\n\
          #define ROBOVEC_VEC_BYTES (ROBOVEC_VBYTES < ROBOVEC_W * {size} ? ROBOVEC_VBYTES : ROBOVEC_W * {size})\n\
          #if defined(__SSE2__) || defined(__AVX__)\n#include <immintrin.h>\n#endif\n\
-         static inline robovec_vec robovec_splat({real} x) {{ robovec_vec r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = x; return r; }}\n"
+         static inline ROBOVEC_UNUSED robovec_vec robovec_splat({real} x) {{ robovec_vec r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = x; return r; }}\n"
     );
     for f in ["sin", "cos", "sqrt"] {
         let _ = writeln!(
             s,
-            "static inline robovec_vec robovec_{f}(robovec_vec x) {{ robovec_vec r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = {f}{sfx}(x[lane]); return r; }}"
+            "static inline ROBOVEC_UNUSED robovec_vec robovec_{f}(robovec_vec x) {{ robovec_vec r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = {f}{sfx}(x[lane]); return r; }}"
         );
     }
     // One vector FMA instruction where the target has one, C99 `fma` per lane otherwise: the
@@ -53,7 +55,7 @@ pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
     let (p, x) = if f32 { ("ps", "") } else { ("pd", "d") };
     let _ = writeln!(
         s,
-        "static inline __attribute__((always_inline)) robovec_vec robovec_fma(robovec_vec a, robovec_vec b, robovec_vec c)\n{{\n\
+        "static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vec robovec_fma(robovec_vec a, robovec_vec b, robovec_vec c)\n{{\n\
          #if defined(__AVX512F__) && ROBOVEC_VEC_BYTES == 64\n  return (robovec_vec)_mm512_fmadd_{p}((__m512{x})a, (__m512{x})b, (__m512{x})c);\n\
          #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 32\n  return (robovec_vec)_mm256_fmadd_{p}((__m256{x})a, (__m256{x})b, (__m256{x})c);\n\
          #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 16\n  return (robovec_vec)_mm_fmadd_{p}((__m128{x})a, (__m128{x})b, (__m128{x})c);\n\

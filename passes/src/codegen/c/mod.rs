@@ -160,12 +160,13 @@ pub const SLP_GUARD: &str =
 /// so GCC does not see it (it needs `-ffp-contract=off`, as the file's opening comment says).
 pub const STDC_GUARD: &str = "#if !defined(__GNUC__) || defined(__clang__)\n#pragma STDC FP_CONTRACT OFF\n#endif\n";
 
-/// `ROBOVEC_UNUSED`, which marks the file's static helper functions (vector lanes, inline
-/// sin/cos) as possibly unused, so that `-Wall -Werror` builds pass with Clang (`-Wunused-function`
-/// covers unused static inline functions there, not in GCC).
+/// `ROBOVEC_UNUSED`, with which [`body::vector_helpers`] and [`trig::helpers`] mark the file's
+/// static helper functions (vector lanes, inline sin/cos) as possibly unused (a function uses
+/// some of them only, no sqrt or no fma), so that `-Wall -Werror` builds pass with Clang
+/// (`-Wunused-function` covers unused static inline functions there, not in GCC).
 pub const UNUSED_HELPERS: &str =
     "#ifndef ROBOVEC_UNUSED\n#if defined(__GNUC__)\n#define ROBOVEC_UNUSED __attribute__((unused))\n\
-                                  #else\n#define ROBOVEC_UNUSED\n#endif\n#endif\n";
+     #else\n#define ROBOVEC_UNUSED\n#endif\n#endif\n";
 
 /// The C back end's options.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -446,9 +447,9 @@ impl CodegenC {
         for (e, units_of) in emitted.into_iter().zip(&unit_of) {
             for (p, &u) in e.parts.iter().zip(units_of) {
                 let storage = if u == 0 { "static " } else { "" };
-                // The body opens with `{`: the parameters a part may not read are cast to void.
-                let rest = p.body.strip_prefix("{\n").expect("a part's body opens with a brace");
-                let _ = write!(files[u], "{storage}{}\n{{\n{}{rest}", p.signature, split::void_params(&p.signature));
+                // The parameters a part may not read are cast to void.
+                let voids = split::void_params(&p.signature);
+                let _ = write!(files[u], "{storage}{}\n{{\n{voids}{}}}\n\n", p.signature, p.body);
             }
             files[0] += &e.entry;
             h += &e.proto;
@@ -532,18 +533,15 @@ impl CodegenC {
                 self.chunk, self.chunk
             );
         }
-        let mut helpers = String::new();
+        if self.batch > 1 || self.trig == Trig::Inline {
+            // The helpers below are `ROBOVEC_UNUSED`: a function uses some of them only.
+            s += UNUSED_HELPERS;
+        }
         if self.batch > 1 {
-            helpers += &body::vector_helpers(self.real(), self.batch, self.f32());
+            s += &body::vector_helpers(self.real(), self.batch, self.f32());
         }
         if self.trig == Trig::Inline {
-            helpers += &trig::helpers(self.f32(), self.batch > 1);
-        }
-        if !helpers.is_empty() {
-            // A function uses some of the helpers only (no sqrt, no fma, `robovec_sincos_n` or the
-            // per-value sin/cos): Clang's -Wall warns of an unused static inline function.
-            s += UNUSED_HELPERS;
-            s += &helpers.replace("static inline ", "static inline ROBOVEC_UNUSED ");
+            s += &trig::helpers(self.f32(), self.batch > 1);
         }
         s
     }

@@ -232,9 +232,8 @@ pub(crate) fn arrays(
         let prefix = part_prefix(symbol, plan.parts(), taken);
         let live_ty = if w > 1 { "robovec_vec" } else { real };
         for k in 0..plan.parts() {
-            let mut body = String::from("{\n");
+            let mut body = String::new();
             statements(&mut body, k);
-            body += "}\n\n";
             parts.push(Part {
                 signature: format!(
                     "ROBOVEC_NOINLINE void {}({params}, {live_ty} *restrict live)",

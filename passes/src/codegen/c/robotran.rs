@@ -237,7 +237,7 @@ pub(crate) fn function(
     let prefix = part_prefix(&defined, plan.parts(), taken);
     let mut parts = Vec::with_capacity(plan.parts());
     for k in 0..plan.parts() {
-        let mut body = String::from("{\n");
+        let mut body = String::new();
         b.statements_with(
             &order[plan.bounds[k]..plan.bounds[k + 1]],
             &mut body,
@@ -258,7 +258,6 @@ pub(crate) fn function(
                 let _ = writeln!(body, "  {lvalue} = {};", b.operand(&out.value));
             }
         }
-        body += "}\n\n";
         parts.push(Part {
             signature: format!("ROBOVEC_NOINLINE void {}({params}, double *restrict live)", part_name(&prefix, k)),
             body,

@@ -233,7 +233,8 @@ pub(crate) fn void_params(sig: &str) -> String {
 pub(crate) struct Part {
     /// `ROBOVEC_NOINLINE void NAME(PARAMS)`.
     pub signature: String,
-    /// `{ … }` and a blank line.
+    /// Its statements, without the braces (the file assembler writes those, and the `(void)`
+    /// casts of [`void_params`] first).
     pub body: String,
     /// Its statements (ops).
     pub ops: usize,

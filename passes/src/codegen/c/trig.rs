@@ -428,7 +428,8 @@ fn kernel_poly(first: u32, m: usize, f32: bool) -> Vec<f64> {
 
 /// The C helpers `robovec_sincos_inline(x, &s, &c)`, `robovec_sin_inline(x)` and
 /// `robovec_cos_inline(x)`: on `robovec_vec` with `vector` (a batch: the vector helpers are
-/// already written), otherwise on one `double` (`float` with `f32`).
+/// already written), otherwise on one `double` (`float` with `f32`). Marked `ROBOVEC_UNUSED`
+/// ([`super::UNUSED_HELPERS`] defines it before them).
 pub(crate) fn helpers(f32: bool, vector: bool) -> String {
     let c = Constants::new(f32);
     let real = if f32 { "float" } else { "double" };
@@ -478,14 +479,14 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
     } else {
         let _ = writeln!(
             s,
-            "static inline {u} robovec_bits({real} x) {{ {u} i; memcpy(&i, &x, sizeof i); return i; }}\n\
-             static inline {real} robovec_real({u} i) {{ {real} x; memcpy(&x, &i, sizeof x); return x; }}"
+            "static inline ROBOVEC_UNUSED {u} robovec_bits({real} x) {{ {u} i; memcpy(&i, &x, sizeof i); return i; }}\n\
+             static inline ROBOVEC_UNUSED {real} robovec_real({u} i) {{ {real} x; memcpy(&x, &i, sizeof x); return x; }}"
         );
     }
     // The scalar form's reduction and polynomials are a branch-free kernel, so that a loop of
     // them vectorises (`robovec_sincos_n`); the vector form tests its lanes' range inside.
     let kernel = if vector { "robovec_sincos_inline" } else { "robovec_sincos_kernel" };
-    let _ = writeln!(s, "static inline void {kernel}({v} x, {v} *sin_out, {v} *cos_out)\n{{");
+    let _ = writeln!(s, "static inline ROBOVEC_UNUSED void {kernel}({v} x, {v} *sin_out, {v} *cos_out)\n{{");
     let _ = writeln!(
         s,
         "  /* k = round(x*2/pi): adding 1.5*2^{} rounds to an integer, whose low bits are t's. */\n  \
@@ -567,7 +568,7 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
         let far = format!("!(x[i] * x[i] <= {})", lit(l * l));
         let _ = writeln!(
             s,
-            "static inline void robovec_sincos_inline({v} x, {v} *sin_out, {v} *cos_out)\n{{\n  \
+            "static inline ROBOVEC_UNUSED void robovec_sincos_inline({v} x, {v} *sin_out, {v} *cos_out)\n{{\n  \
              robovec_sincos_kernel(x, sin_out, cos_out);\n  \
              /* |x| > L or NaN (rare): libm (x*x <= L^2 is |x| <= L exactly, false for NaN). */\n  \
              if (__builtin_expect(!({in_range}), 0)) {{ *sin_out = sin{sfx}(x); *cos_out = cos{sfx}(x); }}\n}}\n\
@@ -575,7 +576,7 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
              * the compiler vectorises it (-O3; -O2 of GCC 12+ and Clang too, n being a multiple of the lanes: callers\n \
              * pad it to {pad}); then the arguments beyond L or NaN (rare) take libm. The same bits as\n \
              * robovec_sincos_inline per argument. */\n\
-             static inline void robovec_sincos_n(const {v} *restrict x, {v} *restrict sin_out, {v} *restrict cos_out, int n)\n{{\n  \
+             static inline ROBOVEC_UNUSED void robovec_sincos_n(const {v} *restrict x, {v} *restrict sin_out, {v} *restrict cos_out, int n)\n{{\n  \
              int i, far = 0;\n  \
              for (i = 0; i < n; i++) robovec_sincos_kernel(x[i], &sin_out[i], &cos_out[i]);\n  \
              for (i = 0; i < n; i++) far |= {far};\n  \
@@ -587,8 +588,8 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
     }
     let _ = writeln!(
         s,
-        "static inline {v} robovec_sin_inline({v} x) {{ {v} s, c; robovec_sincos_inline(x, &s, &c); return s; }}\n\
-         static inline {v} robovec_cos_inline({v} x) {{ {v} s, c; robovec_sincos_inline(x, &s, &c); return c; }}\n"
+        "static inline ROBOVEC_UNUSED {v} robovec_sin_inline({v} x) {{ {v} s, c; robovec_sincos_inline(x, &s, &c); return s; }}\n\
+         static inline ROBOVEC_UNUSED {v} robovec_cos_inline({v} x) {{ {v} s, c; robovec_sincos_inline(x, &s, &c); return c; }}\n"
     );
     s
 }
