@@ -1,4 +1,4 @@
-//! `trig=inline` (`passes/src/codegen/c/trig.rs`): the emitted sin/cos, compiled
+//! `trig=inline` (`passes/src/codegen/c/trig/`): the emitted sin/cos, compiled
 //! (`cc -O1 -ffp-contract=off`, one program, for a generic target and with `-march=native`, and at
 //! `-O2 -march=native`), against a reference computed here in exact
 //! integer arithmetic (the reduction) and double-double (the series) — accurate to about
