@@ -10,8 +10,10 @@
 #   `target/pinocchio-venv` (about 50 s; kept across runs): the numerical oracle of the URDF
 #   front end's tests (with Eigen's, CppAD's and CppADCodeGen's headers for
 #   `cargo bench --bench pinocchio`).
-# Debian packages come from `apt-get` (as root, or through `sudo`). Then it runs
-# `cargo test --workspace --locked` with the arguments given (`scripts/test.sh -p robovec-ir`).
+# Debian packages come from `apt-get` (as root, or through `sudo`). Then, called without
+# arguments, it builds the API docs with rustdoc's warnings as errors (a broken intra-doc link
+# fails the run), and it runs `cargo test --workspace --locked` with the arguments given
+# (`scripts/test.sh -p robovec-ir`).
 # The tests read the Robotran corpus from `../shared` beside the repository and fail without it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -69,5 +71,9 @@ if ! venv_ready; then
 fi
 
 test -d ../shared/corpus/robotran || { echo "../shared/corpus/robotran is missing beside the repository" >&2; exit 1; }
+
+if [ $# = 0 ]; then
+    RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked --quiet
+fi
 
 exec cargo test --workspace --locked "$@"

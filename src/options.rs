@@ -33,7 +33,7 @@ pub struct Options {
     pub stats: bool,
     /// `-sweep-csv=FILE`: the rows of `sweep` runs as CSV.
     pub sweep_csv: Option<PathBuf>,
-    /// `-pareto=A;B;…`: pipelines to compare (speed against error, [`crate::pareto`]).
+    /// `-pareto=A;B;…`: pipelines to compare (speed against error, [`robovec_passes::whole_run::pareto`]).
     pub pareto: Option<String>,
     /// `-pareto-samples=N`: samples of each pipeline's accuracy measurement.
     pub pareto_samples: u32,

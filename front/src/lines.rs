@@ -7,7 +7,7 @@
 //! continuations, and every statement tree at once: WALK-MAN × 16 as Matlab (9.3 MB, 588k
 //! ops) peaked at 445 MB through `atomise,asap-alap`, 48× the input. [`Lines`] keeps one
 //! logical line's tokens (both paths read the file through it), and [`scan_and_lower`] hands
-//! each statement to the lowering ([`Lower`]) and drops its tree, so what grows with the file
+//! each statement to the lowering (`Lower`) and drops its tree, so what grows with the file
 //! is the IR being built, as in the C front end's streaming path ([`crate::c::scan_and_lower`]).
 //!
 //! # Contract

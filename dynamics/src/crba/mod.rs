@@ -99,7 +99,7 @@ pub type Entries = Vec<((usize, usize), Term)>;
 /// fold to 0 left out. Writes the composites and column forces into `b` as temporaries `MC`,
 /// `HC`, `JC` (per body) and `FM`, `CM` (per body and column), each column right after its
 /// body's composite, and every entry as `M{i}_{j}` where it is formed
-/// ([`bind_entry`]; module doc, "Order of the statements").
+/// (`bind_entry`; module doc, "Order of the statements").
 ///
 /// Cost: linear in the bodies and the ops written (each column step writes its entry's ops;
 /// no table of body pairs).

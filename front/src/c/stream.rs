@@ -49,7 +49,7 @@ pub(super) struct Stream<'s> {
 /// The streaming path of [`super::super::parse_str`]: scans and lowers `src` in one go, in
 /// memory independent of the size of its function bodies (see the module doc). `None` when
 /// the file has any error or a form the streaming path leaves to the batch path
-/// ([`super::scan`] then [`super::super::lower::lower_module`]), whose diagnostics are the
+/// ([`super::scan()`] then [`super::super::lower::lower_module`]), whose diagnostics are the
 /// reference.
 ///
 /// Stops at `clock`'s deadline (one tick per token lexed and per statement), returning `None`:

@@ -139,7 +139,7 @@ impl Function {
         self.timings = Timings(table);
     }
 
-    /// Mutable data of `v`; the name must not be changed through it (use [`Function::rename`]).
+    /// Mutable data of `v`; the name must not be changed through it (or [`Function::reindex_names`] must follow).
     pub fn value_mut(&mut self, v: Value) -> &mut ValueData {
         &mut self.values[v.index()]
     }

@@ -6,7 +6,7 @@
 //!   allocation, bit for bit like [`crate::interp`].
 //! - [`dd`]: double-double arithmetic (≈ 106 bits), the fast reference.
 //! - [`big`]: astro-float at ≥ 256 bits, the certified reference.
-//! - [`reference`]: the correctly rounded binary32/binary64 value of every output's exact
+//! - [`reference`](mod@reference): the correctly rounded binary32/binary64 value of every output's exact
 //!   value, certified by a running error bound; double-double first, 256 then 1024 bits where
 //!   the bound does not prove the double-double rounding right.
 //! - [`bits`]: bits of error, `log2(1 + ordinal distance)` (Herbie).

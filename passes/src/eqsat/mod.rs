@@ -142,7 +142,7 @@ pub struct EqsatOptions {
     pub rules_file: Option<PathBuf>,
     /// Latencies for extraction (cycles); `add` and `mul` are used.
     pub lat: Latencies,
-    /// Critical windows ([`window::find_critical_windows`], `scope=critical`) instead of
+    /// Critical windows ([`critical::find_critical_windows`], `scope=critical`) instead of
     /// cluster windows.
     pub critical: bool,
     /// `scope=critical`: largest slack of a window's values, cycles.

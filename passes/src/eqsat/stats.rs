@@ -50,7 +50,7 @@ pub struct EqsatStats {
     /// stopped early).
     pub windows_total: u32,
     /// E-nodes of all the windows' e-graphs together, e-nodes (about at most the work budget,
-    /// [`WORK_ENODES`] by default: egg checks its node limit between rules).
+    /// [`WORK_ENODES`](super::apply::WORK_ENODES) by default: egg checks its node limit between rules).
     pub enodes_total: u64,
     /// Runs over the windows (`rounds`; 1 for cluster windows).
     pub rounds: u32,

@@ -8,7 +8,7 @@
 //! Phase: atomised → atomised. **Back-substitution into linear forms** (Kogge and Stone's
 //! recursive doubling read on a DAG; Kuck's tree-height reduction with distribution; Brent,
 //! Kuck and Maruyama, IEEE TC C-22, 1973): every critical value (slack ≤ `slack` cycles after
-//! `balance`) is written as a [`forms::Form`] `Σ ± c_i·p_i` over *pivots* `p_i`, values that are
+//! `balance`) is written as a `Form` (`forms.rs`) `Σ ± c_i·p_i` over *pivots* `p_i`, values that are
 //! late, with coefficients `c_i` that are early: a sum adds its operands' forms (terms of the
 //! same pivot collected, their coefficients added), a product scales the later operand's form
 //! by the earlier operand, a coefficient that is not earlier than its pivot is multiplied out

@@ -123,7 +123,7 @@ pub fn mark_front(rows: &mut [ParetoRow]) {
 }
 
 /// Splits `-pareto`'s text and builds each pipeline's pass manager (every name and parameter
-/// checked); the driver's preflight calls it before any work, [`run`] again to run them.
+/// checked); the driver's preflight calls it before any work, [`study`] again to run them.
 ///
 /// # Errors
 /// [`Failure::Usage`] for an empty list, an empty pipeline, an unknown pass or a bad parameter.

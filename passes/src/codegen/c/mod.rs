@@ -22,6 +22,7 @@
 
 mod body;
 mod callbacks;
+mod file;
 mod native;
 pub use callbacks::split_callee;
 pub mod pinocchio;
@@ -30,8 +31,9 @@ pub mod robotran;
 mod split;
 pub mod trig;
 
+pub use file::{SLP_GUARD, STDC_GUARD, UNUSED_HELPERS};
+
 use std::collections::HashSet;
-use std::fmt::Write as _;
 use std::path::Path;
 
 use robovec_ir::{Callee, Def, Function, Module};
@@ -39,7 +41,7 @@ use robovec_ir::{Callee, Def, Function, Module};
 use super::names::{free_name, is_c_identifier, is_reserved_symbol, reserved_symbol_reason, sanitise};
 use super::{CodegenArtifact, Interface};
 use crate::params::{word_enum, ParamKind};
-use crate::{GeneratedCode, Member, ParamInfo, Params, Pass, PassContext, PassError};
+use crate::{Member, ParamInfo, Params, Pass, PassContext, PassError};
 
 /// The C back end of `codegen`: `codegen<c;…>`, with its parameters.
 pub const BACK_END: Member = Member {
@@ -140,33 +142,6 @@ word_enum! {
         Inline = "inline",
     }
 }
-
-/// Written at the top of every generated file: GCC 12's SLP vectoriser fuses a vector of
-/// products and an alternating subtract/add into `vfmaddsub`/`vfmsubadd` even under
-/// `-ffp-contract=off` (its `addsub` pattern, `tree-vect-slp-patterns.cc`, did not check the
-/// contraction mode; later GCC does), so on a target with FMA (`-march=native` here) the
-/// code is no longer bit-exact. Four statements suffice (`x1 = in[0]*in[2]; x2 = in[1]*in[3];
-/// out[0] = x1 - in[4]; out[1] = x2 + in[5];`); split code, whose live values sit side by side
-/// in `live[]`, met it on coman's `dirdyna` (23 of 682 outputs off by an ulp at `-O2
-/// -march=native`). For GCC 12 with FMA only, the file turns SLP vectorisation off.
-pub const SLP_GUARD: &str =
-    "/* GCC 12 fuses a*b-c, d*e+f into vfmaddsub despite -ffp-contract=off (SLP addsub pattern): */\n\
-    #if defined(__GNUC__) && !defined(__clang__) && __GNUC__ == 12 && defined(__FMA__)\n\
-    #pragma GCC optimize (\"no-tree-slp-vectorize\")\n#endif\n";
-
-/// C's own switch for contraction, for the compilers that honour it (Clang, and the C99 ones
-/// that follow the standard): GCC ignores `#pragma STDC FP_CONTRACT` and says so under `-Wall`
-/// (`-Wunknown-pragmas`), which `-Werror` builds of the user's project would turn into an error,
-/// so GCC does not see it (it needs `-ffp-contract=off`, as the file's opening comment says).
-pub const STDC_GUARD: &str = "#if !defined(__GNUC__) || defined(__clang__)\n#pragma STDC FP_CONTRACT OFF\n#endif\n";
-
-/// `ROBOVEC_UNUSED`, with which [`body::vector_helpers`] and [`trig::helpers`] mark the file's
-/// static helper functions (vector lanes, inline sin/cos) as possibly unused (a function uses
-/// some of them only, no sqrt or no fma), so that `-Wall -Werror` builds pass with Clang
-/// (`-Wunused-function` covers unused static inline functions there, not in GCC).
-pub const UNUSED_HELPERS: &str =
-    "#ifndef ROBOVEC_UNUSED\n#if defined(__GNUC__)\n#define ROBOVEC_UNUSED __attribute__((unused))\n\
-     #else\n#define ROBOVEC_UNUSED\n#endif\n#endif\n";
 
 /// The C back end's options.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -351,225 +326,6 @@ impl CodegenC {
     pub fn emit_as(&self, m: &Module, main: Option<&Path>) -> Result<CodegenArtifact, PassError> {
         self.emit_within(m, main, &crate::Ticker::default())
     }
-
-    /// [`CodegenC::emit_as`] that stops when `ticker` says so (`-time-limit`; one tick per
-    /// statement written).
-    ///
-    /// # Errors
-    /// As [`CodegenC::emit_as`], and [`PassError::TimeLimit`] when stopped (the code is the
-    /// run's output: no part of it is returned).
-    pub fn emit_within(
-        &self,
-        m: &Module,
-        main: Option<&Path>,
-        ticker: &crate::Ticker,
-    ) -> Result<CodegenArtifact, PassError> {
-        let fused = m.functions.iter().any(has_fused);
-        let callbacks = callbacks::callbacks(m)?;
-        let decls = if self.abi == Abi::Robotran {
-            native::prototypes(m, &callbacks)?
-        } else {
-            callbacks::callback_decls(&callbacks, self.real())
-        };
-        let (symbols, emitted, preface) = if self.abi == Abi::Pinocchio {
-            pinocchio::emit(self, m, ticker)?
-        } else {
-            let symbols = self.symbols(m)?;
-            // The file's global names, which no part may take.
-            let taken: HashSet<String> =
-                symbols.iter().cloned().chain(callbacks.iter().map(|k| k.base.clone())).collect();
-            let mut emitted = Vec::with_capacity(m.functions.len());
-            for (f, symbol) in m.functions.iter().zip(&symbols) {
-                emitted.push(if self.abi == Abi::Robotran {
-                    robotran::function(self, f, symbol, &taken, ticker)?
-                } else {
-                    plain::function(self, f, symbol, &taken, ticker)
-                });
-                if ticker.stopped() {
-                    return Err(ticker.error("codegen", &format!("writing @{}", f.name)));
-                }
-            }
-            (symbols, emitted, String::new())
-        };
-        let units = self.units as usize;
-        let unit_of = unit_assignment(&emitted, units);
-        let file_names: Vec<String> = match main {
-            Some(p) => (0..units).map(|k| crate::unit_path(p, k).display().to_string()).collect(),
-            None => Vec::new(),
-        };
-        let header_name = main.map(|p| p.with_extension("h").display().to_string());
-        let base_name = |k: usize| -> String {
-            file_names.get(k).map_or(format!("unit {}", k + 1), |n| {
-                Path::new(n).file_name().map_or(n.clone(), |x| x.to_string_lossy().into_owned())
-            })
-        };
-        let split = emitted.iter().any(|e| !e.parts.is_empty());
-        let mut files: Vec<String> = (0..units)
-            .map(|k| {
-                let mut c = self.preamble(fused, split);
-                if units > 1 {
-                    let list: Vec<String> = (0..units).map(base_name).collect();
-                    let _ = write!(
-                        c,
-                        "/* Translation unit {} of {units} ({}): compile each, link all. */\n\n",
-                        k + 1,
-                        list.join(", ")
-                    );
-                }
-                if self.abi == Abi::Robotran {
-                    c += "#include \"mbs_data.h\"\n\n";
-                }
-                c += &decls;
-                c
-            })
-            .collect();
-        // The parts in other units are declared in the main file (it calls them) and in
-        // their own unit (before their definitions).
-        let mut externs = String::new();
-        for (e, units_of) in emitted.iter().zip(&unit_of) {
-            for (p, &u) in e.parts.iter().zip(units_of) {
-                if u > 0 {
-                    let _ = writeln!(externs, "{};", p.signature);
-                    let _ = writeln!(files[u], "{};", p.signature);
-                }
-            }
-        }
-        if !externs.is_empty() {
-            files[0] += "/* Parts defined in the other translation units. */\n";
-            files[0] += &externs;
-            files[0].push('\n');
-            for f in &mut files[1..] {
-                f.push('\n');
-            }
-        }
-        let mut h = preface;
-        let mut interfaces = Vec::new();
-        for (e, units_of) in emitted.into_iter().zip(&unit_of) {
-            for (p, &u) in e.parts.iter().zip(units_of) {
-                let storage = if u == 0 { "static " } else { "" };
-                // The parameters a part may not read are cast to void.
-                let voids = split::void_params(&p.signature);
-                let _ = write!(files[u], "{storage}{}\n{{\n{voids}{}}}\n\n", p.signature, p.body);
-            }
-            files[0] += &e.entry;
-            h += &e.proto;
-            let mut iface = e.iface;
-            iface.parts = e.parts.len().max(1);
-            iface.sources.clone_from(&file_names);
-            iface.header.clone_from(&header_name);
-            interfaces.push(iface);
-        }
-        if self.abi == Abi::Robotran {
-            let symbol_of = |f: &Function| {
-                let i = m.functions.iter().position(|g| std::ptr::eq(g, f)).expect("a function of m");
-                symbols[i].clone()
-            };
-            let (code, proto) = robotran::sensor_dispatch(m, symbol_of);
-            files[0] += &code;
-            h += &proto;
-        }
-        // The first symbol as it is (case kept: `AB` and `ab` are two files' symbols, one guard each).
-        let guard = symbols.first().map_or("ROBOVEC_GENERATED_H".to_string(), |s| format!("ROBOVEC_{s}_H"));
-        let units_note = if units > 1 {
-            let list: Vec<String> = (0..units).map(base_name).collect();
-            format!(
-                "/* The code is in {units} translation units: {}. Compile each (in parallel if you wish) and link \
-                 them all. */\n\n",
-                list.join(", ")
-            )
-        } else {
-            String::new()
-        };
-        let header = self.header(&guard, &units_note, &h, &decls);
-        let main_text = files.remove(0);
-        Ok(CodegenArtifact {
-            code: GeneratedCode { language: "C", main: main_text, companions: vec![("h", header)], units: files },
-            interfaces,
-        })
-    }
-
-    fn options_text(&self) -> String {
-        format!(
-            "codegen<c;abi={};precision={};batch={};trig={}>",
-            self.abi.as_str(),
-            self.precision.as_str(),
-            self.batch,
-            self.trig.as_str()
-        )
-    }
-
-    /// The file's opening comment, [`SLP_GUARD`] and includes; `fused`: some function has fused
-    /// multiply-adds (`contract`); `split`: some function is split into parts
-    /// (`ROBOVEC_NOINLINE`).
-    fn preamble(&self, fused: bool, split: bool) -> String {
-        let mut s = format!(
-            "/* Generated by robovec {}.\n * Every operation of robovec's IR is one statement, in the IR's order: compiled without\n \
-             * floating-point contraction it computes bit for bit what robovec's interpreter computes{}.\n \
-             {}* Compile with -ffp-contract=off (GCC contracts a*b+c into an FMA under -march=native),\n \
-             * e.g. cc -O2 -ffp-contract=off -c model.c; link with -lm. */\n\
-             {STDC_GUARD}{SLP_GUARD}#include <math.h>\n#include <string.h>\n\n",
-            self.options_text(),
-            if self.trig == Trig::Inline {
-                ",\n * except sin/cos: with trig=inline they are robovec's own (below), within 1 ulp but not libm's bits;\n \
-                 * never compile with -ffast-math (it would fold their rounding trick)"
-            } else {
-                ""
-            },
-            if fused {
-                "* Fused multiply-adds (the contract pass) are C99 fma, one rounding as in the interpreter: one\n \
-                 * instruction where the target has FMA (-mfma, -march=haswell or later), a slow libm call otherwise.\n "
-            } else {
-                ""
-            }
-        );
-        if split {
-            let _ = write!(
-                s,
-                "/* Functions of more than {} statements are split into parts (chunk={}): the entry point keeps\n \
-                 * its symbol and signature and calls its parts in order, passing the values one part computes\n \
-                 * and a later one reads in an array on its own stack (nothing static: re-entrant). The parts\n \
-                 * are never inlined into it, which would make one large function again. */\n\
-                 #if defined(__GNUC__)\n#define ROBOVEC_NOINLINE __attribute__((noinline))\n#else\n#define ROBOVEC_NOINLINE\n#endif\n\n",
-                self.chunk, self.chunk
-            );
-        }
-        if self.batch > 1 || self.trig == Trig::Inline {
-            // The helpers below are `ROBOVEC_UNUSED`: a function uses some of them only.
-            s += UNUSED_HELPERS;
-        }
-        if self.batch > 1 {
-            s += &body::vector_helpers(self.real(), self.batch, self.f32());
-        }
-        if self.trig == Trig::Inline {
-            s += &trig::helpers(self.f32(), self.batch > 1);
-        }
-        s
-    }
-
-    /// The header: `guard` its include guard (from the first symbol, so that the headers of
-    /// two models can be included together), `units_note` the list of translation units.
-    fn header(&self, guard: &str, units_note: &str, prototypes: &str, callback_decls: &str) -> String {
-        let mut s = format!(
-            "/* Generated by robovec {}: prototypes of the C file beside this one. */\n\
-             #ifndef {guard}\n#define {guard}\n\n{units_note}",
-            self.options_text()
-        );
-        if self.abi == Abi::Robotran {
-            s += "#include \"mbs_data.h\"\n\n";
-        }
-        // Pinocchio's callers are C++.
-        let cpp = self.abi == Abi::Pinocchio;
-        if cpp {
-            s += "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
-        }
-        s += prototypes;
-        s += callback_decls;
-        if cpp {
-            s += "#ifdef __cplusplus\n}\n#endif\n\n";
-        }
-        s += "#endif\n";
-        s
-    }
 }
 
 impl Pass for CodegenC {
@@ -598,27 +354,6 @@ impl Pass for CodegenC {
     fn code_units(&self) -> usize {
         self.units as usize
     }
-}
-
-/// Unit of each part of each function (`units` translation units, 0 the main file):
-/// contiguous runs of about equal statements, in call order (part starting after `s` of the
-/// `total` statements of all parts goes to unit `⌊s·units/total⌋`).
-fn unit_assignment(emitted: &[Emitted], units: usize) -> Vec<Vec<usize>> {
-    let total: usize = emitted.iter().flat_map(|e| &e.parts).map(|p| p.ops).sum();
-    let mut before = 0usize;
-    emitted
-        .iter()
-        .map(|e| {
-            e.parts
-                .iter()
-                .map(|p| {
-                    let u = (before * units).checked_div(total).unwrap_or(0);
-                    before += p.ops;
-                    u.min(units - 1)
-                })
-                .collect()
-        })
-        .collect()
 }
 
 /// True when a `call` is an intrinsic ([`robovec_ir::Intrinsic`]: `sqrt`, and the fused

@@ -14,7 +14,7 @@
 //! (issue 11's measurements). `abi=robotran` keeps reads first and writes last: its output
 //! arrays may alias `MbsData` fields.
 //!
-//! Split into parts (`chunk=OPS`, [`super::split`]), each part is `static void
+//! Split into parts (`chunk=OPS`, `split.rs`), each part is `static void
 //! SYMBOL_partK(const REAL *restrict in, REAL *restrict out, T *restrict live)` with the same
 //! order inside (each part reads the inputs it uses at their first use in it, and the live
 //! values of earlier parts likewise), and the entry point, with the same signature, calls them

@@ -99,9 +99,9 @@
 //! Programming* vol. 2, §4.2.2 (TwoSum).
 //!
 //! # Layout
-//! - [`constants`]: π from [`PI_HEX`] and the Cody–Waite pieces of π/2 cut from it in integer
+//! - `constants.rs`: π from [`PI_HEX`] and the Cody–Waite pieces of π/2 cut from it in integer
 //!   arithmetic ([`Constants`]).
-//! - [`kernel`]: the kernel polynomials' coefficients (weighted minimax by Remez exchange in
+//! - `kernel.rs`: the kernel polynomials' coefficients (weighted minimax by Remez exchange in
 //!   double-double).
 //! - this file: the C text of the helpers.
 
