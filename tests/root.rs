@@ -36,6 +36,7 @@ mod props;
 mod recurrence;
 mod report_dir;
 mod robotran_c;
+mod rotate_3m;
 mod roundtrip;
 mod schedule_cpu;
 mod study;

@@ -25,6 +25,7 @@ pub mod progress;
 pub mod recurrence;
 pub mod reference;
 pub mod report;
+pub mod rotate_3m;
 pub mod schedule_cpu;
 pub mod sim;
 pub mod specialize;
@@ -380,6 +381,7 @@ pub const PASSES: &[PassInfo] = &[
     inline::INFO,
     tree_height::distribute::INFO,
     recurrence::INFO,
+    rotate_3m::INFO,
     depth_bound::INFO,
     specialize::INFO,
     eqsat::INFO,

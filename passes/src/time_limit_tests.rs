@@ -57,6 +57,7 @@ const EVERY_PASS: &[(&str, AtTimeLimit)] = &[
     ("inline", AtTimeLimit::Skip),
     ("distribute", AtTimeLimit::Skip),
     ("recurrence", AtTimeLimit::Skip),
+    ("rotate-3m", AtTimeLimit::Skip),
     ("depth-bound", AtTimeLimit::Skip),
     ("specialize", AtTimeLimit::Required),
     ("eqsat", AtTimeLimit::Skip),
