@@ -95,3 +95,48 @@ fn products_read_elsewhere_or_of_two_joints_are_not_pairs() {
     let mut f = parse(&text).unwrap().functions.remove(0);
     assert_eq!(rotate_function(&mut f, &LAT, Stop::All).pairs, 0);
 }
+
+/// `rotation`'s function with `u` and `v` given as several ops (`%r1`, `%r2` are inputs):
+/// the products as terms of larger sums, with the signs of nested `sub`s.
+fn rotation_in_sums(u: &str, v: &str) -> Function {
+    let src = format!(
+        "func @f {{\n  phase atomised\n  input %q\n  input %x\n  input %y\n  input %z\n  input %r1\n  input %r2\n  \
+         %c = cos %q\n  %s = sin %q\n  %cx = mul %c, %x\n  %sy = mul %y, %s\n  %sx = mul %s, %x\n  %cy = mul %y, %c\n\
+         {u}{v}  output o[1] = %u\n  output o[2] = %v\n  %z1 = add %z, %x\n  %z2 = add %z1, %z\n  %z3 = add %z2, %z\n  \
+         %z4 = add %z3, %z\n  %z5 = add %z4, %z\n  %z6 = add %z5, %z\n  %z7 = add %z6, %z\n  output o[3] = %z7\n}}\n"
+    );
+    let mut m = parse(&src).unwrap_or_else(|e| panic!("{e:?}\n{src}"));
+    m.functions.remove(0)
+}
+
+#[test]
+fn products_that_are_terms_of_larger_sums_are_pairs_too() {
+    let cases = [
+        // u = (c·x + r1) − s·y, v = s·x + (c·y + r2)
+        ("  %u1 = add %cx, %r1\n  %u = sub %u1, %sy\n", "  %v1 = add %cy, %r2\n  %v = add %sx, %v1\n"),
+        // u = r1 − (c·x − s·y): −c·x + s·y; v = (r2 − s·x) − c·y: −s·x − c·y
+        ("  %u1 = sub %cx, %sy\n  %u = sub %r1, %u1\n", "  %v1 = sub %r2, %sx\n  %v = sub %v1, %cy\n"),
+        // u and v in one sum: (c·x − s·y) + (s·x + c·y) + r1, v = r2 alone
+        (
+            "  %u1 = sub %cx, %sy\n  %u2 = add %sx, %cy\n  %u3 = add %u1, %u2\n  %u = add %u3, %r1\n",
+            "  %v = add %r2, %r1\n",
+        ),
+        // c·x and s·y in sums two levels apart: ((c·x + r1) + r2) − (r1 − s·y)
+        (
+            "  %u1 = add %cx, %r1\n  %u2 = add %u1, %r2\n  %u3 = sub %r1, %sy\n  %u = sub %u2, %u3\n",
+            "  %v1 = sub %sx, %r2\n  %v = sub %v1, %cy\n",
+        ),
+    ];
+    for (u, v) in cases {
+        let before = rotation_in_sums(u, v);
+        let mut after = before.clone();
+        let r = rotate_function(&mut after, &LAT, Stop::All);
+        assert!(verify_function(&after).is_empty(), "{u}{v}: {:?}\n{after}", verify_function(&after));
+        assert_eq!((r.pairs, r.rewritten), (1, 1), "{u}{v}\n{after}");
+        assert_eq!(after.op_counts().mul + 1, before.op_counts().mul, "{u}{v}");
+        assert_eq!(cp(&after), cp(&before), "{u}{v}: critical path");
+        for (x, y) in values(&before).into_iter().zip(values(&after)) {
+            assert!((x - y).abs() <= 1e-13 * (1.0 + x.abs()), "{u}{v}: {x} → {y}\n{after}");
+        }
+    }
+}
