@@ -84,6 +84,22 @@ fn tick(v: &f64) -> String {
     }
 }
 
+/// Draws the legend of `chart`'s labelled series in the upper right corner, on a white box.
+fn legend<'a, CT: plotters::coord::CoordTranslate>(chart: &mut ChartContext<'a, SVGBackend<'a>, CT>) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)
+}
+
+/// The legend key of a line series: a 20-pixel line of colour `c`, `width` pixels wide.
+fn line_key<C: Color + 'static>(c: C, width: u32) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(width))
+}
+
 /// Every figure the report's numbers allow, in report.md order.
 ///
 /// # Errors

@@ -4,7 +4,7 @@ use plotters::prelude::*;
 
 use robovec_passes::whole_run::pareto::ParetoRow;
 
-use super::{err, max_of, svg_area, tick, titled, Figure, Result, PALETTE, SIZE};
+use super::{err, legend, line_key, max_of, svg_area, tick, titled, Figure, Result, PALETTE, SIZE};
 use crate::report_dir::data::ReportData;
 
 /// The speed-against-error plane of `-pareto`: time (placed cycles, else critical path)
@@ -55,7 +55,7 @@ pub(super) fn pareto(d: &ReportData) -> Result<Figure> {
             ))
             .map_err(err)?
             .label("Pareto front (binary32)")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c32.stroke_width(1)));
+            .legend(line_key(c32, 1));
         chart
             .draw_series(rows.iter().map(|r| Circle::new((r.f32.mean_bits, f64::from(r.time_cycles)), 5, c32.filled())))
             .map_err(err)?
@@ -74,13 +74,7 @@ pub(super) fn pareto(d: &ReportData) -> Result<Figure> {
                 Text::new(format!("{}{mark}", i + 1), (r.f32.mean_bits, f64::from(r.time_cycles)), ("sans-serif", 13))
             }))
             .map_err(err)?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart)?;
         root.present().map_err(err)?;
     }
     Ok(Figure {

@@ -2,7 +2,7 @@
 
 use plotters::prelude::*;
 
-use super::{err, svg_area, tick, titled, Figure, Result, PALETTE, SIZE};
+use super::{err, legend, line_key, svg_area, tick, titled, Figure, Result, PALETTE, SIZE};
 use crate::report_dir::data::ReportData;
 
 /// Seed Fig. 3.15–3.38: occupation rate of the ADD and MULTI PEs over normalised time, at the
@@ -44,15 +44,9 @@ pub(super) fn occupation(d: &ReportData) -> Result<Figure> {
                 .draw_series(LineSeries::new(xs.iter().enumerate().map(|(i, &x)| (t(i), x)), col.stroke_width(2)))
                 .map_err(err)?
                 .label(label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+                .legend(line_key(col, 2));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart)?;
         root.present().map_err(err)?;
     }
     Ok(Figure {
@@ -129,13 +123,7 @@ pub(super) fn timeline(d: &ReportData) -> Result<Figure> {
                 .label(*op)
                 .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], col.filled()));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart)?;
         root.present().map_err(err)?;
     }
     Ok(Figure {

@@ -1,12 +1,13 @@
 //! The figures over N (seed ch. 3): cycles, µs, parallelisation and memory of the sweep's
 //! configurations.
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use robovec_passes::sweep::{SweepRow, WordStats};
 
-use super::{err, max_of, svg_area, tick, titled, Figure, Result, PALETTE, SIZE};
+use super::{err, legend, line_key, max_of, svg_area, tick, titled, Figure, Result, PALETTE, SIZE};
 use crate::report_dir::data::ReportData;
 
 /// One drawn series: legend label, points (x, y), and whether it is a dashed (bound) or thin
@@ -92,14 +93,9 @@ fn n_chart(
                 .draw_series(DashedLineSeries::new(pts.iter().copied(), 6, 4, c.stroke_width(2)))
                 .map_err(err)?
                 .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                .legend(line_key(c, 2));
         } else {
-            chart
-                .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
-                .map_err(err)?
-                .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
-            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled()))).map_err(err)?;
+            marked_line(&mut chart, label, pts, c)?;
         }
     }
     for (label, y) in marks {
@@ -110,16 +106,10 @@ fn n_chart(
                 .draw_series(DashedLineSeries::new(vec![(*x, 0.0), (*x, y_max)], 4, 4, grey.stroke_width(1)))
                 .map_err(err)?
                 .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1)));
+                .legend(line_key(grey, 1));
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart)?;
     Ok(())
 }
 
@@ -326,14 +316,9 @@ fn n_chart_grouped(
                 .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(1)))
                 .map_err(err)?
                 .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(1)));
+                .legend(line_key(c, 1));
         } else {
-            chart
-                .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
-                .map_err(err)?
-                .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
-            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled()))).map_err(err)?;
+            marked_line(&mut chart, label, pts, c)?;
         }
     }
     chart
@@ -344,5 +329,21 @@ fn n_chart_grouped(
         .border_style(BLACK)
         .draw()
         .map_err(err)?;
+    Ok(())
+}
+
+/// A sweep's series as a line of colour `c` with a marker at each point, labelled `label`.
+fn marked_line<'a>(
+    chart: &mut ChartContext<'a, SVGBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    label: &str,
+    pts: &[(f64, f64)],
+    c: RGBColor,
+) -> Result<()> {
+    chart
+        .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
+        .map_err(err)?
+        .label(label)
+        .legend(line_key(c, 2));
+    chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled()))).map_err(err)?;
     Ok(())
 }
