@@ -137,7 +137,8 @@ pub struct Rotated {
 /// be atomised and verify; the result verifies, computes the same outputs in real arithmetic
 /// and has the same ASAPCycle under `lat`. Cost: O(values + operands).
 pub fn rotate_function(f: &mut Function, lat: &Latencies, stop: Stop) -> Rotated {
-    let found = pairs::find(f);
+    let position = pairs::body_positions(f);
+    let found = pairs::find(f, &position);
     let mut out = Rotated { pairs: found.len(), ..Rotated::default() };
     if found.is_empty() {
         return out;
@@ -150,10 +151,9 @@ pub fn rotate_function(f: &mut Function, lat: &Latencies, stop: Stop) -> Rotated
         }
     }
     let (timing, summary) = compute_timing(f, lat);
-    let path = i64::from(summary.asap_cycle);
     let alap = |v: Value| timing[v.index()].map_or(0, |t| t.alap_cycle);
-    let counts = f.op_counts();
-    let (mut muls, mut add_side) = (counts.mul as i64, (counts.add + counts.sub + counts.div + counts.call) as i64);
+    let (mut add_side, mut muls) = crate::place::ops_per_side(f);
+    let path = u64::from(summary.asap_cycle);
     // Ready cycles with the rewrites chosen so far (inputs and trig values at 0). A rewritten
     // pair's products stand for what replaces them in their sums (`t`, `y·K_u`, `x·K_v`),
     // decided when the first of their readers is reached: `x` and `y` are ready by then
@@ -162,7 +162,7 @@ pub fn rotate_function(f: &mut Function, lat: &Latencies, stop: Stop) -> Rotated
     let mut set = vec![false; f.values.len()];
     let mut decided = vec![false; found.len()];
     let mut chosen = vec![false; found.len()];
-    let mut sums: HashSet<(Value, bool)> = HashSet::new();
+    let mut sums: HashSet<(Value, Value, bool)> = HashSet::new();
     for k in 0..f.body.len() {
         let v = f.body[k];
         for &p in pair_of.get(&v).map_or(&[][..], Vec::as_slice) {
@@ -172,8 +172,8 @@ pub fn rotate_function(f: &mut Function, lat: &Latencies, stop: Stop) -> Rotated
                     Stop::All => true,
                     Stop::Balanced => muls > add_side,
                     Stop::Placed(n) => {
-                        let n = i64::from(n);
-                        (muls + n - 1) / n > path.max((add_side + n - 1) / n)
+                        let n = u64::from(n);
+                        muls.div_ceil(n) > path.max(add_side.div_ceil(n))
                     }
                 };
                 let q = &found[p];
@@ -189,13 +189,7 @@ pub fn rotate_function(f: &mut Function, lat: &Latencies, stop: Stop) -> Rotated
                         ready[m.value.index()] = r;
                         set[m.value.index()] = true;
                     }
-                    let angle = |t: Value| match f.value(t).def {
-                        Def::Trig(_, a) => a,
-                        _ => unreachable!("a trig value"),
-                    };
-                    let joint =
-                        [(angle(q.cx.trig), q.cx.sign == q.sy.sign), (angle(q.cx.trig), q.sx.sign == q.cy.sign)];
-                    let new_sums = joint.into_iter().filter(|&k| sums.insert(k)).count() as i64;
+                    let new_sums = q.joint_sums().into_iter().filter(|&k| sums.insert(k)).count() as u64;
                     muls -= 1;
                     add_side += 1 + new_sums;
                 }
@@ -217,7 +211,6 @@ pub fn rotate_function(f: &mut Function, lat: &Latencies, stop: Stop) -> Rotated
     let mut after: HashMap<Value, Vec<Value>> = HashMap::new();
     let mut joint: HashMap<(Value, Value, bool), Value> = HashMap::new();
     let mut replace: HashMap<Value, Value> = HashMap::new();
-    let position: HashMap<Value, usize> = old_body.iter().enumerate().map(|(i, &v)| (v, i)).collect();
     let bin = |op, a: Value, b: Value| Def::Binary(op, Operand::Value(a), Operand::Value(b));
     for q in found.iter().zip(&chosen).filter(|(_, &c)| c).map(|(q, _)| q) {
         let mut new = Vec::new();
@@ -228,17 +221,17 @@ pub fn rotate_function(f: &mut Function, lat: &Latencies, stop: Stop) -> Rotated
         new.extend([xy, t]);
         // In u, α·c·x + β·s·y = α·t + β·y·(s − αβ·c); in v, γ·s·x + δ·c·y = δ·t + γ·x·(s − γδ·c):
         // `t` takes the cos product's place, `y·K` or `x·K` the sin product's, with its sign.
-        for (cos, sin, factor) in [(q.cx, q.sy, y), (q.cy, q.sx, x)] {
-            let plus = cos.sign != sin.sign;
-            let k = match joint.get(&(s, c, plus)) {
+        for ((cos, sin, factor), key) in [(q.cx, q.sy, y), (q.cy, q.sx, x)].into_iter().zip(q.joint_sums()) {
+            let plus = key.2;
+            let k = match joint.get(&key) {
                 Some(&k) => k,
                 None => {
                     let name = format!("{}.{}", f.name_of(s), if plus { "pc" } else { "mc" });
                     let k = f.define_fresh(&name, bin(if plus { BinOp::Add } else { BinOp::Sub }, s, c), Span::DUMMY);
-                    joint.insert((s, c, plus), k);
+                    joint.insert(key, k);
                     // Shared by the joint's pairs: right after the later of `s` and `c`.
                     // (Trig values are body values, defined before the products that read them.)
-                    let at = if position.get(&s) > position.get(&c) { s } else { c };
+                    let at = if position[s.index()] > position[c.index()] { s } else { c };
                     after.entry(at).or_default().push(k);
                     out.joint_sums += 1;
                     k
@@ -249,7 +242,7 @@ pub fn rotate_function(f: &mut Function, lat: &Latencies, stop: Stop) -> Rotated
             replace.insert(cos.value, t);
             replace.insert(sin.value, p);
         }
-        let first = q.readers().into_iter().min_by_key(|m| position[m]).expect("four readers");
+        let first = q.readers().into_iter().min_by_key(|m| position[m.index()]).expect("four readers");
         before.entry(first).or_default().extend(new);
         out.rewritten += 1;
     }

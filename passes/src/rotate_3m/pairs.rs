@@ -3,7 +3,7 @@
 //! [`super`]).
 //!
 //! A *sum* is a cluster of `add`/`sub` ops whose inner ops are read once, by the cluster
-//! (tree-height reduction's clusters, seed §2.3); each of its leaves enters it with a sign,
+//! (tree-height reduction's additive clusters, [`Clusters`], seed §2.3); each of its leaves enters it with a sign,
 //! the product of the signs on its path (the right operand of a `sub` flips it). `u` is any
 //! sum with a term `±c·x` and a term `±s·y` (`x ≠ y`), `v` any sum with `±s·x` and `±c·y`;
 //! `u` and `v` may be one sum. Cost: O(values + operands) plus, per sum and joint, the
@@ -12,6 +12,8 @@
 use std::collections::{HashMap, HashSet};
 
 use robovec_ir::{BinOp, Def, Function, Operand, TrigFn, Value};
+
+use crate::tree_height::cluster::Clusters;
 
 /// A product `trig·other` read once, as a term of a sum.
 #[derive(Clone, Copy, Debug)]
@@ -45,51 +47,51 @@ impl Pair {
     pub fn readers(&self) -> [Value; 4] {
         [self.cx.reader, self.sy.reader, self.sx.reader, self.cy.reader]
     }
-}
 
-/// The sum each `add`/`sub` value belongs to and its sign there (indexed by value; `None`
-/// for other values): reverse body order visits a reader before what it reads.
-fn sums(f: &Function, uses: &[u32]) -> Vec<Option<(Value, i8)>> {
-    let mut at: Vec<Option<(Value, i8)>> = vec![None; f.values.len()];
-    let is_sum = |v: Value| matches!(f.value(v).def, Def::Binary(BinOp::Add | BinOp::Sub, ..));
-    for &v in f.body.iter().rev() {
-        let Def::Binary(op @ (BinOp::Add | BinOp::Sub), a, b) = f.value(v).def else { continue };
-        let (root, sign) = *at[v.index()].get_or_insert((v, 1));
-        for (k, x) in [a, b].into_iter().enumerate() {
-            if let Operand::Value(x) = x {
-                if is_sum(x) && uses[x.index()] == 1 {
-                    let flip = if op == BinOp::Sub && k == 1 { -1 } else { 1 };
-                    at[x.index()] = Some((root, sign * flip));
-                }
-            }
-        }
+    /// The joint sums `s ± c` its two sides read, as `(s, c, plus)`: `u`'s `s − αβ·c` and
+    /// `v`'s `s − γδ·c` (`plus` when the side's two signs differ; module doc of [`super`]).
+    pub fn joint_sums(&self) -> [(Value, Value, bool); 2] {
+        let (s, c) = (self.sy.trig, self.cx.trig);
+        [(s, c, self.cx.sign != self.sy.sign), (s, c, self.cy.sign != self.sx.sign)]
     }
-    at
 }
 
-/// The rotated pairs of `f`, each product in one pair at most, in the body order of their
-/// first product.
-pub(super) fn find(f: &Function) -> Vec<Pair> {
-    let uses = f.use_counts();
-    let at = sums(f, &uses);
-    // Body position of each value (inputs: 0).
+/// The position of each value in `f`'s body, counted from 1 (inputs: 0).
+pub(super) fn body_positions(f: &Function) -> Vec<usize> {
     let mut position = vec![0usize; f.values.len()];
     for (i, &v) in f.body.iter().enumerate() {
         position[v.index()] = i + 1;
     }
-    // Every product of a trig value read once by a sum: its term.
-    let mut terms: HashMap<(Value, Value), Term> = HashMap::new();
+    position
+}
+
+/// The rotated pairs of `f`, each product in one pair at most, in the body order of the
+/// first product of each sum and joint. `position`: [`body_positions`] of `f`.
+pub(super) fn find(f: &Function, position: &[usize]) -> Vec<Pair> {
+    // The sums are tree-height reduction's additive clusters.
+    let clusters = Clusters::new(f);
+    let uses = &clusters.uses;
+    // What each operand of an `add`/`sub` is a term of: (its reader, the sum's root, its sign
+    // there). Reverse body order visits an op before the ops it reads, so an interior op's
+    // sign is known when its own operands take theirs.
+    let mut sign = vec![1i8; f.values.len()];
     let mut reader: Vec<Option<(Value, Value, i8)>> = vec![None; f.values.len()];
-    for &v in &f.body {
+    for &v in f.body.iter().rev() {
         let Def::Binary(op @ (BinOp::Add | BinOp::Sub), a, b) = f.value(v).def else { continue };
-        let Some((root, sign)) = at[v.index()] else { continue };
+        let Some(root) = clusters.root_of[v.index()] else { continue };
         for (k, x) in [a, b].into_iter().enumerate() {
             if let Operand::Value(x) = x {
                 let flip = if op == BinOp::Sub && k == 1 { -1 } else { 1 };
-                reader[x.index()] = Some((v, root, sign * flip));
+                let s = sign[v.index()] * flip;
+                if clusters.interior[x.index()] {
+                    sign[x.index()] = s;
+                }
+                reader[x.index()] = Some((v, root, s));
             }
         }
     }
+    // Every product of a trig value read once by a sum: its term.
+    let mut terms: HashMap<(Value, Value), Term> = HashMap::new();
     // Per (sum, joint): its cos terms and its sin terms.
     let mut by_sum: HashMap<(Value, Value), (Vec<Term>, Vec<Term>)> = HashMap::new();
     let mut order: Vec<(Value, Value)> = Vec::new();
