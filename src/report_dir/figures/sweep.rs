@@ -76,16 +76,7 @@ fn n_chart(
         .y_label_area_size(64)
         .build_cartesian_2d(range.clone(), 0f64..y_max)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("N (ADD PEs = MULTI PEs), log scale")
-        .y_desc(y_desc)
-        .x_labels(((range.end - range.start).ceil() as usize + 1).max(2))
-        .x_label_formatter(&n_tick)
-        .y_label_formatter(&tick)
-        .light_line_style(RGBColor(242, 242, 242))
-        .draw()
-        .map_err(err)?;
+    n_mesh(&mut chart, "N (ADD PEs = MULTI PEs), log scale", y_desc, &range)?;
     for (i, (label, pts, dashed)) in series.iter().enumerate() {
         let c = PALETTE[i % PALETTE.len()];
         if *dashed {
@@ -298,16 +289,7 @@ fn n_chart_grouped(
         .y_label_area_size(56)
         .build_cartesian_2d(range.clone(), 0f64..y_max)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("N, log scale")
-        .y_desc(y_desc)
-        .x_labels(((range.end - range.start).ceil() as usize + 1).max(2))
-        .x_label_formatter(&n_tick)
-        .y_label_formatter(&tick)
-        .light_line_style(RGBColor(242, 242, 242))
-        .draw()
-        .map_err(err)?;
+    n_mesh(&mut chart, "N, log scale", y_desc, &range)?;
     for (i, (label, pts, dashed)) in series.iter().enumerate() {
         let c = PALETTE[(i / 3) % PALETTE.len()];
         if *dashed {
@@ -346,4 +328,23 @@ fn marked_line<'a>(
         .legend(line_key(c, 2));
     chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled()))).map_err(err)?;
     Ok(())
+}
+
+/// The grid and axes of a log-N chart over `range` (log₂ N): N at the powers of two.
+fn n_mesh<'a>(
+    chart: &mut ChartContext<'a, SVGBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    x_desc: &str,
+    y_desc: &str,
+    range: &std::ops::Range<f64>,
+) -> Result<()> {
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_labels(((range.end - range.start).ceil() as usize + 1).max(2))
+        .x_label_formatter(&n_tick)
+        .y_label_formatter(&tick)
+        .light_line_style(RGBColor(242, 242, 242))
+        .draw()
+        .map_err(err)
 }
