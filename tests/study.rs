@@ -13,7 +13,7 @@ fn gen(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_robovec-gen")).args(args).output().expect("robovec-gen runs")
 }
 
-const BEST: &str = robovec_dynamics::study::DEFAULT_BEST;
+const BEST: &str = robovec::study::DEFAULT_BEST;
 
 /// The table rows of the markdown on stdout, by case label: the cells after the label.
 fn rows(md: &str) -> Vec<(String, Vec<String>)> {
@@ -204,7 +204,7 @@ fn thesis_rows_are_table_3_1_of_the_seed() {
         .map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap_or_default())
         .find(|t| t.contains("Table 3.1: Study Cases Characteristics"))
         .expect("the seed holds Table 3.1");
-    for r in robovec_dynamics::study::cases::THESIS_ROWS {
+    for r in robovec::study::cases::THESIS_ROWS {
         let line = format!(
             "{}-dof {}\t{}\t{} - {}\t{}",
             r.dof,

@@ -4,8 +4,9 @@
 //! unchanged.
 //!
 //! # Dependencies
-//! This crate may import `robovec-ir` (the IR it writes) and `robovec-passes` (the study runs
-//! its cases through the pass manager); never the front ends (`robovec-front`, which depends on
+//! This crate may import `robovec-ir` (the IR it writes, the `-time-limit` deadline the
+//! generator stops at, and the atomise and cse transforms its op counts use); never the passes
+//! (the study, which runs pipelines on the robots of [`topology`], is the driver's: `robovec::study`), never the front ends (`robovec-front`, which depends on
 //! it: the URDF front end parses into [`robot::Robot`] and calls [`generate`]) nor the driver
 //! (`robovec`).
 //!
@@ -14,7 +15,7 @@
 //! (the formulations), [`depth`] (the depth-optimised formulation of `--formulation=depth`), [`lump`] (fixed joints contracted), [`frames`] and [`origins`] (the body
 //! frames the generator may choose),
 //! [`topology`] (the study's robot families), [`urdf_out`] and [`robotran_c`] (the writers of
-//! `robovec-gen`), [`study`] (the thesis's study: cases, one case's run, the table).
+//! `robovec-gen`).
 //!
 //! # What is generated
 //! `invdyna`: inverse dynamics `Qq[i]` of a fixed-base tree by the recursive Newton–Euler
@@ -81,7 +82,7 @@ pub mod origins;
 pub mod rnea;
 pub mod robot;
 pub mod robotran_c;
-pub mod study;
+
 pub mod sym;
 pub mod topology;
 pub mod urdf_out;
@@ -91,8 +92,8 @@ mod scale_tests;
 
 use std::collections::BTreeMap;
 
+use robovec_ir::time_limit::Deadline;
 use robovec_ir::Module;
-use robovec_passes::Deadline;
 use rustc_hash::FxHashMap;
 
 use robot::Robot;

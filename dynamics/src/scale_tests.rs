@@ -2,8 +2,8 @@
 //! the ops it writes, and stops at its deadline. Sizes are structural counts (values, ops,
 //! outputs) computed from the robot, never times.
 
+use robovec_ir::time_limit::Deadline;
 use robovec_ir::{Def, Expr, Function, Operand};
-use robovec_passes::Deadline;
 
 use crate::robot::Robot;
 use crate::topology::{build, Topology};

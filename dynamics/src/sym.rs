@@ -27,8 +27,8 @@
 //! 3 266, UR5 473 → 419 / 486 → 451, TIAGo Pro 7 666 → 7 600 / 7 955 → 7 928; `M` of Panda
 //! 515 → 512, Talos 3 993 → 3 989, TIAGo Pro 8 271 → 8 269 (the others unchanged).
 
+use robovec_ir::time_limit::Deadline;
 use robovec_ir::{BinOp, Def, Expr, Function, Operand, Output, Phase, Span, TrigFn, Value};
-use robovec_passes::Deadline;
 use rustc_hash::FxHashMap;
 
 use super::{Reached, Stopped};
@@ -390,8 +390,8 @@ impl Builder {
         let mut f = self.f.clone();
         let live = f.live_values(&[]);
         f.retain(|_, v| live[v.index()]);
-        let mut f = robovec_passes::atomise::atomise_owned(f);
-        robovec_passes::cse::cse_function(&mut f);
+        let mut f = robovec_ir::transform::atomise::atomise_owned(f);
+        robovec_ir::transform::cse::cse_function(&mut f);
         f.op_counts().total
     }
 

@@ -2,7 +2,7 @@
 //! front ends' long loops (tokens lexed, lines scanned, statements parsed and lowered) tick.
 //!
 //! # Design
-//! The deadline ([`robovec_passes::Deadline`]) starts with the run, before loading, so that
+//! The deadline ([`robovec_ir::time_limit::Deadline`]) starts with the run, before loading, so that
 //! `-time-limit=5` bounds reading a 50 MB file too. The loops call [`Clock::tick`] once per
 //! token, line or statement; the clock is read every [`Clock::EVERY`] ticks (one clock read,
 //! tens of ns, per thousand steps of a few hundred ns each: free), and once it is past the
@@ -14,8 +14,8 @@
 
 use std::cell::Cell;
 
+use robovec_ir::time_limit::{Deadline, Ticker};
 use robovec_ir::Span;
-use robovec_passes::{Deadline, Ticker};
 
 use crate::FrontError;
 

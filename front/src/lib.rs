@@ -133,7 +133,7 @@ pub fn parse_text_until(
     lang: Language,
     text: &str,
     header: Option<&[u8]>,
-    deadline: Option<&robovec_passes::Deadline>,
+    deadline: Option<&robovec_ir::time_limit::Deadline>,
 ) -> Result<robovec_ir::Module, Vec<FrontError>> {
     parse_with_clock(lang, text, header, &clock::Clock::new(deadline))
 }
@@ -223,7 +223,7 @@ mod stream_tests;
 pub fn check_accepted(m: &robovec_ir::Module) -> Result<(), String> {
     robovec_ir::verifier::verify(m).map_err(|e| format!("front end returned a module that does not verify: {e:?}"))?;
     for f in &m.functions {
-        let a = robovec_passes::atomise::atomise_function(f);
+        let a = robovec_ir::transform::atomise::atomise_function(f);
         let errs = robovec_ir::verifier::verify_function(&a);
         if !errs.is_empty() {
             return Err(format!("atomised @{} does not verify: {errs:?}", f.name));

@@ -50,7 +50,7 @@ pub struct FrontOptions {
     /// `-time-limit`: the run's deadline, started before loading. Front ends check it in their
     /// long loops (statements read, bodies generated) and, once it is reached, fail with one
     /// error saying where they stopped (see [`FrontEnd::load`]).
-    pub deadline: Option<robovec_passes::Deadline>,
+    pub deadline: Option<robovec_ir::time_limit::Deadline>,
 }
 
 /// A loaded input: the module, and the values of the model parameters it keeps as inputs.

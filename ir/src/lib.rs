@@ -46,6 +46,8 @@ pub mod span;
 pub mod syntax;
 mod syntax_impl;
 pub mod text;
+pub mod time_limit;
+pub mod transform;
 pub mod verifier;
 
 pub use count::OpCounts;

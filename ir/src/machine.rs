@@ -42,11 +42,10 @@
 //! with `EncodeError::NoUnit` (so `codegen<fpga>` reports them), and so it rejects a step
 //! with more than two writes or an address wider than the layout's fields.
 //!
-//! # Binary32 data words
-//! Constants and inputs are rounded to nearest from `f64` (`x as f32`, as
-//! `-eval-precision=f32` and `interp`'s `Float::from_f64` for `f32` do); trig initial
-//! variables are `sin`/`cos` computed in binary32 on the rounded input, as `interp` does in
-//! `f32` ([`Word::binary32`]).
+//! # Data words
+//! A [`Word`] says what a memory word holds (an input, a trig value of an input, a constant),
+//! not its bits: the bits are the device's (binary32 on the seed's FPGA:
+//! `robovec_machine::encode::word_binary32`), so no number format lives here.
 //!
 //! The image encoding is documented bit by bit in `robovec_machine::encode`.
 
@@ -92,25 +91,6 @@ pub enum Word {
     Trig(TrigFn, String),
     /// A constant (its binary32 rounding in the images).
     Const(f64),
-}
-
-impl Word {
-    /// The binary32 bits of this word, `input(name)` giving each input's value: inputs and
-    /// constants rounded to nearest (`x as f32`), trig values as `sin`/`cos` in `f32` of the
-    /// rounded input (what `interp::eval::<f32>` computes).
-    pub fn binary32(&self, input: impl Fn(&str) -> f64) -> u32 {
-        match self {
-            Word::Input(n) => (input(n) as f32).to_bits(),
-            Word::Trig(t, n) => {
-                let x = input(n) as f32;
-                match t {
-                    TrigFn::Sin => x.sin().to_bits(),
-                    TrigFn::Cos => x.cos().to_bits(),
-                }
-            }
-            Word::Const(c) => (*c as f32).to_bits(),
-        }
-    }
 }
 
 /// The operation an instruction issues. `Add`/`Sub` run on ADD PEs, `Mul` on MULTI PEs; `Div`
@@ -242,23 +222,6 @@ impl MachineProgram {
             MachineOp::Div => l.div,
             MachineOp::Call(_) => l.call,
         }
-    }
-
-    /// The binary32 initial contents of PE slot `slot`'s memory, one word per address (0 where
-    /// nothing is loaded), `input(name)` giving each input ([`Word::binary32`]).
-    ///
-    /// # Panics
-    /// When `slot` is not below [`MachineProgram::n_pe`].
-    pub fn pe_image(&self, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
-        self.pes[slot].init.iter().map(|w| w.as_ref().map_or(0, |w| w.binary32(&input))).collect()
-    }
-
-    /// The binary32 initial contents of PE slot `slot`'s output memory (0 for captured words).
-    ///
-    /// # Panics
-    /// When `slot` is not below [`MachineProgram::n_pe`].
-    pub fn output_image(&self, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
-        self.pes[slot].output_init.iter().map(|w| w.as_ref().map_or(0, |w| w.binary32(&input))).collect()
     }
 
     /// Direct writes (crossbar source a result) in the whole program.

@@ -8,6 +8,7 @@
 use robovec_ir::Module;
 
 use crate::params::ParamKind;
+use crate::time_limit::TickerError;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.

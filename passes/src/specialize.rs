@@ -27,6 +27,7 @@ use robovec_ir::{BinOp, Def, Function, Module, Operand, Phase, TrigFn};
 
 use crate::dce::Dce;
 use crate::params::ParamKind;
+use crate::time_limit::TickerError;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.

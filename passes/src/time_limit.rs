@@ -26,73 +26,14 @@
 //! loop plus what is never interrupted: the verifier after each pass and writing the outputs,
 //! both linear and a fraction of any pass's time.
 //!
+//! [`Deadline`] and [`Ticker`] live in `robovec-ir` (the front ends and the generator read them
+//! too); they are re-exported here.
+//!
 //! Tests make the stops deterministic with [`crate::PassContext::tick_budget`] (every ticker
 //! of the run stops at that tick whatever the machine's speed) or a deadline already passed.
 
-use std::cell::Cell;
-
 use crate::PassError;
-
-/// A wall-clock limit on a pipeline run (`-time-limit=SECONDS`), or its grace (module doc).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Deadline {
-    /// When the limit is reached.
-    pub at: std::time::Instant,
-    /// The limit as given, seconds.
-    pub seconds: f64,
-    /// True for [`Deadline::grace`]: the limit plus the grace the passes the output needs get.
-    pub grace: bool,
-}
-
-impl Deadline {
-    /// A limit of `seconds` from now.
-    pub fn after_seconds(seconds: f64) -> Deadline {
-        let d = std::time::Duration::try_from_secs_f64(seconds.max(0.0)).unwrap_or(std::time::Duration::MAX);
-        Deadline { at: later(std::time::Instant::now(), d), seconds, grace: false }
-    }
-
-    /// The grace of a limit of `seconds`: 5 % of it plus 0.5 s, so that a run whose searches
-    /// stopped at the limit still ends within the issue's 10 % + 1 s of it after the required
-    /// passes, the verifier and the output.
-    pub fn grace_seconds(seconds: f64) -> f64 {
-        0.05 * seconds + 0.5
-    }
-
-    /// The deadline of the passes the output needs ([`AtTimeLimit::Required`]): this limit
-    /// plus [`Deadline::grace_seconds`].
-    pub fn grace(&self) -> Deadline {
-        if self.grace {
-            return *self;
-        }
-        let extra = std::time::Duration::try_from_secs_f64(Self::grace_seconds(self.seconds)).unwrap_or_default();
-        Deadline { at: later(self.at, extra), grace: true, ..*self }
-    }
-
-    /// Time left before the limit (zero once reached).
-    pub fn time_left(&self) -> std::time::Duration {
-        self.at.saturating_duration_since(std::time::Instant::now())
-    }
-
-    /// True once the limit is reached.
-    pub fn reached(&self) -> bool {
-        std::time::Instant::now() >= self.at
-    }
-
-    /// Why a pass stopped: `time limit of 5 s reached` (a grace: `time limit of 5 s and its
-    /// grace of 0.75 s reached`).
-    pub fn reason(&self) -> String {
-        if self.grace {
-            format!("time limit of {} s and its grace of {} s reached", self.seconds, Self::grace_seconds(self.seconds))
-        } else {
-            format!("time limit of {} s reached", self.seconds)
-        }
-    }
-}
-
-/// `t + d`, or about a century from now beyond what the clock represents ("no limit").
-fn later(t: std::time::Instant, d: std::time::Duration) -> std::time::Instant {
-    t.checked_add(d).unwrap_or_else(|| std::time::Instant::now() + std::time::Duration::from_secs(100 * 365 * 86_400))
-}
+pub use robovec_ir::time_limit::{Deadline, Ticker};
 
 /// What the manager does with a pass that has not started when `-time-limit` is reached
 /// (module doc).
@@ -107,79 +48,16 @@ pub enum AtTimeLimit {
     Required,
 }
 
-/// Counts the steps of a long loop and says when to stop for `-time-limit` (module doc).
-///
-/// Not `Sync` (a [`Cell`]): a loop spread over threads keeps one per thread or checks the
-/// [`Deadline`] itself.
-#[derive(Debug, Default)]
-pub struct Ticker {
-    deadline: Option<Deadline>,
-    /// Tests: stop at this tick instead of reading the clock.
-    budget: Option<u64>,
-    ticks: Cell<u64>,
-    stopped: Cell<bool>,
+/// The error of a required pass whose [`Ticker`] stopped.
+pub trait TickerError {
+    /// `pass` stopped `where_` (`in @dirdyna after 41 of 600 000 values`), nothing is written:
+    /// [`PassError::TimeLimit`] with [`Ticker::stop_message`].
+    fn error(&self, pass: &str, where_: &str) -> PassError;
 }
 
-impl Ticker {
-    /// Steps between two reads of the clock (a power of two: one clock read, tens of ns, per
-    /// thousand steps of tens to hundreds of ns each).
-    pub const EVERY: u64 = 1024;
-
-    /// A ticker for `deadline` (`None`: never stops) that, with `budget`, also stops at its
-    /// `budget`-th tick (tests; see [`crate::PassContext::tick_budget`]).
-    pub fn new(deadline: Option<Deadline>, budget: Option<u64>) -> Ticker {
-        Ticker { deadline, budget, ..Ticker::default() }
-    }
-
-    /// Counts one step; true once the limit is reached (the clock is read every
-    /// [`Ticker::EVERY`] steps, and every tick after a stop says stop): the loop must stop.
-    pub fn tick(&self) -> bool {
-        if self.stopped.get() {
-            return true;
-        }
-        let n = self.ticks.get() + 1;
-        self.ticks.set(n);
-        let reached = self.budget.is_some_and(|b| n >= b)
-            || (n.is_multiple_of(Self::EVERY) && self.deadline.is_some_and(|d| d.reached()));
-        self.stopped.set(reached);
-        reached
-    }
-
-    /// Counts one step and reads the clock now (between phases of a pass, or per function
-    /// of a pass too fast to tick per op); true once the limit is reached.
-    pub fn check(&self) -> bool {
-        if !self.tick() && self.deadline.is_some_and(|d| d.reached()) {
-            self.stopped.set(true);
-        }
-        self.stopped.get()
-    }
-
-    /// True once a tick or a check found the limit reached.
-    pub fn stopped(&self) -> bool {
-        self.stopped.get()
-    }
-
-    /// Steps counted so far.
-    pub fn ticks(&self) -> u64 {
-        self.ticks.get()
-    }
-
-    /// Why it stopped: `time limit of 5 s reached` (a test budget: `tick budget of K steps
-    /// reached`).
-    pub fn reason(&self) -> String {
-        match (self.deadline, self.budget) {
-            (Some(d), None) => d.reason(),
-            (Some(d), Some(b)) if d.reached() || self.ticks.get() < b => d.reason(),
-            (_, Some(b)) => format!("tick budget of {b} steps reached"),
-            (None, None) => "no time limit".into(),
-        }
-    }
-
-    /// The error of a required pass that stopped: `pass` stopped `where_` (`in @dirdyna after
-    /// 41 of 600 000 values`), nothing is written.
-    pub fn error(&self, pass: &str, where_: &str) -> PassError {
-        let message = format!("{}: stopped {where_}; the output needs it, so nothing is written", self.reason());
-        PassError::TimeLimit { pass: pass.to_string(), message }
+impl TickerError for Ticker {
+    fn error(&self, pass: &str, where_: &str) -> PassError {
+        PassError::TimeLimit { pass: pass.to_string(), message: self.stop_message(where_) }
     }
 }
 
@@ -188,30 +66,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_reached_deadline_stops_at_the_every_th_tick_and_for_good() {
-        let never = Ticker::new(None, None);
-        assert!((0..10 * Ticker::EVERY).all(|_| !never.tick()) && !never.check() && !never.stopped());
-        let past = Ticker::new(Some(Deadline::after_seconds(0.0)), None);
-        let first = (1..=2 * Ticker::EVERY).find(|_| past.tick()).expect("stops");
-        assert_eq!(first, Ticker::EVERY, "the clock is read at the EVERY-th tick");
-        assert!(past.tick() && past.stopped() && past.check(), "every later tick says stop");
-        assert_eq!(past.reason(), "time limit of 0 s reached");
-        let far = Ticker::new(Some(Deadline::after_seconds(3600.0)), None);
-        assert!((0..10 * Ticker::EVERY).all(|_| !far.tick()) && !far.check());
-        let past = Ticker::new(Some(Deadline::after_seconds(0.0)), None);
-        assert!(past.check() && past.tick(), "check reads the clock at once");
-    }
-
-    #[test]
-    fn a_tick_budget_stops_at_that_tick() {
-        let t = Ticker::new(Some(Deadline::after_seconds(3600.0)), Some(3));
-        assert!(!t.tick() && !t.tick() && t.tick() && t.tick());
-        assert_eq!(t.ticks(), 3);
-        assert_eq!(t.reason(), "tick budget of 3 steps reached");
-        let e = t.error("atomise", "in @f after 2 of 9 values");
+    fn a_stopped_required_pass_fails_with_the_tickers_message() {
+        let t = Ticker::new(None, Some(1));
+        assert!(t.tick());
+        let e = t.error("atomise", "in @f after 0 of 9 values");
         assert_eq!(
             e.to_string(),
-            "pass `atomise`: tick budget of 3 steps reached: stopped in @f after 2 of 9 values; \
+            "pass `atomise`: tick budget of 1 steps reached: stopped in @f after 0 of 9 values; \
              the output needs it, so nothing is written"
         );
     }

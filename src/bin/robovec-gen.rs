@@ -15,8 +15,8 @@
 //!
 //! `robovec-gen --study [--dof 23,50,…] [--topology serial,…] [--seed S] [--samples K]
 //! [--best PIPELINE] [--report-dir DIR] [-q]` runs the thesis's study (seed §3.2, Table 3.1) on
-//! the families instead: see `robovec::study` (the command) and `robovec_dynamics::study` (the
-//! cases, what is measured, the table).
+//! the families instead: see `robovec::study` (the command, the cases, what is measured, the
+//! table).
 //!
 //! Exit status: 0 on success, 1 for a bad URDF or when the output cannot be written, 2 on bad
 //! usage.
@@ -91,7 +91,7 @@ struct StudyArgs {
     #[arg(long, default_value_t = 200, requires = "study", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     samples: u32,
     /// --study: the best rewrite pipeline (from the parsed equations).
-    #[arg(long, default_value = robovec_dynamics::study::DEFAULT_BEST, requires = "study")]
+    #[arg(long, default_value = robovec::study::DEFAULT_BEST, requires = "study")]
     best: String,
     /// --study: write the study folder (study.md/json/csv, figures, per-case reports) here.
     #[arg(long, requires = "study")]
@@ -109,7 +109,7 @@ struct StudyArgs {
 fn study(args: &Args) -> ExitCode {
     use std::io::IsTerminal;
     let dofs = if args.dof.is_empty() {
-        robovec_dynamics::study::cases::THESIS_DOFS.to_vec()
+        robovec::study::cases::THESIS_DOFS.to_vec()
     } else {
         args.dof.iter().map(|&d| d as usize).collect()
     };
@@ -120,7 +120,7 @@ fn study(args: &Args) -> ExitCode {
         seed: args.seed,
         samples: args.study.samples,
         best: args.study.best.clone(),
-        ns: robovec_dynamics::study::DEFAULT_NS.to_vec(),
+        ns: robovec::study::DEFAULT_NS.to_vec(),
         report_dir: args.study.report_dir.clone(),
         case_reports: !args.study.no_case_reports,
         quiet: args.study.quiet,

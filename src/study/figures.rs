@@ -5,7 +5,7 @@
 
 use plotters::prelude::*;
 
-use robovec_dynamics::study::run::{CaseResult, Shape};
+use crate::study::run::{CaseResult, Shape};
 use robovec_dynamics::topology::Topology;
 
 use crate::report_dir::figures::{Figure, PALETTE, SIZE};

@@ -33,6 +33,7 @@ use robovec_ir::{Function, Module, OpKind, Phase};
 pub use bound::{lower_bound, ops_per_side, tight_lower_bound};
 
 use crate::params::ParamKind;
+use crate::time_limit::TickerError;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Priority of ready ops (seed §2.3.1).

@@ -13,7 +13,7 @@ use robovec_ir::placement::{Load, Pe, PeArray};
 use robovec_ir::text::parse;
 use robovec_ir::verifier::machine::verify_machine;
 use robovec_ir::{Function, Operand, Value};
-use robovec_machine::encode::{through_images, Layout};
+use robovec_machine::encode::{output_image, pe_image, through_images, Layout};
 use robovec_machine::exec::execute;
 use robovec_machine::lower::lower;
 
@@ -140,7 +140,7 @@ fn data_words_are_interp_binary32() {
     let p = place_function(&f, &PlaceOptions::with_pes(1));
     let m = lower(&f, &p).unwrap();
     let expected = eval::<f32>(&f, input);
-    let out = m.output_image(0, input);
+    let out = output_image(&m, 0, input);
     for (loc, (name, x)) in m.outputs.iter().zip(&expected).skip(1) {
         assert_eq!(&loc.name, name);
         assert_eq!((loc.slot, out[loc.addr as usize]), (0, x.to_bits()), "output `{name}`");
@@ -148,7 +148,7 @@ fn data_words_are_interp_binary32() {
     assert_eq!(out[m.outputs[2].addr as usize], 0.1f32.to_bits());
     // The multiplier reads cos q and 0.1 from its memory image.
     let mul = &m.pes[1];
-    let image = m.pe_image(1, input);
+    let image = pe_image(&m, 1, input);
     let reads = &mul.steps.iter().find_map(|s| s.issue.as_ref()).unwrap().reads;
     let (cos_q, tenth) = (image[reads[0] as usize], image[reads[1] as usize]);
     assert_eq!(cos_q, (input("q") as f32).cos().to_bits());

@@ -13,6 +13,7 @@ use robovec_ir::{Function, Module};
 use super::{body, callbacks, has_fused, native, pinocchio, plain, robotran, split, trig};
 use super::{Abi, CodegenC, Emitted, Trig};
 use crate::codegen::CodegenArtifact;
+use crate::time_limit::TickerError;
 use crate::{GeneratedCode, PassError};
 
 /// Written at the top of every generated file: GCC 12's SLP vectoriser fuses a vector of

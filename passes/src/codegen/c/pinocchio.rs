@@ -56,6 +56,7 @@ use super::plain::{arrays, Layout, Source};
 use super::{CodegenC, Emitted};
 use crate::codegen::names::reserved_symbol_reason;
 use crate::codegen::Interface;
+use crate::time_limit::TickerError;
 use crate::PassError;
 
 /// The prefix of the symbols without `name=`: `model_rnea`, `model_crba`, ….

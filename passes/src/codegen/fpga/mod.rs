@@ -59,6 +59,7 @@ use robovec_machine::emit::{emit_until, DesignFile};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
 use crate::params::{word_enum, ParamKind, Word};
+use crate::time_limit::TickerError;
 use crate::{
     Artifact, ArtifactFile, Member, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry, Ticker,
 };

@@ -1,9 +1,9 @@
 //! The cases of the study (seed §3.2, Table 3.1): a number of degrees of freedom × a topology
-//! family ([`crate::topology`]), and the thesis's own rows of Table 3.1 to set beside them.
+//! family ([`robovec_dynamics::topology`]), and the thesis's own rows of Table 3.1 to set beside them.
 
 use serde::Serialize;
 
-use crate::topology::Topology;
+use robovec_dynamics::topology::Topology;
 
 /// The thesis's degrees of freedom (seed §3.2: "23-, 50-, 70-, 100- and 130-dof systems").
 pub const THESIS_DOFS: [usize; 5] = [23, 50, 70, 100, 130];

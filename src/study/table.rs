@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::cases::{thesis_row, ThesisRow};
 use super::run::{CaseResult, Shape, GENERATED, ZERO_BALANCE};
-use crate::topology::Topology;
+use robovec_dynamics::topology::Topology;
 
 /// `ops, ASAP − ASAPCycle, Y` of a shape, as the thesis prints them.
 fn shape_cell(s: &Shape) -> String {

@@ -1,5 +1,5 @@
-//! One case of the study, in process: the robot of [`crate::topology::build`], its
-//! equations by [`crate::generate`] (symbolic parameters, as `robovec-opt` reads the URDF
+//! One case of the study, in process: the robot of [`robovec_dynamics::topology::build`], its
+//! equations by [`robovec_dynamics::generate`] (symbolic parameters, as `robovec-opt` reads the URDF
 //! `robovec-gen` writes), then the pipelines through the pass manager. Every figure is read
 //! from the code behind `robovec-opt`'s `-stats` and `-report`: [`Figures::of`] (ops, ASAP,
 //! ASAPCycle, Y; the placement's cycles) and the `accuracy` artifact's report entry (bits of
@@ -12,7 +12,7 @@ use robovec_passes::{Instrumentation, PassContext, PassManager, PassRecord};
 use serde::Serialize;
 
 use super::cases::Case;
-use crate::{generate, topology::build, Model};
+use robovec_dynamics::{generate, topology::build, Model};
 
 /// The function of the study: direct dynamics (seed §3.2, Table 3.1).
 pub const FUNCTION: &str = "dirdyna";
@@ -26,7 +26,7 @@ pub const ZERO_BALANCE: &str = "atomise,zero-removal,balance";
 /// What to run on each case.
 #[derive(Clone, Debug)]
 pub struct Plan {
-    /// Seed of the robots' parameters ([`crate::topology::build`]).
+    /// Seed of the robots' parameters ([`robovec_dynamics::topology::build`]).
     pub seed: u64,
     /// `accuracy<samples=K>`: sampled states (accuracy's own seed stays 1, its default).
     pub samples: u32,
