@@ -20,7 +20,7 @@ use robovec_ir::{verifier, Module};
 use robovec_passes::report::report_text;
 use robovec_passes::summary::{self, Figures};
 use robovec_passes::{
-    whole_run, DumpSink, GeneratedCode, Instrumentation, PassContext, PassError, PassManager, PassRecord,
+    whole_run, DumpSink, GeneratedCode, Instrumentation, PassContext, PassError, PassManager, Session,
 };
 
 use crate::diagnostics::SourceFile;
@@ -172,10 +172,6 @@ impl DumpSink for StagedDumps<'_> {
 
 /// What a run hands to the writing step: the passes' records and context, with everything
 /// rendered in memory.
-struct Ran {
-    records: Vec<PassRecord>,
-    cx: PassContext,
-}
 
 /// Which of the run's standard streams are terminals (`robovec-opt` asks the OS; tests and
 /// library callers say so). Both false by default: a piped run.
@@ -259,7 +255,7 @@ pub fn run_with(
         defaults: loaded.input_defaults,
         defaults_source: loaded.defaults_source,
     });
-    let mut module = loaded.module;
+    let module = loaded.module;
     crate::preflight::check_functions(opts, &module)?;
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
     // removes what it staged.
@@ -276,36 +272,36 @@ pub fn run_with(
         out.stage(path, format!("{json}\n").as_bytes()).map_err(output_failure)?;
     }
     let progress = crate::progress_bars::progress_for(terminal.stderr, opts.quiet);
-    let ran = run_passes(opts, &pm, target, progress, deadline, &mut module, &src, &mut out, stderr)?;
-    write_outputs(opts, &pm, &module, &ran, eval_inputs.as_ref(), terminal, out, stdout, stderr)
+    let session = run_passes(opts, pm, target, progress, deadline, module, &src, &mut out, stderr)?;
+    write_outputs(opts, &session, eval_inputs.as_ref(), terminal, out, stdout, stderr)
 }
 
-/// Runs `-pareto` (before the pipeline, on the input), the pipeline with its dumps staged in
-/// `out`, then `-check`; prints the early-stop notes. `deadline` is the run's, started before
-/// loading.
+/// Runs `-pareto` (before the pipeline, on the input), the pipeline's session with its dumps
+/// staged in `out`, then `-check`; prints the early-stop notes. `deadline` is the run's,
+/// started before loading.
 #[allow(clippy::too_many_arguments)]
 fn run_passes(
     opts: &Options,
-    pm: &PassManager,
+    pm: PassManager,
     target: robovec_machine::target::Target,
     progress: robovec_passes::progress::Progress,
     deadline: Option<robovec_passes::Deadline>,
-    module: &mut Module,
+    module: Module,
     src: &SourceFile,
     out: &mut OutputSet,
     stderr: &mut dyn Write,
-) -> Result<Ran, Failure> {
+) -> Result<Session, Failure> {
     let mut cx = PassContext {
         original: opts.check.map(|_| module.clone()),
         deadline,
         progress,
-        code_file: crate::preflight::code_file(opts, pm),
+        code_file: crate::preflight::code_file(opts, &pm),
         ..PassContext::with_target(target)
     };
     if let Some(text) = &opts.pareto {
-        let name = select(module, &opts.function, "-pareto")?.name.clone();
+        let name = select(&module, &opts.function, "-pareto")?.name.clone();
         let study = whole_run::pareto::study(
-            module,
+            &module,
             &name,
             text,
             opts.pareto_samples,
@@ -317,47 +313,50 @@ fn run_passes(
         .map_err(Failure::from)?;
         cx.emit(study);
     }
-    let records = {
+    let mut session = Session::new(pm, module, cx);
+    {
         let dir = opts.instr.dump_dir.clone().unwrap_or_default();
         let mut dumps = StagedDumps { dir, out, created: false };
-        pm.run_with_dumps(module, &mut cx, stderr, &mut dumps).map_err(|e| match e {
+        session.run(stderr, &mut dumps).map_err(|e| match e {
             PassError::Output { message } => output_failure(message),
             PassError::Log(e) => stderr_failure(e),
             e => pass_failure(e, src),
-        })?
-    };
-    for s in &cx.stopped {
+        })?;
+    }
+    for s in &session.cx.stopped {
         writeln!(stderr, "note: {s}").map_err(stderr_failure)?;
     }
-    if let (Some((samples, seed)), Some(original)) = (opts.check, &cx.original) {
-        let pipeline = pm.pipeline_text();
-        whole_run::check::run(module, original, &pipeline, &opts.function, samples, seed, deadline, stderr)
-            .map_err(Failure::from)?;
+    if let (Some((samples, seed)), Some(original)) = (opts.check, &session.cx.original) {
+        whole_run::check::run(
+            &session.module,
+            original,
+            session.pipeline(),
+            &opts.function,
+            samples,
+            seed,
+            deadline,
+            stderr,
+        )
+        .map_err(Failure::from)?;
     }
-    Ok(Ran { records, cx })
+    Ok(session)
 }
 
 /// The report (SPEC §7) of the function `-report` describes: the run's own fields, the figures
 /// of the final IR, then each artifact's entry (merged by key), then the early stops.
 /// `computed` are those of [`summary::figures`] for `-function` (the reported function is among
 /// them; they are computed again only if it were not).
-fn report_json(
-    opts: &Options,
-    pm: &PassManager,
-    module: &Module,
-    ran: &Ran,
-    computed: &[Figures],
-) -> Result<String, Failure> {
-    let f = select(module, &opts.function, "-report")?;
+fn report_json(opts: &Options, session: &Session, computed: &[Figures]) -> Result<String, Failure> {
+    let f = select(&session.module, &opts.function, "-report")?;
     let fallback;
     let own = match computed.iter().find(|g| g.function == f.name) {
         Some(g) => g,
         None => {
-            fallback = Figures::of(f, &ran.cx);
+            fallback = Figures::of(f, &session.cx);
             &fallback
         }
     };
-    Ok(report_text(&opts.input, &pm.pipeline_text(), &ran.records, &ran.cx, own))
+    Ok(report_text(&opts.input, &session.pipeline().pipeline_text(), session.records(), &session.cx, own))
 }
 
 /// `-eval`'s JSON, with a warning on stderr for each input given that the function does not
@@ -411,16 +410,12 @@ fn eval_json(
 }
 
 /// The generated code `-o` writes when the pipeline ends in a back end.
-fn generated_code<'a>(pm: &PassManager, ran: &'a Ran) -> Result<Option<&'a GeneratedCode>, Failure> {
-    if pm.code_companions().is_none() {
+fn generated_code(session: &Session) -> Result<Option<&GeneratedCode>, Failure> {
+    if session.pipeline().back_end().is_none() {
         return Ok(None);
     }
-    let last = pm.last_index();
-    ran.cx
-        .artifacts
-        .iter()
-        .filter(|p| p.pass_index == last)
-        .find_map(|p| p.artifact.code())
+    session
+        .generated_code()
         .map(Some)
         .ok_or_else(|| Failure::Input("error: the pipeline's last pass is a back end but generated no code\n".into()))
 }
@@ -448,22 +443,20 @@ fn join_csv(tables: impl Iterator<Item = String>) -> String {
 #[allow(clippy::too_many_arguments)]
 fn write_outputs(
     opts: &Options,
-    pm: &PassManager,
-    module: &Module,
-    ran: &Ran,
+    session: &Session,
     eval_inputs: Option<&crate::eval::EvalInputs>,
     terminal: Terminal,
     mut out: OutputSet,
     stdout: &mut dyn Write,
     stderr: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let cx = &ran.cx;
+    let (cx, module) = (&session.cx, &session.module);
     // The final IR's figures, once for both the report and `-stats` (the placement's include
     // the tight lower bound, and a parsed function is atomised to be measured).
     let reporting = opts.report.is_some() || opts.report_dir.is_some();
     let figs =
         if opts.stats || reporting { summary::figures(module, cx, opts.function.as_deref()) } else { Vec::new() };
-    let report = reporting.then(|| report_json(opts, pm, module, ran, &figs)).transpose()?;
+    let report = reporting.then(|| report_json(opts, session, &figs)).transpose()?;
     let eval = eval_inputs.map(|given| eval_json(opts, module, given, stderr)).transpose()?;
     if opts.stats {
         write!(stderr, "{}", summary::stats_text(&figs, cx, opts.function.as_deref())).map_err(stderr_failure)?;
@@ -474,7 +467,7 @@ fn write_outputs(
         tables_shown |= !text.is_empty();
         write!(stderr, "{text}").map_err(stderr_failure)?;
     }
-    let code = generated_code(pm, ran)?;
+    let code = generated_code(session)?;
     // The IR is printed straight into its file or stdout (never held as one string: at 7× the
     // size of a Robotran input it would be the largest allocation of a run).
     let mut print_main = |w: &mut dyn Write| match code {

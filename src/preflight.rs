@@ -18,10 +18,10 @@ use crate::output;
 /// [`Failure::Output`] for a path the policy refuses; [`Failure::Input`] for a file a pass
 /// parameter names that cannot be opened.
 pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
-    if opts.sweep_csv.is_some() && !pm.passes().any(|p| p.makes_csv_table()) {
+    if opts.sweep_csv.is_some() && !pm.makes_csv_table() {
         return Err(Failure::Usage(format!(
             "error: -sweep-csv needs a {} pass in the pipeline (a pass whose results include a CSV table)\n",
-            csv_passes()
+            csv_passes(pm)
         )));
     }
     let output = opts.output.as_deref().filter(|p| p.as_os_str() != "-");
@@ -193,11 +193,13 @@ pub fn companion_path(output: &Path, ext: &str) -> Option<PathBuf> {
     }
 }
 
-/// The registered passes whose artifact has a CSV table, for messages (`` `sweep` ``).
-fn csv_passes() -> String {
-    robovec_passes::PASSES
+/// The registered passes declared with a CSV table ([`robovec_passes::Props::csv_table`]),
+/// for messages (`` `sweep` ``).
+fn csv_passes(pm: &PassManager) -> String {
+    let registry = pm.registry();
+    registry
         .iter()
-        .filter(|i| (i.build)(&robovec_passes::Params::defaults(i)).is_ok_and(|p| p.makes_csv_table()))
+        .filter(|i| registry.props_of(i.name).is_some_and(|p| p.csv_table))
         .map(|i| format!("`{}`", i.name))
         .collect::<Vec<_>>()
         .join(" or ")
@@ -207,7 +209,7 @@ fn csv_passes() -> String {
 fn pass_paths(pm: &PassManager, want: impl Fn(&ParamKind) -> bool) -> Vec<(&str, &str, &str)> {
     let mut out = Vec::new();
     for spec in pm.specs() {
-        let Some(info) = robovec_passes::pass_info(&spec.name) else { continue };
+        let Some(info) = pm.registry().get(&spec.name) else { continue };
         for (key, value) in &spec.params {
             let Some(decl) = info.param(key) else { continue };
             if let Some(value) = value.as_deref().filter(|v| !v.is_empty() && want(&decl.kind)) {

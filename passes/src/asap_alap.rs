@@ -7,9 +7,9 @@
 //! pass on (also for the report's `stats.asap_cycle`). Cost: O(values + operands).
 
 use robovec_ir::analysis::annotate_timing;
-use robovec_ir::{Module, Phase};
+use robovec_ir::Module;
 
-use crate::{AtTimeLimit, LatencyOverride, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{LatencyOverride, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -17,6 +17,13 @@ pub const INFO: PassInfo = PassInfo {
     doc: "annotate ops with ASAP/ALAP (unit) and ASAPCycle/ALAPCycle (latency) and mobility",
     params: crate::params::LATENCY_PARAMS,
     build: |p: &Params| Ok(Box::new(AsapAlap { lat: p.latency_override()? })),
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        preserves_timing: true,
+        bit_exact: true,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// The `asap-alap` pass.
@@ -29,18 +36,6 @@ pub struct AsapAlap {
 impl Pass for AsapAlap {
     fn name(&self) -> &'static str {
         "asap-alap"
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn preserves_timing(&self) -> bool {
-        true
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

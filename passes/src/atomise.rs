@@ -17,6 +17,7 @@ pub const INFO: PassInfo = PassInfo {
     doc: "split equations into binary operations (SPEC §3: left-to-right cascades, 0 - t, literal folding)",
     params: &[],
     build: |_: &Params| Ok(Box::new(Atomise)),
+    props: crate::Props { bit_exact: true, ..crate::Props::DEFAULT },
 };
 
 /// The `atomise` pass.

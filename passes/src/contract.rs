@@ -24,7 +24,7 @@
 
 use robovec_ir::{BinOp, Def, Function, Intrinsic, Module, Operand, Value};
 
-use crate::{AtTimeLimit, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{Params, Pass, PassContext, PassError, PassInfo, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -32,6 +32,7 @@ pub const INFO: PassInfo = PassInfo {
     doc: "fuse a*b +/- c into one fused multiply-add (@fma, @fms, @fnma; one rounding) where every use of the multiply is an add/sub: C's -ffp-contract in the IR, for CPUs with FMA",
     params: &[],
     build: |_: &Params| Ok(Box::new(Contract)),
+    props: crate::Props { requires: Some(robovec_ir::Phase::Atomised), at_time_limit: crate::AtTimeLimit::Skip, ..crate::Props::DEFAULT },
 };
 
 /// The `contract` pass.
@@ -129,14 +130,6 @@ pub fn contract_within(f: &mut Function, ticker: &Ticker) -> Contracted {
 impl Pass for Contract {
     fn name(&self) -> &'static str {
         "contract"
-    }
-
-    fn requires(&self) -> Option<robovec_ir::Phase> {
-        Some(robovec_ir::Phase::Atomised)
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

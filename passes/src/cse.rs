@@ -6,7 +6,7 @@ use robovec_ir::Module;
 
 pub use robovec_ir::transform::cse::{cse_function, cse_within};
 
-use crate::{AtTimeLimit, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -14,6 +14,7 @@ pub const INFO: PassInfo = PassInfo {
     doc: "common-subexpression elimination: an op equal to an earlier one (same operator, same operands; + and * commutative) is dropped, its users read the earlier one (bit-exact)",
     params: &[],
     build: |_: &Params| Ok(Box::new(Cse)),
+    props: crate::Props { at_time_limit: crate::AtTimeLimit::Skip, ..crate::Props::DEFAULT },
 };
 
 /// The `cse` pass.
@@ -23,10 +24,6 @@ pub struct Cse;
 impl Pass for Cse {
     fn name(&self) -> &'static str {
         "cse"
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

@@ -23,7 +23,7 @@ use robovec_ir::{Def, Function, Module, Operand, Phase, Value};
 
 use crate::params::ParamKind;
 use crate::tree_height::cluster::{Class, Clusters};
-use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -42,6 +42,11 @@ pub const INFO: PassInfo = PassInfo {
         },
     ],
     build: |p: &Params| Ok(Box::new(Inline { max_uses: p.u32("max-uses")?, max_size: p.u32("max-size")? })),
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// The `inline` pass.
@@ -69,14 +74,6 @@ pub struct InlineStats {
 impl Pass for Inline {
     fn name(&self) -> &'static str {
         "inline"
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

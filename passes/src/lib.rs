@@ -27,6 +27,7 @@ pub mod reference;
 pub mod report;
 pub mod rotate_3m;
 pub mod schedule_cpu;
+pub mod session;
 pub mod sim;
 pub mod specialize;
 pub mod summary;
@@ -43,9 +44,10 @@ use robovec_ir::{Module, Phase, Span};
 use robovec_machine::target::Target;
 
 pub use artifact::{unit_path, Artifact, ArtifactFile, GeneratedCode, Merge, Produced, ReportEntry};
-pub use manager::{DumpSink, Instrumentation, PassManager, PassRecord, PrintSelector};
+pub use manager::{DumpSink, Element, Instrumentation, PassManager, PassRecord, PrintSelector};
 pub use params::{LatencyOverride, Member, ParamInfo, ParamKind, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
+pub use session::Session;
 pub use time_limit::{AtTimeLimit, Deadline, Ticker};
 
 /// What a pass may fail with.
@@ -290,9 +292,16 @@ impl PassContext {
     pub fn artifacts(&self) -> impl Iterator<Item = &dyn Artifact> {
         self.artifacts.iter().map(|p| p.artifact.as_ref())
     }
+
+    /// The artifacts of type `T` produced so far, in order (results read as their own type).
+    pub fn artifacts_of<T: Artifact>(&self) -> impl Iterator<Item = &T> {
+        self.artifacts().filter_map(|a| (a as &dyn std::any::Any).downcast_ref::<T>())
+    }
 }
 
-/// A transformation or analysis over a whole module (`Debug` shows its options).
+/// A transformation or analysis over a whole module (`Debug` shows its options). What the
+/// manager needs to know of a pass besides running it is declared in the registry
+/// ([`PassInfo::props`], [`Props`]), not asked of the pass.
 pub trait Pass: std::fmt::Debug {
     /// The registered (kebab-case) name.
     fn name(&self) -> &'static str;
@@ -301,42 +310,81 @@ pub trait Pass: std::fmt::Debug {
     /// # Errors
     /// [`PassError`] when the input is not what the pass accepts.
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError>;
-    /// The phase every function must be in, if any; the manager checks it before `run`.
-    fn requires(&self) -> Option<Phase> {
+    /// For a back end whose code `-o` writes (`codegen<c>`; `codegen<fpga>` writes a folder and
+    /// leaves `-o` the IR): what `-o` and the output policy need to know of that code before
+    /// it runs.
+    fn as_back_end(&self) -> Option<&dyn BackEnd> {
         None
     }
-    /// What the manager does when `-time-limit` is reached before the pass starts
-    /// ([`time_limit`]): by default the run ends ([`AtTimeLimit::Required`]); a pass the
-    /// module is valid and complete without says [`AtTimeLimit::Skip`].
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Required
-    }
-    /// True when the pass keeps existing timing attributes valid (analyses that only read, or
-    /// write timing themselves); otherwise the manager clears them after the pass.
-    fn preserves_timing(&self) -> bool {
-        false
-    }
-    /// True when the pass reads [`PassContext::original`] (the manager then keeps a copy of
-    /// the module as it entered the pipeline).
-    fn needs_original(&self) -> bool {
-        false
-    }
-    /// True when the pass's artifact has a CSV table (what `-sweep-csv=FILE` writes).
-    fn makes_csv_table(&self) -> bool {
-        false
-    }
-    /// For a back end: the extensions of the companion files of the code it generates (`["h"]`
-    /// for C's header). A pipeline whose last pass returns `Some` writes that pass's code with
-    /// `-o FILE` instead of the IR, and the companions beside `FILE` (SPEC §8).
-    fn code_companions(&self) -> Option<&'static [&'static str]> {
-        None
+}
+
+/// What a back end's code is written as (SPEC §8): the files beside `-o FILE`. A back end whose
+/// code `-o` writes implements it and returns itself from [`Pass::as_back_end`].
+pub trait BackEnd {
+    /// The extensions of the companion files of the code (`["h"]` for C's header). A pipeline
+    /// whose last pass is a back end writes that pass's code with `-o FILE` instead of the IR,
+    /// and the companions beside `FILE`.
+    fn companions(&self) -> &'static [&'static str] {
+        &[]
     }
 
-    /// For a back end: the translation units its code is written as (`codegen<c;units=K>`;
-    /// 1: the main file only). With more than one, `-o FILE` is required and unit `k` goes to
+    /// The translation units the code is written as (`codegen<c;units=K>`; 1: the main file
+    /// only). With more than one, `-o FILE` is required and unit `k` goes to
     /// [`unit_path`]`(FILE, k)` ([`GeneratedCode::units`]).
-    fn code_units(&self) -> usize {
+    fn units(&self) -> usize {
         1
+    }
+}
+
+/// The properties of a pass, declared with it in the registry ([`PassInfo::props`], or a
+/// family member's [`Member::props`]) and read from there by the manager, the session's
+/// questions ([`Session::is_bit_exact`], …), the driver's checks and the test kit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Props {
+    /// The phase every function must be in, if any; the manager checks it before the pass runs.
+    pub requires: Option<Phase>,
+    /// What the manager does when `-time-limit` is reached before the pass starts
+    /// ([`time_limit`]): the run ends ([`AtTimeLimit::Required`], the default), or the pass is
+    /// skipped ([`AtTimeLimit::Skip`]: the module is valid and complete without it).
+    pub at_time_limit: AtTimeLimit,
+    /// The pass keeps existing timing attributes valid (analyses that only read, or write
+    /// timing themselves); otherwise the manager clears them after the pass.
+    pub preserves_timing: bool,
+    /// The pass reads [`PassContext::original`] (the manager then keeps a copy of the module as
+    /// it entered the pipeline).
+    pub needs_original: bool,
+    /// Every output keeps its value bit for bit in binary32 and binary64 (the sign of an exact
+    /// zero aside): a pipeline of such passes must reproduce its input exactly (`-check`,
+    /// `-pareto`, the test kit's numeric property; docs/accuracy.md).
+    pub bit_exact: bool,
+    /// The pass that must run right before this one (`sim` executes the placement `place`
+    /// attaches; any pass in between may drop it).
+    pub needs_before: Option<&'static str>,
+    /// Its artifact has a CSV table (what `-sweep-csv=FILE` writes).
+    pub csv_table: bool,
+    /// A back end: it writes the module as code or design files (the `codegen` family's
+    /// members); one whose code `-o` writes implements [`BackEnd`].
+    pub back_end: bool,
+}
+
+impl Props {
+    /// A required pass that needs no phase, clears timing and is not bit-exact: the
+    /// properties a declaration starts from (`Props { bit_exact: true, ..Props::DEFAULT }`).
+    pub const DEFAULT: Props = Props {
+        requires: None,
+        at_time_limit: AtTimeLimit::Required,
+        preserves_timing: false,
+        needs_original: false,
+        bit_exact: false,
+        needs_before: None,
+        csv_table: false,
+        back_end: false,
+    };
+}
+
+impl Default for Props {
+    fn default() -> Props {
+        Props::DEFAULT
     }
 }
 
@@ -351,6 +399,8 @@ pub struct PassInfo {
     pub params: &'static [ParamInfo],
     /// Builds the pass from checked parameters (a family: [`Params::build_member`]).
     pub build: fn(&Params) -> Result<Box<dyn Pass>, PassError>,
+    /// Its properties (a family's members declare their own: [`Member::props`]).
+    pub props: Props,
 }
 
 impl PassInfo {
@@ -366,50 +416,109 @@ impl PassInfo {
     }
 }
 
-/// The registry: every pass robovec knows, in `--print-passes` order.
-pub const PASSES: &[PassInfo] = &[
-    atomise::INFO,
-    dce::INFO,
-    asap_alap::INFO,
-    place::INFO,
-    sim::INFO,
-    sweep::INFO,
-    accuracy::INFO,
-    tree_height::zero_removal::INFO,
-    tree_height::swap::INFO,
-    tree_height::balance::INFO,
-    inline::INFO,
-    tree_height::distribute::INFO,
-    recurrence::INFO,
-    rotate_3m::INFO,
-    depth_bound::INFO,
-    specialize::INFO,
-    eqsat::INFO,
-    cse::INFO,
-    contract::INFO,
-    schedule_cpu::INFO,
-    codegen::INFO,
-];
+/// A registry of passes: the table `-passes=` names are looked up in, `--print-passes` and
+/// docs/passes.md are written from, and the manager reads each pass's [`Props`] from. This
+/// crate's own is [`PASSES`] (the transforms and analyses); the complete one, with the back
+/// ends, is `robovec_backends::REGISTRY`.
+#[derive(Clone, Copy, Debug)]
+pub struct Registry {
+    /// Every pass, in `--print-passes` order.
+    pub passes: &'static [&'static PassInfo],
+}
 
-/// Looks up a registered pass.
+impl std::fmt::Debug for PassInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "PassInfo({})", self.name)
+    }
+}
+
+impl Registry {
+    /// Looks up a registered pass.
+    pub fn get(&self, name: &str) -> Option<&'static PassInfo> {
+        self.passes.iter().copied().find(|p| p.name == name)
+    }
+
+    /// Comma-separated names of all registered passes.
+    pub fn names(&self) -> String {
+        self.passes.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
+    }
+
+    /// Every registered pass, in order.
+    pub fn iter(&self) -> impl Iterator<Item = &'static PassInfo> {
+        self.passes.iter().copied()
+    }
+
+    /// Builds the pass of a parsed pipeline element, checking its parameters; with the
+    /// properties it was declared with (a family member's, for a family).
+    ///
+    /// # Errors
+    /// [`PassError::UnknownPass`] or [`PassError::BadParameter`].
+    pub fn build(&self, spec: &PassSpec) -> Result<(Props, Box<dyn Pass>), PassError> {
+        let info = self
+            .get(&spec.name)
+            .ok_or_else(|| PassError::UnknownPass { name: spec.name.clone(), valid: self.names() })?;
+        let params = Params::check(info, &spec.params)?;
+        let props = params.member().map_or(info.props, |m| m.props);
+        (info.build)(&params).map(|p| (props, p))
+    }
+
+    /// The properties of a registered pass built with default parameters (a family: its
+    /// default member's), `None` for an unknown name.
+    pub fn props_of(&self, name: &str) -> Option<Props> {
+        let info = self.get(name)?;
+        let params = Params::defaults(info);
+        Some(params.member().map_or(info.props, |m| m.props))
+    }
+}
+
+impl IntoIterator for Registry {
+    type Item = &'static PassInfo;
+    type IntoIter = std::iter::Copied<std::slice::Iter<'static, &'static PassInfo>>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.passes.iter().copied()
+    }
+}
+
+/// The registry of this crate: every transform and analysis, in `--print-passes` order (the
+/// back ends follow them in `robovec_backends::REGISTRY`).
+pub const PASSES: Registry = Registry {
+    passes: &[
+        &atomise::INFO,
+        &dce::INFO,
+        &asap_alap::INFO,
+        &place::INFO,
+        &sim::INFO,
+        &sweep::INFO,
+        &accuracy::INFO,
+        &tree_height::zero_removal::INFO,
+        &tree_height::swap::INFO,
+        &tree_height::balance::INFO,
+        &inline::INFO,
+        &tree_height::distribute::INFO,
+        &recurrence::INFO,
+        &rotate_3m::INFO,
+        &depth_bound::INFO,
+        &specialize::INFO,
+        &eqsat::INFO,
+        &cse::INFO,
+        &contract::INFO,
+        &schedule_cpu::INFO,
+        &codegen::INFO,
+    ],
+};
+
+/// Looks up a pass of [`PASSES`].
 pub fn pass_info(name: &str) -> Option<&'static PassInfo> {
-    PASSES.iter().find(|p| p.name == name)
+    PASSES.get(name)
 }
 
-/// Comma-separated names of all registered passes.
-pub fn pass_names() -> String {
-    PASSES.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
-}
-
-/// Builds the pass of a parsed pipeline element, checking its parameters.
+/// Builds the pass of a parsed pipeline element from [`PASSES`], checking its parameters.
 ///
 /// # Errors
 /// [`PassError::UnknownPass`] or [`PassError::BadParameter`].
 pub fn build_pass(spec: &PassSpec) -> Result<Box<dyn Pass>, PassError> {
-    let info =
-        pass_info(&spec.name).ok_or_else(|| PassError::UnknownPass { name: spec.name.clone(), valid: pass_names() })?;
-    let params = Params::check(info, &spec.params)?;
-    (info.build)(&params)
+    PASSES.build(spec).map(|(_, p)| p)
 }
 
 /// Checks that every function of `m` is in `phase`.

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use robovec_ir::{verifier, Module};
 
-use crate::{build_pass, parse_pipeline, AtTimeLimit, Pass, PassContext, PassError, PassSpec};
+use crate::{parse_pipeline, AtTimeLimit, BackEnd, Pass, PassContext, PassError, PassSpec, Props, Registry};
 
 /// Which passes to print the IR before/after.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -94,7 +94,7 @@ pub trait DumpSink {
 }
 
 /// The sink of [`PassManager::run`]: dumps need a real sink, so this one refuses them.
-struct NoDumps;
+pub(crate) struct NoDumps;
 
 impl DumpSink for NoDumps {
     fn dump(&mut self, name: &str, _: &str) -> Result<(), String> {
@@ -102,10 +102,23 @@ impl DumpSink for NoDumps {
     }
 }
 
-/// A parsed and checked pipeline with its instrumentation.
+/// One element of a pipeline: as written, its declared properties and the built pass.
+pub struct Element {
+    /// The element as written (name and raw parameters).
+    pub spec: PassSpec,
+    /// Its properties, as the registry declares them ([`crate::PassInfo::props`], or its
+    /// family member's).
+    pub props: Props,
+    /// The built pass.
+    pub pass: Box<dyn Pass>,
+}
+
+/// A parsed and checked pipeline with its instrumentation: what a [`crate::Session`] runs,
+/// and what the checks before any work ask about (its back end, whether it is bit-exact, …).
 pub struct PassManager {
-    passes: Vec<(PassSpec, Box<dyn Pass>)>,
+    passes: Vec<Element>,
     instr: Instrumentation,
+    registry: Registry,
 }
 
 /// Total ops of a module.
@@ -114,48 +127,99 @@ pub fn module_ops(m: &Module) -> u64 {
 }
 
 impl PassManager {
-    /// Parses `pipeline` and builds every pass (all names and parameters checked up front).
+    /// Parses `pipeline` and builds every pass of [`crate::PASSES`] (all names and parameters
+    /// checked up front).
     ///
     /// # Errors
     /// [`PassError::BadPipeline`], [`PassError::UnknownPass`], [`PassError::BadParameter`].
     pub fn new(pipeline: &str, instr: Instrumentation) -> Result<PassManager, PassError> {
+        PassManager::with_registry(crate::PASSES, pipeline, instr)
+    }
+
+    /// Parses `pipeline` and builds every pass from `registry` (all names and parameters
+    /// checked up front).
+    ///
+    /// # Errors
+    /// [`PassError::BadPipeline`], [`PassError::UnknownPass`], [`PassError::BadParameter`].
+    pub fn with_registry(registry: Registry, pipeline: &str, instr: Instrumentation) -> Result<PassManager, PassError> {
         let specs = if pipeline.trim().is_empty() { Vec::new() } else { parse_pipeline(pipeline)? };
-        let passes = specs.into_iter().map(|s| build_pass(&s).map(|p| (s, p))).collect::<Result<Vec<_>, _>>()?;
-        if let PrintSelector::Passes(names) = instr.print_before.clone() {
-            check_names(&names)?;
+        let passes = specs
+            .into_iter()
+            .map(|spec| registry.build(&spec).map(|(props, pass)| Element { spec, props, pass }))
+            .collect::<Result<Vec<_>, _>>()?;
+        for selector in [&instr.print_before, &instr.print_after] {
+            if let PrintSelector::Passes(names) = selector {
+                for n in names {
+                    if registry.get(n).is_none() {
+                        return Err(PassError::UnknownPass { name: n.clone(), valid: registry.names() });
+                    }
+                }
+            }
         }
-        if let PrintSelector::Passes(names) = instr.print_after.clone() {
-            check_names(&names)?;
-        }
-        Ok(PassManager { passes, instr })
+        Ok(PassManager { passes, instr, registry })
+    }
+
+    /// Appends `more`'s elements (a session that ran it after this pipeline:
+    /// [`crate::Session::run_more`]).
+    pub fn append(&mut self, more: PassManager) {
+        self.passes.extend(more.passes);
+    }
+
+    /// The registry the pipeline was built from.
+    pub fn registry(&self) -> Registry {
+        self.registry
     }
 
     /// The normalised pipeline text (round-trips through [`PassManager::new`]).
     pub fn pipeline_text(&self) -> String {
-        self.passes.iter().map(|(s, _)| s.to_string()).collect::<Vec<_>>().join(",")
+        self.passes.iter().map(|e| e.spec.to_string()).collect::<Vec<_>>().join(",")
     }
 
     /// The elements of the pipeline, in order (names and raw parameters), for checking
     /// options against it before any work.
     pub fn specs(&self) -> impl Iterator<Item = &PassSpec> {
-        self.passes.iter().map(|(s, _)| s)
+        self.passes.iter().map(|e| &e.spec)
+    }
+
+    /// The elements of the pipeline, in order: each as written, its declared properties and
+    /// the built pass.
+    pub fn elements(&self) -> impl Iterator<Item = &Element> {
+        self.passes.iter()
     }
 
     /// The built passes, in order.
     pub fn passes(&self) -> impl Iterator<Item = &dyn Pass> {
-        self.passes.iter().map(|(_, p)| p.as_ref())
+        self.passes.iter().map(|e| e.pass.as_ref())
     }
 
-    /// When the pipeline ends in a back end ([`Pass::code_companions`]): the extensions of the
-    /// companion files of its code. `-o FILE` then receives the code, not the IR.
+    /// True when every pass of the pipeline is declared bit-exact ([`Props::bit_exact`]; an
+    /// empty pipeline is): its result must reproduce its input bit for bit.
+    pub fn is_bit_exact(&self) -> bool {
+        self.passes.iter().all(|e| e.props.bit_exact)
+    }
+
+    /// True when some pass's artifact has a CSV table ([`Props::csv_table`]).
+    pub fn makes_csv_table(&self) -> bool {
+        self.passes.iter().any(|e| e.props.csv_table)
+    }
+
+    /// The back end the pipeline ends in, when `-o` writes its code ([`Props::back_end`] and
+    /// [`Pass::as_back_end`]): `-o FILE` then receives its code, not the IR, with its companion
+    /// files beside it.
+    pub fn back_end(&self) -> Option<&dyn BackEnd> {
+        self.passes.last().filter(|e| e.props.back_end).and_then(|e| e.pass.as_back_end())
+    }
+
+    /// When the pipeline ends in a back end ([`PassManager::back_end`]): the extensions of the
+    /// companion files of its code.
     pub fn code_companions(&self) -> Option<&'static [&'static str]> {
-        self.passes.last().and_then(|(_, p)| p.code_companions())
+        self.back_end().map(BackEnd::companions)
     }
 
-    /// The translation units of the back end the pipeline ends in ([`Pass::code_units`]; 1
+    /// The translation units of the back end the pipeline ends in ([`BackEnd::units`]; 1
     /// otherwise).
     pub fn code_units(&self) -> usize {
-        self.passes.last().map_or(1, |(_, p)| p.code_units())
+        self.back_end().map_or(1, BackEnd::units)
     }
 
     /// Index of the last pipeline element (the one whose code `-o` writes).
@@ -192,16 +256,16 @@ impl PassManager {
             Some(_) => dumps.dump(&name, &m.to_string()).map_err(|message| PassError::Output { message }),
             None => Ok(()),
         };
-        if cx.original.is_none() && self.passes.iter().any(|(_, p)| p.needs_original()) {
+        if cx.original.is_none() && self.passes.iter().any(|e| e.props.needs_original) {
             cx.original = Some(m.clone());
         }
         let mut records = Vec::new();
         note_atomised_ops(m, cx);
-        for (i, (spec, pass)) in self.passes.iter().enumerate() {
+        for (i, Element { spec, props, pass }) in self.passes.iter().enumerate() {
             let name = pass.name();
             if let Some(d) = cx.deadline.filter(crate::Deadline::reached) {
                 // `-time-limit` reached before the pass starts (crate::time_limit's policy).
-                match pass.at_time_limit() {
+                match props.at_time_limit {
                     AtTimeLimit::Skip => {
                         cx.stopped.push(format!("{spec} skipped: {} before it started", d.reason()));
                         let (ops_before, ops_after) = (module_ops(m), module_ops(m));
@@ -224,19 +288,19 @@ impl PassManager {
                 write!(log, "*** IR Dump Before {spec} ***\n{m}").map_err(PassError::Log)?;
             }
             dump(format!("{:03}-{name}.before.rvir", i + 1), m)?;
-            if let Some(phase) = pass.requires() {
+            if let Some(phase) = props.requires {
                 crate::require_phase(name, m, phase)?;
             }
             let ops_before = module_ops(m);
             let t0 = Instant::now();
             cx.pass_index = Some(i);
-            cx.running = pass.at_time_limit();
+            cx.running = props.at_time_limit;
             let ran = pass.run(m, cx);
             cx.pass_index = None;
             cx.running = AtTimeLimit::Skip;
             ran?;
             let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-            if !pass.preserves_timing() {
+            if !props.preserves_timing {
                 m.functions.iter_mut().for_each(|f| f.clear_timing());
             }
             records.push(PassRecord { name: spec.to_string(), wall_ms, ops_before, ops_after: module_ops(m) });
@@ -271,15 +335,6 @@ impl PassManager {
         }
         Ok(records)
     }
-}
-
-fn check_names(names: &[String]) -> Result<(), PassError> {
-    for n in names {
-        if crate::pass_info(n).is_none() {
-            return Err(PassError::UnknownPass { name: n.clone(), valid: crate::pass_names() });
-        }
-    }
-    Ok(())
 }
 
 fn verify_named(m: &Module, pass: &str) -> Result<(), PassError> {

@@ -16,7 +16,7 @@ pub fn text() -> String {
     let line =
         |q: &ParamInfo| format!("      {:<12} (default {}; {}) {}\n", q.name, q.default_text(), q.range_text(), q.doc);
     let mut s = String::from("Passes (use -passes=a,b<k=v;k2=v2>,c):\n");
-    for p in PASSES {
+    for p in PASSES.iter() {
         s += &format!("  {:<12} {}\n", p.name, p.doc);
         for q in p.params {
             s += &line(q);
@@ -52,7 +52,7 @@ pub fn markdown() -> String {
          [manual](README.md).\n\n",
     );
     s += "| pass | what it does |\n|---|---|\n";
-    for p in PASSES {
+    for p in PASSES.iter() {
         s += &format!("| [`{}`](#{}) | {} |\n", p.name, p.name, cell(p.doc));
     }
     s += "\nNamed pipelines stand for a list of passes anywhere in a pipeline \
@@ -61,7 +61,7 @@ pub fn markdown() -> String {
     for n in NAMED {
         s += &format!("| `{}` | `{}` | {} |\n", n.name, n.expansion, cell(n.doc));
     }
-    for p in PASSES {
+    for p in PASSES.iter() {
         s += &format!("\n## `{}`\n\n{}\n", p.name, p.doc);
         s += &table(p.params);
         for (selector, m) in members(p) {

@@ -23,7 +23,7 @@
 
 use std::collections::BTreeMap;
 
-use robovec_ir::{BinOp, Def, Function, Module, Operand, Phase, TrigFn};
+use robovec_ir::{BinOp, Def, Function, Module, Operand, TrigFn};
 
 use crate::dce::Dce;
 use crate::params::ParamKind;
@@ -40,6 +40,7 @@ pub const INFO: PassInfo = PassInfo {
         doc: "JSON file: object of canonical input name -> number, e.g. {\"dpt[3][5]\": 0}; without it only constants fold",
     }],
     build: |p: &Params| Ok(Box::new(Specialize { path: p.path("params")? })),
+    props: crate::Props { requires: Some(robovec_ir::Phase::Atomised), ..crate::Props::DEFAULT },
 };
 
 /// The `specialize` pass.
@@ -68,10 +69,6 @@ pub fn read_params(path: &str) -> Result<BTreeMap<String, f64>, PassError> {
 impl Pass for Specialize {
     fn name(&self) -> &'static str {
         "specialize"
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

@@ -19,7 +19,7 @@
 //! fit the device (in any configuration); `null` when none does.
 
 use robovec_ir::analysis::compute_timing;
-use robovec_ir::{Module, Phase};
+use robovec_ir::Module;
 
 use crate::params::ParamKind;
 use crate::place::{
@@ -214,6 +214,14 @@ pub const INFO: PassInfo = PassInfo {
         doc: "values of N, comma-separated",
     }],
     build: |p: &Params| Ok(Box::new(Sweep { ns: p.u32_list("pe")? })),
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        preserves_timing: true,
+        bit_exact: true,
+        csv_table: true,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// The `sweep` pass.
@@ -226,22 +234,6 @@ pub struct Sweep {
 impl Pass for Sweep {
     fn name(&self) -> &'static str {
         "sweep"
-    }
-
-    fn at_time_limit(&self) -> crate::AtTimeLimit {
-        crate::AtTimeLimit::Skip
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn preserves_timing(&self) -> bool {
-        true
-    }
-
-    fn makes_csv_table(&self) -> bool {
-        true
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

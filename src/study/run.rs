@@ -6,9 +6,10 @@
 //! error).
 
 use robovec_ir::Module;
+use robovec_passes::accuracy::report::AccuracyRun;
 use robovec_passes::summary::Figures;
 use robovec_passes::whole_run::{self, Failure};
-use robovec_passes::{Instrumentation, PassContext, PassManager, PassRecord};
+use robovec_passes::{Instrumentation, PassContext, PassManager, Session};
 use serde::Serialize;
 
 use super::cases::Case;
@@ -116,11 +117,13 @@ pub fn manager(pipeline: &str) -> Result<PassManager, Failure> {
         .map_err(|e| Failure::Usage(format!("error: {e}\n")))
 }
 
-/// Runs `pipeline` on `m` with `cx`; the passes' records.
-fn run_on(pipeline: &str, m: &mut Module, cx: &mut PassContext, case: &Case) -> Result<Vec<PassRecord>, Failure> {
-    manager(pipeline)?
-        .run(m, cx, &mut std::io::sink())
-        .map_err(|e| Failure::Input(format!("error: {}: pipeline `{pipeline}`: {e}\n", case.label())))
+/// A session of `pipeline` on `m` with `cx`, run.
+fn run_on(pipeline: &str, m: Module, cx: PassContext, case: &Case) -> Result<Session, Failure> {
+    let mut session = Session::new(manager(pipeline)?, m, cx);
+    session
+        .run_quiet()
+        .map_err(|e| Failure::Input(format!("error: {}: pipeline `{pipeline}`: {e}\n", case.label())))?;
+    Ok(session)
 }
 
 /// The figures of [`FUNCTION`] in `m`.
@@ -154,15 +157,12 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
     let generated = module_of(case, plan.seed);
     let target = robovec_machine::target::Target::de10_nano();
     let shape_after = |pipeline: &str| -> Result<Shape, Failure> {
-        let mut m = generated.clone();
-        let mut cx = PassContext::with_target(target.clone());
-        run_on(pipeline, &mut m, &mut cx, case)?;
-        Ok(Shape::of(&figures(&m, &cx)))
+        let s = run_on(pipeline, generated.clone(), PassContext::with_target(target.clone()), case)?;
+        Ok(Shape::of(&figures(&s.module, &s.cx)))
     };
     let gen_shape = shape_after(GENERATED)?;
     let zb_shape = shape_after(ZERO_BALANCE)?;
 
-    let mut best = generated.clone();
     let mut cx = PassContext { original: Some(generated.clone()), ..PassContext::with_target(target.clone()) };
     if plan.report {
         let text = format!("{GENERATED};{ZERO_BALANCE};{}", plan.best);
@@ -182,8 +182,9 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
         })?;
         cx.emit(pareto);
     }
-    let mut records = run_on(&plan.best, &mut best, &mut cx, case)?;
-    let best_shape = Shape::of(&figures(&best, &cx));
+    let mut session = run_on(&plan.best, generated.clone(), cx, case)?;
+    let best_shape = Shape::of(&figures(&session.module, &session.cx));
+    let best = session.module.clone();
     let n0 = plan.ns.first().copied();
     let mut tail = format!("accuracy<samples={}>", plan.samples);
     if plan.report {
@@ -193,24 +194,29 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
             tail += &format!(",place<pe={n}>");
         }
     }
-    let mut after = best.clone();
-    records.extend(run_on(&tail, &mut after, &mut cx, case)?);
-    let bits = accuracy_bits(&cx, case)?;
+    session
+        .run_more(manager(&tail)?)
+        .map_err(|e| Failure::Input(format!("error: {}: pipeline `{tail}`: {e}\n", case.label())))?;
+    let bits = accuracy_bits(&session, case)?;
     let mut placed = Vec::new();
     let mut report = None;
     if plan.report {
-        let own = figures(&after, &cx);
+        let own = figures(&session.module, &session.cx);
         if let (Some(n), Some(p)) = (n0, &own.placement) {
             placed.push(Placed { n, cycles: p.cycles });
         }
         let pipeline = format!("{},{tail}", plan.best);
-        report = Some(robovec_passes::report::report_text(&case.urdf_name(plan.seed), &pipeline, &records, &cx, &own));
+        report = Some(robovec_passes::report::report_text(
+            &case.urdf_name(plan.seed),
+            &pipeline,
+            session.records(),
+            &session.cx,
+            &own,
+        ));
     }
     for &n in plan.ns.iter().skip(placed.len()) {
-        let mut m = best.clone();
-        let mut pcx = continuing(&cx);
-        run_on(&format!("place<pe={n}>"), &mut m, &mut pcx, case)?;
-        let cycles = figures(&m, &pcx).placement.map_or(0, |p| p.cycles);
+        let s = run_on(&format!("place<pe={n}>"), best.clone(), continuing(&session.cx), case)?;
+        let cycles = figures(&s.module, &s.cx).placement.map_or(0, |p| p.cycles);
         placed.push(Placed { n, cycles });
     }
     Ok(CaseResult {
@@ -224,15 +230,13 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
     })
 }
 
-/// binary32 mean / max bits of the `accuracy` artifact's report entry for [`FUNCTION`] (the
-/// report's `accuracy.f32`, what `-stats` prints as `f32 mean/p95/max`).
-fn accuracy_bits(cx: &PassContext, case: &Case) -> Result<Bits, Failure> {
-    let entries = robovec_passes::artifact::report_entries(cx.artifacts(), FUNCTION);
-    let acc = entries
-        .iter()
-        .find(|(k, _)| *k == "accuracy")
-        .map(|(_, v)| v)
+/// binary32 mean / max bits of the last `accuracy` measurement of [`FUNCTION`] (the report's
+/// `accuracy.f32`, what `-stats` prints as `f32 mean/p95/max`), read as the pass's own type.
+fn accuracy_bits(session: &Session, case: &Case) -> Result<Bits, Failure> {
+    let acc = session
+        .artifacts_of::<AccuracyRun>()
+        .filter_map(|run| run.reports.iter().find(|r| r.function == FUNCTION))
+        .last()
         .ok_or_else(|| Failure::Input(format!("error: {}: accuracy reported nothing\n", case.label())))?;
-    let get = |k: &str| acc.pointer(&format!("/f32/{k}")).and_then(serde_json::Value::as_f64).unwrap_or(f64::NAN);
-    Ok(Bits { mean: get("mean_bits"), max: get("max_bits") })
+    Ok(Bits { mean: acc.f32.mean_bits, max: acc.f32.max_bits })
 }

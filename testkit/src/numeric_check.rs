@@ -7,7 +7,9 @@
 //!   `|fl(after) − exact(before)| ≤ γ_K(after)·M(after) + γ_K(before)(2⁻¹⁰⁰)·M(before) + slack`,
 //!   the second term covering the double-double reference (so an algebraically different
 //!   rewrite fails, a reassociation within its rounding passes);
-//! - pipelines made only of passes in [`BIT_EXACT`] reproduce the original bit for bit, except
+//! - pipelines made only of passes the registry declares bit-exact (`Props::bit_exact`, asked
+//!   of the pipeline as built: `PassManager::is_bit_exact`, so a parameter list such as
+//!   `sweep<pe=8,16>` is never split at its commas) reproduce the original bit for bit, except
 //!   the sign of an exact zero (`atomise` writes `−t` as `0 − t`; docs/ir.md, "Unary minus
 //!   semantics").
 //!
@@ -18,8 +20,7 @@ use robovec_ir::numerics::budget::{allowed, gamma, terms, U32, U64};
 use robovec_ir::numerics::{Tape, DD};
 use robovec_ir::{Function, Module, Phase};
 
-pub use robovec_passes::accuracy::check::BIT_EXACT;
-use robovec_passes::{Instrumentation, PassContext, PassManager, PASSES};
+use robovec_passes::{Instrumentation, PassContext, PassManager, Session, PASSES};
 
 /// Registered passes the property cannot build from default parameters because they need a
 /// file (none today: `accuracy`'s `params` file is optional).
@@ -30,19 +31,20 @@ pub fn checked_passes() -> Vec<&'static str> {
     PASSES.iter().map(|p| p.name).filter(|n| !NEEDS_FILE.contains(n)).collect()
 }
 
-/// Passes that need another pass right before them, beyond the phase (`Pass::requires`):
-/// `sim` executes the placement that `place` attaches (any other pass in between may drop it).
-pub const NEEDS_BEFORE: &[(&str, &str)] = &[("sim", "place")];
+/// The registered passes declared bit-exact (`Props::bit_exact`), in registry order.
+pub fn bit_exact_passes() -> Vec<&'static str> {
+    PASSES.iter().map(|p| p.name).filter(|n| PASSES.props_of(n).is_some_and(|p| p.bit_exact)).collect()
+}
 
 /// The pipeline text for `names` with default parameters: `atomise` inserted before the first
 /// pass that needs the atomised phase (the manager would reject it on parsed input), and the
-/// [`NEEDS_BEFORE`] prerequisites right before the passes that need them.
+/// pass a pass declares it needs right before it (`Props::needs_before`: `sim` after `place`)
+/// inserted there.
 pub fn pipeline_text(names: &[&str]) -> String {
     let mut out: Vec<&str> = Vec::new();
     let mut atomised = false;
     let mut push = |n: &'static str, out: &mut Vec<&'static str>| {
-        let p = robovec_passes::pass_info(n).expect("registered pass");
-        let needs = (p.build)(&robovec_passes::Params::defaults(p)).ok().and_then(|b| b.requires());
+        let needs = PASSES.props_of(n).expect("registered pass").requires;
         if needs == Some(Phase::Atomised) && !atomised {
             out.push("atomise");
             atomised = true;
@@ -52,7 +54,7 @@ pub fn pipeline_text(names: &[&str]) -> String {
     };
     for &n in names {
         let n = checked_passes().into_iter().find(|&x| x == n).expect("registered pass");
-        if let Some(&(_, pre)) = NEEDS_BEFORE.iter().find(|(p, _)| *p == n) {
+        if let Some(pre) = PASSES.props_of(n).and_then(|p| p.needs_before) {
             if out.last() != Some(&pre) {
                 push(pre, &mut out);
             }
@@ -73,11 +75,12 @@ fn same_bits<T: Copy + PartialEq + Into<f64>>(a: T, b: T, bits: impl Fn(T) -> u6
 /// A message naming the pipeline, the output, the point and the figures.
 pub fn check(before: &Function, pipeline: &str, points: &[Vec<f64>]) -> Result<Function, String> {
     let pm = PassManager::new(pipeline, Instrumentation::default()).map_err(|e| format!("{pipeline}: {e}"))?;
-    let mut m = Module { functions: vec![before.clone()] };
-    pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink()).map_err(|e| format!("{pipeline}: {e}"))?;
-    let after = m.functions.pop().ok_or_else(|| format!("{pipeline}: the function disappeared"))?;
+    let bit_exact = pm.is_bit_exact();
+    let m = Module { functions: vec![before.clone()] };
+    let mut session = Session::new(pm, m, PassContext::default());
+    session.run_quiet().map_err(|e| format!("{pipeline}: {e}"))?;
+    let after = session.module.functions.pop().ok_or_else(|| format!("{pipeline}: the function disappeared"))?;
     let (t0, t1) = (Tape::new(before), Tape::new(&after));
-    let bit_exact = pipeline.split(',').all(|p| BIT_EXACT.contains(&p.split('<').next().unwrap_or("").trim()));
     // Where each output and input of `after` sits in `before`.
     let out_at: Vec<usize> = t1
         .outputs
@@ -134,6 +137,19 @@ pub fn check(before: &Function, pipeline: &str, points: &[Vec<f64>]) -> Result<F
 mod tests {
     use super::*;
     use robovec_ir::text;
+
+    #[test]
+    fn bit_exact_comes_from_the_registry_and_parameter_lists_are_not_split() {
+        assert_eq!(
+            bit_exact_passes(),
+            ["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy", "depth-bound"]
+        );
+        // `split(',')` read `sweep<pe=8,16>` as `sweep<pe=8` and `16>`: not bit-exact.
+        let pm = PassManager::new("atomise,sweep<pe=8,16>", Instrumentation::default()).unwrap();
+        assert!(pm.is_bit_exact());
+        let pm = PassManager::new("atomise,sweep<pe=8,16>,balance", Instrumentation::default()).unwrap();
+        assert!(!pm.is_bit_exact());
+    }
 
     #[test]
     fn pipeline_text_inserts_atomise_once() {

@@ -21,7 +21,7 @@
 //! A sound rewrite (the same real function) always passes: its exact value is the original's,
 //! and each bound covers its own rounding. An output where a bound is infinite (a divisor
 //! interval through zero, an overflow) or the reference is not finite is not decided at that
-//! point (counted in `undecided`). Pipelines made only of [`BIT_EXACT`] passes must also reproduce the original bit for bit (the sign of an exact zero aside).
+//! point (counted in `undecided`). Pipelines made only of passes declared bit-exact ([`crate::Props::bit_exact`], asked of a pipeline with [`crate::PassManager::is_bit_exact`]) must also reproduce the original bit for bit (the sign of an exact zero aside).
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -229,19 +229,6 @@ pub fn check_function_until(
     })
 }
 
-/// Passes that never change a computed value (no reassociation, no rewriting of arithmetic):
-/// a pipeline of these is checked bit for bit, by `-check` and by the fuzzing and property tests.
-/// Any other registered pass gets the budget check.
-pub const BIT_EXACT: &[&str] = &["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy", "depth-bound"];
-
-/// True when every pass of `pipeline` (comma-separated, parameters allowed) is in
-/// [`BIT_EXACT`].
-pub fn pipeline_is_bit_exact(pipeline: &str) -> bool {
-    crate::parse_pipeline(pipeline)
-        .map(|specs| specs.iter().all(|s| BIT_EXACT.contains(&s.name.as_str())))
-        .unwrap_or(false)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -274,6 +261,9 @@ mod tests {
         let b = check_function(&same, &before, true, 50, 1).unwrap().violation.expect("not bit-exact");
         assert!(b.bit_exact);
         assert_eq!(check_function(&before, &before, true, 50, 1).unwrap().violation, None);
-        assert!(pipeline_is_bit_exact("atomise,accuracy<samples=3>") && !pipeline_is_bit_exact("atomise,balance"));
+        let bit_exact = |p: &str| crate::PassManager::new(p, Default::default()).unwrap().is_bit_exact();
+        assert!(bit_exact("atomise,accuracy<samples=3>") && !bit_exact("atomise,balance"));
+        // Named pipelines are asked as their expansion: `default<ops>` holds rewrites.
+        assert!(bit_exact("atomise,dce,asap-alap,place<pe=2>,sim") && !bit_exact("default<ops>"));
     }
 }

@@ -154,6 +154,13 @@ pub const INFO: PassInfo = PassInfo {
         },
     ],
     build: |p: &Params| Ok(Box::new(Accuracy { opts: options_from(p)? })),
+    props: crate::Props {
+        at_time_limit: crate::AtTimeLimit::Skip,
+        preserves_timing: true,
+        needs_original: true,
+        bit_exact: true,
+        ..crate::Props::DEFAULT
+    },
 };
 
 fn options_from(p: &Params) -> Result<Options, PassError> {
@@ -183,14 +190,6 @@ pub struct Accuracy {
 impl Pass for Accuracy {
     fn name(&self) -> &'static str {
         "accuracy"
-    }
-
-    fn at_time_limit(&self) -> crate::AtTimeLimit {
-        crate::AtTimeLimit::Skip
-    }
-
-    fn preserves_timing(&self) -> bool {
-        true
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
@@ -231,10 +230,6 @@ impl Pass for Accuracy {
         }
         cx.emit(report::AccuracyRun { reports });
         Ok(())
-    }
-
-    fn needs_original(&self) -> bool {
-        true
     }
 }
 

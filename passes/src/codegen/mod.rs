@@ -32,6 +32,8 @@ pub const INFO: PassInfo = PassInfo {
         doc: "back end, given as the first bare word (`codegen<c;…>`)",
     }],
     build: Params::build_member,
+    // A family: each back end (a `Member`) declares its own properties.
+    props: crate::Props { back_end: true, ..crate::Props::DEFAULT },
 };
 
 /// What one generated function takes and gives, in argument order (SPEC §8 `codegen`).

@@ -27,11 +27,11 @@ pub mod expand;
 mod tests;
 
 use robovec_ir::analysis::{compute_timing, Latencies};
-use robovec_ir::{Function, Module, Phase};
+use robovec_ir::{Function, Module};
 use serde::Serialize;
 
 use crate::params::ParamKind;
-use crate::{AtTimeLimit, LatencyOverride, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{LatencyOverride, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -52,6 +52,13 @@ pub const INFO: PassInfo = PassInfo {
     build: |p: &Params| {
         Ok(Box::new(DepthBound { max_terms: p.u32("max-terms")? as usize, lat: p.latency_override()? }))
     },
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        preserves_timing: true,
+        bit_exact: true,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// The `depth-bound` pass.
@@ -66,18 +73,6 @@ pub struct DepthBound {
 impl Pass for DepthBound {
     fn name(&self) -> &'static str {
         "depth-bound"
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn preserves_timing(&self) -> bool {
-        true
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

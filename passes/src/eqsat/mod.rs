@@ -57,7 +57,7 @@ mod tests;
 use std::path::PathBuf;
 
 use robovec_ir::analysis::Latencies;
-use robovec_ir::{Module, Phase};
+use robovec_ir::Module;
 
 use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
@@ -121,6 +121,11 @@ pub const INFO: PassInfo = PassInfo {
         ParamInfo { doc: "mul latency for extraction, cycles", ..crate::params::LAT_MUL },
     ],
     build: |p: &Params| Ok(Box::new(Eqsat { opts: options_from(p)?, lat: p.latency_override()? })),
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// Options of the `eqsat` pass (see [`INFO`] for the parameters they come from).
@@ -192,14 +197,6 @@ pub struct Eqsat {
 impl Pass for Eqsat {
     fn name(&self) -> &'static str {
         "eqsat"
-    }
-
-    fn at_time_limit(&self) -> crate::AtTimeLimit {
-        crate::AtTimeLimit::Skip
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

@@ -143,6 +143,8 @@ pub struct Member {
     /// # Errors
     /// [`PassError::BadParameter`] for options that cannot go together.
     pub build: fn(&Params) -> Result<Box<dyn Pass>, PassError>,
+    /// Its properties (what the family's own [`crate::PassInfo::props`] would be for it).
+    pub props: crate::Props,
 }
 
 /// The expected-value text of a parameter with a few accepted words: `` `a` or `b` ``,

@@ -29,7 +29,7 @@ fn variants(info: &'static PassInfo) -> Vec<Variant> {
 
 #[test]
 fn every_declared_default_is_the_default_and_every_range_is_enforced() {
-    for info in PASSES {
+    for info in PASSES.iter() {
         build(info, &[]).unwrap_or_else(|e| panic!("{}: {e}", info.name));
         for (select, decls) in variants(info) {
             let with = |extra: &[(&'static str, String)]| {
@@ -77,7 +77,7 @@ fn every_declared_default_is_the_default_and_every_range_is_enforced() {
 
 #[test]
 fn a_set_parameter_takes_only_its_values() {
-    let info = crate::pass_info("codegen").unwrap();
+    let info = crate::PASSES.get("codegen").unwrap();
     let batch = info.param("batch").unwrap();
     assert_eq!((batch.default_text(), batch.range_text()), ("1".to_string(), "1|2|4|8|16".to_string()));
     for bad in ["0", "3", "32", "-1", "x"] {
@@ -112,14 +112,14 @@ fn word_parameters_are_read_as_their_enums() {
 #[test]
 fn option_defaults_come_from_the_declarations() {
     // Window 6 is what eqsat uses; `--print-passes` printed 8 before the declarations.
-    let eqsat = crate::pass_info("eqsat").unwrap();
+    let eqsat = crate::PASSES.get("eqsat").unwrap();
     let window = eqsat.params.iter().find(|p| p.name == "window").unwrap();
     assert_eq!(window.default_text(), crate::eqsat::EqsatOptions::default().window.to_string());
     assert_eq!(
         build(eqsat, &[]).unwrap(),
         format!("{:?}", crate::eqsat::Eqsat { opts: crate::eqsat::EqsatOptions::default(), lat: Default::default() })
     );
-    let place = crate::pass_info("place").unwrap();
+    let place = crate::PASSES.get("place").unwrap();
     assert_eq!(
         build(place, &[]).unwrap(),
         format!(
@@ -131,7 +131,7 @@ fn option_defaults_come_from_the_declarations() {
             }
         )
     );
-    let accuracy = crate::pass_info("accuracy").unwrap();
+    let accuracy = crate::PASSES.get("accuracy").unwrap();
     assert_eq!(
         build(accuracy, &[]).unwrap(),
         format!("{:?}", crate::accuracy::Accuracy { opts: crate::accuracy::Options::default() })

@@ -28,7 +28,7 @@ pub mod schedule;
 pub mod search;
 
 use robovec_ir::placement::{PeArray, Placement};
-use robovec_ir::{Function, Module, OpKind, Phase};
+use robovec_ir::{Function, Module, OpKind};
 
 pub use bound::{lower_bound, ops_per_side, tight_lower_bound};
 
@@ -349,6 +349,12 @@ pub const INFO: PassInfo = PassInfo {
     build: |p: &Params| {
         Ok(Box::new(Place { opts: options_from(p)?, lat: p.latency_override()?, writes: p.u32_given("writes")? }))
     },
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        preserves_timing: true,
+        bit_exact: true,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// The `place` pass.
@@ -367,14 +373,6 @@ pub struct Place {
 impl Pass for Place {
     fn name(&self) -> &'static str {
         "place"
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn preserves_timing(&self) -> bool {
-        true
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

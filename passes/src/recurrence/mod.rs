@@ -52,11 +52,11 @@ mod round;
 mod tests;
 
 use robovec_ir::analysis::{compute_timing, Latencies};
-use robovec_ir::{Function, Module, Phase};
+use robovec_ir::{Function, Module};
 
 use crate::params::ParamKind;
 use crate::tree_height::{rewrite_within, Shape};
-use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 use round::round;
 
 /// Registry entry.
@@ -115,6 +115,11 @@ pub const INFO: PassInfo = PassInfo {
         crate::params::LAT_CALL,
     ],
     build: |p: &Params| Ok(Box::new(Recurrence::from_params(p)?)),
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// The `recurrence` pass.
@@ -176,14 +181,6 @@ impl Default for Recurrence {
 impl Pass for Recurrence {
     fn name(&self) -> &'static str {
         "recurrence"
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

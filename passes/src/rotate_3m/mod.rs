@@ -58,12 +58,12 @@
 use std::collections::{HashMap, HashSet};
 
 use robovec_ir::analysis::{compute_timing, Latencies};
-use robovec_ir::{BinOp, Def, Function, Module, Operand, Phase, Span, Value};
+use robovec_ir::{BinOp, Def, Function, Module, Operand, Span, Value};
 
 mod pairs;
 
 use crate::params::ParamKind;
-use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -96,6 +96,11 @@ pub const INFO: PassInfo = PassInfo {
             (n, _) => Stop::Placed(n),
         };
         Ok(Box::new(Rotate3m { stop, lat: p.latencies()?, given: p.latency_override()? }))
+    },
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        ..crate::Props::DEFAULT
     },
 };
 
@@ -279,14 +284,6 @@ pub fn rotate_function(f: &mut Function, lat: &Latencies, stop: Stop) -> Rotated
 impl Pass for Rotate3m {
     fn name(&self) -> &'static str {
         "rotate-3m"
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

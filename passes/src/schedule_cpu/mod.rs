@@ -40,10 +40,10 @@
 
 pub mod pressure;
 
-use robovec_ir::{Def, Function, Module, Operand, Phase, Value};
+use robovec_ir::{Def, Function, Module, Operand, Value};
 
 use crate::params::ParamKind;
-use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 use pressure::{is_result, pressure_of_order, Pressure};
 
 /// Registry entry.
@@ -70,6 +70,7 @@ pub const INFO: PassInfo = PassInfo {
         };
         Ok(Box::new(ScheduleCpu { order, registers: p.u32("registers")? as usize }))
     },
+    props: crate::Props { requires: Some(robovec_ir::Phase::Atomised), at_time_limit: crate::AtTimeLimit::Skip, ..crate::Props::DEFAULT },
 };
 
 /// Which order the pass writes.
@@ -95,14 +96,6 @@ pub struct ScheduleCpu {
 impl Pass for ScheduleCpu {
     fn name(&self) -> &'static str {
         "schedule-cpu"
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

@@ -306,6 +306,13 @@ pub const INFO: PassInfo = PassInfo {
         doc: "number of pseudo-random input sets (seeds 0..n), each simulated in f32 and f64",
     }],
     build: |p: &Params| Ok(Box::new(Sim { seeds: p.u32("seeds")? })),
+    props: crate::Props {
+        at_time_limit: crate::AtTimeLimit::Skip,
+        preserves_timing: true,
+        bit_exact: true,
+        needs_before: Some("place"),
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// The `sim` pass: checks, never changes, the module.
@@ -318,14 +325,6 @@ pub struct Sim {
 impl Pass for Sim {
     fn name(&self) -> &'static str {
         "sim"
-    }
-
-    fn at_time_limit(&self) -> crate::AtTimeLimit {
-        crate::AtTimeLimit::Skip
-    }
-
-    fn preserves_timing(&self) -> bool {
-        true
     }
 
     /// `-time-limit` stops `sim` wherever it is (the lowering, a simulated run, between the

@@ -400,7 +400,7 @@ fn error_display_names_cycle_pe_and_value() {
 fn pass_needs_placements_and_checks_them() {
     let mut m = parse(SRC).unwrap();
     let pass = (INFO.build)(&Params::defaults(&INFO)).unwrap();
-    assert!(pass.preserves_timing());
+    assert!(INFO.props.preserves_timing && INFO.props.needs_before == Some("place"));
     let e = pass.run(&mut m, &mut PassContext::default()).unwrap_err().to_string();
     assert!(e.contains("run `place` first"), "{e}");
     let p = base(&m.functions[0]);

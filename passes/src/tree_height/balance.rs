@@ -31,4 +31,9 @@ pub const INFO: PassInfo = PassInfo {
     build: |p: &Params| {
         Ok(Box::new(ClusterRewrite { name: "balance", shape: Shape::Balance, lat: p.latency_override()? }))
     },
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        ..crate::Props::DEFAULT
+    },
 };

@@ -24,7 +24,7 @@ use robovec_ir::{BinOp, Def, Function, Module, Operand, Phase, Value};
 use super::cluster::{Class, Clusters};
 use super::{rewrite_within, Shape};
 use crate::params::ParamKind;
-use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -60,6 +60,11 @@ pub const INFO: PassInfo = PassInfo {
             given: p.latency_override()?,
         }))
     },
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// The `distribute` pass.
@@ -81,14 +86,6 @@ pub struct Distribute {
 impl Pass for Distribute {
     fn name(&self) -> &'static str {
         "distribute"
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

@@ -21,4 +21,9 @@ pub const INFO: PassInfo = PassInfo {
     doc: "reorder each cluster's terms so the latest-ready sit nearest the root, shape kept (seed §2.4.2)",
     params: LATENCY_PARAMS,
     build: |p: &Params| Ok(Box::new(ClusterRewrite { name: "swap", shape: Shape::Swap, lat: p.latency_override()? })),
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        ..crate::Props::DEFAULT
+    },
 };

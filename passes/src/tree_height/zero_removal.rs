@@ -20,10 +20,10 @@
 //! sign of an exact zero. Idempotent. Cost: O(values + operands) plus O(k log k) per cluster
 //! with negative terms.
 
-use robovec_ir::{Module, Phase};
+use robovec_ir::Module;
 
 use super::{rewrite_within, summary, Shape};
-use crate::{AtTimeLimit, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
 
 /// The latency parameters the cluster rewrites take (cycles; SPEC §1 defaults).
 pub const LATENCY_PARAMS: &[ParamInfo] = crate::params::LATENCY_PARAMS;
@@ -35,6 +35,11 @@ pub const INFO: PassInfo = PassInfo {
     params: LATENCY_PARAMS,
     build: |p: &Params| {
         Ok(Box::new(ClusterRewrite { name: "zero-removal", shape: Shape::Keep, lat: p.latency_override()? }))
+    },
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        ..crate::Props::DEFAULT
     },
 };
 
@@ -53,14 +58,6 @@ pub struct ClusterRewrite {
 impl Pass for ClusterRewrite {
     fn name(&self) -> &'static str {
         self.name
-    }
-
-    fn requires(&self) -> Option<Phase> {
-        Some(Phase::Atomised)
-    }
-
-    fn at_time_limit(&self) -> AtTimeLimit {
-        AtTimeLimit::Skip
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {

@@ -10,10 +10,12 @@ use std::io::Write;
 use robovec_ir::Module;
 
 use super::Failure;
-use crate::accuracy::check::{check_function_until, pipeline_is_bit_exact};
+use crate::accuracy::check::check_function_until;
+use crate::PassManager;
 
-/// Checks `after` against `original` at `samples` points of `seed`; one line per function on
-/// `stderr` when it passes.
+/// Checks `after`, the result of `pipeline`, against `original` at `samples` points of `seed`
+/// (bit for bit when the pipeline is declared bit-exact, [`PassManager::is_bit_exact`]); one
+/// line per function on `stderr` when it passes.
 ///
 /// # Errors
 /// [`Failure::Input`] naming the function, output, format, point, computed and exact values
@@ -22,14 +24,15 @@ use crate::accuracy::check::{check_function_until, pipeline_is_bit_exact};
 pub fn run(
     after: &Module,
     original: &Module,
-    pipeline: &str,
+    pipeline: &PassManager,
     only: &Option<String>,
     samples: u32,
     seed: u64,
     deadline: Option<crate::Deadline>,
     stderr: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let bit_exact = pipeline_is_bit_exact(pipeline);
+    let bit_exact = pipeline.is_bit_exact();
+    let pipeline = pipeline.pipeline_text();
     for f in &after.functions {
         if only.as_ref().is_some_and(|n| n != &f.name) {
             continue;

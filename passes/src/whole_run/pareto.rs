@@ -24,10 +24,10 @@ use robovec_ir::{Function, Module};
 use serde::{Deserialize, Serialize};
 
 use super::Failure;
-use crate::accuracy::check::{check_function_until, pipeline_is_bit_exact};
+use crate::accuracy::check::check_function_until;
 use crate::accuracy::{measure_against, BitsSummary, Options as AccuracyOptions};
 use crate::summary::stats;
-use crate::{Instrumentation, PassContext, PassManager};
+use crate::{Instrumentation, PassContext, PassManager, Session};
 
 /// One pipeline's figures: a row of the report's `pareto` (written, and read back for
 /// `-report-dir`'s figures) and of the `-pareto` table.
@@ -213,20 +213,22 @@ fn run_reporting(
         module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
     let (pipelines, managers): (Vec<String>, Vec<PassManager>) = managers(text)?.into_iter().unzip();
     let mut rows = Vec::new();
-    for (k, (p, pm)) in pipelines.iter().zip(&managers).enumerate() {
+    let n = pipelines.len();
+    for (k, (p, pm)) in pipelines.iter().zip(managers).enumerate() {
         // Each pipeline gets an equal share of the time left, half of it to measure (the
         // soundness check of the same points takes about as long), so that every pipeline is
         // measured (with fewer samples) before the limit.
         let now = std::time::Instant::now();
-        let share = deadline.map(|d| now + d.at.saturating_duration_since(now) / (2 * (pipelines.len() - k)) as u32);
-        let later_share = deadline.map(|d| now + d.at.saturating_duration_since(now) / (pipelines.len() - k) as u32);
+        let share = deadline.map(|d| now + d.at.saturating_duration_since(now) / (2 * (n - k)) as u32);
+        let later_share = deadline.map(|d| now + d.at.saturating_duration_since(now) / (n - k) as u32);
         let opts = AccuracyOptions { samples, seed, deadline: share, ..AccuracyOptions::default() };
-        let mut m = module.clone();
-        let mut cx =
-            PassContext { original: Some(module.clone()), deadline, ..PassContext::with_target(target.clone()) };
-        pm.run(&mut m, &mut cx, &mut std::io::sink())
-            .map_err(|e| Failure::Input(format!("error: -pareto pipeline `{p}`: {e}\n")))?;
-        let f: &Function = m
+        let bit_exact = pm.is_bit_exact();
+        let cx = PassContext { original: Some(module.clone()), deadline, ..PassContext::with_target(target.clone()) };
+        let mut session = Session::new(pm, module.clone(), cx);
+        session.run_quiet().map_err(|e| Failure::Input(format!("error: -pareto pipeline `{p}`: {e}\n")))?;
+        let (cx, pm) = (&session.cx, session.pipeline());
+        let f: &Function = session
+            .module
             .function(function)
             .ok_or_else(|| Failure::Input(format!("error: -pareto pipeline `{p}` removed function @{function}\n")))?;
         let s = stats(f, &cx.latencies);
@@ -235,8 +237,7 @@ fn run_reporting(
         let acc = measure_against(f, Some(original), &opts).map_err(fail)?;
         // The same points as the measurement (fewer when it stopped early under `-time-limit`).
         let measured = u32::try_from(acc.samples).unwrap_or(samples).min(samples);
-        let check =
-            check_function_until(f, original, pipeline_is_bit_exact(p), measured, seed, later_share).map_err(fail)?;
+        let check = check_function_until(f, original, bit_exact, measured, seed, later_share).map_err(fail)?;
         rows.push(ParetoRow {
             pipeline: pm.pipeline_text(),
             ops: s.ops.total,

@@ -49,6 +49,12 @@ pub const BACK_END: Member = Member {
     doc: "C (SPEC §8); `-o FILE` gets the code and FILE.h its prototypes",
     params: &[ABI, PRECISION, BATCH, TRIG, NAME, CHUNK, UNITS],
     build: |p| Ok(Box::new(CodegenC::from_params(p)?)),
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        preserves_timing: true,
+        back_end: true,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// `abi=plain|robotran|pinocchio`.
@@ -339,19 +345,17 @@ impl Pass for CodegenC {
         super::run_emitter(m, cx, |m| self.emit_within(m, main.as_deref(), &ticker))
     }
 
-    fn requires(&self) -> Option<robovec_ir::Phase> {
-        Some(robovec_ir::Phase::Atomised)
+    fn as_back_end(&self) -> Option<&dyn crate::BackEnd> {
+        Some(self)
+    }
+}
+
+impl crate::BackEnd for CodegenC {
+    fn companions(&self) -> &'static [&'static str] {
+        &["h"]
     }
 
-    fn preserves_timing(&self) -> bool {
-        true
-    }
-
-    fn code_companions(&self) -> Option<&'static [&'static str]> {
-        Some(&["h"])
-    }
-
-    fn code_units(&self) -> usize {
+    fn units(&self) -> usize {
         self.units as usize
     }
 }

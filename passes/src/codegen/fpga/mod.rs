@@ -70,6 +70,7 @@ pub const BACK_END: Member = Member {
     doc: "the placed design's images, manifest, Verilog, simulate script and resources (issue 12), in `out=DIR`",
     params: &[OUT, FORMAT, RESOURCES],
     build: |p| Ok(Box::new(CodegenFpga::from_params(p)?)),
+    props: crate::Props { back_end: true, ..crate::Props::DEFAULT },
 };
 
 /// `out=DIR`.
