@@ -601,7 +601,7 @@ fn main() {
         } else if a == "--core" {
             core = true;
         } else if a == "--split" {
-            split = Some(vec![robovec_passes::codegen::c::DEFAULT_CHUNK]);
+            split = Some(vec![robovec_backends::c::DEFAULT_CHUNK]);
         } else if let Some(list) = a.strip_prefix("--split=") {
             split = Some(list.split(',').map(|x| x.parse().expect("--split=OPS,OPS…")).collect());
         } else if a == "--bench" || a.starts_with('-') {

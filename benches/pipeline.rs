@@ -36,7 +36,7 @@ fn parse(bytes: &[u8]) -> Module {
 
 fn manager(pipeline: &str, verify_each: bool) -> PassManager {
     let instr = Instrumentation { verify_each, ..Instrumentation::default() };
-    PassManager::new(pipeline, instr).expect("pipeline parses")
+    PassManager::with_registry(robovec_backends::REGISTRY, pipeline, instr).expect("pipeline parses")
 }
 
 fn run(pm: &PassManager, m: &mut Module) {

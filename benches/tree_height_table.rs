@@ -79,7 +79,8 @@ fn main() {
         let mut base = None;
         for (i, pipeline) in PIPELINES.iter().enumerate() {
             let mut m = parsed.clone();
-            let pm = PassManager::new(pipeline, Instrumentation::default()).expect("pipeline");
+            let pm = PassManager::with_registry(robovec_backends::REGISTRY, pipeline, Instrumentation::default())
+                .expect("pipeline");
             pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink())
                 .unwrap_or_else(|e| panic!("{name} {pipeline}: {e}"));
             let (ops, cp, placed) = measure(&m, quick);

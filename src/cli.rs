@@ -256,8 +256,8 @@ impl PassListing {
     /// The listing in this format.
     pub fn render(self) -> String {
         match self {
-            PassListing::Text => robovec_passes::reference::text(),
-            PassListing::Markdown => robovec_passes::reference::markdown(),
+            PassListing::Text => robovec_passes::reference::text(robovec_backends::REGISTRY),
+            PassListing::Markdown => robovec_passes::reference::markdown(robovec_backends::REGISTRY),
         }
     }
 }

@@ -243,7 +243,8 @@ pub fn run_with(
     let deadline = opts.time_limit.map(robovec_passes::Deadline::after_seconds);
     // `load` verifies the input (always, whatever `-verify-each` says): the manager need not.
     let instr = Instrumentation { input_verified: true, ..opts.instr.clone() };
-    let pm = PassManager::new(&opts.passes, instr).map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
+    let pm = PassManager::with_registry(robovec_backends::REGISTRY, &opts.passes, instr)
+        .map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     crate::preflight::check_options(opts, &pm)?;
     let target = crate::options::target(opts)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
@@ -291,6 +292,7 @@ fn run_passes(
     out: &mut OutputSet,
     stderr: &mut dyn Write,
 ) -> Result<Session, Failure> {
+    let session_registry = pm.registry();
     let mut cx = PassContext {
         original: opts.check.map(|_| module.clone()),
         deadline,
@@ -301,6 +303,7 @@ fn run_passes(
     if let Some(text) = &opts.pareto {
         let name = select(&module, &opts.function, "-pareto")?.name.clone();
         let study = whole_run::pareto::study(
+            session_registry,
             &module,
             &name,
             text,

@@ -122,7 +122,7 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
     check_pass_files(pm)?;
     // `-pareto`'s pipelines: every name, parameter and file they read, before any work too.
     if let Some(text) = &opts.pareto {
-        let managers = robovec_passes::whole_run::pareto::managers(text).map_err(Failure::from)?;
+        let managers = robovec_passes::whole_run::pareto::managers(pm.registry(), text).map_err(Failure::from)?;
         for (_, other) in managers {
             check_pass_files(&other)?;
         }

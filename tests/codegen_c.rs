@@ -11,10 +11,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use robovec_backends::c::{robotran, split_callee, Abi, CodegenC, Precision, Trig};
+use robovec_backends::input_values;
 use robovec_ir::interp::{callback_standin, eval, pseudo_random_input, Float};
 use robovec_ir::{Callee, Def, Module, TrigFn};
-use robovec_passes::codegen::c::{robotran, split_callee, Abi, CodegenC, Precision, Trig};
-use robovec_passes::codegen::input_values;
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
 use crate::common::{corpus_files, is_loop_file, tmp};
@@ -31,7 +31,7 @@ pub struct Case {
 
 /// Runs `pipeline` (which must not end in codegen) on `m`.
 fn run_pipeline(mut m: Module, pipeline: &str) -> Module {
-    let pm = PassManager::new(pipeline, Instrumentation::default()).unwrap();
+    let pm = PassManager::with_registry(robovec_backends::REGISTRY, pipeline, Instrumentation::default()).unwrap();
     pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink()).unwrap();
     m
 }
@@ -74,7 +74,7 @@ fn callback_uses(m: &Module, out: &mut Vec<(Callee, usize)>) {
     for f in &m.functions {
         for &v in &f.body {
             if let Def::Call(c, args) = &f.value(v).def {
-                if !robovec_passes::codegen::c::is_intrinsic(c, args.len()) && !out.iter().any(|(k, _)| k == &**c) {
+                if !robovec_backends::c::is_intrinsic(c, args.len()) && !out.iter().any(|(k, _)| k == &**c) {
                     out.push(((**c).clone(), args.len()));
                 }
             }
@@ -83,7 +83,7 @@ fn callback_uses(m: &Module, out: &mut Vec<(Callee, usize)>) {
 }
 
 fn lit<T: Float>(x: T, f32: bool) -> String {
-    robovec_passes::codegen::literal::hex(x.to_f64(), f32)
+    robovec_backends::literal::hex(x.to_f64(), f32)
 }
 
 /// The stand-in of callee `c` on `n` operands `a[0..n]` as C statements ending in
@@ -396,7 +396,7 @@ fn robotran_globals(cases: &[Case]) -> String {
 
 /// The driver's block for one function of the robotran ABI: reads the inputs into `s`, calls,
 /// prints the outputs' bits.
-fn robotran_call(f: &robovec_ir::Function, iface: &robovec_passes::codegen::Interface) -> String {
+fn robotran_call(f: &robovec_ir::Function, iface: &robovec_backends::Interface) -> String {
     let ni = iface.inputs.len();
     let mut b =
         format!("  {{ static double in[{}]; if (fread(in, sizeof *in, {ni}, stdin) != {ni}) return 1;\n", ni.max(1));
@@ -578,7 +578,7 @@ fn scalar_forms_equal_the_interpreter_on_random_dags() {
 fn contracted_functions_equal_the_interpreter_bit_for_bit() {
     let cases: Vec<Case> =
         batch_cases().into_iter().map(|c| Case { label: c.label, m: run_pipeline(c.m, "contract") }).collect();
-    let fused = cases.iter().flat_map(|c| &c.m.functions).filter(|f| robovec_passes::codegen::c::has_fused(f)).count();
+    let fused = cases.iter().flat_map(|c| &c.m.functions).filter(|f| robovec_backends::c::has_fused(f)).count();
     assert!(fused >= 12, "only {fused} functions have fused multiply-adds");
     for (batch, f32, native) in
         [(1, false, false), (1, true, true), (4, false, true), (8, true, false), (8, false, true)]

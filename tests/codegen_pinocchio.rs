@@ -17,11 +17,11 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
 
+use robovec_backends::c::{pinocchio::GRAVITY, Abi, CodegenC, Trig};
+use robovec_backends::literal::hex;
 use robovec_front::FrontOptions;
 use robovec_ir::interp::pseudo_random_input;
 use robovec_ir::Module;
-use robovec_passes::codegen::c::{pinocchio::GRAVITY, Abi, CodegenC, Trig};
-use robovec_passes::codegen::literal::hex;
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
 use crate::common::{opt, stderr, tmp};
@@ -60,7 +60,7 @@ fn load_on(path: &str, pipeline: &str, free_flyer: bool, cos_sin: bool) -> Modul
     )
     .unwrap_or_else(|e| panic!("{path}: {}", e.message()));
     let mut m = loaded.module;
-    let pm = PassManager::new(pipeline, Instrumentation::default()).unwrap();
+    let pm = PassManager::with_registry(robovec_backends::REGISTRY, pipeline, Instrumentation::default()).unwrap();
     pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink()).unwrap();
     m
 }

@@ -7,7 +7,7 @@ use robovec_ir::{Def, Function, Operand};
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
 fn run(pipeline: &str, m: &mut robovec_ir::Module) {
-    let pm = PassManager::new(pipeline, Instrumentation::default()).unwrap();
+    let pm = PassManager::with_registry(robovec_backends::REGISTRY, pipeline, Instrumentation::default()).unwrap();
     pm.run(m, &mut PassContext::default(), &mut std::io::sink()).unwrap_or_else(|e| panic!("{e}"));
 }
 

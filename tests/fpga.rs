@@ -280,7 +280,12 @@ fn hierarchical_yosys_agrees_with_flat_synthesis() {
 fn placed_pendulum(n: u32) -> robovec_ir::Module {
     let (mut m, _) = robovec::driver::load(PENDULUM).unwrap_or_else(|f| panic!("{}", f.message()));
     let pipeline = format!("atomise,place<pe={n};restarts=0;search=0>");
-    let pm = robovec_passes::PassManager::new(&pipeline, robovec_passes::Instrumentation::default()).unwrap();
+    let pm = robovec_passes::PassManager::with_registry(
+        robovec_backends::REGISTRY,
+        &pipeline,
+        robovec_passes::Instrumentation::default(),
+    )
+    .unwrap();
     pm.run(&mut m, &mut robovec_passes::PassContext::default(), &mut std::io::sink()).unwrap();
     m
 }

@@ -4,7 +4,7 @@
 
 use std::process::Command;
 
-use robovec_passes::PASSES;
+use robovec_backends::REGISTRY as PASSES;
 
 use crate::common::{opt, stderr};
 

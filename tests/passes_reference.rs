@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use robovec_passes::{ParamInfo, PASSES};
+use robovec_backends::REGISTRY as PASSES;
+use robovec_passes::ParamInfo;
 
 use crate::common::{opt, stderr};
 
@@ -16,7 +17,7 @@ fn committed() -> String {
 
 #[test]
 fn the_committed_passes_page_is_the_registrys() {
-    let (page, generated) = (committed(), robovec_passes::reference::markdown());
+    let (page, generated) = (committed(), robovec_passes::reference::markdown(robovec_backends::REGISTRY));
     if page != generated {
         let first = page.lines().zip(generated.lines()).position(|(a, b)| a != b);
         let line = first.unwrap_or_else(|| page.lines().count().min(generated.lines().count()));
@@ -34,13 +35,13 @@ fn the_committed_passes_page_is_the_registrys() {
 fn print_passes_markdown_prints_the_page() {
     let o = opt(&["--print-passes=markdown"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(String::from_utf8(o.stdout).unwrap(), robovec_passes::reference::markdown());
+    assert_eq!(String::from_utf8(o.stdout).unwrap(), robovec_passes::reference::markdown(robovec_backends::REGISTRY));
     // The text listing is the default format, `--print-passes` bare.
     let bare = opt(&["--print-passes"]);
     let text = opt(&["--print-passes=text"]);
     assert!(bare.status.success() && text.status.success());
     assert_eq!(bare.stdout, text.stdout);
-    assert_eq!(String::from_utf8(bare.stdout).unwrap(), robovec_passes::reference::text());
+    assert_eq!(String::from_utf8(bare.stdout).unwrap(), robovec_passes::reference::text(robovec_backends::REGISTRY));
     let bad = opt(&["--print-passes=html"]);
     assert_eq!(bad.status.code(), Some(2), "{}", stderr(&bad));
 }
@@ -69,7 +70,7 @@ fn assert_rows(rows: &[&str], params: &[ParamInfo], what: &str) {
 
 #[test]
 fn the_page_has_every_pass_member_and_parameter() {
-    let page = robovec_passes::reference::markdown();
+    let page = robovec_passes::reference::markdown(robovec_backends::REGISTRY);
     for p in PASSES {
         let own = rows_under(&page, &format!("## `{}`", p.name));
         assert_rows(&own, p.params, p.name);

@@ -250,8 +250,12 @@ fn long_loops_report_progress_through_the_hook() {
         progress: robovec_passes::progress::Progress::shown(Arc::new(rec.clone())),
         ..robovec_passes::PassContext::default()
     };
-    let pm =
-        robovec_passes::PassManager::new("atomise,sweep<pe=1,2>,accuracy<samples=300>", Default::default()).unwrap();
+    let pm = robovec_passes::PassManager::with_registry(
+        robovec_backends::REGISTRY,
+        "atomise,sweep<pe=1,2>,accuracy<samples=300>",
+        Default::default(),
+    )
+    .unwrap();
     pm.run(&mut m, &mut cx, &mut std::io::sink()).unwrap();
     let log = rec.0.lock().unwrap().clone();
     let sweep = log.iter().find(|x| x.0 == "sweep: placements").expect("sweep task");
@@ -266,8 +270,18 @@ fn long_loops_report_progress_through_the_hook() {
     let rec = Recorder::default();
     let progress = robovec_passes::progress::Progress::shown(Arc::new(rec.clone()));
     let target = robovec_machine::target::Target::de10_nano();
-    robovec_passes::whole_run::pareto::study(&m, "invdyna", "atomise;atomise,balance", 20, 1, None, &target, &progress)
-        .unwrap();
+    robovec_passes::whole_run::pareto::study(
+        robovec_backends::REGISTRY,
+        &m,
+        "invdyna",
+        "atomise;atomise,balance",
+        20,
+        1,
+        None,
+        &target,
+        &progress,
+    )
+    .unwrap();
     let log = rec.0.lock().unwrap().clone();
     assert_eq!(log, [("-pareto: pipelines".to_string(), 2, vec![1, 2])]);
 }

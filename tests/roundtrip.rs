@@ -27,7 +27,8 @@ fn corpus_modules_round_trip_in_every_phase() {
     for p in corpus_files().into_iter().filter(|p| !is_loop_file(p)) {
         let (mut m, _) = robovec::driver::load(p.to_str().unwrap()).unwrap_or_else(|f| panic!("{}", f.message()));
         for pipeline in ["", "atomise", "asap-alap", "place<pe=3;select=naive>"] {
-            let pm = PassManager::new(pipeline, Instrumentation::default()).unwrap();
+            let pm =
+                PassManager::with_registry(robovec_backends::REGISTRY, pipeline, Instrumentation::default()).unwrap();
             pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink()).unwrap();
             // Front ends number values in first-use order; the reader numbers inputs first.
             // Renumbering (inputs, then body) is the canonical form both agree on.

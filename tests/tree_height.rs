@@ -35,7 +35,8 @@ pub fn corpus_functions() -> Vec<(String, Function)> {
 
 /// Runs `pipeline` on a one-function module.
 pub fn run(pipeline: &str, f: &Function) -> Function {
-    let pm = PassManager::new(pipeline, Instrumentation::default()).unwrap_or_else(|e| panic!("{e}"));
+    let pm = PassManager::with_registry(robovec_backends::REGISTRY, pipeline, Instrumentation::default())
+        .unwrap_or_else(|e| panic!("{e}"));
     let mut m = Module { functions: vec![f.clone()] };
     pm.run(&mut m, &mut PassContext::default(), &mut std::io::sink()).unwrap_or_else(|e| panic!("{pipeline}: {e}"));
     m.functions.pop().unwrap()

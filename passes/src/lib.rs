@@ -10,7 +10,6 @@ pub mod accuracy;
 pub mod artifact;
 pub mod asap_alap;
 pub mod atomise;
-pub mod codegen;
 pub mod contract;
 pub mod cse;
 pub mod dce;
@@ -504,7 +503,6 @@ pub const PASSES: Registry = Registry {
         &cse::INFO,
         &contract::INFO,
         &schedule_cpu::INFO,
-        &codegen::INFO,
     ],
 };
 

@@ -1,4 +1,5 @@
-//! The passes reference, read from the registry ([`crate::PASSES`]): the `--print-passes`
+//! The passes reference, read from a registry (the complete one is `robovec_backends::REGISTRY`;
+//! this crate's own is [`crate::PASSES`]): the `--print-passes`
 //! listing ([`text`]) and the manual's page `docs/passes.md` ([`markdown`]).
 //!
 //! Both walk the same declarations the parser and the passes' defaults read (every pass's
@@ -7,16 +8,16 @@
 //! fails when the committed page differs from [`markdown`].
 
 use crate::pipeline::NAMED;
-use crate::{ParamInfo, PassInfo, PASSES};
+use crate::{ParamInfo, PassInfo, Registry};
 
 /// The `--print-passes` listing: each pass and its parameters, one line each as
 /// `name (default D; RANGE) doc`, and for a pass family each member (`back end c: …`) with its
 /// own parameters.
-pub fn text() -> String {
+pub fn text(registry: Registry) -> String {
     let line =
         |q: &ParamInfo| format!("      {:<12} (default {}; {}) {}\n", q.name, q.default_text(), q.range_text(), q.doc);
     let mut s = String::from("Passes (use -passes=a,b<k=v;k2=v2>,c):\n");
-    for p in PASSES.iter() {
+    for p in registry.iter() {
         s += &format!("  {:<12} {}\n", p.name, p.doc);
         for q in p.params {
             s += &line(q);
@@ -38,10 +39,10 @@ pub fn text() -> String {
 /// `docs/passes.md`: a section per pass in registry order (its doc, then a table of its
 /// parameters: name, default, accepted values, meaning with unit), a subsection per member of
 /// a pass family. What `robovec-opt --print-passes=markdown` prints.
-pub fn markdown() -> String {
+pub fn markdown(registry: Registry) -> String {
     let mut s = String::from(
         "# Passes\n\n\
-         <!-- Generated from the pass registry (`robovec_passes::PASSES`) by\n     \
+         <!-- Generated from the pass registry (`robovec_backends::REGISTRY`) by\n     \
          `robovec-opt --print-passes=markdown > docs/passes.md`; do not edit by hand:\n     \
          `tests/passes_reference.rs` fails when this page and the registry differ. -->\n\n\
          Every pass robovec knows, in registry order, with its parameters as the parser reads them.\n\
@@ -52,7 +53,7 @@ pub fn markdown() -> String {
          [manual](README.md).\n\n",
     );
     s += "| pass | what it does |\n|---|---|\n";
-    for p in PASSES.iter() {
+    for p in registry.iter() {
         s += &format!("| [`{}`](#{}) | {} |\n", p.name, p.name, cell(p.doc));
     }
     s += "\nNamed pipelines stand for a list of passes anywhere in a pipeline \
@@ -61,7 +62,7 @@ pub fn markdown() -> String {
     for n in NAMED {
         s += &format!("| `{}` | `{}` | {} |\n", n.name, n.expansion, cell(n.doc));
     }
-    for p in PASSES.iter() {
+    for p in registry.iter() {
         s += &format!("\n## `{}`\n\n{}\n", p.name, p.doc);
         s += &table(p.params);
         for (selector, m) in members(p) {

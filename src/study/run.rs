@@ -113,8 +113,12 @@ pub fn module_of(case: &Case, seed: u64) -> Module {
 /// # Errors
 /// [`Failure::Usage`] for a pipeline that does not parse or names an unknown pass.
 pub fn manager(pipeline: &str) -> Result<PassManager, Failure> {
-    PassManager::new(pipeline, Instrumentation { input_verified: true, ..Instrumentation::default() })
-        .map_err(|e| Failure::Usage(format!("error: {e}\n")))
+    PassManager::with_registry(
+        robovec_backends::REGISTRY,
+        pipeline,
+        Instrumentation { input_verified: true, ..Instrumentation::default() },
+    )
+    .map_err(|e| Failure::Usage(format!("error: {e}\n")))
 }
 
 /// A session of `pipeline` on `m` with `cx`, run.
@@ -167,6 +171,7 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
     if plan.report {
         let text = format!("{GENERATED};{ZERO_BALANCE};{}", plan.best);
         let pareto = whole_run::pareto::study(
+            robovec_backends::REGISTRY,
             &generated,
             FUNCTION,
             &text,

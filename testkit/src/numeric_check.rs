@@ -20,13 +20,15 @@ use robovec_ir::numerics::budget::{allowed, gamma, terms, U32, U64};
 use robovec_ir::numerics::{Tape, DD};
 use robovec_ir::{Function, Module, Phase};
 
-use robovec_passes::{Instrumentation, PassContext, PassManager, Session, PASSES};
+use robovec_backends::REGISTRY as PASSES;
+use robovec_passes::{Instrumentation, PassContext, PassManager, Session};
 
 /// Registered passes the property cannot build from default parameters because they need a
 /// file (none today: `accuracy`'s `params` file is optional).
 pub const NEEDS_FILE: &[&str] = &[];
 
-/// Every registered pass the property exercises (all of `PASSES` but [`NEEDS_FILE`]).
+/// Every registered pass the property exercises (all of `robovec_backends::REGISTRY` but
+/// [`NEEDS_FILE`]).
 pub fn checked_passes() -> Vec<&'static str> {
     PASSES.iter().map(|p| p.name).filter(|n| !NEEDS_FILE.contains(n)).collect()
 }
@@ -74,7 +76,8 @@ fn same_bits<T: Copy + PartialEq + Into<f64>>(a: T, b: T, bits: impl Fn(T) -> u6
 /// # Errors
 /// A message naming the pipeline, the output, the point and the figures.
 pub fn check(before: &Function, pipeline: &str, points: &[Vec<f64>]) -> Result<Function, String> {
-    let pm = PassManager::new(pipeline, Instrumentation::default()).map_err(|e| format!("{pipeline}: {e}"))?;
+    let pm = PassManager::with_registry(robovec_backends::REGISTRY, pipeline, Instrumentation::default())
+        .map_err(|e| format!("{pipeline}: {e}"))?;
     let bit_exact = pm.is_bit_exact();
     let m = Module { functions: vec![before.clone()] };
     let mut session = Session::new(pm, m, PassContext::default());
@@ -145,9 +148,19 @@ mod tests {
             ["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy", "depth-bound"]
         );
         // `split(',')` read `sweep<pe=8,16>` as `sweep<pe=8` and `16>`: not bit-exact.
-        let pm = PassManager::new("atomise,sweep<pe=8,16>", Instrumentation::default()).unwrap();
+        let pm = PassManager::with_registry(
+            robovec_backends::REGISTRY,
+            "atomise,sweep<pe=8,16>",
+            Instrumentation::default(),
+        )
+        .unwrap();
         assert!(pm.is_bit_exact());
-        let pm = PassManager::new("atomise,sweep<pe=8,16>,balance", Instrumentation::default()).unwrap();
+        let pm = PassManager::with_registry(
+            robovec_backends::REGISTRY,
+            "atomise,sweep<pe=8,16>,balance",
+            Instrumentation::default(),
+        )
+        .unwrap();
         assert!(!pm.is_bit_exact());
     }
 

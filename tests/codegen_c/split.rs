@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use robovec_passes::codegen::c::{Abi, CodegenC, Precision, Trig};
+use robovec_backends::c::{Abi, CodegenC, Precision, Trig};
 
 use super::{batch_cases, check_plain, check_plain_tol, check_plain_with, corpus_cases, plain, run_pipeline, Case};
 use crate::common::{opt, stderr, tmp};
@@ -284,7 +284,7 @@ fn split_code_compiles_cleanly_in_c99() {
             dir.join(file).to_str().unwrap(),
         ]);
     }
-    std::fs::write(dir.join("mbs_data.h"), robovec_passes::codegen::c::robotran::mbs_data_header()).unwrap();
+    std::fs::write(dir.join("mbs_data.h"), robovec_backends::c::robotran::mbs_data_header()).unwrap();
     for f in ["p.c", "p_1.c", "r.c", "r_1.c"] {
         let o = cc(&dir, &["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-Wno-unused-parameter", "-c", f]);
         assert!(o.status.success(), "{f}: {}", String::from_utf8_lossy(&o.stderr));
@@ -311,7 +311,7 @@ fn gcc_12_does_not_fuse_products_and_alternating_add_sub_in_generated_code() {
     .unwrap();
     run_ok(&[ir.to_str().unwrap(), "-passes=codegen<c>", "-o", dir.join("f.c").to_str().unwrap()]);
     let code = std::fs::read_to_string(dir.join("f.c")).unwrap();
-    assert!(code.contains(robovec_passes::codegen::c::SLP_GUARD), "{code}");
+    assert!(code.contains(robovec_backends::c::SLP_GUARD), "{code}");
     let fused = |file: &str| {
         let o = cc(&dir, &["-O2", "-mfma", "-ffp-contract=off", "-S", "-o", "-", file]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -323,7 +323,7 @@ fn gcc_12_does_not_fuse_products_and_alternating_add_sub_in_generated_code() {
     let gcc12 = String::from_utf8_lossy(&version.stdout).starts_with("12.")
         && !String::from_utf8_lossy(&cc(&dir, &["--version"]).stdout).contains("clang");
     if gcc12 {
-        std::fs::write(dir.join("bare.c"), code.replace(robovec_passes::codegen::c::SLP_GUARD, "")).unwrap();
+        std::fs::write(dir.join("bare.c"), code.replace(robovec_backends::c::SLP_GUARD, "")).unwrap();
         assert!(fused("bare.c"), "GCC 12 without the guard: the test input no longer triggers the fusion");
     }
 }

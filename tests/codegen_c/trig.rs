@@ -8,9 +8,9 @@
 
 use std::process::{Command, Stdio};
 
+use robovec_backends::c::trig::{Constants, PI_HEX};
+use robovec_backends::c::{CodegenC, Precision, Trig};
 use robovec_ir::rng::SplitMix64;
-use robovec_passes::codegen::c::trig::{Constants, PI_HEX};
-use robovec_passes::codegen::c::{CodegenC, Precision, Trig};
 
 use crate::common::tmp;
 

@@ -7,7 +7,7 @@
 
 use std::process::Command;
 
-use robovec_passes::codegen::c::{robotran, Abi, CodegenC, Trig};
+use robovec_backends::c::{robotran, Abi, CodegenC, Trig};
 
 use super::{batch_cases, check_plain_tol, check_plain_with, corpus_cases, plain, run_pipeline, Case};
 use crate::common::tmp;

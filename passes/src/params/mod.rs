@@ -22,7 +22,7 @@ mod words;
 
 pub use latency::{LatencyOverride, LATENCY_PARAMS, LAT_ADD, LAT_CALL, LAT_DIV, LAT_MUL};
 pub use values::Params;
-pub(crate) use words::word_enum;
+pub use words::word_enum;
 pub use words::Word;
 
 use crate::{Pass, PassError};

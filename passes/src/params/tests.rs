@@ -76,40 +76,6 @@ fn every_declared_default_is_the_default_and_every_range_is_enforced() {
 }
 
 #[test]
-fn a_set_parameter_takes_only_its_values() {
-    let info = crate::PASSES.get("codegen").unwrap();
-    let batch = info.param("batch").unwrap();
-    assert_eq!((batch.default_text(), batch.range_text()), ("1".to_string(), "1|2|4|8|16".to_string()));
-    for bad in ["0", "3", "32", "-1", "x"] {
-        let e = build(info, &[("batch", bad.into())]).unwrap_err().to_string();
-        assert_eq!(
-            e,
-            format!("pass `codegen`: parameter `batch` must be one of `1`, `2`, `4`, `8`, `16`, found `{bad}`")
-        );
-    }
-}
-
-#[test]
-fn word_parameters_are_read_as_their_enums() {
-    use crate::codegen::c::{Abi, Precision, Trig};
-    use crate::codegen::fpga::Format;
-    use robovec_machine::resources::Logic;
-    fn round_trip<T: Word + PartialEq + std::fmt::Debug>(all: &[T]) {
-        assert_eq!(all.len(), T::WORDS.len());
-        for (x, w) in all.iter().zip(T::WORDS) {
-            assert_eq!((x.as_str(), T::from_word(w)), (*w, Some(*x)));
-        }
-        assert_eq!(T::from_word("x"), None);
-    }
-    round_trip(&[Abi::Plain, Abi::Robotran, Abi::Pinocchio]);
-    round_trip(&[Precision::F64, Precision::F32]);
-    round_trip(&[Trig::Libm, Trig::Input, Trig::Inline]);
-    round_trip(&[Format::Both, Format::Mif, Format::Hex]);
-    round_trip(&[Logic::Auto, Logic::Yosys, Logic::Estimate]);
-    assert_eq!(serde_json::to_string(&Abi::Robotran).unwrap(), "\"robotran\"");
-}
-
-#[test]
 fn option_defaults_come_from_the_declarations() {
     // Window 6 is what eqsat uses; `--print-passes` printed 8 before the declarations.
     let eqsat = crate::PASSES.get("eqsat").unwrap();

@@ -16,6 +16,7 @@ pub trait Word: Copy + 'static {
 /// `Variant = "word"`. The enum gets `WORDS` (every word, in variant order: what the
 /// parameter's [`ParamKind::Choice`] declares as `choices`), `const fn as_str`, `from_word`,
 /// [`Word`] (for [`Params::word`]), and `Serialize` as its word (the report writes `"robotran"`).
+#[macro_export]
 macro_rules! word_enum {
     (
         $(#[$meta:meta])*
@@ -68,4 +69,18 @@ macro_rules! word_enum {
         }
     };
 }
-pub(crate) use word_enum;
+pub use crate::word_enum;
+
+/// `codegen<fpga;resources=…>` reads its words from the machine's `Logic`, which holds them
+/// (implemented here: the trait is this crate's, the type the machine's).
+impl Word for robovec_machine::resources::Logic {
+    const WORDS: &'static [&'static str] = robovec_machine::resources::Logic::WORDS;
+
+    fn as_str(self) -> &'static str {
+        robovec_machine::resources::Logic::as_str(self)
+    }
+
+    fn from_word(word: &str) -> Option<robovec_machine::resources::Logic> {
+        robovec_machine::resources::Logic::from_word(word)
+    }
+}

@@ -127,14 +127,20 @@ pub fn mark_front(rows: &mut [ParetoRow]) {
 ///
 /// # Errors
 /// [`Failure::Usage`] for an empty list, an empty pipeline, an unknown pass or a bad parameter.
-pub fn managers(text: &str) -> Result<Vec<(String, PassManager)>, Failure> {
+pub fn managers(registry: crate::Registry, text: &str) -> Result<Vec<(String, PassManager)>, Failure> {
     split_pipelines(text)
         .map_err(Failure::Usage)?
         .into_iter()
         // They run on the driver's loaded module, which `load` verified.
-        .map(|p| match PassManager::new(&p, Instrumentation { input_verified: true, ..Instrumentation::default() }) {
-            Ok(pm) => Ok((p, pm)),
-            Err(e) => Err(Failure::Usage(format!("error: -pareto pipeline `{p}`: {e}\n"))),
+        .map(|p| {
+            match PassManager::with_registry(
+                registry,
+                &p,
+                Instrumentation { input_verified: true, ..Instrumentation::default() },
+            ) {
+                Ok(pm) => Ok((p, pm)),
+                Err(e) => Err(Failure::Usage(format!("error: -pareto pipeline `{p}`: {e}\n"))),
+            }
         })
         .collect()
 }
@@ -163,7 +169,8 @@ impl crate::Artifact for ParetoStudy {
     }
 }
 
-/// Runs every pipeline of `text` on a copy of `module` and measures function `function`.
+/// Runs every pipeline of `text` (built from `registry`) on a copy of `module` and measures
+/// function `function`.
 /// `module` must be verified (the driver's `load` does it): the pipelines do not check it again.
 /// `progress` shows the pipelines done (one task, `-pareto: pipelines`).
 ///
@@ -171,6 +178,7 @@ impl crate::Artifact for ParetoStudy {
 /// [`Failure::Usage`] for a bad pipeline, [`Failure::Input`] when a pipeline fails.
 #[allow(clippy::too_many_arguments)]
 pub fn study(
+    registry: crate::Registry,
     module: &Module,
     function: &str,
     text: &str,
@@ -183,7 +191,7 @@ pub fn study(
     // A bad text fails in `run_reporting` with its own message; the total is then moot.
     let pipelines = split_pipelines(text).map_or(0, |v| v.len());
     let task = progress.task("-pareto: pipelines", pipelines as u64);
-    let rows = run_reporting(module, function, text, samples, seed, deadline, target, &task)?;
+    let rows = run_reporting(registry, module, function, text, samples, seed, deadline, target, &task)?;
     task.finish();
     Ok(ParetoStudy { function: function.to_string(), rows })
 }
@@ -200,6 +208,7 @@ pub fn study(
 /// As [`study`].
 #[allow(clippy::too_many_arguments)]
 fn run_reporting(
+    registry: crate::Registry,
     module: &Module,
     function: &str,
     text: &str,
@@ -211,7 +220,7 @@ fn run_reporting(
 ) -> Result<Vec<ParetoRow>, Failure> {
     let original =
         module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
-    let (pipelines, managers): (Vec<String>, Vec<PassManager>) = managers(text)?.into_iter().unzip();
+    let (pipelines, managers): (Vec<String>, Vec<PassManager>) = managers(registry, text)?.into_iter().unzip();
     let mut rows = Vec::new();
     let n = pipelines.len();
     for (k, (p, pm)) in pipelines.iter().zip(managers).enumerate() {

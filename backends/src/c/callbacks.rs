@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use robovec_ir::{Callee, Def, Module};
 
 use super::is_intrinsic;
-use crate::PassError;
+use robovec_passes::PassError;
 
 /// A user callback the generated code calls: Robotran's name without the integer arguments
 /// the IR appends (`user_ExtForces.1` → `user_ExtForces`, one index).
@@ -42,7 +42,7 @@ pub fn split_callee(c: &Callee) -> Result<(String, Vec<i64>), PassError> {
     let n_idx = parts.iter().rev().take_while(|p| p.parse::<i64>().is_ok()).count().min(parts.len() - 1);
     let base = parts[..parts.len() - n_idx].join("_");
     let idx: Vec<i64> = parts[parts.len() - n_idx..].iter().map(|p| p.parse().expect("checked")).collect();
-    if crate::codegen::names::is_c_identifier(&base) {
+    if crate::names::is_c_identifier(&base) {
         Ok((base, idx))
     } else {
         Err(PassError::Failed {

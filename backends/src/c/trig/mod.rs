@@ -110,7 +110,7 @@ mod kernel;
 
 use std::fmt::Write as _;
 
-use crate::codegen::literal;
+use crate::literal;
 
 use constants::pow2;
 pub use constants::{Constants, PI_HEX};

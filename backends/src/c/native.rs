@@ -27,7 +27,7 @@ use robovec_ir::{Def, Function, Module, Operand, Value};
 use super::body::{Body, Native};
 use super::callbacks::{callee_names, split_callee, Callback};
 use super::is_intrinsic;
-use crate::PassError;
+use robovec_passes::PassError;
 
 /// The local arrays of a vector callback, `(name prefix, number of indices)`, in the order of
 /// the native signature (and of the IR's operands).

@@ -1,6 +1,6 @@
 //! `abi=plain`: `void SYMBOL(const REAL *restrict in, REAL *restrict out)` (SPEC §8).
 //!
-//! Input `i` (canonical names in [`crate::codegen::Interface::inputs`]) is `in[i]`, output `j`
+//! Input `i` (canonical names in [`crate::Interface::inputs`]) is `in[i]`, output `j`
 //! is `out[j]`; with `batch=W`, lane `l` of them is `in[i*W + l]` and `out[j*W + l]`, loaded
 //! and stored with `memcpy` (no alignment is assumed).
 //!
@@ -29,8 +29,8 @@ use robovec_ir::{Function, Operand, Value};
 use super::body::Body;
 use super::split::{part_name, part_prefix, Part, Plan};
 use super::{interface, CodegenC, Emitted};
-use crate::codegen::input_values;
-use crate::codegen::names::c_names;
+use crate::input_values;
+use crate::names::c_names;
 
 /// The parameter and helper names of the plain ABI (never given to a value).
 pub const RESERVED: &[&str] = &["in", "out", "live"];
@@ -43,7 +43,7 @@ pub(crate) fn function(
     f: &Function,
     symbol: &str,
     taken: &HashSet<String>,
-    ticker: &crate::Ticker,
+    ticker: &robovec_passes::Ticker,
 ) -> Emitted {
     let iface = interface(o, f, symbol);
     let layout = Layout {
@@ -111,7 +111,7 @@ pub(crate) fn arrays(
     f: &Function,
     symbol: &str,
     taken: &HashSet<String>,
-    ticker: &crate::Ticker,
+    ticker: &robovec_passes::Ticker,
     layout: &Layout,
     comment: &str,
 ) -> (String, Vec<Part>) {

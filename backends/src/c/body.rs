@@ -9,7 +9,7 @@ use robovec_ir::{BinOp, Def, Function, Operand, TrigFn, Value};
 
 use super::callbacks::split_callee;
 use super::{is_intrinsic, CodegenC, Trig};
-use crate::codegen::literal;
+use crate::literal;
 use robovec_ir::Intrinsic;
 
 /// The vector type `robovec_vec` of a batch of `lanes` states and its per-lane helpers.
@@ -97,8 +97,8 @@ pub(crate) struct Body<'a> {
     /// [`TrigBlock`].
     block: Option<TrigBlock>,
     /// `-time-limit`: one tick per statement written; once it says stop, no more statements
-    /// are written and the caller fails with [`crate::PassError::TimeLimit`].
-    ticker: &'a crate::Ticker,
+    /// are written and the caller fails with [`robovec_passes::PassError::TimeLimit`].
+    ticker: &'a robovec_passes::Ticker,
     /// By value index: no op reads the value and no output is it (a value Robotran computes and
     /// never uses, before `dce`). Its statement is followed by `(void)NAME;`, so that
     /// `-Wall -Werror` builds pass (`-Wunused-variable`).
@@ -113,7 +113,7 @@ impl<'a> Body<'a> {
         f: &'a Function,
         names: &'a [String],
         native: Option<&'a Native>,
-        ticker: &'a crate::Ticker,
+        ticker: &'a robovec_passes::Ticker,
     ) -> Body<'a> {
         let fused = if o.trig == Trig::Inline { fused_trig(f) } else { HashMap::new() };
         let block = if o.trig == Trig::Inline && o.batch == 1 { TrigBlock::of(f) } else { None };

@@ -54,10 +54,10 @@ use robovec_ir::{Function, Module};
 
 use super::plain::{arrays, Layout, Source};
 use super::{CodegenC, Emitted};
-use crate::codegen::names::reserved_symbol_reason;
-use crate::codegen::Interface;
-use crate::time_limit::TickerError;
-use crate::PassError;
+use crate::names::reserved_symbol_reason;
+use crate::Interface;
+use robovec_passes::time_limit::TickerError;
+use robovec_passes::PassError;
 
 /// The prefix of the symbols without `name=`: `model_rnea`, `model_crba`, ….
 pub const DEFAULT_NAME: &str = "model";
@@ -239,7 +239,7 @@ fn prefix(o: &CodegenC) -> Result<String, PassError> {
 pub(crate) fn emit(
     o: &CodegenC,
     m: &Module,
-    ticker: &crate::Ticker,
+    ticker: &robovec_passes::Ticker,
 ) -> Result<(Vec<String>, Vec<Emitted>, String), PassError> {
     let name = prefix(o)?;
     let (mut nq, mut nv) = (0, 0);

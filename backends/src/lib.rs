@@ -1,3 +1,6 @@
+//! robovec's back ends: the layer after the passes (ARCHITECTURE.md), and the complete
+//! registry ([`REGISTRY`]: every pass of `robovec-passes`, then the back ends).
+//!
 //! `codegen<…>`: the back ends (SPEC §8). `codegen<c;…>` writes C ([`c`]); `codegen<fpga;…>`
 //! writes a placed design's files ([`fpga`]). Each back end is a [`Member`] of the family
 //! ([`BACK_ENDS`]) that declares its own parameters: `codegen<c;format=hex>` is refused,
@@ -7,20 +10,49 @@
 //! `codegen<back-end=c;abi=plain>`). Pieces the C emitter shares with its callers live here:
 //! C-identifier naming that keeps Robotran's value names ([`names`]), the input/output maps in
 //! canonical SPEC §2 names ([`Interface`]) and literals that round-trip exactly ([`literal`]).
+//!
+//! A third back end is a folder here with its [`Member`] (selector word, doc, its own typed
+//! parameters, its [`robovec_passes::Props`], constructor) and one line in [`BACK_ENDS`]; a
+//! back end whose code `-o` writes implements [`robovec_passes::BackEnd`] (companion files,
+//! translation units). Machine-specific work stays in the crate of its machine, as
+//! `codegen<fpga>` calls `robovec-machine`.
+#![deny(missing_docs)]
 
 pub mod c;
 pub mod fpga;
 pub mod literal;
 pub mod names;
+#[cfg(test)]
+mod params_tests;
+#[cfg(test)]
+mod time_limit_tests;
 
 use robovec_ir::{Def, Function, Module, Phase};
 
-use crate::params::ParamKind;
-use crate::{Artifact, GeneratedCode, Member, Merge, ParamInfo, Params, PassContext, PassError, PassInfo, ReportEntry};
 use c::{Abi, Precision, Trig};
+use robovec_passes::params::ParamKind;
+use robovec_passes::{
+    Artifact, GeneratedCode, Member, Merge, ParamInfo, Params, PassContext, PassError, PassInfo, Registry, ReportEntry,
+    PASSES,
+};
 
 /// The back ends, selected by the first word of `codegen<…>`, each with its parameters.
 pub const BACK_ENDS: &[Member] = &[c::BACK_END, fpga::BACK_END];
+
+/// The complete registry: every pass of `robovec-passes` ([`robovec_passes::PASSES`]) in its
+/// order, then `codegen` ([`INFO`]); what `-passes=`, `-pareto`, `--print-passes`,
+/// docs/passes.md, the study and the test kit read.
+pub const REGISTRY: Registry = Registry { passes: &ALL };
+
+const ALL: [&PassInfo; PASSES.passes.len() + 1] = {
+    let mut all = [&INFO; PASSES.passes.len() + 1];
+    let mut i = 0;
+    while i < PASSES.passes.len() {
+        all[i] = PASSES.passes[i];
+        i += 1;
+    }
+    all
+};
 
 /// Registry entry: the back-end selector; each back end declares its own parameters.
 pub const INFO: PassInfo = PassInfo {
@@ -33,7 +65,7 @@ pub const INFO: PassInfo = PassInfo {
     }],
     build: Params::build_member,
     // A family: each back end (a `Member`) declares its own properties.
-    props: crate::Props { back_end: true, ..crate::Props::DEFAULT },
+    props: robovec_passes::Props { back_end: true, ..robovec_passes::Props::DEFAULT },
 };
 
 /// What one generated function takes and gives, in argument order (SPEC §8 `codegen`).
@@ -111,7 +143,7 @@ pub(crate) fn run_emitter(
     cx: &mut PassContext,
     emit: impl Fn(&Module) -> Result<CodegenArtifact, PassError>,
 ) -> Result<(), PassError> {
-    crate::require_phase("codegen", m, Phase::Atomised)?;
+    robovec_passes::require_phase("codegen", m, Phase::Atomised)?;
     let a = emit(m)?;
     cx.emit(a);
     Ok(())
@@ -119,7 +151,11 @@ pub(crate) fn run_emitter(
 
 #[cfg(test)]
 mod tests {
-    use crate::{build_pass, parse_pipeline, PassError};
+    use robovec_passes::{parse_pipeline, PassError};
+
+    fn build_pass(spec: &robovec_passes::PassSpec) -> Result<Box<dyn robovec_passes::Pass>, PassError> {
+        crate::REGISTRY.build(spec).map(|(_, p)| p)
+    }
 
     fn build(text: &str) -> Result<String, PassError> {
         let spec = parse_pipeline(text).unwrap().remove(0);
@@ -181,7 +217,7 @@ mod tests {
 
     #[test]
     fn the_registry_declares_each_parameter_once_under_its_back_end() {
-        let info = crate::pass_info("codegen").unwrap();
+        let info = crate::REGISTRY.get("codegen").unwrap();
         let names: Vec<&str> = info.every_param().map(|p| p.name).collect();
         assert_eq!(
             names,

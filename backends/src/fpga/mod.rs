@@ -58,9 +58,9 @@ use robovec_machine::design::Design;
 use robovec_machine::emit::{emit_until, DesignFile};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
-use crate::params::{word_enum, ParamKind, Word};
-use crate::time_limit::TickerError;
-use crate::{
+use robovec_passes::params::{word_enum, ParamKind};
+use robovec_passes::time_limit::TickerError;
+use robovec_passes::{
     Artifact, ArtifactFile, Member, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry, Ticker,
 };
 
@@ -70,7 +70,7 @@ pub const BACK_END: Member = Member {
     doc: "the placed design's images, manifest, Verilog, simulate script and resources (issue 12), in `out=DIR`",
     params: &[OUT, FORMAT, RESOURCES],
     build: |p| Ok(Box::new(CodegenFpga::from_params(p)?)),
-    props: crate::Props { back_end: true, ..crate::Props::DEFAULT },
+    props: robovec_passes::Props { back_end: true, ..robovec_passes::Props::DEFAULT },
 };
 
 /// `out=DIR`.
@@ -101,19 +101,6 @@ word_enum! {
         Mif = "mif",
         /// `hex`: `$readmemh` hex only.
         Hex = "hex",
-    }
-}
-
-/// `resources=` reads its words from the machine's [`Logic`], which holds them.
-impl Word for Logic {
-    const WORDS: &'static [&'static str] = Logic::WORDS;
-
-    fn as_str(self) -> &'static str {
-        Logic::as_str(self)
-    }
-
-    fn from_word(word: &str) -> Option<Logic> {
-        Logic::from_word(word)
     }
 }
 
@@ -292,7 +279,7 @@ impl Pass for CodegenFpga {
     /// the limit, and a limit reached before a function starts stops the pass too; either
     /// ends the run with [`PassError::TimeLimit`] (nothing written).
     fn run(&self, m: &mut robovec_ir::Module, cx: &mut PassContext) -> Result<(), PassError> {
-        crate::require_phase("codegen", m, robovec_ir::Phase::Atomised)?;
+        robovec_passes::require_phase("codegen", m, robovec_ir::Phase::Atomised)?;
         let (limits, model) = (Limits::of(&cx.target), cost_model(&cx.target));
         let ticker = cx.ticker();
         let mut functions = Vec::new();
@@ -325,8 +312,8 @@ impl Pass for CodegenFpga {
 
 #[cfg(test)]
 mod tests {
-    use crate::place::{place_function, PlaceOptions};
-    use crate::{Instrumentation, PassContext, PassError, PassManager};
+    use robovec_passes::place::{place_function, PlaceOptions};
+    use robovec_passes::{Instrumentation, PassContext, PassError, PassManager};
 
     /// `@f`, 200 ops placed on 2 + 2 PEs.
     fn placed() -> robovec_ir::Module {
@@ -337,8 +324,12 @@ mod tests {
     }
 
     fn run(budget: Option<u64>) -> (Result<(), PassError>, usize) {
-        let pm = PassManager::new("codegen<fpga;out=unused;resources=estimate>", Instrumentation::default())
-            .expect("builds");
+        let pm = PassManager::with_registry(
+            crate::REGISTRY,
+            "codegen<fpga;out=unused;resources=estimate>",
+            Instrumentation::default(),
+        )
+        .expect("builds");
         let mut m = placed();
         let mut cx = PassContext { tick_budget: budget, ..PassContext::default() };
         let ran = pm.run(&mut m, &mut cx, &mut Vec::new()).map(|_| ());

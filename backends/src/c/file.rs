@@ -12,9 +12,9 @@ use robovec_ir::{Function, Module};
 
 use super::{body, callbacks, has_fused, native, pinocchio, plain, robotran, split, trig};
 use super::{Abi, CodegenC, Emitted, Trig};
-use crate::codegen::CodegenArtifact;
-use crate::time_limit::TickerError;
-use crate::{GeneratedCode, PassError};
+use crate::CodegenArtifact;
+use robovec_passes::time_limit::TickerError;
+use robovec_passes::{GeneratedCode, PassError};
 
 /// Written at the top of every generated file: GCC 12's SLP vectoriser fuses a vector of
 /// products and an alternating subtract/add into `vfmaddsub`/`vfmsubadd` even under
@@ -54,7 +54,7 @@ impl CodegenC {
         &self,
         m: &Module,
         main: Option<&Path>,
-        ticker: &crate::Ticker,
+        ticker: &robovec_passes::Ticker,
     ) -> Result<CodegenArtifact, PassError> {
         let fused = m.functions.iter().any(has_fused);
         let callbacks = callbacks::callbacks(m)?;
@@ -86,7 +86,7 @@ impl CodegenC {
         let units = self.units as usize;
         let unit_of = unit_assignment(&emitted, units);
         let file_names: Vec<String> = match main {
-            Some(p) => (0..units).map(|k| crate::unit_path(p, k).display().to_string()).collect(),
+            Some(p) => (0..units).map(|k| robovec_passes::unit_path(p, k).display().to_string()).collect(),
             None => Vec::new(),
         };
         let header_name = main.map(|p| p.with_extension("h").display().to_string());

@@ -16,8 +16,8 @@ use robovec_ir::{Function, Module, Operand, Value};
 use super::body::Body;
 use super::split::{part_name, part_prefix, Part, Plan};
 use super::{interface, CodegenC, Emitted};
-use crate::codegen::names::c_names;
-use crate::PassError;
+use crate::names::c_names;
+use robovec_passes::PassError;
 
 /// A Robotran function kind: the IR function name, Robotran's symbol and its output arrays.
 struct Kind {
@@ -140,7 +140,7 @@ pub(crate) fn function(
     f: &Function,
     symbol: &str,
     taken: &HashSet<String>,
-    ticker: &crate::Ticker,
+    ticker: &robovec_passes::Ticker,
 ) -> Result<Emitted, PassError> {
     let fail =
         |message: String| PassError::Failed { pass: "codegen".into(), message: format!("@{}: {message}", f.name) };

@@ -40,8 +40,8 @@ use robovec_ir::{Callee, Def, Function, Module};
 
 use super::names::{free_name, is_c_identifier, is_reserved_symbol, reserved_symbol_reason, sanitise};
 use super::{CodegenArtifact, Interface};
-use crate::params::{word_enum, ParamKind};
-use crate::{Member, ParamInfo, Params, Pass, PassContext, PassError};
+use robovec_passes::params::{word_enum, ParamKind};
+use robovec_passes::{Member, ParamInfo, Params, Pass, PassContext, PassError};
 
 /// The C back end of `codegen`: `codegen<c;…>`, with its parameters.
 pub const BACK_END: Member = Member {
@@ -49,11 +49,11 @@ pub const BACK_END: Member = Member {
     doc: "C (SPEC §8); `-o FILE` gets the code and FILE.h its prototypes",
     params: &[ABI, PRECISION, BATCH, TRIG, NAME, CHUNK, UNITS],
     build: |p| Ok(Box::new(CodegenC::from_params(p)?)),
-    props: crate::Props {
+    props: robovec_passes::Props {
         requires: Some(robovec_ir::Phase::Atomised),
         preserves_timing: true,
         back_end: true,
-        ..crate::Props::DEFAULT
+        ..robovec_passes::Props::DEFAULT
     },
 };
 
@@ -320,7 +320,7 @@ impl CodegenC {
 
     /// The C file, its header, the further translation units (`units=K`: K − 1 of them) and
     /// the interfaces, for every function of `m` (atomised). `main`: where `-o` writes the C
-    /// file; it names the units (`model.c` → `model_1.c`, [`crate::unit_path`]) in the header
+    /// file; it names the units (`model.c` → `model_1.c`, [`robovec_passes::unit_path`]) in the header
     /// and in each interface's `sources` and `header` (the report's `codegen`); `None` (the
     /// code goes to stdout, or a caller of the library) leaves them out.
     ///
@@ -330,7 +330,7 @@ impl CodegenC {
     /// URDF generator's or an input or output with no place in Pinocchio's signatures,
     /// [`pinocchio`]; a callback used with two arities).
     pub fn emit_as(&self, m: &Module, main: Option<&Path>) -> Result<CodegenArtifact, PassError> {
-        self.emit_within(m, main, &crate::Ticker::default())
+        self.emit_within(m, main, &robovec_passes::Ticker::default())
     }
 }
 
@@ -345,12 +345,12 @@ impl Pass for CodegenC {
         super::run_emitter(m, cx, |m| self.emit_within(m, main.as_deref(), &ticker))
     }
 
-    fn as_back_end(&self) -> Option<&dyn crate::BackEnd> {
+    fn as_back_end(&self) -> Option<&dyn robovec_passes::BackEnd> {
         Some(self)
     }
 }
 
-impl crate::BackEnd for CodegenC {
+impl robovec_passes::BackEnd for CodegenC {
     fn companions(&self) -> &'static [&'static str] {
         &["h"]
     }
