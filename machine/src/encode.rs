@@ -44,7 +44,7 @@
 //! captured there).
 //!
 //! ## Data words
-//! Initial PE-memory and output-memory contents are binary32 ([`robovec_ir::machine::Word::binary32`]).
+//! Initial PE-memory and output-memory contents are binary32 ([`word_binary32`]).
 //!
 //! [`decode`] inverts [`encode`] exactly: `decode(encode(p)) == steps of p` for every program
 //! `encode` accepts; it rejects words with bits set outside their fields, a select beyond

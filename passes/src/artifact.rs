@@ -70,7 +70,7 @@ pub struct GeneratedCode {
     pub companions: Vec<(&'static str, String)>,
     /// Further translation units (`codegen<c;units=K>`, issue 28): unit `k` (1-based) goes to
     /// [`unit_path`]`(FILE, k)`. Empty for one file; a back end with several units needs
-    /// `-o FILE` ([`crate::Pass::code_units`]).
+    /// `-o FILE` ([`crate::BackEnd::units`]).
     pub units: Vec<String>,
 }
 

@@ -202,12 +202,12 @@ pub struct PassContext {
     /// real runs.
     pub tick_budget: Option<u64>,
     /// What `-time-limit` does to the pass running now (set by the manager from
-    /// [`Pass::at_time_limit`]; [`AtTimeLimit::Skip`] outside a pipeline): the tickers of a
+    /// [`Props::at_time_limit`]; [`AtTimeLimit::Skip`] outside a pipeline): the tickers of a
     /// required pass ([`PassContext::ticker`]) run to the limit's grace ([`Deadline::grace`]).
     pub running: AtTimeLimit,
     /// The module as it entered the pipeline: the reference `accuracy` measures errors
     /// against (issue 10). The manager sets it when a pass asks for it
-    /// ([`Pass::needs_original`]) and it is not set yet (`-pareto` presets it).
+    /// ([`Props::needs_original`]) and it is not set yet (`-pareto` presets it).
     pub original: Option<robovec_ir::Module>,
     /// What the passes produced, in the order they produced it (see [`crate::artifact`]).
     pub artifacts: Vec<Produced>,
@@ -337,7 +337,7 @@ pub trait BackEnd {
 
 /// The properties of a pass, declared with it in the registry ([`PassInfo::props`], or a
 /// family member's [`Member::props`]) and read from there by the manager, the session's
-/// questions ([`Session::is_bit_exact`], …), the driver's checks and the test kit.
+/// questions ([`PassManager::is_bit_exact`], …), the driver's checks and the test kit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Props {
     /// The phase every function must be in, if any; the manager checks it before the pass runs.

@@ -14,8 +14,8 @@ pub trait Word: Copy + 'static {
 
 /// Declares an enum whose values are the words of a parameter: each variant is written
 /// `Variant = "word"`. The enum gets `WORDS` (every word, in variant order: what the
-/// parameter's [`ParamKind::Choice`] declares as `choices`), `const fn as_str`, `from_word`,
-/// [`Word`] (for [`Params::word`]), and `Serialize` as its word (the report writes `"robotran"`).
+/// parameter's [`crate::params::ParamKind::Choice`] declares as `choices`), `const fn as_str`, `from_word`,
+/// [`crate::params::Word`] (for [`crate::Params::word`]), and `Serialize` as its word (the report writes `"robotran"`).
 #[macro_export]
 macro_rules! word_enum {
     (
