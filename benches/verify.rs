@@ -10,7 +10,7 @@
 //! Prints, per workload, the median of 7 runs of the whole verifier
 //! (`robovec_ir::verifier::verify_function`) and of its placement checks alone
 //! (`verifier::placement::verify_placement`), and the time per op; then the lowering into the
-//! machine program (`robovec_machine::lower::lower`, which always runs the lowered check) and
+//! machine program (`robovec_machine::program::lower`, which always runs the lowered check) and
 //! the lowered check alone (`verifier::machine::verify_machine`), to size what running the
 //! check on every lowering costs (issue 12). Run with `cargo bench --bench verify`.
 
@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use robovec_ir::verifier::{machine::verify_machine, placement::verify_placement, verify_function};
 use robovec_ir::Function;
-use robovec_machine::lower::lower;
+use robovec_machine::program::lower;
 use robovec_passes::place::{place_function, PlaceOptions};
 use robovec_testkit::dag_gen::generate;
 

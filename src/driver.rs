@@ -302,7 +302,7 @@ fn run_passes(
     };
     if let Some(text) = &opts.pareto {
         let name = select(&module, &opts.function, "-pareto")?.name.clone();
-        let study = whole_run::pareto::study(
+        let study = whole_run::pareto::measure(
             session_registry,
             &module,
             &name,
@@ -326,7 +326,7 @@ fn run_passes(
             e => pass_failure(e, src),
         })?;
     }
-    for s in &session.cx.stopped {
+    for s in session.cx.lines(robovec_passes::Severity::Stop) {
         writeln!(stderr, "note: {s}").map_err(stderr_failure)?;
     }
     if let (Some((samples, seed)), Some(original)) = (opts.check, &session.cx.original) {
@@ -349,7 +349,11 @@ fn run_passes(
 /// of the final IR, then each artifact's entry (merged by key), then the early stops.
 /// `computed` are those of [`summary::figures`] for `-function` (the reported function is among
 /// them; they are computed again only if it were not).
-fn report_json(opts: &Options, session: &Session, computed: &[Figures]) -> Result<String, Failure> {
+fn report_json(
+    opts: &Options,
+    session: &Session,
+    computed: &[Figures],
+) -> Result<(String, crate::report_dir::data::ReportData), Failure> {
     let f = select(&session.module, &opts.function, "-report")?;
     let fallback;
     let own = match computed.iter().find(|g| g.function == f.name) {
@@ -359,7 +363,9 @@ fn report_json(opts: &Options, session: &Session, computed: &[Figures]) -> Resul
             &fallback
         }
     };
-    Ok(report_text(&opts.input, &session.pipeline().pipeline_text(), session.records(), &session.cx, own))
+    let pipeline = session.pipeline().pipeline_text();
+    let data = crate::report_dir::data::ReportData::of(&opts.input, &pipeline, own, &session.cx);
+    Ok((report_text(&opts.input, &pipeline, session.records(), &session.cx, own), data))
 }
 
 /// `-eval`'s JSON, with a warning on stderr for each input given that the function does not
@@ -494,11 +500,12 @@ fn write_outputs(
     if let Some(path) = &opts.sweep_csv {
         out.stage(path, join_csv(cx.artifacts().filter_map(|a| a.csv())).as_bytes()).map_err(output_failure)?;
     }
-    if let (Some(path), Some(r)) = (&opts.report, &report) {
+    if let (Some(path), Some((r, _))) = (&opts.report, &report) {
         out.stage(path, r.as_bytes()).map_err(output_failure)?;
     }
-    if let (Some(dir), Some(r)) = (&opts.report_dir, &report) {
-        let files = crate::report_dir::files(r).map_err(|e| Failure::Output(format!("error: -report-dir: {e}\n")))?;
+    if let (Some(dir), Some((r, data))) = (&opts.report_dir, &report) {
+        let files =
+            crate::report_dir::files(r, data).map_err(|e| Failure::Output(format!("error: -report-dir: {e}\n")))?;
         out.stage_folder(dir, &files).map_err(output_failure)?;
     }
     let choice = stdout_choice(opts.output.as_deref(), eval.is_some(), terminal.stdout, tables_shown);

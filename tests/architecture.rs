@@ -65,3 +65,108 @@ fn the_code_map_is_the_crate_graph() {
         }
     }
 }
+
+/// The section of ARCHITECTURE.md's code map for the crate in `folder`: from its heading
+/// (`### \`folder/\` — …`) to the next heading.
+fn section(folder: &str) -> String {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("ARCHITECTURE.md")).expect("ARCHITECTURE.md");
+    let heading = format!("### `{folder}/`");
+    let start = text.find(&heading).unwrap_or_else(|| panic!("no section {heading} in ARCHITECTURE.md"));
+    let rest = &text[start + heading.len()..];
+    let end = rest.find("\n#").unwrap_or(rest.len());
+    rest[..end].to_string()
+}
+
+/// The main modules of a crate: the files and folders right under its `src/` but tests
+/// (`*tests.rs`, `tests/`), the crate root and the binaries' folder.
+fn main_modules(folder: &str) -> Vec<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let src = if folder == "src" { root.join("src") } else { root.join(folder).join("src") };
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(&src).expect("src folder") {
+        let entry = entry.unwrap();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let is_dir = entry.file_type().unwrap().is_dir();
+        if name.ends_with("tests.rs") || name == "tests" || name == "lib.rs" || name == "main.rs" || name == "bin" {
+            continue;
+        }
+        if is_dir {
+            out.push(format!("{name}/"));
+        } else if name.ends_with(".rs") || name.ends_with(".lalrpop") {
+            out.push(name);
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Every `name.rs` or `name/` written in backticks in `text` (paths such as `c/file.rs` give
+/// their last part and their folders).
+fn named_paths(text: &str) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for word in text.split('`').skip(1).step_by(2) {
+        if word.contains(' ') || word.contains("::") {
+            continue;
+        }
+        let parts: Vec<&str> = word.split('/').collect();
+        for (i, p) in parts.iter().enumerate() {
+            let last = i + 1 == parts.len();
+            if last && (p.ends_with(".rs") || p.ends_with(".lalrpop")) {
+                out.insert(p.to_string());
+            } else if !p.is_empty() && (!last || word.ends_with('/')) {
+                out.insert(format!("{p}/"));
+            }
+        }
+    }
+    out
+}
+
+/// Every file or folder with `name` (`x.rs` or `x/`) somewhere under `dir`.
+fn exists_under(dir: &Path, name: &str) -> bool {
+    let (want, is_dir) = match name.strip_suffix('/') {
+        Some(d) => (d, true),
+        None => (name, false),
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else { return false };
+    for e in entries.flatten() {
+        if matches!(e.file_name().to_str(), Some("target" | ".git" | "fuzz")) {
+            continue;
+        }
+        let path = e.path();
+        let file_is_dir = path.is_dir();
+        if e.file_name().to_string_lossy() == want && file_is_dir == is_dir {
+            return true;
+        }
+        if file_is_dir && exists_under(&path, name) {
+            return true;
+        }
+    }
+    false
+}
+
+#[test]
+fn the_module_lists_are_the_files() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (_, folder, _) in table() {
+        let text = section(&folder);
+        let named = named_paths(&text);
+        for m in main_modules(&folder) {
+            assert!(named.contains(&m), "ARCHITECTURE.md's section `{folder}/` does not name its module `{m}`");
+        }
+        let crate_dir = if folder == "src" { root.join("src") } else { root.join(&folder) };
+        for n in &named {
+            // Other crates' folders and files outside the crate (`hdl/`, `docs/`, …) are
+            // named as such: only what the section presents as this crate's must exist in it.
+            let elsewhere =
+                ["ir/", "machine/", "passes/", "backends/", "front/", "dynamics/", "testkit/", "src/", "docs/"];
+            if elsewhere.contains(&n.as_str()) {
+                continue;
+            }
+            assert!(
+                exists_under(&crate_dir, n) || exists_under(root, n),
+                "ARCHITECTURE.md's section `{folder}/` names `{n}`, which is not in the repository"
+            );
+        }
+    }
+}

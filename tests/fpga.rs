@@ -301,7 +301,7 @@ fn images_read_back_from_hex_and_mif_reproduce_the_machine_program_exactly() {
     for n in [2u32, 4] {
         let m = placed_pendulum(n);
         let f = &m.functions[0];
-        let prog = robovec_machine::lower::lower(f, f.placement.as_ref().unwrap()).unwrap();
+        let prog = robovec_machine::program::lower(f, f.placement.as_ref().unwrap()).unwrap();
         let d = from_program(f, &prog, &Limits::of(&t)).unwrap();
         let layout = Layout::new(&prog, t.pe_words, t.buffer_words, t.instr_width).unwrap();
         for from_mif in [false, true] {

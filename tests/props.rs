@@ -233,7 +233,7 @@ fn mutate(skeleton: &str, pos: usize, del: usize, insert: &str) -> Vec<u8> {
 /// The front-end contract on any bytes: no panic; an accepted module verifies and atomises.
 fn check_front(lang: Language, src: &[u8], header: Option<&[u8]>) {
     let Ok(m) = parse_str(lang, src, header) else { return };
-    if let Err(e) = robovec_front::check_accepted(&m) {
+    if let Err(e) = robovec_front::verify_accepted(&m) {
         panic!("{lang:?}: {e}");
     }
 }

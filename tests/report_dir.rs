@@ -270,7 +270,7 @@ fn long_loops_report_progress_through_the_hook() {
     let rec = Recorder::default();
     let progress = robovec_passes::progress::Progress::shown(Arc::new(rec.clone()));
     let target = robovec_machine::target::Target::de10_nano();
-    robovec_passes::whole_run::pareto::study(
+    robovec_passes::whole_run::pareto::measure(
         robovec_backends::REGISTRY,
         &m,
         "invdyna",

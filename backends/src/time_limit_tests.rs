@@ -59,7 +59,7 @@ fn after_the_limit_a_back_end_runs_in_its_grace() {
     let reached = Deadline { at: std::time::Instant::now(), seconds: 1000.0, grace: false };
     let cx = run(&pm, &mut m, PassContext { deadline: Some(reached), ..PassContext::default() }).expect("grace");
     assert_eq!(
-        cx.stopped,
+        cx.stopped(),
         [
             "balance skipped: time limit of 1000 s reached before it started",
             "cse skipped: time limit of 1000 s reached before it started"

@@ -5,7 +5,7 @@
 //!
 //! # Dependencies
 //! This crate may import `robovec-ir` (the IR it produces, its spans and source errors),
-//! `robovec-passes` (only [`check_accepted`]'s atomisation) and `robovec-dynamics` (the robot
+//! `robovec-passes` (only [`verify_accepted`]'s atomisation) and `robovec-dynamics` (the robot
 //! model a URDF is parsed into and the generator that writes its equations); never the driver
 //! (`robovec`), which depends on it.
 //!
@@ -220,7 +220,7 @@ mod stream_tests;
 ///
 /// # Errors
 /// A description of the first broken invariant.
-pub fn check_accepted(m: &robovec_ir::Module) -> Result<(), String> {
+pub fn verify_accepted(m: &robovec_ir::Module) -> Result<(), String> {
     robovec_ir::verifier::verify(m).map_err(|e| format!("front end returned a module that does not verify: {e:?}"))?;
     for f in &m.functions {
         let a = robovec_ir::transform::atomise::atomise_function(f);

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use robovec_front::{check_accepted, parse_str, Language};
+use robovec_front::{verify_accepted, parse_str, Language};
 
 fuzz_target!(|data: &[u8]| {
     // A NUL byte (never in a Robotran file) splits the input into the .c text and the
@@ -13,7 +13,7 @@ fuzz_target!(|data: &[u8]| {
         None => (data, None),
     };
     let Ok(m) = parse_str(Language::C, src, header) else { return };
-    if let Err(e) = check_accepted(&m) {
+    if let Err(e) = verify_accepted(&m) {
         panic!("{e}");
     }
 });

@@ -3,11 +3,11 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use robovec_front::{check_accepted, parse_str, Language};
+use robovec_front::{verify_accepted, parse_str, Language};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(m) = parse_str(Language::Matlab, data, None) else { return };
-    if let Err(e) = check_accepted(&m) {
+    if let Err(e) = verify_accepted(&m) {
         panic!("{e}");
     }
 });

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use robovec_front::{check_accepted, front_end_for, FrontOptions};
+use robovec_front::{verify_accepted, front_end_for, FrontOptions};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
@@ -21,7 +21,7 @@ fuzz_target!(|data: &[u8]| {
         FrontOptions { formulation: depth, functions: every, ..FrontOptions::default() },
     ] {
         let Ok(loaded) = fe.load(Path::new("robot.urdf"), text, &opts) else { return };
-        if let Err(e) = check_accepted(&loaded.module) {
+        if let Err(e) = verify_accepted(&loaded.module) {
             panic!("{e}");
         }
     }

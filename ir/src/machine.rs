@@ -15,7 +15,7 @@
 //! and holds no value: per PE slot and per cycle the addresses read and written, the crossbar
 //! selects, the buffer and output-capture instructions — exactly the words of the FPGA images.
 //! It is never printed in `.rvir` (it is recomputed from the placement by
-//! `robovec_machine::lower::lower`), so the split is: `placement.rs` = what the user or the
+//! `robovec_machine::program::lower`), so the split is: `placement.rs` = what the user or the
 //! placer decides and the text format carries; `machine` = the one lowering every consumer
 //! executes or encodes.
 //!

@@ -25,7 +25,7 @@
 //!
 //! The verifier checks every rule above except word lifetimes (address reuse) whenever a
 //! placement is read or left by a pass ([`crate::verifier::placement`]); the lowering into the
-//! machine program (`robovec_machine::lower::lower`, which `sim` executes and `codegen<fpga>`
+//! machine program (`robovec_machine::program::lower`, which `sim` executes and `codegen<fpga>`
 //! encodes) checks them all.
 //!
 //! A placement is the placer's decision at the level of values, carried by the `.rvir` text;

@@ -82,7 +82,7 @@ pub enum MachineErrorKind {
     /// executed program is inconsistent (a word read before anything was written there).
     Unverified,
     /// The caller's `stop` hook returned true (its time limit, `-time-limit`): the lowering
-    /// ([`crate::lower::lower_measured_until`]) or the execution
+    /// ([`crate::program::lower_measured_until`]) or the execution
     /// ([`crate::exec::execute_until`]) gave up, nothing is returned. Says nothing about the
     /// placement. Only a `stop` hook returning true produces it ([`MachineError::stopped`]).
     Stopped,

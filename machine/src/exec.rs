@@ -28,7 +28,7 @@ pub struct Executed<T> {
 /// # Errors
 /// [`K::Unverified`] when the program is inconsistent (a word read before it was written, a
 /// crossbar source carrying nothing, an address beyond its memory, a result after the last
-/// cycle) — never for a program [`crate::lower::lower`] returned.
+/// cycle) — never for a program [`crate::program::lower`] returned.
 pub fn execute<T: Float>(p: &MachineProgram, input: impl FnMut(&str) -> f64) -> Result<Executed<T>, MachineError> {
     execute_until(p, input, &|| false)
 }

@@ -10,7 +10,7 @@
 //!   `-target=`), its analytic resource estimate ([`target::Target::estimate`]), the one M10K
 //!   model ([`target::m10k_blocks`]) and the PE array a placement is made for
 //!   ([`target::Target::pe_array`]).
-//! - [`lower`]: a placed function lowered into its machine program (the one lowering every
+//! - [`program`]: a placed function lowered into its machine program (the one lowering every
 //!   consumer executes or encodes), checking every rule of the machine model; [`error`]: what
 //!   it rejects.
 //! - [`exec`]: the machine program executed on numbers (what `sim` runs).
@@ -31,6 +31,6 @@ pub mod emit;
 pub mod encode;
 pub mod error;
 pub mod exec;
-pub mod lower;
+pub mod program;
 pub mod resources;
 pub mod target;

@@ -155,7 +155,7 @@ impl Pass for Contract {
                 c.muls_removed
             ));
         }
-        cx.notes.push(format!("contract: {}", parts.join("; ")));
+        cx.remark("contract", m, format!("contract: {}", parts.join("; ")));
         Ok(())
     }
 }

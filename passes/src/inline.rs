@@ -90,7 +90,11 @@ impl Pass for Inline {
                 f.name, s.values, s.copies, s.ops.0, s.ops.1, s.added
             ));
         }
-        cx.notes.push(format!("inline<max-uses={};max-size={}>: {}", self.max_uses, self.max_size, parts.join("; ")));
+        cx.remark(
+            "inline",
+            m,
+            format!("inline<max-uses={};max-size={}>: {}", self.max_uses, self.max_size, parts.join("; ")),
+        );
         Ok(())
     }
 }

@@ -166,6 +166,39 @@ impl PassError {
     }
 }
 
+/// How a pass's [`Diagnostic`] is shown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Severity {
+    /// What a rewriting pass changed or an analysis found, one line per run: printed under
+    /// `-stats`.
+    Remark,
+    /// The pass stopped early or was skipped (`-time-limit`, a work budget), with a valid
+    /// result: always printed as a `note:` line, listed in the report's `stopped_early`.
+    Stop,
+}
+
+/// What a pass says beside its artifacts (typed, as the artifacts are): its severity, the pass,
+/// where (the functions it is about; none: the module or the pipeline), and the line.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Diagnostic {
+    /// How it is shown.
+    pub severity: Severity,
+    /// The pass that said it, as written in the pipeline or registered (`balance`,
+    /// `inline<max-uses=3;max-size=64>`).
+    pub pass: String,
+    /// The functions it is about, in module order (empty: the module, or the pipeline).
+    pub functions: Vec<String>,
+    /// The line as printed (`balance: @dirdyna: ops 4261 -> 4095, …`).
+    pub message: String,
+}
+
+impl std::fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
 /// State that passes share across one pipeline run.
 ///
 /// Results a pass makes for the user (tables, figures, files, generated code) are not fields
@@ -184,19 +217,18 @@ pub struct PassContext {
     /// Which pass last overrode [`PassContext::latencies`] and how (`asap-alap<lat-add=6;lat-mul=4>`);
     /// `None`: they are the target's.
     pub latencies_from: Option<String>,
-    /// One line per run of a rewriting pass saying what it changed (ops added or removed,
-    /// critical path before and after); the driver prints them with `-stats`.
-    pub notes: Vec<String>,
+    /// What the passes said beside their artifacts, in order ([`Diagnostic`]: severity, the
+    /// pass, the functions it is about, the line): one remark per run of a rewriting pass saying
+    /// what it changed (ops added or removed, critical path before and after; the driver prints
+    /// them with `-stats`), one stop per pass that stopped early or was skipped (the driver
+    /// prints each as a `note:` line, with or without `-stats`, and the report lists them in
+    /// `stopped_early`).
+    pub diagnostics: Vec<Diagnostic>,
     /// `-time-limit=SECONDS`: the instant by which the pipeline should end, with the limit it
     /// came from. Passes with long loops (eqsat's windows, place's restarts and search, sweep's
     /// configurations) check [`PassContext::out_of_time`] between steps, stop early with a valid
     /// result, and say so (see [`PassContext::note_stop`]).
     pub deadline: Option<Deadline>,
-    /// One line per early stop of a pass (time limit or work budget reached), such as
-    /// `eqsat stopped after 12 of 345 windows of @dirdyna: time limit of 1 s reached`; the
-    /// driver prints each on stderr as a `note:` line (with or without `-stats`) and lists them
-    /// in the report's `stopped_early`.
-    pub stopped: Vec<String>,
     /// Tests: every [`Ticker`] of the run ([`PassContext::ticker`]) stops at this tick, so a
     /// test stops any pass's loop at a chosen step whatever the machine's speed. `None` in
     /// real runs.
@@ -277,9 +309,33 @@ impl PassContext {
     }
 
     /// Records that `pass` stopped early: `what` says where and why (`after 12 of 345 windows
-    /// of @dirdyna: time limit of 1 s reached`); see [`PassContext::stopped`].
+    /// of @dirdyna: time limit of 1 s reached`); a [`Severity::Stop`] diagnostic
+    /// (`eqsat stopped after …`).
     pub fn note_stop(&mut self, pass: &str, what: &str) {
-        self.stopped.push(format!("{pass} stopped {what}"));
+        self.diagnostics.push(Diagnostic {
+            severity: Severity::Stop,
+            pass: pass.to_string(),
+            functions: Vec::new(),
+            message: format!("{pass} stopped {what}"),
+        });
+    }
+
+    /// Records what `pass` did to the functions of `m` ([`Severity::Remark`]; `message` is the
+    /// whole line `-stats` prints, `balance: @dirdyna: ops 4261 -> 4095, …`).
+    pub fn remark(&mut self, pass: &str, m: &Module, message: String) {
+        let functions = m.functions.iter().map(|f| f.name.clone()).collect();
+        self.diagnostics.push(Diagnostic { severity: Severity::Remark, pass: pass.to_string(), functions, message });
+    }
+
+    /// The lines of the diagnostics of `severity`, in order.
+    pub fn lines(&self, severity: Severity) -> impl Iterator<Item = &str> {
+        self.diagnostics.iter().filter(move |d| d.severity == severity).map(|d| d.message.as_str())
+    }
+
+    /// The early stops so far (the [`Severity::Stop`] lines), in order: what the report lists
+    /// in `stopped_early`.
+    pub fn stopped(&self) -> Vec<String> {
+        self.lines(Severity::Stop).map(str::to_string).collect()
     }
 
     /// Hands over a result of the running pass (see [`crate::artifact`]).

@@ -21,8 +21,9 @@ pub fn report_text(input: &str, pipeline: &str, records: &[PassRecord], cx: &Pas
     for (key, value) in entries {
         r.insert(key.into(), value);
     }
-    if !cx.stopped.is_empty() {
-        r.insert("stopped_early".into(), cx.stopped.clone().into());
+    let stopped = cx.stopped();
+    if !stopped.is_empty() {
+        r.insert("stopped_early".into(), stopped.into());
     }
     serde_json::to_string_pretty(&serde_json::Value::Object(r)).expect("report serialises") + "\n"
 }

@@ -102,7 +102,7 @@ impl Pass for Specialize {
         if !unused.is_empty() {
             note += &format!("; {} given names are not inputs: {}", unused.len(), unused.join(", "));
         }
-        cx.notes.push(note);
+        cx.remark("specialize", m, note);
         Ok(())
     }
 }

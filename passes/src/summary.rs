@@ -107,7 +107,7 @@ pub fn figures(module: &Module, cx: &PassContext, function: Option<&str>) -> Vec
 pub fn stats_text(figures: &[Figures], cx: &PassContext, function: Option<&str>) -> String {
     use std::fmt::Write;
     let mut out = String::new();
-    for note in &cx.notes {
+    for note in cx.lines(crate::Severity::Remark) {
         let _ = writeln!(out, "{note}");
     }
     for g in figures {

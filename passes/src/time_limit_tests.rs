@@ -86,7 +86,7 @@ fn every_registered_pass_is_skipped_or_ends_the_run_when_the_limit_is_reached_be
         match policy {
             AtTimeLimit::Skip => {
                 let records = ran.unwrap_or_else(|e| panic!("{text}: {e}"));
-                assert_eq!(cx.stopped, [format!("{text} skipped: time limit of 0 s reached before it started")]);
+                assert_eq!(cx.stopped(), [format!("{text} skipped: time limit of 0 s reached before it started")]);
                 assert_eq!(m.to_string(), before, "{text}: a skipped pass leaves the module as it was");
                 assert_eq!((records.len(), records[0].wall_ms), (1, 0.0), "{text}: listed with no time");
             }
@@ -113,7 +113,7 @@ fn after_the_limit_required_passes_run_in_its_grace_and_the_others_are_skipped()
     let mut cx = PassContext { deadline: Some(reached_with_grace_left()), ..PassContext::default() };
     pm.run(&mut m, &mut cx, &mut Vec::new()).expect("atomise and dce run in the grace");
     assert_eq!(
-        cx.stopped,
+        cx.stopped(),
         [
             "balance skipped: time limit of 1000 s reached before it started",
             "cse skipped: time limit of 1000 s reached before it started"
@@ -143,7 +143,7 @@ fn run_budget(text: &str, m: &mut Module, budget: u64) -> (Result<(), PassError>
     let pm = PassManager::new(text, Instrumentation::default()).expect("builds");
     let mut cx = PassContext { tick_budget: Some(budget), ..PassContext::default() };
     let ran = pm.run(m, &mut cx, &mut Vec::new()).map(|_| ());
-    (ran, cx.stopped)
+    (ran, cx.stopped())
 }
 
 #[test]
@@ -245,7 +245,7 @@ fn place_stopped_in_its_first_schedule_ends_the_run_and_after_it_keeps_the_best(
     let mut cx = PassContext { deadline: Some(reached_with_grace_left()), ..PassContext::default() };
     pm.run(&mut m, &mut cx, &mut Vec::new()).expect("placed in the grace");
     assert_eq!(
-        cx.stopped,
+        cx.stopped(),
         ["place stopped searching @f early (best schedule so far kept): time limit of 1000 s reached"]
     );
     assert!(verifier::verify(&m).is_ok() && m.functions[0].placement.is_some(), "{:?}", verifier::verify(&m));
@@ -259,7 +259,7 @@ fn sweep_drops_the_configuration_the_limit_stops_inside() {
         let mut cx = PassContext { tick_budget: Some(b), ..PassContext::default() };
         crate::Pass::run(&crate::sweep::Sweep { ns: vec![2] }, &mut m, &mut cx).expect("skippable");
         let csv = cx.artifacts().filter_map(|a| a.csv()).next().unwrap_or_default();
-        (csv.lines().count().saturating_sub(1), cx.stopped)
+        (csv.lines().count().saturating_sub(1), cx.stopped())
     };
     assert_eq!(table(u64::MAX), (4, vec![]), "four configurations at N = 2");
     let (rows, stopped) = table(5);

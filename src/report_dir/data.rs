@@ -1,12 +1,16 @@
-//! The report's numbers the figures draw, read back from the report JSON (SPEC §7) by key:
-//! `sweep` rows, `placement` (occupation, timeline), `pareto` rows. Each is read as the type
-//! the pass that writes it declares ([`SweepRow`], [`PlacementReport`], [`ParetoRow`]: serde
-//! both ways), so the figures read exactly what the report holds.
+//! The report's numbers the figures draw, as the run made them: the `sweep` rows, the
+//! `placement` (occupation, timeline) and the `pareto` rows of the reported function, taken from
+//! the run's artifacts and final figures as their own types ([`SweepRow`] of each
+//! [`SweepTable`], [`ParetoRow`] of the [`ParetoRun`], the final IR's [`PlacementReport`]),
+//! the same values the report JSON holds under the same keys (SPEC §7; the report writes them
+//! from these types, `tests/report_dir.rs` checks the figures' CSVs against the JSON). Nothing
+//! is parsed back.
 
 use robovec_passes::place::report::PlacementReport;
-use robovec_passes::sweep::SweepRow;
-use robovec_passes::whole_run::pareto::ParetoRow;
-use serde_json::Value;
+use robovec_passes::summary::Figures;
+use robovec_passes::sweep::{SweepRow, SweepTable};
+use robovec_passes::whole_run::pareto::{ParetoRow, ParetoRun};
+use robovec_passes::PassContext;
 
 /// What the figures draw, read from one report.
 #[derive(Clone, Debug, Default)]
@@ -26,30 +30,26 @@ pub struct ReportData {
 }
 
 impl ReportData {
-    /// Reads the drawn fields of `report`.
-    ///
-    /// # Errors
-    /// A message naming the key whose shape is not the report's (an internal inconsistency:
-    /// the report is made by the same program).
-    pub fn read(report: &Value) -> Result<ReportData, String> {
-        let text = |k: &str| report.get(k).and_then(Value::as_str).unwrap_or_default().to_string();
-        let input = text("input");
-        let model = std::path::Path::new(&input)
+    /// What the figures of the report of `own.function` draw after a run of `pipeline` on
+    /// `input` with context `cx`: every `sweep` row of the function in the order measured
+    /// (the report's `sweep`, appended run after run), the last `-pareto` study of it (the
+    /// report's `pareto`) and the final IR's placement figures.
+    pub fn of(input: &str, pipeline: &str, own: &Figures, cx: &PassContext) -> ReportData {
+        let model = std::path::Path::new(input)
             .file_stem()
-            .map_or_else(|| input.clone(), |s| s.to_string_lossy().into_owned());
-        fn key<T: serde::de::DeserializeOwned>(report: &Value, k: &str) -> Result<Option<T>, String> {
-            report
-                .get(k)
-                .map(|v| serde_json::from_value(v.clone()).map_err(|e| format!("report key `{k}`: {e}")))
-                .transpose()
-        }
-        Ok(ReportData {
-            model,
-            function: text("function"),
-            pipeline: text("pipeline"),
-            sweep: key(report, "sweep")?.unwrap_or_default(),
-            placement: key(report, "placement")?,
-            pareto: key(report, "pareto")?.unwrap_or_default(),
-        })
+            .map_or_else(|| input.to_string(), |s| s.to_string_lossy().into_owned());
+        let function = own.function.clone();
+        let sweep = cx
+            .artifacts_of::<SweepTable>()
+            .flat_map(|t| t.rows.iter().filter(|r| r.function == function))
+            .cloned()
+            .collect();
+        let pareto = cx
+            .artifacts_of::<ParetoRun>()
+            .filter(|p| p.function == function)
+            .last()
+            .map(|p| p.rows.clone())
+            .unwrap_or_default();
+        ReportData { model, function, pipeline: pipeline.to_string(), sweep, placement: own.placement.clone(), pareto }
     }
 }

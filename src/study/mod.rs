@@ -187,8 +187,8 @@ fn folder_files(results: &[CaseResult], opts: &Options, best: &str) -> Result<Ve
         files.push((format!("{}.csv", f.name), f.csv.into_bytes()));
     }
     for r in results {
-        let Some(report) = &r.report else { continue };
-        let case = crate::report_dir::files(report)
+        let Some((report, data)) = &r.report else { continue };
+        let case = crate::report_dir::files(report, data)
             .map_err(|e| Failure::Output(format!("error: --study: {}: {e}\n", r.case.label())))?;
         for (name, bytes) in case {
             files.push((format!("cases/{}/{name}", r.case.slug()), bytes));

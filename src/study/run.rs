@@ -94,9 +94,9 @@ pub struct CaseResult {
     pub placed: Vec<Placed>,
     /// `accuracy<samples=K>` after the best pipeline, binary32.
     pub f32_bits: Bits,
-    /// The case's report JSON (SPEC §7) when [`Plan::report`].
+    /// The case's report JSON (SPEC §7) and the rows its figures draw, when [`Plan::report`].
     #[serde(skip)]
-    pub report: Option<String>,
+    pub report: Option<(String, crate::report_dir::data::ReportData)>,
 }
 
 /// The parsed-phase module of `case`: `dirdyna` alone (passes work per function, so its
@@ -170,7 +170,7 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
     let mut cx = PassContext { original: Some(generated.clone()), ..PassContext::with_target(target.clone()) };
     if plan.report {
         let text = format!("{GENERATED};{ZERO_BALANCE};{}", plan.best);
-        let pareto = whole_run::pareto::study(
+        let pareto = whole_run::pareto::measure(
             robovec_backends::REGISTRY,
             &generated,
             FUNCTION,
@@ -210,14 +210,9 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
         if let (Some(n), Some(p)) = (n0, &own.placement) {
             placed.push(Placed { n, cycles: p.cycles });
         }
-        let pipeline = format!("{},{tail}", plan.best);
-        report = Some(robovec_passes::report::report_text(
-            &case.urdf_name(plan.seed),
-            &pipeline,
-            session.records(),
-            &session.cx,
-            &own,
-        ));
+        let (input, pipeline) = (case.urdf_name(plan.seed), format!("{},{tail}", plan.best));
+        let text = robovec_passes::report::report_text(&input, &pipeline, session.records(), &session.cx, &own);
+        report = Some((text, crate::report_dir::data::ReportData::of(&input, &pipeline, &own, &session.cx)));
     }
     for &n in plan.ns.iter().skip(placed.len()) {
         let s = run_on(&format!("place<pe={n}>"), best.clone(), continuing(&session.cx), case)?;

@@ -239,7 +239,7 @@ impl CodegenFpga {
     }
 
     /// [`CodegenFpga::build`] whose lowering ticks `ticker` (once per value, write and cycle:
-    /// [`robovec_machine::lower::lower_measured_until`]) and gives up when it says stop
+    /// [`robovec_machine::program::lower_measured_until`]) and gives up when it says stop
     /// (`-time-limit`); the encoding, Yosys and the estimate after it are not interrupted.
     ///
     /// # Errors
@@ -297,11 +297,16 @@ impl Pass for CodegenFpga {
                 s => failed(e.message).at(s),
             })?;
             if self.auto_skips_yosys(report.n_add + report.n_mul) {
-                cx.notes.push(format!(
-                    "codegen<fpga> @{}: {} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway)",
-                    f.name,
-                    report.n_add + report.n_mul
-                ));
+                cx.diagnostics.push(robovec_passes::Diagnostic {
+                    severity: robovec_passes::Severity::Remark,
+                    pass: PASS.to_string(),
+                    functions: vec![f.name.clone()],
+                    message: format!(
+                        "codegen<fpga> @{}: {} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway)",
+                        f.name,
+                        report.n_add + report.n_mul
+                    ),
+                });
             }
             functions.push((f.name.clone(), report, files));
         }
@@ -333,7 +338,7 @@ mod tests {
         let mut m = placed();
         let mut cx = PassContext { tick_budget: budget, ..PassContext::default() };
         let ran = pm.run(&mut m, &mut cx, &mut Vec::new()).map(|_| ());
-        assert!(cx.stopped.is_empty(), "a required pass notes no stop: {:?}", cx.stopped);
+        assert!(cx.stopped().is_empty(), "a required pass notes no stop: {:?}", cx.stopped());
         (ran, cx.artifacts().count())
     }
 

@@ -13,7 +13,7 @@
 //! s_v`, `F = m s_v − h × s_ω`, and `M_ij = s_ω(i)·n + s_v(i)·F` for every coordinate `i` of a
 //! body on the path from the root to `j` (`i ≤ j`).
 
-use super::frames::{bind_v3, vdot, Frames, SUMS};
+use super::kinematics::{bind_v3, vdot, Frames, SUMS};
 use super::scan::suffix;
 use crate::crba::{bind_entry, Entries};
 use crate::rnea::{cross, matvec, vadd, M3, V3};

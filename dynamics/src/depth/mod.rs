@@ -41,7 +41,7 @@
 //! `dirdyna` writes `c` by this sweep (`qdd = 0`) and `M` by the composite-rigid-body algorithm
 //! in the world frame ([`composite`]: a subtree's inertia about the world origin is a suffix sum
 //! of its bodies', each entry one projection on two Plücker axes), both on one set of
-//! kinematics ([`frames`]). `fordyna` solves `M qdd = Qq − c` by the sparse `LᵀDL`, with this
+//! kinematics ([`kinematics`]). `fordyna` solves `M qdd = Qq − c` by the sparse `LᵀDL`, with this
 //! `c` and the body-frame CRBA's `M`, whose leaf entries are ready early ([`fordyna`]).
 //!
 //! The frames of [`crate::frames`] and [`crate::origins`] are still chosen by the fewest ops.
@@ -50,9 +50,9 @@
 //! See `docs/rewrites.md`, "A depth-optimised formulation (issue 31 item 4)".
 
 pub mod composite;
-pub mod frames;
+pub mod forces;
+pub mod kinematics;
 pub mod scan;
-pub mod sweep;
 
 #[cfg(test)]
 mod tests;
@@ -61,25 +61,25 @@ use crate::dirdyna::dirdyna_by;
 use crate::rnea::{motions, Drive, Motion};
 use crate::sym::Builder;
 use crate::{Layout, Model, Stopped};
-use frames::Frames;
+use kinematics::Frames;
 
 /// Writes `invdyna` (outputs `Qq[1..nv]`) by the world-frame parallel-prefix sweep
-/// ([`sweep::sweep`]).
+/// ([`forces::sweep`]).
 ///
 /// # Errors
 /// [`Stopped`] at the builder's deadline.
 pub fn invdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
     let drive = Drive::inputs(b, layout.nv, true);
     let motions = motions(model, layout, b);
-    for (qi, t) in sweep::sweep(model, layout, b, &motions, &drive)? {
+    for (qi, t) in forces::sweep(model, layout, b, &motions, &drive)? {
         b.output(&format!("Qq[{qi}]"), &format!("Qq{qi}"), t);
     }
     Ok(())
 }
 
 /// Writes `dirdyna` (outputs `M[i][j]`, then `c[i]`): `M` by world-frame composite inertias
-/// ([`composite::mass_matrix`]), `c` by [`sweep::sweep_in`] with `qdd = 0`, both on one set of
-/// world-frame kinematics ([`frames::Frames`]).
+/// ([`composite::mass_matrix`]), `c` by [`forces::sweep_in`] with `qdd = 0`, both on one set of
+/// world-frame kinematics ([`kinematics::Frames`]).
 ///
 /// # Errors
 /// [`Stopped`] at the builder's deadline.
@@ -87,12 +87,12 @@ pub fn dirdyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
     let mut parts = |b: &mut Builder, motions: &[Motion], drive: &Drive| {
         let frames = Frames::of(model, layout, b, motions)?;
         let entries = composite::mass_matrix(model, layout, b, &frames)?;
-        Ok((entries, sweep::sweep_in(model, layout, b, &frames, drive)?))
+        Ok((entries, forces::sweep_in(model, layout, b, &frames, drive)?))
     };
     dirdyna_by(model, layout, b, &mut parts)
 }
 
-/// Writes `fordyna` (outputs `qdd[1..nq]`): `c` by [`sweep::sweep_in`] with `qdd = 0` on the
+/// Writes `fordyna` (outputs `qdd[1..nq]`): `c` by [`forces::sweep_in`] with `qdd = 0` on the
 /// world-frame kinematics, `M` by the body-frame CRBA ([`crate::crba`]), then Featherstone's
 /// sparse `LᵀDL` and the two substitutions ([`crate::fordyna`]).
 ///
@@ -114,7 +114,7 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
     let mut parts = |b: &mut Builder, motions: &[Motion], drive: &Drive| {
         let entries = crate::crba::mass_matrix(model, layout, b, motions)?;
         let frames = Frames::of(model, layout, b, motions)?;
-        Ok((entries, sweep::sweep_in(model, layout, b, &frames, drive)?))
+        Ok((entries, forces::sweep_in(model, layout, b, &frames, drive)?))
     };
     crate::fordyna::ltdl_or_aba(model, layout, b, &mut parts, false)
 }

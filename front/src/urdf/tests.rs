@@ -97,7 +97,7 @@ fn every_prefix_and_byte_flip_of_the_example_is_an_error_or_a_valid_module() {
             assert!(!errs.is_empty());
             assert!(errs.iter().all(|e| e.span.end as usize <= t.len()), "span outside the text");
         }
-        Ok(l) => crate::check_accepted(&l.module).expect("accepted module verifies"),
+        Ok(l) => crate::verify_accepted(&l.module).expect("accepted module verifies"),
     };
     let cuts: Vec<usize> = (0..=text.len()).filter(|&i| text.is_char_boundary(i)).step_by(7).collect();
     for i in cuts {

@@ -1,6 +1,6 @@
 //! The phase transition parsed → atomised (SPEC §3; seed §2.1, eq. 2.2): equations →
 //! binary operations. The `atomise` pass of `robovec-passes` runs it on a module; the front ends'
-//! contract (`robovec_front::check_accepted`) and the generator's op counts call it directly.
+//! contract (`robovec_front::verify_accepted`) and the generator's op counts call it directly.
 //!
 //! Phase: parsed → atomised. Every nested expression becomes a sequence of single operations:
 //! - sums and products cascade left to right in source order, as the tree is written:

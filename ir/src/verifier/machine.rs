@@ -1,5 +1,5 @@
 //! Lowered checks of the verifier: a [`MachineProgram`] computes its function. Run by
-//! `robovec_machine::lower::lower` on every program it builds (always, not only in debug
+//! `robovec_machine::program::lower` on every program it builds (always, not only in debug
 //! builds: it costs one pass over the steps, see the lowering's module doc for the figure).
 //! [`verify_machine_until`] gives up when its caller's `stop` hook says so (a time limit).
 //!

@@ -31,7 +31,7 @@
 //! Lowered (on a machine program, not on a module: the program is derived, never stored in
 //! the IR): see [`machine`] — every read address holds the right value at its cycle, every
 //! write source exists, ports within `writes`, addresses within memory sizes, output map
-//! complete. The lowering (`robovec_machine::lower::lower`) runs it on every program it builds.
+//! complete. The lowering (`robovec_machine::program::lower`) runs it on every program it builds.
 //!
 //! TODO: types beyond `f64` scalars do not exist yet; nothing to check there.
 

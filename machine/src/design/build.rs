@@ -1,5 +1,5 @@
 //! From a placed function to the [`Design`]'s images: the machine program
-//! ([`crate::lower::lower`], the one lowering `sim` executes) encoded with [`crate::encode`]
+//! ([`crate::program::lower`], the one lowering `sim` executes) encoded with [`crate::encode`]
 //! (the layout of its module doc, LSB first), checked against the target's memories first so
 //! that every problem is reported with the figures needed and available.
 
@@ -185,7 +185,7 @@ impl std::fmt::Display for DesignError {
 }
 
 /// [`from_placement`] whose lowering gives up when `stop` returns true
-/// ([`crate::lower::lower_until`]; the caller's time limit).
+/// ([`crate::program::lower_until`]; the caller's time limit).
 ///
 /// # Errors
 /// As [`from_placement`]; when `stop` returned true, `the placement cannot be lowered:
@@ -196,7 +196,7 @@ pub fn from_placement_until(
     limits: &Limits,
     stop: &dyn Fn() -> bool,
 ) -> Result<Design, DesignError> {
-    let m = crate::lower::lower_until(f, p, stop)
+    let m = crate::program::lower_until(f, p, stop)
         .map_err(|e| DesignError { message: format!("the placement cannot be lowered: {e}"), span: e.span })?;
     let found = problems(&m, limits);
     if !found.is_empty() {

@@ -206,7 +206,7 @@ impl Pass for Recurrence {
                 f.name, s.rounds, s.ops.0, s.ops.1, s.cp.0, s.cp.1
             ));
         }
-        cx.notes.push(format!("recurrence: {}", parts.join("; ")));
+        cx.remark("recurrence", m, format!("recurrence: {}", parts.join("; ")));
         Ok(())
     }
 }

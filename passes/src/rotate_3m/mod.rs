@@ -302,7 +302,7 @@ impl Pass for Rotate3m {
                 f.name, r.rewritten, r.pairs, r.joint_sums
             ));
         }
-        cx.notes.push(format!("rotate-3m: {}", parts.join("; ")));
+        cx.remark("rotate-3m", m, format!("rotate-3m: {}", parts.join("; ")));
         Ok(())
     }
 }

@@ -120,7 +120,7 @@ impl Pass for ScheduleCpu {
             f.retain(|_, _| true);
             f.clear_timing();
         }
-        cx.notes.push(format!("schedule-cpu: {}", parts.join("; ")));
+        cx.remark("schedule-cpu", m, format!("schedule-cpu: {}", parts.join("; ")));
         Ok(())
     }
 }

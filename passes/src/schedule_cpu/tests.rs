@@ -1,4 +1,5 @@
 use super::*;
+use crate::Severity;
 use robovec_ir::text::parse;
 
 /// Two long-lived chains in derivation order: `x1..x4` are all computed first, then consumed
@@ -71,5 +72,10 @@ fn the_pass_keeps_every_value_bit_for_bit_and_never_raises_the_excess() {
         let bits = |v: &[(String, f64)]| v.iter().map(|(n, x)| (n.clone(), x.to_bits())).collect::<Vec<_>>();
         assert_eq!(bits(&a), bits(&b));
     }
-    assert!(cx.notes[0].starts_with("schedule-cpu: @f max-live 5 -> "), "{}", cx.notes[0]);
+    let note = &cx.diagnostics[0];
+    assert_eq!(
+        (note.severity, note.pass.as_str(), &note.functions[..]),
+        (Severity::Remark, "schedule-cpu", &["f".to_string()][..])
+    );
+    assert!(note.message.starts_with("schedule-cpu: @f max-live 5 -> "), "{}", note.message);
 }

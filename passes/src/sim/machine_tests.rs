@@ -1,4 +1,4 @@
-//! The machine program of placed functions (`place`, then `robovec_machine::lower::lower`): the
+//! The machine program of placed functions (`place`, then `robovec_machine::program::lower`): the
 //! lowered verifier on broken programs, the binary32 data words, and the property of issue 12 —
 //! random DAGs placed at random N, lowered, encoded, decoded, executed: equal to the
 //! interpreter bit for bit in f32 and f64. (The hand-computed lowerings are `robovec-machine`'s
@@ -15,7 +15,7 @@ use robovec_ir::verifier::machine::verify_machine;
 use robovec_ir::{Function, Operand, Value};
 use robovec_machine::encode::{output_image, pe_image, through_images, Layout};
 use robovec_machine::exec::execute;
-use robovec_machine::lower::lower;
+use robovec_machine::program::lower;
 
 use crate::place::{place_function, try_place_function, PlaceOptions};
 

@@ -2,7 +2,7 @@
 //! placement with it against the interpreter, bit for bit, in f32 and f64.
 //!
 //! The simulator reads only the [`Placement`] (never the placer): it lowers it once into the
-//! public machine program ([`robovec_machine::lower::lower`], which checks every rule of the machine
+//! public machine program ([`robovec_machine::program::lower`], which checks every rule of the machine
 //! model of [`robovec_ir::placement`] and keeps the diagnostics below), then executes that
 //! program cycle by cycle ([`robovec_machine::exec::execute`]) — the same program `codegen<fpga>`
 //! encodes:
@@ -18,8 +18,8 @@
 //! - **at the end** the outputs are read from the output memories.
 //!
 //! The choices where the machine model is silent (read addresses, constants, calls, word
-//! occupancy, buffer entries, outputs, error order) are listed in [`robovec_machine::lower`]'s module
-//! doc. Errors are [`SimError`] (= [`robovec_machine::lower::MachineError`]): the first broken rule,
+//! occupancy, buffer entries, outputs, error order) are listed in [`robovec_machine::program`]'s module
+//! doc. Errors are [`SimError`] (= [`robovec_machine::program::MachineError`]): the first broken rule,
 //! with cycle, PE, value and the span of the offending line when the placement was read from
 //! text.
 //!
@@ -35,8 +35,8 @@ use robovec_ir::placement::Placement;
 use robovec_ir::{Function, Module};
 
 use robovec_machine::exec::execute_until;
-use robovec_machine::lower::{lower_measured, lower_measured_until, Occupancy};
-pub use robovec_machine::lower::{MachineError as SimError, MachineErrorKind as SimErrorKind, When};
+use robovec_machine::program::{lower_measured, lower_measured_until, Occupancy};
+pub use robovec_machine::program::{MachineError as SimError, MachineErrorKind as SimErrorKind, When};
 
 use crate::params::ParamKind;
 use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};

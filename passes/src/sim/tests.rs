@@ -564,7 +564,7 @@ fn sim_with_budget(m: &mut Module, budget: u64) -> (Vec<String>, String, [Option
     let stats = cx.artifacts().next().expect("the stats");
     let text = stats.stats_text(None);
     let reports = ["f", "g"].map(|name| stats.report(name).map(|e| e.value));
-    (cx.stopped, text, reports)
+    (cx.stopped(), text, reports)
 }
 
 #[test]

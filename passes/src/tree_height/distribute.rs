@@ -113,7 +113,7 @@ impl Pass for Distribute {
                 s.cp.1
             ));
         }
-        cx.notes.push(format!("distribute: {}", parts.join("; ")));
+        cx.remark("distribute", m, format!("distribute: {}", parts.join("; ")));
         Ok(())
     }
 }

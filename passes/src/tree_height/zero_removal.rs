@@ -74,7 +74,7 @@ impl Pass for ClusterRewrite {
             *f = g;
             outcomes.push((f.name.clone(), o));
         }
-        cx.notes.push(summary(self.name, &outcomes));
+        cx.remark(self.name, m, summary(self.name, &outcomes));
         Ok(())
     }
 }

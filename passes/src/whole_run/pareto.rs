@@ -123,7 +123,7 @@ pub fn mark_front(rows: &mut [ParetoRow]) {
 }
 
 /// Splits `-pareto`'s text and builds each pipeline's pass manager (every name and parameter
-/// checked); the driver's preflight calls it before any work, [`study`] again to run them.
+/// checked); the driver's preflight calls it before any work, [`measure`] again to run them.
 ///
 /// # Errors
 /// [`Failure::Usage`] for an empty list, an empty pipeline, an unknown pass or a bad parameter.
@@ -148,14 +148,14 @@ pub fn managers(registry: crate::Registry, text: &str) -> Result<Vec<(String, Pa
 /// The rows of one `-pareto` study of one function: the table on stderr and the report's
 /// `pareto`.
 #[derive(Clone, Debug)]
-pub struct ParetoStudy {
+pub struct ParetoRun {
     /// The function measured.
     pub function: String,
     /// One row per pipeline, in the order given.
     pub rows: Vec<ParetoRow>,
 }
 
-impl crate::Artifact for ParetoStudy {
+impl crate::Artifact for ParetoRun {
     fn pass(&self) -> &'static str {
         "-pareto"
     }
@@ -177,7 +177,7 @@ impl crate::Artifact for ParetoStudy {
 /// # Errors
 /// [`Failure::Usage`] for a bad pipeline, [`Failure::Input`] when a pipeline fails.
 #[allow(clippy::too_many_arguments)]
-pub fn study(
+pub fn measure(
     registry: crate::Registry,
     module: &Module,
     function: &str,
@@ -187,16 +187,16 @@ pub fn study(
     deadline: Option<crate::Deadline>,
     target: &robovec_machine::target::Target,
     progress: &crate::progress::Progress,
-) -> Result<ParetoStudy, Failure> {
+) -> Result<ParetoRun, Failure> {
     // A bad text fails in `run_reporting` with its own message; the total is then moot.
     let pipelines = split_pipelines(text).map_or(0, |v| v.len());
     let task = progress.task("-pareto: pipelines", pipelines as u64);
     let rows = run_reporting(registry, module, function, text, samples, seed, deadline, target, &task)?;
     task.finish();
-    Ok(ParetoStudy { function: function.to_string(), rows })
+    Ok(ParetoRun { function: function.to_string(), rows })
 }
 
-/// The rows of [`study`]. Under `-time-limit` (`deadline`), each pipeline and measurement stops
+/// The rows of [`measure`]. Under `-time-limit` (`deadline`), each pipeline and measurement stops
 /// early as in a normal run (a valid result, fewer samples) and its row says so in
 /// `stopped_early`; each pipeline gets an equal share of the time left when it starts (half
 /// of it to measure, half for the check of the same points), so every pipeline is measured
@@ -205,7 +205,7 @@ pub fn study(
 /// `task` is set to the pipelines done after each one.
 ///
 /// # Errors
-/// As [`study`].
+/// As [`measure`].
 #[allow(clippy::too_many_arguments)]
 fn run_reporting(
     registry: crate::Registry,
@@ -263,9 +263,8 @@ fn run_reporting(
             violation: check.violation.map(|v| v.to_string()),
             callback_standins: acc.callback_standins,
             stopped_early: cx
-                .stopped
-                .iter()
-                .cloned()
+                .stopped()
+                .into_iter()
                 .chain(acc.stopped_early.map(|w| format!("accuracy stopped early: {w}")))
                 .chain((check.samples < u64::from(measured)).then(|| {
                     format!("soundness check stopped early: {} of {measured} points: time limit", check.samples)

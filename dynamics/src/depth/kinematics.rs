@@ -1,4 +1,4 @@
-//! The world-frame kinematics both depth-optimised writers read ([`super::sweep`] and
+//! The world-frame kinematics both depth-optimised writers read ([`super::forces`] and
 //! [`super::composite`]): each body's orientation, joint axis and origin as parallel prefixes
 //! along the tree's heavy chains ([`super::scan`]), and the helpers that write them.
 

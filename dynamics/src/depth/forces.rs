@@ -2,7 +2,7 @@
 //! ([`crate::rnea::sweep`]) written as a parallel prefix along the tree's heavy chains
 //! ([`super::scan`]). The formulas are in the module doc of [`super`].
 
-use super::frames::{bind_v3, vdot, vector_prefix, vscale, Frames, SUMS};
+use super::kinematics::{bind_v3, vdot, vector_prefix, vscale, Frames, SUMS};
 use super::scan::suffix;
 use crate::rnea::{acceleration_matrix, cross, matvec, vadd, Drive, Motion, M3, V3};
 use crate::robot::JointKind;
