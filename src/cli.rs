@@ -6,6 +6,7 @@
 use std::path::PathBuf;
 
 use clap::{ArgAction, Parser};
+use robovec_front::FrontOption;
 use robovec_passes::{Instrumentation, PrintSelector};
 
 use crate::options::Options;
@@ -129,8 +130,9 @@ pub struct Cli {
     /// URDF input: a continuous joint's configuration, one angle `q[i]` (`angle`, Robotran's)
     /// or Pinocchio's pair `q[i] = cos θ`, `q[i+1] = sin θ` (`cos-sin`, what
     /// `codegen<c;abi=pinocchio>` callers pass; not normalised by the equations).
-    #[arg(long, value_name = "angle|cos-sin", default_value = "angle")]
-    pub continuous: ContinuousJoint,
+    /// Default `angle`.
+    #[arg(long, value_name = "angle|cos-sin")]
+    pub continuous: Option<ContinuousJoint>,
     /// URDF input: the gravity vector `x,y,z` (m/s², world frame), written into the equations
     /// as numbers instead of the inputs `g[1..3]` (Pinocchio's default is `0,0,-9.81`).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_gravity, allow_hyphen_values = true)]
@@ -141,8 +143,8 @@ pub struct Cli {
     /// written in the world frame as a parallel prefix along the tree's chains; `fordyna` solves
     /// with those `M` and `c` by the sparse LᵀDL (the ABA on long chains).
     /// See docs/rewrites.md.
-    #[arg(long, value_name = "ops|depth", default_value = "ops")]
-    pub formulation: FormulationArg,
+    #[arg(long, value_name = "ops|depth")]
+    pub formulation: Option<FormulationArg>,
     /// URDF input: write the values of the parameters kept as inputs to FILE, the JSON object
     /// (`{"m[1]": 2.5, …}`) that `specialize<params=FILE>` and `-eval` read.
     #[arg(long, value_name = "FILE")]
@@ -304,13 +306,25 @@ impl Cli {
             check: self.check.then_some((self.check_samples, self.check_seed)),
             time_limit: self.time_limit,
             target: self.target,
+            front_given: [
+                (FrontOption::FoldParams, self.fold_params),
+                (FrontOption::FloatingBase, self.floating_base),
+                (FrontOption::FreeFlyer, self.free_flyer),
+                (FrontOption::Continuous, self.continuous.is_some()),
+                (FrontOption::Gravity, self.gravity.is_some()),
+                (FrontOption::Formulation, self.formulation.is_some()),
+                (FrontOption::ParamsOut, self.params_out.is_some()),
+            ]
+            .into_iter()
+            .filter_map(|(o, given)| given.then_some(o))
+            .collect(),
             front: robovec_front::FrontOptions {
                 fold_params: self.fold_params,
                 floating_base: self.floating_base,
                 free_flyer: self.free_flyer,
-                continuous_cos_sin: self.continuous == ContinuousJoint::CosSin,
+                continuous_cos_sin: self.continuous == Some(ContinuousJoint::CosSin),
                 gravity: self.gravity,
-                formulation: self.formulation.into(),
+                formulation: self.formulation.unwrap_or(FormulationArg::Ops).into(),
                 ..robovec_front::FrontOptions::default()
             },
             params_out: self.params_out,

@@ -246,6 +246,7 @@ pub fn run_with(
     let pm = PassManager::with_registry(robovec_backends::REGISTRY, &opts.passes, instr)
         .map_err(|e| Failure::Usage(format!("error: {e}\n")))?;
     crate::preflight::check_options(opts, &pm)?;
+    let reads = crate::preflight::read_files(opts, &pm)?;
     let target = crate::options::target(opts)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
     // Only the functions the run uses are built (a URDF's `-function=invdyna` skips `dirdyna`).
@@ -261,10 +262,12 @@ pub fn run_with(
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
     // removes what it staged.
     let mut out = OutputSet::new();
+    out.protect(reads);
     if let Some(path) = &opts.params_out {
+        // The front end reads -params-out (checked before any work); it may still keep no value.
         let Some(params) = &loaded.params else {
             return Err(Failure::Usage(format!(
-                "error: -params-out: `{}` states no parameter values (a URDF does; add --fold-params to fold them instead)\n",
+                "error: -params-out: `{}` leaves no parameter value as an input\n",
                 opts.input
             )));
         };
@@ -484,9 +487,15 @@ fn write_outputs(
         None => write!(w, "{module}"),
     };
 
-    // Then put every file in place at once, and write stdout last.
+    // Then put every file in place at once, and write stdout last. The files of passes'
+    // folders are named only now: none may be a file the run reads (bad usage, as the
+    // outputs checked before any work).
     for a in cx.artifacts() {
-        for file in a.files(module.functions.len() > 1) {
+        let files = a.files(module.functions.len() > 1);
+        for file in &files {
+            out.check_not_read(&file.path).map_err(|e| Failure::Usage(e + "\n"))?;
+        }
+        for file in files {
             if let Some(dir) = file.path.parent().filter(|d| !d.as_os_str().is_empty()) {
                 out.ensure_folder(dir).map_err(output_failure)?;
             }

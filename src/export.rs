@@ -17,7 +17,7 @@ use robovec_front::FrontOptions;
 use robovec_ir::Module;
 
 use crate::options::Failure;
-use crate::output::OutputSet;
+use crate::output::{OutputSet, ReadFile};
 
 /// Where the robot comes from.
 #[derive(Clone, Debug)]
@@ -61,7 +61,8 @@ pub struct Export {
 /// # Errors
 /// [`Failure::Input`] (exit 1) for a URDF the front end refuses or a function the writer cannot
 /// print; [`Failure::Usage`] (exit 2) for C without `-o FILE.c`, `--params-out` with folded
-/// parameters or with URDF output; [`Failure::Output`] (exit 1) when a file cannot be written.
+/// parameters or with URDF output, an output that is the `--urdf` file read;
+/// [`Failure::Output`] (exit 1) when a file cannot be written.
 pub fn run(e: &Export, stdout: &mut dyn Write) -> Result<(), Failure> {
     // Only the function written is generated.
     let front = FrontOptions {
@@ -70,11 +71,19 @@ pub fn run(e: &Export, stdout: &mut dyn Write) -> Result<(), Failure> {
         functions: Some(vec![e.function.clone()]),
         ..FrontOptions::default()
     };
+    // The URDF read is never written over (issue 47: `--urdf X -o X` replaced it).
+    let reads: Vec<ReadFile> = match &e.source {
+        Source::Urdf(p) => vec![ReadFile::new("the input", p)],
+        Source::Topology { .. } => Vec::new(),
+    };
     if e.format == Format::Urdf {
         if e.fold_params || e.params_out.is_some() {
             return Err(Failure::Usage(
                 "error: --fold-params and --params-out concern equations: add --format c\n".into(),
             ));
+        }
+        if let Some(path) = &e.output {
+            not_read(&reads, "-o", path)?;
         }
         let robot = robot(&e.source, e.floating_base)?;
         let text = robovec_dynamics::urdf_out::write_urdf(&robot);
@@ -82,6 +91,7 @@ pub fn run(e: &Export, stdout: &mut dyn Write) -> Result<(), Failure> {
             None => stdout.write_all(text.as_bytes()).map_err(|err| Failure::Output(format!("error: stdout: {err}\n"))),
             Some(path) => {
                 let mut set = OutputSet::new();
+                set.protect(reads);
                 set.stage(path, text.as_bytes()).map_err(Failure::Output)?;
                 set.commit().map(|_| ()).map_err(Failure::Output)
             }
@@ -114,6 +124,9 @@ pub fn run(e: &Export, stdout: &mut dyn Write) -> Result<(), Failure> {
             )));
         }
     }
+    for (flag, p) in &outputs {
+        not_read(&reads, flag, p)?;
+    }
     let (module, params, project) = equations(&e.source, front)?;
     let Some(f) = module.function(&e.function) else {
         return Err(Failure::Usage(format!("error: --function {}: expected invdyna or dirdyna\n", e.function)));
@@ -128,6 +141,7 @@ pub fn run(e: &Export, stdout: &mut dyn Write) -> Result<(), Failure> {
     let banner = Banner { project: &project, joints: coordinates(f), source: &source, header: &header };
     let written = robotran_c::write(f, &banner).map_err(|err| Failure::Input(format!("error: {err}\n")))?;
     let mut set = OutputSet::new();
+    set.protect(reads);
     set.stage(c_path, written.c.as_bytes()).map_err(Failure::Output)?;
     set.stage(&h_path, written.h.as_bytes()).map_err(Failure::Output)?;
     if let Some(p) = &e.params_out {
@@ -136,6 +150,20 @@ pub fn run(e: &Export, stdout: &mut dyn Write) -> Result<(), Failure> {
         set.stage(p, format!("{json}\n").as_bytes()).map_err(Failure::Output)?;
     }
     set.commit().map(|_| ()).map_err(Failure::Output)
+}
+
+/// Refuses, as bad usage, the output `flag` `path` when it is one of the files read, by
+/// identity ([`crate::output::file_id`]: `./x`, `d/../x` and links are the same file).
+fn not_read(reads: &[ReadFile], flag: &str, path: &Path) -> Result<(), Failure> {
+    let Some(id) = crate::output::file_id(path) else { return Ok(()) };
+    match reads.iter().find(|r| r.id.as_ref() == Some(&id)) {
+        Some(r) => Err(Failure::Usage(format!(
+            "error: {flag} `{}` is {}; robovec never writes over a file it reads: choose another path\n",
+            path.display(),
+            r.describe()
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// The robot of `source` (a URDF through the URDF front end's parser and checks).

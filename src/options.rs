@@ -47,6 +47,10 @@ pub struct Options {
     pub time_limit: Option<f64>,
     /// Front-end options (`--fold-params`).
     pub front: robovec_front::FrontOptions,
+    /// The input-specific options the command line gave, even at their default value
+    /// (`--formulation=ops`): checked against the options the input's front end reads
+    /// ([`robovec_front::FrontEnd::options`]) before any work ([`crate::preflight`]).
+    pub front_given: Vec<robovec_front::FrontOption>,
     /// `-params-out=FILE`: the values of the model parameters the input states (a URDF's),
     /// as the JSON object `specialize<params=…>` and `-eval` read.
     pub params_out: Option<PathBuf>,

@@ -29,6 +29,15 @@
 //! written. A run killed by a signal can leave `.robovec-tmp` files behind; no other file is
 //! ever touched before the commit.
 //!
+//! **Never over a file the run reads** (issue 47): the input, the files its front end reads
+//! beside it, `-eval`'s inputs, a `-target` file and the files passes read are
+//! [protected](OutputSet::protect): staging a file that *is* one of them — compared by identity
+//! ([`FileId`]: device and inode, so `./x`, `d/../x`, a symbolic or a hard link to it are the same
+//! file) — or a folder that holds one is refused, and the run writes nothing. `robovec-opt`
+//! refuses such paths before any work already (bad usage, [`crate::preflight`]); the check here
+//! covers the files whose names are known only once a pass made them (`codegen<fpga;out=DIR>`,
+//! `accuracy<worst=DIR>`).
+//!
 //! **Folders written as a whole** (`-report-dir=DIR`, [`OutputSet::stage_folder`]): the files
 //! go into a temporary folder beside `DIR` (`.DIR.PID.K.robovec-tmp`), which the commit renames
 //! to `DIR`, so a reader sees the old report folder or the new one, never a mix. `DIR` may be
@@ -163,6 +172,104 @@ pub fn identity(path: &Path) -> Option<PathBuf> {
     match classify(path) {
         Ok(Kind::Replace { final_path, .. }) => Some(final_path),
         _ => None,
+    }
+}
+
+/// What names one existing file whatever the spelling of its path (`./x`, `d/../x`, a
+/// symbolic link to it, a hard link): its device and inode on Unix, its canonical path
+/// elsewhere. Two paths with the same `FileId` are one file.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct FileId(FileKey);
+
+#[cfg(unix)]
+type FileKey = (u64, u64);
+#[cfg(not(unix))]
+type FileKey = PathBuf;
+
+/// The [`FileId`] of the file at `path` (symbolic links followed); `None` when there is none
+/// (a path to create) and for folders and character devices (`/dev/null` may take any number
+/// of outputs, and a device is never damaged by being written: see the module doc).
+pub fn file_id(path: &Path) -> Option<FileId> {
+    let m = fs::metadata(path).ok()?;
+    if m.is_dir() || is_char_device(&m) {
+        return None;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        Some(FileId((m.dev(), m.ino())))
+    }
+    #[cfg(not(unix))]
+    {
+        fs::canonicalize(path).ok().map(FileId)
+    }
+}
+
+/// The [`FileId`] of the regular file stdin reads, when it is one (`robovec-opt - < x.rvir`);
+/// `None` for a terminal, a pipe, or where the platform cannot tell.
+pub fn stdin_file_id() -> Option<FileId> {
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsFd;
+        use std::os::unix::fs::MetadataExt;
+        let fd = std::io::stdin().as_fd().try_clone_to_owned().ok()?;
+        let m = File::from(fd).metadata().ok()?;
+        m.is_file().then(|| FileId((m.dev(), m.ino())))
+    }
+    #[cfg(not(unix))]
+    {
+        None
+    }
+}
+
+#[cfg(unix)]
+fn is_char_device(m: &fs::Metadata) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    m.file_type().is_char_device()
+}
+
+#[cfg(not(unix))]
+fn is_char_device(_: &fs::Metadata) -> bool {
+    false
+}
+
+/// A file the run reads, which no output may replace ([`OutputSet::protect`]).
+#[derive(Clone, Debug)]
+pub struct ReadFile {
+    /// What it is, for messages (`the input`, `-eval's inputs file`).
+    pub what: String,
+    /// Its path as given.
+    pub path: PathBuf,
+    /// Its identity (`None`: stdin that is not a regular file; then nothing to protect).
+    pub id: Option<FileId>,
+}
+
+impl ReadFile {
+    /// The file at `path`, read as `what`.
+    pub fn new(what: impl Into<String>, path: impl Into<PathBuf>) -> ReadFile {
+        let path = path.into();
+        ReadFile { what: what.into(), id: file_id(&path), path }
+    }
+
+    /// The regular file on stdin, when it is one (see [`stdin_file_id`]); its path is unknown
+    /// (empty).
+    pub fn stdin() -> ReadFile {
+        ReadFile { what: "the input (the file on stdin)".into(), path: PathBuf::new(), id: stdin_file_id() }
+    }
+
+    /// True when this file is `dir` or lies inside it (paths resolved; never for stdin).
+    pub fn is_inside(&self, dir: &Path) -> bool {
+        !self.path.as_os_str().is_empty()
+            && crate::preflight::resolved(&self.path).starts_with(crate::preflight::resolved(dir))
+    }
+
+    /// What it is and its path, for messages (``the input `robot.urdf` ``).
+    pub fn describe(&self) -> String {
+        if self.path.as_os_str().is_empty() {
+            self.what.clone()
+        } else {
+            format!("{} `{}`", self.what, self.path.display())
+        }
     }
 }
 
@@ -318,6 +425,7 @@ struct Staged {
 #[derive(Debug, Default)]
 pub struct OutputSet {
     staged: Vec<Staged>,
+    protected: Vec<ReadFile>,
     folders: Vec<StagedFolder>,
     created_dirs: Vec<PathBuf>,
     counter: u32,
@@ -328,6 +436,28 @@ impl OutputSet {
     /// An empty set.
     pub fn new() -> OutputSet {
         OutputSet::default()
+    }
+
+    /// Protects `files` (the files the run reads): staging one of them, or a folder holding
+    /// one, is refused from now on (see the module doc).
+    pub fn protect(&mut self, files: impl IntoIterator<Item = ReadFile>) {
+        self.protected.extend(files.into_iter().filter(|f| f.id.is_some()));
+    }
+
+    /// Checks that `path` is not a protected file ([`OutputSet::protect`]), without staging it.
+    ///
+    /// # Errors
+    /// A one-line message naming the path and the file the run reads there.
+    pub fn check_not_read(&self, path: &Path) -> Result<(), String> {
+        let Some(id) = file_id(path) else { return Ok(()) };
+        match self.protected.iter().find(|r| r.id.as_ref() == Some(&id)) {
+            Some(r) => Err(format!(
+                "error: cannot write `{}`: it is {}, which this run reads; choose another path",
+                path.display(),
+                r.describe()
+            )),
+            None => Ok(()),
+        }
     }
 
     /// Creates `dir` and its missing ancestors, remembering the ones this run created (removed
@@ -352,7 +482,8 @@ impl OutputSet {
     /// replaces the earlier bytes (the last write wins).
     ///
     /// # Errors
-    /// A one-line message naming the file (refused kind of file, missing folder, I/O error).
+    /// A one-line message naming the file (refused kind of file, a file the run reads
+    /// ([`OutputSet::protect`]), missing folder, I/O error).
     pub fn stage(&mut self, path: &Path, data: &[u8]) -> Result<(), String> {
         self.stage_with(path, &mut |w| w.write_all(data))
     }
@@ -389,6 +520,7 @@ impl OutputSet {
         write: &mut dyn FnMut(&mut dyn Write) -> io::Result<()>,
     ) -> Result<(), String> {
         let fail = |e: io::Error| format!("error: cannot write `{}`: {e}", path.display());
+        self.check_not_read(path)?;
         match classify(path)? {
             Kind::Direct => {
                 let mut data = Vec::new();
@@ -431,10 +563,17 @@ impl OutputSet {
     /// module doc).
     ///
     /// # Errors
-    /// A one-line message: `dir` is not replaceable ([`check_replaceable_folder`]), or a write
-    /// failed.
+    /// A one-line message: `dir` is not replaceable ([`check_replaceable_folder`]), holds a
+    /// protected file ([`OutputSet::protect`]), or a write failed.
     pub fn stage_folder(&mut self, dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), String> {
         check_replaceable_folder(dir)?;
+        if let Some(r) = self.protected.iter().find(|r| r.is_inside(dir)) {
+            return Err(format!(
+                "error: cannot write folder `{}`: it holds {}, which this run reads; choose another folder",
+                dir.display(),
+                r.describe()
+            ));
+        }
         let fail = |e: io::Error| format!("error: cannot write folder `{}`: {e}", dir.display());
         let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
         let name = dir.file_name().ok_or_else(|| fail(io::Error::other("not a folder name")))?.to_string_lossy();

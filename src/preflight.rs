@@ -1,6 +1,11 @@
 //! Checks of `robovec-opt`'s options before any work (issue 10): against each other and the
 //! pipeline, output paths and folders under the output policy ([`crate::output`]), files that
 //! passes will read, and — once the input is read, before any pass runs — `-function`.
+//!
+//! Issue 47 added two: the input-specific options (`--free-flyer`, `-gravity`, …) against the
+//! ones the input's front end reads ([`check_front_options`], declared in the front-end
+//! registry: [`robovec_front::FrontEnd::options`]), and no output over a file the run reads
+//! ([`read_files`]: the input, compared by identity, not by spelling).
 
 use std::path::{Path, PathBuf};
 
@@ -8,16 +13,18 @@ use robovec_ir::Module;
 use robovec_passes::{ParamKind, PassManager};
 
 use crate::options::{output_failure, select, Failure, Options};
-use crate::output;
+use crate::output::{self, ReadFile};
 
 /// Checks every option against the pipeline and every output path and folder under the output
 /// policy, before any work.
 ///
 /// # Errors
-/// [`Failure::Usage`] for options that contradict each other or the pipeline;
-/// [`Failure::Output`] for a path the policy refuses; [`Failure::Input`] for a file a pass
+/// [`Failure::Usage`] for options that contradict each other, the pipeline or the input's
+/// front end ([`check_front_options`]), and for an output that is a file the run reads
+/// ([`read_files`]; a `-report-dir` holding one); [`Failure::Output`] for a path the policy refuses; [`Failure::Input`] for a file a pass
 /// parameter names that cannot be opened.
 pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
+    check_front_options(opts)?;
     if opts.sweep_csv.is_some() && !pm.makes_csv_table() {
         return Err(Failure::Usage(format!(
             "error: -sweep-csv needs a {} pass in the pipeline (a pass whose results include a CSV table)\n",
@@ -61,6 +68,31 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
                     )));
                 }
             }
+        }
+    }
+    // No output over a file the run reads (issue 47: `-o` naming the input replaced it, exit 0).
+    let reads = read_files(opts, pm)?;
+    let dumps: Vec<PathBuf> = match &opts.instr.dump_dir {
+        Some(d) => pm.dump_names().iter().map(|n| d.join(n)).collect(),
+        None => Vec::new(),
+    };
+    for (flag, p) in files.iter().copied().chain(dumps.iter().map(|p| ("-dump-dir's dump", p.as_path()))) {
+        let Some(id) = output::file_id(p) else { continue };
+        if let Some(r) = reads.iter().find(|r| r.id.as_ref() == Some(&id)) {
+            return Err(Failure::Usage(format!(
+                "error: {flag} `{}` is {}; robovec never writes over a file the run reads: choose another path\n",
+                p.display(),
+                r.describe()
+            )));
+        }
+    }
+    if let Some(dir) = &opts.report_dir {
+        if let Some(r) = reads.iter().find(|r| r.is_inside(dir)) {
+            return Err(Failure::Usage(format!(
+                "error: -report-dir `{}` holds {}, and the folder is replaced as a whole; choose another folder\n",
+                dir.display(),
+                r.describe()
+            )));
         }
     }
     // Every folder the run writes, named for messages.
@@ -128,6 +160,76 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// Refuses, as bad usage, an input-specific option (`--free-flyer`, `-gravity`, `-params-out`,
+/// …: [`robovec_front::FrontOption`]) given with an input whose front end does not read it
+/// (issue 47: they were silently ignored on a `.c` file, a `.rvir` or stdin). The registry
+/// says which front end reads which option ([`robovec_front::FrontEnd::options`]); an input no
+/// front end claims is refused when it is loaded. Also `-params-out` with `--fold-params`: no
+/// parameter is then left as an input.
+///
+/// # Errors
+/// [`Failure::Usage`] naming the option, the input and its kind, and the inputs that take it.
+pub fn check_front_options(opts: &Options) -> Result<(), Failure> {
+    let Some(fe) = robovec_front::front_end_for(&opts.input) else { return Ok(()) };
+    if let Some(&o) = opts.front_given.iter().find(|o| !fe.options().contains(o)) {
+        let input = if opts.input == "-" { "stdin".to_string() } else { format!("`{}`", opts.input) };
+        let takers: Vec<String> = o.read_by().iter().map(|n| format!("{n} input")).collect();
+        let takers = if takers.is_empty() { "no input".to_string() } else { takers.join(" or ") };
+        return Err(Failure::Usage(format!(
+            "error: {} does not apply to {input}, a {} input: it concerns {takers} only\n",
+            o.flag(),
+            fe.name()
+        )));
+    }
+    let given = |o| opts.front_given.contains(&o);
+    if given(robovec_front::FrontOption::ParamsOut) && given(robovec_front::FrontOption::FoldParams) {
+        return Err(Failure::Usage(
+            "error: -params-out: with --fold-params no parameter is left as an input (the values are in the equations)\n"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Every file the run reads, which no output may replace: the input (stdin's file when it is
+/// a regular file), the files its front end reads beside it ([`robovec_front::FrontEnd::reads_beside`]:
+/// a `.c` file's `.h`), `-eval`'s inputs, a `-target` file, and the files the passes of the
+/// pipeline and of `-pareto`'s pipelines read ([`ParamKind::Path`]: `specialize<params=…>`,
+/// `accuracy<params=…>`, `eqsat<rules=…>`). Files that do not exist (yet) are listed without
+/// identity: nothing to protect.
+///
+/// # Errors
+/// [`Failure::Usage`] for a `-pareto` text that does not parse.
+pub fn read_files(opts: &Options, pm: &PassManager) -> Result<Vec<ReadFile>, Failure> {
+    let mut reads = Vec::new();
+    if opts.input == "-" {
+        reads.push(ReadFile::stdin());
+    } else {
+        reads.push(ReadFile::new("the input", &opts.input));
+        if let Some(fe) = robovec_front::front_end_for(&opts.input) {
+            let beside = fe.reads_beside(Path::new(&opts.input));
+            let what = format!("the file the {} front end reads beside the input", fe.name());
+            reads.extend(beside.into_iter().map(|p| ReadFile::new(what.clone(), p)));
+        }
+    }
+    if let Some(e) = &opts.eval {
+        reads.push(ReadFile::new("-eval's inputs file", e));
+    }
+    if let Some(t) = opts.target.as_deref().filter(|t| robovec_machine::target::Target::built_in(t).is_none()) {
+        reads.push(ReadFile::new("the -target file", t));
+    }
+    let mut managers = Vec::new();
+    if let Some(text) = &opts.pareto {
+        managers = robovec_passes::whole_run::pareto::managers(pm.registry(), text).map_err(Failure::from)?;
+    }
+    for m in std::iter::once(pm).chain(managers.iter().map(|(_, m)| m)) {
+        for (pass, key, file) in pass_paths(m, |k| matches!(k, ParamKind::Path)) {
+            reads.push(ReadFile::new(format!("pass `{pass}`'s {key}= file"), file));
+        }
+    }
+    Ok(reads)
 }
 
 /// What tells two outputs on one file apart: the file a regular output finally goes to

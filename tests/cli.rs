@@ -313,3 +313,66 @@ fn place_sim_and_sweep_end_to_end() {
     assert_eq!(rows.lines().count(), 1 + 2 * 4);
     assert!(rows.lines().nth(1).unwrap().starts_with("dirdyna,1,classical,preferential,"));
 }
+
+/// Issue 47: the URDF-only options were silently ignored on other inputs. The front-end
+/// registry declares which input reads which option; any other is bad usage before any work
+/// (exit 2), naming the option and the input's kind — on a Robotran file, a `.rvir` and stdin
+/// alike — and nothing is written. The same options on a `.urdf` still run.
+#[test]
+fn urdf_options_are_bad_usage_on_other_inputs() {
+    let d = tmp("front_options");
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let urdf = root.join("examples/double_pendulum/double_pendulum.urdf").display().to_string();
+    let c = root.join("examples/double_pendulum/mbs_invdyna_double_pendulum.c").display().to_string();
+    let ir = opt(&[&c, "-passes=atomise", "-o", "-"]);
+    assert!(ir.status.success(), "{}", stderr(&ir));
+    let rvir = d.join("x.rvir");
+    std::fs::write(&rvir, &ir.stdout).unwrap();
+    let params = d.join("p.json").display().to_string();
+    let params_out = format!("-params-out={params}");
+    let options: [(&[&str], &str); 9] = [
+        (&["--free-flyer"], "--free-flyer"),
+        (&["--floating-base"], "--floating-base"),
+        (&["-gravity=0,0,-9.81"], "-gravity"),
+        (&["--formulation=depth"], "--formulation"),
+        // Given at its default value: still an option that does not apply.
+        (&["--formulation=ops"], "--formulation"),
+        (&["--fold-params"], "--fold-params"),
+        (&["--continuous=cos-sin"], "--continuous"),
+        (&["--continuous=angle"], "--continuous"),
+        (&[&params_out], "-params-out"),
+    ];
+    let out = d.join("out.rvir");
+    for (given, flag) in options {
+        for (input, kind) in [
+            (c.as_str(), format!("`{c}`, a Robotran C input")),
+            (rvir.to_str().unwrap(), format!("`{}`, a robovec IR input", rvir.display())),
+            ("-", "stdin, a robovec IR input".to_string()),
+        ] {
+            let mut args = vec![input, "-passes=atomise", "-o", out.to_str().unwrap()];
+            args.extend(given);
+            let o = Command::new(env!("CARGO_BIN_EXE_robovec-opt"))
+                .args(&args)
+                .stdin(std::fs::File::open(&rvir).unwrap())
+                .output()
+                .unwrap();
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+            let want = format!("error: {flag} does not apply to {kind}: it concerns URDF input only\n");
+            assert_eq!(stderr(&o), want, "{args:?}");
+            assert!(!out.exists() && !d.join("p.json").exists(), "{args:?}: nothing written");
+        }
+        // On a URDF the option is read (with -function=invdyna, the quickest to generate).
+        let mut args = vec![urdf.as_str(), "-function=invdyna", "-passes=atomise", "-o", out.to_str().unwrap()];
+        args.extend(given);
+        let o = opt(&args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        assert!(std::fs::read_to_string(&out).unwrap().contains("func @invdyna"), "{args:?}");
+        std::fs::remove_file(&out).unwrap();
+        let _ = std::fs::remove_file(d.join("p.json"));
+    }
+    // -params-out with --fold-params on a URDF: no parameter is left to write.
+    let o = opt(&[&urdf, "--fold-params", &params_out, "-passes=atomise", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("-params-out: with --fold-params no parameter is left as an input"), "{}", stderr(&o));
+    assert!(!out.exists() && !d.join("p.json").exists());
+}

@@ -22,10 +22,10 @@
 
 use std::path::Path;
 
+use robovec_backends::REGISTRY as PASSES;
 use robovec_ir::text::parse;
 use robovec_ir::{Def, Function, Module, Operand};
 use robovec_passes::artifact::report_entries;
-use robovec_backends::REGISTRY as PASSES;
 use robovec_passes::{parse_pipeline, summary, Instrumentation, Params, PassContext, PassManager, Session};
 
 /// What a pipeline produced, as plain data.

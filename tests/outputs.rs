@@ -410,3 +410,196 @@ fn an_output_inside_another_outputs_folder_is_a_usage_error_naming_both() {
         assert_eq!(entries(&d), Vec::<String>::new(), "{extra:?}: nothing written");
     }
 }
+
+/// `robovec-opt` run in `dir` (for relative spellings), with `stdin` as its standard input.
+fn opt_in(dir: &Path, args: &[&str], stdin: Option<&Path>) -> Output {
+    let mut c = Command::new(BIN);
+    c.current_dir(dir).args(args);
+    if let Some(p) = stdin {
+        c.stdin(fs::File::open(p).unwrap());
+    }
+    c.output().expect("robovec-opt runs")
+}
+
+/// Every file under `d` (relative path → bytes), folders included as empty entries.
+fn snapshot(d: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![d.to_path_buf()];
+    while let Some(p) = stack.pop() {
+        for e in fs::read_dir(&p).unwrap() {
+            let e = e.unwrap();
+            let t = e.file_type().unwrap();
+            let rel = e.path().strip_prefix(d).unwrap().to_path_buf();
+            if t.is_dir() {
+                stack.push(e.path());
+                out.insert(rel, Vec::new());
+            } else if t.is_symlink() {
+                out.insert(rel, fs::read_link(e.path()).unwrap().into_os_string().into_encoded_bytes());
+            } else {
+                out.insert(rel, fs::read(e.path()).unwrap());
+            }
+        }
+    }
+    out
+}
+
+/// Issue 47: an output naming a file the run reads — the input above all — replaced it with
+/// exit 0. It is bad usage (exit 2) before any work, whatever the spelling (`./x`, `d/../x`,
+/// an absolute path, a symbolic or a hard link), and nothing in the folder changes.
+#[test]
+fn no_output_is_written_over_the_input() {
+    let d = tmp("input");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    fs::copy(root.join("examples/double_pendulum/double_pendulum.urdf"), d.join("robot.urdf")).unwrap();
+    fs::copy(root.join("examples/double_pendulum/mbs_invdyna_double_pendulum.c"), d.join("m.c")).unwrap();
+    fs::copy(root.join("examples/double_pendulum/mbs_invdyna_double_pendulum.h"), d.join("m.h")).unwrap();
+    fs::create_dir(d.join("sub")).unwrap();
+    std::os::unix::fs::symlink("robot.urdf", d.join("link.urdf")).unwrap();
+    fs::hard_link(d.join("robot.urdf"), d.join("hard.urdf")).unwrap();
+    let ir = opt(&[&pendulum(), "-passes=atomise", "-o", "-"]);
+    assert!(ir.status.success(), "{}", stderr(&ir));
+    fs::write(d.join("x.rvir"), &ir.stdout).unwrap();
+    fs::write(d.join("in.json"), r#"{"q[1]": 0.5}"#).unwrap();
+    let abs = d.join("robot.urdf").display().to_string();
+    let before = snapshot(&d);
+    let urdf_is = "is the input `robot.urdf`; robovec never writes over a file the run reads";
+    let cases: Vec<(Vec<&str>, String)> = vec![
+        (vec!["robot.urdf", "-o", "robot.urdf"], format!("-o `robot.urdf` {urdf_is}")),
+        (vec!["robot.urdf", "-o", "./robot.urdf"], format!("-o `./robot.urdf` {urdf_is}")),
+        (vec!["robot.urdf", "-o", "link.urdf"], format!("-o `link.urdf` {urdf_is}")),
+        (vec!["robot.urdf", "-o", "sub/../robot.urdf"], format!("-o `sub/../robot.urdf` {urdf_is}")),
+        (vec!["robot.urdf", "-o", &abs], format!("-o `{abs}` {urdf_is}")),
+        (vec!["robot.urdf", "-o", "hard.urdf"], format!("-o `hard.urdf` {urdf_is}")),
+        (vec!["./link.urdf", "-o", "robot.urdf"], "-o `robot.urdf` is the input `./link.urdf`".into()),
+        (vec!["robot.urdf", "-report=robot.urdf", "-o", "/dev/null"], format!("-report `robot.urdf` {urdf_is}")),
+        (
+            vec!["robot.urdf", "-params-out=./robot.urdf", "-o", "/dev/null"],
+            format!("-params-out `./robot.urdf` {urdf_is}"),
+        ),
+        (vec!["x.rvir", "-o", "./x.rvir"], "-o `./x.rvir` is the input `x.rvir`".into()),
+        (vec!["m.c", "-o", "m.c"], "-o `m.c` is the input `m.c`".into()),
+        // The header the C front end reads beside the input, as -o or as -o's companion.
+        (vec!["m.c", "-o", "m.h"], "-o `m.h` is the file the Robotran C front end reads beside the input `m.h`".into()),
+        (
+            vec!["m.c", "-passes=atomise,codegen<c>", "-o", "sub/../m.rvir"],
+            "-o's companion `sub/../m.h` is the file the Robotran C front end reads beside the input `m.h`".into(),
+        ),
+        // -eval's inputs are read too.
+        (
+            vec!["x.rvir", "-eval=in.json", "-report=./in.json", "-o", "/dev/null"],
+            "-report `./in.json` is -eval's inputs file `in.json`".into(),
+        ),
+        (
+            vec!["x.rvir", "-passes=atomise,sweep<pe=1>", "-sweep-csv=x.rvir", "-o", "/dev/null"],
+            "-sweep-csv `x.rvir` is the input `x.rvir`".into(),
+        ),
+        // A file a pass reads.
+        (
+            vec!["x.rvir", "-passes=atomise,specialize<params=in.json>", "-o", "in.json"],
+            "-o `in.json` is pass `specialize`'s params= file `in.json`".into(),
+        ),
+    ];
+    for (args, needle) in &cases {
+        let mut args = args.clone();
+        if !args.iter().any(|a| a.starts_with("-passes")) {
+            args.push("-passes=atomise");
+        }
+        let o = opt_in(&d, &args, None);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(needle.as_str()), "{args:?}: {}", stderr(&o));
+        assert_eq!(stderr(&o).lines().count(), 1, "{args:?}: {}", stderr(&o));
+        assert!(snapshot(&d) == before, "{args:?}: a file changed");
+    }
+    // IR on stdin from a regular file: that file is the input too.
+    let o = opt_in(&d, &["-", "-passes=atomise", "-o", "x.rvir"], Some(&d.join("x.rvir")));
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("-o `x.rvir` is the input (the file on stdin)"), "{}", stderr(&o));
+    // The dumps: `-dump-dir=.` over an input named like one of them.
+    fs::copy(d.join("x.rvir"), d.join("001-atomise.after.rvir")).unwrap();
+    let before = snapshot(&d);
+    let o = opt_in(&d, &["001-atomise.after.rvir", "-passes=atomise", "-dump-dir=.", "-o", "/dev/null"], None);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("-dump-dir's dump `./001-atomise.after.rvir` is the input `001-atomise.after.rvir`"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(snapshot(&d) == before, "nothing changed");
+    // Other paths and outputs that are not read are written as before.
+    let o = opt_in(&d, &["x.rvir", "-passes=atomise", "-o", "y.rvir", "-report=r.json"], None);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(fs::read(d.join("y.rvir")).unwrap(), ir.stdout);
+}
+
+/// A folder replaced as a whole never holds a file the run reads; files a pass names only
+/// when it writes them (`accuracy<worst=DIR>`) are checked when they are known: exit 2,
+/// nothing written.
+#[test]
+fn no_output_folder_replaces_a_file_the_run_reads() {
+    let d = tmp("input_folder");
+    let rep = d.join("rep");
+    fs::create_dir(&rep).unwrap();
+    fs::write(rep.join("report.json"), "{}").unwrap();
+    fs::write(rep.join("in.json"), r#"{"q[1]": 0.5}"#).unwrap();
+    let before = snapshot(&d);
+    let o = opt(&[
+        &pendulum(),
+        "-passes=atomise",
+        &format!("-eval={}", rep.join("in.json").display()),
+        &format!("-report-dir={}", rep.display()),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let needle =
+        format!("-report-dir `{}` holds -eval's inputs file `{}`", rep.display(), rep.join("in.json").display());
+    assert!(stderr(&o).contains(&needle), "{}", stderr(&o));
+    assert!(snapshot(&d) == before, "nothing changed");
+    // `accuracy<worst=W>` writes W/worst-1.json, here the -eval inputs of the same run.
+    let w = d.join("w");
+    let acc = format!("-passes=atomise,accuracy<samples=20;worst={};worst-count=1>", w.display());
+    let o = opt(&[&pendulum(), &acc, "-o", "/dev/null"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let worst = w.join("worst-1.json");
+    let before = snapshot(&d);
+    let o = opt(&[&pendulum(), &acc, &format!("-eval={}", worst.display()), "-o", s(&d.join("out.rvir"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let needle = format!("cannot write `{}`: it is -eval's inputs file `{}`", worst.display(), worst.display());
+    assert!(stderr(&o).contains(&needle), "{}", stderr(&o));
+    assert!(snapshot(&d) == before, "nothing changed, no temporary file left");
+}
+
+/// `robovec-gen --urdf X -o X` replaced the robot it read (issue 47).
+#[test]
+fn robovec_gen_does_not_write_over_its_urdf() {
+    let d = tmp("gen_input");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    fs::copy(root.join("examples/double_pendulum/double_pendulum.urdf"), d.join("robot.urdf")).unwrap();
+    let before = snapshot(&d);
+    let gen = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_robovec-gen")).current_dir(&d).args(args).output().expect("robovec-gen runs")
+    };
+    for (args, needle) in [
+        (&["--urdf", "robot.urdf", "-o", "./robot.urdf"][..], "-o `./robot.urdf` is the input `robot.urdf`"),
+        (
+            &[
+                "--urdf",
+                "robot.urdf",
+                "--format",
+                "c",
+                "--function",
+                "invdyna",
+                "-o",
+                "m.c",
+                "--params-out",
+                "robot.urdf",
+            ],
+            "--params-out `robot.urdf` is the input `robot.urdf`",
+        ),
+    ] {
+        let o = gen(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+        assert!(snapshot(&d) == before, "{args:?}: a file changed");
+    }
+    let o = gen(&["--urdf", "robot.urdf", "-o", "copy.urdf"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -442,3 +442,83 @@ fn depth_formulation_agrees_with_the_default_one() {
     let o = opt(&[URDF, "--formulation=fast", "-o", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// Issue 47: a joint axis of length 1e308 was accepted and the joint silently dropped out of
+/// the equations (`Qq[2] = 0`: `1e308 / ‖v‖ = 1e308 / inf = 0`), while `0 0 0` was refused.
+/// Every axis that cannot be normalised in binary64 is bad input (exit 1) at the `xyz` value,
+/// as non-finite numbers in any attribute robovec reads are.
+#[test]
+fn hostile_numbers_in_a_urdf_are_located_diagnostics() {
+    let d = tmp("hostile");
+    let text = std::fs::read_to_string(path(URDF)).unwrap();
+    let axis = "<axis xyz=\"1 0 0\"/>";
+    // The second joint's axis (j2), and other attributes on their own lines.
+    let at = text.rfind(axis).expect("the example has an x axis");
+    let with_axis = |xyz: &str| format!("{}<axis xyz=\"{xyz}\"/>{}", &text[..at], &text[at + axis.len()..]);
+    let origin = "<origin xyz=\"0 0.8 0\"/>";
+    // (what, the hostile text, the attribute whose value the diagnostic spans, its message)
+    let cases: Vec<(&str, String, &str, &str)> = vec![
+        ("axis 1e308", with_axis("1e308 0 0"), "xyz", "joint axis cannot be normalised: its squared length overflows"),
+        (
+            "axis 1e-200",
+            with_axis("0 1e-200 0"),
+            "xyz",
+            "joint axis cannot be normalised: its squared length underflows",
+        ),
+        ("axis inf", with_axis("inf 0 0"), "xyz", "attribute `xyz` must hold 3 finite numbers"),
+        ("axis nan", with_axis("1 nan 0"), "xyz", "attribute `xyz` must hold 3 finite numbers"),
+        ("axis 0", with_axis("0 0 0"), "xyz", "joint axis has length 0"),
+        (
+            "mass inf",
+            text.replacen("<mass value=\"0.7\"/>", "<mass value=\"inf\"/>", 1),
+            "value",
+            "attribute `value` must hold 1 finite numbers",
+        ),
+        (
+            "inertia nan",
+            text.replacen("iyy=\"0.005\"", "iyy=\"NaN\"", 1),
+            "iyy",
+            "attribute `iyy` must hold 1 finite numbers",
+        ),
+        (
+            "origin 1e999",
+            text.replacen(origin, "<origin xyz=\"0 1e999 0\"/>", 1),
+            "xyz",
+            "attribute `xyz` must hold 3 finite numbers",
+        ),
+        (
+            "rpy -inf",
+            text.replacen(origin, "<origin xyz=\"0 0.8 0\" rpy=\"0 -inf 0\"/>", 1),
+            "rpy",
+            "attribute `rpy` must hold 3 finite numbers",
+        ),
+    ];
+    for (what, bad, attr, message) in cases {
+        assert_ne!(bad, text, "{what}: the fixture changed nothing");
+        let f = d.join("hostile.urdf");
+        std::fs::write(&f, &bad).unwrap();
+        // The diagnostic is at the attribute's value on the line that changed (1-based; ASCII).
+        let (line, changed) =
+            bad.lines().zip(text.lines()).enumerate().find(|(_, (a, b))| a != b).map(|(k, (a, _))| (k + 1, a)).unwrap();
+        let col = changed.find(&format!("{attr}=\"")).unwrap() + attr.len() + 3;
+        let o = opt(&[f.to_str().unwrap(), "-passes=atomise", "-o", d.join("out.rvir").to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(1), "{what}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(message), "{what}: {e}");
+        assert!(
+            e.contains(&format!("hostile.urdf:{line}:{col}\n")),
+            "{what}: expected hostile.urdf:{line}:{col} in {e}"
+        );
+        assert!(!e.contains("panicked"), "{what}: {e}");
+        assert!(!d.join("out.rvir").exists(), "{what}");
+    }
+    // A large axis whose squared length is still a normal number is normalised: the same
+    // equations as `1 0 0`.
+    let big = format!("{}<axis xyz=\"1e150 0 0\"/>{}", &text[..at], &text[at + axis.len()..]);
+    let f = d.join("big.urdf");
+    std::fs::write(&f, big).unwrap();
+    let a = opt(&[f.to_str().unwrap(), "-function=invdyna", "-passes=atomise", "-o", "-"]);
+    let b = opt(&[URDF, "-function=invdyna", "-passes=atomise", "-o", "-"]);
+    assert!(a.status.success() && b.status.success(), "{}", stderr(&a));
+    assert_eq!(a.stdout, b.stdout);
+}

@@ -52,7 +52,7 @@ pub mod synth;
 pub mod urdf;
 
 pub use error::FrontError;
-pub use registry::{extension_list, front_end_for, FrontEnd, FrontOptions, Loaded, FRONT_ENDS};
+pub use registry::{extension_list, front_end_for, FrontEnd, FrontOption, FrontOptions, Loaded, FRONT_ENDS};
 
 /// A Robotran output language (the Robotran front ends' own parameter; the driver goes
 /// through [`registry`]).

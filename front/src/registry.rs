@@ -18,6 +18,8 @@ use robovec_ir::Module;
 use super::{parse_text_until, FrontError, Language};
 
 /// What a front end may be asked beyond the text (command-line options that concern loading).
+/// A front end reads only those it declares ([`FrontEnd::options`]); `robovec-opt` refuses the
+/// others on the command line before any work, so "ignore it" below concerns library callers.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrontOptions {
     /// `--fold-params`: fold the model's numeric parameters into the equations instead of
@@ -51,6 +53,59 @@ pub struct FrontOptions {
     /// long loops (statements read, bodies generated) and, once it is reached, fail with one
     /// error saying where they stopped (see [`FrontEnd::load`]).
     pub deadline: Option<robovec_ir::time_limit::Deadline>,
+}
+
+/// A command-line option that concerns one kind of input only: each front end declares the ones
+/// it reads ([`FrontEnd::options`]), and the driver refuses any other given with its input as
+/// bad usage before any work (issue 47: `--free-flyer` on a `.c` file was silently ignored).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FrontOption {
+    /// `--fold-params` ([`FrontOptions::fold_params`]).
+    FoldParams,
+    /// `--floating-base` ([`FrontOptions::floating_base`]).
+    FloatingBase,
+    /// `--free-flyer` ([`FrontOptions::free_flyer`]).
+    FreeFlyer,
+    /// `--continuous=angle|cos-sin` ([`FrontOptions::continuous_cos_sin`]).
+    Continuous,
+    /// `-gravity=X,Y,Z` ([`FrontOptions::gravity`]).
+    Gravity,
+    /// `--formulation=ops|depth` ([`FrontOptions::formulation`]).
+    Formulation,
+    /// `-params-out=FILE`: the values of the model parameters the input states
+    /// ([`Loaded::params`]).
+    ParamsOut,
+}
+
+impl FrontOption {
+    /// Every option, in the order `--help` lists them.
+    pub const ALL: [FrontOption; 7] = [
+        FrontOption::FoldParams,
+        FrontOption::FloatingBase,
+        FrontOption::FreeFlyer,
+        FrontOption::Continuous,
+        FrontOption::Gravity,
+        FrontOption::Formulation,
+        FrontOption::ParamsOut,
+    ];
+
+    /// The option as the manual spells it (`--free-flyer`, `-gravity`).
+    pub fn flag(self) -> &'static str {
+        match self {
+            FrontOption::FoldParams => "--fold-params",
+            FrontOption::FloatingBase => "--floating-base",
+            FrontOption::FreeFlyer => "--free-flyer",
+            FrontOption::Continuous => "--continuous",
+            FrontOption::Gravity => "-gravity",
+            FrontOption::Formulation => "--formulation",
+            FrontOption::ParamsOut => "-params-out",
+        }
+    }
+
+    /// The names of the front ends that read this option (`URDF`), from [`FRONT_ENDS`].
+    pub fn read_by(self) -> Vec<&'static str> {
+        FRONT_ENDS.iter().filter(|f| f.options().contains(&self)).map(|f| f.name()).collect()
+    }
 }
 
 /// A loaded input: the module, and the values of the model parameters it keeps as inputs.
@@ -109,6 +164,22 @@ pub trait FrontEnd: Sync {
         "expected at least one function"
     }
 
+    /// The input-specific command-line options this front end reads ([`FrontOption`]); the
+    /// driver refuses the others, given with an input of this front end, as bad usage before
+    /// any work. None by default: the front ends of fixed equations (Robotran files, IR) read
+    /// none.
+    fn options(&self) -> &'static [FrontOption] {
+        &[]
+    }
+
+    /// The files beside `path` (the input) that [`FrontEnd::load`] reads too (a Robotran C
+    /// file's `.h`), so that no output of the run is written over one of them; none by
+    /// default.
+    fn reads_beside(&self, path: &Path) -> Vec<std::path::PathBuf> {
+        let _ = path;
+        Vec::new()
+    }
+
     /// True when the input must be valid UTF-8 (XML: a URDF): the driver then refuses one
     /// that is not, at its first invalid byte, instead of reading each such byte as `?` as it
     /// does for Robotran files (issue 29: a URDF with invalid UTF-8 was accepted silently).
@@ -137,11 +208,15 @@ impl FrontEnd for Robotran {
         }
     }
 
+    fn reads_beside(&self, path: &Path) -> Vec<std::path::PathBuf> {
+        match self.0 {
+            Language::C if path.extension().is_some_and(|e| e == "c") => vec![path.with_extension("h")],
+            _ => Vec::new(),
+        }
+    }
+
     fn load(&self, path: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
-        let header = match self.0 {
-            Language::C if path.extension().is_some_and(|e| e == "c") => std::fs::read(path.with_extension("h")).ok(),
-            _ => None,
-        };
+        let header = self.reads_beside(path).first().and_then(|h| std::fs::read(h).ok());
         parse_text_until(self.0, text, header.as_deref(), opts.deadline.as_ref()).map(Loaded::from)
     }
 }
@@ -206,5 +281,21 @@ mod tests {
         dedup.sort_unstable();
         dedup.dedup();
         assert_eq!(all.len(), dedup.len());
+    }
+
+    #[test]
+    fn input_specific_options_are_declared_by_their_front_end() {
+        // Robotran files and IR have fixed equations: no model option applies to them.
+        for input in ["a.c", "a.h", "a.m", "a.py", "a.rvir", "-"] {
+            assert_eq!(front_end_for(input).unwrap().options(), &[] as &[FrontOption], "{input}");
+        }
+        let urdf = front_end_for("r.urdf").unwrap();
+        for o in FrontOption::ALL {
+            assert!(urdf.options().contains(&o), "{}", o.flag());
+            assert_eq!(o.read_by(), ["URDF"], "{}", o.flag());
+        }
+        // The C front end reads the header beside a `.c` file, nothing beside a `.h`.
+        assert_eq!(front_end_for("d/a.c").unwrap().reads_beside(Path::new("d/a.c")), [Path::new("d/a.h")]);
+        assert!(front_end_for("d/a.h").unwrap().reads_beside(Path::new("d/a.h")).is_empty());
     }
 }

@@ -222,6 +222,14 @@ impl PassManager {
         self.back_end().map_or(1, BackEnd::units)
     }
 
+    /// The names of the files `-dump-dir` receives, in order (`001-atomise.before.rvir`,
+    /// `001-atomise.after.rvir`, …): known before the run, so that none is written over a file
+    /// the run reads.
+    pub fn dump_names(&self) -> Vec<String> {
+        let named = self.passes.iter().enumerate().map(|(i, e)| (i, e.pass.name()));
+        named.flat_map(|(i, name)| ["before", "after"].map(|when| dump_name(i, name, when))).collect()
+    }
+
     /// Index of the last pipeline element (the one whose code `-o` writes).
     pub fn last_index(&self) -> Option<usize> {
         self.passes.len().checked_sub(1)
@@ -292,7 +300,7 @@ impl PassManager {
             if self.instr.print_before.selects(name) {
                 write!(log, "*** IR Dump Before {spec} ***\n{m}").map_err(PassError::Log)?;
             }
-            dump(format!("{:03}-{name}.before.rvir", i + 1), m)?;
+            dump(dump_name(i, name, "before"), m)?;
             if let Some(phase) = props.requires {
                 crate::require_phase(name, m, phase)?;
             }
@@ -313,7 +321,7 @@ impl PassManager {
             if self.instr.print_after.selects(name) {
                 write!(log, "*** IR Dump After {spec} ***\n{m}").map_err(PassError::Log)?;
             }
-            dump(format!("{:03}-{name}.after.rvir", i + 1), m)?;
+            dump(dump_name(i, name, "after"), m)?;
             if self.instr.verify_each {
                 verify_named(m, name)?;
             }
@@ -357,4 +365,10 @@ fn note_atomised_ops(m: &Module, cx: &mut PassContext) {
             cx.atomised_ops.insert(f.name.clone(), f.op_counts().total);
         }
     }
+}
+
+/// The dump of the pass at pipeline index `i` (from 0) `when` (`before`, `after`) it runs:
+/// `001-atomise.before.rvir`.
+fn dump_name(i: usize, pass: &str, when: &str) -> String {
+    format!("{:03}-{pass}.{when}.rvir", i + 1)
 }

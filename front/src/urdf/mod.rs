@@ -45,6 +45,11 @@ impl FrontEnd for Urdf {
         true
     }
 
+    /// Every model option: the generator builds the equations from the robot.
+    fn options(&self) -> &'static [crate::registry::FrontOption] {
+        &crate::registry::FrontOption::ALL
+    }
+
     fn load(&self, _: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
         let robot = parse(text).map_err(|e| vec![e])?;
         if !robot.joints.iter().any(|j| j.kind != JointKind::Fixed) {

@@ -110,6 +110,48 @@ fn inertial(node: roxmltree::Node) -> Result<Option<Inertial>, FrontError> {
     Ok(Some(Inertial { mass, com: o.xyz, inertia: rotate_tensor(&o.rot, &m) }))
 }
 
+/// The unit vector of a joint's `<axis xyz="…">` (`v`, finite numbers), normalised as
+/// Pinocchio does (exact for axes along ±x/±y/±z). A fixed joint's axis is never read: it is
+/// kept as given when it cannot be normalised.
+///
+/// # Errors
+/// For a moving joint, spanning the `xyz` value: an axis of length 0, and an axis whose
+/// squared length `x² + y² + z²` is not a normal finite number — it overflows (`1e308 0 0`:
+/// the division by an infinite length made the axis `0 0 0`, and the joint dropped out of
+/// the equations, issue 47) or underflows to a subnormal number or 0 (`1e-200 0 0`), so the
+/// length and the normalised components would be wrong or not finite.
+fn unit_axis(v: [f64; 3], kind: JointKind, el: roxmltree::Node) -> Result<[f64; 3], FrontError> {
+    let squared = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    let n = squared.sqrt();
+    let unit = [v[0] / n, v[1] / n, v[2] / n];
+    let normal = squared.is_normal() && unit.iter().all(|x| x.is_finite());
+    if kind == JointKind::Fixed {
+        return Ok(if normal && n != 1.0 { unit } else { v });
+    }
+    if normal {
+        return Ok(if n == 1.0 { v } else { unit });
+    }
+    let span = el.attribute_node("xyz").map_or(el.range(), |a| a.range_value());
+    let e = if v == [0.0; 3] {
+        FrontError::new(span_of(span), "joint axis has length 0", "this axis")
+    } else {
+        let why = if squared.is_infinite() { "overflows" } else { "underflows" };
+        FrontError::new(
+            span_of(span),
+            format!("joint axis cannot be normalised: its squared length {why} in binary64"),
+            "this axis",
+        )
+        .note(format!(
+            "found `{}`; expected a direction whose squared length x² + y² + z² is a normal number \
+             (between {:e} and {:e}), such as `0 0 1`",
+            el.attribute("xyz").unwrap_or_default(),
+            f64::MIN_POSITIVE,
+            f64::MAX
+        ))
+    };
+    Err(e)
+}
+
 /// Parses and checks a URDF document.
 ///
 /// # Errors
@@ -117,7 +159,8 @@ fn inertial(node: roxmltree::Node) -> Result<Option<Inertial>, FrontError> {
 /// element other than `<robot>`, a joint without `parent`/`child` or naming an unknown link, a
 /// link that is the child of two joints, no root link or a loop, a `planar` or `floating` joint
 /// (unsupported below the root; a floating base is modelled by the generator, not by a joint),
-/// a negative mass, an inertia tensor that is not positive definite, an axis of length 0.
+/// a negative mass, an inertia tensor that is not positive definite, a non-finite number, an
+/// axis of length 0 or whose squared length overflows or underflows.
 ///
 /// Cost: linear in the text (names are found through hash maps, issue 28: a 20,000-link
 /// star spent 2 s comparing names).
@@ -203,12 +246,7 @@ pub fn parse(text: &str) -> Result<Robot, FrontError> {
         let mut axis = [1.0, 0.0, 0.0];
         if let Some(a) = child_elem(j, "axis") {
             if let Some(v) = numbers::<3>(a, "xyz")? {
-                let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                if n == 0.0 && kind != JointKind::Fixed {
-                    return Err(FrontError::new(span_of(a.range()), "joint axis has length 0", "this axis"));
-                }
-                // Exact for axes along ±x/±y/±z; others normalised as Pinocchio does.
-                axis = if n == 1.0 || n == 0.0 { v } else { [v[0] / n, v[1] / n, v[2] / n] };
+                axis = unit_axis(v, kind, a)?;
             }
         }
         joints.push(Joint {

@@ -112,3 +112,49 @@ fn every_prefix_and_byte_flip_of_the_example_is_an_error_or_a_valid_module() {
         check(&b.into_iter().collect::<String>());
     }
 }
+
+/// Issue 47: an axis whose squared length is not a normal binary64 number cannot be normalised
+/// (`1e308 0 0` became `0 0 0` and the joint dropped out of the equations); refused at the
+/// `xyz` value, as a non-finite number is. A fixed joint's axis is never read.
+#[test]
+fn an_axis_that_cannot_be_normalised_is_refused_at_its_xyz() {
+    let joint = |ty: &str, xyz: &str| {
+        format!(
+            "{HEAD}<joint name=\"j\" type=\"{ty}\"><parent link=\"a\"/><child link=\"b\"/>\n  <axis xyz=\"{xyz}\"/></joint></robot>"
+        )
+    };
+    for (xyz, what) in [
+        ("1e308 0 0", "joint axis cannot be normalised: its squared length overflows in binary64"),
+        ("0 -1e200 1e200", "joint axis cannot be normalised: its squared length overflows in binary64"),
+        ("1e-200 0 0", "joint axis cannot be normalised: its squared length underflows in binary64"),
+        // 1e-160² = 1e-320 is subnormal: its square root is off by far more than an ulp.
+        ("0 1e-160 0", "joint axis cannot be normalised: its squared length underflows in binary64"),
+        ("0 0 0", "joint axis has length 0"),
+        ("-0 0 0", "joint axis has length 0"),
+        ("inf 0 0", "attribute `xyz` must hold 3 finite numbers"),
+        ("0 nan 1", "attribute `xyz` must hold 3 finite numbers"),
+        ("0 0 -1e999", "attribute `xyz` must hold 3 finite numbers"),
+    ] {
+        for ty in ["revolute", "continuous", "prismatic"] {
+            let t = joint(ty, xyz);
+            let e = parse(&t).expect_err(xyz);
+            assert_eq!(e.message, what, "{ty} {xyz}");
+            // The span is the attribute's value: line 5, the column of its first character.
+            let at = t.find(&format!("\"{xyz}\"")).unwrap() + 1;
+            assert_eq!((e.span.start as usize, e.span.end as usize), (at, at + xyz.len()), "{ty} {xyz}");
+        }
+        // A fixed joint's axis is not read (a non-finite number is still refused).
+        assert_eq!(parse(&joint("fixed", xyz)).is_ok(), !what.starts_with("attribute"), "fixed {xyz}");
+    }
+    // Large and small axes whose squared length is normal are normalised exactly enough.
+    for (xyz, unit) in [
+        ("1e154 0 0", [1.0, 0.0, 0.0]),
+        ("0 3e-150 4e-150", [0.0, 0.6, 0.8]),
+        ("0 0 -2", [0.0, 0.0, -1.0]),
+        ("3 4 0", [0.6, 0.8, 0.0]),
+    ] {
+        let r = parse(&joint("revolute", xyz)).expect(xyz);
+        let a = r.joints[0].axis;
+        assert!(a.iter().zip(unit).all(|(x, y)| (x - y).abs() <= 4.0 * f64::EPSILON), "{xyz}: {a:?}");
+    }
+}

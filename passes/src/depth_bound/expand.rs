@@ -12,6 +12,11 @@
 //! within [`ZERO_RELATIVE`] of that magnitude — rounding leaves about 1e-16 of it, a nonzero
 //! analytic function vanishes at three random points with probability 0.
 //!
+//! A fused multiply-add (`@fma(a, b, c) = a·b + c`, `@fms = a·b − c`, `@fnma = c − a·b`,
+//! [`robovec_ir::Intrinsic`]; what `contract` writes) is not a call here: it is expanded as the
+//! product and the sum it fuses, and its operands stay x-variables (issue 47: after `contract`
+//! they were taken as θ-inputs, every product became a coefficient and the bound 0 cycles).
+//!
 //! A value is `None` (not expanded) when it divides by an x-variable, reads a value that is not
 //! expanded, or would hold more than `max_terms` monomials (or multiply more than
 //! [`PAIRS_PER_TERM`] × `max_terms` pairs of them): expansion is exponential in the depth of
@@ -22,7 +27,7 @@ use std::collections::HashMap;
 use std::rc::Rc;
 
 use robovec_ir::interp::{eval_call, pseudo_random_input};
-use robovec_ir::{BinOp, Def, Function, Operand, TrigFn, Value};
+use robovec_ir::{BinOp, Def, Function, Intrinsic, Operand, TrigFn, Value};
 
 /// θ points each coefficient is sampled at.
 pub const SAMPLES: usize = 3;
@@ -109,12 +114,21 @@ fn constant(c: f64) -> Poly {
     constant_or_empty(Coef::constant(c))
 }
 
-/// The inputs read, through any chain of values, by a trig variable or a call: by value index.
+/// The fused multiply-add a call is (`@fma`, `@fms`, `@fnma`), if it is one.
+pub fn fused(def: &Def) -> Option<Intrinsic> {
+    match def {
+        Def::Call(callee, args) => Intrinsic::of(callee, args.len()).filter(|i| i.is_fused()),
+        _ => None,
+    }
+}
+
+/// The inputs read, through any chain of values, by a trig variable or a call other than a
+/// fused multiply-add ([`fused`]): by value index.
 pub fn theta_inputs(f: &Function) -> Vec<bool> {
     let mut read = vec![false; f.values.len()];
     for &v in f.body.iter().rev() {
         let def = &f.value(v).def;
-        let under = read[v.index()] || matches!(def, Def::Trig(..) | Def::Call(..));
+        let under = read[v.index()] || (matches!(def, Def::Trig(..) | Def::Call(..)) && fused(def).is_none());
         if under {
             def.for_each_value(|x| read[x.index()] = true);
         }
@@ -156,6 +170,18 @@ pub fn expand(f: &Function, max_terms: usize, mut stop: impl FnMut() -> bool) ->
                 });
                 vec![(Box::default(), Coef::samples(at))]
             }),
+            Def::Call(_, args) if fused(&f.value(v).def).is_some() => {
+                let ops: Option<Vec<Rc<Poly>>> = args.iter().map(|o| ex.of(*o)).collect();
+                ops.and_then(|ops| {
+                    let ab = product(&ops[0], &ops[1], max_terms)?;
+                    match fused(&f.value(v).def)? {
+                        Intrinsic::Fma => Some(sum(&ab, &ops[2], 1.0)),
+                        Intrinsic::Fms => Some(sum(&ab, &ops[2], -1.0)),
+                        Intrinsic::Fnma => Some(sum(&ops[2], &ab, -1.0)),
+                        Intrinsic::Sqrt => None,
+                    }
+                })
+            }
             Def::Call(callee, args) => {
                 let args: Option<Vec<Coef>> = args.iter().map(|o| ex.of(*o).as_deref().and_then(scalar)).collect();
                 args.map(|args| {

@@ -12,6 +12,16 @@
 //! that divide by an x-variable, are left out, so the bound is then one of the expanded
 //! outputs only — still a lower bound, usually far below the critical path.
 //!
+//! **Fused multiply-adds** (`contract`'s `@fma`, `@fms`, `@fnma`) are expanded into the
+//! product and sum they fuse ([`expand`]): the polynomials, so the `+ − ×` bound, are those of
+//! the function before `contract`. But a program with fused ops is in a larger machine model
+//! (`a·b + c` in one op of the `call` latency), whose critical path may lie below the `+ − ×`
+//! bound; for a function that has them the bound is over programs of `+ − ×` **and** fused ops
+//! ([`count::min_cycles_with`], the fma latency `lat-call`, as the timing charges them) — a
+//! lower bound on the critical path of the contracted program — and the `+ − ×` bound is given
+//! beside it ([`FunctionBound::plus_minus_times_cycles`]; issue 47: after `contract` the
+//! bound read 0 cycles).
+//!
 //! Printed after the run, one line per function (`depth-bound @dirdyna: critical path 69
 //! cycles, lower bound 38 cycles (c[2]: 16 monomials of degree 4 in 16 x-variables, a sum at
 //! the root); 10 of 10 outputs expanded`), and in the report as `depth_bound`. The bound holds
@@ -130,18 +140,47 @@ pub struct FunctionBound {
     pub lat_add: u32,
     /// See `lat_add`.
     pub lat_mul: u32,
+    /// When the function has fused multiply-adds (`contract`): their latency (`lat-call`,
+    /// cycles), and the bound is over programs of `+ − ×` and fused ops; absent otherwise
+    /// (the bound is over `+ − ×` programs).
+    #[serde(rename = "lat_fma", skip_serializing_if = "Option::is_none")]
+    pub fma_latency: Option<u32>,
+    /// When the function has fused multiply-adds: the largest bound of its expanded outputs
+    /// over programs of `+ − ×` ops alone (the function's bound before `contract`), cycles.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plus_minus_times_cycles: Option<u32>,
+}
+
+/// The latency of a fused multiply-add in `f`'s timing (`lat.call`) when `f` has one
+/// ([`expand::fused`]); `None` when it has none.
+pub fn fma_latency(f: &Function, lat: &Latencies) -> Option<u32> {
+    f.body.iter().any(|&v| expand::fused(&f.value(v).def).is_some()).then_some(lat.call)
 }
 
 /// The bound of every output of `f` (atomised) that expands within `max_terms` monomials, in
-/// output order; `stop` is asked before each value is expanded.
+/// output order; `stop` is asked before each value is expanded. Over programs of `+ − ×` ops,
+/// and of fused multiply-adds too when `f` has some ([`fma_latency`]).
 pub fn output_bounds(f: &Function, lat: &Latencies, max_terms: usize, stop: impl FnMut() -> bool) -> Vec<OutputBound> {
+    output_bounds_in(f, lat, fma_latency(f, lat), max_terms, stop)
+}
+
+/// [`output_bounds`] in the machine model `fma` says: programs of `+ − ×` ops (`None`), or of
+/// `+ − ×` and fused multiply-adds of latency `fma` (cycles), whatever ops `f` has.
+pub fn output_bounds_in(
+    f: &Function,
+    lat: &Latencies,
+    fma: Option<u32>,
+    max_terms: usize,
+    stop: impl FnMut() -> bool,
+) -> Vec<OutputBound> {
     let ex = expand::expand(f, max_terms, stop);
-    f.outputs.iter().filter_map(|o| Some(output_bound(&o.name, &*ex.of(o.value)?, lat))).collect()
+    f.outputs.iter().filter_map(|o| Some(output_bound_in(&o.name, &*ex.of(o.value)?, lat, fma))).collect()
 }
 
 /// The function's bound: the largest of [`output_bounds`].
 pub fn bound_function(f: &Function, lat: &Latencies, max_terms: usize, stop: impl FnMut() -> bool) -> FunctionBound {
-    let outputs = output_bounds(f, lat, max_terms, stop);
+    let fma = fma_latency(f, lat);
+    let outputs = output_bounds_in(f, lat, fma, max_terms, stop);
     let binding = outputs.iter().fold(None::<&OutputBound>, |best, o| match best {
         Some(b) if b.lower_bound_cycles >= o.lower_bound_cycles => Some(b),
         _ => Some(o),
@@ -155,11 +194,22 @@ pub fn bound_function(f: &Function, lat: &Latencies, max_terms: usize, stop: imp
         binding: binding.cloned(),
         lat_add: lat.add,
         lat_mul: lat.mul,
+        fma_latency: fma,
+        plus_minus_times_cycles: fma.map(|_| {
+            let plain = |o: &OutputBound| count::min_cycles(o.monomials, o.degree, o.sum_root, lat.add, lat.mul);
+            outputs.iter().map(plain).max().unwrap_or(0)
+        }),
     }
 }
 
-/// The bound of one expanded output.
+/// The bound of one expanded output over programs of `+ − ×` ops.
 pub fn output_bound(name: &str, p: &expand::Poly, lat: &Latencies) -> OutputBound {
+    output_bound_in(name, p, lat, None)
+}
+
+/// [`output_bound`] over programs of `+ − ×` and fused multiply-adds of latency `fma`
+/// (cycles) when it is given.
+pub fn output_bound_in(name: &str, p: &expand::Poly, lat: &Latencies, fma: Option<u32>) -> OutputBound {
     let degree = p.iter().map(|(m, _)| m.len() as u32).max().unwrap_or(0);
     // Per x-variable: the monomials that hold it, and whether one of them is the variable alone
     // (one pass over the monomials; a monomial is sorted, so repeats are neighbours).
@@ -182,7 +232,7 @@ pub fn output_bound(name: &str, p: &expand::Poly, lat: &Latencies) -> OutputBoun
         degree,
         variables: holding.len() as u32,
         sum_root,
-        lower_bound_cycles: count::min_cycles(monomials, degree, sum_root, lat.add, lat.mul),
+        lower_bound_cycles: count::min_cycles_with(monomials, degree, sum_root, lat.add, lat.mul, fma),
     }
 }
 
@@ -201,6 +251,9 @@ impl std::fmt::Display for FunctionBound {
             "depth-bound @{}: critical path {} cycles, lower bound {} cycles",
             self.function, self.critical_path_cycles, self.lower_bound_cycles
         )?;
+        if self.fma_latency.is_some() {
+            write!(f, " over programs of + − × and fused multiply-add ops")?;
+        }
         if let Some(b) = &self.binding {
             let root = if b.sum_root { ", a sum at the root" } else { "" };
             write!(
@@ -211,9 +264,13 @@ impl std::fmt::Display for FunctionBound {
         }
         write!(
             f,
-            "; {} of {} outputs expanded (latencies add {}, mul {})",
+            "; {} of {} outputs expanded (latencies add {}, mul {}",
             self.outputs_expanded, self.outputs, self.lat_add, self.lat_mul
-        )
+        )?;
+        match (self.fma_latency, self.plus_minus_times_cycles) {
+            (Some(fma), Some(plain)) => write!(f, ", fma {fma}); over + − × ops alone: {plain} cycles"),
+            _ => write!(f, ")"),
+        }
     }
 }
 

@@ -123,3 +123,69 @@ fn a_stopped_expansion_bounds_the_outputs_it_reached() {
     // p = ac + bc: 2 monomials of degree 2, no variable alone: N(12) = 2 → 12, degree 2 → 7.
     assert_eq!((b.binding.as_ref().unwrap().output.as_str(), b.lower_bound_cycles), ("p", 12));
 }
+
+/// Issue 47: after `contract` the fused ops were calls, their operands θ-inputs, and the bound
+/// 0 cycles. Now they are expanded (the polynomials, and the `+ − ×` bound, are the unfused
+/// function's) and the bound is over programs of `+ − ×` and fused ops of latency `lat-call`,
+/// never above the contracted program's critical path.
+#[test]
+fn fused_multiply_adds_are_expanded_and_bounded_with_their_latency() {
+    // m = a·b; o = m + c; p = d − m; u = p·p + o = d² − 2abd + a²b² + ab + c; r = S·a − b.
+    let text = "func @f { phase atomised input %a input %b input %c input %d input %q %S = sin %q \
+                %m = mul %a, %b %o = add %m, %c %p = sub %d, %m %pp = mul %p, %p %u = add %pp, %o \
+                %sa = mul %S, %a %r = sub %sa, %b output o = %o output u = %u output r = %r }";
+    let plain = parse(text).unwrap();
+    let mut fused = plain.clone();
+    let c = crate::contract::contract_function(&mut fused.functions[0]);
+    assert_eq!((c.fma, c.fms, c.fnma, c.muls_removed), (2, 1, 1, 3), "{}", fused.functions[0]);
+    let (f0, f1) = (&plain.functions[0], &fused.functions[0]);
+    let before = bound_function(f0, &lat(), 4096, || false);
+    let after = bound_function(f1, &lat(), 4096, || false);
+    // The unfused program: a·b at 7, p at 19, p·p at 26, u at 38.
+    assert_eq!((before.critical_path_cycles, before.fma_latency, before.plus_minus_times_cycles), (38, None, None));
+    // u: 5 monomials of degree 4 with c alone: over + − ×, a sum at t with 2·N(t − 12) ≥ 5 and
+    // D(t − 12) ≥ 4: t − 12 = 19 (N(19) = 4, D(14) = 4), so 31.
+    assert_eq!(before.lower_bound_cycles, 31);
+    let ub = before.binding.clone().unwrap();
+    assert_eq!((ub.output.as_str(), ub.monomials, ub.degree, ub.variables, ub.sum_root), ("u", 5, 4, 4, true));
+    // The fused program: o and p at 12 (one fma each), u = fma(p, p, o) at 24 — below 31.
+    assert_eq!(after.critical_path_cycles, 24);
+    // Same polynomials (a, b, c, d stay x-variables: before the fix they were θ-inputs) ...
+    let outs = |f: &Function| output_bounds_in(f, &lat(), None, 4096, || false);
+    assert_eq!(outs(f0), outs(f1));
+    assert_eq!(after.plus_minus_times_cycles, Some(31));
+    // ... and over + − × and fma ops (latency 12): u by a fused op at t with N(t−12)² + N(t−12)
+    // ≥ 5 and 2·D(t−12) ≥ 4: t − 12 = 12 (N(12) = 2, D(12) = 2), so 24 = the critical path.
+    assert_eq!((after.lower_bound_cycles, after.fma_latency), (24, Some(12)));
+    assert_eq!(after.binding.as_ref().map(|b| (b.output.as_str(), b.monomials)), Some(("u", 5)));
+    // The same model on the unfused function gives the same bound: a property of the function.
+    let model = |f: &Function| output_bounds_in(f, &lat(), Some(12), 4096, || false);
+    assert_eq!(model(f0), model(f1));
+    assert_eq!(model(f0).iter().map(|o| o.lower_bound_cycles).max(), Some(24));
+    // o = a·b + c: one fused op, 12 cycles; r = S·a − b: 2 monomials of degree 1, b alone.
+    let o = model(f1).into_iter().find(|o| o.output == "o").unwrap();
+    assert_eq!((o.monomials, o.degree, o.sum_root, o.lower_bound_cycles), (2, 2, true, 12));
+    let r = model(f1).into_iter().find(|o| o.output == "r").unwrap();
+    assert_eq!((r.monomials, r.degree, r.variables, r.sum_root), (2, 1, 2, true));
+    // The line says which model.
+    let line = after.to_string();
+    assert!(
+        line.contains("lower bound 24 cycles over programs of + − × and fused multiply-add ops (u: 5 monomials")
+            && line.ends_with("(latencies add 12, mul 7, fma 12); over + − × ops alone: 31 cycles"),
+        "{line}"
+    );
+    assert!(!before.to_string().contains("fma"), "{before}");
+}
+
+#[test]
+fn a_sqrt_still_makes_its_argument_a_theta_input_under_a_fused_op() {
+    // w = fma(√(e²), a, a) = (|e| + 1)·a: e is read by a call (a θ-input; squared, so that the
+    // square root of its samples is real), a stays an x-variable.
+    let text = "func @f { phase atomised input %a input %e %e2 = mul %e, %e %s = call @sqrt(%e2) \
+                %w = call @fma(%s, %a, %a) output w = %w }";
+    let b = bound(text);
+    let w = b.binding.unwrap();
+    assert_eq!((w.monomials, w.degree, w.variables), (1, 1, 1));
+    // e² at 7, √ at 19, the fma at 31; a alone is ready at 0.
+    assert_eq!((b.lower_bound_cycles, b.critical_path_cycles, b.fma_latency), (0, 31, Some(12)));
+}
