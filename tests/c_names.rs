@@ -3,6 +3,10 @@
 //! and two generated files (both headers in one translation unit) linked into one program;
 //! compiled by `cc` in its default dialect and with `-std=c99`, with
 //! `-Werror=implicit-function-declaration`, and run: outputs equal `-eval` bit for bit.
+//!
+//! Issue 47: the names of the C standard library and POSIX as `name=` (bad usage) and as
+//! function names (renamed: a program calling `time(NULL)` links beside `@time`), every
+//! identifier of the machine's C and POSIX headers as a function name.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -357,4 +361,346 @@ fn two_generated_files_include_and_link_together() {
             assert!((v[2] - k).abs() <= 1e-12, "lane {l}: inline {} vs {k}", v[2]);
         }
     }
+}
+
+/// The C standard library's and POSIX's headers (C89–C23, POSIX.1-2017), each included only
+/// where the machine has it (`__has_include`), and the glibc ones whose names
+/// `passes/src/codegen/names/library.rs` lists.
+const LIBRARY_HEADERS: &[&str] = &[
+    "assert.h",
+    "complex.h",
+    "ctype.h",
+    "errno.h",
+    "fenv.h",
+    "float.h",
+    "inttypes.h",
+    "iso646.h",
+    "limits.h",
+    "locale.h",
+    "math.h",
+    "setjmp.h",
+    "signal.h",
+    "stdalign.h",
+    "stdarg.h",
+    "stdatomic.h",
+    "stdbit.h",
+    "stdbool.h",
+    "stdckdint.h",
+    "stddef.h",
+    "stdint.h",
+    "stdio.h",
+    "stdlib.h",
+    "stdnoreturn.h",
+    "string.h",
+    "tgmath.h",
+    "threads.h",
+    "time.h",
+    "uchar.h",
+    "wchar.h",
+    "wctype.h",
+    "aio.h",
+    "arpa/inet.h",
+    "cpio.h",
+    "dirent.h",
+    "dlfcn.h",
+    "fcntl.h",
+    "fmtmsg.h",
+    "fnmatch.h",
+    "ftw.h",
+    "glob.h",
+    "grp.h",
+    "iconv.h",
+    "langinfo.h",
+    "libgen.h",
+    "monetary.h",
+    "mqueue.h",
+    "ndbm.h",
+    "net/if.h",
+    "netdb.h",
+    "netinet/in.h",
+    "netinet/tcp.h",
+    "nl_types.h",
+    "poll.h",
+    "pthread.h",
+    "pwd.h",
+    "regex.h",
+    "sched.h",
+    "search.h",
+    "semaphore.h",
+    "spawn.h",
+    "strings.h",
+    "sys/ipc.h",
+    "sys/mman.h",
+    "sys/msg.h",
+    "sys/resource.h",
+    "sys/select.h",
+    "sys/sem.h",
+    "sys/shm.h",
+    "sys/socket.h",
+    "sys/stat.h",
+    "sys/statvfs.h",
+    "sys/time.h",
+    "sys/times.h",
+    "sys/types.h",
+    "sys/uio.h",
+    "sys/un.h",
+    "sys/utsname.h",
+    "sys/wait.h",
+    "syslog.h",
+    "tar.h",
+    "termios.h",
+    "ulimit.h",
+    "unistd.h",
+    "utime.h",
+    "utmpx.h",
+    "wordexp.h",
+    "alloca.h",
+    "byteswap.h",
+    "endian.h",
+    "err.h",
+    "error.h",
+    "execinfo.h",
+    "getopt.h",
+    "libintl.h",
+    "malloc.h",
+    "sys/file.h",
+    "sys/ioctl.h",
+    "sys/random.h",
+    "sys/sendfile.h",
+    "sys/sysinfo.h",
+    "sys/epoll.h",
+    "sys/eventfd.h",
+    "sys/inotify.h",
+    "sys/timerfd.h",
+    "sys/signalfd.h",
+    "pty.h",
+    "utmp.h",
+    "mntent.h",
+    "shadow.h",
+    "ifaddrs.h",
+];
+
+/// The dialects the library's headers are read and the generated file compiled in: the
+/// compiler's default (glibc's BSD and SVID extensions), strict C99 with POSIX and XSI, and GNU.
+const LIBRARY_DIALECTS: [&[&str]; 3] = [&[], &["-std=c99", "-D_XOPEN_SOURCE=700"], &["-D_GNU_SOURCE"]];
+
+/// `cc ARGS` on `stdin`, its stdout (panics when it fails).
+fn cc_stdout(args: &[&str], stdin: &str) -> String {
+    use std::io::Write;
+    let o = Command::new("cc")
+        .args(args)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .and_then(|mut c| {
+            c.stdin.take().unwrap().write_all(stdin.as_bytes())?;
+            c.wait_with_output()
+        })
+        .expect("cc");
+    assert!(o.status.success(), "cc {args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// Issue 47: `name=` a function, macro or type of the C or POSIX library is bad usage (exit
+/// 2) that names the header, in every ABI, and the output is not written.
+#[test]
+fn c_and_posix_library_names_as_name_are_bad_usage() {
+    let dir = tmp("library_name_option");
+    let ir = dir.join("f.rvir");
+    std::fs::write(&ir, hostile_ir(&["x", "y"])).unwrap();
+    let out = dir.join("out.c");
+    std::fs::write(&out, "kept").unwrap();
+    let named = [
+        ("printf", "declared by <stdio.h>"),
+        ("time", "declared by <time.h>"),
+        ("clock", "declared by <time.h>"),
+        ("signal", "declared by <signal.h>"),
+        ("fopen", "declared by <stdio.h>"),
+        ("setlocale", "declared by <locale.h>"),
+        ("longjmp", "declared by <setjmp.h>"),
+        ("read", "declared by <unistd.h>"),
+        ("write", "declared by <unistd.h>"),
+        ("kill", "declared by <signal.h>"),
+        ("fork", "declared by <unistd.h>"),
+        ("sleep", "declared by <unistd.h>"),
+        ("pipe", "declared by <unistd.h>"),
+        ("dup", "declared by <unistd.h>"),
+        ("poll", "declared by <poll.h>"),
+        ("thrd_create", "reserved by the C standard for <threads.h>"),
+        ("pthread_create", "reserved by POSIX for <pthread.h>"),
+        ("SIGINT", "reserved by the C standard for <signal.h>"),
+        ("FILE", "declared by <stdio.h>"),
+        ("exit", "a function of the C library"),
+        ("malloc", "a function of the C library"),
+        ("select", "a function of the C library"),
+    ];
+    for (n, why) in named {
+        for abi in ["plain", "robotran", "pinocchio"] {
+            let o = opt(&[
+                ir.to_str().unwrap(),
+                &format!("-passes=atomise,codegen<c;abi={abi};name={n}>"),
+                "-o",
+                out.to_str().unwrap(),
+            ]);
+            assert_eq!(o.status.code(), Some(2), "abi={abi};name={n}: {}", stderr(&o));
+            let e = stderr(&o);
+            assert!(e.contains(&format!("`{n}` cannot name generated C: it is {why}")), "name={n}: {e}");
+        }
+    }
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "kept", "the output is not touched");
+    assert!(!dir.join("out.h").exists());
+}
+
+/// Issue 47: IR functions named like the C and POSIX libraries' functions (`@time`, `@printf`,
+/// `@read`, `@signal`, `@link`, `@exit`) get free symbols (`v_time`, …); a program that
+/// includes the libraries' headers and the generated one compiles in both dialects, calls
+/// `time(NULL)` (the C library's: the current time) and the generated functions, whose
+/// outputs equal `-eval` bit for bit.
+#[test]
+fn functions_named_like_libc_functions_link_beside_libc() {
+    let dir = tmp("library_functions_link");
+    let names = ["time", "printf", "read", "signal", "link", "exit", "sleep", "fopen"];
+    let mut ir = String::new();
+    for (k, n) in names.iter().enumerate() {
+        ir += &format!(
+            "func @{n} {{\n  input %a\n  input %b\n  %s = sin %a\n  %x = mul %s, %b\n  %y = add %x, {k}.5\n  output y = %y\n}}\n"
+        );
+    }
+    std::fs::write(dir.join("m.rvir"), &ir).unwrap();
+    let p = |s: &str| dir.join(s).display().to_string();
+    let o = opt(&[&p("m.rvir"), "-passes=atomise,codegen<c>", "-o", &p("m.c")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let h = std::fs::read_to_string(dir.join("m.h")).unwrap();
+    for n in names {
+        assert!(h.contains(&format!("void v_{n}(const double *restrict in, double *restrict out);")), "{n}: {h}");
+        assert!(!h.contains(&format!("void {n}(")), "{n} keeps the library's name: {h}");
+    }
+    let mut driver = String::from(
+        "#include <stdio.h>\n#include <stdlib.h>\n#include <time.h>\n#include <signal.h>\n#include <unistd.h>\n\
+         #include \"m.h\"\nint main(void)\n{\n  time_t t = time(NULL);\n  double in[2] = {0.75, -1.25}, out[1];\n  \
+         printf(\"%lld\\n\", (long long)t);\n",
+    );
+    for n in names {
+        driver += &format!("  v_{n}(in, out);\n  printf(\"%.17g\\n\", out[0]);\n");
+    }
+    driver += "  return 0;\n}\n";
+    std::fs::write(dir.join("main.c"), driver).unwrap();
+    let inputs: BTreeMap<String, f64> = [("a".to_string(), 0.75), ("b".into(), -1.25)].into();
+    let want: Vec<f64> = names
+        .iter()
+        .map(|n| eval(&dir, &dir.join("m.rvir"), &inputs, &[format!("-function={n}").as_str()])["y"])
+        .collect();
+    for dialect in DIALECTS {
+        let mut args: Vec<&str> = dialect.to_vec();
+        args.extend(["-Wall", "-Werror", "-o", "run", "main.c", "m.c", "-lm"]);
+        cc(&dir, &args);
+        let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_secs() as i64;
+        let run = Command::new(dir.join("run")).output().unwrap();
+        assert!(run.status.success(), "{dialect:?}: {:?}", run.status);
+        let text = String::from_utf8(run.stdout).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 1 + names.len(), "{text}");
+        let t: i64 = lines[0].parse().unwrap();
+        assert!((t - now).abs() <= 60, "{dialect:?}: time(NULL) = {t}, the clock says {now}");
+        for (k, n) in names.iter().enumerate() {
+            let got: f64 = lines[1 + k].parse().unwrap();
+            assert_eq!(got.to_bits(), want[k].to_bits(), "{dialect:?}: v_{n} {got} vs -eval {}", want[k]);
+        }
+    }
+}
+
+/// Issue 47, the general rule checked against the machine's own C library: every identifier
+/// that the C and POSIX headers of [`LIBRARY_HEADERS`] hold in the three dialects of
+/// [`LIBRARY_DIALECTS`] (every token of the preprocessed headers: functions, variables,
+/// types, enumeration constants, parameters and members; and every macro) is the name of a
+/// function of one module. The generated file compiles after all those headers (`-include`)
+/// in each dialect with `-Wall -Werror` (GCC's built-in functions too), and none of its
+/// functions is a symbol `libc.so.6` or `libm.so.6` exports.
+#[test]
+fn no_name_of_the_system_c_library_becomes_a_symbol() {
+    let dir = tmp("library_symbols_all");
+    let mut includes = String::new();
+    for h in LIBRARY_HEADERS {
+        includes += &format!("#if __has_include(<{h}>)\n#include <{h}>\n#endif\n");
+    }
+    std::fs::write(dir.join("all.h"), &includes).unwrap();
+    let mut names: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
+    let mut macros: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
+    for dialect in LIBRARY_DIALECTS {
+        let mut args: Vec<&str> = dialect.to_vec();
+        args.extend(["-E", "-P", "-x", "c", "-"]);
+        let text = cc_stdout(&args, &includes);
+        let mut word = String::new();
+        for c in text.chars().chain([' ']) {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                word.push(c);
+            } else {
+                if word.starts_with(|c: char| c.is_ascii_alphabetic()) {
+                    names.insert(std::mem::take(&mut word));
+                }
+                word.clear();
+            }
+        }
+        args.insert(0, "-dM");
+        for line in cc_stdout(&args, &includes).lines() {
+            let Some(rest) = line.strip_prefix("#define ") else { continue };
+            let name: String = rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+            if name.starts_with(|c: char| c.is_ascii_alphabetic()) {
+                names.insert(name.clone());
+                macros.insert(name);
+            }
+        }
+    }
+    for n in ["printf", "time", "read", "pthread_create", "SIGINT", "EINTR", "FILE", "jmp_buf", "O_RDONLY"] {
+        assert!(names.contains(n), "{n} among {} names", names.len());
+    }
+    let mut ir = String::new();
+    for n in &names {
+        ir += &format!("func @{n} {{\n  input %a\n  %x = mul %a, %a\n  output o = %x\n}}\n");
+    }
+    std::fs::write(dir.join("m.rvir"), ir).unwrap();
+    let (m, c) = (dir.join("m.rvir").display().to_string(), dir.join("m.c").display().to_string());
+    let o = opt(&[&m, "-passes=atomise,codegen<c>", "-o", &c]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // No macro of the headers names a function (`d_fileno` would be `d_ino` where <dirent.h> is
+    // included, whether or not that compiles).
+    let header = std::fs::read_to_string(dir.join("m.h")).unwrap();
+    let symbols: Vec<&str> = header.lines().filter_map(|l| l.strip_prefix("void ")?.split('(').next()).collect();
+    assert_eq!(symbols.len(), names.len(), "one function per name");
+    let named_like_macros: Vec<&&str> = symbols.iter().filter(|s| macros.contains(**s)).collect();
+    assert!(named_like_macros.is_empty(), "symbols named like the headers' macros: {named_like_macros:?}");
+    for dialect in LIBRARY_DIALECTS {
+        let mut args: Vec<&str> = dialect.to_vec();
+        args.extend(["-Wall", "-Werror", "-include", "all.h", "-include", "m.h", "-c", "m.c", "-o", "m.o"]);
+        cc(&dir, &args);
+    }
+    // The symbols the object defines, against those of the C library's shared objects.
+    let defined = |args: &[&str]| -> Vec<String> {
+        let o = Command::new("nm").args(args).output().expect("nm (binutils, with gcc)");
+        assert!(o.status.success(), "nm {args:?}");
+        String::from_utf8(o.stdout)
+            .unwrap()
+            .lines()
+            .filter_map(|l| {
+                let f: Vec<&str> = l.split_whitespace().collect();
+                // Global symbols (uppercase) and indirect functions (`i`: glibc's `memcpy`), not
+                // undefined ones (`U`) nor version nodes (`A`).
+                let global = f.len() == 3 && (f[1] == "i" || f[1].chars().all(|c| c.is_ascii_uppercase()));
+                (global && f[1] != "U" && f[1] != "A").then(|| f[2].split('@').next().unwrap().to_string())
+            })
+            .collect()
+    };
+    let ours = defined(&[dir.join("m.o").to_str().unwrap()]);
+    assert!(ours.len() >= names.len(), "one symbol per function: {} for {}", ours.len(), names.len());
+    let mut exported = std::collections::HashSet::new();
+    for lib in ["libc.so.6", "libm.so.6"] {
+        let path = cc_stdout(&[&format!("-print-file-name={lib}")], "").trim().to_string();
+        if Path::new(&path).is_absolute() {
+            exported.extend(defined(&["-D", "--defined-only", &path]));
+        }
+    }
+    assert!(exported.contains("printf") && exported.contains("time"), "libc's exports: {}", exported.len());
+    let clashes: Vec<&String> = ours.iter().filter(|s| exported.contains(*s)).collect();
+    assert!(clashes.is_empty(), "generated symbols the C library exports: {clashes:?}");
 }
