@@ -6,13 +6,15 @@
 //!
 //! Issue 47: the names of the C standard library and POSIX as `name=` (bad usage) and as
 //! function names (renamed: a program calling `time(NULL)` links beside `@time`), every
-//! identifier of the machine's C and POSIX headers as a function name.
+//! identifier of the machine's C and POSIX headers as a function name; two models under one
+//! name get two include guards, and two models' C files compile `#include`d into one
+//! translation unit.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
 
-use crate::common::{opt, stderr, tmp};
+use crate::common::{corpus_dir, opt, stderr, tmp};
 
 /// The names the issue measured breaking the C, and a few more of the same kinds.
 const HOSTILE: &[&str] = &[
@@ -703,4 +705,161 @@ fn no_name_of_the_system_c_library_becomes_a_symbol() {
     assert!(exported.contains("printf") && exported.contains("time"), "libc's exports: {}", exported.len());
     let clashes: Vec<&String> = ours.iter().filter(|s| exported.contains(*s)).collect();
     assert!(clashes.is_empty(), "generated symbols the C library exports: {clashes:?}");
+}
+
+/// `robovec-opt SOURCE EXTRA… -passes=atomise,codegen<c;OPTIONS> -o dir/NAME.c -report=…`:
+/// the inputs and outputs of the generated function, in argument order.
+fn generate(dir: &Path, source: &[&str], options: &str, name: &str) -> (Vec<String>, Vec<String>) {
+    let (c, report) = (dir.join(format!("{name}.c")), dir.join(format!("{name}.json")));
+    let mut args: Vec<String> = source.iter().map(|s| s.to_string()).collect();
+    args.extend([
+        format!("-passes=atomise,codegen<c;{options}>"),
+        "-o".into(),
+        c.display().to_string(),
+        format!("-report={}", report.display()),
+    ]);
+    let o = opt(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{source:?} {options}: {}", stderr(&o));
+    interface(&report)
+}
+
+/// The include guard of a generated header (its first `#ifndef`).
+fn guard(header: &Path) -> String {
+    let h = std::fs::read_to_string(header).unwrap();
+    h.lines().find_map(|l| l.strip_prefix("#ifndef ")).expect("an include guard").to_string()
+}
+
+const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";
+const ARM_URDF: &str = "examples/three_link_arm/three_link_arm.urdf";
+
+/// Issue 47 item 8: two models written under the same name (`invdyna`, the default) get two
+/// include guards, each the same on every run; including both headers no longer skips the
+/// second silently (the compiler sees its `invdyna_INPUTS`, another size).
+#[test]
+fn two_models_under_one_name_get_two_stable_include_guards() {
+    let dir = tmp("guards");
+    let again = dir.join("again");
+    std::fs::create_dir_all(&again).unwrap();
+    let arm = [ARM_URDF, "-function=invdyna"];
+    generate(&dir, &[PENDULUM], "abi=plain", "a");
+    generate(&again, &[PENDULUM], "abi=plain", "a");
+    generate(&dir, &arm, "abi=plain", "b");
+    let (ga, gb) = (guard(&dir.join("a.h")), guard(&dir.join("b.h")));
+    assert!(ga.starts_with("ROBOVEC_invdyna_H_") && gb.starts_with("ROBOVEC_invdyna_H_"), "{ga} {gb}");
+    assert_ne!(ga, gb, "two models, one name: two guards");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("a.h")).unwrap(),
+        std::fs::read_to_string(again.join("a.h")).unwrap(),
+        "the same model: the same header, guard included"
+    );
+    let h = std::fs::read_to_string(dir.join("a.h")).unwrap();
+    assert_eq!(h.matches(&ga).count(), 2, "#ifndef and #define: {h}");
+    // The pinocchio ABI's default prefix likewise (`model_rnea`…).
+    generate(&dir, &[ARM_URDF, "--fold-params", "-function=invdyna"], "abi=pinocchio", "p");
+    let gp = guard(&dir.join("p.h"));
+    assert!(gp.starts_with("ROBOVEC_model_rnea_H_") && gp.len() == "ROBOVEC_model_rnea_H_".len() + 16, "{gp}");
+    // Both headers of one name in one translation unit: the second is read, its size macro
+    // clashes with the first's and the compiler says so.
+    std::fs::write(dir.join("both.c"), "#include \"a.h\"\n#include \"b.h\"\nint main(void) { return 0; }\n").unwrap();
+    let o = Command::new("cc").current_dir(&dir).args(["-Werror", "-c", "both.c", "-o", "both.o"]).output().unwrap();
+    assert!(!o.status.success(), "the second header was skipped");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("invdyna_INPUTS"), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// Issue 47 item 8: the C files of two models with default names (the double pendulum's
+/// `invdyna`, m454's `dirdyna`), both `#include`d with their headers into one translation unit
+/// that calls both: compiles under GCC and Clang with `-std=c99 -Wall -Wextra -pedantic
+/// -Werror` and in GCC's default dialect, with one state, and with four (vector helpers, split
+/// into parts, and robovec's inline sin/cos: the helpers are shared); the program runs and its
+/// outputs equal `-eval` (bit for bit with libm's sin/cos, to 1e-12 with the inline ones), as
+/// do those of a program that links the two files. Files of other `batch=` in one unit stop
+/// the compilation with an `#error` that says why.
+#[test]
+fn two_models_c_files_include_into_one_translation_unit() {
+    let m454 = corpus_dir().join("c/m454__mbs_dirdyna_m454_project.c").display().to_string();
+    let value = |i: usize, lane: usize| 0.1 + 0.37 * i as f64 - 0.9 * (i % 3) as f64 + 0.01 * lane as f64;
+    for (k, (options, batch)) in
+        [("abi=plain", 1), ("batch=4;chunk=60", 4), ("batch=4;trig=inline;chunk=60", 4)].into_iter().enumerate()
+    {
+        let dir = tmp(&format!("one_unit_{k}"));
+        let exact = !options.contains("trig=inline");
+        let models = [
+            ("a", "invdyna", generate(&dir, &[PENDULUM], options, "a"), PENDULUM.to_string()),
+            ("b", "dirdyna", generate(&dir, &[&m454], options, "b"), m454.clone()),
+        ];
+        let mut body = String::new();
+        let mut want: Vec<f64> = Vec::new();
+        for (file, symbol, (ins, outs), source) in &models {
+            let _ = file;
+            body +=
+                &format!("  {{\n    static double in[{symbol}_INPUTS * {batch}], out[{symbol}_OUTPUTS * {batch}];\n");
+            for (i, _) in ins.iter().enumerate() {
+                for l in 0..batch {
+                    body += &format!("    in[{}] = {:?};\n", i * batch + l, value(i, l));
+                }
+            }
+            body += &format!("    {symbol}(in, out);\n    for (int j = 0; j < {symbol}_OUTPUTS * {batch}; j++) printf(\"%.17g\\n\", out[j]);\n  }}\n");
+            let per_lane: Vec<BTreeMap<String, f64>> = (0..batch)
+                .map(|l| {
+                    let inputs: BTreeMap<String, f64> =
+                        ins.iter().enumerate().map(|(i, n)| (n.clone(), value(i, l))).collect();
+                    eval(&dir, Path::new(source), &inputs, &[])
+                })
+                .collect();
+            for n in outs {
+                for lane in &per_lane {
+                    want.push(lane[n]);
+                }
+            }
+        }
+        let main = format!("int main(void)\n{{\n{body}  return 0;\n}}\n");
+        std::fs::write(
+            dir.join("one.c"),
+            format!(
+                "#include <stdio.h>\n#include \"a.h\"\n#include \"b.h\"\n#include \"a.c\"\n#include \"b.c\"\n{main}"
+            ),
+        )
+        .unwrap();
+        std::fs::write(dir.join("main.c"), format!("#include <stdio.h>\n#include \"a.h\"\n#include \"b.h\"\n{main}"))
+            .unwrap();
+        let strict = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"];
+        let builds: [(&str, &[&str], &[&str]); 4] = [
+            ("gcc", &strict, &["one.c"]),
+            ("clang", &strict, &["one.c"]),
+            ("gcc", &["-Wall", "-Wextra", "-Werror"], &["one.c"]),
+            ("gcc", &strict, &["main.c", "a.c", "b.c"]),
+        ];
+        for (compiler, flags, files) in builds {
+            let o = Command::new(compiler)
+                .current_dir(&dir)
+                .args(["-O0", "-ffp-contract=off"])
+                .args(flags)
+                .args(files)
+                .args(["-o", "run", "-lm"])
+                .output()
+                .unwrap_or_else(|e| panic!("{compiler} ({e}): scripts/test.sh installs gcc and clang"));
+            assert!(
+                o.status.success(),
+                "{options}, {compiler} {flags:?} {files:?}:\n{}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+            let run = Command::new(dir.join("run")).output().unwrap();
+            assert!(run.status.success());
+            let got: Vec<f64> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+            assert_eq!(got.len(), want.len(), "{options}: outputs of both functions, every lane");
+            for (j, (x, w)) in got.iter().zip(&want).enumerate() {
+                let close = if exact { x.to_bits() == w.to_bits() } else { (x - w).abs() <= 1e-12 * w.abs().max(1.0) };
+                assert!(close, "{options}, {compiler} {files:?}: output {j}: C {x} vs -eval {w}");
+            }
+        }
+    }
+    // Helpers of two batch widths cannot be one: the second file's guard says so.
+    let dir = tmp("one_unit_mixed");
+    generate(&dir, &[PENDULUM], "batch=4", "a");
+    generate(&dir, &[&m454], "batch=8", "b");
+    std::fs::write(dir.join("one.c"), "#include \"a.c\"\n#include \"b.c\"\n").unwrap();
+    let o = Command::new("cc").current_dir(&dir).args(["-c", "one.c", "-o", "one.o"]).output().unwrap();
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("must share batch=, precision= and trig="), "{e}");
 }
