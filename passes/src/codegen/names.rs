@@ -21,7 +21,7 @@
 //! of the C and POSIX libraries a program includes and links with ([`is_reserved_symbol`]:
 //! libm's functions with their `f`/`l`/`f128`/`d64`… forms, `<string.h>`'s `str…`/`mem…`,
 //! `<stdlib.h>`'s, `main`, and every identifier of the C standard library (C89–C23), of POSIX
-//! and of glibc, by name or by the families the standards reserve: [`library`], issue 47:
+//! and of glibc, by name or by the families the standards reserve: `names/library.rs`, issue 47:
 //! `printf`, `time`, `read`, `signal`, `pthread_create`, `SIGINT`), the names the file derives
 //! from symbols (`…_INPUTS`, `…_OUTPUTS`, `…_partK`), and a name whose derived names fall in
 //! such a family (`sem`: `sem_INPUTS`, `sem_part1` are POSIX's `sem_…`). `name=` is checked
