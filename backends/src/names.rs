@@ -17,11 +17,16 @@
 //! - what the file itself calls or defines: libm's `sin`, `cos`, `sqrt`, `fma` (and their `f`
 //!   forms), `memcpy`, the helpers `robovec_…`, the macros `ROBOVEC_…`, the ABI's parameters.
 //!
-//! A function's symbol (external linkage) must also avoid every function of the C and POSIX
-//! libraries a program links with ([`is_reserved_symbol`]: libm's functions with their `f`/`l`
-//! forms, `<string.h>`'s `str…`/`mem…`, `<stdlib.h>`'s, `main`) and the names the file derives
-//! from symbols (`…_INPUTS`, `…_OUTPUTS`, `…_partK`). `name=` is checked against it (bad
-//! usage, exit 2); a symbol derived from a function's name is renamed.
+//! A function's symbol (external linkage, declared in the header) must also avoid every name
+//! of the C and POSIX libraries a program includes and links with ([`is_reserved_symbol`]:
+//! libm's functions with their `f`/`l`/`f128`/`d64`… forms, `<string.h>`'s `str…`/`mem…`,
+//! `<stdlib.h>`'s, `main`, and every identifier of the C standard library (C89–C23), of POSIX
+//! and of glibc, by name or by the families the standards reserve: `names/library.rs`, issue 47:
+//! `printf`, `time`, `read`, `signal`, `pthread_create`, `SIGINT`), the names the file derives
+//! from symbols (`…_INPUTS`, `…_OUTPUTS`, `…_partK`), and a name whose derived names fall in
+//! such a family (`sem`: `sem_INPUTS`, `sem_part1` are POSIX's `sem_…`). `name=` is checked
+//! against it (bad usage, exit 2); a symbol derived from a function's name is renamed
+//! (`@time` → `v_time`).
 //!
 //! # Renaming
 //! A name that is no identifier is sanitised; one that is reserved or taken becomes
@@ -29,6 +34,8 @@
 //! `v_NAME_2`, `v_NAME_3`, … until a candidate is neither reserved nor taken: the renaming never
 //! produces a reserved name (`M_PI` becomes `v_M_PI`, not the macro `M_PI_2`). `tests/c_names.rs`
 //! checks the rules against the system compiler's own headers (`cc -dM -E`).
+
+mod library;
 
 use robovec_ir::Function;
 use std::collections::HashSet;
@@ -413,10 +420,11 @@ fn is_keyword(name: &str) -> bool {
     KEYWORDS.contains(&name)
 }
 
-/// A function of libm, with its `f`/`l` forms.
+/// A function of libm, with its `f`/`l` forms and those of C23's other types (`f128`, `d64`, …:
+/// [`library::MATH_SUFFIXES`]).
 fn is_math_function(name: &str) -> bool {
     MATH_FUNCTIONS.contains(&name)
-        || [name.strip_suffix('f'), name.strip_suffix('l')].into_iter().flatten().any(|b| MATH_FUNCTIONS.contains(&b))
+        || library::MATH_SUFFIXES.iter().filter_map(|s| name.strip_suffix(s)).any(|b| MATH_FUNCTIONS.contains(&b))
 }
 
 /// `p` followed by a lowercase letter: the standard's future names (`is…`, `to…`, `str…`,
@@ -454,28 +462,51 @@ pub fn is_reserved_symbol(name: &str) -> bool {
 }
 
 /// Why `name` may not be a symbol of a generated file (`None`: it may), for the diagnostic of
-/// `name=`.
-pub fn reserved_symbol_reason(name: &str) -> Option<&'static str> {
+/// `name=` (`"declared by <stdio.h> (the C standard library)"`).
+pub fn reserved_symbol_reason(name: &str) -> Option<String> {
+    let why = |s: &str| Some(s.to_string());
     if !is_c_identifier(name) {
-        Some("not a C identifier")
+        why("not a C identifier")
     } else if is_keyword(name) {
-        Some("a C keyword")
+        why("a C keyword")
     } else if name.starts_with('_') || name.contains("__") {
-        Some("reserved by the C standard (a leading `_` or a `__`)")
+        why("reserved by the C standard (a leading `_` or a `__`)")
     } else if name.starts_with("robovec_") || name.starts_with("ROBOVEC_") {
-        Some("reserved for robovec's own helpers and macros")
-    } else if is_math_function(name) || name.strip_suffix("_r").is_some_and(is_math_function) {
-        Some("a function or macro of <math.h>")
+        why("reserved for robovec's own helpers and macros")
+    } else if let Some(r) = library_name_reason(name) {
+        Some(r)
+    } else if is_reserved(name) {
+        why("a macro or type of the C headers the file includes, or a name the generated code uses")
+    } else if ["_INPUTS", "_OUTPUTS"].iter().any(|s| name.ends_with(s)) || part_suffix(name) {
+        why("a name robovec derives from another symbol (`…_INPUTS`, `…_OUTPUTS`, `…_partK`)")
+    } else if ["A", "a"].iter().any(|c| library::in_family(&format!("{name}_{c}"))) {
+        Some(format!(
+            "the start of a family of names the C or POSIX library reserves (`{name}_…`), which the names derived \
+             from it (`{name}_INPUTS`, `{name}_part1`) would be in"
+        ))
+    } else {
+        None
+    }
+}
+
+/// Why `name` is a name of the C or POSIX library (libm's, the C library's of
+/// [`LIBC_FUNCTIONS`], the standard's `str…`/`mem…`/`wcs…`/`is…`/`to…`/`atomic_…`, and
+/// [`library`]'s), or a variant of one (`gmtime_r`, `fopen64`, `qsort_s`:
+/// [`library::VARIANTS`]).
+fn library_name_reason(name: &str) -> Option<String> {
+    if is_math_function(name) || name.strip_suffix("_r").is_some_and(is_math_function) {
+        Some("a function or macro of <math.h>".into())
     } else if [Some(name), name.strip_suffix("_r")].into_iter().flatten().any(|n| LIBC_FUNCTIONS.contains(&n))
         || ["str", "mem", "wcs", "is", "to", "atomic_"].iter().any(|p| lower_after(name, p))
     {
-        Some("a function of the C library or a name the standard reserves for it")
-    } else if is_reserved(name) {
-        Some("a macro or type of the C headers the file includes, or a name the generated code uses")
-    } else if ["_INPUTS", "_OUTPUTS"].iter().any(|s| name.ends_with(s)) || part_suffix(name) {
-        Some("a name robovec derives from another symbol (`…_INPUTS`, `…_OUTPUTS`, `…_partK`)")
+        Some("a function of the C library or a name the standard reserves for it".into())
+    } else if let Some(r) = library::library_reason(name) {
+        Some(r)
     } else {
-        None
+        library::VARIANTS.iter().find_map(|s| {
+            let base = name.strip_suffix(s).filter(|b| is_c_identifier(b))?;
+            library_name_reason(base).map(|r| format!("a variant (`{s}`) of `{base}`, {r}"))
+        })
     }
 }
 
@@ -664,6 +695,281 @@ mod tests {
             assert!(reserved_symbol_reason(bad).is_some(), "{bad}");
         }
         for ok in ["invdyna", "mbs_dirdyna", "model_invdyna", "arm", "f_1", "robot2"] {
+            assert_eq!(reserved_symbol_reason(ok), None, "{ok}");
+        }
+    }
+
+    /// Issue 47: the names of the C standard library (C89–C23, Annex K), of POSIX and of
+    /// glibc, by list and by family, are no symbols; the ABIs' own names stay.
+    #[test]
+    fn library_names_are_reserved_symbols_and_robovecs_are_not() {
+        let library = [
+            // The issue's: <stdio.h>, <time.h>, <signal.h>, <setjmp.h>, <locale.h>, <stdlib.h>.
+            "printf",
+            "time",
+            "clock",
+            "signal",
+            "fopen",
+            "setlocale",
+            "longjmp",
+            "setjmp",
+            "exit",
+            "malloc",
+            "raise",
+            "fclose",
+            "puts",
+            "getchar",
+            "remove",
+            "rename",
+            "tmpfile",
+            "difftime",
+            "mktime",
+            "gmtime",
+            "localeconv",
+            "jmp_buf",
+            "FILE",
+            "BUFSIZ",
+            "gets",
+            // <fenv.h>, <threads.h>, <uchar.h>, <stdatomic.h>, <stdbit.h>, <stdckdint.h>, <wchar.h>, <complex.h>.
+            "feclearexcept",
+            "fegetround",
+            "thrd_create",
+            "mtx_lock",
+            "cnd_wait",
+            "tss_get",
+            "call_once",
+            "once_flag",
+            "mbrtoc16",
+            "c8rtomb",
+            "atomic_load",
+            "memory_order",
+            "memory_order_relaxed",
+            "kill_dependency",
+            "stdc_count_ones",
+            "ckd_add",
+            "wprintf",
+            "btowc",
+            "wmemcpy",
+            "cabs",
+            "csqrtf",
+            "cexp2l",
+            "I",
+            "complex",
+            "and",
+            "xor_eq",
+            // C23 and Annex K, math with other types' suffixes, correctly rounded math.
+            "timegm",
+            "gmtime_r",
+            "memset_explicit",
+            "strfromd",
+            "fopen_s",
+            "printf_s",
+            "abort_handler_s",
+            "sinf128",
+            "cosd64",
+            "f32addf64",
+            "dsqrtl",
+            "cr_sin",
+            "unreachable",
+            // POSIX: <unistd.h>, <fcntl.h>, <signal.h>, <sys/select.h>, <poll.h>, <pthread.h>, ….
+            "read",
+            "write",
+            "open",
+            "close",
+            "kill",
+            "fork",
+            "sleep",
+            "pipe",
+            "dup",
+            "select",
+            "poll",
+            "link",
+            "unlink",
+            "access",
+            "alarm",
+            "chdir",
+            "getpid",
+            "sysconf",
+            "sigaction",
+            "sigemptyset",
+            "nanosleep",
+            "pthread_create",
+            "sem_wait",
+            "mq_open",
+            "sched_yield",
+            "clock_gettime",
+            "timer_create",
+            "mmap",
+            "socket",
+            "bind",
+            "connect",
+            "accept",
+            "listen",
+            "send",
+            "recv",
+            "getaddrinfo",
+            "dlopen",
+            "opendir",
+            "stat",
+            "chmod",
+            "umask",
+            "regcomp",
+            "glob",
+            "iconv",
+            "tcsetattr",
+            "wait",
+            "waitpid",
+            "environ",
+            "optarg",
+            "tzset",
+            "daylight",
+            "posix_spawn",
+            "lio_listio",
+            "getline",
+            "fileno",
+            "popen",
+            // Macros and families: errno, signals, fcntl, stdint, locale, float, inttypes.
+            "EINTR",
+            "E2BIG",
+            "SIGINT",
+            "SIGKILL",
+            "SIG_DFL",
+            "O_RDONLY",
+            "F_GETFL",
+            "S_IRUSR",
+            "SEEK_SET",
+            "LC_ALL",
+            "FE_UPWARD",
+            "FLT_MAX",
+            "DEC64_MANT_DIG",
+            "PRId64",
+            "SCNx32",
+            "INT32_C",
+            "UINT64_MAX",
+            "TIME_UTC",
+            "CLOCK_MONOTONIC",
+            "PTHREAD_MUTEX_INITIALIZER",
+            "WEXITSTATUS",
+            "R_OK",
+            "STDIN_FILENO",
+            "CHAR_BIT",
+            "L_tmpnam",
+            "TMP_MAX_S",
+            "B9600",
+            "VMIN",
+            "int32_t",
+            "pid_t",
+            "DIR",
+            // glibc: its BSD/SVID/GNU extensions and libc.so.6's exports.
+            "usleep",
+            "daemon",
+            "vfork",
+            "sbrk",
+            "asprintf",
+            "pipe2",
+            "dup3",
+            "err",
+            "warn",
+            "ioctl",
+            "flock",
+            "backtrace",
+            "gettext",
+            "mount",
+            "step",
+            "fopen64",
+            "readdir64_r",
+            "isalpha_l",
+            "fgets_unlocked",
+            "qsort_s",
+            "fd_set",
+            "d_fileno",
+            "no_argument",
+            "TIOCSIG",
+            // Reserved by the C standard for the implementation.
+            "_Exit",
+            "__x",
+            "_start",
+        ];
+        for n in library {
+            assert!(is_reserved_symbol(n), "{n} is the library's");
+            let why = reserved_symbol_reason(n).unwrap();
+            assert!(!why.is_empty(), "{n}");
+            // Renamed to a name that is free.
+            let r = free_name(n, &HashSet::new(), is_reserved_symbol);
+            assert!(is_c_identifier(&r) && !is_reserved_symbol(&r), "{n} → {r}");
+        }
+        assert_eq!(free_name("time", &HashSet::new(), is_reserved_symbol), "v_time");
+        assert_eq!(free_name("read", &HashSet::new(), is_reserved_symbol), "v_read");
+        // The header the reason names.
+        for (n, header) in [
+            ("printf", "declared by <stdio.h> (the C standard library)"),
+            ("time", "declared by <time.h> (the C standard library)"),
+            ("longjmp", "declared by <setjmp.h> (the C standard library)"),
+            ("read", "declared by <unistd.h> (POSIX)"),
+            ("signal", "declared by <signal.h> (the C standard library)"),
+            ("setlocale", "declared by <locale.h> (the C standard library)"),
+            ("fopen64", "a variant (`64`) of `fopen`, declared by <stdio.h>"),
+            ("qsort_s", "a variant (`_s`) of `qsort`, a function of the C library"),
+            ("pthread_create", "reserved by POSIX for <pthread.h> (`pthread_…`)"),
+            ("SIGINT", "reserved by the C standard for <signal.h> (`SIG…` then an uppercase letter or a digit)"),
+            ("thrd_create", "reserved by the C standard for <threads.h> (`thrd_…` then a lowercase letter)"),
+        ] {
+            let why = reserved_symbol_reason(n).unwrap();
+            assert!(why.starts_with(header), "{n}: {why}");
+        }
+        // A name whose derived names (`sem_INPUTS`, `sem_part1`) fall in a family.
+        for n in ["sem", "pthread", "SIG", "O", "mq", "LC", "thrd", "atomic"] {
+            assert!(is_reserved_symbol(n), "{n}: its derived names are the library's");
+        }
+        // The ABIs' names, the default prefix, Robotran's symbols, ordinary model names.
+        for ok in [
+            "rnea",
+            "model_rnea",
+            "model_crba",
+            "model_nle",
+            "model_aba",
+            "dirdyna",
+            "invdyna",
+            "fordyna",
+            "mbs_dirdyna",
+            "mbs_invdyna",
+            "mbs_cons_hJ",
+            "mbs_cons_jdqd",
+            "mbs_link",
+            "mbs_link3D",
+            "mbs_extforces",
+            "mbs_sensor",
+            "mbs_gensensor",
+            "cons_hJ",
+            "cons_jdqd",
+            "link3D",
+            "extforces",
+            "sensor_3",
+            "gensensor_2",
+            "f",
+            "f_1",
+            "g",
+            "AB",
+            "ab",
+            "arm",
+            "ur5",
+            "robot2",
+            "sigma",
+            "crba",
+            "nle",
+            "aba",
+            "model",
+            "v_time",
+            "v_read",
+            "v_link",
+            "robot_model",
+            "coman",
+            "walkman",
+            "E",
+            "Sigma",
+            "f32",
+            "fd",
+        ] {
             assert_eq!(reserved_symbol_reason(ok), None, "{ok}");
         }
     }
