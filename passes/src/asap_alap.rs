@@ -9,7 +9,7 @@
 use robovec_ir::analysis::annotate_timing;
 use robovec_ir::Module;
 
-use crate::{LatencyOverride, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{each_function, Before, LatencyOverride, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -41,15 +41,8 @@ impl Pass for AsapAlap {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let lat = cx.latencies_for("asap-alap", &self.lat);
         // About 30 ns per op: the clock is read between functions only.
-        let ticker = cx.ticker();
-        for (k, f) in m.functions.iter_mut().enumerate() {
-            if ticker.check() {
-                let what = format!("before @{} ({k} functions annotated)", f.name);
-                cx.note_stop("asap-alap", &format!("{what}: {}", ticker.reason()));
-                break;
-            }
-            annotate_timing(f, &lat);
-        }
+        let skipped = |f: &robovec_ir::Function, k| format!("before @{} ({k} functions annotated)", f.name);
+        each_function(m, cx, "asap-alap", Before::Clock, skipped, |f, _| Step::Done(annotate_timing(f, &lat)));
         Ok(())
     }
 }

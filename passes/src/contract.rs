@@ -24,7 +24,7 @@
 
 use robovec_ir::{BinOp, Def, Function, Intrinsic, Module, Operand, Value};
 
-use crate::{Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{each_function, Before, Params, Pass, PassContext, PassError, PassInfo, Step, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -133,19 +133,10 @@ impl Pass for Contract {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let mut parts = Vec::new();
-        let ticker = cx.ticker();
-        for f in &mut m.functions {
-            if ticker.stopped() {
-                cx.note_stop("contract", &format!("before @{}: {}", f.name, ticker.reason()));
-                break;
-            }
-            let c = contract_within(f, &ticker);
-            if ticker.stopped() {
-                let what = format!("in @{} ({} multiplies fused, the later ones kept)", f.name, c.muls_removed);
-                cx.note_stop("contract", &format!("{what}: {}", ticker.reason()));
-            }
-            parts.push(format!(
+        let skipped = |f: &robovec_ir::Function, _| format!("before @{}", f.name);
+        let parts = each_function(m, cx, "contract", Before::Ticked, skipped, |f, ticker| {
+            let c = contract_within(f, ticker);
+            let part = format!(
                 "@{} {} fused (fma {}, fms {}, fnma {}), {} mul removed",
                 f.name,
                 c.fma + c.fms + c.fnma,
@@ -153,8 +144,13 @@ impl Pass for Contract {
                 c.fms,
                 c.fnma,
                 c.muls_removed
-            ));
-        }
+            );
+            if ticker.stopped() {
+                let what = format!("in @{} ({} multiplies fused, the later ones kept)", f.name, c.muls_removed);
+                return Step::Stopped { what, kept: Some(part) };
+            }
+            Step::Done(part)
+        });
         cx.remark("contract", m, format!("contract: {}", parts.join("; ")));
         Ok(())
     }

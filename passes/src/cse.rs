@@ -6,7 +6,7 @@ use robovec_ir::Module;
 
 pub use robovec_ir::transform::cse::{cse_function, cse_within};
 
-use crate::{Params, Pass, PassContext, PassError, PassInfo};
+use crate::{each_function, Before, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -27,21 +27,17 @@ impl Pass for Cse {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let ticker = cx.ticker();
-        for f in &mut m.functions {
-            if ticker.stopped() {
-                cx.note_stop("cse", &format!("before @{}: {}", f.name, ticker.reason()));
-                break;
-            }
+        let skipped = |f: &robovec_ir::Function, _| format!("before @{}", f.name);
+        each_function(m, cx, "cse", Before::Ticked, skipped, |f, ticker| {
             let (seen, n) = (ticker.ticks(), f.body.len() as u64);
-            cse_within(f, &ticker);
+            cse_within(f, ticker);
             if ticker.stopped() {
                 let done = ticker.ticks().saturating_sub(seen + 1);
                 let what = format!("in @{} after {done} of {n} values (merges found kept)", f.name);
-                cx.note_stop("cse", &format!("{what}: {}", ticker.reason()));
-                break;
+                return Step::Stopped { what, kept: None };
             }
-        }
+            Step::Done(())
+        });
         Ok(())
     }
 }

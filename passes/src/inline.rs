@@ -23,7 +23,7 @@ use robovec_ir::{Def, Function, Module, Operand, Phase, Value};
 
 use crate::params::ParamKind;
 use crate::tree_height::cluster::{Class, Clusters};
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{each_function, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -77,19 +77,19 @@ impl Pass for Inline {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let mut parts = Vec::new();
-        let ticker = cx.ticker();
-        for f in &mut m.functions {
-            let Some((g, s)) = inline_within(f, self.max_uses, self.max_size, &ticker) else {
-                cx.note_stop("inline", &format!("in @{} (kept as it was): {}", f.name, ticker.reason()));
-                break;
+        // The work ticks per value; a stop before a function is found inside it (the first
+        // tick says stop), so that function is named as kept.
+        let skipped = |f: &Function, _| format!("in @{} (kept as it was)", f.name);
+        let parts = each_function(m, cx, "inline", Before::Ticked, skipped, |f, ticker| {
+            let Some((g, s)) = inline_within(f, self.max_uses, self.max_size, ticker) else {
+                return Step::Stopped { what: format!("in @{} (kept as it was)", f.name), kept: None };
             };
             *f = g;
-            parts.push(format!(
+            Step::Done(format!(
                 "@{}: {} values copied into {} uses, ops {} -> {} ({} ops added)",
                 f.name, s.values, s.copies, s.ops.0, s.ops.1, s.added
-            ));
-        }
+            ))
+        });
         cx.remark(
             "inline",
             m,

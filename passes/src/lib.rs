@@ -14,6 +14,7 @@ pub mod contract;
 pub mod cse;
 pub mod dce;
 pub mod depth_bound;
+pub mod each;
 pub mod eqsat;
 pub mod inline;
 pub mod manager;
@@ -43,6 +44,7 @@ use robovec_ir::{Module, Phase, Span};
 use robovec_machine::target::Target;
 
 pub use artifact::{unit_path, Artifact, ArtifactFile, GeneratedCode, Merge, Produced, ReportEntry};
+pub use each::{each_function, Before, Step};
 pub use manager::{DumpSink, Element, Instrumentation, PassManager, PassRecord, PrintSelector};
 pub use params::{LatencyOverride, Member, ParamInfo, ParamKind, Params};
 pub use pipeline::{parse_pipeline, PassSpec};

@@ -63,7 +63,7 @@ use robovec_ir::{BinOp, Def, Function, Module, Operand, Span, Value};
 mod pairs;
 
 use crate::params::ParamKind;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{each_function, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -288,20 +288,15 @@ impl Pass for Rotate3m {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let lat = cx.latencies_for("rotate-3m", &self.given);
-        let ticker = cx.ticker();
-        let mut parts = Vec::new();
-        for (k, f) in m.functions.iter_mut().enumerate() {
-            // `-time-limit`: one linear sweep per function, so the clock is read between them.
-            if ticker.check() {
-                cx.note_stop("rotate-3m", &format!("before @{} ({k} functions done): {}", f.name, ticker.reason()));
-                break;
-            }
+        // `-time-limit`: one linear sweep per function, so the clock is read between them.
+        let skipped = |f: &Function, k| format!("before @{} ({k} functions done)", f.name);
+        let parts = each_function(m, cx, "rotate-3m", Before::Clock, skipped, |f, _| {
             let r = rotate_function(f, &lat, self.stop);
-            parts.push(format!(
+            Step::Done(format!(
                 "@{} {} of {} rotated pairs in three multiplies ({} joint sums added)",
                 f.name, r.rewritten, r.pairs, r.joint_sums
-            ));
-        }
+            ))
+        });
         cx.remark("rotate-3m", m, format!("rotate-3m: {}", parts.join("; ")));
         Ok(())
     }

@@ -43,7 +43,7 @@ pub mod pressure;
 use robovec_ir::{Def, Function, Module, Operand, Value};
 
 use crate::params::ParamKind;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{each_function, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step, Ticker};
 use pressure::{is_result, pressure_of_order, Pressure};
 
 /// Registry entry.
@@ -99,27 +99,23 @@ impl Pass for ScheduleCpu {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let mut parts = Vec::new();
         // The clock is read between functions and between the orders `best` compares (each
         // O(n log n)); a function not started keeps its order.
-        let ticker = cx.ticker();
-        for f in &mut m.functions {
-            if ticker.check() {
-                cx.note_stop("schedule-cpu", &format!("before @{} (kept in its order): {}", f.name, ticker.reason()));
-                break;
-            }
+        let skipped = |f: &Function, _| format!("before @{} (kept in its order)", f.name);
+        let parts = each_function(m, cx, "schedule-cpu", Before::Clock, skipped, |f, ticker| {
             let before = pressure_of_order(f, &f.body, self.registers);
-            let (order, which) = schedule_within(f, self.order, self.registers, &ticker);
+            let (order, which) = schedule_within(f, self.order, self.registers, ticker);
             let after = pressure_of_order(f, &order, self.registers);
-            parts.push(format!(
+            let part = format!(
                 "@{} max-live {} -> {}, excess over {} registers {} -> {} ({which})",
                 f.name, before.max_live, after.max_live, self.registers, before.excess, after.excess
-            ));
+            );
             f.body = order;
             // Renumber into the canonical order (inputs, then body) the text reader produces.
             f.retain(|_, _| true);
             f.clear_timing();
-        }
+            Step::Done(part)
+        });
         cx.remark("schedule-cpu", m, format!("schedule-cpu: {}", parts.join("; ")));
         Ok(())
     }
