@@ -1,4 +1,4 @@
-//! What the lowering ([`crate::lower`]) and the executor ([`crate::exec`]) reject — and so
+//! What the lowering ([`crate::program`]) and the executor ([`crate::exec`]) reject — and so
 //! `sim`, which executes what it lowers: one [`MachineError`] naming when, where and which
 //! value. `sim` re-exports these types as `SimError` and `SimErrorKind`.
 
