@@ -41,8 +41,8 @@ impl Pass for AsapAlap {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let lat = cx.latencies_for("asap-alap", &self.lat);
         // About 30 ns per op: the clock is read between functions only.
-        let skipped = |f: &robovec_ir::Function, k| format!("before @{} ({k} functions annotated)", f.name);
-        each_function(m, cx, "asap-alap", Before::Clock, skipped, |f, _| Step::Done(annotate_timing(f, &lat)));
+        let skipped = |f: &robovec_ir::Function, k| Some(format!("before @{} ({k} functions annotated)", f.name));
+        each_function(m, cx, "asap-alap", Before::Clock, skipped, |f, _, _| Step::Done(annotate_timing(f, &lat)));
         Ok(())
     }
 }

@@ -133,8 +133,8 @@ impl Pass for Contract {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let skipped = |f: &robovec_ir::Function, _| format!("before @{}", f.name);
-        let parts = each_function(m, cx, "contract", Before::Ticked, skipped, |f, ticker| {
+        let skipped = |f: &robovec_ir::Function, _| Some(format!("before @{}", f.name));
+        let parts = each_function(m, cx, "contract", Before::Ticked, skipped, |f, _, ticker| {
             let c = contract_within(f, ticker);
             let part = format!(
                 "@{} {} fused (fma {}, fms {}, fnma {}), {} mul removed",

@@ -27,8 +27,8 @@ impl Pass for Cse {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let skipped = |f: &robovec_ir::Function, _| format!("before @{}", f.name);
-        each_function(m, cx, "cse", Before::Ticked, skipped, |f, ticker| {
+        let skipped = |f: &robovec_ir::Function, _| Some(format!("before @{}", f.name));
+        each_function(m, cx, "cse", Before::Ticked, skipped, |f, _, ticker| {
             let (seen, n) = (ticker.ticks(), f.body.len() as u64);
             cse_within(f, ticker);
             if ticker.stopped() {

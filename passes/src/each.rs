@@ -33,18 +33,20 @@ pub enum Step<T> {
     },
 }
 
-/// Runs `work` on every function of `m` in order with the pass's ticker ([`PassContext::ticker`])
-/// and returns the results of the functions done, in order. Before each function the limit is
-/// read as `before` says; when it is reached the loop ends with the note `{pass} stopped
-/// {skipped(f, k)}: {reason}` (`skipped` names the function not started and the `k` done: `before
-/// @g (1 functions done)`); a [`Step::Stopped`] ends it with `{pass} stopped {what}: {reason}`.
+/// Runs `work` on every function of `m` in order (with its index `k` and the pass's ticker,
+/// [`PassContext::ticker`]) and returns the results of the functions done, in order. Before each
+/// function the limit is read as `before` says; when it is reached the loop ends with the note
+/// `{pass} stopped {skipped(f, k)}: {reason}` (`skipped` names the function not started and the
+/// `k` done: `before @g (1 functions done)`; `None`: the loop ends without a note, the stop
+/// inside the previous function having said it); a [`Step::Stopped`] ends it with
+/// `{pass} stopped {what}: {reason}`.
 pub fn each_function<T>(
     m: &mut Module,
     cx: &mut PassContext,
     pass: &str,
     before: Before,
-    skipped: impl Fn(&Function, usize) -> String,
-    mut work: impl FnMut(&mut Function, &Ticker) -> Step<T>,
+    skipped: impl Fn(&Function, usize) -> Option<String>,
+    mut work: impl FnMut(&mut Function, usize, &Ticker) -> Step<T>,
 ) -> Vec<T> {
     let ticker = cx.ticker();
     let mut done = Vec::new();
@@ -54,10 +56,12 @@ pub fn each_function<T>(
             Before::Clock => ticker.check(),
         };
         if reached {
-            cx.note_stop(pass, &format!("{}: {}", skipped(f, k), ticker.reason()));
+            if let Some(what) = skipped(f, k) {
+                cx.note_stop(pass, &format!("{what}: {}", ticker.reason()));
+            }
             break;
         }
-        match work(f, &ticker) {
+        match work(f, k, &ticker) {
             Step::Done(t) => done.push(t),
             Step::Stopped { what, kept } => {
                 done.extend(kept);
@@ -89,7 +93,7 @@ mod tests {
             "p",
             Before::Ticked,
             |_, _| unreachable!(),
-            |f, _| Step::Done(f.name.clone()),
+            |f, _, _| Step::Done(f.name.clone()),
         );
         assert_eq!(names, ["f", "g"]);
         assert!(cx.stopped().is_empty());
@@ -104,8 +108,8 @@ mod tests {
             &mut cx,
             "p",
             Before::Ticked,
-            |f, k| format!("before @{} ({k} done)", f.name),
-            |f, t| {
+            |f, k| Some(format!("before @{} ({k} done)", f.name)),
+            |f, _, t| {
                 assert!(t.tick(), "the budget of one tick stops at once");
                 Step::Stopped { what: format!("in @{} (half kept)", f.name), kept: Some(1) }
             },
@@ -123,11 +127,22 @@ mod tests {
             &mut cx,
             "p",
             Before::Clock,
-            |f, k| format!("before @{} ({k} done)", f.name),
-            |f, _| Step::Done(f.name.clone()),
+            |f, k| Some(format!("before @{} ({k} done)", f.name)),
+            |f, _, _| Step::Done(f.name.clone()),
         );
         // `check` counts a tick: the first passes, the second reaches the budget of 2.
         assert_eq!(done, ["f"]);
         assert_eq!(cx.stopped(), ["p stopped before @g (1 done): tick budget of 2 steps reached"]);
+        // Without a note for the function not started: the stop is the last one's to say.
+        let mut cx = PassContext { tick_budget: Some(2), ..PassContext::default() };
+        let done = each_function(
+            &mut module(),
+            &mut cx,
+            "p",
+            Before::Clock,
+            |_, _| None,
+            |f, _, _| Step::Done(f.name.clone()),
+        );
+        assert_eq!((done, cx.stopped()), (vec!["f".to_string()], Vec::<String>::new()));
     }
 }

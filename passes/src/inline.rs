@@ -79,8 +79,8 @@ impl Pass for Inline {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         // The work ticks per value; a stop before a function is found inside it (the first
         // tick says stop), so that function is named as kept.
-        let skipped = |f: &Function, _| format!("in @{} (kept as it was)", f.name);
-        let parts = each_function(m, cx, "inline", Before::Ticked, skipped, |f, ticker| {
+        let skipped = |f: &Function, _| Some(format!("in @{} (kept as it was)", f.name));
+        let parts = each_function(m, cx, "inline", Before::Ticked, skipped, |f, _, ticker| {
             let Some((g, s)) = inline_within(f, self.max_uses, self.max_size, ticker) else {
                 return Step::Stopped { what: format!("in @{} (kept as it was)", f.name), kept: None };
             };

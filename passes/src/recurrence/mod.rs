@@ -56,7 +56,7 @@ use robovec_ir::{Function, Module};
 
 use crate::params::ParamKind;
 use crate::tree_height::{rewrite_within, Shape};
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{each_function, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step, Ticker};
 use round::round;
 
 /// Registry entry.
@@ -185,27 +185,33 @@ impl Pass for Recurrence {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let opts = Recurrence { lat: cx.latencies_for("recurrence", &self.given), ..self.clone() };
-        let ticker = cx.ticker();
-        let mut parts = Vec::new();
-        for f in &mut m.functions {
-            if ticker.stopped() {
-                break;
-            }
-            let base = match cx.atomised_ops.get(&f.name) {
-                Some(&a) if opts.budget_of_atomised => a.max(f.op_counts().total),
-                _ => f.op_counts().total,
-            };
-            let (g, s, stopped) = restructure_within(f, &opts, base, &ticker);
-            *f = g;
-            if stopped {
-                let why = ticker.reason();
-                cx.note_stop("recurrence", &format!("in @{} after {} rounds (kept): {why}", f.name, s.rounds));
-            }
-            parts.push(format!(
-                "@{}: {} rounds, ops {} -> {}, balanced critical path {} -> {} cycles",
-                f.name, s.rounds, s.ops.0, s.ops.1, s.cp.0, s.cp.1
-            ));
-        }
+        let atomised = cx.atomised_ops.clone();
+        let parts = each_function(
+            m,
+            cx,
+            "recurrence",
+            Before::Ticked,
+            |_, _| None,
+            |f, _, ticker| {
+                let base = match atomised.get(&f.name) {
+                    Some(&a) if opts.budget_of_atomised => a.max(f.op_counts().total),
+                    _ => f.op_counts().total,
+                };
+                let (g, s, stopped) = restructure_within(f, &opts, base, ticker);
+                *f = g;
+                let part = format!(
+                    "@{}: {} rounds, ops {} -> {}, balanced critical path {} -> {} cycles",
+                    f.name, s.rounds, s.ops.0, s.ops.1, s.cp.0, s.cp.1
+                );
+                match stopped {
+                    true => Step::Stopped {
+                        what: format!("in @{} after {} rounds (kept)", f.name, s.rounds),
+                        kept: Some(part),
+                    },
+                    false => Step::Done(part),
+                }
+            },
+        );
         cx.remark("recurrence", m, format!("recurrence: {}", parts.join("; ")));
         Ok(())
     }

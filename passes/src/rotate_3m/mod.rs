@@ -289,8 +289,8 @@ impl Pass for Rotate3m {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let lat = cx.latencies_for("rotate-3m", &self.given);
         // `-time-limit`: one linear sweep per function, so the clock is read between them.
-        let skipped = |f: &Function, k| format!("before @{} ({k} functions done)", f.name);
-        let parts = each_function(m, cx, "rotate-3m", Before::Clock, skipped, |f, _| {
+        let skipped = |f: &Function, k| Some(format!("before @{} ({k} functions done)", f.name));
+        let parts = each_function(m, cx, "rotate-3m", Before::Clock, skipped, |f, _, _| {
             let r = rotate_function(f, &lat, self.stop);
             Step::Done(format!(
                 "@{} {} of {} rotated pairs in three multiplies ({} joint sums added)",

@@ -101,8 +101,8 @@ impl Pass for ScheduleCpu {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         // The clock is read between functions and between the orders `best` compares (each
         // O(n log n)); a function not started keeps its order.
-        let skipped = |f: &Function, _| format!("before @{} (kept in its order)", f.name);
-        let parts = each_function(m, cx, "schedule-cpu", Before::Clock, skipped, |f, ticker| {
+        let skipped = |f: &Function, _| Some(format!("before @{} (kept in its order)", f.name));
+        let parts = each_function(m, cx, "schedule-cpu", Before::Clock, skipped, |f, _, ticker| {
             let before = pressure_of_order(f, &f.body, self.registers);
             let (order, which) = schedule_within(f, self.order, self.registers, ticker);
             let after = pressure_of_order(f, &order, self.registers);

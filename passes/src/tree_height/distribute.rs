@@ -24,7 +24,7 @@ use robovec_ir::{BinOp, Def, Function, Module, Operand, Phase, Value};
 use super::cluster::{Class, Clusters};
 use super::{rewrite_within, Shape};
 use crate::params::ParamKind;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{each_function, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step, Ticker};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -89,21 +89,18 @@ impl Pass for Distribute {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let mut parts = Vec::new();
         let opts = Distribute { lat: cx.latencies_for("distribute", &self.given), ..self.clone() };
-        let ticker = cx.ticker();
-        for f in &mut m.functions {
-            if ticker.stopped() {
-                break;
-            }
-            let ops0 = f.op_counts().total;
-            let (g, s, stopped) = distribute_within(f, &opts, &ticker);
-            *f = g;
-            if stopped {
-                let why = ticker.reason();
-                cx.note_stop("distribute", &format!("in @{} after {} rounds (kept): {why}", f.name, s.rounds));
-            }
-            parts.push(format!(
+        let parts = each_function(
+            m,
+            cx,
+            "distribute",
+            Before::Ticked,
+            |_, _| None,
+            |f, _, ticker| {
+                let ops0 = f.op_counts().total;
+                let (g, s, stopped) = distribute_within(f, &opts, ticker);
+                *f = g;
+                let part = format!(
                 "@{}: {} products distributed in {} rounds, ops {ops0} -> {}, balanced critical path {} -> {} cycles",
                 f.name,
                 s.products,
@@ -111,8 +108,16 @@ impl Pass for Distribute {
                 f.op_counts().total,
                 s.cp.0,
                 s.cp.1
-            ));
-        }
+            );
+                match stopped {
+                    true => Step::Stopped {
+                        what: format!("in @{} after {} rounds (kept)", f.name, s.rounds),
+                        kept: Some(part),
+                    },
+                    false => Step::Done(part),
+                }
+            },
+        );
         cx.remark("distribute", m, format!("distribute: {}", parts.join("; ")));
         Ok(())
     }

@@ -23,7 +23,7 @@
 use robovec_ir::Module;
 
 use super::{rewrite_within, summary, Shape};
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{each_function, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 /// The latency parameters the cluster rewrites take (cycles; SPEC §1 defaults).
 pub const LATENCY_PARAMS: &[ParamInfo] = crate::params::LATENCY_PARAMS;
@@ -61,19 +61,27 @@ impl Pass for ClusterRewrite {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let mut outcomes = Vec::new();
         let lat = cx.latencies_for(self.name, &self.lat);
-        let ticker = cx.ticker();
         let n = m.functions.len();
-        for (k, f) in m.functions.iter_mut().enumerate() {
-            let Some((g, o)) = rewrite_within(f, self.shape, &lat, &ticker) else {
-                let what = format!("in @{} ({k} of {n} functions rewritten; @{} kept as it was)", f.name, f.name);
-                cx.note_stop(self.name, &format!("{what}: {}", ticker.reason()));
-                break;
-            };
-            *f = g;
-            outcomes.push((f.name.clone(), o));
-        }
+        // The rewrite ticks per op: a limit reached before a function is found inside it (its
+        // first tick says stop), so that function is named as kept.
+        let kept = move |f: &robovec_ir::Function, k| {
+            format!("in @{} ({k} of {n} functions rewritten; @{} kept as it was)", f.name, f.name)
+        };
+        let outcomes = each_function(
+            m,
+            cx,
+            self.name,
+            Before::Ticked,
+            |f, k| Some(kept(f, k)),
+            |f, k, ticker| {
+                let Some((g, o)) = rewrite_within(f, self.shape, &lat, ticker) else {
+                    return Step::Stopped { what: kept(f, k), kept: None };
+                };
+                *f = g;
+                Step::Done((f.name.clone(), o))
+            },
+        );
         cx.remark(self.name, m, summary(self.name, &outcomes));
         Ok(())
     }
