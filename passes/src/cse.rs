@@ -117,6 +117,43 @@ pub fn cse_within(f: &mut Function, ticker: &Ticker) -> usize {
     n
 }
 
+/// How many ops (binary ops; merged `sin`/`cos` are not ops) [`cse_function`] would drop from
+/// `f`, without changing `f`: what the URDF generator needs to compare two formulations by
+/// their ops after `atomise,cse` (issue 47: no copy to rewrite and free). `None` when `ticker`
+/// (one tick per value) says stop. Cost: O(values) expected (hashing), no rebuild.
+pub fn cse_drops_until(f: &Function, ticker: &Ticker) -> Option<u64> {
+    let mut repr: Vec<Value> = (0..f.values.len()).map(|i| Value::with_number(i as u32)).collect();
+    let mut table: HashMap<OpKey, Value> = HashMap::with_capacity(f.body.len());
+    let mut drops = 0;
+    for &v in &f.body {
+        if ticker.tick() {
+            return None;
+        }
+        // The definition as `cse_within` sees it: operands read through the merges so far.
+        let m = |o: &Operand| match o {
+            Operand::Value(x) => Operand::Value(repr[x.index()]),
+            c => *c,
+        };
+        let def = match &f.value(v).def {
+            Def::Binary(op, a, b) => Def::Binary(*op, m(a), m(b)),
+            Def::Trig(t, a) => Def::Trig(*t, repr[a.index()]),
+            _ => continue,
+        };
+        if let Some(k) = op_key(&def) {
+            match table.get(&k) {
+                Some(&first) => {
+                    repr[v.index()] = first;
+                    drops += u64::from(matches!(def, Def::Binary(..)));
+                }
+                None => {
+                    table.insert(k, v);
+                }
+            }
+        }
+    }
+    Some(drops)
+}
+
 impl Pass for Cse {
     fn name(&self) -> &'static str {
         "cse"
@@ -187,5 +224,21 @@ mod tests {
              %c1 = call @sqrt(%x)  %c2 = call @sqrt(%x) \
              output a = %d1  output b = %d2  output c = %z1  output d = %z2  output e = %c1  output f = %c2 }");
         assert_eq!(m.functions[0].body.len(), 6, "nothing merges");
+    }
+
+    /// `cse_drops_until` counts what `cse_function` drops (merged trig variables are no op) and
+    /// stops at a tick budget.
+    #[test]
+    fn the_drop_count_is_what_cse_drops() {
+        let src = "func @f { phase atomised input %x input %y input %z              %c1 = cos %x  %c2 = cos %x  %p1 = mul %c1, %y  %p2 = mul %y, %c2  %s1 = add %p1, %z              %s2 = add %z, %p2  %d = sub %s1, %s2  %e = sub %s2, %s1              output a = %d  output b = %e }";
+        let f = &parse(src).unwrap().functions[0];
+        let drops = cse_drops_until(f, &Ticker::default()).expect("no limit");
+        let mut g = f.clone();
+        let dropped = cse_function(&mut g);
+        // s2 merged into s1, `e` is `d`.
+        assert_eq!(dropped, 4, "c2, p2, s2, e");
+        assert_eq!(drops, 3, "p2, s2 and e are ops; c2 is a trig variable");
+        assert_eq!(f.op_counts().total - drops, g.op_counts().total);
+        assert_eq!(cse_drops_until(f, &Ticker::new(None, Some(4))), None, "the 4th of 8 values stops it");
     }
 }
