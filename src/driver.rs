@@ -47,14 +47,8 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
 /// invdyna, dirdyna, fordyna`, as `-function` against a loaded module); [`Failure::Input`] with codespan
 /// diagnostics naming file, line and column (the time limit reached while loading among them).
 pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile), Failure> {
-    let (bytes, name) = if input == "-" {
-        let mut b = Vec::new();
-        std::io::stdin().read_to_end(&mut b).map_err(|e| Failure::Input(format!("error: cannot read stdin: {e}\n")))?;
-        (b, "<stdin>".to_string())
-    } else {
-        let b = std::fs::read(input).map_err(|e| Failure::Input(format!("error: cannot read `{input}`: {e}\n")))?;
-        (b, input.to_string())
-    };
+    let name = if input == "-" { "<stdin>".to_string() } else { input.to_string() };
+    let bytes = read_input(input, opts.deadline.as_ref())?;
     let Some(fe) = robovec_front::front_end_for(input) else {
         return Err(Failure::Usage(format!(
             "error: cannot tell the language of `{input}`: expected a {} file (or - for IR on stdin)\n",
@@ -94,11 +88,126 @@ pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile
             ]);
         return Err(Failure::Input(src.render(&[d])));
     }
-    if let Err(errs) = verifier::verify(module) {
-        let diags: Vec<_> = errs.iter().map(|e| e.to_diagnostic((), "on input")).collect();
-        return Err(Failure::Input(src.render(&diags)));
+    // Under `-time-limit` the verification stops at the limit too: a generated function may
+    // have millions of outputs (issue 47: 25 million for a 5,000-branch star's `dirdyna`, 2.7 s
+    // to verify).
+    let ticker = robovec_passes::Ticker::new(opts.deadline, None);
+    match verifier::verify_until(module, &mut || ticker.tick()) {
+        Some(Ok(())) => {}
+        Some(Err(errs)) => {
+            let diags: Vec<_> = errs.iter().map(|e| e.to_diagnostic((), "on input")).collect();
+            return Err(Failure::Input(src.render(&diags)));
+        }
+        None => {
+            return Err(Failure::Input(format!(
+                "error: {} while verifying the input\n  = note: {LOADING_NOTE}\n",
+                ticker.reason()
+            )))
+        }
     }
     Ok((loaded, src))
+}
+
+/// The most bytes read from one input, stdin included (1 GiB): far above any real input (the
+/// largest Robotran file of the corpus is a few MB, the scale benchmarks write 100 MB), and
+/// what a run can hold (memory is about 11× the input), so that `robovec-opt - < /dev/zero`
+/// ends with an error instead of reading without end (issue 47).
+pub const INPUT_BOUND: u64 = 1 << 30;
+
+/// The note of a run stopped by `-time-limit` while loading.
+const LOADING_NOTE: &str = "-time-limit covers loading too: nothing is written without a complete module";
+
+/// Why [`read_bounded`] gave up.
+enum ReadStop {
+    /// The input holds more than [`INPUT_BOUND`] bytes (or its size says so).
+    TooLarge,
+    /// The reader was told to stop (its caller's time limit was reached).
+    Abandoned,
+    /// The system's error.
+    Io(std::io::Error),
+}
+
+/// Reads `input` (`-`: stdin) whole, at most `bound` bytes ([`INPUT_BOUND`]), in chunks of
+/// 1 MiB, and gives up between two chunks once `abandoned` is set.
+fn read_bounded(input: &str, bound: u64, abandoned: &std::sync::atomic::AtomicBool) -> Result<Vec<u8>, ReadStop> {
+    let (mut reader, size): (Box<dyn Read>, u64) = if input == "-" {
+        (Box::new(std::io::stdin()), 0)
+    } else {
+        let file = std::fs::File::open(input).map_err(ReadStop::Io)?;
+        // A regular file's length (0 for devices and pipes, which may hold anything).
+        let size = file.metadata().map_or(0, |m| if m.is_file() { m.len() } else { 0 });
+        (Box::new(file), size)
+    };
+    if size > bound {
+        return Err(ReadStop::TooLarge);
+    }
+    let mut bytes = Vec::with_capacity(size as usize);
+    let mut chunk = vec![0u8; 1 << 20];
+    loop {
+        if abandoned.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(ReadStop::Abandoned);
+        }
+        let n = match reader.read(&mut chunk) {
+            Ok(0) => return Ok(bytes),
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(ReadStop::Io(e)),
+        };
+        if (bytes.len() + n) as u64 > bound {
+            return Err(ReadStop::TooLarge);
+        }
+        bytes.extend_from_slice(&chunk[..n]);
+    }
+}
+
+/// The bytes of `input` (`-`: stdin), at most [`INPUT_BOUND`] of them (issue 47:
+/// `robovec-opt - -time-limit=1 < /dev/zero` read 4.2 GB in 8 s and went on). A regular file
+/// larger than the bound is refused before it is read; a smaller one is read whole (a
+/// fraction of a second for the largest: the front end's clock then takes over). Stdin,
+/// pipes, FIFOs and devices, which may give anything or block, are read up to the bound and,
+/// under a deadline, on a thread of their own, which the run leaves behind (told to stop at
+/// its next chunk) once `deadline` is reached.
+///
+/// # Errors
+/// [`Failure::Input`] (exit 1): the file cannot be read, it is larger than the bound
+/// (`error: <stdin> is larger than 1 GiB, the most robovec reads from one input`), or the
+/// deadline was reached first (`error: time limit of 1 s reached while reading <stdin>`).
+fn read_input(input: &str, deadline: Option<&robovec_passes::Deadline>) -> Result<Vec<u8>, Failure> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::{mpsc, Arc};
+    let shown = if input == "-" { "<stdin>".to_string() } else { format!("`{input}`") };
+    let failure = |stop: ReadStop| match stop {
+        ReadStop::TooLarge => Failure::Input(format!(
+            "error: {shown} is larger than 1 GiB ({INPUT_BOUND} bytes), the most robovec reads from one input\n  \
+             = note: the largest Robotran and URDF inputs are tens of megabytes\n"
+        )),
+        ReadStop::Abandoned => unreachable!("only a run past its deadline abandons its reader"),
+        ReadStop::Io(e) if input == "-" => Failure::Input(format!("error: cannot read stdin: {e}\n")),
+        ReadStop::Io(e) => Failure::Input(format!("error: cannot read `{input}`: {e}\n")),
+    };
+    let regular = input != "-" && std::fs::metadata(input).is_ok_and(|m| m.is_file());
+    let Some(deadline) = deadline.copied().filter(|_| !regular) else {
+        return read_bounded(input, INPUT_BOUND, &AtomicBool::new(false)).map_err(failure);
+    };
+    let abandoned = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = mpsc::channel();
+    let (path, flag) = (input.to_string(), Arc::clone(&abandoned));
+    let reader = std::thread::Builder::new().name("robovec-read".into()).spawn(move || {
+        let _ = tx.send(read_bounded(&path, INPUT_BOUND, &flag));
+    });
+    if reader.is_err() {
+        return read_bounded(input, INPUT_BOUND, &abandoned).map_err(failure);
+    }
+    match rx.recv_timeout(deadline.time_left()) {
+        Ok(read) => read.map_err(failure),
+        Err(_) => {
+            abandoned.store(true, Ordering::Relaxed);
+            Err(Failure::Input(format!(
+                "error: {} while reading {shown}\n  = note: {LOADING_NOTE}\n",
+                deadline.reason()
+            )))
+        }
+    }
 }
 
 /// Writes one file under the output policy ([`crate::output`]) on its own. Inside a run, stage
@@ -277,7 +386,7 @@ pub fn run_with(
     }
     let progress = crate::progress_bars::progress_for(terminal.stderr, opts.quiet);
     let session = run_passes(opts, pm, target, progress, deadline, module, &src, &mut out, stderr)?;
-    write_outputs(opts, &session, eval_inputs.as_ref(), terminal, out, stdout, stderr)
+    write_outputs(opts, &session, eval_inputs.as_ref(), &src, terminal, out, stdout, stderr)
 }
 
 /// Runs `-pareto` (before the pipeline, on the input), the pipeline's session with its dumps
@@ -377,6 +486,7 @@ fn eval_json(
     opts: &Options,
     module: &Module,
     given: &crate::eval::EvalInputs,
+    src: &SourceFile,
     stderr: &mut dyn Write,
 ) -> Result<String, Failure> {
     let f = select(module, &opts.function, "-eval")?;
@@ -409,6 +519,11 @@ fn eval_json(
         .map_err(stderr_failure)?;
     }
     let r = crate::eval::evaluate_with(f, &given.given, &given.defaults, opts.eval_f32);
+    // An output that is not finite prints as `null`: say where the values went wrong (issue 47:
+    // a zero mass given for a link made every `qdd` null without a word).
+    if let Some(n) = &r.non_finite {
+        write!(stderr, "{}", n.warning(&f.name, Some((&src.name, &src.text)))).map_err(stderr_failure)?;
+    }
     for c in &r.callback_standins {
         writeln!(
             stderr,
@@ -457,6 +572,7 @@ fn write_outputs(
     opts: &Options,
     session: &Session,
     eval_inputs: Option<&crate::eval::EvalInputs>,
+    src: &SourceFile,
     terminal: Terminal,
     mut out: OutputSet,
     stdout: &mut dyn Write,
@@ -469,7 +585,7 @@ fn write_outputs(
     let figs =
         if opts.stats || reporting { summary::figures(module, cx, opts.function.as_deref()) } else { Vec::new() };
     let report = reporting.then(|| report_json(opts, session, &figs)).transpose()?;
-    let eval = eval_inputs.map(|given| eval_json(opts, module, given, stderr)).transpose()?;
+    let eval = eval_inputs.map(|given| eval_json(opts, module, given, src, stderr)).transpose()?;
     if opts.stats {
         write!(stderr, "{}", summary::stats_text(&figs, cx, opts.function.as_deref())).map_err(stderr_failure)?;
     }
@@ -561,4 +677,27 @@ fn write_outputs(
         };
         Failure::Output(format!("error: cannot write to stdout: {e}{already}\n"))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::AtomicBool;
+
+    use super::{read_bounded, ReadStop};
+
+    /// Issue 47: a device that never ends (`/dev/zero`) stops at the bound, a regular file is
+    /// refused by its size before any read, an abandoned reader stops at its next chunk.
+    #[cfg(unix)]
+    #[test]
+    fn reading_stops_at_the_bound_and_when_abandoned() {
+        let go = AtomicBool::new(false);
+        assert!(matches!(read_bounded("/dev/zero", 3 << 20, &go), Err(ReadStop::TooLarge)));
+        let f = std::env::temp_dir().join(format!("robovec-read-bound-{}", std::process::id()));
+        std::fs::write(&f, vec![b'x'; 5000]).unwrap();
+        let name = f.to_str().unwrap();
+        assert!(matches!(read_bounded(name, 4999, &go), Err(ReadStop::TooLarge)));
+        assert_eq!(read_bounded(name, 5000, &go).ok().map(|b| b.len()), Some(5000));
+        assert!(matches!(read_bounded("/dev/zero", 3 << 20, &AtomicBool::new(true)), Err(ReadStop::Abandoned)));
+        std::fs::remove_file(&f).unwrap();
+    }
 }

@@ -4,7 +4,8 @@
 
 use std::collections::BTreeMap;
 
-use robovec_ir::{interp, Function};
+use robovec_ir::interp::{self, Float};
+use robovec_ir::{Def, Function, Operand, Span, TrigFn, Value};
 use serde::Serialize;
 
 /// `-eval` output: every input used and every output, in the evaluation precision.
@@ -19,6 +20,133 @@ pub struct EvalResult {
     /// User callbacks evaluated with the interpreter's stand-in (absent when none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub callback_standins: Vec<String>,
+    /// The first value that was not finite, when an output is not (the JSON prints such an
+    /// output as `null`; the driver warns on stderr, issue 47). Not part of the JSON.
+    #[serde(skip)]
+    pub non_finite: Option<NonFinite>,
+}
+
+/// Where an evaluation first went non-finite ([`EvalResult::non_finite`]): the first value, in
+/// program order, whose result is infinite or NaN. Its operands were all finite (inputs and
+/// constants are), so it is where the trouble starts: a division by zero (a singular mass
+/// matrix: a zero mass given for a link, issue 47), an overflow, `sqrt` of a negative number.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NonFinite {
+    /// The value's name, without `%`.
+    pub name: String,
+    /// Its definition as the IR text writes it (`1 / %D3`, `div 1, %D3`), cut to about 160
+    /// characters.
+    pub definition: String,
+    /// Its result (`inf`, `-inf`, `NaN`), in `f64`.
+    pub value: f64,
+    /// The values it reads, in operand order, each once, with their values (at most 6).
+    pub reads: Vec<(String, f64)>,
+    /// Its definition's span in the input (`Span::DUMMY` when a pass or the generator made it).
+    pub span: Span,
+    /// The outputs that are not finite, in output order.
+    pub outputs: Vec<String>,
+}
+
+/// The outputs of `f` from its values `vals` (as [`interp::eval`]), and where the values first
+/// went non-finite when an output is not finite.
+fn outputs_of<T: Float>(f: &Function, vals: &[T]) -> (Vec<(String, f64)>, Option<NonFinite>) {
+    let value = |o: &Operand| match o {
+        Operand::Value(v) => vals[v.index()].to_f64(),
+        Operand::Const(c) => T::from_f64(*c).to_f64(),
+    };
+    let outputs: Vec<(String, f64)> = f.outputs.iter().map(|o| (o.name.clone(), value(&o.value))).collect();
+    let bad: Vec<String> = outputs.iter().filter(|(_, x)| !x.is_finite()).map(|(n, _)| n.clone()).collect();
+    if bad.is_empty() {
+        return (outputs, None);
+    }
+    let first = f.body.iter().copied().find(|v| !vals[v.index()].to_f64().is_finite());
+    let non_finite = first.map(|v| {
+        let d = f.value(v);
+        let mut reads: Vec<(String, f64)> = Vec::new();
+        d.def.for_each_value(|a: Value| {
+            let name = f.name_of(a).to_string();
+            if reads.len() < 6 && !reads.iter().any(|(n, _)| *n == name) {
+                reads.push((name, vals[a.index()].to_f64()));
+            }
+        });
+        NonFinite {
+            name: d.name.clone(),
+            definition: definition_text(f, &d.def),
+            value: vals[v.index()].to_f64(),
+            reads,
+            span: d.span,
+            outputs: bad.clone(),
+        }
+    });
+    (outputs, non_finite)
+}
+
+impl NonFinite {
+    /// The warning line(s) for `-eval` on stderr: `warning: @f: %iD3 = 1/%D3 is inf (the first
+    /// value that is not finite; %D3 = 0): outputs qdd[1], qdd[3] are not finite`, then
+    /// `  --> file:line:col` when `at` (the file's name and text) locates its definition.
+    pub fn warning(&self, function: &str, at: Option<(&str, &str)>) -> String {
+        let reads: Vec<String> = self.reads.iter().map(|(n, x)| format!("%{n} = {x}")).collect();
+        let reads = if reads.is_empty() { String::new() } else { format!("; {}", reads.join(", ")) };
+        let shown: Vec<&str> = self.outputs.iter().take(6).map(String::as_str).collect();
+        let more = self.outputs.len() - shown.len();
+        let more = if more > 0 { format!(" and {more} more") } else { String::new() };
+        let mut w = format!(
+            "warning: @{function}: %{} = {} is {} (the first value that is not finite{reads}): output{} {}{more} {} not finite\n",
+            self.name,
+            self.definition,
+            self.value,
+            if self.outputs.len() == 1 { "" } else { "s" },
+            shown.join(", "),
+            if self.outputs.len() == 1 { "is" } else { "are" },
+        );
+        match at {
+            Some((file, text)) if self.span != Span::DUMMY && self.span.end as usize <= text.len() => {
+                let (line, col) = robovec_ir::span::line_col(text, self.span.start as usize);
+                w += &format!("  --> {file}:{line}:{col}\n");
+            }
+            _ => {}
+        }
+        w
+    }
+}
+
+/// `def` as the IR text writes it after `%name = `, cut in the middle beyond 160 characters.
+fn definition_text(f: &Function, def: &Def) -> String {
+    // The forms of one op as `robovec_ir::text::printer::write_function` writes them; an
+    // expression through its `write_expr`.
+    let mut out = String::new();
+    let op = |o: &Operand| match o {
+        Operand::Value(v) => format!("%{}", f.name_of(*v)),
+        Operand::Const(c) => {
+            let mut s = String::new();
+            let _ = robovec_ir::text::write_const(&mut s, *c);
+            s
+        }
+    };
+    match def {
+        Def::Input => out.push_str("input"),
+        Def::Trig(t, a) => {
+            let t = if matches!(t, TrigFn::Sin) { "sin" } else { "cos" };
+            out += &format!("{t} %{}", f.name_of(*a));
+        }
+        Def::Binary(b, x, y) => out += &format!("{} {}, {}", b.mnemonic(), op(x), op(y)),
+        Def::Call(c, args) => {
+            out += &format!("call @{}(", c.name);
+            out += &args.iter().map(op).collect::<Vec<_>>().join(", ");
+            out.push(')');
+        }
+        Def::Expr(e) => {
+            let _ = robovec_ir::text::printer::write_expr(&mut out, f, e);
+        }
+    }
+    let n = out.chars().count();
+    if n > 160 {
+        let head: String = out.chars().take(80).collect();
+        let tail: String = out.chars().skip(n - 70).collect();
+        out = format!("{head} … {tail}");
+    }
+    out
 }
 
 /// The inputs of an `-eval`: those the file gives, then the values the input's conventions
@@ -74,28 +202,26 @@ pub fn evaluate_with(
         let stated = given.get(name).or_else(|| defaults.get(name));
         stated.copied().unwrap_or_else(|| interp::pseudo_random_input(name, 0))
     };
-    let outputs: BTreeMap<String, f64> = if single {
-        interp::eval::<f32>(f, |name| {
+    let (outputs, non_finite) = if single {
+        let vals = interp::eval_values::<f32>(f, |name| {
             let x = value(name) as f32 as f64;
             inputs.insert(name.to_string(), x);
             x
-        })
-        .into_iter()
-        .map(|(k, v)| (k, v as f64))
-        .collect()
+        });
+        outputs_of(f, &vals)
     } else {
-        interp::eval::<f64>(f, |name| {
+        let vals = interp::eval_values::<f64>(f, |name| {
             let x = value(name);
             inputs.insert(name.to_string(), x);
             x
-        })
-        .into_iter()
-        .collect()
+        });
+        outputs_of(f, &vals)
     };
     EvalResult {
         precision: if single { "f32" } else { "f64" },
         inputs,
-        outputs,
+        outputs: outputs.into_iter().collect(),
         callback_standins: robovec_ir::numerics::Tape::new(f).standin_callees(),
+        non_finite,
     }
 }

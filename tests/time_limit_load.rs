@@ -104,3 +104,101 @@ fn a_urdf_stops_at_a_body_of_the_generator() {
     assert!(e.contains(&format!("star.urdf:{joint_line}:")), "{e}");
     assert!(opt(&[file.to_str().unwrap(), "-passes=atomise", "-o", "/dev/null"]).status.success());
 }
+
+/// `robovec-opt` with `args`, stdin from `stdin`; its output and wall time.
+fn timed(args: &[&str], stdin: std::process::Stdio) -> (std::process::Output, f64) {
+    let t = std::time::Instant::now();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_robovec-opt"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .stdin(stdin)
+        .output()
+        .expect("robovec-opt runs");
+    (o, t.elapsed().as_secs_f64())
+}
+
+/// The grace of a limit (`robovec_passes::Deadline::grace_seconds`) plus a margin for a loaded
+/// machine running a debug build.
+fn within_grace(limit: f64, elapsed: f64) -> bool {
+    elapsed <= limit + robovec_passes::Deadline::grace_seconds(limit) + 2.0
+}
+
+/// Issue 47: stdin that gives nothing (a pipe whose writer never writes) or never ends
+/// (`/dev/zero`) is read under the deadline: the run ends at the limit with exit 1, where it
+/// waited or read without end (`/dev/zero`: 4.2 GB at 8 s).
+#[cfg(unix)]
+#[test]
+fn stdin_is_read_under_the_deadline() {
+    // A pipe held open and never written.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_robovec-opt"))
+        .args(["-", "-time-limit=0.5", "-o", "/dev/null"])
+        .stdin(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .expect("robovec-opt runs");
+    let held = child.stdin.take();
+    let t = std::time::Instant::now();
+    let o = child.wait_with_output().expect("it ends");
+    let elapsed = t.elapsed().as_secs_f64();
+    drop(held);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.starts_with("error: time limit of 0.5 s reached while reading <stdin>\n"), "{e}");
+    assert!(within_grace(0.5, elapsed), "{elapsed} s");
+    // `/dev/zero`: stopped at the limit, or at the input bound if it reads faster than 1 GiB/s.
+    let zero = std::fs::File::open("/dev/zero").expect("/dev/zero");
+    let (o, elapsed) = timed(&["-", "-time-limit=1", "-o", "/dev/null"], zero.into());
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.starts_with("error: time limit of 1 s reached while reading <stdin>")
+            || e.starts_with("error: <stdin> is larger than 1 GiB (1073741824 bytes)"),
+        "{e}"
+    );
+    assert!(within_grace(1.0, elapsed), "{elapsed} s");
+}
+
+/// Issue 47: an input larger than the bound (1 GiB) is refused at once, before it is read (a
+/// sparse file: no disk space used).
+#[test]
+fn an_input_over_the_bound_is_refused_before_it_is_read() {
+    let d = tmp("bound");
+    let big = d.join("big.rvir");
+    let f = std::fs::File::create(&big).unwrap();
+    f.set_len(robovec::driver::INPUT_BOUND + 1).unwrap();
+    drop(f);
+    let (o, elapsed) = timed(&[big.to_str().unwrap(), "-o", "/dev/null"], std::process::Stdio::null());
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.starts_with(&format!(
+            "error: `{}` is larger than 1 GiB (1073741824 bytes), the most robovec reads from one input\n",
+            big.display()
+        )),
+        "{e}"
+    );
+    assert!(elapsed < 5.0, "refused without reading: {elapsed} s");
+    std::fs::remove_file(&big).unwrap();
+}
+
+/// Issue 47, against the clock (the tick-budget tests of `robovec-dynamics` stop every step at
+/// a chosen tick): a 1,500-branch star's `dirdyna` (2.25 million outputs of `M`, compacted and
+/// verified after they are written) and a 2,000-joint chain's `fordyna` end within the grace
+/// of a 1 s limit, with the time-limit error, wherever the limit falls.
+#[test]
+fn generated_functions_end_within_the_grace() {
+    let d = tmp("grace");
+    for (t, dof, function) in
+        [(Topology::Star, 1500, "-function=dirdyna"), (Topology::Serial, 2000, "-function=fordyna")]
+    {
+        let file = d.join(format!("{t}{dof}.urdf"));
+        std::fs::write(&file, robovec_dynamics::urdf_out::write_urdf(&build(t, dof, 1))).unwrap();
+        let (o, elapsed) =
+            timed(&[file.to_str().unwrap(), function, "-time-limit=1", "-o", "/dev/null"], std::process::Stdio::null());
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{t} {dof}: {e}");
+        assert!(e.contains("error: time limit of 1 s reached while "), "{t} {dof}: {e}");
+        assert!(within_grace(1.0, elapsed), "{t} {dof}: {elapsed} s");
+    }
+}

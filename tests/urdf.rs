@@ -522,3 +522,103 @@ fn hostile_numbers_in_a_urdf_are_located_diagnostics() {
     assert!(a.status.success() && b.status.success(), "{}", stderr(&a));
     assert_eq!(a.stdout, b.stdout);
 }
+
+/// Issue 47: a link that makes the mass matrix singular (a leaf with mass 0, or without
+/// `<inertial>`) under `-function=fordyna` is named with its joint at its `<link>` (before: the
+/// verifier's `constant inf is not finite (on input)`, no file, no link, no cause); `dirdyna`
+/// (`M` itself) and `invdyna` are written.
+#[test]
+fn a_singular_mass_matrix_names_the_link_and_its_joint() {
+    for (file, what) in [
+        ("tests/inputs/singular/massless_leaf.urdf", "has mass 0 and no inertia about its joint's axis"),
+        ("tests/inputs/singular/no_inertial_leaf.urdf", "has no `<inertial>`"),
+    ] {
+        let text = std::fs::read_to_string(path(file)).unwrap();
+        let line_of = |needle: &str| text.lines().position(|l| l.contains(needle)).expect(needle) + 1;
+        for extra in [&[][..], &["--fold-params"], &["--formulation=depth"], &["--free-flyer"]] {
+            let mut args = vec![file, "-function=fordyna", "-passes=atomise", "-o", "/dev/null"];
+            args.extend(extra);
+            let o = opt(&args);
+            let e = stderr(&o);
+            assert_eq!(o.status.code(), Some(1), "{file} {extra:?}: {e}");
+            // On the free flyer the base's six coordinates come first.
+            let row = if extra.contains(&"--free-flyer") { 9 } else { 3 };
+            let message = format!(
+                "error: link `l3` (joint `j3`) {what}: the mass matrix is singular (a zero pivot in row {row} of M, qdd[{row}])"
+            );
+            assert!(e.starts_with(&message), "{file} {extra:?}: {e}");
+            assert!(e.contains(&format!("{file}:{}:3", line_of("<link name=\"l3\""))), "{file}: at the link: {e}");
+            assert!(e.contains(&format!("joint `j3` (line {}) moves it", line_of("<joint name=\"j3\""))), "{e}");
+            assert!(e.contains("give link `l3` an <inertial> with a positive mass"), "{e}");
+            assert!(!e.contains("verifier"), "{e}");
+        }
+        for function in ["-function=dirdyna", "-function=invdyna"] {
+            let o = opt(&[file, function, "-passes=atomise", "-o", "/dev/null"]);
+            assert!(o.status.success(), "{file} {function}: {}", stderr(&o));
+        }
+    }
+}
+
+/// Issue 47: `-eval` of a function whose values go non-finite (a zero mass given for a link
+/// in a parameter file from `-params-out`) still prints its JSON (`null` outputs, exit 0) but
+/// warns, naming the first value that is not finite, what it read, and the outputs affected.
+#[test]
+fn eval_warns_at_the_first_value_that_is_not_finite() {
+    let d = tmp("non_finite");
+    let arm = path("examples/three_link_arm/three_link_arm.urdf");
+    let params = d.join("params.json");
+    let o =
+        opt(&[&arm, "-function=fordyna", "-passes=", "-o", "/dev/null", &format!("-params-out={}", params.display())]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The telescope (prismatic, `q[3]`) moves the forearm and the tool fixed to it: body 3,
+    // whose mass is the pivot of row 3 of M. Zero it, with the state.
+    let mut values: BTreeMap<String, f64> = serde_json::from_slice(&std::fs::read(&params).unwrap()).unwrap();
+    assert!(values["m[3]"] > 0.0);
+    values.insert("m[3]".into(), 0.0);
+    for (k, x) in [("q[1]", 0.3), ("q[2]", -0.5), ("q[3]", 0.1), ("qd[1]", 0.2), ("qd[2]", 0.1), ("qd[3]", -0.3)] {
+        values.insert(k.into(), x);
+    }
+    for k in 1..=3 {
+        values.insert(format!("Qq[{k}]"), 1.0);
+    }
+    let zero = d.join("zero_mass.json");
+    std::fs::write(&zero, serde_json::to_string(&values).unwrap()).unwrap();
+    let o = opt(&[&arm, "-function=fordyna", "-passes=atomise", &format!("-eval={}", zero.display())]);
+    let e = stderr(&o);
+    assert!(o.status.success(), "{e}");
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(json["outputs"]["qdd[3]"].is_null(), "{json}");
+    let warning =
+        e.lines().find(|l| l.starts_with("warning: @fordyna: %")).unwrap_or_else(|| panic!("no warning: {e}"));
+    // The first value that is not finite is the reciprocal of a pivot that is 0 …
+    assert!(warning.contains(" is inf (the first value that is not finite; %"), "{warning}");
+    assert!(warning.contains(" = 0)") || warning.contains(" = 0,"), "it read a zero: {warning}");
+    // … and every output past it is named.
+    assert!(warning.contains("qdd[3]") && warning.ends_with("not finite"), "{warning}");
+    // With the file's own mass, no warning.
+    let o = opt(&[&arm, "-function=fordyna", "-passes=atomise", &format!("-eval={}", params.display())]);
+    assert!(o.status.success() && !stderr(&o).contains("not finite"), "{}", stderr(&o));
+}
+
+/// The warning of an `.rvir` function gives its definition's line (a Robotran file's too).
+#[test]
+fn eval_locates_the_first_value_that_is_not_finite_in_its_file() {
+    let d = tmp("non_finite_rvir");
+    let f = d.join("f.rvir");
+    std::fs::write(&f, "func @f {\n  phase parsed\n  input %m\n  input %x\n  %a = %x*%x\n  %inv = 1/%m\n  %y = %a*%inv\n  output y = %y\n  output z = %a\n}\n")
+        .unwrap();
+    let given = d.join("in.json");
+    std::fs::write(&given, r#"{"m": 0, "x": 2}"#).unwrap();
+    let o = opt(&[f.to_str().unwrap(), &format!("-eval={}", given.display())]);
+    let e = stderr(&o);
+    assert!(o.status.success(), "{e}");
+    assert!(
+        e.contains(
+            "warning: @f: %inv = 1.0/%m is inf (the first value that is not finite; %m = 0): output y is not finite\n"
+        ),
+        "{e}"
+    );
+    assert!(e.contains(&format!("  --> {}:6:3\n", f.display())), "{e}");
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((json["outputs"]["y"].is_null(), json["outputs"]["z"].as_f64()), (true, Some(4.0)));
+}

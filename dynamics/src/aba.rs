@@ -186,8 +186,9 @@ struct Link {
 
 /// `x` with `A x = r` for a symmetric positive-definite 6 × 6 `A` (only `a[i][j]`, `i ≤ j`, is
 /// read) by `LDLᵀ` and the two substitutions: `n³/6` multiply–adds, one reciprocal per pivot,
-/// 6 of them. Temporaries `{name}L{i}_{j}`, `{name}D{i}`, `{name}Y{i}` (1-based).
-fn solve6(b: &mut Builder, name: &str, a: &[[Term; 6]; 6], r: [Term; 6]) -> [Term; 6] {
+/// 6 of them. Temporaries `{name}L{i}_{j}`, `{name}D{i}`, `{name}Y{i}` (1-based). Row `i` is
+/// velocity coordinate `first + i` (what a zero pivot is reported against, [`reciprocal`]).
+fn solve6(b: &mut Builder, name: &str, first: usize, a: &[[Term; 6]; 6], r: [Term; 6]) -> [Term; 6] {
     // l[i][j] (j < i) of the unit lower L, and D.
     let mut l: [[Term; 6]; 6] = Default::default();
     let mut inv_d: [Term; 6] = Default::default();
@@ -200,7 +201,7 @@ fn solve6(b: &mut Builder, name: &str, a: &[[Term; 6]; 6], r: [Term; 6]) -> [Ter
             l[i][j] = b.bind(&format!("{name}L{}_{}", i + 1, j + 1), mul(dl[i][j].clone(), inv_d[j].clone()));
         }
         let d = (0..i).fold(a[i][i].clone(), |t, k| sub(t, mul(dl[i][k].clone(), l[i][k].clone())));
-        inv_d[i] = reciprocal(b, &format!("{name}D{}", i + 1), &format!("i{name}D{}", i + 1), d);
+        inv_d[i] = reciprocal(b, first + i, &format!("{name}D{}", i + 1), &format!("i{name}D{}", i + 1), d);
     }
     // L y = r, then Lᵀ x = D⁻¹ y.
     let mut y: [Term; 6] = Default::default();
@@ -329,7 +330,7 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
                 let (uw, ua) = inertia.apply(sw, sa);
                 let (uw, ua) = (bind3(b, "UW", body, uw), bind3(b, "UA", body, ua));
                 let d = add(vdot(sw, &uw), vdot(sa, &ua));
-                let inv = reciprocal(b, &format!("AD{body}"), &format!("iAD{body}"), d);
+                let inv = reciprocal(b, qi, &format!("AD{body}"), &format!("iAD{body}"), d);
                 let u = sub(forces[qi - 1].clone(), add(vdot(sw, &pn), vdot(sa, &pf)));
                 let u = b.bind(&format!("AU{body}"), u);
                 let ia_a = inertia.minus_outer(&uw, &ua, &inv);
@@ -389,7 +390,7 @@ pub fn fordyna(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), St
                 (false, true) => ia.h[r - 3][c].clone(),
                 (false, false) => ia.j[r - 3][c - 3].clone(),
             };
-            let x = solve6(b, "FB", &std::array::from_fn(|r| std::array::from_fn(|c| e(r, c))), rhs);
+            let x = solve6(b, "FB", qi, &std::array::from_fn(|r| std::array::from_fn(|c| e(r, c))), rhs);
             for (k, t) in x.iter().enumerate() {
                 qdd[qi - 1 + k] = b.bind(&format!("QDD{}", qi + k), t.clone());
             }

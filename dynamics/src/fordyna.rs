@@ -105,8 +105,15 @@ fn crba_rnea<'a>(model: &'a Model, layout: &'a Layout) -> impl FnMut(&mut Builde
 /// updates cost fewer ops than the ABA (the depth formulation, whose `c` takes more ops for a
 /// shorter path: [`crate::depth::fordyna`]).
 ///
+/// The ABA's ops after `atomise,cse` are counted only when the factorisation might win: its
+/// ops as written bound them from above (atomising writes exactly the ops counted, pruning and
+/// merging only remove), so a factorisation whose updates alone cost as many never needs the
+/// count (issue 47: on a 10,000-joint chain the count took 19 s of the 27 s per frame
+/// candidate; the choice is the same).
+///
 /// # Errors
-/// [`Stopped`] at the builder's deadline.
+/// [`Stopped`] at the builder's deadline; the functions written are then abandoned
+/// ([`crate::abandon`]).
 pub(crate) fn ltdl_or_aba(
     model: &Model,
     layout: &Layout,
@@ -115,17 +122,44 @@ pub(crate) fn ltdl_or_aba(
     whole: bool,
 ) -> Result<(), Stopped> {
     let mut aba = b.fresh();
-    crate::aba::fordyna(model, layout, &mut aba)?;
-    let aba_ops = aba.ops_after_cse();
-    if factorisation_ops(&coordinate_parents(model, layout)) < aba_ops {
-        let mut by_ltdl = b.fresh();
-        ltdl_by(model, layout, &mut by_ltdl, parts)?;
-        if !whole || by_ltdl.ops_after_cse() <= aba_ops {
-            *b = by_ltdl;
-            return Ok(());
+    if let Err(stop) = crate::aba::fordyna(model, layout, &mut aba) {
+        crate::abandon(aba.f);
+        return Err(stop);
+    }
+    let updates = factorisation_ops(&coordinate_parents(model, layout));
+    let Some(written) = crate::sym::op_counts_until(&aba.f, &aba.ticker()) else {
+        let stop = aba.stopped(Reached::Step("counting its ops"));
+        crate::abandon(aba.f);
+        return Err(stop);
+    };
+    if updates < written.total {
+        let aba_ops = match aba.ops_after_cse_until() {
+            Ok(n) => n,
+            Err(stop) => {
+                crate::abandon(aba.f);
+                return Err(stop);
+            }
+        };
+        if updates < aba_ops {
+            let mut by_ltdl = b.fresh();
+            let kept = ltdl_by(model, layout, &mut by_ltdl, parts)
+                .and_then(|()| Ok(!whole || by_ltdl.ops_after_cse_until()? <= aba_ops));
+            match kept {
+                Ok(true) => {
+                    crate::drop_later(std::mem::replace(b, by_ltdl).f);
+                    crate::drop_later(aba.f);
+                    return Ok(());
+                }
+                Ok(false) => crate::drop_later(by_ltdl.f),
+                Err(stop) => {
+                    crate::abandon(by_ltdl.f);
+                    crate::abandon(aba.f);
+                    return Err(stop);
+                }
+            }
         }
     }
-    *b = aba;
+    crate::drop_later(std::mem::replace(b, aba).f);
     Ok(())
 }
 
@@ -174,7 +208,7 @@ pub(crate) fn ltdl_by(model: &Model, layout: &Layout, b: &mut Builder, parts: &m
     for k in (1..=nq).rev() {
         b.check_at(at(k))?;
         let d = h.remove(&(k, k)).unwrap_or(ZERO);
-        inv_d[k] = reciprocal(b, &format!("D{k}"), &format!("iD{k}"), d);
+        inv_d[k] = reciprocal(b, k, &format!("D{k}"), &format!("iD{k}"), d);
         let anc: Vec<usize> = ancestors(k).collect();
         for (n, &i) in anc.iter().enumerate() {
             let hki = h.remove(&(k, i)).unwrap_or(ZERO);

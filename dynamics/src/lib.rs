@@ -200,6 +200,12 @@ pub struct Generated {
     pub module: Module,
     /// Values of the parameters left as inputs (`None` when they were folded).
     pub params: Option<BTreeMap<String, f64>>,
+    /// The first function (by name) whose factorisation of `M` met a pivot that folded to 0 (or
+    /// a number whose reciprocal is not finite), and where: `M` is singular whatever the
+    /// joint values, and that function holds the constant `inf`, which the verifier rejects.
+    /// The front end reports it against the URDF (issue 47); `None` when every pivot is
+    /// symbolic or non-zero.
+    pub singular: Option<(String, sym::Singular)>,
 }
 
 /// What to generate ([`generate_with`]): which functions, folded or not, and by when.
@@ -214,9 +220,13 @@ pub struct Request {
     /// the generator does not write are ignored (the driver reports them against
     /// [`FUNCTION_NAMES`] before loading).
     pub functions: Option<Vec<String>>,
-    /// `-time-limit`: checked once per body of every recursion and per row of `M`'s outputs
-    /// (see [`Stopped`]).
+    /// `-time-limit`: checked once per body of every recursion and per row of `M`'s outputs,
+    /// and every 1024 steps of the passes over a whole function (counting its ops, compacting
+    /// it; see [`Stopped`]).
     pub deadline: Option<Deadline>,
+    /// Tests: the passes over a whole function stop at this tick of each
+    /// ([`sym::Builder::tick_budget`]), whatever the clock says.
+    pub tick_budget: Option<u64>,
     /// `--formulation`: the fewest ops (today's, the default) or the shortest dependence depth
     /// ([`depth`]).
     pub formulation: Formulation,
@@ -284,17 +294,49 @@ pub enum Reached {
         /// Rows of `M`.
         rows: usize,
     },
+    /// A pass over the whole function once its equations are written (issue 47): `counting its
+    /// ops`, `counting its ops after atomise,cse` (to choose a formulation or body frames),
+    /// `compacting it` (dropping what no output reads).
+    Step(&'static str),
 }
 
 impl std::fmt::Display for Stopped {
     /// `time limit of 5 s reached while generating @dirdyna (body 1200 of 4000)`, or
-    /// `(… (row 1200 of 4000 of M)`.
+    /// `(… (row 1200 of 4000 of M)`, or `(… (compacting it)`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "time limit of {} s reached while generating @{} ", self.seconds, self.function)?;
         match self.at {
             Reached::Body { body, bodies } => write!(f, "(body {body} of {bodies})"),
             Reached::Row { row, rows } => write!(f, "(row {row} of {rows} of M)"),
+            Reached::Step(what) => write!(f, "({what})"),
         }
+    }
+}
+
+/// Values and outputs from which a function is [large](drop_later).
+const LARGE: usize = 100_000;
+
+/// Drops a function no longer needed (a formulation or frame candidate that lost, a copy that
+/// was counted) on a thread of its own when it is large (issue 47): freeing the millions of
+/// small allocations of a large generated function (names, expression trees) takes about a
+/// second per gigabyte, which the generation need not wait for. Small ones, and any when no
+/// thread can be started, are dropped here.
+pub(crate) fn drop_later(f: robovec_ir::Function) {
+    if f.values.len() + f.outputs.len() >= LARGE {
+        // On failure the closure, and `f` with it, is dropped here.
+        let _ = std::thread::Builder::new().name("robovec-drop".into()).spawn(move || drop(f));
+    }
+}
+
+/// Gives up a function the time limit stopped (issue 47): a large one is leaked, not freed.
+/// A generation stops at its deadline only for a run that then ends with an error (the URDF
+/// front end fails the load, `robovec-opt` exits 1), and the system reclaims a process's
+/// memory at once, where freeing it block by block took about a second per gigabyte (after a
+/// 10 s limit on a 10,000-joint chain: 0.7 s of the 1 s grace, freed on another thread and
+/// collected at exit). Small ones are dropped here.
+pub(crate) fn abandon(f: robovec_ir::Function) {
+    if f.values.len() + f.outputs.len() >= LARGE {
+        std::mem::forget(f);
     }
 }
 
@@ -394,13 +436,48 @@ pub fn generate_with(model: &Model, request: &Request) -> Result<Generated, Stop
     for i in 0..robots.len() {
         robots.extend(origins::slide(&robots[i]));
     }
-    let ops = |g: &Generated| g.module.functions.iter().map(|f| f.op_counts().total).sum::<u64>();
+    // The ops of each candidate, counted at the deadline's pace (a 10,000-joint chain's
+    // `fordyna` takes 0.8 s to count); the candidates that lose are dropped on a thread of
+    // their own ([`drop_later`]), those a stop leaves are abandoned ([`abandon`]).
+    let ticker = robovec_ir::time_limit::Ticker::new(request.deadline, request.tick_budget);
+    let drop_all = |g: Generated| g.module.functions.into_iter().for_each(drop_later);
+    let abandon_all = |g: Generated| g.module.functions.into_iter().for_each(abandon);
     let mut best: Option<(u64, Generated)> = None;
     for robot in robots {
-        let g = generate_in_frames(&Model { robot }, request).map_err(renumber)?;
-        let n = ops(&g);
-        if best.as_ref().is_none_or(|(m, _)| n < *m) {
-            best = Some((n, g));
+        let g = match generate_in_frames(&Model { robot }, request) {
+            Ok(g) => g,
+            Err(stop) => {
+                if let Some((_, g)) = best {
+                    abandon_all(g);
+                }
+                return Err(renumber(stop));
+            }
+        };
+        let mut n = 0;
+        for f in &g.module.functions {
+            match sym::op_counts_until(f, &ticker) {
+                Some(c) => n += c.total,
+                None => {
+                    let stop = Stopped {
+                        function: f.name.clone(),
+                        at: Reached::Step("counting its ops"),
+                        seconds: request.deadline.map_or(0.0, |d| d.seconds),
+                    };
+                    abandon_all(g);
+                    if let Some((_, g)) = best {
+                        abandon_all(g);
+                    }
+                    return Err(stop);
+                }
+            }
+        }
+        match best.as_ref().is_none_or(|(m, _)| n < *m) {
+            true => {
+                if let Some((_, old)) = best.replace((n, g)) {
+                    drop_all(old);
+                }
+            }
+            false => drop_all(g),
         }
     }
     Ok(best.expect("the robot's own frames are a candidate").1)
@@ -416,17 +493,34 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
         .into_iter()
         .chain(request.gravity.iter().flat_map(|g| (0..3).map(|k| (format!("g[{}]", k + 1), g[k]))))
         .collect();
-    let mut functions = Vec::new();
+    let mut functions: Vec<robovec_ir::Function> = Vec::new();
+    let mut singular = None;
     for f in FUNCTIONS.iter().filter(|f| request.wants(f.0)) {
         let (name, write) = (f.0, writer(f, request.formulation));
         let mut b = Builder::new(name, consts.clone());
         b.deadline = request.deadline;
-        write(model, &layout, &mut b)?;
-        functions.push(b.finish());
+        b.tick_budget = request.tick_budget;
+        let written = match write(model, &layout, &mut b) {
+            Ok(()) => {
+                singular = singular.or(b.singular.map(|s| (name.to_string(), s)));
+                b.finish_until()
+            }
+            Err(stop) => {
+                abandon(b.f);
+                Err(stop)
+            }
+        };
+        match written {
+            Ok(f) => functions.push(f),
+            Err(stop) => {
+                functions.into_iter().for_each(abandon);
+                return Err(stop);
+            }
+        }
     }
     let params = (!request.fold).then(|| {
         // Only the parameters some function reads.
         layout.nonzero().into_iter().filter(|(k, _)| functions.iter().any(|f| f.lookup(k).is_some())).collect()
     });
-    Ok(Generated { module: Module { functions }, params })
+    Ok(Generated { module: Module { functions }, params, singular })
 }

@@ -27,8 +27,8 @@
 //! 3 266, UR5 473 → 419 / 486 → 451, TIAGo Pro 7 666 → 7 600 / 7 955 → 7 928; `M` of Panda
 //! 515 → 512, Talos 3 993 → 3 989, TIAGo Pro 8 271 → 8 269 (the others unchanged).
 
-use robovec_ir::time_limit::Deadline;
-use robovec_ir::{BinOp, Def, Expr, Function, Operand, Output, Phase, Span, TrigFn, Value};
+use robovec_ir::time_limit::{Deadline, Ticker};
+use robovec_ir::{BinOp, Def, Expr, Function, OpCounts, Operand, Output, Phase, Span, TrigFn, Value};
 use rustc_hash::FxHashMap;
 
 use super::{Reached, Stopped};
@@ -273,13 +273,41 @@ pub struct Builder {
     consts: FxHashMap<String, f64>,
     /// The time limit the writers check per body ([`Builder::check`]); `None`: no limit.
     pub deadline: Option<Deadline>,
+    /// Tests: the steps over the whole function ([`Builder::ticker`]) stop at this tick whatever
+    /// the clock says ([`crate::Request::tick_budget`]).
+    pub tick_budget: Option<u64>,
+    /// The first pivot that folded to a number that is zero or not finite ([`reciprocal`]), by
+    /// the writers' coordinate: a singular mass matrix (issue 47).
+    pub singular: Option<Singular>,
+}
+
+/// A pivot of a factorisation of `M` that folded to a number whose reciprocal is not finite
+/// (`1/0`): the mass matrix is singular at that coordinate, whatever the joint values
+/// ([`Builder::singular`]; the URDF front end names the joint and link, issue 47).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Singular {
+    /// The velocity coordinate (1-based, `qdd[i]`, row `i` of `M`) whose pivot it is.
+    pub coordinate: usize,
+    /// The pivot's value (0, or not finite).
+    pub pivot: f64,
 }
 
 impl Builder {
     /// An empty function `name`. Inputs named in `consts` are folded to their value instead of
     /// becoming inputs (`--fold-params`).
     pub fn new(name: &str, consts: FxHashMap<String, f64>) -> Builder {
-        Builder { f: Function::new(name, Phase::Parsed), consts, deadline: None }
+        Builder { f: Function::new(name, Phase::Parsed), consts, deadline: None, tick_budget: None, singular: None }
+    }
+
+    /// A [`Ticker`] on the builder's deadline (and test budget) for a step over the whole
+    /// function: counting its ops, compacting it (issue 47: these took longer than writing).
+    pub fn ticker(&self) -> Ticker {
+        Ticker::new(self.deadline, self.tick_budget)
+    }
+
+    /// The [`Stopped`] of this function at `at`.
+    pub fn stopped(&self, at: Reached) -> Stopped {
+        Stopped { function: self.f.name.clone(), at, seconds: self.deadline.map_or(0.0, |d| d.seconds) }
     }
 
     /// Checks the time limit once a writer reached `body` of `bodies` (one clock read, tens of
@@ -297,7 +325,7 @@ impl Builder {
     /// [`Stopped`] at `at` once [`Builder::deadline`] is reached.
     pub fn check_at(&self, at: Reached) -> Result<(), Stopped> {
         match &self.deadline {
-            Some(d) if d.reached() => Err(Stopped { function: self.f.name.clone(), at, seconds: d.seconds }),
+            Some(d) if d.reached() => Err(self.stopped(at)),
             _ => Ok(()),
         }
     }
@@ -378,39 +406,149 @@ impl Builder {
     /// An empty builder for another function of the same name, folded constants and deadline
     /// (a writer that tries two formulations writes the second into it).
     pub fn fresh(&self) -> Builder {
-        Builder { f: Function::new(&self.f.name, Phase::Parsed), consts: self.consts.clone(), deadline: self.deadline }
+        Builder {
+            f: Function::new(&self.f.name, Phase::Parsed),
+            consts: self.consts.clone(),
+            deadline: self.deadline,
+            tick_budget: self.tick_budget,
+            singular: None,
+        }
     }
 
     /// The ops of what [`Builder::finish`] would keep once atomised and its repeated ops merged
     /// (`-passes=atomise,cse`, what every pipeline of a user starts with): the count to compare
     /// two formulations by, since one may repeat more terms than the other (the ABA's articulated
-    /// inertias, built entry by entry, repeat many). A copy of the function is pruned, this
-    /// builder is unchanged. Cost: linear in the ops.
+    /// inertias, built entry by entry, repeat many). This builder is unchanged. Cost: linear in
+    /// the ops. [`Builder::ops_after_cse_until`] without a time limit.
     pub fn ops_after_cse(&self) -> u64 {
-        let mut f = self.f.clone();
-        let live = f.live_values(&[]);
-        f.retain(|_, v| live[v.index()]);
-        let mut f = robovec_ir::transform::atomise::atomise_owned(f);
-        robovec_ir::transform::cse::cse_function(&mut f);
-        f.op_counts().total
+        ops_after_cse_of(&self.f, &Ticker::default()).expect("a ticker without a limit never stops")
+    }
+
+    /// [`Builder::ops_after_cse`] that stops at the builder's deadline (one tick per equation,
+    /// op and value; issue 47: on a 10,000-joint chain this count took 19 s, over twice the
+    /// time of writing the function, and never looked at the clock).
+    ///
+    /// # Errors
+    /// [`Stopped`] at [`Reached::Step`] once the deadline is reached.
+    pub fn ops_after_cse_until(&self) -> Result<u64, Stopped> {
+        ops_after_cse_of(&self.f, &self.ticker()).ok_or_else(|| self.stopped(Reached::Step(COUNTING)))
     }
 
     /// The finished function: what no output needs is dropped (Robotran writes only the
     /// equations its outputs read), inputs included; `equations` counts what is left. The
     /// names of values and outputs are indexed again ([`Function::retain`]).
-    pub fn finish(mut self) -> Function {
-        let live = self.f.live_values(&[]);
-        self.f.retain(|_, v| live[v.index()]);
+    /// [`Builder::finish_until`] without a time limit.
+    pub fn finish(self) -> Function {
+        let unlimited = Builder { deadline: None, tick_budget: None, ..self };
+        unlimited.finish_until().expect("a ticker without a limit never stops")
+    }
+
+    /// [`Builder::finish`] that stops at the builder's deadline (one tick per value and output;
+    /// issue 47: compacting the 25 million outputs of a 5,000-branch star's `dirdyna` takes
+    /// seconds).
+    ///
+    /// # Errors
+    /// [`Stopped`] at [`Reached::Step`] once the deadline is reached; the function is then
+    /// abandoned ([`crate::abandon`]).
+    pub fn finish_until(mut self) -> Result<Function, Stopped> {
+        let ticker = self.ticker();
+        let done = live_values_until(&self.f, &ticker)
+            .is_some_and(|live| self.f.retain_until(|_, v| live[v.index()], &mut || ticker.tick()));
+        if !done {
+            let stop = self.stopped(Reached::Step(COMPACTING));
+            crate::abandon(self.f);
+            return Err(stop);
+        }
         let kept = self.f.body.iter().filter(|&&v| matches!(self.f.value(v).def, Def::Expr(_))).count();
         self.f.equations = Some(kept as u32);
-        self.f
+        Ok(self.f)
     }
 }
 
+/// [`Reached::Step`] of [`Builder::ops_after_cse_until`].
+const COUNTING: &str = "counting its ops after atomise,cse";
+
+/// [`Reached::Step`] of [`Builder::finish_until`].
+const COMPACTING: &str = "compacting it";
+
+/// [`Function::live_values`] of `f` (no extra roots), one tick per output and value; `None`
+/// when `ticker` says stop.
+fn live_values_until(f: &Function, ticker: &Ticker) -> Option<Vec<bool>> {
+    let mut live = vec![false; f.values.len()];
+    for o in &f.outputs {
+        if ticker.tick() {
+            return None;
+        }
+        if let Operand::Value(v) = o.value {
+            live[v.index()] = true;
+        }
+    }
+    for &v in f.body.iter().rev() {
+        if ticker.tick() {
+            return None;
+        }
+        if live[v.index()] {
+            f.value(v).def.for_each_value(|a| live[a.index()] = true);
+        }
+    }
+    Some(live)
+}
+
+/// [`Function::op_counts`] of `f`, one tick per value; `None` when `ticker` says stop.
+pub(crate) fn op_counts_until(f: &Function, ticker: &Ticker) -> Option<OpCounts> {
+    let mut c = OpCounts::default();
+    for &v in &f.body {
+        if ticker.tick() {
+            return None;
+        }
+        match &f.value(v).def {
+            Def::Expr(e) => robovec_ir::count::count_expr(e, &mut c),
+            d => {
+                if let Some(k) = d.op_kind() {
+                    c.bump(k)
+                }
+            }
+        }
+    }
+    Some(c)
+}
+
+/// The ops of `f` once atomised, pruned of what no output reads and its repeated ops merged
+/// ([`Builder::ops_after_cse`]); `None` when `ticker` says stop. The atomised copy is pruned
+/// (atomising a dead equation writes only dead ops) and its merges counted in place
+/// ([`robovec_ir::transform::cse::cse_drops_until`]), then it is dropped on a thread of its own
+/// ([`crate::drop_later`]: freeing its millions of names took longer than counting), or
+/// abandoned on a stop ([`crate::abandon`]).
+fn ops_after_cse_of(f: &Function, ticker: &Ticker) -> Option<u64> {
+    let mut a = robovec_ir::transform::atomise::atomise_until(f, ticker)?;
+    let pruned =
+        live_values_until(&a, ticker).is_some_and(|live| a.retain_until(|_, v| live[v.index()], &mut || ticker.tick()));
+    let ops = if pruned {
+        let drops = robovec_ir::transform::cse::cse_drops_until(&a, ticker);
+        drops.and_then(|d| Some(op_counts_until(&a, ticker)?.total - d))
+    } else {
+        None
+    };
+    match ops {
+        Some(_) => crate::drop_later(a),
+        None => crate::abandon(a),
+    }
+    ops
+}
+
 /// `1 / d`: `d` bound as `d_name`, its reciprocal as `inv_name` (a number stays a number).
-pub(crate) fn reciprocal(b: &mut Builder, d_name: &str, inv_name: &str, d: Term) -> Term {
+/// `d` is the pivot of velocity coordinate `coordinate` (1-based) in a factorisation of `M`: a
+/// number whose reciprocal is not finite (a zero pivot) is recorded as [`Builder::singular`]
+/// (the first one), so that the front end can say which joint and link make `M` singular
+/// instead of the verifier rejecting the constant `inf` (issue 47).
+pub(crate) fn reciprocal(b: &mut Builder, coordinate: usize, d_name: &str, inv_name: &str, d: Term) -> Term {
     let d = match d {
-        Term::C(x) => return Term::C(1.0 / x),
+        Term::C(x) => {
+            if !(1.0 / x).is_finite() && b.singular.is_none() {
+                b.singular = Some(Singular { coordinate, pivot: x });
+            }
+            return Term::C(1.0 / x);
+        }
         d => b.bind(d_name, d),
     };
     let e = Expr::Binary(BinOp::Div, Box::new(Expr::Operand(Operand::Const(1.0))), Box::new(to_expr(&d)));

@@ -6,7 +6,7 @@ use std::borrow::Cow;
 
 use robovec_ir::{Function, Module, Phase};
 
-pub use robovec_ir::transform::atomise::{atomise_function, atomise_owned, atomise_within};
+pub use robovec_ir::transform::atomise::{atomise_function, atomise_owned, atomise_until, atomise_within};
 
 use crate::time_limit::TickerError;
 use crate::{Params, Pass, PassContext, PassError, PassInfo};

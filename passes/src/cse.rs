@@ -4,7 +4,7 @@
 
 use robovec_ir::Module;
 
-pub use robovec_ir::transform::cse::{cse_function, cse_within};
+pub use robovec_ir::transform::cse::{cse_drops_until, cse_function, cse_within};
 
 use crate::{each_function, Before, Params, Pass, PassContext, PassError, PassInfo, Step};
 
@@ -45,6 +45,7 @@ impl Pass for Cse {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Ticker;
     use robovec_ir::text::parse;
     use robovec_ir::{BinOp, Def, Operand};
 
@@ -84,5 +85,21 @@ mod tests {
              %c1 = call @sqrt(%x)  %c2 = call @sqrt(%x) \
              output a = %d1  output b = %d2  output c = %z1  output d = %z2  output e = %c1  output f = %c2 }");
         assert_eq!(m.functions[0].body.len(), 6, "nothing merges");
+    }
+
+    /// `cse_drops_until` counts what `cse_function` drops (merged trig variables are no op) and
+    /// stops at a tick budget.
+    #[test]
+    fn the_drop_count_is_what_cse_drops() {
+        let src = "func @f { phase atomised input %x input %y input %z              %c1 = cos %x  %c2 = cos %x  %p1 = mul %c1, %y  %p2 = mul %y, %c2  %s1 = add %p1, %z              %s2 = add %z, %p2  %d = sub %s1, %s2  %e = sub %s2, %s1              output a = %d  output b = %e }";
+        let f = &parse(src).unwrap().functions[0];
+        let drops = cse_drops_until(f, &Ticker::default()).expect("no limit");
+        let mut g = f.clone();
+        let dropped = cse_function(&mut g);
+        // s2 merged into s1, `e` is `d`.
+        assert_eq!(dropped, 4, "c2, p2, s2, e");
+        assert_eq!(drops, 3, "p2, s2 and e are ops; c2 is a trig variable");
+        assert_eq!(f.op_counts().total - drops, g.op_counts().total);
+        assert_eq!(cse_drops_until(f, &Ticker::new(None, Some(4))), None, "the 4th of 8 values stops it");
     }
 }

@@ -80,6 +80,7 @@ impl FrontEnd for Urdf {
             fold: opts.fold_params,
             functions: opts.functions.clone(),
             deadline: opts.deadline,
+            tick_budget: None,
             formulation: opts.formulation,
         };
         let model = robovec_dynamics::Model { robot };
@@ -88,7 +89,7 @@ impl FrontEnd for Urdf {
             let order = model.robot.dfs_joints();
             let joint = match stop.at {
                 robovec_dynamics::Reached::Body { body, .. } => body.checked_sub(1).and_then(|k| order.get(k)),
-                robovec_dynamics::Reached::Row { .. } => None,
+                robovec_dynamics::Reached::Row { .. } | robovec_dynamics::Reached::Step(_) => None,
             };
             let span = match joint {
                 Some(&j) => model.robot.joints[j].span,
@@ -97,6 +98,9 @@ impl FrontEnd for Urdf {
             vec![FrontError::new(span, stop.to_string(), "reached here")
                 .note("-time-limit covers loading too: nothing is written without a complete module")]
         })?;
+        if let Some((function, singular)) = &g.singular {
+            return Err(vec![singular_error(&model.robot, text, function, singular)]);
+        }
         // `-eval`'s values for inputs not given: the model's own, and gravity as Pinocchio's
         // `Model::gravity` (−9.81 m/s² along z).
         // (With -gravity, no function has the inputs `g[k]`.)
@@ -105,6 +109,66 @@ impl FrontEnd for Urdf {
         let defaults_source = "the URDF's parameters and Pinocchio's gravity (0, 0, -9.81)";
         Ok(Loaded { module: g.module, params: g.params, input_defaults, defaults_source })
     }
+}
+
+/// The error of a mass matrix the generator found singular ([`robovec_dynamics::Generated::singular`],
+/// issue 47): the link whose joint's pivot is zero, at its `<link>` element, with its joint and
+/// what to give it. Before, the verifier rejected the constant `inf` of `1/0` with no file, link
+/// or cause.
+fn singular_error(
+    robot: &robovec_dynamics::robot::Robot,
+    text: &str,
+    function: &str,
+    s: &robovec_dynamics::sym::Singular,
+) -> FrontError {
+    let layout = robovec_dynamics::Layout::of(robot);
+    let order = robot.dfs_joints();
+    // The joint whose velocity coordinates hold the pivot's.
+    let body = (0..order.len()).find(|&i| {
+        let nv = robot.joints[order[i]].kind.nv();
+        layout.v_index[i].is_some_and(|first| (first..first + nv).contains(&s.coordinate))
+    });
+    let row = format!("row {0} of M, qdd[{0}]", s.coordinate);
+    let Some(body) = body else {
+        let root = &robot.links[robot.root];
+        return FrontError::new(
+            root.span,
+            format!("the mass matrix is singular (a zero pivot in {row})"),
+            "this robot",
+        )
+        .note(format!("@{function} would divide by it: give every moving link an <inertial>"));
+    };
+    let joint = &robot.joints[order[body]];
+    let link = &robot.links[joint.child];
+    // Links below it: the pivot is the inertia of the whole subtree the joint moves.
+    let carries = robot.joints.iter().any(|j| j.parent == joint.child);
+    let prismatic = joint.kind == JointKind::Prismatic;
+    let own = match link.inertial {
+        None => "has no `<inertial>`",
+        Some(i) if i.mass == 0.0 && prismatic => "has mass 0",
+        Some(i) if i.mass == 0.0 => "has mass 0 and no inertia about its joint's axis",
+        Some(_) if prismatic => "has no mass along its joint's axis",
+        Some(_) => "has no inertia about its joint's axis (its mass lies on the axis)",
+    };
+    let carried = if carries { ", nor do the links it carries" } else { "" };
+    let about = if prismatic { "" } else { " and inertia about the joint's axis" };
+    let (line, _) = robovec_ir::span::line_col(text, joint.span.start as usize);
+    FrontError::new(
+        link.span,
+        format!(
+            "link `{}` (joint `{}`) {own}{carried}: the mass matrix is singular (a zero pivot in {row})",
+            link.name, joint.name
+        ),
+        "this link",
+    )
+    .note(format!(
+        "joint `{}` (line {line}) moves it; @{function} would divide by that pivot, 1/{}",
+        joint.name, s.pivot
+    ))
+    .note(format!(
+        "give link `{}` an <inertial> with a positive mass{about}, or make joint `{}` fixed",
+        link.name, joint.name
+    ))
 }
 
 #[cfg(test)]

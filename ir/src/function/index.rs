@@ -102,9 +102,18 @@ impl NameIndex {
     }
 
     pub(super) fn build(values: &[ValueData]) -> NameIndex {
+        NameIndex::build_until(values, &mut || false).expect("never stopped")
+    }
+
+    /// [`NameIndex::build`] that calls `stop` once per value and gives up (`None`) at the
+    /// first `true` (a time limit, [`super::Function::retain_until`]).
+    pub(super) fn build_until(values: &[ValueData], stop: &mut dyn FnMut() -> bool) -> Option<NameIndex> {
         let mut ix = NameIndex(hashbrown::HashTable::with_capacity(values.len()));
         // As a map built by inserting every value in order: the last of equal names wins.
         for (i, d) in values.iter().enumerate() {
+            if stop() {
+                return None;
+            }
             let v = Value::with_number(i as u32);
             let h = short_hash(&d.name);
             match ix.0.find_mut(spread(h), |&(eh, x)| eh == h && name_is(values, x, &d.name)) {
@@ -112,7 +121,7 @@ impl NameIndex {
                 None => ix.insert(values, v),
             }
         }
-        ix
+        Some(ix)
     }
 }
 
@@ -142,8 +151,20 @@ impl PartialEq for OutputIndex {
 impl OutputIndex {
     /// The index of `outputs` (the last of equal names wins, as in a map built in order).
     pub(super) fn build(outputs: &[Output]) -> hashbrown::HashTable<(u64, usize)> {
+        OutputIndex::build_until(outputs, &mut || false).expect("never stopped")
+    }
+
+    /// [`OutputIndex::build`] that calls `stop` once per output and gives up (`None`) at the
+    /// first `true` (a time limit, [`super::Function::retain_until`]).
+    pub(super) fn build_until(
+        outputs: &[Output],
+        stop: &mut dyn FnMut() -> bool,
+    ) -> Option<hashbrown::HashTable<(u64, usize)>> {
         let mut pos = hashbrown::HashTable::with_capacity(outputs.len());
         for (i, o) in outputs.iter().enumerate() {
+            if stop() {
+                return None;
+            }
             let h = name_hash(&o.name);
             match pos.find_mut(h, |&(eh, j): &(u64, usize)| eh == h && outputs[j].name == o.name) {
                 Some(e) => e.1 = i,
@@ -152,7 +173,7 @@ impl OutputIndex {
                 }
             }
         }
-        pos
+        Some(pos)
     }
 
     /// The position indexed under the name hashed `h` and whether an entry is there.

@@ -296,17 +296,48 @@ impl Function {
     /// The caller guarantees that no kept value refers to a dropped one. The kept values are
     /// moved, not copied (issue 28: copying every expression doubled the peak memory of the
     /// URDF generator, which compacts each function it writes).
-    pub fn retain(&mut self, mut keep: impl FnMut(&Function, Value) -> bool) {
+    pub fn retain(&mut self, keep: impl FnMut(&Function, Value) -> bool) {
+        let done = self.retain_until(keep, &mut || false);
+        debug_assert!(done, "never stopped");
+    }
+
+    /// [`Function::retain`] that calls `stop` about once per value and per output (a time
+    /// limit's clock, issue 47: the URDF generator compacts functions of millions of values
+    /// and outputs) and gives up at the first `true`: it then returns false and leaves the
+    /// function in an unspecified state that does not verify, still holding every output and
+    /// every value it keeps (those are not freed: freeing millions of them takes seconds, which
+    /// the caller may not want to spend). Returns true when done. Cost: as
+    /// [`Function::retain`].
+    #[must_use]
+    pub fn retain_until(
+        &mut self,
+        mut keep: impl FnMut(&Function, Value) -> bool,
+        stop: &mut dyn FnMut() -> bool,
+    ) -> bool {
         let n = self.values.len();
         let mut map: Vec<Option<Value>> = vec![None; n];
         let order: Vec<Value> = self.inputs.iter().chain(self.body.iter()).copied().collect();
-        let kept: Vec<Value> = order.into_iter().filter(|&v| keep(self, v)).collect();
+        let mut kept: Vec<Value> = Vec::new();
+        for v in order {
+            if stop() {
+                return false;
+            }
+            if keep(self, v) {
+                kept.push(v);
+            }
+        }
         let mut new_values = Vec::with_capacity(kept.len());
         let mut slots: Vec<Option<ValueData>> = std::mem::take(&mut self.values).into_iter().map(Some).collect();
         let mut new_inputs = Vec::new();
         let mut new_body = Vec::new();
         let mut new_timings = Vec::new();
         for v in kept {
+            if stop() {
+                // Every value back in the arena, moved, not freed.
+                self.values = new_values;
+                self.values.extend(slots.into_iter().flatten());
+                return false;
+            }
             let nv = Value::with_number(new_values.len() as u32);
             map[v.index()] = Some(nv);
             if let Some(t) = self.timings.get(v.index()) {
@@ -323,8 +354,17 @@ impl Function {
         }
         drop(slots);
         let remap = |v: Value| map[v.index()].expect("kept value refers to a dropped value");
+        let mut remapped = true;
         for d in &mut new_values {
+            if stop() {
+                remapped = false;
+                break;
+            }
             d.def.map_values(&remap);
+        }
+        if !remapped {
+            self.values = new_values;
+            return false;
         }
         for o in &mut self.outputs {
             if let Operand::Value(v) = o.value {
@@ -368,7 +408,16 @@ impl Function {
         self.timings = Timings(new_timings);
         self.inputs = new_inputs;
         self.body = new_body;
-        self.reindex_names();
+        let indexed = OutputIndex::build_until(&self.outputs, stop)
+            .and_then(|pos| Some((pos, NameIndex::build_until(&self.values, stop)?)));
+        match indexed {
+            Some((pos, names)) => {
+                self.outputs_by_name.pos = pos;
+                self.names = names;
+                true
+            }
+            None => false,
+        }
     }
 }
 
@@ -403,6 +452,51 @@ mod tests {
         f.value_mut(b).name = "b".into();
         f.reindex_names();
         assert!(crate::verifier::verify_function(&f).is_empty());
+    }
+
+    /// Issue 47: `retain_until` and `verify_until` call their `stop` once per element of each
+    /// loop and give up at the first `true`; a stopped `retain_until` keeps every value and
+    /// output (nothing freed), a completed one is `retain`.
+    #[test]
+    fn retain_and_verify_stop_when_told_and_lose_nothing() {
+        let text = "func @f { phase atomised input %x input %y input %z \
+             %a = mul %x, %y  %dead = add %x, %z  %b = add %a, %z  %c = sub %b, %x \
+             output p = %b  output q = %c  output r = 2.0 }";
+        let f = crate::text::parse(text).unwrap().functions.remove(0);
+        let keep = |f: &Function, v: Value| f.name_of(v) != "dead";
+        // Walk of inputs and body (7), kept moved (6) and renumbered (6), output index (3),
+        // name index (6).
+        let calls = 7 + 6 + 6 + 3 + 6;
+        let mut reference = f.clone();
+        reference.retain(keep);
+        for k in 1..=calls + 1 {
+            let mut g = f.clone();
+            let mut n = 0;
+            let done = g.retain_until(keep, &mut || {
+                n += 1;
+                n == k
+            });
+            assert_eq!(done, k > calls, "stop at call {k}");
+            if done {
+                assert_eq!(g, reference);
+                assert!(crate::verifier::verify_function(&g).is_empty());
+            } else {
+                assert!(g.values.len() >= 6, "call {k}: every value kept is still there");
+                assert_eq!(g.outputs.len(), 3);
+            }
+        }
+        // The verifier: inputs and body, the name index, the body, the outputs.
+        let calls = 7 + 7 + 4 + 3;
+        let m = Module { functions: vec![f] };
+        for k in 1..=calls + 1 {
+            let mut n = 0;
+            let verdict = crate::verifier::verify_until(&m, &mut || {
+                n += 1;
+                n == k
+            });
+            assert_eq!(verdict.is_some(), k > calls, "stop at call {k}");
+        }
+        assert_eq!(crate::verifier::verify_until(&m, &mut || false), Some(Ok(())));
     }
 
     /// Issue 10 §3: a large function is mostly value records and, parsed, expression nodes.

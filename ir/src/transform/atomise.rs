@@ -40,6 +40,12 @@ pub fn atomise_owned(f: Function) -> Function {
     atomise_within(Cow::Owned(f), &Ticker::default()).expect("a ticker without a limit never stops")
 }
 
+/// [`atomise_function`] that stops when `ticker` says so (one tick per equation; `None`
+/// then): the URDF generator's op counts under `-time-limit` (issue 47).
+pub fn atomise_until(f: &Function, ticker: &Ticker) -> Option<Function> {
+    atomise_within(Cow::Borrowed(f), ticker)
+}
+
 /// The name, definition and span of `v`: borrowed, or taken out of an owned function.
 fn take<'a>(src: &mut Cow<'a, Function>, v: Value) -> (Cow<'a, str>, Cow<'a, Def>, Span) {
     match src {

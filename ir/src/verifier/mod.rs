@@ -108,6 +108,17 @@ fn intrinsic_misuse(c: &Callee, n: usize) -> Option<String> {
 /// # Errors
 /// All violations found, in function order.
 pub fn verify(m: &Module) -> Result<(), Vec<VerifierError>> {
+    verify_until(m, &mut || false).expect("never stopped")
+}
+
+/// [`verify`] that calls `stop` about once per value and per output (a time limit's clock:
+/// the driver verifies its input under `-time-limit`, and a generated function may have
+/// millions of outputs, issue 47) and gives up at the first `true`: `None`, nothing said
+/// about the module.
+///
+/// # Errors
+/// As [`verify`].
+pub fn verify_until(m: &Module, stop: &mut dyn FnMut() -> bool) -> Option<Result<(), Vec<VerifierError>>> {
     let mut errs = Vec::new();
     let mut names = HashSet::default();
     for f in &m.functions {
@@ -119,17 +130,19 @@ pub fn verify(m: &Module) -> Result<(), Vec<VerifierError>> {
                 span: f.span,
             });
         }
-        errs.extend(verify_function(f));
+        errs.extend(verify_function_until(f, stop)?);
     }
-    if errs.is_empty() {
-        Ok(())
-    } else {
-        Err(errs)
-    }
+    Some(if errs.is_empty() { Ok(()) } else { Err(errs) })
 }
 
 /// Verifies one function; returns every violation (empty when it verifies).
 pub fn verify_function(f: &Function) -> Vec<VerifierError> {
+    verify_function_until(f, &mut || false).expect("never stopped")
+}
+
+/// [`verify_function`] that calls `stop` about once per value and per output and gives up
+/// (`None`) at the first `true` ([`verify_until`]).
+pub fn verify_function_until(f: &Function, stop: &mut dyn FnMut() -> bool) -> Option<Vec<VerifierError>> {
     let mut errs = Vec::new();
     let mut err = |loc: Location, span: Span, message: String| {
         errs.push(VerifierError { function: f.name.clone(), location: loc, message, span })
@@ -138,9 +151,12 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
     // Structure: indexes first, so later checks can index infallibly.
     let mut placed = vec![false; n];
     for &v in f.inputs.iter().chain(&f.body) {
+        if stop() {
+            return None;
+        }
         if v.index() >= n {
             err(Location::Function, f.span, format!("{v} is out of range ({n} values)"));
-            return errs;
+            return Some(errs);
         }
         if std::mem::replace(&mut placed[v.index()], true) {
             err(Location::Value(v), f.value(v).span, format!("`%{}` is listed twice", f.name_of(v)));
@@ -154,8 +170,16 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
     }
     // A current index maps every name to its own value, so no two values share a name: the
     // set of names seen is only needed (to tell which error) when the index is not current.
-    let index_current =
-        f.values.iter().enumerate().all(|(i, d)| f.lookup(&d.name) == Some(Value::with_number(i as u32)));
+    let mut index_current = true;
+    for (i, d) in f.values.iter().enumerate() {
+        if stop() {
+            return None;
+        }
+        if f.lookup(&d.name) != Some(Value::with_number(i as u32)) {
+            index_current = false;
+            break;
+        }
+    }
     let mut seen_names = HashSet::default();
     for (i, d) in f.values.iter().enumerate().filter(|_| !index_current) {
         let v = Value::with_number(i as u32);
@@ -176,6 +200,9 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
         defined[v.index()] = true;
     }
     for &v in &f.body {
+        if stop() {
+            return None;
+        }
         let d = f.value(v);
         let here = |m: String| (Location::Value(v), d.span, m);
         let mut local = Vec::new();
@@ -245,6 +272,9 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
     }
     let mut out_names = HashSet::with_capacity_and_hasher(f.outputs.len(), Default::default());
     for (i, o) in f.outputs.iter().enumerate() {
+        if stop() {
+            return None;
+        }
         if !out_names.insert(o.name.as_str()) {
             err(Location::Output(i), o.span, format!("output `{}` is defined twice", o.name));
         }
@@ -261,5 +291,5 @@ pub fn verify_function(f: &Function) -> Vec<VerifierError> {
     if errs.is_empty() {
         errs.extend(placement::verify_placement(f));
     }
-    errs
+    Some(errs)
 }
