@@ -276,7 +276,7 @@ pub struct Builder {
     /// Tests: the steps over the whole function ([`Builder::ticker`]) stop at this tick whatever
     /// the clock says ([`crate::Request::tick_budget`]).
     pub tick_budget: Option<u64>,
-    /// The first pivot that folded to a number that is zero or not finite ([`reciprocal`]), by
+    /// The first pivot that folded to a number that is zero or not finite (`reciprocal`), by
     /// the writers' coordinate: a singular mass matrix (issue 47).
     pub singular: Option<Singular>,
 }
@@ -449,7 +449,7 @@ impl Builder {
     ///
     /// # Errors
     /// [`Stopped`] at [`Reached::Step`] once the deadline is reached; the function is then
-    /// abandoned ([`crate::abandon`]).
+    /// abandoned (`crate::abandon`).
     pub fn finish_until(mut self) -> Result<Function, Stopped> {
         let ticker = self.ticker();
         let done = live_values_until(&self.f, &ticker)
