@@ -474,13 +474,12 @@ pub fn generate_with(model: &Model, request: &Request) -> Result<Generated, Stop
                 }
             }
         }
-        match best.as_ref().is_none_or(|(m, _)| n < *m) {
-            true => {
-                if let Some((_, old)) = best.replace((n, g)) {
-                    drop_all(old);
-                }
+        if best.as_ref().is_none_or(|(m, _)| n < *m) {
+            if let Some((_, old)) = best.replace((n, g)) {
+                drop_all(old);
             }
-            false => drop_all(g),
+        } else {
+            drop_all(g);
         }
     }
     Ok(best.expect("the robot's own frames are a candidate").1)
