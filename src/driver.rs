@@ -3,7 +3,8 @@
 //! Order of work: every option is checked before any work ([`crate::preflight`]: pipeline,
 //! `-sweep-csv` against it, every output path and folder under the output policy of
 //! [`crate::output`], files passes will read; then the `-eval` inputs);
-//! the input is read and `-function` checked against it before any pass runs; the passes run
+//! the input is read (at most [`INPUT_BOUND`] bytes, under the deadline: [`load_with`]) and
+//! `-function` checked against it before any pass runs; the passes run
 //! with their dumps staged; the other outputs are staged; then [`OutputSet::commit`] puts every
 //! file in place at once, and stdout is written last. A failure before the commit leaves
 //! nothing of this run behind (see [`crate::output`] for the policy and its limits).
@@ -40,12 +41,16 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
 /// the front end knows ([`Loaded::params`]). The front end is the registered one for the
 /// input's extension ([`robovec_front::front_end_for`]); the driver names none. A front end
 /// that builds its functions (URDF) builds only `opts.functions` and stops at `opts.deadline`.
+/// At most [`INPUT_BOUND`] bytes are read (stdin, pipes and devices under the deadline too), and
+/// the module's verification stops at the deadline as well (issue 47).
 ///
 /// # Errors
 /// [`Failure::Usage`] for an extension no front end claims, or a requested function a front
 /// end that builds its functions cannot build (`no function `foo` in the input; functions:
 /// invdyna, dirdyna, fordyna`, as `-function` against a loaded module); [`Failure::Input`] with codespan
-/// diagnostics naming file, line and column (the time limit reached while loading among them).
+/// diagnostics naming file, line and column (the time limit reached while loading among them),
+/// or for an input larger than [`INPUT_BOUND`], or the time limit reached while reading or
+/// verifying it.
 pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile), Failure> {
     let name = if input == "-" { "<stdin>".to_string() } else { input.to_string() };
     let bytes = read_input(input, opts.deadline.as_ref())?;
@@ -88,10 +93,12 @@ pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile
             ]);
         return Err(Failure::Input(src.render(&[d])));
     }
-    // Under `-time-limit` the verification stops at the limit too: a generated function may
-    // have millions of outputs (issue 47: 25 million for a 5,000-branch star's `dirdyna`, 2.7 s
-    // to verify).
-    let ticker = robovec_passes::Ticker::new(opts.deadline, None);
+    // Under `-time-limit` the verification of what a front end built (a URDF's generated
+    // functions) stops at the limit too: it may have millions of outputs (issue 47: 25 million
+    // for a 5,000-branch star's `dirdyna` from a 2.5 MB file, 2.7 s to verify). A module read
+    // from its text is verified in time linear in that text, as it was read.
+    let generated = fe.function_names().is_some();
+    let ticker = robovec_passes::Ticker::new(opts.deadline.filter(|_| generated), None);
     match verifier::verify_until(module, &mut || ticker.tick()) {
         Some(Ok(())) => {}
         Some(Err(errs)) => {
@@ -99,13 +106,24 @@ pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile
             return Err(Failure::Input(src.render(&diags)));
         }
         None => {
+            leave_past_deadline(loaded, opts.deadline.as_ref());
             return Err(Failure::Input(format!(
                 "error: {} while verifying the input\n  = note: {LOADING_NOTE}\n",
                 ticker.reason()
-            )))
+            )));
         }
     }
     Ok((loaded, src))
+}
+
+/// Drops `x`, or, once `deadline` has passed, leaves it to the process's exit (issue 47): a run
+/// that fails past its time limit ends at once, and freeing a large module block by block
+/// took about a second per gigabyte (a 5,000-branch star's `dirdyna` stopped while verifying
+/// at a 10 s limit: 4.5 GB), where the system reclaims a process's memory at once.
+fn leave_past_deadline<T>(x: T, deadline: Option<&robovec_passes::Deadline>) {
+    if deadline.is_some_and(|d| d.reached()) {
+        std::mem::forget(x);
+    }
 }
 
 /// The most bytes read from one input, stdin included (1 GiB): far above any real input (the
@@ -432,11 +450,16 @@ fn run_passes(
     {
         let dir = opts.instr.dump_dir.clone().unwrap_or_default();
         let mut dumps = StagedDumps { dir, out, created: false };
-        session.run(stderr, &mut dumps).map_err(|e| match e {
+        let ran = session.run(stderr, &mut dumps).map_err(|e| match e {
             PassError::Output { message } => output_failure(message),
             PassError::Log(e) => stderr_failure(e),
             e => pass_failure(e, src),
-        })?;
+        });
+        if let Err(f) = ran {
+            // A run that fails past its limit leaves its module to the exit.
+            leave_past_deadline(std::mem::take(&mut session.module), deadline.as_ref());
+            return Err(f);
+        }
     }
     for s in session.cx.lines(robovec_passes::Severity::Stop) {
         writeln!(stderr, "note: {s}").map_err(stderr_failure)?;

@@ -121,6 +121,7 @@ pub(crate) fn ltdl_or_aba(
     parts: &mut Parts<'_>,
     whole: bool,
 ) -> Result<(), Stopped> {
+    let limited = b.deadline.is_some();
     let mut aba = b.fresh();
     if let Err(stop) = crate::aba::fordyna(model, layout, &mut aba) {
         crate::abandon(aba.f);
@@ -146,11 +147,11 @@ pub(crate) fn ltdl_or_aba(
                 .and_then(|()| Ok(!whole || by_ltdl.ops_after_cse_until()? <= aba_ops));
             match kept {
                 Ok(true) => {
-                    crate::drop_later(std::mem::replace(b, by_ltdl).f);
-                    crate::drop_later(aba.f);
+                    crate::drop_later(std::mem::replace(b, by_ltdl).f, limited);
+                    crate::drop_later(aba.f, limited);
                     return Ok(());
                 }
-                Ok(false) => crate::drop_later(by_ltdl.f),
+                Ok(false) => crate::drop_later(by_ltdl.f, limited),
                 Err(stop) => {
                     crate::abandon(by_ltdl.f);
                     crate::abandon(aba.f);
@@ -159,7 +160,7 @@ pub(crate) fn ltdl_or_aba(
             }
         }
     }
-    crate::drop_later(std::mem::replace(b, aba).f);
+    crate::drop_later(std::mem::replace(b, aba).f, limited);
     Ok(())
 }
 

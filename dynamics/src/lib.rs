@@ -317,12 +317,15 @@ impl std::fmt::Display for Stopped {
 const LARGE: usize = 100_000;
 
 /// Drops a function no longer needed (a formulation or frame candidate that lost, a copy that
-/// was counted) on a thread of its own when it is large (issue 47): freeing the millions of
-/// small allocations of a large generated function (names, expression trees) takes about a
-/// second per gigabyte, which the generation need not wait for. Small ones, and any when no
-/// thread can be started, are dropped here.
-pub(crate) fn drop_later(f: robovec_ir::Function) {
-    if f.values.len() + f.outputs.len() >= LARGE {
+/// was counted). Under a time limit (`limited`) a large one is dropped on a thread of its own
+/// (issue 47): freeing the millions of small allocations of a large generated function (names,
+/// expression trees) takes about a second per gigabyte, which a run near its limit cannot
+/// spend. Without one it is dropped here, as it is cheaper overall (freed by the thread that
+/// allocated it: a 5,000-branch star's `dirdyna` took 1-2 s longer, of 15 s, with its losing
+/// candidate freed on another thread). Small ones, and any when no thread can be started, are
+/// dropped here.
+pub(crate) fn drop_later(f: robovec_ir::Function, limited: bool) {
+    if limited && f.values.len() + f.outputs.len() >= LARGE {
         // On failure the closure, and `f` with it, is dropped here.
         let _ = std::thread::Builder::new().name("robovec-drop".into()).spawn(move || drop(f));
     }
@@ -437,10 +440,11 @@ pub fn generate_with(model: &Model, request: &Request) -> Result<Generated, Stop
         robots.extend(origins::slide(&robots[i]));
     }
     // The ops of each candidate, counted at the deadline's pace (a 10,000-joint chain's
-    // `fordyna` takes 0.8 s to count); the candidates that lose are dropped on a thread of
-    // their own ([`drop_later`]), those a stop leaves are abandoned ([`abandon`]).
+    // `fordyna` takes 0.8 s to count); under a limit the candidates that lose are dropped on a
+    // thread of their own ([`drop_later`]), those a stop leaves are abandoned ([`abandon`]).
     let ticker = robovec_ir::time_limit::Ticker::new(request.deadline, request.tick_budget);
-    let drop_all = |g: Generated| g.module.functions.into_iter().for_each(drop_later);
+    let limited = request.deadline.is_some();
+    let drop_all = |g: Generated| g.module.functions.into_iter().for_each(|f| drop_later(f, limited));
     let abandon_all = |g: Generated| g.module.functions.into_iter().for_each(abandon);
     let mut best: Option<(u64, Generated)> = None;
     for robot in robots {
@@ -471,13 +475,12 @@ pub fn generate_with(model: &Model, request: &Request) -> Result<Generated, Stop
                 }
             }
         }
-        match best.as_ref().is_none_or(|(m, _)| n < *m) {
-            true => {
-                if let Some((_, old)) = best.replace((n, g)) {
-                    drop_all(old);
-                }
+        if best.as_ref().is_none_or(|(m, _)| n < *m) {
+            if let Some((_, old)) = best.replace((n, g)) {
+                drop_all(old);
             }
-            false => drop_all(g),
+        } else {
+            drop_all(g);
         }
     }
     Ok(best.expect("the robot's own frames are a candidate").1)

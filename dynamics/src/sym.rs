@@ -276,7 +276,7 @@ pub struct Builder {
     /// Tests: the steps over the whole function ([`Builder::ticker`]) stop at this tick whatever
     /// the clock says ([`crate::Request::tick_budget`]).
     pub tick_budget: Option<u64>,
-    /// The first pivot that folded to a number that is zero or not finite (`reciprocal`), by
+    /// The first pivot that folded to a number that is zero or not finite (`1/d` of a number), by
     /// the writers' coordinate: a singular mass matrix (issue 47).
     pub singular: Option<Singular>,
 }
@@ -421,7 +421,7 @@ impl Builder {
     /// inertias, built entry by entry, repeat many). This builder is unchanged. Cost: linear in
     /// the ops. [`Builder::ops_after_cse_until`] without a time limit.
     pub fn ops_after_cse(&self) -> u64 {
-        ops_after_cse_of(&self.f, &Ticker::default()).expect("a ticker without a limit never stops")
+        ops_after_cse_of(&self.f, &Ticker::default(), false).expect("a ticker without a limit never stops")
     }
 
     /// [`Builder::ops_after_cse`] that stops at the builder's deadline (one tick per equation,
@@ -431,7 +431,8 @@ impl Builder {
     /// # Errors
     /// [`Stopped`] at [`Reached::Step`] once the deadline is reached.
     pub fn ops_after_cse_until(&self) -> Result<u64, Stopped> {
-        ops_after_cse_of(&self.f, &self.ticker()).ok_or_else(|| self.stopped(Reached::Step(COUNTING)))
+        let limited = self.deadline.is_some();
+        ops_after_cse_of(&self.f, &self.ticker(), limited).ok_or_else(|| self.stopped(Reached::Step(COUNTING)))
     }
 
     /// The finished function: what no output needs is dropped (Robotran writes only the
@@ -448,8 +449,8 @@ impl Builder {
     /// seconds).
     ///
     /// # Errors
-    /// [`Stopped`] at [`Reached::Step`] once the deadline is reached; the function is then
-    /// abandoned (`crate::abandon`).
+    /// [`Stopped`] at [`Reached::Step`] once the deadline is reached; a large function is then
+    /// leaked, not freed (the run ends with an error; freeing a gigabyte took a second).
     pub fn finish_until(mut self) -> Result<Function, Stopped> {
         let ticker = self.ticker();
         let done = live_values_until(&self.f, &ticker)
@@ -516,10 +517,10 @@ pub(crate) fn op_counts_until(f: &Function, ticker: &Ticker) -> Option<OpCounts>
 /// The ops of `f` once atomised, pruned of what no output reads and its repeated ops merged
 /// ([`Builder::ops_after_cse`]); `None` when `ticker` says stop. The atomised copy is pruned
 /// (atomising a dead equation writes only dead ops) and its merges counted in place
-/// ([`robovec_ir::transform::cse::cse_drops_until`]), then it is dropped on a thread of its own
-/// ([`crate::drop_later`]: freeing its millions of names took longer than counting), or
-/// abandoned on a stop ([`crate::abandon`]).
-fn ops_after_cse_of(f: &Function, ticker: &Ticker) -> Option<u64> {
+/// ([`robovec_ir::transform::cse::cse_drops_until`]), then dropped, under a time limit (`limited`) on
+/// a thread of its own ([`crate::drop_later`]: freeing the millions of names of a large one
+/// took seconds), or abandoned on a stop ([`crate::abandon`]).
+fn ops_after_cse_of(f: &Function, ticker: &Ticker, limited: bool) -> Option<u64> {
     let mut a = robovec_ir::transform::atomise::atomise_until(f, ticker)?;
     let pruned =
         live_values_until(&a, ticker).is_some_and(|live| a.retain_until(|_, v| live[v.index()], &mut || ticker.tick()));
@@ -530,7 +531,7 @@ fn ops_after_cse_of(f: &Function, ticker: &Ticker) -> Option<u64> {
         None
     };
     match ops {
-        Some(_) => crate::drop_later(a),
+        Some(_) => crate::drop_later(a, limited),
         None => crate::abandon(a),
     }
     ops

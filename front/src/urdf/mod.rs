@@ -14,6 +14,11 @@
 //! ([`robovec_dynamics::Request::deadline`]); once it is reached the load fails with
 //! `time limit of 5 s reached while generating @dirdyna (body k of n)` at that body's
 //! `<joint>` and no output is written: no pass can run on part of a function.
+//!
+//! A link that makes the mass matrix singular (no mass or no inertia about its joint's axis,
+//! with what it carries) is named at its `<link>` with its joint when `fordyna` is asked for
+//! ([`robovec_dynamics::Generated::singular`], issue 47), instead of the verifier's rejection of
+//! the constant `inf` that `1/0` folds to.
 
 mod parse;
 
