@@ -8,8 +8,7 @@ use robovec_ir::{Function, Module, Phase};
 
 pub use robovec_ir::transform::atomise::{atomise_function, atomise_owned, atomise_until, atomise_within};
 
-use crate::time_limit::TickerError;
-use crate::{Params, Pass, PassContext, PassError, PassInfo};
+use crate::{try_each_function, AtTimeLimit, Before, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -32,16 +31,29 @@ impl Pass for Atomise {
     /// `-time-limit`: required (every later pass needs the atomised phase); it ticks once per
     /// equation and a stop ends the run ([`PassError::TimeLimit`]).
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
-        let ticker = cx.ticker();
-        for f in &mut m.functions {
-            let parsed = std::mem::replace(f, Function::new(String::new(), Phase::Atomised));
-            let (name, n, seen) = (parsed.name.clone(), parsed.body.len(), ticker.ticks());
-            *f = atomise_within(Cow::Owned(parsed), &ticker).ok_or_else(|| {
-                let done = ticker.ticks().saturating_sub(seen + 1);
-                ticker.error("atomise", &format!("in @{name} after {done} of {n} equations"))
-            })?;
-        }
-        Ok(())
+        try_each_function(
+            m,
+            cx,
+            "atomise",
+            AtTimeLimit::Required,
+            Before::Ticked,
+            |_, _| None,
+            |f, _, ticker| {
+                let parsed = std::mem::replace(f, Function::new(String::new(), Phase::Atomised));
+                let (name, n, seen) = (parsed.name.clone(), parsed.body.len(), ticker.ticks());
+                Ok(match atomise_within(Cow::Owned(parsed), ticker) {
+                    Some(atomised) => {
+                        *f = atomised;
+                        Step::Done(())
+                    }
+                    None => {
+                        let done = ticker.ticks().saturating_sub(seen + 1);
+                        Step::Stopped { what: format!("in @{name} after {done} of {n} equations"), kept: None }
+                    }
+                })
+            },
+        )
+        .map(drop)
     }
 }
 

@@ -8,8 +8,7 @@
 use robovec_ir::Module;
 
 use crate::params::ParamKind;
-use crate::time_limit::TickerError;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -56,19 +55,24 @@ impl Pass for Dce {
         }
         // `-time-limit`: required (it changes what a function outputs and takes); two linear
         // sweeps per function, so the clock is read between functions.
-        let ticker = cx.ticker();
-        for (k, f) in m.functions.iter_mut().enumerate() {
-            if ticker.check() {
-                return Err(ticker.error("dce", &format!("before @{} ({k} functions done)", f.name)));
-            }
-            if let Some(keep) = &self.keep {
-                f.outputs.retain(|o| keep.iter().any(|e| matches(e, &o.name)));
-            }
-            let live = f.live_values(&[]);
-            f.retain(|_, v| live[v.index()]);
-            f.clear_timing();
-        }
-        Ok(())
+        try_each_function(
+            m,
+            cx,
+            "dce",
+            AtTimeLimit::Required,
+            Before::Clock,
+            |_, _| None,
+            |f, _, _| {
+                if let Some(keep) = &self.keep {
+                    f.outputs.retain(|o| keep.iter().any(|e| matches(e, &o.name)));
+                }
+                let live = f.live_values(&[]);
+                f.retain(|_, v| live[v.index()]);
+                f.clear_timing();
+                Ok(Step::Done(()))
+            },
+        )
+        .map(drop)
     }
 }
 

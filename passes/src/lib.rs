@@ -44,7 +44,7 @@ use robovec_ir::{Module, Phase, Span};
 use robovec_machine::target::Target;
 
 pub use artifact::{unit_path, Artifact, ArtifactFile, GeneratedCode, Merge, Produced, ReportEntry};
-pub use each::{each_function, Before, Step};
+pub use each::{each_function, try_each_function, Before, Step};
 pub use manager::{DumpSink, Element, Instrumentation, PassManager, PassRecord, PrintSelector};
 pub use params::{LatencyOverride, Member, ParamInfo, ParamKind, Params};
 pub use pipeline::{parse_pipeline, PassSpec};
@@ -322,10 +322,28 @@ impl PassContext {
         });
     }
 
+    /// Records that the manager skipped `pass` (`-time-limit` reached before it started;
+    /// `reason`: `time limit of 1 s reached`): a [`Severity::Stop`] diagnostic
+    /// (`balance skipped: time limit of 1 s reached before it started`).
+    pub fn note_skip(&mut self, pass: &str, reason: &str) {
+        self.diagnostics.push(Diagnostic {
+            severity: Severity::Stop,
+            pass: pass.to_string(),
+            functions: Vec::new(),
+            message: format!("{pass} skipped: {reason} before it started"),
+        });
+    }
+
     /// Records what `pass` did to the functions of `m` ([`Severity::Remark`]; `message` is the
     /// whole line `-stats` prints, `balance: @dirdyna: ops 4261 -> 4095, …`).
     pub fn remark(&mut self, pass: &str, m: &Module, message: String) {
         let functions = m.functions.iter().map(|f| f.name.clone()).collect();
+        self.remark_in(pass, functions, message);
+    }
+
+    /// [`PassContext::remark`] about the named `functions` only (`codegen<fpga>`'s estimate of
+    /// one function's resources).
+    pub fn remark_in(&mut self, pass: &str, functions: Vec<String>, message: String) {
         self.diagnostics.push(Diagnostic { severity: Severity::Remark, pass: pass.to_string(), functions, message });
     }
 

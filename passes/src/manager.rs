@@ -275,12 +275,7 @@ impl PassManager {
                 // `-time-limit` reached before the pass starts (crate::time_limit's policy).
                 match props.at_time_limit {
                     AtTimeLimit::Skip => {
-                        cx.diagnostics.push(crate::Diagnostic {
-                            severity: crate::Severity::Stop,
-                            pass: spec.to_string(),
-                            functions: Vec::new(),
-                            message: format!("{spec} skipped: {} before it started", d.reason()),
-                        });
+                        cx.note_skip(&spec.to_string(), &d.reason());
                         let (ops_before, ops_after) = (module_ops(m), module_ops(m));
                         records.push(PassRecord { name: spec.to_string(), wall_ms: 0.0, ops_before, ops_after });
                         continue;

@@ -27,8 +27,7 @@ use robovec_ir::{BinOp, Def, Function, Module, Operand, TrigFn};
 
 use crate::dce::Dce;
 use crate::params::ParamKind;
-use crate::time_limit::TickerError;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -81,18 +80,21 @@ impl Pass for Specialize {
             .filter(|k| !m.functions.iter().any(|f| f.lookup(k).is_some_and(|v| matches!(f.value(v).def, Def::Input))))
             .map(String::as_str)
             .collect();
-        let mut parts = Vec::new();
         // `-time-limit`: required (it changes what a function takes); one linear sweep per
         // function, so the clock is read between functions (and by `dce` after).
-        let ticker = cx.ticker();
-        for (k, f) in m.functions.iter_mut().enumerate() {
-            if ticker.check() {
-                return Err(ticker.error("specialize", &format!("before @{} ({k} functions done)", f.name)));
-            }
-            let before = f.op_counts().total;
-            let known = specialize_function(f, &params);
-            parts.push((f.name.clone(), before, known));
-        }
+        let parts = try_each_function(
+            m,
+            cx,
+            "specialize",
+            AtTimeLimit::Required,
+            Before::Clock,
+            |_, _| None,
+            |f, _, _| {
+                let before = f.op_counts().total;
+                let known = specialize_function(f, &params);
+                Ok(Step::Done((f.name.clone(), before, known)))
+            },
+        )?;
         Dce { keep: None }.run(m, cx)?;
         let mut line = Vec::new();
         for ((name, before, known), f) in parts.into_iter().zip(&m.functions) {

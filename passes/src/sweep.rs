@@ -27,7 +27,9 @@ use crate::place::{
     Priority, Select,
 };
 use crate::sim::{SimError, SimErrorKind};
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{
+    try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step, Ticker,
+};
 
 /// min / mean / max of words over the PEs of one type.
 #[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
@@ -248,107 +250,113 @@ impl Pass for Sweep {
         let total = m.functions.len() * self.ns.len() * configs.len();
         let mut done = 0usize;
         let task = cx.progress.task("sweep: placements", total as u64);
-        let mut rows = Vec::new();
-        let mut fit = Vec::new();
-        for f in &m.functions {
-            let ops = f.op_counts().total;
-            let cp_now = compute_timing(f, &cx.latencies).1.asap_cycle;
-            let (n_add_side, n_mul) = ops_per_side(f);
-            for &n in &self.ns {
-                for (priority, select, improve, pname, sname) in configs {
-                    if let Some(d) = cx.deadline.filter(|d| d.reached()) {
-                        task.finish();
-                        cx.note_stop("sweep", &format!("after {done} of {total} configurations: {}", d.reason()));
-                        fit.push(fit_row(&f.name, &cx.target, cp_now, &rows));
-                        cx.emit(SweepTable { rows });
-                        cx.emit(SweepFit { rows: fit });
-                        return Ok(());
-                    }
-                    done += 1;
-                    let mut o = PlaceOptions::with_pes(n);
-                    // A configuration the limit reaches is dropped (its placement or its
-                    // simulation stops inside): sweep is skippable, so no grace.
-                    (o.deadline, o.grace, o.tick_budget) = (cx.deadline, cx.deadline, cx.tick_budget);
-                    o.arch.lat = cx.latencies;
-                    o.arch.writes = cx.target.writes;
-                    o.priority = priority;
-                    o.select = select;
-                    o.improve = improve;
-                    if improve == 0 {
-                        // The seed's algorithm alone: no restarts or search either.
-                        (o.restarts, o.search) = (0, 0);
-                    }
-                    let ticker = cx.ticker();
-                    let verified = match try_place_function_within(f, &o) {
-                        Ok((p, _)) => crate::sim::verify_until(f, &p, &[1], &ticker).map(|_| p),
-                        Err(PlaceError::Stopped) => Err(SimError::stopped()),
-                        Err(PlaceError::Stuck(e)) => {
-                            return Err(PassError::Failed { pass: "sweep".into(), message: e })
+        let (deadline, tick_budget, latencies, target) = (cx.deadline, cx.tick_budget, cx.latencies, cx.target.clone());
+        // A stop (before a configuration, or inside one, which is dropped) ends the sweep with the
+        // rows done and the fit of the function it stopped in.
+        let per_function = try_each_function(
+            m,
+            cx,
+            "sweep",
+            AtTimeLimit::Skip,
+            Before::Ticked,
+            |_, _| None,
+            |f, _, _| {
+                let ops = f.op_counts().total;
+                let cp_now = compute_timing(f, &latencies).1.asap_cycle;
+                let (n_add_side, n_mul) = ops_per_side(f);
+                let mut rows = Vec::new();
+                for &n in &self.ns {
+                    for (priority, select, improve, pname, sname) in configs {
+                        if deadline.is_some_and(|d| d.reached()) {
+                            let fit = fit_row(&f.name, &target, cp_now, &rows);
+                            return Ok(Step::Stopped {
+                                what: format!("after {done} of {total} configurations"),
+                                kept: Some((rows, fit)),
+                            });
                         }
-                    };
-                    let p = match verified {
-                        Ok(p) => p,
-                        Err(e) if e.kind == SimErrorKind::Stopped => {
-                            task.finish();
-                            let what = format!(
-                                "in N={n} {pname}/{sname} of @{} ({} of {total} configurations done, that one dropped): {}",
+                        done += 1;
+                        let mut o = PlaceOptions::with_pes(n);
+                        // A configuration the limit reaches is dropped (its placement or its
+                        // simulation stops inside): sweep is skippable, so no grace.
+                        (o.deadline, o.grace, o.tick_budget) = (deadline, deadline, tick_budget);
+                        o.arch.lat = latencies;
+                        o.arch.writes = target.writes;
+                        o.priority = priority;
+                        o.select = select;
+                        o.improve = improve;
+                        if improve == 0 {
+                            // The seed's algorithm alone: no restarts or search either.
+                            (o.restarts, o.search) = (0, 0);
+                        }
+                        let ticker = Ticker::new(deadline, tick_budget);
+                        let verified = match try_place_function_within(f, &o) {
+                            Ok((p, _)) => crate::sim::verify_until(f, &p, &[1], &ticker).map(|_| p),
+                            Err(PlaceError::Stopped) => Err(SimError::stopped()),
+                            Err(PlaceError::Stuck(e)) => {
+                                return Err(PassError::Failed { pass: "sweep".into(), message: e })
+                            }
+                        };
+                        let p = match verified {
+                            Ok(p) => p,
+                            Err(e) if e.kind == SimErrorKind::Stopped => {
+                                let what = format!(
+                                "in N={n} {pname}/{sname} of @{} ({} of {total} configurations done, that one dropped)",
                                 f.name,
                                 done - 1,
-                                ticker.reason()
                             );
-                            cx.note_stop("sweep", &what);
-                            fit.push(fit_row(&f.name, &cx.target, cp_now, &rows));
-                            cx.emit(SweepTable { rows });
-                            cx.emit(SweepFit { rows: fit });
-                            return Ok(());
-                        }
-                        Err(e) => {
-                            return Err(PassError::Failed {
-                                pass: "sweep".into(),
-                                message: format!("@{} N={n} {pname}/{sname}: simulation failed: {e}", f.name),
-                            })
-                        }
-                    };
-                    let p = &p;
-                    let c = cycles(f, p);
-                    let (_, cp) = compute_timing(f, &o.arch.lat);
-                    let side = |k: u64, lat: u32| if k == 0 { 0 } else { (k.div_ceil(n as u64) - 1) as u32 + lat };
-                    let na = n as usize;
-                    let indirect = p.writes.iter().filter(|w| w.buffer_addr.is_some()).count() as u64;
-                    let est = crate::place::report::estimate(p, c, &cx.target);
-                    rows.push(SweepRow {
-                        function: f.name.clone(),
-                        n,
-                        priority: pname.to_string(),
-                        select: sname.to_string(),
-                        cycles: c,
-                        us: cx.target.us(c),
-                        lower_bound: lower_bound(f, &o.arch),
-                        tight_lower_bound: tight_lower_bound(f, &o.arch),
-                        resource_bound: side(n_add_side, o.arch.lat.add).max(side(n_mul, o.arch.lat.mul)),
-                        critical_path: cp.asap_cycle,
-                        y: if cp.asap_cycle == 0 { 0.0 } else { ops as f64 / cp.asap_cycle as f64 },
-                        parallelisation_rate: if c == 0 { 0.0 } else { ops as f64 / (c as f64 * 2.0 * n as f64) },
-                        pe_words_add: word_stats(&p.pe_words[..na]),
-                        pe_words_mul: word_stats(&p.pe_words[na..]),
-                        buffer_words_add: word_stats(&p.buffer_words[..na]),
-                        buffer_words_mul: word_stats(&p.buffer_words[na..]),
-                        writes_direct: p.writes.len() as u64 - indirect,
-                        writes_indirect: indirect,
-                        lat_add: o.arch.lat.add,
-                        lat_mul: o.arch.lat.mul,
-                        alm: est.alm,
-                        m10k: est.m10k,
-                        dsp: est.dsp,
-                        fits: est.fits,
-                    });
-                    task.set(done as u64);
+                                let fit = fit_row(&f.name, &target, cp_now, &rows);
+                                return Ok(Step::Stopped { what, kept: Some((rows, fit)) });
+                            }
+                            Err(e) => {
+                                return Err(PassError::Failed {
+                                    pass: "sweep".into(),
+                                    message: format!("@{} N={n} {pname}/{sname}: simulation failed: {e}", f.name),
+                                })
+                            }
+                        };
+                        let p = &p;
+                        let c = cycles(f, p);
+                        let (_, cp) = compute_timing(f, &o.arch.lat);
+                        let side = |k: u64, lat: u32| if k == 0 { 0 } else { (k.div_ceil(n as u64) - 1) as u32 + lat };
+                        let na = n as usize;
+                        let indirect = p.writes.iter().filter(|w| w.buffer_addr.is_some()).count() as u64;
+                        let est = crate::place::report::estimate(p, c, &target);
+                        rows.push(SweepRow {
+                            function: f.name.clone(),
+                            n,
+                            priority: pname.to_string(),
+                            select: sname.to_string(),
+                            cycles: c,
+                            us: target.us(c),
+                            lower_bound: lower_bound(f, &o.arch),
+                            tight_lower_bound: tight_lower_bound(f, &o.arch),
+                            resource_bound: side(n_add_side, o.arch.lat.add).max(side(n_mul, o.arch.lat.mul)),
+                            critical_path: cp.asap_cycle,
+                            y: if cp.asap_cycle == 0 { 0.0 } else { ops as f64 / cp.asap_cycle as f64 },
+                            parallelisation_rate: if c == 0 { 0.0 } else { ops as f64 / (c as f64 * 2.0 * n as f64) },
+                            pe_words_add: word_stats(&p.pe_words[..na]),
+                            pe_words_mul: word_stats(&p.pe_words[na..]),
+                            buffer_words_add: word_stats(&p.buffer_words[..na]),
+                            buffer_words_mul: word_stats(&p.buffer_words[na..]),
+                            writes_direct: p.writes.len() as u64 - indirect,
+                            writes_indirect: indirect,
+                            lat_add: o.arch.lat.add,
+                            lat_mul: o.arch.lat.mul,
+                            alm: est.alm,
+                            m10k: est.m10k,
+                            dsp: est.dsp,
+                            fits: est.fits,
+                        });
+                        task.set(done as u64);
+                    }
                 }
-            }
-            fit.push(fit_row(&f.name, &cx.target, cp_now, &rows));
-        }
+                let fit = fit_row(&f.name, &target, cp_now, &rows);
+                Ok(Step::Done((rows, fit)))
+            },
+        )?;
         task.finish();
-        cx.emit(SweepTable { rows });
+        let (rows, fit): (Vec<Vec<SweepRow>>, Vec<FitRow>) = per_function.into_iter().unzip();
+        cx.emit(SweepTable { rows: rows.into_iter().flatten().collect() });
         cx.emit(SweepFit { rows: fit });
         Ok(())
     }

@@ -59,7 +59,7 @@ use robovec_machine::emit::{emit_until, DesignFile};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
 use robovec_passes::params::{word_enum, ParamKind};
-use robovec_passes::time_limit::TickerError;
+use robovec_passes::{try_each_function, AtTimeLimit, Before, Step};
 use robovec_passes::{
     Artifact, ArtifactFile, Member, Merge, ParamInfo, Params, Pass, PassContext, PassError, ReportEntry, Ticker,
 };
@@ -281,34 +281,38 @@ impl Pass for CodegenFpga {
     fn run(&self, m: &mut robovec_ir::Module, cx: &mut PassContext) -> Result<(), PassError> {
         robovec_passes::require_phase("codegen", m, robovec_ir::Phase::Atomised)?;
         let (limits, model) = (Limits::of(&cx.target), cost_model(&cx.target));
-        let ticker = cx.ticker();
-        let mut functions = Vec::new();
-        for f in &m.functions {
-            if ticker.check() {
-                return Err(ticker.error(PASS, &format!("before @{} ({} functions done)", f.name, functions.len())));
-            }
-            let built = self.build_within(f, &limits, &model, &ticker);
-            if ticker.stopped() {
-                return Err(ticker.error(PASS, &format!("in @{} while lowering", f.name)));
-            }
-            // Located at the value or placement line the lowering names, as `sim` does.
-            let (_, report, files) = built.map_err(|e| match e.span {
-                s if s == robovec_ir::Span::DUMMY => failed(e.message),
-                s => failed(e.message).at(s),
-            })?;
-            if self.auto_skips_yosys(report.n_add + report.n_mul) {
-                cx.diagnostics.push(robovec_passes::Diagnostic {
-                    severity: robovec_passes::Severity::Remark,
-                    pass: PASS.to_string(),
-                    functions: vec![f.name.clone()],
-                    message: format!(
-                        "codegen<fpga> @{}: {} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway)",
-                        f.name,
-                        report.n_add + report.n_mul
-                    ),
-                });
-            }
-            functions.push((f.name.clone(), report, files));
+        let mut estimated = Vec::new();
+        let functions = try_each_function(
+            m,
+            cx,
+            PASS,
+            AtTimeLimit::Required,
+            Before::Clock,
+            |_, _| None,
+            |f, _, ticker| {
+                let built = self.build_within(f, &limits, &model, ticker);
+                if ticker.stopped() {
+                    return Ok(Step::Stopped { what: format!("in @{} while lowering", f.name), kept: None });
+                }
+                // Located at the value or placement line the lowering names, as `sim` does.
+                let (_, report, files) = built.map_err(|e| match e.span {
+                    s if s == robovec_ir::Span::DUMMY => failed(e.message),
+                    s => failed(e.message).at(s),
+                })?;
+                if self.auto_skips_yosys(report.n_add + report.n_mul) {
+                    estimated.push((f.name.clone(), report.n_add + report.n_mul));
+                }
+                Ok(Step::Done((f.name.clone(), report, files)))
+            },
+        )?;
+        for (f, pes) in estimated {
+            cx.remark_in(
+                PASS,
+                vec![f.clone()],
+                format!(
+                    "codegen<fpga> @{f}: {pes} PEs: resources from the analytic estimate (resources=auto gives Yosys designs of at most {AUTO_YOSYS_MAX_PES} PEs; resources=yosys runs it anyway)"
+                ),
+            );
         }
         cx.emit(FpgaArtifact { functions, out: self.out.clone() });
         Ok(())

@@ -41,7 +41,7 @@ use robovec_ir::{Function, Module};
 use serde::Serialize;
 
 use crate::params::ParamKind;
-use crate::{LatencyOverride, ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{each_function, Before, LatencyOverride, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -87,18 +87,24 @@ impl Pass for DepthBound {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let lat = cx.latencies_for("depth-bound", &self.lat);
-        let ticker = cx.ticker();
-        let mut functions = Vec::new();
-        for f in &m.functions {
-            // After a stop, the functions left expand nothing: their bounds are 0, with 0 outputs
-            // expanded. The note names the function the stop came in.
-            let stopped_before = ticker.stopped();
-            let b = bound_function(f, &lat, self.max_terms, || ticker.check());
-            if ticker.stopped() && !stopped_before {
-                cx.note_stop("depth-bound", &format!("while expanding @{}: {}", f.name, ticker.reason()));
-            }
-            functions.push(b);
-        }
+        let mut functions = each_function(
+            m,
+            cx,
+            "depth-bound",
+            Before::Ticked,
+            |_, _| None,
+            |f, _, ticker| {
+                let b = bound_function(f, &lat, self.max_terms, || ticker.check());
+                match ticker.stopped() {
+                    true => Step::Stopped { what: format!("while expanding @{}", f.name), kept: Some(b) },
+                    false => Step::Done(b),
+                }
+            },
+        );
+        // After a stop, the functions left expand nothing: their bounds are 0, with 0 outputs
+        // expanded. The note names the function the stop came in.
+        let rest = &m.functions[functions.len()..];
+        functions.extend(rest.iter().map(|f| bound_function(f, &lat, self.max_terms, || true)));
         cx.emit(DepthBoundRun { functions });
         Ok(())
     }

@@ -60,7 +60,7 @@ use robovec_ir::analysis::Latencies;
 use robovec_ir::Module;
 
 use crate::params::ParamKind;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{each_function, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 pub use apply::{eqsat_function, eqsat_function_within, MIN_WINDOW_WORK, WORK_ENODES};
 pub use stats::{EqsatStats, StopCounts};
@@ -206,17 +206,30 @@ impl Pass for Eqsat {
                 .map_err(|message| PassError::Failed { pass: "eqsat".into(), message })?;
             rules.extend(extra);
         }
-        let mut runs = Vec::new();
         let opts = EqsatOptions { lat: cx.latencies_for("eqsat", &self.lat), ..self.opts.clone() };
-        for f in &mut m.functions {
-            let stats = eqsat_function_within(f, &opts, &rules, cx.deadline);
-            if let Some(why) = &stats.stopped_early {
-                let what =
-                    format!("after {} of {} windows of @{}: {why}", stats.windows_tried, stats.windows_total, f.name);
-                cx.note_stop("eqsat", &what);
-            }
-            runs.push(stats);
-        }
+        // Each function gets at most the time left, and its own e-node budget: a stop cuts that
+        // function's search short (a note each) and the next one is tried with what is left.
+        let deadline = cx.deadline;
+        let runs = each_function(
+            m,
+            cx,
+            "eqsat",
+            Before::Ticked,
+            |_, _| None,
+            |f, _, _| {
+                let stats = eqsat_function_within(f, &opts, &rules, deadline);
+                match &stats.stopped_early {
+                    Some(why) => Step::Cut {
+                        note: format!(
+                            "after {} of {} windows of @{}: {why}",
+                            stats.windows_tried, stats.windows_total, f.name
+                        ),
+                        result: stats,
+                    },
+                    None => Step::Done(stats),
+                }
+            },
+        );
         cx.emit(EqsatRun { functions: runs });
         Ok(())
     }

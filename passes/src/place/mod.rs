@@ -33,8 +33,7 @@ use robovec_ir::{Function, Module, OpKind};
 pub use bound::{lower_bound, ops_per_side, tight_lower_bound};
 
 use crate::params::ParamKind;
-use crate::time_limit::TickerError;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo};
+use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 
 /// Priority of ready ops (seed §2.3.1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -380,24 +379,40 @@ impl Pass for Place {
         let arch = PeArray { lat, writes: self.writes.unwrap_or(cx.target.writes), ..self.opts.arch };
         // `-time-limit`: the first list schedule, which the placement needs, runs to the
         // limit's grace (`cx.ticker()`: place is required); the improvement, restarts and
-        // search stop at the limit itself.
-        let ticker = cx.ticker();
+        // search stop at the limit itself (a note for the function, the next one placed).
         let grace = cx.deadline.map(|d| d.grace());
         let opts = PlaceOptions { deadline: cx.deadline, grace, tick_budget: cx.tick_budget, arch, ..self.opts };
-        for f in &mut m.functions {
-            let (p, stopped) = try_place_function_progress(f, &opts, &cx.progress).map_err(|e| match e {
-                PlaceError::Stopped => ticker.error("place", &format!("in @{} in its first list schedule", f.name)),
-                PlaceError::Stuck(e) => {
-                    PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) }
-                }
-            })?;
-            if stopped {
-                let why = crate::Ticker::new(cx.deadline, cx.tick_budget).reason();
-                let what = format!("searching @{} early (best schedule so far kept): {why}", f.name);
-                cx.note_stop("place", &what);
-            }
-            f.placement = Some(p);
-        }
-        Ok(())
+        let progress = cx.progress.clone();
+        let limit = crate::Ticker::new(cx.deadline, cx.tick_budget);
+        try_each_function(
+            m,
+            cx,
+            "place",
+            AtTimeLimit::Required,
+            Before::Ticked,
+            |_, _| None,
+            |f, _, _| {
+                let (p, stopped) = match try_place_function_progress(f, &opts, &progress) {
+                    Ok(placed) => placed,
+                    Err(PlaceError::Stopped) => {
+                        let what = format!("in @{} in its first list schedule", f.name);
+                        return Ok(Step::Stopped { what, kept: None });
+                    }
+                    Err(PlaceError::Stuck(e)) => {
+                        return Err(PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) })
+                    }
+                };
+                let name = f.name.clone();
+                f.placement = Some(p);
+                Ok(match stopped {
+                    true => Step::Cut {
+                        note: format!("searching @{name} early (best schedule so far kept): {}", limit.reason()),
+                        result: (),
+                    },
+                    false => Step::Done(()),
+                })
+            },
+        )
+        .map(drop)
     }
 }

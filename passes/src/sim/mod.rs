@@ -39,7 +39,9 @@ use robovec_machine::program::{lower_measured, lower_measured_until, Occupancy};
 pub use robovec_machine::program::{MachineError as SimError, MachineErrorKind as SimErrorKind, When};
 
 use crate::params::ParamKind;
-use crate::{ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Ticker};
+use crate::{
+    try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step, Ticker,
+};
 
 /// What one simulated run computed and measured.
 #[derive(Clone, Debug, PartialEq)]
@@ -334,56 +336,46 @@ impl Pass for Sim {
     /// simulated and the fewest seeds simulated.
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let seeds: Vec<u64> = (0..self.seeds as u64).collect();
-        let mut functions = Vec::new();
-        let mut fewest = self.seeds;
-        let ticker = cx.ticker();
-        for f in &m.functions {
-            let fail = |message: String| PassError::Failed { pass: "sim".into(), message };
+        let fail = |message: String| PassError::Failed { pass: "sim".into(), message };
+        if let Some(f) = m.functions.iter().find(|f| f.placement.is_none()) {
+            return Err(fail(format!("function @{} has no placement; run `place` first", f.name)));
+        }
+        let before = |f: &Function, _| Some(format!("before @{}", f.name));
+        let simulated = try_each_function(m, cx, "sim", AtTimeLimit::Skip, Before::Clock, before, |f, _, ticker| {
             let fail_on = |e: SimError| fail(format!("@{}: {e}", f.name)).at(e.span);
-            let p = f
-                .placement
-                .as_ref()
-                .ok_or_else(|| fail(format!("function @{} has no placement; run `place` first", f.name)))?;
-            if ticker.check() {
-                cx.note_stop("sim", &format!("before @{}: {}", f.name, ticker.reason()));
-                break;
-            }
-            let not_simulated = |stage: &str| {
-                format!(
-                    "in @{0} before its first seed completed ({stage}): {1}; @{0} not simulated",
-                    f.name,
-                    ticker.reason()
-                )
+            let p = f.placement.as_ref().expect("every function is placed (checked above)");
+            let not_simulated = |stage: &str| Step::Stopped {
+                what: format!("in @{0} before its first seed completed ({stage}; @{0} not simulated)", f.name),
+                kept: None,
             };
             let (mach, occ) = match lower_measured_until(f, p, &|| ticker.tick()) {
                 Ok(x) => x,
-                Err(e) if e.kind == SimErrorKind::Stopped => {
-                    cx.note_stop("sim", &not_simulated("lowering"));
-                    break;
-                }
+                Err(e) if e.kind == SimErrorKind::Stopped => return Ok(not_simulated("lowering")),
                 Err(e) => return Err(fail_on(e)),
             };
-            let r = match verify_lowered(f, &mach, &occ, &seeds, &ticker) {
+            let r = match verify_lowered(f, &mach, &occ, &seeds, ticker) {
                 Ok(r) => r,
-                Err(e) if e.kind == SimErrorKind::Stopped => {
-                    cx.note_stop("sim", &not_simulated("seed 0"));
-                    break;
-                }
+                Err(e) if e.kind == SimErrorKind::Stopped => return Ok(not_simulated("seed 0")),
                 Err(e) => return Err(fail_on(e)),
             };
-            if r.seeds.len() < seeds.len() {
-                let why = ticker.reason();
-                cx.note_stop("sim", &format!("after {} of {} seeds of @{}: {why}", r.seeds.len(), seeds.len(), f.name));
-                fewest = fewest.min(r.seeds.len() as u32);
-            }
-            functions.push(SimFunctionStats {
+            let stats = SimFunctionStats {
                 function: f.name.clone(),
                 cycles: r.cycles,
                 outputs: r.outputs,
                 writes_direct: r.writes_direct,
                 writes_indirect: r.writes_indirect,
-            });
-        }
+            };
+            let n = r.seeds.len() as u32;
+            Ok(match r.seeds.len() < seeds.len() {
+                true => Step::Stopped {
+                    what: format!("after {} of {} seeds of @{}", r.seeds.len(), seeds.len(), f.name),
+                    kept: Some((stats, n)),
+                },
+                false => Step::Done((stats, n)),
+            })
+        })?;
+        let fewest = simulated.iter().map(|(_, n)| *n).min().unwrap_or(self.seeds);
+        let functions: Vec<SimFunctionStats> = simulated.into_iter().map(|(s, _)| s).collect();
         cx.emit(SimStats {
             placements: functions.len(),
             seeds: if functions.is_empty() { 0 } else { fewest },
