@@ -280,6 +280,30 @@ fn stderr_failure(_: std::io::Error) -> Failure {
     Failure::Output(String::new())
 }
 
+/// A writer that stops at a `-time-limit`'s grace: every write ticks `ticker` (a write of
+/// 4 KiB or more reads the clock, and at most 64 KiB is written per call), and once it stopped
+/// writes fail with the ticker's message (`… reached: stopped while writing it; the output
+/// needs it, so nothing is written`): the staged file is then removed with the run's others.
+struct GraceWriter<'a> {
+    inner: &'a mut dyn Write,
+    ticker: &'a robovec_passes::Ticker,
+}
+
+impl Write for GraceWriter<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        const CHUNK: usize = 1 << 16;
+        let stopped = if buf.len() >= 4096 { self.ticker.check() } else { self.ticker.tick() };
+        if stopped {
+            return Err(std::io::Error::other(self.ticker.stop_message("while writing it")));
+        }
+        self.inner.write(&buf[..buf.len().min(CHUNK)])
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
 /// Dumps of `-dump-dir` staged into the run's [`OutputSet`] as the passes run.
 struct StagedDumps<'a> {
     dir: PathBuf,
@@ -620,10 +644,15 @@ fn write_outputs(
     }
     let code = generated_code(session)?;
     // The IR is printed straight into its file or stdout (never held as one string: at 7× the
-    // size of a Robotran input it would be the largest allocation of a run).
-    let mut print_main = |w: &mut dyn Write| match code {
-        Some(c) => w.write_all(c.main.as_bytes()),
-        None => write!(w, "{module}"),
+    // size of a Robotran input it would be the largest allocation of a run), within the
+    // limit's grace: the output needs it.
+    let grace = robovec_passes::Ticker::new(cx.deadline.map(|d| d.grace()), None);
+    let mut print_main = |w: &mut dyn Write| {
+        let mut w = GraceWriter { inner: w, ticker: &grace };
+        match code {
+            Some(c) => w.write_all(c.main.as_bytes()),
+            None => write!(w, "{module}"),
+        }
     };
 
     // Then put every file in place at once, and write stdout last. The files of passes'
@@ -706,7 +735,29 @@ fn write_outputs(
 mod tests {
     use std::sync::atomic::AtomicBool;
 
-    use super::{read_bounded, ReadStop};
+    use super::{read_bounded, GraceWriter, ReadStop};
+    use std::io::Write;
+
+    /// Issue 47: writing the output reads the grace's clock, so it is never what holds a run
+    /// past its grace; a stop is the write's error (the staged file is then removed).
+    #[test]
+    fn writing_stops_at_the_grace_and_writes_at_most_a_chunk_per_call() {
+        let mut out = Vec::new();
+        let ticker = robovec_passes::Ticker::new(None, Some(3));
+        let mut w = GraceWriter { inner: &mut out, ticker: &ticker };
+        assert_eq!(w.write(&[b'a'; 100_000]).unwrap(), 1 << 16, "one chunk of 64 KiB per call");
+        w.write_all(b"bc").unwrap();
+        let e = w.write_all(b"d").expect_err("the third tick stops");
+        assert_eq!(
+            e.to_string(),
+            "tick budget of 3 steps reached: stopped while writing it; the output needs it, so nothing is written"
+        );
+        assert_eq!(out.len(), (1 << 16) + 2);
+        let never = robovec_passes::Ticker::new(None, None);
+        let mut all = Vec::new();
+        write!(GraceWriter { inner: &mut all, ticker: &never }, "{}", "x".repeat(200_000)).unwrap();
+        assert_eq!(all.len(), 200_000);
+    }
 
     /// Issue 47: a device that never ends (`/dev/zero`) stops at the bound, a regular file is
     /// refused by its size before any read, an abandoned reader stops at its next chunk.

@@ -141,7 +141,9 @@ proptest::proptest! {
         let dag = if seed % 2 == 0 { OpDag::new(&f) } else { OpDag::ordered(&f, &keys) };
         let s = schedule::schedule(&dag, &o.arch, &dag.gather(&keys), Select::Preferential, feed).expect("buffers on");
         let mut g = f.clone();
-        g.placement = Some(memory::build(&f, &dag, &o.arch, &s));
+        g.placement = memory::build(&f, &dag, &o.arch, &s, &|| false);
+        // `-time-limit`: building the memories stops (at the grace) when told to.
+        proptest::prop_assert!(memory::build(&f, &dag, &o.arch, &s, &|| true).is_none());
         proptest::prop_assert!(cycles(&g, g.placement.as_ref().unwrap()) >= tight_lower_bound(&f, &o.arch));
         if let Err(e) = verify_placement(&g, &[seed]) {
             proptest::prop_assert!(false, "{e}");

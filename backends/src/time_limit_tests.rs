@@ -39,7 +39,10 @@ fn every_back_end_is_required_when_the_limit_is_reached_before_it() {
         let pm = pipeline(text);
         assert_eq!(pm.elements().next().map(|e| e.props.at_time_limit), Some(AtTimeLimit::Required), "{text}");
         let at = std::time::Instant::now().checked_sub(std::time::Duration::from_secs(1)).expect("clock");
-        let cx = PassContext { deadline: Some(Deadline { at, seconds: 0.0, grace: false }), ..PassContext::default() };
+        let cx = PassContext {
+            deadline: Some(Deadline { at, seconds: 0.0, grace: false, kept: std::time::Duration::ZERO }),
+            ..PassContext::default()
+        };
         match run(&pm, &mut atomised(20), cx) {
             Err(PassError::TimeLimit { pass, message }) => {
                 assert_eq!(pass, text);
@@ -56,7 +59,8 @@ fn every_back_end_is_required_when_the_limit_is_reached_before_it() {
 fn after_the_limit_a_back_end_runs_in_its_grace() {
     let pm = pipeline("atomise,balance,cse,codegen<c>");
     let mut m = parse("func @f { input %a input %b %x = %a*%b + %a*%b - %b output y = %x }\n").unwrap();
-    let reached = Deadline { at: std::time::Instant::now(), seconds: 1000.0, grace: false };
+    let reached =
+        Deadline { at: std::time::Instant::now(), seconds: 1000.0, grace: false, kept: std::time::Duration::ZERO };
     let cx = run(&pm, &mut m, PassContext { deadline: Some(reached), ..PassContext::default() }).expect("grace");
     assert_eq!(
         cx.stopped(),

@@ -20,13 +20,32 @@ pub struct Deadline {
     pub seconds: f64,
     /// True for [`Deadline::grace`]: the limit plus the grace the passes the output needs get.
     pub grace: bool,
+    /// The time kept back before the limit ([`Deadline::keeping`]): the work that may be cut
+    /// short stops this long before `at`, so that what the output cannot do without and what is
+    /// never interrupted still end by the limit. Zero for a grace.
+    pub kept: std::time::Duration,
 }
 
 impl Deadline {
     /// A limit of `seconds` from now.
     pub fn after_seconds(seconds: f64) -> Deadline {
         let d = std::time::Duration::try_from_secs_f64(seconds.max(0.0)).unwrap_or(std::time::Duration::MAX);
-        Deadline { at: later(std::time::Instant::now(), d), seconds, grace: false }
+        Deadline { at: later(std::time::Instant::now(), d), seconds, grace: false, kept: std::time::Duration::ZERO }
+    }
+
+    /// This limit with `kept` kept back before it ([`Deadline::kept`]; the pass manager keeps
+    /// the estimated time of the output's tail, `robovec_passes::time_limit`); a grace is
+    /// returned as it is.
+    pub fn keeping(&self, kept: std::time::Duration) -> Deadline {
+        if self.grace {
+            return *self;
+        }
+        Deadline { kept, ..*self }
+    }
+
+    /// When the work this deadline bounds must stop: the limit less what is kept back.
+    pub fn end(&self) -> std::time::Instant {
+        self.at.checked_sub(self.kept).unwrap_or(self.at)
     }
 
     /// The grace of a limit of `seconds`: 5 % of it plus 0.5 s, so that a run whose searches
@@ -43,17 +62,17 @@ impl Deadline {
             return *self;
         }
         let extra = std::time::Duration::try_from_secs_f64(Self::grace_seconds(self.seconds)).unwrap_or_default();
-        Deadline { at: later(self.at, extra), grace: true, ..*self }
+        Deadline { at: later(self.at, extra), grace: true, kept: std::time::Duration::ZERO, ..*self }
     }
 
-    /// Time left before the limit (zero once reached).
+    /// Time left before [`Deadline::end`] (zero once reached).
     pub fn time_left(&self) -> std::time::Duration {
-        self.at.saturating_duration_since(std::time::Instant::now())
+        self.end().saturating_duration_since(std::time::Instant::now())
     }
 
-    /// True once the limit is reached.
+    /// True once [`Deadline::end`] is reached: the limit, less what is kept back.
     pub fn reached(&self) -> bool {
-        std::time::Instant::now() >= self.at
+        std::time::Instant::now() >= self.end()
     }
 
     /// Why a pass stopped: `time limit of 5 s reached` (a grace: `time limit of 5 s and its
@@ -165,6 +184,21 @@ mod tests {
         assert!((0..10 * Ticker::EVERY).all(|_| !far.tick()) && !far.check());
         let past = Ticker::new(Some(Deadline::after_seconds(0.0)), None);
         assert!(past.check() && past.tick(), "check reads the clock at once");
+    }
+
+    #[test]
+    fn time_kept_back_ends_the_work_earlier_but_not_the_grace() {
+        let d = Deadline::after_seconds(3600.0);
+        let kept = d.keeping(std::time::Duration::from_secs(3601));
+        assert!(!d.reached() && kept.reached(), "an hour's limit keeping more than an hour is reached now");
+        assert_eq!(kept.time_left(), std::time::Duration::ZERO);
+        assert!(d.time_left() > std::time::Duration::from_secs(3599));
+        assert_eq!(kept.grace(), d.grace(), "the grace counts from the limit itself");
+        assert!(!kept.grace().reached());
+        assert_eq!(kept.grace().keeping(std::time::Duration::from_secs(1)), d.grace(), "a grace keeps nothing");
+        assert_eq!(kept.reason(), d.reason());
+        // Keeping replaces what was kept (the manager sets it before each pass).
+        assert!(!kept.keeping(std::time::Duration::ZERO).reached());
     }
 
     #[test]

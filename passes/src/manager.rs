@@ -271,13 +271,20 @@ impl PassManager {
         note_atomised_ops(m, cx);
         for (i, Element { spec, props, pass }) in self.passes.iter().enumerate() {
             let name = pass.name();
+            let ops_before = module_ops(m);
+            // What may be cut short stops early enough for the output's tail (time_limit::kept_for).
+            cx.deadline = cx.deadline.map(|d| d.keeping(crate::time_limit::kept_for(ops_before)));
             if let Some(d) = cx.deadline.filter(crate::Deadline::reached) {
                 // `-time-limit` reached before the pass starts (crate::time_limit's policy).
                 match props.at_time_limit {
                     AtTimeLimit::Skip => {
                         cx.note_skip(&spec.to_string(), &d.reason());
-                        let (ops_before, ops_after) = (module_ops(m), module_ops(m));
-                        records.push(PassRecord { name: spec.to_string(), wall_ms: 0.0, ops_before, ops_after });
+                        records.push(PassRecord {
+                            name: spec.to_string(),
+                            wall_ms: 0.0,
+                            ops_before,
+                            ops_after: ops_before,
+                        });
                         continue;
                     }
                     AtTimeLimit::Required if d.grace().reached() => {
@@ -299,7 +306,6 @@ impl PassManager {
             if let Some(phase) = props.requires {
                 crate::require_phase(name, m, phase)?;
             }
-            let ops_before = module_ops(m);
             let t0 = Instant::now();
             cx.pass_index = Some(i);
             cx.running = props.at_time_limit;
@@ -318,7 +324,7 @@ impl PassManager {
             }
             dump(dump_name(i, name, "after"), m)?;
             if self.instr.verify_each {
-                verify_named(m, name)?;
+                verify_within(m, name, &spec.to_string(), cx.deadline)?;
             }
         }
         if self.instr.time_passes {
@@ -346,7 +352,25 @@ impl PassManager {
 }
 
 fn verify_named(m: &Module, pass: &str) -> Result<(), PassError> {
-    verifier::verify(m).map_err(|errs| PassError::Verify {
+    verify_within(m, pass, pass, None)
+}
+
+/// The verifier after `pass` (`spec`: as written in the pipeline). The output needs it, so
+/// under `-time-limit` it runs within the limit's grace (the clock read once per value, op,
+/// load and write) and its end is [`PassError::TimeLimit`]: the verifier is never the step
+/// that holds a run past its grace (`crate::time_limit`).
+pub(crate) fn verify_within(
+    m: &Module,
+    pass: &str,
+    spec: &str,
+    deadline: Option<crate::Deadline>,
+) -> Result<(), PassError> {
+    let ticker = crate::Ticker::new(deadline.map(|d| d.grace()), None);
+    let verified = verifier::verify_until(m, &mut || ticker.tick()).ok_or_else(|| PassError::TimeLimit {
+        pass: spec.to_string(),
+        message: ticker.stop_message("while verifying the module after it"),
+    })?;
+    verified.map_err(|errs| PassError::Verify {
         pass: pass.to_string(),
         errors: errs.iter().map(|e| format!("  {e}")).collect::<Vec<_>>().join("\n"),
         list: errs,

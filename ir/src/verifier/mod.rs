@@ -289,7 +289,7 @@ pub fn verify_function_until(f: &Function, stop: &mut dyn FnMut() -> bool) -> Op
         }
     }
     if errs.is_empty() {
-        errs.extend(placement::verify_placement(f));
+        errs.extend(placement::verify_placement_until(f, stop)?);
     }
     Some(errs)
 }

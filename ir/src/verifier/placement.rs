@@ -103,9 +103,15 @@ impl Sink<'_> {
 
 /// Checks `f.placement` (nothing when there is none); returns every violation found.
 pub fn verify_placement(f: &Function) -> Vec<VerifierError> {
-    let Some(p) = &f.placement else { return Vec::new() };
+    verify_placement_until(f, &mut || false).expect("never stopped")
+}
+
+/// [`verify_placement`] that calls `stop` about once per issue, op, load and write and gives
+/// up (`None`) at the first `true` (`-time-limit`: [`super::verify_until`]).
+pub fn verify_placement_until(f: &Function, stop: &mut dyn FnMut() -> bool) -> Option<Vec<VerifierError>> {
+    let Some(p) = &f.placement else { return Some(Vec::new()) };
     let mut s = Sink { f, errs: Vec::new(), more: 0 };
-    check(f, p, &mut s);
+    check(f, p, &mut s, stop)?;
     let Sink { mut errs, more, .. } = s;
     if more > 0 {
         errs.push(VerifierError {
@@ -115,10 +121,10 @@ pub fn verify_placement(f: &Function) -> Vec<VerifierError> {
             span: p.spans.block,
         });
     }
-    errs
+    Some(errs)
 }
 
-fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
+fn check(f: &Function, p: &Placement, s: &mut Sink<'_>, stop: &mut dyn FnMut() -> bool) -> Option<()> {
     let a = p.arch;
     let n = f.values.len();
     let name = |v: Value| if v.index() < n { format!("%{}", f.name_of(v)) } else { format!("{v}") };
@@ -132,11 +138,11 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
             p.spans.block,
             format!("placement on a function in phase {:?}; only an atomised function can be placed", f.phase),
         );
-        return;
+        return Some(());
     }
     if let Some(&v) = f.body.iter().find(|&&v| matches!(f.value(v).def, Def::Expr(_))) {
         s.push(f.value(v).span, format!("placement on a function with a nested expression (`%{}`)", f.name_of(v)));
-        return;
+        return Some(());
     }
     let n_pe = a.n_pe();
     if a.n_add == 0 || a.n_mul == 0 {
@@ -151,12 +157,12 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
                 p.buffer_words.len()
             ),
         );
-        return;
+        return Some(());
     }
     for k in [OpKind::Add, OpKind::Mul, OpKind::Div, OpKind::Call] {
         if p.latency(k) == 0 {
             s.push(p.spans.block, format!("placement: latency of {k:?} is 0; latencies must be ≥ 1"));
-            return;
+            return Some(());
         }
     }
     let exists = |q: Pe| match q {
@@ -169,6 +175,9 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
     let mut arrival: Vec<Option<u64>> = vec![None; n];
     let mut busy: Map<(usize, u32), Value> = map(p.issue.len());
     for (i, is) in p.issue.iter().enumerate() {
+        if stop() {
+            return None;
+        }
         let Some(is) = is else { continue };
         let v = Value::with_number(i as u32);
         let span = p.spans.issue(v);
@@ -198,6 +207,9 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
         arrival[i] = Some(is.cycle as u64 + p.latency(kind) as u64);
     }
     for &v in &f.body {
+        if stop() {
+            return None;
+        }
         if f.op_kind(v).is_some() && p.issue.get(v.index()).copied().flatten().is_none() {
             s.push(f.value(v).span, format!("op {} is never issued in the placement", name(v)));
         }
@@ -206,6 +218,9 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
     // Loads and writes: first cycle each key is in each PE memory (loads: −1).
     let mut present: Map<(usize, Key), i64> = map(p.loads.len() + p.writes.len());
     for (i, l) in p.loads.iter().enumerate() {
+        if stop() {
+            return None;
+        }
         let span = p.spans.load(i);
         let k = key_of(&l.operand);
         if !exists(l.pe) {
@@ -237,6 +252,9 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
     let mut buf_addr: Map<Value, u32> = map(0);
     let mut buf_read: Map<(usize, u32), (u32, Value)> = map(0);
     for (i, w) in p.writes.iter().enumerate() {
+        if stop() {
+            return None;
+        }
         let span = p.spans.write(i);
         let v = w.value;
         if !exists(w.pe) {
@@ -347,6 +365,9 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
 
     // Operands present at issue.
     for &v in &f.body {
+        if stop() {
+            return None;
+        }
         let Some(is) = p.issue.get(v.index()).copied().flatten() else { continue };
         if !exists(is.pe) {
             continue;
@@ -380,4 +401,5 @@ fn check(f: &Function, p: &Placement, s: &mut Sink<'_>) {
             );
         }
     }
+    Some(())
 }

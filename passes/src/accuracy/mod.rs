@@ -195,7 +195,7 @@ impl Pass for Accuracy {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let mut o = self.opts.clone();
         // `-time-limit`: accuracy checks it once per chunk of samples.
-        o.deadline = cx.deadline.map(|d| d.at);
+        o.deadline = cx.deadline.map(|d| d.end());
         if let Some(path) = &o.params {
             o.known =
                 inputs::read_params(path).map_err(|message| PassError::Failed { pass: "accuracy".into(), message })?;

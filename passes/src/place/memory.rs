@@ -55,8 +55,10 @@ fn allocate(items: &[(u32, u32)]) -> (Vec<u32>, u32) {
 }
 
 /// Builds the placement of `f` from its schedule `s` (indexed by the nodes of `dag`, built
-/// from `f`).
-pub fn build(f: &Function, dag: &OpDag, arch: &PeArray, s: &Schedule) -> Placement {
+/// from `f`): the memories' addresses, loads and writes. Calls `stop` about once per op, per
+/// booking and per load (`-time-limit`: the first schedule's grace, [`super::try_place_function_progress`])
+/// and gives up (`None`) at the first `true`.
+pub fn build(f: &Function, dag: &OpDag, arch: &PeArray, s: &Schedule, stop: &dyn Fn() -> bool) -> Option<Placement> {
     let n_pe = arch.n_pe();
     let n = dag.len();
     // Bookings of each node (compressed rows), to find the one an op reads on its PE.
@@ -80,6 +82,9 @@ pub fn build(f: &Function, dag: &OpDag, arch: &PeArray, s: &Schedule) -> Placeme
     let mut last_load: Vec<Vec<u32>> = vec![Vec::new(); n_pe];
     // In node order (operands are near their users there), then the loads in body order.
     for j in 0..n as Node {
+        if stop() {
+            return None;
+        }
         let (q, t) = s.issue[j as usize];
         for a in dag.distinct_operands(j) {
             let row = &by_node[at[a as usize] as usize..at[a as usize + 1] as usize];
@@ -89,6 +94,9 @@ pub fn build(f: &Function, dag: &OpDag, arch: &PeArray, s: &Schedule) -> Placeme
         }
     }
     for &v in &f.body {
+        if stop() {
+            return None;
+        }
         let Some(j) = dag.node(v) else { continue };
         let (q, t) = s.issue[j as usize];
         let q = q as usize;
@@ -135,6 +143,9 @@ pub fn build(f: &Function, dag: &OpDag, arch: &PeArray, s: &Schedule) -> Placeme
     for q in 0..n_pe {
         let mut spans: Vec<(u32, u32)> = last_load[q].iter().map(|&e| (0, e)).collect();
         spans.extend(per_memory[q].iter().map(|&i| (s.bookings[i].cycle, last_booking[i])));
+        if stop() {
+            return None;
+        }
         let (addrs, words) = allocate(&spans);
         pe_words[q] = words;
         let pe = pe_of(arch, q);
@@ -152,7 +163,7 @@ pub fn build(f: &Function, dag: &OpDag, arch: &PeArray, s: &Schedule) -> Placeme
     for (&v, &(q, cycle)) in dag.ops.iter().zip(&s.issue) {
         issue[v.index()] = Some(Issue { pe: pe_of(arch, q as usize), cycle });
     }
-    Placement { arch: *arch, issue, loads, writes, pe_words, buffer_words, spans: Default::default() }
+    Some(Placement { arch: *arch, issue, loads, writes, pe_words, buffer_words, spans: Default::default() })
 }
 
 #[cfg(test)]

@@ -93,7 +93,8 @@ pub struct PlaceOptions {
 pub enum PlaceError {
     /// Only with `buffer = false`: an operand can no longer reach any PE memory of its type.
     Stuck(String),
-    /// [`PlaceOptions::grace`] (or the test budget) was reached in the first list schedule.
+    /// [`PlaceOptions::grace`] (or the test budget) was reached in the first list schedule or
+    /// while building the memories of the schedule kept.
     Stopped,
 }
 
@@ -101,7 +102,7 @@ impl std::fmt::Display for PlaceError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             PlaceError::Stuck(m) => f.write_str(m),
-            PlaceError::Stopped => f.write_str("stopped in the first list schedule: time limit"),
+            PlaceError::Stopped => f.write_str("stopped in the first list schedule or its memories: time limit"),
         }
     }
 }
@@ -158,7 +159,7 @@ pub fn try_place_function(f: &Function, opts: &PlaceOptions) -> Result<Placement
 ///
 /// # Errors
 /// [`PlaceError::Stuck`] as [`try_place_function`]; [`PlaceError::Stopped`] when
-/// `opts.grace` stopped the first list schedule.
+/// `opts.grace` stopped the first list schedule or the memories.
 pub fn try_place_function_within(f: &Function, opts: &PlaceOptions) -> Result<(Placement, bool), PlaceError> {
     try_place_function_progress(f, opts, &crate::progress::Progress::hidden())
 }
@@ -187,17 +188,20 @@ pub fn try_place_function_progress(
     if required.check() {
         return Err(PlaceError::Stopped);
     }
+    // The memories of the schedule kept: required, within the grace.
+    let build =
+        |best: &schedule::Schedule| memory::build(f, &dag, a, best, &|| required.tick()).ok_or(PlaceError::Stopped);
     if cut {
-        return Ok((memory::build(f, &dag, a, &best), true));
+        return Ok((build(&best)?, true));
     }
     let spec = lower_bound(f, a) as u64;
     // Within 2% of SPEC §4's bound (hence of the tight bound too): nothing to search for, and
     // the tight bound (O(n log n) but not free) is not computed.
     if (opts.restarts > 0 || opts.search > 0) && end(&best) as u64 * 100 > spec * 102 {
         let (best, stopped) = search::restarts_and_search(f, &dag, opts, seed, best, progress)?;
-        return Ok((memory::build(f, &dag, a, &best), stopped));
+        return Ok((build(&best)?, stopped));
     }
-    Ok((memory::build(f, &dag, a, &best), false))
+    Ok((build(&best)?, false))
 }
 
 /// Cycles of a schedule: the largest arrival.
@@ -395,7 +399,7 @@ impl Pass for Place {
                 let (p, stopped) = match try_place_function_progress(f, &opts, &progress) {
                     Ok(placed) => placed,
                     Err(PlaceError::Stopped) => {
-                        let what = format!("in @{} in its first list schedule", f.name);
+                        let what = format!("in @{} in its first list schedule or its memories", f.name);
                         return Ok(Step::Stopped { what, kept: None });
                     }
                     Err(PlaceError::Stuck(e)) => {

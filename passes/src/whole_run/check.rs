@@ -45,7 +45,7 @@ pub fn run(
         let before = original
             .function(&f.name)
             .ok_or_else(|| fail(format!("function @{} is not in the input of the pipeline", f.name)))?;
-        let r = check_function_until(f, before, bit_exact, samples, seed, deadline.map(|d| d.at)).map_err(fail)?;
+        let r = check_function_until(f, before, bit_exact, samples, seed, deadline.map(|d| d.end())).map_err(fail)?;
         if r.samples < u64::from(samples) {
             let why = deadline.map(|d| d.reason()).unwrap_or_default();
             let _ =

@@ -228,8 +228,8 @@ fn run_reporting(
         // soundness check of the same points takes about as long), so that every pipeline is
         // measured (with fewer samples) before the limit.
         let now = std::time::Instant::now();
-        let share = deadline.map(|d| now + d.at.saturating_duration_since(now) / (2 * (n - k)) as u32);
-        let later_share = deadline.map(|d| now + d.at.saturating_duration_since(now) / (n - k) as u32);
+        let share = deadline.map(|d| now + d.time_left() / (2 * (n - k)) as u32);
+        let later_share = deadline.map(|d| now + d.time_left() / (n - k) as u32);
         let opts = AccuracyOptions { samples, seed, deadline: share, ..AccuracyOptions::default() };
         let bit_exact = pm.is_bit_exact();
         let cx = PassContext { original: Some(module.clone()), deadline, ..PassContext::with_target(target.clone()) };
