@@ -321,9 +321,6 @@ impl DumpSink for StagedDumps<'_> {
     }
 }
 
-/// What a run hands to the writing step: the passes' records and context, with everything
-/// rendered in memory.
-
 /// Which of the run's standard streams are terminals (`robovec-opt` asks the OS; tests and
 /// library callers say so). Both false by default: a piped run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

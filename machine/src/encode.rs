@@ -448,6 +448,42 @@ pub fn decode(im: &Images) -> Result<Vec<Vec<Step>>, DecodeError> {
     Ok(out)
 }
 
+/// The binary32 bits of a data word (module doc of [`robovec_ir::machine`], "Data words"),
+/// `input(name)` giving each input's value: inputs and constants rounded to nearest
+/// (`x as f32`, as `-eval-precision=f32` and `interp`'s `Float::from_f64` for `f32` do), trig
+/// values as `sin`/`cos` in `f32` of the rounded input (what `interp::eval::<f32>` computes).
+pub fn word_binary32(w: &Word, input: impl Fn(&str) -> f64) -> u32 {
+    match w {
+        Word::Input(n) => (input(n) as f32).to_bits(),
+        Word::Trig(t, n) => {
+            let x = input(n) as f32;
+            match t {
+                TrigFn::Sin => x.sin().to_bits(),
+                TrigFn::Cos => x.cos().to_bits(),
+            }
+        }
+        Word::Const(c) => (*c as f32).to_bits(),
+    }
+}
+
+/// The binary32 initial contents of PE slot `slot`'s memory in `p`, one word per address (0
+/// where nothing is loaded), `input(name)` giving each input ([`word_binary32`]).
+///
+/// # Panics
+/// When `slot` is not below [`MachineProgram::n_pe`].
+pub fn pe_image(p: &MachineProgram, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
+    p.pes[slot].init.iter().map(|w| w.as_ref().map_or(0, |w| word_binary32(w, &input))).collect()
+}
+
+/// The binary32 initial contents of PE slot `slot`'s output memory in `p` (0 for captured
+/// words).
+///
+/// # Panics
+/// When `slot` is not below [`MachineProgram::n_pe`].
+pub fn output_image(p: &MachineProgram, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
+    p.pes[slot].output_init.iter().map(|w| w.as_ref().map_or(0, |w| word_binary32(w, &input))).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -551,40 +587,4 @@ mod tests {
             prop_assert_eq!(decode_step(&l, slot, 0, w).unwrap(), step);
         }
     }
-}
-
-/// The binary32 bits of a data word (module doc of [`robovec_ir::machine`], "Data words"),
-/// `input(name)` giving each input's value: inputs and constants rounded to nearest
-/// (`x as f32`, as `-eval-precision=f32` and `interp`'s `Float::from_f64` for `f32` do), trig
-/// values as `sin`/`cos` in `f32` of the rounded input (what `interp::eval::<f32>` computes).
-pub fn word_binary32(w: &Word, input: impl Fn(&str) -> f64) -> u32 {
-    match w {
-        Word::Input(n) => (input(n) as f32).to_bits(),
-        Word::Trig(t, n) => {
-            let x = input(n) as f32;
-            match t {
-                TrigFn::Sin => x.sin().to_bits(),
-                TrigFn::Cos => x.cos().to_bits(),
-            }
-        }
-        Word::Const(c) => (*c as f32).to_bits(),
-    }
-}
-
-/// The binary32 initial contents of PE slot `slot`'s memory in `p`, one word per address (0
-/// where nothing is loaded), `input(name)` giving each input ([`word_binary32`]).
-///
-/// # Panics
-/// When `slot` is not below [`MachineProgram::n_pe`].
-pub fn pe_image(p: &MachineProgram, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
-    p.pes[slot].init.iter().map(|w| w.as_ref().map_or(0, |w| word_binary32(w, &input))).collect()
-}
-
-/// The binary32 initial contents of PE slot `slot`'s output memory in `p` (0 for captured
-/// words).
-///
-/// # Panics
-/// When `slot` is not below [`MachineProgram::n_pe`].
-pub fn output_image(p: &MachineProgram, slot: usize, input: impl Fn(&str) -> f64) -> Vec<u32> {
-    p.pes[slot].output_init.iter().map(|w| w.as_ref().map_or(0, |w| word_binary32(w, &input))).collect()
 }
