@@ -1,21 +1,42 @@
 //! `report.md`: the report as a readable page — the run, the final IR's figures, the tables of
-//! the report (sweep, Pareto, accuracy) and the figures embedded as images.
+//! the report (sweep, Pareto, accuracy) and the figures embedded as images — written from the
+//! run's typed results ([`ReportData`]), the same values `report.json` holds, printed as its
+//! numbers read: integers as they are, fractions to 3 decimals, a missing value as `-`.
 
 use std::fmt::Write;
-
-use serde_json::Value;
 
 use super::data::ReportData;
 use super::figures::Figure;
 
-fn num(v: Option<&Value>) -> String {
-    match v {
-        Some(Value::Number(n)) => match n.as_f64() {
-            Some(x) if x.fract() != 0.0 => format!("{x:.3}"),
-            _ => n.to_string(),
-        },
-        Some(Value::Null) | None => "-".into(),
-        Some(v) => v.to_string(),
+/// A number of the page, as the report's JSON gives it (see the module doc).
+trait Num {
+    fn num(&self) -> String;
+}
+
+macro_rules! integer_num {
+    ($($t:ty),*) => {$(impl Num for $t {
+        fn num(&self) -> String {
+            self.to_string()
+        }
+    })*};
+}
+integer_num!(u32, u64);
+
+impl Num for f64 {
+    /// A fraction to 3 decimals; an integral value as JSON writes it (`12.0`); a value JSON
+    /// cannot hold (not finite: `null`) as `-`.
+    fn num(&self) -> String {
+        match serde_json::Number::from_f64(*self) {
+            Some(_) if self.fract() != 0.0 => format!("{self:.3}"),
+            Some(n) => n.to_string(),
+            None => "-".into(),
+        }
+    }
+}
+
+impl Num for bool {
+    fn num(&self) -> String {
+        self.to_string()
     }
 }
 
@@ -25,88 +46,80 @@ fn cell(s: &str) -> String {
 }
 
 /// The page (see the module doc).
-pub fn markdown(report: &Value, d: &ReportData, figures: &[Figure]) -> String {
+pub fn markdown(d: &ReportData, figures: &[Figure]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# {} @{}\n", d.model, d.function);
-    let _ = writeln!(s, "- input: `{}`", report.get("input").and_then(Value::as_str).unwrap_or("?"));
+    let _ = writeln!(s, "- input: `{}`", d.input);
     let _ = writeln!(s, "- pipeline: `{}`", d.pipeline);
-    if let Some(st) = report.get("stats") {
-        let ops = st.get("ops").and_then(|o| o.get("total"));
-        let _ = writeln!(
-            s,
-            "- final IR: {} ops, critical path {} ops / {} cycles, Y = {} (latencies add {}, mul {}: {})",
-            num(ops),
-            num(st.get("asap")),
-            num(st.get("asap_cycle")),
-            num(st.get("y")),
-            num(st.get("latencies").and_then(|l| l.get("add"))),
-            num(st.get("latencies").and_then(|l| l.get("mul"))),
-            st.get("latencies_from").and_then(Value::as_str).unwrap_or("given"),
-        );
-    }
-    if let Some(p) = report.get("placement") {
+    let st = &d.stats;
+    let _ = writeln!(
+        s,
+        "- final IR: {} ops, critical path {} ops / {} cycles, Y = {} (latencies add {}, mul {}: {})",
+        st.ops.total.num(),
+        st.asap.num(),
+        st.asap_cycle.num(),
+        st.y.num(),
+        st.latencies.add.num(),
+        st.latencies.mul.num(),
+        st.latencies_from.as_deref().unwrap_or("given"),
+    );
+    if let Some(p) = &d.placement {
         let _ = writeln!(
             s,
             "- placement: {} ADD + {} MULTI PEs, {} cycles ({} µs at {} MHz), lower bound {}, tight lower bound {}, parallelisation rate {}",
-            num(p.get("n_add")),
-            num(p.get("n_mul")),
-            num(p.get("cycles")),
-            num(p.get("us")),
-            num(p.get("clock_mhz")),
-            num(p.get("lower_bound")),
-            num(p.get("tight_lower_bound")),
-            num(p.get("parallelisation_rate")),
+            p.n_add.num(),
+            p.n_mul.num(),
+            p.cycles.num(),
+            p.us.num(),
+            p.clock_mhz.num(),
+            p.lower_bound.num(),
+            p.tight_lower_bound.num(),
+            p.parallelisation_rate.num(),
         );
     }
-    if let Some(a) = report.get("accuracy") {
-        let b = |k: &str, f: &str| num(a.get(k).and_then(|x| x.get(f)));
+    if let Some(a) = &d.accuracy {
         let _ = writeln!(
             s,
             "- accuracy ({} samples): binary32 mean / p95 / max {} / {} / {} bits, binary64 {} / {} / {} bits",
-            num(a.get("samples")),
-            b("f32", "mean_bits"),
-            b("f32", "p95_bits"),
-            b("f32", "max_bits"),
-            b("f64", "mean_bits"),
-            b("f64", "p95_bits"),
-            b("f64", "max_bits"),
+            a.samples.num(),
+            a.f32.mean_bits.num(),
+            a.f32.p95_bits.num(),
+            a.f32.max_bits.num(),
+            a.f64.mean_bits.num(),
+            a.f64.p95_bits.num(),
+            a.f64.max_bits.num(),
         );
     }
-    if let Some(Value::Array(stops)) = report.get("stopped_early") {
-        for x in stops {
-            let _ = writeln!(s, "- stopped early: {}", x.as_str().unwrap_or_default());
-        }
+    for x in &d.stopped_early {
+        let _ = writeln!(s, "- stopped early: {x}");
     }
-    if let Some(Value::Array(rows)) = report.get("sweep") {
+    if d.swept {
         let _ = writeln!(s, "\n## Sweep\n");
         let _ = writeln!(
             s,
             "| N | priority | select | cycles | µs | LB | tight LB | bound 1 | critical path | par. rate | PE words ADD min/mean/max | PE words MUL | buffer ADD | buffer MUL | fits |"
         );
         let _ = writeln!(s, "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---|---|---|---|---|");
-        let w = |r: &Value, k: &str| {
-            let g = |f: &str| num(r.get(k).and_then(|x| x.get(f)));
-            format!("{}/{}/{}", g("min"), g("mean"), g("max"))
-        };
-        for r in rows {
+        let w = |w: &robovec_passes::sweep::WordStats| format!("{}/{}/{}", w.min.num(), w.mean.num(), w.max.num());
+        for r in &d.sweep {
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                num(r.get("n")),
-                r.get("priority").and_then(Value::as_str).unwrap_or(""),
-                r.get("select").and_then(Value::as_str).unwrap_or(""),
-                num(r.get("cycles")),
-                num(r.get("us")),
-                num(r.get("lower_bound")),
-                num(r.get("tight_lower_bound")),
-                num(r.get("resource_bound")),
-                num(r.get("critical_path")),
-                num(r.get("parallelisation_rate")),
-                w(r, "pe_words_add"),
-                w(r, "pe_words_mul"),
-                w(r, "buffer_words_add"),
-                w(r, "buffer_words_mul"),
-                num(r.get("fits")),
+                r.n.num(),
+                r.priority,
+                r.select,
+                r.cycles.num(),
+                r.us.num(),
+                r.lower_bound.num(),
+                r.tight_lower_bound.num(),
+                r.resource_bound.num(),
+                r.critical_path.num(),
+                r.parallelisation_rate.num(),
+                w(&r.pe_words_add),
+                w(&r.pe_words_mul),
+                w(&r.buffer_words_add),
+                w(&r.buffer_words_mul),
+                r.fits.num(),
             );
         }
     }

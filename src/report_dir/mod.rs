@@ -28,10 +28,9 @@ pub use markdown::markdown;
 /// # Errors
 /// A message when the report text is not JSON or a figure cannot be drawn (internal errors).
 pub fn files(report_text: &str, d: &data::ReportData) -> Result<Vec<(String, Vec<u8>)>, String> {
-    let value: serde_json::Value = serde_json::from_str(report_text).map_err(|e| format!("report.json: {e}"))?;
     let figs = figures::all(d)?;
     let mut out = vec![("report.json".to_string(), report_text.as_bytes().to_vec())];
-    out.push(("report.md".to_string(), markdown(&value, d, &figs).into_bytes()));
+    out.push(("report.md".to_string(), markdown(d, &figs).into_bytes()));
     for f in figs {
         out.push((format!("{}.svg", f.name), f.svg.into_bytes()));
         out.push((format!("{}.csv", f.name), f.csv.into_bytes()));
