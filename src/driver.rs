@@ -582,13 +582,7 @@ fn eval_json(
 
 /// The generated code `-o` writes when the pipeline ends in a back end.
 fn generated_code(session: &Session) -> Result<Option<&GeneratedCode>, Failure> {
-    if session.pipeline().back_end().is_none() {
-        return Ok(None);
-    }
-    session
-        .generated_code()
-        .map(Some)
-        .ok_or_else(|| Failure::Input("error: the pipeline's last pass is a back end but generated no code\n".into()))
+    session.generated_code().map_err(|e| Failure::Input(format!("error: {e}\n")))
 }
 
 /// The CSV tables of several artifacts as one file: a header line equal to the first table's is

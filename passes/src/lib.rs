@@ -533,16 +533,14 @@ impl Registry {
             .get(&spec.name)
             .ok_or_else(|| PassError::UnknownPass { name: spec.name.clone(), valid: self.names() })?;
         let params = Params::check(info, &spec.params)?;
-        let props = params.member().map_or(info.props, |m| m.props);
-        (info.build)(&params).map(|p| (props, p))
+        (info.build)(&params).map(|p| (params.props(info), p))
     }
 
     /// The properties of a registered pass built with default parameters (a family: its
     /// default member's), `None` for an unknown name.
     pub fn props_of(&self, name: &str) -> Option<Props> {
         let info = self.get(name)?;
-        let params = Params::defaults(info);
-        Some(params.member().map_or(info.props, |m| m.props))
+        Some(Params::defaults(info).props(info))
     }
 }
 
@@ -581,11 +579,6 @@ pub const PASSES: Registry = Registry {
         &schedule_cpu::INFO,
     ],
 };
-
-/// Looks up a pass of [`PASSES`].
-pub fn pass_info(name: &str) -> Option<&'static PassInfo> {
-    PASSES.get(name)
-}
 
 /// Builds the pass of a parsed pipeline element from [`PASSES`], checking its parameters.
 ///

@@ -87,11 +87,21 @@ impl Session {
     }
 
     /// The code the back end the pipeline ends in generated (`None` when it ends in no back
-    /// end, or before the run).
-    pub fn generated_code(&self) -> Option<&GeneratedCode> {
-        self.pipeline.back_end()?;
+    /// end: `-o` then writes the IR).
+    ///
+    /// # Errors
+    /// [`PassError::Failed`] when it ends in a back end that generated no code (before the
+    /// run, or a back end that failed to say).
+    pub fn generated_code(&self) -> Result<Option<&GeneratedCode>, PassError> {
+        if self.pipeline.back_end().is_none() {
+            return Ok(None);
+        }
         let last = self.pipeline.last_index();
-        self.cx.artifacts.iter().filter(|p| p.pass_index == last).find_map(|p| p.artifact.code())
+        let code = self.cx.artifacts.iter().filter(|p| p.pass_index == last).find_map(|p| p.artifact.code());
+        code.map(Some).ok_or_else(|| PassError::Failed {
+            pass: self.pipeline.elements().last().map_or_else(String::new, |e| e.spec.to_string()),
+            message: "the pipeline's last pass is a back end but generated no code".into(),
+        })
     }
 
     /// The module, the context and the records, taking the session apart.

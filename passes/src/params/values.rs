@@ -114,6 +114,12 @@ impl Params {
         self.member
     }
 
+    /// The declared properties of the pass these parameters build: the selected member's for
+    /// a family, else `info`'s own (`info`: the pass they were checked against).
+    pub fn props(&self, info: &PassInfo) -> crate::Props {
+        self.member.map_or(info.props, |m| m.props)
+    }
+
     /// Builds the selected member of a pass family: the `build` of a family's [`PassInfo`].
     ///
     /// # Errors
