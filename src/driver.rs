@@ -280,10 +280,11 @@ fn stderr_failure(_: std::io::Error) -> Failure {
     Failure::Output(String::new())
 }
 
-/// A writer that stops at a `-time-limit`'s grace: every write ticks `ticker` (a write of
-/// 4 KiB or more reads the clock, and at most 64 KiB is written per call), and once it stopped
-/// writes fail with the ticker's message (`… reached: stopped while writing it; the output
-/// needs it, so nothing is written`): the staged file is then removed with the run's others.
+/// A writer that stops at a `-time-limit`'s grace: every write reads the clock
+/// ([`robovec_passes::Ticker::check`]; at most 64 KiB is written per call, and the caller
+/// buffers the small writes before it), and once it stopped writes fail with the ticker's
+/// message (`… reached: stopped while writing it; the output needs it, so nothing is
+/// written`): the staged file is then removed with the run's others.
 struct GraceWriter<'a> {
     inner: &'a mut dyn Write,
     ticker: &'a robovec_passes::Ticker,
@@ -292,8 +293,7 @@ struct GraceWriter<'a> {
 impl Write for GraceWriter<'_> {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
         const CHUNK: usize = 1 << 16;
-        let stopped = if buf.len() >= 4096 { self.ticker.check() } else { self.ticker.tick() };
-        if stopped {
+        if self.ticker.check() {
             return Err(std::io::Error::other(self.ticker.stop_message("while writing it")));
         }
         self.inner.write(&buf[..buf.len().min(CHUNK)])
@@ -639,11 +639,13 @@ fn write_outputs(
     // limit's grace: the output needs it.
     let grace = robovec_passes::Ticker::new(cx.deadline.map(|d| d.grace()), None);
     let mut print_main = |w: &mut dyn Write| {
-        let mut w = GraceWriter { inner: w, ticker: &grace };
+        // Buffered before the clock: the printer's many small writes reach it 64 KiB at a time.
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, GraceWriter { inner: w, ticker: &grace });
         match code {
-            Some(c) => w.write_all(c.main.as_bytes()),
-            None => write!(w, "{module}"),
+            Some(c) => w.write_all(c.main.as_bytes())?,
+            None => write!(w, "{module}")?,
         }
+        w.flush()
     };
 
     // Then put every file in place at once, and write stdout last. The files of passes'
