@@ -562,7 +562,18 @@ fn eval_json(
         )
         .map_err(stderr_failure)?;
     }
-    let r = crate::eval::evaluate_with(f, &given.given, &given.defaults, opts.eval_f32);
+    let r = if f.has_formats() {
+        if opts.eval_f32 {
+            return Err(Failure::Usage(format!(
+                "error: -eval-precision=f32: the values of @{} carry their own numeric formats, which say how each is computed\n",
+                f.name
+            )));
+        }
+        crate::eval::evaluate_formats(f, &given.given, &given.defaults, Some((&src.name, &src.text)))
+            .map_err(Failure::Input)?
+    } else {
+        crate::eval::evaluate_with(f, &given.given, &given.defaults, opts.eval_f32)
+    };
     // An output that is not finite prints as `null`: say where the values went wrong (issue 47:
     // a zero mass given for a link made every `qdd` null without a word).
     if let Some(n) = &r.non_finite {

@@ -11,7 +11,8 @@ use serde::Serialize;
 /// `-eval` output: every input used and every output, in the evaluation precision.
 #[derive(Clone, Debug, Serialize)]
 pub struct EvalResult {
-    /// `f64` or `f32` (`-eval-precision`).
+    /// `f64` or `f32` (`-eval-precision`), or `formats` when the function's values carry
+    /// numeric formats ([`evaluate_formats`]).
     pub precision: &'static str,
     /// Input name → value used (in `f32`: the binary32 value, printed as a number).
     pub inputs: BTreeMap<String, f64>,
@@ -187,6 +188,54 @@ pub fn not_given(f: &Function, inputs: &EvalInputs) -> NotGiven {
 /// (`robovec_ir::interp::pseudo_random_input` with seed 0).
 pub fn evaluate(f: &Function, given: &BTreeMap<String, f64>, single: bool) -> EvalResult {
     evaluate_with(f, given, &BTreeMap::new(), single)
+}
+
+/// [`evaluate_with`] for a function whose values carry numeric formats (issue 48,
+/// `robovec_ir::format`): every value computed in its format, as the back ends must
+/// (`robovec_ir::format::eval_values`); `precision` is `formats`.
+///
+/// # Errors
+/// The message of the first value, in program order, whose result its fixed-point format cannot
+/// hold (`error: @f: %x = 40.3 overflows fix<8,2> (values -32 ..= 31.75)`, with `  --> file:line:col`
+/// when `at` (file name, text) locates its definition).
+pub fn evaluate_formats(
+    f: &Function,
+    given: &BTreeMap<String, f64>,
+    defaults: &BTreeMap<String, f64>,
+    at: Option<(&str, &str)>,
+) -> Result<EvalResult, String> {
+    let mut inputs = BTreeMap::new();
+    let vals = robovec_ir::format::eval_values(f, |name| {
+        let stated = given.get(name).or_else(|| defaults.get(name));
+        let x = stated.copied().unwrap_or_else(|| interp::pseudo_random_input(name, 0));
+        inputs.insert(name.to_string(), x);
+        x
+    })
+    .map_err(|e| {
+        let format = f.format(e.value);
+        let what = match e.error {
+            robovec_ir::format::StoreError::Overflow => {
+                let (lo, hi) = format.fix_range().unwrap_or((f64::NAN, f64::NAN));
+                format!("overflows {format} (values {lo} ..= {hi})")
+            }
+            robovec_ir::format::StoreError::NotFinite => format!("is not finite, which {format} cannot hold"),
+        };
+        let mut m = format!("error: @{}: %{} = {} {what}\n", f.name, f.name_of(e.value), e.result);
+        let span = f.value(e.value).span;
+        if let Some((file, text)) = at.filter(|(_, t)| span != Span::DUMMY && span.end as usize <= t.len()) {
+            let (line, col) = robovec_ir::span::line_col(text, span.start as usize);
+            m += &format!("  --> {file}:{line}:{col}\n");
+        }
+        m
+    })?;
+    let (outputs, non_finite) = outputs_of(f, &vals);
+    Ok(EvalResult {
+        precision: "formats",
+        inputs,
+        outputs: outputs.into_iter().collect(),
+        callback_standins: robovec_ir::numerics::Tape::new(f).standin_callees(),
+        non_finite,
+    })
 }
 
 /// [`evaluate`] where inputs not in `given` take `defaults` first ([`EvalInputs`]; see

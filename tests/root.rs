@@ -22,6 +22,7 @@ mod error_reference;
 mod exact_gap;
 mod example;
 mod filetests;
+mod formats;
 mod fpga;
 mod inline_specialize;
 mod numerics;

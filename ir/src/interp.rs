@@ -92,7 +92,7 @@ pub fn eval_values<T: Float>(f: &Function, mut input: impl FnMut(&str) -> f64) -
     vals.into_iter().map(|x| x.unwrap_or(T::from_f64(f64::NAN))).collect()
 }
 
-fn eval_expr<T: Float>(e: &Expr, get: &impl Fn(&Operand) -> T) -> T {
+pub(crate) fn eval_expr<T: Float>(e: &Expr, get: &impl Fn(&Operand) -> T) -> T {
     match e {
         Expr::Operand(o) => get(o),
         Expr::Neg(x) => -eval_expr(x, get),

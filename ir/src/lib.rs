@@ -34,6 +34,7 @@ pub mod count;
 pub mod diagnostic;
 pub mod entities;
 pub mod float;
+pub mod format;
 pub mod function;
 pub mod interp;
 pub mod intrinsic;

@@ -20,7 +20,8 @@ pub const INFO: PassInfo = PassInfo {
         doc: "outputs to keep: names (`Qq[1],Qq[2]`) or arrays (`c`), comma-separated",
     }],
     build: |p: &Params| Ok(Box::new(Dce { keep: p.names("outputs")? })),
-    props: crate::Props { bit_exact: true, ..crate::Props::DEFAULT },
+    // It drops values and keeps the others as they are, formats included.
+    props: crate::Props { bit_exact: true, formats: true, ..crate::Props::DEFAULT },
 };
 
 /// The `dce` pass.

@@ -440,6 +440,10 @@ pub struct Props {
     /// A back end: it writes the module as code or design files (the `codegen` family's
     /// members); one whose code `-o` writes implements [`BackEnd`].
     pub back_end: bool,
+    /// The pass understands numeric formats (`robovec_ir::format`: binary32 and fixed-point
+    /// values, issue 48): it keeps them or computes with them. The manager refuses to run a pass
+    /// without it on a function that has any (never a silent reinterpretation as binary64).
+    pub formats: bool,
 }
 
 impl Props {
@@ -454,6 +458,7 @@ impl Props {
         needs_before: None,
         csv_table: false,
         back_end: false,
+        formats: false,
     };
 }
 

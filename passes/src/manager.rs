@@ -306,6 +306,9 @@ impl PassManager {
             if let Some(phase) = props.requires {
                 crate::require_phase(name, m, phase)?;
             }
+            if !props.formats {
+                refuse_formats(&spec.to_string(), m)?;
+            }
             let t0 = Instant::now();
             cx.pass_index = Some(i);
             cx.running = props.at_time_limit;
@@ -349,6 +352,24 @@ impl PassManager {
         }
         Ok(records)
     }
+}
+
+/// [`PassError::Failed`] when a function of `m` has a value in a numeric format other than
+/// binary64: `pass` does not declare that it understands formats (`Props::formats`).
+fn refuse_formats(pass: &str, m: &Module) -> Result<(), PassError> {
+    let Some(f) = m.functions.iter().find(|f| f.has_formats()) else { return Ok(()) };
+    let v = f.inputs.iter().chain(&f.body).copied().find(|&v| !f.format(v).is_default()).expect("has formats");
+    Err(PassError::Failed {
+        pass: pass.to_string(),
+        message: format!(
+            "@{} has values in numeric formats (`%{}` is {}), which this pass does not understand; \
+             it would compute them as binary64",
+            f.name,
+            f.name_of(v),
+            f.format(v)
+        ),
+    }
+    .at(f.value(v).span))
 }
 
 fn verify_named(m: &Module, pass: &str) -> Result<(), PassError> {

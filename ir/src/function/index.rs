@@ -3,6 +3,7 @@
 //! function's own data (ignored by `==`, except the attributes), rebuilt when they do not match.
 
 use crate::entities::Value;
+use crate::format::Format;
 use crate::syntax::{Output, Timing, ValueData};
 
 /// Every value by name, holding only the [`Value`]s (the names stay in `values`: one `String`
@@ -33,6 +34,23 @@ impl Timings {
 
 impl PartialEq for Timings {
     fn eq(&self, other: &Timings) -> bool {
+        (0..self.0.len().max(other.0.len())).all(|i| self.get(i) == other.get(i))
+    }
+}
+
+/// The numeric format of each value by index (issue 48), the default ([`Format::Binary64`]) past
+/// its end: most functions carry none, and then it is empty.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Formats(pub(super) Vec<Format>);
+
+impl Formats {
+    pub(super) fn get(&self, i: usize) -> Format {
+        self.0.get(i).copied().unwrap_or_default()
+    }
+}
+
+impl PartialEq for Formats {
+    fn eq(&self, other: &Formats) -> bool {
         (0..self.0.len().max(other.0.len())).all(|i| self.get(i) == other.get(i))
     }
 }

@@ -8,7 +8,7 @@ use crate::syntax::{Def, OpKind, Operand, Output, Phase, Timing, ValueData};
 
 mod index;
 
-use index::{name_hash, NameIndex, OutputIndex, Timings};
+use index::{name_hash, Formats, NameIndex, OutputIndex, Timings};
 
 /// One Robotran function in SSA form (`dirdyna`, `invdyna`, `sensor_3`, …).
 ///
@@ -37,6 +37,8 @@ pub struct Function {
     pub placement: Option<crate::placement::Placement>,
     /// Schedule attributes by value index ([`Function::timing`]).
     timings: Timings,
+    /// Numeric formats by value index ([`Function::format`]).
+    formats: Formats,
     names: NameIndex,
     outputs_by_name: OutputIndex,
 }
@@ -104,6 +106,7 @@ impl Function {
             span: Span::DUMMY,
             placement: None,
             timings: Timings::default(),
+            formats: Formats::default(),
             names: NameIndex::default(),
             outputs_by_name: OutputIndex::default(),
         }
@@ -131,6 +134,29 @@ impl Function {
             self.timings.0.resize(i + 1, None);
         }
         self.timings.0[i] = t;
+    }
+
+    /// The numeric format of `v` (binary64 unless set; [`crate::format`]).
+    pub fn format(&self, v: Value) -> crate::format::Format {
+        self.formats.get(v.index())
+    }
+
+    /// Sets the numeric format of `v`.
+    pub fn set_format(&mut self, v: Value, format: crate::format::Format) {
+        let i = v.index();
+        if i >= self.formats.0.len() {
+            if format.is_default() {
+                return;
+            }
+            self.formats.0.resize(i + 1, crate::format::Format::default());
+        }
+        self.formats.0[i] = format;
+    }
+
+    /// True when some value has a format other than binary64: passes that do not declare
+    /// that they understand formats refuse the function (`Props::formats` in `robovec-passes`).
+    pub fn has_formats(&self) -> bool {
+        self.formats.0.iter().any(|f| !f.is_default())
     }
 
     /// Replaces every value's schedule attributes by `table` (indexed by value index; values
@@ -331,6 +357,7 @@ impl Function {
         let mut new_inputs = Vec::new();
         let mut new_body = Vec::new();
         let mut new_timings = Vec::new();
+        let mut new_formats = Vec::new();
         for v in kept {
             if stop() {
                 // Every value back in the arena, moved, not freed.
@@ -343,6 +370,11 @@ impl Function {
             if let Some(t) = self.timings.get(v.index()) {
                 new_timings.resize(nv.index(), None);
                 new_timings.push(Some(t));
+            }
+            let format = self.formats.get(v.index());
+            if !format.is_default() {
+                new_formats.resize(nv.index(), crate::format::Format::default());
+                new_formats.push(format);
             }
             let d = slots[v.index()].take().expect("inputs and body name each value once");
             if matches!(d.def, Def::Input) {
@@ -406,6 +438,7 @@ impl Function {
         }
         self.values = new_values;
         self.timings = Timings(new_timings);
+        self.formats = Formats(new_formats);
         self.inputs = new_inputs;
         self.body = new_body;
         let indexed = OutputIndex::build_until(&self.outputs, stop)

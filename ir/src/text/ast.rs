@@ -82,9 +82,9 @@ pub enum PlacementLineAst<'a> {
 /// One line of a function body.
 #[derive(Debug)]
 pub enum ItemAst<'a> {
-    /// `input %name`
-    Input(&'a str, Span),
-    /// `%name = rhs {timing}`
+    /// `input %name : format`
+    Input(&'a str, Span, Option<crate::format::Format>),
+    /// `%name = rhs : format {timing}`
     Def {
         /// Defined name.
         name: &'a str,
@@ -92,6 +92,8 @@ pub enum ItemAst<'a> {
         name_span: Span,
         /// Right-hand side.
         rhs: RhsAst<'a>,
+        /// Numeric format, when not binary64.
+        format: Option<crate::format::Format>,
         /// Schedule attributes.
         timing: Option<Timing>,
     },

@@ -21,6 +21,15 @@ pub enum GrammarError {
         /// What was expected ("a finite number").
         what: &'static str,
     },
+    /// A numeric format that is not one (`: f16`, `: fix<64,3>`).
+    BadFormat {
+        /// First byte.
+        start: usize,
+        /// One past the last byte.
+        end: usize,
+        /// What was expected.
+        message: String,
+    },
     /// A malformed `{…}` timing attribute.
     BadTiming {
         /// First byte.
@@ -69,6 +78,9 @@ impl ParseError {
                 }
                 GrammarError::BadNumber { start, end, what } => {
                     ParseError::new(Span::new(start, end), "number does not parse", format!("expected {what}"))
+                }
+                GrammarError::BadFormat { start, end, message } => {
+                    ParseError::new(Span::new(start, end), message, "not a numeric format")
                 }
                 GrammarError::BadTiming { start, end, message } => {
                     ParseError::new(Span::new(start, end), message, "in this timing attribute")

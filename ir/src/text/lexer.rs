@@ -97,6 +97,10 @@ pub enum Tok<'a> {
     /// `/`
     #[token("/")]
     Slash,
+    /// A value's numeric format after `:` (`: f32`, `:fix<32,20>` → `f32`, `fix<32,20>`);
+    /// checked by the grammar ([`crate::format::Format`]).
+    #[regex(r":[ \t]*[A-Za-z0-9_]*(<[^>\n]*>)?", |lex| lex.slice()[1..].trim_start())]
+    Format(&'a str),
     /// A value name after `%` (`%AlF15` → `AlF15`, `%frc[2][11].1`).
     #[regex(r"%[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+|\[[0-9]+\])*", |lex| &lex.slice()[1..])]
     Local(&'a str),
@@ -117,6 +121,7 @@ impl std::fmt::Display for Tok<'_> {
             Tok::Local(s) => write!(f, "%{s}"),
             Tok::Global(s) => write!(f, "@{s}"),
             Tok::Name(s) | Tok::Number(s) => write!(f, "{s}"),
+            Tok::Format(s) => write!(f, ": {s}"),
             Tok::LBrace => f.write_str("{"),
             Tok::RBrace => f.write_str("}"),
             Tok::LParen => f.write_str("("),

@@ -48,12 +48,11 @@ fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
     func.span = f.span;
     for item in f.items {
         match item {
-            ItemAst::Input(name, span) => {
-                if func.add_input(name, span).is_err() {
-                    errors.push(redefined(name, span));
-                }
-            }
-            ItemAst::Def { name, name_span, rhs, timing } => {
+            ItemAst::Input(name, span, format) => match func.add_input(name, span) {
+                Ok(v) => func.set_format(v, format.unwrap_or_default()),
+                Err(_) => errors.push(redefined(name, span)),
+            },
+            ItemAst::Def { name, name_span, rhs, format, timing } => {
                 let def = match rhs {
                     RhsAst::Bin(op, a, b) => Def::Binary(op, operand(&func, a, errors), operand(&func, b, errors)),
                     RhsAst::Trig(t, a) => match operand(&func, a, errors) {
@@ -72,7 +71,10 @@ fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
                     RhsAst::Expr(e) => Def::Expr(expr(&func, e, errors)),
                 };
                 match func.define(name, def, name_span) {
-                    Ok(v) => func.set_timing(v, timing),
+                    Ok(v) => {
+                        func.set_timing(v, timing);
+                        func.set_format(v, format.unwrap_or_default());
+                    }
                     Err(_) => errors.push(redefined(name, name_span)),
                 }
             }

@@ -114,6 +114,15 @@ pub fn write_expr_with(out: &mut impl Write, leaves: &impl Leaves, e: &Expr) -> 
     write_sum(out, leaves, e)
 }
 
+/// ` : FORMAT` after a value's definition, when its format is not binary64.
+fn write_format(out: &mut impl Write, f: &Function, v: crate::entities::Value) -> fmt::Result {
+    let format = f.format(v);
+    if format.is_default() {
+        return Ok(());
+    }
+    write!(out, " : {format}")
+}
+
 /// Writes one function.
 pub fn write_function(out: &mut impl Write, f: &Function) -> fmt::Result {
     writeln!(out, "func @{} {{", f.name)?;
@@ -126,7 +135,9 @@ pub fn write_function(out: &mut impl Write, f: &Function) -> fmt::Result {
         writeln!(out, "  equations {n}")?;
     }
     for &v in &f.inputs {
-        writeln!(out, "  input %{}", f.name_of(v))?;
+        write!(out, "  input %{}", f.name_of(v))?;
+        write_format(out, f, v)?;
+        out.write_char('\n')?;
     }
     for &v in &f.body {
         let d = f.value(v);
@@ -160,6 +171,7 @@ pub fn write_function(out: &mut impl Write, f: &Function) -> fmt::Result {
             }
             Def::Expr(e) => write_expr(out, f, e)?,
         }
+        write_format(out, f, v)?;
         if let Some(t) = &f.timing(v) {
             write!(
                 out,

@@ -288,6 +288,19 @@ pub fn verify_function_until(f: &Function, stop: &mut dyn FnMut() -> bool) -> Op
             _ => {}
         }
     }
+    if f.phase == Phase::Parsed && f.has_formats() {
+        // An expression rounds at every node; a format says how one op's result is stored.
+        let v = f.inputs.iter().chain(&f.body).copied().find(|&v| !f.format(v).is_default()).expect("has formats");
+        err(
+            Location::Value(v),
+            f.value(v).span,
+            format!(
+                "`%{}` has the numeric format {}, but a format needs an atomised function (`phase atomised`: one rounding per op)",
+                f.name_of(v),
+                f.format(v)
+            ),
+        );
+    }
     if errs.is_empty() {
         errs.extend(placement::verify_placement_until(f, stop)?);
     }

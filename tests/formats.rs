@@ -1,0 +1,147 @@
+//! Numeric formats in the IR (issue 48 item 4, `robovec_ir::format`): the text form writes and
+//! reads them back, the verifier refuses them outside atomised functions, passes that do not
+//! understand them refuse a formatted function, and `-eval` computes every value in its format
+//! (expected values worked out by hand below, not read from the output).
+
+use crate::common::{opt, stderr, tmp};
+use proptest::prelude::*;
+use robovec_ir::format::Format;
+use robovec_ir::text::parse;
+use robovec_ir::{verifier, Module};
+
+const FIXED: &str = "func @f {
+  phase atomised
+  input %a : fix<16,8>
+  input %b : f32
+  %p = mul %a, %b : fix<16,4>
+  %s = add %p, 0.03 : fix<8,2>
+  %t = div %s, 3.0 : f32
+  %u = sin %a : fix<12,10>
+  output y = %s
+  output z = %t
+  output w = %u
+}
+";
+
+#[test]
+fn formats_print_and_read_back_and_binary64_is_not_written() {
+    let m = parse(FIXED).expect("parses");
+    let f = &m.functions[0];
+    let fmt = |n: &str| f.format(f.lookup(n).unwrap());
+    assert_eq!(fmt("a"), Format::fix(16, 8).unwrap());
+    assert_eq!(fmt("b"), Format::Binary32);
+    assert_eq!(fmt("t"), Format::Binary32);
+    assert!(verifier::verify(&m).is_ok());
+    let text = m.to_string();
+    assert!(text.contains("  %p = mul %a, %b : fix<16,4>\n"), "{text}");
+    assert!(text.contains("  input %b : f32\n"), "{text}");
+    assert_eq!(parse(&text).unwrap(), m, "the text reads back to the same module");
+    // Without formats nothing is written: the text of every file before issue 48 is unchanged.
+    let plain = parse("func @g { phase atomised input %a %x = add %a, 1.0 output y = %x }").unwrap();
+    assert!(!plain.to_string().contains(':') && !plain.functions[0].has_formats());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// Any assignment of formats to a random function's values survives printing and parsing.
+    #[test]
+    fn random_formats_round_trip(n_ops in 5usize..200, seed in 0u64..1000, picks in proptest::collection::vec(0u32..4, 1..64)) {
+        let mut f = robovec_testkit::dag_gen::generate(n_ops, seed);
+        let values: Vec<_> = f.inputs.iter().chain(&f.body).copied().collect();
+        for (k, &v) in values.iter().enumerate() {
+            let format = match picks[k % picks.len()] {
+                0 => Format::Binary64,
+                1 => Format::Binary32,
+                2 => Format::fix(32, (k % 40) as i32 - 8).unwrap(),
+                _ => Format::fix(1 + (k as u32 % 53), 3).unwrap(),
+            };
+            f.set_format(v, format);
+        }
+        let m = Module { functions: vec![f] };
+        let text = m.to_string();
+        let back = parse(&text).map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
+        // The same text (spans aside, the same module), and every value's format.
+        prop_assert_eq!(back.to_string(), text);
+        let (f, g) = (&m.functions[0], &back.functions[0]);
+        for &v in &values {
+            prop_assert_eq!(g.format(g.lookup(f.name_of(v)).unwrap()), f.format(v));
+        }
+    }
+}
+
+#[test]
+fn a_bad_format_is_a_located_parse_error() {
+    let e = parse("func @f { phase atomised input %a : fix<64,3> output y = %a }").unwrap_err();
+    let text = format!("{e:?}");
+    assert!(text.contains("expected f64, f32 or fix<W,F>"), "{text}");
+    assert!(text.contains("not a numeric format"), "{text}");
+}
+
+#[test]
+fn a_format_needs_an_atomised_function() {
+    let m = parse("func @f { input %a %x = %a*2.0 : f32 output y = %x }").unwrap();
+    let errs = verifier::verify(&m).unwrap_err();
+    assert!(errs[0].message.contains("`%x` has the numeric format f32, but a format needs an atomised function"));
+}
+
+#[test]
+fn eval_computes_each_value_in_its_format() {
+    let dir = tmp("formats-eval");
+    let file = dir.join("f.rvir");
+    std::fs::write(&file, FIXED).unwrap();
+    let inputs = dir.join("in.json");
+    // a = 1.3 → fix<16,8>: floor(1.3·256 + 0.5)/256 = 333/256 = 1.30078125;
+    // b = 0.7 → binary32: 0.699999988079071044921875.
+    std::fs::write(&inputs, r#"{"a": 1.3, "b": 0.7}"#).unwrap();
+    let o = opt(&[file.to_str().unwrap(), "-passes=dce", &format!("-eval={}", inputs.display()), "-o", "/dev/null"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let a = 333.0 / 256.0;
+    let b = 0.7f32 as f64;
+    // p = a·b in binary64, stored in fix<16,4> (steps of 1/16); s = p + 0.03 in fix<8,2>.
+    let p = (a * b * 16.0 + 0.5).floor() / 16.0;
+    let s = ((p + 0.03) * 4.0 + 0.5).floor() / 4.0;
+    let t = (s / 3.0) as f32 as f64;
+    let u = (a.sin() * 1024.0 + 0.5).floor() / 1024.0;
+    assert_eq!((p, s), (0.9375, 1.0), "by hand: a·b = 0.91055 → 15/16; 0.9375 + 0.03 = 0.9675 → 4/4");
+    assert_eq!(json["precision"], "formats");
+    assert_eq!(json["outputs"]["y"].as_f64(), Some(s));
+    assert_eq!(json["outputs"]["z"].as_f64(), Some(t));
+    assert_eq!(json["outputs"]["w"].as_f64(), Some(u));
+    assert_eq!(json["inputs"]["a"].as_f64(), Some(1.3), "the inputs as given");
+    // An overflow stops with the value, located: a = 100 needs more than fix<16,4>'s 2^11.
+    std::fs::write(&inputs, r#"{"a": 127.9, "b": 100.0}"#).unwrap();
+    let o = opt(&[file.to_str().unwrap(), "-passes=dce", &format!("-eval={}", inputs.display()), "-o", "/dev/null"]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("error: @f: %p = 12789.84375 ") && e.contains("overflows fix<16,4> (values -2048 ..= 2047.9375)"),
+        "{e}"
+    );
+    assert!(e.contains(&format!("--> {}:5:3", file.display())), "{e}");
+    // The formats say the precision: -eval-precision=f32 is bad usage.
+    let o =
+        opt(&[file.to_str().unwrap(), "-passes=dce", &format!("-eval={}", inputs.display()), "-eval-precision=f32"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+#[test]
+fn a_pass_that_does_not_understand_formats_refuses_them() {
+    let dir = tmp("formats-refuse");
+    let file = dir.join("f.rvir");
+    std::fs::write(&file, FIXED).unwrap();
+    let o = opt(&[file.to_str().unwrap(), "-passes=cse", "-o", "/dev/null"]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains(
+            "pass `cse`: @f has values in numeric formats (`%a` is fix<16,8>), which this pass does not understand"
+        ),
+        "{e}"
+    );
+    // `dce` keeps them: the output has them still.
+    let out = dir.join("out.rvir");
+    let o = opt(&[file.to_str().unwrap(), "-passes=dce", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), FIXED);
+}
