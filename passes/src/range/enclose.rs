@@ -93,7 +93,22 @@ fn of(x: &[Interval], o: &Operand) -> Interval {
 /// # Errors
 /// [`EncloseError`]: inputs without a range (all named), the first division by an enclosure
 /// holding 0 or square root of one holding negatives, or the stop.
-pub fn enclose(f: &Function, domain: &Domain, mut tick: impl FnMut() -> bool) -> Result<Vec<Interval>, EncloseError> {
+pub fn enclose(f: &Function, domain: &Domain, tick: impl FnMut() -> bool) -> Result<Vec<Interval>, EncloseError> {
+    enclose_with(f, domain, None, tick)
+}
+
+/// [`enclose`], and with `affine = Some(cap)` each interval intersected with the range of the
+/// value's affine form of at most `cap` noise symbols ([`super::affine`]): never wider than
+/// [`enclose`]'s, O(ops · cap).
+///
+/// # Errors
+/// As [`enclose`].
+pub fn enclose_with(
+    f: &Function,
+    domain: &Domain,
+    affine: Option<usize>,
+    mut tick: impl FnMut() -> bool,
+) -> Result<Vec<Interval>, EncloseError> {
     let missing = domain.missing(f);
     if !missing.is_empty() {
         return Err(EncloseError::Missing(missing.into_iter().map(str::to_string).collect()));
@@ -102,11 +117,15 @@ pub fn enclose(f: &Function, domain: &Domain, mut tick: impl FnMut() -> bool) ->
     for &v in &f.inputs {
         x[v.index()] = domain.get(f.name_of(v)).expect("no input is missing").interval;
     }
+    let mut sweep = affine.map(|cap| super::affine::AffineSweep::new(f, domain, cap));
     for (k, &v) in f.body.iter().enumerate() {
         if tick() {
             return Err(EncloseError::Stopped(k));
         }
         x[v.index()] = enclose_value(f, v, &x)?;
+        if let Some(s) = &mut sweep {
+            x[v.index()] = s.step(v, &x)?;
+        }
     }
     Ok(x)
 }

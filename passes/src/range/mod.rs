@@ -25,6 +25,7 @@
 //! available to later analyses through [`enclose`]. Cost: O(ops) for the enclosure, plus
 //! O(ops · samples) for the samples.
 
+pub mod affine;
 pub mod enclose;
 
 use std::collections::HashMap;
@@ -35,7 +36,17 @@ use serde::Serialize;
 
 use crate::params::ParamKind;
 use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
-pub use enclose::{enclose, EncloseError};
+pub use enclose::{enclose, enclose_with, EncloseError};
+
+crate::params::word_enum! {
+    /// How `range` encloses the values.
+    pub enum Method {
+        /// Outward-rounded interval arithmetic alone.
+        Interval = "interval",
+        /// Intervals intersected with affine forms of at most `terms` noise symbols.
+        Affine = "affine",
+    }
+}
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -49,13 +60,32 @@ pub const INFO: PassInfo = PassInfo {
                   domain (-ranges)",
         },
         ParamInfo {
+            name: "method",
+            kind: ParamKind::Choice { choices: Method::WORDS, default: "affine" },
+            doc: "interval: outward-rounded interval arithmetic; affine: intervals intersected with affine forms \
+                  (correlation-aware, O(ops · terms))",
+        },
+        ParamInfo {
+            name: "terms",
+            kind: ParamKind::U32 { default: 16, min: 2, max: 1024 },
+            doc: "most noise symbols of one affine form (method=affine); the smallest beyond are folded into the \
+                  value's own symbol",
+        },
+        ParamInfo {
             name: "samples",
             kind: ParamKind::U32 { default: 64, min: 0, max: 1_000_000 },
             doc: "points of the domain each function is evaluated at, to check the enclosures and measure their \
                   tightness",
         },
     ],
-    build: |p: &Params| Ok(Box::new(RangePass { ranges: p.path("ranges")?, samples: p.u32("samples")? })),
+    build: |p: &Params| {
+        Ok(Box::new(RangePass {
+            ranges: p.path("ranges")?,
+            samples: p.u32("samples")?,
+            method: p.word("method")?,
+            terms: p.u32("terms")? as usize,
+        }))
+    },
     props: crate::Props {
         requires: Some(robovec_ir::Phase::Atomised),
         at_time_limit: AtTimeLimit::Skip,
@@ -73,6 +103,10 @@ pub struct RangePass {
     pub ranges: Option<String>,
     /// Sample points per function.
     pub samples: u32,
+    /// Interval arithmetic alone, or with affine forms.
+    pub method: Method,
+    /// Most noise symbols of an affine form.
+    pub terms: usize,
 }
 
 /// The domain of `m`'s inputs: `base` (the run's) with the keys of the ranges file `path`
@@ -107,6 +141,10 @@ impl Pass for RangePass {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let dom = domain_with_file(cx.domain.as_ref(), self.ranges.as_deref(), m)?;
         let samples = self.samples;
+        let (method, affine) = match self.method {
+            Method::Interval => (self.method, None),
+            Method::Affine => (self.method, Some(self.terms)),
+        };
         let functions = try_each_function(
             m,
             cx,
@@ -115,7 +153,7 @@ impl Pass for RangePass {
             Before::Ticked,
             |f, k| Some(format!("before @{} ({k} functions enclosed)", f.name)),
             |f, _, ticker| {
-                let x = match enclose(f, &dom, || ticker.tick()) {
+                let x = match enclose_with(f, &dom, affine, || ticker.tick()) {
                     Ok(x) => x,
                     Err(e @ EncloseError::Stopped(_)) => {
                         return Ok(Step::Stopped { what: e.message(&f.name), kept: None });
@@ -125,7 +163,7 @@ impl Pass for RangePass {
                         return Err(PassError::Failed { pass: "range".into(), message: e.message(&f.name) }.at(span));
                     }
                 };
-                measure(f, &dom, &x, samples).map(Step::Done)
+                measure(f, &x, samples, method).map(Step::Done)
             },
         )?;
         let domains = m
@@ -161,8 +199,8 @@ pub struct OutputRange {
 pub struct FunctionRange {
     /// Function name.
     pub function: String,
-    /// How the enclosures were computed (`interval`: outward-rounded interval arithmetic).
-    pub method: &'static str,
+    /// How the enclosures were computed.
+    pub method: Method,
     /// Per output, in output order.
     pub outputs: Vec<OutputRange>,
     /// Values (inputs and body) whose enclosure is unbounded (a callback's, an overflow).
@@ -179,16 +217,17 @@ pub struct FunctionRange {
     pub widest: Option<(String, f64)>,
 }
 
-/// Evaluates `f` at `samples` points of `dom`, checks every value against its enclosure in
+/// Evaluates `f` at `samples` points of the domain (its inputs' enclosures in `x`), checks every value against its enclosure in
 /// `x` and summarises the outputs.
-fn measure(f: &Function, dom: &Domain, x: &[Interval], samples: u32) -> Result<FunctionRange, PassError> {
-    let ranges: HashMap<&str, Interval> = f.inputs.iter().map(|&v| (f.name_of(v), x[v.index()])).collect();
+fn measure(f: &Function, x: &[Interval], samples: u32, method: Method) -> Result<FunctionRange, PassError> {
+    // Inputs in input order: the draws do not depend on a hash order.
+    let ranges: Vec<(&str, Interval)> = f.inputs.iter().map(|&v| (f.name_of(v), x[v.index()])).collect();
     let mut rng = robovec_ir::rng::SplitMix64::new(1);
     let mut sampled: Vec<Option<Interval>> = vec![None; f.outputs.len()];
     for k in 0..samples {
         let point: HashMap<&str, f64> = ranges
             .iter()
-            .map(|(&n, r)| {
+            .map(|&(n, r)| {
                 let t = match k {
                     0 => 0.0,
                     1 => 1.0,
@@ -237,13 +276,12 @@ fn measure(f: &Function, dom: &Domain, x: &[Interval], samples: u32) -> Result<F
             OutputRange { output: o.name.clone(), enclosure, sampled, ratio }
         })
         .collect();
-    let _ = dom;
     let mut ratios: Vec<(f64, &str)> = outputs.iter().filter_map(|o| Some((o.ratio?, o.output.as_str()))).collect();
     ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
     let widest = outputs.iter().map(|o| (o.output.clone(), o.enclosure.width())).max_by(|a, b| a.1.total_cmp(&b.1));
     Ok(FunctionRange {
         function: f.name.clone(),
-        method: "interval",
+        method,
         unbounded_values: x.iter().filter(|i| !i.is_bounded()).count(),
         samples,
         median_ratio: ratios.get(ratios.len() / 2).map(|r| r.0),
@@ -302,7 +340,7 @@ pub struct RangeRun {
 
 impl std::fmt::Display for FunctionRange {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "range @{}: {} outputs enclosed ({})", self.function, self.outputs.len(), self.method)?;
+        write!(f, "range @{}: {} outputs enclosed ({})", self.function, self.outputs.len(), self.method.as_str())?;
         if let Some((o, w)) = &self.widest {
             write!(f, "; widest {o} (width {w:.3e})")?;
         }
@@ -324,7 +362,7 @@ impl std::fmt::Display for FunctionRange {
 /// The report's `range` object.
 #[derive(Serialize)]
 struct RangeReport<'a> {
-    method: &'static str,
+    method: Method,
     outputs: serde_json::Map<String, serde_json::Value>,
     samples: u32,
     median_ratio: Option<f64>,
