@@ -16,7 +16,7 @@
 //! are dropped after their value's last use, so memory is O(live values · cap).
 //!
 //! **Soundness.** Every coefficient is computed in round-to-nearest and its rounding error
-//! bounded (`|fl(t) − t| ≤ u·|fl(t)|` with `u = 2⁻⁵²`, twice the unit roundoff, plus 2⁻¹⁰⁶⁰ for
+//! bounded (`|fl(t) − t| ≤ u·|fl(t)|` with `u = 2⁻⁵²`, twice the unit roundoff, plus 10⁻³⁰⁰ for
 //! underflow) and added to the own symbol; the form's range `c ± Σ|xᵢ|` is summed with
 //! outward rounding. Each operation's own symbol also covers the rounding of the binary64
 //! operation on the computed operands (`u`·magnitude of its interval enclosure), so a form
@@ -38,8 +38,9 @@ pub const DEFAULT_TERMS: usize = 16;
 /// coefficient (relative), generous on purpose.
 const U: f64 = f64::EPSILON;
 
-/// Absolute slack per rounding for underflow (2⁻¹⁰⁶⁰ > the largest gradual-underflow error).
-const TINY: f64 = 8.289046058458095e-320;
+/// Absolute slack per rounding for underflow (10⁻³⁰⁰, far above the largest gradual-underflow
+/// error 2⁻¹⁰⁷⁴).
+const TINY: f64 = 1e-300;
 
 /// An affine form: centre, terms `(symbol, coefficient)` sorted by symbol, no zero coefficient.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -208,9 +209,10 @@ impl<'f> AffineSweep<'f> {
     }
 
     /// The form of body value `v`, given every value's interval enclosure so far in `x`
-    /// (`x[v]` already holds `v`'s own). Its range, intersected with `x[v]`, is the enclosure.
-    /// Returns `None` when the value is unbounded (a callback's, an overflow): its form is
-    /// then the interval's.
+    /// (`x[v]` already holds `v`'s own): returns the enclosure, the form's range intersected
+    /// with `x[v]`. An unbounded value (a callback's, an overflow) keeps its interval and has
+    /// no form; a value that reads one gets a form of its own from its interval
+    /// (`mid ± rad` on its own symbol), as does a value when that is narrower.
     pub fn step(&mut self, v: robovec_ir::Value, x: &[Interval]) -> Result<Interval, EncloseError> {
         let f = self.f;
         let data = f.value(v);
@@ -223,8 +225,22 @@ impl<'f> AffineSweep<'f> {
             Operand::Value(p) => x[p.index()],
             Operand::Const(c) => Interval::point(*c),
         };
+        let formless = |o: &Operand| matches!(o, Operand::Value(p) if self.forms[p.index()].is_none());
+        let reads_formless = match &data.def {
+            Def::Trig(_, a) => formless(&Operand::Value(*a)),
+            Def::Binary(_, a, b) => formless(a) || formless(b),
+            Def::Call(_, args) => args.iter().any(formless),
+            Def::Input | Def::Expr(_) => false,
+        };
         let (centre, mut terms) = match &data.def {
             Def::Input | Def::Expr(_) => (0.0, Vec::new()),
+            _ if iv.is_bounded() && reads_formless => {
+                self.finish_operands(&data.def);
+                if self.uses[v.index()] > 0 {
+                    self.forms[v.index()] = Some(own_interval(iv, own));
+                }
+                return Ok(iv);
+            }
             _ if !iv.is_bounded() => {
                 self.finish_operands(&data.def);
                 self.forms[v.index()] = None;
