@@ -1,6 +1,7 @@
 //! The run's input domain (issue 48): the input's defaults ([`robovec_front::Loaded::domain_defaults`],
 //! a URDF's limits and parameters) overridden by `-ranges=FILE` ([`robovec_ir::domain`]),
-//! resolved once after loading for the functions the run describes (`-function`, or all), and
+//! resolved once after loading for the inputs of the module's functions (those a URDF's `-function`
+//! built; every function of a Robotran file, as the passes see them), and
 //! handed to the passes as [`robovec_passes::PassContext::domain`].
 
 use std::collections::BTreeMap;
@@ -13,7 +14,7 @@ use crate::diagnostics::SourceFile;
 use crate::options::{Failure, Options};
 
 /// The domain of the run: `defaults` overridden by `-ranges=FILE` over the inputs of the
-/// functions the run describes; when `required` (a pass of the pipeline needs the domain,
+/// module's functions (a key must match an input of one of them); when `required` (a pass of the pipeline needs the domain,
 /// `robovec_passes::Props::needs_domain`), every one of their inputs must have a range.
 ///
 /// # Errors
@@ -26,10 +27,9 @@ pub fn domain(
     defaults: &BTreeMap<String, Range>,
     required: bool,
 ) -> Result<Domain, Failure> {
-    let functions: Vec<&robovec_ir::Function> = match &opts.function {
-        Some(name) => module.functions.iter().filter(|f| &f.name == name).collect(),
-        None => module.functions.iter().collect(),
-    };
+    // Every function of the module: passes run on all of them (`-function` selects what the
+    // report and `-eval` describe, not what the passes see).
+    let functions: Vec<&robovec_ir::Function> = module.functions.iter().collect();
     let mut inputs: Vec<&str> = functions.iter().flat_map(|f| f.inputs.iter().map(|&v| f.name_of(v))).collect();
     inputs.sort_unstable();
     inputs.dedup();

@@ -350,3 +350,88 @@ fn a_divisor_whose_range_holds_zero_is_named_at_its_line() {
     assert_eq!(code, Some(0), "{e}");
     assert!(e.contains("range @f: 1 outputs enclosed (interval)"), "{e}");
 }
+
+/// The measurements of docs/accuracy.md ("Certified ranges"): per corpus function, the ratio of
+/// each output's enclosure width to the width of its values at 256 points of the generous
+/// domain, for intervals and affine forms of 16 and 64 symbols, and the time of the enclosure.
+/// `cargo test --release --test root -- range::measure_tightness --ignored --nocapture`.
+#[test]
+#[ignore = "a measurement: prints the table of docs/accuracy.md"]
+fn measure_tightness() {
+    let narrow = std::env::var("RANGE_NARROW").is_ok();
+    let methods: [(&str, Option<usize>); 3] = [("interval", None), ("affine16", Some(16)), ("affine64", Some(64))];
+    let mut all: Vec<Vec<f64>> = vec![Vec::new(); methods.len()];
+    for (name, f) in crate::tree_height::corpus_functions() {
+        let mut dom = generous_domain(&f);
+        if narrow {
+            // Joint angles ±0.1 rad and velocities ±1 around 0.3, forces ±1.
+            for (n, r) in dom.ranges.iter_mut() {
+                let fam = n.split('[').next().unwrap_or(n);
+                match fam {
+                    "q" => r.interval = Interval::new(0.2, 0.4),
+                    "qd" | "qdd" | "frc" | "trq" => r.interval = Interval::new(-1.0, 1.0),
+                    _ => {}
+                }
+            }
+        }
+        // Sampled widths per output.
+        let mut rng = SplitMix64::new(9);
+        let inputs: Vec<(&str, Interval)> =
+            f.inputs.iter().map(|&v| (f.name_of(v), dom.get(f.name_of(v)).unwrap().interval)).collect();
+        let mut lo = vec![f64::INFINITY; f.outputs.len()];
+        let mut hi = vec![f64::NEG_INFINITY; f.outputs.len()];
+        for _ in 0..256 {
+            let point: BTreeMap<&str, f64> =
+                inputs.iter().map(|&(n, i)| (n, i.lo + rng.unit() * (i.hi - i.lo))).collect();
+            for (k, (_, y)) in robovec_ir::interp::eval::<f64>(&f, |n| point[n]).into_iter().enumerate() {
+                lo[k] = lo[k].min(y);
+                hi[k] = hi[k].max(y);
+            }
+        }
+        let mut line = format!("{name:70} {:>6} ops", f.op_counts().total);
+        for (m, (label, affine)) in methods.iter().enumerate() {
+            let t = std::time::Instant::now();
+            let x = match enclose_with(&f, &dom, *affine, || false) {
+                Ok(x) => x,
+                Err(_) => {
+                    line += &format!(" | {label}: refused");
+                    continue;
+                }
+            };
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            let mut r: Vec<f64> = f
+                .outputs
+                .iter()
+                .enumerate()
+                .filter_map(|(k, o)| {
+                    let e = match o.value {
+                        robovec_ir::Operand::Value(v) => x[v.index()],
+                        robovec_ir::Operand::Const(c) => Interval::point(c),
+                    };
+                    let s = hi[k] - lo[k];
+                    // Outputs whose sampled width is below 1e-9 of their magnitude are left out
+                    // (structural zeros and constants: the ratio is rounding noise).
+                    (s > 1e-9 * hi[k].abs().max(lo[k].abs()) && e.width().is_finite()).then(|| e.width() / s)
+                })
+                .collect();
+            r.sort_by(f64::total_cmp);
+            all[m].extend(&r);
+            let med = r.get(r.len() / 2).copied().unwrap_or(f64::NAN);
+            let worst = r.last().copied().unwrap_or(f64::NAN);
+            line += &format!(" | {label}: median {med:9.3e} worst {worst:9.3e} {ms:7.1} ms");
+        }
+        println!("{line}");
+    }
+    for (m, (label, _)) in methods.iter().enumerate() {
+        let r = &mut all[m];
+        r.sort_by(f64::total_cmp);
+        let q = |p: f64| r.get(((r.len() as f64 - 1.0) * p) as usize).copied().unwrap_or(f64::NAN);
+        println!(
+            "ALL {label}: {} outputs, ratio median {:.3e}, p90 {:.3e}, worst {:.3e}",
+            r.len(),
+            q(0.5),
+            q(0.9),
+            q(1.0)
+        );
+    }
+}

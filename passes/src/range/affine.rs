@@ -10,7 +10,7 @@
 //! widths.
 //!
 //! **Cap.** A form keeps at most `cap` symbols (the parameter `terms`, default
-//! [`DEFAULT_TERMS`]): when an operation gives more, the smallest coefficients are summed
+//! [`DEFAULT_TERMS`], 64): when an operation gives more, the smallest coefficients are summed
 //! (rounded up) into the value's own symbol. Each operation thus costs O(cap) (merges of sorted
 //! lists; the cap's selection is a partial sort), and the sweep is O(ops · cap) in time; forms
 //! are dropped after their value's last use, so memory is O(live values · cap).
@@ -32,7 +32,7 @@ use robovec_ir::{BinOp, Def, Function, Interval, Intrinsic, Operand, TrigFn};
 use super::enclose::EncloseError;
 
 /// Default cap on the noise symbols of one affine form.
-pub const DEFAULT_TERMS: usize = 16;
+pub const DEFAULT_TERMS: usize = 64;
 
 /// `2⁻⁵²`: twice the unit roundoff of binary64, the bound used for one rounding of a
 /// coefficient (relative), generous on purpose.
@@ -324,6 +324,8 @@ impl<'f> AffineSweep<'f> {
         };
         // Cap: the smallest coefficients beyond cap − 1 go to the own symbol.
         if terms.len() >= self.cap {
+            // Largest first (keeping the inputs' symbols first measured worse: 30-dof chain, 64
+            // symbols, median ratio 3279 against 2040).
             terms.sort_unstable_by(|p, q| q.1.abs().total_cmp(&p.1.abs()));
             for t in terms.drain(self.cap - 1..) {
                 slack.add(t.1);

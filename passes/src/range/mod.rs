@@ -67,7 +67,7 @@ pub const INFO: PassInfo = PassInfo {
         },
         ParamInfo {
             name: "terms",
-            kind: ParamKind::U32 { default: 16, min: 2, max: 1024 },
+            kind: ParamKind::U32 { default: affine::DEFAULT_TERMS as u32, min: 2, max: 1024 },
             doc: "most noise symbols of one affine form (method=affine); the smallest beyond are folded into the \
                   value's own symbol",
         },
