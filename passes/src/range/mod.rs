@@ -1,6 +1,6 @@
 //! `range<ranges=FILE;samples=64>`: a certified enclosure of every value of each function over
 //! the input domain (issue 48 item 2), by outward-rounded interval arithmetic
-//! ([`robovec_ir::interval`], [`enclose`]).
+//! ([`robovec_ir::interval`], [`enclose()`]).
 //!
 //! Phase: atomised → atomised; an analysis: the IR is unchanged (bit-exact, timing kept). The
 //! domain is the run's ([`PassContext::domain`]: the input's defaults and `-ranges=FILE`),
@@ -22,7 +22,7 @@
 //! Printed after the run, one line per function (`range @f: 24 outputs enclosed over 31
 //! inputs; …`), and in the report as `range` (per output `[lo, hi]`, the summary) and `domain`
 //! (per input `[lo, hi]` and where it came from). The enclosures of every value stay
-//! available to later analyses through [`enclose`]. Cost: O(ops) for the enclosure, plus
+//! available to later analyses through [`enclose_with()`]. Cost: O(ops) for the enclosure, plus
 //! O(ops · samples) for the samples.
 
 pub mod affine;
