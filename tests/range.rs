@@ -113,7 +113,11 @@ fn random_function(seed: u64, ops: usize) -> (Function, Domain) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+    // 64 cases (PROPTEST_CASES=N for a longer campaign).
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(64),
+        ..ProptestConfig::default()
+    })]
 
     /// Every op the IR has, both methods: no value computed at a point of the domain leaves
     /// its enclosure.

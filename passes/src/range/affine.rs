@@ -264,7 +264,10 @@ impl<'f> AffineSweep<'f> {
                     slack.add(r * r / 2.0 * (1.0 + 4.0 * U));
                     // sin c and cos c each within `libm`; the interpreter's own sin at the point too.
                     slack.add(libm * (2.0 + r));
-                    let (c0, t) = combine(&q, d, &Form::point(0.0), 0.0, v0 - d * q.centre, &mut slack);
+                    // The constant v0 − d·c is itself rounded twice.
+                    let k = v0 - d * q.centre;
+                    slack.add(2.0 * U * (v0.abs() + (d * q.centre).abs() + k.abs()) + TINY);
+                    let (c0, t) = combine(&q, d, &Form::point(0.0), 0.0, k, &mut slack);
                     self.finish_operands(&data.def);
                     (c0, t)
                 } else {
