@@ -8,6 +8,7 @@ use std::collections::BTreeMap;
 use proptest::prelude::*;
 use robovec_ir::domain::{Domain, Range};
 use robovec_ir::interp::eval_values;
+use robovec_ir::numerics::{Tape, DD};
 use robovec_ir::rng::SplitMix64;
 use robovec_ir::{Function, Interval};
 use robovec_passes::range::{enclose_with, EncloseError};
@@ -19,11 +20,12 @@ fn range(lo: f64, hi: f64) -> Range {
 }
 
 /// Evaluates `f` at `n` points of `dom` (the corners, then uniform draws) and asserts every
-/// value lies in its enclosure `x`. Returns the points checked.
+/// value computed in binary64, and every output's exact value, lies in its enclosure `x`.
 fn assert_sound(what: &str, f: &Function, dom: &Domain, x: &[Interval], n: usize, seed: u64) {
     let mut rng = SplitMix64::new(seed);
     let inputs: Vec<(&str, Interval)> =
         f.inputs.iter().map(|&v| (f.name_of(v), dom.get(f.name_of(v)).unwrap().interval)).collect();
+    let tape = Tape::new(f);
     for k in 0..n {
         let point: BTreeMap<&str, f64> = inputs
             .iter()
@@ -43,6 +45,22 @@ fn assert_sound(what: &str, f: &Function, dom: &Domain, x: &[Interval], n: usize
                 y.is_nan() || e.contains(y),
                 "{what}: %{} = {y:e} at point {k} is outside its enclosure {e}",
                 f.name_of(v)
+            );
+        }
+        // The exact value too (double-double, ≈ 2⁻¹⁰⁰ relative: a tolerance of 10⁻²⁰ relative
+        // tells an enclosure of the binary64 value alone, ~10⁻¹⁶ off, from one of both).
+        let xs: Vec<f64> = tape.inputs.iter().map(|n| point[n.as_str()]).collect();
+        for ((name, _), exact) in tape.outputs.iter().zip(tape.eval::<DD>(&xs)) {
+            let o = f.outputs.iter().find(|o| &o.name == name).unwrap();
+            let e = match o.value {
+                robovec_ir::Operand::Value(v) => x[v.index()],
+                robovec_ir::Operand::Const(c) => Interval::point(c),
+            };
+            let r = exact.hi + exact.lo;
+            let tol = 1e-20 * r.abs().max(1.0);
+            assert!(
+                !r.is_finite() || (e.lo - tol <= r && r <= e.hi + tol),
+                "{what}: the exact value of {name}, {r:e}, at point {k} is outside its enclosure {e}"
             );
         }
     }
