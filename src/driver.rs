@@ -475,6 +475,19 @@ fn run_passes(
         .map_err(Failure::from)?;
         cx.emit(study);
     }
+    // The domain in the report (`domain`) whether or not a pass reads it (`range` reports the
+    // one it used, which replaces this).
+    if let Some(dom) = &cx.domain {
+        let functions = module
+            .functions
+            .iter()
+            .map(|f| robovec_passes::range::FunctionDomain {
+                function: f.name.clone(),
+                inputs: dom.of_function(f).into_iter().map(|(n, r)| (n, r.clone())).collect(),
+            })
+            .collect();
+        cx.emit(robovec_passes::range::DomainUsed { functions });
+    }
     let mut session = Session::new(pm, module, cx);
     {
         let dir = opts.instr.dump_dir.clone().unwrap_or_default();

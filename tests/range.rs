@@ -320,6 +320,20 @@ fn inputs_without_a_range_are_named_with_the_hint() {
     assert_eq!(r["range"]["method"], "affine");
     assert!(r["range"]["outputs"]["Qq[1]"].as_array().is_some_and(|a| a.len() == 2), "{}", r["range"]);
     assert!(r["stats"].is_object(), "existing keys unchanged");
+    // Without a pass that reads it, -ranges still puts the domain in the report.
+    let o = opt(&[
+        "tests/inputs/ranges/limits.urdf",
+        "-function=invdyna",
+        "-passes=atomise",
+        &format!("-ranges={}", ranges.display()),
+        &format!("-report={}", report.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["domain"]["qd[3]"]["range"], serde_json::json!([-0.1, 0.1]));
+    assert!(r.get("range").is_none());
 }
 
 #[test]
