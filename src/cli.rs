@@ -112,6 +112,11 @@ pub struct Cli {
     /// given.
     #[arg(long, value_name = "de10-nano|FILE.json")]
     pub target: Option<String>,
+    /// The input domain: a JSON object of input name or glob → [lo, hi] (`{"q[3]": [-1.2,
+    /// 2.5], "qd[*]": [-10, 10]}`), over the input's defaults (a URDF's limits and parameters);
+    /// what `range` encloses every value over (docs/accuracy.md, "Certified ranges").
+    #[arg(long, value_name = "FILE")]
+    pub ranges: Option<PathBuf>,
     /// URDF input: fold the model's numeric parameters (masses, inertias, lengths) into the
     /// equations instead of keeping them as inputs `dpt`, `l`, `m`, `In`.
     #[arg(long)]
@@ -306,6 +311,7 @@ impl Cli {
             check: self.check.then_some((self.check_samples, self.check_seed)),
             time_limit: self.time_limit,
             target: self.target,
+            ranges: self.ranges,
             front_given: [
                 (FrontOption::FoldParams, self.fold_params),
                 (FrontOption::FloatingBase, self.floating_base),

@@ -407,6 +407,12 @@ pub fn run_with(
     });
     let module = loaded.module;
     crate::preflight::check_functions(opts, &module)?;
+    // The input domain, when the pipeline needs it (every input must then have a range) or
+    // -ranges gives one: resolved before any pass runs.
+    let needs_domain = pm.elements().any(|e| e.props.needs_domain);
+    let domain = (needs_domain || opts.ranges.is_some())
+        .then(|| crate::ranges::domain(opts, &module, &loaded.domain_defaults, needs_domain))
+        .transpose()?;
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it
     // removes what it staged.
     let mut out = OutputSet::new();
@@ -424,7 +430,7 @@ pub fn run_with(
         out.stage(path, format!("{json}\n").as_bytes()).map_err(output_failure)?;
     }
     let progress = crate::progress_bars::progress_for(terminal.stderr, opts.quiet);
-    let session = run_passes(opts, pm, target, progress, deadline, module, &src, &mut out, stderr)?;
+    let session = run_passes(opts, pm, target, progress, deadline, domain, module, &src, &mut out, stderr)?;
     write_outputs(opts, &session, eval_inputs.as_ref(), &src, terminal, out, stdout, stderr)
 }
 
@@ -438,6 +444,7 @@ fn run_passes(
     target: robovec_machine::target::Target,
     progress: robovec_passes::progress::Progress,
     deadline: Option<robovec_passes::Deadline>,
+    domain: Option<robovec_ir::domain::Domain>,
     module: Module,
     src: &SourceFile,
     out: &mut OutputSet,
@@ -449,6 +456,7 @@ fn run_passes(
         deadline,
         progress,
         code_file: crate::preflight::code_file(opts, &pm),
+        domain,
         ..PassContext::with_target(target)
     };
     if let Some(text) = &opts.pareto {
@@ -466,6 +474,19 @@ fn run_passes(
         )
         .map_err(Failure::from)?;
         cx.emit(study);
+    }
+    // The domain in the report (`domain`) whether or not a pass reads it (`range` reports the
+    // one it used, which replaces this).
+    if let Some(dom) = &cx.domain {
+        let functions = module
+            .functions
+            .iter()
+            .map(|f| robovec_passes::range::FunctionDomain {
+                function: f.name.clone(),
+                inputs: dom.of_function(f).into_iter().map(|(n, r)| (n, r.clone())).collect(),
+            })
+            .collect();
+        cx.emit(robovec_passes::range::DomainUsed { functions });
     }
     let mut session = Session::new(pm, module, cx);
     {

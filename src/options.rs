@@ -57,6 +57,8 @@ pub struct Options {
     /// `-target=de10-nano|FILE.json` as given (`None`: `de10-nano`); read by
     /// [`target`] before any work.
     pub target: Option<String>,
+    /// `-ranges=FILE`: input ranges over the input's defaults ([`crate::ranges`]).
+    pub ranges: Option<PathBuf>,
 }
 
 /// The target `-target` selects (`de10-nano` when absent).

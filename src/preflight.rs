@@ -217,6 +217,9 @@ pub fn read_files(opts: &Options, pm: &PassManager) -> Result<Vec<ReadFile>, Fai
     if let Some(e) = &opts.eval {
         reads.push(ReadFile::new("-eval's inputs file", e));
     }
+    if let Some(r) = &opts.ranges {
+        reads.push(ReadFile::new("the -ranges file", r));
+    }
     if let Some(t) = opts.target.as_deref().filter(|t| robovec_machine::target::Target::built_in(t).is_none()) {
         reads.push(ReadFile::new("the -target file", t));
     }

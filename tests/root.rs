@@ -34,6 +34,7 @@ mod pinocchio;
 mod placement;
 mod placement_verify;
 mod props;
+mod range;
 mod recurrence;
 mod report_dir;
 mod robotran_c;

@@ -124,11 +124,23 @@ pub struct Loaded {
     /// What [`Loaded::input_defaults`] are, for messages (`the URDF's parameters and
     /// Pinocchio's gravity (0, 0, -9.81)`); empty when there are none.
     pub defaults_source: &'static str,
+    /// The ranges the input's own description gives its functions' inputs (issue 48), the
+    /// defaults of the run's domain (`-ranges=FILE` overrides them): a URDF's `<limit>`s for
+    /// `q`, `qd` and `Qq`, its documented defaults for continuous joints, accelerations and a
+    /// free flyer, its parameters as point intervals (docs/accuracy.md, "Certified ranges");
+    /// each range says where it came from. Empty for a Robotran file or IR.
+    pub domain_defaults: BTreeMap<String, robovec_ir::domain::Range>,
 }
 
 impl From<Module> for Loaded {
     fn from(module: Module) -> Loaded {
-        Loaded { module, params: None, input_defaults: BTreeMap::new(), defaults_source: "" }
+        Loaded {
+            module,
+            params: None,
+            input_defaults: BTreeMap::new(),
+            defaults_source: "",
+            domain_defaults: BTreeMap::new(),
+        }
     }
 }
 

@@ -57,3 +57,18 @@ pub fn line_col(src: &str, offset: usize) -> (usize, usize) {
     }
     (line, col)
 }
+
+/// The byte offset of 1-based `line` and `column` (chars; serde_json's error positions) in
+/// `src`: the start of the character there, clamped to the line's end and to `src`'s end
+/// (column 0 is the line's start).
+pub fn offset_of_line_col(src: &str, line: usize, column: usize) -> usize {
+    let mut off = 0;
+    for (i, text) in src.split_inclusive('\n').enumerate() {
+        if i + 1 == line {
+            let col = column.saturating_sub(1);
+            return off + text.char_indices().nth(col).map_or(text.len(), |(b, _)| b);
+        }
+        off += text.len();
+    }
+    src.len()
+}

@@ -22,6 +22,7 @@ pub mod params;
 pub mod pipeline;
 pub mod place;
 pub mod progress;
+pub mod range;
 pub mod recurrence;
 pub mod reference;
 pub mod report;
@@ -261,6 +262,10 @@ pub struct PassContext {
     /// hidden by default; the driver plugs a display in when stderr is a terminal (see
     /// [`progress`]). Passes never write to the terminal themselves.
     pub progress: progress::Progress,
+    /// The input domain (issue 48): each input's range of values, from the input's defaults
+    /// (a URDF's joint limits and parameter values) and `-ranges=FILE`, set by the driver
+    /// (`None` outside `robovec-opt`: a pass that needs it then reads its own `ranges=FILE`).
+    pub domain: Option<robovec_ir::domain::Domain>,
 }
 
 impl PassContext {
@@ -444,6 +449,9 @@ pub struct Props {
     /// values, issue 48): it keeps them or computes with them. The manager refuses to run a pass
     /// without it on a function that has any (never a silent reinterpretation as binary64).
     pub formats: bool,
+    /// The pass reads the input domain ([`PassContext::domain`]: `range`): the driver then
+    /// resolves it before any work and refuses a run where an input has no range.
+    pub needs_domain: bool,
 }
 
 impl Props {
@@ -459,6 +467,7 @@ impl Props {
         csv_table: false,
         back_end: false,
         formats: false,
+        needs_domain: false,
     };
 }
 
@@ -577,6 +586,7 @@ pub const PASSES: Registry = Registry {
         &recurrence::INFO,
         &rotate_3m::INFO,
         &depth_bound::INFO,
+        &range::INFO,
         &specialize::INFO,
         &eqsat::INFO,
         &cse::INFO,

@@ -59,6 +59,7 @@ const EVERY_PASS: &[(&str, AtTimeLimit)] = &[
     ("recurrence", AtTimeLimit::Skip),
     ("rotate-3m", AtTimeLimit::Skip),
     ("depth-bound", AtTimeLimit::Skip),
+    ("range", AtTimeLimit::Skip),
     ("specialize", AtTimeLimit::Required),
     ("eqsat", AtTimeLimit::Skip),
     ("cse", AtTimeLimit::Skip),
@@ -205,6 +206,35 @@ fn passes_that_check_between_functions_stop_before_the_next_one() {
         assert!(stopped[0].starts_with(&format!("{text} stopped before @f")), "{}", stopped[0]);
         assert_eq!(m.to_string(), before, "{text}");
     }
+}
+
+#[test]
+fn range_stopped_inside_a_function_keeps_the_functions_enclosed_before_it() {
+    // Every input of the test module in [-1, 1]; one tick per value of the body.
+    let domain = robovec_ir::domain::Domain {
+        ranges: ["q[1]", "q[2]", "qd[1]", "qd[2]"]
+            .into_iter()
+            .map(|n| {
+                let r =
+                    robovec_ir::domain::Range { interval: robovec_ir::Interval::new(-1.0, 1.0), source: "test".into() };
+                (n.to_string(), r)
+            })
+            .collect(),
+    };
+    let pm = PassManager::new("range<samples=4>", Instrumentation::default()).expect("builds");
+    let mut m = atomised(60);
+    let before = m.to_string();
+    let mut cx = PassContext { tick_budget: Some(5), domain: Some(domain.clone()), ..PassContext::default() };
+    pm.run(&mut m, &mut cx, &mut Vec::new()).expect("skippable");
+    assert_eq!(cx.stopped(), ["range stopped in @f after 4 values: tick budget of 5 steps reached"]);
+    assert_eq!(m.to_string(), before);
+    let run = cx.artifacts_of::<crate::range::RangeRun>().next().expect("an artifact");
+    assert!(run.functions.is_empty(), "@f not enclosed");
+    // Without a limit @f is enclosed.
+    let mut cx = PassContext { domain: Some(domain), ..PassContext::default() };
+    pm.run(&mut m, &mut cx, &mut Vec::new()).expect("runs");
+    assert!(cx.stopped().is_empty());
+    assert_eq!(cx.artifacts_of::<crate::range::RangeRun>().next().expect("an artifact").functions.len(), 1);
 }
 
 #[test]

@@ -80,7 +80,22 @@ pub fn check(before: &Function, pipeline: &str, points: &[Vec<f64>]) -> Result<F
         .map_err(|e| format!("{pipeline}: {e}"))?;
     let bit_exact = pm.is_bit_exact();
     let m = Module { functions: vec![before.clone()] };
-    let mut session = Session::new(pm, m, PassContext::default());
+    // A domain covering every point (for the passes that need one, `range`): each input's
+    // hull over the points, or [-1, 1] without points.
+    let ranges = before
+        .inputs
+        .iter()
+        .enumerate()
+        .map(|(k, &v)| {
+            let xs = points.iter().map(|p| p[k]);
+            let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+            let interval =
+                if lo <= hi { robovec_ir::Interval::new(lo, hi) } else { robovec_ir::Interval::new(-1.0, 1.0) };
+            (before.name_of(v).to_string(), robovec_ir::domain::Range { interval, source: "the points".into() })
+        })
+        .collect();
+    let cx = PassContext { domain: Some(robovec_ir::domain::Domain { ranges }), ..PassContext::default() };
+    let mut session = Session::new(pm, m, cx);
     session.run_quiet().map_err(|e| format!("{pipeline}: {e}"))?;
     let after = session.module.functions.pop().ok_or_else(|| format!("{pipeline}: the function disappeared"))?;
     let (t0, t1) = (Tape::new(before), Tape::new(&after));
@@ -145,7 +160,7 @@ mod tests {
     fn bit_exact_comes_from_the_registry_and_parameter_lists_are_not_split() {
         assert_eq!(
             bit_exact_passes(),
-            ["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy", "depth-bound"]
+            ["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy", "depth-bound", "range"]
         );
         // `split(',')` read `sweep<pe=8,16>` as `sweep<pe=8` and `16>`: not bit-exact.
         let pm = PassManager::with_registry(

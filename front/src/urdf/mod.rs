@@ -20,11 +20,12 @@
 //! ([`robovec_dynamics::Generated::singular`], issue 47), instead of the verifier's rejection of
 //! the constant `inf` that `1/0` folds to.
 
+mod domain;
 mod parse;
 
 use std::path::Path;
 
-pub use parse::parse;
+pub use parse::{parse, parse_with_limits, Limit};
 
 use robovec_dynamics::robot::JointKind;
 
@@ -56,7 +57,7 @@ impl FrontEnd for Urdf {
     }
 
     fn load(&self, _: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
-        let robot = parse(text).map_err(|e| vec![e])?;
+        let (robot, limits) = parse_with_limits(text).map_err(|e| vec![e])?;
         if !robot.joints.iter().any(|j| j.kind != JointKind::Fixed) {
             return Err(vec![FrontError::new(
                 robot.links[robot.root].span,
@@ -112,7 +113,8 @@ impl FrontEnd for Urdf {
         let mut input_defaults = g.params.clone().unwrap_or_default();
         input_defaults.extend([("g[1]".to_string(), 0.0), ("g[2]".to_string(), 0.0), ("g[3]".to_string(), -9.81)]);
         let defaults_source = "the URDF's parameters and Pinocchio's gravity (0, 0, -9.81)";
-        Ok(Loaded { module: g.module, params: g.params, input_defaults, defaults_source })
+        let domain_defaults = domain::defaults(&model.robot, &limits, &g.module, &input_defaults);
+        Ok(Loaded { module: g.module, params: g.params, input_defaults, defaults_source, domain_defaults })
     }
 }
 

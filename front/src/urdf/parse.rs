@@ -6,7 +6,8 @@
 //! keeps no positions, so its errors could not name a line; its data model is also what this
 //! module needs in 200 lines.) Only what the dynamics reads is parsed: `<link>` with
 //! `<inertial>` (`origin`, `mass`, `inertia`), `<joint>` with `type`, `parent`, `child`,
-//! `origin` and `axis`; visuals, collisions, limits, transmissions and gazebo tags are ignored.
+//! `origin` and `axis`; `<limit>` is read by [`parse_with_limits`] for the input domain's defaults (issue 48); visuals,
+//! collisions, transmissions and gazebo tags are ignored.
 
 use robovec_ir::Span;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -152,6 +153,54 @@ fn unit_axis(v: [f64; 3], kind: JointKind, el: roxmltree::Node) -> Result<[f64; 
     Err(e)
 }
 
+/// A joint's `<limit>` (issue 48): the ranges its coordinate, velocity and effort default to
+/// (radians or metres; rad/s or m/s; N·m or N). A bound is `None` when the element does not
+/// state it — or states a placeholder: `velocity="0"` or `effort="0"` (a joint that cannot
+/// move or act would be fixed; writers put 0 where they know no limit), `lower` = `upper`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Limit {
+    /// `[lower, upper]`, when both are given and `lower < upper`.
+    pub position: Option<(f64, f64)>,
+    /// `velocity`, when positive.
+    pub velocity: Option<f64>,
+    /// `effort`, when positive.
+    pub effort: Option<f64>,
+}
+
+/// Reads a joint's `<limit>`, if it has one.
+///
+/// # Errors
+/// A bound that is not a finite number, a negative `velocity` or `effort`, `lower > upper`;
+/// at the attribute.
+fn limit(j: roxmltree::Node) -> Result<Option<Limit>, FrontError> {
+    let Some(l) = child_elem(j, "limit") else { return Ok(None) };
+    let one = |name: &str| numbers::<1>(l, name).map(|x| x.map(|[x]| x));
+    let at = |name: &str| span_of(l.attribute_node(name).map_or(l.range(), |a| a.range_value()));
+    let (lower, upper) = (one("lower")?, one("upper")?);
+    let (velocity, effort) = (one("velocity")?, one("effort")?);
+    for (name, x) in [("velocity", velocity), ("effort", effort)] {
+        if x.is_some_and(|x| x < 0.0) {
+            return Err(FrontError::new(at(name), format!("negative {name} limit"), "here")
+                .note(format!("expected a {name} limit >= 0 (the joint's range is [-{name}, {name}])")));
+        }
+    }
+    if let (Some(lo), Some(hi)) = (lower, upper) {
+        if lo > hi {
+            return Err(FrontError::new(
+                at("lower"),
+                format!("joint limit lower = {lo} is above upper = {hi}"),
+                "here",
+            )
+            .note("expected lower <= upper"));
+        }
+    }
+    Ok(Some(Limit {
+        position: lower.zip(upper).filter(|(lo, hi)| lo < hi),
+        velocity: velocity.filter(|&v| v > 0.0),
+        effort: effort.filter(|&e| e > 0.0),
+    }))
+}
+
 /// Parses and checks a URDF document.
 ///
 /// # Errors
@@ -165,6 +214,17 @@ fn unit_axis(v: [f64; 3], kind: JointKind, el: roxmltree::Node) -> Result<[f64; 
 /// Cost: linear in the text (names are found through hash maps, issue 28: a 20,000-link
 /// star spent 2 s comparing names).
 pub fn parse(text: &str) -> Result<Robot, FrontError> {
+    parse_with_limits(text).map(|(robot, _)| robot)
+}
+
+/// [`parse`], with the `<limit>` of each joint that has one, by joint name (issue 48: the
+/// defaults of the input domain). A `<limit>` is checked ([`Limit`]) whatever the joint's type.
+///
+/// # Errors
+/// As [`parse`], and a `<limit>` bound that is not a finite number, a negative velocity or
+/// effort, a lower bound above the upper one.
+pub fn parse_with_limits(text: &str) -> Result<(Robot, FxHashMap<String, Limit>), FrontError> {
+    let mut limits = FxHashMap::default();
     let doc = roxmltree::Document::parse(text).map_err(|e| {
         let at = offset_of(text, e.pos());
         FrontError::new(Span::new(at, at), format!("malformed XML: {e}"), "here")
@@ -243,6 +303,9 @@ pub fn parse(text: &str) -> Result<Robot, FrontError> {
             .note("a URDF is a tree: closed loops must be cut"));
         }
         parent_joint[child] = Some(joints.len());
+        if let Some(l) = limit(j)? {
+            limits.insert(jname.to_string(), l);
+        }
         let mut axis = [1.0, 0.0, 0.0];
         if let Some(a) = child_elem(j, "axis") {
             if let Some(v) = numbers::<3>(a, "xyz")? {
@@ -299,5 +362,5 @@ pub fn parse(text: &str) -> Result<Robot, FrontError> {
         )
         .note("a URDF is a tree with one root link: closed loops must be cut"));
     }
-    Ok(robot)
+    Ok((robot, limits))
 }
