@@ -398,7 +398,15 @@ pub fn run_with(
     let target = crate::options::target(opts)?;
     let eval_inputs = opts.eval.as_deref().map(read_eval_inputs).transpose()?;
     // Only the functions the run uses are built (a URDF's `-function=invdyna` skips `dirdyna`).
-    let front = FrontOptions { functions: opts.function.clone().map(|f| vec![f]), deadline, ..opts.front.clone() };
+    // The input domain, when the pipeline needs it (every input must then have a range) or
+    // -ranges gives one: its defaults are computed while loading, then resolved before any pass.
+    let needs_domain = pm.elements().any(|e| e.props.needs_domain);
+    let front = FrontOptions {
+        functions: opts.function.clone().map(|f| vec![f]),
+        deadline,
+        domain: needs_domain || opts.ranges.is_some(),
+        ..opts.front.clone()
+    };
     let (loaded, src) = load_with(&opts.input, &front)?;
     let eval_inputs = eval_inputs.map(|given| crate::eval::EvalInputs {
         given,
@@ -407,9 +415,6 @@ pub fn run_with(
     });
     let module = loaded.module;
     crate::preflight::check_functions(opts, &module)?;
-    // The input domain, when the pipeline needs it (every input must then have a range) or
-    // -ranges gives one: resolved before any pass runs.
-    let needs_domain = pm.elements().any(|e| e.props.needs_domain);
     let domain = (needs_domain || opts.ranges.is_some())
         .then(|| crate::ranges::domain(opts, &module, &loaded.domain_defaults, needs_domain))
         .transpose()?;

@@ -246,7 +246,8 @@ fn enclosures_hold_every_value_of_the_corpus() {
 /// not limit; every value sound at 64 points.
 #[test]
 fn the_three_link_arm_is_enclosed_over_its_urdf_domain() {
-    let front = robovec_front::FrontOptions { functions: Some(vec!["invdyna".into()]), ..Default::default() };
+    let front =
+        robovec_front::FrontOptions { functions: Some(vec!["invdyna".into()]), domain: true, ..Default::default() };
     let (loaded, _) = robovec::driver::load_with("examples/three_link_arm/three_link_arm.urdf", &front).unwrap();
     let mut defaults = loaded.domain_defaults.clone();
     defaults.insert("qd[2]".into(), range(-3.0, 3.0));
@@ -262,8 +263,11 @@ fn the_three_link_arm_is_enclosed_over_its_urdf_domain() {
 
 #[test]
 fn urdf_limits_give_the_domain_defaults() {
-    let front =
-        robovec_front::FrontOptions { functions: Some(vec!["invdyna".into(), "fordyna".into()]), ..Default::default() };
+    let front = robovec_front::FrontOptions {
+        functions: Some(vec!["invdyna".into(), "fordyna".into()]),
+        domain: true,
+        ..Default::default()
+    };
     let (loaded, _) = robovec::driver::load_with("tests/inputs/ranges/limits.urdf", &front).unwrap();
     let d = &loaded.domain_defaults;
     let get = |n: &str| d.get(n).map(|r| (r.interval.lo, r.interval.hi));

@@ -53,6 +53,10 @@ pub struct FrontOptions {
     /// long loops (statements read, bodies generated) and, once it is reached, fail with one
     /// error saying where they stopped (see [`FrontEnd::load`]).
     pub deadline: Option<robovec_ir::time_limit::Deadline>,
+    /// Compute the input domain's defaults ([`Loaded::domain_defaults`], issue 48): asked when
+    /// the run needs a domain (a pass reads it, or `-ranges` gives one); otherwise they stay
+    /// empty and the load does not pay for them.
+    pub domain: bool,
 }
 
 /// A command-line option that concerns one kind of input only: each front end declares the ones

@@ -113,7 +113,10 @@ impl FrontEnd for Urdf {
         let mut input_defaults = g.params.clone().unwrap_or_default();
         input_defaults.extend([("g[1]".to_string(), 0.0), ("g[2]".to_string(), 0.0), ("g[3]".to_string(), -9.81)]);
         let defaults_source = "the URDF's parameters and Pinocchio's gravity (0, 0, -9.81)";
-        let domain_defaults = domain::defaults(&model.robot, &limits, &g.module, &input_defaults);
+        let domain_defaults = match opts.domain {
+            true => domain::defaults(&model.robot, &limits, &g.module, &input_defaults),
+            false => Default::default(),
+        };
         Ok(Loaded { module: g.module, params: g.params, input_defaults, defaults_source, domain_defaults })
     }
 }
