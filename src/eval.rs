@@ -190,6 +190,12 @@ pub fn evaluate(f: &Function, given: &BTreeMap<String, f64>, single: bool) -> Ev
     evaluate_with(f, given, &BTreeMap::new(), single)
 }
 
+/// The value of input `name`: `given`, else `defaults`, else pseudo-random in [-1, 1] (seed 0).
+fn input_value(given: &BTreeMap<String, f64>, defaults: &BTreeMap<String, f64>, name: &str) -> f64 {
+    let stated = given.get(name).or_else(|| defaults.get(name));
+    stated.copied().unwrap_or_else(|| interp::pseudo_random_input(name, 0))
+}
+
 /// [`evaluate_with`] for a function whose values carry numeric formats (issue 48,
 /// `robovec_ir::format`): every value computed in its format, as the back ends must
 /// (`robovec_ir::format::eval_values`); `precision` is `formats`.
@@ -206,8 +212,7 @@ pub fn evaluate_formats(
 ) -> Result<EvalResult, String> {
     let mut inputs = BTreeMap::new();
     let vals = robovec_ir::format::eval_values(f, |name| {
-        let stated = given.get(name).or_else(|| defaults.get(name));
-        let x = stated.copied().unwrap_or_else(|| interp::pseudo_random_input(name, 0));
+        let x = input_value(given, defaults, name);
         inputs.insert(name.to_string(), x);
         x
     })
@@ -247,10 +252,7 @@ pub fn evaluate_with(
     single: bool,
 ) -> EvalResult {
     let mut inputs = BTreeMap::new();
-    let value = |name: &str| {
-        let stated = given.get(name).or_else(|| defaults.get(name));
-        stated.copied().unwrap_or_else(|| interp::pseudo_random_input(name, 0))
-    };
+    let value = |name: &str| input_value(given, defaults, name);
     let (outputs, non_finite) = if single {
         let vals = interp::eval_values::<f32>(f, |name| {
             let x = value(name) as f32 as f64;

@@ -189,35 +189,10 @@ pub struct FormatError {
 ///
 /// # Errors
 /// The first value in program order whose result a fixed-point format cannot hold.
-pub fn eval_values(f: &crate::Function, mut input: impl FnMut(&str) -> f64) -> Result<Vec<f64>, FormatError> {
-    use crate::interp::{eval_binop, eval_call};
-    use crate::syntax::{Def, Operand, TrigFn};
-    let mut vals = vec![f64::NAN; f.values.len()];
-    let store =
-        |v: crate::Value, x: f64| f.format(v).store(x).map_err(|error| FormatError { value: v, result: x, error });
-    for &v in &f.inputs {
-        vals[v.index()] = store(v, input(f.name_of(v)))?;
-    }
-    for &v in &f.body {
-        let get = |vals: &[f64], o: &Operand| match o {
-            Operand::Value(x) => vals[x.index()],
-            Operand::Const(c) => *c,
-        };
-        let r = match &f.value(v).def {
-            Def::Input => unreachable!("inputs are not in the body"),
-            Def::Trig(TrigFn::Sin, a) => vals[a.index()].sin(),
-            Def::Trig(TrigFn::Cos, a) => vals[a.index()].cos(),
-            Def::Binary(op, a, b) => eval_binop(*op, get(&vals, a), get(&vals, b)),
-            Def::Call(c, args) => {
-                let a: Vec<f64> = args.iter().map(|o| get(&vals, o)).collect();
-                eval_call(c, &a)
-            }
-            // A parsed expression has no format (the verifier refuses one): binary64 throughout.
-            Def::Expr(e) => crate::interp::eval_expr(e, &|o| get(&vals, o)),
-        };
-        vals[v.index()] = store(v, r)?;
-    }
-    Ok(vals)
+pub fn eval_values(f: &crate::Function, input: impl FnMut(&str) -> f64) -> Result<Vec<f64>, FormatError> {
+    crate::interp::eval_values_stored(f, input, |v, x: f64| {
+        f.format(v).store(x).map_err(|error| FormatError { value: v, result: x, error })
+    })
 }
 
 #[cfg(test)]

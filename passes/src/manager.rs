@@ -357,8 +357,7 @@ impl PassManager {
 /// [`PassError::Failed`] when a function of `m` has a value in a numeric format other than
 /// binary64: `pass` does not declare that it understands formats (`Props::formats`).
 fn refuse_formats(pass: &str, m: &Module) -> Result<(), PassError> {
-    let Some(f) = m.functions.iter().find(|f| f.has_formats()) else { return Ok(()) };
-    let v = f.inputs.iter().chain(&f.body).copied().find(|&v| !f.format(v).is_default()).expect("has formats");
+    let Some((f, v)) = m.functions.iter().find_map(|f| f.first_formatted().map(|v| (f, v))) else { return Ok(()) };
     Err(PassError::Failed {
         pass: pass.to_string(),
         message: format!(

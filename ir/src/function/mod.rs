@@ -159,6 +159,15 @@ impl Function {
         self.formats.0.iter().any(|f| !f.is_default())
     }
 
+    /// The first value, inputs then body, whose format is not binary64 (what a refusal of
+    /// formats names).
+    pub fn first_formatted(&self) -> Option<Value> {
+        if !self.has_formats() {
+            return None;
+        }
+        self.inputs.iter().chain(&self.body).copied().find(|&v| !self.format(v).is_default())
+    }
+
     /// Replaces every value's schedule attributes by `table` (indexed by value index; values
     /// past its end have none).
     pub fn set_timings(&mut self, table: Vec<Option<Timing>>) {

@@ -288,9 +288,8 @@ pub fn verify_function_until(f: &Function, stop: &mut dyn FnMut() -> bool) -> Op
             _ => {}
         }
     }
-    if f.phase == Phase::Parsed && f.has_formats() {
+    if let Some(v) = f.first_formatted().filter(|_| f.phase == Phase::Parsed) {
         // An expression rounds at every node; a format says how one op's result is stored.
-        let v = f.inputs.iter().chain(&f.body).copied().find(|&v| !f.format(v).is_default()).expect("has formats");
         err(
             Location::Value(v),
             f.value(v).span,
