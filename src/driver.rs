@@ -400,11 +400,12 @@ pub fn run_with(
     // Only the functions the run uses are built (a URDF's `-function=invdyna` skips `dirdyna`).
     // The input domain, when the pipeline needs it (every input must then have a range) or
     // -ranges gives one: its defaults are computed while loading, then resolved before any pass.
-    let needs_domain = pm.elements().any(|e| e.props.needs_domain);
+    // The first pass that needs the domain, named in the diagnostic when an input has no range.
+    let needs_domain = pm.elements().find(|e| e.props.needs_domain).map(|e| e.pass.name());
     let front = FrontOptions {
         functions: opts.function.clone().map(|f| vec![f]),
         deadline,
-        domain: needs_domain || opts.ranges.is_some(),
+        domain: needs_domain.is_some() || opts.ranges.is_some(),
         ..opts.front.clone()
     };
     let (loaded, src) = load_with(&opts.input, &front)?;
@@ -415,7 +416,7 @@ pub fn run_with(
     });
     let module = loaded.module;
     crate::preflight::check_functions(opts, &module)?;
-    let domain = (needs_domain || opts.ranges.is_some())
+    let domain = (needs_domain.is_some() || opts.ranges.is_some())
         .then(|| crate::ranges::domain(opts, &module, &loaded.domain_defaults, needs_domain))
         .transpose()?;
     // Every file of this run goes through `out`; dropped uncommitted (any `?` below), it

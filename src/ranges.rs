@@ -14,8 +14,9 @@ use crate::diagnostics::SourceFile;
 use crate::options::{Failure, Options};
 
 /// The domain of the run: `defaults` overridden by `-ranges=FILE` over the inputs of the
-/// module's functions (a key must match an input of one of them); when `required` (a pass of the pipeline needs the domain,
-/// `robovec_passes::Props::needs_domain`), every one of their inputs must have a range.
+/// module's functions (a key must match an input of one of them); when `required` names a pass
+/// (the first of the pipeline that needs the domain, `robovec_passes::Props::needs_domain`),
+/// every one of their inputs must have a range.
 ///
 /// # Errors
 /// [`Failure::Input`] (exit 1): the ranges file cannot be read or is refused (a codespan
@@ -25,7 +26,7 @@ pub fn domain(
     opts: &Options,
     module: &Module,
     defaults: &BTreeMap<String, Range>,
-    required: bool,
+    required: Option<&str>,
 ) -> Result<Domain, Failure> {
     // Every function of the module: passes run on all of them (`-function` selects what the
     // report and `-eval` describe, not what the passes see).
@@ -48,7 +49,7 @@ pub fn domain(
             domain::resolve(defaults, Some((&name, &keys)), inputs.iter().copied()).map_err(render)?
         }
     };
-    if required {
+    if let Some(pass) = required {
         let mut missing: Vec<String> = Vec::new();
         for f in &functions {
             for n in dom.missing(f) {
@@ -67,12 +68,12 @@ pub fn domain(
             return Err(Failure::Input(format!(
                 "error: no range for {} input{} of @{}: {}{more}\n  = help: give them with -ranges=FILE, a JSON \
                  object of input name (or glob) → [lo, hi], such as {{\"q[*]\": [-3.1416, 3.1416], \"qd[*]\": [-10, \
-                 10]}}\n  = note: the domain is needed by the pipeline's `range` pass; defaults cover a URDF's \
+                 10]}}\n  = note: the domain is needed by the pipeline's `{pass}` pass; defaults cover a URDF's \
                  limits and parameters only (docs/accuracy.md, \"Certified ranges\")\n",
                 missing.len(),
                 if missing.len() == 1 { "" } else { "s" },
                 fs.join(", @"),
-                shown.join(", ")
+                shown.join(", "),
             )));
         }
     }

@@ -18,6 +18,7 @@ mod cse;
 mod depth_bound;
 mod diagnostics;
 mod eqsat;
+mod error_bound;
 mod error_reference;
 mod exact_gap;
 mod example;

@@ -15,11 +15,13 @@
 //! not `qdd[4]` nor `qd[1][2]`; `In[*][*]` matches every `In`). An exact key beats a glob;
 //! of several globs matching one input the one with fewer `*` wins, then the later in the file.
 //! Units are the input's (rad, m, rad/s, N·m, kg …). Bounds are binary64 numbers, finite,
-//! `lo ≤ hi` (`[x, x]` fixes an input at `x`).
+//! `lo ≤ hi` (`[x, x]` fixes an input at `x`). A glob that matches no input is allowed (one
+//! file serves a family of models: `qdd[*]` for `dirdyna` and `invdyna`); an exact name that
+//! names no input is an error (a typo would otherwise leave an input at its default).
 //!
 //! Errors are [`SourceError`]s located in the file's text: not JSON, not an object, a value
 //! that is not a pair of finite numbers `lo ≤ hi`, a key given twice ([`parse_ranges`]); a key
-//! that matches no input of the functions the run describes ([`resolve`]).
+//! that is an exact name of no input of the functions the run describes ([`resolve`]).
 
 use std::collections::BTreeMap;
 
@@ -223,15 +225,14 @@ pub fn resolve<'a>(
             used[i] = true;
         }
     }
-    if let Some(k) = keys.iter().zip(&used).find(|(_, &u)| !u).map(|(k, _)| k) {
+    if let Some(k) = keys.iter().zip(&used).find(|(k, &u)| !u && k.stars() == 0).map(|(k, _)| k) {
         let shown: Vec<&str> = inputs.iter().take(8).copied().collect();
         let more = if inputs.len() > shown.len() {
             format!(" and {} more", inputs.len() - shown.len())
         } else {
             String::new()
         };
-        let what = if k.stars() == 0 { "no input is named" } else { "the glob matches no input" };
-        return Err(SourceError::new(k.span, format!("`{}`: {what} so", k.key), "this key")
+        return Err(SourceError::new(k.span, format!("`{}`: no input is named so", k.key), "this key")
             .note(format!("the inputs are {}{more}", shown.join(", ")))
             .note(
                 "a key is an input's canonical name (`q[3]`, `dpt[1][2]`) or a glob with `*` for an index (`qd[*]`)",
@@ -291,8 +292,12 @@ mod tests {
         let e = parse_ranges("{\"q[1]\": [0, 1]\n\"q[2]\": 3}").unwrap_err();
         assert!(e.message.starts_with("not a ranges file"), "{e}");
         assert_eq!(e.span.start, 16, "line 2, column 1");
-        let keys = parse_ranges("{\"qq[*]\": [0, 1]}").unwrap();
+        let keys = parse_ranges("{\"qq[1]\": [0, 1]}").unwrap();
         let e = resolve(&BTreeMap::new(), Some(("r.json", &keys)), ["q[1]"]).unwrap_err();
-        assert!(e.message.contains("`qq[*]`: the glob matches no input"), "{e}");
+        assert!(e.message.contains("`qq[1]`: no input is named so"), "{e}");
+        // A glob that matches nothing is allowed (one file for a family of models).
+        let keys = parse_ranges("{\"qq[*]\": [0, 1], \"q[*]\": [2, 3]}").unwrap();
+        let dom = resolve(&BTreeMap::new(), Some(("r.json", &keys)), ["q[1]"]).unwrap();
+        assert_eq!(dom.get("q[1]").unwrap().interval, Interval::new(2.0, 3.0));
     }
 }

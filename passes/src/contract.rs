@@ -32,7 +32,7 @@ pub const INFO: PassInfo = PassInfo {
     doc: "fuse a*b +/- c into one fused multiply-add (@fma, @fms, @fnma; one rounding) where every use of the multiply is an add/sub: C's -ffp-contract in the IR, for CPUs with FMA",
     params: &[],
     build: |_: &Params| Ok(Box::new(Contract)),
-    props: crate::Props { requires: Some(robovec_ir::Phase::Atomised), at_time_limit: crate::AtTimeLimit::Skip, ..crate::Props::DEFAULT },
+    props: crate::Props { requires: Some(robovec_ir::Phase::Atomised), at_time_limit: crate::AtTimeLimit::Skip, exact_in_reals: true, ..crate::Props::DEFAULT },
 };
 
 /// The `contract` pass.

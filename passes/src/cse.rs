@@ -14,7 +14,7 @@ pub const INFO: PassInfo = PassInfo {
     doc: "common-subexpression elimination: an op equal to an earlier one (same operator, same operands; + and * commutative) is dropped, its users read the earlier one (bit-exact)",
     params: &[],
     build: |_: &Params| Ok(Box::new(Cse)),
-    props: crate::Props { at_time_limit: crate::AtTimeLimit::Skip, ..crate::Props::DEFAULT },
+    props: crate::Props { at_time_limit: crate::AtTimeLimit::Skip, exact_in_reals: true, ..crate::Props::DEFAULT },
 };
 
 /// The `cse` pass.

@@ -16,6 +16,7 @@ pub mod dce;
 pub mod depth_bound;
 pub mod each;
 pub mod eqsat;
+pub mod error_bound;
 pub mod inline;
 pub mod manager;
 pub mod params;
@@ -266,6 +267,10 @@ pub struct PassContext {
     /// (a URDF's joint limits and parameter values) and `-ranges=FILE`, set by the driver
     /// (`None` outside `robovec-opt`: a pass that needs it then reads its own `ranges=FILE`).
     pub domain: Option<robovec_ir::domain::Domain>,
+    /// The first pass of the run that may have changed the exact real-number function of the
+    /// module (one without [`Props::exact_in_reals`] or [`Props::bit_exact`]; set by the
+    /// manager): from there on no error bound against the pipeline's input holds.
+    pub reals_changed_by: Option<String>,
 }
 
 impl PassContext {
@@ -452,6 +457,12 @@ pub struct Props {
     /// The pass reads the input domain ([`PassContext::domain`]: `range`): the driver then
     /// resolves it before any work and refuses a run where an input has no range.
     pub needs_domain: bool,
+    /// The pass keeps the exact real-number value of every output as a function of the inputs
+    /// (identities only: reassociation, distribution, common subexpressions, fused
+    /// multiply-adds, reordering; every analysis). `error-bound` proves its bound against the
+    /// pipeline's input only after such passes; a pass without it (constant folding in
+    /// binary64, user rules) sets [`PassContext::reals_changed_by`]. `bit_exact` implies it.
+    pub exact_in_reals: bool,
 }
 
 impl Props {
@@ -468,6 +479,7 @@ impl Props {
         back_end: false,
         formats: false,
         needs_domain: false,
+        exact_in_reals: false,
     };
 }
 
@@ -587,6 +599,7 @@ pub const PASSES: Registry = Registry {
         &rotate_3m::INFO,
         &depth_bound::INFO,
         &range::INFO,
+        &error_bound::INFO,
         &specialize::INFO,
         &eqsat::INFO,
         &cse::INFO,

@@ -316,6 +316,9 @@ impl PassManager {
             cx.pass_index = None;
             cx.running = AtTimeLimit::Skip;
             ran?;
+            if !(props.exact_in_reals || props.bit_exact) && cx.reals_changed_by.is_none() {
+                cx.reals_changed_by = Some(spec.to_string());
+            }
             let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
             if !props.preserves_timing {
                 m.functions.iter_mut().for_each(|f| f.clear_timing());

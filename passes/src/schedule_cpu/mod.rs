@@ -70,7 +70,7 @@ pub const INFO: PassInfo = PassInfo {
         };
         Ok(Box::new(ScheduleCpu { order, registers: p.u32("registers")? as usize }))
     },
-    props: crate::Props { requires: Some(robovec_ir::Phase::Atomised), at_time_limit: crate::AtTimeLimit::Skip, ..crate::Props::DEFAULT },
+    props: crate::Props { requires: Some(robovec_ir::Phase::Atomised), at_time_limit: crate::AtTimeLimit::Skip, exact_in_reals: true, ..crate::Props::DEFAULT },
 };
 
 /// Which order the pass writes.

@@ -24,6 +24,7 @@ pub const INFO: PassInfo = PassInfo {
     props: crate::Props {
         requires: Some(robovec_ir::Phase::Atomised),
         at_time_limit: crate::AtTimeLimit::Skip,
+        exact_in_reals: true,
         ..crate::Props::DEFAULT
     },
 };

@@ -1,0 +1,387 @@
+//! The worst-case error of every value of an atomised function over a domain: one sweep over
+//! the body in order, O(1) per op, from the values' enclosures ([`crate::range::enclose_with`]).
+//!
+//! # The bound
+//! Write `z` for a value's exact real value at an input point and `ẑ` for the value the
+//! function computes there (in the formats [`Formats`] gives). With `X_z` the enclosure of `z`
+//! over the domain, `M_z = max |X_z|` its magnitude and `E_a` the bounds of the operands
+//! already computed, `|ẑ − z| ≤ E_z` where, before the result's own rounding,
+//!
+//! | op | propagated error `P_z` |
+//! |---|---|
+//! | `a ± b` | `E_a + E_b` (0 for `a − a`) |
+//! | `a × b` | `M_a·E_b + M_b·E_a + E_a·E_b` |
+//! | `a / b` | `(E_a + M_z·E_b) / (mig_b − E_b)`, `mig_b = min |X_b|` (unbounded when `E_b ≥ mig_b`) |
+//! | `√a` | `E_a / (√(lo_a − E_a) + √lo_a)` when `E_a < lo_a`, else `√E_a` (unbounded when the computed operand may be negative) |
+//! | `sin a`, `cos a` | `min(E_a, 2)` (both are 1-Lipschitz) |
+//! | `fma(a, b, c)` (and `fms`, `fnma`) | `M_a·E_b + M_b·E_a + E_a·E_b + E_c` |
+//!
+//! (exact identities: `âb̂ − ab = a·e_b + b·e_a + e_a·e_b`, `â/b̂ − a/b = (e_a − z·e_b)/b̂`,
+//! `√â − √a = e_a/(√â + √a)` and `|√x − √y| ≤ √|x − y|`), and the result's rounding adds
+//! `rel·(M_z + P_z) + abs` (`|fl(y) − y| ≤ rel·|y| + abs` for the format, [`Rounding`]), so
+//! `E_z = P_z + rel·(M_z + P_z) + abs`. Nothing is first-order: the products of errors are
+//! kept, so the bound holds for any size of error, and every sum and product of the bound is
+//! rounded upward. A value whose bound is not finite (a callback, a divisor or a square root's
+//! operand that the error may carry through 0, an overflow of the enclosure) makes every value
+//! computed from it unbounded; the pass reports them, never a finite number it cannot prove.
+//!
+//! # How each format rounds ([`Formats`])
+//! - **`f64`** (every value binary64, as `-eval` and the C back end's `double` compute):
+//!   inputs and constants exact; each op `rel = 2⁻⁵³` (`u`), `abs = 2⁻¹⁰⁷⁵` (half the smallest
+//!   subnormal: what underflow may lose); `sin`, `cos` `rel = `[`LIBM_ULPS`]`·2⁻⁵²`, `abs =
+//!   `[`LIBM_ULPS`]`·2⁻¹⁰⁷⁴` (the C library's error, as the enclosures assume).
+//! - **`f32`** (every value binary32, as `accuracy`'s binary32 evaluation and the C back end's
+//!   `float` compute): inputs and constants rounded to binary32 (a constant's error is its
+//!   exact distance to its binary32 value); each op `rel = 2⁻²⁴`, `abs = 2⁻¹⁵⁰`; `sin`, `cos` of
+//!   binary32 `rel = `[`LIBM_ULPS`]`·2⁻²³`.
+//! - **`mixed`** (each value in its own format, [`robovec_ir::format`]: the op computes in
+//!   binary64 on its operands' values, then stores in the value's format): binary64 as above;
+//!   binary32 the binary64 rounding then the binary32 one (`rel = 2⁻⁵³ + 2⁻²⁴ + 2⁻⁷⁷`, sound
+//!   whether or not the double rounding is innocuous); `fix<w,f>` the binary64 rounding then
+//!   `abs = 2^-(f+1)` (round to nearest), and the computed value's whole range must fit the
+//!   format: `[lo_z − E_z, hi_z + E_z]` within the values that store without overflow, or the
+//!   sweep stops with [`BoundError::FixOverflow`]. Inputs in fixed point or binary32 are
+//!   rounded on the way in; constants are binary64 (the ops compute in binary64).
+//!
+//! Exact steps the bound knows: `a − a` is 0; a product by a constant power of two, or by
+//! ±1, 0, only loses bits to underflow (`rel = 0`); a sum with the constant 0 is exact.
+
+use robovec_ir::format::Format;
+use robovec_ir::interval::LIBM_ULPS;
+use robovec_ir::{BinOp, Def, Function, Interval, Intrinsic, Operand, Span, Value};
+
+/// Which format each value is computed in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Formats {
+    /// Every value binary64.
+    F64,
+    /// Every value binary32 (inputs and constants rounded to it).
+    F32,
+    /// Each value in its own format ([`Function::format`]).
+    Mixed,
+}
+
+/// The rounding of a stored result: `|fl(y) − y| ≤ rel·|y| + abs`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rounding {
+    /// Relative part (unit roundoff).
+    pub rel: f64,
+    /// Absolute part (underflow, or half a fixed-point step).
+    pub abs: f64,
+}
+
+/// 2⁻⁵³, binary64's unit roundoff.
+const U64: f64 = f64::EPSILON / 2.0;
+/// 2⁻²⁴, binary32's unit roundoff.
+const U32: f64 = f32::EPSILON as f64 / 2.0;
+
+impl Rounding {
+    /// No rounding.
+    pub const EXACT: Rounding = Rounding { rel: 0.0, abs: 0.0 };
+    /// One binary64 rounding of an op (underflow included).
+    pub const F64: Rounding = Rounding { rel: U64, abs: 2.4703282292062327e-324 };
+    /// One binary32 rounding of an op (underflow included: half of 2⁻¹⁴⁹).
+    pub const F32: Rounding = Rounding { rel: U32, abs: 7.006_492_321_624_085e-46 };
+
+    /// The rounding of storing a binary64 result in `format` (after the binary64 op's own).
+    pub fn store(format: Format) -> Rounding {
+        match format {
+            Format::Binary64 => Rounding::EXACT,
+            Format::Binary32 => Rounding::F32,
+            Format::Fix { fraction, .. } => Rounding { rel: 0.0, abs: 2f64.powi(-fraction - 1) },
+        }
+    }
+
+    /// This rounding followed by `then` (`(1 + r₁)(1 + r₂) − 1` and the absolute parts
+    /// carried through), rounded upward.
+    pub fn then(self, then: Rounding) -> Rounding {
+        let rel = up(up(self.rel + then.rel) + up(self.rel * then.rel));
+        let abs = up(up(self.abs * (1.0 + then.rel).next_up()) + then.abs);
+        Rounding { rel, abs }
+    }
+
+    /// The error of rounding a value of magnitude at most `m`.
+    fn of(self, m: f64) -> f64 {
+        up(up(self.rel * m) + self.abs)
+    }
+}
+
+/// `x` rounded upward by one float (bounds are sums and products rounded to nearest: the next
+/// float up is at least the exact result).
+fn up(x: f64) -> f64 {
+    if x.is_nan() {
+        f64::INFINITY
+    } else {
+        x.next_up()
+    }
+}
+
+/// Why the sweep cannot bound a function.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BoundError {
+    /// A fixed-point value whose computed range does not fit its format.
+    FixOverflow {
+        /// The value's name.
+        value: String,
+        /// Its definition's source span.
+        span: Span,
+        /// Its format.
+        format: Format,
+        /// The range the computed value may take (enclosure widened by its error bound).
+        range: Interval,
+        /// The format's range.
+        fits: (f64, f64),
+    },
+    /// The ticker stopped the sweep after this many values of the body.
+    Stopped(usize),
+}
+
+impl BoundError {
+    /// The message (`@f: …`) for function `f`.
+    pub fn message(&self, f: &str) -> String {
+        match self {
+            BoundError::FixOverflow { value, format, range, fits, .. } => format!(
+                "@{f}: %{value} in {format} may overflow over the domain: its computed value may reach {range}, \
+                 beyond the format's [{:e}, {:e}]; give it more integer bits (fewer fractional bits) or narrow the \
+                 inputs' ranges",
+                fits.0, fits.1
+            ),
+            BoundError::Stopped(k) => format!("in @{f} after {k} values"),
+        }
+    }
+
+    /// The source span the error points at, if any.
+    pub fn span(&self) -> Option<Span> {
+        match self {
+            BoundError::FixOverflow { span, .. } => Some(*span).filter(|s| *s != Span::DUMMY),
+            BoundError::Stopped(_) => None,
+        }
+    }
+}
+
+/// The error bound of every value of `f` (atomised), indexed by [`Value::index`], from the
+/// enclosures `x` of its exact values over the domain ([`crate::range::enclose_with`], same
+/// indexing): `f64::INFINITY` where no finite bound is proved (module doc). `tick` is called
+/// once per value of the body and stops the sweep when it returns true.
+///
+/// # Errors
+/// [`BoundError::FixOverflow`] (mode [`Formats::Mixed`] only), or the stop.
+pub fn bound(
+    f: &Function,
+    x: &[Interval],
+    mode: Formats,
+    mut tick: impl FnMut() -> bool,
+) -> Result<Vec<f64>, BoundError> {
+    let mut e = vec![f64::INFINITY; f.values.len()];
+    let mut nonneg = vec![false; f.values.len()];
+    for &v in &f.inputs {
+        let m = x[v.index()].mag();
+        e[v.index()] = match mode {
+            Formats::F64 => 0.0,
+            Formats::F32 => Rounding::F32.of(m),
+            Formats::Mixed => Rounding::store(f.format(v)).of(m),
+        };
+        nonneg[v.index()] = x[v.index()].lo >= 0.0;
+        check_fits(f, v, x, &e, mode)?;
+    }
+    for (k, &v) in f.body.iter().enumerate() {
+        if tick() {
+            return Err(BoundError::Stopped(k));
+        }
+        e[v.index()] = value_bound(f, v, x, &e, &nonneg, mode);
+        nonneg[v.index()] = computed_nonneg(f, v, x, &e, &nonneg);
+        check_fits(f, v, x, &e, mode)?;
+    }
+    Ok(e)
+}
+
+/// True when the operand's computed value is never negative (or is NaN).
+fn is_nonneg(o: &Operand, nonneg: &[bool]) -> bool {
+    match *o {
+        Operand::Value(v) => nonneg[v.index()],
+        Operand::Const(c) => c >= 0.0,
+    }
+}
+
+/// True when `v`'s computed value is never negative: its enclosure widened by its error is, or
+/// it is a square, a root, or a sum, product or quotient of such values (rounding to nearest,
+/// to binary32 and to fixed point keeps the sign of a result ≥ 0).
+fn computed_nonneg(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool]) -> bool {
+    if x[v.index()].lo - e[v.index()] >= 0.0 {
+        return true;
+    }
+    let n = |o: &Operand| is_nonneg(o, nonneg);
+    match &f.value(v).def {
+        Def::Binary(BinOp::Mul, a, b) => a == b || (n(a) && n(b)),
+        Def::Binary(BinOp::Add | BinOp::Div, a, b) => n(a) && n(b),
+        Def::Call(callee, args) => match Intrinsic::of(callee, args.len()) {
+            Some(Intrinsic::Sqrt) => true,
+            Some(Intrinsic::Fma) => (args[0] == args[1] || (n(&args[0]) && n(&args[1]))) && n(&args[2]),
+            _ => false,
+        },
+        _ => false,
+    }
+}
+
+/// [`BoundError::FixOverflow`] when `v` is fixed point (mode mixed) and its computed range may
+/// store out of the format.
+fn check_fits(f: &Function, v: Value, x: &[Interval], e: &[f64], mode: Formats) -> Result<(), BoundError> {
+    let format = f.format(v);
+    let (Formats::Mixed, Some((lo, hi)), Some(step)) = (mode, format.fix_range(), format.fix_step()) else {
+        return Ok(());
+    };
+    let err = e[v.index()];
+    let r = x[v.index()];
+    let range = Interval::new((r.lo - err).next_down(), (r.hi + err).next_up());
+    // Storing rounds to nearest, ties up: it overflows from hi + step/2 on, and below lo − step/2.
+    let fits = range.lo >= lo - step / 2.0 && range.hi < hi + step / 2.0 && err.is_finite();
+    if fits {
+        return Ok(());
+    }
+    let data = f.value(v);
+    Err(BoundError::FixOverflow { value: data.name.clone(), span: data.span, format, range, fits: (lo, hi) })
+}
+
+/// The operand's enclosure and error bound in `mode` (a constant's error is its rounding to
+/// binary32 in mode f32, else 0).
+fn operand(o: &Operand, x: &[Interval], e: &[f64], mode: Formats) -> (Interval, f64) {
+    match *o {
+        Operand::Value(v) => (x[v.index()], e[v.index()]),
+        Operand::Const(c) => {
+            let err = match mode {
+                Formats::F32 => up((c - c as f32 as f64).abs()),
+                _ => 0.0,
+            };
+            (Interval::point(c), err)
+        }
+    }
+}
+
+/// True for a constant whose product is exact but for underflow: 0, ±1, ±2^k.
+fn exact_factor(o: &Operand, mode: Formats) -> bool {
+    let Operand::Const(c) = *o else { return false };
+    let c = if mode == Formats::F32 { c as f32 as f64 } else { c };
+    c == 0.0
+        || (c.is_finite() && {
+            let (m, _) = frexp(c.abs());
+            m == 0.5
+        })
+}
+
+/// The mantissa in [0.5, 1) and exponent of a positive finite `x`.
+fn frexp(x: f64) -> (f64, i32) {
+    if x == 0.0 {
+        return (0.0, 0);
+    }
+    let bits = x.to_bits();
+    let exp = ((bits >> 52) & 0x7ff) as i32;
+    if exp == 0 {
+        // Subnormal: scale up first.
+        let (m, e) = frexp(x * 2f64.powi(64));
+        return (m, e - 64);
+    }
+    let m = f64::from_bits((bits & !(0x7ff << 52)) | (1022 << 52));
+    (m, exp - 1022)
+}
+
+/// `a·b + c`'s propagated error: `M_a·E_b + M_b·E_a + E_a·E_b + E_c`.
+fn product_error(ma: f64, ea: f64, mb: f64, eb: f64) -> f64 {
+    if ea == 0.0 && eb == 0.0 {
+        return 0.0;
+    }
+    up(up(up(ma * eb) + up(mb * ea)) + up(ea * eb))
+}
+
+/// The error bound of body value `v` (module doc's table, then the result's rounding).
+fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool], mode: Formats) -> f64 {
+    let data = f.value(v);
+    let mz = x[v.index()].mag();
+    if !mz.is_finite() {
+        return f64::INFINITY;
+    }
+    let op = match mode {
+        Formats::F64 | Formats::Mixed => Rounding::F64,
+        Formats::F32 => Rounding::F32,
+    };
+    let libm_ulps = |r: Rounding| Rounding { rel: LIBM_ULPS * 2.0 * r.rel, abs: LIBM_ULPS * 2.0 * r.abs };
+    let (propagated, rounding) = match &data.def {
+        Def::Input | Def::Expr(_) => return f64::INFINITY,
+        Def::Trig(_, a) => (e[a.index()].min(2.0), libm_ulps(op)),
+        Def::Binary(op_kind, a, b) => {
+            let (ia, ea) = operand(a, x, e, mode);
+            let (ib, eb) = operand(b, x, e, mode);
+            let same = matches!((a, b), (Operand::Value(p), Operand::Value(q)) if p == q);
+            match op_kind {
+                BinOp::Sub if same => (0.0, Rounding::EXACT),
+                BinOp::Add | BinOp::Sub => {
+                    let zero = |o: &Operand| matches!(o, Operand::Const(c) if *c == 0.0);
+                    let r = if zero(a) || zero(b) { Rounding::EXACT } else { op };
+                    (up(ea + eb), r)
+                }
+                BinOp::Mul => {
+                    let r = if exact_factor(a, mode) || exact_factor(b, mode) {
+                        Rounding { rel: 0.0, abs: op.abs }
+                    } else {
+                        op
+                    };
+                    (product_error(ia.mag(), ea, ib.mag(), eb), r)
+                }
+                BinOp::Div => {
+                    let mig = if ib.lo > 0.0 {
+                        ib.lo
+                    } else if ib.hi < 0.0 {
+                        -ib.hi
+                    } else {
+                        0.0
+                    };
+                    let room = (mig - eb).next_down();
+                    if room.is_nan() || room <= 0.0 {
+                        return f64::INFINITY;
+                    }
+                    let num = up(ea + up(mz * eb));
+                    (if num == 0.0 { 0.0 } else { up(num / room) }, op)
+                }
+            }
+        }
+        Def::Call(callee, args) => match Intrinsic::of(callee, args.len()) {
+            Some(Intrinsic::Sqrt) => {
+                let (ia, ea) = operand(&args[0], x, e, mode);
+                let p = if ea == 0.0 {
+                    0.0
+                } else if ea < ia.lo {
+                    // e_a / (√â + √a) with â ≥ lo − E_a > 0; never above √E_a.
+                    let low = (ia.lo - ea).next_down().max(0.0);
+                    let den = (low.sqrt().next_down() + ia.lo.sqrt().next_down()).next_down();
+                    let quotient = if den > 0.0 { up(ea / den) } else { f64::INFINITY };
+                    quotient.min(up(ea.sqrt()))
+                } else if is_nonneg(&args[0], nonneg) {
+                    up(ea.sqrt())
+                } else {
+                    // The computed operand may be negative: its root is NaN.
+                    return f64::INFINITY;
+                };
+                (p, op)
+            }
+            Some(Intrinsic::Fma | Intrinsic::Fms | Intrinsic::Fnma) => {
+                let (ia, ea) = operand(&args[0], x, e, mode);
+                let (ib, eb) = operand(&args[1], x, e, mode);
+                let (_, ec) = operand(&args[2], x, e, mode);
+                (up(product_error(ia.mag(), ea, ib.mag(), eb) + ec), op)
+            }
+            None => return f64::INFINITY,
+        },
+    };
+    if !propagated.is_finite() {
+        return f64::INFINITY;
+    }
+    let rounding = match mode {
+        Formats::Mixed => rounding.then(Rounding::store(f.format(v))),
+        _ => rounding,
+    };
+    let total = up(propagated + rounding.of(up(mz + propagated)));
+    if total.is_finite() {
+        total
+    } else {
+        f64::INFINITY
+    }
+}

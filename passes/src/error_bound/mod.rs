@@ -1,0 +1,307 @@
+//! `error-bound<format=f64|f32|mixed;ranges=FILE>`: the worst-case rounding error of every
+//! output over the input domain (issue 48 item 3), proved, not sampled.
+//!
+//! Phase: atomised → atomised; an analysis (the IR is unchanged, bit-exact). For each function
+//! it encloses every value over the domain ([`crate::range::enclose_with`], intervals and affine
+//! forms as `range<method=affine>`), then bounds every value's error in one sweep
+//! ([`bound::bound`]: the table and the roundings of each format are in its module doc). The
+//! bound is against **the exact real-number function of the pipeline's input** (the function
+//! `accuracy` measures against): the passes before it must keep the exact real value of every
+//! output ([`crate::Props::exact_in_reals`]: reassociation, distribution, common
+//! subexpressions, fused multiply-adds, reordering, analyses). A pass that changes it (a
+//! constant folded in binary64 by `specialize` or `eqsat`, or a user rule of `eqsat`) before
+//! `error-bound` is an error naming it: the bound would then be against the rewritten function.
+//! To bound a specialised function, give the parameters as point ranges instead
+//! (`{"m[2]": [1.5, 1.5]}`) and leave them to the bound.
+//!
+//! `format`: `f64` every value binary64 (the C back end's `double`, `-eval`), `f32` every
+//! value binary32 (inputs and constants rounded to it: the C back end's `float`, `accuracy`'s
+//! binary32 evaluation — whose inputs are binary32 already, so it measures no input rounding:
+//! the bound counts it), `mixed` each value in its IR format ([`robovec_ir::format`]; a
+//! function without formats is binary64). A fixed-point value whose computed range may
+//! overflow its format is an error naming it (the range proof of the format).
+//!
+//! Report, per function, `error_bound: {format, outputs: {NAME: {abs, rel}}, max_abs,
+//! max_rel}`: `abs` the bound on |computed − exact| over the domain, `rel` = `abs` / the
+//! smallest |value| of the output's enclosure when that enclosure excludes 0 (else `null`),
+//! the maxima over the outputs; an output with no finite bound (a callback, a divisor the
+//! error may carry through 0) has `abs: null` and is named in `unbounded`. Cost: O(ops ·
+//! terms) for the enclosures, O(ops) for the bound.
+
+pub mod bound;
+
+use robovec_ir::{Function, Interval, Module, Operand};
+use serde::Serialize;
+
+use crate::params::ParamKind;
+use crate::range::{domain_with_file, enclose_with, EncloseError, Method};
+use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
+pub use bound::{bound, BoundError, Formats, Rounding};
+
+crate::params::word_enum! {
+    /// Which format the function is computed in.
+    pub enum FormatWord {
+        /// Every value binary64.
+        F64 = "f64",
+        /// Every value binary32.
+        F32 = "f32",
+        /// Each value in its IR format.
+        Mixed = "mixed",
+    }
+}
+
+impl FormatWord {
+    /// The sweep's mode.
+    pub fn formats(self) -> Formats {
+        match self {
+            FormatWord::F64 => Formats::F64,
+            FormatWord::F32 => Formats::F32,
+            FormatWord::Mixed => Formats::Mixed,
+        }
+    }
+}
+
+/// Registry entry.
+pub const INFO: PassInfo = PassInfo {
+    name: "error-bound",
+    doc: "certified worst-case rounding error of every output over the input domain, against the exact function of \
+          the pipeline's input",
+    params: &[
+        ParamInfo {
+            name: "format",
+            kind: ParamKind::Choice { choices: FormatWord::WORDS, default: "mixed" },
+            doc: "f64: every value binary64; f32: every value binary32 (inputs and constants rounded); mixed: each \
+                  value in its IR format (binary64 by default)",
+        },
+        ParamInfo {
+            name: "ranges",
+            kind: ParamKind::Path,
+            doc: "JSON file of input ranges over the run's domain (-ranges), as range<ranges=FILE>",
+        },
+        ParamInfo {
+            name: "method",
+            kind: ParamKind::Choice { choices: Method::WORDS, default: "affine" },
+            doc: "how the values are enclosed: interval, or affine (correlation-aware, O(ops · terms))",
+        },
+        ParamInfo {
+            name: "terms",
+            kind: ParamKind::U32 { default: crate::range::affine::DEFAULT_TERMS as u32, min: 2, max: 1024 },
+            doc: "most noise symbols of one affine form (method=affine)",
+        },
+    ],
+    build: |p: &Params| {
+        Ok(Box::new(ErrorBoundPass {
+            format: p.word("format")?,
+            ranges: p.path("ranges")?,
+            method: p.word("method")?,
+            terms: p.u32("terms")? as usize,
+        }))
+    },
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: AtTimeLimit::Skip,
+        preserves_timing: true,
+        bit_exact: true,
+        exact_in_reals: true,
+        formats: true,
+        needs_domain: true,
+        ..crate::Props::DEFAULT
+    },
+};
+
+/// The `error-bound` pass.
+#[derive(Debug)]
+pub struct ErrorBoundPass {
+    /// The formats the function is computed in.
+    pub format: FormatWord,
+    /// A ranges file applied over the run's domain.
+    pub ranges: Option<String>,
+    /// How the values are enclosed.
+    pub method: Method,
+    /// Most noise symbols of an affine form.
+    pub terms: usize,
+}
+
+impl Pass for ErrorBoundPass {
+    fn name(&self) -> &'static str {
+        "error-bound"
+    }
+
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        let failed = |message: String| PassError::Failed { pass: "error-bound".into(), message };
+        if let Some(pass) = &cx.reals_changed_by {
+            return Err(failed(format!(
+                "`{pass}` ran before it and changes the exact real-number function (a constant folded in binary64, \
+                 or a rule that is not an identity), so no bound against the pipeline's input can be proved; run \
+                 error-bound before it, or give folded parameters as point ranges (-ranges) instead of specializing \
+                 (docs/accuracy.md, \"Certified error bounds\")"
+            )));
+        }
+        let dom = domain_with_file(cx.domain.as_ref(), self.ranges.as_deref(), m)?;
+        let affine = (self.method == Method::Affine).then_some(self.terms);
+        let (word, formats) = (self.format, self.format.formats());
+        let functions = try_each_function(
+            m,
+            cx,
+            "error-bound",
+            AtTimeLimit::Skip,
+            Before::Ticked,
+            |f, k| Some(format!("before @{} ({k} functions bounded)", f.name)),
+            |f, _, ticker| {
+                let located = |message: String, span: Option<robovec_ir::Span>| {
+                    PassError::Failed { pass: "error-bound".into(), message }
+                        .at(span.unwrap_or(robovec_ir::Span::DUMMY))
+                };
+                let x = match enclose_with(f, &dom, affine, || ticker.tick()) {
+                    Ok(x) => x,
+                    Err(e @ EncloseError::Stopped(_)) => {
+                        return Ok(Step::Stopped { what: e.message(&f.name), kept: None });
+                    }
+                    Err(e) => return Err(located(e.message(&f.name), e.span())),
+                };
+                let e = match bound(f, &x, formats, || ticker.tick()) {
+                    Ok(e) => e,
+                    Err(err @ BoundError::Stopped(_)) => {
+                        return Ok(Step::Stopped { what: err.message(&f.name), kept: None });
+                    }
+                    Err(err) => return Err(located(err.message(&f.name), err.span())),
+                };
+                Ok(Step::Done(summarise(f, &x, &e, word)))
+            },
+        )?;
+        cx.emit(ErrorBoundRun { functions });
+        Ok(())
+    }
+}
+
+/// One output's bound.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct OutputBound {
+    /// Bound on |computed − exact| over the domain (`None`: no finite bound).
+    pub abs: Option<f64>,
+    /// `abs` / min |exact| over the domain, when the output's enclosure excludes 0.
+    pub rel: Option<f64>,
+}
+
+/// One function's bounds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FunctionBound {
+    /// Function name.
+    pub function: String,
+    /// The formats it was bounded in.
+    pub format: FormatWord,
+    /// Per output, in output order: name and bound.
+    pub outputs: Vec<(String, OutputBound)>,
+    /// The largest finite `abs` and its output.
+    pub max_abs: Option<(String, f64)>,
+    /// The largest `rel` and its output.
+    pub max_rel: Option<(String, f64)>,
+    /// Outputs without a finite bound.
+    pub unbounded: Vec<String>,
+}
+
+/// The bounds of `f`'s outputs from the enclosures `x` and value bounds `e`.
+fn summarise(f: &Function, x: &[Interval], e: &[f64], format: FormatWord) -> FunctionBound {
+    let outputs: Vec<(String, OutputBound)> = f
+        .outputs
+        .iter()
+        .map(|o| {
+            let (range, err) = match o.value {
+                Operand::Value(v) => (x[v.index()], e[v.index()]),
+                // A constant output is computed exactly (binary32 rounds it).
+                Operand::Const(c) => {
+                    (Interval::point(c), if format == FormatWord::F32 { (c - c as f32 as f64).abs() } else { 0.0 })
+                }
+            };
+            let abs = err.is_finite().then_some(err);
+            let mig = if range.lo > 0.0 {
+                range.lo
+            } else if range.hi < 0.0 {
+                -range.hi
+            } else {
+                0.0
+            };
+            let rel = abs.filter(|_| mig > 0.0).map(|a| (a / mig).next_up());
+            (o.name.clone(), OutputBound { abs, rel })
+        })
+        .collect();
+    let largest = |pick: fn(&OutputBound) -> Option<f64>| {
+        outputs.iter().filter_map(|(n, b)| Some((n.clone(), pick(b)?))).max_by(|a, b| a.1.total_cmp(&b.1))
+    };
+    FunctionBound {
+        function: f.name.clone(),
+        format,
+        max_abs: largest(|b| b.abs),
+        max_rel: largest(|b| b.rel),
+        unbounded: outputs.iter().filter(|(_, b)| b.abs.is_none()).map(|(n, _)| n.clone()).collect(),
+        outputs,
+    }
+}
+
+/// What one `error-bound` run proved, per function: printed after the run, and the report's
+/// `error_bound`.
+#[derive(Clone, Debug)]
+pub struct ErrorBoundRun {
+    /// Per function.
+    pub functions: Vec<FunctionBound>,
+}
+
+impl std::fmt::Display for FunctionBound {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let n = self.outputs.len() - self.unbounded.len();
+        write!(
+            f,
+            "error-bound @{} ({}): {n} of {} outputs bounded",
+            self.function,
+            self.format.as_str(),
+            self.outputs.len()
+        )?;
+        if let Some((o, a)) = &self.max_abs {
+            write!(f, "; max abs {a:.3e} ({o})")?;
+        }
+        if let Some((o, r)) = &self.max_rel {
+            write!(f, "; max rel {r:.3e} ({o})")?;
+        }
+        if let Some(first) = self.unbounded.first() {
+            write!(f, "; unbounded: {first}")?;
+            if self.unbounded.len() > 1 {
+                write!(f, " and {} more", self.unbounded.len() - 1)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The report's `error_bound` object.
+#[derive(Serialize)]
+struct ErrorBoundReport<'a> {
+    format: &'static str,
+    outputs: serde_json::Map<String, serde_json::Value>,
+    max_abs: Option<f64>,
+    max_rel: Option<f64>,
+    unbounded: &'a [String],
+}
+
+impl crate::Artifact for ErrorBoundRun {
+    fn pass(&self) -> &'static str {
+        "error-bound"
+    }
+
+    fn log_text(&self, _detail: bool) -> String {
+        self.functions.iter().map(|r| format!("{r}\n")).collect()
+    }
+
+    fn report(&self, function: &str) -> Option<crate::ReportEntry> {
+        let r = self.functions.iter().find(|r| r.function == function)?;
+        let outputs =
+            r.outputs.iter().map(|(n, b)| (n.clone(), serde_json::to_value(b).expect("serialises"))).collect();
+        let value = ErrorBoundReport {
+            format: r.format.as_str(),
+            outputs,
+            max_abs: r.max_abs.as_ref().map(|m| m.1),
+            max_rel: r.max_rel.as_ref().map(|m| m.1),
+            unbounded: &r.unbounded,
+        };
+        Some(crate::ReportEntry::new("error_bound", &value, crate::Merge::Last))
+    }
+}

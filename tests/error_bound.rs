@@ -1,0 +1,305 @@
+//! `error-bound` (issue 48 item 3): the certified bound is sound — no error measured at a
+//! point of the domain against the certified reference ever exceeds it — on random functions
+//! with every op the IR has, on Robotran-like DAGs and on the corpus, in binary64, binary32 and
+//! mixed formats; hand-computed bounds of small functions; the pass's report and refusals.
+
+use std::collections::BTreeMap;
+
+use proptest::prelude::*;
+use robovec_ir::domain::Domain;
+use robovec_ir::format::Format;
+use robovec_ir::numerics::{RefValue, Reference, Tape};
+use robovec_ir::rng::SplitMix64;
+use robovec_ir::{Function, Operand};
+use robovec_passes::error_bound::{bound, Formats};
+use robovec_passes::range::{enclose_with, EncloseError};
+
+use crate::common::{opt, stderr};
+use crate::range::{generous_domain, random_function, range};
+
+/// The largest error measured over the outputs, as a multiple of their bounds (≤ 1 when
+/// sound), with the output.
+#[derive(Debug, Default)]
+struct Worst {
+    ratio: f64,
+    output: String,
+    /// (output, point) pairs compared.
+    compared: u64,
+}
+
+/// A lower bound of |computed − exact| from the certified reference `r` (the exact value
+/// correctly rounded to binary64: within half an ulp of it).
+fn error_at_least(computed: f64, r: &RefValue) -> f64 {
+    let ulp = (r.f64.abs().next_up() - r.f64.abs()).max(f64::from_bits(1));
+    ((computed - r.f64).abs() - ulp / 2.0).max(0.0)
+}
+
+/// A point of `dom` for `f`'s tape inputs: corners first (all lo, all hi), then each input at
+/// an end (a third of the time) or uniform inside.
+fn point(tape: &Tape, dom: &Domain, k: usize, rng: &mut SplitMix64) -> Vec<f64> {
+    tape.inputs
+        .iter()
+        .map(|n| {
+            let i = dom.get(n).unwrap().interval;
+            let t = match k {
+                0 => 0.0,
+                1 => 1.0,
+                _ if rng.chance(333) => rng.below(2) as f64,
+                _ => rng.unit(),
+            };
+            (i.lo + t * (i.hi - i.lo)).clamp(i.lo, i.hi)
+        })
+        .collect()
+}
+
+/// Bounds `f` over `dom` in `formats` and compares with the error at `n` points of the domain
+/// (computed as `formats` says, against the certified exact value); panics on any error above
+/// its bound.
+fn check_sound(what: &str, f: &Function, dom: &Domain, formats: Formats, n: usize, seed: u64) -> Worst {
+    let x = enclose_with(f, dom, Some(16), || false).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+    let e = bound(f, &x, formats, || false).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+    let tape = Tape::new(f);
+    let mut reference = Reference::new();
+    let mut refs = Vec::new();
+    let mut rng = SplitMix64::new(seed);
+    let mut worst = Worst::default();
+    for k in 0..n {
+        let xs = point(&tape, dom, k, &mut rng);
+        let computed: Vec<f64> = match formats {
+            Formats::F64 => tape.eval::<f64>(&xs),
+            Formats::F32 => tape.eval::<f32>(&xs).into_iter().map(f64::from).collect(),
+            Formats::Mixed => {
+                let at: BTreeMap<&str, f64> = tape.inputs.iter().map(String::as_str).zip(xs.iter().copied()).collect();
+                let vals = robovec_ir::format::eval_values(f, |n| at[n]).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+                tape.outputs
+                    .iter()
+                    .map(|(name, _)| {
+                        let o = f.outputs.iter().find(|o| &o.name == name).unwrap();
+                        match o.value {
+                            Operand::Value(v) => vals[v.index()],
+                            Operand::Const(c) => c,
+                        }
+                    })
+                    .collect()
+            }
+        };
+        reference.eval(&tape, &xs, &mut refs);
+        for (((name, _), &y), r) in tape.outputs.iter().zip(&computed).zip(&refs) {
+            let o = f.outputs.iter().find(|o| &o.name == name).unwrap();
+            let b = match o.value {
+                Operand::Value(v) => e[v.index()],
+                Operand::Const(_) => continue,
+            };
+            if !b.is_finite() || !r.certified || r.f64.is_nan() {
+                continue;
+            }
+            let err = if y.is_finite() { error_at_least(y, r) } else { f64::INFINITY };
+            assert!(
+                err <= b,
+                "{what}: output {name} in {formats:?} at point {k} ({xs:?}) is {y:e}, {err:e} from the exact \
+                 {:e}: above its bound {b:e}",
+                r.f64
+            );
+            worst.compared += 1;
+            let ratio = if b > 0.0 { err / b } else { 0.0 };
+            if ratio > worst.ratio {
+                worst.ratio = ratio;
+                worst.output = name.clone();
+            }
+        }
+    }
+    worst
+}
+
+/// A copy of `f` with some values in binary32 and some in a fixed-point format wide enough
+/// for its range (16 to 40 bits; the fraction chosen from the value's enclosure and error in
+/// binary64, with two guard bits of integer headroom).
+fn with_random_formats(f: &Function, dom: &Domain, seed: u64) -> Function {
+    let x = enclose_with(f, dom, Some(16), || false).unwrap();
+    let mut g = f.clone();
+    let mut rng = SplitMix64::new(seed);
+    let values: Vec<robovec_ir::Value> = f.inputs.iter().chain(&f.body).copied().collect();
+    for v in values {
+        let m = x[v.index()].mag();
+        if !m.is_finite() {
+            continue;
+        }
+        match rng.below(3) {
+            0 => g.set_format(v, Format::Binary32),
+            1 => {
+                let width = 16 + rng.below(25) as u32;
+                // Integer bits: enough for 4·m (the value, its error, headroom), sign included.
+                let int_bits = (4.0 * m.max(1e-6)).log2().ceil() as i32 + 1;
+                let fraction = (width as i32 - int_bits).clamp(-64, 126);
+                if let Some(fmt) = Format::fix(width, fraction) {
+                    g.set_format(v, fmt);
+                }
+            }
+            _ => {}
+        }
+    }
+    g
+}
+
+proptest! {
+    // 64 cases (PROPTEST_CASES=N for a longer campaign: the issue's 10⁴ random DAGs).
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(64),
+        ..ProptestConfig::default()
+    })]
+
+    /// Every op the IR has, in binary64 and binary32: no error measured at a point of the
+    /// domain exceeds the bound.
+    #[test]
+    fn bounds_hold_on_random_functions(seed in any::<u64>(), ops in 1usize..60) {
+        let (f, dom) = random_function(seed, ops);
+        for formats in [Formats::F64, Formats::F32] {
+            check_sound(&format!("seed {seed}"), &f, &dom, formats, 32, seed);
+        }
+    }
+
+    /// Mixed formats: random values in binary32 and fixed point, the rest binary64.
+    #[test]
+    fn bounds_hold_on_random_functions_in_mixed_formats(seed in any::<u64>(), ops in 1usize..40) {
+        let (f, dom) = random_function(seed, ops);
+        let g = with_random_formats(&f, &dom, seed);
+        let x = enclose_with(&g, &dom, Some(16), || false).unwrap();
+        match bound(&g, &x, Formats::Mixed, || false) {
+            Ok(_) => {
+                check_sound(&format!("mixed seed {seed}"), &g, &dom, Formats::Mixed, 32, seed);
+            }
+            // A fixed-point format the bound cannot prove wide enough is refused, never bounded.
+            Err(robovec_passes::error_bound::BoundError::FixOverflow { .. }) => {}
+            Err(e) => panic!("{e:?}"),
+        }
+    }
+
+    /// The synthetic Robotran-like DAGs (deep sums of products, trig of joint angles).
+    #[test]
+    fn bounds_hold_on_robotran_like_dags(seed in any::<u64>(), ops in 50usize..600) {
+        let f = robovec_testkit::dag_gen::generate(ops, seed);
+        let mut rng = SplitMix64::new(seed ^ 7);
+        let mut dom = Domain::default();
+        for &v in &f.inputs {
+            let a = rng.unit() * 4.0 - 2.0;
+            let w = if rng.chance(300) { 0.0 } else { rng.unit() };
+            dom.ranges.insert(f.name_of(v).to_string(), range(a, a + w));
+        }
+        for formats in [Formats::F64, Formats::F32] {
+            check_sound(&format!("dag {seed}"), &f, &dom, formats, 16, seed);
+        }
+    }
+}
+
+/// Every corpus function whose values can all be enclosed over the generous domain, binary32
+/// and binary64, 24 points each: no error above its bound.
+#[test]
+fn bounds_hold_on_the_corpus() {
+    let (mut bounded, mut compared) = (0, 0);
+    for (name, f) in crate::tree_height::corpus_functions() {
+        let dom = generous_domain(&f);
+        match enclose_with(&f, &dom, Some(16), || false) {
+            Ok(_) => {}
+            Err(EncloseError::DivisorHoldsZero { .. } | EncloseError::SqrtOfNegative { .. }) => continue,
+            Err(e) => panic!("{name}: {e:?}"),
+        }
+        let mut any = false;
+        for formats in [Formats::F32, Formats::F64] {
+            any |= check_sound(&name, &f, &dom, formats, 24, 3).compared > 0;
+        }
+        bounded += 1;
+        compared += usize::from(any);
+    }
+    // Functions whose outputs all call user callbacks have no finite bound to compare.
+    assert!(bounded >= 60 && compared >= 55, "{bounded} corpus functions bounded, {compared} compared");
+}
+
+/// Hand-computed bounds of `y = x · 0.1` over x ∈ [1, 2]. Binary64: the input and the
+/// constant are exact and the product rounds once, so the bound is u·max|y| = 2⁻⁵³·0.2 (within
+/// a few ulps: outward and upward roundings). Binary32: the input rounds (E_x = 2⁻²⁴·2), the
+/// constant rounds to 13421773·2⁻²⁷ (E_c its exact distance to 0.1), the product propagates
+/// M_c·E_x + M_x·E_c + E_x·E_c and rounds once. Fixed point: the binary64 product, then half a
+/// step; a format too narrow for [0.1, 0.2] is refused.
+#[test]
+fn hand_computed_bounds() {
+    let m =
+        robovec_ir::text::parse("func @f {\n  phase atomised\n  input %x\n  %y = mul %x, 0.1\n  output y = %y\n}\n")
+            .unwrap();
+    let f = &m.functions[0];
+    let mut dom = Domain::default();
+    dom.ranges.insert("x".into(), range(1.0, 2.0));
+    let x = enclose_with(f, &dom, None, || false).unwrap();
+    let y = f.lookup("y").unwrap().index();
+    let e64 = bound(f, &x, Formats::F64, || false).unwrap()[y];
+    let u64_ = 2f64.powi(-53);
+    let expected = u64_ * 0.2;
+    assert!(e64 >= expected && e64 <= expected * (1.0 + 1e-12), "{e64:e} vs {expected:e}");
+    let u = 2f64.powi(-24);
+    let c32 = 13_421_773.0 / 134_217_728.0; // 0.1 rounded to binary32
+    let eps = (c32 - 0.1f64).abs(); // exact in binary64: both are within 2⁻⁵⁰ of 0.1
+    let propagated = 0.1 * (2.0 * u) + 2.0 * eps + (2.0 * u) * eps; // M_c·E_x + M_x·E_c + E_x·E_c
+    let expected = propagated + u * (0.2 + propagated);
+    let e32 = bound(f, &x, Formats::F32, || false).unwrap()[y];
+    assert!(e32 >= expected && e32 <= expected * (1.0 + 1e-9), "{e32:e} vs {expected:e}");
+    // A fixed-point value: y in fix<16,12> — the binary64 product then half a step, 2⁻¹³.
+    let mut g = f.clone();
+    g.set_format(f.lookup("y").unwrap(), Format::fix(16, 12).unwrap());
+    let e = bound(&g, &x, Formats::Mixed, || false).unwrap()[y];
+    let expected = u64_ * 0.2 + 2f64.powi(-13);
+    assert!(e >= expected && e <= expected * (1.0 + 1e-9), "{e:e} vs {expected:e}");
+    // fix<2,3> holds [-0.25, 0.125]: 0.2 overflows.
+    g.set_format(f.lookup("y").unwrap(), Format::fix(2, 3).unwrap());
+    let err = bound(&g, &x, Formats::Mixed, || false).unwrap_err();
+    assert!(err.message("f").contains("%y in fix<2,3> may overflow"), "{}", err.message("f"));
+}
+
+/// The pass on a ranges file: the report's `error_bound` has every output with `abs` and
+/// `rel`, the maxima and the format; a pass that folds constants in binary64 before it is
+/// refused (exit 1) naming it.
+#[test]
+fn the_pass_reports_and_refuses() {
+    let dir = crate::common::tmp("error-bound");
+    let (ranges, report) = (dir.join("r.json"), dir.join("report.json"));
+    std::fs::write(&ranges, r#"{"a": [1, 2], "b": [0.5, 1]}"#).unwrap();
+    let o = opt(&[
+        "tests/inputs/ranges/div.rvir",
+        &format!("-ranges={}", ranges.display()),
+        "-passes=error-bound<format=f32>",
+        &format!("-report={}", report.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("error-bound @"), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let eb = &r["error_bound"];
+    assert_eq!(eb["format"], "f32");
+    let outs = eb["outputs"].as_object().unwrap();
+    assert!(!outs.is_empty());
+    let mut max_abs: f64 = 0.0;
+    for (name, b) in outs {
+        let abs = b["abs"].as_f64().unwrap_or_else(|| panic!("{name}: {b}"));
+        assert!(abs > 0.0 && abs < 1e-3, "{name}: {abs}");
+        max_abs = max_abs.max(abs);
+    }
+    assert_eq!(eb["max_abs"].as_f64().unwrap(), max_abs);
+    // specialize folds in binary64: the bound against the input would not hold.
+    let o = opt(&[
+        "tests/inputs/ranges/div.rvir",
+        &format!("-ranges={}", ranges.display()),
+        "-passes=specialize,error-bound",
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("`specialize` ran before it"), "{}", stderr(&o));
+    // Identities keep it: cse, contract.
+    let o = opt(&[
+        "tests/inputs/ranges/div.rvir",
+        &format!("-ranges={}", ranges.display()),
+        "-passes=cse,contract,error-bound",
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
