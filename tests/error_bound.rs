@@ -303,3 +303,105 @@ fn the_pass_reports_and_refuses() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
+
+/// Tightness on the corpus (a measurement, not a check: `cargo test --release --test root
+/// error_bound::tightness -- --ignored --nocapture`): per `dirdyna`/`invdyna` function, the
+/// binary32 bound over the generous domain divided by the largest error sampled at `N` points
+/// (env `TIGHTNESS_POINTS`, default 2000), its median and the share of outputs within 100×.
+#[test]
+#[ignore]
+fn tightness() {
+    let n: usize = std::env::var("TIGHTNESS_POINTS").ok().and_then(|s| s.parse().ok()).unwrap_or(2000);
+    let mut pooled: Vec<f64> = Vec::new();
+    for (name, f) in crate::tree_height::corpus_functions() {
+        if !(name.contains("dirdyna") || name.contains("invdyna") || name.contains("accelred")) {
+            continue;
+        }
+        let mut dom = generous_domain(&f);
+        // TIGHTNESS_HALF_WIDTH=w: joint coordinates in [q₀ − w, q₀ + w] around a pose, rates in ±10·w.
+        if let Some(w) = std::env::var("TIGHTNESS_HALF_WIDTH").ok().and_then(|s| s.parse::<f64>().ok()) {
+            for (n, r) in dom.ranges.iter_mut() {
+                let c = robovec_ir::interp::pseudo_random_input(n, 5);
+                if n.starts_with("q[") {
+                    *r = range(c - w, c + w);
+                } else if n.starts_with("qd[") || n.starts_with("qdd[") {
+                    *r = range(-10.0 * w, 10.0 * w);
+                }
+            }
+        }
+        let Ok(x) = enclose_with(&f, &dom, Some(std::env::var("TERMS").ok().and_then(|s| s.parse().ok()).unwrap_or(64)), || false) else {
+            println!("{name}: not enclosed");
+            continue;
+        };
+        let e = bound(&f, &x, Formats::F32, || false).unwrap();
+        let tape = Tape::new(&f);
+        let mut reference = Reference::new();
+        let mut refs = Vec::new();
+        let mut rng = SplitMix64::new(11);
+        let mut worst = vec![0f64; tape.outputs.len()];
+        let mut hull = vec![(f64::INFINITY, f64::NEG_INFINITY); tape.outputs.len()];
+        for k in 0..n {
+            let xs = point(&tape, &dom, k, &mut rng);
+            let y = tape.eval::<f32>(&xs);
+            reference.eval(&tape, &xs, &mut refs);
+            for (((w, &y), r), h) in worst.iter_mut().zip(&y).zip(&refs).zip(hull.iter_mut()) {
+                *h = (h.0.min(r.f64), h.1.max(r.f64));
+                if r.certified {
+                    *w = w.max((y as f64 - r.f64).abs());
+                }
+            }
+        }
+        let mut ratios: Vec<(f64, &str)> = tape
+            .outputs
+            .iter()
+            .zip(&worst)
+            .filter_map(|((o, _), &w)| {
+                let out = f.outputs.iter().find(|x| &x.name == o).unwrap();
+                let Operand::Value(v) = out.value else { return None };
+                let b = e[v.index()];
+                (b.is_finite() && w > 0.0).then(|| (b / w, o.as_str()))
+            })
+            .collect();
+        ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if ratios.is_empty() {
+            continue;
+        }
+        let mut widths: Vec<f64> = tape
+            .outputs
+            .iter()
+            .zip(&hull)
+            .filter_map(|((o, _), h)| {
+                let out = f.outputs.iter().find(|x| &x.name == o).unwrap();
+                let Operand::Value(v) = out.value else { return None };
+                (h.1 > h.0).then(|| x[v.index()].width() / (h.1 - h.0))
+            })
+            .collect();
+        widths.sort_by(f64::total_cmp);
+        if !widths.is_empty() {
+            println!("  enclosure/sampled width: median {:.1}, p90 {:.1}", widths[widths.len() / 2], widths[widths.len() * 9 / 10]);
+        }
+        pooled.extend(ratios.iter().map(|r| r.0));
+        let within = ratios.iter().filter(|r| r.0 <= 100.0).count();
+        println!(
+            "{name}: {} outputs; bound/sampled median {:.1}, p90 {:.1}, worst {:.1} ({}); within 100x: {:.0}%",
+            ratios.len(),
+            ratios[ratios.len() / 2].0,
+            ratios[ratios.len() * 9 / 10].0,
+            ratios.last().unwrap().0,
+            ratios.last().unwrap().1,
+            100.0 * within as f64 / ratios.len() as f64
+        );
+    }
+    pooled.sort_by(f64::total_cmp);
+    if !pooled.is_empty() {
+        let within = pooled.iter().filter(|&&r| r <= 100.0).count();
+        println!(
+            "all: {} outputs; median {:.1}, p90 {:.1}, worst {:.3e}; within 100x: {:.0}%",
+            pooled.len(),
+            pooled[pooled.len() / 2],
+            pooled[pooled.len() * 9 / 10],
+            pooled.last().unwrap(),
+            100.0 * within as f64 / pooled.len() as f64
+        );
+    }
+}

@@ -177,6 +177,7 @@ pub fn bound(
     for &v in &f.inputs {
         let m = x[v.index()].mag();
         e[v.index()] = match mode {
+            _ if m > largest(f, v, mode) => f64::INFINITY,
             Formats::F64 => 0.0,
             Formats::F32 => Rounding::F32.of(m),
             Formats::Mixed => Rounding::store(f.format(v)).of(m),
@@ -220,6 +221,20 @@ fn computed_nonneg(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[
             _ => false,
         },
         _ => false,
+    }
+}
+
+/// The largest finite magnitude `v` may take in `mode` before its rounding may overflow (a
+/// fixed-point format's overflow is [`check_fits`]'s).
+fn largest(f: &Function, v: Value, mode: Formats) -> f64 {
+    let f32_max = f32::MAX as f64;
+    match mode {
+        Formats::F64 => f64::MAX,
+        Formats::F32 => f32_max,
+        Formats::Mixed => match f.format(v) {
+            Format::Binary32 => f32_max,
+            _ => f64::MAX,
+        },
     }
 }
 
@@ -378,7 +393,12 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
         Formats::Mixed => rounding.then(Rounding::store(f.format(v))),
         _ => rounding,
     };
-    let total = up(propagated + rounding.of(up(mz + propagated)));
+    let magnitude = up(mz + propagated);
+    if magnitude > largest(f, v, mode) {
+        // The result may overflow to ±∞: no rounding model holds.
+        return f64::INFINITY;
+    }
+    let total = up(propagated + rounding.of(magnitude));
     if total.is_finite() {
         total
     } else {
