@@ -329,7 +329,12 @@ fn tightness() {
                 }
             }
         }
-        let Ok(x) = enclose_with(&f, &dom, Some(std::env::var("TERMS").ok().and_then(|s| s.parse().ok()).unwrap_or(64)), || false) else {
+        let Ok(x) = enclose_with(
+            &f,
+            &dom,
+            Some(std::env::var("TERMS").ok().and_then(|s| s.parse().ok()).unwrap_or(64)),
+            || false,
+        ) else {
             println!("{name}: not enclosed");
             continue;
         };
@@ -378,7 +383,11 @@ fn tightness() {
             .collect();
         widths.sort_by(f64::total_cmp);
         if !widths.is_empty() {
-            println!("  enclosure/sampled width: median {:.1}, p90 {:.1}", widths[widths.len() / 2], widths[widths.len() * 9 / 10]);
+            println!(
+                "  enclosure/sampled width: median {:.1}, p90 {:.1}",
+                widths[widths.len() / 2],
+                widths[widths.len() * 9 / 10]
+            );
         }
         pooled.extend(ratios.iter().map(|r| r.0));
         let within = ratios.iter().filter(|r| r.0 <= 100.0).count();
@@ -404,4 +413,29 @@ fn tightness() {
             100.0 * within as f64 / pooled.len() as f64
         );
     }
+}
+
+/// The verifier's range check of fixed-point formats: `y = x · 0.1` in fix<8,4> holds
+/// [−8, 7.9375]; over x ∈ [0, 10] y fits, over x ∈ [0, 100] it may reach 10: the run stops
+/// with exit 1 naming the value, its range and the format's, before any pass output.
+#[test]
+fn the_verifier_checks_fixed_point_ranges_over_the_domain() {
+    let dir = crate::common::tmp("fix-range");
+    let run = |hi: f64| {
+        let ranges = dir.join(format!("r{hi}.json"));
+        std::fs::write(&ranges, format!(r#"{{"x": [0, {hi}]}}"#)).unwrap();
+        opt(&[
+            "tests/inputs/formats/fix_range.rvir",
+            &format!("-ranges={}", ranges.display()),
+            "-passes=dce",
+            "-o",
+            "/dev/null",
+        ])
+    };
+    let o = run(10.0);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let o = run(100.0);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("%y in fix<8,4> may overflow") && e.contains("[-8e0, 7.9375e0]"), "{e}");
 }

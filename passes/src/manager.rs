@@ -260,6 +260,7 @@ impl PassManager {
         if self.instr.verify_each && !self.instr.input_verified {
             verify_named(m, "input")?;
         }
+        check_fixed_formats(m, cx, "input")?;
         let mut dump = |name: String, m: &Module| match &self.instr.dump_dir {
             Some(_) => dumps.dump(&name, &m.to_string()).map_err(|message| PassError::Output { message }),
             None => Ok(()),
@@ -332,6 +333,9 @@ impl PassManager {
             if self.instr.verify_each {
                 verify_within(m, name, &spec.to_string(), cx.deadline)?;
             }
+            if props.formats {
+                check_fixed_formats(m, cx, name)?;
+            }
         }
         if self.instr.time_passes {
             let total: f64 = records.iter().map(|r| r.wall_ms).sum();
@@ -398,6 +402,20 @@ pub(crate) fn verify_within(
         errors: errs.iter().map(|e| format!("  {e}")).collect::<Vec<_>>().join("\n"),
         list: errs,
     })
+}
+
+/// The verifier's range check of fixed-point formats after `pass` (or on the `input`), when the
+/// run has a domain ([`crate::error_bound::bound::check_fixed_formats`]): a fixed-point value
+/// whose computed range may not store in its format is an error.
+fn check_fixed_formats(m: &Module, cx: &PassContext, pass: &str) -> Result<(), PassError> {
+    let Some(domain) = &cx.domain else { return Ok(()) };
+    for f in m.functions.iter().filter(|f| f.has_formats()) {
+        crate::error_bound::bound::check_fixed_formats(f, domain).map_err(|message| PassError::Failed {
+            pass: pass.to_string(),
+            message: format!("the verifier's fixed-point range check failed: {message}"),
+        })?;
+    }
+    Ok(())
 }
 
 /// Records in [`PassContext::atomised_ops`] the ops of every atomised function not recorded yet.

@@ -405,3 +405,25 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
         f64::INFINITY
     }
 }
+
+/// The verifier's check of fixed-point formats over a domain (issue 48 item 4: "the verifier
+/// checks that a fixed-point value's range fits its integer bits"): when `f` (atomised) has a
+/// fixed-point value and `domain` covers its inputs, every fixed-point value's computed range
+/// (its enclosure widened by its error bound, mode [`Formats::Mixed`]) must store in its
+/// format. `Ok` when there is nothing to check or the domain does not cover the inputs (the
+/// interpreter still stops at an overflow).
+///
+/// # Errors
+/// [`BoundError::FixOverflow`] for the first value that may overflow, or the enclosure's own
+/// refusal (a divisor that may be 0 over the domain) as its message.
+pub fn check_fixed_formats(f: &Function, domain: &robovec_ir::domain::Domain) -> Result<(), String> {
+    let has_fix = f.phase == robovec_ir::Phase::Atomised
+        && f.has_formats()
+        && f.inputs.iter().chain(&f.body).any(|&v| matches!(f.format(v), Format::Fix { .. }));
+    if !has_fix || !domain.missing(f).is_empty() {
+        return Ok(());
+    }
+    let x = crate::range::enclose_with(f, domain, Some(crate::range::affine::DEFAULT_TERMS), || false)
+        .map_err(|e| e.message(&f.name))?;
+    bound(f, &x, Formats::Mixed, || false).map(|_| ()).map_err(|e| e.message(&f.name))
+}
