@@ -114,7 +114,7 @@ fn check_sound(what: &str, f: &Function, dom: &Domain, formats: Formats, n: usiz
 /// A copy of `f` with some values in binary32 and some in a fixed-point format wide enough
 /// for its range (16 to 40 bits; the fraction chosen from the value's enclosure and error in
 /// binary64, with two guard bits of integer headroom).
-fn with_random_formats(f: &Function, dom: &Domain, seed: u64) -> Function {
+pub(crate) fn with_random_formats(f: &Function, dom: &Domain, seed: u64) -> Function {
     let x = enclose_with(f, dom, Some(16), || false).unwrap();
     let mut g = f.clone();
     let mut rng = SplitMix64::new(seed);
@@ -230,6 +230,9 @@ fn hand_computed_bounds() {
     dom.ranges.insert("x".into(), range(1.0, 2.0));
     let x = enclose_with(f, &dom, None, || false).unwrap();
     let y = f.lookup("y").unwrap().index();
+    // Underflow's absolute terms are binary64 numbers above zero (2⁻¹⁰⁷⁵ itself is not one).
+    use robovec_passes::error_bound::Rounding;
+    assert!(Rounding::F64.abs >= 2f64.powi(-1074) && Rounding::F32.abs >= 2f64.powi(-150));
     let e64 = bound(f, &x, Formats::F64, || false).unwrap()[y];
     let u64_ = 2f64.powi(-53);
     let expected = u64_ * 0.2;

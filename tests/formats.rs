@@ -145,3 +145,120 @@ fn a_pass_that_does_not_understand_formats_refuses_them() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert_eq!(std::fs::read_to_string(&out).unwrap(), FIXED);
 }
+
+/// The C back end computes every value in its format bit for bit as `-eval` does: 48 random
+/// functions with every op the IR has, random values in binary32 and fixed point, 16 points
+/// of their domain each, compiled at -O1 (and the hand-written `FIXED` function); the
+/// expected bits are the interpreter's (`robovec_ir::format::eval_values`).
+#[test]
+fn c_computes_every_format_bit_for_bit_as_eval() {
+    use robovec_backends::c::CodegenC;
+    use robovec_ir::rng::SplitMix64;
+    use robovec_ir::Operand;
+    use std::fmt::Write as _;
+    let dir = tmp("formats-c");
+    let mut main = String::from("#include <stdio.h>\n#include <string.h>\n#include <stdint.h>\n");
+    let mut calls = String::new();
+    let mut files = vec!["main.c".to_string()];
+    let mut input_bytes: Vec<u8> = Vec::new();
+    let mut want: Vec<(String, f64)> = Vec::new();
+    let mut cases = 0;
+    for seed in 0..48u64 {
+        let (f, dom) = crate::range::random_function(seed * 7919 + 1, 4 + (seed as usize % 40));
+        let g = crate::error_bound::with_random_formats(&f, &dom, seed);
+        if robovec_passes::error_bound::bound::check_fixed_formats(&g, &dom).is_err() {
+            continue;
+        }
+        let m = Module { functions: vec![g.clone()] };
+        let o = CodegenC { name: Some(format!("t{seed}")), ..CodegenC::default() };
+        let art = o.emit(&m).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        std::fs::write(dir.join(format!("t{seed}.c")), &art.code.main).unwrap();
+        files.push(format!("t{seed}.c"));
+        let iface = &art.interfaces[0];
+        let (ni, no) = (iface.inputs.len(), iface.outputs.len());
+        let _ = writeln!(main, "void {}(const double *restrict in, double *restrict out);", iface.symbol);
+        let mut rng = SplitMix64::new(seed);
+        let mut points = 0;
+        for _ in 0..16 {
+            let point: Vec<f64> = iface
+                .inputs
+                .iter()
+                .map(|n| {
+                    let i = dom.get(n).unwrap().interval;
+                    (i.lo + rng.unit() * (i.hi - i.lo)).clamp(i.lo, i.hi)
+                })
+                .collect();
+            let at = |n: &str| point[iface.inputs.iter().position(|x| x == n).unwrap()];
+            let Ok(vals) = robovec_ir::format::eval_values(&g, at) else { continue };
+            for x in &point {
+                input_bytes.extend(x.to_le_bytes());
+            }
+            for (name, out) in iface.outputs.iter().zip(&g.outputs) {
+                let y = match out.value {
+                    Operand::Value(v) => vals[v.index()],
+                    Operand::Const(c) => c,
+                };
+                want.push((format!("seed {seed} {name} at {point:?}"), y));
+            }
+            points += 1;
+        }
+        let _ = writeln!(
+            calls,
+            "  for (int k = 0; k < {points}; k++) {{ double in[{}], out[{}]; if (fread(in, 8, {ni}, stdin) != {ni}) return 1; \
+             {}(in, out); for (int i = 0; i < {no}; i++) {{ uint64_t b; memcpy(&b, &out[i], 8); printf(\"%016llx\\n\", \
+             (unsigned long long)b); }} }}",
+            ni.max(1),
+            no.max(1),
+            iface.symbol
+        );
+        cases += 1;
+    }
+    assert!(cases >= 30, "only {cases} functions with fitting formats");
+    main += "int main(void)\n{\n";
+    main += &calls;
+    main += "  return 0;\n}\n";
+    std::fs::write(dir.join("main.c"), main).unwrap();
+    let exe = dir.join("run");
+    let o = std::process::Command::new("cc")
+        .current_dir(&dir)
+        .args(["-O1", "-std=c99", "-ffp-contract=off", "-o"])
+        .arg(&exe)
+        .args(&files)
+        .arg("-lm")
+        .output()
+        .expect("cc (scripts/test.sh installs gcc)");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut child = std::process::Command::new(&exe)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write as _;
+    child.stdin.take().unwrap().write_all(&input_bytes).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success());
+    let got: Vec<u64> =
+        String::from_utf8(out.stdout).unwrap().lines().map(|l| u64::from_str_radix(l, 16).unwrap()).collect();
+    assert_eq!(got.len(), want.len());
+    for (g, (what, y)) in got.iter().zip(&want) {
+        let same = *g == y.to_bits() || (y.is_nan() && f64::from_bits(*g).is_nan());
+        assert!(same, "{what}: C gives {:e}, -eval {y:e}", f64::from_bits(*g));
+    }
+}
+
+/// Formats with options that cannot honour them are refused (exit 1), naming both.
+#[test]
+fn c_refuses_formats_with_options_that_cannot_honour_them() {
+    let dir = tmp("formats-c-refused");
+    let input = dir.join("f.rvir");
+    std::fs::write(&input, FIXED).unwrap();
+    for (opts, why) in [("precision=f32", "precision=f32"), ("batch=4", "batch=4"), ("abi=robotran", "abi=robotran")] {
+        let o = opt(&[input.to_str().unwrap(), &format!("-passes=codegen<c;{opts}>"), "-o", "/dev/null"]);
+        assert_eq!(o.status.code(), Some(1), "{opts}: {}", stderr(&o));
+        assert!(stderr(&o).contains("has values in numeric formats") && stderr(&o).contains(why), "{}", stderr(&o));
+    }
+    let o = opt(&[input.to_str().unwrap(), "-passes=codegen<c>", "-o", dir.join("f.c").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let c = std::fs::read_to_string(dir.join("f.c")).unwrap();
+    assert!(c.contains("robovec_fix_store(") && c.contains("(double)(float)("), "{c}");
+}

@@ -183,6 +183,18 @@ impl<'a> Body<'a> {
         }
     }
 
+    /// `expr` (a binary64 result) stored in `v`'s numeric format ([`robovec_ir::format`]):
+    /// itself for binary64, `(double)(float)(expr)` for binary32, `robovec_fix_store(expr, f)`
+    /// for `fix<w,f>` (the file's [`super::file::FORMAT_HELPERS`]). Formats are written with
+    /// `precision=f64` and one state only (checked before), so every temporary is a `double`.
+    pub fn stored(&self, v: Value, expr: String) -> String {
+        match self.f.format(v) {
+            robovec_ir::format::Format::Binary64 => expr,
+            robovec_ir::format::Format::Binary32 => format!("(double)(float)({expr})"),
+            robovec_ir::format::Format::Fix { fraction, .. } => format!("robovec_fix_store({expr}, {fraction})"),
+        }
+    }
+
     /// The type of a value: `double`, `float` or `robovec_vec`.
     pub fn value_type(&self) -> &'static str {
         if self.o.batch > 1 {
@@ -261,7 +273,7 @@ impl<'a> Body<'a> {
                     if vec {
                         let _ = writeln!(s, "  const {ty} {name} = robovec_{fun}({arg});");
                     } else {
-                        let _ = writeln!(s, "  const {ty} {name} = {fun}{sfx}({arg});");
+                        let _ = writeln!(s, "  const {ty} {name} = {};", self.stored(v, format!("{fun}{sfx}({arg})")));
                     }
                 }
                 Def::Binary(op, a, b) => {
@@ -277,7 +289,11 @@ impl<'a> Body<'a> {
                     } else {
                         self.operand(a)
                     };
-                    let _ = writeln!(s, "  const {ty} {name} = {a} {op} {};", self.operand(b));
+                    let _ = writeln!(
+                        s,
+                        "  const {ty} {name} = {};",
+                        self.stored(v, format!("{a} {op} {}", self.operand(b)))
+                    );
                 }
                 Def::Call(c, args) if is_intrinsic(c, args.len()) => {
                     let i = Intrinsic::of(c, args.len()).expect("checked");
@@ -294,7 +310,11 @@ impl<'a> Body<'a> {
                         .collect();
                     let callee = if i == Intrinsic::Sqrt { "sqrt" } else { "fma" };
                     let callee = if vec { format!("robovec_{callee}") } else { format!("{callee}{sfx}") };
-                    let _ = writeln!(s, "  const {ty} {name} = {callee}({});", list.join(", "));
+                    let _ = writeln!(
+                        s,
+                        "  const {ty} {name} = {};",
+                        self.stored(v, format!("{callee}({})", list.join(", ")))
+                    );
                 }
                 Def::Call(..) if self.native.is_some() => {
                     s.push_str(&self.native.expect("checked").statements[&v.index()]);
@@ -319,7 +339,7 @@ impl<'a> Body<'a> {
                             "  {ty} {name};\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) {name}[lane] = {call};"
                         );
                     } else {
-                        let _ = writeln!(s, "  const {ty} {name} = {call};");
+                        let _ = writeln!(s, "  const {ty} {name} = {};", self.stored(v, call));
                     }
                 }
             }

@@ -53,6 +53,7 @@ pub const BACK_END: Member = Member {
         requires: Some(robovec_ir::Phase::Atomised),
         preserves_timing: true,
         back_end: true,
+        formats: true,
         ..robovec_passes::Props::DEFAULT
     },
 };

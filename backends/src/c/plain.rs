@@ -166,10 +166,10 @@ pub(crate) fn arrays(
                     let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, {p} + {}{at}, sizeof {n});", e * w);
                 }
                 Source::Elem(p, e) => {
-                    let _ = writeln!(s, "  const {ty} {n} = {}[{e}];", layout.params[p].0);
+                    let _ = writeln!(s, "  const {ty} {n} = {};", b.stored(v, format!("{}[{e}]", layout.params[p].0)));
                 }
                 Source::Const(c) => {
-                    let _ = writeln!(s, "  const {ty} {n} = {};", b.operand_value(&Operand::Const(c)));
+                    let _ = writeln!(s, "  const {ty} {n} = {};", b.stored(v, b.operand_value(&Operand::Const(c))));
                 }
             }
         } else if plan.reads_live(v, k) {

@@ -27,9 +27,9 @@
 //!
 //! # How each format rounds ([`Formats`])
 //! - **`f64`** (every value binary64, as `-eval` and the C back end's `double` compute):
-//!   inputs and constants exact; each op `rel = 2⁻⁵³` (`u`), `abs = 2⁻¹⁰⁷⁵` (half the smallest
-//!   subnormal: what underflow may lose); `sin`, `cos` `rel = `[`LIBM_ULPS`]`·2⁻⁵²`, `abs =
-//!   `[`LIBM_ULPS`]`·2⁻¹⁰⁷⁴` (the C library's error, as the enclosures assume).
+//!   inputs and constants exact; each op `rel = 2⁻⁵³` (`u`), `abs = 2⁻¹⁰⁷⁴` (the smallest subnormal,
+//!   above what underflow may lose); `sin`, `cos` `rel = `[`LIBM_ULPS`]`·2⁻⁵²`, `abs =
+//!   `[`LIBM_ULPS`]`·2⁻¹⁰⁷³` (the C library's error, as the enclosures assume).
 //! - **`f32`** (every value binary32, as `accuracy`'s binary32 evaluation and the C back end's
 //!   `float` compute): inputs and constants rounded to binary32 (a constant's error is its
 //!   exact distance to its binary32 value); each op `rel = 2⁻²⁴`, `abs = 2⁻¹⁵⁰`; `sin`, `cos` of
@@ -78,8 +78,9 @@ const U32: f64 = f32::EPSILON as f64 / 2.0;
 impl Rounding {
     /// No rounding.
     pub const EXACT: Rounding = Rounding { rel: 0.0, abs: 0.0 };
-    /// One binary64 rounding of an op (underflow included).
-    pub const F64: Rounding = Rounding { rel: U64, abs: 2.4703282292062327e-324 };
+    /// One binary64 rounding of an op (underflow included: 2⁻¹⁰⁷⁴, the subnormal step, as
+    /// half of it is not a binary64 number).
+    pub const F64: Rounding = Rounding { rel: U64, abs: f64::from_bits(1) };
     /// One binary32 rounding of an op (underflow included: half of 2⁻¹⁴⁹).
     pub const F32: Rounding = Rounding { rel: U32, abs: 7.006_492_321_624_085e-46 };
 
