@@ -208,10 +208,17 @@ fn hard_within(rng: &mut SplitMix64, r: &Range) -> f64 {
     use std::f64::consts::{FRAC_PI_2, PI};
     let (lo, hi) = (r.lo, r.hi);
     if r.family == Family::Angle {
-        let mut bases: Vec<f64> =
-            [0.0, FRAC_PI_2, -FRAC_PI_2, PI, -PI].into_iter().filter(|&p| lo <= p && p <= hi).collect();
-        bases.extend([lo, hi]);
-        let base = bases[rng.below(bases.len() as u64) as usize];
+        // The poses inside, then the two ends, which always are (no allocation: this runs per
+        // input and point).
+        let mut bases = [0.0; 7];
+        let mut n = 0;
+        for p in [0.0, FRAC_PI_2, -FRAC_PI_2, PI, -PI, lo, hi] {
+            if lo <= p && p <= hi {
+                bases[n] = p;
+                n += 1;
+            }
+        }
+        let base = bases[rng.below(n as u64) as usize];
         if rng.below(4) == 0 {
             return base;
         }
