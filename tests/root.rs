@@ -6,6 +6,7 @@
 mod common;
 
 mod accuracy;
+mod accuracy_domain;
 mod architecture;
 mod artifacts;
 mod bounds;

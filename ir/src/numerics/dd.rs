@@ -32,8 +32,9 @@ pub struct DD {
     pub lo: f64,
 }
 
+/// TwoSum (Knuth): `(s, e)` with `s = fl(a + b)` and `s + e = a + b` exactly (barring overflow).
 #[inline]
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     let bb = s - a;
     (s, (a - (s - bb)) + (b - bb))

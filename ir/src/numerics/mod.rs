@@ -25,5 +25,5 @@ pub mod tape;
 
 pub use bits::{bits_f32, bits_f64};
 pub use dd::DD;
-pub use reference::{RefValue, Reference};
+pub use reference::{Enclosure, RefValue, Reference};
 pub use tape::Tape;

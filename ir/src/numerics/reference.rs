@@ -28,7 +28,7 @@
 
 use astro_float::{BigFloat, RoundingMode};
 
-use super::dd::{DD, DD_TRIG_ABS, DD_UNIT};
+use super::dd::{two_sum, DD, DD_TRIG_ABS, DD_UNIT};
 use super::tape::{Step, Tape};
 use crate::intrinsic::Intrinsic;
 use crate::syntax::BinOp;
@@ -56,6 +56,65 @@ pub struct RefValue {
     pub near_zero: bool,
 }
 
+/// An enclosure of one output's exact value: every real number within [`Enclosure::radius`]
+/// of [`Enclosure::center`] (the exact sum `hi + lo` of the double-double). The reference's
+/// running error bound makes it rigorous: the exact value lies inside. What the absolute
+/// errors of the accuracy measurement are bounded from ([`Enclosure::abs_error_bound`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Enclosure {
+    /// The centre: the double-double (or the 256/1024-bit value rounded to a double-double)
+    /// the reference computed; NaN when the exact value is undefined (`sqrt` of a negative
+    /// value), non-finite on overflow.
+    pub center: DD,
+    /// Radius, same units as the value, `≥ 0`; infinite when the bound is unbounded (a
+    /// divisor's interval through zero, an overflow).
+    pub radius: f64,
+}
+
+/// `a + b` for `a, b ≥ 0`, rounded upward (to `+∞` on overflow).
+fn add_up(a: f64, b: f64) -> f64 {
+    let (s, e) = two_sum(a, b);
+    if e > 0.0 {
+        s.next_up()
+    } else {
+        s
+    }
+}
+
+impl Enclosure {
+    /// An exact value: radius 0.
+    pub fn exact(center: DD) -> Enclosure {
+        Enclosure { center, radius: 0.0 }
+    }
+
+    /// An upper bound, rounded upward, of `|x − v|` over every `v` in the enclosure — so of
+    /// the absolute error of a computed value `x` against the exact value. The distance to the
+    /// centre is split exactly by error-free transformations (TwoSum) into a leading binary64
+    /// term and two remainders, whose magnitudes are summed with the radius rounding upward:
+    /// with a radius of 0 and no remainders (as for `x − hi` with `lo = 0`, or any `x` within
+    /// a few ulps of a centre whose parts are representable together) the result is
+    /// `|x − (hi + lo)|` itself; otherwise it is at most a few ulps of binary64 above. Infinite
+    /// when `x` or the centre is not finite (NaN included) or the radius is infinite.
+    pub fn abs_error_bound(&self, x: f64) -> f64 {
+        let c = self.center;
+        if !(x.is_finite() && c.is_finite() && self.radius >= 0.0 && self.radius.is_finite()) {
+            return f64::INFINITY;
+        }
+        // x − hi − lo = y + z + q exactly.
+        let (s, t) = two_sum(x, -c.hi);
+        let (u, w) = two_sum(t, -c.lo);
+        let (a, b) = two_sum(s, u);
+        let (p, q) = two_sum(b, w);
+        let (y, z) = two_sum(a, p);
+        let r = add_up(add_up(add_up(y.abs(), z.abs()), q.abs()), self.radius);
+        if r.is_nan() {
+            f64::INFINITY
+        } else {
+            r
+        }
+    }
+}
+
 /// Reusable buffers for reference evaluations (one per thread; no allocation per sample once
 /// warm, except on the rare 256-bit path).
 #[derive(Default)]
@@ -64,6 +123,7 @@ pub struct Reference {
     scratch: Vec<DD>,
     val: Vec<f64>,
     err: Vec<f64>,
+    encl: Vec<Enclosure>,
 }
 
 /// What is known to be exact besides inputs and constants.
@@ -177,6 +237,10 @@ impl Reference {
         self.val.extend(self.dd.iter().map(|x| x.hi));
         propagate(tape, &self.val, Known::DoubleDouble(&self.dd), DD_UNIT, DD_TRIG_ABS, &mut self.err);
         out.clear();
+        self.encl.clear();
+        self.encl.extend(
+            tape.outputs.iter().map(|&(_, s)| Enclosure { center: self.dd[s as usize], radius: self.err[s as usize] }),
+        );
         let mut redo = Vec::new();
         for (k, &(_, s)) in tape.outputs.iter().enumerate() {
             let (v, e) = (self.dd[s as usize], self.err[s as usize]);
@@ -192,13 +256,21 @@ impl Reference {
             if redo.is_empty() {
                 break;
             }
-            for (&k, b) in redo.iter().zip(eval_big(tape, inputs, bits, &redo)) {
+            for (&k, (b, e)) in redo.iter().zip(eval_big_enclosed(tape, inputs, bits, &redo)) {
                 out[k] = b;
+                self.encl[k] = e;
             }
             // 1024 bits only where 256 could not decide a rounding away from zero: an interval
             // around zero at 256 bits is an exact zero for all practical purposes.
             redo.retain(|&k| !out[k].certified && !out[k].near_zero);
         }
+    }
+
+    /// An enclosure of the exact value of every output of the last [`Reference::eval`] or
+    /// [`Reference::eval_with`], in output order: the double-double value and its running
+    /// error bound, or, for outputs re-evaluated at 256 or 1024 bits, that value and its bound.
+    pub fn enclosures(&self) -> &[Enclosure] {
+        &self.encl
     }
 }
 
@@ -249,6 +321,14 @@ fn dd_certified(v: DD, e: f64) -> bool {
 /// computed at `bits` of precision with astro-float (only the steps they need) and certified
 /// by the same running error bound (`U = 2^(1−bits)`).
 pub fn eval_big(tape: &Tape, inputs: &[f64], bits: usize, outputs: &[usize]) -> Vec<RefValue> {
+    eval_big_enclosed(tape, inputs, bits, outputs).into_iter().map(|(r, _)| r).collect()
+}
+
+/// [`eval_big`] with an enclosure of each exact value: the `bits`-bit value rounded to a
+/// double-double (`hi` the value rounded to binary64, `lo` the rest rounded to binary64), with
+/// the running error bound plus a bound on that rounding (`2⁻¹⁰⁴·|hi| + 2⁻¹⁰⁷³`, 0 when the
+/// rest is 0).
+fn eval_big_enclosed(tape: &Tape, inputs: &[f64], bits: usize, outputs: &[usize]) -> Vec<(RefValue, Enclosure)> {
     let mask = tape.cone(outputs);
     let slots = super::big::eval(tape, inputs, bits, Some(&mask));
     let val: Vec<f64> = slots.iter().map(super::big::to_f64).collect();
@@ -270,15 +350,31 @@ pub fn eval_big(tape: &Tape, inputs: &[f64], bits: usize, outputs: &[usize]) -> 
                     && super::big::to_f64(&lo) == super::big::to_f64(&hi)
                     && super::big::to_f32(&lo) == super::big::to_f32(&hi)
             };
-            RefValue {
+            let r = RefValue {
                 f64: super::big::to_f64(v),
                 f32: super::big::to_f32(v),
                 certified: certified && !val[s as usize].is_infinite(),
                 bits: bits as u32,
                 near_zero: err[s as usize] > 0.0 && val[s as usize].abs() <= err[s as usize],
-            }
+            };
+            (r, big_enclosure(v, e, bits))
         })
         .collect()
+}
+
+/// The enclosure of a `bits`-bit value `v` whose distance from the exact value is at most `e`.
+fn big_enclosure(v: &BigFloat, e: f64, bits: usize) -> Enclosure {
+    let hi = super::big::to_f64(v);
+    if !hi.is_finite() {
+        return Enclosure { center: DD { hi, lo: 0.0 }, radius: f64::INFINITY };
+    }
+    // |v − hi| ≤ 2⁻⁵³·|hi| (or half the smallest subnormal), so the rest holds in `bits` bits
+    // and rounds to `lo` within 2⁻⁵³ of itself: |v − hi − lo| ≤ 2⁻¹⁰⁶·|hi| + 2⁻¹⁰⁷⁴ with room.
+    let rest = v.sub(&super::big::from_f64(hi, bits), bits, RoundingMode::ToEven);
+    let lo = super::big::to_f64(&rest);
+    let extra = if rest.is_zero() { 0.0 } else { 2f64.powi(-104) * hi.abs() + 2f64.powi(-1073) };
+    let radius = if e.is_nan() { f64::INFINITY } else { add_up(e, extra) };
+    Enclosure { center: DD { hi, lo }, radius }
 }
 
 #[cfg(test)]
@@ -332,6 +428,15 @@ mod tests {
         let mut out = Vec::new();
         r.eval(&t, &x, &mut out);
         assert_eq!(out[0], RefValue { f64: 1.5, f32: 1.5, certified: true, bits: 106, near_zero: false });
+        // Every step is error-free in double-double: the enclosure is the exact value, and the
+        // binary64 result 0.5 is exactly 1 away.
+        // (1e16 + 1 is a double-double with lo = 1, so the subtraction's rounding bound enters:
+        // the radius is tiny but not 0.)
+        let enc = r.enclosures()[0];
+        assert_eq!(enc.center, DD::from_f64(1.5));
+        assert!(enc.radius > 0.0 && enc.radius < 2f64.powi(-90), "{enc:?}");
+        let b = enc.abs_error_bound(0.5);
+        assert!((1.0..=1.0 + 2f64.powi(-51)).contains(&b), "{b}");
         assert_eq!(eval_big(&t, &x, 256, &[0])[0], RefValue { bits: 256, ..out[0] });
     }
 
@@ -354,6 +459,32 @@ mod tests {
         );
         // binary64 in the same order loses x entirely in the first sum: −x·2^60.
         assert_eq!(t.eval::<f64>(&x)[0], -x[0] * x[1]);
+        // The enclosure comes from the 256-bit path: the exact 2^-10 with radius 0 (every
+        // step exact there), so the error bound of the binary64 result is exactly its distance
+        // |−x·2^60 − 2^-10| rounded upward.
+        let enc = r.enclosures()[0];
+        assert_eq!((enc.center.hi + enc.center.lo, enc.radius), (2f64.powi(-10), 0.0));
+        let got = -x[0] * x[1];
+        assert_eq!(enc.abs_error_bound(got), (x[0] * x[1]).next_up());
+        assert_eq!(enc.abs_error_bound(f64::NAN), f64::INFINITY);
+    }
+
+    #[test]
+    fn enclosure_bounds_are_upper_bounds_rounded_upward() {
+        // |x − (hi + lo)| exact when it is a binary64 number; a radius adds on top, upward.
+        let c = DD { hi: 1.0, lo: 2f64.powi(-70) };
+        let e = Enclosure { center: c, radius: 0.0 };
+        assert_eq!(e.abs_error_bound(1.0), 2f64.powi(-70));
+        let b = e.abs_error_bound(3.0);
+        assert!((2.0..=2.0 + 2f64.powi(-50)).contains(&b), "2 − 2^-70 rounded upward, with a remainder: {b}");
+        let e = Enclosure { center: c, radius: 2f64.powi(-80) };
+        let b = e.abs_error_bound(1.0);
+        assert_eq!(b, 2f64.powi(-70) + 2f64.powi(-80), "a representable sum: exact");
+        // Near cancellation: x − hi = 0 exactly, the distance is |lo|.
+        let e = Enclosure::exact(DD { hi: 0.1, lo: -1e-18 });
+        assert_eq!(e.abs_error_bound(0.1), 1e-18);
+        assert_eq!(Enclosure { center: c, radius: f64::INFINITY }.abs_error_bound(1.0), f64::INFINITY);
+        assert_eq!(Enclosure::exact(DD::from_f64(f64::NAN)).abs_error_bound(1.0), f64::INFINITY);
     }
 
     #[test]

@@ -51,6 +51,12 @@ pub struct Acc {
     pub reference: ReferenceCounts,
     /// The mean binary32 bits of each point (its confidence interval).
     pub point_means: Moments,
+    /// Per output, the largest binary32 absolute error of every point added, in the output's
+    /// units (upper bounds; `+∞` for a non-finite result: [`PointErrors::abs_f32`]). A
+    /// maximum: order-independent, and kept by [`Acc::remove`].
+    pub max_abs_f32: Vec<f64>,
+    /// The same in binary64.
+    pub max_abs_f64: Vec<f64>,
     /// The worst points, worst first (at most `keep`).
     pub worst: Vec<Kept>,
     keep: usize,
@@ -71,7 +77,14 @@ fn count_reference(r: &mut ReferenceCounts, e: &PointErrors, sign: i64) {
 impl Acc {
     /// Empty statistics for `n` outputs, keeping the `keep` worst points.
     pub fn new(n: usize, keep: usize) -> Acc {
-        Acc { f32: vec![Stream::default(); n], f64: vec![Stream::default(); n], keep, ..Acc::default() }
+        Acc {
+            f32: vec![Stream::default(); n],
+            f64: vec![Stream::default(); n],
+            max_abs_f32: vec![0.0; n],
+            max_abs_f64: vec![0.0; n],
+            keep,
+            ..Acc::default()
+        }
     }
 
     /// Adds point `index` (`point` is called only when the point is kept).
@@ -85,6 +98,12 @@ impl Acc {
         for (k, (&a, &b)) in errs.f32.iter().zip(&errs.f64).enumerate() {
             self.f32[k].add(a);
             self.f64[k].add(b);
+        }
+        for (m, &a) in self.max_abs_f32.iter_mut().zip(&errs.abs_f32) {
+            *m = m.max(a);
+        }
+        for (m, &a) in self.max_abs_f64.iter_mut().zip(&errs.abs_f64) {
+            *m = m.max(a);
         }
         count_reference(&mut self.reference, errs, 1);
         self.point_means.add(errs.mean_f32(), 1);
@@ -127,6 +146,12 @@ impl Acc {
         }
         for (a, b) in self.f64.iter_mut().zip(&o.f64) {
             a.merge(b);
+        }
+        for (a, b) in self.max_abs_f32.iter_mut().zip(&o.max_abs_f32) {
+            *a = a.max(*b);
+        }
+        for (a, b) in self.max_abs_f64.iter_mut().zip(&o.max_abs_f64) {
+            *a = a.max(*b);
         }
         let r = &mut self.reference;
         r.double_double += o.reference.double_double;

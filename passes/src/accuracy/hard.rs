@@ -6,7 +6,8 @@
 //! inputs changed: an angle moved by ±2^−k (k uniform in [2, 30]), any other input scaled by
 //! 1 ± 2^−k (k in [1, 24]), or (1 in 8) redrawn as a hard value — rounded to binary32, and
 //! moves to the best neighbour that is worse than the current point. Known inputs (`params`)
-//! never move. Every point has its own generator, so the result does not depend on threads.
+//! never move; an input of the run's domain stays inside its range (each new value is clamped
+//! into it and rounded to binary32 inward: [`super::inputs::Range::settle`]). Every point has its own generator, so the result does not depend on threads.
 //! `-time-limit` (issue 28): each climb reads the clock once per round and stops there; the
 //! rounds done are in `stopped_early` (and the result then depends on the machine's speed).
 
@@ -73,13 +74,14 @@ pub fn climb(
                     for _ in 0..1 + rng.below(3) {
                         let k = free[rng.below(free.len() as u64) as usize];
                         let sign = if rng.below(2) == 0 { 1.0 } else { -1.0 };
-                        y[k] = if rng.below(8) == 0 {
+                        // Rounded to binary32, and inside the domain's range when it has one.
+                        y[k] = ranges[k].settle(if rng.below(8) == 0 {
                             draw_hard(&mut rng, &ranges[k])
                         } else if ranges[k].family == Family::Angle {
                             y[k] + sign * 2f64.powf(-(2.0 + 28.0 * rng.unit()))
                         } else {
                             y[k] * (1.0 + sign * 2f64.powf(-(1.0 + 23.0 * rng.unit())))
-                        } as f32 as f64;
+                        });
                     }
                     let ey = errors_at(sub, &y, ws, Some(skip));
                     if best.as_ref().is_none_or(|(_, b)| better(&ey, b)) {

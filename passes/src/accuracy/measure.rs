@@ -1,6 +1,8 @@
 //! Bits of error of one function at many input points: binary32 and binary64 evaluations in the
 //! IR's own operation order against the certified reference (`robovec_ir::numerics`) of the
-//! function as it entered the pipeline, and their statistics.
+//! function as it entered the pipeline, and their statistics; beside the bits, the absolute
+//! error of each output: an upper bound of |computed − exact| from the reference's enclosure of
+//! the exact value (`robovec_ir::numerics::Enclosure::abs_error_bound`).
 
 use robovec_ir::numerics::{bits_f32, bits_f64, RefValue, Reference, Tape};
 use robovec_ir::Function;
@@ -92,6 +94,13 @@ pub struct PointErrors {
     /// How each output's reference was obtained: precision in bits (106 double-double, 256,
     /// 1024), whether the bound certified it, and whether the bound reaches zero.
     pub reference: Vec<(u32, bool, bool)>,
+    /// Absolute error of each output in binary32, in the output's units: an upper bound of
+    /// |computed − exact| rounded upward (the distance to the reference's enclosure of the
+    /// exact value plus its radius); `+∞` when the computed value is not finite or the
+    /// reference is unbounded.
+    pub abs_f32: Vec<f64>,
+    /// The same in binary64.
+    pub abs_f64: Vec<f64>,
 }
 
 impl PointErrors {
@@ -123,10 +132,13 @@ pub fn errors_at(sub: &Subject, point: &[f64], ws: &mut Workspace, skip_big: Opt
     tape.eval_into::<f64>(&ws.xt, &mut ws.s64, &mut ws.x64);
     ws.reference.eval_with(&sub.reference, &ws.xr, &mut ws.refs, skip_big);
     let mut e = PointErrors::default();
-    for (&(_, s), r) in tape.outputs.iter().zip(&ws.refs) {
-        e.f32.push(bits_f32(ws.s32[s as usize], r.f32));
-        e.f64.push(bits_f64(ws.s64[s as usize], r.f64));
+    for ((&(_, s), r), x) in tape.outputs.iter().zip(&ws.refs).zip(ws.reference.enclosures()) {
+        let (c32, c64) = (ws.s32[s as usize], ws.s64[s as usize]);
+        e.f32.push(bits_f32(c32, r.f32));
+        e.f64.push(bits_f64(c64, r.f64));
         e.reference.push((r.bits, r.certified, r.near_zero));
+        e.abs_f32.push(x.abs_error_bound(c32 as f64));
+        e.abs_f64.push(x.abs_error_bound(c64));
     }
     e
 }

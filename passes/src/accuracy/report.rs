@@ -1,5 +1,6 @@
-//! What `accuracy` reports: SPEC §7's `accuracy` object (`samples`, `f32`, `f64`, `outputs`)
-//! plus how the reference was obtained and the worst points; a text summary for stderr; the
+//! What `accuracy` reports: SPEC §7's `accuracy` object (`samples`, `f32`, `f64`, `outputs`,
+//! each output with its largest absolute errors `max_abs_f32`/`max_abs_f64`) plus where the
+//! inputs were drawn (`drawn_in`), how the reference was obtained and the worst points; a text summary for stderr; the
 //! `worst-K.json` files.
 
 use std::collections::BTreeMap;
@@ -21,9 +22,26 @@ pub struct OutputAccuracy {
     pub f64: BitsSummary,
 }
 
+/// Errors of one output over the points: bits of error and the largest absolute errors.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct OutputErrors {
+    /// binary32, bits.
+    pub f32: BitsSummary,
+    /// binary64, bits.
+    pub f64: BitsSummary,
+    /// The largest absolute error in binary32 over the points measured (the samples and the
+    /// hill-climbing results), in the output's units: max over the points of an upper bound of
+    /// |computed − exact| (the distance to the reference's certified enclosure of the exact
+    /// value, rounded upward). `+∞` (JSON `null`) when a computed value was not finite or a
+    /// reference unbounded at some point.
+    pub max_abs_f32: f64,
+    /// The same in binary64.
+    pub max_abs_f64: f64,
+}
+
 /// Outputs in the function's output order, serialised as a JSON object.
 #[derive(Clone, Debug, Default)]
-pub struct OutputsMap(pub Vec<(String, OutputAccuracy)>);
+pub struct OutputsMap(pub Vec<(String, OutputErrors)>);
 
 impl Serialize for OutputsMap {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
@@ -73,6 +91,14 @@ pub struct AccuracyReport {
     pub samples: u64,
     /// Seed of the draws.
     pub seed: u64,
+    /// Where the inputs were drawn: [`DRAWN_IN_DOMAIN`] (every drawn input in its range of
+    /// the run's domain), [`DRAWN_IN_TABLE`] (the physical table of
+    /// [`super::inputs`], no domain or none of the inputs in it) or [`DRAWN_IN_BOTH`] (some of
+    /// each). Inputs fixed by `params` are not drawn.
+    pub drawn_in: &'static str,
+    /// Drawn inputs the domain covers, and drawn inputs (stderr only).
+    #[serde(skip)]
+    pub drawn_counts: (usize, usize),
     /// Points evaluated, including hill-climbing neighbours.
     pub evaluations: u64,
     /// Over every (output, point) pair, binary32, bits.
@@ -114,6 +140,26 @@ pub struct AccuracyReport {
     pub worst_dir: Option<String>,
 }
 
+/// [`AccuracyReport::drawn_in`]: every drawn input in its range of the run's domain.
+pub const DRAWN_IN_DOMAIN: &str = "domain";
+/// [`AccuracyReport::drawn_in`]: every drawn input from the physical table.
+pub const DRAWN_IN_TABLE: &str = "physical table";
+/// [`AccuracyReport::drawn_in`]: some drawn inputs in the domain, the others from the table.
+pub const DRAWN_IN_BOTH: &str = "domain and physical table";
+
+/// Where the inputs of `sub` not fixed by `o.known` are drawn (see [`AccuracyReport::drawn_in`]),
+/// and how many of them the domain covers, of how many.
+pub fn drawn_in(sub: &Subject, o: &Options) -> (&'static str, usize, usize) {
+    let drawn: Vec<&String> = sub.names.iter().filter(|n| !o.known.contains_key(*n)).collect();
+    let covered = drawn.iter().filter(|n| o.domain.as_ref().is_some_and(|d| d.get(n).is_some())).count();
+    let word = match covered {
+        0 => DRAWN_IN_TABLE,
+        c if c == drawn.len() => DRAWN_IN_DOMAIN,
+        _ => DRAWN_IN_BOTH,
+    };
+    (word, covered, drawn.len())
+}
+
 fn merged<'a>(xs: impl Iterator<Item = &'a Stream>) -> BitsSummary {
     let mut all = Stream::default();
     xs.for_each(|x| all.merge(x));
@@ -128,7 +174,15 @@ pub fn build(function: &str, sub: &Subject, o: &Options, run: Run, against: &str
         .outputs
         .iter()
         .enumerate()
-        .map(|(k, (name, _))| (name.clone(), OutputAccuracy { f32: acc.f32[k].summary(), f64: acc.f64[k].summary() }))
+        .map(|(k, (name, _))| {
+            let e = OutputErrors {
+                f32: acc.f32[k].summary(),
+                f64: acc.f64[k].summary(),
+                max_abs_f32: acc.max_abs_f32[k],
+                max_abs_f64: acc.max_abs_f64[k],
+            };
+            (name.clone(), e)
+        })
         .collect();
     let kept = |v: &[Stream]| -> BitsSummary { merged(v.iter().zip(&skip).filter(|(_, &z)| !z).map(|(s, _)| s)) };
     let worst = acc
@@ -147,6 +201,7 @@ pub fn build(function: &str, sub: &Subject, o: &Options, run: Run, against: &str
             }
         })
         .collect();
+    let drawn = drawn_in(sub, o);
     let mut standins = sub.tape.standin_callees();
     standins.extend(sub.reference.standin_callees());
     standins.sort();
@@ -156,6 +211,8 @@ pub fn build(function: &str, sub: &Subject, o: &Options, run: Run, against: &str
         mode: o.mode.name(),
         samples: acc.samples(),
         seed: o.seed,
+        drawn_in: drawn.0,
+        drawn_counts: (drawn.1, drawn.2),
         evaluations,
         f32: merged(acc.f32.iter()),
         f64: merged(acc.f64.iter()),
@@ -237,7 +294,33 @@ pub fn to_text(reports: &[AccuracyReport], per_output: bool) -> String {
                 r.function, w.max_f32_bits, w.output, w.max_f64_bits
             );
         }
-        if per_output {
+        // The physical table's runs print as they always did; a domain's add where the inputs
+        // were drawn and the absolute errors.
+        let in_domain = r.drawn_in != DRAWN_IN_TABLE;
+        if in_domain {
+            let (covered, drawn) = r.drawn_counts;
+            s += &format!(
+                "@{}: inputs drawn in: {} ({covered} of {drawn} drawn inputs in the domain); max abs = the largest \
+                 |computed - exact|, an upper bound\n",
+                r.function, r.drawn_in
+            );
+        }
+        if per_output && in_domain {
+            s += &format!(
+                "  {:<16} {:>20} {:>20} {:>12} {:>12}\n",
+                "output", "f32 mean/p95/max", "f64 mean/p95/max", "max abs f32", "max abs f64"
+            );
+            for (name, o) in &r.outputs.0 {
+                s += &format!(
+                    "  {:<16} {:>20} {:>20} {:>12.3e} {:>12.3e}\n",
+                    name,
+                    b(&o.f32),
+                    b(&o.f64),
+                    o.max_abs_f32,
+                    o.max_abs_f64
+                );
+            }
+        } else if per_output {
             s += &format!("  {:<16} {:>20} {:>20}\n", "output", "f32 mean/p95/max", "f64 mean/p95/max");
             for (name, o) in &r.outputs.0 {
                 s += &format!("  {:<16} {:>20} {:>20}\n", name, b(&o.f32), b(&o.f64));

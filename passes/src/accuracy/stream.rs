@@ -20,7 +20,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::acc::Acc;
-use super::inputs::{self, range_of, rng_for};
+use super::inputs::{self, range_in, rng_for};
 use super::measure::{errors_at, skip_after_probes, PointErrors, Subject, Workspace, PROBES};
 use super::{Mode, Options};
 
@@ -50,7 +50,7 @@ pub fn run(sub: &Subject, o: &Options) -> Run {
 /// [`run`] with `chunk` samples per chunk (the results do not depend on it).
 pub fn run_chunked(sub: &Subject, o: &Options, chunk: u64) -> Run {
     let n_out = sub.n_outputs();
-    let ranges: Vec<inputs::Range> = sub.names.iter().map(|n| range_of(n)).collect();
+    let ranges: Vec<inputs::Range> = sub.names.iter().map(|n| range_in(n, o.domain.as_ref())).collect();
     let hard = o.mode == Mode::Hard;
     let stream = hard as u64;
     let keep = o.worst_count.max(if hard { o.climb_points } else { 0 }) as usize;
@@ -127,7 +127,7 @@ mod tests {
             let r = measure_function(&f, &o);
             // Batch, independently: every point kept, sorted summaries (the former code path).
             let sub = Subject::new(&f, None).unwrap();
-            let ranges: Vec<inputs::Range> = sub.names.iter().map(|n| range_of(n)).collect();
+            let ranges: Vec<inputs::Range> = sub.names.iter().map(|n| inputs::range_of(n)).collect();
             let mut ws = Workspace::default();
             let errs: Vec<PointErrors> = (0..700)
                 .map(|i| {
