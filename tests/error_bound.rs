@@ -309,8 +309,9 @@ fn the_pass_reports_and_refuses() {
 
 /// Tightness on the corpus (a measurement, not a check: `cargo test --release --test root
 /// error_bound::tightness -- --ignored --nocapture`): per `dirdyna`/`invdyna` function, the
-/// binary32 bound over the generous domain divided by the largest error sampled at `N` points
-/// (env `TIGHTNESS_POINTS`, default 2000), its median and the share of outputs within 100×.
+/// binary32 bound over the generous domain divided by the largest error found at `N` points
+/// (env `TIGHTNESS_POINTS`, default 2000) of the domain and by `accuracy<mode=hard>` with `N`
+/// samples in it, its median and the share of outputs within 100×.
 #[test]
 #[ignore]
 fn tightness() {
@@ -356,6 +357,15 @@ fn tightness() {
                 *h = (h.0.min(r.f64), h.1.max(r.f64));
                 if r.certified {
                     *w = w.max((y as f64 - r.f64).abs());
+                }
+            }
+        }
+        // The largest error accuracy<mode=hard> finds in the same domain counts too.
+        let hard = robovec_passes::accuracy::max_abs_errors(&f, None, &dom, n as u64, 1, true).unwrap();
+        for ((o, _), w) in tape.outputs.iter().zip(worst.iter_mut()) {
+            if let Some((_, m32, _)) = hard.iter().find(|h| &h.0 == o) {
+                if m32.is_finite() {
+                    *w = w.max(*m32);
                 }
             }
         }
@@ -441,4 +451,36 @@ fn the_verifier_checks_fixed_point_ranges_over_the_domain() {
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let e = stderr(&o);
     assert!(e.contains("%y in fix<8,4> may overflow") && e.contains("[-8e0, 7.9375e0]"), "{e}");
+}
+
+/// The soundness check against `accuracy<mode=hard>` drawn in the same domain
+/// ([`robovec_passes::accuracy::max_abs_errors`]: singular poses, ends, hill climbing, every
+/// point inside the domain): on every corpus function that encloses over the generous domain,
+/// no output's largest measured absolute error, binary32 or binary64, exceeds its bound.
+#[test]
+fn bounds_hold_against_accuracy_hard_on_the_corpus() {
+    let samples: u64 = std::env::var("HARD_SAMPLES").ok().and_then(|s| s.parse().ok()).unwrap_or(48);
+    let mut compared = 0;
+    for (name, f) in crate::tree_height::corpus_functions() {
+        let dom = generous_domain(&f);
+        let Ok(x) = enclose_with(&f, &dom, Some(64), || false) else { continue };
+        let e32 = bound(&f, &x, Formats::F32, || false).unwrap();
+        let e64 = bound(&f, &x, Formats::F64, || false).unwrap();
+        let measured = robovec_passes::accuracy::max_abs_errors(&f, None, &dom, samples, 1, true)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        for ((out, m32, m64), o) in measured.iter().zip(&f.outputs) {
+            assert_eq!(out, &o.name);
+            let Operand::Value(v) = o.value else { continue };
+            for (format, m, b) in [("f32", m32, e32[v.index()]), ("f64", m64, e64[v.index()])] {
+                if b.is_finite() && m.is_finite() {
+                    assert!(
+                        m <= &b,
+                        "{name}: output {out} in {format}: accuracy<mode=hard> measured {m:e}, above the bound {b:e}"
+                    );
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert!(compared > 5000, "{compared} (output, format) pairs compared");
 }
