@@ -131,6 +131,9 @@ proptest! {
         // `sweep` places at 7 N × 4 configurations and `accuracy` measures 1000 points: keep
         // them out of the random pipelines (each is checked alone above) to stay fast.
         prop_assume!(!pipeline.contains("sweep") && !pipeline.contains("accuracy"));
+        // `precision` writes formats, which the rewrites after it refuse, and `error-bound`
+        // refuses to follow a pass that folds in binary64: both are checked alone above.
+        prop_assume!(!pipeline.contains("precision") && !pipeline.contains("error-bound"));
         if let Err(e) = run_case(seed, &pipeline) {
             prop_assert!(false, "seed {}: {}", seed, e);
         }

@@ -35,6 +35,7 @@ mod passes_reference;
 mod pinocchio;
 mod placement;
 mod placement_verify;
+mod precision;
 mod props;
 mod range;
 mod recurrence;

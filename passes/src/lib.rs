@@ -22,6 +22,7 @@ pub mod manager;
 pub mod params;
 pub mod pipeline;
 pub mod place;
+pub mod precision;
 pub mod progress;
 pub mod range;
 pub mod recurrence;
@@ -600,6 +601,7 @@ pub const PASSES: Registry = Registry {
         &depth_bound::INFO,
         &range::INFO,
         &error_bound::INFO,
+        &precision::INFO,
         &specialize::INFO,
         &eqsat::INFO,
         &cse::INFO,

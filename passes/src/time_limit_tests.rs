@@ -60,6 +60,8 @@ const EVERY_PASS: &[(&str, AtTimeLimit)] = &[
     ("rotate-3m", AtTimeLimit::Skip),
     ("depth-bound", AtTimeLimit::Skip),
     ("range", AtTimeLimit::Skip),
+    ("error-bound", AtTimeLimit::Skip),
+    ("precision", AtTimeLimit::Skip),
     ("specialize", AtTimeLimit::Required),
     ("eqsat", AtTimeLimit::Skip),
     ("cse", AtTimeLimit::Skip),

@@ -1,0 +1,240 @@
+//! The search of `precision` (the module doc of [`super`]): rank the cheaper formats by the
+//! first-order damage they do to the outputs' bounds, then binary-search the longest prefix
+//! of the ranking that the certified bound accepts.
+
+use std::collections::BTreeMap;
+
+use robovec_ir::format::{Format, FIX_FRACTION_RANGE};
+use robovec_ir::{BinOp, Def, Function, Interval, Operand, Value};
+
+use crate::error_bound::bound::{bound, sensitivities, Formats, Rounding};
+
+crate::params::word_enum! {
+    /// What the formats are chosen for (`target=`).
+    pub enum Target {
+        /// C on a CPU: binary32 where the bound allows.
+        C = "c",
+        /// A microcontroller without FPU: 32-bit fixed point first, then binary32.
+        Mcu = "mcu",
+    }
+}
+
+/// The formats chosen for one function and what they give.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Choice {
+    /// Every value not in binary64, with its format.
+    pub formats: Vec<(Value, Format)>,
+    /// The target.
+    pub target: Target,
+    /// The relative budget.
+    pub budget: f64,
+    /// Per output with a budget: name, certified bound, budget (absolute), largest magnitude
+    /// of its range.
+    pub outputs: Vec<(String, f64, f64, f64)>,
+    /// Cost with every value binary64, and with the formats.
+    pub cost: (f64, f64),
+    /// Values per format.
+    pub histogram: BTreeMap<String, usize>,
+    /// Bound sweeps run by the search.
+    pub sweeps: usize,
+    /// Outputs whose binary64 bound exceeds the budget: kept as binary64 computes them.
+    pub unreachable: Vec<String>,
+    /// Outputs without a finite bound (a callback, a divisor near 0): not constrained.
+    pub unbounded: Vec<String>,
+}
+
+impl Choice {
+    /// The report of this choice for function `name`.
+    pub fn report(&self, name: &str) -> super::PrecisionReport {
+        let worst = self.outputs.iter().map(|(n, b, _, m)| (n, b / m)).max_by(|a, b| a.1.total_cmp(&b.1));
+        super::PrecisionReport {
+            function: name.to_string(),
+            target: self.target.as_str(),
+            budget: self.budget,
+            formats: self.histogram.clone(),
+            max_rel_to_range: worst.map_or(0.0, |w| w.1),
+            worst_output: worst.map(|w| w.0.clone()),
+            cost_before: self.cost.0,
+            cost_after: self.cost.1,
+            sweeps: self.sweeps,
+            unreachable: self.unreachable.clone(),
+            unbounded: self.unbounded.clone(),
+        }
+    }
+}
+
+/// One candidate: value, the format it would take, its first-order damage.
+struct Candidate {
+    value: Value,
+    format: Format,
+    damage: f64,
+}
+
+/// Chooses formats for `f` (atomised; its own formats are ignored) whose certified bound keeps
+/// every output `o` within `budget · max|o|` over the domain whose enclosures are `x`
+/// ([`crate::range::enclose_with`]).
+///
+/// Outputs whose binary64 bound already exceeds the budget keep their binary64 bound as
+/// theirs ([`Choice::unreachable`]); outputs with no finite bound are not constrained
+/// ([`Choice::unbounded`]).
+///
+/// # Errors
+/// A message (`@f: …`) when the enclosures cannot be bounded at all (never for a function the
+/// enclosures accept) or, as an internal error, when the final formats fail the bound.
+pub fn choose(f: &Function, x: &[Interval], budget: f64, target: Target) -> Result<Choice, String> {
+    let mut g = f.clone();
+    let values: Vec<Value> = f.inputs.iter().chain(&f.body).copied().collect();
+    for &v in &values {
+        g.set_format(v, Format::Binary64);
+    }
+    let e64 = bound(&g, x, Formats::Mixed, || false).map_err(|e| e.message(&f.name))?;
+    // Outputs with a budget: those whose range is not 0. One whose binary64 bound already
+    // exceeds it keeps that bound as its budget (it stays as binary64 computes it); one with
+    // no finite bound is left out (nothing about it can be proved).
+    let mut outs: Vec<(String, Value, f64)> = Vec::new();
+    let (mut unreachable, mut unbounded) = (Vec::new(), Vec::new());
+    for o in &f.outputs {
+        let Operand::Value(v) = o.value else { continue };
+        let m = x[v.index()].mag();
+        if !m.is_finite() || !e64[v.index()].is_finite() {
+            unbounded.push(o.name.clone());
+            continue;
+        }
+        if m <= 0.0 {
+            continue;
+        }
+        let mut b = budget * m;
+        if e64[v.index()] > b {
+            unreachable.push(o.name.clone());
+            b = e64[v.index()];
+        }
+        outs.push((o.name.clone(), v, b));
+    }
+    let seeds: Vec<(Value, f64)> = outs.iter().map(|&(_, v, b)| (v, 1.0 / b)).collect();
+    let lam = sensitivities(&g, x, &e64, &seeds);
+    let mut sweeps = 0;
+    let accepts = |h: &Function, sweeps: &mut usize| -> Option<Vec<f64>> {
+        *sweeps += 1;
+        let e = bound(h, x, Formats::Mixed, || false).ok()?;
+        outs.iter().all(|&(_, v, b)| e[v.index()] <= b).then_some(e)
+    };
+    let phases: &[fn(f64, f64) -> Option<Format>] = match target {
+        Target::C => &[binary32],
+        Target::Mcu => &[fix32, binary32],
+    };
+    for phase in phases {
+        let mut candidates: Vec<Candidate> = values
+            .iter()
+            .filter_map(|&v| {
+                let (m, err) = (x[v.index()].mag(), e64[v.index()]);
+                if !m.is_finite() || !err.is_finite() || !g.format(v).is_default() {
+                    return None;
+                }
+                let format = phase(m, err)?;
+                let r = Rounding::store(format);
+                let added = r.rel * (m + err) + r.abs;
+                Some(Candidate { value: v, format, damage: lam[v.index()] * added })
+            })
+            .collect();
+        candidates.sort_by(|a, b| a.damage.total_cmp(&b.damage));
+        // The longest accepted prefix (k = 0 is the current assignment, accepted).
+        let with = |k: usize| {
+            let mut h = g.clone();
+            for c in &candidates[..k] {
+                h.set_format(c.value, c.format);
+            }
+            h
+        };
+        let (mut lo, mut hi) = (0usize, candidates.len());
+        while lo < hi {
+            let mid = (lo + hi).div_ceil(2);
+            if accepts(&with(mid), &mut sweeps).is_some() {
+                lo = mid;
+            } else {
+                hi = mid - 1;
+            }
+        }
+        // Cost is not monotone in the prefix (conversions between formats cost too): the
+        // cheapest of 17 accepted prefixes, 0 and `lo` included, if the bound accepts it.
+        let mut best = (cost(f, &g, target), 0usize);
+        for i in 1..=16 {
+            let k = lo * i / 16;
+            let c = cost(f, &with(k), target);
+            if c < best.0 {
+                best = (c, k);
+            }
+        }
+        let k = if best.1 == lo || accepts(&with(best.1), &mut sweeps).is_some() { best.1 } else { lo };
+        g = with(k);
+    }
+    let e = accepts(&g, &mut sweeps)
+        .ok_or_else(|| format!("@{}: internal error: the chosen formats fail (please report)", f.name))?;
+    let mut histogram = BTreeMap::new();
+    let mut formats = Vec::new();
+    for &v in &values {
+        let fmt = g.format(v);
+        *histogram.entry(fmt.to_string()).or_insert(0) += 1;
+        if !fmt.is_default() {
+            formats.push((v, fmt));
+        }
+    }
+    Ok(Choice {
+        formats,
+        target,
+        budget,
+        outputs: outs.iter().map(|(n, v, b)| (n.clone(), e[v.index()], *b, x[v.index()].mag())).collect(),
+        cost: (cost(f, &f_with_default(f), target), cost(f, &g, target)),
+        histogram,
+        sweeps,
+        unreachable,
+        unbounded,
+    })
+}
+
+/// `f` with every value binary64.
+fn f_with_default(f: &Function) -> Function {
+    let mut g = f.clone();
+    for &v in f.inputs.iter().chain(&f.body) {
+        g.set_format(v, Format::Binary64);
+    }
+    g
+}
+
+/// Binary32 for a value of magnitude `m` and error `err`, unless it may overflow.
+fn binary32(m: f64, err: f64) -> Option<Format> {
+    (m + err < f32::MAX as f64 / 2.0).then_some(Format::Binary32)
+}
+
+/// `fix<32,f>` for a value of magnitude `m` and error `err`: integer bits for twice its
+/// magnitude (one bit of headroom for the error the formats add), the sign included.
+fn fix32(m: f64, err: f64) -> Option<Format> {
+    let top = 2.0 * (m + err);
+    let int_bits = if top < f64::MIN_POSITIVE { -60 } else { top.log2().ceil() as i32 + 1 };
+    let fraction = 32 - int_bits;
+    FIX_FRACTION_RANGE.contains(&fraction).then(|| Format::fix(32, fraction)).flatten()
+}
+
+/// The cost of `f` under `g`'s formats for `target` (the module doc's model).
+fn cost(f: &Function, g: &Function, target: Target) -> f64 {
+    let mut total = 0.0;
+    for &v in &f.body {
+        let fv = g.format(v);
+        let operands: Vec<Operand> = match &f.value(v).def {
+            Def::Binary(_, a, b) => vec![*a, *b],
+            Def::Call(_, args) => args.clone(),
+            Def::Trig(_, a) => vec![Operand::Value(*a)],
+            _ => Vec::new(),
+        };
+        let conversions =
+            operands.iter().filter(|o| matches!(o, Operand::Value(a) if g.format(*a) != fv)).count() as f64;
+        let is_mul = matches!(f.value(v).def, Def::Binary(BinOp::Mul, ..));
+        total += match (target, fv) {
+            (Target::C, Format::Binary32) => 0.5 + 0.5 * conversions,
+            (Target::C, _) => 1.0 + 0.5 * conversions,
+            (Target::Mcu, Format::Fix { .. }) => (if is_mul { 3.0 } else { 1.0 }) + 20.0 * conversions,
+            (Target::Mcu, Format::Binary32) => 50.0 + 20.0 * conversions,
+            (Target::Mcu, Format::Binary64) => 100.0 + 20.0 * conversions,
+        };
+    }
+    total
+}

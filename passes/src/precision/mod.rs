@@ -1,0 +1,221 @@
+//! `precision<budget=REL;target=c|mcu>`: a numeric format per value (issue 48 item 5) that
+//! lowers the target's cost while the certified error bound of every output stays within the
+//! budget over the input domain.
+//!
+//! Phase: atomised → atomised; it writes formats ([`robovec_ir::format`]) and nothing else (the
+//! ops, their order and timing are kept; the exact real function too). The budget of output `o`
+//! is `budget · max|o|`, `max|o|` the magnitude of its enclosure over the domain (relative to
+//! each output's range, as the issue states); the bound is `error-bound<format=mixed>`'s
+//! ([`crate::error_bound::bound`]), so after the pass `error-bound` proves every output within
+//! its budget and `codegen<c>` writes the formats bit for bit as `-eval` computes them.
+//!
+//! **How it chooses** ([`choose`]): every value binary64 first (an output whose binary64 bound
+//! already exceeds its budget keeps that bound as its budget and is named in `unreachable`:
+//! the values it depends on stay binary64; one with no finite bound is named in `unbounded`
+//! and not constrained); then the
+//! first-order weight of each value's rounding in the outputs' bounds
+//! ([`crate::error_bound::bound::sensitivities`], seeded with 1/budget per output) times the
+//! rounding a cheaper format adds ranks the candidates, cheapest damage first; a binary search
+//! finds the longest prefix of that ranking whose formats the certified bound accepts (each
+//! step one O(ops) sweep, about log₂(values) of them). Targets:
+//! - `c`: binary32 where the bound allows (twice the lanes of a vector of binary64);
+//! - `mcu`: 32-bit fixed point first (`fix<32,f>`, `f` from the value's range with one bit of
+//!   headroom: integer arithmetic on a microcontroller without a floating-point unit), then
+//!   binary32 among the rest.
+//!
+//! Cost (reported before and after): `c` counts ops as 1 per binary64 op and ½ per binary32 op
+//! (lanes per vector) plus ½ per conversion (an operand read in another format than its
+//! user's); `mcu` estimates cycles of a Cortex-M3-class core without an FPU: fixed-point add 1,
+//! multiply 3 (`SMULL`, round, shift), binary32 operation 50 and binary64 100 (software
+//! floating point, order of magnitude), conversions 20.
+
+pub mod choose;
+
+use robovec_ir::Module;
+use serde::Serialize;
+
+use crate::params::ParamKind;
+use crate::range::{domain_with_file, enclose_with, EncloseError};
+use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
+pub use choose::{choose, Choice, Target};
+
+/// Registry entry.
+pub const INFO: PassInfo = PassInfo {
+    name: "precision",
+    doc: "choose a numeric format per value (binary32, 32-bit fixed point) that lowers the target's cost while the \
+          certified error bound of every output stays within the budget over the input domain",
+    params: &[
+        ParamInfo {
+            name: "budget",
+            kind: ParamKind::F64 { default: 1e-6, min: 1e-16, max: 1.0 },
+            doc: "error budget of each output, relative to the largest magnitude of its range over the domain",
+        },
+        ParamInfo {
+            name: "target",
+            kind: ParamKind::Choice { choices: Target::WORDS, default: "c" },
+            doc: "c: binary32 where the bound allows (vector lanes); mcu: 32-bit fixed point first, then binary32 \
+                  (a microcontroller without FPU)",
+        },
+        ParamInfo {
+            name: "ranges",
+            kind: ParamKind::Path,
+            doc: "JSON file of input ranges over the run's domain (-ranges), as range<ranges=FILE>",
+        },
+    ],
+    build: |p: &Params| {
+        Ok(Box::new(PrecisionPass { budget: p.f64("budget")?, target: p.word("target")?, ranges: p.path("ranges")? }))
+    },
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: AtTimeLimit::Skip,
+        preserves_timing: true,
+        exact_in_reals: true,
+        formats: true,
+        needs_domain: true,
+        ..crate::Props::DEFAULT
+    },
+};
+
+/// The `precision` pass.
+#[derive(Debug)]
+pub struct PrecisionPass {
+    /// Relative error budget per output.
+    pub budget: f64,
+    /// What the formats are for.
+    pub target: Target,
+    /// A ranges file applied over the run's domain.
+    pub ranges: Option<String>,
+}
+
+impl Pass for PrecisionPass {
+    fn name(&self) -> &'static str {
+        "precision"
+    }
+
+    fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        let dom = domain_with_file(cx.domain.as_ref(), self.ranges.as_deref(), m)?;
+        let (budget, target) = (self.budget, self.target);
+        let mut chosen: Vec<(usize, Choice)> = Vec::new();
+        let functions = try_each_function(
+            m,
+            cx,
+            "precision",
+            AtTimeLimit::Skip,
+            Before::Ticked,
+            |f, k| Some(format!("before @{} ({k} functions given formats)", f.name)),
+            |f, _, ticker| {
+                let failed = |message: String| PassError::Failed { pass: "precision".into(), message };
+                let x = match enclose_with(f, &dom, Some(crate::range::affine::DEFAULT_TERMS), || ticker.tick()) {
+                    Ok(x) => x,
+                    Err(e @ EncloseError::Stopped(_)) => {
+                        return Ok(Step::Stopped { what: e.message(&f.name), kept: None })
+                    }
+                    Err(e) => return Err(failed(e.message(&f.name)).at(e.span().unwrap_or(robovec_ir::Span::DUMMY))),
+                };
+                let c = choose(f, &x, budget, target).map_err(failed)?;
+                Ok(Step::Done(c))
+            },
+        )?;
+        for (k, c) in functions.into_iter().enumerate() {
+            chosen.push((k, c));
+        }
+        let mut reports = Vec::new();
+        for (k, c) in chosen {
+            let f = &mut m.functions[k];
+            for &(v, format) in &c.formats {
+                f.set_format(v, format);
+            }
+            reports.push(c.report(&f.name));
+        }
+        cx.emit(PrecisionRun { functions: reports });
+        Ok(())
+    }
+}
+
+/// What `precision` chose for one function: printed after the run and the report's
+/// `precision`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PrecisionReport {
+    /// Function name.
+    #[serde(skip)]
+    pub function: String,
+    /// `c` or `mcu`.
+    pub target: &'static str,
+    /// The relative budget.
+    pub budget: f64,
+    /// Values per format (`f64`, `f32`, `fix<32,f>`), inputs included.
+    pub formats: std::collections::BTreeMap<String, usize>,
+    /// The largest bound over the outputs, relative to each output's largest magnitude.
+    pub max_rel_to_range: f64,
+    /// The output that reaches it.
+    pub worst_output: Option<String>,
+    /// The target's cost with every value binary64 (module doc's model).
+    pub cost_before: f64,
+    /// Its cost with the chosen formats.
+    pub cost_after: f64,
+    /// Certified bound sweeps the search ran.
+    pub sweeps: usize,
+    /// Outputs whose binary64 bound already exceeds the budget (kept as binary64 computes them).
+    pub unreachable: Vec<String>,
+    /// Outputs with no finite bound (not constrained).
+    pub unbounded: Vec<String>,
+}
+
+impl std::fmt::Display for PrecisionReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // Fixed-point formats grouped by width on this line (the report has each).
+        let mut grouped: std::collections::BTreeMap<String, usize> = std::collections::BTreeMap::new();
+        for (k, n) in &self.formats {
+            let key = match k.split_once(',') {
+                Some((w, _)) if k.starts_with("fix<") => format!("{w},*>"),
+                _ => k.clone(),
+            };
+            *grouped.entry(key).or_insert(0) += n;
+        }
+        let hist: Vec<String> = grouped.iter().map(|(k, n)| format!("{n} {k}")).collect();
+        write!(
+            f,
+            "precision @{} ({}, budget {:e}): {}; bound {:.3e} of the range at most ({}); cost {:.0} -> {:.0}",
+            self.function,
+            self.target,
+            self.budget,
+            hist.join(", "),
+            self.max_rel_to_range,
+            self.worst_output.as_deref().unwrap_or("no output"),
+            self.cost_before,
+            self.cost_after
+        )?;
+        for (what, list) in [
+            ("cannot meet the budget even in binary64 (kept so)", &self.unreachable),
+            ("have no finite bound", &self.unbounded),
+        ] {
+            if let Some(first) = list.first() {
+                let more = if list.len() > 1 { format!(" and {} more", list.len() - 1) } else { String::new() };
+                write!(f, "; {first}{more} {what}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One `precision` run, per function.
+#[derive(Clone, Debug)]
+pub struct PrecisionRun {
+    /// Per function.
+    pub functions: Vec<PrecisionReport>,
+}
+
+impl crate::Artifact for PrecisionRun {
+    fn pass(&self) -> &'static str {
+        "precision"
+    }
+
+    fn log_text(&self, _detail: bool) -> String {
+        self.functions.iter().map(|r| format!("{r}\n")).collect()
+    }
+
+    fn report(&self, function: &str) -> Option<crate::ReportEntry> {
+        let r = self.functions.iter().find(|r| r.function == function)?;
+        Some(crate::ReportEntry::new("precision", r, crate::Merge::Last))
+    }
+}

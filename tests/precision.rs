@@ -1,0 +1,152 @@
+//! `precision` (issue 48 item 5): the formats it chooses keep every output within its budget,
+//! proved by `error-bound` over the same domain and checked against `-eval` at sampled points
+//! (against the certified exact value); cheaper formats where the budget allows, none where it
+//! does not; an unreachable budget is a diagnostic (exit 1).
+
+use robovec_ir::domain::Domain;
+use robovec_ir::numerics::{Reference, Tape};
+use robovec_ir::rng::SplitMix64;
+use robovec_ir::{Function, Operand};
+use robovec_passes::error_bound::{bound, Formats};
+use robovec_passes::precision::{choose, Target};
+use robovec_passes::range::enclose_with;
+
+use crate::common::{opt, stderr};
+use crate::range::{random_function, range};
+
+/// Applies `choose`'s formats to a copy of `f`.
+fn with_choice(f: &Function, dom: &Domain, budget: f64, target: Target) -> Option<(Function, Vec<(String, f64)>)> {
+    let x = enclose_with(f, dom, Some(64), || false).unwrap();
+    let c = choose(f, &x, budget, target).ok()?;
+    let mut g = f.clone();
+    for &(v, fmt) in &c.formats {
+        g.set_format(v, fmt);
+    }
+    Some((g, c.outputs.iter().map(|(n, _, b, _)| (n.clone(), *b)).collect()))
+}
+
+/// Every output of `g` (formatted) within its budget: by `error-bound`'s certified bound, and
+/// at 32 points of the domain by `-eval`'s formats against the certified exact value.
+fn assert_within(what: &str, g: &Function, dom: &Domain, budgets: &[(String, f64)], seed: u64) {
+    let x = enclose_with(g, dom, Some(64), || false).unwrap();
+    let e = bound(g, &x, Formats::Mixed, || false).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+    let tape = Tape::new(g);
+    let mut reference = Reference::new();
+    let mut refs = Vec::new();
+    let mut rng = SplitMix64::new(seed);
+    for (name, b) in budgets {
+        let o = g.outputs.iter().find(|o| &o.name == name).unwrap();
+        let Operand::Value(v) = o.value else { continue };
+        assert!(e[v.index()] <= *b, "{what}: {name}: bound {:e} above its budget {b:e}", e[v.index()]);
+    }
+    for _ in 0..32 {
+        let xs: Vec<f64> = tape
+            .inputs
+            .iter()
+            .map(|n| {
+                let i = dom.get(n).unwrap().interval;
+                (i.lo + rng.unit() * (i.hi - i.lo)).clamp(i.lo, i.hi)
+            })
+            .collect();
+        let at = |n: &str| xs[tape.inputs.iter().position(|m| m == n).unwrap()];
+        let vals = robovec_ir::format::eval_values(g, at).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+        reference.eval(&tape, &xs, &mut refs);
+        for ((name, _), r) in tape.outputs.iter().zip(&refs) {
+            let Some((_, b)) = budgets.iter().find(|(n, _)| n == name) else { continue };
+            let o = g.outputs.iter().find(|o| &o.name == name).unwrap();
+            let Operand::Value(v) = o.value else { continue };
+            if r.certified {
+                let err = (vals[v.index()] - r.f64).abs();
+                assert!(err <= *b * (1.0 + 1e-12), "{what}: {name} off by {err:e}, budget {b:e}");
+            }
+        }
+    }
+}
+
+/// Random functions with every op, both targets, budgets from 10⁻¹² to 10⁻²: the formats chosen
+/// always meet the budget; loose budgets give cheaper formats.
+#[test]
+fn chosen_formats_meet_the_budget_on_random_functions() {
+    let mut cheaper = 0;
+    for seed in 0..60u64 {
+        let (f, dom) = random_function(seed * 31 + 5, 5 + seed as usize % 50);
+        for (budget, target) in [(1e-2, Target::C), (1e-6, Target::Mcu), (1e-12, Target::C), (1e-4, Target::Mcu)] {
+            let Some((g, budgets)) = with_choice(&f, &dom, budget, target) else { continue };
+            assert_within(&format!("seed {seed} {budget:e} {target:?}"), &g, &dom, &budgets, seed);
+            cheaper += usize::from(g.has_formats());
+        }
+    }
+    assert!(cheaper > 60, "only {cheaper} choices used a cheaper format");
+}
+
+/// The Segway `dirdyna` over a narrow domain: at 10⁻³ every value is binary32 (C) and the cost
+/// halves; at 10⁻⁹ most stay binary64; for the microcontroller 32-bit fixed point; every
+/// choice meets its budget.
+#[test]
+fn the_segway_gets_binary32_at_a_loose_budget() {
+    let path = crate::common::corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c");
+    let (m, _) = robovec::driver::load(path.to_str().unwrap()).unwrap_or_else(|e| panic!("{}", e.message()));
+    let f = robovec_ir::transform::atomise::atomise_function(&m.functions[0]);
+    let mut dom = crate::range::generous_domain(&f);
+    for (n, r) in dom.ranges.iter_mut() {
+        if n.starts_with("q[") {
+            *r = range(0.1, 0.3);
+        } else if n.starts_with("qd") {
+            *r = range(-1.0, 1.0);
+        }
+    }
+    let (g, budgets) = with_choice(&f, &dom, 1e-3, Target::C).unwrap();
+    let values = f.inputs.len() + f.body.len();
+    let f32s = f.inputs.iter().chain(&f.body).filter(|&&v| g.format(v) == robovec_ir::format::Format::Binary32).count();
+    assert_eq!(f32s, values, "every value binary32 at 1e-3");
+    assert_within("segway 1e-3", &g, &dom, &budgets, 1);
+    let (g, budgets) = with_choice(&f, &dom, 1e-9, Target::C).unwrap();
+    let f32s = f.inputs.iter().chain(&f.body).filter(|&&v| g.format(v) == robovec_ir::format::Format::Binary32).count();
+    assert!(f32s < values / 10, "{f32s} of {values} binary32 at 1e-9");
+    assert_within("segway 1e-9", &g, &dom, &budgets, 2);
+    let (g, budgets) = with_choice(&f, &dom, 1e-5, Target::Mcu).unwrap();
+    let fixed = f
+        .inputs
+        .iter()
+        .chain(&f.body)
+        .filter(|&&v| matches!(g.format(v), robovec_ir::format::Format::Fix { width: 32, .. }))
+        .count();
+    assert!(fixed > values * 9 / 10, "{fixed} of {values} in fix<32,*>");
+    assert_within("segway mcu 1e-5", &g, &dom, &budgets, 3);
+}
+
+/// An unreachable budget (below binary64's own error) keeps the outputs as binary64 computes
+/// them and names them; the pass's line and report, and the formats in the output IR.
+#[test]
+fn the_pass_reports_and_keeps_binary64_where_the_budget_is_unreachable() {
+    let dir = crate::common::tmp("precision");
+    let (ranges, report) = (dir.join("r.json"), dir.join("report.json"));
+    std::fs::write(&ranges, r#"{"a": [1, 2], "b": [0.5, 1]}"#).unwrap();
+    let run = |budget: &str| {
+        opt(&[
+            "tests/inputs/ranges/div.rvir",
+            &format!("-ranges={}", ranges.display()),
+            &format!("-passes=precision<budget={budget}>,error-bound"),
+            &format!("-report={}", report.display()),
+            "-o",
+            dir.join("out.rvir").to_str().unwrap(),
+        ])
+    };
+    let o = run("1e-16");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("cannot meet the budget even in binary64"), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(!r["precision"]["unreachable"].as_array().unwrap().is_empty(), "{}", r["precision"]);
+    assert!(r["precision"]["formats"].get("f32").is_none(), "{}", r["precision"]);
+    let o = run("1e-3");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("precision @"), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["precision"]["target"], "c");
+    assert!(r["precision"]["formats"]["f32"].as_u64().unwrap() > 0, "{}", r["precision"]);
+    assert!(r["precision"]["max_rel_to_range"].as_f64().unwrap() <= 1e-3);
+    // The output IR carries the formats and reads back.
+    let text = std::fs::read_to_string(dir.join("out.rvir")).unwrap();
+    assert!(text.contains(": f32"), "{text}");
+    robovec_ir::text::parse(&text).unwrap();
+}
