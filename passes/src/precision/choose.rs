@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use robovec_ir::format::{Format, FIX_FRACTION_RANGE};
 use robovec_ir::{BinOp, Def, Function, Interval, Operand, Value};
 
-use crate::error_bound::bound::{bound, sensitivities, Formats, Rounding};
+use crate::error_bound::bound::{bound, sensitivities, BoundError, Formats, Rounding};
 
 crate::params::word_enum! {
     /// What the formats are chosen for (`target=`).
@@ -113,11 +113,21 @@ pub fn choose(f: &Function, x: &[Interval], budget: f64, target: Target) -> Resu
     let seeds: Vec<(Value, f64)> = outs.iter().map(|&(_, v, b)| (v, 1.0 / b)).collect();
     let lam = sensitivities(&g, x, &e64, &seeds);
     let mut sweeps = 0;
-    let accepts = |h: &Function, sweeps: &mut usize| -> Option<Vec<f64>> {
+    // The bounds when `h`'s formats meet every budget; otherwise `Err` with the fixed-point
+    // value that may overflow, if that is why.
+    let check = |h: &Function, sweeps: &mut usize| -> Result<Vec<f64>, Option<String>> {
         *sweeps += 1;
-        let e = bound(h, x, Formats::Mixed, || false).ok()?;
-        outs.iter().all(|&(_, v, b)| e[v.index()] <= b).then_some(e)
+        let e = bound(h, x, Formats::Mixed, || false).map_err(|err| match err {
+            BoundError::FixOverflow { value, .. } => Some(value),
+            BoundError::Stopped(_) => None,
+        })?;
+        if outs.iter().all(|&(_, v, b)| e[v.index()] <= b) {
+            Ok(e)
+        } else {
+            Err(None)
+        }
     };
+    let accepts = |h: &Function, sweeps: &mut usize| check(h, sweeps).ok();
     let phases: &[fn(f64, f64) -> Option<Format>] = match target {
         Target::C => &[binary32],
         Target::Mcu => &[fix32, binary32],
@@ -138,34 +148,49 @@ pub fn choose(f: &Function, x: &[Interval], budget: f64, target: Target) -> Resu
             .collect();
         candidates.sort_by(|a, b| a.damage.total_cmp(&b.damage));
         // The longest accepted prefix (k = 0 is the current assignment, accepted).
-        let with = |k: usize| {
+        let with = |candidates: &[Candidate], k: usize| {
             let mut h = g.clone();
             for c in &candidates[..k] {
                 h.set_format(c.value, c.format);
             }
             h
         };
-        let (mut lo, mut hi) = (0usize, candidates.len());
-        while lo < hi {
-            let mid = (lo + hi).div_ceil(2);
-            if accepts(&with(mid), &mut sweeps).is_some() {
-                lo = mid;
-            } else {
-                hi = mid - 1;
+        // A fixed-point candidate whose range the others' added error pushes out of its format
+        // stops the prefix there: it leaves the ranking and the search goes on (at most 64
+        // times per phase, each a binary search).
+        let mut lo = 0usize;
+        for _ in 0..64 {
+            let mut hi = candidates.len();
+            let mut overflow = None;
+            while lo < hi {
+                let mid = (lo + hi).div_ceil(2);
+                match check(&with(&candidates, mid), &mut sweeps) {
+                    Ok(_) => lo = mid,
+                    Err(o) => {
+                        overflow = overflow.or(o);
+                        hi = mid - 1;
+                    }
+                }
             }
+            let Some(name) = overflow else { break };
+            let Some(j) = candidates.iter().position(|c| f.name_of(c.value) == name) else { break };
+            if j < lo {
+                break;
+            }
+            candidates.remove(j);
         }
         // Cost is not monotone in the prefix (conversions between formats cost too): the
         // cheapest of 17 accepted prefixes, 0 and `lo` included, if the bound accepts it.
         let mut best = (cost(f, &g, target), 0usize);
         for i in 1..=16 {
             let k = lo * i / 16;
-            let c = cost(f, &with(k), target);
+            let c = cost(f, &with(&candidates, k), target);
             if c < best.0 {
                 best = (c, k);
             }
         }
-        let k = if best.1 == lo || accepts(&with(best.1), &mut sweeps).is_some() { best.1 } else { lo };
-        g = with(k);
+        let k = if best.1 == lo || accepts(&with(&candidates, best.1), &mut sweeps).is_some() { best.1 } else { lo };
+        g = with(&candidates, k);
     }
     let e = accepts(&g, &mut sweeps)
         .ok_or_else(|| format!("@{}: internal error: the chosen formats fail (please report)", f.name))?;
@@ -206,9 +231,11 @@ fn binary32(m: f64, err: f64) -> Option<Format> {
 }
 
 /// `fix<32,f>` for a value of magnitude `m` and error `err`: integer bits for twice its
-/// magnitude (one bit of headroom for the error the formats add), the sign included.
+/// magnitude (one bit of headroom for the error the formats add) and at least 2⁻¹⁶, the sign
+/// included.
 fn fix32(m: f64, err: f64) -> Option<Format> {
-    let top = 2.0 * (m + err);
+    // At least 2⁻¹⁶ of range: a value near 0 still holds the error its operands' roundings add.
+    let top = (2.0 * (m + err)).max(2f64.powi(-16));
     let int_bits = if top < f64::MIN_POSITIVE { -60 } else { top.log2().ceil() as i32 + 1 };
     let fraction = 32 - int_bits;
     FIX_FRACTION_RANGE.contains(&fraction).then(|| Format::fix(32, fraction)).flatten()

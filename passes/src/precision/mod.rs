@@ -6,10 +6,10 @@
 //! ops, their order and timing are kept; the exact real function too). The budget of output `o`
 //! is `budget · max|o|`, `max|o|` the magnitude of its enclosure over the domain (relative to
 //! each output's range, as the issue states); the bound is `error-bound<format=mixed>`'s
-//! ([`crate::error_bound::bound`]), so after the pass `error-bound` proves every output within
+//! ([`crate::error_bound::bound()`]), so after the pass `error-bound` proves every output within
 //! its budget and `codegen<c>` writes the formats bit for bit as `-eval` computes them.
 //!
-//! **How it chooses** ([`choose`]): every value binary64 first (an output whose binary64 bound
+//! **How it chooses** ([`choose()`]): every value binary64 first (an output whose binary64 bound
 //! already exceeds its budget keeps that bound as its budget and is named in `unreachable`:
 //! the values it depends on stay binary64; one with no finite bound is named in `unbounded`
 //! and not constrained); then the
