@@ -477,6 +477,7 @@ fn run_passes(
             deadline,
             &cx.target,
             &cx.progress,
+            cx.domain.as_ref(),
         )
         .map_err(Failure::from)?;
         cx.emit(study);

@@ -484,3 +484,44 @@ fn bounds_hold_against_accuracy_hard_on_the_corpus() {
     }
     assert!(compared > 5000, "{compared} (output, format) pairs compared");
 }
+
+/// `-pareto` with an input domain adds each row's certified bounds (binary32 above binary64,
+/// both positive), none for a pipeline that changes the exact function (`specialize`), and
+/// none at all without a domain.
+#[test]
+fn pareto_rows_carry_the_certified_bound_over_the_domain() {
+    let dir = crate::common::tmp("pareto-certified");
+    let (ranges, report) = (dir.join("r.json"), dir.join("report.json"));
+    std::fs::write(&ranges, r#"{"qd[2]": [-3, 3]}"#).unwrap();
+    let run = |with_ranges: bool| {
+        let mut args = vec![
+            "examples/three_link_arm/three_link_arm.urdf".to_string(),
+            "-function=invdyna".into(),
+            "-pareto=atomise;atomise,contract;atomise,specialize".into(),
+            "-pareto-samples=50".into(),
+            "-passes=atomise".into(),
+            format!("-report={}", report.display()),
+            "-o".into(),
+            "/dev/null".into(),
+        ];
+        if with_ranges {
+            args.push(format!("-ranges={}", ranges.display()));
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = opt(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        (r["pareto"].as_array().unwrap().clone(), stderr(&o))
+    };
+    let (rows, err) = run(true);
+    assert!(err.contains("certified over the domain"), "{err}");
+    for row in &rows[..2] {
+        let c = &row["certified"];
+        let (a, b) = (c["f32_max_rel"].as_f64().unwrap(), c["f64_max_rel"].as_f64().unwrap());
+        assert!(a > b && b > 0.0 && a < 1e-3, "{row}");
+    }
+    assert!(rows[2].get("certified").is_none(), "specialize folds in binary64: {}", rows[2]);
+    let (rows, err) = run(false);
+    assert!(!err.contains("certified over the domain"), "{err}");
+    assert!(rows.iter().all(|r| r.get("certified").is_none()));
+}

@@ -280,6 +280,7 @@ fn long_loops_report_progress_through_the_hook() {
         None,
         &target,
         &progress,
+        None,
     )
     .unwrap();
     let log = rec.0.lock().unwrap().clone();

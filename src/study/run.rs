@@ -180,6 +180,7 @@ pub fn run_case(case: &Case, plan: &Plan) -> Result<CaseResult, Failure> {
             None,
             &cx.target,
             &robovec_passes::progress::Progress::hidden(),
+            None,
         )
         .map_err(|f| match f {
             Failure::Input(s) => Failure::Input(format!("{}: {s}", case.label())),

@@ -69,6 +69,47 @@ pub struct ParetoRow {
     pub stopped_early: Vec<String>,
     /// True when no other row dominates this one (never for a row that is not sound).
     pub pareto_optimal: bool,
+    /// With an input domain (`-ranges`, a URDF's limits): the certified bound of the row's
+    /// function in binary32 and binary64 (`error-bound`'s, [`crate::error_bound`]), the largest
+    /// over the outputs relative to each output's largest magnitude over the domain; `None`
+    /// without a domain, or when the pipeline changed the exact function or its values cannot
+    /// be bounded (absent from the report then).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub certified: Option<Certified>,
+}
+
+/// A row's certified bounds (see [`ParetoRow::certified`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Certified {
+    /// Largest binary32 bound over the outputs, relative to each output's range (`null`: some
+    /// output has no finite bound).
+    pub f32_max_rel: Option<f64>,
+    /// Largest binary64 bound, likewise.
+    pub f64_max_rel: Option<f64>,
+}
+
+/// The certified bounds of `f` over `domain` (see [`ParetoRow::certified`]): `None` when its
+/// values cannot all be enclosed.
+pub fn certify(f: &Function, domain: &robovec_ir::domain::Domain) -> Option<Certified> {
+    use crate::error_bound::bound::{bound, Formats};
+    let x = crate::range::enclose_with(f, domain, Some(crate::range::affine::DEFAULT_TERMS), || false).ok()?;
+    let worst = |formats: Formats| -> Option<f64> {
+        let e = bound(f, &x, formats, || false).ok()?;
+        let mut worst = 0.0f64;
+        for o in &f.outputs {
+            let robovec_ir::Operand::Value(v) = o.value else { continue };
+            let m = x[v.index()].mag();
+            if m > 0.0 {
+                let r = e[v.index()] / m;
+                if !r.is_finite() {
+                    return None;
+                }
+                worst = worst.max(r);
+            }
+        }
+        Some(worst)
+    };
+    Some(Certified { f32_max_rel: worst(Formats::F32), f64_max_rel: worst(Formats::F64) })
 }
 
 /// Splits `-pareto`'s text into pipelines at `;` outside `<…>`.
@@ -187,11 +228,12 @@ pub fn measure(
     deadline: Option<crate::Deadline>,
     target: &robovec_machine::target::Target,
     progress: &crate::progress::Progress,
+    domain: Option<&robovec_ir::domain::Domain>,
 ) -> Result<ParetoRun, Failure> {
     // A bad text fails in `run_reporting` with its own message; the total is then moot.
     let pipelines = split_pipelines(text).map_or(0, |v| v.len());
     let task = progress.task("-pareto: pipelines", pipelines as u64);
-    let rows = run_reporting(registry, module, function, text, samples, seed, deadline, target, &task)?;
+    let rows = run_reporting(registry, module, function, text, samples, seed, deadline, target, &task, domain)?;
     task.finish();
     Ok(ParetoRun { function: function.to_string(), rows })
 }
@@ -217,6 +259,7 @@ fn run_reporting(
     deadline: Option<crate::Deadline>,
     target: &robovec_machine::target::Target,
     task: &crate::progress::Task,
+    domain: Option<&robovec_ir::domain::Domain>,
 ) -> Result<Vec<ParetoRow>, Failure> {
     let original =
         module.function(function).ok_or_else(|| Failure::Usage(format!("error: no function `{function}`\n")))?;
@@ -230,7 +273,8 @@ fn run_reporting(
         let now = std::time::Instant::now();
         let share = deadline.map(|d| now + d.time_left() / (2 * (n - k)) as u32);
         let later_share = deadline.map(|d| now + d.time_left() / (n - k) as u32);
-        let opts = AccuracyOptions { samples, seed, deadline: share, ..AccuracyOptions::default() };
+        let opts =
+            AccuracyOptions { samples, seed, deadline: share, domain: domain.cloned(), ..AccuracyOptions::default() };
         let bit_exact = pm.is_bit_exact();
         let cx = PassContext { original: Some(module.clone()), deadline, ..PassContext::with_target(target.clone()) };
         let mut session = Session::new(pm, module.clone(), cx);
@@ -271,6 +315,7 @@ fn run_reporting(
                 }))
                 .collect(),
             pareto_optimal: false,
+            certified: domain.filter(|_| cx.reals_changed_by.is_none()).and_then(|d| certify(f, d)),
         });
         task.set(rows.len() as u64);
     }
@@ -312,6 +357,14 @@ pub fn to_table(function: &str, rows: &[ParetoRow]) -> String {
             format!("{:.3}", r.f32_mean_ci95_bits),
             b(&r.f64)
         );
+    }
+    if rows.iter().any(|r| r.certified.is_some()) {
+        s += "  certified over the domain (error-bound, largest bound / output range; - = not certifiable):\n";
+        let c = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2e}"));
+        for r in rows {
+            let (a, b) = r.certified.map_or((None, None), |x| (x.f32_max_rel, x.f64_max_rel));
+            s += &format!("  {:<w$} f32 {:>9}  f64 {:>9}\n", r.pipeline, c(a), c(b));
+        }
     }
     for r in rows {
         if let Some(v) = &r.violation {
@@ -357,6 +410,7 @@ mod tests {
             callback_standins: Vec::new(),
             stopped_early: Vec::new(),
             pareto_optimal: false,
+            certified: None,
         }
     }
 
