@@ -102,7 +102,7 @@ pub fn check_options(opts: &Options, pm: &PassManager) -> Result<(), Failure> {
         .iter()
         .map(|d| ("-dump-dir".to_string(), d.clone()))
         .chain(
-            pass_paths(pm, |k| matches!(k, ParamKind::OutputFolder))
+            pass_paths(pm, |k, _| matches!(k, ParamKind::OutputFolder))
                 .into_iter()
                 .map(|(pass, key, d)| (format!("pass `{pass}`'s {key}="), PathBuf::from(d))),
         )
@@ -228,7 +228,7 @@ pub fn read_files(opts: &Options, pm: &PassManager) -> Result<Vec<ReadFile>, Fai
         managers = robovec_passes::whole_run::pareto::managers(pm.registry(), text).map_err(Failure::from)?;
     }
     for m in std::iter::once(pm).chain(managers.iter().map(|(_, m)| m)) {
-        for (pass, key, file) in pass_paths(m, |k| matches!(k, ParamKind::Path)) {
+        for (pass, key, file) in pass_paths(m, reads_file) {
             reads.push(ReadFile::new(format!("pass `{pass}`'s {key}= file"), file));
         }
     }
@@ -311,18 +311,24 @@ fn csv_passes(pm: &PassManager) -> String {
 }
 
 /// Every path parameter of the pipeline whose declared kind satisfies `want`: `(pass, key, path)`.
-fn pass_paths(pm: &PassManager, want: impl Fn(&ParamKind) -> bool) -> Vec<(&str, &str, &str)> {
+fn pass_paths(pm: &PassManager, want: impl Fn(&ParamKind, &str) -> bool) -> Vec<(&str, &str, &str)> {
     let mut out = Vec::new();
     for spec in pm.specs() {
         let Some(info) = pm.registry().get(&spec.name) else { continue };
         for (key, value) in &spec.params {
             let Some(decl) = info.param(key) else { continue };
-            if let Some(value) = value.as_deref().filter(|v| !v.is_empty() && want(&decl.kind)) {
+            if let Some(value) = value.as_deref().filter(|v| !v.is_empty() && want(&decl.kind, v)) {
                 out.push((spec.name.as_str(), key.as_str(), value));
             }
         }
     }
     out
+}
+
+/// True when a parameter of kind `k` with value `v` names a file the pass reads: a
+/// [`ParamKind::Path`], or a [`ParamKind::F64OrPath`] whose value is not a number.
+fn reads_file(k: &ParamKind, v: &str) -> bool {
+    matches!(k, ParamKind::Path) || (matches!(k, ParamKind::F64OrPath { .. }) && v.parse::<f64>().is_err())
 }
 
 /// Files a pass reads when it runs (every parameter declared [`ParamKind::Path`]:
@@ -332,7 +338,7 @@ fn pass_paths(pm: &PassManager, want: impl Fn(&ParamKind) -> bool) -> Vec<(&str,
 /// # Errors
 /// [`Failure::Input`] naming the pass, the parameter and the file.
 fn check_pass_files(pm: &PassManager) -> Result<(), Failure> {
-    for (pass, key, file) in pass_paths(pm, |k| matches!(k, ParamKind::Path)) {
+    for (pass, key, file) in pass_paths(pm, reads_file) {
         std::fs::File::open(file)
             .map_err(|e| Failure::Input(format!("error: pass `{pass}`: cannot read {key} file `{file}`: {e}\n")))?;
     }

@@ -17,7 +17,8 @@ use crate::range::{random_function, range};
 /// Applies `choose`'s formats to a copy of `f`.
 fn with_choice(f: &Function, dom: &Domain, budget: f64, target: Target) -> Option<(Function, Vec<(String, f64)>)> {
     let x = enclose_with(f, dom, Some(64), || false).unwrap();
-    let c = choose(f, &x, budget, target).ok()?;
+    let budgets = vec![robovec_passes::precision::budget::Budget::Rel(budget); f.outputs.len()];
+    let c = choose(f, &x, &budgets, target).ok()?;
     let mut g = f.clone();
     for &(v, fmt) in &c.formats {
         g.set_format(v, fmt);
@@ -149,4 +150,51 @@ fn the_pass_reports_and_keeps_binary64_where_the_budget_is_unreachable() {
     let text = std::fs::read_to_string(dir.join("out.rvir")).unwrap();
     assert!(text.contains(": f32"), "{text}");
     robovec_ir::text::parse(&text).unwrap();
+}
+
+/// `budget=FILE`: absolute budgets per output (globs), the chosen formats meet each (the
+/// report's bound, and `error-bound` after it), an output without a budget is exit 1.
+#[test]
+fn a_budget_file_gives_absolute_budgets_per_output() {
+    let dir = crate::common::tmp("precision-file");
+    let (ranges, budgets, report) = (dir.join("r.json"), dir.join("b.json"), dir.join("report.json"));
+    std::fs::write(&ranges, r#"{"qd[2]": [-3, 3]}"#).unwrap();
+    let run = |text: &str| {
+        std::fs::write(&budgets, text).unwrap();
+        opt(&[
+            "examples/three_link_arm/three_link_arm.urdf",
+            "-function=invdyna",
+            &format!("-ranges={}", ranges.display()),
+            &format!("-passes=atomise,precision<budget={};target=mcu>,error-bound", budgets.display()),
+            &format!("-report={}", report.display()),
+            "-o",
+            "/dev/null",
+        ])
+    };
+    let o = run(r#"{"Qq[*]": {"abs": 1e-4}}"#);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    for (name, b) in r["error_bound"]["outputs"].as_object().unwrap() {
+        assert!(b["abs"].as_f64().unwrap() <= 1e-4, "{name}: {b}");
+    }
+    assert!(r["precision"]["budget"].is_null());
+    assert!(
+        r["precision"]["formats"].as_object().unwrap().keys().any(|k| k.starts_with("fix<32,")),
+        "{}",
+        r["precision"]
+    );
+    let o = run(r#"{"Qq[1]": {"abs": 1e-4}}"#);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no budget for output"), "{}", stderr(&o));
+    // A missing file is found before any work.
+    let o = opt(&[
+        "examples/three_link_arm/three_link_arm.urdf",
+        "-function=invdyna",
+        &format!("-ranges={}", ranges.display()),
+        "-passes=atomise,precision<budget=nowhere.json>",
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("cannot read budget file `nowhere.json`"), "{}", stderr(&o));
 }

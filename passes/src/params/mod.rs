@@ -21,7 +21,7 @@ mod values;
 mod words;
 
 pub use latency::{LatencyOverride, LATENCY_PARAMS, LAT_ADD, LAT_CALL, LAT_DIV, LAT_MUL};
-pub use values::Params;
+pub use values::{NumberOrPath, Params};
 pub use words::word_enum;
 pub use words::Word;
 
@@ -76,6 +76,17 @@ pub enum ParamKind {
         /// Smallest accepted value.
         min: f64,
         /// Largest accepted value.
+        max: f64,
+    },
+    /// A finite number in `min..=max`, or (any value that does not read as a number) a file
+    /// the pass reads (`precision<budget=1e-6>` or `budget=FILE`); `robovec-opt` checks a file
+    /// can be opened before any work.
+    F64OrPath {
+        /// Value when the parameter is not given.
+        default: f64,
+        /// Smallest accepted number.
+        min: f64,
+        /// Largest accepted number.
         max: f64,
     },
     /// One word of `choices`.
@@ -182,7 +193,7 @@ impl ParamInfo {
             ParamKind::U32Or { fallback, .. } => format!("`{fallback}`"),
             ParamKind::U32Target { builtin, .. } => format!("the target's, de10-nano {builtin}"),
             ParamKind::U64 { default, .. } => default.to_string(),
-            ParamKind::F64 { default, .. } => format!("{default}"),
+            ParamKind::F64 { default, .. } | ParamKind::F64OrPath { default, .. } => format!("{default}"),
             ParamKind::Choice { default, .. } | ParamKind::Selector { default, .. } => default.to_string(),
             ParamKind::Flag { default } => if default { "on" } else { "off" }.to_string(),
             ParamKind::Path | ParamKind::OutputFolder => "none".to_string(),
@@ -213,6 +224,7 @@ impl ParamInfo {
             | ParamKind::U32Target { min, max, .. } => format!("{min}..={max}"),
             ParamKind::U64 { min, max, .. } => format!("{min}..={max}"),
             ParamKind::F64 { min, max, .. } => format!("{min}..={max}"),
+            ParamKind::F64OrPath { min, max, .. } => format!("{min}..={max} or path"),
             ParamKind::Choice { choices, .. } => choices.join("|"),
             ParamKind::Selector { members, .. } => joined(members.iter().map(|m| m.name.to_string()), "|"),
             ParamKind::U32Set { allowed, .. } => joined(allowed.iter().map(u32::to_string), "|"),
@@ -251,7 +263,9 @@ impl ParamInfo {
             | ParamKind::U32Or { min, max, .. }
             | ParamKind::U32Target { min, max, .. } => Some((min.to_string(), max.to_string())),
             ParamKind::U64 { min, max, .. } => Some((min.to_string(), max.to_string())),
-            ParamKind::F64 { min, max, .. } => Some((format!("{min}"), format!("{max}"))),
+            ParamKind::F64 { min, max, .. } | ParamKind::F64OrPath { min, max, .. } => {
+                Some((format!("{min}"), format!("{max}")))
+            }
             _ => None,
         }
     }
@@ -271,7 +285,9 @@ impl ParamInfo {
                 v.push((max as u128 + 1).to_string());
                 v
             }
-            ParamKind::F64 { min, max, .. } => vec![format!("{}", min - 1.0), format!("{}", max + 1.0)],
+            ParamKind::F64 { min, max, .. } | ParamKind::F64OrPath { min, max, .. } => {
+                vec![format!("{}", min - 1.0), format!("{}", max + 1.0)]
+            }
             _ => Vec::new(),
         }
     }

@@ -60,7 +60,11 @@ fn every_declared_default_is_the_default_and_every_range_is_enforced() {
                 for c in p.every_value() {
                     ok(&c).unwrap_or_else(|e| panic!("{} {}={c}: {e}", info.name, p.name));
                 }
-                if !matches!(p.kind, ParamKind::Path | ParamKind::OutputFolder | ParamKind::Names) {
+                // (`F64OrPath` reads a word that is not a number as a file name.)
+                if !matches!(
+                    p.kind,
+                    ParamKind::Path | ParamKind::OutputFolder | ParamKind::Names | ParamKind::F64OrPath { .. }
+                ) {
                     assert!(ok("x").is_err(), "{} {}=x accepted", info.name, p.name);
                 }
             }

@@ -272,6 +272,26 @@ impl Params {
         }
     }
 
+    /// An `F64OrPath` parameter: the number given (or the declared default), or the file
+    /// named by a value that does not read as a number.
+    ///
+    /// # Errors
+    /// [`PassError::BadParameter`] for a number outside the declared range or an empty value.
+    pub fn f64_or_path(&self, key: &str) -> Result<NumberOrPath, PassError> {
+        let ParamKind::F64OrPath { default, min, max } = self.decl(key) else {
+            panic!("parameter `{key}` of `{}` is not a number or a path", self.pass)
+        };
+        match self.get(key) {
+            None => Ok(NumberOrPath::Number(default)),
+            Some("") => Err(self.bad(key, format!("a number in {min}..={max} or a file"), "")),
+            Some(v) => match v.parse::<f64>() {
+                Ok(x) if (min..=max).contains(&x) => Ok(NumberOrPath::Number(x)),
+                Ok(_) => Err(self.bad(key, format!("a number in {min}..={max} or a file"), v)),
+                Err(_) => Ok(NumberOrPath::Path(v.to_string())),
+            },
+        }
+    }
+
     /// A `Choice` parameter: the word given, or the declared default.
     ///
     /// # Errors
@@ -378,4 +398,13 @@ impl Params {
             }
         }
     }
+}
+
+/// The value of an `F64OrPath` parameter ([`Params::f64_or_path`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum NumberOrPath {
+    /// A number in the declared range.
+    Number(f64),
+    /// A file the pass reads.
+    Path(String),
 }

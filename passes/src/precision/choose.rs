@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use robovec_ir::format::{Format, FIX_FRACTION_RANGE};
 use robovec_ir::{BinOp, Def, Function, Interval, Operand, Value};
 
+use super::budget::Budget;
 use crate::error_bound::bound::{bound, sensitivities, BoundError, Formats, Rounding};
 
 crate::params::word_enum! {
@@ -26,8 +27,8 @@ pub struct Choice {
     pub formats: Vec<(Value, Format)>,
     /// The target.
     pub target: Target,
-    /// The relative budget.
-    pub budget: f64,
+    /// The relative budget when every output has the same relative one.
+    pub budget: Option<f64>,
     /// Per output with a budget: name, certified bound, budget (absolute), largest magnitude
     /// of its range.
     pub outputs: Vec<(String, f64, f64, f64)>,
@@ -71,7 +72,8 @@ struct Candidate {
 }
 
 /// Chooses formats for `f` (atomised; its own formats are ignored) whose certified bound keeps
-/// every output `o` within `budget · max|o|` over the domain whose enclosures are `x`
+/// every output `o` within its budget (`budgets`, one per output in order: absolute, or
+/// relative to `max|o|` over the domain) over the domain whose enclosures are `x`
 /// ([`crate::range::enclose_with`]).
 ///
 /// Outputs whose binary64 bound already exceeds the budget keep their binary64 bound as
@@ -81,7 +83,8 @@ struct Candidate {
 /// # Errors
 /// A message (`@f: …`) when the enclosures cannot be bounded at all (never for a function the
 /// enclosures accept) or, as an internal error, when the final formats fail the bound.
-pub fn choose(f: &Function, x: &[Interval], budget: f64, target: Target) -> Result<Choice, String> {
+pub fn choose(f: &Function, x: &[Interval], budgets: &[Budget], target: Target) -> Result<Choice, String> {
+    assert_eq!(budgets.len(), f.outputs.len(), "one budget per output");
     let mut g = f.clone();
     let values: Vec<Value> = f.inputs.iter().chain(&f.body).copied().collect();
     for &v in &values {
@@ -93,17 +96,17 @@ pub fn choose(f: &Function, x: &[Interval], budget: f64, target: Target) -> Resu
     // no finite bound is left out (nothing about it can be proved).
     let mut outs: Vec<(String, Value, f64)> = Vec::new();
     let (mut unreachable, mut unbounded) = (Vec::new(), Vec::new());
-    for o in &f.outputs {
+    for (o, budget) in f.outputs.iter().zip(budgets) {
         let Operand::Value(v) = o.value else { continue };
         let m = x[v.index()].mag();
         if !m.is_finite() || !e64[v.index()].is_finite() {
             unbounded.push(o.name.clone());
             continue;
         }
-        if m <= 0.0 {
+        let mut b = budget.absolute(m);
+        if b <= 0.0 {
             continue;
         }
-        let mut b = budget * m;
         if e64[v.index()] > b {
             unreachable.push(o.name.clone());
             b = e64[v.index()];
@@ -203,6 +206,10 @@ pub fn choose(f: &Function, x: &[Interval], budget: f64, target: Target) -> Resu
             formats.push((v, fmt));
         }
     }
+    let budget = match budgets.first() {
+        Some(&Budget::Rel(r)) if budgets.iter().all(|b| *b == Budget::Rel(r)) => Some(r),
+        _ => None,
+    };
     Ok(Choice {
         formats,
         target,

@@ -29,6 +29,7 @@
 //! multiply 3 (`SMULL`, round, shift), binary32 operation 50 and binary64 100 (software
 //! floating point, order of magnitude), conversions 20.
 
+pub mod budget;
 pub mod choose;
 
 use robovec_ir::Module;
@@ -47,8 +48,9 @@ pub const INFO: PassInfo = PassInfo {
     params: &[
         ParamInfo {
             name: "budget",
-            kind: ParamKind::F64 { default: 1e-6, min: 1e-16, max: 1.0 },
-            doc: "error budget of each output, relative to the largest magnitude of its range over the domain",
+            kind: ParamKind::F64OrPath { default: 1e-6, min: 1e-16, max: 1.0 },
+            doc: "error budget of each output, relative to the largest magnitude of its range over the domain; or a \
+                  JSON file of output name or glob -> {\"abs\": x} | {\"rel\": x} ({\"Qq[*]\": {\"abs\": 1e-4}})",
         },
         ParamInfo {
             name: "target",
@@ -63,7 +65,11 @@ pub const INFO: PassInfo = PassInfo {
         },
     ],
     build: |p: &Params| {
-        Ok(Box::new(PrecisionPass { budget: p.f64("budget")?, target: p.word("target")?, ranges: p.path("ranges")? }))
+        Ok(Box::new(PrecisionPass {
+            budget: p.f64_or_path("budget")?,
+            target: p.word("target")?,
+            ranges: p.path("ranges")?,
+        }))
     },
     props: crate::Props {
         requires: Some(robovec_ir::Phase::Atomised),
@@ -79,8 +85,8 @@ pub const INFO: PassInfo = PassInfo {
 /// The `precision` pass.
 #[derive(Debug)]
 pub struct PrecisionPass {
-    /// Relative error budget per output.
-    pub budget: f64,
+    /// Relative error budget of every output, or a budget file (`budget=FILE`, [`budget`]).
+    pub budget: crate::params::NumberOrPath,
     /// What the formats are for.
     pub target: Target,
     /// A ranges file applied over the run's domain.
@@ -94,7 +100,20 @@ impl Pass for PrecisionPass {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let dom = domain_with_file(cx.domain.as_ref(), self.ranges.as_deref(), m)?;
-        let (budget, target) = (self.budget, self.target);
+        let target = self.target;
+        let file = match &self.budget {
+            crate::params::NumberOrPath::Number(_) => None,
+            crate::params::NumberOrPath::Path(path) => {
+                let failed = |message: String| PassError::Failed { pass: "precision".into(), message };
+                let text = std::fs::read_to_string(path)
+                    .map_err(|e| failed(format!("cannot read budget file `{path}`: {e}")))?;
+                Some(budget::parse(&text).map_err(|e| failed(format!("budget file `{path}`: {e}")))?)
+            }
+        };
+        let relative = match self.budget {
+            crate::params::NumberOrPath::Number(r) => Some(r),
+            crate::params::NumberOrPath::Path(_) => None,
+        };
         let mut chosen: Vec<(usize, Choice)> = Vec::new();
         let functions = try_each_function(
             m,
@@ -112,7 +131,15 @@ impl Pass for PrecisionPass {
                     }
                     Err(e) => return Err(failed(e.message(&f.name)).at(e.span().unwrap_or(robovec_ir::Span::DUMMY))),
                 };
-                let c = choose(f, &x, budget, target).map_err(failed)?;
+                let budgets: Vec<budget::Budget> = match (&file, relative) {
+                    (Some(file), _) => {
+                        let names: Vec<&str> = f.outputs.iter().map(|o| o.name.as_str()).collect();
+                        file.resolve(&names).map_err(|e| failed(format!("@{}: budget file: {e}", f.name)))?
+                    }
+                    (None, Some(r)) => vec![budget::Budget::Rel(r); f.outputs.len()],
+                    (None, None) => unreachable!("a number or a file"),
+                };
+                let c = choose(f, &x, &budgets, target).map_err(failed)?;
                 Ok(Step::Done(c))
             },
         )?;
@@ -141,8 +168,8 @@ pub struct PrecisionReport {
     pub function: String,
     /// `c` or `mcu`.
     pub target: &'static str,
-    /// The relative budget.
-    pub budget: f64,
+    /// The relative budget of every output (`None` with a budget file).
+    pub budget: Option<f64>,
     /// Values per format (`f64`, `f32`, `fix<32,f>`), inputs included.
     pub formats: std::collections::BTreeMap<String, usize>,
     /// The largest bound over the outputs, relative to each output's largest magnitude.
@@ -175,10 +202,10 @@ impl std::fmt::Display for PrecisionReport {
         let hist: Vec<String> = grouped.iter().map(|(k, n)| format!("{n} {k}")).collect();
         write!(
             f,
-            "precision @{} ({}, budget {:e}): {}; bound {:.3e} of the range at most ({}); cost {:.0} -> {:.0}",
+            "precision @{} ({}, budget {}): {}; bound {:.3e} of the range at most ({}); cost {:.0} -> {:.0}",
             self.function,
             self.target,
-            self.budget,
+            self.budget.map_or("per output".to_string(), |b| format!("{b:e}")),
             hist.join(", "),
             self.max_rel_to_range,
             self.worst_output.as_deref().unwrap_or("no output"),
