@@ -31,8 +31,8 @@
 //!   above what underflow may lose); `sin`, `cos` `rel = `[`LIBM_ULPS`]`·2⁻⁵²`, `abs =
 //!   `[`LIBM_ULPS`]`·2⁻¹⁰⁷³` (the C library's error, as the enclosures assume).
 //! - **`f32`** (every value binary32, as `accuracy`'s binary32 evaluation and the C back end's
-//!   `float` compute): inputs and constants rounded to binary32 (a constant's error is its
-//!   exact distance to its binary32 value); each op `rel = 2⁻²⁴`, `abs = 2⁻¹⁵⁰`; `sin`, `cos` of
+//!   `float` compute): inputs and constants rounded to binary32 (a constant's error, and that
+//!   of an input whose range is a point, is its exact distance to its binary32 value); each op `rel = 2⁻²⁴`, `abs = 2⁻¹⁵⁰`; `sin`, `cos` of
 //!   binary32 `rel = `[`LIBM_ULPS`]`·2⁻²³`.
 //! - **`mixed`** (each value in its own format, [`robovec_ir::format`]: the op computes in
 //!   binary64 on its operands' values, then stores in the value's format): binary64 as above;
@@ -176,12 +176,18 @@ pub fn bound(
     let mut e = vec![f64::INFINITY; f.values.len()];
     let mut nonneg = vec![false; f.values.len()];
     for &v in &f.inputs {
-        let m = x[v.index()].mag();
-        e[v.index()] = match mode {
+        let r = x[v.index()];
+        let m = r.mag();
+        let format = match mode {
+            Formats::F64 => Format::Binary64,
+            Formats::F32 => Format::Binary32,
+            Formats::Mixed => f.format(v),
+        };
+        e[v.index()] = match format.store(r.lo) {
             _ if m > largest(f, v, mode) => f64::INFINITY,
-            Formats::F64 => 0.0,
-            Formats::F32 => Rounding::F32.of(m),
-            Formats::Mixed => Rounding::store(f.format(v)).of(m),
+            // A point (a fixed parameter): its rounding is known exactly.
+            Ok(stored) if r.lo == r.hi => up((stored - r.lo).abs()),
+            _ => Rounding::store(format).of(m),
         };
         nonneg[v.index()] = x[v.index()].lo >= 0.0;
         check_fits(f, v, x, &e, mode)?;
