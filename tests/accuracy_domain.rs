@@ -178,5 +178,5 @@ fn a_bad_ranges_file_of_the_pass_is_a_located_error() {
     ]);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{e}");
-    assert!(e.contains("`c[*]`: the glob matches no input") && e.contains("unknown.json:2:2"), "{e}");
+    assert!(e.contains("`c`: no input is named so") && e.contains("unknown.json:2:2"), "{e}");
 }

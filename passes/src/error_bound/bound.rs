@@ -101,8 +101,11 @@ impl Rounding {
         Rounding { rel, abs }
     }
 
-    /// The error of rounding a value of magnitude at most `m`.
+    /// The error of rounding a value of magnitude at most `m` (0 for no rounding).
     fn of(self, m: f64) -> f64 {
+        if self == Rounding::EXACT {
+            return 0.0;
+        }
         up(up(self.rel * m) + self.abs)
     }
 }
@@ -405,7 +408,12 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
         // The result may overflow to ±∞: no rounding model holds.
         return f64::INFINITY;
     }
-    let total = up(propagated + rounding.of(magnitude));
+    let own = rounding.of(magnitude);
+    if propagated == 0.0 && own == 0.0 {
+        // Exact operands and an exact step (`a − a`, a sum with 0 of an exact value).
+        return 0.0;
+    }
+    let total = up(propagated + own);
     if total.is_finite() {
         total
     } else {
