@@ -160,7 +160,7 @@ mod tests {
     fn bit_exact_comes_from_the_registry_and_parameter_lists_are_not_split() {
         assert_eq!(
             bit_exact_passes(),
-            ["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy", "depth-bound", "range"]
+            ["atomise", "dce", "asap-alap", "place", "sim", "sweep", "accuracy", "depth-bound", "range", "error-bound"]
         );
         // `split(',')` read `sweep<pe=8,16>` as `sweep<pe=8` and `16>`: not bit-exact.
         let pm = PassManager::with_registry(
