@@ -18,7 +18,7 @@ use crate::range::{random_function, range};
 fn with_choice(f: &Function, dom: &Domain, budget: f64, target: Target) -> Option<(Function, Vec<(String, f64)>)> {
     let x = enclose_with(f, dom, Some(64), || false).unwrap();
     let budgets = vec![robovec_passes::precision::budget::Budget::Rel(budget); f.outputs.len()];
-    let c = choose(f, &x, &budgets, target).ok()?;
+    let c = choose(f, &x, &budgets, target, || false).ok()?;
     let mut g = f.clone();
     for &(v, fmt) in &c.formats {
         g.set_format(v, fmt);
@@ -197,4 +197,27 @@ fn a_budget_file_gives_absolute_budgets_per_output() {
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("cannot read budget file `nowhere.json`"), "{}", stderr(&o));
+}
+
+/// A stop inside the search keeps the formats accepted so far: still within every budget.
+#[test]
+fn a_stopped_search_keeps_accepted_formats() {
+    for seed in 0..20u64 {
+        let (f, dom) = random_function(seed * 13 + 2, 30);
+        let x = enclose_with(&f, &dom, Some(64), || false).unwrap();
+        let budgets = vec![robovec_passes::precision::budget::Budget::Rel(1e-4); f.outputs.len()];
+        let mut left = (seed % 4) as i32;
+        let Ok(c) = choose(&f, &x, &budgets, Target::Mcu, || {
+            left -= 1;
+            left < 0
+        }) else {
+            continue;
+        };
+        let mut g = f.clone();
+        for &(v, fmt) in &c.formats {
+            g.set_format(v, fmt);
+        }
+        let named: Vec<(String, f64)> = c.outputs.iter().map(|(n, _, b, _)| (n.clone(), *b)).collect();
+        assert_within(&format!("stopped seed {seed}"), &g, &dom, &named, seed);
+    }
 }

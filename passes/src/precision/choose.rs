@@ -42,6 +42,8 @@ pub struct Choice {
     pub unreachable: Vec<String>,
     /// Outputs without a finite bound (a callback, a divisor near 0): not constrained.
     pub unbounded: Vec<String>,
+    /// The search was stopped (`-time-limit`) with the formats accepted so far.
+    pub stopped: bool,
 }
 
 impl Choice {
@@ -80,10 +82,19 @@ struct Candidate {
 /// theirs ([`Choice::unreachable`]); outputs with no finite bound are not constrained
 /// ([`Choice::unbounded`]).
 ///
+/// `stop` is read before each sweep of the search: once it says stop, the search keeps the
+/// formats accepted so far ([`Choice::stopped`]; the final check still runs).
+///
 /// # Errors
 /// A message (`@f: …`) when the enclosures cannot be bounded at all (never for a function the
 /// enclosures accept) or, as an internal error, when the final formats fail the bound.
-pub fn choose(f: &Function, x: &[Interval], budgets: &[Budget], target: Target) -> Result<Choice, String> {
+pub fn choose(
+    f: &Function,
+    x: &[Interval],
+    budgets: &[Budget],
+    target: Target,
+    mut stop: impl FnMut() -> bool,
+) -> Result<Choice, String> {
     assert_eq!(budgets.len(), f.outputs.len(), "one budget per output");
     let mut g = f.clone();
     let values: Vec<Value> = f.inputs.iter().chain(&f.body).copied().collect();
@@ -135,7 +146,11 @@ pub fn choose(f: &Function, x: &[Interval], budgets: &[Budget], target: Target) 
         Target::C => &[binary32],
         Target::Mcu => &[fix32, binary32],
     };
+    let mut stopped = false;
     for phase in phases {
+        if stopped {
+            break;
+        }
         let mut candidates: Vec<Candidate> = values
             .iter()
             .filter_map(|&v| {
@@ -166,6 +181,10 @@ pub fn choose(f: &Function, x: &[Interval], budgets: &[Budget], target: Target) 
             let mut hi = candidates.len();
             let mut overflow = None;
             while lo < hi {
+                if stop() {
+                    stopped = true;
+                    break;
+                }
                 let mid = (lo + hi).div_ceil(2);
                 match check(&with(&candidates, mid), &mut sweeps) {
                     Ok(_) => lo = mid,
@@ -174,6 +193,9 @@ pub fn choose(f: &Function, x: &[Interval], budgets: &[Budget], target: Target) 
                         hi = mid - 1;
                     }
                 }
+            }
+            if stopped {
+                break;
             }
             let Some(name) = overflow else { break };
             let Some(j) = candidates.iter().position(|c| f.name_of(c.value) == name) else { break };
@@ -192,7 +214,12 @@ pub fn choose(f: &Function, x: &[Interval], budgets: &[Budget], target: Target) 
                 best = (c, k);
             }
         }
-        let k = if best.1 == lo || accepts(&with(&candidates, best.1), &mut sweeps).is_some() { best.1 } else { lo };
+        // (After a stop only `lo`, accepted, is kept: no further sweep.)
+        let k = if !stopped && best.1 != lo && accepts(&with(&candidates, best.1), &mut sweeps).is_some() {
+            best.1
+        } else {
+            lo
+        };
         g = with(&candidates, k);
     }
     let e = accepts(&g, &mut sweeps)
@@ -220,6 +247,7 @@ pub fn choose(f: &Function, x: &[Interval], budgets: &[Budget], target: Target) 
         sweeps,
         unreachable,
         unbounded,
+        stopped,
     })
 }
 

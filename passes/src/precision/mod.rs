@@ -139,7 +139,14 @@ impl Pass for PrecisionPass {
                     (None, Some(r)) => vec![budget::Budget::Rel(r); f.outputs.len()],
                     (None, None) => unreachable!("a number or a file"),
                 };
-                let c = choose(f, &x, &budgets, target).map_err(failed)?;
+                let c = choose(f, &x, &budgets, target, || ticker.tick()).map_err(failed)?;
+                if c.stopped {
+                    let note = format!(
+                        "stopped searching @{} early (the formats accepted so far kept, every budget met)",
+                        f.name
+                    );
+                    return Ok(Step::Cut { note, result: c });
+                }
                 Ok(Step::Done(c))
             },
         )?;
