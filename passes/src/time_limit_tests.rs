@@ -239,6 +239,37 @@ fn range_stopped_inside_a_function_keeps_the_functions_enclosed_before_it() {
     assert_eq!(cx.artifacts_of::<crate::range::RangeRun>().next().expect("an artifact").functions.len(), 1);
 }
 
+/// `precision` stopped inside its search keeps the formats accepted so far, with a note.
+#[test]
+fn precision_stopped_in_its_search_keeps_what_it_accepted() {
+    let domain = robovec_ir::domain::Domain {
+        ranges: ["q[1]", "q[2]", "qd[1]", "qd[2]"]
+            .into_iter()
+            .map(|n| {
+                let r =
+                    robovec_ir::domain::Range { interval: robovec_ir::Interval::new(-1.0, 1.0), source: "test".into() };
+                (n.to_string(), r)
+            })
+            .collect(),
+    };
+    let pm = PassManager::new("precision<budget=1e-3>", Instrumentation::default()).expect("builds");
+    let mut m = atomised(60);
+    // The enclosure ticks once per value of the body; then two sweeps of the search.
+    let budget = m.functions[0].body.len() as u64 + 3;
+    let mut cx = PassContext { tick_budget: Some(budget), domain: Some(domain), ..PassContext::default() };
+    pm.run(&mut m, &mut cx, &mut Vec::new()).expect("skippable");
+    assert_eq!(
+        cx.stopped(),
+        [format!(
+            "precision stopped searching @f early (the formats accepted so far kept, every budget met): tick budget \
+             of {budget} steps reached"
+        )]
+    );
+    let run = cx.artifacts_of::<crate::precision::PrecisionRun>().next().expect("an artifact");
+    assert_eq!(run.functions.len(), 1, "@f keeps its formats");
+    assert!(run.functions[0].max_rel_to_range <= 1e-3);
+}
+
 #[test]
 fn required_passes_stopped_inside_end_the_run_saying_where() {
     for (text, budget, expect) in [

@@ -142,8 +142,9 @@ impl Pass for PrecisionPass {
                 let c = choose(f, &x, &budgets, target, || ticker.tick()).map_err(failed)?;
                 if c.stopped {
                     let note = format!(
-                        "stopped searching @{} early (the formats accepted so far kept, every budget met)",
-                        f.name
+                        "searching @{} early (the formats accepted so far kept, every budget met): {}",
+                        f.name,
+                        ticker.reason()
                     );
                     return Ok(Step::Cut { note, result: c });
                 }
