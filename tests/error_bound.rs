@@ -178,13 +178,7 @@ proptest! {
     #[test]
     fn bounds_hold_on_robotran_like_dags(seed in any::<u64>(), ops in 50usize..600) {
         let f = robovec_testkit::dag_gen::generate(ops, seed);
-        let mut rng = SplitMix64::new(seed ^ 7);
-        let mut dom = Domain::default();
-        for &v in &f.inputs {
-            let a = rng.unit() * 4.0 - 2.0;
-            let w = if rng.chance(300) { 0.0 } else { rng.unit() };
-            dom.ranges.insert(f.name_of(v).to_string(), range(a, a + w));
-        }
+        let dom = crate::range::random_domain(&f, seed);
         for formats in [Formats::F64, Formats::F32] {
             check_sound(&format!("dag {seed}"), &f, &dom, formats, 16, seed);
         }

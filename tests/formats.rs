@@ -180,14 +180,7 @@ fn c_computes_every_format_bit_for_bit_as_eval() {
         let mut rng = SplitMix64::new(seed);
         let mut points = 0;
         for _ in 0..16 {
-            let point: Vec<f64> = iface
-                .inputs
-                .iter()
-                .map(|n| {
-                    let i = dom.get(n).unwrap().interval;
-                    (i.lo + rng.unit() * (i.hi - i.lo)).clamp(i.lo, i.hi)
-                })
-                .collect();
+            let point = crate::range::uniform_point(&iface.inputs, &dom, &mut rng);
             let at = |n: &str| point[iface.inputs.iter().position(|x| x == n).unwrap()];
             let Ok(vals) = robovec_ir::format::eval_values(&g, at) else { continue };
             for x in &point {

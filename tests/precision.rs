@@ -41,14 +41,7 @@ fn assert_within(what: &str, g: &Function, dom: &Domain, budgets: &[(String, f64
         assert!(e[v.index()] <= *b, "{what}: {name}: bound {:e} above its budget {b:e}", e[v.index()]);
     }
     for _ in 0..32 {
-        let xs: Vec<f64> = tape
-            .inputs
-            .iter()
-            .map(|n| {
-                let i = dom.get(n).unwrap().interval;
-                (i.lo + rng.unit() * (i.hi - i.lo)).clamp(i.lo, i.hi)
-            })
-            .collect();
+        let xs = crate::range::uniform_point(&tape.inputs, dom, &mut rng);
         let at = |n: &str| xs[tape.inputs.iter().position(|m| m == n).unwrap()];
         let vals = robovec_ir::format::eval_values(g, at).unwrap_or_else(|e| panic!("{what}: {e:?}"));
         reference.eval(&tape, &xs, &mut refs);

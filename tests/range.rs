@@ -19,6 +19,30 @@ pub(crate) fn range(lo: f64, hi: f64) -> Range {
     Range { interval: Interval::new(lo, hi), source: "test".into() }
 }
 
+/// A uniform point of `dom` for the inputs `names`, in that order.
+pub(crate) fn uniform_point(names: &[String], dom: &Domain, rng: &mut SplitMix64) -> Vec<f64> {
+    names
+        .iter()
+        .map(|n| {
+            let i = dom.get(n).unwrap().interval;
+            (i.lo + rng.unit() * (i.hi - i.lo)).clamp(i.lo, i.hi)
+        })
+        .collect()
+}
+
+/// A random domain for `f`'s inputs: each `[a, a + w]` with `a` in [−2, 2] and `w` in [0, 1]
+/// (a point 30 % of the time).
+pub(crate) fn random_domain(f: &Function, seed: u64) -> Domain {
+    let mut rng = SplitMix64::new(seed ^ 7);
+    let mut dom = Domain::default();
+    for &v in &f.inputs {
+        let a = rng.unit() * 4.0 - 2.0;
+        let w = if rng.chance(300) { 0.0 } else { rng.unit() };
+        dom.ranges.insert(f.name_of(v).to_string(), range(a, a + w));
+    }
+    dom
+}
+
 /// Evaluates `f` at `n` points of `dom` (the corners, then uniform draws) and asserts every
 /// value computed in binary64, and every output's exact value, lies in its enclosure `x`.
 fn assert_sound(what: &str, f: &Function, dom: &Domain, x: &[Interval], n: usize, seed: u64) {
@@ -153,13 +177,7 @@ proptest! {
     #[test]
     fn enclosures_hold_every_value_of_robotran_like_dags(seed in any::<u64>(), ops in 50usize..800) {
         let f = robovec_testkit::dag_gen::generate(ops, seed);
-        let mut rng = SplitMix64::new(seed ^ 7);
-        let mut dom = Domain::default();
-        for &v in &f.inputs {
-            let a = rng.unit() * 4.0 - 2.0;
-            let w = if rng.chance(300) { 0.0 } else { rng.unit() };
-            dom.ranges.insert(f.name_of(v).to_string(), range(a, a + w));
-        }
+        let dom = random_domain(&f, seed);
         for affine in [None, Some(8)] {
             let x = enclose_with(&f, &dom, affine, || false).unwrap();
             assert_sound(&format!("dag {seed} {affine:?}"), &f, &dom, &x, 16, seed);
@@ -340,18 +358,22 @@ fn inputs_without_a_range_are_named_with_the_hint() {
     assert!(r.get("range").is_none());
 }
 
+/// `pipeline` on `tests/inputs/ranges/div.rvir` with `-ranges=tests/inputs/ranges/FILE`: the
+/// exit code and stderr.
+fn run_on_div(pipeline: &str, file: &str) -> (Option<i32>, String) {
+    let o = opt(&[
+        "tests/inputs/ranges/div.rvir",
+        &format!("-passes={pipeline}"),
+        &format!("-ranges=tests/inputs/ranges/{file}"),
+        "-o",
+        "/dev/null",
+    ]);
+    (o.status.code(), stderr(&o))
+}
+
 #[test]
 fn bad_ranges_files_are_located() {
-    let run = |file: &str| {
-        let o = opt(&[
-            "tests/inputs/ranges/div.rvir",
-            "-passes=range",
-            &format!("-ranges=tests/inputs/ranges/{file}"),
-            "-o",
-            "/dev/null",
-        ]);
-        (o.status.code(), stderr(&o))
-    };
+    let run = |file: &str| run_on_div("range", file);
     let (code, e) = run("reversed.json");
     assert_eq!(code, Some(1), "{e}");
     assert!(e.contains("bad range for `b`: lo = 3 is greater than hi = -1"), "{e}");
@@ -370,16 +392,7 @@ fn bad_ranges_files_are_located() {
 
 #[test]
 fn a_divisor_whose_range_holds_zero_is_named_at_its_line() {
-    let run = |file: &str| {
-        let o = opt(&[
-            "tests/inputs/ranges/div.rvir",
-            "-passes=range<method=interval>",
-            &format!("-ranges=tests/inputs/ranges/{file}"),
-            "-o",
-            "/dev/null",
-        ]);
-        (o.status.code(), stderr(&o))
-    };
+    let run = |file: &str| run_on_div("range<method=interval>", file);
     // b ∈ [−1, 1]: s = b + 0.5 ∈ [−0.5, 1.5] holds 0.
     let (code, e) = run("div.json");
     assert_eq!(code, Some(1), "{e}");

@@ -193,6 +193,18 @@ impl Interval {
         self.lo.abs().max(self.hi.abs())
     }
 
+    /// The smallest magnitude of the enclosed values: `lo` when all are positive, `-hi` when
+    /// all are negative, 0 when the interval holds 0.
+    pub fn mig(self) -> f64 {
+        if self.lo > 0.0 {
+            self.lo
+        } else if self.hi < 0.0 {
+            -self.hi
+        } else {
+            0.0
+        }
+    }
+
     /// An interval from two endpoints computed outward, NaN-free by construction.
     fn of(lo: f64, hi: f64) -> Interval {
         debug_assert!(!lo.is_nan() && !hi.is_nan() && lo <= hi, "[{lo}, {hi}]");

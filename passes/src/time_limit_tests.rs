@@ -213,16 +213,7 @@ fn passes_that_check_between_functions_stop_before_the_next_one() {
 #[test]
 fn range_stopped_inside_a_function_keeps_the_functions_enclosed_before_it() {
     // Every input of the test module in [-1, 1]; one tick per value of the body.
-    let domain = robovec_ir::domain::Domain {
-        ranges: ["q[1]", "q[2]", "qd[1]", "qd[2]"]
-            .into_iter()
-            .map(|n| {
-                let r =
-                    robovec_ir::domain::Range { interval: robovec_ir::Interval::new(-1.0, 1.0), source: "test".into() };
-                (n.to_string(), r)
-            })
-            .collect(),
-    };
+    let domain = unit_domain();
     let pm = PassManager::new("range<samples=4>", Instrumentation::default()).expect("builds");
     let mut m = atomised(60);
     let before = m.to_string();
@@ -239,19 +230,18 @@ fn range_stopped_inside_a_function_keeps_the_functions_enclosed_before_it() {
     assert_eq!(cx.artifacts_of::<crate::range::RangeRun>().next().expect("an artifact").functions.len(), 1);
 }
 
+/// Every input of the test module ([`atomised`]) in [−1, 1].
+fn unit_domain() -> robovec_ir::domain::Domain {
+    let r = robovec_ir::domain::Range { interval: robovec_ir::Interval::new(-1.0, 1.0), source: "test".into() };
+    robovec_ir::domain::Domain {
+        ranges: ["q[1]", "q[2]", "qd[1]", "qd[2]"].into_iter().map(|n| (n.to_string(), r.clone())).collect(),
+    }
+}
+
 /// `precision` stopped inside its search keeps the formats accepted so far, with a note.
 #[test]
 fn precision_stopped_in_its_search_keeps_what_it_accepted() {
-    let domain = robovec_ir::domain::Domain {
-        ranges: ["q[1]", "q[2]", "qd[1]", "qd[2]"]
-            .into_iter()
-            .map(|n| {
-                let r =
-                    robovec_ir::domain::Range { interval: robovec_ir::Interval::new(-1.0, 1.0), source: "test".into() };
-                (n.to_string(), r)
-            })
-            .collect(),
-    };
+    let domain = unit_domain();
     let pm = PassManager::new("precision<budget=1e-3>", Instrumentation::default()).expect("builds");
     let mut m = atomised(60);
     // The enclosure ticks once per value of the body; then two sweeps of the search.

@@ -352,13 +352,7 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
                     (product_error(ia.mag(), ea, ib.mag(), eb), r)
                 }
                 BinOp::Div => {
-                    let mig = if ib.lo > 0.0 {
-                        ib.lo
-                    } else if ib.hi < 0.0 {
-                        -ib.hi
-                    } else {
-                        0.0
-                    };
+                    let mig = ib.mig();
                     let room = (mig - eb).next_down();
                     if room.is_nan() || room <= 0.0 {
                         return f64::INFINITY;
@@ -483,19 +477,8 @@ pub fn sensitivities(f: &Function, x: &[Interval], e: &[f64], seed: &[(Value, f6
                     pass(b, mag(a), &mut lam);
                 }
                 BinOp::Div => {
-                    let ib = match *b {
-                        Operand::Value(w) => x[w.index()],
-                        Operand::Const(c) => Interval::point(c),
-                    };
-                    let eb = if let Operand::Value(w) = *b { e[w.index()] } else { 0.0 };
-                    let mig = if ib.lo > 0.0 {
-                        ib.lo
-                    } else if ib.hi < 0.0 {
-                        -ib.hi
-                    } else {
-                        0.0
-                    };
-                    let room = (mig - eb).max(f64::MIN_POSITIVE);
+                    let (ib, eb) = operand(b, x, e, Formats::Mixed);
+                    let room = (ib.mig() - eb).max(f64::MIN_POSITIVE);
                     pass(a, 1.0 / room, &mut lam);
                     pass(b, x[v.index()].mag() / room, &mut lam);
                 }

@@ -34,7 +34,7 @@ use robovec_ir::{Function, Interval, Module, Operand};
 use serde::Serialize;
 
 use crate::params::ParamKind;
-use crate::range::{domain_with_file, enclose_with, EncloseError, Method};
+use crate::range::{domain_with_file, enclose_in_pass, Method};
 use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 pub use bound::{bound, BoundError, Formats, Rounding};
 
@@ -73,21 +73,9 @@ pub const INFO: PassInfo = PassInfo {
             doc: "f64: every value binary64; f32: every value binary32 (inputs and constants rounded); mixed: each \
                   value in its IR format (binary64 by default)",
         },
-        ParamInfo {
-            name: "ranges",
-            kind: ParamKind::Path,
-            doc: "JSON file of input ranges over the run's domain (-ranges), as range<ranges=FILE>",
-        },
-        ParamInfo {
-            name: "method",
-            kind: ParamKind::Choice { choices: Method::WORDS, default: "affine" },
-            doc: "how the values are enclosed: interval, or affine (correlation-aware, O(ops · terms))",
-        },
-        ParamInfo {
-            name: "terms",
-            kind: ParamKind::U32 { default: crate::range::affine::DEFAULT_TERMS as u32, min: 2, max: 1024 },
-            doc: "most noise symbols of one affine form (method=affine)",
-        },
+        crate::range::RANGES,
+        crate::range::METHOD,
+        crate::range::TERMS,
     ],
     build: |p: &Params| {
         Ok(Box::new(ErrorBoundPass {
@@ -152,12 +140,9 @@ impl Pass for ErrorBoundPass {
                     PassError::Failed { pass: "error-bound".into(), message }
                         .at(span.unwrap_or(robovec_ir::Span::DUMMY))
                 };
-                let x = match enclose_with(f, &dom, affine, || ticker.tick()) {
+                let x = match enclose_in_pass("error-bound", f, &dom, affine, ticker)? {
                     Ok(x) => x,
-                    Err(e @ EncloseError::Stopped(_)) => {
-                        return Ok(Step::Stopped { what: e.message(&f.name), kept: None });
-                    }
-                    Err(e) => return Err(located(e.message(&f.name), e.span())),
+                    Err(stop) => return Ok(stop),
                 };
                 let e = match bound(f, &x, formats, || ticker.tick()) {
                     Ok(e) => e,
@@ -214,13 +199,7 @@ fn summarise(f: &Function, x: &[Interval], e: &[f64], format: FormatWord) -> Fun
                 }
             };
             let abs = err.is_finite().then_some(err);
-            let mig = if range.lo > 0.0 {
-                range.lo
-            } else if range.hi < 0.0 {
-                -range.hi
-            } else {
-                0.0
-            };
+            let mig = range.mig();
             let rel = abs.filter(|_| mig > 0.0).map(|a| (a / mig).next_up());
             (o.name.clone(), OutputBound { abs, rel })
         })

@@ -34,6 +34,15 @@ impl Budget {
     }
 }
 
+/// What `budget=` gives: one budget for every output, or a file's per output.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Budgets {
+    /// The same budget for every output (`budget=1e-6`: relative).
+    Every(Budget),
+    /// A budget file.
+    File(BudgetFile),
+}
+
 /// The keys of a budget file, in file order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BudgetFile {

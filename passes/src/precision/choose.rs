@@ -96,11 +96,8 @@ pub fn choose(
     mut stop: impl FnMut() -> bool,
 ) -> Result<Choice, String> {
     assert_eq!(budgets.len(), f.outputs.len(), "one budget per output");
-    let mut g = f.clone();
+    let mut g = f_with_default(f);
     let values: Vec<Value> = f.inputs.iter().chain(&f.body).copied().collect();
-    for &v in &values {
-        g.set_format(v, Format::Binary64);
-    }
     let e64 = bound(&g, x, Formats::Mixed, || false).map_err(|e| e.message(&f.name))?;
     // Outputs with a budget: those whose range is not 0. One whose binary64 bound already
     // exceeds it keeps that bound as its budget (it stays as binary64 computes it); one with

@@ -36,7 +36,7 @@ use robovec_ir::Module;
 use serde::Serialize;
 
 use crate::params::ParamKind;
-use crate::range::{domain_with_file, enclose_with, EncloseError};
+use crate::range::{domain_with_file, enclose_in_pass};
 use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 pub use choose::{choose, Choice, Target};
 
@@ -58,11 +58,7 @@ pub const INFO: PassInfo = PassInfo {
             doc: "c: binary32 where the bound allows (vector lanes); mcu: 32-bit fixed point first, then binary32 \
                   (a microcontroller without FPU)",
         },
-        ParamInfo {
-            name: "ranges",
-            kind: ParamKind::Path,
-            doc: "JSON file of input ranges over the run's domain (-ranges), as range<ranges=FILE>",
-        },
+        crate::range::RANGES,
     ],
     build: |p: &Params| {
         Ok(Box::new(PrecisionPass {
@@ -101,20 +97,16 @@ impl Pass for PrecisionPass {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let dom = domain_with_file(cx.domain.as_ref(), self.ranges.as_deref(), m)?;
         let target = self.target;
-        let file = match &self.budget {
-            crate::params::NumberOrPath::Number(_) => None,
+        // One relative budget for every output, or the budget file's per output.
+        let budgets_given = match &self.budget {
+            crate::params::NumberOrPath::Number(r) => budget::Budgets::Every(budget::Budget::Rel(*r)),
             crate::params::NumberOrPath::Path(path) => {
                 let failed = |message: String| PassError::Failed { pass: "precision".into(), message };
                 let text = std::fs::read_to_string(path)
                     .map_err(|e| failed(format!("cannot read budget file `{path}`: {e}")))?;
-                Some(budget::parse(&text).map_err(|e| failed(format!("budget file `{path}`: {e}")))?)
+                budget::Budgets::File(budget::parse(&text).map_err(|e| failed(format!("budget file `{path}`: {e}")))?)
             }
         };
-        let relative = match self.budget {
-            crate::params::NumberOrPath::Number(r) => Some(r),
-            crate::params::NumberOrPath::Path(_) => None,
-        };
-        let mut chosen: Vec<(usize, Choice)> = Vec::new();
         let functions = try_each_function(
             m,
             cx,
@@ -124,20 +116,17 @@ impl Pass for PrecisionPass {
             |f, k| Some(format!("before @{} ({k} functions given formats)", f.name)),
             |f, _, ticker| {
                 let failed = |message: String| PassError::Failed { pass: "precision".into(), message };
-                let x = match enclose_with(f, &dom, Some(crate::range::affine::DEFAULT_TERMS), || ticker.tick()) {
+                let x = match enclose_in_pass("precision", f, &dom, Some(crate::range::affine::DEFAULT_TERMS), ticker)?
+                {
                     Ok(x) => x,
-                    Err(e @ EncloseError::Stopped(_)) => {
-                        return Ok(Step::Stopped { what: e.message(&f.name), kept: None })
-                    }
-                    Err(e) => return Err(failed(e.message(&f.name)).at(e.span().unwrap_or(robovec_ir::Span::DUMMY))),
+                    Err(stop) => return Ok(stop),
                 };
-                let budgets: Vec<budget::Budget> = match (&file, relative) {
-                    (Some(file), _) => {
+                let budgets: Vec<budget::Budget> = match &budgets_given {
+                    budget::Budgets::Every(b) => vec![*b; f.outputs.len()],
+                    budget::Budgets::File(file) => {
                         let names: Vec<&str> = f.outputs.iter().map(|o| o.name.as_str()).collect();
                         file.resolve(&names).map_err(|e| failed(format!("@{}: budget file: {e}", f.name)))?
                     }
-                    (None, Some(r)) => vec![budget::Budget::Rel(r); f.outputs.len()],
-                    (None, None) => unreachable!("a number or a file"),
                 };
                 let c = choose(f, &x, &budgets, target, || ticker.tick()).map_err(failed)?;
                 if c.stopped {
@@ -151,11 +140,8 @@ impl Pass for PrecisionPass {
                 Ok(Step::Done(c))
             },
         )?;
-        for (k, c) in functions.into_iter().enumerate() {
-            chosen.push((k, c));
-        }
         let mut reports = Vec::new();
-        for (k, c) in chosen {
+        for (k, c) in functions.into_iter().enumerate() {
             let f = &mut m.functions[k];
             for &(v, format) in &c.formats {
                 f.set_format(v, format);

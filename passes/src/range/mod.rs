@@ -48,29 +48,37 @@ crate::params::word_enum! {
     }
 }
 
+/// `ranges=FILE`: input ranges over the run's domain (also `error-bound`'s and `precision`'s).
+pub const RANGES: ParamInfo = ParamInfo {
+    name: "ranges",
+    kind: ParamKind::Path,
+    doc: "JSON file of input ranges ({\"q[*]\": [-3.1416, 3.1416], \"m[2]\": [1, 1]}) over the run's domain (-ranges)",
+};
+
+/// `method=interval|affine` (also `error-bound`'s).
+pub const METHOD: ParamInfo = ParamInfo {
+    name: "method",
+    kind: ParamKind::Choice { choices: Method::WORDS, default: "affine" },
+    doc: "interval: outward-rounded interval arithmetic; affine: intervals intersected with affine forms \
+          (correlation-aware, O(ops · terms))",
+};
+
+/// `terms=K` (also `error-bound`'s).
+pub const TERMS: ParamInfo = ParamInfo {
+    name: "terms",
+    kind: ParamKind::U32 { default: affine::DEFAULT_TERMS as u32, min: 2, max: 1024 },
+    doc: "most noise symbols of one affine form (method=affine); the smallest beyond are folded into the value's \
+          own symbol",
+};
+
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
     name: "range",
     doc: "certified enclosure of every value over the input domain (outward-rounded interval arithmetic)",
     params: &[
-        ParamInfo {
-            name: "ranges",
-            kind: ParamKind::Path,
-            doc: "JSON file of input ranges ({\"q[*]\": [-3.1416, 3.1416], \"m[2]\": [1, 1]}) over the run's \
-                  domain (-ranges)",
-        },
-        ParamInfo {
-            name: "method",
-            kind: ParamKind::Choice { choices: Method::WORDS, default: "affine" },
-            doc: "interval: outward-rounded interval arithmetic; affine: intervals intersected with affine forms \
-                  (correlation-aware, O(ops · terms))",
-        },
-        ParamInfo {
-            name: "terms",
-            kind: ParamKind::U32 { default: affine::DEFAULT_TERMS as u32, min: 2, max: 1024 },
-            doc: "most noise symbols of one affine form (method=affine); the smallest beyond are folded into the \
-                  value's own symbol",
-        },
+        RANGES,
+        METHOD,
+        TERMS,
         ParamInfo {
             name: "samples",
             kind: ParamKind::U32 { default: 64, min: 0, max: 1_000_000 },
@@ -153,15 +161,9 @@ impl Pass for RangePass {
             Before::Ticked,
             |f, k| Some(format!("before @{} ({k} functions enclosed)", f.name)),
             |f, _, ticker| {
-                let x = match enclose_with(f, &dom, affine, || ticker.tick()) {
+                let x = match enclose_in_pass("range", f, &dom, affine, ticker)? {
                     Ok(x) => x,
-                    Err(e @ EncloseError::Stopped(_)) => {
-                        return Ok(Step::Stopped { what: e.message(&f.name), kept: None });
-                    }
-                    Err(e) => {
-                        let span = e.span().unwrap_or(robovec_ir::Span::DUMMY);
-                        return Err(PassError::Failed { pass: "range".into(), message: e.message(&f.name) }.at(span));
-                    }
+                    Err(stop) => return Ok(stop),
                 };
                 measure(f, &x, samples, method).map(Step::Done)
             },
@@ -178,6 +180,32 @@ impl Pass for RangePass {
         cx.emit(DomainUsed { functions: domains });
         cx.emit(RangeRun { functions });
         Ok(())
+    }
+}
+
+/// The enclosures of `f` (as [`enclose_with`]) in the per-function loop of pass `pass`
+/// ([`try_each_function`]), its ticker read once per value: `Ok(Ok(x))`, or `Ok(Err(step))` —
+/// the loop's [`Step::Stopped`] — when the limit stopped the sweep (`range`, `error-bound` and
+/// `precision` share it).
+///
+/// # Errors
+/// The enclosure's refusal ([`EncloseError`]: inputs without a range, a divisor that may be 0,
+/// a square root of a range holding negatives) as [`PassError::Failed`] of `pass`, located at the
+/// value's definition.
+pub fn enclose_in_pass<T>(
+    pass: &str,
+    f: &Function,
+    dom: &Domain,
+    affine: Option<usize>,
+    ticker: &crate::Ticker,
+) -> Result<Result<Vec<Interval>, Step<T>>, PassError> {
+    match enclose_with(f, dom, affine, || ticker.tick()) {
+        Ok(x) => Ok(Ok(x)),
+        Err(e @ EncloseError::Stopped(_)) => Ok(Err(Step::Stopped { what: e.message(&f.name), kept: None })),
+        Err(e) => {
+            let span = e.span().unwrap_or(robovec_ir::Span::DUMMY);
+            Err(PassError::Failed { pass: pass.into(), message: e.message(&f.name) }.at(span))
+        }
     }
 }
 
