@@ -17,9 +17,11 @@ const FIXED: &str = "func @f {
   %s = add %p, 0.03 : fix<8,2>
   %t = div %s, 3.0 : f32
   %u = sin %a : fix<12,10>
+  %v = mul %b, 0.3 : f32
   output y = %s
   output z = %t
   output w = %u
+  output x = %v
 }
 ";
 
@@ -108,6 +110,11 @@ fn eval_computes_each_value_in_its_format() {
     assert_eq!(json["outputs"]["y"].as_f64(), Some(s));
     assert_eq!(json["outputs"]["z"].as_f64(), Some(t));
     assert_eq!(json["outputs"]["w"].as_f64(), Some(u));
+    // A binary32 op reads its constant as a binary32 (C's `0.3f`) and rounds once: 0.7f·0.3f,
+    // whose binary32 product differs from rounding the binary64 0.7f·0.3 (0.21000001 against 0.21).
+    let v = (0.7f32 * 0.3f32) as f64;
+    assert_ne!(v, (b * 0.3) as f32 as f64, "the case tells the two readings apart");
+    assert_eq!(json["outputs"]["x"].as_f64(), Some(v));
     assert_eq!(json["inputs"]["a"].as_f64(), Some(1.3), "the inputs as given");
     // An overflow stops with the value, located: a = 100 needs more than fix<16,4>'s 2^11.
     std::fs::write(&inputs, r#"{"a": 127.9, "b": 100.0}"#).unwrap();
@@ -148,15 +155,30 @@ fn a_pass_that_does_not_understand_formats_refuses_them() {
 
 /// The C back end computes every value in its format bit for bit as `-eval` does: 48 random
 /// functions with every op the IR has, random values in binary32 and fixed point, 16 points
-/// of their domain each, compiled at -O1 (and the hand-written `FIXED` function); the
-/// expected bits are the interpreter's (`robovec_ir::format::eval_values`).
+/// of their domain each, compiled at -O1; the expected bits are the interpreter's
+/// (`robovec_ir::format::eval_values`). One state per call.
 #[test]
 fn c_computes_every_format_bit_for_bit_as_eval() {
+    c_bit_exact("formats-c", 1, "-O1");
+}
+
+/// As [`c_computes_every_format_bit_for_bit_as_eval`] with `batch=8` (`float` and `double`
+/// vectors side by side, converted where formats meet) and `batch=2`, at -O2 with the
+/// machine's own vector instructions (its FMA where it has one).
+#[test]
+fn c_batches_compute_every_format_bit_for_bit_as_eval() {
+    c_bit_exact("formats-c-batch8", 8, "-O2");
+    c_bit_exact("formats-c-batch2", 2, "-O1");
+}
+
+/// The bit-exact campaign at `batch` lanes (each call evaluates `batch` points,
+/// lane-contiguous), compiled with `opt_level` (and `-march=native` in a batch).
+fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str) {
     use robovec_backends::c::CodegenC;
     use robovec_ir::rng::SplitMix64;
     use robovec_ir::Operand;
     use std::fmt::Write as _;
-    let dir = tmp("formats-c");
+    let dir = tmp(dir_name);
     let mut main = String::from("#include <stdio.h>\n#include <string.h>\n#include <stdint.h>\n");
     let mut calls = String::new();
     let mut files = vec!["main.c".to_string()];
@@ -170,7 +192,7 @@ fn c_computes_every_format_bit_for_bit_as_eval() {
             continue;
         }
         let m = Module { functions: vec![g.clone()] };
-        let o = CodegenC { name: Some(format!("t{seed}")), ..CodegenC::default() };
+        let o = CodegenC { name: Some(format!("t{seed}")), batch: batch as u32, ..CodegenC::default() };
         let art = o.emit(&m).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         std::fs::write(dir.join(format!("t{seed}.c")), &art.code.main).unwrap();
         files.push(format!("t{seed}.c"));
@@ -178,31 +200,43 @@ fn c_computes_every_format_bit_for_bit_as_eval() {
         let (ni, no) = (iface.inputs.len(), iface.outputs.len());
         let _ = writeln!(main, "void {}(const double *restrict in, double *restrict out);", iface.symbol);
         let mut rng = SplitMix64::new(seed);
-        let mut points = 0;
-        for _ in 0..16 {
+        // Points where -eval computes (no fixed-point overflow), `batch` per call.
+        let mut points: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
+        for _ in 0..4 * batch.max(4) {
             let point = crate::range::uniform_point(&iface.inputs, &dom, &mut rng);
             let at = |n: &str| point[iface.inputs.iter().position(|x| x == n).unwrap()];
-            let Ok(vals) = robovec_ir::format::eval_values(&g, at) else { continue };
-            for x in &point {
-                input_bytes.extend(x.to_le_bytes());
+            if let Ok(vals) = robovec_ir::format::eval_values(&g, at) {
+                points.push((point, vals));
+            }
+        }
+        let calls_made = points.len() / batch;
+        for group in points.chunks_exact(batch) {
+            for i in 0..ni {
+                for (point, _) in group {
+                    input_bytes.extend(point[i].to_le_bytes());
+                }
             }
             for (name, out) in iface.outputs.iter().zip(&g.outputs) {
-                let y = match out.value {
-                    Operand::Value(v) => vals[v.index()],
-                    Operand::Const(c) => c,
-                };
-                want.push((format!("seed {seed} {name} at {point:?}"), y));
+                for (point, vals) in group {
+                    let y = match out.value {
+                        Operand::Value(v) => vals[v.index()],
+                        Operand::Const(c) => c,
+                    };
+                    want.push((format!("seed {seed} {name} at {point:?}"), y));
+                }
             }
-            points += 1;
         }
         let _ = writeln!(
             calls,
-            "  for (int k = 0; k < {points}; k++) {{ double in[{}], out[{}]; if (fread(in, 8, {ni}, stdin) != {ni}) return 1; \
-             {}(in, out); for (int i = 0; i < {no}; i++) {{ uint64_t b; memcpy(&b, &out[i], 8); printf(\"%016llx\\n\", \
+            "  for (int k = 0; k < {calls_made}; k++) {{ double in[{}], out[{}]; if (fread(in, 8, {}, stdin) != {}) return 1; \
+             {}(in, out); for (int i = 0; i < {}; i++) {{ uint64_t b; memcpy(&b, &out[i], 8); printf(\"%016llx\\n\", \
              (unsigned long long)b); }} }}",
-            ni.max(1),
-            no.max(1),
-            iface.symbol
+            (ni * batch).max(1),
+            (no * batch).max(1),
+            ni * batch,
+            ni * batch,
+            iface.symbol,
+            no * batch
         );
         cases += 1;
     }
@@ -212,14 +246,12 @@ fn c_computes_every_format_bit_for_bit_as_eval() {
     main += "  return 0;\n}\n";
     std::fs::write(dir.join("main.c"), main).unwrap();
     let exe = dir.join("run");
-    let o = std::process::Command::new("cc")
-        .current_dir(&dir)
-        .args(["-O1", "-std=c99", "-ffp-contract=off", "-o"])
-        .arg(&exe)
-        .args(&files)
-        .arg("-lm")
-        .output()
-        .expect("cc (scripts/test.sh installs gcc)");
+    let mut cc = std::process::Command::new("cc");
+    cc.current_dir(&dir).args([opt_level, "-std=c99", "-ffp-contract=off"]);
+    if batch > 1 {
+        cc.arg("-march=native");
+    }
+    let o = cc.arg("-o").arg(&exe).args(&files).arg("-lm").output().expect("cc (scripts/test.sh installs gcc)");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let mut child = std::process::Command::new(&exe)
         .stdin(std::process::Stdio::piped())
@@ -235,7 +267,7 @@ fn c_computes_every_format_bit_for_bit_as_eval() {
     assert_eq!(got.len(), want.len());
     for (g, (what, y)) in got.iter().zip(&want) {
         let same = *g == y.to_bits() || (y.is_nan() && f64::from_bits(*g).is_nan());
-        assert!(same, "{what}: C gives {:e}, -eval {y:e}", f64::from_bits(*g));
+        assert!(same, "batch={batch}: {what}: C gives {:e}, -eval {y:e}", f64::from_bits(*g));
     }
 }
 
@@ -245,7 +277,7 @@ fn c_refuses_formats_with_options_that_cannot_honour_them() {
     let dir = tmp("formats-c-refused");
     let input = dir.join("f.rvir");
     std::fs::write(&input, FIXED).unwrap();
-    for (opts, why) in [("precision=f32", "precision=f32"), ("batch=4", "batch=4"), ("abi=robotran", "abi=robotran")] {
+    for (opts, why) in [("precision=f32", "precision=f32"), ("abi=robotran", "abi=robotran")] {
         let o = opt(&[input.to_str().unwrap(), &format!("-passes=codegen<c;{opts}>"), "-o", "/dev/null"]);
         assert_eq!(o.status.code(), Some(1), "{opts}: {}", stderr(&o));
         assert!(stderr(&o).contains("has values in numeric formats") && stderr(&o).contains(why), "{}", stderr(&o));
@@ -253,5 +285,5 @@ fn c_refuses_formats_with_options_that_cannot_honour_them() {
     let o = opt(&[input.to_str().unwrap(), "-passes=codegen<c>", "-o", dir.join("f.c").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let c = std::fs::read_to_string(dir.join("f.c")).unwrap();
-    assert!(c.contains("robovec_fix_store(") && c.contains("(double)(float)("), "{c}");
+    assert!(c.contains("robovec_fix_store(") && c.contains("const float t = (float)s / 0x1.8p+1f;"), "{c}");
 }

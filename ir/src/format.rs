@@ -5,13 +5,21 @@
 //!
 //! # Semantics (what `-eval` computes and the back ends must reproduce bit for bit)
 //! Every value of every format is a binary64 number (binary32 widens exactly; `fix<w,f>` has
-//! `w ≤ 53`). An op computes in **binary64** on its operands' values (IEEE 754, round to nearest
-//! even; `sin`, `cos`, `sqrt` and calls as the binary64 functions), then **stores** the result
-//! in its value's format ([`Format::store`]):
-//! - **binary64**: as it is; **binary32**: rounded to nearest, ties to even. For `+ - * /` and
-//!   `sqrt` of binary32 operands this is exactly IEEE binary32 arithmetic (binary64 carries more
-//!   than 2 × 24 + 2 bits, so the double rounding is innocuous: Figueroa, "When is double
-//!   rounding innocuous?", SIGNUM 1995); C: `float x = (float)((double)a * (double)b);`.
+//! `w ≤ 53`). An op **computes in its value's format**:
+//! - **binary64**: in binary64 on its operands' values (IEEE 754, round to nearest even; `sin`,
+//!   `cos`, `sqrt` and calls as the binary64 functions).
+//! - **binary32**: every operand is first rounded to binary32 (a constant too, as a C `float`
+//!   literal; a binary64 or fixed-point operand to nearest even), then the op is the IEEE
+//!   binary32 operation: `+ - * /`, `sqrt` and the fused ops rounded once in binary32 (`fmaf`),
+//!   `sin`/`cos` the C library's `sinf`/`cosf`, a callback in binary64 on the rounded operands
+//!   then rounded ([`binary32_op`]). That is C's `float` arithmetic exactly: `float x = a * b;`
+//!   with `float` operands, so a function whose values are all binary32 computes what
+//!   `-eval-precision=f32` and `codegen<c;precision=f32>` compute, and `codegen<c>` writes
+//!   binary32 values as `float` vectors (twice the lanes of `double`).
+//! - **`fix<w,f>`**: in binary64 on its operands' values, then **stored** ([`Format::store`]).
+//!
+//! Storing:
+//! - **binary64**: as it is; **binary32**: rounded to nearest, ties to even.
 //! - **`fix<w,f>`**: a value is `k · 2^-f` with `k` a `w`-bit two's complement integer,
 //!   `-2^(w-1) ≤ k < 2^(w-1)`; storing rounds to nearest, **ties toward +∞** (`floor(x · 2^f +
 //!   1/2)`: what adding half a step and an arithmetic right shift give in a PE or on a
@@ -183,16 +191,48 @@ pub struct FormatError {
 }
 
 /// The values of every value of `f` (indexed by `Value::index()`) computed in their formats
-/// (module doc): inputs given by `input(name)` in binary64 and stored in their formats; every
-/// op in binary64 on its operands' values, then stored. A function without formats gives
-/// exactly [`crate::interp::eval_values`]`::<f64>`.
+/// (module doc): inputs given by `input(name)` in binary64 and stored in their formats; a
+/// binary32 value's op in binary32 on its operands rounded to binary32 ([`binary32_op`]);
+/// every other op in binary64 on its operands' values, then stored. A function without
+/// formats gives exactly [`crate::interp::eval_values`]`::<f64>`.
 ///
 /// # Errors
 /// The first value in program order whose result a fixed-point format cannot hold.
-pub fn eval_values(f: &crate::Function, input: impl FnMut(&str) -> f64) -> Result<Vec<f64>, FormatError> {
-    crate::interp::eval_values_stored(f, input, |v, x: f64| {
-        f.format(v).store(x).map_err(|error| FormatError { value: v, result: x, error })
-    })
+pub fn eval_values(f: &crate::Function, mut input: impl FnMut(&str) -> f64) -> Result<Vec<f64>, FormatError> {
+    let mut vals = vec![f64::NAN; f.values.len()];
+    let store = |v: crate::Value, x: f64| f.format(v).store(x).map_err(|error| FormatError { value: v, result: x, error });
+    for &v in &f.inputs {
+        vals[v.index()] = store(v, input(f.name_of(v)))?;
+    }
+    for &v in &f.body {
+        let def = &f.value(v).def;
+        let get = |o: &crate::Operand| match *o {
+            crate::Operand::Value(x) => vals[x.index()],
+            crate::Operand::Const(c) => c,
+        };
+        let r = match f.format(v) {
+            Format::Binary32 => binary32_op(def, get),
+            _ => crate::interp::eval_def(def, get),
+        };
+        vals[v.index()] = store(v, r)?;
+    }
+    Ok(vals)
+}
+
+/// The op `def` of a binary32 value, on operands `get` gives in binary64 (module doc): each
+/// operand (constants included) rounded to binary32, then `+ - * /`, `sqrt`, the fused ops,
+/// `sin` and `cos` as IEEE binary32 operations and the C library's `sinf`/`cosf` (what C's
+/// `float` arithmetic computes), a callback in binary64 on the rounded operands; the result
+/// rounded to binary32, widened exactly.
+pub fn binary32_op(def: &crate::Def, get: impl Fn(&crate::Operand) -> f64) -> f64 {
+    let narrow = |o: &crate::Operand| get(o) as f32;
+    match def {
+        crate::Def::Call(c, args) if crate::intrinsic::Intrinsic::of(c, args.len()).is_none() => {
+            let a: Vec<f64> = args.iter().map(|o| narrow(o) as f64).collect();
+            crate::interp::eval_call(c, &a) as f32 as f64
+        }
+        _ => crate::interp::eval_def::<f32>(def, narrow) as f64,
+    }
 }
 
 #[cfg(test)]

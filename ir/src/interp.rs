@@ -88,25 +88,31 @@ pub fn eval_values_stored<T: Float, E>(
             Operand::Value(x) => vals[x.index()].expect("value read before definition"),
             Operand::Const(c) => T::from_f64(*c),
         };
-        let r = match &f.value(v).def {
-            Def::Input => unreachable!("inputs are not in the body"),
-            Def::Trig(t, a) => {
-                let x = vals[a.index()].expect("value read before definition");
-                match t {
-                    TrigFn::Sin => x.sin(),
-                    TrigFn::Cos => x.cos(),
-                }
-            }
-            Def::Binary(op, a, b) => eval_binop(*op, get(&vals, a), get(&vals, b)),
-            Def::Call(c, args) => {
-                let a: Vec<T> = args.iter().map(|o| get(&vals, o)).collect();
-                eval_call(c, &a)
-            }
-            Def::Expr(e) => eval_expr(e, &|o| get(&vals, o)),
-        };
+        let r = eval_def(&f.value(v).def, |o| get(&vals, o));
         vals[v.index()] = Some(store(v, r)?);
     }
     Ok(vals.into_iter().map(|x| x.unwrap_or(T::from_f64(f64::NAN))).collect())
+}
+
+/// One body value's definition computed in precision `T` from its operands (`get`; a trig
+/// argument is read as `Operand::Value`). Panics on [`Def::Input`], which has no definition.
+pub fn eval_def<T: Float>(def: &Def, get: impl Fn(&Operand) -> T) -> T {
+    match def {
+        Def::Input => unreachable!("inputs are not in the body"),
+        Def::Trig(t, a) => {
+            let x = get(&Operand::Value(*a));
+            match t {
+                TrigFn::Sin => x.sin(),
+                TrigFn::Cos => x.cos(),
+            }
+        }
+        Def::Binary(op, a, b) => eval_binop(*op, get(a), get(b)),
+        Def::Call(c, args) => {
+            let a: Vec<T> = args.iter().map(&get).collect();
+            eval_call(c, &a)
+        }
+        Def::Expr(e) => eval_expr(e, &get),
+    }
 }
 
 fn eval_expr<T: Float>(e: &Expr, get: &impl Fn(&Operand) -> T) -> T {

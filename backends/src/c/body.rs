@@ -10,6 +10,7 @@ use robovec_ir::{BinOp, Def, Function, Operand, TrigFn, Value};
 use super::callbacks::split_callee;
 use super::{is_intrinsic, CodegenC, Trig};
 use crate::literal;
+use robovec_ir::format::Format;
 use robovec_ir::Intrinsic;
 
 /// The vector type `robovec_vec` of a batch of `lanes` states and its per-lane helpers.
@@ -61,6 +62,80 @@ pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
          #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 16\n  return (robovec_vec)_mm_fmadd_{p}((__m128{x})a, (__m128{x})b, (__m128{x})c);\n\
          #else\n  robovec_vec r;\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = fma{sfx}(a[lane], b[lane], c[lane]);\n  return r;\n\
          #endif\n}}"
+    );
+    s.push('\n');
+    s
+}
+
+/// The vector type of a batch's binary32 values (`narrow`) or of its other values.
+fn vector_type(narrow: bool) -> &'static str {
+    if narrow {
+        "robovec_vec32"
+    } else {
+        "robovec_vec"
+    }
+}
+
+/// The vector types of a batch of `lanes` states in a file whose values carry numeric formats
+/// ([`robovec_ir::format`], `precision=f64`): `robovec_vec32` of `float` for binary32 values and
+/// `robovec_vec` of `double` for the others, both of `ROBOVEC_VL` lanes, the lanes of the widest
+/// `float` vector the compiler targets (8 with AVX2): a binary32 op is one instruction on a
+/// full register, a binary64 one two (the compiler splits a `double` vector wider than the
+/// target's). Their per-lane helpers (sin, cos, sqrt and fma of both types; the fused ones as
+/// vector FMA instructions where the target has them, split in halves for the `double`
+/// vector of twice the register) and `robovec_fix_store_v`, a batch's store in `fix<w,f>`.
+pub(crate) fn format_vector_helpers(lanes: u32) -> String {
+    let mut s = format!(
+        "/* {lanes} states per call: lane l of element i is in[i*{lanes} + l] (GCC/Clang vector extensions).\n \
+         * The values carry numeric formats: binary32 ones are robovec_vec32 (float), the others robovec_vec\n \
+         * (double), both of ROBOVEC_VL lanes: the lanes of the widest float vector the compiler targets\n \
+         * (AVX-512: 64 bytes, AVX: 32, otherwise 16; -DROBOVEC_VBYTES=N chooses), {lanes}/ROBOVEC_VL times per call. */\n\
+         #ifndef ROBOVEC_VBYTES\n\
+         #if defined(__AVX512F__)\n#define ROBOVEC_VBYTES 64\n\
+         #elif defined(__AVX__)\n#define ROBOVEC_VBYTES 32\n\
+         #else\n#define ROBOVEC_VBYTES 16\n#endif\n#endif\n\
+         #define ROBOVEC_W {lanes}\n\
+         #define ROBOVEC_VL (ROBOVEC_VBYTES / 4 < ROBOVEC_W ? ROBOVEC_VBYTES / 4 : ROBOVEC_W)\n\
+         _Static_assert(ROBOVEC_VL >= 1 && ROBOVEC_W % ROBOVEC_VL == 0, \"ROBOVEC_VBYTES must be a power of two of at least one float\");\n\
+         typedef double robovec_vec __attribute__((vector_size(ROBOVEC_VL * 8)));\n\
+         typedef float robovec_vec32 __attribute__((vector_size(ROBOVEC_VL * 4)));\n\
+         /* The bytes of one robovec_vec and of one robovec_vec32, for the preprocessor. */\n\
+         #define ROBOVEC_VEC_BYTES (ROBOVEC_VBYTES < ROBOVEC_W * 4 ? 2 * ROBOVEC_VBYTES : ROBOVEC_W * 8)\n\
+         #define ROBOVEC_VEC32_BYTES (ROBOVEC_VBYTES < ROBOVEC_W * 4 ? ROBOVEC_VBYTES : ROBOVEC_W * 4)\n\
+         #if defined(__SSE2__) || defined(__AVX__)\n#include <immintrin.h>\n#endif\n"
+    );
+    for (ty, sfx, real) in [("robovec_vec", "", "double"), ("robovec_vec32", "32", "float")] {
+        let f = if sfx.is_empty() { "" } else { "f" };
+        let _ = writeln!(
+            s,
+            "static inline ROBOVEC_UNUSED {ty} robovec_splat{sfx}({real} x) {{ {ty} r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = x; return r; }}"
+        );
+        for fun in ["sin", "cos", "sqrt"] {
+            let _ = writeln!(
+                s,
+                "static inline ROBOVEC_UNUSED {ty} robovec_{fun}{sfx}({ty} x) {{ {ty} r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = {fun}{f}(x[lane]); return r; }}"
+            );
+        }
+    }
+    // Vector FMA instructions as in `vector_helpers`; a `double` vector of two registers in halves.
+    let _ = writeln!(
+        s,
+        "static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vec32 robovec_fma32(robovec_vec32 a, robovec_vec32 b, robovec_vec32 c)\n{{\n\
+         #if defined(__AVX512F__) && ROBOVEC_VEC32_BYTES == 64\n  return (robovec_vec32)_mm512_fmadd_ps((__m512)a, (__m512)b, (__m512)c);\n\
+         #elif defined(__FMA__) && ROBOVEC_VEC32_BYTES == 32\n  return (robovec_vec32)_mm256_fmadd_ps((__m256)a, (__m256)b, (__m256)c);\n\
+         #elif defined(__FMA__) && ROBOVEC_VEC32_BYTES == 16\n  return (robovec_vec32)_mm_fmadd_ps((__m128)a, (__m128)b, (__m128)c);\n\
+         #else\n  robovec_vec32 r;\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = fmaf(a[lane], b[lane], c[lane]);\n  return r;\n\
+         #endif\n}}\n\
+         static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vec robovec_fma(robovec_vec a, robovec_vec b, robovec_vec c)\n{{\n\
+         #if defined(__AVX512F__) && ROBOVEC_VEC_BYTES == 128\n  __m512d h[6];\n  memcpy(h, &a, 128); memcpy(h + 2, &b, 128); memcpy(h + 4, &c, 128);\n  \
+         h[0] = _mm512_fmadd_pd(h[0], h[2], h[4]); h[1] = _mm512_fmadd_pd(h[1], h[3], h[5]);\n  memcpy(&a, h, 128);\n  return a;\n\
+         #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 64\n  __m256d h[6];\n  memcpy(h, &a, 64); memcpy(h + 2, &b, 64); memcpy(h + 4, &c, 64);\n  \
+         h[0] = _mm256_fmadd_pd(h[0], h[2], h[4]); h[1] = _mm256_fmadd_pd(h[1], h[3], h[5]);\n  memcpy(&a, h, 64);\n  return a;\n\
+         #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 32\n  return (robovec_vec)_mm256_fmadd_pd((__m256d)a, (__m256d)b, (__m256d)c);\n\
+         #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 16\n  return (robovec_vec)_mm_fmadd_pd((__m128d)a, (__m128d)b, (__m128d)c);\n\
+         #else\n  robovec_vec r;\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = fma(a[lane], b[lane], c[lane]);\n  return r;\n\
+         #endif\n}}\n\
+         static inline ROBOVEC_UNUSED robovec_vec robovec_fix_store_v(robovec_vec x, int f) {{ for (int lane = 0; lane < ROBOVEC_VL; lane++) x[lane] = robovec_fix_store(x[lane], f); return x; }}"
     );
     s.push('\n');
     s
@@ -175,27 +250,64 @@ impl<'a> Body<'a> {
         (order, attached)
     }
 
-    /// An operand as a C expression (a constant exact in the precision: [`literal::operand`]).
+    /// An operand as a C expression (a constant exact in the precision: [`literal::operand`]),
+    /// as an op that does not narrow reads it ([`Body::read`]).
     pub fn operand(&self, x: &Operand) -> String {
+        self.read(x, false)
+    }
+
+    /// True when `v` is computed in binary32 in a file of `precision=f64` ([`robovec_ir::format`]):
+    /// a `float` temporary (a `robovec_vec32` in a batch).
+    pub fn narrow(&self, v: Value) -> bool {
+        self.f.format(v) == Format::Binary32
+    }
+
+    /// `x` as an op reads it: `narrow` (the op's value is binary32) rounds a constant to a
+    /// `float` literal and converts a value of another format to `float`; an op that does not
+    /// narrow reads a binary32 value widened to `double` (exact). A batch converts whole
+    /// vectors (`__builtin_convertvector`).
+    pub fn read(&self, x: &Operand, narrow: bool) -> String {
         match x {
-            Operand::Value(v) => self.names[v.index()].clone(),
-            Operand::Const(c) => literal::operand(*c, self.o.f32()),
+            Operand::Const(c) => literal::operand(*c, narrow || self.o.f32()),
+            Operand::Value(w) => {
+                let n = &self.names[w.index()];
+                if self.narrow(*w) == narrow {
+                    n.clone()
+                } else if self.o.batch > 1 {
+                    format!("__builtin_convertvector({n}, {})", vector_type(narrow))
+                } else {
+                    format!("({}){n}", if narrow { "float" } else { "double" })
+                }
+            }
         }
     }
 
-    /// `expr` (a binary64 result) stored in `v`'s numeric format ([`robovec_ir::format`]):
-    /// itself for binary64, `(double)(float)(expr)` for binary32, `robovec_fix_store(expr, f)`
-    /// for `fix<w,f>` (the file's [`super::file::FORMAT_HELPERS`]). Formats are written with
-    /// `precision=f64` and one state only (checked before), so every temporary is a `double`.
+    /// [`Body::read`] as a value of the op's type (a constant is splat in a batch).
+    pub fn read_value(&self, x: &Operand, narrow: bool) -> String {
+        match x {
+            Operand::Const(_) if self.o.batch > 1 => {
+                format!("robovec_splat{}({})", if narrow { "32" } else { "" }, self.read(x, narrow))
+            }
+            _ => self.read(x, narrow),
+        }
+    }
+
+    /// `expr`, of the file's real type (`double`, or `robovec_vec` in a batch), as a value of
+    /// `v`'s format ([`robovec_ir::format`]): itself for binary64, converted to `float` (to
+    /// `robovec_vec32`) for binary32, `robovec_fix_store(expr, f)` (`robovec_fix_store_v` in a
+    /// batch) for `fix<w,f>` (the file's [`super::file::FORMAT_HELPERS`]).
     pub fn stored(&self, v: Value, expr: String) -> String {
+        let vec = self.o.batch > 1;
         match self.f.format(v) {
-            robovec_ir::format::Format::Binary64 => expr,
-            robovec_ir::format::Format::Binary32 => format!("(double)(float)({expr})"),
-            robovec_ir::format::Format::Fix { fraction, .. } => format!("robovec_fix_store({expr}, {fraction})"),
+            Format::Binary64 => expr,
+            Format::Binary32 if vec => format!("__builtin_convertvector({expr}, robovec_vec32)"),
+            Format::Binary32 => format!("(float)({expr})"),
+            Format::Fix { fraction, .. } if vec => format!("robovec_fix_store_v({expr}, {fraction})"),
+            Format::Fix { fraction, .. } => format!("robovec_fix_store({expr}, {fraction})"),
         }
     }
 
-    /// The type of a value: `double`, `float` or `robovec_vec`.
+    /// The type of the file's real values: `double`, `float` or `robovec_vec`.
     pub fn value_type(&self) -> &'static str {
         if self.o.batch > 1 {
             "robovec_vec"
@@ -204,12 +316,18 @@ impl<'a> Body<'a> {
         }
     }
 
+    /// The C type of `v`: [`Body::value_type`], or `float` (`robovec_vec32`) for a binary32 value.
+    pub fn type_of(&self, v: Value) -> &'static str {
+        match (self.narrow(v), self.o.batch > 1) {
+            (true, true) => "robovec_vec32",
+            (true, false) => "float",
+            (false, _) => self.value_type(),
+        }
+    }
+
     /// An operand as a value of [`Body::value_type`] (a constant is splat in a batch).
     pub fn operand_value(&self, x: &Operand) -> String {
-        match x {
-            Operand::Const(_) if self.o.batch > 1 => format!("robovec_splat({})", self.operand(x)),
-            _ => self.operand(x),
-        }
+        self.read_value(x, false)
     }
 
     /// The statements of `order` (a slice of [`Body::order`] that never starts with an
@@ -227,7 +345,7 @@ impl<'a> Body<'a> {
         before: &mut dyn FnMut(&mut String, Value),
         after: &mut dyn FnMut(&mut String, Value),
     ) {
-        let ty = self.value_type();
+        let real_ty = self.value_type();
         let vec = self.o.batch > 1;
         let sfx = if self.o.f32() { "f" } else { "" };
         // Members of the trig block whose `after` waits for the block's statement.
@@ -250,18 +368,33 @@ impl<'a> Body<'a> {
                 }
                 continue;
             }
+            let ty = self.type_of(v);
+            let narrow = self.narrow(v);
             match def {
                 Def::Input | Def::Expr(_) => unreachable!("atomised bodies hold trig, binary ops and calls"),
                 Def::Trig(..) if self.fused.get(&v.index()).is_some_and(|&(_, leads)| !leads) => {} // with its partner
                 Def::Trig(t, a) if self.o.trig == Trig::Inline => {
-                    let arg = &self.names[a.index()];
+                    // robovec's sin/cos compute in the file's real type, then convert.
+                    let arg = self.read(&Operand::Value(*a), false);
                     if let Some(&(other, _)) = self.fused.get(&v.index()) {
-                        let other_name = &self.names[other.index()];
-                        let (sin, cos) = if *t == TrigFn::Sin { (name, other_name) } else { (other_name, name) };
-                        let _ = writeln!(s, "  {ty} {sin}, {cos};\n  robovec_sincos_inline({arg}, &{sin}, &{cos});");
+                        let (sin, cos) = if *t == TrigFn::Sin { (v, other) } else { (other, v) };
+                        let (sn, cn) = (&self.names[sin.index()], &self.names[cos.index()]);
+                        if self.f.format(sin).is_default() && self.f.format(cos).is_default() {
+                            let _ = writeln!(s, "  {real_ty} {sn}, {cn};\n  robovec_sincos_inline({arg}, &{sn}, &{cn});");
+                        } else {
+                            let _ = writeln!(
+                                s,
+                                "  {} {sn};\n  {} {cn};\n  {{\n    {real_ty} robovec_s, robovec_c;\n    \
+                                 robovec_sincos_inline({arg}, &robovec_s, &robovec_c);\n    {sn} = {};\n    {cn} = {};\n  }}",
+                                self.type_of(sin),
+                                self.type_of(cos),
+                                self.stored(sin, "robovec_s".into()),
+                                self.stored(cos, "robovec_c".into()),
+                            );
+                        }
                     } else {
                         let fun = if *t == TrigFn::Sin { "sin" } else { "cos" };
-                        let _ = writeln!(s, "  const {ty} {name} = robovec_{fun}_inline({arg});");
+                        let _ = writeln!(s, "  const {ty} {name} = {};", self.stored(v, format!("robovec_{fun}_inline({arg})")));
                     }
                 }
                 Def::Trig(t, a) => {
@@ -269,12 +402,14 @@ impl<'a> Body<'a> {
                         TrigFn::Sin => "sin",
                         TrigFn::Cos => "cos",
                     };
-                    let arg = &self.names[a.index()];
-                    if vec {
-                        let _ = writeln!(s, "  const {ty} {name} = robovec_{fun}({arg});");
-                    } else {
-                        let _ = writeln!(s, "  const {ty} {name} = {};", self.stored(v, format!("{fun}{sfx}({arg})")));
-                    }
+                    let arg = self.read(&Operand::Value(*a), narrow);
+                    let expr = match (vec, narrow) {
+                        (true, true) => format!("robovec_{fun}32({arg})"),
+                        (false, true) => format!("{fun}f({arg})"),
+                        (true, false) => self.stored(v, format!("robovec_{fun}({arg})")),
+                        (false, false) => self.stored(v, format!("{fun}{sfx}({arg})")),
+                    };
+                    let _ = writeln!(s, "  const {ty} {name} = {expr};");
                 }
                 Def::Binary(op, a, b) => {
                     let op = match op {
@@ -285,15 +420,13 @@ impl<'a> Body<'a> {
                     };
                     // Scalar with vector is fine in a batch; two constants need one splat.
                     let a = if matches!((a, b), (Operand::Const(_), Operand::Const(_))) {
-                        self.operand_value(a)
+                        self.read_value(a, narrow)
                     } else {
-                        self.operand(a)
+                        self.read(a, narrow)
                     };
-                    let _ = writeln!(
-                        s,
-                        "  const {ty} {name} = {};",
-                        self.stored(v, format!("{a} {op} {}", self.operand(b)))
-                    );
+                    let expr = format!("{a} {op} {}", self.read(b, narrow));
+                    let expr = if narrow { expr } else { self.stored(v, expr) };
+                    let _ = writeln!(s, "  const {ty} {name} = {expr};");
                 }
                 Def::Call(c, args) if is_intrinsic(c, args.len()) => {
                     let i = Intrinsic::of(c, args.len()).expect("checked");
@@ -303,27 +436,38 @@ impl<'a> Body<'a> {
                         .iter()
                         .enumerate()
                         .map(|(k, x)| match (x, neg(k)) {
-                            (Operand::Const(c), true) => self.operand_value(&Operand::Const(-c)),
-                            (_, true) => format!("-{}", self.operand_value(x)),
-                            (_, false) => self.operand_value(x),
+                            (Operand::Const(c), true) => self.read_value(&Operand::Const(-c), narrow),
+                            (_, true) => format!("-{}", self.read_value(x, narrow)),
+                            (_, false) => self.read_value(x, narrow),
                         })
                         .collect();
                     let callee = if i == Intrinsic::Sqrt { "sqrt" } else { "fma" };
-                    let callee = if vec { format!("robovec_{callee}") } else { format!("{callee}{sfx}") };
-                    let _ = writeln!(
-                        s,
-                        "  const {ty} {name} = {};",
-                        self.stored(v, format!("{callee}({})", list.join(", ")))
-                    );
+                    let callee = match (vec, narrow) {
+                        (true, true) => format!("robovec_{callee}32"),
+                        (false, true) => format!("{callee}f"),
+                        (true, false) => format!("robovec_{callee}"),
+                        (false, false) => format!("{callee}{sfx}"),
+                    };
+                    let expr = format!("{callee}({})", list.join(", "));
+                    let expr = if narrow { expr } else { self.stored(v, expr) };
+                    let _ = writeln!(s, "  const {ty} {name} = {expr};");
                 }
                 Def::Call(..) if self.native.is_some() => {
                     s.push_str(&self.native.expect("checked").statements[&v.index()]);
                 }
                 Def::Call(c, args) => {
+                    // A callback computes in binary64 on its operands as the op reads them.
                     let (base, idx) = split_callee(c).expect("checked by callbacks()");
                     let lane = |x: &Operand| match x {
-                        Operand::Value(_) if vec => format!("{}[lane]", self.operand(x)),
-                        _ => self.operand(x),
+                        Operand::Value(w) if vec => {
+                            let n = format!("{}[lane]", self.names[w.index()]);
+                            if narrow && !self.narrow(*w) {
+                                format!("(float){n}")
+                            } else {
+                                n
+                            }
+                        }
+                        _ => self.read(x, narrow),
                     };
                     let list: Vec<String> = args.iter().map(lane).collect();
                     let argv = if list.is_empty() {
@@ -334,9 +478,14 @@ impl<'a> Body<'a> {
                     let idx: String = idx.iter().map(|i| format!("{i}, ")).collect();
                     let call = format!("{base}({idx}{}, {}, {argv})", c.elem.unwrap_or(0), args.len());
                     if vec {
+                        let one = match self.f.format(v) {
+                            Format::Binary64 => call,
+                            Format::Binary32 => format!("(float)({call})"),
+                            Format::Fix { fraction, .. } => format!("robovec_fix_store({call}, {fraction})"),
+                        };
                         let _ = writeln!(
                             s,
-                            "  {ty} {name};\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) {name}[lane] = {call};"
+                            "  {ty} {name};\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) {name}[lane] = {one};"
                         );
                     } else {
                         let _ = writeln!(s, "  const {ty} {name} = {};", self.stored(v, call));
@@ -413,12 +562,8 @@ impl TrigBlock {
         );
         for &v in &self.members {
             let (k, sin) = self.slot_of[&v.index()];
-            let _ = writeln!(
-                s,
-                "  const {real} {} = robovec_t{}[{k}];",
-                body.names[v.index()],
-                if sin { 's' } else { 'c' }
-            );
+            let slot = format!("robovec_t{}[{k}]", if sin { 's' } else { 'c' });
+            let _ = writeln!(s, "  const {} {} = {};", body.type_of(v), body.names[v.index()], body.stored(v, slot));
         }
     }
 }

@@ -236,38 +236,38 @@ impl CodegenC {
             // The helpers below are `ROBOVEC_UNUSED`: a function uses some of them only.
             s += UNUSED_HELPERS;
         }
+        if formats {
+            // Before the vector helpers: robovec_fix_store_v calls it.
+            s += FORMAT_HELPERS;
+        }
         let mut helpers = String::new();
-        if self.batch > 1 {
+        if self.batch > 1 && formats {
+            helpers += &body::format_vector_helpers(self.batch);
+        } else if self.batch > 1 {
             helpers += &body::vector_helpers(self.real(), self.batch, self.f32());
         }
         if self.trig == Trig::Inline {
             helpers += &trig::helpers(self.f32(), self.batch > 1);
         }
         s += &shared_helpers(&helpers);
-        if formats {
-            s += FORMAT_HELPERS;
-        }
         s
     }
 
     /// True when a function of `m` has values in numeric formats (issue 48,
-    /// [`robovec_ir::format`]), which the C then computes each in its format ([`FORMAT_HELPERS`],
-    /// `Body::stored`): every temporary a `double` holding the value as stored, bit for bit
-    /// what `-eval` computes.
+    /// [`robovec_ir::format`]), which the C then computes each in its format (`Body::read`,
+    /// `Body::stored`): binary32 values as `float` (`robovec_vec32` vectors in a batch, twice the
+    /// lanes of `double`), the others as `double` (fixed point through [`FORMAT_HELPERS`]), bit
+    /// for bit what `-eval` computes (but for `trig=inline`'s sin/cos, never bit-exact).
     ///
     /// # Errors
     /// [`PassError::Failed`] when formats meet options that cannot honour them: `precision=f32`
-    /// (the formats say how each value is computed), `batch>1`, `trig=inline`, or an ABI other
-    /// than `plain`.
+    /// (the formats say how each value is computed) or `abi=robotran` (Robotran's signature is
+    /// refused with `precision=f32` for the same reason: its `MbsData` is `double`).
     fn check_formats(&self, m: &Module) -> Result<bool, PassError> {
         let Some(f) = m.functions.iter().find(|f| f.has_formats()) else { return Ok(false) };
         let clash = if self.f32() {
             Some("precision=f32 (the formats say how each value is computed)".to_string())
-        } else if self.batch > 1 {
-            Some(format!("batch={} (formats are written for one state per call)", self.batch))
-        } else if self.trig == Trig::Inline {
-            Some("trig=inline (not bit-exact with -eval)".to_string())
-        } else if self.abi != Abi::Plain {
+        } else if self.abi == Abi::Robotran {
             Some(format!("abi={}", self.abi.as_str()))
         } else {
             None
@@ -276,8 +276,8 @@ impl CodegenC {
             Some(c) => Err(PassError::Failed {
                 pass: "codegen".into(),
                 message: format!(
-                    "@{} has values in numeric formats, which codegen<c> writes with abi=plain, precision=f64, \
-                     batch=1 and trig=libm or input only, not with {c}",
+                    "@{} has values in numeric formats, which codegen<c> writes with abi=plain or abi=pinocchio and \
+                     precision=f64, not with {c}",
                     f.name
                 ),
             }),
@@ -336,7 +336,7 @@ fn unit_assignment(emitted: &[Emitted], units: usize) -> Vec<Vec<usize>> {
 /// The store of a value in a fixed-point format (`robovec_ir::format::Format::store`: round
 /// to nearest, ties toward +∞, `floor(x · 2^f + 1/2) · 2^-f`, every step exact for the values
 /// the range proof admits), under its own guard so that files with and without formats can
-/// be `#include`d into one translation unit. binary32 values need no helper: `(double)(float)x`.
+/// be `#include`d into one translation unit. binary32 values need no helper: they are `float`.
 pub const FORMAT_HELPERS: &str = "#ifndef ROBOVEC_FIX_STORE\n#define ROBOVEC_FIX_STORE\n\
      /* A value stored in fix<w,f>: round to nearest, ties toward +inf (what -eval computes). */\n\
      static inline double robovec_fix_store(double x, int f) { return ldexp(floor(ldexp(x, f) + 0.5), -f); }\n\

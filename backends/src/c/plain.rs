@@ -160,21 +160,35 @@ pub(crate) fn arrays(
         let n = &names[v.index()];
         if let Some(i) = input_at[v.index()] {
             read[v.index()] = k as u32 + 1;
+            let vty = b.type_of(v);
             match layout.inputs[i] {
-                Source::Elem(p, e) if w > 1 => {
+                Source::Elem(p, e) if w > 1 && f.format(v).is_default() => {
                     let p = layout.params[p].0;
                     let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, {p} + {}{at}, sizeof {n});", e * w);
                 }
+                Source::Elem(p, e) if w > 1 => {
+                    // The arrays are of the file's real type: load, then store in the format.
+                    let p = layout.params[p].0;
+                    let _ = writeln!(
+                        s,
+                        "  {vty} {n};\n  {{\n    {ty} robovec_in;\n    memcpy(&robovec_in, {p} + {}{at}, sizeof robovec_in);\n    \
+                         {n} = {};\n  }}",
+                        e * w,
+                        b.stored(v, "robovec_in".into())
+                    );
+                }
                 Source::Elem(p, e) => {
-                    let _ = writeln!(s, "  const {ty} {n} = {};", b.stored(v, format!("{}[{e}]", layout.params[p].0)));
+                    let _ = writeln!(s, "  const {vty} {n} = {};", b.stored(v, format!("{}[{e}]", layout.params[p].0)));
                 }
                 Source::Const(c) => {
-                    let _ = writeln!(s, "  const {ty} {n} = {};", b.stored(v, b.operand_value(&Operand::Const(c))));
+                    let _ = writeln!(s, "  const {vty} {n} = {};", b.stored(v, b.operand_value(&Operand::Const(c))));
                 }
             }
         } else if plan.reads_live(v, k) {
             read[v.index()] = k as u32 + 1;
-            let _ = writeln!(s, "  const {ty} {n} = live[{}];", plan.slot(v).expect("read from live"));
+            let slot = format!("live[{}]", plan.slot(v).expect("read from live"));
+            // A live slot is of the file's real type: a binary32 value converts back (exactly).
+            let _ = writeln!(s, "  const {} {n} = {};", b.type_of(v), if b.narrow(v) { b.stored(v, slot) } else { slot });
         }
     };
     let store = |s: &mut String, j: usize, x: &Operand| {
@@ -183,10 +197,10 @@ pub(crate) fn arrays(
             let p = layout.params[p].0;
             if w > 1 {
                 match x {
-                    Operand::Value(_) => {
+                    Operand::Value(v) if !b.narrow(*v) => {
                         let _ = writeln!(s, "  memcpy({p} + {}{at}, &{e}, sizeof {e});", el * w);
                     }
-                    Operand::Const(_) => {
+                    _ => {
                         let _ = writeln!(s, "  {{ const {ty} k = {e}; memcpy({p} + {}{at}, &k, sizeof k); }}", el * w);
                     }
                 }
@@ -208,7 +222,7 @@ pub(crate) fn arrays(
                     store(s, j, &f.outputs[j].value);
                 }
                 if let Some(slot) = plan.slot(v) {
-                    let _ = writeln!(s, "  live[{slot}] = {};", names[v.index()]);
+                    let _ = writeln!(s, "  live[{slot}] = {};", b.operand(&Operand::Value(v)));
                 }
             },
         );

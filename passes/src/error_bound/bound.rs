@@ -34,14 +34,15 @@
 //!   `float` compute): inputs and constants rounded to binary32 (a constant's error, and that
 //!   of an input whose range is a point, is its exact distance to its binary32 value); each op `rel = 2⁻²⁴`, `abs = 2⁻¹⁵⁰`; `sin`, `cos` of
 //!   binary32 `rel = `[`LIBM_ULPS`]`·2⁻²³`.
-//! - **`mixed`** (each value in its own format, [`robovec_ir::format`]: the op computes in
-//!   binary64 on its operands' values, then stores in the value's format): binary64 as above;
-//!   binary32 the binary64 rounding then the binary32 one (`rel = 2⁻⁵³ + 2⁻²⁴ + 2⁻⁷⁷`, sound
-//!   whether or not the double rounding is innocuous); `fix<w,f>` the binary64 rounding then
+//! - **`mixed`** (each value in its own format, [`robovec_ir::format`]: an op computes in its
+//!   value's format): binary64 as above; a binary32 op reads its operands rounded to binary32
+//!   (a constant's error is its exact distance to binary32, a binary64 or fixed-point operand
+//!   adds `2⁻²⁴` of its computed magnitude, beyond binary32's largest number it is unbounded)
+//!   and rounds once as in `f32`; `fix<w,f>` the binary64 rounding then
 //!   `abs = 2^-(f+1)` (round to nearest), and the computed value's whole range must fit the
 //!   format: `[lo_z − E_z, hi_z + E_z]` within the values that store without overflow, or the
 //!   sweep stops with [`BoundError::FixOverflow`]. Inputs in fixed point or binary32 are
-//!   rounded on the way in; constants are binary64 (the ops compute in binary64).
+//!   rounded on the way in; a fixed-point or binary64 op reads constants exactly.
 //!
 //! Exact steps the bound knows: `a − a` is 0; a product by a constant power of two, or by
 //! ±1, 0, only loses bits to underflow (`rel = 0`); a sum with the constant 0 is exact.
@@ -267,30 +268,63 @@ fn check_fits(f: &Function, v: Value, x: &[Interval], e: &[f64], mode: Formats) 
     Err(BoundError::FixOverflow { value: data.name.clone(), span: data.span, format, range, fits: (lo, hi) })
 }
 
-/// The operand's enclosure and error bound in `mode` (a constant's error is its rounding to
-/// binary32 in mode f32, else 0).
-fn operand(o: &Operand, x: &[Interval], e: &[f64], mode: Formats) -> (Interval, f64) {
-    match *o {
-        Operand::Value(v) => (x[v.index()], e[v.index()]),
-        Operand::Const(c) => {
-            let err = match mode {
-                Formats::F32 => up((c - c as f32 as f64).abs()),
-                _ => 0.0,
-            };
-            (Interval::point(c), err)
-        }
+/// The format `w` is computed in under `mode`.
+fn format_in(f: &Function, w: Value, mode: Formats) -> Format {
+    match mode {
+        Formats::F64 => Format::Binary64,
+        Formats::F32 => Format::Binary32,
+        Formats::Mixed => f.format(w),
     }
 }
 
-/// True for a constant whose product is exact but for underflow: 0, ±1, ±2^k.
-fn exact_factor(o: &Operand, mode: Formats) -> bool {
-    let Operand::Const(c) = *o else { return false };
-    let c = if mode == Formats::F32 { c as f32 as f64 } else { c };
-    c == 0.0
-        || (c.is_finite() && {
-            let (m, _) = frexp(c.abs());
-            m == 0.5
-        })
+/// How an op reads its operands: `narrow` when its value is binary32, which rounds every
+/// operand to binary32 first (`robovec_ir::format`'s semantics; in mode f32 every value is).
+#[derive(Clone, Copy)]
+struct Reader<'a> {
+    f: &'a Function,
+    mode: Formats,
+    narrow: bool,
+}
+
+impl Reader<'_> {
+    /// The reader of `v`'s op.
+    fn of(f: &Function, v: Value, mode: Formats) -> Reader<'_> {
+        Reader { f, mode, narrow: format_in(f, v, mode) == Format::Binary32 }
+    }
+
+    /// The operand's enclosure and error bound as the op reads it: a constant's error is its
+    /// exact distance to binary32 when the op narrows, else 0; a value not in binary32 read by
+    /// a narrowing op adds a binary32 rounding of its computed magnitude (∞ past binary32's
+    /// largest number).
+    fn operand(&self, o: &Operand, x: &[Interval], e: &[f64]) -> (Interval, f64) {
+        match *o {
+            Operand::Value(v) => {
+                let (r, err) = (x[v.index()], e[v.index()]);
+                if !self.narrow || format_in(self.f, v, self.mode) == Format::Binary32 {
+                    return (r, err);
+                }
+                let m = up(r.mag() + err);
+                let conv = if m > f32::MAX as f64 { f64::INFINITY } else { Rounding::F32.of(m) };
+                (r, up(err + conv))
+            }
+            Operand::Const(c) => {
+                let err = if self.narrow { up((c - c as f32 as f64).abs()) } else { 0.0 };
+                (Interval::point(c), err)
+            }
+        }
+    }
+
+    /// True for a constant whose product is exact but for underflow: 0, ±1, ±2^k (after the
+    /// rounding to binary32 of a narrowing op).
+    fn exact_factor(&self, o: &Operand) -> bool {
+        let Operand::Const(c) = *o else { return false };
+        let c = if self.narrow { c as f32 as f64 } else { c };
+        c == 0.0
+            || (c.is_finite() && {
+                let (m, _) = frexp(c.abs());
+                m == 0.5
+            })
+    }
 }
 
 /// The mantissa in [0.5, 1) and exponent of a positive finite `x`.
@@ -324,17 +358,15 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
     if !mz.is_finite() {
         return f64::INFINITY;
     }
-    let op = match mode {
-        Formats::F64 | Formats::Mixed => Rounding::F64,
-        Formats::F32 => Rounding::F32,
-    };
+    let rd = Reader::of(f, v, mode);
+    let op = if rd.narrow { Rounding::F32 } else { Rounding::F64 };
     let libm_ulps = |r: Rounding| Rounding { rel: LIBM_ULPS * 2.0 * r.rel, abs: LIBM_ULPS * 2.0 * r.abs };
     let (propagated, rounding) = match &data.def {
         Def::Input | Def::Expr(_) => return f64::INFINITY,
-        Def::Trig(_, a) => (e[a.index()].min(2.0), libm_ulps(op)),
+        Def::Trig(_, a) => (rd.operand(&Operand::Value(*a), x, e).1.min(2.0), libm_ulps(op)),
         Def::Binary(op_kind, a, b) => {
-            let (ia, ea) = operand(a, x, e, mode);
-            let (ib, eb) = operand(b, x, e, mode);
+            let (ia, ea) = rd.operand(a, x, e);
+            let (ib, eb) = rd.operand(b, x, e);
             let same = matches!((a, b), (Operand::Value(p), Operand::Value(q)) if p == q);
             match op_kind {
                 BinOp::Sub if same => (0.0, Rounding::EXACT),
@@ -344,7 +376,7 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
                     (up(ea + eb), r)
                 }
                 BinOp::Mul => {
-                    let r = if exact_factor(a, mode) || exact_factor(b, mode) {
+                    let r = if rd.exact_factor(a) || rd.exact_factor(b) {
                         Rounding { rel: 0.0, abs: op.abs }
                     } else {
                         op
@@ -364,7 +396,7 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
         }
         Def::Call(callee, args) => match Intrinsic::of(callee, args.len()) {
             Some(Intrinsic::Sqrt) => {
-                let (ia, ea) = operand(&args[0], x, e, mode);
+                let (ia, ea) = rd.operand(&args[0], x, e);
                 let p = if ea == 0.0 {
                     0.0
                 } else if ea < ia.lo {
@@ -382,9 +414,9 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
                 (p, op)
             }
             Some(Intrinsic::Fma | Intrinsic::Fms | Intrinsic::Fnma) => {
-                let (ia, ea) = operand(&args[0], x, e, mode);
-                let (ib, eb) = operand(&args[1], x, e, mode);
-                let (_, ec) = operand(&args[2], x, e, mode);
+                let (ia, ea) = rd.operand(&args[0], x, e);
+                let (ib, eb) = rd.operand(&args[1], x, e);
+                let (_, ec) = rd.operand(&args[2], x, e);
                 (up(product_error(ia.mag(), ea, ib.mag(), eb) + ec), op)
             }
             None => return f64::INFINITY,
@@ -393,8 +425,9 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
     if !propagated.is_finite() {
         return f64::INFINITY;
     }
+    // A binary32 op rounds once, in binary32; a fixed-point value after its binary64 op.
     let rounding = match mode {
-        Formats::Mixed => rounding.then(Rounding::store(f.format(v))),
+        Formats::Mixed if !rd.narrow => rounding.then(Rounding::store(f.format(v))),
         _ => rounding,
     };
     let magnitude = up(mz + propagated);
@@ -477,7 +510,7 @@ pub fn sensitivities(f: &Function, x: &[Interval], e: &[f64], seed: &[(Value, f6
                     pass(b, mag(a), &mut lam);
                 }
                 BinOp::Div => {
-                    let (ib, eb) = operand(b, x, e, Formats::Mixed);
+                    let (ib, eb) = Reader::of(f, v, Formats::Mixed).operand(b, x, e);
                     let room = (ib.mig() - eb).max(f64::MIN_POSITIVE);
                     pass(a, 1.0 / room, &mut lam);
                     pass(b, x[v.index()].mag() / room, &mut lam);
