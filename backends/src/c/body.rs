@@ -67,6 +67,11 @@ pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
     s
 }
 
+/// The name of value `index`'s copy converted to binary32 (`narrow`) or to binary64 ([`Body::converted`]).
+fn converted_name(index: usize, narrow: bool) -> String {
+    format!("robovec_{}{index}", if narrow { 'f' } else { 'd' })
+}
+
 /// The vector type of a batch's binary32 values (`narrow`) or of its other values.
 fn vector_type(narrow: bool) -> &'static str {
     if narrow {
@@ -135,6 +140,24 @@ pub(crate) fn format_vector_helpers(lanes: u32) -> String {
          #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 16\n  return (robovec_vec)_mm_fmadd_pd((__m128d)a, (__m128d)b, (__m128d)c);\n\
          #else\n  robovec_vec r;\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = fma(a[lane], b[lane], c[lane]);\n  return r;\n\
          #endif\n}}\n\
+         /* A binary32 input's lanes from the double array, an output's lanes into it: by 32- or 16-byte\n \
+         * instructions where the vector is one such register (no 64-byte double vector on an AVX-512 machine,\n \
+         * whose wide instructions lower the clock), lane by lane otherwise. */\n\
+         static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vec32 robovec_load32(const double *p)\n{{\n\
+         #if defined(__AVX__) && ROBOVEC_VEC32_BYTES == 32\n  \
+         return (robovec_vec32)_mm256_set_m128(_mm256_cvtpd_ps(_mm256_loadu_pd(p + 4)), _mm256_cvtpd_ps(_mm256_loadu_pd(p)));\n\
+         #elif defined(__SSE2__) && ROBOVEC_VEC32_BYTES == 16\n  \
+         return (robovec_vec32)_mm_movelh_ps(_mm_cvtpd_ps(_mm_loadu_pd(p)), _mm_cvtpd_ps(_mm_loadu_pd(p + 2)));\n\
+         #else\n  robovec_vec32 r;\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = (float)p[lane];\n  return r;\n\
+         #endif\n}}\n\
+         static inline ROBOVEC_UNUSED __attribute__((always_inline)) void robovec_store32(double *p, robovec_vec32 x)\n{{\n\
+         #if defined(__AVX__) && ROBOVEC_VEC32_BYTES == 32\n  \
+         _mm256_storeu_pd(p, _mm256_cvtps_pd(_mm256_castps256_ps128((__m256)x)));\n  \
+         _mm256_storeu_pd(p + 4, _mm256_cvtps_pd(_mm256_extractf128_ps((__m256)x, 1)));\n\
+         #elif defined(__SSE2__) && ROBOVEC_VEC32_BYTES == 16\n  \
+         _mm_storeu_pd(p, _mm_cvtps_pd((__m128)x));\n  _mm_storeu_pd(p + 2, _mm_cvtps_pd(_mm_movehl_ps((__m128)x, (__m128)x)));\n\
+         #else\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) p[lane] = (double)x[lane];\n\
+         #endif\n}}\n\
          static inline ROBOVEC_UNUSED robovec_vec robovec_fix_store_v(robovec_vec x, int f) {{ for (int lane = 0; lane < ROBOVEC_VL; lane++) x[lane] = robovec_fix_store(x[lane], f); return x; }}"
     );
     s.push('\n');
@@ -178,6 +201,11 @@ pub(crate) struct Body<'a> {
     /// never uses, before `dce`). Its statement is followed by `(void)NAME;`, so that
     /// `-Wall -Werror` builds pass (`-Wunused-variable`).
     unused: Vec<bool>,
+    /// A batch with formats: (value index, to binary32) of the operands already converted in the
+    /// statements written by this [`Body::statements_with`] call, whose converted copy
+    /// (`robovec_f{index}`, `robovec_d{index}`) later reads use: one conversion per value and
+    /// direction per part, not one per use (bit-identical: a conversion is a function of the value).
+    converted: std::cell::RefCell<std::collections::HashSet<(usize, bool)>>,
 }
 
 impl<'a> Body<'a> {
@@ -193,7 +221,7 @@ impl<'a> Body<'a> {
         let fused = if o.trig == Trig::Inline { fused_trig(f) } else { HashMap::new() };
         let block = if o.trig == Trig::Inline && o.batch == 1 { TrigBlock::of(f) } else { None };
         let unused = f.use_counts().iter().map(|&n| n == 0).collect();
-        Body { o, f, names, native, fused, block, ticker, unused }
+        Body { o, f, names, native, fused, block, ticker, unused, converted: Default::default() }
     }
 
     /// The values that have a statement, in the order they are written, and for each whether
@@ -273,6 +301,8 @@ impl<'a> Body<'a> {
                 let n = &self.names[w.index()];
                 if self.narrow(*w) == narrow {
                     n.clone()
+                } else if self.converted.borrow().contains(&(w.index(), narrow)) {
+                    converted_name(w.index(), narrow)
                 } else if self.o.batch > 1 {
                     format!("__builtin_convertvector({n}, {})", vector_type(narrow))
                 } else {
@@ -350,6 +380,7 @@ impl<'a> Body<'a> {
         let sfx = if self.o.f32() { "f" } else { "" };
         // Members of the trig block whose `after` waits for the block's statement.
         let mut waiting: Vec<Value> = Vec::new();
+        self.converted.borrow_mut().clear();
         for &v in order {
             if self.ticker.tick() {
                 return;
@@ -357,6 +388,12 @@ impl<'a> Body<'a> {
             let name = &self.names[v.index()];
             let def = &self.f.value(v).def;
             before(s, v);
+            // Not for callbacks (lane by lane) nor robovec's sin/cos (their own reads).
+            let own_reads = matches!(def, Def::Call(c, a) if !is_intrinsic(c, a.len()))
+                || (matches!(def, Def::Trig(..)) && self.o.trig == Trig::Inline);
+            if vec && self.f.has_formats() && !own_reads {
+                self.convert_operands(s, v);
+            }
             if let Some(b) = self.block.as_ref().filter(|b| b.slot_of.contains_key(&v.index())) {
                 waiting.push(v);
                 if b.members.last() == Some(&v) {
@@ -374,12 +411,18 @@ impl<'a> Body<'a> {
                 Def::Input | Def::Expr(_) => unreachable!("atomised bodies hold trig, binary ops and calls"),
                 Def::Trig(..) if self.fused.get(&v.index()).is_some_and(|&(_, leads)| !leads) => {} // with its partner
                 Def::Trig(t, a) if self.o.trig == Trig::Inline => {
-                    // robovec's sin/cos compute in the file's real type, then convert.
+                    // robovec's sin/cos compute in the file's real type, then convert; binary32
+                    // values of a batch in binary32 (`robovec_sincos_inline32`, trig::helpers_vec32).
                     let arg = self.read(&Operand::Value(*a), false);
-                    if let Some(&(other, _)) = self.fused.get(&v.index()) {
+                    let partner = self.fused.get(&v.index()).map(|&(other, _)| other);
+                    let all32 = vec && narrow && partner.is_none_or(|p| self.narrow(p));
+                    if let Some(other) = partner {
                         let (sin, cos) = if *t == TrigFn::Sin { (v, other) } else { (other, v) };
                         let (sn, cn) = (&self.names[sin.index()], &self.names[cos.index()]);
-                        if self.f.format(sin).is_default() && self.f.format(cos).is_default() {
+                        if all32 {
+                            let arg = self.read(&Operand::Value(*a), true);
+                            let _ = writeln!(s, "  robovec_vec32 {sn}, {cn};\n  robovec_sincos_inline32({arg}, &{sn}, &{cn});");
+                        } else if self.f.format(sin).is_default() && self.f.format(cos).is_default() {
                             let _ = writeln!(s, "  {real_ty} {sn}, {cn};\n  robovec_sincos_inline({arg}, &{sn}, &{cn});");
                         } else {
                             let _ = writeln!(
@@ -394,7 +437,12 @@ impl<'a> Body<'a> {
                         }
                     } else {
                         let fun = if *t == TrigFn::Sin { "sin" } else { "cos" };
-                        let _ = writeln!(s, "  const {ty} {name} = {};", self.stored(v, format!("robovec_{fun}_inline({arg})")));
+                        let expr = if all32 {
+                            format!("robovec_{fun}_inline32({})", self.read(&Operand::Value(*a), true))
+                        } else {
+                            self.stored(v, format!("robovec_{fun}_inline({arg})"))
+                        };
+                        let _ = writeln!(s, "  const {ty} {name} = {expr};");
                     }
                 }
                 Def::Trig(t, a) => {
@@ -495,6 +543,21 @@ impl<'a> Body<'a> {
             self.mark_unused(s, v);
             after(s, v);
         }
+    }
+
+    /// A batch with formats: the converted copy of each operand of `v`'s op read in another
+    /// format than the op computes in, written once per [`Body::statements_with`] call (see
+    /// [`Body::converted`]) just before the first statement that reads it.
+    fn convert_operands(&self, s: &mut String, v: Value) {
+        let narrow = self.narrow(v);
+        self.f.value(v).def.for_each_value(|w| {
+            if self.narrow(w) == narrow || self.converted.borrow().contains(&(w.index(), narrow)) {
+                return;
+            }
+            let expr = self.read(&Operand::Value(w), narrow);
+            let _ = writeln!(s, "  const {} {} = {expr};", vector_type(narrow), converted_name(w.index(), narrow));
+            self.converted.borrow_mut().insert((w.index(), narrow));
+        });
     }
 
     /// `(void)NAME;` after the statement of a value nothing reads ([`Body::unused`]); the

@@ -248,6 +248,9 @@ impl CodegenC {
         }
         if self.trig == Trig::Inline {
             helpers += &trig::helpers(self.f32(), self.batch > 1);
+            if formats && self.batch > 1 {
+                helpers += &trig::helpers_vec32();
+            }
         }
         s += &shared_helpers(&helpers);
         s

@@ -166,6 +166,10 @@ pub(crate) fn arrays(
                     let p = layout.params[p].0;
                     let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, {p} + {}{at}, sizeof {n});", e * w);
                 }
+                Source::Elem(p, e) if w > 1 && b.narrow(v) => {
+                    let p = layout.params[p].0;
+                    let _ = writeln!(s, "  const {vty} {n} = robovec_load32({p} + {}{at});", e * w);
+                }
                 Source::Elem(p, e) if w > 1 => {
                     // The arrays are of the file's real type: load, then store in the format.
                     let p = layout.params[p].0;
@@ -197,7 +201,10 @@ pub(crate) fn arrays(
             let p = layout.params[p].0;
             if w > 1 {
                 match x {
-                    Operand::Value(v) if !b.narrow(*v) => {
+                    Operand::Value(v) if b.narrow(*v) => {
+                        let _ = writeln!(s, "  robovec_store32({p} + {}{at}, {});", el * w, names[v.index()]);
+                    }
+                    Operand::Value(_) => {
                         let _ = writeln!(s, "  memcpy({p} + {}{at}, &{e}, sizeof {e});", el * w);
                     }
                     _ => {

@@ -284,6 +284,46 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
     s
 }
 
+/// The vector helpers of [`helpers`] for the binary32 values of a batch whose values carry
+/// numeric formats (`robovec_vec32` beside `robovec_vec`, [`super::body::format_vector_helpers`]):
+/// the `float` code under names ending in `32` (`robovec_sincos_inline32`,
+/// `robovec_sin_inline32`, …, on `robovec_vec32`, with `robovec_fma32`), so that both forms
+/// live in one file. Within 1 ulp of binary32, as `precision=f32`'s.
+pub(crate) fn helpers_vec32() -> String {
+    const RENAMED: [&str; 10] = [
+        "robovec_vec",
+        "robovec_uvec",
+        "robovec_ivec",
+        "robovec_sincos_inline",
+        "robovec_sin_inline",
+        "robovec_cos_inline",
+        "robovec_fma",
+        "robovec_splat",
+        "ROBOVEC_MADD",
+        "ROBOVEC_VEC_BYTES",
+    ];
+    let text = helpers(true, true);
+    let mut out = String::with_capacity(text.len() + 256);
+    let mut word = String::new();
+    let flush = |word: &mut String, out: &mut String| {
+        out.push_str(word);
+        if RENAMED.contains(&word.as_str()) {
+            out.push_str("32");
+        }
+        word.clear();
+    };
+    for ch in text.chars() {
+        if ch.is_ascii_alphanumeric() || ch == '_' {
+            word.push(ch);
+        } else {
+            flush(&mut word, &mut out);
+            out.push(ch);
+        }
+    }
+    flush(&mut word, &mut out);
+    out
+}
+
 /// `trig=inline`, one state: the length of the argument array of `robovec_sincos_n` is a
 /// multiple of this (64 bytes: the lanes of the widest vector, AVX-512), so that every vector
 /// width divides it and the loop needs no scalar remainder.
