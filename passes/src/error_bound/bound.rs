@@ -304,7 +304,14 @@ impl Reader<'_> {
                     return (r, err);
                 }
                 let m = up(r.mag() + err);
-                let conv = if m > f32::MAX as f64 { f64::INFINITY } else { Rounding::F32.of(m) };
+                let conv = if m > f32::MAX as f64 {
+                    f64::INFINITY
+                } else if r.lo == r.hi && err == 0.0 {
+                    // An exact point (a fixed parameter): its rounding is known exactly.
+                    up((r.lo - r.lo as f32 as f64).abs())
+                } else {
+                    Rounding::F32.of(m)
+                };
                 (r, up(err + conv))
             }
             Operand::Const(c) => {
