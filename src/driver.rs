@@ -510,6 +510,14 @@ fn run_passes(
             return Err(f);
         }
     }
+    // `-report-dir`'s cost-against-budget figure: the budget ladder of the reported function,
+    // when the pipeline's `precision` gave it formats (its target and domain).
+    if opts.report_dir.is_some() {
+        if let Ok(f) = select(&session.module, &opts.function, "-report-dir") {
+            let name = f.name.clone();
+            robovec_passes::precision::ladder::study(&session.module, &mut session.cx, &name);
+        }
+    }
     for s in session.cx.lines(robovec_passes::Severity::Stop) {
         writeln!(stderr, "note: {s}").map_err(stderr_failure)?;
     }

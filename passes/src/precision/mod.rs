@@ -31,6 +31,7 @@
 
 pub mod budget;
 pub mod choose;
+pub mod ladder;
 
 use robovec_ir::Module;
 use serde::Serialize;
@@ -148,7 +149,7 @@ impl Pass for PrecisionPass {
             }
             reports.push(c.report(&f.name));
         }
-        cx.emit(PrecisionRun { functions: reports });
+        cx.emit(PrecisionRun { functions: reports, target, domain: dom });
         Ok(())
     }
 }
@@ -224,6 +225,11 @@ impl std::fmt::Display for PrecisionReport {
 pub struct PrecisionRun {
     /// Per function.
     pub functions: Vec<PrecisionReport>,
+    /// The run's target.
+    pub target: Target,
+    /// The domain the run enclosed the functions over (the run's, with the pass's
+    /// `ranges=FILE` applied): what [`ladder::study`] reads to run the chooser again.
+    pub domain: robovec_ir::domain::Domain,
 }
 
 impl crate::Artifact for PrecisionRun {
