@@ -441,7 +441,8 @@ pub fn run_with(
 }
 
 /// Runs `-pareto` (before the pipeline, on the input), the pipeline's session with its dumps
-/// staged in `out`, then `-check`; prints the early-stop notes. `deadline` is the run's,
+/// staged in `out`, `-report-dir`'s budget ladder (`precision::ladder::study`), then `-check`;
+/// prints the early-stop notes. `deadline` is the run's,
 /// started before loading.
 #[allow(clippy::too_many_arguments)]
 fn run_passes(

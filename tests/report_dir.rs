@@ -457,7 +457,10 @@ fn precision_draws_cost_against_budget_and_pareto_its_certified_bounds() {
     assert_eq!(par.len(), 2);
     for (c, row) in par.iter().zip(rows) {
         let k = c.len();
-        assert_eq!([f(&c[k - 2]), f(&c[k - 1])], [num(&row["certified"]["f32_max_rel"]), num(&row["certified"]["f64_max_rel"])]);
+        assert_eq!(
+            [f(&c[k - 2]), f(&c[k - 1])],
+            [num(&row["certified"]["f32_max_rel"]), num(&row["certified"]["f64_max_rel"])]
+        );
     }
     for (fmt, k) in [("f32", 2), ("f64", 1)] {
         let direct = arm_report(&d, &format!("-passes=atomise,range,error-bound<format={fmt}>"));

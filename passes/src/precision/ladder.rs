@@ -88,16 +88,20 @@ pub fn ladder(
 /// (its last [`PrecisionRun`] with a report of it: that run's target and domain), emitted into
 /// `cx` as an artifact; nothing when no `precision` ran on it. `-time-limit` (`cx.deadline`,
 /// and `cx.tick_budget` in tests) stops it as the module doc says, with a note in
-/// `cx`'s early stops (`-report-dir: budget ladder stopped …`); a function that cannot be
+/// `cx`'s early stops (`-report-dir: budget ladder stopped …`), keeping back the time of the
+/// output's tail ([`crate::time_limit::kept_for`]); a function that cannot be
 /// enclosed gets a note and no ladder (the figure is then not drawn).
 pub fn study(module: &Module, cx: &mut PassContext, function: &str) {
-    let Some(run) = cx.artifacts_of::<PrecisionRun>().filter(|r| r.functions.iter().any(|p| p.function == function)).last()
+    let Some(run) =
+        cx.artifacts_of::<PrecisionRun>().filter(|r| r.functions.iter().any(|p| p.function == function)).last()
     else {
         return;
     };
     let Some(f) = module.function(function) else { return };
     let (target, domain) = (run.target, run.domain.clone());
-    let ticker = Ticker::new(cx.deadline, cx.tick_budget);
+    // Skippable work: it stops early enough for the output's tail, as the passes do.
+    let kept = crate::time_limit::kept_for(crate::manager::module_ops(module));
+    let ticker = Ticker::new(cx.deadline.map(|d| d.keeping(kept)), cx.tick_budget);
     match ladder(f, &domain, target, &BUDGETS, &ticker) {
         Ok(l) => {
             if let Some(why) = &l.stopped {

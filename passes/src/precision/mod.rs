@@ -28,6 +28,9 @@
 //! user's); `mcu` estimates cycles of a Cortex-M3-class core without an FPU: fixed-point add 1,
 //! multiply 3 (`SMULL`, round, shift), binary32 operation 50 and binary64 100 (software
 //! floating point, order of magnitude), conversions 20.
+//!
+//! [`ladder`]: the same search at budgets 10⁻² … 10⁻¹⁰, for `-report-dir`'s figure of cost
+//! against the budget.
 
 pub mod budget;
 pub mod choose;

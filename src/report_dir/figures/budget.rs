@@ -76,7 +76,8 @@ pub(super) fn budget(d: &ReportData) -> Result<Figure> {
         );
     }
     let bx = |p: &PrecisionReport| p.budget.unwrap_or(1.0).log10();
-    let (x_lo, x_hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(bx(p)), hi.max(bx(p))));
+    let (x_lo, x_hi) =
+        pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(bx(p)), hi.max(bx(p))));
     let (x_lo, x_hi) = if x_lo.is_finite() { (x_lo - 0.4, x_hi + 0.4) } else { (-10.4, -1.6) };
     let mut svg = String::new();
     {
@@ -123,7 +124,9 @@ pub(super) fn budget(d: &ReportData) -> Result<Figure> {
                 .map_err(err)?
                 .label(label)
                 .legend(line_key(c, 2));
-            chart.draw_series(pts.iter().map(|p| TriangleMarker::new((bx(p), share(p, k)), 5, c.filled()))).map_err(err)?;
+            chart
+                .draw_series(pts.iter().map(|p| TriangleMarker::new((bx(p), share(p, k)), 5, c.filled())))
+                .map_err(err)?;
         }
         legend(&mut chart)?;
 
@@ -159,7 +162,10 @@ pub(super) fn budget(d: &ReportData) -> Result<Figure> {
             .legend(line_key(grey, 1));
         let c = PALETTE[2];
         chart
-            .draw_series(LineSeries::new(pts.iter().map(|p| (bx(p), l10(p.max_rel_to_range, floor))), c.stroke_width(2)))
+            .draw_series(LineSeries::new(
+                pts.iter().map(|p| (bx(p), l10(p.max_rel_to_range, floor))),
+                c.stroke_width(2),
+            ))
             .map_err(err)?
             .label("certified max bound / range, chosen formats")
             .legend(line_key(c, 2));
