@@ -441,7 +441,8 @@ pub fn run_with(
 }
 
 /// Runs `-pareto` (before the pipeline, on the input), the pipeline's session with its dumps
-/// staged in `out`, then `-check`; prints the early-stop notes. `deadline` is the run's,
+/// staged in `out`, `-report-dir`'s budget ladder (`precision::ladder::study`), then `-check`;
+/// prints the early-stop notes. `deadline` is the run's,
 /// started before loading.
 #[allow(clippy::too_many_arguments)]
 fn run_passes(
@@ -508,6 +509,14 @@ fn run_passes(
             // A run that fails past its limit leaves its module to the exit.
             leave_past_deadline(std::mem::take(&mut session.module), deadline.as_ref());
             return Err(f);
+        }
+    }
+    // `-report-dir`'s cost-against-budget figure: the budget ladder of the reported function,
+    // when the pipeline's `precision` gave it formats (its target and domain).
+    if opts.report_dir.is_some() {
+        if let Ok(f) = select(&session.module, &opts.function, "-report-dir") {
+            let name = f.name.clone();
+            robovec_passes::precision::ladder::study(&session.module, &mut session.cx, &name);
         }
     }
     for s in session.cx.lines(robovec_passes::Severity::Stop) {

@@ -214,3 +214,49 @@ fn a_stopped_search_keeps_accepted_formats() {
         assert_within(&format!("stopped seed {seed}"), &g, &dom, &named, seed);
     }
 }
+
+/// The budget ladder of `-report-dir`'s cost-against-budget figure: each point is `choose` at
+/// that budget (run here directly, on the function without formats), the certified bound within
+/// the budget, the cost never above binary64's; a tick budget stops it with the points finished
+/// and says where, never a panic.
+#[test]
+fn the_budget_ladder_is_the_chooser_at_each_budget() {
+    use robovec_passes::precision::budget::Budget;
+    use robovec_passes::precision::ladder::{ladder, BUDGETS};
+    for seed in 0..12u64 {
+        let (f, dom) = random_function(seed * 7 + 3, 20 + seed as usize);
+        let x = enclose_with(&f, &dom, Some(robovec_passes::range::affine::DEFAULT_TERMS), || false).unwrap();
+        for target in [Target::C, Target::Mcu] {
+            // The ladder runs on the function with formats already chosen: they are ignored.
+            let formatted = with_choice(&f, &dom, 1e-3, target).map_or_else(|| f.clone(), |(g, _)| g);
+            let Ok(l) = ladder(&formatted, &dom, target, &BUDGETS, &robovec_passes::Ticker::new(None, None)) else {
+                continue;
+            };
+            assert_eq!(l.stopped, None);
+            assert_eq!(l.points.len(), BUDGETS.len(), "seed {seed}");
+            for (p, &b) in l.points.iter().zip(&BUDGETS) {
+                let direct = choose(&f, &x, &vec![Budget::Rel(b); f.outputs.len()], target, || false).unwrap();
+                assert_eq!(p, &direct.report(&f.name), "seed {seed} {target:?} {b:e}");
+                assert_eq!(p.budget, Some(b));
+                assert!(p.cost_after <= p.cost_before, "seed {seed} {b:e}: {p:?}");
+                if p.unreachable.is_empty() {
+                    assert!(p.max_rel_to_range <= b, "seed {seed} {b:e}: {p:?}");
+                }
+            }
+        }
+    }
+    // Stopped by a tick budget: fewer points, each still the chooser's, and the reason.
+    let (f, dom) = random_function(11, 40);
+    let counted = robovec_passes::Ticker::new(None, None);
+    let full = ladder(&f, &dom, Target::C, &BUDGETS, &counted).unwrap();
+    let total = counted.ticks();
+    let mut cut = None;
+    for ticks in [1, total / 4, total / 2, total * 3 / 4, total - 1] {
+        let l = ladder(&f, &dom, Target::C, &BUDGETS, &robovec_passes::Ticker::new(None, Some(ticks))).unwrap();
+        let why = l.stopped.as_deref().unwrap_or_else(|| panic!("{ticks} ticks: not stopped"));
+        assert!(why.contains("tick budget of"), "{why}");
+        assert_eq!(l.points[..], full.points[..l.points.len()], "{ticks} ticks");
+        cut = cut.max(Some(l.points.len()));
+    }
+    assert!(cut.unwrap() > 0, "some budget stops after a point");
+}

@@ -154,18 +154,21 @@ fn every_figure_is_svg_and_draws_the_reports_numbers() {
         let n = if c[0] == "add" { num(&p["n_add"]) } else { num(&p["n_mul"]) };
         assert!(f(&c[1]) < n && f(&c[2]) < cycles_placed);
     }
-    // Pareto: time and mean bits of each row (columns from the end: the pipeline is quoted).
+    // Pareto: time and mean bits of each row (columns from the end: the pipeline is quoted);
+    // no domain, so the two certified columns at the end are empty.
     let par = csv_rows(&dir, "pareto.csv");
     let rows = r["pareto"].as_array().unwrap();
     assert_eq!(par.len(), rows.len());
     for (c, row) in par.iter().zip(rows) {
         let k = c.len();
         assert_eq!(
-            [f(&c[k - 5]), f(&c[k - 4]), f(&c[k - 3])],
+            [f(&c[k - 7]), f(&c[k - 6]), f(&c[k - 5])],
             [num(&row["time_cycles"]), num(&row["f32"]["mean_bits"]), num(&row["f64"]["mean_bits"])]
         );
-        assert_eq!(c[k - 2], row["pareto_optimal"].to_string());
+        assert_eq!(c[k - 4], row["pareto_optimal"].to_string());
+        assert_eq!([c[k - 2].as_str(), c[k - 1].as_str()], ["", ""]);
     }
+    assert!(md.contains("cost-against-budget figure needs `precision`"), "{md}");
 }
 
 #[test]
@@ -353,4 +356,124 @@ fn no_other_output_may_go_inside_the_report_folder() {
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing written");
+}
+
+const ARM: &str = "examples/three_link_arm/three_link_arm.urdf";
+
+/// `-ranges` for `ARM`: its continuous joint's velocity (the URDF's limits give the rest).
+fn arm_ranges(d: &Path) -> String {
+    let path = d.join("ranges.json");
+    std::fs::write(&path, r#"{"qd[2]": [-3, 3]}"#).unwrap();
+    format!("-ranges={}", path.display())
+}
+
+/// The report of `ARM @invdyna` over [`arm_ranges`] after `passes`, read as JSON.
+fn arm_report(d: &Path, passes: &str) -> Value {
+    let report = d.join("direct.json");
+    let o = opt(&[
+        ARM,
+        "-function=invdyna",
+        &arm_ranges(d),
+        passes,
+        &format!("-report={}", report.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    assert!(o.status.success(), "{passes}: {}", stderr(&o));
+    serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap()
+}
+
+/// Issue 48 item 6: with `precision` in the pipeline, the cost-against-budget figure has one
+/// CSV row per budget of the ladder, each the report `precision` itself writes at that budget
+/// (the pass run directly), certified within its budget; with a domain (the URDF's limits and
+/// `-ranges`), `-pareto`'s CSV and
+/// table carry each row's certified bounds, as `error-bound` and `range` compute them directly.
+#[test]
+fn precision_draws_cost_against_budget_and_pareto_its_certified_bounds() {
+    use robovec_passes::precision::ladder::BUDGETS;
+    let d = tmp("budget");
+    let dir = d.join("rep");
+    let o = opt(&[
+        ARM,
+        "-function=invdyna",
+        &arm_ranges(&d),
+        "-passes=atomise,precision<budget=1e-5;target=mcu>",
+        "-pareto=atomise;atomise,balance",
+        "-pareto-samples=20",
+        &format!("-report-dir={}", dir.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: Value = serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    let svg = std::fs::read_to_string(dir.join("budget.svg")).unwrap();
+    roxmltree::Document::parse(&svg).unwrap();
+    assert!(md.contains("](budget.svg)") && md.contains("not measured"), "{md}");
+    assert!(!md.contains("cost-against-budget figure needs"), "{md}");
+
+    // One row per budget, in the ladder's order; each the pass's own report at that budget.
+    let text = std::fs::read_to_string(dir.join("budget.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
+    let rows = csv_rows(&dir, "budget.csv");
+    assert_eq!(rows.len(), BUDGETS.len());
+    assert_eq!(r["precision_ladder"]["points"].as_array().unwrap().len(), BUDGETS.len());
+    assert_eq!(r["precision_ladder"]["target"], "mcu");
+    let mut pass_costs = Vec::new();
+    for (row, &b) in rows.iter().zip(&BUDGETS) {
+        assert_eq!(f(&row[col("budget")]), b);
+        let p = &arm_report(&d, &format!("-passes=atomise,precision<budget={b:e};target=mcu>"))["precision"];
+        for key in ["cost_before", "cost_after", "max_rel_to_range"] {
+            assert_eq!(f(&row[col(key)]), num(&p[key]), "{key} at {b:e}");
+        }
+        let count = |pick: &dyn Fn(&str) -> bool| -> f64 {
+            p["formats"].as_object().unwrap().iter().filter(|(k, _)| pick(k)).map(|(_, n)| num(n)).sum()
+        };
+        assert_eq!(f(&row[col("fixed_values")]), count(&|k| k.starts_with("fix<")));
+        assert_eq!(f(&row[col("f32_values")]), count(&|k| k == "f32"));
+        assert_eq!(f(&row[col("f64_values")]), count(&|k| k == "f64"));
+        assert_eq!(f(&row[col("unreachable")]), p["unreachable"].as_array().unwrap().len() as f64);
+        assert!(f(&row[col("cost_after")]) <= f(&row[col("cost_before")]));
+        if p["unreachable"].as_array().unwrap().is_empty() {
+            assert!(f(&row[col("max_rel_to_range")]) <= b, "certified within {b:e}");
+        }
+        pass_costs.push(num(&p["cost_after"]));
+    }
+    // The pipeline's own point (1e-5) is on the ladder.
+    let k = BUDGETS.iter().position(|&b| b == 1e-5).unwrap();
+    assert_eq!(pass_costs[k], num(&r["precision"]["cost_after"]));
+    // Looser budgets never cost more here (the chooser does not promise it in general).
+    assert!(pass_costs.windows(2).all(|w| w[0] <= w[1]), "{pass_costs:?}");
+
+    // -pareto: the certified columns (appended last), equal to the report's and to error-bound's
+    // bound over range's enclosure of each output, computed directly.
+    let text = std::fs::read_to_string(dir.join("pareto.csv")).unwrap();
+    assert!(text.starts_with(
+        "index,pipeline,time_cycles,f32_mean_bits,f64_mean_bits,pareto_optimal,sound,f32_certified_max_rel,f64_certified_max_rel\n"
+    ));
+    let par = csv_rows(&dir, "pareto.csv");
+    let rows = r["pareto"].as_array().unwrap();
+    assert_eq!(par.len(), 2);
+    for (c, row) in par.iter().zip(rows) {
+        let k = c.len();
+        assert_eq!(
+            [f(&c[k - 2]), f(&c[k - 1])],
+            [num(&row["certified"]["f32_max_rel"]), num(&row["certified"]["f64_max_rel"])]
+        );
+    }
+    for (fmt, k) in [("f32", 2), ("f64", 1)] {
+        let direct = arm_report(&d, &format!("-passes=atomise,range,error-bound<format={fmt}>"));
+        let mut worst = 0.0f64;
+        for (name, enclosure) in direct["range"]["outputs"].as_object().unwrap() {
+            let mag = enclosure.as_array().unwrap().iter().map(|v| num(v).abs()).fold(0.0, f64::max);
+            let abs = num(&direct["error_bound"]["outputs"][name]["abs"]);
+            if mag > 0.0 {
+                worst = worst.max(abs / mag);
+            }
+        }
+        let got = f(&par[0][par[0].len() - k]);
+        assert!((got - worst).abs() <= 1e-12 * worst, "{fmt}: pareto {got:e}, direct {worst:e}");
+    }
+    assert!(md.contains("f32 certified max rel"), "{md}");
 }

@@ -1,14 +1,15 @@
 //! The report's numbers that `report.md` and the figures show, as the run made them: the final
-//! IR's `stats` and `placement` (occupation, timeline), the `sweep` rows, the `pareto` rows and
-//! the `accuracy` of the reported function and the `stopped_early` notes, taken from the run's
-//! artifacts and final figures as their own types ([`Stats`], [`SweepRow`] of each
-//! [`SweepTable`], [`ParetoRow`] of the [`ParetoRun`], the final IR's [`PlacementReport`], the
-//! last [`AccuracyReport`]), the same values the report JSON holds under the same keys (SPEC
+//! IR's `stats` and `placement` (occupation, timeline), the `sweep` rows, the `pareto` rows,
+//! the `accuracy` and `precision_ladder` of the reported function and the `stopped_early`
+//! notes, taken from the run's artifacts and final figures as their own types ([`Stats`],
+//! [`SweepRow`] of each [`SweepTable`], [`ParetoRow`] of the [`ParetoRun`], the final IR's
+//! [`PlacementReport`], the last [`AccuracyReport`], the [`BudgetLadder`]), the same values the report JSON holds under the same keys (SPEC
 //! §7; the report writes them from these types, `tests/report_dir.rs` checks the figures' CSVs
 //! against the JSON). Nothing is parsed back.
 
 use robovec_passes::accuracy::report::{AccuracyReport, AccuracyRun};
 use robovec_passes::place::report::PlacementReport;
+use robovec_passes::precision::ladder::BudgetLadder;
 use robovec_passes::summary::{Figures, Stats};
 use robovec_passes::sweep::{SweepRow, SweepTable};
 use robovec_passes::whole_run::pareto::{ParetoRow, ParetoRun};
@@ -37,6 +38,10 @@ pub struct ReportData {
     pub pareto: Vec<ParetoRow>,
     /// The last `accuracy` measurement of the function, if any.
     pub accuracy: Option<AccuracyReport>,
+    /// The report's `precision_ladder`: the cost of `precision`'s formats at each budget of
+    /// [`robovec_passes::precision::ladder::BUDGETS`], computed for `-report-dir` when the
+    /// pipeline's `precision` gave the function formats ([`robovec_passes::precision::ladder::study`]).
+    pub precision_ladder: Option<BudgetLadder>,
     /// The early stops of the run (`stopped_early`), in order.
     pub stopped_early: Vec<String>,
 }
@@ -63,6 +68,7 @@ impl ReportData {
             .last()
             .map(|p| p.rows.clone())
             .unwrap_or_default();
+        let precision_ladder = cx.artifacts_of::<BudgetLadder>().filter(|l| l.function == function).last().cloned();
         let accuracy = cx
             .artifacts_of::<AccuracyRun>()
             .filter_map(|a| a.reports.iter().rev().find(|r| r.function == function))
@@ -78,6 +84,7 @@ impl ReportData {
             placement: own.placement.clone(),
             pareto,
             accuracy,
+            precision_ladder,
             stopped_early: cx.stopped(),
             function,
         }

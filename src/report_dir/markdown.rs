@@ -1,5 +1,5 @@
 //! `report.md`: the report as a readable page — the run, the final IR's figures, the tables of
-//! the report (sweep, Pareto, accuracy) and the figures embedded as images — written from the
+//! the report (sweep, Pareto, accuracy, the budget ladder) and the figures embedded as images — written from the
 //! run's typed results ([`ReportData`]), the same values `report.json` holds, printed as its
 //! numbers read: integers as they are, fractions to 3 decimals, a missing value as `-`.
 
@@ -125,11 +125,15 @@ pub fn markdown(d: &ReportData, figures: &[Figure]) -> String {
     }
     if !d.pareto.is_empty() {
         let _ = writeln!(s, "\n## Speed against error (`-pareto`)\n");
-        let _ =
-            writeln!(s, "| # | pipeline | time (cycles) | f32 mean bits | f64 mean bits | Pareto-optimal | sound |");
-        let _ = writeln!(s, "|---:|---|---:|---:|---:|---|---|");
+        // With a domain, the certified bounds (`error-bound`'s, largest bound / output range)
+        // beside the sampled bits, as the last two columns.
+        let certified = d.pareto.iter().any(|r| r.certified.is_some());
+        let _ = write!(s, "| # | pipeline | time (cycles) | f32 mean bits | f64 mean bits | Pareto-optimal | sound |");
+        let _ = writeln!(s, "{}", if certified { " f32 certified max rel | f64 certified max rel |" } else { "" });
+        let _ = writeln!(s, "|---:|---|---:|---:|---:|---|---|{}", if certified { "---:|---:|" } else { "" });
+        let sci = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.3e}"));
         for (i, r) in d.pareto.iter().enumerate() {
-            let _ = writeln!(
+            let _ = write!(
                 s,
                 "| {} | `{}` | {} | {:.3} | {:.3} | {} | {} |",
                 i + 1,
@@ -139,6 +143,38 @@ pub fn markdown(d: &ReportData, figures: &[Figure]) -> String {
                 r.f64.mean_bits,
                 if r.pareto_optimal { "yes" } else { "" },
                 if r.sound { "yes" } else { "no" }
+            );
+            if certified {
+                let (a, b) = r.certified.map_or((None, None), |c| (c.f32_max_rel, c.f64_max_rel));
+                let _ = write!(s, " {} | {} |", sci(a), sci(b));
+            }
+            let _ = writeln!(s);
+        }
+    }
+    if let Some(l) = d.precision_ladder.as_ref().filter(|l| !l.points.is_empty()) {
+        let _ = writeln!(s, "\n## Cost against error budget (`precision`, target {})\n", l.target);
+        let _ = writeln!(
+            s,
+            "The chooser of `precision` run again at each budget with the pipeline's target and domain; cost is the \
+             target's cost model (the pass's documentation), not a measurement.\n"
+        );
+        let _ = writeln!(
+            s,
+            "| budget | cost before | cost after | after / before | values f64 / f32 / fixed | certified max bound / range | worst output | unreachable outputs |"
+        );
+        let _ = writeln!(s, "|---:|---:|---:|---:|---|---:|---|---:|");
+        for p in &l.points {
+            let (a, b, c) = super::figures::budget::per_kind(p);
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {:.3} | {a} / {b} / {c} | {:.3e} | {} | {} |",
+                p.budget.map_or("-".to_string(), |b| format!("{b:e}")),
+                p.cost_before.num(),
+                p.cost_after.num(),
+                super::figures::budget::ratio(p),
+                p.max_rel_to_range,
+                cell(p.worst_output.as_deref().unwrap_or("-")),
+                p.unreachable.len()
             );
         }
     }
@@ -161,6 +197,13 @@ pub fn markdown(d: &ReportData, figures: &[Figure]) -> String {
     }
     if d.pareto.is_empty() {
         missing.push("the speed-against-error figure needs `-pareto=A;B;…`");
+    }
+    if d.precision_ladder.as_ref().is_none_or(|l| l.points.is_empty()) {
+        missing.push(if d.precision_ladder.is_some() {
+            "the cost-against-budget figure's ladder stopped before its first budget (see the early stops above)"
+        } else {
+            "the cost-against-budget figure needs `precision` in the pipeline"
+        });
     }
     if !missing.is_empty() {
         let _ = writeln!(s, "Not drawn: {}.", missing.join("; "));

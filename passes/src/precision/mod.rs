@@ -28,9 +28,13 @@
 //! user's); `mcu` estimates cycles of a Cortex-M3-class core without an FPU: fixed-point add 1,
 //! multiply 3 (`SMULL`, round, shift), binary32 operation 50 and binary64 100 (software
 //! floating point, order of magnitude), conversions 20.
+//!
+//! [`ladder`]: the same search at budgets 10⁻² … 10⁻¹⁰, for `-report-dir`'s figure of cost
+//! against the budget.
 
 pub mod budget;
 pub mod choose;
+pub mod ladder;
 
 use robovec_ir::Module;
 use serde::Serialize;
@@ -148,7 +152,7 @@ impl Pass for PrecisionPass {
             }
             reports.push(c.report(&f.name));
         }
-        cx.emit(PrecisionRun { functions: reports });
+        cx.emit(PrecisionRun { functions: reports, target, domain: dom });
         Ok(())
     }
 }
@@ -224,6 +228,11 @@ impl std::fmt::Display for PrecisionReport {
 pub struct PrecisionRun {
     /// Per function.
     pub functions: Vec<PrecisionReport>,
+    /// The run's target.
+    pub target: Target,
+    /// The domain the run enclosed the functions over (the run's, with the pass's
+    /// `ranges=FILE` applied): what [`ladder::study`] reads to run the chooser again.
+    pub domain: robovec_ir::domain::Domain,
 }
 
 impl crate::Artifact for PrecisionRun {

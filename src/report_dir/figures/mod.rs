@@ -7,17 +7,20 @@
 //!
 //! This file has what every figure shares (the heading, ticks, colours); `sweep.rs` the figures
 //! over N (cycles, µs, parallelisation, memory), `placement.rs` the placed function's
-//! occupation and timeline, `pareto.rs` speed against error.
+//! occupation and timeline, `pareto.rs` speed against error, `budget.rs` the cost of
+//! `precision`'s formats against the error budget.
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::data::ReportData;
 
+pub(crate) mod budget;
 mod pareto;
 mod placement;
 mod sweep;
 
+use budget::budget;
 use pareto::pareto;
 use placement::{occupation, timeline};
 use sweep::{cycles, memory, microseconds, parallelisation};
@@ -120,6 +123,9 @@ pub fn all(d: &ReportData) -> Result<Vec<Figure>> {
     }
     if !d.pareto.is_empty() {
         out.push(pareto(d)?);
+    }
+    if d.precision_ladder.as_ref().is_some_and(|l| !l.points.is_empty()) {
+        out.push(budget(d)?);
     }
     Ok(out)
 }

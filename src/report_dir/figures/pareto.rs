@@ -1,27 +1,38 @@
-//! Speed against error (`-pareto`): each pipeline's cycles against its bits of error.
+//! Speed against error (`-pareto`): each pipeline's cycles against its bits of error, with its
+//! certified bound beside them when the run has a domain.
 
 use plotters::prelude::*;
 
-use robovec_passes::whole_run::pareto::ParetoRow;
+use robovec_passes::whole_run::pareto::{Certified, ParetoRow};
 
 use super::{err, legend, line_key, max_of, svg_area, tick, titled, Figure, Result, PALETTE, SIZE};
 use crate::report_dir::data::ReportData;
 
 /// The speed-against-error plane of `-pareto`: time (placed cycles, else critical path)
-/// against mean bits of error in binary32 and binary64; Pareto-optimal rows joined.
+/// against mean bits of error in binary32 and binary64; Pareto-optimal rows joined; with a
+/// domain, each row's certified binary32 bound (relative to the output's range) written beside
+/// its point and both bounds in the CSV's last two columns.
 pub(super) fn pareto(d: &ReportData) -> Result<Figure> {
     let rows = &d.pareto;
-    let mut csv = String::from("index,pipeline,time_cycles,f32_mean_bits,f64_mean_bits,pareto_optimal,sound\n");
+    // The certified columns come last (other tools read the first seven by position); empty
+    // without a domain or where the row has no finite bound.
+    let mut csv = String::from(
+        "index,pipeline,time_cycles,f32_mean_bits,f64_mean_bits,pareto_optimal,sound,f32_certified_max_rel,f64_certified_max_rel\n",
+    );
+    let opt = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
     for (i, r) in rows.iter().enumerate() {
+        let (c32, c64) = r.certified.map_or((None, None), |c| (c.f32_max_rel, c.f64_max_rel));
         csv += &format!(
-            "{},\"{}\",{},{},{},{},{}\n",
+            "{},\"{}\",{},{},{},{},{},{},{}\n",
             i + 1,
             r.pipeline.replace('"', "\"\""),
             r.time_cycles,
             r.f32.mean_bits,
             r.f64.mean_bits,
             r.pareto_optimal,
-            r.sound
+            r.sound,
+            opt(c32),
+            opt(c64)
         );
     }
     let x_max = max_of(rows.iter().flat_map(|r| [r.f32.mean_bits, r.f64.mean_bits])).max(0.5) * 1.15;
@@ -68,10 +79,21 @@ pub(super) fn pareto(d: &ReportData) -> Result<Figure> {
             .map_err(err)?
             .label("binary64")
             .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, c64.filled()));
+        // Each binary32 point is labelled with its row number and, with a domain, its certified
+        // bound beside the sampled bits (`≤ 3.1e-6`: largest binary32 bound / output range).
         chart
             .draw_series(rows.iter().enumerate().map(|(i, r)| {
                 let mark = if r.sound { "" } else { " (unsound)" };
-                Text::new(format!("{}{mark}", i + 1), (r.f32.mean_bits, f64::from(r.time_cycles)), ("sans-serif", 13))
+                let cert = match r.certified {
+                    Some(Certified { f32_max_rel: Some(b), .. }) => format!(" certified ≤ {b:.1e}"),
+                    Some(_) => " certified: -".to_string(),
+                    None => String::new(),
+                };
+                Text::new(
+                    format!("{}{mark}{cert}", i + 1),
+                    (r.f32.mean_bits, f64::from(r.time_cycles)),
+                    ("sans-serif", 13),
+                )
             }))
             .map_err(err)?;
         legend(&mut chart)?;
@@ -79,7 +101,11 @@ pub(super) fn pareto(d: &ReportData) -> Result<Figure> {
     }
     Ok(Figure {
         name: "pareto",
-        caption: "Speed against error of the -pareto pipelines (numbers: the rows of the table above); the line joins the Pareto-optimal rows".into(),
+        caption: if rows.iter().any(|r| r.certified.is_some()) {
+            "Speed against error of the -pareto pipelines (numbers: the rows of the table above); the line joins the Pareto-optimal rows; beside each binary32 point its certified bound over the domain (error-bound: largest bound / output range; the sampled bits are Herbie's mean over the samples)".into()
+        } else {
+            "Speed against error of the -pareto pipelines (numbers: the rows of the table above); the line joins the Pareto-optimal rows".into()
+        },
         svg,
         csv,
     })
