@@ -5,7 +5,7 @@
 # rotated, medians of ns/state and of paired ratios), on UR5, Panda and Talos over their URDF
 # limits, for each function given (default invdyna: RNEA).
 #
-#   scripts/precision_speed.sh [--budget=1e-5] [--runs=2] [--flags="-O3 -march=native -mno-avx512f"] [FUNCTION…]
+#   scripts/precision_speed.sh [--budget=1e-5] [--runs=2] [--flags="-O3 -march=native -mno-avx512f"] [--trig=inline|input] [FUNCTION…]
 #
 # Needs a release robovec-opt (cargo build --release), cc, and the example-robot-data URDFs of
 # the Pinocchio venv (target/pinocchio-venv, scripts/test.sh makes it). Prints a Markdown table.
@@ -14,12 +14,14 @@ cd "$(dirname "$0")/.."
 budget=1e-5
 runs=2
 flags="-O3 -march=native -mno-avx512f"
+trig=inline
 functions=()
 for a in "$@"; do
   case "$a" in
     --budget=*) budget="${a#*=}" ;;
     --runs=*) runs="${a#*=}" ;;
     --flags=*) flags="${a#*=}" ;;
+    --trig=*) trig="${a#*=}" ;;
     -*) echo "unknown option $a" >&2; exit 2 ;;
     *) functions+=("$a") ;;
   esac
@@ -41,13 +43,13 @@ for robot in ur5:ur_description/urdf/ur5_robot.urdf panda:panda_description/urdf
     d=$work/$name-$fn
     mkdir -p "$d"
     common=("$urdf" -function="$fn" --fold-params)
-    "$opt" "${common[@]}" -passes="$pipeline,codegen<c;abi=plain;batch=4;trig=inline;name=rv_a>" -o "$d/a.c" 2>/dev/null
-    if ! "$opt" "${common[@]}" -passes="$pipeline,precision<budget=$budget>,error-bound<format=mixed>,codegen<c;abi=plain;batch=8;trig=inline;name=rv_b>" \
+    "$opt" "${common[@]}" -passes="$pipeline,codegen<c;abi=plain;batch=4;trig=$trig;name=rv_a>" -o "$d/a.c" 2>/dev/null
+    if ! "$opt" "${common[@]}" -passes="$pipeline,precision<budget=$budget>,error-bound<format=mixed>,codegen<c;abi=plain;batch=8;trig=$trig;name=rv_b>" \
       -o "$d/b.c" -report="$d/b.json" 2>"$d/b.err"; then
       echo "| $name | $fn | refused: $(head -1 "$d/b.err") | | | | | | |"
       continue
     fi
-    "$opt" "${common[@]}" -passes="$pipeline,codegen<c;abi=plain;batch=8;trig=inline;precision=f32;name=rv_c>" -o "$d/c.c" 2>/dev/null
+    "$opt" "${common[@]}" -passes="$pipeline,codegen<c;abi=plain;batch=8;trig=$trig;precision=f32;name=rv_c>" -o "$d/c.c" 2>/dev/null
     ni=$(grep -o 'in\[[0-9]*\]' "$d/a.h" | tr -d 'in[]' | sort -n | tail -1)
     no=$(grep -o 'out\[[0-9]*\]' "$d/a.h" | tr -d 'out[]' | sort -n | tail -1)
     # shellcheck disable=SC2086

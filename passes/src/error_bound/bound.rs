@@ -102,6 +102,11 @@ impl Rounding {
         Rounding { rel, abs }
     }
 
+    /// This rounding with both parts times `scale` (`2^-bits`: `bits` more bits of precision).
+    pub fn scaled(self, scale: f64) -> Rounding {
+        Rounding { rel: self.rel * scale, abs: self.abs * scale }
+    }
+
     /// The error of rounding a value of magnitude at most `m` (0 for no rounding).
     fn of(self, m: f64) -> f64 {
         if self == Rounding::EXACT {
@@ -175,23 +180,40 @@ pub fn bound(
     f: &Function,
     x: &[Interval],
     mode: Formats,
+    tick: impl FnMut() -> bool,
+) -> Result<Vec<f64>, BoundError> {
+    bound_with_more_bits(f, x, mode, 0, tick)
+}
+
+/// [`bound`] as if every binary32 and fixed-point format had `bits` more bits of precision
+/// (`bits = 1`: binary32 rounding to half its unit, `fix<w,f>` as `fix<w+1,f+1>`; binary64, the
+/// reference, as it is): their roundings, conversions and input stores scaled by `2^-bits`, the
+/// values' ranges and the overflow limits as they are. `precision` reports with it what one
+/// more bit would give each output. For fixed point it is exactly [`bound`] of the function
+/// with the wider formats; for binary32 a bound for a hypothetical format of 24 + `bits`
+/// significant bits (`bits = 0` is [`bound`]).
+///
+/// # Errors
+/// As [`bound`].
+pub fn bound_with_more_bits(
+    f: &Function,
+    x: &[Interval],
+    mode: Formats,
+    bits: i32,
     mut tick: impl FnMut() -> bool,
 ) -> Result<Vec<f64>, BoundError> {
+    let scale = 2f64.powi(-bits);
     let mut e = vec![f64::INFINITY; f.values.len()];
     let mut nonneg = vec![false; f.values.len()];
     for &v in &f.inputs {
         let r = x[v.index()];
         let m = r.mag();
-        let format = match mode {
-            Formats::F64 => Format::Binary64,
-            Formats::F32 => Format::Binary32,
-            Formats::Mixed => f.format(v),
-        };
+        let format = format_in(f, v, mode);
         e[v.index()] = match format.store(r.lo) {
             _ if m > largest(f, v, mode) => f64::INFINITY,
             // A point (a fixed parameter): its rounding is known exactly.
-            Ok(stored) if r.lo == r.hi => up((stored - r.lo).abs()),
-            _ => Rounding::store(format).of(m),
+            Ok(stored) if r.lo == r.hi && bits == 0 => up((stored - r.lo).abs()),
+            _ => Rounding::store(format).scaled(scale).of(m),
         };
         nonneg[v.index()] = x[v.index()].lo >= 0.0;
         check_fits(f, v, x, &e, mode)?;
@@ -200,7 +222,7 @@ pub fn bound(
         if tick() {
             return Err(BoundError::Stopped(k));
         }
-        e[v.index()] = value_bound(f, v, x, &e, &nonneg, mode);
+        e[v.index()] = value_bound(f, v, x, &e, &nonneg, mode, scale);
         nonneg[v.index()] = computed_nonneg(f, v, x, &e, &nonneg);
         check_fits(f, v, x, &e, mode)?;
     }
@@ -284,12 +306,14 @@ struct Reader<'a> {
     f: &'a Function,
     mode: Formats,
     narrow: bool,
+    /// `2^-bits` ([`bound_with_more_bits`]).
+    scale: f64,
 }
 
 impl Reader<'_> {
     /// The reader of `v`'s op.
-    fn of(f: &Function, v: Value, mode: Formats) -> Reader<'_> {
-        Reader { f, mode, narrow: format_in(f, v, mode) == Format::Binary32 }
+    fn of(f: &Function, v: Value, mode: Formats, scale: f64) -> Reader<'_> {
+        Reader { f, mode, narrow: format_in(f, v, mode) == Format::Binary32, scale }
     }
 
     /// The operand's enclosure and error bound as the op reads it: a constant's error is its
@@ -306,16 +330,20 @@ impl Reader<'_> {
                 let m = up(r.mag() + err);
                 let conv = if m > f32::MAX as f64 {
                     f64::INFINITY
-                } else if r.lo == r.hi && err == 0.0 {
+                } else if r.lo == r.hi && err == 0.0 && self.scale == 1.0 {
                     // An exact point (a fixed parameter): its rounding is known exactly.
                     up((r.lo - r.lo as f32 as f64).abs())
                 } else {
-                    Rounding::F32.of(m)
+                    Rounding::F32.scaled(self.scale).of(m)
                 };
                 (r, up(err + conv))
             }
             Operand::Const(c) => {
-                let err = if self.narrow { up((c - c as f32 as f64).abs()) } else { 0.0 };
+                let err = match (self.narrow, self.scale == 1.0) {
+                    (false, _) => 0.0,
+                    (true, true) => up((c - c as f32 as f64).abs()),
+                    (true, false) => Rounding::F32.scaled(self.scale).of(c.abs()),
+                };
                 (Interval::point(c), err)
             }
         }
@@ -359,14 +387,14 @@ fn product_error(ma: f64, ea: f64, mb: f64, eb: f64) -> f64 {
 }
 
 /// The error bound of body value `v` (module doc's table, then the result's rounding).
-fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool], mode: Formats) -> f64 {
+fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool], mode: Formats, scale: f64) -> f64 {
     let data = f.value(v);
     let mz = x[v.index()].mag();
     if !mz.is_finite() {
         return f64::INFINITY;
     }
-    let rd = Reader::of(f, v, mode);
-    let op = if rd.narrow { Rounding::F32 } else { Rounding::F64 };
+    let rd = Reader::of(f, v, mode, scale);
+    let op = if rd.narrow { Rounding::F32.scaled(scale) } else { Rounding::F64 };
     let libm_ulps = |r: Rounding| Rounding { rel: LIBM_ULPS * 2.0 * r.rel, abs: LIBM_ULPS * 2.0 * r.abs };
     let (propagated, rounding) = match &data.def {
         Def::Input | Def::Expr(_) => return f64::INFINITY,
@@ -434,7 +462,7 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
     }
     // A binary32 op rounds once, in binary32; a fixed-point value after its binary64 op.
     let rounding = match mode {
-        Formats::Mixed if !rd.narrow => rounding.then(Rounding::store(f.format(v))),
+        Formats::Mixed if !rd.narrow => rounding.then(Rounding::store(f.format(v)).scaled(scale)),
         _ => rounding,
     };
     let magnitude = up(mz + propagated);
@@ -517,7 +545,7 @@ pub fn sensitivities(f: &Function, x: &[Interval], e: &[f64], seed: &[(Value, f6
                     pass(b, mag(a), &mut lam);
                 }
                 BinOp::Div => {
-                    let (ib, eb) = Reader::of(f, v, Formats::Mixed).operand(b, x, e);
+                    let (ib, eb) = Reader::of(f, v, Formats::Mixed, 1.0).operand(b, x, e);
                     let room = (ib.mig() - eb).max(f64::MIN_POSITIVE);
                     pass(a, 1.0 / room, &mut lam);
                     pass(b, x[v.index()].mag() / room, &mut lam);
