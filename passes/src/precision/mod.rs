@@ -31,6 +31,7 @@
 
 pub mod budget;
 pub mod choose;
+pub mod fpga;
 
 use robovec_ir::Module;
 use serde::Serialize;
@@ -38,7 +39,7 @@ use serde::Serialize;
 use crate::params::ParamKind;
 use crate::range::{domain_with_file, enclose_in_pass};
 use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
-pub use choose::{choose, Choice, Target};
+pub use choose::{choose, choose_on, Choice, FpgaFigures, Target};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -97,6 +98,7 @@ impl Pass for PrecisionPass {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let dom = domain_with_file(cx.domain.as_ref(), self.ranges.as_deref(), m)?;
         let target = self.target;
+        let device = &cx.target.clone();
         // One relative budget for every output, or the budget file's per output.
         let budgets_given = match &self.budget {
             crate::params::NumberOrPath::Number(r) => budget::Budgets::Every(budget::Budget::Rel(*r)),
@@ -128,7 +130,7 @@ impl Pass for PrecisionPass {
                         file.resolve(&names).map_err(|e| failed(format!("@{}: budget file: {e}", f.name)))?
                     }
                 };
-                let c = choose(f, &x, &budgets, target, || ticker.tick()).map_err(failed)?;
+                let c = choose_on(f, &x, &budgets, target, device, || ticker.tick()).map_err(failed)?;
                 if c.stopped {
                     let note = format!(
                         "searching @{} early (the formats accepted so far kept, every budget met): {}",
@@ -180,32 +182,53 @@ pub struct PrecisionReport {
     pub unreachable: Vec<String>,
     /// Outputs with no finite bound (not constrained).
     pub unbounded: Vec<String>,
+    /// `fpga`: fixed-point values per word width.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub widths: Option<std::collections::BTreeMap<u32, usize>>,
+    /// `fpga`: DSP blocks of the datapath with the chosen formats ([`fpga::resources`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dsp: Option<f64>,
+    /// `fpga`: its ALM.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alm: Option<f64>,
+    /// `fpga`: the target description costed against (`-target`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub device: Option<String>,
 }
 
 impl std::fmt::Display for PrecisionReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        // Fixed-point formats grouped by width on this line (the report has each).
-        let mut grouped: std::collections::BTreeMap<String, usize> = std::collections::BTreeMap::new();
+        // Fixed-point formats grouped by width on this line (the report has each), narrowest
+        // first after the binary formats.
+        let mut grouped: std::collections::BTreeMap<(u32, String), usize> = std::collections::BTreeMap::new();
         for (k, n) in &self.formats {
             let key = match k.split_once(',') {
-                Some((w, _)) if k.starts_with("fix<") => format!("{w},*>"),
-                _ => k.clone(),
+                Some((w, _)) if k.starts_with("fix<") => {
+                    (w.trim_start_matches("fix<").parse::<u32>().unwrap_or(u32::MAX), format!("{w},*>"))
+                }
+                _ => (0, k.clone()),
             };
             *grouped.entry(key).or_insert(0) += n;
         }
-        let hist: Vec<String> = grouped.iter().map(|(k, n)| format!("{n} {k}")).collect();
+        let hist: Vec<String> = grouped.iter().map(|((_, k), n)| format!("{n} {k}")).collect();
         write!(
             f,
-            "precision @{} ({}, budget {}): {}; bound {:.3e} of the range at most ({}); cost {:.0} -> {:.0}",
+            "precision @{} ({}, budget {}): {}; bound {:.3e} of the range at most ({}); ",
             self.function,
             self.target,
             self.budget.map_or("per output".to_string(), |b| format!("{b:e}")),
             hist.join(", "),
             self.max_rel_to_range,
             self.worst_output.as_deref().unwrap_or("no output"),
-            self.cost_before,
-            self.cost_after
         )?;
+        match (self.dsp, self.alm, &self.device) {
+            (Some(dsp), Some(alm), Some(device)) => write!(
+                f,
+                "cost {:.1} -> {:.1} % of {device} ({dsp:.1} DSP, {alm:.0} ALM)",
+                self.cost_before, self.cost_after
+            )?,
+            _ => write!(f, "cost {:.0} -> {:.0}", self.cost_before, self.cost_after)?,
+        }
         for (what, list) in [
             ("cannot meet the budget even in binary64 (kept so)", &self.unreachable),
             ("have no finite bound", &self.unbounded),
