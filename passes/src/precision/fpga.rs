@@ -45,7 +45,10 @@
 //! 3. **Bits removed in batches**: values ranked by first-order damage of one bit less (their
 //!    sensitivity re-seeded with `1/(budget_o − E_o)`, the room each output has left) per unit of
 //!    cost saved; a binary search finds the longest prefix of that ranking that can lose a bit;
-//!    up to [`ROUNDS`] rounds.
+//!    up to [`ROUNDS`] rounds. Before and after them, the operands of products at most
+//!    [`SNAP_BITS`] bits wider than an operand size of a DSP mode (9, 18, 19, 27 on the Cyclone
+//!    V) are offered that size, the same way ([`snap`]): the DSP count of a product is a step
+//!    function of the widths that the smooth per-bit cost does not see.
 //! 4. **Widths from the bound**: during the search every fixed value is `fix<53,f>` (the bound of
 //!    every value depends on fraction bits only; the width only decides whether the range fits);
 //!    the final width of each is the smallest whose range holds the value's enclosure widened by
@@ -480,8 +483,11 @@ pub fn fixed_phase<S: FnMut() -> bool>(
             }
         }
     }
-    // Step 3: rounds of one bit less on the longest accepted prefix of the ranking.
+    // Step 3: products down to a DSP mode's operand size, rounds of one bit less on the longest
+    // accepted prefix of the ranking, products again.
     let (mut h, mut e) = best;
+    let factors = product_operands(f);
+    (h, e) = snap(f, h, e, &factors, device, s);
     for _ in 0..ROUNDS {
         if s.stopped {
             break;
@@ -531,8 +537,93 @@ pub fn fixed_phase<S: FnMut() -> bool>(
             _ => break,
         }
     }
+    (h, _) = snap(f, h, e, &factors, device, s);
     h
 }
+
+/// How many fixed-point products (`×`, the product of a fused op) each value is an operand of.
+fn product_operands(f: &Function) -> Vec<u32> {
+    let mut n = vec![0u32; f.values.len()];
+    for &v in &f.body {
+        let pair = match &f.value(v).def {
+            Def::Binary(BinOp::Mul, a, b) => Some((*a, *b)),
+            Def::Call(callee, args) if matches!(Intrinsic::of(callee, args.len()), Some(i) if i != Intrinsic::Sqrt) => {
+                Some((args[0], args[1]))
+            }
+            _ => None,
+        };
+        if let Some((a, b)) = pair {
+            for o in [a, b] {
+                if let Operand::Value(x) = o {
+                    n[x.index()] += 1;
+                }
+            }
+        }
+    }
+    n
+}
+
+/// Step 3's product pass (module doc): each fixed value that is an operand of a product and at most
+/// [`SNAP_BITS`] bits wider than an operand size of a DSP mode (9, 18, 19, 27 on the Cyclone V)
+/// is offered that size (its fraction bits lowered by the difference), ranked by first-order
+/// damage per product; the longest accepted prefix of the ranking is kept (a binary search).
+fn snap<S: FnMut() -> bool>(
+    f: &Function,
+    h: Function,
+    e: Vec<f64>,
+    factors: &[u32],
+    device: &Device,
+    s: &mut Search<'_, S>,
+) -> (Function, Vec<f64>) {
+    let mut sizes: Vec<u32> = device.datapath.dsp_modes.iter().flat_map(|m| [m.a, m.b]).collect();
+    sizes.sort_unstable();
+    sizes.dedup();
+    let seeds: Vec<(Value, f64)> = s.outs.iter().map(|&(v, b)| (v, 1.0 / (b - e[v.index()]).max(b * 1e-12))).collect();
+    let lam = sensitivities(&h, s.x, &e, &seeds);
+    let mut offers: Vec<(f64, Value, i32)> = Vec::new();
+    for &v in f.inputs.iter().chain(&f.body) {
+        let Format::Fix { fraction, .. } = h.format(v) else { continue };
+        if factors[v.index()] == 0 {
+            continue;
+        }
+        let Some(w) = min_width(s.x[v.index()], e[v.index()], fraction) else { continue };
+        let Some(&t) = sizes.iter().rev().find(|&&t| t < w) else { continue };
+        let k = (w - t) as i32;
+        if k > SNAP_BITS || !FIX_FRACTION_RANGE.contains(&(fraction - k)) {
+            continue;
+        }
+        let damage = lam[v.index()] * (2f64.powi(-fraction - 1 + k) - 2f64.powi(-fraction - 1));
+        offers.push((damage / f64::from(factors[v.index()]), v, fraction - k));
+    }
+    offers.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let with = |k: usize| {
+        let mut t = h.clone();
+        for &(_, v, fr) in &offers[..k] {
+            if let Some(fmt) = Format::fix(FIX_MAX_WIDTH, fr) {
+                t.set_format(v, fmt);
+            }
+        }
+        t
+    };
+    let (mut lo, mut hi) = (0usize, offers.len());
+    let mut got = None;
+    while lo < hi {
+        let mid = (lo + hi).div_ceil(2);
+        let t = with(mid);
+        match s.probe(&t) {
+            Ok(et) => {
+                lo = mid;
+                got = Some((t, et));
+            }
+            Err(Refused::Stopped) => break,
+            Err(_) => hi = mid - 1,
+        }
+    }
+    got.unwrap_or((h, e))
+}
+
+/// The most bits [`snap`] takes from a value at once.
+pub const SNAP_BITS: i32 = 3;
 
 /// `g` (accepted, its fixed values in probe widths) with every fixed value's width the smallest
 /// that holds it ([`min_width`] of its certified bound): one sweep to get the bounds, one to

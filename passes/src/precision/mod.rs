@@ -1,4 +1,4 @@
-//! `precision<budget=REL;target=c|mcu>`: a numeric format per value (issue 48 item 5) that
+//! `precision<budget=REL;target=c|mcu|fpga>`: a numeric format per value (issue 48 item 5) that
 //! lowers the target's cost while the certified error bound of every output stays within the
 //! budget over the input domain.
 //!
@@ -21,13 +21,20 @@
 //! - `c`: binary32 where the bound allows (twice the lanes of a vector of binary64);
 //! - `mcu`: 32-bit fixed point first (`fix<32,f>`, `f` from the value's range with one bit of
 //!   headroom: integer arithmetic on a microcontroller without a floating-point unit), then
-//!   binary32 among the rest.
+//!   binary32 among the rest;
+//! - `fpga`: fixed point in words as narrow as the budget allows (`fix<w,f>`, `w ≤ 53`, each
+//!   value its own), then binary32 among the rest: fraction bits from the sensitivities and a
+//!   cost per bit, one global shift and batches of bits removed, each step checked by the
+//!   bound, and each width the smallest that holds the value's certified range ([`fpga`]).
 //!
 //! Cost (reported before and after): `c` counts ops as 1 per binary64 op and ½ per binary32 op
 //! (lanes per vector) plus ½ per conversion (an operand read in another format than its
 //! user's); `mcu` estimates cycles of a Cortex-M3-class core without an FPU: fixed-point add 1,
 //! multiply 3 (`SMULL`, round, shift), binary32 operation 50 and binary64 100 (software
-//! floating point, order of magnitude), conversions 20.
+//! floating point, order of magnitude), conversions 20; `fpga` the share of the device,
+//! `100·(DSP/dsp + ALM/alm)`, of a datapath of one operator per op in its value's format, from
+//! the target description (`-target`: its DSP modes, ALM per adder bit, binary32 PE and
+//! binary64 unit costs, [`robovec_machine::target::Datapath`]; the table in [`fpga`]).
 
 pub mod budget;
 pub mod choose;
@@ -44,7 +51,7 @@ pub use choose::{choose, choose_on, Choice, FpgaFigures, Target};
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
     name: "precision",
-    doc: "choose a numeric format per value (binary32, 32-bit fixed point) that lowers the target's cost while the \
+    doc: "choose a numeric format per value (binary32, fixed point) that lowers the target's cost while the \
           certified error bound of every output stays within the budget over the input domain",
     params: &[
         ParamInfo {
@@ -57,7 +64,8 @@ pub const INFO: PassInfo = PassInfo {
             name: "target",
             kind: ParamKind::Choice { choices: Target::WORDS, default: "c" },
             doc: "c: binary32 where the bound allows (vector lanes); mcu: 32-bit fixed point first, then binary32 \
-                  (a microcontroller without FPU)",
+                  (a microcontroller without FPU); fpga: fixed-point words as narrow as the budget allows, then \
+                  binary32, costed in DSP blocks and ALM of the -target description",
         },
         crate::range::RANGES,
     ],
@@ -162,7 +170,7 @@ pub struct PrecisionReport {
     /// Function name.
     #[serde(skip)]
     pub function: String,
-    /// `c` or `mcu`.
+    /// `c`, `mcu` or `fpga`.
     pub target: &'static str,
     /// The relative budget of every output (`None` with a budget file).
     pub budget: Option<f64>,
@@ -172,7 +180,8 @@ pub struct PrecisionReport {
     pub max_rel_to_range: f64,
     /// The output that reaches it.
     pub worst_output: Option<String>,
-    /// The target's cost with every value binary64 (module doc's model).
+    /// The target's cost with every value binary64 (module doc's model; `fpga`: percent of the
+    /// device).
     pub cost_before: f64,
     /// Its cost with the chosen formats.
     pub cost_after: f64,
