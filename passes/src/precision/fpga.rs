@@ -10,7 +10,7 @@
 //! | op | DSP | ALM |
 //! |---|---|---|
 //! | `a ± b` | 0 | `p·(max(i_a, i_b, i_z) + f_z + 1)` (aligned adder and its rounding bit) |
-//! | `a × b` | [`Datapath::product`]`(w_a, w_b)` | its tile adders + `p·(w_z + 1)` (rounding) |
+//! | `a × b` | [`robovec_machine::target::Datapath::product`]`(w_a, w_b)` | its tile adders + `p·(w_z + 1)` (rounding) |
 //! | `a / b` | 0 | `p·w_z·(w_b + 1)` (digit recurrence: one `w_b + 1`-bit add/sub per quotient bit) |
 //! | `√a` | 0 | `p·w_z·(w_z + 2)` |
 //! | `sin`, `cos` | 0 | `3·p·w_z²` (CORDIC: three `w_z`-bit adders per iteration, `w_z` iterations) |
@@ -47,7 +47,7 @@
 //!    cost saved; a binary search finds the longest prefix of that ranking that can lose a bit;
 //!    up to [`ROUNDS`] rounds. Before and after them, the operands of products at most
 //!    [`SNAP_BITS`] bits wider than an operand size of a DSP mode (9, 18, 19, 27 on the Cyclone
-//!    V) are offered that size, the same way ([`snap`]): the DSP count of a product is a step
+//!    V) are offered that size, the same way: the DSP count of a product is a step
 //!    function of the widths that the smooth per-bit cost does not see.
 //! 4. **Widths from the bound**: during the search every fixed value is `fix<53,f>` (the bound of
 //!    every value depends on fraction bits only; the width only decides whether the range fits);
@@ -262,7 +262,7 @@ pub fn min_width(r: Interval, err: f64, fraction: i32) -> Option<u32> {
     })
 }
 
-/// What the search needs of [`super::choose`]: the enclosures, the outputs with a budget (value,
+/// What the search needs of [`super::choose()`]: the enclosures, the outputs with a budget (value,
 /// absolute budget), and its sweep counter and stop.
 pub struct Search<'a, S: FnMut() -> bool> {
     /// Enclosures of every value.
@@ -417,7 +417,7 @@ pub fn fixed_phase<S: FnMut() -> bool>(
                 Ok(e) => return Some((h, e)),
                 Err(Refused::Overflow(name)) if overflows < 32 => {
                     overflows += 1;
-                    let Some(&(v, ..)) = cands.iter().find(|c| f.name_of(c.0) == name) else { return None };
+                    let &(v, ..) = cands.iter().find(|c| f.name_of(c.0) == name)?;
                     demoted[v.index()] = true;
                 }
                 Err(_) => return None,
@@ -622,7 +622,7 @@ fn snap<S: FnMut() -> bool>(
     got.unwrap_or((h, e))
 }
 
-/// The most bits [`snap`] takes from a value at once.
+/// The most bits the product pass of step 3 (module doc) takes from a value at once.
 pub const SNAP_BITS: i32 = 3;
 
 /// `g` (accepted, its fixed values in probe widths) with every fixed value's width the smallest
