@@ -206,8 +206,9 @@ fn a_stopped_search_keeps_accepted_formats() {
         let (f, dom) = random_function(seed * 13 + 2, 30);
         let x = enclose_with(&f, &dom, Some(64), || false).unwrap();
         let budgets = vec![robovec_passes::precision::budget::Budget::Rel(1e-4); f.outputs.len()];
-        let mut left = (seed % 4) as i32;
-        let Ok(c) = choose(&f, &x, &budgets, Target::Mcu, || {
+        let mut left = (seed % 8) as i32;
+        let target = if seed % 2 == 0 { Target::Mcu } else { Target::Fpga };
+        let Ok(c) = choose(&f, &x, &budgets, target, || {
             left -= 1;
             left < 0
         }) else {
@@ -218,7 +219,7 @@ fn a_stopped_search_keeps_accepted_formats() {
             g.set_format(v, fmt);
         }
         let named: Vec<(String, f64)> = c.outputs.iter().map(|(n, _, b, _)| (n.clone(), *b)).collect();
-        assert_within(&format!("stopped seed {seed}"), &g, &dom, &named, seed);
+        assert_within(&format!("stopped seed {seed} {target:?}"), &g, &dom, &named, seed);
     }
 }
 
@@ -328,4 +329,27 @@ fn the_pass_reports_widths_and_device_resources_for_the_fpga() {
     for key in ["widths", "dsp", "alm", "device"] {
         assert!(r["precision"].get(key).is_none(), "{key}: {}", r["precision"]);
     }
+    // A target description without the 9- and 18-bit modes, named after the file's `name`:
+    // every product takes whole DSP blocks.
+    let mut t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("examples/targets/de10-nano.json").unwrap()).unwrap();
+    t["name"] = "only-27".into();
+    t["datapath"] = serde_json::json!({ "dsp_modes": [{ "a": 27, "b": 27, "per_block": 1 }] });
+    let target = dir.join("only27.json");
+    std::fs::write(&target, t.to_string()).unwrap();
+    let o = opt(&[
+        "examples/three_link_arm/three_link_arm.urdf",
+        "-function=invdyna",
+        &format!("-ranges={}", ranges.display()),
+        &format!("-target={}", target.display()),
+        "-passes=default<ops>,precision<budget=1e-4;target=fpga>",
+        &format!("-report={}", report.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let r27: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r27["precision"]["device"], "only-27");
+    let dsp = r27["precision"]["dsp"].as_f64().unwrap();
+    assert!(dsp > 0.0 && dsp.fract() == 0.0, "{}", r27["precision"]);
 }
