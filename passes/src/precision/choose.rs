@@ -1,6 +1,7 @@
 //! The search of `precision` (the module doc of [`super`]): rank the cheaper formats by the
 //! first-order damage they do to the outputs' bounds, then binary-search the longest prefix
-//! of the ranking that the certified bound accepts.
+//! of the ranking that the certified bound accepts. `target=fpga` first gives narrow fixed-point
+//! words by its own search ([`super::fpga`]), then runs the binary32 phase on the rest.
 
 use std::collections::BTreeMap;
 

@@ -174,7 +174,7 @@ pub struct PrecisionReport {
     pub target: &'static str,
     /// The relative budget of every output (`None` with a budget file).
     pub budget: Option<f64>,
-    /// Values per format (`f64`, `f32`, `fix<32,f>`), inputs included.
+    /// Values per format (`f64`, `f32`, `fix<w,f>`), inputs included.
     pub formats: std::collections::BTreeMap<String, usize>,
     /// The largest bound over the outputs, relative to each output's largest magnitude.
     pub max_rel_to_range: f64,
