@@ -519,3 +519,53 @@ fn pareto_rows_carry_the_certified_bound_over_the_domain() {
     assert!(!err.contains("certified over the domain"), "{err}");
     assert!(rows.iter().all(|r| r.get("certified").is_none()));
 }
+
+/// "One more bit" (`bound_with_more_bits`, precision's report): for fixed-point formats it is
+/// the bound of the same function with every `fix<w,f>` widened to `fix<w+1,f+1>`, computed
+/// here by the ordinary bound on that function. (It is not always below the bound as it is:
+/// that one rounds a binary32 constant by its exact distance, one more bit by half an ulp.)
+#[test]
+fn one_more_bit_is_the_bound_of_the_wider_formats() {
+    use robovec_passes::error_bound::bound::bound_with_more_bits;
+    let mut compared = 0;
+    for seed in 0..60u64 {
+        let (f, dom) = random_function(seed * 31 + 5, 6 + (seed as usize % 30));
+        let mixed = crate::error_bound::with_random_formats(&f, &dom, seed);
+        let x = enclose_with(&f, &dom, Some(16), || false).unwrap();
+        // Fixed point only: binary32 values back to binary64, then every fix<w,f> one bit wider.
+        let mut fixed = mixed.clone();
+        let mut wider = mixed.clone();
+        for &v in f.inputs.iter().chain(&f.body) {
+            match mixed.format(v) {
+                Format::Binary32 => {
+                    fixed.set_format(v, Format::Binary64);
+                    wider.set_format(v, Format::Binary64);
+                }
+                Format::Fix { width, fraction } if width < 53 && fraction < 126 => {
+                    wider.set_format(v, Format::fix(width + 1, fraction + 1).unwrap());
+                }
+                Format::Fix { .. } => {
+                    fixed.set_format(v, Format::Binary64);
+                    wider.set_format(v, Format::Binary64);
+                }
+                Format::Binary64 => {}
+            }
+        }
+        // Point inputs round by their exact distance in the ordinary bound: none here.
+        if f.inputs.iter().any(|&v| x[v.index()].lo == x[v.index()].hi) {
+            continue;
+        }
+        let (Ok(more), Ok(wide)) =
+            (bound_with_more_bits(&fixed, &x, Formats::Mixed, 1, || false), bound(&wider, &x, Formats::Mixed, || false))
+        else {
+            continue;
+        };
+        for o in &f.outputs {
+            if let Operand::Value(v) = o.value {
+                assert_eq!(more[v.index()].to_bits(), wide[v.index()].to_bits(), "seed {seed} {}", o.name);
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared >= 40, "only {compared} outputs compared");
+}

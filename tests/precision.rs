@@ -57,14 +57,21 @@ fn assert_within(what: &str, g: &Function, dom: &Domain, budgets: &[(String, f64
     }
 }
 
-/// Random functions with every op, both targets, budgets from 10⁻¹² to 10⁻²: the formats chosen
+/// Random functions with every op, the three targets, budgets from 10⁻¹² to 10⁻²: the formats chosen
 /// always meet the budget; loose budgets give cheaper formats.
 #[test]
 fn chosen_formats_meet_the_budget_on_random_functions() {
     let mut cheaper = 0;
     for seed in 0..60u64 {
         let (f, dom) = random_function(seed * 31 + 5, 5 + seed as usize % 50);
-        for (budget, target) in [(1e-2, Target::C), (1e-6, Target::Mcu), (1e-12, Target::C), (1e-4, Target::Mcu)] {
+        for (budget, target) in [
+            (1e-2, Target::C),
+            (1e-6, Target::Mcu),
+            (1e-12, Target::C),
+            (1e-4, Target::Mcu),
+            (1e-3, Target::Fpga),
+            (1e-9, Target::Fpga),
+        ] {
             let Some((g, budgets)) = with_choice(&f, &dom, budget, target) else { continue };
             assert_within(&format!("seed {seed} {budget:e} {target:?}"), &g, &dom, &budgets, seed);
             cheaper += usize::from(g.has_formats());
@@ -199,8 +206,9 @@ fn a_stopped_search_keeps_accepted_formats() {
         let (f, dom) = random_function(seed * 13 + 2, 30);
         let x = enclose_with(&f, &dom, Some(64), || false).unwrap();
         let budgets = vec![robovec_passes::precision::budget::Budget::Rel(1e-4); f.outputs.len()];
-        let mut left = (seed % 4) as i32;
-        let Ok(c) = choose(&f, &x, &budgets, Target::Mcu, || {
+        let mut left = (seed % 8) as i32;
+        let target = if seed % 2 == 0 { Target::Mcu } else { Target::Fpga };
+        let Ok(c) = choose(&f, &x, &budgets, target, || {
             left -= 1;
             left < 0
         }) else {
@@ -211,7 +219,7 @@ fn a_stopped_search_keeps_accepted_formats() {
             g.set_format(v, fmt);
         }
         let named: Vec<(String, f64)> = c.outputs.iter().map(|(n, _, b, _)| (n.clone(), *b)).collect();
-        assert_within(&format!("stopped seed {seed}"), &g, &dom, &named, seed);
+        assert_within(&format!("stopped seed {seed} {target:?}"), &g, &dom, &named, seed);
     }
 }
 
@@ -259,4 +267,135 @@ fn the_budget_ladder_is_the_chooser_at_each_budget() {
         cut = cut.max(Some(l.points.len()));
     }
     assert!(cut.unwrap() > 0, "some budget stops after a point");
+}
+
+/// The Segway `dirdyna` over the narrow domain of the test above, for the Segway tests below.
+fn segway() -> (Function, Domain) {
+    let path = crate::common::corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c");
+    let (m, _) = robovec::driver::load(path.to_str().unwrap()).unwrap_or_else(|e| panic!("{}", e.message()));
+    let f = robovec_ir::transform::atomise::atomise_function(&m.functions[0]);
+    let mut dom = crate::range::generous_domain(&f);
+    for (n, r) in dom.ranges.iter_mut() {
+        if n.starts_with("q[") {
+            *r = range(0.1, 0.3);
+        } else if n.starts_with("qd") {
+            *r = range(-1.0, 1.0);
+        }
+    }
+    (f, dom)
+}
+
+/// `target=fpga` on the Segway `dirdyna`: every choice meets its budget (bound and sampled
+/// points); at 10⁻³ most values are fixed point and the words average under 32 bits (narrower
+/// than `mcu`'s); the device share the cost model gives never grows as the budget loosens
+/// (10⁻⁷ to 10⁻²), and it is below binary64's.
+#[test]
+fn the_segway_gets_narrow_fixed_point_words_on_the_fpga() {
+    let (f, dom) = segway();
+    let x = enclose_with(&f, &dom, Some(64), || false).unwrap();
+    let device = robovec_machine::target::Target::de10_nano();
+    let values = f.inputs.len() + f.body.len();
+    let mut last: Option<(f64, f64)> = None;
+    for (k, budget) in [1e-7, 1e-5, 1e-3, 1e-2].into_iter().enumerate() {
+        let budgets = vec![robovec_passes::precision::budget::Budget::Rel(budget); f.outputs.len()];
+        let c = robovec_passes::precision::choose_on(&f, &x, &budgets, Target::Fpga, &device, || false).unwrap();
+        let mut g = f.clone();
+        for &(v, fmt) in &c.formats {
+            g.set_format(v, fmt);
+        }
+        let named: Vec<(String, f64)> = c.outputs.iter().map(|(n, _, b, _)| (n.clone(), *b)).collect();
+        assert_within(&format!("segway fpga {budget:e}"), &g, &dom, &named, 10 + k as u64);
+        let fig = c.fpga.as_ref().expect("fpga figures");
+        assert_eq!(fig.device, "de10-nano");
+        let share = 100.0 * (fig.dsp.1 / 112.0 + fig.alm.1 / 41_910.0);
+        assert!((share - c.cost.1).abs() <= 1e-9 * share, "{share} vs {}", c.cost.1);
+        assert!(c.cost.1 < c.cost.0, "{budget:e}: {} not below binary64's {}", c.cost.1, c.cost.0);
+        if let Some((prev_budget, prev)) = last {
+            assert!(c.cost.1 <= prev, "{budget:e} costs {} > {prev} at the tighter {prev_budget:e}", c.cost.1);
+        }
+        last = Some((budget, c.cost.1));
+        if budget == 1e-3 {
+            let fixed: usize = fig.widths.values().sum();
+            let bits: usize = fig.widths.iter().map(|(w, n)| *w as usize * n).sum();
+            assert!(fixed > values * 9 / 10, "{fixed} of {values} fixed point");
+            let mean = bits as f64 / fixed as f64;
+            assert!(mean < 32.0, "mean width {mean}");
+            eprintln!("segway fpga 1e-3: mean width {mean:.1}, {} DSP, {} ALM", fig.dsp.1, fig.alm.1);
+        }
+    }
+}
+
+/// The pass with `target=fpga` through the command line: the report's `widths`, `dsp`, `alm`
+/// and `device` (absent for `c`), the formats in the output IR, and `error-bound` after it
+/// within the budget.
+#[test]
+fn the_pass_reports_widths_and_device_resources_for_the_fpga() {
+    let dir = crate::common::tmp("precision-fpga");
+    let (ranges, report) = (dir.join("r.json"), dir.join("report.json"));
+    std::fs::write(&ranges, r#"{"qd[2]": [-3, 3]}"#).unwrap();
+    let run = |target: &str| {
+        let o = opt(&[
+            "examples/three_link_arm/three_link_arm.urdf",
+            "-function=invdyna",
+            &format!("-ranges={}", ranges.display()),
+            &format!("-passes=default<ops>,precision<budget=1e-4;target={target}>,error-bound"),
+            &format!("-report={}", report.display()),
+            "-o",
+            dir.join("out.rvir").to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        (stderr(&o), r)
+    };
+    let (err, r) = run("fpga");
+    assert!(err.contains("% of de10-nano"), "{err}");
+    let p = &r["precision"];
+    assert_eq!(p["target"], "fpga");
+    assert_eq!(p["device"], "de10-nano");
+    assert!(p["dsp"].as_f64().unwrap() >= 0.0 && p["alm"].as_f64().unwrap() > 0.0, "{p}");
+    let widths = p["widths"].as_object().unwrap();
+    assert!(!widths.is_empty(), "{p}");
+    let fixed: u64 = widths.values().map(|n| n.as_u64().unwrap()).sum();
+    let in_formats: u64 = p["formats"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .filter(|(k, _)| k.starts_with("fix<"))
+        .map(|(_, n)| n.as_u64().unwrap())
+        .sum();
+    assert_eq!(fixed, in_formats, "{p}");
+    assert!(p["max_rel_to_range"].as_f64().unwrap() <= 1e-4, "{p}");
+    for (name, b) in r["error_bound"]["outputs"].as_object().unwrap() {
+        assert!(b["abs"].as_f64().is_some_and(f64::is_finite), "{name}: {b}");
+    }
+    let text = std::fs::read_to_string(dir.join("out.rvir")).unwrap();
+    assert!(text.contains(": fix<"), "{text}");
+    robovec_ir::text::parse(&text).unwrap();
+    let (_, r) = run("c");
+    for key in ["widths", "dsp", "alm", "device"] {
+        assert!(r["precision"].get(key).is_none(), "{key}: {}", r["precision"]);
+    }
+    // A target description without the 9- and 18-bit modes, named after the file's `name`:
+    // every product takes whole DSP blocks.
+    let mut t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("examples/targets/de10-nano.json").unwrap()).unwrap();
+    t["name"] = "only-27".into();
+    t["datapath"] = serde_json::json!({ "dsp_modes": [{ "a": 27, "b": 27, "per_block": 1 }] });
+    let target = dir.join("only27.json");
+    std::fs::write(&target, t.to_string()).unwrap();
+    let o = opt(&[
+        "examples/three_link_arm/three_link_arm.urdf",
+        "-function=invdyna",
+        &format!("-ranges={}", ranges.display()),
+        &format!("-target={}", target.display()),
+        "-passes=default<ops>,precision<budget=1e-4;target=fpga>",
+        &format!("-report={}", report.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let r27: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r27["precision"]["device"], "only-27");
+    let dsp = r27["precision"]["dsp"].as_f64().unwrap();
+    assert!(dsp > 0.0 && dsp.fract() == 0.0, "{}", r27["precision"]);
 }

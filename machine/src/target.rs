@@ -27,7 +27,17 @@
 //! | `pe_memory_alm` | 3 ALM per PE memory | seed Table 1.4, row "PE Memory" |
 //! | `crossbar_alm` | 8.125 ALM per (PE-memory write port × crossbar source) | seed Table 1.4, row "Interconnections": 2080 ALM for 8 PE memories × 2 write ports (one multiplexer each, 16 in all, §1.3.1) × 16 sources (8 results + 8 buffer reads) |
 //! | `control_alm` | 469 ALM | seed Table 1.4: the total (4413) minus the rows (4·360 + 4·100 + 8·3 + 2080 = 3944): cycle counter, start/done and glue the table does not itemise |
+//! | `datapath.dsp_modes` | 3 × (9×9), 2 × (18×19), 1 × (27×27) multipliers per DSP block | Intel, *Cyclone V Device Overview* (CV-51001), "Variable-Precision DSP Block": each block is "independent three 9 x 9, two 18 x 18, or one 27 x 27 multipliers"; the device handbook (vol. 1, "Variable Precision DSP Blocks") names the 18-bit mode 18 × 19 |
+//! | `datapath.fix_alm_per_bit` | 0.5 ALM per bit of a fixed-point adder | Cyclone V device handbook, "Adaptive Logic Module": an ALM in arithmetic mode has two dedicated full adders, so a `w`-bit carry chain takes `w/2` ALM |
+//! | `datapath.fp64_add` | 886 ALM, 0 DSP | Intel, *Floating-Point IP Cores User Guide* (UG-01058), "FP_FUNCTIONS Resource Utilization": double-precision Add on Arria V (the same 28 nm ALM and variable-precision DSP block as Cyclone V; its single-precision Add is the seed's 360 ALM) |
+//! | `datapath.fp64_mul` | 250 ALM, 4 DSP | estimate: a 53 × 53 mantissa product tiles into four 27 × 27 blocks (the "54 × 54: four blocks" row of Intel's variable-precision DSP tables); ALM 2.5 × the seed's binary32 MULTI (exponent, rounding and normalisation twice as wide, plus the tiles' adder). No datasheet figure at hand |
+//! | `datapath.convert_alm` | 100 ALM per conversion | estimate: a conversion between fixed and floating point (or binary32 and binary64) is a leading-zero count and a barrel shift of the word, of the order of the seed's MULTI PE logic (100 ALM) |
 //! | `output_word_alm` | 16 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are 32-bit registers read asynchronously, 32 registers at two per ALM = 16 ALM a word, which is also the slope Yosys measures per PE ([`crate::resources`]). Used only where the output words are known (the FPGA back end's estimate); optional in a JSON target (default 0: not counted) |
+//!
+//!
+//! The `datapath` record (issue 48 item 5, `precision<target=fpga>`) costs a datapath of one
+//! operator per op in each value's own format, not the PE array; its fields and their use are in
+//! [`Datapath`]. It is optional in a JSON target (every field defaults to the row above).
 //!
 //! ## The clock
 //! Seed §1.3: the M10K is limited to 240 MHz on the DE10-Nano and the PE memory runs at twice the
@@ -43,7 +53,8 @@
 //!
 //! # The JSON format (`-target=FILE.json`)
 //! One object, every key required except `output_word_alm` (default 0), `latencies.div` and
-//! `latencies.call` (default: the `add` latency, as they run on ADD PEs); an unknown key
+//! `latencies.call` (default: the `add` latency, as they run on ADD PEs) and `datapath` (each
+//! of its fields defaults to the DE10-Nano's, the table above); an unknown key
 //! anywhere is an error, as is a value that makes no sense (zero latency, ports, words, width
 //! or capacity; a clock that is not a positive finite number; a negative or non-finite cost):
 //!
@@ -66,7 +77,15 @@
 //!   "pe_memory_alm": 3,
 //!   "crossbar_alm": 8.125,
 //!   "control_alm": 469,
-//!   "output_word_alm": 16
+//!   "output_word_alm": 16,
+//!   "datapath": {
+//!     "dsp_modes": [{ "a": 9, "b": 9, "per_block": 3 }, { "a": 18, "b": 19, "per_block": 2 },
+//!                   { "a": 27, "b": 27, "per_block": 1 }],
+//!     "fix_alm_per_bit": 0.5,
+//!     "fp64_add": { "alm": 886, "dsp": 0, "m10k": 0 },
+//!     "fp64_mul": { "alm": 250, "dsp": 4, "m10k": 0 },
+//!     "convert_alm": 100
+//!   }
 //! }
 //! ```
 //!
@@ -168,6 +187,91 @@ pub struct Target {
     /// ALM per output-memory word (32-bit registers the outputs are captured in; the FPGA back
     /// end's analytic estimate, which knows the output words per PE).
     pub output_word_alm: f64,
+    /// What the operators of a datapath in per-value formats cost (`precision<target=fpga>`).
+    pub datapath: Datapath,
+}
+
+/// One multiplier mode of a DSP block: `per_block` independent `a × b` signed products.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DspMode {
+    /// Bits of one operand.
+    pub a: u32,
+    /// Bits of the other.
+    pub b: u32,
+    /// Products of this size one block computes.
+    pub per_block: u32,
+}
+
+/// The cost of the operators of a datapath whose values each have their own format (issue 48
+/// item 5, `precision<target=fpga>`): fixed-point words of any width up to 53 bits, binary32 and
+/// binary64. Module doc for the DE10-Nano's figures and their sources.
+///
+/// - A product of `wa`- and `wb`-bit words: [`Datapath::product`] — the fewest DSP blocks over
+///   the modes tiling the product (`⌈wa/a⌉·⌈wb/b⌉` products of mode `a × b`, either way round,
+///   `per_block` of them a block; fractional when a mode packs several products), plus
+///   `fix_alm_per_bit` ALM per bit of the adders summing the tiles when there is more than
+///   one. On the Cyclone V this gives ⅓ block for 9 × 9, ½ for 18 × 19, 1 for 27 × 27, 1 for
+///   19 × 36, 2 for 36 × 36 and 4 for 54 × 54, Intel's own figures for those sizes.
+/// - A `w`-bit fixed-point adder: `fix_alm_per_bit · w` ALM.
+/// - Binary32 operators: the target's `fp_add` / `fp_mul` (the seed's PE figures); binary64:
+///   `fp64_add` / `fp64_mul`.
+/// - A conversion between formats of different kinds: `convert_alm`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Datapath {
+    /// Multiplier modes of one DSP block.
+    pub dsp_modes: Vec<DspMode>,
+    /// ALM per bit of a fixed-point adder (carry chain).
+    pub fix_alm_per_bit: f64,
+    /// One binary64 adder/subtractor.
+    pub fp64_add: UnitCost,
+    /// One binary64 multiplier.
+    pub fp64_mul: UnitCost,
+    /// ALM of one conversion between fixed and floating point, or binary32 and binary64.
+    pub convert_alm: f64,
+}
+
+impl Default for Datapath {
+    /// The DE10-Nano's Cyclone V (module doc).
+    fn default() -> Self {
+        Datapath {
+            dsp_modes: vec![
+                DspMode { a: 9, b: 9, per_block: 3 },
+                DspMode { a: 18, b: 19, per_block: 2 },
+                DspMode { a: 27, b: 27, per_block: 1 },
+            ],
+            fix_alm_per_bit: 0.5,
+            fp64_add: UnitCost { alm: 886.0, dsp: 0, m10k: 0 },
+            fp64_mul: UnitCost { alm: 250.0, dsp: 4, m10k: 0 },
+            convert_alm: 100.0,
+        }
+    }
+}
+
+impl Datapath {
+    /// DSP blocks and ALM of one product of a `wa`-bit and a `wb`-bit signed word (the struct
+    /// doc): `(0, 0)` when either is 0 bits (a product by a power of two is a shift).
+    pub fn product(&self, wa: u32, wb: u32) -> (f64, f64) {
+        if wa == 0 || wb == 0 {
+            return (0.0, 0.0);
+        }
+        let tiles = |m: &DspMode, x: u32, y: u32| u64::from(x.div_ceil(m.a)) * u64::from(y.div_ceil(m.b));
+        let best = self
+            .dsp_modes
+            .iter()
+            .filter(|m| m.a > 0 && m.b > 0 && m.per_block > 0)
+            .map(|m| {
+                let t = tiles(m, wa, wb).min(tiles(m, wb, wa));
+                (t as f64 / f64::from(m.per_block), t)
+            })
+            .min_by(|x, y| x.0.total_cmp(&y.0));
+        match best {
+            Some((dsp, t)) => (dsp, (t - 1) as f64 * f64::from(wa + wb) * self.fix_alm_per_bit),
+            // No DSP mode: the product in logic, one adder of `wa + wb` bits per bit of `wb`.
+            None => (0.0, f64::from(wb) * f64::from(wa + wb) * self.fix_alm_per_bit),
+        }
+    }
 }
 
 /// The resources a configuration needs, against the target's capacity ([`Target::estimate`]).
@@ -250,6 +354,8 @@ struct TargetFile {
     control_alm: f64,
     #[serde(default)]
     output_word_alm: f64,
+    #[serde(default)]
+    datapath: Datapath,
 }
 
 /// How a memory is mapped onto M10K blocks (module doc, "M10K blocks").
@@ -330,6 +436,7 @@ impl Target {
             crossbar_alm: 8.125,
             control_alm: 469.0,
             output_word_alm: 16.0,
+            datapath: Datapath::default(),
         }
     }
 
@@ -377,6 +484,7 @@ impl Target {
             crossbar_alm: f.crossbar_alm,
             control_alm: f.control_alm,
             output_word_alm: f.output_word_alm,
+            datapath: f.datapath,
         };
         t.validate().map_err(|message| TargetError::Value { path: path.to_string(), message })?;
         Ok(t)
@@ -444,10 +552,22 @@ impl Target {
             ("control_alm", self.control_alm),
             ("output_word_alm", self.output_word_alm),
         ];
+        let d = &self.datapath;
+        let costs = costs.into_iter().chain([
+            ("datapath.fix_alm_per_bit", d.fix_alm_per_bit),
+            ("datapath.fp64_add.alm", d.fp64_add.alm),
+            ("datapath.fp64_mul.alm", d.fp64_mul.alm),
+            ("datapath.convert_alm", d.convert_alm),
+        ]);
         for (k, v) in costs {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("`{k}` must be a non-negative number of ALM, got {v}"));
             }
+        }
+        if let Some(m) = d.dsp_modes.iter().find(|m| m.a == 0 || m.b == 0 || m.per_block == 0) {
+            return Err(format!(
+                "`datapath.dsp_modes`: {m:?} must have operands of at least 1 bit and 1 product a block"
+            ));
         }
         Ok(())
     }
@@ -543,6 +663,34 @@ mod tests {
         // Seed §1.3.2: CLK240 reached about 50 MHz, so the PE clock (half of it) 25 MHz.
         assert_eq!(t.clock_mhz, 25.0);
         assert_eq!(Target { name: "de10-nano".into(), clock_mhz: 120.0, ..t }, Target::de10_nano());
+    }
+
+    #[test]
+    fn datapath_defaults_when_absent_and_products_tile_as_intel_counts() {
+        // The shipped files have no `datapath`: they get the Cyclone V's (equal to the built-in
+        // above); one field given, the others default.
+        let mut v: serde_json::Value = serde_json::from_str(&de10_json()).unwrap();
+        v["datapath"] = serde_json::json!({ "convert_alm": 50.0 });
+        let t = Target::from_json("x.json", &v.to_string()).unwrap();
+        assert_eq!(t.datapath, Datapath { convert_alm: 50.0, ..Datapath::default() });
+        v["datapath"] = serde_json::json!({ "convert": 50.0 });
+        assert!(Target::from_json("x.json", &v.to_string()).unwrap_err().to_string().contains("unknown field"));
+        v["datapath"] = serde_json::json!({ "dsp_modes": [{ "a": 0, "b": 9, "per_block": 1 }] });
+        assert!(Target::from_json("x.json", &v.to_string()).unwrap_err().to_string().contains("dsp_modes"));
+        let d = Datapath::default();
+        let dsp = |a, b| d.product(a, b).0;
+        // Intel's table of variable-precision DSP usage: 9×9 a third of a block (three a
+        // block), 18×19 half, 27×27 one, 19×36 one, 36×36 two, 54×54 four.
+        assert!((dsp(9, 9) - 1.0 / 3.0).abs() < 1e-12);
+        assert_eq!(
+            (dsp(18, 19), dsp(19, 18), dsp(27, 27), dsp(19, 36), dsp(36, 36), dsp(54, 54)),
+            (0.5, 0.5, 1.0, 1.0, 2.0, 4.0)
+        );
+        assert_eq!(dsp(53, 53), 4.0);
+        assert_eq!(d.product(0, 20), (0.0, 0.0));
+        // One tile: no adder; four: three adders of 106 bits.
+        assert_eq!(d.product(27, 27).1, 0.0);
+        assert_eq!(d.product(53, 53).1, 3.0 * 106.0 * 0.5);
     }
 
     #[test]

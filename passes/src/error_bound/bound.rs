@@ -44,7 +44,7 @@
 //!   sweep stops with [`BoundError::FixOverflow`]. Inputs in fixed point or binary32 are
 //!   rounded on the way in; a fixed-point or binary64 op reads constants exactly.
 //!
-//! Exact steps the bound knows: `a − a` is 0; a product by a constant power of two, or by
+//! Exact steps the bound knows: `a − a` is 0 (while `a`'s bound is finite); a product by a constant power of two, or by
 //! ±1, 0, only loses bits to underflow (`rel = 0`); a sum with the constant 0 is exact.
 
 use robovec_ir::format::Format;
@@ -404,7 +404,9 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
             let (ib, eb) = rd.operand(b, x, e);
             let same = matches!((a, b), (Operand::Value(p), Operand::Value(q)) if p == q);
             match op_kind {
-                BinOp::Sub if same => (0.0, Rounding::EXACT),
+                // `a − a` is 0 while the computed `a` is finite (∞ − ∞ is NaN).
+                BinOp::Sub if same && ea.is_finite() => (0.0, Rounding::EXACT),
+                BinOp::Sub if same => return f64::INFINITY,
                 BinOp::Add | BinOp::Sub => {
                     let zero = |o: &Operand| matches!(o, Operand::Const(c) if *c == 0.0);
                     let r = if zero(a) || zero(b) { Rounding::EXACT } else { op };

@@ -1,13 +1,17 @@
 //! The search of `precision` (the module doc of [`super`]): rank the cheaper formats by the
 //! first-order damage they do to the outputs' bounds, then binary-search the longest prefix
-//! of the ranking that the certified bound accepts.
+//! of the ranking that the certified bound accepts. `target=fpga` first gives narrow fixed-point
+//! words by its own search ([`super::fpga`]), then runs the binary32 phase on the rest.
 
 use std::collections::BTreeMap;
 
 use robovec_ir::format::{Format, FIX_FRACTION_RANGE};
 use robovec_ir::{BinOp, Def, Function, Interval, Operand, Value};
 
+use robovec_machine::target::Target as Device;
+
 use super::budget::Budget;
+use super::fpga;
 use crate::error_bound::bound::{bound, sensitivities, BoundError, Formats, Rounding};
 
 crate::params::word_enum! {
@@ -17,7 +21,23 @@ crate::params::word_enum! {
         C = "c",
         /// A microcontroller without FPU: 32-bit fixed point first, then binary32.
         Mcu = "mcu",
+        /// An FPGA datapath: fixed-point words as narrow as the budget allows, costed in DSP
+        /// blocks and ALM from the target description ([`super::fpga`]).
+        Fpga = "fpga",
     }
+}
+
+/// What `target=fpga` reports besides the common figures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FpgaFigures {
+    /// The target description's name (`de10-nano`, a JSON file's `name`).
+    pub device: String,
+    /// DSP blocks with every value binary64, and with the formats ([`super::fpga::resources`]).
+    pub dsp: (f64, f64),
+    /// ALM, likewise.
+    pub alm: (f64, f64),
+    /// Fixed-point values per word width.
+    pub widths: BTreeMap<u32, usize>,
 }
 
 /// The formats chosen for one function and what they give.
@@ -44,6 +64,12 @@ pub struct Choice {
     pub unbounded: Vec<String>,
     /// The search was stopped (`-time-limit`) with the formats accepted so far.
     pub stopped: bool,
+    /// `target=fpga`: the device's figures.
+    pub fpga: Option<FpgaFigures>,
+    /// Per output of [`Choice::outputs`], in order: its certified bound if every binary32 and
+    /// fixed-point value had one more bit ([`crate::error_bound::bound::bound_with_more_bits`]),
+    /// ∞ where none is finite.
+    pub one_more_bit: Vec<f64>,
 }
 
 impl Choice {
@@ -62,6 +88,22 @@ impl Choice {
             sweeps: self.sweeps,
             unreachable: self.unreachable.clone(),
             unbounded: self.unbounded.clone(),
+            widths: self.fpga.as_ref().map(|x| x.widths.clone()),
+            dsp: self.fpga.as_ref().map(|x| x.dsp.1),
+            alm: self.fpga.as_ref().map(|x| x.alm.1),
+            device: self.fpga.as_ref().map(|x| x.device.clone()),
+            outputs: self
+                .outputs
+                .iter()
+                .zip(&self.one_more_bit)
+                .map(|((n, bound, budget, _), &more)| {
+                    let finite = |x: f64| x.is_finite().then_some(x);
+                    (
+                        n.clone(),
+                        super::OutputBound { bound: finite(*bound), budget: *budget, one_more_bit: finite(more) },
+                    )
+                })
+                .collect(),
         }
     }
 }
@@ -85,6 +127,8 @@ struct Candidate {
 /// `stop` is read before each sweep of the search: once it says stop, the search keeps the
 /// formats accepted so far ([`Choice::stopped`]; the final check still runs).
 ///
+/// `target=fpga` is costed on the built-in DE10-Nano ([`choose_on`] takes a target description).
+///
 /// # Errors
 /// A message (`@f: …`) when the enclosures cannot be bounded at all (never for a function the
 /// enclosures accept) or, as an internal error, when the final formats fail the bound.
@@ -93,6 +137,22 @@ pub fn choose(
     x: &[Interval],
     budgets: &[Budget],
     target: Target,
+    stop: impl FnMut() -> bool,
+) -> Result<Choice, String> {
+    choose_on(f, x, budgets, target, &Device::de10_nano(), stop)
+}
+
+/// [`choose`] for the target description `device` (what `target=fpga` costs against: its DSP
+/// blocks, ALM and [`robovec_machine::target::Datapath`]; the other targets ignore it).
+///
+/// # Errors
+/// As [`choose`].
+pub fn choose_on(
+    f: &Function,
+    x: &[Interval],
+    budgets: &[Budget],
+    target: Target,
+    device: &Device,
     mut stop: impl FnMut() -> bool,
 ) -> Result<Choice, String> {
     assert_eq!(budgets.len(), f.outputs.len(), "one budget per output");
@@ -121,7 +181,29 @@ pub fn choose(
         }
         outs.push((o.name.clone(), v, b));
     }
-    let seeds: Vec<(Value, f64)> = outs.iter().map(|&(_, v, b)| (v, 1.0 / b)).collect();
+    // The bound takes `a − a` as exactly 0, but it is NaN when the computed `a` is infinite or
+    // NaN, which only an infinite bound of `a` allows: so the operand of each keeps a finite
+    // bound (a guard: at most its magnitude or twice its binary64 bound, checked with the
+    // outputs' budgets), and the values computed from one whose binary64 bound is already
+    // infinite are marked (`target=fpga` leaves them binary64).
+    let mut guards: Vec<(Value, f64)> = Vec::new();
+    let mut poisoned = vec![false; f.values.len()];
+    for &v in &f.body {
+        let def = &f.value(v).def;
+        if let Def::Binary(BinOp::Sub, Operand::Value(a), Operand::Value(b)) = def {
+            let ea = e64[a.index()];
+            if a == b && ea.is_finite() {
+                guards.push((*a, (2.0 * ea).max(x[a.index()].mag()).max(f64::MIN_POSITIVE)));
+            } else if a == b {
+                poisoned[v.index()] = true;
+            }
+        }
+        if operands(def).iter().any(|o| matches!(o, Operand::Value(a) if poisoned[a.index()])) {
+            poisoned[v.index()] = true;
+        }
+    }
+    let seeds: Vec<(Value, f64)> =
+        outs.iter().map(|&(_, v, b)| (v, 1.0 / b)).chain(guards.iter().map(|&(v, b)| (v, 1.0 / b))).collect();
     let lam = sensitivities(&g, x, &e64, &seeds);
     let mut sweeps = 0;
     // The bounds when `h`'s formats meet every budget; otherwise `Err` with the fixed-point
@@ -132,7 +214,7 @@ pub fn choose(
             BoundError::FixOverflow { value, .. } => Some(value),
             BoundError::Stopped(_) => None,
         })?;
-        if outs.iter().all(|&(_, v, b)| e[v.index()] <= b) {
+        if outs.iter().all(|&(_, v, b)| e[v.index()] <= b) && guards.iter().all(|&(v, b)| e[v.index()] <= b) {
             Ok(e)
         } else {
             Err(None)
@@ -140,10 +222,24 @@ pub fn choose(
     };
     let accepts = |h: &Function, sweeps: &mut usize| check(h, sweeps).ok();
     let phases: &[fn(f64, f64) -> Option<Format>] = match target {
-        Target::C => &[binary32],
+        Target::C | Target::Fpga => &[binary32],
         Target::Mcu => &[fix32, binary32],
     };
     let mut stopped = false;
+    let reached: Vec<Value> = outs.iter().filter(|(n, ..)| unreachable.contains(n)).map(|o| o.1).collect();
+    let budgeted: Vec<(Value, f64)> = outs.iter().map(|&(_, v, b)| (v, b)).chain(guards.iter().copied()).collect();
+    let search = |stop| {
+        let mut s = fpga::Search::new(x, budgeted.clone(), reached.clone(), stop);
+        s.keep = poisoned.clone();
+        s
+    };
+    if target == Target::Fpga {
+        // Narrow fixed-point words first (in probe widths of 53 bits until `tighten`).
+        let mut s = search(&mut stop);
+        g = fpga::fixed_phase(f, &g, &e64, device, &mut s);
+        sweeps += s.sweeps;
+        stopped = s.stopped;
+    }
     for phase in phases {
         if stopped {
             break;
@@ -203,10 +299,10 @@ pub fn choose(
         }
         // Cost is not monotone in the prefix (conversions between formats cost too): the
         // cheapest of 17 accepted prefixes, 0 and `lo` included, if the bound accepts it.
-        let mut best = (cost(f, &g, target), 0usize);
+        let mut best = (cost(f, &g, target, device), 0usize);
         for i in 1..=16 {
             let k = lo * i / 16;
-            let c = cost(f, &with(&candidates, k), target);
+            let c = cost(f, &with(&candidates, k), target, device);
             if c < best.0 {
                 best = (c, k);
             }
@@ -218,6 +314,11 @@ pub fn choose(
             lo
         };
         g = with(&candidates, k);
+    }
+    if target == Target::Fpga {
+        let mut s = fpga::Search::new(x, budgeted.clone(), reached.clone(), || false);
+        g = fpga::tighten(f, &g, &mut s);
+        sweeps += s.sweeps;
     }
     let e = accepts(&g, &mut sweeps)
         .ok_or_else(|| format!("@{}: internal error: the chosen formats fail (please report)", f.name))?;
@@ -234,18 +335,41 @@ pub fn choose(
         Some(&Budget::Rel(r)) if budgets.iter().all(|b| *b == Budget::Rel(r)) => Some(r),
         _ => None,
     };
+    let more = crate::error_bound::bound::bound_with_more_bits(&g, x, Formats::Mixed, 1, || false).ok();
+    let one_more_bit = outs.iter().map(|(_, v, _)| more.as_ref().map_or(f64::INFINITY, |m| m[v.index()])).collect();
     Ok(Choice {
+        one_more_bit,
         formats,
         target,
         budget,
         outputs: outs.iter().map(|(n, v, b)| (n.clone(), e[v.index()], *b, x[v.index()].mag())).collect(),
-        cost: (cost(f, &f_with_default(f), target), cost(f, &g, target)),
+        cost: (cost(f, &f_with_default(f), target, device), cost(f, &g, target, device)),
         histogram,
         sweeps,
         unreachable,
         unbounded,
         stopped,
+        fpga: (target == Target::Fpga).then(|| {
+            let before = fpga::resources(f, &f_with_default(f), device);
+            let after = fpga::resources(f, &g, device);
+            FpgaFigures {
+                device: device.name.clone(),
+                dsp: (before.0, after.0),
+                alm: (before.1, after.1),
+                widths: fpga::widths(f, &g),
+            }
+        }),
     })
+}
+
+/// The operands of a definition.
+fn operands(def: &Def) -> Vec<Operand> {
+    match def {
+        Def::Binary(_, a, b) => vec![*a, *b],
+        Def::Call(_, args) => args.clone(),
+        Def::Trig(_, a) => vec![Operand::Value(*a)],
+        Def::Input | Def::Expr(_) => Vec::new(),
+    }
 }
 
 /// `f` with every value binary64.
@@ -273,17 +397,17 @@ fn fix32(m: f64, err: f64) -> Option<Format> {
     FIX_FRACTION_RANGE.contains(&fraction).then(|| Format::fix(32, fraction)).flatten()
 }
 
-/// The cost of `f` under `g`'s formats for `target` (the module doc's model).
-fn cost(f: &Function, g: &Function, target: Target) -> f64 {
+/// The cost of `f` under `g`'s formats for `target` (the module doc's model; `fpga`'s is the
+/// device share of [`fpga::resources`] on `device`).
+fn cost(f: &Function, g: &Function, target: Target, device: &Device) -> f64 {
+    if target == Target::Fpga {
+        let (dsp, alm) = fpga::resources(f, g, device);
+        return fpga::share(dsp, alm, device);
+    }
     let mut total = 0.0;
     for &v in &f.body {
         let fv = g.format(v);
-        let operands: Vec<Operand> = match &f.value(v).def {
-            Def::Binary(_, a, b) => vec![*a, *b],
-            Def::Call(_, args) => args.clone(),
-            Def::Trig(_, a) => vec![Operand::Value(*a)],
-            _ => Vec::new(),
-        };
+        let operands = operands(&f.value(v).def);
         let conversions =
             operands.iter().filter(|o| matches!(o, Operand::Value(a) if g.format(*a) != fv)).count() as f64;
         let is_mul = matches!(f.value(v).def, Def::Binary(BinOp::Mul, ..));
@@ -293,6 +417,7 @@ fn cost(f: &Function, g: &Function, target: Target) -> f64 {
             (Target::Mcu, Format::Fix { .. }) => (if is_mul { 3.0 } else { 1.0 }) + 20.0 * conversions,
             (Target::Mcu, Format::Binary32) => 50.0 + 20.0 * conversions,
             (Target::Mcu, Format::Binary64) => 100.0 + 20.0 * conversions,
+            (Target::Fpga, _) => unreachable!("costed above"),
         };
     }
     total

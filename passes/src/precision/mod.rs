@@ -1,4 +1,4 @@
-//! `precision<budget=REL;target=c|mcu>`: a numeric format per value (issue 48 item 5) that
+//! `precision<budget=REL;target=c|mcu|fpga>`: a numeric format per value (issue 48 item 5) that
 //! lowers the target's cost while the certified error bound of every output stays within the
 //! budget over the input domain.
 //!
@@ -21,19 +21,27 @@
 //! - `c`: binary32 where the bound allows (twice the lanes of a vector of binary64);
 //! - `mcu`: 32-bit fixed point first (`fix<32,f>`, `f` from the value's range with one bit of
 //!   headroom: integer arithmetic on a microcontroller without a floating-point unit), then
-//!   binary32 among the rest.
+//!   binary32 among the rest;
+//! - `fpga`: fixed point in words as narrow as the budget allows (`fix<w,f>`, `w ≤ 53`, each
+//!   value its own), then binary32 among the rest: fraction bits from the sensitivities and a
+//!   cost per bit, one global shift and batches of bits removed, each step checked by the
+//!   bound, and each width the smallest that holds the value's certified range ([`fpga`]).
 //!
 //! Cost (reported before and after): `c` counts ops as 1 per binary64 op and ½ per binary32 op
 //! (lanes per vector) plus ½ per conversion (an operand read in another format than its
 //! user's); `mcu` estimates cycles of a Cortex-M3-class core without an FPU: fixed-point add 1,
 //! multiply 3 (`SMULL`, round, shift), binary32 operation 50 and binary64 100 (software
-//! floating point, order of magnitude), conversions 20.
+//! floating point, order of magnitude), conversions 20; `fpga` the share of the device,
+//! `100·(DSP/dsp + ALM/alm)`, of a datapath of one operator per op in its value's format, from
+//! the target description (`-target`: its DSP modes, ALM per adder bit, binary32 PE and
+//! binary64 unit costs, [`robovec_machine::target::Datapath`]; the table in [`fpga`]).
 //!
 //! [`ladder`]: the same search at budgets 10⁻² … 10⁻¹⁰, for `-report-dir`'s figure of cost
 //! against the budget.
 
 pub mod budget;
 pub mod choose;
+pub mod fpga;
 pub mod ladder;
 
 use robovec_ir::Module;
@@ -42,12 +50,12 @@ use serde::Serialize;
 use crate::params::ParamKind;
 use crate::range::{domain_with_file, enclose_in_pass};
 use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
-pub use choose::{choose, Choice, Target};
+pub use choose::{choose, choose_on, Choice, FpgaFigures, Target};
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
     name: "precision",
-    doc: "choose a numeric format per value (binary32, 32-bit fixed point) that lowers the target's cost while the \
+    doc: "choose a numeric format per value (binary32, fixed point) that lowers the target's cost while the \
           certified error bound of every output stays within the budget over the input domain",
     params: &[
         ParamInfo {
@@ -60,7 +68,8 @@ pub const INFO: PassInfo = PassInfo {
             name: "target",
             kind: ParamKind::Choice { choices: Target::WORDS, default: "c" },
             doc: "c: binary32 where the bound allows (vector lanes); mcu: 32-bit fixed point first, then binary32 \
-                  (a microcontroller without FPU)",
+                  (a microcontroller without FPU); fpga: fixed-point words as narrow as the budget allows, then \
+                  binary32, costed in DSP blocks and ALM of the -target description",
         },
         crate::range::RANGES,
     ],
@@ -101,6 +110,7 @@ impl Pass for PrecisionPass {
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let dom = domain_with_file(cx.domain.as_ref(), self.ranges.as_deref(), m)?;
         let target = self.target;
+        let device = &cx.target.clone();
         // One relative budget for every output, or the budget file's per output.
         let budgets_given = match &self.budget {
             crate::params::NumberOrPath::Number(r) => budget::Budgets::Every(budget::Budget::Rel(*r)),
@@ -132,7 +142,7 @@ impl Pass for PrecisionPass {
                         file.resolve(&names).map_err(|e| failed(format!("@{}: budget file: {e}", f.name)))?
                     }
                 };
-                let c = choose(f, &x, &budgets, target, || ticker.tick()).map_err(failed)?;
+                let c = choose_on(f, &x, &budgets, target, device, || ticker.tick()).map_err(failed)?;
                 if c.stopped {
                     let note = format!(
                         "searching @{} early (the formats accepted so far kept, every budget met): {}",
@@ -164,17 +174,18 @@ pub struct PrecisionReport {
     /// Function name.
     #[serde(skip)]
     pub function: String,
-    /// `c` or `mcu`.
+    /// `c`, `mcu` or `fpga`.
     pub target: &'static str,
     /// The relative budget of every output (`None` with a budget file).
     pub budget: Option<f64>,
-    /// Values per format (`f64`, `f32`, `fix<32,f>`), inputs included.
+    /// Values per format (`f64`, `f32`, `fix<w,f>`), inputs included.
     pub formats: std::collections::BTreeMap<String, usize>,
     /// The largest bound over the outputs, relative to each output's largest magnitude.
     pub max_rel_to_range: f64,
     /// The output that reaches it.
     pub worst_output: Option<String>,
-    /// The target's cost with every value binary64 (module doc's model).
+    /// The target's cost with every value binary64 (module doc's model; `fpga`: percent of the
+    /// device).
     pub cost_before: f64,
     /// Its cost with the chosen formats.
     pub cost_after: f64,
@@ -184,32 +195,70 @@ pub struct PrecisionReport {
     pub unreachable: Vec<String>,
     /// Outputs with no finite bound (not constrained).
     pub unbounded: Vec<String>,
+    /// `fpga`: fixed-point values per word width.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub widths: Option<std::collections::BTreeMap<u32, usize>>,
+    /// `fpga`: DSP blocks of the datapath with the chosen formats ([`fpga::resources`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dsp: Option<f64>,
+    /// `fpga`: its ALM.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alm: Option<f64>,
+    /// `fpga`: the target description costed against (`-target`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub device: Option<String>,
+    /// Per output with a budget: the certified bound reached, its budget, and the bound it would
+    /// reach with one more bit in every binary32 and fixed-point value (the issue's "what bound
+    /// each output would need one more bit for").
+    pub outputs: std::collections::BTreeMap<String, OutputBound>,
+}
+
+/// One output's line of [`PrecisionReport::outputs`]: absolute, in the output's units.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OutputBound {
+    /// Its certified bound with the chosen formats (`null`: none finite).
+    pub bound: Option<f64>,
+    /// Its budget (absolute: a relative budget times the largest magnitude of its range; an
+    /// unreachable output's binary64 bound).
+    pub budget: f64,
+    /// Its certified bound if every binary32 value had 25 significant bits and every `fix<w,f>`
+    /// were `fix<w+1,f+1>`: what one more bit buys (`null`: none finite).
+    pub one_more_bit: Option<f64>,
 }
 
 impl std::fmt::Display for PrecisionReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        // Fixed-point formats grouped by width on this line (the report has each).
-        let mut grouped: std::collections::BTreeMap<String, usize> = std::collections::BTreeMap::new();
+        // Fixed-point formats grouped by width on this line (the report has each), narrowest
+        // first after the binary formats.
+        let mut grouped: std::collections::BTreeMap<(u32, String), usize> = std::collections::BTreeMap::new();
         for (k, n) in &self.formats {
             let key = match k.split_once(',') {
-                Some((w, _)) if k.starts_with("fix<") => format!("{w},*>"),
-                _ => k.clone(),
+                Some((w, _)) if k.starts_with("fix<") => {
+                    (w.trim_start_matches("fix<").parse::<u32>().unwrap_or(u32::MAX), format!("{w},*>"))
+                }
+                _ => (0, k.clone()),
             };
             *grouped.entry(key).or_insert(0) += n;
         }
-        let hist: Vec<String> = grouped.iter().map(|(k, n)| format!("{n} {k}")).collect();
+        let hist: Vec<String> = grouped.iter().map(|((_, k), n)| format!("{n} {k}")).collect();
         write!(
             f,
-            "precision @{} ({}, budget {}): {}; bound {:.3e} of the range at most ({}); cost {:.0} -> {:.0}",
+            "precision @{} ({}, budget {}): {}; bound {:.3e} of the range at most ({}); ",
             self.function,
             self.target,
             self.budget.map_or("per output".to_string(), |b| format!("{b:e}")),
             hist.join(", "),
             self.max_rel_to_range,
             self.worst_output.as_deref().unwrap_or("no output"),
-            self.cost_before,
-            self.cost_after
         )?;
+        match (self.dsp, self.alm, &self.device) {
+            (Some(dsp), Some(alm), Some(device)) => write!(
+                f,
+                "cost {:.1} -> {:.1} % of {device} ({dsp:.1} DSP, {alm:.0} ALM)",
+                self.cost_before, self.cost_after
+            )?,
+            _ => write!(f, "cost {:.0} -> {:.0}", self.cost_before, self.cost_after)?,
+        }
         for (what, list) in [
             ("cannot meet the budget even in binary64 (kept so)", &self.unreachable),
             ("have no finite bound", &self.unbounded),
