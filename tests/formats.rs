@@ -159,7 +159,7 @@ fn a_pass_that_does_not_understand_formats_refuses_them() {
 /// (`robovec_ir::format::eval_values`). One state per call.
 #[test]
 fn c_computes_every_format_bit_for_bit_as_eval() {
-    c_bit_exact("formats-c", 1, "-O1");
+    c_bit_exact("formats-c", 1, "-O1", false);
 }
 
 /// As [`c_computes_every_format_bit_for_bit_as_eval`] with `batch=8` (`float` and `double`
@@ -167,13 +167,25 @@ fn c_computes_every_format_bit_for_bit_as_eval() {
 /// machine's own vector instructions (its FMA where it has one).
 #[test]
 fn c_batches_compute_every_format_bit_for_bit_as_eval() {
-    c_bit_exact("formats-c-batch8", 8, "-O2");
-    c_bit_exact("formats-c-batch2", 2, "-O1");
+    c_bit_exact("formats-c-batch8", 8, "-O2", false);
+    c_bit_exact("formats-c-batch2", 2, "-O1", false);
+}
+
+/// With `trig=inline` (robovec's own sin/cos: binary32 values in `float` code, the others in
+/// `double` code on half vectors) the C is not bit-exact, but every output stays within twice
+/// the certified mixed-format bound of `-eval`'s (both are within the bound of the exact value:
+/// the inline code's 1 ulp is inside the bound's allowance for the C library), at `batch=8`
+/// with the machine's vectors and `batch=2` with SSE2 only; `-Wall -Wextra -Werror` clean.
+#[test]
+fn c_batches_with_inline_trig_stay_within_the_certified_bound() {
+    c_bit_exact("formats-c-inline8", 8, "-O2", true);
+    c_bit_exact("formats-c-inline2", 2, "-O1", true);
 }
 
 /// The bit-exact campaign at `batch` lanes (each call evaluates `batch` points,
-/// lane-contiguous), compiled with `opt_level` (and `-march=native` in a batch).
-fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str) {
+/// lane-contiguous), compiled with `opt_level` (and `-march=native` in a batch of 8); with
+/// `inline_trig`, `trig=inline` and each output within twice its certified bound of `-eval`'s.
+fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool) {
     use robovec_backends::c::CodegenC;
     use robovec_ir::rng::SplitMix64;
     use robovec_ir::Operand;
@@ -183,7 +195,8 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str) {
     let mut calls = String::new();
     let mut files = vec!["main.c".to_string()];
     let mut input_bytes: Vec<u8> = Vec::new();
-    let mut want: Vec<(String, f64)> = Vec::new();
+    // (what, -eval's value, allowed distance: 0 for bit-exact).
+    let mut want: Vec<(String, f64, f64)> = Vec::new();
     let mut cases = 0;
     for seed in 0..48u64 {
         let (f, dom) = crate::range::random_function(seed * 7919 + 1, 4 + (seed as usize % 40));
@@ -192,7 +205,14 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str) {
             continue;
         }
         let m = Module { functions: vec![g.clone()] };
-        let o = CodegenC { name: Some(format!("t{seed}")), batch: batch as u32, ..CodegenC::default() };
+        let trig = if inline_trig { robovec_backends::c::Trig::Inline } else { robovec_backends::c::Trig::Libm };
+        let o = CodegenC { name: Some(format!("t{seed}")), batch: batch as u32, trig, ..CodegenC::default() };
+        let bounds = if inline_trig {
+            let x = robovec_passes::range::enclose_with(&g, &dom, Some(16), || false).unwrap();
+            robovec_passes::error_bound::bound(&g, &x, robovec_passes::error_bound::Formats::Mixed, || false).unwrap()
+        } else {
+            Vec::new()
+        };
         let art = o.emit(&m).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         std::fs::write(dir.join(format!("t{seed}.c")), &art.code.main).unwrap();
         files.push(format!("t{seed}.c"));
@@ -218,11 +238,12 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str) {
             }
             for (name, out) in iface.outputs.iter().zip(&g.outputs) {
                 for (point, vals) in group {
-                    let y = match out.value {
-                        Operand::Value(v) => vals[v.index()],
-                        Operand::Const(c) => c,
+                    let (y, allowed) = match out.value {
+                        Operand::Value(v) if inline_trig => (vals[v.index()], 2.0 * bounds[v.index()]),
+                        Operand::Value(v) => (vals[v.index()], 0.0),
+                        Operand::Const(c) => (c, 0.0),
                     };
-                    want.push((format!("seed {seed} {name} at {point:?}"), y));
+                    want.push((format!("seed {seed} {name} at {point:?}"), y, allowed));
                 }
             }
         }
@@ -247,8 +268,8 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str) {
     std::fs::write(dir.join("main.c"), main).unwrap();
     let exe = dir.join("run");
     let mut cc = std::process::Command::new("cc");
-    cc.current_dir(&dir).args([opt_level, "-std=c99", "-ffp-contract=off"]);
-    if batch > 1 {
+    cc.current_dir(&dir).args([opt_level, "-std=c99", "-ffp-contract=off", "-Wall", "-Wextra", "-Werror", "-Wno-psabi"]);
+    if batch == 8 {
         cc.arg("-march=native");
     }
     let o = cc.arg("-o").arg(&exe).args(&files).arg("-lm").output().expect("cc (scripts/test.sh installs gcc)");
@@ -265,10 +286,19 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str) {
     let got: Vec<u64> =
         String::from_utf8(out.stdout).unwrap().lines().map(|l| u64::from_str_radix(l, 16).unwrap()).collect();
     assert_eq!(got.len(), want.len());
-    for (g, (what, y)) in got.iter().zip(&want) {
-        let same = *g == y.to_bits() || (y.is_nan() && f64::from_bits(*g).is_nan());
-        assert!(same, "batch={batch}: {what}: C gives {:e}, -eval {y:e}", f64::from_bits(*g));
+    let mut checked = 0;
+    for (g, (what, y, allowed)) in got.iter().zip(&want) {
+        let c = f64::from_bits(*g);
+        let same = *g == y.to_bits() || (y.is_nan() && c.is_nan());
+        if *allowed > 0.0 && allowed.is_finite() {
+            assert!((c - y).abs() <= *allowed, "batch={batch}: {what}: C gives {c:e}, -eval {y:e}, allowed {allowed:e}");
+            checked += 1;
+        } else if *allowed == 0.0 {
+            assert!(same, "batch={batch}: {what}: C gives {c:e}, -eval {y:e}");
+            checked += 1;
+        }
     }
+    assert!(checked * 2 >= want.len(), "only {checked} of {} outputs checked", want.len());
 }
 
 /// Formats with options that cannot honour them are refused (exit 1), naming both.

@@ -107,6 +107,10 @@ pub(crate) fn format_vector_helpers(lanes: u32) -> String {
          /* The bytes of one robovec_vec and of one robovec_vec32, for the preprocessor. */\n\
          #define ROBOVEC_VEC_BYTES (ROBOVEC_VBYTES < ROBOVEC_W * 4 ? 2 * ROBOVEC_VBYTES : ROBOVEC_W * 8)\n\
          #define ROBOVEC_VEC32_BYTES (ROBOVEC_VBYTES < ROBOVEC_W * 4 ? ROBOVEC_VBYTES : ROBOVEC_W * 4)\n\
+         /* Half a robovec_vec (trig=inline's double code runs on halves: one register each). */\n\
+         #define ROBOVEC_HL (ROBOVEC_VL / 2)\n\
+         typedef double robovec_vech __attribute__((vector_size(ROBOVEC_HL * 8)));\n\
+         #define ROBOVEC_VECH_BYTES (ROBOVEC_HL * 8)\n\
          #if defined(__SSE2__) || defined(__AVX__)\n#include <immintrin.h>\n#endif\n"
     );
     for (ty, sfx, real) in [("robovec_vec", "", "double"), ("robovec_vec32", "32", "float")] {
@@ -157,6 +161,13 @@ pub(crate) fn format_vector_helpers(lanes: u32) -> String {
          #elif defined(__SSE2__) && ROBOVEC_VEC32_BYTES == 16\n  \
          _mm_storeu_pd(p, _mm_cvtps_pd((__m128)x));\n  _mm_storeu_pd(p + 2, _mm_cvtps_pd(_mm_movehl_ps((__m128)x, (__m128)x)));\n\
          #else\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) p[lane] = (double)x[lane];\n\
+         #endif\n}}\n\
+         static inline ROBOVEC_UNUSED robovec_vech robovec_splath(double x) {{ robovec_vech r; for (int lane = 0; lane < ROBOVEC_HL; lane++) r[lane] = x; return r; }}\n\
+         static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vech robovec_fmah(robovec_vech a, robovec_vech b, robovec_vech c)\n{{\n\
+         #if defined(__AVX512F__) && ROBOVEC_VECH_BYTES == 64\n  return (robovec_vech)_mm512_fmadd_pd((__m512d)a, (__m512d)b, (__m512d)c);\n\
+         #elif defined(__FMA__) && ROBOVEC_VECH_BYTES == 32\n  return (robovec_vech)_mm256_fmadd_pd((__m256d)a, (__m256d)b, (__m256d)c);\n\
+         #elif defined(__FMA__) && ROBOVEC_VECH_BYTES == 16\n  return (robovec_vech)_mm_fmadd_pd((__m128d)a, (__m128d)b, (__m128d)c);\n\
+         #else\n  robovec_vech r;\n  for (int lane = 0; lane < ROBOVEC_HL; lane++) r[lane] = fma(a[lane], b[lane], c[lane]);\n  return r;\n\
          #endif\n}}\n\
          static inline ROBOVEC_UNUSED robovec_vec robovec_fix_store_v(robovec_vec x, int f) {{ for (int lane = 0; lane < ROBOVEC_VL; lane++) x[lane] = robovec_fix_store(x[lane], f); return x; }}"
     );
@@ -434,6 +445,12 @@ impl<'a> Body<'a> {
                                 self.stored(sin, "robovec_s".into()),
                                 self.stored(cos, "robovec_c".into()),
                             );
+                            // Assigned, not passed by address: an unread one needs its (void).
+                            for w in [sin, cos] {
+                                if self.unused[w.index()] {
+                                    let _ = writeln!(s, "  (void){};", self.names[w.index()]);
+                                }
+                            }
                         }
                     } else {
                         let fun = if *t == TrigFn::Sin { "sin" } else { "cos" };

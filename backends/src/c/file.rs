@@ -246,11 +246,11 @@ impl CodegenC {
         } else if self.batch > 1 {
             helpers += &body::vector_helpers(self.real(), self.batch, self.f32());
         }
-        if self.trig == Trig::Inline {
+        if self.trig == Trig::Inline && formats && self.batch > 1 {
+            helpers += &trig::helpers_halves();
+            helpers += &trig::helpers_vec32();
+        } else if self.trig == Trig::Inline {
             helpers += &trig::helpers(self.f32(), self.batch > 1);
-            if formats && self.batch > 1 {
-                helpers += &trig::helpers_vec32();
-            }
         }
         s += &shared_helpers(&helpers);
         s

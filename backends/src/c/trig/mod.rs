@@ -324,6 +324,58 @@ pub(crate) fn helpers_vec32() -> String {
     out
 }
 
+/// `trig=inline` in a batch whose values carry numeric formats: [`helpers`]' `double` code on
+/// `robovec_vech`, half a `robovec_vec` (its `double` vectors have the lanes of the `float`
+/// ones, twice the target's register: 8 with AVX2), and `robovec_sincos_inline`,
+/// `robovec_sin_inline`, `robovec_cos_inline` on `robovec_vec` calling it on each half. The
+/// kernel's 64-bit integer lane operations on a vector of twice the register are scalarised by
+/// GCC 12 without AVX-512 (the Segway's `dirdyna` with 51 binary64 values at `batch=8`: mixed
+/// 1.23× binary64 `batch=4` with the whole-vector kernel); on halves they are one register.
+/// The same operations per lane: the same bits as the whole-vector form.
+pub(crate) fn helpers_halves() -> String {
+    const RENAMED: [(&str, &str); 11] = [
+        ("robovec_vec", "robovec_vech"),
+        ("robovec_uvec", "robovec_uvech"),
+        ("robovec_ivec", "robovec_ivech"),
+        ("robovec_sincos_inline", "robovec_sincos_inlineh"),
+        ("robovec_sin_inline", "robovec_sin_inlineh"),
+        ("robovec_cos_inline", "robovec_cos_inlineh"),
+        ("robovec_fma", "robovec_fmah"),
+        ("robovec_splat", "robovec_splath"),
+        ("ROBOVEC_MADD", "ROBOVEC_MADDH"),
+        ("ROBOVEC_VEC_BYTES", "ROBOVEC_VECH_BYTES"),
+        ("ROBOVEC_VL", "ROBOVEC_HL"),
+    ];
+    let text = helpers(false, true);
+    let mut out = String::with_capacity(text.len() + 1024);
+    let mut word = String::new();
+    let flush = |word: &mut String, out: &mut String| {
+        out.push_str(RENAMED.iter().find(|(from, _)| *from == word.as_str()).map_or(word.as_str(), |(_, to)| to));
+        word.clear();
+    };
+    for ch in text.chars() {
+        if ch.is_ascii_alphanumeric() || ch == '_' {
+            word.push(ch);
+        } else {
+            flush(&mut word, &mut out);
+            out.push(ch);
+        }
+    }
+    flush(&mut word, &mut out);
+    out.push_str(
+        "/* The whole robovec_vec: its two halves. */\n\
+         static inline ROBOVEC_UNUSED void robovec_sincos_inline(robovec_vec x, robovec_vec *sin_out, robovec_vec *cos_out)\n{\n  \
+         robovec_vech x0, x1, s0, s1, c0, c1;\n  \
+         memcpy(&x0, &x, sizeof x0);\n  memcpy(&x1, (const char *)&x + sizeof x0, sizeof x1);\n  \
+         robovec_sincos_inlineh(x0, &s0, &c0);\n  robovec_sincos_inlineh(x1, &s1, &c1);\n  \
+         memcpy(sin_out, &s0, sizeof s0);\n  memcpy((char *)sin_out + sizeof s0, &s1, sizeof s1);\n  \
+         memcpy(cos_out, &c0, sizeof c0);\n  memcpy((char *)cos_out + sizeof c0, &c1, sizeof c1);\n}\n\
+         static inline ROBOVEC_UNUSED robovec_vec robovec_sin_inline(robovec_vec x) { robovec_vec s, c; robovec_sincos_inline(x, &s, &c); return s; }\n\
+         static inline ROBOVEC_UNUSED robovec_vec robovec_cos_inline(robovec_vec x) { robovec_vec s, c; robovec_sincos_inline(x, &s, &c); return c; }\n\n",
+    );
+    out
+}
+
 /// `trig=inline`, one state: the length of the argument array of `robovec_sincos_n` is a
 /// multiple of this (64 bytes: the lanes of the widest vector, AVX-512), so that every vector
 /// width divides it and the loop needs no scalar remainder.
