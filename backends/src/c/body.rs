@@ -217,6 +217,8 @@ pub(crate) struct Body<'a> {
     /// (`robovec_f{index}`, `robovec_d{index}`) later reads use: one conversion per value and
     /// direction per part, not one per use (bit-identical: a conversion is a function of the value).
     converted: std::cell::RefCell<std::collections::HashSet<(usize, bool)>>,
+    /// Some value has a numeric format ([`Function::has_formats`], read once: it scans the values).
+    formats: bool,
 }
 
 impl<'a> Body<'a> {
@@ -232,7 +234,8 @@ impl<'a> Body<'a> {
         let fused = if o.trig == Trig::Inline { fused_trig(f) } else { HashMap::new() };
         let block = if o.trig == Trig::Inline && o.batch == 1 { TrigBlock::of(f) } else { None };
         let unused = f.use_counts().iter().map(|&n| n == 0).collect();
-        Body { o, f, names, native, fused, block, ticker, unused, converted: Default::default() }
+        let formats = f.has_formats();
+        Body { o, f, names, native, fused, block, ticker, unused, converted: Default::default(), formats }
     }
 
     /// The values that have a statement, in the order they are written, and for each whether
@@ -402,7 +405,7 @@ impl<'a> Body<'a> {
             // Not for callbacks (lane by lane) nor robovec's sin/cos (their own reads).
             let own_reads = matches!(def, Def::Call(c, a) if !is_intrinsic(c, a.len()))
                 || (matches!(def, Def::Trig(..)) && self.o.trig == Trig::Inline);
-            if vec && self.f.has_formats() && !own_reads {
+            if vec && self.formats && !own_reads {
                 self.convert_operands(s, v);
             }
             if let Some(b) = self.block.as_ref().filter(|b| b.slot_of.contains_key(&v.index())) {
