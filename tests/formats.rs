@@ -317,3 +317,40 @@ fn c_refuses_formats_with_options_that_cannot_honour_them() {
     let c = std::fs::read_to_string(dir.join("f.c")).unwrap();
     assert!(c.contains("robovec_fix_store(") && c.contains("const float t = (float)s / 0x1.8p+1f;"), "{c}");
 }
+
+/// Formats with `abi=pinocchio` (Pinocchio's `double` vectors, the formats inside): a URDF's RNEA
+/// after `precision` compiles cleanly (`-Wall -Wextra -Werror -std=c99`) at one state and in
+/// batches, with `trig=libm` and `trig=inline`, and its entry point has Pinocchio's signature.
+#[test]
+fn pinocchio_abi_writes_formats() {
+    let dir = tmp("formats-pinocchio");
+    let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/three_link_arm/three_link_arm.urdf");
+    // The arm's second joint has no velocity limit in its URDF.
+    let ranges = dir.join("ranges.json");
+    std::fs::write(&ranges, r#"{"qd[*]": [-5, 5]}"#).unwrap();
+    let ranges = format!("-ranges={}", ranges.display());
+    for (batch, trig) in [(1, "libm"), (4, "inline"), (8, "libm")] {
+        let c = dir.join(format!("arm_{batch}_{trig}.c"));
+        let o = opt(&[
+            urdf,
+            "-function=invdyna",
+            "--fold-params",
+            &ranges,
+            &format!("-passes=atomise,cse,precision<budget=1e-5>,codegen<c;abi=pinocchio;batch={batch};trig={trig}>"),
+            "-o",
+            c.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        assert!(stderr(&o).contains(" f32"), "precision chose binary32 somewhere: {}", stderr(&o));
+        let text = std::fs::read_to_string(&c).unwrap();
+        assert!(text.contains("void model_rnea(const double *restrict q, const double *restrict v, const double *restrict a, double *restrict tau)"), "{text}");
+        assert!(text.contains(if batch > 1 { "robovec_vec32" } else { "const float " }), "binary32 temporaries");
+        let cc = std::process::Command::new("cc")
+            .args(["-O1", "-std=c99", "-Wall", "-Wextra", "-Werror", "-Wno-psabi", "-ffp-contract=off", "-c", "-o"])
+            .arg(dir.join(format!("arm_{batch}_{trig}.o")))
+            .arg(&c)
+            .output()
+            .expect("cc");
+        assert!(cc.status.success(), "batch={batch} trig={trig}: {}", String::from_utf8_lossy(&cc.stderr));
+    }
+}
