@@ -13,6 +13,12 @@ use crate::literal;
 use robovec_ir::format::Format;
 use robovec_ir::Intrinsic;
 
+/// The default of `ROBOVEC_VBYTES`, the widest vector the compiler targets, in bytes (AVX-512:
+/// 64, AVX: 32, otherwise 16: SSE2, NEON); `-DROBOVEC_VBYTES=N` chooses by hand.
+const VBYTES_DEFAULT: &str = "#ifndef ROBOVEC_VBYTES\n#if defined(__AVX512F__)\n#define ROBOVEC_VBYTES 64\n\
+                              #elif defined(__AVX__)\n#define ROBOVEC_VBYTES 32\n\
+                              #else\n#define ROBOVEC_VBYTES 16\n#endif\n#endif\n";
+
 /// The vector type `robovec_vec` of a batch of `lanes` states and its per-lane helpers.
 ///
 /// The body runs on vectors of `ROBOVEC_VL` lanes — the widest the compiler targets (64 bytes
@@ -31,19 +37,16 @@ pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
          * The body runs on vectors of ROBOVEC_VL lanes, the widest the compiler targets (AVX-512: 64 bytes,\n \
          * AVX: 32, otherwise 16: SSE2, NEON; -DROBOVEC_VBYTES=N chooses), {lanes}/ROBOVEC_VL times per call:\n \
          * wider vectors than the target's are split by the compiler, slowly to compile and to run. */\n\
-         #ifndef ROBOVEC_VBYTES\n\
-         #if defined(__AVX512F__)\n#define ROBOVEC_VBYTES 64\n\
-         #elif defined(__AVX__)\n#define ROBOVEC_VBYTES 32\n\
-         #else\n#define ROBOVEC_VBYTES 16\n#endif\n#endif\n\
+         {VBYTES_DEFAULT}\
          #define ROBOVEC_W {lanes}\n\
          #define ROBOVEC_VL (ROBOVEC_VBYTES / (int)sizeof({real}) < ROBOVEC_W ? ROBOVEC_VBYTES / (int)sizeof({real}) : ROBOVEC_W)\n\
          _Static_assert(ROBOVEC_VL >= 1 && ROBOVEC_W % ROBOVEC_VL == 0, \"ROBOVEC_VBYTES must be a power of two of at least one {real}\");\n\
          typedef {real} robovec_vec __attribute__((vector_size(ROBOVEC_VL * sizeof({real}))));\n\
          /* The bytes of one robovec_vec, for the preprocessor (intrinsics of that width). */\n\
          #define ROBOVEC_VEC_BYTES (ROBOVEC_VBYTES < ROBOVEC_W * {size} ? ROBOVEC_VBYTES : ROBOVEC_W * {size})\n\
-         #if defined(__SSE2__) || defined(__AVX__)\n#include <immintrin.h>\n#endif\n\
-         static inline ROBOVEC_UNUSED robovec_vec robovec_splat({real} x) {{ robovec_vec r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = x; return r; }}\n"
+         #if defined(__SSE2__) || defined(__AVX__)\n#include <immintrin.h>\n#endif\n"
     );
+    s += &splat_helper("robovec_splat", "robovec_vec", real, "ROBOVEC_VL");
     for f in ["sin", "cos", "sqrt"] {
         let _ = writeln!(
             s,
@@ -53,18 +56,43 @@ pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
     // One vector FMA instruction where the target has one, C99 `fma` per lane otherwise: the
     // same bits either way. Intrinsics, not a lane loop: in a large function GCC 12 neither
     // inlines nor fully vectorises the loop (serial30's `M`: 2.5x slower than without FMA).
-    let (p, x) = if f32 { ("ps", "") } else { ("pd", "d") };
-    let _ = writeln!(
-        s,
-        "static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vec robovec_fma(robovec_vec a, robovec_vec b, robovec_vec c)\n{{\n\
-         #if defined(__AVX512F__) && ROBOVEC_VEC_BYTES == 64\n  return (robovec_vec)_mm512_fmadd_{p}((__m512{x})a, (__m512{x})b, (__m512{x})c);\n\
-         #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 32\n  return (robovec_vec)_mm256_fmadd_{p}((__m256{x})a, (__m256{x})b, (__m256{x})c);\n\
-         #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 16\n  return (robovec_vec)_mm_fmadd_{p}((__m128{x})a, (__m128{x})b, (__m128{x})c);\n\
-         #else\n  robovec_vec r;\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = fma{sfx}(a[lane], b[lane], c[lane]);\n  return r;\n\
-         #endif\n}}"
-    );
+    s += &fma_helper("robovec_fma", "robovec_vec", f32, "ROBOVEC_VEC_BYTES", "ROBOVEC_VL", false);
     s.push('\n');
     s
+}
+
+/// `static inline {ty} {name}({real} x)`: `x` in every one of the `lanes` (a macro) lanes.
+fn splat_helper(name: &str, ty: &str, real: &str, lanes: &str) -> String {
+    format!(
+        "static inline ROBOVEC_UNUSED {ty} {name}({real} x) {{ {ty} r; for (int lane = 0; lane < {lanes}; lane++) r[lane] = x; return r; }}\n"
+    )
+}
+
+/// `{name}(a, b, c)` on vectors `ty` of `float` (`f32`) or `double` whose size in bytes is the
+/// macro `bytes`: one vector FMA instruction where the target has one of that width, C99 `fma`
+/// per lane otherwise (the same bits either way). Intrinsics, not a lane loop: in a large
+/// function GCC 12 neither inlines nor fully vectorises the loop (serial30's `M`: 2.5x slower
+/// than without FMA). `halves`: a `double` vector of two registers (formats in a batch), two
+/// instructions on its halves instead of the 64-byte one.
+fn fma_helper(name: &str, ty: &str, f32: bool, bytes: &str, lanes: &str, halves: bool) -> String {
+    let (p, x, sfx) = if f32 { ("ps", "", "f") } else { ("pd", "d", "") };
+    let wide = if halves {
+        format!(
+            "#if defined(__AVX512F__) && {bytes} == 128\n  __m512d h[6];\n  memcpy(h, &a, 128); memcpy(h + 2, &b, 128); memcpy(h + 4, &c, 128);\n  \
+             h[0] = _mm512_fmadd_pd(h[0], h[2], h[4]); h[1] = _mm512_fmadd_pd(h[1], h[3], h[5]);\n  memcpy(&a, h, 128);\n  return a;\n\
+             #elif defined(__FMA__) && {bytes} == 64\n  __m256d h[6];\n  memcpy(h, &a, 64); memcpy(h + 2, &b, 64); memcpy(h + 4, &c, 64);\n  \
+             h[0] = _mm256_fmadd_pd(h[0], h[2], h[4]); h[1] = _mm256_fmadd_pd(h[1], h[3], h[5]);\n  memcpy(&a, h, 64);\n  return a;\n"
+        )
+    } else {
+        format!("#if defined(__AVX512F__) && {bytes} == 64\n  return ({ty})_mm512_fmadd_{p}((__m512{x})a, (__m512{x})b, (__m512{x})c);\n")
+    };
+    format!(
+        "static inline ROBOVEC_UNUSED __attribute__((always_inline)) {ty} {name}({ty} a, {ty} b, {ty} c)\n{{\n{wide}\
+         #elif defined(__FMA__) && {bytes} == 32\n  return ({ty})_mm256_fmadd_{p}((__m256{x})a, (__m256{x})b, (__m256{x})c);\n\
+         #elif defined(__FMA__) && {bytes} == 16\n  return ({ty})_mm_fmadd_{p}((__m128{x})a, (__m128{x})b, (__m128{x})c);\n\
+         #else\n  {ty} r;\n  for (int lane = 0; lane < {lanes}; lane++) r[lane] = fma{sfx}(a[lane], b[lane], c[lane]);\n  return r;\n\
+         #endif\n}}\n"
+    )
 }
 
 /// The name of value `index`'s copy converted to binary32 (`narrow`) or to binary64 ([`Body::converted`]).
@@ -95,10 +123,7 @@ pub(crate) fn format_vector_helpers(lanes: u32) -> String {
          * The values carry numeric formats: binary32 ones are robovec_vec32 (float), the others robovec_vec\n \
          * (double), both of ROBOVEC_VL lanes: the lanes of the widest float vector the compiler targets\n \
          * (AVX-512: 64 bytes, AVX: 32, otherwise 16; -DROBOVEC_VBYTES=N chooses), {lanes}/ROBOVEC_VL times per call. */\n\
-         #ifndef ROBOVEC_VBYTES\n\
-         #if defined(__AVX512F__)\n#define ROBOVEC_VBYTES 64\n\
-         #elif defined(__AVX__)\n#define ROBOVEC_VBYTES 32\n\
-         #else\n#define ROBOVEC_VBYTES 16\n#endif\n#endif\n\
+         {VBYTES_DEFAULT}\
          #define ROBOVEC_W {lanes}\n\
          #define ROBOVEC_VL (ROBOVEC_VBYTES / 4 < ROBOVEC_W ? ROBOVEC_VBYTES / 4 : ROBOVEC_W)\n\
          _Static_assert(ROBOVEC_VL >= 1 && ROBOVEC_W % ROBOVEC_VL == 0, \"ROBOVEC_VBYTES must be a power of two of at least one float\");\n\
@@ -115,10 +140,7 @@ pub(crate) fn format_vector_helpers(lanes: u32) -> String {
     );
     for (ty, sfx, real) in [("robovec_vec", "", "double"), ("robovec_vec32", "32", "float")] {
         let f = if sfx.is_empty() { "" } else { "f" };
-        let _ = writeln!(
-            s,
-            "static inline ROBOVEC_UNUSED {ty} robovec_splat{sfx}({real} x) {{ {ty} r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = x; return r; }}"
-        );
+        s += &splat_helper(&format!("robovec_splat{sfx}"), ty, real, "ROBOVEC_VL");
         for fun in ["sin", "cos", "sqrt"] {
             let _ = writeln!(
                 s,
@@ -127,24 +149,11 @@ pub(crate) fn format_vector_helpers(lanes: u32) -> String {
         }
     }
     // Vector FMA instructions as in `vector_helpers`; a `double` vector of two registers in halves.
-    let _ = writeln!(
+    s += &fma_helper("robovec_fma32", "robovec_vec32", true, "ROBOVEC_VEC32_BYTES", "ROBOVEC_VL", false);
+    s += &fma_helper("robovec_fma", "robovec_vec", false, "ROBOVEC_VEC_BYTES", "ROBOVEC_VL", true);
+    let _ = write!(
         s,
-        "static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vec32 robovec_fma32(robovec_vec32 a, robovec_vec32 b, robovec_vec32 c)\n{{\n\
-         #if defined(__AVX512F__) && ROBOVEC_VEC32_BYTES == 64\n  return (robovec_vec32)_mm512_fmadd_ps((__m512)a, (__m512)b, (__m512)c);\n\
-         #elif defined(__FMA__) && ROBOVEC_VEC32_BYTES == 32\n  return (robovec_vec32)_mm256_fmadd_ps((__m256)a, (__m256)b, (__m256)c);\n\
-         #elif defined(__FMA__) && ROBOVEC_VEC32_BYTES == 16\n  return (robovec_vec32)_mm_fmadd_ps((__m128)a, (__m128)b, (__m128)c);\n\
-         #else\n  robovec_vec32 r;\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = fmaf(a[lane], b[lane], c[lane]);\n  return r;\n\
-         #endif\n}}\n\
-         static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vec robovec_fma(robovec_vec a, robovec_vec b, robovec_vec c)\n{{\n\
-         #if defined(__AVX512F__) && ROBOVEC_VEC_BYTES == 128\n  __m512d h[6];\n  memcpy(h, &a, 128); memcpy(h + 2, &b, 128); memcpy(h + 4, &c, 128);\n  \
-         h[0] = _mm512_fmadd_pd(h[0], h[2], h[4]); h[1] = _mm512_fmadd_pd(h[1], h[3], h[5]);\n  memcpy(&a, h, 128);\n  return a;\n\
-         #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 64\n  __m256d h[6];\n  memcpy(h, &a, 64); memcpy(h + 2, &b, 64); memcpy(h + 4, &c, 64);\n  \
-         h[0] = _mm256_fmadd_pd(h[0], h[2], h[4]); h[1] = _mm256_fmadd_pd(h[1], h[3], h[5]);\n  memcpy(&a, h, 64);\n  return a;\n\
-         #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 32\n  return (robovec_vec)_mm256_fmadd_pd((__m256d)a, (__m256d)b, (__m256d)c);\n\
-         #elif defined(__FMA__) && ROBOVEC_VEC_BYTES == 16\n  return (robovec_vec)_mm_fmadd_pd((__m128d)a, (__m128d)b, (__m128d)c);\n\
-         #else\n  robovec_vec r;\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = fma(a[lane], b[lane], c[lane]);\n  return r;\n\
-         #endif\n}}\n\
-         /* A binary32 input's lanes from the double array, an output's lanes into it: by 32- or 16-byte\n \
+        "/* A binary32 input's lanes from the double array, an output's lanes into it: by 32- or 16-byte\n \
          * instructions where the vector is one such register (no 64-byte double vector on an AVX-512 machine,\n \
          * whose wide instructions lower the clock), lane by lane otherwise. */\n\
          static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vec32 robovec_load32(const double *p)\n{{\n\
@@ -161,15 +170,13 @@ pub(crate) fn format_vector_helpers(lanes: u32) -> String {
          #elif defined(__SSE2__) && ROBOVEC_VEC32_BYTES == 16\n  \
          _mm_storeu_pd(p, _mm_cvtps_pd((__m128)x));\n  _mm_storeu_pd(p + 2, _mm_cvtps_pd(_mm_movehl_ps((__m128)x, (__m128)x)));\n\
          #else\n  for (int lane = 0; lane < ROBOVEC_VL; lane++) p[lane] = (double)x[lane];\n\
-         #endif\n}}\n\
-         static inline ROBOVEC_UNUSED robovec_vech robovec_splath(double x) {{ robovec_vech r; for (int lane = 0; lane < ROBOVEC_HL; lane++) r[lane] = x; return r; }}\n\
-         static inline ROBOVEC_UNUSED __attribute__((always_inline)) robovec_vech robovec_fmah(robovec_vech a, robovec_vech b, robovec_vech c)\n{{\n\
-         #if defined(__AVX512F__) && ROBOVEC_VECH_BYTES == 64\n  return (robovec_vech)_mm512_fmadd_pd((__m512d)a, (__m512d)b, (__m512d)c);\n\
-         #elif defined(__FMA__) && ROBOVEC_VECH_BYTES == 32\n  return (robovec_vech)_mm256_fmadd_pd((__m256d)a, (__m256d)b, (__m256d)c);\n\
-         #elif defined(__FMA__) && ROBOVEC_VECH_BYTES == 16\n  return (robovec_vech)_mm_fmadd_pd((__m128d)a, (__m128d)b, (__m128d)c);\n\
-         #else\n  robovec_vech r;\n  for (int lane = 0; lane < ROBOVEC_HL; lane++) r[lane] = fma(a[lane], b[lane], c[lane]);\n  return r;\n\
-         #endif\n}}\n\
-         static inline ROBOVEC_UNUSED robovec_vec robovec_fix_store_v(robovec_vec x, int f) {{ for (int lane = 0; lane < ROBOVEC_VL; lane++) x[lane] = robovec_fix_store(x[lane], f); return x; }}"
+         #endif\n}}\n"
+    );
+    s += &splat_helper("robovec_splath", "robovec_vech", "double", "ROBOVEC_HL");
+    s += &fma_helper("robovec_fmah", "robovec_vech", false, "ROBOVEC_VECH_BYTES", "ROBOVEC_HL", false);
+    let _ = writeln!(
+        s,
+        "static inline ROBOVEC_UNUSED robovec_vec robovec_fix_store_v(robovec_vec x, int f) {{ for (int lane = 0; lane < ROBOVEC_VL; lane++) x[lane] = robovec_fix_store(x[lane], f); return x; }}"
     );
     s.push('\n');
     s

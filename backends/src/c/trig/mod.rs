@@ -290,7 +290,7 @@ pub(crate) fn helpers(f32: bool, vector: bool) -> String {
 /// `robovec_sin_inline32`, …, on `robovec_vec32`, with `robovec_fma32`), so that both forms
 /// live in one file. Within 1 ulp of binary32, as `precision=f32`'s.
 pub(crate) fn helpers_vec32() -> String {
-    const RENAMED: [&str; 10] = [
+    const NAMES: [&str; 10] = [
         "robovec_vec",
         "robovec_uvec",
         "robovec_ivec",
@@ -302,13 +302,19 @@ pub(crate) fn helpers_vec32() -> String {
         "ROBOVEC_MADD",
         "ROBOVEC_VEC_BYTES",
     ];
-    let text = helpers(true, true);
-    let mut out = String::with_capacity(text.len() + 256);
+    renamed(&helpers(true, true), |word| NAMES.contains(&word).then(|| format!("{word}32")))
+}
+
+/// `text` with every C identifier `rename` maps replaced by its new name (whole identifiers
+/// only: `robovec_vec` is renamed, `robovec_vec32` is not): the helpers of [`helpers`] under
+/// other names, so that two forms of them live in one file.
+fn renamed(text: &str, rename: impl Fn(&str) -> Option<String>) -> String {
+    let mut out = String::with_capacity(text.len() + 1024);
     let mut word = String::new();
     let flush = |word: &mut String, out: &mut String| {
-        out.push_str(word);
-        if RENAMED.contains(&word.as_str()) {
-            out.push_str("32");
+        match rename(word) {
+            Some(new) => out.push_str(&new),
+            None => out.push_str(word),
         }
         word.clear();
     };
@@ -346,22 +352,9 @@ pub(crate) fn helpers_halves() -> String {
         ("ROBOVEC_VEC_BYTES", "ROBOVEC_VECH_BYTES"),
         ("ROBOVEC_VL", "ROBOVEC_HL"),
     ];
-    let text = helpers(false, true);
-    let mut out = String::with_capacity(text.len() + 1024);
-    let mut word = String::new();
-    let flush = |word: &mut String, out: &mut String| {
-        out.push_str(RENAMED.iter().find(|(from, _)| *from == word.as_str()).map_or(word.as_str(), |(_, to)| to));
-        word.clear();
-    };
-    for ch in text.chars() {
-        if ch.is_ascii_alphanumeric() || ch == '_' {
-            word.push(ch);
-        } else {
-            flush(&mut word, &mut out);
-            out.push(ch);
-        }
-    }
-    flush(&mut word, &mut out);
+    let mut out = renamed(&helpers(false, true), |word| {
+        RENAMED.iter().find(|(from, _)| *from == word).map(|(_, to)| to.to_string())
+    });
     out.push_str(
         "/* The whole robovec_vec: its two halves. */\n\
          static inline ROBOVEC_UNUSED void robovec_sincos_inline(robovec_vec x, robovec_vec *sin_out, robovec_vec *cos_out)\n{\n  \
