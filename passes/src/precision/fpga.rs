@@ -299,6 +299,37 @@ impl<'a, S: FnMut() -> bool> Search<'a, S> {
     }
 
     /// The bounds when `h`'s formats meet every budget.
+    /// The longest non-empty prefix of `offers` (rank, value, fraction bits: each value's
+    /// fewer bits, best first) whose formats `fix<53, f>` on `h` the bound accepts, with its
+    /// bounds: a binary search, one [`Search::probe`] per step. `None` when no prefix is
+    /// accepted, or the search stops before one is.
+    fn longest_prefix(&mut self, h: &Function, offers: &[(f64, Value, i32)]) -> Option<(Function, Vec<f64>)> {
+        let with = |k: usize| {
+            let mut t = h.clone();
+            for &(_, v, fr) in &offers[..k] {
+                if let Some(fmt) = Format::fix(FIX_MAX_WIDTH, fr) {
+                    t.set_format(v, fmt);
+                }
+            }
+            t
+        };
+        let (mut lo, mut hi) = (0usize, offers.len());
+        let mut got = None;
+        while lo < hi {
+            let mid = (lo + hi).div_ceil(2);
+            let t = with(mid);
+            match self.probe(&t) {
+                Ok(et) => {
+                    lo = mid;
+                    got = Some((t, et));
+                }
+                Err(Refused::Stopped) => break,
+                Err(_) => hi = mid - 1,
+            }
+        }
+        got
+    }
+
     fn probe(&mut self, h: &Function) -> Result<Vec<f64>, Refused> {
         if self.stopped || (self.stop)() {
             self.stopped = true;
@@ -500,41 +531,18 @@ pub fn fixed_phase<S: FnMut() -> bool>(
             .filter_map(|&v| match h.format(v) {
                 Format::Fix { fraction, .. } if fraction > *FIX_FRACTION_RANGE.start() => {
                     let damage = lam[v.index()] * 2f64.powi(-fraction - 1);
-                    Some((damage / cost[v.index()], v, fraction))
+                    Some((damage / cost[v.index()], v, fraction - 1))
                 }
                 _ => None,
             })
             .collect();
         ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let with = |k: usize| {
-            let mut t = h.clone();
-            for &(_, v, fr) in &ranked[..k] {
-                if let Some(fmt) = Format::fix(FIX_MAX_WIDTH, fr - 1) {
-                    t.set_format(v, fmt);
-                }
-            }
-            t
-        };
-        let (mut lo, mut hi) = (0usize, ranked.len());
-        let mut got = None;
-        while lo < hi {
-            let mid = (lo + hi).div_ceil(2);
-            let t = with(mid);
-            match s.probe(&t) {
-                Ok(et) => {
-                    lo = mid;
-                    got = Some((t, et));
-                }
-                Err(Refused::Stopped) => break,
-                Err(_) => hi = mid - 1,
-            }
-        }
-        match got {
-            Some((t, et)) if lo > 0 => {
+        match s.longest_prefix(&h, &ranked) {
+            Some((t, et)) => {
                 h = t;
                 e = et;
             }
-            _ => break,
+            None => break,
         }
     }
     (h, _) = snap(f, h, e, &factors, device, s);
@@ -596,30 +604,7 @@ fn snap<S: FnMut() -> bool>(
         offers.push((damage / f64::from(factors[v.index()]), v, fraction - k));
     }
     offers.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let with = |k: usize| {
-        let mut t = h.clone();
-        for &(_, v, fr) in &offers[..k] {
-            if let Some(fmt) = Format::fix(FIX_MAX_WIDTH, fr) {
-                t.set_format(v, fmt);
-            }
-        }
-        t
-    };
-    let (mut lo, mut hi) = (0usize, offers.len());
-    let mut got = None;
-    while lo < hi {
-        let mid = (lo + hi).div_ceil(2);
-        let t = with(mid);
-        match s.probe(&t) {
-            Ok(et) => {
-                lo = mid;
-                got = Some((t, et));
-            }
-            Err(Refused::Stopped) => break,
-            Err(_) => hi = mid - 1,
-        }
-    }
-    got.unwrap_or((h, e))
+    s.longest_prefix(&h, &offers).unwrap_or((h, e))
 }
 
 /// The most bits the product pass of step 3 (module doc) takes from a value at once.
