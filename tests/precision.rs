@@ -85,17 +85,7 @@ fn chosen_formats_meet_the_budget_on_random_functions() {
 /// choice meets its budget.
 #[test]
 fn the_segway_gets_binary32_at_a_loose_budget() {
-    let path = crate::common::corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c");
-    let (m, _) = robovec::driver::load(path.to_str().unwrap()).unwrap_or_else(|e| panic!("{}", e.message()));
-    let f = robovec_ir::transform::atomise::atomise_function(&m.functions[0]);
-    let mut dom = crate::range::generous_domain(&f);
-    for (n, r) in dom.ranges.iter_mut() {
-        if n.starts_with("q[") {
-            *r = range(0.1, 0.3);
-        } else if n.starts_with("qd") {
-            *r = range(-1.0, 1.0);
-        }
-    }
+    let (f, dom) = segway();
     let (g, budgets) = with_choice(&f, &dom, 1e-3, Target::C).unwrap();
     let values = f.inputs.len() + f.body.len();
     let f32s = f.inputs.iter().chain(&f.body).filter(|&&v| g.format(v) == robovec_ir::format::Format::Binary32).count();
@@ -269,7 +259,8 @@ fn the_budget_ladder_is_the_chooser_at_each_budget() {
     assert!(cut.unwrap() > 0, "some budget stops after a point");
 }
 
-/// The Segway `dirdyna` over the narrow domain of the test above, for the Segway tests below.
+/// The Segway `dirdyna` (atomised) with `q` in [0.1, 0.3] rad and `qd`, `qdd` in ±1, the other
+/// inputs over `generous_domain`'s ranges.
 fn segway() -> (Function, Domain) {
     let path = crate::common::corpus_dir().join("c/frank_segway__mbs_dirdyna_Frank_segway.c");
     let (m, _) = robovec::driver::load(path.to_str().unwrap()).unwrap_or_else(|e| panic!("{}", e.message()));

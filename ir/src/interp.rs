@@ -61,37 +61,19 @@ pub fn eval_binop<T: Float>(op: BinOp, a: T, b: T) -> T {
 ///
 /// `input(name)` gives each input's value in `f64`. Panics only if `f` does not verify (a value
 /// read before its definition).
-pub fn eval_values<T: Float>(f: &Function, input: impl FnMut(&str) -> f64) -> Vec<T> {
-    match eval_values_stored(f, input, |_, x: T| Ok::<T, std::convert::Infallible>(x)) {
-        Ok(vals) => vals,
-        Err(never) => match never {},
-    }
-}
-
-/// [`eval_values`] where each value's result (each input's converted value too) goes through
-/// `store(value, result)` before any user reads it: what a value's numeric format does
-/// (`crate::format::eval_values`).
-///
-/// # Errors
-/// The first error of `store`, in program order (inputs first).
-pub fn eval_values_stored<T: Float, E>(
-    f: &Function,
-    mut input: impl FnMut(&str) -> f64,
-    mut store: impl FnMut(crate::Value, T) -> Result<T, E>,
-) -> Result<Vec<T>, E> {
+pub fn eval_values<T: Float>(f: &Function, mut input: impl FnMut(&str) -> f64) -> Vec<T> {
     let mut vals: Vec<Option<T>> = vec![None; f.values.len()];
     for &v in &f.inputs {
-        vals[v.index()] = Some(store(v, T::from_f64(input(f.name_of(v))))?);
+        vals[v.index()] = Some(T::from_f64(input(f.name_of(v))));
     }
     for &v in &f.body {
-        let get = |vals: &[Option<T>], o: &Operand| match o {
+        let get = |o: &Operand| match o {
             Operand::Value(x) => vals[x.index()].expect("value read before definition"),
             Operand::Const(c) => T::from_f64(*c),
         };
-        let r = eval_def(&f.value(v).def, |o| get(&vals, o));
-        vals[v.index()] = Some(store(v, r)?);
+        vals[v.index()] = Some(eval_def(&f.value(v).def, get));
     }
-    Ok(vals.into_iter().map(|x| x.unwrap_or(T::from_f64(f64::NAN))).collect())
+    vals.into_iter().map(|x| x.unwrap_or(T::from_f64(f64::NAN))).collect()
 }
 
 /// One body value's definition computed in precision `T` from its operands (`get`; a trig

@@ -6,7 +6,7 @@ use plotters::prelude::*;
 use robovec_ir::format::Format;
 use robovec_passes::precision::PrecisionReport;
 
-use super::{err, legend, line_key, svg_area, titled, Figure, Result, PALETTE};
+use super::{err, legend, legend_at, line_key, svg_area, titled, Figure, Result, PALETTE};
 use crate::report_dir::data::ReportData;
 
 /// Size of the two-panel figure, pixels.
@@ -172,13 +172,7 @@ pub(super) fn budget(d: &ReportData) -> Result<Figure> {
         chart
             .draw_series(pts.iter().map(|p| Circle::new((bx(p), l10(p.max_rel_to_range, floor)), 4, c.filled())))
             .map_err(err)?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend_at(&mut chart, SeriesLabelPosition::UpperLeft)?;
         root.present().map_err(err)?;
     }
     Ok(Figure {
