@@ -100,7 +100,8 @@ fn eval_computes_each_value_in_its_format() {
     let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let a = 333.0 / 256.0;
     let b = 0.7f32 as f64;
-    // p = a·b in binary64, stored in fix<16,4> (steps of 1/16); s = p + 0.03 in fix<8,2>.
+    // p = a·b in binary64 (b is binary32), stored in fix<16,4> (steps of 1/16); s = p + 0.03,
+    // an integer op: exact on p's integer and 0.03's 32-bit word, rounded once to fix<8,2>.
     let p = (a * b * 16.0 + 0.5).floor() / 16.0;
     let s = ((p + 0.03) * 4.0 + 0.5).floor() / 4.0;
     let t = (s / 3.0) as f32 as f64;
@@ -159,7 +160,18 @@ fn a_pass_that_does_not_understand_formats_refuses_them() {
 /// (`robovec_ir::format::eval_values`). One state per call.
 #[test]
 fn c_computes_every_format_bit_for_bit_as_eval() {
-    c_bit_exact("formats-c", 1, "-O1", false);
+    c_bit_exact("formats-c", 1, "-O1", false, Mix::Random);
+}
+
+/// Fixed point everywhere it fits (16- to 40-bit formats): the C computes most values as
+/// integer ops (`int32_t` where the whole intermediate fits 31 bits, `int64_t` otherwise,
+/// `robovec_veci` vectors in a batch), bit for bit as `-eval`'s exact integers, at one state
+/// (`-std=c99 -Wall -Wextra -Werror`) and `batch=4`.
+#[test]
+fn c_computes_fixed_point_as_integers_bit_for_bit() {
+    let ops = c_bit_exact("formats-c-fix", 1, "-O1", false, Mix::FixedPoint);
+    assert!(ops.integer >= 300 && ops.int32 >= 30 && ops.int64 >= 30, "{ops:?}");
+    c_bit_exact("formats-c-fix4", 4, "-O1", false, Mix::FixedPoint);
 }
 
 /// As [`c_computes_every_format_bit_for_bit_as_eval`] with `batch=8` (`float` and `double`
@@ -167,8 +179,8 @@ fn c_computes_every_format_bit_for_bit_as_eval() {
 /// machine's own vector instructions (its FMA where it has one).
 #[test]
 fn c_batches_compute_every_format_bit_for_bit_as_eval() {
-    c_bit_exact("formats-c-batch8", 8, "-O2", false);
-    c_bit_exact("formats-c-batch2", 2, "-O1", false);
+    c_bit_exact("formats-c-batch8", 8, "-O2", false, Mix::Random);
+    c_bit_exact("formats-c-batch2", 2, "-O1", false, Mix::Random);
 }
 
 /// With `trig=inline` (robovec's own sin/cos: binary32 values in `float` code, the others in
@@ -178,14 +190,32 @@ fn c_batches_compute_every_format_bit_for_bit_as_eval() {
 /// with the machine's vectors and `batch=2` with SSE2 only; `-Wall -Wextra -Werror` clean.
 #[test]
 fn c_batches_with_inline_trig_stay_within_the_certified_bound() {
-    c_bit_exact("formats-c-inline8", 8, "-O2", true);
-    c_bit_exact("formats-c-inline2", 2, "-O1", true);
+    c_bit_exact("formats-c-inline8", 8, "-O2", true, Mix::Random);
+    c_bit_exact("formats-c-inline2", 2, "-O1", true, Mix::Random);
+}
+
+/// Which formats [`c_bit_exact`] gives the random functions' values.
+#[derive(Clone, Copy, PartialEq)]
+enum Mix {
+    /// `crate::error_bound::with_random_formats`: binary32, fixed point or binary64.
+    Random,
+    /// `crate::error_bound::with_fixed_point_formats`: fixed point wherever the range is finite.
+    FixedPoint,
+}
+
+/// How many ops of the compiled functions were integer ops, by the C type they compute in.
+#[derive(Debug, Default)]
+struct IntegerOps {
+    integer: usize,
+    int32: usize,
+    int64: usize,
 }
 
 /// The bit-exact campaign at `batch` lanes (each call evaluates `batch` points,
 /// lane-contiguous), compiled with `opt_level` (and `-march=native` in a batch of 8); with
 /// `inline_trig`, `trig=inline` and each output within twice its certified bound of `-eval`'s.
-fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool) {
+/// Returns the count of integer ops compiled (one state: by intermediate type).
+fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool, mix: Mix) -> IntegerOps {
     use robovec_backends::c::CodegenC;
     use robovec_ir::rng::SplitMix64;
     use robovec_ir::Operand;
@@ -198,11 +228,25 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool)
     // (what, -eval's value, allowed distance: 0 for bit-exact).
     let mut want: Vec<(String, f64, f64)> = Vec::new();
     let mut cases = 0;
+    let mut ops = IntegerOps::default();
     for seed in 0..48u64 {
         let (f, dom) = crate::range::random_function(seed * 7919 + 1, 4 + (seed as usize % 40));
-        let g = crate::error_bound::with_random_formats(&f, &dom, seed);
+        let g = match mix {
+            Mix::Random => crate::error_bound::with_random_formats(&f, &dom, seed),
+            Mix::FixedPoint => crate::error_bound::with_fixed_point_formats(&f, &dom, seed),
+        };
         if robovec_passes::error_bound::bound::check_fixed_formats(&g, &dom).is_err() {
             continue;
+        }
+        for &v in &g.body {
+            if let Some(op) = robovec_ir::format::integer_op(&g, v) {
+                ops.integer += 1;
+                if op.bits <= 30 && op.shift <= 30 {
+                    ops.int32 += 1;
+                } else {
+                    ops.int64 += 1;
+                }
+            }
         }
         let m = Module { functions: vec![g.clone()] };
         let trig = if inline_trig { robovec_backends::c::Trig::Inline } else { robovec_backends::c::Trig::Libm };
@@ -299,6 +343,7 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool)
         }
     }
     assert!(checked * 2 >= want.len(), "only {checked} of {} outputs checked", want.len());
+    ops
 }
 
 /// Formats with options that cannot honour them are refused (exit 1), naming both.
@@ -315,7 +360,7 @@ fn c_refuses_formats_with_options_that_cannot_honour_them() {
     let o = opt(&[input.to_str().unwrap(), "-passes=codegen<c>", "-o", dir.join("f.c").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let c = std::fs::read_to_string(dir.join("f.c")).unwrap();
-    assert!(c.contains("robovec_fix_store(") && c.contains("const float t = (float)s / 0x1.8p+1f;"), "{c}");
+    assert!(c.contains("robovec_fix_from(") && c.contains("const float t = (float)((double)s * 0x1p-2) / 0x1.8p+1f;"), "{c}");
 }
 
 /// Formats with `abi=pinocchio` (Pinocchio's `double` vectors, the formats inside): a URDF's RNEA

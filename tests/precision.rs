@@ -390,3 +390,121 @@ fn the_pass_reports_widths_and_device_resources_for_the_fpga() {
     let dsp = r27["precision"]["dsp"].as_f64().unwrap();
     assert!(dsp > 0.0 && dsp.fract() == 0.0, "{}", r27["precision"]);
 }
+
+/// `target=mcu` end to end: a URDF arm's RNEA (`--fold-params`, over `q` ±1.5 rad, `qd` ±3
+/// rad/s, `qdd` ±10 rad/s²) at a loose budget is 32-bit fixed point everywhere; `codegen<c>`
+/// writes it as integer code — every op but sin/cos an integer op in `int32_t`/`int64_t`, the
+/// only `double` arithmetic the inputs' and the four sin/cos' conversions — which compiles as
+/// `-std=c99 -pedantic -Wall -Wextra -Werror` and computes bit for bit what `-eval` computes
+/// at 64 points, each output within `error-bound`'s certified bound of the binary64 function.
+#[test]
+fn mcu_formats_are_integer_c_bit_exact_and_within_the_bound() {
+    use robovec_backends::c::CodegenC;
+    use std::fmt::Write as _;
+    let dir = crate::common::tmp("precision-mcu-c");
+    let ranges = dir.join("r.json");
+    std::fs::write(
+        &ranges,
+        r#"{"q[*]": [-1.5, 1.5], "qd[*]": [-3, 3], "qdd[*]": [-10, 10], "g[1]": [0, 0], "g[2]": [0, 0], "g[3]": [-9.81, -9.81]}"#,
+    )
+    .unwrap();
+    let (ir, report) = (dir.join("arm.rvir"), dir.join("report.json"));
+    let o = opt(&[
+        "examples/three_link_arm/three_link_arm.urdf",
+        "-function=invdyna",
+        "--fold-params",
+        &format!("-ranges={}", ranges.display()),
+        "-passes=default<ops>,precision<budget=1e-2;target=mcu>,error-bound",
+        &format!("-report={}", report.display()),
+        "-o",
+        ir.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let m = robovec_ir::text::parse(&std::fs::read_to_string(&ir).unwrap()).unwrap();
+    let g = &m.functions[0];
+    let fix = |v| matches!(g.format(v), robovec_ir::format::Format::Fix { width: 32, .. });
+    assert!(g.inputs.iter().chain(&g.body).all(|&v| fix(v)), "{}", r["precision"]);
+    let trig = g.body.iter().filter(|&&v| matches!(g.value(v).def, robovec_ir::Def::Trig(..))).count();
+    let integer = g.body.iter().filter(|&&v| robovec_ir::format::integer_op(g, v).is_some()).count();
+    assert_eq!(trig, 4, "cos and sin of q[1] and q[2]");
+    assert_eq!(integer + trig, g.body.len(), "every op but sin/cos is an integer op");
+    let art = CodegenC { name: Some("arm".into()), ..CodegenC::default() }.emit(&m).unwrap();
+    let code = &art.code.main;
+    // The body's only binary64: one conversion per input and per sin/cos (and the helper's own).
+    let conversions = code.matches("robovec_fix_from(").count() - 1;
+    assert_eq!(conversions, g.inputs.len() + trig, "{code}");
+    std::fs::write(dir.join("arm.c"), code).unwrap();
+    let iface = &art.interfaces[0];
+    let (ni, no) = (iface.inputs.len(), iface.outputs.len());
+    let dom = robovec_ir::domain::Domain {
+        ranges: iface
+            .inputs
+            .iter()
+            .map(|n| {
+                let (lo, hi) = match n.split('[').next().unwrap() {
+                    "q" => (-1.5, 1.5),
+                    "qd" => (-3.0, 3.0),
+                    "qdd" => (-10.0, 10.0),
+                    _ if n == "g[3]" => (-9.81, -9.81),
+                    _ => (0.0, 0.0),
+                };
+                (n.clone(), range(lo, hi))
+            })
+            .collect(),
+    };
+    let mut rng = SplitMix64::new(48);
+    let mut binary64 = g.clone();
+    for &v in g.inputs.iter().chain(&g.body) {
+        binary64.set_format(v, robovec_ir::format::Format::Binary64);
+    }
+    let (mut bytes, mut want) = (Vec::new(), Vec::new());
+    for _ in 0..64 {
+        let xs = crate::range::uniform_point(&iface.inputs, &dom, &mut rng);
+        let at = |n: &str| xs[iface.inputs.iter().position(|m| m == n).unwrap()];
+        let vals = robovec_ir::format::eval_values(g, at).unwrap();
+        let exact = robovec_ir::format::eval_values(&binary64, at).unwrap();
+        bytes.extend(xs.iter().flat_map(|x| x.to_le_bytes()));
+        for (name, out) in iface.outputs.iter().zip(&g.outputs) {
+            let Operand::Value(v) = out.value else { panic!("{name} is a constant") };
+            let b = r["error_bound"]["outputs"][name.as_str()]["abs"].as_f64().unwrap();
+            want.push((name.clone(), vals[v.index()], exact[v.index()], b));
+        }
+    }
+    let mut main = String::from("#include <stdio.h>\n#include <string.h>\n#include <stdint.h>\n");
+    let _ = writeln!(
+        main,
+        "void arm(const double *restrict in, double *restrict out);\nint main(void)\n{{\n  double in[{ni}], out[{no}];\n  \
+         while (fread(in, 8, {ni}, stdin) == {ni}) {{\n    arm(in, out);\n    for (int i = 0; i < {no}; i++) {{ uint64_t b; \
+         memcpy(&b, &out[i], 8); printf(\"%016llx\\n\", (unsigned long long)b); }}\n  }}\n  return 0;\n}}"
+    );
+    std::fs::write(dir.join("main.c"), main).unwrap();
+    let exe = dir.join("run");
+    let o = std::process::Command::new("cc")
+        .current_dir(&dir)
+        .args(["-O1", "-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror", "-o"])
+        .arg(&exe)
+        .args(["main.c", "arm.c", "-lm"])
+        .output()
+        .expect("cc (scripts/test.sh installs gcc)");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut child = std::process::Command::new(&exe)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write as _;
+    child.stdin.take().unwrap().write_all(&bytes).unwrap();
+    let out = child.wait_with_output().unwrap();
+    let got: Vec<f64> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| f64::from_bits(u64::from_str_radix(l, 16).unwrap()))
+        .collect();
+    assert_eq!(got.len(), want.len());
+    for (c, (name, eval, exact, b)) in got.iter().zip(&want) {
+        assert_eq!(c.to_bits(), eval.to_bits(), "{name}: C gives {c:e}, -eval {eval:e}");
+        // The binary64 function's own error is far below the fixed-point bound.
+        assert!((c - exact).abs() <= b * (1.0 + 1e-6), "{name}: {c:e} is {:e} from binary64, bound {b:e}", c - exact);
+    }
+}

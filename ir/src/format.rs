@@ -16,18 +16,24 @@
 //!   with `float` operands, so a function whose values are all binary32 computes what
 //!   `-eval-precision=f32` and `codegen<c;precision=f32>` compute, and `codegen<c>` writes
 //!   binary32 values as `float` vectors (twice the lanes of `double`).
-//! - **`fix<w,f>`**: in binary64 on its operands' values, then **stored** ([`Format::store`]).
+//! - **`fix<w,f>`**, an **integer op** ([`integer_op`]): `add`, `sub`, `mul`, `fma`, `fms` and
+//!   `fnma` whose operands are all fixed-point values or constants (one value at least), and
+//!   whose exact intermediate fits [`INTEGER_BITS`]: computed **exactly** on the operands'
+//!   mantissas (two's complement integers, aligned by shifts), then rounded once to the value's
+//!   format as storing rounds. A constant is first read as a 32-bit fixed-point word
+//!   ([`fix_constant`]: 32 significant bits, `0.1` as `858993459 · 2^-33`; `0.5`, `3` exactly).
+//!   What an MCU's `int32_t`/`int64_t` code and a PE compute: `codegen<c>` writes it so.
+//! - **`fix<w,f>`**, any other op (`/`, `sqrt`, `sin`, `cos`, a callback, or an operand in a
+//!   binary format): in binary64 on its operands' values, then **stored** ([`Format::store`]).
 //!
 //! Storing:
 //! - **binary64**: as it is; **binary32**: rounded to nearest, ties to even.
 //! - **`fix<w,f>`**: a value is `k · 2^-f` with `k` a `w`-bit two's complement integer,
-//!   `-2^(w-1) ≤ k < 2^(w-1)`; storing rounds to nearest, **ties toward +∞** (`floor(x · 2^f +
-//!   1/2)`: what adding half a step and an arithmetic right shift give in a PE or on a
-//!   microcontroller). `add`/`sub` of fixed-point operands are exact in binary64 while the
-//!   operands' mantissas and scales fit 53 bits together, and so is `mul` while the product of
-//!   the mantissas does (two 26-bit words); past that the binary64 rounding comes first, which
-//!   the error bound counts. A result outside the `w` bits is an overflow, never wrapped: the
-//!   interpreter stops with the value ([`eval_values`]), and the range proof excludes it.
+//!   `-2^(w-1) ≤ k < 2^(w-1)`; storing rounds to nearest, **ties toward +∞** (`k = ⌊x · 2^f +
+//!   1/2⌋`, computed without rounding the half step in: what adding half a step and an
+//!   arithmetic right shift give in a PE or on a microcontroller). A result outside the `w`
+//!   bits is an overflow, never wrapped: the interpreter stops with the value
+//!   ([`eval_values`]), and the range proof excludes it.
 //!
 //! Sources: the Q format of fixed-point DSP practice (Texas Instruments' `Qm.n`, here written
 //! by total width and fractional bits as Daisy and RoboPrec write `Fixed(w, f)`); IEEE 754-2019
@@ -111,8 +117,10 @@ impl Format {
                 }
                 // x · 2^f is exact (a power of two) unless it overflows or underflows, which
                 // only a value far outside any width (or far below the step) reaches: both are
-                // checked below on the rounded integer.
-                let k = (scale_by(x, fraction) + 0.5).floor();
+                // checked below on the rounded integer. `y − ⌊y⌋` is exact, so the tie test is
+                // (`⌊y + 1/2⌋` in binary64 would round 0.5 − 2⁻⁶⁰ + 1/2 up to 1).
+                let y = scale_by(x, fraction);
+                let k = y.floor() + if y - y.floor() >= 0.5 { 1.0 } else { 0.0 };
                 let top = 2f64.powi(width as i32 - 1);
                 if k < -top || k >= top {
                     return Err(StoreError::Overflow);
@@ -212,11 +220,217 @@ pub fn eval_values(f: &crate::Function, mut input: impl FnMut(&str) -> f64) -> R
         };
         let r = match f.format(v) {
             Format::Binary32 => binary32_op(def, get),
+            Format::Fix { width, fraction } => match integer_op(f, v) {
+                Some(op) => {
+                    let k = op.eval(|w| vals[w.index()]);
+                    let top = 1i128 << (width - 1);
+                    if k < -top || k >= top {
+                        let result = scale_by(k as f64, -fraction);
+                        return Err(FormatError { value: v, result, error: StoreError::Overflow });
+                    }
+                    vals[v.index()] = scale_by(k as f64, -fraction);
+                    continue;
+                }
+                None => crate::interp::eval_def(def, get),
+            },
             _ => crate::interp::eval_def(def, get),
         };
         vals[v.index()] = store(v, r)?;
     }
     Ok(vals)
+}
+
+/// The largest magnitude, in bits, of an [`integer_op`]'s exact intermediate (every term
+/// aligned, their sum, or the result shifted left): `|K| ≤ 2^62`, so with a shift of at most
+/// 62 the rounding's half step keeps it in a C `int64_t` (`2^62 + 2^61 < 2^63`): the product
+/// of two 32-bit words, `2^31 · 2^31`, is one.
+pub const INTEGER_BITS: u32 = 62;
+
+/// Width of the word a constant operand of an integer op is read as, bits ([`fix_constant`]).
+pub const CONSTANT_WIDTH: u32 = 32;
+
+/// A constant as an integer op reads it (module doc): the 32-bit fixed-point word nearest to
+/// it (ties toward +∞), with the most fractional bits that keep it in 32 bits, then trailing
+/// zero bits removed: `(k, f)` with `c ≈ k · 2^-f`, `|k| ≤ 2^31` (`0.1` → `(858993459, 33)`,
+/// `0.5` → `(1, 1)`, `-3` → `(-3, 0)`, `0` → `(0, 0)`). `None` for a constant no 32-bit
+/// word holds (above `2^95`) or not finite. The fraction stays in [`FIX_FRACTION_RANGE`], so a
+/// constant below `2^-127` reads as 0 (its whole value is the conversion error, which the error
+/// bound counts).
+pub fn fix_constant(c: f64) -> Option<(i64, i32)> {
+    if !c.is_finite() {
+        return None;
+    }
+    if c == 0.0 {
+        return Some((0, 0));
+    }
+    // |c| = m · 2^e with m in [0.5, 1): c · 2^(31 − e) has magnitude in [2^30, 2^31).
+    let e = c.abs().log2().floor() as i32 + 1;
+    let (lo, hi) = (*FIX_FRACTION_RANGE.start(), *FIX_FRACTION_RANGE.end());
+    let start = (CONSTANT_WIDTH as i32 - 1 - e + 1).clamp(lo, hi);
+    let word = (lo..=start).rev().find_map(|f| {
+        let fmt = Format::Fix { width: CONSTANT_WIDTH, fraction: f };
+        fmt.store(c).ok().map(|x| (scale_by(x, f) as i64, f))
+    })?;
+    let (mut k, mut f) = word;
+    while k != 0 && k % 2 == 0 && f > lo {
+        k /= 2;
+        f -= 1;
+    }
+    if k == 0 {
+        f = 0;
+    }
+    Some((k, f))
+}
+
+/// One factor of an [`IntegerOp`]'s term.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IntFactor {
+    /// A fixed-point value: its mantissa `k` at its format's `fraction` (`k · 2^-fraction`).
+    Value {
+        /// The value.
+        value: crate::Value,
+        /// Its format's fractional bits.
+        fraction: i32,
+        /// Its format's width, bits.
+        width: u32,
+    },
+    /// A constant read as a 32-bit word ([`fix_constant`]): `mantissa · 2^-fraction`.
+    Const {
+        /// The word's integer.
+        mantissa: i64,
+        /// Its fractional bits.
+        fraction: i32,
+    },
+}
+
+impl IntFactor {
+    /// The factor's fractional bits.
+    pub fn fraction(&self) -> i32 {
+        match *self {
+            IntFactor::Value { fraction, .. } | IntFactor::Const { fraction, .. } => fraction,
+        }
+    }
+
+    /// `b` with `|mantissa| ≤ 2^b` (a `fix<w,f>` value: `w − 1`; a constant: ⌈log2 |k|⌉).
+    pub fn bits(&self) -> u32 {
+        match *self {
+            IntFactor::Value { width, .. } => width - 1,
+            IntFactor::Const { mantissa, .. } => 64 - (mantissa.unsigned_abs().max(1) - 1).leading_zeros(),
+        }
+    }
+}
+
+/// One term of an [`IntegerOp`]: `±` the product of its factors (one or two).
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntTerm {
+    /// Subtracted instead of added.
+    pub negative: bool,
+    /// The factors (one, or two for a product).
+    pub factors: Vec<IntFactor>,
+}
+
+impl IntTerm {
+    /// The product's fractional bits (the sum of the factors').
+    pub fn fraction(&self) -> i32 {
+        self.factors.iter().map(IntFactor::fraction).sum()
+    }
+
+    /// `b` with `|product| ≤ 2^b`.
+    pub fn bits(&self) -> u32 {
+        self.factors.iter().map(IntFactor::bits).sum()
+    }
+}
+
+/// A fixed-point value's op computed exactly on integers (module doc): the exact result is
+/// `K · 2^-fraction` with `K = Σ ±term · 2^(fraction − term's fraction)`, then rounded to the
+/// value's format `fix<w,f>` by `shift = fraction − f` bits (`⌊(K + 2^(shift−1)) / 2^shift⌋`
+/// when `shift > 0`, `K · 2^-shift` otherwise).
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntegerOp {
+    /// The terms (two for `add`, `sub` and the fused ops, one for `mul`).
+    pub terms: Vec<IntTerm>,
+    /// Fractional bits of the exact result: the finest term's.
+    pub fraction: i32,
+    /// `fraction − f`: bits the rounding removes (added when negative).
+    pub shift: i32,
+    /// `b` bounding the intermediate: `|K| ≤ 2^b`, and `|K · 2^-shift| ≤ 2^b` when `shift ≤ 0`
+    /// (at most [`INTEGER_BITS`]; with `shift > 0` the rounding adds `2^(shift−1)`, at most 2^61).
+    pub bits: u32,
+}
+
+impl IntegerOp {
+    /// The rounded mantissa of the result (before the overflow check), from the operands'
+    /// values `get` gives (each on its format's grid). Exact: `i128` holds every intermediate.
+    pub fn eval(&self, get: impl Fn(crate::Value) -> f64) -> i128 {
+        let mut k: i128 = 0;
+        for t in &self.terms {
+            let mut p: i128 = 1;
+            for x in &t.factors {
+                p *= match *x {
+                    IntFactor::Value { value, fraction, .. } => scale_by(get(value), fraction) as i128,
+                    IntFactor::Const { mantissa, .. } => mantissa as i128,
+                };
+            }
+            p <<= self.fraction - t.fraction();
+            k += if t.negative { -p } else { p };
+        }
+        match self.shift {
+            s if s > 0 => (k + (1i128 << (s - 1))) >> s,
+            s => k << -s,
+        }
+    }
+}
+
+/// The integer op of `v` when its value is fixed point and its op is one (module doc: `add`,
+/// `sub`, `mul`, `fma`, `fms`, `fnma` on fixed-point values and constants, one value at least,
+/// the intermediate within [`INTEGER_BITS`] and the shift below 63); `None` otherwise (the op
+/// computes in binary64, then stores).
+pub fn integer_op(f: &crate::Function, v: crate::Value) -> Option<IntegerOp> {
+    use crate::{BinOp, Def, Intrinsic, Operand};
+    let Format::Fix { fraction: f_out, .. } = f.format(v) else { return None };
+    let factor = |o: &Operand| -> Option<IntFactor> {
+        match *o {
+            Operand::Value(w) => match f.format(w) {
+                Format::Fix { width, fraction } => Some(IntFactor::Value { value: w, fraction, width }),
+                _ => None,
+            },
+            Operand::Const(c) => fix_constant(c).map(|(mantissa, fraction)| IntFactor::Const { mantissa, fraction }),
+        }
+    };
+    let term = |negative: bool, os: &[&Operand]| -> Option<IntTerm> {
+        Some(IntTerm { negative, factors: os.iter().map(|o| factor(o)).collect::<Option<Vec<_>>>()? })
+    };
+    let (terms, operands): (Vec<IntTerm>, Vec<&Operand>) = match &f.value(v).def {
+        Def::Binary(BinOp::Add, a, b) => (vec![term(false, &[a])?, term(false, &[b])?], vec![a, b]),
+        Def::Binary(BinOp::Sub, a, b) => (vec![term(false, &[a])?, term(true, &[b])?], vec![a, b]),
+        Def::Binary(BinOp::Mul, a, b) => (vec![term(false, &[a, b])?], vec![a, b]),
+        Def::Call(c, args) => {
+            let (a, b, cc) = match args.as_slice() {
+                [a, b, c] => (a, b, c),
+                _ => return None,
+            };
+            let (neg_product, neg_addend) = match Intrinsic::of(c, args.len())? {
+                Intrinsic::Fma => (false, false),
+                Intrinsic::Fms => (false, true),
+                Intrinsic::Fnma => (true, false),
+                Intrinsic::Sqrt => return None,
+            };
+            (vec![term(neg_product, &[a, b])?, term(neg_addend, &[cc])?], vec![a, b, cc])
+        }
+        _ => return None,
+    };
+    if !operands.iter().any(|o| matches!(o, Operand::Value(_))) {
+        return None;
+    }
+    let fraction = terms.iter().map(IntTerm::fraction).max()?;
+    let aligned = terms.iter().map(|t| t.bits() as i64 + (fraction - t.fraction()) as i64).max()?;
+    // The sum of two terms: one bit more.
+    let sum = aligned + (terms.len() as i64 - 1);
+    let shift = fraction - f_out;
+    // Rounding multiplies by 2^-shift (shift ≤ 0) or adds half a step (shift > 0), which
+    // `|K| ≤ 2^62` and a shift ≤ 62 keep below 2^63: 2^62 + 2^61.
+    let bits = if shift > 0 { sum } else { sum - shift as i64 };
+    (bits <= INTEGER_BITS as i64 && (-62..=62).contains(&shift)).then_some(IntegerOp { terms, fraction, shift, bits: bits as u32 })
 }
 
 /// The op `def` of a binary32 value, on operands `get` gives in binary64 (module doc): each
@@ -256,6 +470,9 @@ mod tests {
         assert_eq!(q.fix_range(), Some((-32.0, 31.75)));
         assert_eq!(q.store(1.1), Ok(1.0));
         assert_eq!(q.store(1.125), Ok(1.25), "a tie rounds up");
+        // Just below a tie: ⌊y + 1/2⌋ in binary64 would round y + 1/2 = 1 − 2^-54 up to 1.
+        let fine = Format::fix(8, 0).unwrap();
+        assert_eq!(fine.store(0.5f64.next_down()), Ok(0.0));
         assert_eq!(q.store(-1.125), Ok(-1.0), "a tie rounds toward +inf");
         assert_eq!(q.store(-1.2), Ok(-1.25));
         assert_eq!(q.store(31.75), Ok(31.75));
@@ -269,6 +486,95 @@ mod tests {
         let coarse = Format::fix(4, -3).unwrap();
         assert_eq!((coarse.store(13.0), coarse.store(11.9)), (Ok(16.0), Ok(8.0)));
         assert_eq!(coarse.fix_range(), Some((-64.0, 56.0)));
+    }
+
+    #[test]
+    fn constants_read_as_32_bit_words() {
+        // 0.1 · 2^34 = 1717986918.4 → 1717986918 = 2 · 858993459 (odd).
+        assert_eq!(fix_constant(0.1), Some((858_993_459, 33)));
+        // 0.03 · 2^36 = 2061584302.08 → 2061584302 = 2 · 1030792151.
+        assert_eq!(fix_constant(0.03), Some((1_030_792_151, 35)));
+        assert_eq!(fix_constant(0.5), Some((1, 1)));
+        assert_eq!(fix_constant(-3.0), Some((-3, 0)));
+        assert_eq!(fix_constant(-1.0), Some((-1, 0)), "-2^31 · 2^-31 fits the word");
+        assert_eq!(fix_constant(0.0), Some((0, 0)));
+        assert_eq!(fix_constant(1e-40), Some((0, 0)), "below 2^-127: read as 0");
+        assert_eq!(fix_constant(2f64.powi(94)), Some((1 << 30, -64)), "the coarsest word");
+        assert_eq!(fix_constant(2f64.powi(100)), None, "no 32-bit word holds it");
+        assert_eq!(fix_constant(f64::INFINITY), None);
+        // 1 − 2^-40 rounds up to 2^31 · 2^-31 at 31 fractional bits, one past the word: 30 bits.
+        assert_eq!(fix_constant(1.0 - 2f64.powi(-40)), Some((1, 0)));
+    }
+
+    /// The op of value `name` in `src` (an atomised function).
+    fn op_of(src: &str, name: &str) -> (crate::Function, Option<IntegerOp>) {
+        let f = crate::text::parse(src).expect("parses").functions.remove(0);
+        let v = f.inputs.iter().chain(&f.body).copied().find(|&v| f.name_of(v) == name).expect("named");
+        let op = integer_op(&f, v);
+        (f, op)
+    }
+
+    #[test]
+    fn an_integer_op_is_exact_before_its_one_rounding() {
+        // a = 2^27 + 3, b = 2^27 + 1: a·b = 2^54 + 2^29 + 3 (≡ 3 mod 8), stored with steps of 8:
+        // exactly 2^51 + 2^26 + 0.375 steps → 2^54 + 2^29. In binary64 the product would round
+        // to 2^54 + 2^29 + 4 (ulp 4), a tie at 2^51 + 2^26 + 0.5 steps, rounded up: + 8.
+        let src = "func @f { phase atomised input %a : fix<29,0> input %b : fix<29,0> \
+                   %p = mul %a, %b : fix<53,-3> output y = %p }";
+        let (f, op) = op_of(src, "p");
+        let op = op.expect("an integer op");
+        assert_eq!((op.fraction, op.shift, op.bits), (0, 3, 56), "28 + 28 bits");
+        let (a, b) = (2f64.powi(27) + 3.0, 2f64.powi(27) + 1.0);
+        let vals = eval_values(&f, |n| if n == "a" { a } else { b }).unwrap();
+        let p = vals[f.body[0].index()];
+        assert_eq!(p, 2f64.powi(54) + 2f64.powi(29));
+        let binary64 = Format::fix(53, -3).unwrap().store(a * b).unwrap();
+        assert_eq!(binary64, p + 8.0, "the case tells the two semantics apart");
+    }
+
+    #[test]
+    fn integer_ops_align_round_toward_plus_infinity_and_read_constant_words() {
+        // a = 1.3 → fix<8,2>: 5.2 → 5 (1.25); b = -0.7 → fix<8,3>: -5.6 → -6 (-0.75).
+        // p = a·b = -30 · 2^-5 exactly; to fix<8,1>: (-30 + 8) >> 4 = floor(-1.375) = -2 → -1.0.
+        // s = p − 0.1: 0.1 is 858993459 · 2^-33; -1 − 0.1000000000931 = -1.1000000000931,
+        //   · 2^6 = -70.40000000596 → -70 → -1.09375.
+        // t = fnma(a, b, 0.75) = -(a·b) + 0.75 = 0.9375 + 0.75 = 1.6875 exactly, to fix<6,2>:
+        //   6.75 steps → 7 → 1.75; u = fms(a, a, 2.0) = 1.5625 − 2 = -0.4375 → fix<6,3>: -3.5
+        //   steps, a tie, toward +∞: -3 → -0.375.
+        let src = "func @f { phase atomised input %a : fix<8,2> input %b : fix<8,3> \
+                   %p = mul %a, %b : fix<8,1> %s = sub %p, 0.1 : fix<12,6> \
+                   %t = call @fnma(%a, %b, 0.75) : fix<6,2> %u = call @fms(%a, %a, 2.0) : fix<6,3> \
+                   output p = %p output s = %s output t = %t output u = %u }";
+        let f = crate::text::parse(src).expect("parses").functions.remove(0);
+        for &v in &f.body {
+            assert!(integer_op(&f, v).is_some(), "{}", f.name_of(v));
+        }
+        let vals = eval_values(&f, |n| if n == "a" { 1.3 } else { -0.7 }).unwrap();
+        let got: Vec<f64> = f.body.iter().map(|v| vals[v.index()]).collect();
+        assert_eq!(got, [-1.0, -1.09375, 1.75, -0.375]);
+    }
+
+    #[test]
+    fn other_ops_and_wide_intermediates_compute_in_binary64() {
+        let head = "func @f { phase atomised input %a : fix<40,10> input %b : fix<40,10> input %c : f32";
+        for (def, why) in [
+            ("div %a, %b : fix<40,10>", "a quotient"),
+            ("mul %a, %c : fix<40,10>", "a binary32 operand"),
+            ("mul %a, %b : fix<53,20>", "39 + 39 bits, past 62"),
+            ("call @fma(%a, %b, %a) : fix<53,20>", "past 62"),
+            ("add %a, %b : f64", "a binary64 value"),
+        ] {
+            let (_, op) = op_of(&format!("{head} %x = {def} output y = %x }}"), "x");
+            assert!(op.is_none(), "{why}");
+        }
+        let (_, op) = op_of(&format!("{head} %x = add %a, %b : fix<41,10> output y = %x }}"), "x");
+        assert_eq!(op.map(|o| (o.shift, o.bits)), Some((0, 40)), "39 bits and a carry");
+        // Two 32-bit words: |k_a · k_b| ≤ 2^31 · 2^31 = 2^62, the widest product kept.
+        let words = "func @f { phase atomised input %a : fix<32,29> input %b : fix<32,20>";
+        let (_, op) = op_of(&format!("{words} %x = mul %a, %b : fix<32,16> output y = %x }}"), "x");
+        assert_eq!(op.map(|o| (o.shift, o.bits)), Some((33, 62)));
+        let (_, op) = op_of(&format!("{words} %x = call @fma(%a, %b, %b) : fix<32,16> output y = %x }}"), "x");
+        assert!(op.is_none(), "a product of two words and a sum: 63 bits");
     }
 
     #[test]

@@ -116,7 +116,8 @@ fn vector_type(narrow: bool) -> &'static str {
 /// full register, a binary64 one two (the compiler splits a `double` vector wider than the
 /// target's). Their per-lane helpers (sin, cos, sqrt and fma of both types; the fused ones as
 /// vector FMA instructions where the target has them, split in halves for the `double`
-/// vector of twice the register) and `robovec_fix_store_v`, a batch's store in `fix<w,f>`.
+/// vector of twice the register), `robovec_veci` of `int64_t` for fixed-point values' integers
+/// and `robovec_fix_from_v`, a batch's store in `fix<w,f>`.
 pub(crate) fn format_vector_helpers(lanes: u32) -> String {
     let mut s = format!(
         "/* {lanes} states per call: lane l of element i is in[i*{lanes} + l] (GCC/Clang vector extensions).\n \
@@ -176,7 +177,10 @@ pub(crate) fn format_vector_helpers(lanes: u32) -> String {
     s += &fma_helper("robovec_fmah", "robovec_vech", false, "ROBOVEC_VECH_BYTES", "ROBOVEC_HL", false);
     let _ = writeln!(
         s,
-        "static inline ROBOVEC_UNUSED robovec_vec robovec_fix_store_v(robovec_vec x, int f) {{ for (int lane = 0; lane < ROBOVEC_VL; lane++) x[lane] = robovec_fix_store(x[lane], f); return x; }}"
+        "/* Fixed-point values' integers (robovec_ir::format::integer_op), one 64-bit lane per state; a double\n \
+         * result stored in fix<w,f> lane by lane (robovec_fix_from, s = 2^f). */\n\
+         typedef int64_t robovec_veci __attribute__((vector_size(ROBOVEC_VL * 8)));\n\
+         static inline ROBOVEC_UNUSED robovec_veci robovec_fix_from_v(robovec_vec x, double s) {{ robovec_veci r; for (int lane = 0; lane < ROBOVEC_VL; lane++) r[lane] = robovec_fix_from(x[lane], s); return r; }}"
     );
     s.push('\n');
     s
@@ -313,18 +317,33 @@ impl<'a> Body<'a> {
 
     /// `x` as an op reads it: `narrow` (the op's value is binary32) rounds a constant to a
     /// `float` literal and converts a value of another format to `float`; an op that does not
-    /// narrow reads a binary32 value widened to `double` (exact). A batch converts whole
-    /// vectors (`__builtin_convertvector`).
+    /// narrow reads a binary32 value widened to `double` (exact). A fixed-point value, held as
+    /// its integer `k`, reads as `k · 2^-f` in `double` (exact: `w ≤ 53`), then `float`. A batch
+    /// converts whole vectors (`__builtin_convertvector`). (An integer op reads fixed-point
+    /// integers as they are: [`Body::integer_expr`].)
     pub fn read(&self, x: &Operand, narrow: bool) -> String {
         match x {
             Operand::Const(c) => literal::operand(*c, narrow || self.o.f32()),
             Operand::Value(w) => {
                 let n = &self.names[w.index()];
-                if self.narrow(*w) == narrow {
+                let vec = self.o.batch > 1;
+                let fix = self.fix_unit(*w);
+                if fix.is_none() && self.narrow(*w) == narrow {
                     n.clone()
                 } else if self.converted.borrow().contains(&(w.index(), narrow)) {
                     converted_name(w.index(), narrow)
-                } else if self.o.batch > 1 {
+                } else if let Some(unit) = fix {
+                    let d = if vec {
+                        format!("(__builtin_convertvector({n}, robovec_vec) * {unit})")
+                    } else {
+                        format!("((double){n} * {unit})")
+                    };
+                    match (narrow, vec) {
+                        (false, _) => d,
+                        (true, true) => format!("__builtin_convertvector({d}, robovec_vec32)"),
+                        (true, false) => format!("(float){d}"),
+                    }
+                } else if vec {
                     format!("__builtin_convertvector({n}, {})", vector_type(narrow))
                 } else {
                     format!("({}){n}", if narrow { "float" } else { "double" })
@@ -345,16 +364,77 @@ impl<'a> Body<'a> {
 
     /// `expr`, of the file's real type (`double`, or `robovec_vec` in a batch), as a value of
     /// `v`'s format ([`robovec_ir::format`]): itself for binary64, converted to `float` (to
-    /// `robovec_vec32`) for binary32, `robovec_fix_store(expr, f)` (`robovec_fix_store_v` in a
-    /// batch) for `fix<w,f>` (the file's [`super::file::FORMAT_HELPERS`]).
+    /// `robovec_vec32`) for binary32, the integer `robovec_fix_from(expr, 2^f)`
+    /// (`robovec_fix_from_v` in a batch) for `fix<w,f>` (the file's
+    /// [`super::file::FORMAT_HELPERS`]).
     pub fn stored(&self, v: Value, expr: String) -> String {
         let vec = self.o.batch > 1;
         match self.f.format(v) {
             Format::Binary64 => expr,
             Format::Binary32 if vec => format!("__builtin_convertvector({expr}, robovec_vec32)"),
             Format::Binary32 => format!("(float)({expr})"),
-            Format::Fix { fraction, .. } if vec => format!("robovec_fix_store_v({expr}, {fraction})"),
-            Format::Fix { fraction, .. } => format!("robovec_fix_store({expr}, {fraction})"),
+            Format::Fix { fraction, .. } => {
+                let scale = literal::operand(2f64.powi(fraction), false);
+                if vec {
+                    format!("robovec_fix_from_v({expr}, {scale})")
+                } else {
+                    format!("({})robovec_fix_from({expr}, {scale})", self.type_of(v))
+                }
+            }
+        }
+    }
+
+    /// For a fixed-point value (held as its integer `k`), the `double` literal `2^-f` that
+    /// scales it to its value; `None` for a binary one.
+    fn fix_unit(&self, v: Value) -> Option<String> {
+        match self.f.format(v) {
+            Format::Fix { fraction, .. } => Some(literal::operand(2f64.powi(-fraction), false)),
+            _ => None,
+        }
+    }
+
+    /// The C expression of an integer op ([`robovec_ir::format::integer_op`]) of the
+    /// fixed-point value `v`: its terms on the operands' integers, aligned by multiplying by
+    /// powers of two, summed, then rounded by `robovec_fix_shr` (`floor(x / 2^n)`, portable)
+    /// after adding half a step: bit for bit `IntegerOp::eval`. One state: in `int32_t` when the
+    /// whole intermediate fits 31 bits (a 32-bit microcontroller's word: `|K| ≤ 2^30`, a half
+    /// step at most 2^29), else `int64_t` (`|K| ≤ 2^62`, a half step at most 2^61); a batch: `robovec_veci` vectors of `int64_t`, its shift GCC's and
+    /// Clang's arithmetic `>>` of vectors.
+    fn integer_expr(&self, op: &robovec_ir::format::IntegerOp) -> String {
+        use robovec_ir::format::IntFactor;
+        let vec = self.o.batch > 1;
+        // |K| ≤ 2^30 and a half step ≤ 2^29: below 2^31.
+        let small = !vec && op.bits <= 30 && op.shift <= 30;
+        let t = if small { "int32_t" } else { "int64_t" };
+        let power = |n: i32| format!("(({t})1 << {n})");
+        let mut sum = String::new();
+        for (i, term) in op.terms.iter().enumerate() {
+            let factors: Vec<String> = term
+                .factors
+                .iter()
+                .map(|x| match *x {
+                    IntFactor::Value { value, .. } if vec => self.names[value.index()].clone(),
+                    IntFactor::Value { value, .. } => format!("({t}){}", self.names[value.index()]),
+                    IntFactor::Const { mantissa, .. } => format!("(({t})({mantissa}))"),
+                })
+                .collect();
+            let mut e = factors.join(" * ");
+            let align = op.fraction - term.fraction();
+            if align > 0 {
+                e = format!("{e} * {}", power(align));
+            }
+            match (i, term.negative) {
+                (0, false) => sum += &e,
+                (0, true) => sum += &format!("-({e})"),
+                (_, false) => sum += &format!(" + {e}"),
+                (_, true) => sum += &format!(" - {e}"),
+            }
+        }
+        match op.shift {
+            0 => sum,
+            s if s > 0 && vec => format!("(({sum} + {}) >> {s})", power(s - 1)),
+            s if s > 0 => format!("robovec_fix_shr{}({sum} + {}, {s})", if small { "32" } else { "" }, power(s - 1)),
+            s => format!("(({sum}) * {})", power(-s)),
         }
     }
 
@@ -367,12 +447,17 @@ impl<'a> Body<'a> {
         }
     }
 
-    /// The C type of `v`: [`Body::value_type`], or `float` (`robovec_vec32`) for a binary32 value.
+    /// The C type of `v`: [`Body::value_type`], or `float` (`robovec_vec32`) for a binary32
+    /// value; for a fixed-point value its integer `k` (the value is `k · 2^-f`): `int32_t` up to
+    /// 32 bits, `int64_t` above (`robovec_veci`, 64-bit lanes, in a batch).
     pub fn type_of(&self, v: Value) -> &'static str {
-        match (self.narrow(v), self.o.batch > 1) {
-            (true, true) => "robovec_vec32",
-            (true, false) => "float",
-            (false, _) => self.value_type(),
+        match (self.f.format(v), self.o.batch > 1) {
+            (Format::Fix { .. }, true) => "robovec_veci",
+            (Format::Fix { width, .. }, false) if width <= 32 => "int32_t",
+            (Format::Fix { .. }, false) => "int64_t",
+            (Format::Binary32, true) => "robovec_vec32",
+            (Format::Binary32, false) => "float",
+            (Format::Binary64, _) => self.value_type(),
         }
     }
 
@@ -428,6 +513,12 @@ impl<'a> Body<'a> {
             }
             let ty = self.type_of(v);
             let narrow = self.narrow(v);
+            if let Some(op) = self.integer_op(v) {
+                let _ = writeln!(s, "  const {ty} {name} = ({ty})({});", self.integer_expr(&op));
+                self.mark_unused(s, v);
+                after(s, v);
+                continue;
+            }
             match def {
                 Def::Input | Def::Expr(_) => unreachable!("atomised bodies hold trig, binary ops and calls"),
                 Def::Trig(..) if self.fused.get(&v.index()).is_some_and(|&(_, leads)| !leads) => {} // with its partner
@@ -536,6 +627,10 @@ impl<'a> Body<'a> {
                     let lane = |x: &Operand| match x {
                         Operand::Value(w) if vec => {
                             let n = format!("{}[lane]", self.names[w.index()]);
+                            let n = match self.fix_unit(*w) {
+                                Some(unit) => format!("((double){n} * {unit})"),
+                                None => n,
+                            };
                             if narrow && !self.narrow(*w) {
                                 format!("(float){n}")
                             } else {
@@ -556,7 +651,9 @@ impl<'a> Body<'a> {
                         let one = match self.f.format(v) {
                             Format::Binary64 => call,
                             Format::Binary32 => format!("(float)({call})"),
-                            Format::Fix { fraction, .. } => format!("robovec_fix_store({call}, {fraction})"),
+                            Format::Fix { fraction, .. } => {
+                                format!("robovec_fix_from({call}, {})", literal::operand(2f64.powi(fraction), false))
+                            }
                         };
                         let _ = writeln!(
                             s,
@@ -576,15 +673,29 @@ impl<'a> Body<'a> {
     /// format than the op computes in, written once per [`Body::statements_with`] call (see
     /// [`Body::converted`]) just before the first statement that reads it.
     fn convert_operands(&self, s: &mut String, v: Value) {
+        if self.integer_op(v).is_some() {
+            return; // it reads the integers as they are
+        }
         let narrow = self.narrow(v);
         self.f.value(v).def.for_each_value(|w| {
-            if self.narrow(w) == narrow || self.converted.borrow().contains(&(w.index(), narrow)) {
+            let same = self.fix_unit(w).is_none() && self.narrow(w) == narrow;
+            if same || self.converted.borrow().contains(&(w.index(), narrow)) {
                 return;
             }
             let expr = self.read(&Operand::Value(w), narrow);
             let _ = writeln!(s, "  const {} {} = {expr};", vector_type(narrow), converted_name(w.index(), narrow));
             self.converted.borrow_mut().insert((w.index(), narrow));
         });
+    }
+
+    /// `v`'s integer op, when its value is fixed point and its op is one (only in a function
+    /// with formats: the check reads `v`'s format).
+    fn integer_op(&self, v: Value) -> Option<robovec_ir::format::IntegerOp> {
+        if self.formats {
+            robovec_ir::format::integer_op(self.f, v)
+        } else {
+            None
+        }
     }
 
     /// `(void)NAME;` after the statement of a value nothing reads ([`Body::unused`]); the
@@ -638,11 +749,12 @@ impl TrigBlock {
         let pad = super::trig::block_pad(body.o.f32());
         let n = self.args.len().div_ceil(pad) * pad;
         let zero = literal::operand(0.0, body.o.f32());
-        let args: Vec<&str> = self
+        // An input in a format reads as the file's real type (a fixed-point integer scaled).
+        let args: Vec<String> = self
             .args
             .iter()
-            .map(|a| body.names[a.index()].as_str())
-            .chain(std::iter::repeat_n(zero.as_str(), n - self.args.len()))
+            .map(|&a| body.read(&Operand::Value(a), false))
+            .chain(std::iter::repeat_n(zero, n - self.args.len()))
             .collect();
         let _ = writeln!(
             s,

@@ -237,7 +237,7 @@ impl CodegenC {
             s += UNUSED_HELPERS;
         }
         if formats {
-            // Before the vector helpers: robovec_fix_store_v calls it.
+            // Before the vector helpers: robovec_fix_from_v calls robovec_fix_from.
             s += FORMAT_HELPERS;
         }
         let mut helpers = String::new();
@@ -336,13 +336,21 @@ fn unit_assignment(emitted: &[Emitted], units: usize) -> Vec<Vec<usize>> {
         .collect()
 }
 
-/// The store of a value in a fixed-point format (`robovec_ir::format::Format::store`: round
-/// to nearest, ties toward +∞, `floor(x · 2^f + 1/2) · 2^-f`, every step exact for the values
-/// the range proof admits), under its own guard so that files with and without formats can
-/// be `#include`d into one translation unit. binary32 values need no helper: they are `float`.
-pub const FORMAT_HELPERS: &str = "#ifndef ROBOVEC_FIX_STORE\n#define ROBOVEC_FIX_STORE\n\
-     /* A value stored in fix<w,f>: round to nearest, ties toward +inf (what -eval computes). */\n\
-     static inline double robovec_fix_store(double x, int f) { return ldexp(floor(ldexp(x, f) + 0.5), -f); }\n\
+/// The fixed-point helpers (a fixed-point value is held as its integer `k`, the value `k · 2^-f`):
+/// `robovec_fix_from(x, 2^f)`, a `double` stored in `fix<w,f>` (`robovec_ir::format::Format::store`:
+/// round to nearest, ties toward +∞, exact for the values the range proof admits), and
+/// `robovec_fix_shr(x, n)` = `floor(x / 2^n)` (`robovec_fix_shr32` on `int32_t`) without the
+/// implementation-defined right shift of a negative integer (C99 6.5.7; GCC and Clang compile
+/// it to one arithmetic shift), for integer ops' rounding. Under their own guard, so that files
+/// with and without formats can be `#include`d into one translation unit. binary32 values need
+/// no helper: they are `float`.
+pub const FORMAT_HELPERS: &str = "#ifndef ROBOVEC_FIX_HELPERS\n#define ROBOVEC_FIX_HELPERS\n#include <stdint.h>\n\
+     /* Fixed-point values are integers k, the value k * 2^-f of their format fix<w,f>.\n \
+     * robovec_fix_from: a double x stored in fix<w,f> (s = 2^f), to nearest, ties toward +inf (what -eval computes);\n \
+     * robovec_fix_shr: floor(x / 2^n), 0 <= n < 63, without the implementation-defined shift of a negative integer. */\n\
+     static inline int64_t robovec_fix_from(double x, double s) { double y = x * s, k = floor(y); return (int64_t)k + (y - k >= 0.5); }\n\
+     static inline int64_t robovec_fix_shr(int64_t x, int n) { return x >= 0 ? x >> n : ~(~x >> n); }\n\
+     static inline int32_t robovec_fix_shr32(int32_t x, int n) { return x >= 0 ? x >> n : ~(~x >> n); }\n\
      #endif\n\n";
 
 /// `helpers` (the file's static helpers, its vector type and their macros: the same text for

@@ -191,8 +191,10 @@ pub(crate) fn arrays(
         } else if plan.reads_live(v, k) {
             read[v.index()] = k as u32 + 1;
             let slot = format!("live[{}]", plan.slot(v).expect("read from live"));
-            // A live slot is of the file's real type: a binary32 value converts back (exactly).
-            let _ = writeln!(s, "  const {} {n} = {};", b.type_of(v), if b.narrow(v) { b.stored(v, slot) } else { slot });
+            // A live slot is of the file's real type: a value in another format converts back
+            // (exactly: it was written from that format).
+            let back = if f.format(v).is_default() { slot } else { b.stored(v, slot) };
+            let _ = writeln!(s, "  const {} {n} = {back};", b.type_of(v));
         }
     };
     let store = |s: &mut String, j: usize, x: &Operand| {
@@ -204,9 +206,10 @@ pub(crate) fn arrays(
                     Operand::Value(v) if b.narrow(*v) => {
                         let _ = writeln!(s, "  robovec_store32({p} + {}{at}, {});", el * w, names[v.index()]);
                     }
-                    Operand::Value(_) => {
+                    Operand::Value(v) if f.format(*v).is_default() => {
                         let _ = writeln!(s, "  memcpy({p} + {}{at}, &{e}, sizeof {e});", el * w);
                     }
+                    // A constant, or a fixed-point value's integers scaled.
                     _ => {
                         let _ = writeln!(s, "  {{ const {ty} k = {e}; memcpy({p} + {}{at}, &k, sizeof k); }}", el * w);
                     }

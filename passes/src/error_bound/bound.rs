@@ -38,11 +38,14 @@
 //!   value's format): binary64 as above; a binary32 op reads its operands rounded to binary32
 //!   (a constant's error is its exact distance to binary32, a binary64 or fixed-point operand
 //!   adds `2⁻²⁴` of its computed magnitude, beyond binary32's largest number it is unbounded)
-//!   and rounds once as in `f32`; `fix<w,f>` the binary64 rounding then
-//!   `abs = 2^-(f+1)` (round to nearest), and the computed value's whole range must fit the
+//!   and rounds once as in `f32`; `fix<w,f>` rounds once, `abs = 2^-(f+1)` (round to nearest),
+//!   after the exact integer op ([`robovec_ir::format::integer_op`], whose constants read as
+//!   32-bit words add their exact distance, [`robovec_ir::format::fix_constant`]) or after the
+//!   binary64 op and its rounding (any other op), and the computed value's whole range must fit the
 //!   format: `[lo_z − E_z, hi_z + E_z]` within the values that store without overflow, or the
 //!   sweep stops with [`BoundError::FixOverflow`]. Inputs in fixed point or binary32 are
-//!   rounded on the way in; a fixed-point or binary64 op reads constants exactly.
+//!   rounded on the way in; a binary64 op, or a fixed-point op that is not an integer op, reads
+//!   constants exactly.
 //!
 //! Exact steps the bound knows: `a − a` is 0 (while `a`'s bound is finite); a product by a constant power of two, or by
 //! ±1, 0, only loses bits to underflow (`rel = 0`); a sum with the constant 0 is exact.
@@ -190,7 +193,9 @@ pub fn bound(
 /// reference, as it is): their roundings, conversions and input stores scaled by `2^-bits`, the
 /// values' ranges and the overflow limits as they are. `precision` reports with it what one
 /// more bit would give each output. For fixed point it is exactly [`bound`] of the function
-/// with the wider formats; for binary32 a bound for a hypothetical format of 24 + `bits`
+/// with the wider formats while each op that is an integer op ([`robovec_ir::format::integer_op`],
+/// decided on `f`'s formats) stays one in the wider function (its intermediate two bits longer
+/// at most, within [`robovec_ir::format::INTEGER_BITS`]); for binary32 a bound for a hypothetical format of 24 + `bits`
 /// significant bits (`bits = 0` is [`bound`]).
 ///
 /// # Errors
@@ -306,6 +311,8 @@ struct Reader<'a> {
     f: &'a Function,
     mode: Formats,
     narrow: bool,
+    /// The op is a fixed-point integer op (mode mixed): constants read as 32-bit words.
+    integer: bool,
     /// `2^-bits` ([`bound_with_more_bits`]).
     scale: f64,
 }
@@ -313,7 +320,9 @@ struct Reader<'a> {
 impl Reader<'_> {
     /// The reader of `v`'s op.
     fn of(f: &Function, v: Value, mode: Formats, scale: f64) -> Reader<'_> {
-        Reader { f, mode, narrow: format_in(f, v, mode) == Format::Binary32, scale }
+        let format = format_in(f, v, mode);
+        let integer = matches!(format, Format::Fix { .. }) && robovec_ir::format::integer_op(f, v).is_some();
+        Reader { f, mode, narrow: format == Format::Binary32, integer, scale }
     }
 
     /// The operand's enclosure and error bound as the op reads it: a constant's error is its
@@ -337,6 +346,13 @@ impl Reader<'_> {
                     Rounding::F32.scaled(self.scale).of(m)
                 };
                 (r, up(err + conv))
+            }
+            Operand::Const(c) if self.integer => {
+                let (k, fc) = robovec_ir::format::fix_constant(c).expect("an integer op's constants are words");
+                // k · 2^-fc is exact in binary64 (|k| ≤ 2^31), and so is the difference
+                // (Sterbenz, or both within 32 significant bits of each other): rounded up anyway.
+                let word = k as f64 * 2f64.powi(-fc);
+                (Interval::point(c), up((c - word).abs()))
             }
             Operand::Const(c) => {
                 let err = match (self.narrow, self.scale == 1.0) {
@@ -394,7 +410,14 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
         return f64::INFINITY;
     }
     let rd = Reader::of(f, v, mode, scale);
-    let op = if rd.narrow { Rounding::F32.scaled(scale) } else { Rounding::F64 };
+    // An integer op is exact before its value's store ([`Rounding::store`], below).
+    let op = if rd.narrow {
+        Rounding::F32.scaled(scale)
+    } else if rd.integer {
+        Rounding::EXACT
+    } else {
+        Rounding::F64
+    };
     let libm_ulps = |r: Rounding| Rounding { rel: LIBM_ULPS * 2.0 * r.rel, abs: LIBM_ULPS * 2.0 * r.abs };
     let (propagated, rounding) = match &data.def {
         Def::Input | Def::Expr(_) => return f64::INFINITY,
@@ -462,7 +485,7 @@ fn value_bound(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool
     if !propagated.is_finite() {
         return f64::INFINITY;
     }
-    // A binary32 op rounds once, in binary32; a fixed-point value after its binary64 op.
+    // A binary32 op rounds once, in binary32; a fixed-point value after its integer or binary64 op.
     let rounding = match mode {
         Formats::Mixed if !rd.narrow => rounding.then(Rounding::store(f.format(v)).scaled(scale)),
         _ => rounding,

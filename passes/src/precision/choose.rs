@@ -410,11 +410,22 @@ fn cost(f: &Function, g: &Function, target: Target, device: &Device) -> f64 {
         let operands = operands(&f.value(v).def);
         let conversions =
             operands.iter().filter(|o| matches!(o, Operand::Value(a) if g.format(*a) != fv)).count() as f64;
-        let is_mul = matches!(f.value(v).def, Def::Binary(BinOp::Mul, ..));
         total += match (target, fv) {
             (Target::C, Format::Binary32) => 0.5 + 0.5 * conversions,
             (Target::C, _) => 1.0 + 0.5 * conversions,
-            (Target::Mcu, Format::Fix { .. }) => (if is_mul { 3.0 } else { 1.0 }) + 20.0 * conversions,
+            (Target::Mcu, Format::Fix { .. }) => match robovec_ir::format::integer_op(g, v) {
+                // Integer adds and multiplies (a product 3), one shift to align or round.
+                Some(op) => {
+                    let terms: f64 = op.terms.iter().map(|t| if t.factors.len() == 2 { 3.0 } else { 1.0 }).sum();
+                    terms + if op.shift != 0 { 1.0 } else { 0.0 }
+                }
+                // A binary64 op on the operands' values, then the store: each operand not in
+                // binary64 converted, and the result.
+                None => {
+                    let wide = operands.iter().filter(|o| matches!(o, Operand::Value(a) if !g.format(*a).is_default())).count();
+                    100.0 + 20.0 * (wide as f64 + 1.0)
+                }
+            },
             (Target::Mcu, Format::Binary32) => 50.0 + 20.0 * conversions,
             (Target::Mcu, Format::Binary64) => 100.0 + 20.0 * conversions,
             (Target::Fpga, _) => unreachable!("costed above"),
