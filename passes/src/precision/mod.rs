@@ -32,7 +32,8 @@
 //! user's); `mcu` estimates cycles of a Cortex-M3-class core without an FPU: a fixed-point
 //! integer op (`robovec_ir::format::integer_op`, what `codegen<c>` writes as `int32_t`/`int64_t`
 //! code) 1 per add, 3 per product (`SMULL`), 1 more to shift; binary32 operation 50 and binary64
-//! 100 (software floating point, order of magnitude), conversions 20 — a fixed-point value
+//! 100 (software floating point, order of magnitude), conversions 150 (`robovec_fix_from` is
+//! five software floating-point routines) — a fixed-point value
 //! whose op is not an integer op costs a binary64 op, its operands' conversions and its store; `fpga` the share of the device,
 //! `100·(DSP/dsp + ALM/alm)`, of a datapath of one operator per op in its value's format, from
 //! the target description (`-target`: its DSP modes, ALM per adder bit, binary32 PE and
