@@ -13,6 +13,7 @@
 
 pub mod allocator;
 pub mod cli;
+pub mod cpu_time;
 pub mod diagnostics;
 pub mod driver;
 pub mod eval;

@@ -477,3 +477,47 @@ fn precision_draws_cost_against_budget_and_pareto_its_certified_bounds() {
     }
     assert!(md.contains("f32 certified max rel"), "{md}");
 }
+
+/// With `precision<target=c>`, `-report-dir` times each point of the budget ladder on this
+/// machine (`src/report_dir/ladder_time.rs`): every row has a positive `ns_per_state` at batch 8
+/// or 16, the binary64 baseline at batch 4 or 8, their ratio in `measured_ratio`; points with
+/// the same formats share one measurement. (No speed is claimed: a timed test cannot.)
+#[test]
+fn the_budget_ladder_of_target_c_is_timed() {
+    let d = tmp("budget-time");
+    let dir = d.join("rep");
+    let o = opt(&[
+        ARM,
+        "-function=invdyna",
+        &arm_ranges(&d),
+        "-passes=atomise,precision<budget=1e-5>",
+        &format!("-report-dir={}", dir.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(dir.join("budget.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
+    let rows = csv_rows(&dir, "budget.csv");
+    let r: Value = serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let base = num(&r["precision_ladder"]["binary64_ns_per_state"]);
+    assert!(base > 0.0);
+    assert!([4.0, 8.0].contains(&num(&r["precision_ladder"]["binary64_batch"])));
+    let mut by_formats: Vec<(String, f64)> = Vec::new();
+    for (row, p) in rows.iter().zip(r["precision_ladder"]["points"].as_array().unwrap()) {
+        let ns = f(&row[col("ns_per_state")]);
+        assert!(ns > 0.0 && ns == num(&p["ns_per_state"]));
+        assert!([8.0, 16.0].contains(&f(&row[col("ns_batch")])));
+        assert_eq!(f(&row[col("binary64_ns_per_state")]), base);
+        assert!((f(&row[col("measured_ratio")]) - ns / base).abs() <= 1e-12 * ns / base);
+        let formats = p["formats"].to_string();
+        match by_formats.iter().find(|(k, _)| *k == formats) {
+            Some((_, t)) => assert_eq!(*t, ns, "one measurement per assignment"),
+            None => by_formats.push((formats, ns)),
+        }
+    }
+    assert!(by_formats.len() >= 2, "the ladder has binary32 and binary64 points");
+    let svg = std::fs::read_to_string(dir.join("budget.svg")).unwrap();
+    assert!(svg.contains("measured ns/state after / before"), "the figure draws the measured line");
+}

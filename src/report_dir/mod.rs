@@ -17,6 +17,7 @@
 
 pub mod data;
 pub mod figures;
+pub mod ladder_time;
 mod markdown;
 
 pub use markdown::markdown;

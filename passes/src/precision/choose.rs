@@ -92,6 +92,8 @@ impl Choice {
             dsp: self.fpga.as_ref().map(|x| x.dsp.1),
             alm: self.fpga.as_ref().map(|x| x.alm.1),
             device: self.fpga.as_ref().map(|x| x.device.clone()),
+            ns_per_state: None,
+            ns_batch: None,
             outputs: self
                 .outputs
                 .iter()

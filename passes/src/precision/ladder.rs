@@ -43,6 +43,18 @@ pub struct BudgetLadder {
     /// Why the ladder has fewer points than [`BUDGETS`] (`-time-limit`), if it has.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stopped: Option<String>,
+    /// The formats chosen at each point (value, format; binary64 values not listed), for
+    /// `-report-dir`'s measured time of each point's C.
+    #[serde(skip)]
+    pub assignments: Vec<Vec<(robovec_ir::Value, robovec_ir::format::Format)>>,
+    /// `-report-dir`, target `c`: the median ns per state of the function's best binary64 C
+    /// (every value binary64, the faster of `batch=4` and `batch=8`: the baseline each point's
+    /// [`PrecisionReport::ns_per_state`] is measured against), when measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub binary64_ns_per_state: Option<f64>,
+    /// The `batch` of [`BudgetLadder::binary64_ns_per_state`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub binary64_batch: Option<u32>,
 }
 
 /// The ladder of `f` over `domain` for `target` at `budgets` (relative, one per point). The
@@ -59,7 +71,15 @@ pub fn ladder(
     budgets: &[f64],
     ticker: &Ticker,
 ) -> Result<BudgetLadder, String> {
-    let mut out = BudgetLadder { function: f.name.clone(), target: target.as_str(), points: Vec::new(), stopped: None };
+    let mut out = BudgetLadder {
+        function: f.name.clone(),
+        target: target.as_str(),
+        points: Vec::new(),
+        stopped: None,
+        assignments: Vec::new(),
+        binary64_ns_per_state: None,
+        binary64_batch: None,
+    };
     let x = match enclose_with(f, domain, Some(DEFAULT_TERMS), || ticker.tick()) {
         Ok(x) => x,
         Err(e @ EncloseError::Stopped(_)) => {
@@ -80,6 +100,7 @@ pub fn ladder(
             break;
         }
         out.points.push(c.report(&f.name));
+        out.assignments.push(c.formats.clone());
     }
     Ok(out)
 }

@@ -210,6 +210,14 @@ pub struct PrecisionReport {
     /// `fpga`: the target description costed against (`-target`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub device: Option<String>,
+    /// `-report-dir`'s budget ladder, target `c`: the median ns per state of the C with these
+    /// formats on the machine that ran it, at the faster of `batch=8` and `batch=16` (`None`
+    /// elsewhere: not measured).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ns_per_state: Option<f64>,
+    /// The `batch` of `ns_per_state`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ns_batch: Option<u32>,
     /// Per output with a budget: the certified bound reached, its budget, and the bound it would
     /// reach with one more bit in every binary32 and fixed-point value (the issue's "what bound
     /// each output would need one more bit for").

@@ -58,12 +58,14 @@ pub(super) fn budget(d: &ReportData) -> Result<Figure> {
     let Some(l) = &d.precision_ladder else { return Err("no budget ladder".into()) };
     let pts: Vec<&PrecisionReport> = l.points.iter().filter(|p| p.budget.is_some_and(|b| b > 0.0)).collect();
     let mut csv = String::from(
-        "budget,cost_before,cost_after,cost_ratio,max_rel_to_range,values,f64_values,f32_values,fixed_values,sweeps,unreachable,worst_output\n",
+        "budget,cost_before,cost_after,cost_ratio,max_rel_to_range,values,f64_values,f32_values,fixed_values,sweeps,unreachable,worst_output,\
+         ns_per_state,ns_batch,binary64_ns_per_state,binary64_batch,measured_ratio\n",
     );
+    let opt = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
     for p in &pts {
         let (a, b, c) = per_kind(p);
         csv += &format!(
-            "{},{},{},{},{},{},{a},{b},{c},{},{},{}\n",
+            "{},{},{},{},{},{},{a},{b},{c},{},{},{},{},{},{},{},{}\n",
             p.budget.unwrap_or(0.0),
             p.cost_before,
             p.cost_after,
@@ -72,7 +74,12 @@ pub(super) fn budget(d: &ReportData) -> Result<Figure> {
             a + b + c,
             p.sweeps,
             p.unreachable.len(),
-            p.worst_output.as_deref().unwrap_or("")
+            p.worst_output.as_deref().unwrap_or(""),
+            opt(p.ns_per_state),
+            p.ns_batch.map_or(String::new(), |b| b.to_string()),
+            opt(l.binary64_ns_per_state),
+            l.binary64_batch.map_or(String::new(), |b| b.to_string()),
+            opt(measured(p, l.binary64_ns_per_state))
         );
     }
     let bx = |p: &PrecisionReport| p.budget.unwrap_or(1.0).log10();
@@ -113,6 +120,21 @@ pub(super) fn budget(d: &ReportData) -> Result<Figure> {
             .label(format!("model cost after / before ({})", unit(l.target)))
             .legend(line_key(c0, 2));
         chart.draw_series(pts.iter().map(|p| Circle::new((bx(p), ratio(p)), 4, c0.filled()))).map_err(err)?;
+        // The measured time of each point's C against binary64's, where measured (target c).
+        let timed: Vec<(f64, f64)> =
+            pts.iter().filter_map(|p| measured(p, l.binary64_ns_per_state).map(|r| (bx(p), r.min(1.45)))).collect();
+        if !timed.is_empty() {
+            let c = PALETTE[3];
+            chart
+                .draw_series(LineSeries::new(timed.iter().copied(), c.stroke_width(2)))
+                .map_err(err)?
+                .label(format!(
+                    "measured ns/state after / before (best batch of 8, 16 / binary64's best, batch={}; this machine)",
+                    l.binary64_batch.unwrap_or(0)
+                ))
+                .legend(line_key(c, 2));
+            chart.draw_series(timed.iter().map(|&p| Cross::new(p, 5, c.stroke_width(2)))).map_err(err)?;
+        }
         let mut kinds = vec![(1usize, "share of values in binary32")];
         if pts.iter().any(|p| per_kind(p).2 > 0) {
             kinds.push((2, "share of values in 32-bit fixed point"));
@@ -181,13 +203,28 @@ pub(super) fn budget(d: &ReportData) -> Result<Figure> {
             "Cost against error budget: `precision`'s chooser run again at each budget (relative to each output's \
              largest magnitude over the domain) with the pipeline's target ({}) and domain; the cost is the target's \
              cost model ({}), not measured ns or µs; below, the certified bound the chosen formats reach (the rows of \
-             the table above)",
+             the table above){}",
             l.target,
-            unit(l.target)
+            unit(l.target),
+            if l.binary64_ns_per_state.is_some() {
+                "; with target c, each point's C is also timed on the machine that made the report \
+                 (`ns_per_state`, the faster of batch=8 and batch=16, against the faster binary64 C of batch=4 \
+                 and batch=8, `measured_ratio`: one process each, medians)"
+            } else {
+                ""
+            }
         ),
         svg,
         csv,
     })
+}
+
+/// A point's measured ns per state over the binary64 baseline's, when both were measured.
+fn measured(p: &PrecisionReport, baseline: Option<f64>) -> Option<f64> {
+    match (p.ns_per_state, baseline) {
+        (Some(ns), Some(b)) if b > 0.0 => Some(ns / b),
+        _ => None,
+    }
 }
 
 /// What the target's cost model counts.

@@ -1,0 +1,90 @@
+//! The time of a function's generated C on the machine that runs robovec: what `-report-dir`
+//! draws beside a model's cost (issue 48 item 6, "cost (ns/state …) against the budget"; the
+//! CPU beside the FPGA of issue 49 is the same measurement).
+//!
+//! One measurement ([`ns_per_state`]): the function's C (`codegen<c;abi=plain;trig=inline>`,
+//! `batch=W`) and a driver are compiled by the system compiler (`$CC`, else `cc`) with
+//! `-O3 -march=native -ffp-contract=off` in a temporary folder; the driver calls the function on
+//! [`STATES`] states drawn uniformly from the domain (a point where an input's range is one),
+//! cycling through them, in [`REPEATS`] timed repeats of about 2 ms each, and prints the median
+//! ns per state. One process, one function: the numbers of a figure are side by side in time
+//! but not interleaved, so they are a picture of the machine, not a benchmark claim
+//! (`scripts/precision_speed.sh` alternates its contestants).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use robovec_backends::c::{CodegenC, Trig};
+use robovec_ir::domain::Domain;
+use robovec_ir::rng::SplitMix64;
+use robovec_ir::{Function, Module};
+
+/// States the driver cycles through (drawn once, lane-contiguous per call).
+pub const STATES: usize = 16;
+/// Timed repeats; the median is reported.
+pub const REPEATS: usize = 31;
+
+/// The median ns per state of `f`'s C at `batch` states per call, compiled and run in `dir`
+/// (an existing folder the caller removes), its inputs drawn from `domain` (seed 48).
+///
+/// # Errors
+/// A message when an input has no range in `domain`, the C cannot be written (a pass error of
+/// `codegen<c>`), or the compiler or the program fails (the compiler's own message).
+pub fn ns_per_state(f: &Function, domain: &Domain, batch: u32, dir: &Path) -> Result<f64, String> {
+    let m = Module { functions: vec![f.clone()] };
+    let codegen = CodegenC { name: Some("robovec_timed".into()), batch, trig: Trig::Inline, ..CodegenC::default() };
+    let art = codegen.emit(&m).map_err(|e| e.to_string())?;
+    let iface = &art.interfaces[0];
+    let (ni, no, w) = (iface.inputs.len(), iface.outputs.len(), batch as usize);
+    let mut rng = SplitMix64::new(48);
+    let mut states = String::new();
+    for _ in 0..STATES {
+        let mut call = vec![0.0; ni * w];
+        for lane in 0..w {
+            for (i, name) in iface.inputs.iter().enumerate() {
+                let r = domain.get(name).ok_or_else(|| format!("input `{name}` has no range in the domain"))?.interval;
+                call[i * w + lane] = (r.lo + rng.unit() * (r.hi - r.lo)).clamp(r.lo, r.hi);
+            }
+        }
+        let row: Vec<String> = call.iter().map(|x| format!("{x:e}")).collect();
+        let _ = writeln!(states, "  {{{}}},", if row.is_empty() { "0".into() } else { row.join(", ") });
+    }
+    // About 2 ms a repeat, from the op count (≈ 1 ns an op and state at worst).
+    let ops = f.op_counts().total.max(1) as usize;
+    let calls = (2_000_000 / (ops * w)).clamp(1, 1_000_000);
+    let symbol = &iface.symbol;
+    let main = format!(
+        "#define _POSIX_C_SOURCE 199309L\n#include <stdio.h>\n#include <stdlib.h>\n#include <time.h>\n\
+         void {symbol}(const double *restrict in, double *restrict out);\n\
+         static const double states[{STATES}][{}] = {{\n{states}}};\n\
+         static double out[{}];\n\
+         static int by_value(const void *a, const void *b) {{ double x = *(const double *)a, y = *(const double *)b; return (x > y) - (x < y); }}\n\
+         int main(void)\n{{\n  double t[{REPEATS}];\n  volatile double sink = 0;\n  \
+         for (int r = 0; r < {REPEATS}; r++) {{\n    struct timespec a, b;\n    clock_gettime(CLOCK_MONOTONIC, &a);\n    \
+         for (int k = 0; k < {calls}; k++) {{ {symbol}(states[k % {STATES}], out); sink += out[0]; }}\n    \
+         clock_gettime(CLOCK_MONOTONIC, &b);\n    \
+         t[r] = ((double)(b.tv_sec - a.tv_sec) * 1e9 + (double)(b.tv_nsec - a.tv_nsec)) / ({calls}.0 * {w});\n  }}\n  \
+         qsort(t, {REPEATS}, sizeof t[0], by_value);\n  printf(\"%.6g\\n\", t[{REPEATS} / 2]);\n  (void)sink;\n  return 0;\n}}\n",
+        (ni * w).max(1),
+        (no * w).max(1),
+    );
+    std::fs::write(dir.join("timed.c"), &art.code.main).map_err(|e| e.to_string())?;
+    std::fs::write(dir.join("main.c"), main).map_err(|e| e.to_string())?;
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let exe = dir.join("timed");
+    let o = std::process::Command::new(&cc)
+        .current_dir(dir)
+        .args(["-O3", "-march=native", "-ffp-contract=off", "-std=c99", "-o"])
+        .arg(&exe)
+        .args(["main.c", "timed.c", "-lm"])
+        .output()
+        .map_err(|e| format!("cannot run the C compiler `{cc}`: {e}"))?;
+    if !o.status.success() {
+        return Err(format!("`{cc}` failed: {}", String::from_utf8_lossy(&o.stderr).lines().next().unwrap_or("")));
+    }
+    let o = std::process::Command::new(&exe).output().map_err(|e| e.to_string())?;
+    if !o.status.success() {
+        return Err("the timed program failed".into());
+    }
+    String::from_utf8_lossy(&o.stdout).trim().parse::<f64>().map_err(|e| format!("the timed program printed no time: {e}"))
+}
