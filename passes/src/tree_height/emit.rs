@@ -56,10 +56,7 @@ impl Engine<'_> {
         };
         debug_assert!(!negative || rep.neg || matches!(rep.op, Operand::Const(_)));
         self.rep[root.index()] = Some(rep);
-        if rep.neg
-            && !self.absorb[root.index()]
-            && (self.cl.is_strict(root) || self.cl.non_additive_uses[root.index()] >= 2)
-        {
+        if rep.neg && !self.absorb[root.index()] && self.needs_flip(root) {
             self.flip_of(root);
         }
     }

@@ -24,6 +24,15 @@
 //! IEEE 754. [`rewrite`] enforces the first two: if a rebuild would break them (the sign
 //! analysis is one sign at a time, so two negations meeting can cost an op), it retries without
 //! trusting the analysis and, failing that, keeps the function as it was.
+//!
+//! The retry, the *cautious* rebuild, moves no sign out of its cluster: a negative result gets
+//! its true sign there (for a `0 − x` that is the `0 − x` again), so every value is at hand
+//! with its true sign, as in the input, and signs move only within a cluster (`(0 − a) + b` →
+//! `b − a`). A sign carried out can cost more than the zero it removes: shared, it reaches
+//! each consumer, and every one that cannot take it pays an op; carried through products into
+//! a sum where it meets another one, the negation left there lengthens paths that had none
+//! (tests `a_shared_negation_keeps_its_zero_in_the_cautious_rebuild`,
+//! `signs_carried_through_products_keep_their_zeros_in_the_cautious_rebuild`).
 
 pub mod balance;
 pub mod cluster;

@@ -20,9 +20,11 @@
 //!    ([`super::sign::absorbs`]), `rep` is negative and no op is made. Otherwise the cheapest
 //!    of these is chosen (fewest new ops, then earliest): keep the result negative, with
 //!    `flip(root)` for consumers that need the true sign (outputs, calls, and all non-additive
-//!    uses when there are two or more, so that a sign never fans out); or flip one negative
-//!    term (using its existing `flip`, or making it), which makes the result positive. Options
-//!    that would be ready later than the original op are taken only when nothing else is.
+//!    uses when there are two or more, so that a sign never fans out to products; in the
+//!    cautious rebuild, every consumer, so that no sign leaves its cluster); or flip one
+//!    negative term (using its existing `flip`, or making it), which makes the result positive.
+//!    Options that would be ready later than the original op are taken only when nothing else
+//!    is.
 //! 5. **Emit.** New ops reuse the names of the cluster's original ops (the root keeps the
 //!    root's name); a materialised negation of `v` is named `v` when free, else `v.neg`.
 //!
@@ -70,6 +72,9 @@ pub(super) struct Term {
 /// reassociation (`Keep`: bit for bit, up to the sign of zero) and is never ready later than
 /// `f` op by op when the sign analysis holds (callers check the whole function).
 ///
+/// `trust_absorbs` false is the cautious rebuild: no sign is taken as absorbed and none leaves
+/// its cluster (a negative result gets its true sign there, step 4), so every value is at hand
+/// with its true sign, as in `f`, and signs move only within a cluster.
 /// `orig` is the ASAPCycle of every value of `f` under `lat` ([`ready_times`]). Returns the new
 /// function, what was done, and its critical path (`asap_cycle`, cycles); `None` when `ticker`
 /// (one tick per value) says stop (`-time-limit`): the caller keeps `f`.
@@ -96,6 +101,7 @@ pub fn rebuild(
         f,
         cl: &cl,
         absorb: &absorb,
+        cautious: !trust_absorbs,
         orig,
         shape,
         lat: *lat,
@@ -147,6 +153,9 @@ pub(super) struct Engine<'a> {
     pub(super) f: &'a Function,
     pub(super) cl: &'a Clusters,
     pub(super) absorb: &'a [bool],
+    /// The cautious rebuild: no sign is taken as absorbed and none leaves its cluster
+    /// ([`Engine::needs_flip`]).
+    pub(super) cautious: bool,
     pub(super) orig: &'a [u32],
     pub(super) shape: Shape,
     pub(super) lat: Latencies,
@@ -212,6 +221,14 @@ impl Engine<'_> {
         self.stats.negations += 1;
         self.flip[v.index()] = Some(n);
         n
+    }
+
+    /// True when `root`'s result, negative and not absorbed, needs its true sign made in its
+    /// own cluster (`flip(root)`, shared by the consumers that need it, or one flipped term;
+    /// step 4 of the module doc): always in the cautious rebuild, else when it is an output or
+    /// a call argument or has two or more non-additive uses.
+    pub(super) fn needs_flip(&self, root: Value) -> bool {
+        self.cautious || self.cl.is_strict(root) || self.cl.non_additive_uses[root.index()] >= 2
     }
 
     /// `v` with its true sign.
@@ -361,7 +378,7 @@ impl Engine<'_> {
             return base;
         }
         let orig = self.orig[root.index()];
-        let needs_flip = self.cl.is_strict(root) || self.cl.non_additive_uses[root.index()] >= 2;
+        let needs_flip = self.needs_flip(root);
         let keep_time = base.time + if needs_flip { self.lat.add } else { 0 };
         // (valid, cost, time, which): which = None keeps the result negative. Keeping it
         // without a flip only defers the sign to the one non-additive consumer, which cannot
