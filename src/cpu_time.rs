@@ -19,6 +19,14 @@ use robovec_ir::domain::Domain;
 use robovec_ir::rng::SplitMix64;
 use robovec_ir::{Function, Module};
 
+/// The compiler's flags (the generated file asks for `-ffp-contract=off`).
+pub const FLAGS: [&str; 4] = ["-O3", "-march=native", "-ffp-contract=off", "-std=c99"];
+
+/// The system C compiler: `$CC`, else `cc`.
+pub fn compiler() -> String {
+    std::env::var("CC").unwrap_or_else(|_| "cc".into())
+}
+
 /// States the driver cycles through (drawn once, lane-contiguous per call).
 pub const STATES: usize = 16;
 /// Timed repeats; the median is reported.
@@ -31,6 +39,29 @@ pub const REPEATS: usize = 31;
 /// A message when an input has no range in `domain`, the C cannot be written (a pass error of
 /// `codegen<c>`), or the compiler or the program fails (the compiler's own message).
 pub fn ns_per_state(f: &Function, domain: &Domain, batch: u32, dir: &Path) -> Result<f64, String> {
+    ns_per_state_drawn(f, batch, dir, |name, u| {
+        let r = domain.get(name).ok_or_else(|| format!("input `{name}` has no range in the domain"))?.interval;
+        Ok((r.lo + u * (r.hi - r.lo)).clamp(r.lo, r.hi))
+    })
+}
+
+/// [`ns_per_state`] without a domain: every input uniform in [0.1, 1] (no divisor or square
+/// root's operand at 0 for a Robotran model's trig and parameters; the time of straight-line
+/// code does not depend on the values otherwise, subnormals aside).
+///
+/// # Errors
+/// As [`ns_per_state`].
+pub fn ns_per_state_anywhere(f: &Function, batch: u32, dir: &Path) -> Result<f64, String> {
+    ns_per_state_drawn(f, batch, dir, |_, u| Ok(0.1 + 0.9 * u))
+}
+
+/// [`ns_per_state`] with input `name`'s value `draw(name, u)` for `u` uniform in [0, 1).
+fn ns_per_state_drawn(
+    f: &Function,
+    batch: u32,
+    dir: &Path,
+    mut draw: impl FnMut(&str, f64) -> Result<f64, String>,
+) -> Result<f64, String> {
     let m = Module { functions: vec![f.clone()] };
     let codegen = CodegenC { name: Some("robovec_timed".into()), batch, trig: Trig::Inline, ..CodegenC::default() };
     let art = codegen.emit(&m).map_err(|e| e.to_string())?;
@@ -42,8 +73,7 @@ pub fn ns_per_state(f: &Function, domain: &Domain, batch: u32, dir: &Path) -> Re
         let mut call = vec![0.0; ni * w];
         for lane in 0..w {
             for (i, name) in iface.inputs.iter().enumerate() {
-                let r = domain.get(name).ok_or_else(|| format!("input `{name}` has no range in the domain"))?.interval;
-                call[i * w + lane] = (r.lo + rng.unit() * (r.hi - r.lo)).clamp(r.lo, r.hi);
+                call[i * w + lane] = draw(name, rng.unit())?;
             }
         }
         let row: Vec<String> = call.iter().map(|x| format!("{x:e}")).collect();
@@ -70,11 +100,12 @@ pub fn ns_per_state(f: &Function, domain: &Domain, batch: u32, dir: &Path) -> Re
     );
     std::fs::write(dir.join("timed.c"), &art.code.main).map_err(|e| e.to_string())?;
     std::fs::write(dir.join("main.c"), main).map_err(|e| e.to_string())?;
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let cc = compiler();
     let exe = dir.join("timed");
     let o = std::process::Command::new(&cc)
         .current_dir(dir)
-        .args(["-O3", "-march=native", "-ffp-contract=off", "-std=c99", "-o"])
+        .args(FLAGS)
+        .arg("-o")
         .arg(&exe)
         .args(["main.c", "timed.c", "-lm"])
         .output()

@@ -513,12 +513,13 @@ fn run_passes(
     }
     // `-report-dir`'s cost-against-budget figure: the budget ladder of the reported function,
     // when the pipeline's `precision` gave it formats (its target and domain), and its points'
-    // C timed on this machine (target `c`).
+    // C timed on this machine (target `c`); a swept function's C timed for the µs figure.
     if opts.report_dir.is_some() {
         if let Ok(f) = select(&session.module, &opts.function, "-report-dir") {
             let name = f.name.clone();
             robovec_passes::precision::ladder::study(&session.module, &mut session.cx, &name);
             crate::report_dir::ladder_time::measure(&session.module, &mut session.cx, &name);
+            crate::report_dir::cpu_line::measure(&session.module, &mut session.cx, &name);
         }
     }
     for s in session.cx.lines(robovec_passes::Severity::Stop) {

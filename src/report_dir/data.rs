@@ -42,6 +42,9 @@ pub struct ReportData {
     /// [`robovec_passes::precision::ladder::BUDGETS`], computed for `-report-dir` when the
     /// pipeline's `precision` gave the function formats ([`robovec_passes::precision::ladder::study`]).
     pub precision_ladder: Option<BudgetLadder>,
+    /// The reported function's C timed on this machine when it was swept
+    /// ([`crate::report_dir::cpu_line`]).
+    pub cpu: Option<crate::report_dir::cpu_line::CpuTimes>,
     /// The early stops of the run (`stopped_early`), in order.
     pub stopped_early: Vec<String>,
 }
@@ -69,6 +72,11 @@ impl ReportData {
             .map(|p| p.rows.clone())
             .unwrap_or_default();
         let precision_ladder = cx.artifacts_of::<BudgetLadder>().filter(|l| l.function == function).last().cloned();
+        let cpu = cx
+            .artifacts_of::<crate::report_dir::cpu_line::CpuTimes>()
+            .filter(|c| c.function == function)
+            .last()
+            .cloned();
         let accuracy = cx
             .artifacts_of::<AccuracyRun>()
             .filter_map(|a| a.reports.iter().rev().find(|r| r.function == function))
@@ -85,6 +93,7 @@ impl ReportData {
             pareto,
             accuracy,
             precision_ladder,
+            cpu,
             stopped_early: cx.stopped(),
             function,
         }

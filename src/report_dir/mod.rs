@@ -15,6 +15,7 @@
 //! The folder is written as a whole ([`crate::output::OutputSet::stage_folder`]: temporary
 //! folder beside `DIR`, then one rename), with the run's other outputs.
 
+pub mod cpu_line;
 pub mod data;
 pub mod figures;
 pub mod ladder_time;

@@ -192,20 +192,49 @@ fn per_config(
     Ok(Figure { name, caption, svg, csv })
 }
 
-/// µs against N at the target's clock.
+/// µs against N at the target's clock, with the function's C on this machine (one state, and
+/// per state in a batch) as horizontal dashed lines when `-report-dir` timed it.
 pub(super) fn microseconds(d: &ReportData) -> Result<Figure> {
     let clock = d.sweep.iter().find(|r| r.us > 0.0).map(|r| f64::from(r.cycles) / r.us);
     let what = match clock {
         Some(mhz) => format!("µs vs N at {mhz:.0} MHz"),
         None => "µs vs N".into(),
     };
-    per_config(
+    let mut fig = per_config(
         d,
         ("microseconds", "Time of one evaluation (µs) against N at the target's clock".into()),
         (&what, "time (µs)"),
         "us",
         |r| r.us,
-    )
+    )?;
+    let Some(cpu) = &d.cpu else { return Ok(fig) };
+    // Drawn again with the CPU's lines (the same chart and rows).
+    let rows = &d.sweep;
+    let ns = ns(rows);
+    let mut series: Vec<Series> = configs(rows)
+        .into_iter()
+        .map(|c| {
+            let pts = of_config(rows, &c).iter().map(|r| (lx(r.n), r.us)).collect();
+            (c, pts, false)
+        })
+        .collect();
+    let flat = |y: f64| ns.iter().map(|&n| (lx(n), y)).collect::<Vec<_>>();
+    series.push(("robovec's C, one state per call (this machine)".into(), flat(cpu.one_state_us), true));
+    series.push((format!("robovec's C, batch={}, per state (this machine)", cpu.batch), flat(cpu.batched_us), true));
+    fig.csv += &format!("cpu_one_state,,{}\ncpu_batch{},,{}\n", cpu.one_state_us, cpu.batch, cpu.batched_us);
+    fig.caption += &format!(
+        "; dashed, the function's C on the machine that ran the sweep ({}): one state per call and per state at batch={}",
+        cpu.build, cpu.batch
+    );
+    let mut svg = String::new();
+    {
+        let root = svg_area(&mut svg, SIZE);
+        let area = titled(&root, d)?;
+        n_chart(&area, &what, "time (µs)", &ns, &series, &[])?;
+        root.present().map_err(err)?;
+    }
+    fig.svg = svg;
+    Ok(fig)
 }
 
 /// Seed Fig. 3.9–3.13: parallelisation rate against N.
