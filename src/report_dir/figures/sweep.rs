@@ -163,13 +163,15 @@ pub(super) fn cycles(d: &ReportData) -> Result<Figure> {
 }
 
 /// One line per sweep configuration of `value` against N: the figure `name`, its CSV column
-/// `column`, chart title `what` and y label `y_label`.
+/// `column`, chart title `what` and y label `y_label`; then the dashed lines `flat` (label,
+/// CSV row name, y: a value that does not depend on N).
 fn per_config(
     d: &ReportData,
     (name, caption): (&'static str, String),
     (what, y_label): (&str, &str),
     column: &str,
     value: fn(&SweepRow) -> f64,
+    flat: &[(String, String, f64)],
 ) -> Result<Figure> {
     let rows = &d.sweep;
     let ns = ns(rows);
@@ -181,6 +183,10 @@ fn per_config(
             csv += &format!("{c},{},{}\n", r.n, value(r));
         }
         series.push((c, of.iter().map(|r| (lx(r.n), value(r))).collect(), false));
+    }
+    for (label, row, y) in flat {
+        csv += &format!("{row},,{y}\n");
+        series.push((label.clone(), ns.iter().map(|&n| (lx(n), *y)).collect(), true));
     }
     let mut svg = String::new();
     {
@@ -200,44 +206,24 @@ pub(super) fn microseconds(d: &ReportData) -> Result<Figure> {
         Some(mhz) => format!("µs vs N at {mhz:.0} MHz"),
         None => "µs vs N".into(),
     };
-    let mut fig = per_config(
-        d,
-        ("microseconds", "Time of one evaluation (µs) against N at the target's clock".into()),
-        (&what, "time (µs)"),
-        "us",
-        |r| r.us,
-    )?;
-    let Some(cpu) = &d.cpu else { return Ok(fig) };
-    // Drawn again with the CPU's lines (the same chart and rows).
-    let rows = &d.sweep;
-    let ns = ns(rows);
-    let mut series: Vec<Series> = configs(rows)
-        .into_iter()
-        .map(|c| {
-            let pts = of_config(rows, &c).iter().map(|r| (lx(r.n), r.us)).collect();
-            (c, pts, false)
-        })
-        .collect();
-    let flat = |y: f64| ns.iter().map(|&n| (lx(n), y)).collect::<Vec<_>>();
-    series.push(("robovec's C, one state per call (this machine)".into(), flat(cpu.one_state_us), true));
-    series.push((format!("robovec's C, batch={}, per state (this machine)", cpu.batch), flat(cpu.batched_us), true));
-    fig.csv += &format!("cpu_one_state,,{}\ncpu_batch{},,{}\n", cpu.one_state_us, cpu.batch, cpu.batched_us);
-    fig.caption += &format!(
-        "; dashed, the function's C on the machine that ran the sweep ({}): one state per call and per state at batch={}",
-        cpu.build, cpu.batch
-    );
-    let mut svg = String::new();
-    {
-        let root = svg_area(&mut svg, SIZE);
-        let area = titled(&root, d)?;
-        n_chart(&area, &what, "time (µs)", &ns, &series, &[])?;
-        root.present().map_err(err)?;
+    let mut caption = "Time of one evaluation (µs) against N at the target's clock".to_string();
+    let mut flat = Vec::new();
+    if let Some(cpu) = &d.cpu {
+        caption += &format!(
+            "; dashed, the function's C on the machine that made the report ({}): one state per call and per state at batch={}",
+            cpu.build, cpu.batch
+        );
+        flat.push(("robovec's C, one state per call (this machine)".into(), "cpu_one_state".into(), cpu.one_state_us));
+        flat.push((
+            format!("robovec's C, batch={}, per state (this machine)", cpu.batch),
+            format!("cpu_batch{}", cpu.batch),
+            cpu.batched_us,
+        ));
     }
-    fig.svg = svg;
-    Ok(fig)
+    per_config(d, ("microseconds", caption), (&what, "time (µs)"), "us", |r| r.us, &flat)
 }
 
-/// Seed Fig. 3.9–3.13: parallelisation rate against N.
+/// Parallelisation rate against N (seed Fig. 3.9–3.13).
 pub(super) fn parallelisation(d: &ReportData) -> Result<Figure> {
     per_config(
         d,
@@ -245,6 +231,7 @@ pub(super) fn parallelisation(d: &ReportData) -> Result<Figure> {
         ("Parallelisation rate vs N", "parallelisation rate (ops / (cycles x 2N))"),
         "parallelisation_rate",
         |r| r.parallelisation_rate,
+        &[],
     )
 }
 
