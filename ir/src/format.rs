@@ -586,3 +586,95 @@ mod tests {
         assert_eq!(Format::Binary64.store(0.1), Ok(0.1));
     }
 }
+
+/// Integer ops against exact arithmetic computed independently: the operands' values and the
+/// constants' words as 512-bit floats (exact: every intermediate has fewer bits), the exact
+/// result, then `⌊x · 2^f + 1/2⌋` there.
+#[cfg(test)]
+mod exact {
+    use super::*;
+    use astro_float::{BigFloat, RoundingMode};
+    use proptest::prelude::*;
+
+    const P: usize = 512;
+    const RM: RoundingMode = RoundingMode::ToEven;
+
+    fn big(x: f64) -> BigFloat {
+        crate::numerics::big::from_f64(x, P)
+    }
+
+    /// `value` as an integer op reads it, exactly: a fixed-point operand's value as it is, a
+    /// constant as its 32-bit word ([`fix_constant`], checked by hand above).
+    fn read(value: f64, constant: bool) -> BigFloat {
+        if constant {
+            let (k, f) = fix_constant(value).expect("a word");
+            big(k as f64).mul(&big(2f64.powi(-f)), P, RM)
+        } else {
+            big(value)
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 2000, max_global_rejects: 100_000, ..ProptestConfig::default() })]
+        #[test]
+        fn integer_ops_round_the_exact_result_once(
+            op in 0usize..6,
+            widths in prop::array::uniform3(2u32..=34),
+            fractions in prop::array::uniform3(-8i32..=50),
+            units in prop::array::uniform3(-1.0f64..1.0),
+            constant in prop::option::of((0usize..3, 0.0f64..100.0)),
+            out in (2u32..=53, -8i32..=60),
+        ) {
+            // The operands: a k · 2^-f of each format (k uniform in its width), or a constant.
+            let vals: Vec<f64> = (0..3).map(|i| {
+                let top = 2f64.powi(widths[i] as i32 - 1);
+                let k = (units[i] * top).floor().clamp(-top, top - 1.0);
+                k * 2f64.powi(-fractions[i])
+            }).collect();
+            let text = |i: usize| match constant {
+                Some((j, c)) if j == i => format!("{c:?}"),
+                _ => ["%a", "%b", "%c"][i].to_string(),
+            };
+            let value = |i: usize| match constant {
+                Some((j, c)) if j == i => read(c, true),
+                _ => read(vals[i], false),
+            };
+            let (def, exact) = match op {
+                0 => (format!("add {}, {}", text(0), text(1)), value(0).add(&value(1), P, RM)),
+                1 => (format!("sub {}, {}", text(0), text(1)), value(0).sub(&value(1), P, RM)),
+                2 => (format!("mul {}, {}", text(0), text(1)), value(0).mul(&value(1), P, RM)),
+                k => {
+                    let ab = value(0).mul(&value(1), P, RM);
+                    let name = ["fma", "fms", "fnma"][k - 3];
+                    let x = match k {
+                        3 => ab.add(&value(2), P, RM),
+                        4 => ab.sub(&value(2), P, RM),
+                        _ => value(2).sub(&ab, P, RM),
+                    };
+                    (format!("call @{name}({}, {}, {})", text(0), text(1), text(2)), x)
+                }
+            };
+            let src = format!(
+                "func @f {{ phase atomised input %a : fix<{},{}> input %b : fix<{},{}> input %c : fix<{},{}> \
+                 %x = {def} : fix<{},{}> output y = %x }}",
+                widths[0], fractions[0], widths[1], fractions[1], widths[2], fractions[2], out.0, out.1
+            );
+            let f = crate::text::parse(&src).expect("parses").functions.remove(0);
+            let x = f.body[0];
+            prop_assume!(integer_op(&f, x).is_some());
+            // The expected integer: ⌊exact · 2^f + 1/2⌋, exactly.
+            let scaled = exact.mul(&big(2f64.powi(out.1)), P, RM).add(&big(0.5), P, RM).floor();
+            let top = 2f64.powi(out.0 as i32 - 1);
+            let fits = scaled.cmp(&big(-top)).is_some_and(|c| c >= 0) && scaled.cmp(&big(top)).is_some_and(|c| c < 0);
+            let names = ["a", "b", "c"];
+            match eval_values(&f, |n| vals[names.iter().position(|m| *m == n).unwrap()]) {
+                Ok(v) => {
+                    prop_assert!(fits, "{src}: -eval gives {} but the exact result overflows", v[x.index()]);
+                    let got = big(v[x.index()]).mul(&big(2f64.powi(out.1)), P, RM);
+                    prop_assert_eq!(got.cmp(&scaled), Some(0), "{}: -eval {} at {:?}", src, v[x.index()], vals);
+                }
+                Err(e) => prop_assert!(!fits && e.error == StoreError::Overflow, "{src}: {e:?}"),
+            }
+        }
+    }
+}
