@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Speed from precision (issue 48's goal, docs/accuracy.md "Speed from precision"): robovec's
 # best binary64 C at batch=4 against the mixed-precision C that `precision<budget=B>` certifies
-# at batch=8, side by side in one process (benches/precision_speed/driver.c: alternating, order
+# at batch=8 — with double arrays, and with float arrays (`precision=f32` with formats: the
+# caller's data already in binary32) — side by side in one process (benches/precision_speed/driver.c: alternating, order
 # rotated, medians of ns/state and of paired ratios), on UR5, Panda and Talos over their URDF
 # limits, for each function given (default invdyna: RNEA).
 #
@@ -34,7 +35,7 @@ robots=$(ls -d target/pinocchio-venv/lib/python3*/site-packages/cmeel.prefix/sha
 work=target/precision_speed
 mkdir -p "$work"
 pipeline='atomise,cse,zero-removal,contract,schedule-cpu'
-echo "| robot | function | precision's choice | certified max_rel | f64 batch=4 ns/state | mixed batch=8 ns/state | f32 batch=8 ns/state | mixed vs f64 | f32 vs f64 |"
+echo "| robot | function | precision's choice | certified max_rel | f64 batch=4 ns/state | mixed batch=8 ns/state | mixed, float arrays, batch=8 ns/state | mixed vs f64 | mixed, float arrays vs f64 |"
 echo "|---|---|---|---|---|---|---|---|---|"
 for robot in ur5:ur_description/urdf/ur5_robot.urdf panda:panda_description/urdf/panda.urdf talos:talos_data/robots/talos_reduced.urdf; do
   name=${robot%%:*}
@@ -49,7 +50,8 @@ for robot in ur5:ur_description/urdf/ur5_robot.urdf panda:panda_description/urdf
       echo "| $name | $fn | refused: $(head -1 "$d/b.err") | | | | | | |"
       continue
     fi
-    "$opt" "${common[@]}" -passes="$pipeline,codegen<c;abi=plain;batch=8;trig=$trig;precision=f32;name=rv_c>" -o "$d/c.c" 2>/dev/null
+    # The same formats with float arrays (precision=f32 with formats: data already in binary32).
+    "$opt" "${common[@]}" -passes="$pipeline,precision<budget=$budget>,codegen<c;abi=plain;batch=8;trig=$trig;precision=f32;name=rv_c>" -o "$d/c.c" 2>/dev/null
     ni=$(grep -o 'in\[[0-9]*\]' "$d/a.h" | tr -d 'in[]' | sort -n | tail -1)
     no=$(grep -o 'out\[[0-9]*\]' "$d/a.h" | tr -d 'out[]' | sort -n | tail -1)
     # shellcheck disable=SC2086

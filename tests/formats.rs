@@ -352,10 +352,14 @@ fn c_refuses_formats_with_options_that_cannot_honour_them() {
     let dir = tmp("formats-c-refused");
     let input = dir.join("f.rvir");
     std::fs::write(&input, FIXED).unwrap();
-    for (opts, why) in [("precision=f32", "precision=f32"), ("abi=robotran", "abi=robotran")] {
+    for (opts, why) in [
+        ("abi=robotran", "has values in numeric formats, which codegen<c> writes with abi=plain"),
+        // Float arrays need binary32 outputs: `y` is fixed point.
+        ("precision=f32", "output `y` is not a binary32 value"),
+    ] {
         let o = opt(&[input.to_str().unwrap(), &format!("-passes=codegen<c;{opts}>"), "-o", "/dev/null"]);
         assert_eq!(o.status.code(), Some(1), "{opts}: {}", stderr(&o));
-        assert!(stderr(&o).contains("has values in numeric formats") && stderr(&o).contains(why), "{}", stderr(&o));
+        assert!(stderr(&o).contains(why), "{opts}: {}", stderr(&o));
     }
     let o = opt(&[input.to_str().unwrap(), "-passes=codegen<c>", "-o", dir.join("f.c").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
@@ -397,5 +401,103 @@ fn pinocchio_abi_writes_formats() {
             .output()
             .expect("cc");
         assert!(cc.status.success(), "batch={batch} trig={trig}: {}", String::from_utf8_lossy(&cc.stderr));
+    }
+}
+
+/// Formats with `precision=f32`: the plain ABI's arrays are `float` (data already in binary32),
+/// the values computed in their formats. A URDF arm's RNEA all in binary32 after `precision`
+/// (one input kept binary64 by hand, to read a float into a double), at one state and
+/// `batch=8` (`-O2 -march=native`), equals `-eval` at the same float inputs bit for bit; the
+/// interface says `f32`; an output not in binary32 is refused (above).
+#[test]
+fn formats_with_float_arrays_equal_eval() {
+    use robovec_backends::c::CodegenC;
+    use robovec_ir::format::Format;
+    use std::fmt::Write as _;
+    let dir = tmp("formats-float-io");
+    let ranges = dir.join("r.json");
+    std::fs::write(&ranges, r#"{"qd[*]": [-3, 3]}"#).unwrap();
+    let ir = dir.join("arm.rvir");
+    let o = opt(&[
+        concat!(env!("CARGO_MANIFEST_DIR"), "/examples/three_link_arm/three_link_arm.urdf"),
+        "-function=invdyna",
+        "--fold-params",
+        &format!("-ranges={}", ranges.display()),
+        "-passes=default<ops>,precision<budget=1e-3>",
+        "-o",
+        ir.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let mut m = parse(&std::fs::read_to_string(&ir).unwrap()).unwrap();
+    let g = &mut m.functions[0];
+    assert!(g.outputs.iter().all(|o| matches!(o.value, robovec_ir::Operand::Value(v) if g.format(v) == Format::Binary32)));
+    let q1 = g.inputs.iter().copied().find(|&v| g.name_of(v) == "q[1]").unwrap();
+    g.set_format(q1, Format::Binary64);
+    let g = g.clone();
+    let mut rng = robovec_ir::rng::SplitMix64::new(7);
+    for batch in [1usize, 8] {
+        let o = CodegenC { name: Some("arm".into()), batch: batch as u32, precision: robovec_backends::c::Precision::F32, ..CodegenC::default() };
+        let art = o.emit(&m).unwrap();
+        let iface = &art.interfaces[0];
+        assert_eq!(iface.precision, robovec_backends::c::Precision::F32);
+        assert!(art.code.main.contains("void arm(const float *restrict in, float *restrict out)"));
+        let (ni, no) = (iface.inputs.len(), iface.outputs.len());
+        std::fs::write(dir.join("arm.c"), &art.code.main).unwrap();
+        let calls = 8;
+        let mut bytes = Vec::new();
+        let mut want = Vec::new();
+        let mut points = Vec::new();
+        for _ in 0..calls * batch {
+            let p: Vec<f32> = iface.inputs.iter().map(|n| {
+                let u = rng.unit() as f32;
+                if n.starts_with("qd") { 6.0 * u - 3.0 } else if n.starts_with("qdd") { 20.0 * u - 10.0 } else if n.starts_with("q[") { 3.0 * u - 1.5 } else if n == "g[3]" { -9.81 } else { 0.0 }
+            }).collect();
+            points.push(p);
+        }
+        for call in points.chunks(batch) {
+            for i in 0..ni {
+                for p in call {
+                    bytes.extend(p[i].to_le_bytes());
+                }
+            }
+            for (j, out) in g.outputs.iter().enumerate() {
+                for p in call {
+                    let at = |n: &str| p[iface.inputs.iter().position(|m| m == n).unwrap()] as f64;
+                    let vals = robovec_ir::format::eval_values(&g, at).unwrap();
+                    let robovec_ir::Operand::Value(v) = out.value else { unreachable!() };
+                    want.push((format!("batch {batch} {} at {p:?}", iface.outputs[j]), vals[v.index()] as f32));
+                }
+            }
+        }
+        let mut main = String::from("#include <stdio.h>\n#include <string.h>\n#include <stdint.h>\n");
+        let _ = writeln!(
+            main,
+            "void arm(const float *restrict in, float *restrict out);\nint main(void)\n{{\n  float in[{}], out[{}];\n  \
+             while (fread(in, 4, {}, stdin) == {}) {{\n    arm(in, out);\n    for (int i = 0; i < {}; i++) {{ uint32_t b; \
+             memcpy(&b, &out[i], 4); printf(\"%08x\\n\", (unsigned)b); }}\n  }}\n  return 0;\n}}",
+            ni * batch, no * batch, ni * batch, ni * batch, no * batch
+        );
+        std::fs::write(dir.join("main.c"), main).unwrap();
+        let exe = dir.join("run");
+        let mut cc = std::process::Command::new("cc");
+        cc.current_dir(&dir).args(["-O2", "-std=c99", "-ffp-contract=off", "-Wall", "-Wextra", "-Werror", "-Wno-psabi"]);
+        if batch == 8 {
+            cc.arg("-march=native");
+        }
+        let o = cc.arg("-o").arg(&exe).args(["main.c", "arm.c", "-lm"]).output().expect("cc");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let mut child = std::process::Command::new(&exe)
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        use std::io::Write as _;
+        child.stdin.take().unwrap().write_all(&bytes).unwrap();
+        let out = child.wait_with_output().unwrap();
+        let got: Vec<u32> = String::from_utf8(out.stdout).unwrap().lines().map(|l| u32::from_str_radix(l, 16).unwrap()).collect();
+        assert_eq!(got.len(), want.len());
+        for (g, (what, y)) in got.iter().zip(&want) {
+            assert_eq!(*g, y.to_bits(), "{what}: C gives {}, -eval {y}", f32::from_bits(*g));
+        }
     }
 }

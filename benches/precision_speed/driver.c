@@ -1,6 +1,6 @@
 /* Side-by-side timing of robovec's binary64 C at batch=4 (A) against the mixed-precision C
- * `precision` chose at batch=8 (B) and binary32 everywhere at batch=8 (C, the ceiling: float
- * arrays, no certificate), for one function (scripts/precision_speed.sh writes the three files
+ * `precision` chose at batch=8 (B) and the same formats with float arrays at batch=8 (C: the
+ * caller's data already in binary32), for one function (scripts/precision_speed.sh writes the three files
  * with the symbols rv_a, rv_b, rv_c and -DNI/-DNO, the inputs and outputs per state).
  * Each rep times CALLS calls of each, alternating, the order rotated each rep; inputs cycle over
  * 64 states (uniform in [-1, 1]: the code has no data-dependent branch but for |x| > 2^11 in

@@ -56,8 +56,27 @@ impl CodegenC {
         main: Option<&Path>,
         ticker: &robovec_passes::Ticker,
     ) -> Result<CodegenArtifact, PassError> {
-        let fused = m.functions.iter().any(has_fused);
         let formats = self.check_formats(m)?;
+        if formats && self.f32() {
+            // Formats with float arrays: the values computed as their formats say (the body of
+            // precision=f64), the plain ABI's arrays `float` (`plain::function`'s `io_f32`).
+            let inner = CodegenC { precision: super::Precision::F64, ..self.clone() };
+            return inner.emit_files(m, main, ticker, true);
+        }
+        self.emit_files(m, main, ticker, false)
+    }
+
+    /// [`CodegenC::emit_within`] once formats are checked: `io_f32`, the plain ABI's arrays are
+    /// `float` (formats with `precision=f32`), the interface says `f32`.
+    fn emit_files(
+        &self,
+        m: &Module,
+        main: Option<&Path>,
+        ticker: &robovec_passes::Ticker,
+        io_f32: bool,
+    ) -> Result<CodegenArtifact, PassError> {
+        let fused = m.functions.iter().any(has_fused);
+        let formats = m.functions.iter().any(|f| f.has_formats());
         let callbacks = callbacks::callbacks(m)?;
         let decls = if self.abi == Abi::Robotran {
             native::prototypes(m, &callbacks)?
@@ -76,7 +95,7 @@ impl CodegenC {
                 emitted.push(if self.abi == Abi::Robotran {
                     robotran::function(self, f, symbol, &taken, ticker)?
                 } else {
-                    plain::function(self, f, symbol, &taken, ticker)
+                    plain::function(self, f, symbol, &taken, ticker, io_f32)
                 });
                 if ticker.stopped() {
                     return Err(ticker.error("codegen", &format!("writing @{}", f.name)));
@@ -262,25 +281,46 @@ impl CodegenC {
     /// lanes of `double`), the others as `double` (fixed point through [`FORMAT_HELPERS`]), bit
     /// for bit what `-eval` computes (but for `trig=inline`'s sin/cos, never bit-exact).
     ///
+    /// With `precision=f32` (`abi=plain` only) the arrays are `float` — data already in binary32,
+    /// an RL simulator's or a GPU pipeline's — and every output must be a binary32 value (or a
+    /// constant exact in binary32): an output in another format would be rounded on the way out,
+    /// a rounding the certified bound does not count. An input of any format reads its `float`
+    /// exactly (widened, or stored in its fixed-point format).
+    ///
     /// # Errors
-    /// [`PassError::Failed`] when formats meet options that cannot honour them: `precision=f32`
-    /// (the formats say how each value is computed) or `abi=robotran` (Robotran's signature is
-    /// refused with `precision=f32` for the same reason: its `MbsData` is `double`).
+    /// [`PassError::Failed`] when formats meet options that cannot honour them: `abi=robotran`
+    /// (its `MbsData` is `double`), or `precision=f32` with an output not in binary32 (named).
     fn check_formats(&self, m: &Module) -> Result<bool, PassError> {
         let Some(f) = m.functions.iter().find(|f| f.has_formats()) else { return Ok(false) };
-        let clash = if self.f32() {
-            Some("precision=f32 (the formats say how each value is computed)".to_string())
-        } else if self.abi == Abi::Robotran {
-            Some(format!("abi={}", self.abi.as_str()))
-        } else {
-            None
-        };
+        // (`abi=pinocchio` with `precision=f32` is bad usage already: its vectors are double.)
+        let clash = (self.abi == Abi::Robotran).then(|| format!("abi={}", self.abi.as_str()));
+        if clash.is_none() && self.f32() {
+            for f in &m.functions {
+                for o in &f.outputs {
+                    let in_float = match o.value {
+                        robovec_ir::Operand::Value(v) => f.format(v) == robovec_ir::format::Format::Binary32,
+                        robovec_ir::Operand::Const(c) => c as f32 as f64 == c,
+                    };
+                    if !in_float {
+                        return Err(PassError::Failed {
+                            pass: "codegen".into(),
+                            message: format!(
+                                "@{}: precision=f32 writes float arrays, but output `{}` is not a binary32 value: its \
+                                 value would be rounded on the way out, which no certified bound counts (give it the \
+                                 format f32, or write double arrays with precision=f64)",
+                                f.name, o.name
+                            ),
+                        });
+                    }
+                }
+            }
+        }
         match clash {
             Some(c) => Err(PassError::Failed {
                 pass: "codegen".into(),
                 message: format!(
-                    "@{} has values in numeric formats, which codegen<c> writes with abi=plain or abi=pinocchio and \
-                     precision=f64, not with {c}",
+                    "@{} has values in numeric formats, which codegen<c> writes with abi=plain (double or float \
+                     arrays) or abi=pinocchio (double), not with {c}",
                     f.name
                 ),
             }),

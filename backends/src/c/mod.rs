@@ -70,7 +70,7 @@ pub const ABI: ParamInfo = ParamInfo {
 pub const PRECISION: ParamInfo = ParamInfo {
     name: "precision",
     kind: ParamKind::Choice { choices: Precision::WORDS, default: Precision::F64.as_str() },
-    doc: "C: arithmetic in `double` (f64) or `float` (f32)",
+    doc: "C: arithmetic and arrays in `double` (f64) or `float` (f32); with numeric formats the values compute in theirs and f32 makes the arrays `float` (binary32 outputs only)",
 };
 /// `batch=1|2|4|8|16`.
 pub const BATCH: ParamInfo = ParamInfo {

@@ -322,7 +322,7 @@ pub(crate) fn emit(
         }
         let layout = Layout { params, inputs, outputs };
         let comment = format!("@{} as {symbol}: Pinocchio's {}", f.name, a.pinocchio());
-        let (entry, parts) = arrays(o, f, symbol, &taken, ticker, &layout, &comment);
+        let (entry, parts) = arrays(o, f, symbol, &taken, ticker, &layout, &comment, false);
         if ticker.stopped() {
             return Err(ticker.error("codegen", &format!("writing {symbol}")));
         }

@@ -30,6 +30,7 @@ use super::body::Body;
 use super::split::{part_name, part_prefix, Part, Plan};
 use super::{interface, CodegenC, Emitted};
 use crate::input_values;
+use crate::literal;
 use crate::names::c_names;
 
 /// The parameter and helper names of the plain ABI (never given to a value).
@@ -44,8 +45,12 @@ pub(crate) fn function(
     symbol: &str,
     taken: &HashSet<String>,
     ticker: &robovec_passes::Ticker,
+    io_f32: bool,
 ) -> Emitted {
-    let iface = interface(o, f, symbol);
+    let mut iface = interface(o, f, symbol);
+    if io_f32 {
+        iface.precision = super::Precision::F32;
+    }
     let layout = Layout {
         params: vec![("in", false), ("out", true)],
         inputs: (0..iface.inputs.len()).map(|i| Source::Elem(0, i)).collect(),
@@ -53,8 +58,8 @@ pub(crate) fn function(
     };
     let comment =
         format!("@{}: {} inputs, {} outputs (order: see the header)", f.name, iface.inputs.len(), iface.outputs.len());
-    let (s, parts) = arrays(o, f, symbol, taken, ticker, &layout, &comment);
-    let real = o.real();
+    let (s, parts) = arrays(o, f, symbol, taken, ticker, &layout, &comment, io_f32);
+    let real = if io_f32 { "float" } else { o.real() };
     let w = o.batch as usize;
     let sig = format!("void {symbol}(const {real} *restrict in, {real} *restrict out)");
     let mut proto = format!("/* @{} as {symbol}", f.name);
@@ -114,6 +119,7 @@ pub(crate) fn arrays(
     ticker: &robovec_passes::Ticker,
     layout: &Layout,
     comment: &str,
+    io_f32: bool,
 ) -> (String, Vec<Part>) {
     let mut reserved: Vec<&str> = layout.params.iter().map(|p| p.0).collect();
     reserved.extend(RESERVED);
@@ -124,7 +130,8 @@ pub(crate) fn arrays(
     let b = Body::new(o, f, &names, None, ticker);
     let (order, attached) = b.order();
     let plan = Plan::new(f, &order, &attached, o.chunk as usize, &[], &[]);
-    let real = o.real();
+    // The arrays' type: `float` with formats and precision=f32 (`io_f32`), else the values'.
+    let real = if io_f32 { "float" } else { o.real() };
     let w = o.batch as usize;
     let params: Vec<String> = layout
         .params
@@ -162,6 +169,21 @@ pub(crate) fn arrays(
             read[v.index()] = k as u32 + 1;
             let vty = b.type_of(v);
             match layout.inputs[i] {
+                Source::Elem(p, e) if w > 1 && io_f32 => {
+                    // A float array: the lanes as a robovec_vec32, then in the value's format.
+                    let p = layout.params[p].0;
+                    let expr = if b.narrow(v) {
+                        "robovec_in32".to_string()
+                    } else {
+                        b.stored(v, "__builtin_convertvector(robovec_in32, robovec_vec)".into())
+                    };
+                    let _ = writeln!(
+                        s,
+                        "  {vty} {n};\n  {{\n    robovec_vec32 robovec_in32;\n    memcpy(&robovec_in32, {p} + {}{at}, sizeof robovec_in32);\n    \
+                         {n} = {expr};\n  }}",
+                        e * w
+                    );
+                }
                 Source::Elem(p, e) if w > 1 && f.format(v).is_default() => {
                     let p = layout.params[p].0;
                     let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, {p} + {}{at}, sizeof {n});", e * w);
@@ -201,7 +223,23 @@ pub(crate) fn arrays(
         let e = b.operand_value(x);
         for &(p, el) in &layout.outputs[j] {
             let p = layout.params[p].0;
-            if w > 1 {
+            if w > 1 && io_f32 {
+                // Every output is binary32 or a constant exact in it (`check_formats`).
+                match x {
+                    Operand::Value(v) => {
+                        let n = &names[v.index()];
+                        let _ = writeln!(s, "  memcpy({p} + {}{at}, &{n}, sizeof {n});", el * w);
+                    }
+                    Operand::Const(c) => {
+                        let k = literal::operand(*c, true);
+                        let _ = writeln!(
+                            s,
+                            "  {{ const robovec_vec32 k = robovec_splat32({k}); memcpy({p} + {}{at}, &k, sizeof k); }}",
+                            el * w
+                        );
+                    }
+                }
+            } else if w > 1 {
                 match x {
                     Operand::Value(v) if b.narrow(*v) => {
                         let _ = writeln!(s, "  robovec_store32({p} + {}{at}, {});", el * w, names[v.index()]);
@@ -254,7 +292,7 @@ pub(crate) fn arrays(
     let mut parts = Vec::new();
     if split {
         let prefix = part_prefix(symbol, plan.parts(), taken);
-        let live_ty = if w > 1 { "robovec_vec" } else { real };
+        let live_ty = if w > 1 { "robovec_vec" } else { o.real() };
         for k in 0..plan.parts() {
             let mut body = String::new();
             statements(&mut body, k);
