@@ -320,9 +320,9 @@ pub(crate) fn emit(
                 ),
             ));
         }
-        let layout = Layout { params, inputs, outputs };
+        let layout = Layout { params, inputs, outputs, float_arrays: false };
         let comment = format!("@{} as {symbol}: Pinocchio's {}", f.name, a.pinocchio());
-        let (entry, parts) = arrays(o, f, symbol, &taken, ticker, &layout, &comment, false);
+        let (entry, parts) = arrays(o, f, symbol, &taken, ticker, &layout, &comment);
         if ticker.stopped() {
             return Err(ticker.error("codegen", &format!("writing {symbol}")));
         }

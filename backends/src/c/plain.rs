@@ -55,10 +55,11 @@ pub(crate) fn function(
         params: vec![("in", false), ("out", true)],
         inputs: (0..iface.inputs.len()).map(|i| Source::Elem(0, i)).collect(),
         outputs: (0..f.outputs.len()).map(|j| vec![(1, j)]).collect(),
+        float_arrays: io_f32,
     };
     let comment =
         format!("@{}: {} inputs, {} outputs (order: see the header)", f.name, iface.inputs.len(), iface.outputs.len());
-    let (s, parts) = arrays(o, f, symbol, taken, ticker, &layout, &comment, io_f32);
+    let (s, parts) = arrays(o, f, symbol, taken, ticker, &layout, &comment);
     let real = if io_f32 { "float" } else { o.real() };
     let w = o.batch as usize;
     let sig = format!("void {symbol}(const {real} *restrict in, {real} *restrict out)");
@@ -103,6 +104,9 @@ pub(crate) struct Layout<'a> {
     /// Per output of the function: the `(parameter, element)` it is written to, one or more (a
     /// mass matrix's mirrored triangle).
     pub outputs: Vec<Vec<(usize, usize)>>,
+    /// The arrays are `float` while the values compute in their formats (formats with
+    /// `precision=f32`; the body's options are then `precision=f64`).
+    pub float_arrays: bool,
 }
 
 /// `f` as `symbol` over the arrays of `layout`: the definition of the entry point, opening with
@@ -119,8 +123,8 @@ pub(crate) fn arrays(
     ticker: &robovec_passes::Ticker,
     layout: &Layout,
     comment: &str,
-    io_f32: bool,
 ) -> (String, Vec<Part>) {
+    let io_f32 = layout.float_arrays;
     let mut reserved: Vec<&str> = layout.params.iter().map(|p| p.0).collect();
     reserved.extend(RESERVED);
     reserved.push(symbol);
