@@ -9,7 +9,8 @@
 //! cycling through them, in [`REPEATS`] timed repeats of about 2 ms each, and prints the median
 //! ns per state. One process, one function: the numbers of a figure are side by side in time
 //! but not interleaved, so they are a picture of the machine, not a benchmark claim
-//! (`scripts/precision_speed.sh` alternates its contestants).
+//! (`scripts/precision_speed.sh` alternates its contestants). Under `-time-limit` the compiler
+//! and the program are stopped (killed) at the deadline given, and the measurement fails.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -17,6 +18,7 @@ use std::path::Path;
 use robovec_backends::c::{CodegenC, Trig};
 use robovec_ir::domain::Domain;
 use robovec_ir::rng::SplitMix64;
+use robovec_ir::time_limit::Deadline;
 use robovec_ir::{Function, Module};
 
 /// The compiler's flags (the generated file asks for `-ffp-contract=off`).
@@ -33,13 +35,21 @@ pub const STATES: usize = 16;
 pub const REPEATS: usize = 31;
 
 /// The median ns per state of `f`'s C at `batch` states per call, compiled and run in `dir`
-/// (an existing folder the caller removes), its inputs drawn from `domain` (seed 48).
+/// (an existing folder the caller removes), its inputs drawn from `domain` (seed 48), stopped
+/// at `deadline`.
 ///
 /// # Errors
 /// A message when an input has no range in `domain`, the C cannot be written (a pass error of
-/// `codegen<c>`), or the compiler or the program fails (the compiler's own message).
-pub fn ns_per_state(f: &Function, domain: &Domain, batch: u32, dir: &Path) -> Result<f64, String> {
-    ns_per_state_drawn(f, batch, dir, |name, u| {
+/// `codegen<c>`), the compiler or the program fails (the compiler's own message), or the
+/// deadline comes first.
+pub fn ns_per_state(
+    f: &Function,
+    domain: &Domain,
+    batch: u32,
+    dir: &Path,
+    deadline: Option<&Deadline>,
+) -> Result<f64, String> {
+    ns_per_state_drawn(f, batch, dir, deadline, |name, u| {
         let r = domain.get(name).ok_or_else(|| format!("input `{name}` has no range in the domain"))?.interval;
         Ok((r.lo + u * (r.hi - r.lo)).clamp(r.lo, r.hi))
     })
@@ -51,8 +61,8 @@ pub fn ns_per_state(f: &Function, domain: &Domain, batch: u32, dir: &Path) -> Re
 ///
 /// # Errors
 /// As [`ns_per_state`].
-pub fn ns_per_state_anywhere(f: &Function, batch: u32, dir: &Path) -> Result<f64, String> {
-    ns_per_state_drawn(f, batch, dir, |_, u| Ok(0.1 + 0.9 * u))
+pub fn ns_per_state_anywhere(f: &Function, batch: u32, dir: &Path, deadline: Option<&Deadline>) -> Result<f64, String> {
+    ns_per_state_drawn(f, batch, dir, deadline, |_, u| Ok(0.1 + 0.9 * u))
 }
 
 /// [`ns_per_state`] with input `name`'s value `draw(name, u)` for `u` uniform in [0, 1).
@@ -60,6 +70,7 @@ fn ns_per_state_drawn(
     f: &Function,
     batch: u32,
     dir: &Path,
+    deadline: Option<&Deadline>,
     mut draw: impl FnMut(&str, f64) -> Result<f64, String>,
 ) -> Result<f64, String> {
     let m = Module { functions: vec![f.clone()] };
@@ -102,20 +113,71 @@ fn ns_per_state_drawn(
     std::fs::write(dir.join("main.c"), main).map_err(|e| e.to_string())?;
     let cc = compiler();
     let exe = dir.join("timed");
-    let o = std::process::Command::new(&cc)
-        .current_dir(dir)
-        .args(FLAGS)
-        .arg("-o")
-        .arg(&exe)
-        .args(["main.c", "timed.c", "-lm"])
-        .output()
-        .map_err(|e| format!("cannot run the C compiler `{cc}`: {e}"))?;
+    let mut compile = std::process::Command::new(&cc);
+    compile.current_dir(dir).args(FLAGS).arg("-o").arg(&exe).args(["main.c", "timed.c", "-lm"]);
+    let o = run(compile, deadline).map_err(|e| format!("the C compiler `{cc}`: {e}"))?;
     if !o.status.success() {
         return Err(format!("`{cc}` failed: {}", String::from_utf8_lossy(&o.stderr).lines().next().unwrap_or("")));
     }
-    let o = std::process::Command::new(&exe).output().map_err(|e| e.to_string())?;
+    let o = run(std::process::Command::new(&exe), deadline).map_err(|e| format!("the timed program: {e}"))?;
     if !o.status.success() {
         return Err("the timed program failed".into());
     }
     String::from_utf8_lossy(&o.stdout).trim().parse::<f64>().map_err(|e| format!("the timed program printed no time: {e}"))
+}
+
+/// `cmd`'s output, the process killed when `deadline` comes first.
+fn run(mut cmd: std::process::Command, deadline: Option<&Deadline>) -> Result<std::process::Output, String> {
+    use std::io::Read as _;
+    let mut child = cmd
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot start: {e}"))?;
+    loop {
+        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+            let (mut out, mut err) = (Vec::new(), Vec::new());
+            if let Some(mut s) = child.stdout.take() {
+                let _ = s.read_to_end(&mut out);
+            }
+            if let Some(mut s) = child.stderr.take() {
+                let _ = s.read_to_end(&mut err);
+            }
+            return Ok(std::process::Output { status, stdout: out, stderr: err });
+        }
+        if deadline.is_some_and(Deadline::reached) {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err("stopped at the time limit".into());
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn f() -> Function {
+        robovec_ir::text::parse(
+            "func @f { phase atomised input %a input %b %x = mul %a, %b %y = add %x, %a output y = %y }",
+        )
+        .unwrap()
+        .functions
+        .remove(0)
+    }
+
+    /// A measurement gives a positive time; past its deadline it stops (the compiler killed)
+    /// and says so.
+    #[test]
+    fn it_times_and_stops_at_the_deadline() {
+        let dir = std::env::temp_dir().join(format!("robovec-cpu-time-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ns = ns_per_state_anywhere(&f(), 4, &dir, None).expect("cc (scripts/test.sh installs gcc)");
+        assert!(ns > 0.0 && ns.is_finite(), "{ns}");
+        let past = Deadline::after_seconds(0.0);
+        let e = ns_per_state_anywhere(&f(), 1, &dir, Some(&past)).unwrap_err();
+        assert!(e.contains("stopped at the time limit"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -39,10 +39,13 @@ pub fn measure(module: &robovec_ir::Module, cx: &mut PassContext, function: &str
         plain.set_format(v, robovec_ir::format::Format::Binary64);
     }
     let dir = std::env::temp_dir().join(format!("robovec-time-{}", std::process::id()));
+    // Skippable work: it stops early enough for the output's tail, as the passes do.
+    let kept = robovec_passes::time_limit::kept_for(robovec_passes::manager::module_ops(module));
+    let deadline = cx.deadline.map(|d| d.keeping(kept));
     let result = (|| -> Result<BudgetLadder, String> {
         std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
         let mut out = ladder.clone();
-        let best = fastest(&plain, &domain, &BINARY64_BATCHES, &dir)?;
+        let best = fastest(&plain, &domain, &BINARY64_BATCHES, &dir, deadline.as_ref())?;
         out.binary64_ns_per_state = best.map(|b| b.0);
         out.binary64_batch = best.map(|b| b.1);
         let mut seen: Vec<(&Vec<_>, Option<(f64, u32)>)> = Vec::new();
@@ -54,7 +57,7 @@ pub fn measure(module: &robovec_ir::Module, cx: &mut PassContext, function: &str
                     for &(v, fmt) in formats {
                         g.set_format(v, fmt);
                     }
-                    let time = fastest(&g, &domain, &BATCHES, &dir)?;
+                    let time = fastest(&g, &domain, &BATCHES, &dir, deadline.as_ref())?;
                     seen.push((formats, time));
                     time
                 }
@@ -77,10 +80,11 @@ fn fastest(
     domain: &robovec_ir::domain::Domain,
     batches: &[u32],
     dir: &std::path::Path,
+    deadline: Option<&robovec_ir::time_limit::Deadline>,
 ) -> Result<Option<(f64, u32)>, String> {
     let mut best: Option<(f64, u32)> = None;
     for &batch in batches {
-        let ns = crate::cpu_time::ns_per_state(f, domain, batch, dir)?;
+        let ns = crate::cpu_time::ns_per_state(f, domain, batch, dir, deadline)?;
         if best.is_none_or(|(b, _)| ns < b) {
             best = Some((ns, batch));
         }
