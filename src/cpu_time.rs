@@ -34,6 +34,26 @@ pub const STATES: usize = 16;
 /// Timed repeats; the median is reported.
 pub const REPEATS: usize = 31;
 
+/// Runs `work` in a scratch folder (`$TMPDIR/robovec-TAG-PID`, made first, removed after) with
+/// the deadline of skippable work on `module`: `cx`'s, keeping back the output's tail as the
+/// passes do ([`robovec_passes::time_limit::kept_for`]).
+///
+/// # Errors
+/// `work`'s, or a message when the folder cannot be made.
+pub fn measuring<T>(
+    module: &Module,
+    cx: &robovec_passes::PassContext,
+    tag: &str,
+    work: impl FnOnce(&Path, Option<&Deadline>) -> Result<T, String>,
+) -> Result<T, String> {
+    let kept = robovec_passes::time_limit::kept_for(robovec_passes::manager::module_ops(module));
+    let deadline = cx.deadline.map(|d| d.keeping(kept));
+    let dir = std::env::temp_dir().join(format!("robovec-{tag}-{}", std::process::id()));
+    let result = std::fs::create_dir_all(&dir).map_err(|e| e.to_string()).and_then(|()| work(&dir, deadline.as_ref()));
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}
+
 /// The median ns per state of `f`'s C at `batch` states per call, compiled and run in `dir`
 /// (an existing folder the caller removes), its inputs drawn from `domain` (seed 48), stopped
 /// at `deadline`.

@@ -56,3 +56,35 @@ pub fn tmp(name: &str) -> PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// Compiles `files` (C, in `dir`) with the system compiler, `flags` and `-lm` into `dir/run`,
+/// and returns its path; the compiler's message is the panic's when it fails.
+pub fn compile_c(dir: &std::path::Path, flags: &[&str], files: &[&str]) -> PathBuf {
+    let exe = dir.join("run");
+    let o = std::process::Command::new("cc")
+        .current_dir(dir)
+        .args(flags)
+        .arg("-o")
+        .arg(&exe)
+        .args(files)
+        .arg("-lm")
+        .output()
+        .expect("cc (scripts/test.sh installs gcc)");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    exe
+}
+
+/// Runs `exe` with `input` on its stdin (it must exit 0) and reads its stdout: one hexadecimal
+/// integer a line, the bits of a result as a test's C driver prints them.
+pub fn run_hex_lines(exe: &std::path::Path, input: &[u8]) -> Vec<u64> {
+    use std::io::Write as _;
+    let mut child = std::process::Command::new(exe)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(input).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "{} failed", exe.display());
+    String::from_utf8(out.stdout).unwrap().lines().map(|l| u64::from_str_radix(l, 16).unwrap()).collect()
+}

@@ -153,6 +153,19 @@ fn random_formats(f: &Function, dom: &Domain, seed: u64, fix_only: bool) -> Func
     g
 }
 
+/// [`check_sound`] of `g` (in formats) in mode mixed, at 32 points; a fixed-point format the
+/// bound cannot prove wide enough is refused (`FixOverflow`), never bounded, and not checked.
+fn check_sound_formatted(what: &str, g: &Function, dom: &Domain, seed: u64) {
+    let x = enclose_with(g, dom, Some(16), || false).unwrap();
+    match bound(g, &x, Formats::Mixed, || false) {
+        Ok(_) => {
+            check_sound(what, g, dom, Formats::Mixed, 32, seed);
+        }
+        Err(robovec_passes::error_bound::BoundError::FixOverflow { .. }) => {}
+        Err(e) => panic!("{e:?}"),
+    }
+}
+
 proptest! {
     // 64 cases (PROPTEST_CASES=N for a longer campaign: the 10⁴ random DAGs).
     #![proptest_config(ProptestConfig {
@@ -174,16 +187,7 @@ proptest! {
     #[test]
     fn bounds_hold_on_random_functions_in_mixed_formats(seed in any::<u64>(), ops in 1usize..40) {
         let (f, dom) = random_function(seed, ops);
-        let g = with_random_formats(&f, &dom, seed);
-        let x = enclose_with(&g, &dom, Some(16), || false).unwrap();
-        match bound(&g, &x, Formats::Mixed, || false) {
-            Ok(_) => {
-                check_sound(&format!("mixed seed {seed}"), &g, &dom, Formats::Mixed, 32, seed);
-            }
-            // A fixed-point format the bound cannot prove wide enough is refused, never bounded.
-            Err(robovec_passes::error_bound::BoundError::FixOverflow { .. }) => {}
-            Err(e) => panic!("{e:?}"),
-        }
+        check_sound_formatted(&format!("mixed seed {seed}"), &with_random_formats(&f, &dom, seed), &dom, seed);
     }
 
     /// Fixed point everywhere it fits: mostly integer ops, whose constants read as 32-bit
@@ -191,15 +195,7 @@ proptest! {
     #[test]
     fn bounds_hold_on_random_functions_in_fixed_point(seed in any::<u64>(), ops in 1usize..40) {
         let (f, dom) = random_function(seed, ops);
-        let g = with_fixed_point_formats(&f, &dom, seed);
-        let x = enclose_with(&g, &dom, Some(16), || false).unwrap();
-        match bound(&g, &x, Formats::Mixed, || false) {
-            Ok(_) => {
-                check_sound(&format!("fixed seed {seed}"), &g, &dom, Formats::Mixed, 32, seed);
-            }
-            Err(robovec_passes::error_bound::BoundError::FixOverflow { .. }) => {}
-            Err(e) => panic!("{e:?}"),
-        }
+        check_sound_formatted(&format!("fixed seed {seed}"), &with_fixed_point_formats(&f, &dom, seed), &dom, seed);
     }
 
     /// The synthetic Robotran-like DAGs (deep sums of products, trig of joint angles).

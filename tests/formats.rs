@@ -310,25 +310,12 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool,
     main += &calls;
     main += "  return 0;\n}\n";
     std::fs::write(dir.join("main.c"), main).unwrap();
-    let exe = dir.join("run");
-    let mut cc = std::process::Command::new("cc");
-    cc.current_dir(&dir).args([opt_level, "-std=c99", "-ffp-contract=off", "-Wall", "-Wextra", "-Werror", "-Wno-psabi"]);
+    let mut flags = vec![opt_level, "-std=c99", "-ffp-contract=off", "-Wall", "-Wextra", "-Werror", "-Wno-psabi"];
     if batch == 8 {
-        cc.arg("-march=native");
+        flags.push("-march=native");
     }
-    let o = cc.arg("-o").arg(&exe).args(&files).arg("-lm").output().expect("cc (scripts/test.sh installs gcc)");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let mut child = std::process::Command::new(&exe)
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write as _;
-    child.stdin.take().unwrap().write_all(&input_bytes).unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(out.status.success());
-    let got: Vec<u64> =
-        String::from_utf8(out.stdout).unwrap().lines().map(|l| u64::from_str_radix(l, 16).unwrap()).collect();
+    let files: Vec<&str> = files.iter().map(String::as_str).collect();
+    let got = crate::common::run_hex_lines(&crate::common::compile_c(&dir, &flags, &files), &input_bytes);
     assert_eq!(got.len(), want.len());
     let mut checked = 0;
     for (g, (what, y, allowed)) in got.iter().zip(&want) {
@@ -478,26 +465,14 @@ fn formats_with_float_arrays_equal_eval() {
             ni * batch, no * batch, ni * batch, ni * batch, no * batch
         );
         std::fs::write(dir.join("main.c"), main).unwrap();
-        let exe = dir.join("run");
-        let mut cc = std::process::Command::new("cc");
-        cc.current_dir(&dir).args(["-O2", "-std=c99", "-ffp-contract=off", "-Wall", "-Wextra", "-Werror", "-Wno-psabi"]);
+        let mut flags = vec!["-O2", "-std=c99", "-ffp-contract=off", "-Wall", "-Wextra", "-Werror", "-Wno-psabi"];
         if batch == 8 {
-            cc.arg("-march=native");
+            flags.push("-march=native");
         }
-        let o = cc.arg("-o").arg(&exe).args(["main.c", "arm.c", "-lm"]).output().expect("cc");
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let mut child = std::process::Command::new(&exe)
-            .stdin(std::process::Stdio::piped())
-            .stdout(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        use std::io::Write as _;
-        child.stdin.take().unwrap().write_all(&bytes).unwrap();
-        let out = child.wait_with_output().unwrap();
-        let got: Vec<u32> = String::from_utf8(out.stdout).unwrap().lines().map(|l| u32::from_str_radix(l, 16).unwrap()).collect();
+        let got = crate::common::run_hex_lines(&crate::common::compile_c(&dir, &flags, &["main.c", "arm.c"]), &bytes);
         assert_eq!(got.len(), want.len());
-        for (g, (what, y)) in got.iter().zip(&want) {
-            assert_eq!(*g, y.to_bits(), "{what}: C gives {}, -eval {y}", f32::from_bits(*g));
+        for (&g, (what, y)) in got.iter().zip(&want) {
+            assert_eq!(g, u64::from(y.to_bits()), "{what}: C gives {}, -eval {y}", f32::from_bits(g as u32));
         }
     }
 }

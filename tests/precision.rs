@@ -455,9 +455,7 @@ fn mcu_formats_are_integer_c_bit_exact_and_within_the_bound() {
     };
     let mut rng = SplitMix64::new(48);
     let mut binary64 = g.clone();
-    for &v in g.inputs.iter().chain(&g.body) {
-        binary64.set_format(v, robovec_ir::format::Format::Binary64);
-    }
+    binary64.clear_formats();
     let (mut bytes, mut want) = (Vec::new(), Vec::new());
     for _ in 0..64 {
         let xs = crate::range::uniform_point(&iface.inputs, &dom, &mut rng);
@@ -479,28 +477,9 @@ fn mcu_formats_are_integer_c_bit_exact_and_within_the_bound() {
          memcpy(&b, &out[i], 8); printf(\"%016llx\\n\", (unsigned long long)b); }}\n  }}\n  return 0;\n}}"
     );
     std::fs::write(dir.join("main.c"), main).unwrap();
-    let exe = dir.join("run");
-    let o = std::process::Command::new("cc")
-        .current_dir(&dir)
-        .args(["-O1", "-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror", "-o"])
-        .arg(&exe)
-        .args(["main.c", "arm.c", "-lm"])
-        .output()
-        .expect("cc (scripts/test.sh installs gcc)");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let mut child = std::process::Command::new(&exe)
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write as _;
-    child.stdin.take().unwrap().write_all(&bytes).unwrap();
-    let out = child.wait_with_output().unwrap();
-    let got: Vec<f64> = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .map(|l| f64::from_bits(u64::from_str_radix(l, 16).unwrap()))
-        .collect();
+    let flags = ["-O1", "-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror"];
+    let exe = crate::common::compile_c(&dir, &flags, &["main.c", "arm.c"]);
+    let got: Vec<f64> = crate::common::run_hex_lines(&exe, &bytes).into_iter().map(f64::from_bits).collect();
     assert_eq!(got.len(), want.len());
     for (c, (name, eval, exact, b)) in got.iter().zip(&want) {
         assert_eq!(c.to_bits(), eval.to_bits(), "{name}: C gives {c:e}, -eval {eval:e}");

@@ -47,19 +47,14 @@ pub fn measure(module: &robovec_ir::Module, cx: &mut PassContext, function: &str
         return;
     }
     let Some(f) = module.function(function) else { return };
-    let dir = std::env::temp_dir().join(format!("robovec-cpu-{}", std::process::id()));
-    let covered = cx.domain.as_ref().filter(|d| d.missing(f).is_empty()).cloned();
-    // Skippable work: it stops early enough for the output's tail, as the passes do.
-    let kept = robovec_passes::time_limit::kept_for(robovec_passes::manager::module_ops(module));
-    let deadline = cx.deadline.map(|d| d.keeping(kept));
-    let time = |batch: u32| match &covered {
-        Some(d) => crate::cpu_time::ns_per_state(f, d, batch, &dir, deadline.as_ref()),
-        None => crate::cpu_time::ns_per_state_anywhere(f, batch, &dir, deadline.as_ref()),
-    };
-    let result = std::fs::create_dir_all(&dir)
-        .map_err(|e| e.to_string())
-        .and_then(|()| Ok((time(1)?, time(BATCH)?)));
-    let _ = std::fs::remove_dir_all(&dir);
+    let covered = cx.domain.as_ref().filter(|d| d.missing(f).is_empty());
+    let result = crate::cpu_time::measuring(module, cx, "cpu", |dir, deadline| {
+        let time = |batch: u32| match covered {
+            Some(d) => crate::cpu_time::ns_per_state(f, d, batch, dir, deadline),
+            None => crate::cpu_time::ns_per_state_anywhere(f, batch, dir, deadline),
+        };
+        Ok((time(1)?, time(BATCH)?))
+    });
     match result {
         Ok((one, batched)) => cx.emit(CpuTimes {
             function: function.to_string(),

@@ -35,17 +35,10 @@ pub fn measure(module: &robovec_ir::Module, cx: &mut PassContext, function: &str
     let domain = run.domain.clone();
     let Some(f) = module.function(function) else { return };
     let mut plain = f.clone();
-    for &v in f.inputs.iter().chain(&f.body) {
-        plain.set_format(v, robovec_ir::format::Format::Binary64);
-    }
-    let dir = std::env::temp_dir().join(format!("robovec-time-{}", std::process::id()));
-    // Skippable work: it stops early enough for the output's tail, as the passes do.
-    let kept = robovec_passes::time_limit::kept_for(robovec_passes::manager::module_ops(module));
-    let deadline = cx.deadline.map(|d| d.keeping(kept));
-    let result = (|| -> Result<BudgetLadder, String> {
-        std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    plain.clear_formats();
+    let result = crate::cpu_time::measuring(module, cx, "time", |dir, deadline| {
         let mut out = ladder.clone();
-        let best = fastest(&plain, &domain, &BINARY64_BATCHES, &dir, deadline.as_ref())?;
+        let best = fastest(&plain, &domain, &BINARY64_BATCHES, dir, deadline)?;
         out.binary64_ns_per_state = best.map(|b| b.0);
         out.binary64_batch = best.map(|b| b.1);
         let mut seen: Vec<(&Vec<_>, Option<(f64, u32)>)> = Vec::new();
@@ -57,7 +50,7 @@ pub fn measure(module: &robovec_ir::Module, cx: &mut PassContext, function: &str
                     for &(v, fmt) in formats {
                         g.set_format(v, fmt);
                     }
-                    let time = fastest(&g, &domain, &BATCHES, &dir, deadline.as_ref())?;
+                    let time = fastest(&g, &domain, &BATCHES, dir, deadline)?;
                     seen.push((formats, time));
                     time
                 }
@@ -66,8 +59,7 @@ pub fn measure(module: &robovec_ir::Module, cx: &mut PassContext, function: &str
             out.points[k].ns_batch = time.map(|t| t.1);
         }
         Ok(out)
-    })();
-    let _ = std::fs::remove_dir_all(&dir);
+    });
     match result {
         Ok(l) => cx.emit(l),
         Err(e) => cx.note_stop("-report-dir: measured time of the budget ladder", &format!("not measured: {e}")),

@@ -495,8 +495,11 @@ impl<'a> Body<'a> {
             let def = &self.f.value(v).def;
             before(s, v);
             // Not for callbacks (lane by lane) nor robovec's sin/cos (their own reads).
+            // Nor integer ops: they read the fixed-point integers as they are.
+            let integer = self.integer_op(v);
             let own_reads = matches!(def, Def::Call(c, a) if !is_intrinsic(c, a.len()))
-                || (matches!(def, Def::Trig(..)) && self.o.trig == Trig::Inline);
+                || (matches!(def, Def::Trig(..)) && self.o.trig == Trig::Inline)
+                || integer.is_some();
             if vec && self.formats && !own_reads {
                 self.convert_operands(s, v);
             }
@@ -513,7 +516,7 @@ impl<'a> Body<'a> {
             }
             let ty = self.type_of(v);
             let narrow = self.narrow(v);
-            if let Some(op) = self.integer_op(v) {
+            if let Some(op) = integer {
                 let _ = writeln!(s, "  const {ty} {name} = ({ty})({});", self.integer_expr(&op));
                 self.mark_unused(s, v);
                 after(s, v);
@@ -673,9 +676,6 @@ impl<'a> Body<'a> {
     /// format than the op computes in, written once per [`Body::statements_with`] call (see
     /// [`Body::converted`]) just before the first statement that reads it.
     fn convert_operands(&self, s: &mut String, v: Value) {
-        if self.integer_op(v).is_some() {
-            return; // it reads the integers as they are
-        }
         let narrow = self.narrow(v);
         self.f.value(v).def.for_each_value(|w| {
             let same = self.fix_unit(w).is_none() && self.narrow(w) == narrow;

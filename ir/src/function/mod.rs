@@ -153,6 +153,11 @@ impl Function {
         self.formats.0[i] = format;
     }
 
+    /// Every value back to binary64, the default (the function as it is without formats).
+    pub fn clear_formats(&mut self) {
+        self.formats = Formats::default();
+    }
+
     /// True when some value has a format other than binary64: passes that do not declare
     /// that they understand formats refuse the function (`Props::formats` in `robovec-passes`).
     pub fn has_formats(&self) -> bool {

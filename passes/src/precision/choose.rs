@@ -377,9 +377,7 @@ fn operands(def: &Def) -> Vec<Operand> {
 /// `f` with every value binary64.
 fn f_with_default(f: &Function) -> Function {
     let mut g = f.clone();
-    for &v in f.inputs.iter().chain(&f.body) {
-        g.set_format(v, Format::Binary64);
-    }
+    g.clear_formats();
     g
 }
 
