@@ -88,3 +88,18 @@ pub fn run_hex_lines(exe: &std::path::Path, input: &[u8]) -> Vec<u64> {
     assert!(out.status.success(), "{} failed", exe.display());
     String::from_utf8(out.stdout).unwrap().lines().map(|l| u64::from_str_radix(l, 16).unwrap()).collect()
 }
+
+/// The path of a robot of `example-robot-data` (`rel` under its `robots/` folder) in the
+/// Pinocchio environment `scripts/test.sh` creates (`target/pinocchio-venv`); `None` (a note)
+/// when the environment is missing outside CI, a panic in CI.
+pub fn robot_urdf(rel: &str) -> Option<PathBuf> {
+    crate::pinocchio::python()?;
+    let lib = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/pinocchio-venv/lib");
+    let found = std::fs::read_dir(&lib)
+        .ok()?
+        .flatten()
+        .map(|d| d.path().join("site-packages/cmeel.prefix/share/example-robot-data/robots").join(rel));
+    let path = found.into_iter().find(|p| p.exists());
+    assert!(path.is_some() || std::env::var_os("CI").is_none(), "{rel} is not in {}", lib.display());
+    path
+}

@@ -579,9 +579,10 @@ fn one_more_bit_is_the_bound_of_the_wider_formats() {
         if f.inputs.iter().any(|&v| x[v.index()].lo == x[v.index()].hi) {
             continue;
         }
-        let (Ok(more), Ok(wide)) =
-            (bound_with_more_bits(&fixed, &x, Formats::Mixed, 1, || false), bound(&wider, &x, Formats::Mixed, || false))
-        else {
+        let (Ok(more), Ok(wide)) = (
+            bound_with_more_bits(&fixed, &x, Formats::Mixed, 1, || false),
+            bound(&wider, &x, Formats::Mixed, || false),
+        ) else {
             continue;
         };
         for o in &f.outputs {
@@ -592,4 +593,203 @@ fn one_more_bit_is_the_bound_of_the_wider_formats() {
         }
     }
     assert!(compared >= 40, "only {compared} outputs compared");
+}
+
+/// `∂out/∂z` at a point for every value `z` (by value index), by reverse-mode differentiation
+/// in binary64 from the values `vals`, and the same sweep on magnitudes (`Σ` over paths of
+/// `|∂|` products: what the binary64 rounding of the first can be off by, times a few ulps).
+fn jacobian_row(f: &Function, vals: &[f64], out: robovec_ir::Value) -> (Vec<f64>, Vec<f64>) {
+    use robovec_ir::{BinOp, Def, Intrinsic, TrigFn};
+    let n = f.values.len();
+    let (mut adj, mut mag) = (vec![0.0; n], vec![0.0; n]);
+    adj[out.index()] = 1.0;
+    mag[out.index()] = 1.0;
+    let val = |o: &Operand| match o {
+        Operand::Value(v) => vals[v.index()],
+        Operand::Const(c) => *c,
+    };
+    for &z in f.body.iter().rev() {
+        let (a, m) = (adj[z.index()], mag[z.index()]);
+        if m == 0.0 {
+            continue;
+        }
+        let mut give = |o: &Operand, d: f64| {
+            if let Operand::Value(v) = o {
+                adj[v.index()] += a * d;
+                mag[v.index()] += m * d.abs();
+            }
+        };
+        match &f.value(z).def {
+            Def::Trig(t, p) => {
+                let q = vals[p.index()];
+                give(&Operand::Value(*p), if *t == TrigFn::Sin { q.cos() } else { -q.sin() });
+            }
+            Def::Binary(op, p, q) => match op {
+                BinOp::Add => {
+                    give(p, 1.0);
+                    give(q, 1.0);
+                }
+                BinOp::Sub => {
+                    give(p, 1.0);
+                    give(q, -1.0);
+                }
+                BinOp::Mul => {
+                    give(p, val(q));
+                    give(q, val(p));
+                }
+                BinOp::Div => {
+                    give(p, 1.0 / val(q));
+                    give(q, -val(p) / (val(q) * val(q)));
+                }
+            },
+            Def::Call(c, args) => match Intrinsic::of(c, args.len()) {
+                Some(Intrinsic::Sqrt) => give(&args[0], 0.5 / val(&args[0]).sqrt()),
+                Some(i) => {
+                    let s = if i == Intrinsic::Fnma { -1.0 } else { 1.0 };
+                    give(&args[0], s * val(&args[1]));
+                    give(&args[1], s * val(&args[0]));
+                    give(&args[2], if i == Intrinsic::Fms { -1.0 } else { 1.0 });
+                }
+                None => {}
+            },
+            _ => {}
+        }
+    }
+    (adj, mag)
+}
+
+/// The adjoints' enclosures hold: at `n` points of `dom` (corners, ends, uniform), every
+/// `|∂out/∂z|` is within `max|∂out/∂z|` of [`robovec_passes::error_bound::bound::adjoint_sups`]
+/// (up to binary64's own rounding of the point's derivative). Returns the number of
+/// (output, value, point) comparisons with a nonzero derivative.
+fn check_adjoints(what: &str, f: &Function, dom: &Domain, n: usize, seed: u64) -> usize {
+    use robovec_passes::error_bound::bound::adjoint_sups;
+    let x = match enclose_with(f, dom, Some(16), || false) {
+        Ok(x) => x,
+        Err(EncloseError::DivisorHoldsZero { .. } | EncloseError::SqrtOfNegative { .. }) => return 0,
+        Err(e) => panic!("{what}: {e:?}"),
+    };
+    let tape = Tape::new(f);
+    let mut rng = SplitMix64::new(seed);
+    let mut compared = 0;
+    let outs: Vec<robovec_ir::Value> = f
+        .outputs
+        .iter()
+        .filter_map(|o| match o.value {
+            Operand::Value(v) => Some(v),
+            Operand::Const(_) => None,
+        })
+        .collect();
+    let sups: Vec<Option<Vec<f64>>> = outs.iter().map(|&o| adjoint_sups(f, &x, o)).collect();
+    for k in 0..n {
+        let xs = point(&tape, dom, k, &mut rng);
+        let at: BTreeMap<&str, f64> = tape.inputs.iter().map(String::as_str).zip(xs.iter().copied()).collect();
+        let vals = robovec_ir::interp::eval_values::<f64>(f, |name| at[name]);
+        if vals.iter().any(|v| !v.is_finite()) {
+            continue;
+        }
+        for (&o, sup) in outs.iter().zip(&sups) {
+            let Some(sup) = sup else { continue };
+            let (j, m) = jacobian_row(f, &vals, o);
+            for (i, (&jz, &mz)) in j.iter().zip(&m).enumerate() {
+                let v = robovec_ir::Value::with_number(i as u32);
+                assert!(
+                    jz.abs() <= sup[i] + 1e-10 * mz + 1e-300,
+                    "{what}: |∂{}/∂{}| = {:e} at point {k} exceeds its enclosure's {:e}",
+                    f.name_of(o),
+                    f.name_of(v),
+                    jz.abs(),
+                    sup[i]
+                );
+                compared += usize::from(jz != 0.0);
+            }
+        }
+    }
+    compared
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(64),
+        ..ProptestConfig::default()
+    })]
+
+    /// The adjoints `error-bound` weighs roundings with enclose the true derivatives: random
+    /// functions with every op, half their inputs over more than a whole turn (where `sin` and
+    /// `cos` ride on harmonics), and the Robotran-like DAGs over whole turns.
+    #[test]
+    fn adjoint_enclosures_hold(seed in any::<u64>(), ops in 1usize..50, dag_ops in 50usize..400) {
+        let (f, mut dom) = random_function(seed, ops);
+        let mut rng = SplitMix64::new(seed ^ 0x51);
+        for r in dom.ranges.values_mut() {
+            if rng.chance(500) {
+                let a = rng.unit() * 4.0 - 2.0;
+                r.interval = robovec_ir::Interval::new(a, a + 7.0);
+            }
+        }
+        check_adjoints(&format!("seed {seed}"), &f, &dom, 16, seed);
+        let g = robovec_testkit::dag_gen::generate(dag_ops, seed);
+        let mut dom = crate::range::random_domain(&g, seed);
+        for (name, r) in dom.ranges.iter_mut() {
+            if name.starts_with('q') {
+                r.interval = robovec_ir::Interval::new(-3.5, 3.5);
+            }
+        }
+        check_adjoints(&format!("dag {seed}"), &g, &dom, 8, seed);
+    }
+}
+
+/// The adjoints of the UR5's RNEA (`robovec-gen`'s `invdyna`, every joint over its URDF limits,
+/// a whole turn or two) enclose its derivatives at 200 points, and the adjoint bound is what
+/// certifies its 32-bit fixed point (issue 48's "Beyond RoboPrec" goal, 10⁻⁴ N·m): the forward
+/// bound alone is above it.
+#[test]
+fn adjoints_of_the_ur5_rnea_and_its_fixed_point_bound() {
+    let dir = crate::common::tmp("adjoint-ur5");
+    let Some(urdf) = crate::common::robot_urdf("ur_description/urdf/ur5_robot.urdf") else { return };
+    let (ir, report) = (dir.join("ur5.rvir"), dir.join("r.json"));
+    let budget = dir.join("b.json");
+    std::fs::write(&budget, r#"{"Qq[*]": {"abs": 1e-4}}"#).unwrap();
+    let o = opt(&[
+        urdf.to_str().unwrap(),
+        "-function=invdyna",
+        "--fold-params",
+        &format!("-passes=default<ops>,precision<budget={};target=mcu>,error-bound", budget.display()),
+        &format!("-report={}", report.display()),
+        "-o",
+        ir.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let m = robovec_ir::text::parse(&std::fs::read_to_string(&ir).unwrap()).unwrap();
+    let g = &m.functions[0];
+    assert!(
+        g.inputs.iter().chain(&g.body).all(|&v| matches!(g.format(v), Format::Fix { width: 32, .. })),
+        "every value in 32-bit fixed point: {}",
+        r["precision"]
+    );
+    let max_abs = r["error_bound"]["max_abs"].as_f64().unwrap();
+    assert!(max_abs <= 1e-4, "certified {max_abs:e} N·m");
+    // The domain the report used, for the adjoints' check and the forward bound alone.
+    let mut dom = Domain::default();
+    for (name, d) in r["domain"].as_object().unwrap() {
+        dom.ranges.insert(name.clone(), range(d["range"][0].as_f64().unwrap(), d["range"][1].as_f64().unwrap()));
+    }
+    let mut plain = g.clone();
+    plain.clear_formats();
+    assert!(check_adjoints("UR5", &plain, &dom, 200, 5) > 10_000);
+    let x = enclose_with(g, &dom, Some(64), || false).unwrap();
+    let adjoint = bound(g, &x, Formats::Mixed, || false).unwrap();
+    let forward = robovec_passes::error_bound::bound::forward_bound(g, &x, Formats::Mixed).unwrap();
+    let worst = |e: &[f64]| {
+        g.outputs
+            .iter()
+            .map(|o| match o.value {
+                Operand::Value(v) => e[v.index()],
+                _ => 0.0,
+            })
+            .fold(0.0, f64::max)
+    };
+    assert!((worst(&adjoint) - max_abs).abs() <= 1e-12 * max_abs);
+    assert!(worst(&forward) > 1e-4, "the forward bound alone, {:e}, already meets the goal", worst(&forward));
 }

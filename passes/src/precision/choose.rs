@@ -12,7 +12,7 @@ use robovec_machine::target::Target as Device;
 
 use super::budget::Budget;
 use super::fpga;
-use crate::error_bound::bound::{bound, sensitivities, BoundError, Formats, Rounding};
+use crate::error_bound::bound::{bound_with_adjoints, sensitivities, BoundError, Formats, OutputAdjoints, Rounding};
 
 crate::params::word_enum! {
     /// What the formats are chosen for (`target=`).
@@ -115,6 +115,8 @@ struct Candidate {
     value: Value,
     format: Format,
     damage: f64,
+    /// A fixed-point format given one more integer bit after the bound found it may overflow.
+    widened: bool,
 }
 
 /// Chooses formats for `f` (atomised; its own formats are ignored) whose certified bound keeps
@@ -160,7 +162,11 @@ pub fn choose_on(
     assert_eq!(budgets.len(), f.outputs.len(), "one budget per output");
     let mut g = f_with_default(f);
     let values: Vec<Value> = f.inputs.iter().chain(&f.body).copied().collect();
-    let e64 = bound(&g, x, Formats::Mixed, || false).map_err(|e| e.message(&f.name))?;
+    // The outputs' adjoints depend on the ops and the enclosures only: once for every sweep.
+    let adjoints = OutputAdjoints::new(f, x);
+    let adjoints = adjoints.as_ref();
+    let bound = |h: &Function, x: &[Interval], mode| bound_with_adjoints(h, x, mode, 0, adjoints, || false);
+    let e64 = bound(&g, x, Formats::Mixed).map_err(|e| e.message(&f.name))?;
     // Outputs with a budget: those whose range is not 0. One whose binary64 bound already
     // exceeds it keeps that bound as its budget (it stays as binary64 computes it); one with
     // no finite bound is left out (nothing about it can be proved).
@@ -212,7 +218,7 @@ pub fn choose_on(
     // value that may overflow, if that is why.
     let check = |h: &Function, sweeps: &mut usize| -> Result<Vec<f64>, Option<String>> {
         *sweeps += 1;
-        let e = bound(h, x, Formats::Mixed, || false).map_err(|err| match err {
+        let e = bound(h, x, Formats::Mixed).map_err(|err| match err {
             BoundError::FixOverflow { value, .. } => Some(value),
             BoundError::Stopped(_) => None,
         })?;
@@ -233,6 +239,7 @@ pub fn choose_on(
     let search = |stop| {
         let mut s = fpga::Search::new(x, budgeted.clone(), reached.clone(), stop);
         s.keep = poisoned.clone();
+        s.adjoints = adjoints;
         s
     };
     if target == Target::Fpga {
@@ -256,7 +263,7 @@ pub fn choose_on(
                 let format = phase(m, err)?;
                 let r = Rounding::store(format);
                 let added = r.rel * (m + err) + r.abs;
-                Some(Candidate { value: v, format, damage: lam[v.index()] * added })
+                Some(Candidate { value: v, format, damage: lam[v.index()] * added, widened: false })
             })
             .collect();
         candidates.sort_by(|a, b| a.damage.total_cmp(&b.damage));
@@ -297,7 +304,19 @@ pub fn choose_on(
             if j < lo {
                 break;
             }
-            candidates.remove(j);
+            // A fixed-point candidate gets one more integer bit; one that has it already (or
+            // another format) leaves the ranking.
+            match candidates[j].format {
+                Format::Fix { width, fraction }
+                    if fraction > *FIX_FRACTION_RANGE.start() && !candidates[j].widened =>
+                {
+                    candidates[j].format = Format::fix(width, fraction - 1).expect("a narrower fraction is a format");
+                    candidates[j].widened = true;
+                }
+                _ => {
+                    candidates.remove(j);
+                }
+            }
         }
         // Cost is not monotone in the prefix (conversions between formats cost too): the
         // cheapest of 17 accepted prefixes, 0 and `lo` included, if the bound accepts it.
@@ -319,6 +338,7 @@ pub fn choose_on(
     }
     if target == Target::Fpga {
         let mut s = fpga::Search::new(x, budgeted.clone(), reached.clone(), || false);
+        s.adjoints = adjoints;
         g = fpga::tighten(f, &g, &mut s);
         sweeps += s.sweeps;
     }
@@ -337,7 +357,7 @@ pub fn choose_on(
         Some(&Budget::Rel(r)) if budgets.iter().all(|b| *b == Budget::Rel(r)) => Some(r),
         _ => None,
     };
-    let more = crate::error_bound::bound::bound_with_more_bits(&g, x, Formats::Mixed, 1, || false).ok();
+    let more = bound_with_adjoints(&g, x, Formats::Mixed, 1, adjoints, || false).ok();
     let one_more_bit = outs.iter().map(|(_, v, _)| more.as_ref().map_or(f64::INFINITY, |m| m[v.index()])).collect();
     Ok(Choice {
         one_more_bit,
@@ -386,13 +406,15 @@ fn binary32(m: f64, err: f64) -> Option<Format> {
     (m + err < f32::MAX as f64 / 2.0).then_some(Format::Binary32)
 }
 
-/// `fix<32,f>` for a value of magnitude `m` and error `err`: integer bits for twice its
-/// magnitude (one bit of headroom for the error the formats add) and at least 2⁻¹⁶, the sign
-/// included.
+/// `fix<32,f>` for a value of magnitude `m` and error `err`: the fewest integer bits (the sign
+/// included) that hold `(m + err)·(1 + 2⁻¹⁰)` and at least 2⁻¹⁶ — the margin for the error the
+/// formats add; a value the bound still finds may overflow gets one more integer bit
+/// ([`choose_on`]'s repair).
 fn fix32(m: f64, err: f64) -> Option<Format> {
     // At least 2⁻¹⁶ of range: a value near 0 still holds the error its operands' roundings add.
-    let top = (2.0 * (m + err)).max(2f64.powi(-16));
-    let int_bits = if top < f64::MIN_POSITIVE { -60 } else { top.log2().ceil() as i32 + 1 };
+    let top = ((m + err) * (1.0 + 2f64.powi(-10))).max(2f64.powi(-16));
+    // |x| ≤ top < 2^(int_bits − 1): int_bits = ⌊log₂ top⌋ + 2.
+    let int_bits = if top < f64::MIN_POSITIVE { -60 } else { top.log2().floor() as i32 + 2 };
     let fraction = 32 - int_bits;
     FIX_FRACTION_RANGE.contains(&fraction).then(|| Format::fix(32, fraction)).flatten()
 }
@@ -429,7 +451,10 @@ fn cost(f: &Function, g: &Function, target: Target, device: &Device) -> f64 {
                 // A binary64 op on the operands' values, then the store: each operand not in
                 // binary64 converted, and the result.
                 None => {
-                    let wide = operands.iter().filter(|o| matches!(o, Operand::Value(a) if !g.format(*a).is_default())).count();
+                    let wide = operands
+                        .iter()
+                        .filter(|o| matches!(o, Operand::Value(a) if !g.format(*a).is_default()))
+                        .count();
                     100.0 + MCU_CONVERSION * (wide as f64 + 1.0)
                 }
             },

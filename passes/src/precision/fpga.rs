@@ -61,7 +61,7 @@ use robovec_ir::format::{Format, FIX_FRACTION_RANGE, FIX_MAX_WIDTH};
 use robovec_ir::{BinOp, Def, Function, Interval, Intrinsic, Operand, Value};
 use robovec_machine::target::Target as Device;
 
-use crate::error_bound::bound::{bound, sensitivities, BoundError, Formats};
+use crate::error_bound::bound::{bound_with_adjoints, sensitivities, BoundError, Formats, OutputAdjoints};
 
 /// Rounds of bit removal (step 3 of the module doc).
 pub const ROUNDS: usize = 4;
@@ -279,6 +279,8 @@ pub struct Search<'a, S: FnMut() -> bool> {
     pub stopped: bool,
     /// Values that stay binary64 (by index; empty: none).
     pub keep: Vec<bool>,
+    /// The outputs' adjoints, shared by every probe ([`OutputAdjoints`]).
+    pub adjoints: Option<&'a OutputAdjoints>,
 }
 
 /// Why a probe failed.
@@ -295,7 +297,7 @@ impl<'a, S: FnMut() -> bool> Search<'a, S> {
     /// A search over enclosures `x` for the outputs `outs` (value, absolute budget), those in
     /// `unreachable` at their binary64 bound, reading `stop` before each sweep.
     pub fn new(x: &'a [Interval], outs: Vec<(Value, f64)>, unreachable: Vec<Value>, stop: S) -> Self {
-        Search { x, outs, unreachable, sweeps: 0, stop, stopped: false, keep: Vec::new() }
+        Search { x, outs, unreachable, sweeps: 0, stop, stopped: false, keep: Vec::new(), adjoints: None }
     }
 
     /// The bounds when `h`'s formats meet every budget.
@@ -336,10 +338,11 @@ impl<'a, S: FnMut() -> bool> Search<'a, S> {
             return Err(Refused::Stopped);
         }
         self.sweeps += 1;
-        let e = bound(h, self.x, Formats::Mixed, || false).map_err(|err| match err {
-            BoundError::FixOverflow { value, .. } => Refused::Overflow(value),
-            BoundError::Stopped(_) => Refused::Stopped,
-        })?;
+        let e =
+            bound_with_adjoints(h, self.x, Formats::Mixed, 0, self.adjoints, || false).map_err(|err| match err {
+                BoundError::FixOverflow { value, .. } => Refused::Overflow(value),
+                BoundError::Stopped(_) => Refused::Stopped,
+            })?;
         if self.outs.iter().all(|&(v, b)| e[v.index()] <= b) {
             Ok(e)
         } else {
@@ -620,7 +623,7 @@ pub fn tighten<S: FnMut() -> bool>(f: &Function, g: &Function, s: &mut Search<'_
         return g.clone();
     }
     s.sweeps += 1;
-    let Ok(e) = bound(g, s.x, Formats::Mixed, || false) else { return g.clone() };
+    let Ok(e) = bound_with_adjoints(g, s.x, Formats::Mixed, 0, s.adjoints, || false) else { return g.clone() };
     let mut h = g.clone();
     for &v in &values {
         if let Format::Fix { fraction, .. } = g.format(v) {
@@ -632,7 +635,7 @@ pub fn tighten<S: FnMut() -> bool>(f: &Function, g: &Function, s: &mut Search<'_
         }
     }
     s.sweeps += 1;
-    match bound(&h, s.x, Formats::Mixed, || false) {
+    match bound_with_adjoints(&h, s.x, Formats::Mixed, 0, s.adjoints, || false) {
         Ok(eh) if s.outs.iter().all(|&(v, b)| eh[v.index()] <= b) => h,
         _ => g.clone(),
     }

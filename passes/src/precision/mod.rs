@@ -19,9 +19,10 @@
 //! finds the longest prefix of that ranking whose formats the certified bound accepts (each
 //! step one O(ops) sweep, about log₂(values) of them). Targets:
 //! - `c`: binary32 where the bound allows (twice the lanes of a vector of binary64);
-//! - `mcu`: 32-bit fixed point first (`fix<32,f>`, `f` from the value's range with one bit of
-//!   headroom: integer arithmetic on a microcontroller without a floating-point unit), then
-//!   binary32 among the rest;
+//! - `mcu`: 32-bit fixed point first (`fix<32,f>`, the fewest integer bits that hold the
+//!   value's range and binary64 error widened by 2⁻¹⁰; a value the bound finds may overflow
+//!   gets one more: integer arithmetic on a microcontroller without a floating-point unit),
+//!   then binary32 among the rest;
 //! - `fpga`: fixed point in words as narrow as the budget allows (`fix<w,f>`, `w ≤ 53`, each
 //!   value its own), then binary32 among the rest: fraction bits from the sensitivities and a
 //!   cost per bit, one global shift and batches of bits removed, each step checked by the

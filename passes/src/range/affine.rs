@@ -396,28 +396,9 @@ fn mul(x: &Form, y: &Form, rx: f64, ry: f64, same: bool, slack: &mut Slack) -> (
 }
 
 /// `1/y` over `y`'s enclosure `iy` (not holding 0): the min-range linear approximation
-/// `α·y + ζ ± δ` with `α = −1/b²` at the end `b` of largest magnitude (1/t − αt is monotone on
-/// the enclosure), all computed with intervals.
+/// `α·y + ζ ± δ` ([`reciprocal_line`]).
 fn reciprocal(y: &Form, iy: Interval, own: u32, slack: &mut Slack) -> Form {
-    let neg = iy.hi < 0.0;
-    let (a, b) = if neg { (-iy.hi, -iy.lo) } else { (iy.lo, iy.hi) };
-    // On [a, b] (0 < a ≤ b): g(t) = 1/t + t/b² decreases, so g ∈ [g(b), g(a)] = [2/b, 1/a + a/b²].
-    let one = Interval::point(1.0);
-    let (ia, ib) = (Interval::point(a), Interval::point(b));
-    let Some(b2) = one.checked_div(ib * ib) else { return own_unknown(iy, own, slack) };
-    // |α| ≤ 1/b² keeps g monotone: g'(t) = −1/t² − α ≤ −1/t² + 1/b² ≤ 0.
-    let alpha = -b2.lo;
-    let g = |t: Interval| one.checked_div(t).map(|r| r - Interval::point(alpha) * t);
-    let (Some(ga), Some(gb)) = (g(ia), g(ib)) else { return own_unknown(iy, own, slack) };
-    let lo = ga.lo.min(gb.lo);
-    let hi = ga.hi.max(gb.hi);
-    let zeta = lo / 2.0 + hi / 2.0;
-    let delta = (Interval::point(hi) - Interval::point(zeta)).hi.max((Interval::point(zeta) - Interval::point(lo)).hi);
-    if !(alpha.is_finite() && zeta.is_finite() && delta.is_finite()) {
-        return own_unknown(iy, own, slack);
-    }
-    // For y < 0: 1/y = −1/(−y) = −(α·(−y) + ζ) = α·y − ζ.
-    let zeta = if neg { -zeta } else { zeta };
+    let Some((alpha, zeta, delta)) = reciprocal_line(iy) else { return own_unknown(iy, own, slack) };
     // The approximation's error δ and the combination's roundings on the own symbol, kept in
     // the form: the quotient multiplies them by the dividend.
     let mut own_slack = Slack::new();
@@ -425,6 +406,32 @@ fn reciprocal(y: &Form, iy: Interval, own: u32, slack: &mut Slack) -> Form {
     let (c, mut terms) = combine(y, alpha, &Form::point(0.0), 0.0, zeta, &mut own_slack);
     put_own(&mut terms, own, own_slack.total());
     Form { centre: c, terms }
+}
+
+/// The min-range linear approximation of `1/t` over `iy` (not holding 0): `(α, ζ, δ)` with
+/// `|1/t − (α·t + ζ)| ≤ δ` for every `t` of `iy`, `α = −1/b²` at the end `b` of largest magnitude
+/// (`1/t − αt` is monotone on the enclosure), all computed with intervals; `None` when a
+/// coefficient is not finite.
+pub(super) fn reciprocal_line(iy: Interval) -> Option<(f64, f64, f64)> {
+    let neg = iy.hi < 0.0;
+    let (a, b) = if neg { (-iy.hi, -iy.lo) } else { (iy.lo, iy.hi) };
+    // On [a, b] (0 < a ≤ b): g(t) = 1/t + t/b² decreases, so g ∈ [g(b), g(a)] = [2/b, 1/a + a/b²].
+    let one = Interval::point(1.0);
+    let (ia, ib) = (Interval::point(a), Interval::point(b));
+    let b2 = one.checked_div(ib * ib)?;
+    // |α| ≤ 1/b² keeps g monotone: g'(t) = −1/t² − α ≤ −1/t² + 1/b² ≤ 0.
+    let alpha = -b2.lo;
+    let g = |t: Interval| one.checked_div(t).map(|r| r - Interval::point(alpha) * t);
+    let (ga, gb) = (g(ia)?, g(ib)?);
+    let lo = ga.lo.min(gb.lo);
+    let hi = ga.hi.max(gb.hi);
+    let zeta = lo / 2.0 + hi / 2.0;
+    let delta = (Interval::point(hi) - Interval::point(zeta)).hi.max((Interval::point(zeta) - Interval::point(lo)).hi);
+    if !(alpha.is_finite() && zeta.is_finite() && delta.is_finite()) {
+        return None;
+    }
+    // For y < 0: 1/y = −1/(−y) = −(α·(−y) + ζ) = α·y − ζ.
+    Some((alpha, if neg { -zeta } else { zeta }, delta))
 }
 
 /// Adds `e ≥ 0` to the coefficient of symbol `own` in `terms` (sorted), as a magnitude: a
@@ -446,23 +453,31 @@ fn own_unknown(iy: Interval, own: u32, slack: &mut Slack) -> Form {
     own_interval(r, own)
 }
 
-/// `√x` over `x`'s enclosure `ix` (nonnegative): the min-range approximation with the slope
-/// at the upper end, `α = 1/(2√b)`; `g(t) = √t − αt` increases on `[a, b]`.
+/// `√x` over `x`'s enclosure `ix` (nonnegative): the min-range approximation
+/// [`sqrt_line`], or the interval of `√x` when it fails.
 fn sqrt(x: &Form, ix: Interval, slack: &mut Slack) -> (f64, Vec<(u32, f64)>) {
-    let (a, b) = (ix.lo, ix.hi);
-    let sb = Interval::point(b).sqrt().unwrap_or(Interval::ENTIRE);
-    let fallback = |slack: &mut Slack| {
+    let Some((alpha, zeta, delta)) = sqrt_line(ix) else {
         // The interval of √x: its centre, its radius on the own symbol (through the slack).
         let r = ix.sqrt().unwrap_or(Interval::ENTIRE);
         let f = own_interval(r, 0);
         slack.add(f.radius());
-        (f.centre, Vec::new())
+        return (f.centre, Vec::new());
     };
+    slack.add(delta);
+    combine(x, alpha, &Form::point(0.0), 0.0, zeta, slack)
+}
+
+/// The min-range linear approximation of `√t` over `ix` (nonnegative): `(α, ζ, δ)` with
+/// `|√t − (α·t + ζ)| ≤ δ` on `ix`, the slope at the upper end, `α = 1/(2√b)`
+/// (`g(t) = √t − αt` increases on `[a, b]`); `None` when `b ≤ 0` or a coefficient is not finite.
+pub(super) fn sqrt_line(ix: Interval) -> Option<(f64, f64, f64)> {
+    let (a, b) = (ix.lo, ix.hi);
+    let sb = Interval::point(b).sqrt().unwrap_or(Interval::ENTIRE);
     if b <= 0.0 || !sb.is_bounded() || sb.lo <= 0.0 {
-        return fallback(slack);
+        return None;
     }
     // α ≤ 1/(2√b) keeps g increasing: g'(t) = 1/(2√t) − α ≥ 0.
-    let Some(alpha) = Interval::point(0.5).checked_div(sb).map(|q| q.lo) else { return fallback(slack) };
+    let alpha = Interval::point(0.5).checked_div(sb).map(|q| q.lo)?;
     let g = |t: f64| {
         let s = Interval::point(t).sqrt().unwrap_or(Interval::ENTIRE);
         s - Interval::point(alpha) * Interval::point(t)
@@ -471,9 +486,5 @@ fn sqrt(x: &Form, ix: Interval, slack: &mut Slack) -> (f64, Vec<(u32, f64)>) {
     let (lo, hi) = (ga.lo.min(gb.lo), ga.hi.max(gb.hi));
     let zeta = lo / 2.0 + hi / 2.0;
     let delta = (Interval::point(hi) - Interval::point(zeta)).hi.max((Interval::point(zeta) - Interval::point(lo)).hi);
-    if !(alpha.is_finite() && delta.is_finite()) {
-        return fallback(slack);
-    }
-    slack.add(delta);
-    combine(x, alpha, &Form::point(0.0), 0.0, zeta, slack)
+    (alpha.is_finite() && delta.is_finite()).then_some((alpha, zeta, delta))
 }

@@ -118,6 +118,8 @@ pub fn enclose_with(
         x[v.index()] = domain.get(f.name_of(v)).expect("no input is missing").interval;
     }
     let mut sweep = affine.map(|cap| super::affine::AffineSweep::new(f, domain, cap));
+    let mut harmonic =
+        affine.and_then(|_| super::harmonic::HarmonicSweep::new(f, domain, super::harmonic::DEFAULT_ATOMS));
     for (k, &v) in f.body.iter().enumerate() {
         if tick() {
             return Err(EncloseError::Stopped(k));
@@ -125,6 +127,9 @@ pub fn enclose_with(
         x[v.index()] = enclose_value(f, v, &x)?;
         if let Some(s) = &mut sweep {
             x[v.index()] = s.step(v, &x)?;
+        }
+        if let Some(h) = &mut harmonic {
+            x[v.index()] = h.step(v, &x);
         }
     }
     Ok(x)

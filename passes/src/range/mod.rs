@@ -1,6 +1,8 @@
 //! `range<ranges=FILE;samples=64>`: a certified enclosure of every value of each function over
 //! the input domain (issue 48 item 2), by outward-rounded interval arithmetic
-//! ([`robovec_ir::interval`], [`enclose()`]).
+//! ([`robovec_ir::interval`], [`enclose()`]) intersected, with `method=affine` (the default),
+//! with affine forms ([`affine`]) and with affine forms on the harmonics of the joint angles
+//! ([`harmonic`], which keep `sin² + cos² = 1` through rotations).
 //!
 //! Phase: atomised → atomised; an analysis: the IR is unchanged (bit-exact, timing kept). The
 //! domain is the run's ([`PassContext::domain`]: the input's defaults and `-ranges=FILE`),
@@ -27,6 +29,7 @@
 
 pub mod affine;
 pub mod enclose;
+pub mod harmonic;
 
 use std::collections::HashMap;
 
