@@ -404,12 +404,14 @@ pub fn adjoint_sups(f: &Function, x: &[Interval], out: Value) -> Option<Vec<f64>
 }
 
 /// The most `outputs × ops` for which [`bound`] also bounds each output by its adjoints
-/// ([`HarmonicSweep::adjoints`]: one reverse sweep of O(ops · cap²) per output, about 10 µs
-/// per op on this machine); beyond it the forward bound alone. Measured (`error-bound<format=f32>`,
-/// release): UR5 RNEA (6 × 399) 25 ms and a bound 11× tighter than the forward one, Panda
-/// (9 × 944) 0.2 s and 2.3×, Talos (32 × 3,969) 1.4 s for 1.17× — beyond the cap, as a
-/// humanoid's `dirdyna` (1,306 × 33k) is.
-pub const ADJOINT_WORK: usize = 50_000;
+/// ([`HarmonicSweep::adjoints`]: one reverse sweep of O(ops · cap²) per output, 2–10 µs per op
+/// on this machine); beyond it the forward bound alone. Measured (`error-bound<format=f32>`,
+/// release), forward → with adjoints: UR5 RNEA (6 × 399) 4.2·10⁻² → 8.0·10⁻³ N·m in 25 ms;
+/// Panda (9 × 944) 2.3× tighter in 0.2 s; beyond the cap, Talos (32 × 3,969) 1.17× in 1.4 s
+/// against 0.02 s, the Segway's `dirdyna` over whole turns (192 × 3,633) 1.9× at the median
+/// output, up to 5.6×, in 1.5 s against 0.08 s; a humanoid's `dirdyna` (1,306 × 33k) would
+/// take minutes.
+pub const ADJOINT_WORK: usize = 100_000;
 
 /// The operands of a definition, in order.
 fn operands(def: &Def) -> Vec<Operand> {

@@ -125,10 +125,14 @@ struct Harmonics {
     pairs: FxHashMap<(u32, u32), [(u32, f64); 2]>,
     /// Each angle's domain range, by angle number.
     angle_ranges: Vec<Interval>,
+    /// The sweep's cap on a form's atoms.
+    cap: usize,
+    /// [`Harmonics::mul`]'s buffer.
+    scratch: Vec<Atom>,
 }
 
 impl Harmonics {
-    fn new(angle_ranges: Vec<Interval>) -> Harmonics {
+    fn new(angle_ranges: Vec<Interval>, cap: usize) -> Harmonics {
         let mut h = Harmonics {
             combos: Vec::new(),
             ranges: Vec::new(),
@@ -137,6 +141,8 @@ impl Harmonics {
             ids: FxHashMap::default(),
             pairs: FxHashMap::default(),
             angle_ranges,
+            cap,
+            scratch: Vec::new(),
         };
         h.intern(Vec::new());
         h
@@ -223,7 +229,10 @@ impl Harmonics {
     /// symbol atom of `x` times `y`'s centre part, and the product of the symbol parts bounded by
     /// `rx·ry` on the own symbol (for a square, in `[0, rx²]`).
     fn mul(&mut self, x: &HForm, y: &HForm, same: bool, slack: &mut FastUp) -> Vec<Atom> {
-        let mut out = Vec::new();
+        // The products go to a buffer kept between calls (thousands of atoms at a time: a fresh
+        // vector each time cost a third of the sweep in the kernel's page clearing).
+        let mut out = std::mem::take(&mut self.scratch);
+        out.clear();
         let mut mag = FastUp::zero();
         for p in x.atoms.iter().filter(|a| a.sym == CENTRE) {
             for q in &y.atoms {
@@ -241,7 +250,19 @@ impl Harmonics {
         }
         // Each product rounded once (the halvings are exact).
         slack.add(U * mag.total() + TINY * out.len() as f64);
-        let mut out = normalise(out, slack);
+        // Many more products than a form keeps: all but the largest 4·cap go to the slack
+        // before the sort (each bounded by its |c|: |trig · ε| ≤ 1).
+        let keep = 4 * self.cap;
+        if out.len() > 2 * keep {
+            out.select_nth_unstable_by(keep, |p, q| q.c.abs().total_cmp(&p.c.abs()));
+            for a in out.drain(keep..) {
+                slack.add(a.c);
+            }
+        }
+        merge_in_place(&mut out, slack);
+        let mut result = out.clone();
+        self.scratch = out;
+        let mut out = std::mem::take(&mut result);
         let (rx, ry) = (self.symbol_radius(x), self.symbol_radius(y));
         let nonlinear = Interval::point(rx) * Interval::point(ry);
         if same {
@@ -383,29 +404,35 @@ fn product_atoms(hs: &mut Harmonics, p: Atom, q: Atom, c: f64, sym: u32, out: &m
 
 /// Sorts `atoms` and merges equal keys, the sums' roundings on `slack`.
 fn normalise(mut atoms: Vec<Atom>, slack: &mut FastUp) -> Vec<Atom> {
+    merge_in_place(&mut atoms, slack);
+    atoms
+}
+
+/// [`normalise`] in place: sorts `atoms`, merges equal keys (the sums' roundings on `slack`) and
+/// drops zeros.
+fn merge_in_place(atoms: &mut Vec<Atom>, slack: &mut FastUp) {
     atoms.sort_unstable_by_key(Atom::key);
-    let mut out: Vec<Atom> = Vec::with_capacity(atoms.len());
+    let mut w = 0usize;
     let mut mag = 0.0;
-    for a in atoms {
-        match out.last_mut() {
-            Some(last) if last.key() == a.key() => {
-                mag += a.c.abs();
-                last.c += a.c;
+    for r in 0..atoms.len() {
+        let a = atoms[r];
+        if w > 0 && atoms[w - 1].key() == a.key() {
+            mag += a.c.abs();
+            atoms[w - 1].c += a.c;
+        } else {
+            if mag > 0.0 {
+                slack.add(U * mag + TINY);
             }
-            _ => {
-                if mag > 0.0 {
-                    slack.add(U * mag + TINY);
-                }
-                mag = a.c.abs();
-                out.push(a);
-            }
+            mag = a.c.abs();
+            atoms[w] = a;
+            w += 1;
         }
     }
     if mag > 0.0 {
         slack.add(U * mag + TINY);
     }
-    out.retain(|a| a.c != 0.0);
-    out
+    atoms.truncate(w);
+    atoms.retain(|a| a.c != 0.0);
 }
 
 /// The forms of a function's values, swept in body order (beside [`super::affine::AffineSweep`]).
@@ -472,7 +499,7 @@ impl<'f> HarmonicSweep<'f> {
             }
             forms[v.index()] = Some(interval_form(i, v.index() as u32));
         }
-        Some(HarmonicSweep { f, cap: cap.max(4), forms, uses, angle, hs: Harmonics::new(angle_ranges) })
+        Some(HarmonicSweep { f, cap: cap.max(4), forms, uses, angle, hs: Harmonics::new(angle_ranges, cap.max(4)) })
     }
 
     fn form(&self, o: &Operand) -> Option<HForm> {

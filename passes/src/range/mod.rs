@@ -46,7 +46,8 @@ crate::params::word_enum! {
     pub enum Method {
         /// Outward-rounded interval arithmetic alone.
         Interval = "interval",
-        /// Intervals intersected with affine forms of at most `terms` noise symbols.
+        /// Intervals intersected with affine forms of at most `terms` noise symbols and with
+        /// harmonic forms ([`harmonic`]).
         Affine = "affine",
     }
 }
@@ -63,7 +64,8 @@ pub const METHOD: ParamInfo = ParamInfo {
     name: "method",
     kind: ParamKind::Choice { choices: Method::WORDS, default: "affine" },
     doc: "interval: outward-rounded interval arithmetic; affine: intervals intersected with affine forms \
-          (correlation-aware, O(ops · terms))",
+          (correlation-aware, O(ops · terms)) and with affine forms on the harmonics of the joint angles \
+          (rotations exact, O(ops · 48²))",
 };
 
 /// `terms=K` (also `error-bound`'s).
