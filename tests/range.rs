@@ -207,6 +207,47 @@ fn affine_forms_keep_correlations_that_intervals_lose() {
     assert!(af.lo >= -1e-12 && af.lo <= 0.0 && af.hi >= 2.0 && af.hi <= 2.0 + 1e-12, "{af}");
 }
 
+/// Harmonic forms keep `sin² + cos² = 1` through rotations: a planar chain of `k` joints over
+/// whole turns rotating the vector (1, 0), `(x', y') = (c·x − s·y, s·x + c·y)` at each joint,
+/// keeps its length 1, so each component's exact range is [−1, 1]; and `c·c + s·s` of one angle
+/// is exactly 1. Affine forms alone give `|x| + |y|` per joint (the width doubles every two
+/// joints: 2^(k/2) by hand), intervals the same.
+#[test]
+fn harmonic_forms_keep_rotations_exact() {
+    let k = 8;
+    let mut text = String::from("func @chain {\n  phase atomised\n");
+    for j in 1..=k {
+        text += &format!("  input %q{j}\n");
+    }
+    text += "  %x0 = add 1.0, 0.0\n  %y0 = sub 0.0, 0.0\n";
+    for j in 1..=k {
+        let (p, n) = (j - 1, j);
+        text += &format!(
+            "  %c{j} = cos %q{j}\n  %s{j} = sin %q{j}\n  %a{j} = mul %c{j}, %x{p}\n  %b{j} = mul %s{j}, %y{p}\n  \
+             %x{n} = sub %a{j}, %b{j}\n  %d{j} = mul %s{j}, %x{p}\n  %e{j} = mul %c{j}, %y{p}\n  %y{n} = add %d{j}, %e{j}\n"
+        );
+    }
+    text += "  %cc = mul %c1, %c1\n  %ss = mul %s1, %s1\n  %one = add %cc, %ss\n";
+    text += &format!("  output x = %x{k}\n  output y = %y{k}\n  output one = %one\n}}\n");
+    let f = robovec_ir::text::parse(&text).unwrap().functions.remove(0);
+    let mut dom = Domain::default();
+    for j in 1..=k {
+        dom.ranges.insert(format!("q{j}"), range(-3.5, 3.5));
+    }
+    let x = enclose_with(&f, &dom, Some(64), || false).unwrap();
+    let iv = enclose_with(&f, &dom, None, || false).unwrap();
+    for name in [format!("x{k}"), format!("y{k}")] {
+        let e = x[f.lookup(&name).unwrap().index()];
+        assert!(e.lo >= -1.0 - 1e-9 && e.hi <= 1.0 + 1e-9 && e.lo <= -1.0 + 0.05 && e.hi >= 1.0 - 0.05, "{name}: {e}");
+        // Intervals: the width doubles every two joints (both components reach 2^(k/2) = 16).
+        let i = iv[f.lookup(&name).unwrap().index()];
+        assert!(i.hi >= 8.0, "intervals give {i} for {name}");
+    }
+    let one = x[f.lookup("one").unwrap().index()];
+    assert!((one.lo - 1.0).abs() <= 1e-12 && (one.hi - 1.0).abs() <= 1e-12, "cos² + sin² enclosed by {one}");
+    assert_sound("rotation chain", &f, &dom, &x, 256, 9);
+}
+
 /// A generous domain for a corpus function: joint angles a full turn and a bit, velocities and
 /// accelerations ±10, forces ±100, parameters at fixed points (masses and principal inertias
 /// positive, as `accuracy` draws them), anything else a point in [−1, 1].
