@@ -103,3 +103,17 @@ pub fn robot_urdf(rel: &str) -> Option<PathBuf> {
     assert!(path.is_some() || std::env::var_os("CI").is_none(), "{rel} is not in {}", lib.display());
     path
 }
+
+/// Runs `robovec-opt` on `args` with `-report` and `-o` into `dir` (`report.json`, `out.rvir`),
+/// asserts exit 0, and returns the report and the module written.
+pub fn opt_to_ir(dir: &std::path::Path, args: &[&str]) -> (serde_json::Value, robovec_ir::Module) {
+    let (ir, report) = (dir.join("out.rvir"), dir.join("report.json"));
+    let report_arg = format!("-report={}", report.display());
+    let mut all = args.to_vec();
+    all.extend([report_arg.as_str(), "-o", ir.to_str().unwrap()]);
+    let o = opt(&all);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let r = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let m = robovec_ir::text::parse(&std::fs::read_to_string(&ir).unwrap()).unwrap();
+    (r, m)
+}

@@ -747,21 +747,17 @@ proptest! {
 fn adjoints_of_the_ur5_rnea_and_its_fixed_point_bound() {
     let dir = crate::common::tmp("adjoint-ur5");
     let Some(urdf) = crate::common::robot_urdf("ur_description/urdf/ur5_robot.urdf") else { return };
-    let (ir, report) = (dir.join("ur5.rvir"), dir.join("r.json"));
     let budget = dir.join("b.json");
     std::fs::write(&budget, r#"{"Qq[*]": {"abs": 1e-4}}"#).unwrap();
-    let o = opt(&[
-        urdf.to_str().unwrap(),
-        "-function=invdyna",
-        "--fold-params",
-        &format!("-passes=default<ops>,precision<budget={};target=mcu>,error-bound", budget.display()),
-        &format!("-report={}", report.display()),
-        "-o",
-        ir.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
-    let m = robovec_ir::text::parse(&std::fs::read_to_string(&ir).unwrap()).unwrap();
+    let (r, m) = crate::common::opt_to_ir(
+        &dir,
+        &[
+            urdf.to_str().unwrap(),
+            "-function=invdyna",
+            "--fold-params",
+            &format!("-passes=default<ops>,precision<budget={};target=mcu>,error-bound", budget.display()),
+        ],
+    );
     let g = &m.functions[0];
     assert!(
         g.inputs.iter().chain(&g.body).all(|&v| matches!(g.format(v), Format::Fix { width: 32, .. })),

@@ -408,20 +408,16 @@ fn mcu_formats_are_integer_c_bit_exact_and_within_the_bound() {
         r#"{"q[*]": [-1.5, 1.5], "qd[*]": [-3, 3], "qdd[*]": [-10, 10], "g[1]": [0, 0], "g[2]": [0, 0], "g[3]": [-9.81, -9.81]}"#,
     )
     .unwrap();
-    let (ir, report) = (dir.join("arm.rvir"), dir.join("report.json"));
-    let o = opt(&[
-        "examples/three_link_arm/three_link_arm.urdf",
-        "-function=invdyna",
-        "--fold-params",
-        &format!("-ranges={}", ranges.display()),
-        "-passes=default<ops>,precision<budget=1e-2;target=mcu>,error-bound",
-        &format!("-report={}", report.display()),
-        "-o",
-        ir.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
-    let m = robovec_ir::text::parse(&std::fs::read_to_string(&ir).unwrap()).unwrap();
+    let (r, m) = crate::common::opt_to_ir(
+        &dir,
+        &[
+            "examples/three_link_arm/three_link_arm.urdf",
+            "-function=invdyna",
+            "--fold-params",
+            &format!("-ranges={}", ranges.display()),
+            "-passes=default<ops>,precision<budget=1e-2;target=mcu>,error-bound",
+        ],
+    );
     let g = &m.functions[0];
     let fix = |v| matches!(g.format(v), robovec_ir::format::Format::Fix { width: 32, .. });
     assert!(g.inputs.iter().chain(&g.body).all(|&v| fix(v)), "{}", r["precision"]);

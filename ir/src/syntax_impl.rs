@@ -15,6 +15,17 @@ impl Def {
         }
     }
 
+    /// The operands this definition reads, in order (the angle of a trig variable as a value;
+    /// none for an input or a nested expression).
+    pub fn operands(&self) -> Vec<Operand> {
+        match self {
+            Def::Trig(_, a) => vec![Operand::Value(*a)],
+            Def::Binary(_, a, b) => vec![*a, *b],
+            Def::Call(_, args) => args.clone(),
+            Def::Input | Def::Expr(_) => Vec::new(),
+        }
+    }
+
     /// Calls `f` on every value this definition reads, in operand order.
     pub fn for_each_value(&self, mut f: impl FnMut(Value)) {
         match self {

@@ -320,7 +320,7 @@ fn sweep(
                 let own =
                     if b.is_finite() { (Interval::point(b) - Interval::point(propagated)).hi.max(0.0) } else { b };
                 let mut conversions = [0.0; 3];
-                for (k, (o, &read)) in operands(&f.value(v).def).iter().zip(&reads).enumerate().take(3) {
+                for (k, (o, &read)) in f.value(v).def.operands().iter().zip(&reads).enumerate().take(3) {
                     let base = match o {
                         Operand::Value(p) => e[p.index()],
                         Operand::Const(_) => 0.0,
@@ -412,16 +412,6 @@ pub fn adjoint_sups(f: &Function, x: &[Interval], out: Value) -> Option<Vec<f64>
 /// output, up to 5.6×, in 1.5 s against 0.08 s; a humanoid's `dirdyna` (1,306 × 33k) would
 /// take minutes.
 pub const ADJOINT_WORK: usize = 100_000;
-
-/// The operands of a definition, in order.
-fn operands(def: &Def) -> Vec<Operand> {
-    match def {
-        Def::Trig(_, a) => vec![Operand::Value(*a)],
-        Def::Binary(_, a, b) => vec![*a, *b],
-        Def::Call(_, args) => args.clone(),
-        Def::Input | Def::Expr(_) => Vec::new(),
-    }
-}
 
 /// True when the operand's computed value is never negative (or is NaN).
 fn is_nonneg(o: &Operand, nonneg: &[bool]) -> bool {

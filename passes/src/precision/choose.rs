@@ -206,7 +206,7 @@ pub fn choose_on(
                 poisoned[v.index()] = true;
             }
         }
-        if operands(def).iter().any(|o| matches!(o, Operand::Value(a) if poisoned[a.index()])) {
+        if def.operands().iter().any(|o| matches!(o, Operand::Value(a) if poisoned[a.index()])) {
             poisoned[v.index()] = true;
         }
     }
@@ -384,16 +384,6 @@ pub fn choose_on(
     })
 }
 
-/// The operands of a definition.
-fn operands(def: &Def) -> Vec<Operand> {
-    match def {
-        Def::Binary(_, a, b) => vec![*a, *b],
-        Def::Call(_, args) => args.clone(),
-        Def::Trig(_, a) => vec![Operand::Value(*a)],
-        Def::Input | Def::Expr(_) => Vec::new(),
-    }
-}
-
 /// `f` with every value binary64.
 fn f_with_default(f: &Function) -> Function {
     let mut g = f.clone();
@@ -436,7 +426,7 @@ fn cost(f: &Function, g: &Function, target: Target, device: &Device) -> f64 {
     let mut total = 0.0;
     for &v in &f.body {
         let fv = g.format(v);
-        let operands = operands(&f.value(v).def);
+        let operands = f.value(v).def.operands();
         let conversions =
             operands.iter().filter(|o| matches!(o, Operand::Value(a) if g.format(*a) != fv)).count() as f64;
         total += match (target, fv) {

@@ -221,10 +221,7 @@ impl<'f> AffineSweep<'f> {
         let mut slack = Slack::new();
         // The rounding of the binary64 operation itself on the computed operands.
         let op_rounding = |slack: &mut Slack| slack.add(iv.mag() * U + TINY);
-        let interval_of = |o: &Operand| match o {
-            Operand::Value(p) => x[p.index()],
-            Operand::Const(c) => Interval::point(*c),
-        };
+        let interval_of = |o: &Operand| super::enclose::of(x, o);
         let formless = |o: &Operand| matches!(o, Operand::Value(p) if self.forms[p.index()].is_none());
         let reads_formless = match &data.def {
             Def::Trig(_, a) => formless(&Operand::Value(*a)),

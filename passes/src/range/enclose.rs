@@ -76,7 +76,7 @@ impl EncloseError {
 }
 
 /// The interval of an operand.
-fn of(x: &[Interval], o: &Operand) -> Interval {
+pub(super) fn of(x: &[Interval], o: &Operand) -> Interval {
     match o {
         Operand::Value(v) => x[v.index()],
         Operand::Const(c) => Interval::point(*c),

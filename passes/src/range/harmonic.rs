@@ -43,6 +43,7 @@ use robovec_ir::{BinOp, Def, Function, Interval, Intrinsic, Operand, TrigFn, Val
 use rustc_hash::FxHashMap;
 
 use super::affine::{reciprocal_line, sqrt_line};
+use super::enclose::of;
 
 /// Default cap on the atoms of one form.
 pub const DEFAULT_ATOMS: usize = 48;
@@ -281,7 +282,7 @@ impl Harmonics {
     /// [`Self::pair_bound`].
     fn symbol_radius(&self, x: &HForm) -> f64 {
         let mut r = FastUp::zero();
-        for_pairs(&x.atoms, |h, sym, a, b| {
+        for_pairs(&x.atoms, |_, h, sym, a, b| {
             if sym != CENTRE {
                 r.add(self.pair_bound(h, a, b));
             }
@@ -307,7 +308,7 @@ impl Harmonics {
     fn range(&self, x: &HForm) -> Interval {
         let mut r = Interval::point(0.0);
         let mut spread = FastUp::zero();
-        for_pairs(&x.atoms, |h, sym, a, b| {
+        for_pairs(&x.atoms, |_, h, sym, a, b| {
             if sym != CENTRE {
                 spread.add(self.pair_bound(h, a, b));
             } else if h == 0 {
@@ -331,16 +332,7 @@ impl Harmonics {
             return;
         }
         let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
-        let mut k = 0;
-        while k < atoms.len() {
-            let mut e = k + 1;
-            while e < atoms.len() && atoms[e].h == atoms[k].h && atoms[e].sym == atoms[k].sym {
-                e += 1;
-            }
-            let (a, b) = split(&atoms[k..e]);
-            pairs.push((self.pair_bound(atoms[k].h, a, b), k, e));
-            k = e;
-        }
+        for_pairs(atoms, |run, h, _, a, b| pairs.push((self.pair_bound(h, a, b), run.start, run.end)));
         pairs.sort_unstable_by(|p, q| q.0.total_cmp(&p.0));
         let mut keep = vec![false; atoms.len()];
         let mut kept = 0;
@@ -475,11 +467,7 @@ impl<'f> HarmonicSweep<'f> {
         let mut angle_ranges = Vec::new();
         for &v in &f.body {
             let def = &f.value(v).def;
-            for o in operands(def) {
-                if let Operand::Value(p) = o {
-                    uses[p.index()] += 1;
-                }
-            }
+            def.for_each_value(|p| uses[p.index()] += 1);
             if let Def::Trig(_, a) = def {
                 let Some(r) = input(*a) else { continue };
                 if r.width() > 0.0 && r.is_bounded() && angle[a.index()].is_none() {
@@ -510,15 +498,13 @@ impl<'f> HarmonicSweep<'f> {
     }
 
     fn release(&mut self, def: &Def) {
-        for o in operands(def) {
-            if let Operand::Value(v) = o {
-                let u = &mut self.uses[v.index()];
-                *u = u.saturating_sub(1);
-                if *u == 0 {
-                    self.forms[v.index()] = None;
-                }
+        def.for_each_value(|v| {
+            let u = &mut self.uses[v.index()];
+            *u = u.saturating_sub(1);
+            if *u == 0 {
+                self.forms[v.index()] = None;
             }
-        }
+        });
     }
 
     /// The enclosure of body value `v` from its form, intersected with `x[v]` (the enclosure so
@@ -528,12 +514,9 @@ impl<'f> HarmonicSweep<'f> {
         let data = f.value(v);
         let own = v.index() as u32;
         let iv = x[v.index()];
-        let interval_of = |o: &Operand| match o {
-            Operand::Value(p) => x[p.index()],
-            Operand::Const(c) => Interval::point(*c),
-        };
+        let interval_of = |o: &Operand| of(x, o);
         let mut slack = FastUp::zero();
-        let ops = operands(&data.def);
+        let ops = data.def.operands();
         let forms: Option<Vec<HForm>> = ops.iter().map(|o| self.form(o)).collect();
         let atoms = match (&data.def, forms) {
             _ if !iv.is_bounded() => None,
@@ -554,7 +537,7 @@ impl<'f> HarmonicSweep<'f> {
                     BinOp::Sub => Some(lin(&fs[0], 1.0, &fs[1], -1.0, &mut slack)),
                     BinOp::Mul => Some(self.hs.mul(&fs[0], &fs[1], same, &mut slack)),
                     BinOp::Div => reciprocal_line(interval_of(b)).map(|(alpha, zeta, delta)| {
-                        let recip = affine_of(&fs[1], alpha, zeta, delta, own, &mut slack);
+                        let recip = affine_of(&fs[1], alpha, zeta, delta, own);
                         self.hs.mul(&fs[0], &recip, false, &mut slack)
                     }),
                 };
@@ -566,7 +549,7 @@ impl<'f> HarmonicSweep<'f> {
             (Def::Call(callee, args), Some(fs)) => {
                 let r = match Intrinsic::of(callee, args.len()) {
                     Some(Intrinsic::Sqrt) => sqrt_line(interval_of(&args[0]))
-                        .map(|(alpha, zeta, delta)| affine_of(&fs[0], alpha, zeta, delta, own, &mut slack).atoms),
+                        .map(|(alpha, zeta, delta)| affine_of(&fs[0], alpha, zeta, delta, own).atoms),
                     Some(i) => {
                         let a = if i == Intrinsic::Fnma { negate(&fs[0]) } else { fs[0].clone() };
                         let p = HForm { atoms: self.hs.mul(&a, &fs[1], false, &mut slack) };
@@ -616,9 +599,9 @@ fn split(run: &[Atom]) -> (f64, f64) {
     ab
 }
 
-/// Calls `each(h, symbol, a, b)` per pair `(h, symbol)` of `atoms` (sorted), `a` the cos
-/// coefficient and `b` the sin one.
-fn for_pairs(atoms: &[Atom], mut each: impl FnMut(u32, u32, f64, f64)) {
+/// Calls `each(run, h, symbol, a, b)` per pair `(h, symbol)` of `atoms` (sorted): `run` its
+/// atoms' positions, `a` the cos coefficient and `b` the sin one.
+fn for_pairs(atoms: &[Atom], mut each: impl FnMut(std::ops::Range<usize>, u32, u32, f64, f64)) {
     let mut k = 0;
     while k < atoms.len() {
         let mut e = k + 1;
@@ -626,18 +609,8 @@ fn for_pairs(atoms: &[Atom], mut each: impl FnMut(u32, u32, f64, f64)) {
             e += 1;
         }
         let (a, b) = split(&atoms[k..e]);
-        each(atoms[k].h, atoms[k].sym, a, b);
+        each(k..e, atoms[k].h, atoms[k].sym, a, b);
         k = e;
-    }
-}
-
-/// The operands of a definition.
-fn operands(def: &Def) -> Vec<Operand> {
-    match def {
-        Def::Trig(_, a) => vec![Operand::Value(*a)],
-        Def::Binary(_, a, b) => vec![*a, *b],
-        Def::Call(_, args) => args.clone(),
-        Def::Input | Def::Expr(_) => Vec::new(),
     }
 }
 
@@ -688,12 +661,11 @@ fn lin(x: &HForm, a: f64, y: &HForm, b: f64, slack: &mut FastUp) -> Vec<Atom> {
 }
 
 /// `α·x + ζ ± δ`, `δ` on symbol `own` (kept in the form: a quotient multiplies it).
-fn affine_of(x: &HForm, alpha: f64, zeta: f64, delta: f64, own: u32, slack: &mut FastUp) -> HForm {
+fn affine_of(x: &HForm, alpha: f64, zeta: f64, delta: f64, own: u32) -> HForm {
     let mut own_slack = FastUp::zero();
     own_slack.add(delta);
     let mut atoms = lin(x, alpha, &constant(zeta), 1.0, &mut own_slack);
     put_own(&mut atoms, own, own_slack.total());
-    let _ = slack;
     HForm { atoms }
 }
 
@@ -711,13 +683,6 @@ fn put_own(atoms: &mut Vec<Atom>, own: u32, e: f64) {
 }
 
 impl HarmonicSweep<'_> {
-    /// The exact form of an operand.
-    fn exact(&self, o: &Operand) -> Option<HForm> {
-        match o {
-            Operand::Const(c) => Some(constant(*c)),
-            Operand::Value(v) => self.forms[v.index()].clone(),
-        }
-    }
 
     /// The enclosures of `∂out/∂z` for every value `z` (by value index: `sup` its magnitude,
     /// 0 where `out` does not depend on `z`) and, per operand read of each op, `sup|∂out/∂z| ·
@@ -778,17 +743,17 @@ impl HarmonicSweep<'_> {
                             parts.push((*b, None, -1.0));
                         }
                         BinOp::Mul => {
-                            let (Some(xa), Some(xb)) = (self.exact(a), self.exact(b)) else { return None };
+                            let (Some(xa), Some(xb)) = (self.form(a), self.form(b)) else { return None };
                             parts.push((*a, Some(xb), 1.0));
                             parts.push((*b, Some(xa), 1.0));
                         }
                         BinOp::Div => {
-                            let (Some(xb), Some(xz)) = (self.exact(b), self.exact(&Operand::Value(z))) else {
+                            let (Some(xb), Some(xz)) = (self.form(b), self.form(&Operand::Value(z))) else {
                                 return None;
                             };
-                            let (alpha, zeta, delta) = reciprocal_line(x_of(x, b))?;
+                            let (alpha, zeta, delta) = reciprocal_line(of(x, b))?;
                             let mut slack = FastUp::zero();
-                            let recip = affine_of(&xb, alpha, zeta, delta, n + z.index() as u32, &mut slack);
+                            let recip = affine_of(&xb, alpha, zeta, delta, n + z.index() as u32);
                             let mut quotient = self.hs.mul(&xz, &recip, false, &mut slack);
                             put_own(&mut quotient, n + z.index() as u32, slack.total());
                             parts.push((*a, Some(recip), 1.0));
@@ -799,14 +764,13 @@ impl HarmonicSweep<'_> {
                 Def::Call(callee, args) => match Intrinsic::of(callee, args.len()) {
                     Some(Intrinsic::Sqrt) => {
                         // ∂√a/∂a = 1/(2√a) = ½ · 1/z.
-                        let xz = self.exact(&Operand::Value(z))?;
+                        let xz = self.form(&Operand::Value(z))?;
                         let (alpha, zeta, delta) = reciprocal_line(x[z.index()])?;
-                        let mut slack = FastUp::zero();
-                        let recip = affine_of(&xz, alpha, zeta, delta, n + z.index() as u32, &mut slack);
+                        let recip = affine_of(&xz, alpha, zeta, delta, n + z.index() as u32);
                         parts.push((args[0], Some(recip), 0.5));
                     }
                     Some(i) => {
-                        let (Some(xa), Some(xb)) = (self.exact(&args[0]), self.exact(&args[1])) else {
+                        let (Some(xa), Some(xb)) = (self.form(&args[0]), self.form(&args[1])) else {
                             return None;
                         };
                         let (sp, sc) = match i {
@@ -863,12 +827,4 @@ pub struct Adjoints {
     pub sup: Vec<f64>,
     /// Per operand position of `z`'s op: `max|∂out/∂z| · max|∂z/∂operand|`.
     pub conversion_weight: Vec<[f64; 3]>,
-}
-
-/// The enclosure of an operand.
-fn x_of(x: &[Interval], o: &Operand) -> Interval {
-    match o {
-        Operand::Value(v) => x[v.index()],
-        Operand::Const(c) => Interval::point(*c),
-    }
 }
