@@ -209,6 +209,87 @@ proptest! {
     }
 }
 
+/// [`check_witness`] of `f` in `formats` at `n` points: no execution the rounding model allows
+/// ([`robovec_passes::error_bound::witness`]: every rounding at its largest, aligned with the
+/// output's gradient) has an error above the bound. Far stronger than sampling: the witness is
+/// what sampling's random-signed roundings would take ~10⁵× more points to approach. Returns the
+/// number of (output, point) pairs compared.
+fn check_witness(what: &str, f: &Function, dom: &Domain, formats: Formats, n: usize, seed: u64) -> usize {
+    use robovec_passes::error_bound::witness::Witness;
+    let x = enclose_with(f, dom, Some(16), || false).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+    let e = match bound(f, &x, formats, || false) {
+        Ok(e) => e,
+        Err(robovec_passes::error_bound::BoundError::FixOverflow { .. }) => return 0,
+        Err(err) => panic!("{what}: {err:?}"),
+    };
+    let mut w = Witness::new(f, formats);
+    let tape = Tape::new(f);
+    let mut rng = SplitMix64::new(seed);
+    let mut compared = 0;
+    for k in 0..n {
+        let xs = point(&tape, dom, k, &mut rng);
+        let Ok(errors) = w.errors_at(&xs) else { continue };
+        for (o, err) in f.outputs.iter().zip(errors) {
+            let (Operand::Value(v), Some(err)) = (o.value, err) else { continue };
+            let b = e[v.index()];
+            assert!(
+                err <= b,
+                "{what}: output {} in {formats:?} at point {k} ({xs:?}): an execution the rounding model allows is \
+                 {err:e} off, above the bound {b:e}",
+                o.name
+            );
+            compared += 1;
+        }
+    }
+    compared
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(64),
+        ..ProptestConfig::default()
+    })]
+
+    /// The bound holds against the rounding model's own adversarial executions (every op,
+    /// binary64, binary32, mixed and fixed-point formats).
+    #[test]
+    fn bounds_hold_against_the_models_worst_executions(seed in any::<u64>(), ops in 1usize..50) {
+        let (f, dom) = random_function(seed, ops);
+        for formats in [Formats::F64, Formats::F32] {
+            check_witness(&format!("seed {seed}"), &f, &dom, formats, 16, seed);
+        }
+        check_witness(&format!("mixed seed {seed}"), &with_random_formats(&f, &dom, seed), &dom, Formats::Mixed, 16, seed);
+        check_witness(&format!("fixed seed {seed}"), &with_fixed_point_formats(&f, &dom, seed), &dom, Formats::Mixed, 16, seed);
+    }
+
+    /// The same on the synthetic Robotran-like DAGs.
+    #[test]
+    fn bounds_hold_against_the_models_worst_executions_on_dags(seed in any::<u64>(), ops in 50usize..400) {
+        let f = robovec_testkit::dag_gen::generate(ops, seed);
+        let dom = crate::range::random_domain(&f, seed);
+        for formats in [Formats::F64, Formats::F32] {
+            check_witness(&format!("dag {seed}"), &f, &dom, formats, 8, seed);
+        }
+    }
+}
+
+/// Every corpus function that encloses over the generous domain, binary32, at 2 points (a
+/// corner and a uniform draw): no execution the rounding model allows is above the bound.
+#[test]
+fn bounds_hold_against_the_models_worst_executions_on_the_corpus() {
+    let (mut functions, mut compared) = (0, 0);
+    for (name, f) in crate::tree_height::corpus_functions() {
+        let dom = generous_domain(&f);
+        if enclose_with(&f, &dom, Some(16), || false).is_err() {
+            continue;
+        }
+        let n = check_witness(&name, &f, &dom, Formats::F32, 3, 7);
+        functions += usize::from(n > 0);
+        compared += n;
+    }
+    assert!(functions >= 55 && compared >= 5_000, "{functions} functions, {compared} (output, point) pairs");
+}
+
 /// Every corpus function whose values can all be enclosed over the generous domain, binary32
 /// and binary64, 24 points each: no error above its bound.
 #[test]
@@ -788,4 +869,194 @@ fn adjoints_of_the_ur5_rnea_and_its_fixed_point_bound() {
     };
     assert!((worst(&adjoint) - max_abs).abs() <= 1e-12 * max_abs);
     assert!(worst(&forward) > 1e-4, "the forward bound alone, {:e}, already meets the goal", worst(&forward));
+}
+
+/// A point of `dom` with every coordinate a binary32 number inside its range (as `accuracy`
+/// draws them), from [`point`].
+fn point_f32(tape: &Tape, dom: &Domain, k: usize, rng: &mut SplitMix64) -> Vec<f64> {
+    let xs = point(tape, dom, k, rng);
+    tape.inputs
+        .iter()
+        .zip(xs)
+        .map(|(n, x)| {
+            let i = dom.get(n).unwrap().interval;
+            let mut y = x as f32;
+            if (y as f64) > i.hi {
+                y = y.next_down();
+            }
+            if (y as f64) < i.lo {
+                y = y.next_up();
+            }
+            if (y as f64) < i.lo || (y as f64) > i.hi {
+                x
+            } else {
+                y as f64
+            }
+        })
+        .collect()
+}
+
+/// Per output (in `f.outputs` order), the largest witness error ([`Witness`]) over `n` points
+/// of `dom` in `mode`.
+fn witness_errors(f: &Function, dom: &Domain, mode: Formats, n: usize, seed: u64) -> Vec<f64> {
+    use robovec_passes::error_bound::witness::Witness;
+    let mut w = Witness::new(f, mode);
+    let mut plain = f.clone();
+    plain.clear_formats();
+    let tape = Tape::new(&plain);
+    assert_eq!(tape.inputs, w.inputs());
+    let mut rng = SplitMix64::new(seed);
+    let mut worst = vec![0f64; f.outputs.len()];
+    for k in 0..n {
+        let xs = point_f32(&tape, dom, k, &mut rng);
+        let Ok(e) = w.errors_at(&xs) else { continue };
+        for (m, e) in worst.iter_mut().zip(e) {
+            *m = m.max(e.unwrap_or(0.0));
+        }
+    }
+    worst
+}
+
+/// The first-order size of the model's worst execution at `xs`: `Σ_z |∂o/∂z|·½ ulp₃₂(z)`.
+fn first_order_witness(f: &Function, names: &[String], xs: &[f64], o: robovec_ir::Value) -> f64 {
+    let vals = robovec_ir::interp::eval_values::<f64>(f, |n| xs[names.iter().position(|t| t == n).unwrap()]);
+    let g = robovec_passes::error_bound::witness::gradient(f, &vals, o);
+    f.body
+        .iter()
+        .map(|z| {
+            let v = vals[z.index()];
+            if v == 0.0 || !v.is_finite() {
+                0.0
+            } else {
+                g[z.index()].abs() * 2f64.powi(v.abs().log2().floor() as i32 - 24)
+            }
+        })
+        .sum()
+}
+
+/// Per output (in `f.outputs` order), the witness error at a point found by coordinate ascent
+/// on [`first_order_witness`]: the best of 50 uniform points, then 3 rounds over the inputs
+/// trying each at its ends, middle and quarters.
+fn climbed_witnesses(f: &Function, dom: &Domain) -> Vec<f64> {
+    use robovec_passes::error_bound::witness::Witness;
+    let mut w = Witness::new(f, Formats::F32);
+    let names: Vec<String> = w.inputs().to_vec();
+    let ranges: Vec<(f64, f64)> = names
+        .iter()
+        .map(|n| {
+            let i = dom.get(n).unwrap().interval;
+            (i.lo, i.hi)
+        })
+        .collect();
+    let mut rng = SplitMix64::new(1);
+    let mut out = vec![0.0; f.outputs.len()];
+    for (k, o) in f.outputs.iter().enumerate() {
+        let Operand::Value(v) = o.value else { continue };
+        let (mut best, mut top) = (Vec::new(), -1.0);
+        for _ in 0..50 {
+            let xs: Vec<f64> = ranges.iter().map(|&(lo, hi)| lo + rng.unit() * (hi - lo)).collect();
+            let p = first_order_witness(f, &names, &xs, v);
+            if p > top {
+                (best, top) = (xs, p);
+            }
+        }
+        for _ in 0..3 {
+            for (i, &(lo, hi)) in ranges.iter().enumerate() {
+                for t in [0.0, 1.0, 0.5, 0.25, 0.75] {
+                    let old = best[i];
+                    best[i] = lo + t * (hi - lo);
+                    let p = first_order_witness(f, &names, &best, v);
+                    if p > top {
+                        top = p;
+                    } else {
+                        best[i] = old;
+                    }
+                }
+            }
+        }
+        // Binary32 inputs inside their ranges, as accuracy draws them.
+        let xs: Vec<f64> = best.iter().zip(&ranges).map(|(&x, &(lo, hi))| (x as f32 as f64).clamp(lo, hi)).collect();
+        out[k] = w.errors_at(&xs).ok().and_then(|e| e[k]).unwrap_or(0.0);
+    }
+    out
+}
+
+/// How much of the tightness gap no certification can close (a measurement: `cargo test
+/// --release --test root error_bound::witness_tightness -- --ignored --nocapture`; env
+/// `WITNESS_POINTS`, default 200, `HARD_SAMPLES`, default 10⁴): for UR5, Panda and Talos RNEA
+/// over their URDF limits (binary32), per output the bound `B`, the largest error
+/// `accuracy<mode=hard>` finds `S`, and the witness `W` (the error of an execution the
+/// rounding model allows: a lower bound of every sound bound). Prints the medians of `B/S`,
+/// `W/S`, `B/W` and the shares of outputs with `W/S > 100` (beyond any certified bound's
+/// reach) and `B/W ≤ 100`. Asserts `W ≤ B` (soundness against the model's own worst case).
+#[test]
+#[ignore]
+fn witness_tightness() {
+    let n: usize = std::env::var("WITNESS_POINTS").ok().and_then(|s| s.parse().ok()).unwrap_or(200);
+    let samples: u64 = std::env::var("HARD_SAMPLES").ok().and_then(|s| s.parse().ok()).unwrap_or(10_000);
+    let dir = crate::common::tmp("witness-tightness");
+    let mut cases: Vec<(String, Function, Domain)> = Vec::new();
+    for (name, rel) in [
+        ("UR5", "ur_description/urdf/ur5_robot.urdf"),
+        ("Panda", "panda_description/urdf/panda.urdf"),
+        ("Talos", "talos_data/robots/talos_reduced.urdf"),
+    ] {
+        let urdf = crate::common::robot_urdf(rel).unwrap_or_else(|| panic!("{rel}"));
+        let (r, m) = crate::common::opt_to_ir(
+            &dir,
+            &[urdf.to_str().unwrap(), "-function=invdyna", "--fold-params", "-passes=default<ops>,error-bound<format=f32>"],
+        );
+        let mut dom = Domain::default();
+        for (input, d) in r["domain"].as_object().unwrap() {
+            dom.ranges.insert(input.clone(), range(d["range"][0].as_f64().unwrap(), d["range"][1].as_f64().unwrap()));
+        }
+        cases.push((name.to_string(), m.functions[0].clone(), dom));
+    }
+    if let Ok(only) = std::env::var("WITNESS_CORPUS") {
+        for (name, f) in crate::tree_height::corpus_functions() {
+            if name.contains(&only) {
+                let dom = generous_domain(&f);
+                cases.push((name, f, dom));
+            }
+        }
+    }
+    for (name, f, dom) in cases {
+        let x = enclose_with(&f, &dom, Some(64), || false).unwrap();
+        let e = bound(&f, &x, Formats::F32, || false).unwrap();
+        let t = std::time::Instant::now();
+        let mut w = witness_errors(&f, &dom, Formats::F32, n, 3);
+        for (k, c) in climbed_witnesses(&f, &dom).into_iter().enumerate() {
+            w[k] = w[k].max(c);
+        }
+        let secs = t.elapsed().as_secs_f64();
+        let hard = robovec_passes::accuracy::max_abs_errors(&f, None, &dom, samples, 1, true).unwrap();
+        let (mut bs, mut ws, mut bw) = (Vec::new(), Vec::new(), Vec::new());
+        for ((o, w), (_, s, _)) in f.outputs.iter().zip(&w).zip(&hard) {
+            let Operand::Value(v) = o.value else { continue };
+            let b = e[v.index()];
+            assert!(*w <= b, "{name}: {}: witness {w:e} above the bound {b:e}", o.name);
+            if b.is_finite() && *s > 0.0 && *w > 0.0 && s.is_finite() {
+                bs.push(b / s);
+                ws.push(w / s);
+                bw.push(b / w);
+            }
+        }
+        let med = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+        };
+        let share = |v: &[f64], p: &dyn Fn(f64) -> bool| 100.0 * v.iter().filter(|&&r| p(r)).count() as f64 / v.len().max(1) as f64;
+        let (over, within_b_s, within_b_w) =
+            (share(&ws, &|r| r > 100.0), share(&bs, &|r| r <= 100.0), share(&bw, &|r| r <= 100.0));
+        println!(
+            "{name}: {} outputs; B/S median {:.1}, W/S median {:.1} (max {:.1}), B/W median {:.1} (max {:.1}); \
+             W/S > 100: {over:.0}%; B/S <= 100: {within_b_s:.0}%; B/W <= 100: {within_b_w:.0}%; witness {secs:.2} s",
+            bs.len(),
+            med(&mut bs),
+            med(&mut ws),
+            ws.last().copied().unwrap_or(f64::NAN),
+            med(&mut bw),
+            bw.last().copied().unwrap_or(f64::NAN),
+        );
+    }
 }

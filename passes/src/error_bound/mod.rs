@@ -29,6 +29,7 @@
 //! terms) for the enclosures, O(ops) for the bound.
 
 pub mod bound;
+pub mod witness;
 
 use robovec_ir::{Function, Interval, Module, Operand};
 use serde::Serialize;
