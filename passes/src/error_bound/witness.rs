@@ -1,7 +1,7 @@
 //! A lower bound of what any certified bound must say: the error of one execution the
 //! rounding model allows, found at a point of the domain.
 //!
-//! Every certified bound of the field (robovec's [`super::bound`], Daisy, FPTaylor, Satire,
+//! Every certified bound of the field (robovec's [`super::bound()`], Daisy, FPTaylor, Satire,
 //! RoboPrec) models each rounding as an unknown `δ` with `|δ| ≤ ½ ulp` of the result in its
 //! format (half a step in fixed point), and bounds the output's error over **every** choice of
 //! the `δ`s and every point of the domain. So if one choice at one point gives an output error
@@ -27,7 +27,7 @@
 //! does not see. Cost at one point: one forward run, then per output one reverse sweep and two
 //! double-double runs, `O(outputs · ops)`.
 //!
-//! What it is for: the tightness of [`super::bound`] (bound / witness is the pessimism of the
+//! What it is for: the tightness of [`super::bound()`] (bound / witness is the pessimism of the
 //! analysis, witness / sampled error the part no model-based certification can remove), and
 //! a soundness test far stronger than sampling (a bound below a witness is a bug).
 
