@@ -1060,3 +1060,59 @@ fn witness_tightness() {
         );
     }
 }
+
+/// The witness of `y = x · 0.1` in binary32 at x = 1.5, by hand. The exact function's constant
+/// is the binary64 number `0.1` parses to (`c64`); the computation reads it as the binary32
+/// c = 13421773·2⁻²⁷. The product 1.5·c is not a binary32 number, so it rounds, and the worst
+/// execution adds just under half an ulp (2⁻²⁷ in [0.125, 0.25)) on the side of the constant's
+/// error: W = 1.5·(c − c64) + (1 − 2⁻²⁰)·2⁻²⁷, less half an ulp of the reference in binary64
+/// (2⁻⁵⁶), within the reference's own rounding (2⁻⁵⁶). At x = 2 the product is exact (a power
+/// of 2 times a binary32 number): only the constant's error, 2·(c − c64) − 2⁻⁵⁶ (0.2 is in [0.125, 0.25) too).
+#[test]
+fn the_witness_of_a_product_by_hand() {
+    use robovec_passes::error_bound::witness::Witness;
+    let m =
+        robovec_ir::text::parse("func @f {\n  phase atomised\n  input %x\n  %y = mul %x, 0.1\n  output y = %y\n}\n")
+            .unwrap();
+    let f = &m.functions[0];
+    let mut w = Witness::new(f, Formats::F32);
+    let (c, c64) = (13_421_773.0 / 134_217_728.0, 0.1f64);
+    let got = w.errors_at(&[1.5]).unwrap()[0].unwrap();
+    // c − c64 is exact in binary64 (both within 2⁻²⁷ of each other, 53-bit aligned).
+    let expected = 1.5 * (c - c64) + (1.0 - 2f64.powi(-20)) * 2f64.powi(-27) - 2f64.powi(-56);
+    assert!((got - expected).abs() <= 2f64.powi(-55), "{got:e} vs {expected:e}");
+    let got = w.errors_at(&[2.0]).unwrap()[0].unwrap();
+    let expected = 2.0 * (c - c64) - 2f64.powi(-56);
+    assert!((got - expected).abs() <= 1e-24, "{got:e} vs {expected:e}");
+    // Binary64: 1.5·c64 rounds; the worst execution is half an ulp of 0.15 away, less the
+    // reference's own half ulp: at most 2⁻⁵⁶ (+ the reference's rounding, 2⁻⁵⁶).
+    let mut w64 = Witness::new(f, Formats::F64);
+    let got = w64.errors_at(&[1.5]).unwrap()[0].unwrap();
+    assert!(got <= 2f64.powi(-55), "{got:e}");
+}
+
+/// `error-bound<witness=N>` on the UR5's RNEA over its URDF limits in binary32: every output
+/// has a witness, positive and below its bound (the model's worst execution cannot beat a
+/// sound bound), and the log prints the pessimism; without `witness` the key is absent.
+#[test]
+fn the_pass_reports_witnesses_below_the_bound() {
+    let dir = crate::common::tmp("witness-pass");
+    let urdf = crate::common::robot_urdf("ur_description/urdf/ur5_robot.urdf").expect("UR5 from example-robot-data");
+    let (r, _) = crate::common::opt_to_ir(
+        &dir,
+        &[urdf.to_str().unwrap(), "-function=invdyna", "--fold-params", "-passes=default<ops>,error-bound<format=f32;witness=8>"],
+    );
+    let outs = r["error_bound"]["outputs"].as_object().unwrap();
+    assert_eq!(outs.len(), 6);
+    for (name, b) in outs {
+        let (abs, w) = (b["abs"].as_f64().unwrap(), b["witness"].as_f64().unwrap_or_else(|| panic!("{name}: {b}")));
+        assert!(w > 0.0 && w <= abs, "{name}: witness {w:e}, bound {abs:e}");
+        // The bound is not absurdly far from what the model allows (UR5: ~15× at the median).
+        assert!(abs / w < 1e3, "{name}: bound / witness {}", abs / w);
+    }
+    let (r, _) = crate::common::opt_to_ir(
+        &dir,
+        &[urdf.to_str().unwrap(), "-function=invdyna", "--fold-params", "-passes=default<ops>,error-bound<format=f32>"],
+    );
+    assert!(r["error_bound"]["outputs"].as_object().unwrap().values().all(|b| b.get("witness").is_none()));
+}

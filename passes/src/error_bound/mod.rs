@@ -25,8 +25,12 @@
 //! max_rel}`: `abs` the bound on |computed − exact| over the domain, `rel` = `abs` / the
 //! smallest |value| of the output's enclosure when that enclosure excludes 0 (else `null`),
 //! the maxima over the outputs; an output with no finite bound (a callback, a divisor the
-//! error may carry through 0) has `abs: null` and is named in `unbounded`. Cost: O(ops ·
-//! terms) for the enclosures, O(ops) for the bound.
+//! error may carry through 0) has `abs: null` and is named in `unbounded`. With `witness=N`
+//! each output also gets `witness`: the largest error of the rounding model's worst execution
+//! at `N` points of the domain ([`witness`]), a lower bound of every bound sound under the
+//! model (so `abs / witness` is the bound's pessimism; printed as its median). Cost: O(ops ·
+//! terms) for the enclosures, O(ops) for the bound, O(N · outputs · ops) in double-double for
+//! the witnesses.
 
 pub mod bound;
 pub mod witness;
@@ -77,6 +81,13 @@ pub const INFO: PassInfo = PassInfo {
         crate::range::RANGES,
         crate::range::METHOD,
         crate::range::TERMS,
+        ParamInfo {
+            name: "witness",
+            kind: ParamKind::U32 { default: 0, min: 0, max: 1_000_000 },
+            doc: "points of the domain (the two corners, then draws) at which the rounding model's worst execution is \
+                  run (witness.rs; 0: none): each output's `witness`, a lower bound of every bound sound under the \
+                  model, so abs / witness is how pessimistic the bound is",
+        },
     ],
     build: |p: &Params| {
         Ok(Box::new(ErrorBoundPass {
@@ -84,6 +95,7 @@ pub const INFO: PassInfo = PassInfo {
             ranges: p.path("ranges")?,
             method: p.word("method")?,
             terms: p.u32("terms")? as usize,
+            witness: p.u32("witness")?,
         }))
     },
     props: crate::Props {
@@ -109,6 +121,8 @@ pub struct ErrorBoundPass {
     pub method: Method,
     /// Most noise symbols of an affine form.
     pub terms: usize,
+    /// Points the model's worst execution is run at ([`witness`]; 0: none).
+    pub witness: u32,
 }
 
 impl Pass for ErrorBoundPass {
@@ -152,7 +166,17 @@ impl Pass for ErrorBoundPass {
                     }
                     Err(err) => return Err(located(err.message(&f.name), err.span())),
                 };
-                Ok(Step::Done(summarise(f, &x, &e, word)))
+                let mut summary = summarise(f, &x, &e, word);
+                if self.witness > 0 {
+                    let found = witnesses(f, &dom, formats, self.witness, || ticker.tick());
+                    let Some(found) = found else {
+                        return Ok(Step::Stopped { what: format!("in @{}'s witnesses", f.name), kept: None });
+                    };
+                    for ((_, b), w) in summary.outputs.iter_mut().zip(found) {
+                        b.witness = w;
+                    }
+                }
+                Ok(Step::Done(summary))
             },
         )?;
         cx.emit(ErrorBoundRun { functions });
@@ -167,6 +191,55 @@ pub struct OutputBound {
     pub abs: Option<f64>,
     /// `abs` / min |exact| over the domain, when the output's enclosure excludes 0.
     pub rel: Option<f64>,
+    /// With `witness=N`: the largest error of the rounding model's worst execution at the `N`
+    /// points ([`witness`]), in the output's units; no bound sound under the model is below
+    /// it. Absent without `witness`, or when no point gave one (a constant output, an
+    /// uncertified reference).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub witness: Option<f64>,
+}
+
+/// Per output of `f` (in output order), the largest [`witness::Witness`] error over `n` points
+/// of `dom` in `formats`: the corner of every input at its lower end, the one at its upper
+/// end, then points with each input at an end (⅓) or uniform inside (seeded: the same points
+/// every run). A point where a fixed-point value overflows is skipped. `None` when `tick`
+/// stopped it (called once per point).
+pub fn witnesses(
+    f: &Function,
+    dom: &robovec_ir::domain::Domain,
+    formats: Formats,
+    n: u32,
+    mut tick: impl FnMut() -> bool,
+) -> Option<Vec<Option<f64>>> {
+    let mut w = witness::Witness::new(f, formats);
+    let ranges: Vec<Interval> =
+        w.inputs().iter().map(|name| dom.get(name).map_or(Interval::point(0.0), |r| r.interval)).collect();
+    let mut rng = robovec_ir::rng::SplitMix64::new(0x5eed);
+    let mut worst: Vec<Option<f64>> = vec![None; f.outputs.len()];
+    for k in 0..n {
+        if tick() {
+            return None;
+        }
+        let xs: Vec<f64> = ranges
+            .iter()
+            .map(|i| {
+                let t = match k {
+                    0 => 0.0,
+                    1 => 1.0,
+                    _ if rng.chance(333) => rng.below(2) as f64,
+                    _ => rng.unit(),
+                };
+                (i.lo + t * (i.hi - i.lo)).clamp(i.lo, i.hi)
+            })
+            .collect();
+        let Ok(errors) = w.errors_at(&xs) else { continue };
+        for (m, e) in worst.iter_mut().zip(errors) {
+            if let Some(e) = e {
+                *m = Some(m.map_or(e, |m| m.max(e)));
+            }
+        }
+    }
+    Some(worst)
 }
 
 /// One function's bounds.
@@ -202,7 +275,7 @@ fn summarise(f: &Function, x: &[Interval], e: &[f64], format: FormatWord) -> Fun
             let abs = err.is_finite().then_some(err);
             let mig = range.mig();
             let rel = abs.filter(|_| mig > 0.0).map(|a| (a / mig).next_up());
-            (o.name.clone(), OutputBound { abs, rel })
+            (o.name.clone(), OutputBound { abs, rel, witness: None })
         })
         .collect();
     let largest = |pick: fn(&OutputBound) -> Option<f64>| {
@@ -241,6 +314,17 @@ impl std::fmt::Display for FunctionBound {
         }
         if let Some((o, r)) = &self.max_rel {
             write!(f, "; max rel {r:.3e} ({o})")?;
+        }
+        let mut pessimism: Vec<f64> =
+            self.outputs.iter().filter_map(|(_, b)| Some(b.abs? / b.witness.filter(|w| *w > 0.0)?)).collect();
+        if !pessimism.is_empty() {
+            pessimism.sort_by(f64::total_cmp);
+            write!(
+                f,
+                "; bound / witness median {:.1}, max {:.1}",
+                pessimism[pessimism.len() / 2],
+                pessimism[pessimism.len() - 1]
+            )?;
         }
         if let Some(first) = self.unbounded.first() {
             write!(f, "; unbounded: {first}")?;
