@@ -230,6 +230,36 @@ fn range_stopped_inside_a_function_keeps_the_functions_enclosed_before_it() {
     assert_eq!(cx.artifacts_of::<crate::range::RangeRun>().next().expect("an artifact").functions.len(), 1);
 }
 
+/// `error-bound<witness=N>` stopped in its witnesses keeps the bounds (without witnesses), with
+/// a note; without a limit every output gets a witness.
+#[test]
+fn error_bound_stopped_in_its_witnesses_keeps_the_bounds() {
+    let pm = PassManager::new("error-bound<format=f32;witness=1000>", Instrumentation::default()).expect("builds");
+    let mut m = atomised(60);
+    // One tick per value to enclose, one per value to bound, then the witnesses' ticks.
+    let budget = 2 * m.functions[0].body.len() as u64 + 10;
+    let mut cx = PassContext { tick_budget: Some(budget), domain: Some(unit_domain()), ..PassContext::default() };
+    pm.run(&mut m, &mut cx, &mut Vec::new()).expect("skippable");
+    assert_eq!(
+        cx.stopped(),
+        [format!(
+            "error-bound stopped in @f's witnesses (its bounds kept, without witnesses): tick budget of {budget} steps \
+             reached"
+        )]
+    );
+    let run = cx.artifacts_of::<crate::error_bound::ErrorBoundRun>().next().expect("an artifact");
+    let outputs = &run.functions[0].outputs;
+    assert!(outputs.iter().all(|(_, b)| b.abs.is_some() && b.witness.is_none()), "{outputs:?}");
+    let mut cx = PassContext { domain: Some(unit_domain()), ..PassContext::default() };
+    PassManager::new("error-bound<format=f32;witness=4>", Instrumentation::default())
+        .expect("builds")
+        .run(&mut m, &mut cx, &mut Vec::new())
+        .expect("runs");
+    assert!(cx.stopped().is_empty());
+    let run = cx.artifacts_of::<crate::error_bound::ErrorBoundRun>().next().expect("an artifact");
+    assert!(run.functions[0].outputs.iter().all(|(_, b)| b.witness.is_some_and(|w| w <= b.abs.unwrap())));
+}
+
 /// Every input of the test module ([`atomised`]) in [−1, 1].
 fn unit_domain() -> robovec_ir::domain::Domain {
     let r = robovec_ir::domain::Range { interval: robovec_ir::Interval::new(-1.0, 1.0), source: "test".into() };

@@ -170,7 +170,8 @@ impl Pass for ErrorBoundPass {
                 if self.witness > 0 {
                     let found = witnesses(f, &dom, formats, self.witness, || ticker.tick());
                     let Some(found) = found else {
-                        return Ok(Step::Stopped { what: format!("in @{}'s witnesses", f.name), kept: None });
+                        let what = format!("in @{}'s witnesses (its bounds kept, without witnesses)", f.name);
+                        return Ok(Step::Stopped { what, kept: Some(summary) });
                     };
                     for ((_, b), w) in summary.outputs.iter_mut().zip(found) {
                         b.witness = w;
@@ -203,7 +204,7 @@ pub struct OutputBound {
 /// of `dom` in `formats`: the corner of every input at its lower end, the one at its upper
 /// end, then points with each input at an end (⅓) or uniform inside (seeded: the same points
 /// every run). A point where a fixed-point value overflows is skipped. `None` when `tick`
-/// stopped it (called once per point).
+/// stopped it (called once per point and [`witness::Witness::errors_at_until`]'s per output).
 pub fn witnesses(
     f: &Function,
     dom: &robovec_ir::domain::Domain,
@@ -232,7 +233,11 @@ pub fn witnesses(
                 (i.lo + t * (i.hi - i.lo)).clamp(i.lo, i.hi)
             })
             .collect();
-        let Ok(errors) = w.errors_at(&xs) else { continue };
+        let errors = match w.errors_at_until(&xs, &mut tick) {
+            Ok(Some(errors)) => errors,
+            Ok(None) => return None,
+            Err(_) => continue,
+        };
         for (m, e) in worst.iter_mut().zip(errors) {
             if let Some(e) = e {
                 *m = Some(m.map_or(e, |m| m.max(e)));

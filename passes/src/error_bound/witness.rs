@@ -96,7 +96,22 @@ impl Witness {
     /// A fixed-point value that overflows its format at this point (the computation itself
     /// is undefined there).
     pub fn errors_at(&mut self, xs: &[f64]) -> Result<Vec<Option<f64>>, FormatError> {
+        Ok(self.errors_at_until(xs, || false)?.expect("never stopped"))
+    }
+
+    /// [`Witness::errors_at`], calling `tick` `1 + ops/1024` times per output (about one call
+    /// per 2,000 double-double ops: [`robovec_ir::time_limit::Ticker`]'s step) and stopping
+    /// with `Ok(None)` when it returns true.
+    ///
+    /// # Errors
+    /// As [`Witness::errors_at`].
+    pub fn errors_at_until(
+        &mut self,
+        xs: &[f64],
+        mut tick: impl FnMut() -> bool,
+    ) -> Result<Option<Vec<Option<f64>>>, FormatError> {
         let f = &self.f;
+        let ticks_per_output = 1 + f.body.len() / 1024;
         let names = &self.tape.inputs;
         let input = |name: &str| xs[names.iter().position(|n| n == name).expect("an input of the tape")];
         let actual = eval_values(f, input)?;
@@ -111,6 +126,11 @@ impl Witness {
         }
         let mut out = Vec::with_capacity(self.outputs.len());
         for (k, o) in self.outputs.iter().enumerate() {
+            for _ in 0..ticks_per_output {
+                if tick() {
+                    return Ok(None);
+                }
+            }
             let Some(o) = *o else {
                 out.push(None);
                 continue;
@@ -133,7 +153,7 @@ impl Witness {
             }
             out.push(worst);
         }
-        Ok(out)
+        Ok(Some(out))
     }
 }
 
