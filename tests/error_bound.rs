@@ -37,19 +37,8 @@ fn error_at_least(computed: f64, r: &RefValue) -> f64 {
 /// A point of `dom` for `f`'s tape inputs: corners first (all lo, all hi), then each input at
 /// an end (a third of the time) or uniform inside.
 fn point(tape: &Tape, dom: &Domain, k: usize, rng: &mut SplitMix64) -> Vec<f64> {
-    tape.inputs
-        .iter()
-        .map(|n| {
-            let i = dom.get(n).unwrap().interval;
-            let t = match k {
-                0 => 0.0,
-                1 => 1.0,
-                _ if rng.chance(333) => rng.below(2) as f64,
-                _ => rng.unit(),
-            };
-            (i.lo + t * (i.hi - i.lo)).clamp(i.lo, i.hi)
-        })
-        .collect()
+    let ranges: Vec<robovec_ir::Interval> = tape.inputs.iter().map(|n| dom.get(n).unwrap().interval).collect();
+    robovec_passes::error_bound::domain_point(&ranges, k as u64, rng)
 }
 
 /// Bounds `f` over `dom` in `formats` and compares with the error at `n` points of the domain
@@ -198,6 +187,52 @@ proptest! {
         check_sound_formatted(&format!("fixed seed {seed}"), &with_fixed_point_formats(&f, &dom, seed), &dom, seed);
     }
 
+    /// The bound holds against the rounding model's own adversarial executions (every op,
+    /// binary64, binary32, mixed and fixed-point formats).
+    #[test]
+    fn bounds_hold_against_the_models_worst_executions(seed in any::<u64>(), ops in 1usize..50) {
+        let (f, dom) = random_function(seed, ops);
+        for formats in [Formats::F64, Formats::F32] {
+            check_witness(&format!("seed {seed}"), &f, &dom, formats, 16, seed);
+        }
+        check_witness(&format!("mixed seed {seed}"), &with_random_formats(&f, &dom, seed), &dom, Formats::Mixed, 16, seed);
+        check_witness(&format!("fixed seed {seed}"), &with_fixed_point_formats(&f, &dom, seed), &dom, Formats::Mixed, 16, seed);
+    }
+
+    /// The same on the synthetic Robotran-like DAGs.
+    #[test]
+    fn bounds_hold_against_the_models_worst_executions_on_dags(seed in any::<u64>(), ops in 50usize..400) {
+        let f = robovec_testkit::dag_gen::generate(ops, seed);
+        let dom = crate::range::random_domain(&f, seed);
+        for formats in [Formats::F64, Formats::F32] {
+            check_witness(&format!("dag {seed}"), &f, &dom, formats, 8, seed);
+        }
+    }
+
+    /// The adjoints `error-bound` weighs roundings with enclose the true derivatives: random
+    /// functions with every op, half their inputs over more than a whole turn (where `sin` and
+    /// `cos` ride on harmonics), and the Robotran-like DAGs over whole turns.
+    #[test]
+    fn adjoint_enclosures_hold(seed in any::<u64>(), ops in 1usize..50, dag_ops in 50usize..400) {
+        let (f, mut dom) = random_function(seed, ops);
+        let mut rng = SplitMix64::new(seed ^ 0x51);
+        for r in dom.ranges.values_mut() {
+            if rng.chance(500) {
+                let a = rng.unit() * 4.0 - 2.0;
+                r.interval = robovec_ir::Interval::new(a, a + 7.0);
+            }
+        }
+        check_adjoints(&format!("seed {seed}"), &f, &dom, 16, seed);
+        let g = robovec_testkit::dag_gen::generate(dag_ops, seed);
+        let mut dom = crate::range::random_domain(&g, seed);
+        for (name, r) in dom.ranges.iter_mut() {
+            if name.starts_with('q') {
+                r.interval = robovec_ir::Interval::new(-3.5, 3.5);
+            }
+        }
+        check_adjoints(&format!("dag {seed}"), &g, &dom, 8, seed);
+    }
+
     /// The synthetic Robotran-like DAGs (deep sums of products, trig of joint angles).
     #[test]
     fn bounds_hold_on_robotran_like_dags(seed in any::<u64>(), ops in 50usize..600) {
@@ -244,34 +279,6 @@ fn check_witness(what: &str, f: &Function, dom: &Domain, formats: Formats, n: us
     compared
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(64),
-        ..ProptestConfig::default()
-    })]
-
-    /// The bound holds against the rounding model's own adversarial executions (every op,
-    /// binary64, binary32, mixed and fixed-point formats).
-    #[test]
-    fn bounds_hold_against_the_models_worst_executions(seed in any::<u64>(), ops in 1usize..50) {
-        let (f, dom) = random_function(seed, ops);
-        for formats in [Formats::F64, Formats::F32] {
-            check_witness(&format!("seed {seed}"), &f, &dom, formats, 16, seed);
-        }
-        check_witness(&format!("mixed seed {seed}"), &with_random_formats(&f, &dom, seed), &dom, Formats::Mixed, 16, seed);
-        check_witness(&format!("fixed seed {seed}"), &with_fixed_point_formats(&f, &dom, seed), &dom, Formats::Mixed, 16, seed);
-    }
-
-    /// The same on the synthetic Robotran-like DAGs.
-    #[test]
-    fn bounds_hold_against_the_models_worst_executions_on_dags(seed in any::<u64>(), ops in 50usize..400) {
-        let f = robovec_testkit::dag_gen::generate(ops, seed);
-        let dom = crate::range::random_domain(&f, seed);
-        for formats in [Formats::F64, Formats::F32] {
-            check_witness(&format!("dag {seed}"), &f, &dom, formats, 8, seed);
-        }
-    }
-}
 
 /// Every corpus function that encloses over the generous domain, binary32, at 2 points (a
 /// corner and a uniform draw): no execution the rounding model allows is above the bound.
@@ -680,61 +687,19 @@ fn one_more_bit_is_the_bound_of_the_wider_formats() {
 /// in binary64 from the values `vals`, and the same sweep on magnitudes (`Σ` over paths of
 /// `|∂|` products: what the binary64 rounding of the first can be off by, times a few ulps).
 fn jacobian_row(f: &Function, vals: &[f64], out: robovec_ir::Value) -> (Vec<f64>, Vec<f64>) {
-    use robovec_ir::{BinOp, Def, Intrinsic, TrigFn};
     let n = f.values.len();
     let (mut adj, mut mag) = (vec![0.0; n], vec![0.0; n]);
     adj[out.index()] = 1.0;
     mag[out.index()] = 1.0;
-    let val = |o: &Operand| match o {
-        Operand::Value(v) => vals[v.index()],
-        Operand::Const(c) => *c,
-    };
     for &z in f.body.iter().rev() {
         let (a, m) = (adj[z.index()], mag[z.index()]);
         if m == 0.0 {
             continue;
         }
-        let mut give = |o: &Operand, d: f64| {
-            if let Operand::Value(v) = o {
-                adj[v.index()] += a * d;
-                mag[v.index()] += m * d.abs();
-            }
-        };
-        match &f.value(z).def {
-            Def::Trig(t, p) => {
-                let q = vals[p.index()];
-                give(&Operand::Value(*p), if *t == TrigFn::Sin { q.cos() } else { -q.sin() });
-            }
-            Def::Binary(op, p, q) => match op {
-                BinOp::Add => {
-                    give(p, 1.0);
-                    give(q, 1.0);
-                }
-                BinOp::Sub => {
-                    give(p, 1.0);
-                    give(q, -1.0);
-                }
-                BinOp::Mul => {
-                    give(p, val(q));
-                    give(q, val(p));
-                }
-                BinOp::Div => {
-                    give(p, 1.0 / val(q));
-                    give(q, -val(p) / (val(q) * val(q)));
-                }
-            },
-            Def::Call(c, args) => match Intrinsic::of(c, args.len()) {
-                Some(Intrinsic::Sqrt) => give(&args[0], 0.5 / val(&args[0]).sqrt()),
-                Some(i) => {
-                    let s = if i == Intrinsic::Fnma { -1.0 } else { 1.0 };
-                    give(&args[0], s * val(&args[1]));
-                    give(&args[1], s * val(&args[0]));
-                    give(&args[2], if i == Intrinsic::Fms { -1.0 } else { 1.0 });
-                }
-                None => {}
-            },
-            _ => {}
-        }
+        robovec_passes::error_bound::witness::local_partials(&f.value(z).def, vals, |v, d| {
+            adj[v.index()] += a * d;
+            mag[v.index()] += m * d.abs();
+        });
     }
     (adj, mag)
 }
@@ -789,36 +754,6 @@ fn check_adjoints(what: &str, f: &Function, dom: &Domain, n: usize, seed: u64) -
     compared
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(64),
-        ..ProptestConfig::default()
-    })]
-
-    /// The adjoints `error-bound` weighs roundings with enclose the true derivatives: random
-    /// functions with every op, half their inputs over more than a whole turn (where `sin` and
-    /// `cos` ride on harmonics), and the Robotran-like DAGs over whole turns.
-    #[test]
-    fn adjoint_enclosures_hold(seed in any::<u64>(), ops in 1usize..50, dag_ops in 50usize..400) {
-        let (f, mut dom) = random_function(seed, ops);
-        let mut rng = SplitMix64::new(seed ^ 0x51);
-        for r in dom.ranges.values_mut() {
-            if rng.chance(500) {
-                let a = rng.unit() * 4.0 - 2.0;
-                r.interval = robovec_ir::Interval::new(a, a + 7.0);
-            }
-        }
-        check_adjoints(&format!("seed {seed}"), &f, &dom, 16, seed);
-        let g = robovec_testkit::dag_gen::generate(dag_ops, seed);
-        let mut dom = crate::range::random_domain(&g, seed);
-        for (name, r) in dom.ranges.iter_mut() {
-            if name.starts_with('q') {
-                r.interval = robovec_ir::Interval::new(-3.5, 3.5);
-            }
-        }
-        check_adjoints(&format!("dag {seed}"), &g, &dom, 8, seed);
-    }
-}
 
 /// The adjoints of the UR5's RNEA (`robovec-gen`'s `invdyna`, every joint over its URDF limits,
 /// a whole turn or two) enclose its derivatives at 200 points, and the adjoint bound is what

@@ -200,10 +200,27 @@ pub struct OutputBound {
     pub witness: Option<f64>,
 }
 
+/// The `k`-th point of a box of `ranges` (one interval per input): the corner of every input
+/// at its lower end for `k = 0`, at its upper end for `k = 1`, then each input at an end (⅓,
+/// either end) or uniform inside, drawn from `rng`; every coordinate inside its interval.
+pub fn domain_point(ranges: &[Interval], k: u64, rng: &mut robovec_ir::rng::SplitMix64) -> Vec<f64> {
+    ranges
+        .iter()
+        .map(|i| {
+            let t = match k {
+                0 => 0.0,
+                1 => 1.0,
+                _ if rng.chance(333) => rng.below(2) as f64,
+                _ => rng.unit(),
+            };
+            (i.lo + t * (i.hi - i.lo)).clamp(i.lo, i.hi)
+        })
+        .collect()
+}
+
 /// Per output of `f` (in output order), the largest [`witness::Witness`] error over `n` points
-/// of `dom` in `formats`: the corner of every input at its lower end, the one at its upper
-/// end, then points with each input at an end (⅓) or uniform inside (seeded: the same points
-/// every run). A point where a fixed-point value overflows is skipped. `None` when `tick`
+/// of `dom` in `formats`: the points of [`domain_point`] (seeded: the same points every
+/// run). A point where a fixed-point value overflows is skipped. `None` when `tick`
 /// stopped it (called once per point and [`witness::Witness::errors_at_until`]'s per output).
 pub fn witnesses(
     f: &Function,
@@ -221,18 +238,7 @@ pub fn witnesses(
         if tick() {
             return None;
         }
-        let xs: Vec<f64> = ranges
-            .iter()
-            .map(|i| {
-                let t = match k {
-                    0 => 0.0,
-                    1 => 1.0,
-                    _ if rng.chance(333) => rng.below(2) as f64,
-                    _ => rng.unit(),
-                };
-                (i.lo + t * (i.hi - i.lo)).clamp(i.lo, i.hi)
-            })
-            .collect();
+        let xs = domain_point(&ranges, u64::from(k), &mut rng);
         let errors = match w.errors_at_until(&xs, &mut tick) {
             Ok(Some(errors)) => errors,
             Ok(None) => return None,

@@ -49,8 +49,9 @@ pub struct Witness {
     tape: Tape,
     reference: Reference,
     refs: Vec<RefValue>,
-    /// Output values, in `f.outputs` order (`None`: a constant output).
-    outputs: Vec<Option<Value>>,
+    /// Per output, in `f.outputs` order: its value and its position among the tape's
+    /// outputs (the reference's order); `None` for a constant output.
+    outputs: Vec<Option<(Value, usize)>>,
 }
 
 impl Witness {
@@ -69,17 +70,20 @@ impl Witness {
                 }
             }
         }
+        let mut plain = f.clone();
+        plain.clear_formats();
+        let tape = Tape::new(&plain);
         let outputs = f
             .outputs
             .iter()
             .map(|o| match o.value {
-                Operand::Value(v) => Some(v),
+                Operand::Value(v) => {
+                    Some((v, tape.outputs.iter().position(|(name, _)| *name == o.name).expect("an output of the tape")))
+                }
                 Operand::Const(_) => None,
             })
             .collect();
-        let mut plain = f.clone();
-        plain.clear_formats();
-        Witness { tape: Tape::new(&plain), f: g, reference: Reference::new(), refs: Vec::new(), outputs }
+        Witness { tape, f: g, reference: Reference::new(), refs: Vec::new(), outputs }
     }
 
     /// The inputs' names in the order [`Witness::errors_at`] reads them.
@@ -125,17 +129,17 @@ impl Witness {
             rounds[z.index()] = DD::from_f64(actual[z.index()]) != r;
         }
         let mut out = Vec::with_capacity(self.outputs.len());
-        for (k, o) in self.outputs.iter().enumerate() {
+        for o in &self.outputs {
             for _ in 0..ticks_per_output {
                 if tick() {
                     return Ok(None);
                 }
             }
-            let Some(o) = *o else {
+            let Some((o, at)) = *o else {
                 out.push(None);
                 continue;
             };
-            let r = self.refs[self.tape.outputs.iter().position(|(name, _)| *name == f.outputs[k].name).expect("output")];
+            let r = self.refs[at];
             if !r.certified || !r.f64.is_finite() {
                 out.push(None);
                 continue;
@@ -212,55 +216,64 @@ fn execution(f: &Function, actual: &[f64], rounds: &[bool], grad: &[f64], sign: 
 pub fn gradient(f: &Function, vals: &[f64], out: Value) -> Vec<f64> {
     let mut adj = vec![0.0; f.values.len()];
     adj[out.index()] = 1.0;
-    let val = |o: &Operand| match o {
-        Operand::Value(v) => vals[v.index()],
-        Operand::Const(c) => *c,
-    };
     for &z in f.body.iter().rev() {
         let a = adj[z.index()];
         if a == 0.0 {
             continue;
         }
-        let mut give = |o: &Operand, d: f64| {
-            if let Operand::Value(v) = o {
-                adj[v.index()] += a * d;
-            }
-        };
-        match &f.value(z).def {
-            Def::Trig(t, p) => {
-                let q = vals[p.index()];
-                give(&Operand::Value(*p), if *t == TrigFn::Sin { q.cos() } else { -q.sin() });
-            }
-            Def::Binary(op, p, q) => match op {
-                BinOp::Add => {
-                    give(p, 1.0);
-                    give(q, 1.0);
-                }
-                BinOp::Sub => {
-                    give(p, 1.0);
-                    give(q, -1.0);
-                }
-                BinOp::Mul => {
-                    give(p, val(q));
-                    give(q, val(p));
-                }
-                BinOp::Div => {
-                    give(p, 1.0 / val(q));
-                    give(q, -val(p) / (val(q) * val(q)));
-                }
-            },
-            Def::Call(c, args) => match Intrinsic::of(c, args.len()) {
-                Some(Intrinsic::Sqrt) => give(&args[0], 0.5 / val(&args[0]).sqrt()),
-                Some(i) => {
-                    let s = if i == Intrinsic::Fnma { -1.0 } else { 1.0 };
-                    give(&args[0], s * val(&args[1]));
-                    give(&args[1], s * val(&args[0]));
-                    give(&args[2], if i == Intrinsic::Fms { -1.0 } else { 1.0 });
-                }
-                None => {}
-            },
-            Def::Input | Def::Expr(_) => {}
-        }
+        local_partials(&f.value(z).def, vals, |v, d| adj[v.index()] += a * d);
     }
     adj
+}
+
+/// Calls `give(operand, ∂z/∂operand)` for each value operand of the op `def` of an atomised
+/// value `z`, at the binary64 values `vals` (by [`Value::index`]): `1`, `−1` for sums, the other
+/// factor for products, `1/b` and `−a/b²` for `a/b`, `1/(2√a)`, `cos a` and `−sin a`, the
+/// fused ops' factors. A callback, an input or an expression gives none. An operand read
+/// twice is given twice (the partials add up).
+pub fn local_partials(def: &Def, vals: &[f64], mut give: impl FnMut(Value, f64)) {
+    let val = |o: &Operand| match o {
+        Operand::Value(v) => vals[v.index()],
+        Operand::Const(c) => *c,
+    };
+    let mut give = |o: &Operand, d: f64| {
+        if let Operand::Value(v) = o {
+            give(*v, d);
+        }
+    };
+    match def {
+        Def::Trig(t, p) => {
+            let q = vals[p.index()];
+            give(&Operand::Value(*p), if *t == TrigFn::Sin { q.cos() } else { -q.sin() });
+        }
+        Def::Binary(op, p, q) => match op {
+            BinOp::Add => {
+                give(p, 1.0);
+                give(q, 1.0);
+            }
+            BinOp::Sub => {
+                give(p, 1.0);
+                give(q, -1.0);
+            }
+            BinOp::Mul => {
+                give(p, val(q));
+                give(q, val(p));
+            }
+            BinOp::Div => {
+                give(p, 1.0 / val(q));
+                give(q, -val(p) / (val(q) * val(q)));
+            }
+        },
+        Def::Call(c, args) => match Intrinsic::of(c, args.len()) {
+            Some(Intrinsic::Sqrt) => give(&args[0], 0.5 / val(&args[0]).sqrt()),
+            Some(i) => {
+                let s = if i == Intrinsic::Fnma { -1.0 } else { 1.0 };
+                give(&args[0], s * val(&args[1]));
+                give(&args[1], s * val(&args[0]));
+                give(&args[2], if i == Intrinsic::Fms { -1.0 } else { 1.0 });
+            }
+            None => {}
+        },
+        Def::Input | Def::Expr(_) => {}
+    }
 }
