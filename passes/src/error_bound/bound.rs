@@ -68,7 +68,7 @@ use robovec_ir::format::Format;
 use robovec_ir::interval::LIBM_ULPS;
 use robovec_ir::{BinOp, Def, Function, Interval, Intrinsic, Operand, Span, Value};
 
-use crate::range::harmonic::{Adjoints, HarmonicSweep, DEFAULT_ATOMS};
+use crate::range::harmonic::{adjoint_atoms, Adjoints, HarmonicSweep};
 
 /// Which format each value is computed in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -254,7 +254,14 @@ impl OutputAdjoints {
         if f.outputs.len().saturating_mul(f.body.len()) > ADJOINT_WORK {
             return None;
         }
-        let mut exact = HarmonicSweep::over_enclosures(f, x, DEFAULT_ATOMS);
+        Some(Self::with_atoms(f, x, adjoint_atoms(f.outputs.len(), f.body.len())))
+    }
+
+    /// The adjoints of `f`'s outputs over the enclosures `x`, their forms capped at `atoms`
+    /// atoms (≥ 4) whatever the function's size: [`OutputAdjoints::new`] takes
+    /// [`adjoint_atoms`]; this is for comparisons. O(outputs · ops · atoms²) time.
+    pub fn with_atoms(f: &Function, x: &[Interval], atoms: usize) -> OutputAdjoints {
+        let mut exact = HarmonicSweep::over_enclosures(f, x, atoms);
         for &v in &f.body {
             exact.step(v, x);
         }
@@ -266,7 +273,7 @@ impl OutputAdjoints {
             }
             outputs.push((v, exact.adjoints(v, x)));
         }
-        Some(OutputAdjoints { outputs })
+        OutputAdjoints { outputs }
     }
 }
 
@@ -396,7 +403,7 @@ fn adjoint_sum(adj: &Adjoints, s: &Sources) -> f64 {
 /// each value's rounding with ([`HarmonicSweep::adjoints`]); `None` when a value on the way
 /// has no form (a callback, a divisor or root's operand whose enclosure holds 0).
 pub fn adjoint_sups(f: &Function, x: &[Interval], out: Value) -> Option<Vec<f64>> {
-    let mut exact = HarmonicSweep::over_enclosures(f, x, DEFAULT_ATOMS);
+    let mut exact = HarmonicSweep::over_enclosures(f, x, adjoint_atoms(1, f.body.len()));
     for &v in &f.body {
         exact.step(v, x);
     }
@@ -404,14 +411,17 @@ pub fn adjoint_sups(f: &Function, x: &[Interval], out: Value) -> Option<Vec<f64>
 }
 
 /// The most `outputs × ops` for which [`bound`] also bounds each output by its adjoints
-/// ([`HarmonicSweep::adjoints`]: one reverse sweep of O(ops · cap²) per output, 2–10 µs per op
-/// on this machine); beyond it the forward bound alone. Measured (`error-bound<format=f32>`,
-/// release), forward → with adjoints: UR5 RNEA (6 × 399) 4.2·10⁻² → 8.0·10⁻³ N·m in 25 ms;
-/// Panda (9 × 944) 2.3× tighter in 0.2 s; beyond the cap, Talos (32 × 3,969) 1.17× in 1.4 s
-/// against 0.02 s, the Segway's `dirdyna` over whole turns (192 × 3,633) 1.9× at the median
-/// output, up to 5.6×, in 1.5 s against 0.08 s; a humanoid's `dirdyna` (1,306 × 33k) would
-/// take minutes.
-pub const ADJOINT_WORK: usize = 100_000;
+/// ([`HarmonicSweep::adjoints`]: one reverse sweep of O(ops · atoms²) per output, the atoms
+/// [`adjoint_atoms`]); beyond it the forward bound alone. Measured (`error-bound<format=f32>`,
+/// release, the whole run), forward → with adjoints: UR5 RNEA (6 × 399, 1,024 atoms) 4.2·10⁻²
+/// → 4.7·10⁻³ N·m in 0.14 s; Panda (9 × 944, 1,024 atoms) 3.2·10⁻¹ → 1.2·10⁻¹ N·m in 1.6 s;
+/// Talos (32 × 3,969, 48 atoms) 3.0·10¹ → 2.6·10¹ N·m, median bound / witness 1,196 → 917, in
+/// 1.4 s against 0.8 s; a 30-dof chain's `invdyna` (30 × 2,971) in 4.7 s and 0.5 GB. Beyond it:
+/// the Segway's `dirdyna` over whole turns (192 × 3,633) would be 1.9× tighter at the median
+/// output, up to 5.6×, in 1.5 s against 0.08 s (left out: every corpus function between 2·10⁵
+/// and 10⁶ would add seconds to the test suite's corpus sweeps); a humanoid's `dirdyna`
+/// (1,306 × 33k) would take minutes.
+pub const ADJOINT_WORK: usize = 200_000;
 
 /// True when the operand's computed value is never negative (or is NaN).
 fn is_nonneg(o: &Operand, nonneg: &[bool]) -> bool {

@@ -98,8 +98,10 @@ pub fn enclose(f: &Function, domain: &Domain, tick: impl FnMut() -> bool) -> Res
 }
 
 /// [`enclose`], and with `affine = Some(cap)` each interval intersected with the range of the
-/// value's affine form of at most `cap` noise symbols ([`super::affine`]): never wider than
-/// [`enclose`]'s, O(ops · cap).
+/// value's affine form of at most `cap` noise symbols ([`super::affine`]) and with the range of
+/// its harmonic form of at most [`super::harmonic::range_atoms`]`(ops)` atoms
+/// ([`super::harmonic`]): never wider than [`enclose`]'s, O(ops · cap) for the affine forms and
+/// O(ops · atoms²) for the harmonic ones.
 ///
 /// # Errors
 /// As [`enclose`].
@@ -119,7 +121,7 @@ pub fn enclose_with(
     }
     let mut sweep = affine.map(|cap| super::affine::AffineSweep::new(f, domain, cap));
     let mut harmonic =
-        affine.and_then(|_| super::harmonic::HarmonicSweep::new(f, domain, super::harmonic::DEFAULT_ATOMS));
+        affine.and_then(|_| super::harmonic::HarmonicSweep::new(f, domain, super::harmonic::range_atoms(f.body.len())));
     for (k, &v) in f.body.iter().enumerate() {
         if tick() {
             return Err(EncloseError::Stopped(k));

@@ -35,7 +35,9 @@
 //! **Cap.** A form keeps at most `cap` atoms: the pairs `(h, symbol)` of smallest bound beyond
 //! it go to the own symbol (their bound, rounded up). A product costs O(cap²) (the centre part of
 //! one operand times the other), the sweep O(ops · cap²) in time and O(live values · cap) in
-//! memory; the harmonics are interned once per sweep.
+//! memory; the harmonics are interned once per sweep. The cap scales with the function's size
+//! ([`range_atoms`], [`adjoint_atoms`]): within [48, 1,024], many atoms where a function is
+//! small enough to afford them, 48 for the largest, so the work stays linear in ops.
 
 use robovec_ir::domain::Domain;
 use robovec_ir::interval::LIBM_ULPS;
@@ -45,8 +47,45 @@ use rustc_hash::FxHashMap;
 use super::affine::{reciprocal_line, sqrt_line};
 use super::enclose::of;
 
-/// Default cap on the atoms of one form.
-pub const DEFAULT_ATOMS: usize = 48;
+/// Fewest atoms a form keeps: the cap of the largest functions (WALK-MAN's 33k ops and beyond).
+pub const MIN_ATOMS: usize = 48;
+/// Most atoms a form keeps: the cap of the smallest functions (an arm's RNEA).
+pub const MAX_ATOMS: usize = 1024;
+/// `ops × cap` the enclosing sweep ([`HarmonicSweep::new`]) may spend: the cap is
+/// `2²⁰ / ops` within [[`MIN_ATOMS`], [`MAX_ATOMS`]] ([`range_atoms`]).
+pub const RANGE_ATOM_WORK: usize = 1 << 20;
+/// `(outputs × ops)² × cap` the adjoint sweeps ([`HarmonicSweep::adjoints`], one per output)
+/// may spend: the cap is `2³⁷ / (outputs × ops)²` within [[`MIN_ATOMS`], [`MAX_ATOMS`]]
+/// ([`adjoint_atoms`]).
+pub const ADJOINT_ATOM_WORK: u64 = 1 << 37;
+
+/// The cap on a form's atoms when enclosing a function of `ops` ops: `2²⁰ / ops` within
+/// [48, 1,024] atoms.
+///
+/// More atoms keep more (harmonic, symbol) pairs apart, fewer go to the value's own symbol:
+/// the enclosures tighten (Panda's RNEA: the binary32 bound 3.2·10⁻¹ → 2.5·10⁻¹ N·m at 48 →
+/// 1,024 atoms) for O(ops · cap²) time, which is why the cap falls as the function grows:
+/// 1,024 atoms up to 1,024 ops (an arm: +0.02 s), 264 at Talos's 3,969, 48 from 21,845 ops on
+/// (a humanoid's `dirdyna`, where the sweep already takes a fifth of a second). docs/accuracy.md.
+pub fn range_atoms(ops: usize) -> usize {
+    (RANGE_ATOM_WORK / ops.max(1)).clamp(MIN_ATOMS, MAX_ATOMS)
+}
+
+/// The cap on a form's atoms in the adjoint sweeps of a function with `outputs` outputs and
+/// `ops` ops: `2³⁷ / (outputs × ops)²` within [48, 1,024] atoms.
+///
+/// The sweeps cost O(outputs × ops × atoms²) when the forms fill their cap, which a long chain's
+/// do (30 revolute joints in series: 30 × 2,971 at 94 atoms took 15 s and 2 GB), and much less
+/// when they do not (an arm's): so the cap falls with the square of the work and reaches 48 at
+/// 53,000 `outputs × ops`. Measured (release, binary32 bound, the largest over the outputs and
+/// the median bound / witness): UR5 RNEA (1,024 atoms) 8.0·10⁻³ → 4.7·10⁻³ N·m (median 19.6 →
+/// 14.1) in 0.14 s; Panda (1,024) 3.2·10⁻¹ → 1.2·10⁻¹ N·m (117 → 59) in 1.6 s.
+/// docs/accuracy.md.
+pub fn adjoint_atoms(outputs: usize, ops: usize) -> usize {
+    let work = (outputs.max(1) as u64).saturating_mul(ops.max(1) as u64);
+    let cap = ADJOINT_ATOM_WORK / work.saturating_mul(work);
+    usize::try_from(cap).unwrap_or(usize::MAX).clamp(MIN_ATOMS, MAX_ATOMS)
+}
 
 /// `2⁻⁵²`, as [`super::affine`]'s bound for one rounding (relative).
 const U: f64 = f64::EPSILON;

@@ -65,7 +65,7 @@ pub const METHOD: ParamInfo = ParamInfo {
     kind: ParamKind::Choice { choices: Method::WORDS, default: "affine" },
     doc: "interval: outward-rounded interval arithmetic; affine: intervals intersected with affine forms \
           (correlation-aware, O(ops · terms)) and with affine forms on the harmonics of the joint angles \
-          (rotations exact, O(ops · 48²))",
+          (rotations exact, O(ops · atoms²), atoms = 2^20 / ops within [48, 1024])",
 };
 
 /// `terms=K` (also `error-bound`'s).
