@@ -289,7 +289,7 @@ fn the_segway_gets_narrow_fixed_point_words_on_the_fpga() {
     let mut last: Option<(f64, f64)> = None;
     for (k, budget) in [1e-7, 1e-5, 1e-3, 1e-2].into_iter().enumerate() {
         let budgets = vec![robovec_passes::precision::budget::Budget::Rel(budget); f.outputs.len()];
-        let c = robovec_passes::precision::choose_on(&f, &x, &budgets, Target::Fpga, &device, || false).unwrap();
+        let c = robovec_passes::precision::choose_on(&f, &x, &budgets, Target::Fpga, &device, robovec_passes::error_bound::TrigImpl::Libm, || false).unwrap();
         let mut g = f.clone();
         for &(v, fmt) in &c.formats {
             g.set_format(v, fmt);

@@ -47,7 +47,9 @@
 //! - **`f32`** (every value binary32, as `accuracy`'s binary32 evaluation and the C back end's
 //!   `float` compute): inputs and constants rounded to binary32 (a constant's error, and that
 //!   of an input whose range is a point, is its exact distance to its binary32 value); each op `rel = 2⁻²⁴`, `abs = 2⁻¹⁵⁰`; `sin`, `cos` of
-//!   binary32 `rel = `[`LIBM_ULPS`]`·2⁻²³`.
+//!   binary32 `rel = `[`LIBM_ULPS`]`·2⁻²³` — or `2⁻²³` (1 ulp, [`INLINE32_ULPS`]) with
+//!   [`TrigImpl::Inline`] when the computed argument is within [`INLINE32_LIMIT`]: robovec's own
+//!   binary32 kernel, as `codegen<c;trig=inline>` writes it, checked on every such argument.
 //! - **`mixed`** (each value in its own format, [`robovec_ir::format`]: an op computes in its
 //!   value's format): binary64 as above; a binary32 op reads its operands rounded to binary32
 //!   (a constant's error is its exact distance to binary32, a binary64 or fixed-point operand
@@ -80,6 +82,31 @@ pub enum Formats {
     /// Each value in its own format ([`Function::format`]).
     Mixed,
 }
+
+crate::params::word_enum! {
+    /// Which `sin`/`cos` the computed function calls: the error each is allowed.
+    pub enum TrigImpl {
+        /// The C library's (and `-eval`'s): [`LIBM_ULPS`] ulps of the result's format.
+        Libm = "libm",
+        /// robovec's own, as `codegen<c;trig=inline>` writes it: a binary32 `sin`/`cos` whose
+        /// argument is within [`INLINE32_LIMIT`] is within [`INLINE32_ULPS`] ulp of the exact
+        /// value (every such binary32 argument checked); beyond it, and in binary64 (tested on
+        /// hard arguments, not on all of them), [`LIBM_ULPS`].
+        Inline = "inline",
+    }
+}
+
+/// The largest `|x|` (rad) whose binary32 `sin`/`cos` `codegen<c;trig=inline>` computes with its
+/// own kernel (2¹¹; beyond it the C library's `sinf`/`cosf`): `backends/src/c/trig`.
+pub const INLINE32_LIMIT: f64 = 2048.0;
+
+/// The error allowed to the binary32 `sin`/`cos` of `codegen<c;trig=inline>` on
+/// `|x| ≤` [`INLINE32_LIMIT`], in ulps of the exact value's binade: 1. Every binary32 argument
+/// of that range, both signs, through the three kernels the back end writes (one state, a
+/// `float` batch, binary32 values in a `double` file), compiled with and without FMA, was
+/// compared with the C library's binary64 `sin`/`cos` (`scripts/trig_ulps.sh`; the largest
+/// error and where are in docs/accuracy.md).
+pub const INLINE32_ULPS: f64 = 1.0;
 
 /// The rounding of a stored result: `|fl(y) − y| ≤ rel·|y| + abs`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -219,12 +246,13 @@ pub fn bound_with_more_bits(
     tick: impl FnMut() -> bool,
 ) -> Result<Vec<f64>, BoundError> {
     let adjoints = OutputAdjoints::new(f, x);
-    bound_with_adjoints(f, x, mode, bits, adjoints.as_ref(), tick)
+    bound_with_adjoints(f, x, mode, bits, adjoints.as_ref(), TrigImpl::Libm, tick)
 }
 
 /// [`bound_with_more_bits`] with each output's adjoints computed already ([`OutputAdjoints`]:
 /// they depend on the ops and the enclosures, not on the formats, so `precision` computes them
-/// once for all its candidates); `None`: the forward bound alone.
+/// once for all its candidates; `None`: the forward bound alone), for the `sin`/`cos` `trig`
+/// (the others take [`TrigImpl::Libm`]).
 ///
 /// # Errors
 /// As [`bound`].
@@ -234,9 +262,10 @@ pub fn bound_with_adjoints(
     mode: Formats,
     bits: i32,
     adjoints: Option<&OutputAdjoints>,
+    trig: TrigImpl,
     tick: impl FnMut() -> bool,
 ) -> Result<Vec<f64>, BoundError> {
-    sweep(f, x, mode, bits, adjoints, tick)
+    sweep(f, x, mode, bits, adjoints, trig, tick)
 }
 
 /// The adjoints of each output of a function ([`HarmonicSweep::adjoints`]): `max|∂o/∂z|` for
@@ -283,7 +312,7 @@ impl OutputAdjoints {
 /// # Errors
 /// As [`bound`].
 pub fn forward_bound(f: &Function, x: &[Interval], mode: Formats) -> Result<Vec<f64>, BoundError> {
-    sweep(f, x, mode, 0, None, || false)
+    sweep(f, x, mode, 0, None, TrigImpl::Libm, || false)
 }
 
 /// The forward sweep, then (with `adjoint`) each output's adjoint bound where smaller.
@@ -293,6 +322,7 @@ fn sweep(
     mode: Formats,
     bits: i32,
     adjoints: Option<&OutputAdjoints>,
+    trig: TrigImpl,
     mut tick: impl FnMut() -> bool,
 ) -> Result<Vec<f64>, BoundError> {
     let scale = 2f64.powi(-bits);
@@ -320,7 +350,7 @@ fn sweep(
         if tick() {
             return Err(BoundError::Stopped(k));
         }
-        let (bound, local, conversions) = match propagate(f, v, x, &e, &nonneg, mode, scale) {
+        let (bound, local, conversions) = match propagate(f, v, x, &e, &nonneg, mode, trig, scale) {
             Step::Known(b) => (b, b, [0.0; 3]),
             Step::Propagated { propagated, rounding, reads, remainder } => {
                 let b = round(f, v, x, mode, scale, propagated, rounding);
@@ -604,7 +634,17 @@ enum Step {
 }
 
 /// The error `v` propagates from its operands (module doc's table) and its rounding.
-fn propagate(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool], mode: Formats, scale: f64) -> Step {
+#[allow(clippy::too_many_arguments)]
+fn propagate(
+    f: &Function,
+    v: Value,
+    x: &[Interval],
+    e: &[f64],
+    nonneg: &[bool],
+    mode: Formats,
+    trig: TrigImpl,
+    scale: f64,
+) -> Step {
     let data = f.value(v);
     let mz = x[v.index()].mag();
     if !mz.is_finite() {
@@ -619,7 +659,7 @@ fn propagate(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool],
     } else {
         Rounding::F64
     };
-    let libm_ulps = |r: Rounding| Rounding { rel: LIBM_ULPS * 2.0 * r.rel, abs: LIBM_ULPS * 2.0 * r.abs };
+    let trig_ulps = |r: Rounding, ulps: f64| Rounding { rel: ulps * 2.0 * r.rel, abs: ulps * 2.0 * r.abs };
     let reads: Vec<f64>;
     let mut remainder = 0.0;
     let (propagated, rounding) = match &data.def {
@@ -629,7 +669,9 @@ fn propagate(f: &Function, v: Value, x: &[Interval], e: &[f64], nonneg: &[bool],
             reads = vec![ea];
             // |sin(a + e) − sin a − cos a · e| ≤ e²/2 (and for cos).
             remainder = up(up(ea * ea) / 2.0);
-            (ea.min(2.0), libm_ulps(op))
+            // The computed argument is within `|a| + e_a` of 0: robovec's binary32 kernel there.
+            let own = trig == TrigImpl::Inline && rd.narrow && up(x[a.index()].mag() + ea) <= INLINE32_LIMIT;
+            (ea.min(2.0), trig_ulps(op, if own { INLINE32_ULPS } else { LIBM_ULPS }))
         }
         Def::Binary(op_kind, a, b) => {
             let (ia, ea) = rd.operand(a, x, e);

@@ -41,7 +41,7 @@ use serde::Serialize;
 use crate::params::ParamKind;
 use crate::range::{domain_with_file, enclose_in_pass, Method};
 use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
-pub use bound::{bound, BoundError, Formats, Rounding};
+pub use bound::{bound, BoundError, Formats, Rounding, TrigImpl};
 
 crate::params::word_enum! {
     /// Which format the function is computed in.
@@ -81,6 +81,7 @@ pub const INFO: PassInfo = PassInfo {
         crate::range::RANGES,
         crate::range::METHOD,
         crate::range::TERMS,
+        TRIG,
         ParamInfo {
             name: "witness",
             kind: ParamKind::U32 { default: 0, min: 0, max: 1_000_000 },
@@ -96,6 +97,7 @@ pub const INFO: PassInfo = PassInfo {
             method: p.word("method")?,
             terms: p.u32("terms")? as usize,
             witness: p.u32("witness")?,
+            trig: p.word("trig")?,
         }))
     },
     props: crate::Props {
@@ -123,7 +125,18 @@ pub struct ErrorBoundPass {
     pub terms: usize,
     /// Points the model's worst execution is run at ([`witness`]; 0: none).
     pub witness: u32,
+    /// The `sin`/`cos` the code will call.
+    pub trig: TrigImpl,
 }
+
+/// `trig=libm|inline` (also `precision`'s): the `sin`/`cos` the computed function calls.
+pub const TRIG: ParamInfo = ParamInfo {
+    name: "trig",
+    kind: ParamKind::Choice { choices: TrigImpl::WORDS, default: "libm" },
+    doc: "libm: the C library's sin/cos (and -eval's), allowed 4 ulps; inline: robovec's own, as codegen<c;trig=inline> \
+          writes it, whose binary32 sin/cos within |x| <= 2048 is allowed 1 ulp (every such argument checked: \
+          scripts/trig_ulps.sh); the certificate then holds for that code only",
+};
 
 impl Pass for ErrorBoundPass {
     fn name(&self) -> &'static str {
@@ -159,14 +172,15 @@ impl Pass for ErrorBoundPass {
                     Ok(x) => x,
                     Err(stop) => return Ok(stop),
                 };
-                let e = match bound(f, &x, formats, || ticker.tick()) {
+                let adjoints = bound::OutputAdjoints::new(f, &x);
+                let e = match bound::bound_with_adjoints(f, &x, formats, 0, adjoints.as_ref(), self.trig, || ticker.tick()) {
                     Ok(e) => e,
                     Err(err @ BoundError::Stopped(_)) => {
                         return Ok(Step::Stopped { what: err.message(&f.name), kept: None });
                     }
                     Err(err) => return Err(located(err.message(&f.name), err.span())),
                 };
-                let mut summary = summarise(f, &x, &e, word);
+                let mut summary = summarise(f, &x, &e, word, self.trig);
                 if self.witness > 0 {
                     let found = witnesses(f, &dom, formats, self.witness, || ticker.tick());
                     let Some(found) = found else {
@@ -260,6 +274,8 @@ pub struct FunctionBound {
     pub function: String,
     /// The formats it was bounded in.
     pub format: FormatWord,
+    /// The `sin`/`cos` it was bounded for.
+    pub trig: TrigImpl,
     /// Per output, in output order: name and bound.
     pub outputs: Vec<(String, OutputBound)>,
     /// The largest finite `abs` and its output.
@@ -271,7 +287,7 @@ pub struct FunctionBound {
 }
 
 /// The bounds of `f`'s outputs from the enclosures `x` and value bounds `e`.
-fn summarise(f: &Function, x: &[Interval], e: &[f64], format: FormatWord) -> FunctionBound {
+fn summarise(f: &Function, x: &[Interval], e: &[f64], format: FormatWord, trig: TrigImpl) -> FunctionBound {
     let outputs: Vec<(String, OutputBound)> = f
         .outputs
         .iter()
@@ -295,6 +311,7 @@ fn summarise(f: &Function, x: &[Interval], e: &[f64], format: FormatWord) -> Fun
     FunctionBound {
         function: f.name.clone(),
         format,
+        trig,
         max_abs: largest(|b| b.abs),
         max_rel: largest(|b| b.rel),
         unbounded: outputs.iter().filter(|(_, b)| b.abs.is_none()).map(|(n, _)| n.clone()).collect(),
@@ -315,9 +332,10 @@ impl std::fmt::Display for FunctionBound {
         let n = self.outputs.len() - self.unbounded.len();
         write!(
             f,
-            "error-bound @{} ({}): {n} of {} outputs bounded",
+            "error-bound @{} ({}{}): {n} of {} outputs bounded",
             self.function,
             self.format.as_str(),
+            if self.trig == TrigImpl::Inline { ", trig=inline" } else { "" },
             self.outputs.len()
         )?;
         if let Some((o, a)) = &self.max_abs {
@@ -351,6 +369,9 @@ impl std::fmt::Display for FunctionBound {
 #[derive(Serialize)]
 struct ErrorBoundReport<'a> {
     format: &'static str,
+    /// Present with `trig=inline` only (the report is unchanged by default).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    trig: Option<&'static str>,
     outputs: serde_json::Map<String, serde_json::Value>,
     max_abs: Option<f64>,
     max_rel: Option<f64>,
@@ -372,6 +393,7 @@ impl crate::Artifact for ErrorBoundRun {
             r.outputs.iter().map(|(n, b)| (n.clone(), serde_json::to_value(b).expect("serialises"))).collect();
         let value = ErrorBoundReport {
             format: r.format.as_str(),
+            trig: (r.trig == TrigImpl::Inline).then_some(r.trig.as_str()),
             outputs,
             max_abs: r.max_abs.as_ref().map(|m| m.1),
             max_rel: r.max_rel.as_ref().map(|m| m.1),

@@ -12,7 +12,9 @@ use robovec_machine::target::Target as Device;
 
 use super::budget::Budget;
 use super::fpga;
-use crate::error_bound::bound::{bound_with_adjoints, sensitivities, BoundError, Formats, OutputAdjoints, Rounding};
+use crate::error_bound::bound::{
+    bound_with_adjoints, sensitivities, BoundError, Formats, OutputAdjoints, Rounding, TrigImpl,
+};
 
 crate::params::word_enum! {
     /// What the formats are chosen for (`target=`).
@@ -143,11 +145,13 @@ pub fn choose(
     target: Target,
     stop: impl FnMut() -> bool,
 ) -> Result<Choice, String> {
-    choose_on(f, x, budgets, target, &Device::de10_nano(), stop)
+    choose_on(f, x, budgets, target, &Device::de10_nano(), TrigImpl::Libm, stop)
 }
 
 /// [`choose`] for the target description `device` (what `target=fpga` costs against: its DSP
-/// blocks, ALM and [`robovec_machine::target::Datapath`]; the other targets ignore it).
+/// blocks, ALM and [`robovec_machine::target::Datapath`]; the other targets ignore it) and the
+/// `sin`/`cos` the code will call (`trig`: [`TrigImpl::Inline`] for `codegen<c;trig=inline>`,
+/// whose binary32 kernel is allowed 1 ulp where the C library is allowed 4).
 ///
 /// # Errors
 /// As [`choose`].
@@ -157,6 +161,7 @@ pub fn choose_on(
     budgets: &[Budget],
     target: Target,
     device: &Device,
+    trig: TrigImpl,
     mut stop: impl FnMut() -> bool,
 ) -> Result<Choice, String> {
     assert_eq!(budgets.len(), f.outputs.len(), "one budget per output");
@@ -165,7 +170,7 @@ pub fn choose_on(
     // The outputs' adjoints depend on the ops and the enclosures only: once for every sweep.
     let adjoints = OutputAdjoints::new(f, x);
     let adjoints = adjoints.as_ref();
-    let bound = |h: &Function, x: &[Interval], mode| bound_with_adjoints(h, x, mode, 0, adjoints, || false);
+    let bound = |h: &Function, x: &[Interval], mode| bound_with_adjoints(h, x, mode, 0, adjoints, trig, || false);
     let e64 = bound(&g, x, Formats::Mixed).map_err(|e| e.message(&f.name))?;
     // Outputs with a budget: those whose range is not 0. One whose binary64 bound already
     // exceeds it keeps that bound as its budget (it stays as binary64 computes it); one with
@@ -357,7 +362,7 @@ pub fn choose_on(
         Some(&Budget::Rel(r)) if budgets.iter().all(|b| *b == Budget::Rel(r)) => Some(r),
         _ => None,
     };
-    let more = bound_with_adjoints(&g, x, Formats::Mixed, 1, adjoints, || false).ok();
+    let more = bound_with_adjoints(&g, x, Formats::Mixed, 1, adjoints, trig, || false).ok();
     let one_more_bit = outs.iter().map(|(_, v, _)| more.as_ref().map_or(f64::INFINITY, |m| m[v.index()])).collect();
     Ok(Choice {
         one_more_bit,

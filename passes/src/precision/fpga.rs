@@ -61,7 +61,7 @@ use robovec_ir::format::{Format, FIX_FRACTION_RANGE, FIX_MAX_WIDTH};
 use robovec_ir::{BinOp, Def, Function, Interval, Intrinsic, Operand, Value};
 use robovec_machine::target::Target as Device;
 
-use crate::error_bound::bound::{bound_with_adjoints, sensitivities, BoundError, Formats, OutputAdjoints};
+use crate::error_bound::bound::{bound_with_adjoints, sensitivities, BoundError, Formats, OutputAdjoints, TrigImpl};
 
 /// Rounds of bit removal (step 3 of the module doc).
 pub const ROUNDS: usize = 4;
@@ -339,7 +339,7 @@ impl<'a, S: FnMut() -> bool> Search<'a, S> {
         }
         self.sweeps += 1;
         let e =
-            bound_with_adjoints(h, self.x, Formats::Mixed, 0, self.adjoints, || false).map_err(|err| match err {
+            bound_with_adjoints(h, self.x, Formats::Mixed, 0, self.adjoints, TrigImpl::Libm, || false).map_err(|err| match err {
                 BoundError::FixOverflow { value, .. } => Refused::Overflow(value),
                 BoundError::Stopped(_) => Refused::Stopped,
             })?;
@@ -623,7 +623,7 @@ pub fn tighten<S: FnMut() -> bool>(f: &Function, g: &Function, s: &mut Search<'_
         return g.clone();
     }
     s.sweeps += 1;
-    let Ok(e) = bound_with_adjoints(g, s.x, Formats::Mixed, 0, s.adjoints, || false) else { return g.clone() };
+    let Ok(e) = bound_with_adjoints(g, s.x, Formats::Mixed, 0, s.adjoints, TrigImpl::Libm, || false) else { return g.clone() };
     let mut h = g.clone();
     for &v in &values {
         if let Format::Fix { fraction, .. } = g.format(v) {
@@ -635,7 +635,7 @@ pub fn tighten<S: FnMut() -> bool>(f: &Function, g: &Function, s: &mut Search<'_
         }
     }
     s.sweeps += 1;
-    match bound_with_adjoints(&h, s.x, Formats::Mixed, 0, s.adjoints, || false) {
+    match bound_with_adjoints(&h, s.x, Formats::Mixed, 0, s.adjoints, TrigImpl::Libm, || false) {
         Ok(eh) if s.outs.iter().all(|&(v, b)| eh[v.index()] <= b) => h,
         _ => g.clone(),
     }

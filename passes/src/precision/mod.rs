@@ -55,6 +55,7 @@ use crate::params::ParamKind;
 use crate::range::{domain_with_file, enclose_in_pass};
 use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 pub use choose::{choose, choose_on, Choice, FpgaFigures, Target};
+use crate::error_bound::TrigImpl;
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
@@ -76,13 +77,21 @@ pub const INFO: PassInfo = PassInfo {
                   binary32, costed in DSP blocks and ALM of the -target description",
         },
         crate::range::RANGES,
+        crate::error_bound::TRIG,
     ],
     build: |p: &Params| {
-        Ok(Box::new(PrecisionPass {
-            budget: p.f64_or_path("budget")?,
-            target: p.word("target")?,
-            ranges: p.path("ranges")?,
-        }))
+        let (target, trig): (Target, TrigImpl) = (p.word("target")?, p.word("trig")?);
+        if trig == TrigImpl::Inline && target != Target::C {
+            return Err(PassError::BadParameter {
+                pass: "precision".into(),
+                message: format!(
+                    "trig=inline is the C back end's own sin/cos (codegen<c;trig=inline>): it goes with target=c, \
+                     not target={}",
+                    target.as_str()
+                ),
+            });
+        }
+        Ok(Box::new(PrecisionPass { budget: p.f64_or_path("budget")?, target, ranges: p.path("ranges")?, trig }))
     },
     props: crate::Props {
         requires: Some(robovec_ir::Phase::Atomised),
@@ -104,6 +113,8 @@ pub struct PrecisionPass {
     pub target: Target,
     /// A ranges file applied over the run's domain.
     pub ranges: Option<String>,
+    /// The `sin`/`cos` the code will call (`trig=inline` with `target=c` only).
+    pub trig: TrigImpl,
 }
 
 impl Pass for PrecisionPass {
@@ -146,7 +157,7 @@ impl Pass for PrecisionPass {
                         file.resolve(&names).map_err(|e| failed(format!("@{}: budget file: {e}", f.name)))?
                     }
                 };
-                let c = choose_on(f, &x, &budgets, target, device, || ticker.tick()).map_err(failed)?;
+                let c = choose_on(f, &x, &budgets, target, device, self.trig, || ticker.tick()).map_err(failed)?;
                 if c.stopped {
                     let note = format!(
                         "searching @{} early (the formats accepted so far kept, every budget met): {}",
