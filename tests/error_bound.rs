@@ -155,6 +155,15 @@ fn check_sound_formatted(what: &str, g: &Function, dom: &Domain, seed: u64) {
     }
 }
 
+/// The domain a `-report` says its run used (`domain`: each input's `range`).
+fn report_domain(r: &serde_json::Value) -> Domain {
+    let mut dom = Domain::default();
+    for (name, d) in r["domain"].as_object().expect("the report has a domain") {
+        dom.ranges.insert(name.clone(), range(d["range"][0].as_f64().unwrap(), d["range"][1].as_f64().unwrap()));
+    }
+    dom
+}
+
 proptest! {
     // 64 cases (PROPTEST_CASES=N for a longer campaign: the 10⁴ random DAGs).
     #![proptest_config(ProptestConfig {
@@ -783,10 +792,7 @@ fn adjoints_of_the_ur5_rnea_and_its_fixed_point_bound() {
     let max_abs = r["error_bound"]["max_abs"].as_f64().unwrap();
     assert!(max_abs <= 1e-4, "certified {max_abs:e} N·m");
     // The domain the report used, for the adjoints' check and the forward bound alone.
-    let mut dom = Domain::default();
-    for (name, d) in r["domain"].as_object().unwrap() {
-        dom.ranges.insert(name.clone(), range(d["range"][0].as_f64().unwrap(), d["range"][1].as_f64().unwrap()));
-    }
+    let dom = report_domain(&r);
     let mut plain = g.clone();
     plain.clear_formats();
     assert!(check_adjoints("UR5", &plain, &dom, 200, 5) > 10_000);
@@ -941,11 +947,7 @@ fn witness_tightness() {
             &dir,
             &[urdf.to_str().unwrap(), "-function=invdyna", "--fold-params", "-passes=default<ops>,error-bound<format=f32>"],
         );
-        let mut dom = Domain::default();
-        for (input, d) in r["domain"].as_object().unwrap() {
-            dom.ranges.insert(input.clone(), range(d["range"][0].as_f64().unwrap(), d["range"][1].as_f64().unwrap()));
-        }
-        cases.push((name.to_string(), m.functions[0].clone(), dom));
+        cases.push((name.to_string(), m.functions[0].clone(), report_domain(&r)));
     }
     if let Ok(only) = std::env::var("WITNESS_CORPUS") {
         for (name, f) in crate::tree_height::corpus_functions() {
@@ -1075,10 +1077,7 @@ fn the_atom_cap_scales_with_the_function() {
         &[urdf.to_str().unwrap(), "-function=invdyna", "--fold-params", "-passes=default<ops>,error-bound<format=f32>"],
     );
     let f = &m.functions[0];
-    let mut dom = Domain::default();
-    for (name, d) in r["domain"].as_object().unwrap() {
-        dom.ranges.insert(name.clone(), range(d["range"][0].as_f64().unwrap(), d["range"][1].as_f64().unwrap()));
-    }
+    let dom = report_domain(&r);
     let x = enclose_with(f, &dom, Some(64), || false).unwrap();
     let outs: Vec<_> = f
         .outputs

@@ -529,6 +529,8 @@ fn inline_trig_meets_its_one_ulp_allowance_in_the_bound() {
     use std::fmt::Write as _;
     let n = 512;
     let mut rng = robovec_ir::rng::SplitMix64::new(11);
+    // `x` moved by `k` binary32 steps (down for negative `k`).
+    let steps = |x: f32, k: i32| (0..k.abs()).fold(x, |x, _| if k > 0 { x.next_up() } else { x.next_down() });
     let xs: Vec<f32> = (0..n)
         .map(|k| {
             let x = if k % 2 == 0 {
@@ -536,7 +538,7 @@ fn inline_trig_meets_its_one_ulp_allowance_in_the_bound() {
             } else {
                 let j = (rng.unit() * 2600.0) as i64 - 1300;
                 let near = j as f64 * std::f64::consts::FRAC_PI_2;
-                (near as f32).next_after_n(k % 7 - 3)
+                steps(near as f32, k % 7 - 3)
             };
             x.clamp(-2048.0, 2048.0)
         })
@@ -609,16 +611,5 @@ fn inline_trig_meets_its_one_ulp_allowance_in_the_bound() {
         }
         // The allowance is used: the worst output takes a good part of it.
         assert!(worst > 0.2, "batch={batch}: the largest error is only {worst} of its bound");
-    }
-}
-
-/// `f32::next_up` applied `n` times (`next_down` for negative `n`).
-trait NextAfter {
-    fn next_after_n(self, n: i32) -> Self;
-}
-
-impl NextAfter for f32 {
-    fn next_after_n(self, n: i32) -> f32 {
-        (0..n.abs()).fold(self, |x, _| if n > 0 { x.next_up() } else { x.next_down() })
     }
 }

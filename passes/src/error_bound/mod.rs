@@ -133,7 +133,8 @@ pub struct ErrorBoundPass {
 pub const TRIG: ParamInfo = ParamInfo {
     name: "trig",
     kind: ParamKind::Choice { choices: TrigImpl::WORDS, default: "libm" },
-    doc: "libm: the C library's sin/cos (and -eval's), allowed 4 ulps; inline: robovec's own, as codegen<c;trig=inline> \
+    doc:
+        "libm: the C library's sin/cos (and -eval's), allowed 4 ulps; inline: robovec's own, as codegen<c;trig=inline> \
           writes it, whose binary32 sin/cos within |x| <= 2048 is allowed 1 ulp (every such argument checked: \
           scripts/trig_ulps.sh); the certificate then holds for that code only",
 };
@@ -173,13 +174,15 @@ impl Pass for ErrorBoundPass {
                     Err(stop) => return Ok(stop),
                 };
                 let adjoints = bound::OutputAdjoints::new(f, &x);
-                let e = match bound::bound_with_adjoints(f, &x, formats, 0, adjoints.as_ref(), self.trig, || ticker.tick()) {
-                    Ok(e) => e,
-                    Err(err @ BoundError::Stopped(_)) => {
-                        return Ok(Step::Stopped { what: err.message(&f.name), kept: None });
-                    }
-                    Err(err) => return Err(located(err.message(&f.name), err.span())),
-                };
+                let e =
+                    match bound::bound_with_adjoints(f, &x, formats, 0, adjoints.as_ref(), self.trig, || ticker.tick())
+                    {
+                        Ok(e) => e,
+                        Err(err @ BoundError::Stopped(_)) => {
+                            return Ok(Step::Stopped { what: err.message(&f.name), kept: None });
+                        }
+                        Err(err) => return Err(located(err.message(&f.name), err.span())),
+                    };
                 let mut summary = summarise(f, &x, &e, word, self.trig);
                 if self.witness > 0 {
                     let found = witnesses(f, &dom, formats, self.witness, || ticker.tick());

@@ -338,11 +338,12 @@ impl<'a, S: FnMut() -> bool> Search<'a, S> {
             return Err(Refused::Stopped);
         }
         self.sweeps += 1;
-        let e =
-            bound_with_adjoints(h, self.x, Formats::Mixed, 0, self.adjoints, TrigImpl::Libm, || false).map_err(|err| match err {
+        let e = bound_with_adjoints(h, self.x, Formats::Mixed, 0, self.adjoints, TrigImpl::Libm, || false).map_err(
+            |err| match err {
                 BoundError::FixOverflow { value, .. } => Refused::Overflow(value),
                 BoundError::Stopped(_) => Refused::Stopped,
-            })?;
+            },
+        )?;
         if self.outs.iter().all(|&(v, b)| e[v.index()] <= b) {
             Ok(e)
         } else {
@@ -623,7 +624,9 @@ pub fn tighten<S: FnMut() -> bool>(f: &Function, g: &Function, s: &mut Search<'_
         return g.clone();
     }
     s.sweeps += 1;
-    let Ok(e) = bound_with_adjoints(g, s.x, Formats::Mixed, 0, s.adjoints, TrigImpl::Libm, || false) else { return g.clone() };
+    let Ok(e) = bound_with_adjoints(g, s.x, Formats::Mixed, 0, s.adjoints, TrigImpl::Libm, || false) else {
+        return g.clone();
+    };
     let mut h = g.clone();
     for &v in &values {
         if let Format::Fix { fraction, .. } = g.format(v) {

@@ -51,11 +51,11 @@ pub mod ladder;
 use robovec_ir::Module;
 use serde::Serialize;
 
+use crate::error_bound::TrigImpl;
 use crate::params::ParamKind;
 use crate::range::{domain_with_file, enclose_in_pass};
 use crate::{try_each_function, AtTimeLimit, Before, ParamInfo, Params, Pass, PassContext, PassError, PassInfo, Step};
 pub use choose::{choose, choose_on, Choice, FpgaFigures, Target};
-use crate::error_bound::TrigImpl;
 
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
