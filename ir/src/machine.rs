@@ -184,6 +184,76 @@ pub struct OutputLoc {
     pub addr: u32,
 }
 
+/// The shifts of one op on a fixed-point PE (issue 49): the op is computed exactly on its
+/// operands' integers `ka`, `kb` (words of values `k · 2^-f`), aligned by `align` bits, then
+/// rounded by `shift` bits to the result's format ([`crate::format::IntegerOp`]: ADD PE
+/// `K = (ka << la) ± (kb << lb)` with one of `la`, `lb` zero; MULTI PE `K = ka · kb`; then
+/// `(K + 2^(shift−1)) >> shift` for `shift > 0`, `K << −shift` otherwise).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FixShifts {
+    /// Bits the aligned operand is shifted left (0..=62).
+    pub align: u8,
+    /// The aligned operand is `b` (else `a`).
+    pub align_b: bool,
+    /// Bits the exact result's fraction exceeds the result's (−62..=62).
+    pub shift: i8,
+}
+
+impl FixShifts {
+    /// Bits of [`FixShifts::word`].
+    pub const BITS: u32 = 14;
+
+    /// The shift word of the design's shift memory: `[0,6)` align, bit 6 `align_b`, `[7,14)`
+    /// shift in two's complement.
+    pub fn word(&self) -> u64 {
+        u64::from(self.align & 63) | (u64::from(self.align_b) << 6) | ((u64::from(self.shift as u8) & 127) << 7)
+    }
+
+    /// The shifts of a shift word ([`FixShifts::word`]'s inverse on its 14 bits).
+    pub fn from_word(w: u64) -> FixShifts {
+        let s = ((w >> 7) & 127) as i16;
+        let shift = (if s >= 64 { s - 128 } else { s }) as i8;
+        FixShifts { align: (w & 63) as u8, align_b: (w >> 6) & 1 == 1, shift }
+    }
+
+    /// The rounded result of the exact intermediate `k` (exact in `i128`).
+    pub fn round(&self, k: i128) -> i128 {
+        match self.shift {
+            s if s > 0 => (k + (1i128 << (s - 1))) >> s,
+            s => k << -s,
+        }
+    }
+}
+
+/// The fixed-point side of a program whose PEs compute in fixed point (issue 49): a function
+/// whose every op is an integer op of `fix<w,f>` values with `w ≤ 32`. Words are the values'
+/// integers `k` (32-bit two's complement); the fractions say what each loaded word and output
+/// means (`k · 2^-f`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FixedProgram {
+    /// Per PE slot, per cycle `0..=cycles`: the shifts of the op issued there.
+    pub shifts: Vec<Vec<Option<FixShifts>>>,
+    /// Fractional bits of each input's format, by canonical name.
+    pub inputs: std::collections::BTreeMap<String, i32>,
+    /// Fractional bits of each trig value's format, by (`sin`/`cos`, input name).
+    pub trig: std::collections::BTreeMap<(TrigFn, String), i32>,
+    /// Fractional bits of each output's format, in [`MachineProgram::outputs`] order.
+    pub outputs: Vec<i32>,
+}
+
+impl FixedProgram {
+    /// The fractional bits of a loaded word (a constant: [`crate::format::fix_constant`]'s);
+    /// `None` for an input or trig value without a fixed-point format, or a constant no 32-bit
+    /// word holds.
+    pub fn fraction(&self, w: &Word) -> Option<i32> {
+        match w {
+            Word::Input(n) => self.inputs.get(n).copied(),
+            Word::Trig(t, n) => self.trig.get(&(*t, n.clone())).copied(),
+            Word::Const(c) => crate::format::fix_constant(*c).map(|(_, f)| f),
+        }
+    }
+}
+
 /// A lowered function: what the machine executes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MachineProgram {
@@ -205,6 +275,9 @@ pub struct MachineProgram {
     /// Provenance (not encoded): the `(slot, cycle)` where each op issues, by
     /// `Value::index()` (`None` for non-ops). Lets the verifier name values.
     pub issue_of: Vec<Option<(usize, u32)>>,
+    /// Fixed-point PEs: the shifts of every op and the fractions of the words (`None`: binary32
+    /// PEs, the seed's).
+    pub fixed: Option<FixedProgram>,
 }
 
 impl MachineProgram {

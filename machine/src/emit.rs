@@ -10,8 +10,20 @@ use robovec_ir::Function;
 
 use crate::design::build::{from_placement_until, DesignError, Limits};
 use crate::design::images::Image;
-use crate::design::{Design, HDL_LIBRARY, SIMULATE};
+use crate::design::routes::Interconnect;
+use crate::design::{Design, PeKind, HDL_LIBRARY, SIMULATE};
 use crate::resources::{self, CostModel, Logic, Resources};
+
+/// What `codegen<fpga>` was asked for, beyond the placement and the target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EmitOptions<'a> {
+    /// Where the logic ALMs come from (`resources=`).
+    pub logic: Logic,
+    /// The image formats written: `mif`, `hex` or `both` (`format=`).
+    pub format: &'a str,
+    /// The interconnect (`interconnect=`; [`crate::design::routes`]).
+    pub interconnect: Interconnect,
+}
 
 /// One file of a design, its path relative to the function's folder.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -87,6 +99,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
                 ("out", m(&p.out)),
             ]
             .into_iter()
+            .chain(p.fix.as_ref().map(|i| ("fix", m(i))))
             .collect();
             ManifestPe {
                 slot: p.slot,
@@ -102,16 +115,51 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
     hdl.push("robovec_top.v");
     let w = d.widths;
     let (e, n) = (4 * w.aw, d.n_pe());
+    let xbar = match &d.routes {
+        None => format!(
+            "[0,{s}) port-0 select, [{s},{}) port-1 select: 0 none, 1..={n} result of slot s-1, {}..={} buffer read of slot s-{}",
+            2 * w.sw,
+            n + 1,
+            2 * n,
+            n + 1,
+            s = w.sw
+        ),
+        Some(_) => "per PE (its memory's `width`): port-0 select in the low bits (`routes[slot].select_bits[0]`), \
+            port-1 select above: 0 none, i the port's i-th route (`routes[slot].port0` / `port1`, 1-based)"
+            .to_string(),
+    };
+    let routes = d.routes.as_ref().map(|r| {
+        r.ports
+            .iter()
+            .enumerate()
+            .map(|(slot, ports)| {
+                let names = |port: usize| -> Vec<String> {
+                    ports[port].iter().map(|&g| r.source_name(g, |k| pe_name_of(d, k))).collect()
+                };
+                serde_json::json!({
+                    "slot": slot,
+                    "pe": pe_name_of(d, slot),
+                    "port0": names(0),
+                    "port1": names(1),
+                    "select_bits": [r.select_bits(slot, 0), r.select_bits(slot, 1)],
+                })
+            })
+            .collect::<Vec<_>>()
+    });
     let layout = serde_json::json!({
         "instr": format!("[0,{a}) read A, [{a},{b}) read B, [{b},{c}) write-0 address, [{c},{e}) write-1 address, \
             bit {e} we0, bit {} we1, bit {} issue valid, bit {} sub (ADD PE: 1 = a - b), zero up to {}",
             e + 1, e + 2, e + 3, w.instr, a = w.aw, b = 2 * w.aw, c = 3 * w.aw),
-        "xbar": format!("[0,{s}) port-0 select, [{s},{}) port-1 select: 0 none, 1..={n} result of slot s-1, {}..={} buffer read of slot s-{}",
-            2 * w.sw, n + 1, 2 * n, n + 1, s = w.sw),
+        "xbar": xbar,
         "bufi": format!("[0,{b}) store address, [{b},{}) read address, bit {} store enable, bit {} read enable",
             2 * w.bw, 2 * w.bw, 2 * w.bw + 1, b = w.bw),
         "capt": format!("[0,{o}) output-memory address, bit {o} enable", o = w.ow),
-        "data": "binary32",
+        "data": match d.pe_kind {
+            PeKind::Binary32 => "binary32",
+            PeKind::Fixed => "fixed point: the 32-bit two's complement integer k of a value k·2^-f (each load's and output's `fraction`)",
+        },
+        "fix": "fixed-point PEs: per PE and cycle, [0,6) align (bits the aligned operand is shifted left), bit 6 align b (else a), \
+            [7,14) s (two's complement): s > 0 rounds (K + 2^(s-1)) >> s, s <= 0 shifts left by -s",
     });
     let v = serde_json::json!({
         "format": "robovec-fpga/1",
@@ -123,22 +171,43 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "n_add": d.n_add,
         "n_mul": d.n_mul,
         "latency": {"add": d.lat_add, "mul": d.lat_mul},
+        "interconnect": d.interconnect().as_str(),
+        "pe_kind": d.pe_kind.as_str(),
+        "mux_inputs": mux_inputs(d),
         "widths": w,
         "layout": layout,
         "hdl": hdl,
         "pes": pes,
         "inputs": d.inputs,
+        "input_fractions": d.input_fractions,
         "loads": d.loads,
         "output_loads": d.output_loads,
         "outputs": d.outputs,
     });
+    let mut v = v;
+    if let Some(r) = routes {
+        v["routes"] = serde_json::Value::Array(r);
+    }
     let mut s = serde_json::to_string_pretty(&v).expect("manifest serialises");
     s.push('\n');
     s
 }
 
+fn pe_name_of(d: &Design, slot: usize) -> String {
+    d.pes.get(slot).map(|p| p.pe.clone()).unwrap_or_else(|| format!("pe{slot}"))
+}
+
+/// The 32-bit multiplexer inputs of the design's write ports: `2·n_pe` per port for the
+/// crossbar, the routes for a specialised interconnect ([`crate::design::routes::Routes::mux_inputs`]).
+pub fn mux_inputs(d: &Design) -> u64 {
+    match &d.routes {
+        Some(r) => r.mux_inputs(),
+        None => 2 * (2 * d.n_pe() as u64) * d.n_pe() as u64,
+    }
+}
+
 /// The design, resource estimate and files of function `f` placed by `p`, on a target of
-/// `limits` and `model`, the logic from `logic`, the images in `format` (`mif`, `hex` or `both`).
+/// `limits` and `model`, as `opts` asks (the logic's source, the image formats, the interconnect).
 ///
 /// # Errors
 /// A diagnostic naming the function and the target: what
@@ -149,10 +218,9 @@ pub fn emit(
     p: &Placement,
     limits: &Limits,
     model: &CostModel,
-    logic: Logic,
-    format: &str,
+    opts: &EmitOptions,
 ) -> Result<(Design, Resources, Vec<DesignFile>), String> {
-    emit_until(f, p, limits, model, logic, format, &|| false).map_err(|e| e.message)
+    emit_until(f, p, limits, model, opts, &|| false).map_err(|e| e.message)
 }
 
 /// [`emit`] whose lowering gives up when `stop` returns true ([`from_placement_until`]; the
@@ -166,14 +234,16 @@ pub fn emit_until(
     p: &Placement,
     limits: &Limits,
     model: &CostModel,
-    logic: Logic,
-    format: &str,
+    opts: &EmitOptions,
     stop: &dyn Fn() -> bool,
 ) -> Result<(Design, Resources, Vec<DesignFile>), DesignError> {
-    let d = from_placement_until(f, p, limits, stop).map_err(|e| DesignError {
-        message: format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target),
-        span: e.span,
-    })?;
+    let (logic, format) = (opts.logic, opts.format);
+    let d = from_placement_until(f, p, limits, stop)
+        .map_err(|e| DesignError {
+            message: format!("function @{} cannot be emitted for target `{}`:\n{e}", f.name, model.target),
+            span: e.span,
+        })?
+        .with_interconnect(opts.interconnect);
     let cells =
         match logic {
             _ if logic.skips_yosys(d.n_add + d.n_mul) => None,

@@ -81,6 +81,10 @@ pub enum MachineErrorKind {
     /// The lowered program fails the verifier's lowered check (a lowering bug), or an
     /// executed program is inconsistent (a word read before anything was written there).
     Unverified,
+    /// The function's numeric formats fit no kind of PE array (issue 49: binary32 PEs without
+    /// numeric formats, fixed-point PEs when every value is a `fix<w ≤ 32, f>` integer op;
+    /// [`crate::program::fixed::pe_kind`]).
+    Formats,
     /// The caller's `stop` hook returned true (its time limit, `-time-limit`): the lowering
     /// ([`crate::program::lower_measured_until`]) or the execution
     /// ([`crate::exec::execute_until`]) gave up, nothing is returned. Says nothing about the

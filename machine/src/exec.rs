@@ -7,7 +7,7 @@
 use std::collections::HashMap;
 
 use robovec_ir::interp::{eval_binop, eval_call, Float};
-use robovec_ir::machine::{MachineOp, MachineProgram, Source, Word};
+use robovec_ir::machine::{Instr, MachineOp, MachineProgram, Source, Word};
 use robovec_ir::syntax::{BinOp, TrigFn};
 
 use crate::error::{MachineError, MachineErrorKind as K, When};
@@ -44,6 +44,96 @@ pub fn execute_until<T: Float>(
     mut input: impl FnMut(&str) -> f64,
     stop: &dyn Fn() -> bool,
 ) -> Result<Executed<T>, MachineError> {
+    let mut inputs: HashMap<String, T> = HashMap::new();
+    let load = |w: &Word| -> Result<T, String> {
+        let mut get = |n: &str| *inputs.entry(n.to_string()).or_insert_with(|| T::from_f64(input(n)));
+        Ok(match w {
+            Word::Input(n) => get(n),
+            Word::Trig(TrigFn::Sin, n) => get(n).sin(),
+            Word::Trig(TrigFn::Cos, n) => get(n).cos(),
+            Word::Const(c) => T::from_f64(*c),
+        })
+    };
+    let op = |i: &Instr, _slot: usize, _cycle: usize, args: &[T]| -> Result<T, String> {
+        let binary = |op: BinOp| match args {
+            [a, b] => Ok(eval_binop(op, *a, *b)),
+            _ => Err(format!("{op:?} reads {} words", args.len())),
+        };
+        match &i.op {
+            MachineOp::Add => binary(BinOp::Add),
+            MachineOp::Sub => binary(BinOp::Sub),
+            MachineOp::Mul => binary(BinOp::Mul),
+            MachineOp::Div => binary(BinOp::Div),
+            MachineOp::Call(callee) => Ok(eval_call(callee, args)),
+        }
+    };
+    run(p, load, op, stop)
+}
+
+/// Runs `p` on fixed-point PEs (`p.fixed`, issue 49): words are the values' integers, each
+/// op exact on them then rounded by its [`robovec_ir::machine::FixShifts`] (what the HDL's
+/// `fix_add_sub`/`fix_mul` and `-eval` compute); inputs are stored in their formats (rounded to
+/// nearest, ties up), trig words are `sin`/`cos` in binary64 of the stored input, then stored;
+/// outputs are `k · 2^-f` in their formats.
+///
+/// # Errors
+/// As [`execute`]; [`K::Formats`] for a program without a fixed-point side, a loaded word no
+/// 32-bit word holds, or a result beyond 32 bits (an overflow the range proof excludes).
+pub fn execute_fixed_until(
+    p: &MachineProgram,
+    mut input: impl FnMut(&str) -> f64,
+    stop: &dyn Fn() -> bool,
+) -> Result<Executed<f64>, MachineError> {
+    use crate::program::fixed::{constant_word, word_of};
+    let fx = p.fixed.as_ref().ok_or_else(|| MachineError::new(K::Formats, "the program is not for fixed-point PEs"))?;
+    let mut inputs: HashMap<String, f64> = HashMap::new();
+    let load = |w: &Word| -> Result<i64, String> {
+        let frac = fx.fraction(w).ok_or_else(|| format!("no fixed-point format for the word {w:?}"))?;
+        let mut stored = |n: &str| -> Result<f64, String> {
+            let x = *inputs.entry(n.to_string()).or_insert_with(|| input(n));
+            let f = fx.inputs.get(n).copied().ok_or_else(|| format!("input `{n}` has no fixed-point format"))?;
+            word_of(x, f).map(|k| k as f64 * (-f64::from(f)).exp2()).ok_or_else(|| format!("input `{n}` = {x} overflows its format"))
+        };
+        let k = match w {
+            Word::Input(n) => word_of(stored(n)?, frac),
+            Word::Trig(TrigFn::Sin, n) => word_of(stored(n)?.sin(), frac),
+            Word::Trig(TrigFn::Cos, n) => word_of(stored(n)?.cos(), frac),
+            Word::Const(c) => constant_word(*c),
+        };
+        k.ok_or_else(|| format!("the word {w:?} does not fit 32 bits at {frac} fractional bits"))
+    };
+    let op = |i: &Instr, slot: usize, cycle: usize, args: &[i64]| -> Result<i64, String> {
+        let sh = fx.shifts.get(slot).and_then(|c| c.get(cycle)).copied().flatten().ok_or("an op without shifts")?;
+        let [a, b] = args else { return Err(format!("{:?} reads {} words", i.op, args.len())) };
+        let (a, b) = (i128::from(*a), i128::from(*b));
+        let (xa, xb) = if sh.align_b { (a, b << sh.align) } else { (a << sh.align, b) };
+        let k = match i.op {
+            MachineOp::Add => xa + xb,
+            MachineOp::Sub => xa - xb,
+            MachineOp::Mul => a * b,
+            _ => return Err(format!("{:?} has no fixed-point unit", i.op)),
+        };
+        let r = sh.round(k);
+        i32::try_from(r).map(i64::from).map_err(|_| format!("the result {r} overflows the 32-bit word"))
+    };
+    let x = run(p, load, op, stop)?;
+    let outputs = x
+        .outputs
+        .into_iter()
+        .zip(&fx.outputs)
+        .map(|((n, k), &f)| (n, k as f64 * (-f64::from(f)).exp2()))
+        .collect();
+    Ok(Executed { outputs, cycles: x.cycles })
+}
+
+/// The cycle-by-cycle run of `p` (module doc) with words `T`: `load` gives each initial word,
+/// `op` computes an issued instruction on PE `slot` in cycle `cycle` from its operands.
+fn run<T: Copy>(
+    p: &MachineProgram,
+    mut load: impl FnMut(&Word) -> Result<T, String>,
+    op: impl Fn(&Instr, usize, usize, &[T]) -> Result<T, String>,
+    stop: &dyn Fn() -> bool,
+) -> Result<Executed<T>, MachineError> {
     let n_pe = p.n_pe();
     let span = p.cycles as usize + 1;
     let bad = |when: When, s: usize, message: String| {
@@ -56,20 +146,15 @@ pub fn execute_until<T: Float>(
     if p.pes.iter().any(|q| q.steps.len() != span) || p.buffer_words.len() != n_pe {
         return Err(MachineError::new(K::Unverified, "program steps do not cover cycles 0..=cycles"));
     }
-    let mut inputs: HashMap<String, T> = HashMap::new();
-    let mut value = |w: &Word| -> T {
-        let mut get = |n: &str| *inputs.entry(n.to_string()).or_insert_with(|| T::from_f64(input(n)));
-        match w {
-            Word::Input(n) => get(n),
-            Word::Trig(TrigFn::Sin, n) => get(n).sin(),
-            Word::Trig(TrigFn::Cos, n) => get(n).cos(),
-            Word::Const(c) => T::from_f64(*c),
-        }
+    let mut value = |w: &Word| -> Result<T, MachineError> {
+        load(w).map_err(|m| MachineError::new(K::Formats, m).at(When::Load))
     };
-    let mut mem: Vec<Vec<Option<T>>> =
-        p.pes.iter().map(|q| q.init.iter().map(|w| w.as_ref().map(&mut value)).collect()).collect();
+    let words = |ws: &[Option<Word>], value: &mut dyn FnMut(&Word) -> Result<T, MachineError>| {
+        ws.iter().map(|w| w.as_ref().map(&mut *value).transpose()).collect::<Result<Vec<Option<T>>, MachineError>>()
+    };
+    let mut mem: Vec<Vec<Option<T>>> = p.pes.iter().map(|q| words(&q.init, &mut value)).collect::<Result<_, _>>()?;
     let mut out: Vec<Vec<Option<T>>> =
-        p.pes.iter().map(|q| q.output_init.iter().map(|w| w.as_ref().map(&mut value)).collect()).collect();
+        p.pes.iter().map(|q| words(&q.output_init, &mut value)).collect::<Result<_, _>>()?;
     let mut buf: Vec<Vec<Option<T>>> = p.buffer_words.iter().map(|&w| vec![None; w as usize]).collect();
     // Results in flight by (arrival cycle mod `ring`, slot): a result arrives at most the
     // longest latency after its issue, so `ring` cycles of one word per PE hold them all (a
@@ -139,17 +224,7 @@ pub fn execute_until<T: Float>(
                         .ok_or_else(|| bad(when, s, format!("read address {a} empty or out of range")))?,
                 );
             }
-            let binary = |op: BinOp, args: &[T]| match args {
-                [a, b] => Ok(eval_binop(op, *a, *b)),
-                _ => Err(bad(when, s, format!("{op:?} reads {} words", args.len()))),
-            };
-            let x = match &i.op {
-                MachineOp::Add => binary(BinOp::Add, &args)?,
-                MachineOp::Sub => binary(BinOp::Sub, &args)?,
-                MachineOp::Mul => binary(BinOp::Mul, &args)?,
-                MachineOp::Div => binary(BinOp::Div, &args)?,
-                MachineOp::Call(callee) => eval_call(callee, &args),
-            };
+            let x = op(i, s, c, &args).map_err(|m| bad(when, s, m))?;
             let at = c + p.latency(&i.op) as usize;
             if at >= span {
                 return Err(bad(when, s, format!("result arrives at cycle {at}, after the last cycle")));

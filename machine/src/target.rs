@@ -32,6 +32,8 @@
 //! | `datapath.fp64_add` | 886 ALM, 0 DSP | Intel, *Floating-Point IP Cores User Guide* (UG-01058), "FP_FUNCTIONS Resource Utilization": double-precision Add on Arria V (the same 28 nm ALM and variable-precision DSP block as Cyclone V; its single-precision Add is the seed's 360 ALM) |
 //! | `datapath.fp64_mul` | 250 ALM, 4 DSP | estimate: a 53 × 53 mantissa product tiles into four 27 × 27 blocks (the "54 × 54: four blocks" row of Intel's variable-precision DSP tables); ALM 2.5 × the seed's binary32 MULTI (exponent, rounding and normalisation twice as wide, plus the tiles' adder). No datasheet figure at hand |
 //! | `datapath.convert_alm` | 100 ALM per conversion | estimate: a conversion between fixed and floating point (or binary32 and binary64) is a leading-zero count and a barrel shift of the word, of the order of the seed's MULTI PE logic (100 ALM) |
+//! | `fix_pe.add` | latency 4 cycles = 2 stages + 2; 627 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`) in two pipeline stages (the issue's "1–2 stages"; declared, not timed: the ECP5 place and route measures a clock); ALM from Yosys 0.23 `synth_intel_alm` of that module by [`crate::resources`]' packing bound (251 LUT6, 744 smaller LUTs and carry bits): its two barrel shifters (any alignment, either rounding direction) cost more than the seed's hardened binary32 adder (360 ALM) |
+//! | `fix_pe.mul` | latency 5 cycles = 3 stages + 2; 416 ALM, 2 DSP | a 32 × 32 signed product (Cyclone V: 36 × 36 takes two variable-precision blocks, the `datapath` row) with its input and output registers, and the rounding shift; ALM from Yosys as above (168 LUT6, 495 smaller LUTs and carry bits; Yosys tiles the product over four multipliers of 18 × 18 and 27 × 27, which Quartus packs in two blocks) |
 //! | `output_word_alm` | 16 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are 32-bit registers read asynchronously, 32 registers at two per ALM = 16 ALM a word, which is also the slope Yosys measures per PE ([`crate::resources`]). Used only where the output words are known (the FPGA back end's estimate); optional in a JSON target (default 0: not counted) |
 //!
 //!
@@ -53,8 +55,9 @@
 //!
 //! # The JSON format (`-target=FILE.json`)
 //! One object, every key required except `output_word_alm` (default 0), `latencies.div` and
-//! `latencies.call` (default: the `add` latency, as they run on ADD PEs) and `datapath` (each
-//! of its fields defaults to the DE10-Nano's, the table above); an unknown key
+//! `latencies.call` (default: the `add` latency, as they run on ADD PEs), `datapath` (each
+//! of its fields defaults to the DE10-Nano's, the table above) and `fix_pe` (the DE10-Nano's
+//! when left out); an unknown key
 //! anywhere is an error, as is a value that makes no sense (zero latency, ports, words, width
 //! or capacity; a clock that is not a positive finite number; a negative or non-finite cost):
 //!
@@ -85,6 +88,10 @@
 //!     "fp64_add": { "alm": 886, "dsp": 0, "m10k": 0 },
 //!     "fp64_mul": { "alm": 250, "dsp": 4, "m10k": 0 },
 //!     "convert_alm": 100
+//!   },
+//!   "fix_pe": {
+//!     "add": { "latency": 4, "alm": 627, "dsp": 0, "m10k": 0 },
+//!     "mul": { "latency": 5, "alm": 416, "dsp": 2, "m10k": 0 }
 //!   }
 //! }
 //! ```
@@ -189,6 +196,51 @@ pub struct Target {
     pub output_word_alm: f64,
     /// What the operators of a datapath in per-value formats cost (`precision<target=fpga>`).
     pub datapath: Datapath,
+    /// The fixed-point PEs (issue 49): their latencies and costs, for a function whose values
+    /// are all `fix<w ≤ 32, f>` ([`crate::program::fixed::pe_kind`]).
+    pub fix_pe: FixPe,
+}
+
+/// One fixed-point PE's unit: its latency (cycles from issue to a result written, the `+ 2` of
+/// the PE memory read and crossbar registers included, as [`Target::latencies`]) and cost.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FixUnit {
+    /// Cycles from issue to a result written in the target PE memory (≥ 3: one unit stage).
+    pub latency: u32,
+    /// Adaptive logic modules.
+    pub alm: f64,
+    /// DSP blocks.
+    pub dsp: u32,
+    /// M10K blocks.
+    pub m10k: u32,
+}
+
+/// The fixed-point PEs of a target (module doc for the DE10-Nano's figures and their sources).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FixPe {
+    /// The ADD PE's aligned adder/subtractor with its rounding (`hdl/fix_units.v`, `fix_add_sub`).
+    pub add: FixUnit,
+    /// The MULTI PE's 32 × 32 multiplier with its rounding (`fix_mul`).
+    pub mul: FixUnit,
+}
+
+impl Default for FixPe {
+    /// The DE10-Nano's (module doc).
+    fn default() -> Self {
+        FixPe {
+            add: FixUnit { latency: 4, alm: 627.0, dsp: 0, m10k: 0 },
+            mul: FixUnit { latency: 5, alm: 416.0, dsp: 2, m10k: 0 },
+        }
+    }
+}
+
+impl FixPe {
+    /// The latencies of a fixed-point PE array (`div`, `call`: the ADD PE's; they have no unit).
+    pub fn latencies(&self) -> Latencies {
+        Latencies { add: self.add.latency, mul: self.mul.latency, div: self.add.latency, call: self.add.latency }
+    }
 }
 
 /// One multiplier mode of a DSP block: `per_block` independent `a × b` signed products.
@@ -356,6 +408,8 @@ struct TargetFile {
     output_word_alm: f64,
     #[serde(default)]
     datapath: Datapath,
+    #[serde(default)]
+    fix_pe: FixPe,
 }
 
 /// How a memory is mapped onto M10K blocks (module doc, "M10K blocks").
@@ -437,6 +491,7 @@ impl Target {
             control_alm: 469.0,
             output_word_alm: 16.0,
             datapath: Datapath::default(),
+            fix_pe: FixPe::default(),
         }
     }
 
@@ -485,6 +540,7 @@ impl Target {
             control_alm: f.control_alm,
             output_word_alm: f.output_word_alm,
             datapath: f.datapath,
+            fix_pe: f.fix_pe,
         };
         t.validate().map_err(|message| TargetError::Value { path: path.to_string(), message })?;
         Ok(t)
@@ -526,6 +582,17 @@ impl Target {
         for (k, v) in [("add", l.add), ("mul", l.mul), ("div", l.div), ("call", l.call)] {
             if v == 0 {
                 return Err(format!("`latencies.{k}` must be at least 1 cycle, got 0"));
+            }
+        }
+        for (k, u) in [("add", &self.fix_pe.add), ("mul", &self.fix_pe.mul)] {
+            if u.latency < 3 {
+                return Err(format!(
+                    "`fix_pe.{k}.latency` must be at least 3 cycles (one unit stage + the PE memory read and crossbar registers), got {}",
+                    u.latency
+                ));
+            }
+            if !(u.alm.is_finite() && u.alm >= 0.0) {
+                return Err(format!("`fix_pe.{k}.alm` must be a non-negative number, got {}", u.alm));
             }
         }
         let counts = [

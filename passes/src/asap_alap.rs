@@ -18,6 +18,7 @@ pub const INFO: PassInfo = PassInfo {
     params: crate::params::LATENCY_PARAMS,
     build: |p: &Params| Ok(Box::new(AsapAlap { lat: p.latency_override()? })),
     props: crate::Props {
+        formats: true,
         requires: Some(robovec_ir::Phase::Atomised),
         at_time_limit: crate::AtTimeLimit::Skip,
         preserves_timing: true,
@@ -42,7 +43,11 @@ impl Pass for AsapAlap {
         let lat = cx.latencies_for("asap-alap", &self.lat);
         // About 30 ns per op: the clock is read between functions only.
         let skipped = |f: &robovec_ir::Function, k| Some(format!("before @{} ({k} functions annotated)", f.name));
-        each_function(m, cx, "asap-alap", Before::Clock, skipped, |f, _, _| Step::Done(annotate_timing(f, &lat)));
+        let target = cx.target.clone();
+        each_function(m, cx, "asap-alap", Before::Clock, skipped, |f, _, _| {
+            let lat = crate::function_latencies(&target, f, lat, &self.lat);
+            Step::Done(annotate_timing(f, &lat))
+        });
         Ok(())
     }
 }

@@ -274,6 +274,23 @@ pub struct PassContext {
     pub reals_changed_by: Option<String>,
 }
 
+/// The latencies function `f` runs with on `target`'s PE array (issue 49): `pipeline` (the
+/// pass's, [`PassContext::latencies_for`]) for binary32 PEs; for a function on fixed-point PEs
+/// ([`robovec_machine::program::fixed::pe_kind`]) the target's `fix_pe` latencies with those
+/// `given` on the pass applied. `asap-alap` and `place` time each function with it.
+pub fn function_latencies(
+    target: &Target,
+    f: &robovec_ir::Function,
+    pipeline: Latencies,
+    given: &LatencyOverride,
+) -> Latencies {
+    use robovec_machine::program::fixed::{pe_kind, PeKind};
+    match pe_kind(f) {
+        Ok(PeKind::Fixed) => given.apply(&target.fix_pe.latencies()),
+        _ => pipeline,
+    }
+}
+
 impl PassContext {
     /// A context for `target`, its latencies the pipeline's.
     pub fn with_target(target: Target) -> PassContext {

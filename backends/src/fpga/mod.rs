@@ -55,7 +55,8 @@ use serde::Serialize;
 
 use robovec_machine::design::build::{DesignError, Limits};
 use robovec_machine::design::Design;
-use robovec_machine::emit::{emit_until, DesignFile};
+use robovec_machine::design::routes::Interconnect;
+use robovec_machine::emit::{emit_until, mux_inputs, DesignFile, EmitOptions};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
 use robovec_passes::params::{word_enum, ParamKind};
@@ -68,9 +69,9 @@ use robovec_passes::{
 pub const BACK_END: Member = Member {
     name: "fpga",
     doc: "the placed design's images, manifest, Verilog, simulate script and resources (issue 12), in `out=DIR`",
-    params: &[OUT, FORMAT, RESOURCES],
+    params: &[OUT, FORMAT, RESOURCES, INTERCONNECT],
     build: |p| Ok(Box::new(CodegenFpga::from_params(p)?)),
-    props: robovec_passes::Props { back_end: true, ..robovec_passes::Props::DEFAULT },
+    props: robovec_passes::Props { back_end: true, formats: true, ..robovec_passes::Props::DEFAULT },
 };
 
 /// `out=DIR`.
@@ -90,6 +91,13 @@ pub const RESOURCES: ParamInfo = ParamInfo {
     name: "resources",
     kind: ParamKind::Choice { choices: Logic::WORDS, default: Logic::Auto.as_str() },
     doc: "FPGA: logic ALMs from Yosys (auto: when on PATH and at most 8 PEs) or the analytic estimate",
+};
+
+/// `interconnect=crossbar|specialised`.
+pub const INTERCONNECT: ParamInfo = ParamInfo {
+    name: "interconnect",
+    kind: ParamKind::Choice { choices: Interconnect::WORDS, default: Interconnect::Crossbar.as_str() },
+    doc: "FPGA: the write ports' multiplexers: over every PE's result and buffer (crossbar: any program of the same PEs loads) or over the sources this program routes (specialised; issue 49)",
 };
 
 word_enum! {
@@ -113,6 +121,8 @@ pub struct CodegenFpga {
     pub format: Format,
     /// `resources=`.
     pub resources: Logic,
+    /// `interconnect=`.
+    pub interconnect: Interconnect,
 }
 
 /// The pass's name in its time-limit errors.
@@ -130,7 +140,12 @@ impl CodegenFpga {
     /// [`PassError::BadParameter`] for an empty `out`.
     pub fn from_params(p: &Params) -> Result<CodegenFpga, PassError> {
         let out = p.path("out")?.unwrap_or_else(|| "fpga".into());
-        Ok(CodegenFpga { out: out.into(), format: p.word("format")?, resources: p.word("resources")? })
+        Ok(CodegenFpga {
+            out: out.into(),
+            format: p.word("format")?,
+            resources: p.word("resources")?,
+            interconnect: p.word("interconnect")?,
+        })
     }
 }
 
@@ -147,6 +162,10 @@ pub struct FpgaReport {
     pub n_mul: u32,
     /// Cycles per evaluation.
     pub cycles: u32,
+    /// `crossbar` or `specialised` (`interconnect=`).
+    pub interconnect: &'static str,
+    /// 32-bit multiplexer inputs of all write ports (crossbar: `2·n_pe` per port).
+    pub mux_inputs: u64,
     /// Clock, MHz.
     pub clock_mhz: f64,
     /// µs per evaluation.
@@ -179,9 +198,10 @@ impl Artifact for FpgaArtifact {
         for (f, r, _) in self.functions.iter().filter(|(f, _, _)| function.is_none_or(|x| x == f)) {
             let x = &r.resources;
             s += &format!(
-                "fpga @{f}: {} ADD + {} MULTI PEs, {} cycles, {:.3} us at {} MHz; {} ALM, {} M10K, {} DSP ({}; {})\n",
+                "fpga @{f}: {} ADD + {} MULTI PEs, {} interconnect, {} cycles, {:.3} us at {} MHz; {} ALM, {} M10K, {} DSP ({}; {})\n",
                 r.n_add,
                 r.n_mul,
+                r.interconnect,
                 r.cycles,
                 r.us,
                 r.clock_mhz,
@@ -255,13 +275,16 @@ impl CodegenFpga {
         let Some(p) = &f.placement else {
             return Err(format!("function @{} has no placement; run `place` before `codegen<fpga>`", f.name).into());
         };
-        let (d, r, files) = emit_until(f, p, limits, model, self.resources, self.format.as_str(), &|| ticker.tick())?;
+        let opts = EmitOptions { logic: self.resources, format: self.format.as_str(), interconnect: self.interconnect };
+        let (d, r, files) = emit_until(f, p, limits, model, &opts, &|| ticker.tick())?;
         let report = FpgaReport {
             out: self.out.display().to_string(),
             format: self.format.as_str(),
             n_add: d.n_add,
             n_mul: d.n_mul,
             cycles: d.cycles,
+            interconnect: d.interconnect().as_str(),
+            mux_inputs: mux_inputs(&d),
             clock_mhz: model.clock_mhz,
             us: r.us,
             resources: r,

@@ -10,7 +10,7 @@ use robovec_ir::Function;
 use robovec_ir::Span;
 
 use super::images::Image;
-use super::{addr_bits, Design, LoadWord, OutputWord, PeImages, Source, Widths};
+use super::{addr_bits, Design, LoadWord, OutputWord, PeImages, PeKind, Source, Widths};
 use crate::encode::{self, Layout};
 use crate::target::Target;
 
@@ -47,7 +47,7 @@ pub fn f32_bits(x: f64) -> u32 {
     (x as f32).to_bits()
 }
 
-fn source(w: &Word) -> Source {
+fn source(w: &Word, fixed: Option<&robovec_ir::machine::FixedProgram>) -> Source {
     match w {
         Word::Input(n) => Source::Input { input: n.clone() },
         Word::Trig(t, n) => {
@@ -57,13 +57,22 @@ fn source(w: &Word) -> Source {
             };
             Source::Trig { name: format!("{trig}({n})"), trig, of: n.clone() }
         }
-        Word::Const(c) => Source::Const { value: *c, bits: format!("0x{:08x}", f32_bits(*c)) },
+        Word::Const(c) => Source::Const { value: *c, bits: format!("0x{:08x}", constant_bits(*c, fixed)) },
     }
 }
 
-fn initial_word(w: &Option<Word>) -> u64 {
+/// The word of constant `c`: its binary32 bits, or on fixed-point PEs its 32-bit integer
+/// ([`crate::program::fixed::constant_word`], two's complement).
+fn constant_bits(c: f64, fixed: Option<&robovec_ir::machine::FixedProgram>) -> u32 {
+    match fixed {
+        None => f32_bits(c),
+        Some(_) => crate::program::fixed::constant_word(c).map_or(0, |k| k as u32),
+    }
+}
+
+fn initial_word(w: &Option<Word>, fixed: Option<&robovec_ir::machine::FixedProgram>) -> u64 {
     match w {
-        Some(Word::Const(c)) => u64::from(f32_bits(*c)),
+        Some(Word::Const(c)) => u64::from(constant_bits(*c, fixed)),
         _ => 0,
     }
 }
@@ -223,21 +232,33 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
     let mut loads = Vec::new();
     let mut output_loads = Vec::new();
     let mut pes = Vec::new();
+    let fx = m.fixed.as_ref();
+    let load = |s: usize, pname: &str, a: usize, w: &Word| LoadWord {
+        slot: s,
+        pe: pname.to_string(),
+        addr: a as u32,
+        source: source(w, fx),
+        fraction: fx.and_then(|x| x.fraction(w)),
+    };
     for (s, pe) in m.pes.iter().enumerate() {
         let pname = pe_name(&m.arch, s);
         for (a, w) in pe.init.iter().enumerate() {
             if let Some(w) = w {
-                loads.push(LoadWord { slot: s, pe: pname.clone(), addr: a as u32, source: source(w) });
+                loads.push(load(s, &pname, a, w));
             }
         }
         for (a, w) in pe.output_init.iter().enumerate() {
             if let Some(w) = w {
-                output_loads.push(LoadWord { slot: s, pe: pname.clone(), addr: a as u32, source: source(w) });
+                output_loads.push(load(s, &pname, a, w));
             }
         }
         let img = |k: &str, width: u32, words: Vec<u64>| Image { name: format!("pe{s}_{k}"), width, words };
-        let mut data: Vec<u64> = pe.init.iter().map(initial_word).collect();
-        let mut out: Vec<u64> = pe.output_init.iter().map(initial_word).collect();
+        let mut data: Vec<u64> = pe.init.iter().map(|w| initial_word(w, fx)).collect();
+        let mut out: Vec<u64> = pe.output_init.iter().map(|w| initial_word(w, fx)).collect();
+        let fix = fx.map(|x| {
+            let words = x.shifts[s].iter().map(|sh| sh.map_or(0, |sh| sh.word())).collect();
+            img("fix", robovec_ir::machine::FixShifts::BITS, words)
+        });
         data.resize(data.len().max(1), 0);
         out.resize(out.len().max(1), 0);
         pes.push(PeImages {
@@ -251,6 +272,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
             data: img("data", 32, data),
             out: img("out", 32, out),
             buffer_words: m.buffer_words[s],
+            fix,
         });
     }
     Ok(Design {
@@ -263,13 +285,23 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
         widths,
         pes,
         inputs: f.inputs.iter().map(|&v| f.name_of(v).to_string()).collect(),
+        input_fractions: fx.map(|x| x.inputs.clone()).unwrap_or_default(),
         loads,
         output_loads,
         outputs: m
             .outputs
             .iter()
-            .map(|o| OutputWord { name: o.name.clone(), slot: o.slot, pe: pe_name(&m.arch, o.slot), addr: o.addr })
+            .enumerate()
+            .map(|(i, o)| OutputWord {
+                name: o.name.clone(),
+                slot: o.slot,
+                pe: pe_name(&m.arch, o.slot),
+                addr: o.addr,
+                fraction: fx.map(|x| x.outputs[i]),
+            })
             .collect(),
+        routes: None,
+        pe_kind: if fx.is_some() { PeKind::Fixed } else { PeKind::Binary32 },
     })
 }
 

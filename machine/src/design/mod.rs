@@ -6,12 +6,16 @@
 
 pub mod build;
 pub mod images;
+pub mod routes;
 
 use std::fmt::Write;
 
 use serde::Serialize;
 
 use images::Image;
+use routes::{selects, Interconnect, Routes};
+
+pub use crate::program::fixed::PeKind;
 
 /// Bit widths of the design's words (the encoding of [`crate::encode`], LSB first).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -84,6 +88,9 @@ pub enum Source {
 /// A word of initial data: PE slot, address, source.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LoadWord {
+    /// Fixed-point PEs (issue 49): the fractional bits of the word's value (`k · 2^-f`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fraction: Option<i32>,
     /// PE slot ([`robovec_ir::placement::Pe::slot`]).
     pub slot: usize,
     /// PE name (`add0`, `mul1`).
@@ -106,6 +113,9 @@ pub struct OutputWord {
     pub pe: String,
     /// Output memory address.
     pub addr: u32,
+    /// Fixed-point PEs (issue 49): the fractional bits of the output's format (`k · 2^-f`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fraction: Option<i32>,
 }
 
 /// The memory images of one PE.
@@ -119,7 +129,9 @@ pub struct PeImages {
     pub is_mul: bool,
     /// Instruction memory, one word per cycle `0..=cycles`.
     pub instr: Image,
-    /// Crossbar memory (this PE memory's two write selects), one word per cycle.
+    /// Crossbar memory (this PE memory's two write selects), one word per cycle: the
+    /// crossbar's selects ([`crate::encode`]), or with a specialised interconnect each port's
+    /// route index ([`routes`]: port 0 in the low [`Routes::select_bits`], port 1 above).
     pub xbar: Image,
     /// Buffer instruction memory, one word per cycle.
     pub bufi: Image,
@@ -132,12 +144,17 @@ pub struct PeImages {
     pub out: Image,
     /// Buffer words (depth of the buffer memory).
     pub buffer_words: u32,
+    /// Fixed-point PEs (issue 49): the shift memory, one [`robovec_ir::machine::FixShifts`]
+    /// word per cycle (14 bits).
+    pub fix: Option<Image>,
 }
 
 impl PeImages {
-    /// The six images, in file order.
-    pub fn images(&self) -> [&Image; 6] {
-        [&self.instr, &self.xbar, &self.bufi, &self.capt, &self.data, &self.out]
+    /// The images, in file order (the shift memory last, on fixed-point PEs).
+    pub fn images(&self) -> Vec<&Image> {
+        let mut v = vec![&self.instr, &self.xbar, &self.bufi, &self.capt, &self.data, &self.out];
+        v.extend(&self.fix);
+        v
     }
 }
 
@@ -162,17 +179,25 @@ pub struct Design {
     pub pes: Vec<PeImages>,
     /// The function's inputs, canonical names, in order.
     pub inputs: Vec<String>,
+    /// Fixed-point PEs: each input's format's fractional bits, by name (empty otherwise).
+    pub input_fractions: std::collections::BTreeMap<String, i32>,
     /// Initial PE memory words that are inputs, trig values or constants.
     pub loads: Vec<LoadWord>,
     /// Initial output memory words (outputs that are inputs, trig values or constants).
     pub output_loads: Vec<LoadWord>,
     /// The output map.
     pub outputs: Vec<OutputWord>,
+    /// The specialised interconnect's routes; `None`: the crossbar ([`routes`]).
+    pub routes: Option<Routes>,
+    /// The kind of PEs: binary32 (the seed's) or fixed point (issue 49; words are the values'
+    /// 32-bit integers, [`crate::program::fixed`]).
+    pub pe_kind: PeKind,
 }
 
 /// The fixed Verilog files, `(name, text)`: the FP unit models, the memories and the PE.
 pub const HDL_LIBRARY: &[(&str, &str)] = &[
     ("fp_units.v", include_str!("hdl/fp_units.v")),
+    ("fix_units.v", include_str!("hdl/fix_units.v")),
     ("rv_mem.v", include_str!("hdl/rv_mem.v")),
     ("rv_lib.v", include_str!("hdl/rv_lib.v")),
 ];
@@ -189,6 +214,92 @@ impl Design {
         (self.n_add + self.n_mul) as usize
     }
 
+    /// The interconnect the design has.
+    pub fn interconnect(&self) -> Interconnect {
+        match self.routes {
+            Some(_) => Interconnect::Specialised,
+            None => Interconnect::Crossbar,
+        }
+    }
+
+    /// The design with interconnect `i`: for [`Interconnect::Specialised`], each write port's
+    /// multiplexer over the sources its program routes, its crossbar image re-encoded as route
+    /// indices ([`routes`]); the crossbar otherwise. Idempotent.
+    pub fn with_interconnect(mut self, i: Interconnect) -> Design {
+        let global: Vec<Vec<u64>> = (0..self.pes.len()).map(|s| self.crossbar_words(s)).collect();
+        match i {
+            Interconnect::Crossbar => {
+                for (p, words) in self.pes.iter_mut().zip(global) {
+                    p.xbar.width = self.widths.xbar();
+                    p.xbar.words = words;
+                }
+                self.routes = None;
+            }
+            Interconnect::Specialised => {
+                let refs: Vec<&[u64]> = global.iter().map(|w| w.as_slice()).collect();
+                let r = Routes::of_crossbar(self.n_pe(), self.widths.sw, &refs);
+                for (s, (p, words)) in self.pes.iter_mut().zip(&global).enumerate() {
+                    let b0 = r.select_bits(s, 0);
+                    p.xbar.width = b0 + r.select_bits(s, 1);
+                    p.xbar.words = words
+                        .iter()
+                        .map(|&w| {
+                            let [g0, g1] = selects(w, self.widths.sw);
+                            let local = |port, g| r.local(s, port, g).expect("every select of the image is a route");
+                            local(0, g0) | (local(1, g1) << b0)
+                        })
+                        .collect();
+                }
+                self.routes = Some(r);
+            }
+        }
+        self
+    }
+
+    /// PE `slot`'s crossbar memory as the crossbar's selects ([`crate::encode`]'s words),
+    /// whatever the interconnect.
+    pub fn crossbar_words(&self, slot: usize) -> Vec<u64> {
+        let p = &self.pes[slot];
+        let Some(r) = &self.routes else { return p.xbar.words.clone() };
+        let b0 = r.select_bits(slot, 0);
+        let sw = self.widths.sw;
+        p.xbar
+            .words
+            .iter()
+            .map(|&w| {
+                let [l0, l1] = [w & ((1 << b0) - 1), w >> b0];
+                let global = |port, l| r.global(slot, port, l).expect("a route index within the port's routes");
+                global(0, l0) | (global(1, l1) << sw)
+            })
+            .collect()
+    }
+
+    /// The Verilog expression of port `port`'s multiplexer sources on PE `slot` (most
+    /// significant word first), their count and select bits: the whole bus `sources` for the
+    /// crossbar, the routed words for a specialised design (`32'h0` alone for a port without
+    /// routes: its select is always 0).
+    fn port_sources(&self, slot: usize, port: usize) -> (String, usize, u32) {
+        let n = self.n_pe();
+        let Some(r) = &self.routes else { return ("sources".into(), 2 * n, self.widths.sw) };
+        let list = &r.ports[slot][port];
+        if list.is_empty() {
+            return ("32'h0".into(), 1, r.select_bits(slot, port));
+        }
+        let words: Vec<String> = list
+            .iter()
+            .rev()
+            .map(|&g| {
+                let g = g as usize;
+                if g <= n {
+                    format!("result{}", g - 1)
+                } else {
+                    format!("buffer{}", g - n - 1)
+                }
+            })
+            .collect();
+        (format!("{{{}}}", words.join(", ")), list.len(), r.select_bits(slot, port))
+    }
+
     /// Bits of the output read port's PE select.
     fn pe_bits(&self) -> u32 {
         addr_bits(self.n_pe() as u64)
@@ -203,8 +314,13 @@ impl Design {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "// robovec codegen<fpga>: function `{}`, {} ADD + {} MULTI PEs, {} cycles (generated; do not edit).",
-            self.function, self.n_add, self.n_mul, self.cycles
+            "// robovec codegen<fpga>: function `{}`, {} ADD + {} MULTI {} PEs, {} cycles, {} interconnect (generated; do not edit).",
+            self.function,
+            self.n_add,
+            self.n_mul,
+            self.pe_kind.as_str(),
+            self.cycles,
+            self.interconnect().as_str()
         );
         s += "// Ports: start (one clock high while idle) runs the program once; done rises after its last\n";
         s += "// cycle; the outputs are then read through out_pe / out_addr (manifest.json's output map).\n";
@@ -224,26 +340,36 @@ impl Design {
         for p in &self.pes {
             let _ = writeln!(s, "  wire [31:0] result{0}, buffer{0}, out{0};", p.slot);
         }
-        let mut bus: Vec<String> = (0..n).rev().map(|i| format!("buffer{i}")).collect();
-        bus.extend((0..n).rev().map(|i| format!("result{i}")));
-        let _ = writeln!(
-            s,
-            "  // crossbar sources: select s = 1..{n} is result s-1, {}..{} is buffer s-{}",
-            n + 1,
-            2 * n,
-            n + 1
-        );
-        let _ = writeln!(s, "  wire [{}:0] sources = {{{}}};", 64 * n - 1, bus.join(", "));
+        if self.routes.is_some() {
+            s += "  // specialised interconnect: each write port multiplexes only the results and buffer reads\n";
+            s += "  // its program routes (manifest.json's `routes`; select 0 = no write, i = the i-th source)\n";
+        } else {
+            let mut bus: Vec<String> = (0..n).rev().map(|i| format!("buffer{i}")).collect();
+            bus.extend((0..n).rev().map(|i| format!("result{i}")));
+            let _ = writeln!(
+                s,
+                "  // crossbar sources: select s = 1..{n} is result s-1, {}..{} is buffer s-{}",
+                n + 1,
+                2 * n,
+                n + 1
+            );
+            let _ = writeln!(s, "  wire [{}:0] sources = {{{}}};", 64 * n - 1, bus.join(", "));
+        }
         for p in &self.pes {
             let lat = if p.is_mul { self.lat_mul } else { self.lat_add };
             let f = |i: &Image| format!("\"{dir}{}.hex\"", i.name);
+            let (src0, n0, sw0) = self.port_sources(p.slot, 0);
+            let (src1, n1, sw1) = self.port_sources(p.slot, 1);
+            let fix = match &p.fix {
+                Some(img) => format!(".FIX(1), .FIX_FILE({}), ", f(img)),
+                None => String::new(),
+            };
             let _ = writeln!(
                 s,
-                "  rv_pe #(.IS_MUL({mul}), .LAT({lat}), .NPE({n}), .AW({aw}), .BW({bw}), .SW({sw}), .OW({ow}), .CW({cw}), .IW({iw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}),\n        .INSTR_FILE({fi}), .XBAR_FILE({fx}), .BUFI_FILE({fb}), .CAPT_FILE({fc}),\n        .DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .sources(sources), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
+                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .IW({iw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}),\n        .INSTR_FILE({fi}), .XBAR_FILE({fx}), .BUFI_FILE({fb}), .CAPT_FILE({fc}),\n        .DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .src0({src0}), .src1({src1}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
                 mul = u8::from(p.is_mul),
                 aw = w.aw,
                 bw = w.bw,
-                sw = w.sw,
                 ow = w.ow,
                 cw = w.cw,
                 iw = w.instr,

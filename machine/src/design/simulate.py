@@ -12,14 +12,20 @@ robovec's interpreter calls. The words go into the initial PE memory images at t
 manifest.json's load map; the design runs in `iverilog`/`vvp` from `start` to `done`; the output
 memories are read back through the manifest's output map.
 
+On fixed-point PEs (manifest "pe_kind": "fixed", issue 49) words are 32-bit two's complement
+integers k of values k * 2^-f: each input is stored in its format (k = floor(x * 2^f + 1/2),
+exactly, as robovec's `-eval` stores it), a trig value is the C library's binary64 sin/cos of
+the stored input, stored in its own format, and each output is k * 2^-f at its "fraction".
+
 Prints on stdout: {"cycles": C, "clocks": K, "outputs": {name: value}, "bits": {name: "0x…"}}
-with every output as its binary32 value (a JSON number that parses to exactly that value; null
+with every output as its binary32 value (on fixed-point PEs, its exact value k * 2^-f) (a JSON number that parses to exactly that value; null
 for NaN and infinities, whose bits are in "bits"). Exit status 1 with a message on stderr when
 the input file is bad, an input name is unknown, or the simulator is missing or fails.
 Needs Python 3 (standard library only) and Icarus Verilog (Debian package `iverilog`).
 """
 import ctypes
 import ctypes.util
+import fractions
 import json
 import math
 import os
@@ -106,6 +112,23 @@ def number(b):
     return x if math.isfinite(x) else None
 
 
+def fix_word(x, f):
+    """The integer of x stored in fix<32,f>: floor(x * 2^f + 1/2), exactly (ties toward +inf)."""
+    k = math.floor(fractions.Fraction(x) * fractions.Fraction(2) ** f + fractions.Fraction(1, 2))
+    if not -(1 << 31) <= k < (1 << 31):
+        fail("%r does not fit a 32-bit word at %d fractional bits" % (x, f))
+    return k
+
+
+def fix_value(k, f):
+    """k * 2^-f as a float (exact: |k| < 2^31)."""
+    return math.ldexp(k, -f)
+
+
+def signed32(w):
+    return w - (1 << 32) if w & (1 << 31) else w
+
+
 def main(argv):
     if len(argv) != 2:
         fail("usage: simulate INPUTS.json (robovec -eval's input format; - for stdin)")
@@ -128,12 +151,23 @@ def main(argv):
                  % (argv[1], k, man["function"], ", ".join(sorted(names)) or "none"))
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             fail("input `%s` must be a number, found %s" % (k, json.dumps(v)))
+    fixed = man.get("pe_kind") == "fixed"
     word = {}
+    stored = {}
     for n in man["inputs"]:
         x = float(given[n]) if n in given else pseudo_random_input(n)
-        word[n] = f32_bits(x)
+        if fixed:
+            f = man["input_fractions"][n]
+            stored[n] = fix_value(fix_word(x, f), f)
+        else:
+            word[n] = f32_bits(x)
 
     def load_bits(l):
+        if fixed and "input" in l:
+            return fix_word(stored[l["input"]], l["fraction"]) & 0xFFFFFFFF
+        if fixed and "trig" in l:
+            y = (math.sin if l["trig"] == "sin" else math.cos)(stored[l["of"]])
+            return fix_word(y, l["fraction"]) & 0xFFFFFFFF
         if "input" in l:
             return word[l["input"]]
         if "trig" in l:
@@ -192,7 +226,10 @@ def main(argv):
     result = {"cycles": int(cycles), "clocks": int(clocks), "outputs": {}, "bits": {}}
     for o in man["outputs"]:
         b = outs[o["slot"]][o["addr"]]
-        result["outputs"][o["name"]] = number(b)
+        if fixed:
+            result["outputs"][o["name"]] = fix_value(signed32(b), o["fraction"])
+        else:
+            result["outputs"][o["name"]] = number(b)
         result["bits"][o["name"]] = "0x%08x" % b
     sys.stdout.write(json.dumps(result, indent=1) + "\n")
 

@@ -678,6 +678,7 @@ impl<'a> Lowering<'a> {
             pes: self.pes,
             outputs,
             issue_of: self.issue_of,
+            fixed: None,
         };
         let occupancy = Occupancy {
             max_words_per_memory: peak(

@@ -59,6 +59,7 @@
 //! true the lowering returns [`MachineErrorKind::Stopped`] and no program. `sim` and
 //! `codegen<fpga>` pass their `-time-limit` ticker there; [`lower`] never stops.
 
+pub mod fixed;
 mod lowering;
 mod plan;
 
@@ -111,7 +112,8 @@ pub fn lower_measured_until(
     p: &Placement,
     stop: &dyn Fn() -> bool,
 ) -> Result<(MachineProgram, Occupancy), MachineError> {
-    let (m, occ) = lowering::lower(f, p, stop)?;
+    let (mut m, occ) = lowering::lower(f, p, stop)?;
+    fixed::attach(f, &mut m)?;
     let errs = verify_machine_until(f, &m, stop).ok_or_else(MachineError::stopped)?;
     if let Some(e) = errs.first() {
         return Err(MachineError::new(

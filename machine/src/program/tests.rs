@@ -99,6 +99,7 @@ fn a_lone_add_takes_12_cycles() {
             i[v(&f, "x").index()] = Some((0, 0));
             i
         },
+        fixed: None,
     };
     assert_eq!(m, expected);
     let x = execute::<f32>(&m, input).unwrap();

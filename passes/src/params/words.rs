@@ -84,3 +84,16 @@ impl Word for robovec_machine::resources::Logic {
         robovec_machine::resources::Logic::from_word(word)
     }
 }
+
+/// `codegen<fpga;interconnect=…>` reads its words from the machine's `Interconnect`.
+impl Word for robovec_machine::design::routes::Interconnect {
+    const WORDS: &'static [&'static str] = robovec_machine::design::routes::Interconnect::WORDS;
+
+    fn as_str(self) -> &'static str {
+        robovec_machine::design::routes::Interconnect::as_str(self)
+    }
+
+    fn from_word(word: &str) -> Option<robovec_machine::design::routes::Interconnect> {
+        robovec_machine::design::routes::Interconnect::from_word(word)
+    }
+}

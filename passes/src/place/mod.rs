@@ -356,6 +356,7 @@ pub const INFO: PassInfo = PassInfo {
         requires: Some(robovec_ir::Phase::Atomised),
         preserves_timing: true,
         bit_exact: true,
+        formats: true,
         ..crate::Props::DEFAULT
     },
 };
@@ -388,6 +389,7 @@ impl Pass for Place {
         let opts = PlaceOptions { deadline: cx.deadline, grace, tick_budget: cx.tick_budget, arch, ..self.opts };
         let progress = cx.progress.clone();
         let limit = crate::Ticker::new(cx.deadline, cx.tick_budget);
+        let target = cx.target.clone();
         try_each_function(
             m,
             cx,
@@ -396,6 +398,8 @@ impl Pass for Place {
             Before::Ticked,
             |_, _| None,
             |f, _, _| {
+                let lat = crate::function_latencies(&target, f, opts.arch.lat, &self.lat);
+                let opts = PlaceOptions { arch: PeArray { lat, ..opts.arch }, ..opts };
                 let (p, stopped) = match try_place_function_progress(f, &opts, &progress) {
                     Ok(placed) => placed,
                     Err(PlaceError::Stopped) => {

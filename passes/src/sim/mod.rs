@@ -166,6 +166,11 @@ fn run<T: Float>(
 ) -> Result<SimOutcome<T>, SimError> {
     let values: HashMap<&str, f64> = f.inputs.iter().map(|&v| (f.name_of(v), input(f.name_of(v)))).collect();
     let x = execute_until::<T>(m, |n| values.get(n).copied().unwrap_or(f64::NAN), &|| ticker.tick())?;
+    Ok(statistics(m, occ, x.outputs))
+}
+
+/// The machine figures of program `m` with the outputs an execution computed.
+fn statistics<T>(m: &MachineProgram, occ: &Occupancy, outputs: Vec<(String, T)>) -> SimOutcome<T> {
     let mut issued_add = vec![0u32; m.cycles as usize];
     let mut issued_mul = vec![0u32; m.cycles as usize];
     for q in &m.pes {
@@ -177,8 +182,8 @@ fn run<T: Float>(
             }
         }
     }
-    Ok(SimOutcome {
-        outputs: x.outputs,
+    SimOutcome {
+        outputs,
         cycles: m.cycles,
         writes_direct: m.writes_direct(),
         writes_indirect: m.writes_indirect(),
@@ -186,7 +191,7 @@ fn run<T: Float>(
         max_buffer_words: occ.max_buffer_words.clone(),
         issued_per_cycle_add: issued_add,
         issued_per_cycle_mul: issued_mul,
-    })
+    }
 }
 
 /// Simulates `f.placement` in f64 and f32 on `interp::pseudo_random_input(name, seed)` for each
@@ -222,7 +227,73 @@ pub fn verify_with(f: &Function, p: &Placement, seeds: &[u64]) -> Result<SimRepo
 /// the first seed (nothing was checked).
 pub fn verify_until(f: &Function, p: &Placement, seeds: &[u64], ticker: &Ticker) -> Result<SimReport, SimError> {
     let (m, occ) = lower_measured_until(f, p, &|| ticker.tick())?;
-    verify_lowered(f, &m, &occ, seeds, ticker)
+    verify_lowered(f, &m, &occ, seeds, None, ticker)
+}
+
+/// The inputs of seed `seed` for a function on fixed-point PEs: a point of the input domain
+/// (`error_bound::domain_point`: the corners for seeds 0 and 1, then ends and uniform draws),
+/// where the range proof excludes every overflow.
+///
+/// # Errors
+/// [`SimErrorKind::Formats`] without a domain, or with an input the domain does not cover.
+fn fixed_inputs(
+    f: &Function,
+    seed: u64,
+    domain: Option<&robovec_ir::domain::Domain>,
+) -> Result<HashMap<String, f64>, SimError> {
+    let dom = domain.ok_or_else(|| {
+        SimError::new(
+            SimErrorKind::Formats,
+            format!("@{} runs on fixed-point PEs: sim draws its inputs in the input domain (-ranges=FILE, or a URDF's limits), which this run does not have", f.name),
+        )
+    })?;
+    let mut ranges = Vec::with_capacity(f.inputs.len());
+    for &v in &f.inputs {
+        let r = dom.get(f.name_of(v)).ok_or_else(|| {
+            SimError::new(SimErrorKind::Formats, format!("input `{}` has no range in the domain", f.name_of(v)))
+        })?;
+        ranges.push(r.interval);
+    }
+    let mut rng = robovec_ir::rng::SplitMix64::new(0x5eed ^ seed);
+    let xs = crate::error_bound::domain_point(&ranges, seed, &mut rng);
+    Ok(f.inputs.iter().zip(xs).map(|(&v, x)| (f.name_of(v).to_string(), x)).collect())
+}
+
+/// One seed of a function on fixed-point PEs: the machine's integers against `-eval`'s
+/// formatted evaluation ([`robovec_ir::format::eval_values`]), bit for bit.
+fn compare_fixed(
+    f: &Function,
+    m: &MachineProgram,
+    occ: &Occupancy,
+    seed: u64,
+    domain: Option<&robovec_ir::domain::Domain>,
+    ticker: &Ticker,
+) -> Result<SimOutcome<f64>, SimError> {
+    if ticker.check() {
+        return Err(SimError::stopped().at(When::Load));
+    }
+    let xs = fixed_inputs(f, seed, domain)?;
+    let input = |n: &str| xs.get(n).copied().unwrap_or(f64::NAN);
+    let x = robovec_machine::exec::execute_fixed_until(m, input, &|| ticker.tick())?;
+    let reference = robovec_ir::format::eval_values(f, input).map_err(|e| {
+        SimError::new(SimErrorKind::Formats, format!("-eval stops on a fixed-point overflow at seed {seed}: {e:?}"))
+    })?;
+    for ((name, s), o) in x.outputs.iter().zip(&f.outputs) {
+        let e = match o.value {
+            robovec_ir::Operand::Value(v) => reference[v.index()],
+            robovec_ir::Operand::Const(c) => c,
+        };
+        if s.to_bits() != e.to_bits() {
+            return Err(SimError::new(
+                SimErrorKind::Mismatch,
+                format!("simulated {s:?} but the interpreter gives {e:?} (fixed point, seed {seed})"),
+            )
+            .at(When::End)
+            .of(format!("output `{name}`"))
+            .src(o.span));
+        }
+    }
+    Ok(statistics(m, occ, x.outputs))
 }
 
 /// The seeds of [`verify_until`] on `f`'s lowered program `m` (occupancy `occ`).
@@ -234,13 +305,17 @@ fn verify_lowered(
     m: &MachineProgram,
     occ: &Occupancy,
     seeds: &[u64],
+    domain: Option<&robovec_ir::domain::Domain>,
     ticker: &Ticker,
 ) -> Result<SimReport, SimError> {
     let seeds: &[u64] = if seeds.is_empty() { &[0] } else { seeds };
     let mut report: Option<SimReport> = None;
     for (i, &seed) in seeds.iter().enumerate() {
-        let both = compare::<f64>(f, m, occ, seed, "f64", ticker)
-            .and_then(|o| compare::<f32>(f, m, occ, seed, "f32", ticker).map(|_| o));
+        let both = match m.fixed {
+            Some(_) => compare_fixed(f, m, occ, seed, domain, ticker),
+            None => compare::<f64>(f, m, occ, seed, "f64", ticker)
+                .and_then(|o| compare::<f32>(f, m, occ, seed, "f32", ticker).map(|_| o)),
+        };
         let o = match both {
             Ok(o) => o,
             Err(e) if e.kind == SimErrorKind::Stopped && i > 0 => {
@@ -312,6 +387,7 @@ pub const INFO: PassInfo = PassInfo {
         at_time_limit: crate::AtTimeLimit::Skip,
         preserves_timing: true,
         bit_exact: true,
+        formats: true,
         needs_before: Some("place"),
         ..crate::Props::DEFAULT
     },
@@ -341,6 +417,9 @@ impl Pass for Sim {
             return Err(fail(format!("function @{} has no placement; run `place` first", f.name)));
         }
         let before = |f: &Function, _| Some(format!("before @{}", f.name));
+        let domain = cx.domain.clone();
+        // binary32 PEs (simulated in f32 and f64), fixed-point PEs
+        let mut kinds = [false, false];
         let simulated = try_each_function(m, cx, "sim", AtTimeLimit::Skip, Before::Clock, before, |f, _, ticker| {
             let fail_on = |e: SimError| fail(format!("@{}: {e}", f.name)).at(e.span);
             let p = f.placement.as_ref().expect("every function is placed (checked above)");
@@ -353,7 +432,8 @@ impl Pass for Sim {
                 Err(e) if e.kind == SimErrorKind::Stopped => return Ok(not_simulated("lowering")),
                 Err(e) => return Err(fail_on(e)),
             };
-            let r = match verify_lowered(f, &mach, &occ, &seeds, ticker) {
+            kinds[usize::from(mach.fixed.is_some())] = true;
+            let r = match verify_lowered(f, &mach, &occ, &seeds, domain.as_ref(), ticker) {
                 Ok(r) => r,
                 Err(e) if e.kind == SimErrorKind::Stopped => return Ok(not_simulated("seed 0")),
                 Err(e) => return Err(fail_on(e)),
@@ -379,7 +459,11 @@ impl Pass for Sim {
         cx.emit(SimStats {
             placements: functions.len(),
             seeds: if functions.is_empty() { 0 } else { fewest },
-            precisions: vec!["f32", "f64"],
+            precisions: match kinds {
+                [_, false] => vec!["f32", "f64"],
+                [false, true] => vec!["fixed point"],
+                [true, true] => vec!["f32", "f64", "fixed point"],
+            },
             bit_exact: true,
             functions,
         });

@@ -1,7 +1,8 @@
 // robovec codegen<fpga>: the building blocks of the generated design (issue 12; seed §1.1, §1.3;
 // SPEC §5). The generated top `robovec_top` instantiates `rv_pe` once per PE (ADD PEs first,
 // then MULTI PEs, in `Pe::slot` order) and wires every PE's arriving result and buffer read
-// into every PE's crossbar.
+// into every PE's crossbar (`interconnect=crossbar`), or into the write ports whose program
+// routes it (`interconnect=specialised`: each port's `src` bus holds its routes only).
 //
 // Timing (machine cycle k of the program = clock k of the run, counted from `start`):
 //   * the instruction, crossbar, buffer-instruction and output-capture words of cycle k are
@@ -22,11 +23,15 @@
 // manifest's `layout` and the `machine` module doc (LSB first).
 module rv_pe #(
     parameter integer IS_MUL = 0,      // 0: ADD PE (fp_add_sub), 1: MULTI PE (fp_mul)
+    parameter integer FIX = 0,         // 1: fixed-point PE (fix_add_sub / fix_mul, shift memory)
+    parameter FIX_FILE = "",           // its shift memory image (14-bit words, fix_units.v)
     parameter integer LAT = 12,        // cycles from issue to arrival (>= 3)
-    parameter integer NPE = 2,         // PEs in the design (crossbar sources: 2 NPE)
+    parameter integer N0 = 4,          // sources of write port 0 (crossbar: 2 NPE)
+    parameter integer SW0 = 3,         // its select bits
+    parameter integer N1 = 4,          // sources of write port 1
+    parameter integer SW1 = 3,         // its select bits
     parameter integer AW = 11,         // PE memory address bits
     parameter integer BW = 4,          // buffer address bits
-    parameter integer SW = 3,          // crossbar select bits
     parameter integer OW = 1,          // output memory address bits
     parameter integer CW = 1,          // program counter bits
     parameter integer IW = 52,         // instruction word bits
@@ -44,13 +49,14 @@ module rv_pe #(
     input  wire                 clk,
     input  wire                 run,       // executing cycle `pc` of the program
     input  wire [CW-1:0]        fetch,     // the cycle whose words are fetched at this edge
-    input  wire [64*NPE-1:0]    sources,   // {buffer reads, results}, PE slot order
+    input  wire [32*N0-1:0]     src0,      // port 0's sources (crossbar: {buffer reads, results})
+    input  wire [32*N1-1:0]     src1,      // port 1's sources
     output reg  [31:0]          result,    // the result arriving this cycle
     output wire [31:0]          buf_read,  // this cycle's buffer read
     input  wire [OW-1:0]        out_addr,  // output memory read port
     output wire [31:0]          out_data
 );
-  localparam integer XW = 2 * SW;
+  localparam integer XW = SW0 + SW1;
   localparam integer BIW = 2 * BW + 2;
   localparam integer OCW = OW + 1;
   localparam integer ROM_DEPTH = CYCLES + 1;
@@ -73,12 +79,13 @@ module rv_pe #(
   wire          we1 = instr[4*AW+1] & run;
   wire          sub = instr[4*AW+3];
 
-  // crossbar: 0 = none, 1..NPE = result of slot s-1, NPE+1..2NPE = buffer read of slot s-NPE-1
-  wire [SW-1:0] sel0 = xbar[SW-1:0];
-  wire [SW-1:0] sel1 = xbar[2*SW-1:SW];
+  // write-port selects: 0 = none, i = word i-1 of the port's sources (crossbar: 1..NPE =
+  // result of slot s-1, NPE+1..2NPE = buffer read of slot s-NPE-1)
+  wire [SW0-1:0] sel0 = xbar[SW0-1:0];
+  wire [SW1-1:0] sel1 = xbar[SW0+SW1-1:SW0];
   wire [31:0] wd0, wd1;
-  rv_xbar_port #(.NPE(NPE), .SW(SW)) u_x0 (.sources(sources), .sel(sel0), .y(wd0));
-  rv_xbar_port #(.NPE(NPE), .SW(SW)) u_x1 (.sources(sources), .sel(sel1), .y(wd1));
+  rv_mux #(.N(N0), .SW(SW0)) u_x0 (.sources(src0), .sel(sel0), .y(wd0));
+  rv_mux #(.N(N1), .SW(SW1)) u_x1 (.sources(src1), .sel(sel1), .y(wd1));
 
   wire [31:0] qa, qb;
   rv_pe_mem #(.AW(AW), .DEPTH(MEM_DEPTH), .FILE(DATA_FILE)) u_mem (
@@ -91,7 +98,19 @@ module rv_pe #(
 
   wire [31:0] y;
   generate
-    if (IS_MUL != 0) begin : g_mul
+    if (FIX != 0) begin : g_fix
+      // the op's shift word, fetched with the instruction and registered with the operands
+      wire [13:0] sh;
+      reg  [13:0] sh_q;
+      initial sh_q = 0;
+      rv_rom #(.WIDTH(14), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(FIX_FILE)) u_fix (.clk(clk), .addr(fetch), .q(sh));
+      always @(posedge clk) sh_q <= sh;
+      if (IS_MUL != 0) begin : g_mul
+        fix_mul #(.LATENCY(LAT - 2)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
+      end else begin : g_add
+        fix_add_sub #(.LATENCY(LAT - 2)) u_fx (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .sh(sh_q), .y(y));
+      end
+    end else if (IS_MUL != 0) begin : g_mul
       fp_mul #(.LATENCY(LAT - 2)) u_fp (.clk(clk), .a(qa), .b(qb), .y(y));
     end else begin : g_add
       fp_add_sub #(.LATENCY(LAT - 2)) u_fp (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .y(y));
@@ -120,30 +139,31 @@ module rv_pe #(
   assign out_data = omem[out_addr];
 endmodule
 
-// One write port's crossbar multiplexer: y = 0 for sel = 0 or sel > 2 NPE, else the 32-bit word
-// sel - 1 of `sources`. Written as a balanced tree of 2:1 multiplexers on the bits of sel - 1
-// (level k decides on bit k) over 2^SW leaves, gated by `valid`, so that synthesis sees
-// 32 (2^SW - 1) multiplexers that it packs four data inputs to a LUT6, and not a variable shift
-// of the whole 64 NPE-bit bus (the form `sources[32*(sel-1) +: 32]`, which Yosys maps as a
-// barrel shifter first: its time exploded beyond 4 + 4 PEs). One module for every write port of
-// every PE of a design (parameters NPE and SW only): a hierarchical synthesis maps it once.
-module rv_xbar_port #(
-    parameter integer NPE = 2,
+// One write port's multiplexer: y = 0 for sel = 0 or sel > N, else the 32-bit word sel - 1 of
+// `sources` (a crossbar port has N = 2 NPE sources, a specialised one its routes). Written as a
+// balanced tree of 2:1 multiplexers on the bits of sel - 1 (level k decides on bit k) over 2^SW
+// leaves, gated by `valid`, so that synthesis sees 32 (2^SW - 1) multiplexers that it packs
+// four data inputs to a LUT6, and not a variable shift of the whole bus (the form
+// `sources[32*(sel-1) +: 32]`, which Yosys maps as a barrel shifter first: its time exploded
+// beyond 4 + 4 PEs). The crossbar's ports share one module (parameters N and SW only): a
+// hierarchical synthesis maps it once.
+module rv_mux #(
+    parameter integer N = 4,
     parameter integer SW = 3
 ) (
-    input  wire [64*NPE-1:0] sources,
-    input  wire [SW-1:0]     sel,
-    output wire [31:0]       y
+    input  wire [32*N-1:0] sources,
+    input  wire [SW-1:0]   sel,
+    output wire [31:0]     y
 );
   localparam integer L = 1 << SW;
   wire [SW-1:0] idx = sel - 1'b1;
-  wire valid = sel != 0 && sel <= 2 * NPE;
-  // level k holds L >> k words; level 0 are the leaves (source j at leaf j, zeros beyond 2 NPE)
+  wire valid = sel != 0 && sel <= N;
+  // level k holds L >> k words; level 0 are the leaves (source j at leaf j, zeros beyond N)
   wire [32*L-1:0] lv [0:SW];
   genvar k, j;
   generate
     for (j = 0; j < L; j = j + 1) begin : g_leaf
-      if (j < 2 * NPE) begin : g_src
+      if (j < N) begin : g_src
         assign lv[0][32*j +: 32] = sources[32*j +: 32];
       end else begin : g_zero
         assign lv[0][32*j +: 32] = 32'h0;

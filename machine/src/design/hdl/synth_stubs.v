@@ -1,5 +1,6 @@
 // Black boxes for the resource estimate (codegen<fpga>'s Yosys run): the floating-point units
-// are counted from the target's per-unit costs (seed Table 1.4) and the memories as M10K blocks
+// are counted from the target's per-unit costs (seed Table 1.4; the fixed-point units from the
+// target's `fix_pe`) and the memories as M10K blocks
 // from their sizes, so Yosys counts only the logic around them (crossbar, control, buffers,
 // output memories, address decoding).
 (* blackbox *)
@@ -10,6 +11,17 @@ endmodule
 (* blackbox *)
 module fp_mul #(parameter integer LATENCY = 5) (
     input wire clk, input wire [31:0] a, input wire [31:0] b, output wire [31:0] y);
+endmodule
+
+(* blackbox *)
+module fix_add_sub #(parameter integer LATENCY = 2) (
+    input wire clk, input wire [31:0] a, input wire [31:0] b, input wire sub, input wire [13:0] sh,
+    output wire [31:0] y);
+endmodule
+
+(* blackbox *)
+module fix_mul #(parameter integer LATENCY = 3) (
+    input wire clk, input wire [31:0] a, input wire [31:0] b, input wire [13:0] sh, output wire [31:0] y);
 endmodule
 
 (* blackbox *)

@@ -1,0 +1,75 @@
+// robovec codegen<fpga>: the fixed-point units (issue 49).
+//
+// A design whose values are all fixed point (`fix<w,f>`, w <= 32: what `precision<target=mcu>`
+// chooses) has fixed-point PEs: its words are 32-bit two's complement integers k of values
+// k * 2^-f, every value with its own f (robovec's `ir/src/format.rs`, "integer op"). An op is
+// computed exactly on the operands' integers, aligned by a constant shift, then rounded once to
+// the result's format: what `-eval` computes and the C back end writes as `int64_t` arithmetic.
+//
+//   fix_add_sub #(.LATENCY(L)) u (.clk, .a, .b, .sub, .sh, .y);   ADD PE
+//   fix_mul     #(.LATENCY(L)) u (.clk, .a, .b, .sh, .y);         MULTI PE
+//
+// `sh` is the op's shift word (the PE's shift memory `peS_fix`, one word per cycle, registered
+// with the operands):
+//   [0,6)  align: the bits the aligned operand is shifted left (the two operands' fractions
+//          differ by it);
+//   bit 6  1: align b, 0: align a (ADD PE only; a MULTI PE's product is not aligned);
+//   [7,14) s, two's complement: the bits the exact result's fraction exceeds the result's.
+//          s > 0 rounds to nearest, ties toward +inf: (K + 2^(s-1)) >>> s; s <= 0 shifts K left
+//          by -s.
+// The exact intermediate K fits 64 bits (robovec's `INTEGER_BITS` bound, with the range proof
+// of every value: the result fits its w <= 32 bits, so y is K's low 32 bits after rounding).
+// The multiplier is a 32 x 32 signed product: DSP blocks on the device (Cyclone V: two
+// variable-precision blocks for 36 x 36; ECP5: four MULT18X18D). y is the result of the
+// operands presented LATENCY rising edges earlier (a combinational core and a delay line, as
+// `fp_units.v`; a synthesis tool retimes it into the DSP's pipeline registers).
+
+// Rounding of the exact result K by s bits (see above).
+module fix_round (
+    input  wire signed [63:0] k,
+    input  wire        [6:0]  s,
+    output wire        [31:0] y
+);
+  wire        neg = s[6];
+  wire [5:0]  right = s[5:0];
+  wire [5:0]  left = 6'd0 - s[5:0];
+  wire signed [63:0] half = (right == 6'd0) ? 64'sd0 : (64'sd1 <<< (right - 6'd1));
+  wire signed [63:0] r = neg ? (k <<< left) : ((k + half) >>> right);
+  assign y = r[31:0];
+endmodule
+
+// The ADD PE's unit: y = round(align(a) +- align(b)), LATENCY clocks after the operands.
+module fix_add_sub #(parameter integer LATENCY = 1) (
+    input  wire        clk,
+    input  wire [31:0] a,
+    input  wire [31:0] b,
+    input  wire        sub,
+    input  wire [13:0] sh,
+    output wire [31:0] y
+);
+  wire signed [63:0] ea = {{32{a[31]}}, a};
+  wire signed [63:0] eb = {{32{b[31]}}, b};
+  wire [5:0] al = sh[5:0];
+  wire signed [63:0] xa = sh[6] ? ea : (ea <<< al);
+  wire signed [63:0] xb = sh[6] ? (eb <<< al) : eb;
+  wire signed [63:0] k = sub ? (xa - xb) : (xa + xb);
+  wire [31:0] r;
+  fix_round rnd (.k(k), .s(sh[13:7]), .y(r));
+  fp_delay #(.LATENCY(LATENCY)) line (.clk(clk), .d(r), .q(y));
+endmodule
+
+// The MULTI PE's unit: y = round(a * b), LATENCY clocks after the operands.
+module fix_mul #(parameter integer LATENCY = 2) (
+    input  wire        clk,
+    input  wire [31:0] a,
+    input  wire [31:0] b,
+    input  wire [13:0] sh,
+    output wire [31:0] y
+);
+  wire signed [31:0] sa = a;
+  wire signed [31:0] sb = b;
+  wire signed [63:0] k = sa * sb;
+  wire [31:0] r;
+  fix_round rnd (.k(k), .s(sh[13:7]), .y(r));
+  fp_delay #(.LATENCY(LATENCY)) line (.clk(clk), .d(r), .q(y));
+endmodule

@@ -1,0 +1,221 @@
+//! The interconnect of a design (issue 49 item 2, `codegen<fpga;interconnect=…>`).
+//!
+//! The seed's machine (§1.3) has a **crossbar**: each of a PE memory's two write ports selects
+//! any of the `2·n_pe` words of a cycle (every PE's arriving result and buffer read), so any
+//! program of `n_pe` PEs can be loaded into the same hardware, at `2·n_pe · 2·n_pe` 32-bit
+//! multiplexer inputs: the logic that grows as N² and keeps designs beyond 8 + 8 PEs off the
+//! DE10-Nano (docs/fpga.md). But a placement is static: a port needs only the sources its
+//! program routes to it. The **specialised** interconnect gives each write port a multiplexer
+//! over exactly those sources ([`Routes`]), and its crossbar memory a select of
+//! `⌈log2(k + 1)⌉` bits for `k` sources (0: no write, `i`: the port's `i`-th source), where the
+//! crossbar's select has `⌈log2(2·n_pe + 1)⌉` bits.
+//!
+//! Which programs a specialised design accepts ([`Routes::admits`]): one on the same PEs
+//! (`n_add`, `n_mul`, latencies) whose every write routes a source the port already has, whose
+//! memories are within the design's (PE memory, buffer and output memory depths) and whose
+//! cycles are within its instruction memories. Another placement of the same function, or
+//! another function, generally routes other sources: it needs the crossbar design or a
+//! specialised design of its own. Both designs compute the same bits for their program
+//! (`tests/fpga.rs` simulates both against `-eval`).
+
+use serde::Serialize;
+
+use super::addr_bits;
+
+/// How the PE memories' write ports are connected (`codegen<fpga;interconnect=…>`; module
+/// doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interconnect {
+    /// The seed's crossbar: every port selects any of the `2·n_pe` sources (any program of the
+    /// same PEs can be loaded).
+    Crossbar,
+    /// A multiplexer per port over the sources its program routes ([`Routes`]).
+    Specialised,
+}
+
+impl Interconnect {
+    /// Every word of `interconnect=`, in the variants' order.
+    pub const WORDS: &'static [&'static str] = &["crossbar", "specialised"];
+
+    /// The value's word.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Interconnect::Crossbar => "crossbar",
+            Interconnect::Specialised => "specialised",
+        }
+    }
+
+    /// The value written `word`, if any.
+    pub fn from_word(word: &str) -> Option<Interconnect> {
+        [Interconnect::Crossbar, Interconnect::Specialised].into_iter().find(|i| i.as_str() == word)
+    }
+}
+
+/// Per PE memory and write port, the crossbar selects its program routes (the selects of
+/// [`crate::encode`]: `1..=n_pe` the result arriving from slot `s − 1`, `n_pe + 1..=2·n_pe`
+/// the buffer read of slot `s − n_pe − 1`).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Routes {
+    /// PEs of the design (the selects' range is `1..=2·n_pe`).
+    pub n_pe: usize,
+    /// Per PE slot, per write port (0, 1): the selects routed, ascending, without duplicates.
+    pub ports: Vec<[Vec<u32>; 2]>,
+}
+
+/// A crossbar word's two selects (`[0, sw)` port 0, `[sw, 2sw)` port 1).
+pub fn selects(word: u64, sw: u32) -> [u64; 2] {
+    let mask = (1u64 << sw) - 1;
+    [word & mask, (word >> sw) & mask]
+}
+
+impl Routes {
+    /// The routes of crossbar images `xbar` (per PE slot, one word per cycle, selects of `sw`
+    /// bits) of a design of `n_pe` PEs.
+    pub fn of_crossbar(n_pe: usize, sw: u32, xbar: &[&[u64]]) -> Routes {
+        let ports = xbar
+            .iter()
+            .map(|words| {
+                let mut used = [Vec::new(), Vec::new()];
+                for &w in words.iter() {
+                    for (port, sel) in selects(w, sw).into_iter().enumerate() {
+                        if sel != 0 {
+                            used[port].push(sel as u32);
+                        }
+                    }
+                }
+                for u in &mut used {
+                    u.sort_unstable();
+                    u.dedup();
+                }
+                used
+            })
+            .collect();
+        Routes { n_pe, ports }
+    }
+
+    /// Bits of port `port`'s select on PE `slot`: `⌈log2(k + 1)⌉` for `k` sources, at least 1.
+    pub fn select_bits(&self, slot: usize, port: usize) -> u32 {
+        addr_bits(self.ports[slot][port].len() as u64 + 1)
+    }
+
+    /// The specialised select of crossbar select `sel` on `slot`'s port `port`: 0 for 0, `i`
+    /// for the port's `i`-th source (1-based); `None` when the port has no such route.
+    pub fn local(&self, slot: usize, port: usize, sel: u64) -> Option<u64> {
+        if sel == 0 {
+            return Some(0);
+        }
+        let list = &self.ports[slot][port];
+        list.binary_search(&u32::try_from(sel).ok()?).ok().map(|i| i as u64 + 1)
+    }
+
+    /// The crossbar select of specialised select `local` on `slot`'s port `port` (inverse of
+    /// [`Routes::local`]); `None` beyond the port's sources.
+    pub fn global(&self, slot: usize, port: usize, local: u64) -> Option<u64> {
+        if local == 0 {
+            return Some(0);
+        }
+        let i = usize::try_from(local - 1).ok()?;
+        self.ports.get(slot)?.get(port)?.get(i).map(|&s| u64::from(s))
+    }
+
+    /// Multiplexer inputs of every port (32-bit words): `Σ k`; a crossbar has `2·n_pe` per port.
+    pub fn mux_inputs(&self) -> u64 {
+        self.ports.iter().flat_map(|p| p.iter()).map(|l| l.len() as u64).sum()
+    }
+
+    /// The name of select `sel` in the design (`result add0`, `buffer mul1`), PE names by
+    /// `name(slot)`.
+    pub fn source_name(&self, sel: u32, name: impl Fn(usize) -> String) -> String {
+        let s = sel as usize;
+        if s <= self.n_pe {
+            format!("result {}", name(s - 1))
+        } else {
+            format!("buffer {}", name(s - self.n_pe - 1))
+        }
+    }
+
+    /// `Ok` when every route of `program` (the routes of another program on the same PEs) is
+    /// one of these: the interconnect of this design can carry it (module doc).
+    ///
+    /// # Errors
+    /// The first route missing (PE slot, port, select) and how many are missing, or a
+    /// different number of PEs.
+    pub fn admits(&self, program: &Routes) -> Result<(), String> {
+        if program.n_pe != self.n_pe || program.ports.len() != self.ports.len() {
+            return Err(format!("the program has {} PEs; the design has {}", program.n_pe, self.n_pe));
+        }
+        let mut missing = Vec::new();
+        for (slot, (have, want)) in self.ports.iter().zip(&program.ports).enumerate() {
+            for port in 0..2 {
+                for &sel in &want[port] {
+                    if have[port].binary_search(&sel).is_err() {
+                        missing.push((slot, port, sel));
+                    }
+                }
+            }
+        }
+        match missing.first() {
+            None => Ok(()),
+            Some(&(slot, port, sel)) => Err(format!(
+                "{} route(s) missing from the specialised interconnect; first: select {sel} into port {port} of PE slot {slot}",
+                missing.len()
+            )),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn routes_are_the_selects_used_per_port_and_local_selects_invert() {
+        // 3 PEs, sw = 3 (selects 0..=6): slot 0 routes 2 and 5 on port 0, 4 on port 1
+        let sw = 3;
+        let w = |a: u64, b: u64| a | (b << sw);
+        let slot0 = [w(2, 0), w(5, 4), w(2, 4), w(0, 0)];
+        let slot1 = [w(0, 0)];
+        let slot2 = [w(6, 1), w(1, 6)];
+        let r = Routes::of_crossbar(3, sw, &[&slot0, &slot1, &slot2]);
+        assert_eq!(r.ports[0], [vec![2, 5], vec![4]]);
+        assert!(r.ports[1].iter().all(Vec::is_empty));
+        assert_eq!(r.ports[2], [vec![1, 6], vec![1, 6]]);
+        assert_eq!(r.mux_inputs(), 2 + 1 + 4);
+        // k sources need ⌈log2(k + 1)⌉ bits, at least 1
+        assert_eq!([r.select_bits(0, 0), r.select_bits(0, 1), r.select_bits(1, 0)], [2, 1, 1]);
+        for (slot, port) in [(0, 0), (0, 1), (2, 0), (2, 1)] {
+            for &g in &r.ports[slot][port] {
+                let l = r.local(slot, port, u64::from(g)).unwrap();
+                assert!(l >= 1 && l <= r.ports[slot][port].len() as u64);
+                assert_eq!(r.global(slot, port, l), Some(u64::from(g)));
+            }
+        }
+        assert_eq!(r.local(0, 0, 3), None, "select 3 is not routed into slot 0's port 0");
+        assert_eq!(r.local(1, 0, 0), Some(0));
+        assert_eq!(r.global(0, 1, 2), None);
+        assert_eq!(r.source_name(2, |s| format!("pe{s}")), "result pe1");
+        assert_eq!(r.source_name(6, |s| format!("pe{s}")), "buffer pe2");
+    }
+
+    #[test]
+    fn a_design_admits_its_own_routes_and_their_subsets_only() {
+        let r = Routes { n_pe: 2, ports: vec![[vec![1, 3], vec![2]], [vec![], vec![4]]] };
+        assert!(r.admits(&r).is_ok());
+        let sub = Routes { n_pe: 2, ports: vec![[vec![3], vec![]], [vec![], vec![4]]] };
+        assert!(r.admits(&sub).is_ok());
+        let other = Routes { n_pe: 2, ports: vec![[vec![2], vec![2]], [vec![1], vec![4]]] };
+        let e = r.admits(&other).unwrap_err();
+        assert!(e.starts_with("2 route(s) missing"), "{e}");
+        assert!(e.contains("select 2 into port 0 of PE slot 0"), "{e}");
+        let bigger = Routes { n_pe: 3, ports: vec![[vec![], vec![]]; 3] };
+        assert!(r.admits(&bigger).unwrap_err().contains("3 PEs"));
+    }
+
+    #[test]
+    fn words() {
+        for w in Interconnect::WORDS {
+            assert_eq!(Interconnect::from_word(w).unwrap().as_str(), *w);
+        }
+        assert_eq!(Interconnect::from_word("mesh"), None);
+    }
+}

@@ -1,0 +1,160 @@
+//! Fixed-point PEs (issue 49 item 1): which PEs a function runs on, and the fixed-point side of
+//! its machine program ([`FixedProgram`]: the shifts of every op, the fractions of the words).
+//!
+//! A PE array is of one kind. A function without numeric formats runs on the seed's binary32
+//! PEs (`-eval-precision=f32`'s arithmetic). A function whose every value is `fix<w,f>` with
+//! `w ≤ 32` ([`FIX_WORD_BITS`], the PE memories' word) and whose every op is an `add`, `sub` or
+//! `mul` that is an integer op ([`robovec_ir::format::integer_op`]: exact on the operands'
+//! integers, then rounded once) runs on fixed-point PEs: the ADD PE aligns one operand by a
+//! constant shift and adds, the MULTI PE multiplies; both round to the result's format
+//! ([`FixShifts`]). That is what `precision<target=mcu>` chooses (32-bit words), and what
+//! `-eval` computes bit for bit. Anything else (a binary32 value beside fixed-point ones, a
+//! word wider than 32 bits, a quotient or root) is refused with the value named: the array has
+//! no unit for it.
+
+use robovec_ir::format::{integer_op, Format};
+use robovec_ir::machine::{FixShifts, FixedProgram, MachineProgram};
+use robovec_ir::{BinOp, Def, Function, Value};
+
+use crate::error::{MachineError, MachineErrorKind};
+
+/// Bits of a fixed-point PE's memory word: the widest `fix<w,f>` a fixed-point PE array holds.
+pub const FIX_WORD_BITS: u32 = 32;
+
+/// The kind of PE a function runs on (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PeKind {
+    /// The seed's binary32 PEs (a function without numeric formats).
+    Binary32,
+    /// Fixed-point PEs (every value `fix<w ≤ 32, f>`, every op an integer `add`/`sub`/`mul`).
+    Fixed,
+}
+
+impl PeKind {
+    /// `binary32` or `fixed`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            PeKind::Binary32 => "binary32",
+            PeKind::Fixed => "fixed",
+        }
+    }
+}
+
+fn refuse(f: &Function, v: Value, why: &str) -> String {
+    format!(
+        "@{}: `%{}` ({}) {why}; a PE array is of one kind: binary32 PEs for a function without numeric formats, fixed-point PEs when every value is fix<w,f> with w <= {FIX_WORD_BITS} and every op an integer add, sub or mul (precision<target=mcu> chooses such formats)",
+        f.name,
+        f.name_of(v),
+        f.format(v)
+    )
+}
+
+/// The kind of PE `f` runs on (module doc).
+///
+/// # Errors
+/// The first value that keeps `f` off both kinds, named, with the rule.
+pub fn pe_kind(f: &Function) -> Result<PeKind, String> {
+    if !f.has_formats() {
+        return Ok(PeKind::Binary32);
+    }
+    for v in f.inputs.iter().chain(&f.body).copied() {
+        match f.format(v) {
+            Format::Fix { width, .. } if width <= FIX_WORD_BITS => {}
+            Format::Fix { .. } => return Err(refuse(f, v, &format!("is wider than the PE word of {FIX_WORD_BITS} bits"))),
+            _ => return Err(refuse(f, v, "is not fixed point while the function has numeric formats")),
+        }
+        match &f.value(v).def {
+            Def::Input | Def::Trig(..) => {}
+            Def::Binary(BinOp::Add | BinOp::Sub | BinOp::Mul, ..) => {
+                if integer_op(f, v).is_none() {
+                    return Err(refuse(f, v, "is not an integer op (its operands are not all fixed point or constants, or its intermediate is beyond 62 bits)"));
+                }
+            }
+            _ => return Err(refuse(f, v, "is not an add, sub or mul: the fixed-point PEs have no unit for it")),
+        }
+    }
+    Ok(PeKind::Fixed)
+}
+
+/// The shifts of fixed-point op `v` ([`FixShifts`]), from its integer op.
+///
+/// # Panics
+/// Never for a function [`pe_kind`] calls fixed.
+pub fn shifts(f: &Function, v: Value) -> Option<FixShifts> {
+    let op = integer_op(f, v)?;
+    let shift = i8::try_from(op.shift).ok()?;
+    match op.terms.as_slice() {
+        [a, b] => {
+            let (la, lb) = (op.fraction - a.fraction(), op.fraction - b.fraction());
+            let (align, align_b) = if lb > 0 { (lb, true) } else { (la, false) };
+            Some(FixShifts { align: u8::try_from(align).ok()?, align_b, shift })
+        }
+        [_] => Some(FixShifts { align: 0, align_b: false, shift }),
+        _ => None,
+    }
+}
+
+/// Attaches the fixed-point side to `m`, the program of `f`, when `f` runs on fixed-point PEs
+/// (`m.fixed` stays `None` for binary32 PEs).
+///
+/// # Errors
+/// [`MachineErrorKind::Formats`] when `f`'s formats fit neither kind of PE ([`pe_kind`]).
+pub fn attach(f: &Function, m: &mut MachineProgram) -> Result<(), MachineError> {
+    if pe_kind(f).map_err(|e| MachineError::new(MachineErrorKind::Formats, e))? == PeKind::Binary32 {
+        return Ok(());
+    }
+    let frac = |v: Value| match f.format(v) {
+        Format::Fix { fraction, .. } => fraction,
+        _ => 0,
+    };
+    let mut fx = FixedProgram {
+        shifts: m.pes.iter().map(|p| vec![None; p.steps.len()]).collect(),
+        ..FixedProgram::default()
+    };
+    for &v in &f.inputs {
+        fx.inputs.insert(f.name_of(v).to_string(), frac(v));
+    }
+    for &v in &f.body {
+        match &f.value(v).def {
+            Def::Trig(t, x) => {
+                fx.trig.insert((*t, f.name_of(*x).to_string()), frac(v));
+            }
+            Def::Binary(..) => {
+                let Some((slot, c)) = m.issue_of.get(v.index()).copied().flatten() else { continue };
+                let sh = shifts(f, v).ok_or_else(|| {
+                    MachineError::new(MachineErrorKind::Formats, format!("no integer op for `%{}`", f.name_of(v)))
+                })?;
+                fx.shifts[slot][c as usize] = Some(sh);
+            }
+            _ => {}
+        }
+    }
+    // an output that is a constant is loaded as the constant's word, at its own fraction
+    let by_name: std::collections::HashMap<&str, i32> = f
+        .outputs
+        .iter()
+        .map(|o| {
+            let fr = match o.value {
+                robovec_ir::Operand::Value(v) => frac(v),
+                robovec_ir::Operand::Const(c) => robovec_ir::format::fix_constant(c).map_or(0, |(_, f)| f),
+            };
+            (o.name.as_str(), fr)
+        })
+        .collect();
+    fx.outputs = m.outputs.iter().map(|o| by_name.get(o.name.as_str()).copied().unwrap_or(0)).collect();
+    m.fixed = Some(fx);
+    Ok(())
+}
+
+/// The integer word of a loaded value `x` in `fix<·,fraction>`: `⌊x·2^f + ½⌋` computed exactly
+/// (what storing rounds to, [`Format::store`]); `None` when it does not fit 32 bits.
+pub fn word_of(x: f64, fraction: i32) -> Option<i64> {
+    let fmt = Format::fix(FIX_WORD_BITS, fraction)?;
+    let stored = fmt.store(x).ok()?;
+    fmt.mantissa(stored)
+}
+
+/// A constant's word: [`robovec_ir::format::fix_constant`]'s integer.
+pub fn constant_word(c: f64) -> Option<i64> {
+    robovec_ir::format::fix_constant(c).map(|(k, _)| k)
+}
