@@ -294,6 +294,26 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
     }
 }
 
+/// A function whose formats fit no kind of PE (binary32 values from `precision<target=c>`) is
+/// a diagnostic naming a value, exit 1, nothing written.
+#[test]
+fn formats_no_pe_array_computes_are_a_diagnostic_and_nothing_is_written() {
+    let d = tmp("mixed_formats");
+    let ranges = d.join("ranges.json");
+    std::fs::write(&ranges, PENDULUM_RANGES).unwrap();
+    let dir = d.join("out");
+    let passes = format!(
+        "-passes=atomise,cse,precision<budget=1e-4;target=c>,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=estimate>",
+        dir.display()
+    );
+    let o = opt(&[PENDULUM, &format!("-ranges={}", ranges.display()), &passes, "-o", "/dev/null"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("is not fixed point while the function has numeric formats"), "{err}");
+    assert!(err.contains("a PE array is of one kind"), "{err}");
+    assert!(!dir.exists(), "nothing written");
+}
+
 /// `simulate` runs from a folder whose name holds a `"`, a space and a `$` (issue 29: iverilog
 /// quoted the sources' paths in its `line directives and failed with a syntax error).
 #[test]

@@ -207,7 +207,7 @@ mod tests {
         }
         // A parameter no back end has lists the selected back end's.
         let e = build("codegen<fpga;frobnicate=1>").unwrap_err().to_string();
-        assert_eq!(e, "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, out, format, resources)");
+        assert_eq!(e, "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, out, format, resources, interconnect)");
         let e = build("codegen<frobnicate=1>").unwrap_err().to_string();
         assert_eq!(
             e,
@@ -221,7 +221,7 @@ mod tests {
         let names: Vec<&str> = info.every_param().map(|p| p.name).collect();
         assert_eq!(
             names,
-            ["back-end", "abi", "precision", "batch", "trig", "name", "chunk", "units", "out", "format", "resources"]
+            ["back-end", "abi", "precision", "batch", "trig", "name", "chunk", "units", "out", "format", "resources", "interconnect"]
         );
         let members: Vec<(&str, Vec<&str>)> =
             super::BACK_ENDS.iter().map(|m| (m.name, m.params.iter().map(|p| p.name).collect())).collect();
@@ -229,7 +229,7 @@ mod tests {
             members,
             [
                 ("c", vec!["abi", "precision", "batch", "trig", "name", "chunk", "units"]),
-                ("fpga", vec!["out", "format", "resources"])
+                ("fpga", vec!["out", "format", "resources", "interconnect"])
             ]
         );
         assert_eq!(info.param("format").map(|p| p.name), Some("format"));

@@ -77,9 +77,15 @@ pub struct Figures {
 }
 
 impl Figures {
-    /// The figures of `f` under the run's latencies.
+    /// The figures of `f` under the run's latencies (a function on fixed-point PEs: the
+    /// target's `fix_pe` latencies, [`crate::function_latencies`]).
     pub fn of(f: &Function, cx: &PassContext) -> Figures {
-        let stats = Stats { latencies_from: Some(cx.latencies_source()), ..stats(f, &cx.latencies) };
+        let lat = crate::function_latencies(&cx.target, f, cx.latencies, &crate::LatencyOverride::default());
+        let from = match lat == cx.latencies {
+            true => cx.latencies_source(),
+            false => format!("target {} fixed-point PEs", cx.target.name),
+        };
+        let stats = Stats { latencies_from: Some(from), ..stats(f, &lat) };
         Figures { function: f.name.clone(), stats, placement: placement_report(f, &cx.target) }
     }
 

@@ -158,3 +158,67 @@ pub fn word_of(x: f64, fraction: i32) -> Option<i64> {
 pub fn constant_word(c: f64) -> Option<i64> {
     robovec_ir::format::fix_constant(c).map(|(k, _)| k)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use robovec_ir::machine::FixShifts;
+    use robovec_ir::text::parse;
+
+    fn func(text: &str) -> Function {
+        parse(text).unwrap().functions.remove(0)
+    }
+
+    #[test]
+    fn a_function_is_binary32_fixed_or_refused_with_the_value_named() {
+        let plain = func("func @f { phase atomised input %a input %b %x = mul %a, %b output o = %x }");
+        assert_eq!(pe_kind(&plain), Ok(PeKind::Binary32));
+        let fixed = func(
+            "func @f { phase atomised input %a : fix<32,20> input %b : fix<16,8> %x = mul %a, %b : fix<32,24> %y = sub %x, 0.5 : fix<32,24> output o = %y }",
+        );
+        assert_eq!(pe_kind(&fixed), Ok(PeKind::Fixed));
+        let mixed = func(
+            "func @f { phase atomised input %a : fix<32,20> input %b : f32 %x = mul %a, %b : fix<32,24> output o = %x }",
+        );
+        let e = pe_kind(&mixed).unwrap_err();
+        assert!(e.contains("`%b` (f32) is not fixed point"), "{e}");
+        let wide = func("func @f { phase atomised input %a : fix<40,20> %x = add %a, %a : fix<32,10> output o = %x }");
+        assert!(pe_kind(&wide).unwrap_err().contains("`%a` (fix<40,20>) is wider than the PE word of 32 bits"));
+        let quotient =
+            func("func @f { phase atomised input %a : fix<32,20> %x = div %a, %a : fix<32,10> output o = %x }");
+        assert!(pe_kind(&quotient).unwrap_err().contains("is not an add, sub or mul"));
+    }
+
+    #[test]
+    fn the_shifts_align_the_coarser_operand_and_round_to_the_result() {
+        // a: 20 fractional bits, b: 8; the sum is exact at 20 bits: b shifted left by 12; the
+        // result at 16 bits: 4 bits rounded off
+        let f = func(
+            "func @f { phase atomised input %a : fix<32,20> input %b : fix<16,8> %x = add %a, %b : fix<32,16> %y = sub %b, %a : fix<32,22> %z = mul %a, %b : fix<32,24> output o = %x output p = %y output q = %z }",
+        );
+        let v = |n: &str| f.lookup(n).unwrap();
+        assert_eq!(shifts(&f, v("x")), Some(FixShifts { align: 12, align_b: true, shift: 4 }));
+        // b − a: b is the coarser, first operand; the result finer than the exact one: shift −2
+        assert_eq!(shifts(&f, v("y")), Some(FixShifts { align: 12, align_b: false, shift: -2 }));
+        // a · b at 28 bits, stored at 24
+        assert_eq!(shifts(&f, v("z")), Some(FixShifts { align: 0, align_b: false, shift: 4 }));
+        for s in [shifts(&f, v("x")).unwrap(), shifts(&f, v("y")).unwrap(), shifts(&f, v("z")).unwrap()] {
+            assert_eq!(FixShifts::from_word(s.word()), s);
+            assert!(s.word() < 1 << FixShifts::BITS);
+        }
+        // the rounding: to nearest, ties toward +∞, as storing rounds
+        let r = FixShifts { align: 0, align_b: false, shift: 2 };
+        assert_eq!([r.round(6), r.round(-6), r.round(5), r.round(-5)], [2, -1, 1, -1]);
+        assert_eq!(FixShifts { shift: -3, ..r }.round(-5), -40);
+    }
+
+    #[test]
+    fn words_are_stored_integers() {
+        assert_eq!(word_of(0.75, 2), Some(3));
+        assert_eq!(word_of(-0.125, 2), Some(0), "−0.5 step rounds toward +∞");
+        assert_eq!(word_of(0.125, 2), Some(1));
+        assert_eq!(word_of(2.0f64.powi(31), 0), None);
+        assert_eq!(constant_word(0.5), Some(1));
+        assert_eq!(constant_word(-3.0), Some(-3));
+    }
+}
