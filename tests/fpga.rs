@@ -294,6 +294,38 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
     }
 }
 
+/// `sweep` places a fixed-point function with the fixed-point PEs' latencies and costs them with
+/// their units (the DE10-Nano's `fix_pe`: ADD 627 ALM, MULTI 416 ALM + 2 DSP), simulating each
+/// placement in the input domain.
+#[test]
+fn sweep_times_and_costs_a_fixed_point_function_with_its_pes() {
+    let d = tmp("fixed_sweep");
+    let ranges = d.join("ranges.json");
+    std::fs::write(&ranges, PENDULUM_RANGES).unwrap();
+    let rep = d.join("report.json");
+    let o = opt(&[
+        PENDULUM,
+        &format!("-ranges={}", ranges.display()),
+        "-passes=atomise,cse,precision<budget=1e-4;target=mcu>,sweep<pe=1,2>",
+        &format!("-report={}", rep.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let rows = r["sweep"].as_array().unwrap();
+    assert!(!rows.is_empty());
+    for row in rows {
+        assert_eq!((row["lat_add"].as_u64(), row["lat_mul"].as_u64()), (Some(4), Some(5)), "{row}");
+        let n = row["n"].as_u64().unwrap() as f64;
+        // n fixed ADD + n MULTI units, 3 ALM per PE memory, the crossbar (8.125 ALM per write
+        // port and source: 2n memories × 2 ports × 4n sources) and the control (469)
+        let alm = n * 627.0 + n * 416.0 + 2.0 * n * 3.0 + 8.125 * 2.0 * n * 2.0 * 4.0 * n + 469.0;
+        assert_eq!(row["alm"].as_f64().unwrap(), alm.ceil(), "N={n}");
+        assert_eq!(row["dsp"].as_f64().unwrap(), 2.0 * n, "N={n}: two DSP blocks per 32 × 32 product");
+    }
+}
+
 /// A function whose formats fit no kind of PE (binary32 values from `precision<target=c>`) is
 /// a diagnostic naming a value, exit 1, nothing written.
 #[test]

@@ -661,6 +661,14 @@ impl Target {
         address_bits(self.buffer_words)
     }
 
+    /// This target with its PE units replaced by the fixed-point PEs' (`fix_pe`: their ALM,
+    /// DSP and M10K as `fp_add`/`fp_mul`; issue 49): what [`Target::estimate`] costs a
+    /// fixed-point PE array with.
+    pub fn with_fixed_units(&self) -> Target {
+        let unit = |u: &FixUnit| UnitCost { alm: u.alm, dsp: u.dsp, m10k: u.m10k };
+        Target { fp_add: unit(&self.fix_pe.add), fp_mul: unit(&self.fix_pe.mul), ..self.clone() }
+    }
+
     /// The analytic resource estimate of `n_add` ADD and `n_mul` MULTI PEs running `cycles`
     /// cycles (module doc: the model and its figures against seed Table 1.4).
     pub fn estimate(&self, n_add: u32, n_mul: u32, cycles: u32) -> Resources {

@@ -221,6 +221,7 @@ pub const INFO: PassInfo = PassInfo {
         at_time_limit: crate::AtTimeLimit::Skip,
         preserves_timing: true,
         bit_exact: true,
+        formats: true,
         csv_table: true,
         ..crate::Props::DEFAULT
     },
@@ -251,6 +252,7 @@ impl Pass for Sweep {
         let mut done = 0usize;
         let task = cx.progress.task("sweep: placements", total as u64);
         let (deadline, tick_budget, latencies, target) = (cx.deadline, cx.tick_budget, cx.latencies, cx.target.clone());
+        let domain = cx.domain.clone();
         // A stop (before a configuration, or inside one, which is dropped) ends the sweep with the
         // rows done and the fit of the function it stopped in.
         let per_function = try_each_function(
@@ -261,6 +263,9 @@ impl Pass for Sweep {
             Before::Ticked,
             |_, _| None,
             |f, _, _| {
+                // a function on fixed-point PEs (issue 49): their latencies and units
+                let latencies = crate::function_latencies(&target, f, latencies, &crate::LatencyOverride::default());
+                let target = crate::place::report::units_of(f, &target);
                 let ops = f.op_counts().total;
                 let cp_now = compute_timing(f, &latencies).1.asap_cycle;
                 let (n_add_side, n_mul) = ops_per_side(f);
@@ -290,7 +295,9 @@ impl Pass for Sweep {
                         }
                         let ticker = Ticker::new(deadline, tick_budget);
                         let verified = match try_place_function_within(f, &o) {
-                            Ok((p, _)) => crate::sim::verify_until(f, &p, &[1], &ticker).map(|_| p),
+                            Ok((p, _)) => {
+                                crate::sim::verify_in(f, &p, &[1], domain.as_ref(), &ticker).map(|_| p)
+                            }
                             Err(PlaceError::Stopped) => Err(SimError::stopped()),
                             Err(PlaceError::Stuck(e)) => {
                                 return Err(PassError::Failed { pass: "sweep".into(), message: e })

@@ -64,6 +64,15 @@ pub fn fits_memories(p: &robovec_ir::placement::Placement, cycles: u32, target: 
         && u64::from(cycles) < u64::from(target.instr_words)
 }
 
+/// `target` with the units of the PEs `f` runs on: the fixed-point PEs' for a function whose
+/// values are all fixed point ([`robovec_machine::program::fixed::pe_kind`], issue 49).
+pub fn units_of(f: &Function, target: &Target) -> Target {
+    match robovec_machine::program::fixed::pe_kind(f) {
+        Ok(robovec_machine::program::fixed::PeKind::Fixed) => target.with_fixed_units(),
+        _ => target.clone(),
+    }
+}
+
 /// The estimate of [`PlacementReport::estimate`].
 pub fn estimate(p: &robovec_ir::placement::Placement, cycles: u32, target: &Target) -> Resources {
     let r = target.estimate(p.arch.n_add, p.arch.n_mul, cycles);
@@ -169,6 +178,6 @@ pub fn placement_report(f: &Function, target: &Target) -> Option<PlacementReport
         writes_indirect: indirect,
         occupation: Occupation { add: occupation(&add, a.n_add, 50), mul: occupation(&mul, a.n_mul, 50) },
         timeline: timeline(f, p, c),
-        estimate: estimate(p, c, target),
+        estimate: estimate(p, c, &units_of(f, target)),
     })
 }

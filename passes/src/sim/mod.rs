@@ -226,8 +226,23 @@ pub fn verify_with(f: &Function, p: &Placement, seeds: &[u64]) -> Result<SimRepo
 /// As [`verify_placement`]; [`SimErrorKind::Stopped`] when `ticker` stopped the lowering or
 /// the first seed (nothing was checked).
 pub fn verify_until(f: &Function, p: &Placement, seeds: &[u64], ticker: &Ticker) -> Result<SimReport, SimError> {
+    verify_in(f, p, seeds, None, ticker)
+}
+
+/// [`verify_until`] with the input domain a function on fixed-point PEs draws its inputs in
+/// (issue 49; binary32 PEs ignore it).
+///
+/// # Errors
+/// As [`verify_until`]; for a function on fixed-point PEs without `domain`, [`SimErrorKind::Formats`].
+pub fn verify_in(
+    f: &Function,
+    p: &Placement,
+    seeds: &[u64],
+    domain: Option<&robovec_ir::domain::Domain>,
+    ticker: &Ticker,
+) -> Result<SimReport, SimError> {
     let (m, occ) = lower_measured_until(f, p, &|| ticker.tick())?;
-    verify_lowered(f, &m, &occ, seeds, None, ticker)
+    verify_lowered(f, &m, &occ, seeds, domain, ticker)
 }
 
 /// The inputs of seed `seed` for a function on fixed-point PEs: a point of the input domain
