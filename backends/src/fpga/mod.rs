@@ -164,6 +164,8 @@ pub struct FpgaReport {
     pub cycles: u32,
     /// `crossbar` or `specialised` (`interconnect=`).
     pub interconnect: &'static str,
+    /// `binary32` or `fixed`: the PEs the function runs on (issue 49).
+    pub pe_kind: &'static str,
     /// 32-bit multiplexer inputs of all write ports (crossbar: `2·n_pe` per port).
     pub mux_inputs: u64,
     /// Clock, MHz.
@@ -198,9 +200,10 @@ impl Artifact for FpgaArtifact {
         for (f, r, _) in self.functions.iter().filter(|(f, _, _)| function.is_none_or(|x| x == f)) {
             let x = &r.resources;
             s += &format!(
-                "fpga @{f}: {} ADD + {} MULTI PEs, {} interconnect, {} cycles, {:.3} us at {} MHz; {} ALM, {} M10K, {} DSP ({}; {})\n",
+                "fpga @{f}: {} ADD + {} MULTI {} PEs, {} interconnect, {} cycles, {:.3} us at {} MHz; {} ALM, {} M10K, {} DSP ({}; {})\n",
                 r.n_add,
                 r.n_mul,
+                r.pe_kind,
                 r.interconnect,
                 r.cycles,
                 r.us,
@@ -284,6 +287,7 @@ impl CodegenFpga {
             n_mul: d.n_mul,
             cycles: d.cycles,
             interconnect: d.interconnect().as_str(),
+            pe_kind: d.pe_kind.as_str(),
             mux_inputs: mux_inputs(&d),
             clock_mhz: model.clock_mhz,
             us: r.us,
