@@ -181,12 +181,19 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
                 serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap()
             };
             let (mx, ms) = (read(&xdir), read(&sdir));
-            assert_eq!((mx["interconnect"].as_str(), ms["interconnect"].as_str()), (Some("crossbar"), Some("specialised")));
+            assert_eq!(
+                (mx["interconnect"].as_str(), ms["interconnect"].as_str()),
+                (Some("crossbar"), Some("specialised"))
+            );
             let n_pe = 2 * n as usize;
             let sw = mx["widths"]["sw"].as_u64().unwrap() as u32;
             let used = routed_selects(&xdir, n_pe, sw);
             let total: usize = used.iter().map(|u| u[0].len() + u[1].len()).sum();
-            assert_eq!(mx["mux_inputs"].as_u64().unwrap() as usize, 4 * n_pe * n_pe, "{what}: n_pe memories × 2 ports × 2·n_pe sources");
+            assert_eq!(
+                mx["mux_inputs"].as_u64().unwrap() as usize,
+                4 * n_pe * n_pe,
+                "{what}: n_pe memories × 2 ports × 2·n_pe sources"
+            );
             assert_eq!(ms["mux_inputs"].as_u64().unwrap() as usize, total, "{what}");
             assert!(total < 4 * n_pe * n_pe, "{what}: {total} routes, the crossbar has {}", 4 * n_pe * n_pe);
             // each PE's route lists are the selects used, by name; its select widths hold them
@@ -200,9 +207,17 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
                         .map(|&g| {
                             let k = g as usize;
                             let pe = |slot: usize| -> String {
-                                if slot < n as usize { format!("add{slot}") } else { format!("mul{}", slot - n as usize) }
+                                if slot < n as usize {
+                                    format!("add{slot}")
+                                } else {
+                                    format!("mul{}", slot - n as usize)
+                                }
                             };
-                            if k <= n_pe { format!("result {}", pe(k - 1)) } else { format!("buffer {}", pe(k - n_pe - 1)) }
+                            if k <= n_pe {
+                                format!("result {}", pe(k - 1))
+                            } else {
+                                format!("buffer {}", pe(k - n_pe - 1))
+                            }
                         })
                         .collect();
                     assert_eq!(names.iter().map(|v| v.as_str().unwrap().to_string()).collect::<Vec<_>>(), want);
@@ -217,7 +232,12 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
             let (rx, rs) = (res(&xdir), res(&sdir));
             let saved = 8.125 * (4 * n_pe * n_pe - total) as f64;
             let dl = rx["logic_alm"].as_f64().unwrap() - rs["logic_alm"].as_f64().unwrap();
-            assert!((dl - saved).abs() <= 1.0, "{what}: logic {} → {}, {saved} saved", rx["logic_alm"], rs["logic_alm"]);
+            assert!(
+                (dl - saved).abs() <= 1.0,
+                "{what}: logic {} → {}, {saved} saved",
+                rx["logic_alm"],
+                rs["logic_alm"]
+            );
             assert_eq!(rx["m10k"], rs["m10k"], "{what}: narrower crossbar words stay within their blocks here");
         }
     }
@@ -258,7 +278,8 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
     };
     let place = "place<pe=2;restarts=0;search=0>";
     let float_dir = d.join("binary32");
-    let (_, float_rep) = run(&format!("atomise,cse,{place},codegen<fpga;out={};resources=estimate>", float_dir.display()), &float_dir);
+    let (_, float_rep) =
+        run(&format!("atomise,cse,{place},codegen<fpga;out={};resources=estimate>", float_dir.display()), &float_dir);
     for interconnect in ["crossbar", "specialised"] {
         let dir = d.join(format!("fixed-{interconnect}"));
         let (eval, rep) = run(
@@ -287,7 +308,9 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
             let (e, s) = (v.as_f64().unwrap(), got[k].as_f64().unwrap());
             assert_eq!(e.to_bits(), s.to_bits(), "{interconnect}: output {k}: simulated {s}, -eval {e}");
             // the word is the output's integer at its fraction
-            let f = man["outputs"].as_array().unwrap().iter().find(|o| o["name"] == *k).unwrap()["fraction"].as_i64().unwrap();
+            let f = man["outputs"].as_array().unwrap().iter().find(|o| o["name"] == *k).unwrap()["fraction"]
+                .as_i64()
+                .unwrap();
             let bits = u32::from_str_radix(sim["bits"][k].as_str().unwrap().trim_start_matches("0x"), 16).unwrap();
             assert_eq!(f64::from(bits as i32) * (-(f as f64)).exp2(), e, "{interconnect}: {k}");
         }

@@ -77,8 +77,9 @@ pub fn execute_until<T: Float>(
 /// outputs are `k · 2^-f` in their formats.
 ///
 /// # Errors
-/// As [`execute`]; [`K::Formats`] for a program without a fixed-point side, a loaded word no
-/// 32-bit word holds, or a result beyond 32 bits (an overflow the range proof excludes).
+/// As [`execute`]; [`K::Formats`] for a program without a fixed-point side or a loaded word no
+/// 32-bit word holds; [`K::Unverified`] for a result beyond 32 bits (an overflow the range
+/// proof excludes, which the hardware would wrap).
 pub fn execute_fixed_until(
     p: &MachineProgram,
     mut input: impl FnMut(&str) -> f64,
@@ -92,7 +93,9 @@ pub fn execute_fixed_until(
         let mut stored = |n: &str| -> Result<f64, String> {
             let x = *inputs.entry(n.to_string()).or_insert_with(|| input(n));
             let f = fx.inputs.get(n).copied().ok_or_else(|| format!("input `{n}` has no fixed-point format"))?;
-            word_of(x, f).map(|k| k as f64 * (-f64::from(f)).exp2()).ok_or_else(|| format!("input `{n}` = {x} overflows its format"))
+            word_of(x, f)
+                .map(|k| k as f64 * (-f64::from(f)).exp2())
+                .ok_or_else(|| format!("input `{n}` = {x} overflows its format"))
         };
         let k = match w {
             Word::Input(n) => word_of(stored(n)?, frac),
@@ -117,12 +120,8 @@ pub fn execute_fixed_until(
         i32::try_from(r).map(i64::from).map_err(|_| format!("the result {r} overflows the 32-bit word"))
     };
     let x = run(p, load, op, stop)?;
-    let outputs = x
-        .outputs
-        .into_iter()
-        .zip(&fx.outputs)
-        .map(|((n, k), &f)| (n, k as f64 * (-f64::from(f)).exp2()))
-        .collect();
+    let outputs =
+        x.outputs.into_iter().zip(&fx.outputs).map(|((n, k), &f)| (n, k as f64 * (-f64::from(f)).exp2())).collect();
     Ok(Executed { outputs, cycles: x.cycles })
 }
 
@@ -146,9 +145,8 @@ fn run<T: Copy>(
     if p.pes.iter().any(|q| q.steps.len() != span) || p.buffer_words.len() != n_pe {
         return Err(MachineError::new(K::Unverified, "program steps do not cover cycles 0..=cycles"));
     }
-    let mut value = |w: &Word| -> Result<T, MachineError> {
-        load(w).map_err(|m| MachineError::new(K::Formats, m).at(When::Load))
-    };
+    let mut value =
+        |w: &Word| -> Result<T, MachineError> { load(w).map_err(|m| MachineError::new(K::Formats, m).at(When::Load)) };
     let words = |ws: &[Option<Word>], value: &mut dyn FnMut(&Word) -> Result<T, MachineError>| {
         ws.iter().map(|w| w.as_ref().map(&mut *value).transpose()).collect::<Result<Vec<Option<T>>, MachineError>>()
     };

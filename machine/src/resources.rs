@@ -89,9 +89,9 @@ use std::process::Command;
 
 use serde::Serialize;
 
-use crate::design::{Design, HDL_LIBRARY, SYNTH_STUBS};
 #[cfg(doc)]
 use crate::design::routes::Routes;
+use crate::design::{Design, HDL_LIBRARY, SYNTH_STUBS};
 use crate::target::{m10k_blocks, M10kFit, Target};
 
 /// Cost of one unit in device resources.
@@ -236,8 +236,16 @@ pub fn cost_model(t: &Target) -> CostModel {
         capacity: UnitCost { alm: u64::from(t.alm), m10k: u64::from(t.m10k), dsp: u64::from(t.dsp) },
         fp_add: unit(&t.fp_add),
         fp_mul: unit(&t.fp_mul),
-        fix_add: UnitCost { alm: t.fix_pe.add.alm.ceil() as u64, dsp: u64::from(t.fix_pe.add.dsp), m10k: u64::from(t.fix_pe.add.m10k) },
-        fix_mul: UnitCost { alm: t.fix_pe.mul.alm.ceil() as u64, dsp: u64::from(t.fix_pe.mul.dsp), m10k: u64::from(t.fix_pe.mul.m10k) },
+        fix_add: UnitCost {
+            alm: t.fix_pe.add.alm.ceil() as u64,
+            dsp: u64::from(t.fix_pe.add.dsp),
+            m10k: u64::from(t.fix_pe.add.m10k),
+        },
+        fix_mul: UnitCost {
+            alm: t.fix_pe.mul.alm.ceil() as u64,
+            dsp: u64::from(t.fix_pe.mul.dsp),
+            m10k: u64::from(t.fix_pe.mul.m10k),
+        },
         crossbar_alm: t.crossbar_alm,
         pe_memory_alm: t.pe_memory_alm,
         control_alm: t.control_alm,

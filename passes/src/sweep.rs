@@ -295,9 +295,7 @@ impl Pass for Sweep {
                         }
                         let ticker = Ticker::new(deadline, tick_budget);
                         let verified = match try_place_function_within(f, &o) {
-                            Ok((p, _)) => {
-                                crate::sim::verify_in(f, &p, &[1], domain.as_ref(), &ticker).map(|_| p)
-                            }
+                            Ok((p, _)) => crate::sim::verify_in(f, &p, &[1], domain.as_ref(), &ticker).map(|_| p),
                             Err(PlaceError::Stopped) => Err(SimError::stopped()),
                             Err(PlaceError::Stuck(e)) => {
                                 return Err(PassError::Failed { pass: "sweep".into(), message: e })

@@ -60,7 +60,9 @@ pub fn pe_kind(f: &Function) -> Result<PeKind, String> {
     for v in f.inputs.iter().chain(&f.body).copied() {
         match f.format(v) {
             Format::Fix { width, .. } if width <= FIX_WORD_BITS => {}
-            Format::Fix { .. } => return Err(refuse(f, v, &format!("is wider than the PE word of {FIX_WORD_BITS} bits"))),
+            Format::Fix { .. } => {
+                return Err(refuse(f, v, &format!("is wider than the PE word of {FIX_WORD_BITS} bits")))
+            }
             _ => return Err(refuse(f, v, "is not fixed point while the function has numeric formats")),
         }
         match &f.value(v).def {
@@ -107,10 +109,8 @@ pub fn attach(f: &Function, m: &mut MachineProgram) -> Result<(), MachineError> 
         Format::Fix { fraction, .. } => fraction,
         _ => 0,
     };
-    let mut fx = FixedProgram {
-        shifts: m.pes.iter().map(|p| vec![None; p.steps.len()]).collect(),
-        ..FixedProgram::default()
-    };
+    let mut fx =
+        FixedProgram { shifts: m.pes.iter().map(|p| vec![None; p.steps.len()]).collect(), ..FixedProgram::default() };
     for &v in &f.inputs {
         fx.inputs.insert(f.name_of(v).to_string(), frac(v));
     }
