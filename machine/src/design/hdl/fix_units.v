@@ -9,6 +9,7 @@
 //   fix_add_sub #(.LATENCY(L)) u (.clk, .a, .b, .sub, .sh, .y);   ADD PE
 //   fix_mul     #(.LATENCY(L)) u (.clk, .a, .b, .sh, .y);         MULTI PE
 //
+// The exact result is registered before its rounding (`fix_stages`), then a delay line.
 // `sh` is the op's shift word (the PE's shift memory `peS_fix`, one word per cycle, registered
 // with the operands):
 //   [0,6)  align: the bits the aligned operand is shifted left (the two operands' fractions
@@ -21,8 +22,9 @@
 // of every value: the result fits its w <= 32 bits, so y is K's low 32 bits after rounding).
 // The multiplier is a 32 x 32 signed product: DSP blocks on the device (Cyclone V: two
 // variable-precision blocks for 36 x 36; ECP5: four MULT18X18D). y is the result of the
-// operands presented LATENCY rising edges earlier (a combinational core and a delay line, as
-// `fp_units.v`; a synthesis tool retimes it into the DSP's pipeline registers).
+// operands presented LATENCY rising edges earlier: the exact result in the first clock, its
+// rounding in the second, then a delay line (measured on the ECP5-85F, nextpnr: the double
+// pendulum's 2 + 2 design at 58 MHz with the rounding in the product's clock; docs/fpga.md).
 
 // Rounding of the exact result K by s bits (see above).
 module fix_round (
@@ -36,6 +38,37 @@ module fix_round (
   wire signed [63:0] half = (right == 6'd0) ? 64'sd0 : (64'sd1 <<< (right - 6'd1));
   wire signed [63:0] r = neg ? (k <<< left) : ((k + half) >>> right);
   assign y = r[31:0];
+endmodule
+
+// The stages after the exact result K: with LATENCY >= 1, K and the shift are registered
+// before the rounding (the arithmetic and the rounding in separate clocks), then LATENCY - 1
+// delay stages; with LATENCY = 0, combinational.
+module fix_stages #(parameter integer LATENCY = 1) (
+    input  wire               clk,
+    input  wire signed [63:0] k,
+    input  wire        [6:0]  s,
+    output wire        [31:0] y
+);
+  wire [31:0] r;
+  generate
+    if (LATENCY == 0) begin : g_comb
+      fix_round rnd (.k(k), .s(s), .y(r));
+      assign y = r;
+    end else begin : g_split
+      reg signed [63:0] k_q;
+      reg        [6:0]  s_q;
+      initial begin
+        k_q = 0;
+        s_q = 0;
+      end
+      always @(posedge clk) begin
+        k_q <= k;
+        s_q <= s;
+      end
+      fix_round rnd (.k(k_q), .s(s_q), .y(r));
+      fp_delay #(.LATENCY(LATENCY - 1)) line (.clk(clk), .d(r), .q(y));
+    end
+  endgenerate
 endmodule
 
 // The ADD PE's unit: y = round(align(a) +- align(b)), LATENCY clocks after the operands.
@@ -53,9 +86,7 @@ module fix_add_sub #(parameter integer LATENCY = 1) (
   wire signed [63:0] xa = sh[6] ? ea : (ea <<< al);
   wire signed [63:0] xb = sh[6] ? (eb <<< al) : eb;
   wire signed [63:0] k = sub ? (xa - xb) : (xa + xb);
-  wire [31:0] r;
-  fix_round rnd (.k(k), .s(sh[13:7]), .y(r));
-  fp_delay #(.LATENCY(LATENCY)) line (.clk(clk), .d(r), .q(y));
+  fix_stages #(.LATENCY(LATENCY)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
 endmodule
 
 // The MULTI PE's unit: y = round(a * b), LATENCY clocks after the operands.
@@ -69,7 +100,5 @@ module fix_mul #(parameter integer LATENCY = 2) (
   wire signed [31:0] sa = a;
   wire signed [31:0] sb = b;
   wire signed [63:0] k = sa * sb;
-  wire [31:0] r;
-  fix_round rnd (.k(k), .s(sh[13:7]), .y(r));
-  fp_delay #(.LATENCY(LATENCY)) line (.clk(clk), .d(r), .q(y));
+  fix_stages #(.LATENCY(LATENCY)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
 endmodule

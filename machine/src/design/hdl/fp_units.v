@@ -56,7 +56,7 @@ module fp_add_sub_comb (
     y = 32'h0;
     // defaults so that every reg is assigned on every path (no latches)
     sl = 0; same = 0; xa = 0; xb = 0; xl = 0; xs = 0; d = 0; ma = 0; mb = 0; ml = 0; ms = 0;
-    bg = 0; sml = 0; s = 0; shifted = 0; sticky = 0; g = 0; st = 0; p = 0; sh = 0; ef = 0; il = 0;
+    bg = 0; sml = 0; s = 0; shifted = 0; sticky = 0; g = 0; st = 0; p = 0; i = 0; sh = 0; ef = 0; il = 0;
     m = 0; bits = 0;
     if (a_nan) y = a | 32'h0040_0000;
     else if (b_nan) y = b | 32'h0040_0000;
@@ -142,7 +142,7 @@ module fp_mul_comb (
     a_zero = (ea == 0) && (fa == 0);
     b_zero = (eb == 0) && (fb == 0);
     y = 32'h0;
-    ma = 0; mb = 0; prod = 0; m = 0; pw = 0; g = 0; st = 0; xa = 0; xb = 0; p = 0; sh = 0; ef = 0;
+    ma = 0; mb = 0; prod = 0; m = 0; pw = 0; g = 0; st = 0; xa = 0; xb = 0; p = 0; i = 0; sh = 0; ef = 0;
     bits = 0;
     if (a_nan) y = a | 32'h0040_0000;
     else if (b_nan) y = b | 32'h0040_0000;
