@@ -52,6 +52,59 @@ fn fp_units_equal_c_float_bit_for_bit_on_random_and_edge_operands() {
     assert!(text.contains(&format!("checked {n} vectors, 0 mismatches")), "{text}");
 }
 
+/// The fixed-point units (`hdl/fix_units.v`, issue 49) against robovec's model of the PEs on
+/// 20,000 random operand pairs and shift words: `a ± b` with one operand aligned by up to 40
+/// bits, `a · b` (the split 16 × 16 partial products), rounded by −20 … 62 bits, operands of
+/// 8, 16 or 31 bits; a vector whose exact result overflows 32 bits (the range proof excludes
+/// it) is drawn again.
+#[test]
+fn fixed_point_units_equal_the_model_bit_for_bit_on_random_operands() {
+    use robovec_ir::machine::FixShifts;
+    tool("iverilog");
+    let d = tmp("fix_units");
+    let mut rng = robovec_ir::rng::SplitMix64::new(49);
+    let mut lines = String::new();
+    let mut n = 0;
+    while n < 20_000 {
+        let op = rng.below(3);
+        let bits = [8u32, 16, 31][rng.below(3) as usize];
+        let mut draw = || (rng.below(1 << (bits + 1)) as i64 - (1i64 << bits)).clamp(i32::MIN.into(), i32::MAX.into());
+        let (a, b) = (draw(), draw());
+        let sh = FixShifts {
+            align: if op == 2 { 0 } else { rng.below(41) as u8 },
+            align_b: rng.below(2) == 1,
+            shift: rng.below(83) as i8 - 20,
+        };
+        let (a, b) = (i128::from(a), i128::from(b));
+        let (xa, xb) = if sh.align_b { (a, b << sh.align) } else { (a << sh.align, b) };
+        let k = match op {
+            0 => xa + xb,
+            1 => xa - xb,
+            _ => a * b,
+        };
+        if k.abs() >= 1 << 62 {
+            continue;
+        }
+        let Ok(y) = i32::try_from(sh.round(k)) else { continue };
+        let w = |x: i128| x as i32 as u32;
+        lines += &format!("{op:01x}{:08x}{:08x}{:08x}{:08x}\n", w(a), w(b), sh.word(), y as u32);
+        n += 1;
+    }
+    std::fs::write(d.join("vec.hex"), lines).unwrap();
+    let st = Command::new("iverilog")
+        .current_dir(&d)
+        .args(["-g2005", &format!("-DN={n}"), "-DVEC=\"vec.hex\"", "-o", "tb.vvp"])
+        .arg(inputs_dir().join("fix_check_tb.v"))
+        .arg(hdl("fix_units.v"))
+        .arg(hdl("fp_units.v"))
+        .status()
+        .expect("iverilog runs");
+    assert!(st.success());
+    let out = Command::new("vvp").current_dir(&d).args(["-n", "tb.vvp"]).output().expect("vvp runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains(&format!("checked {n} vectors, 0 mismatches")), "{text}");
+}
+
 #[test]
 fn fp_units_and_pe_library_pass_verilator_lint() {
     tool("verilator");
@@ -333,7 +386,7 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
 }
 
 /// `sweep` places a fixed-point function with the fixed-point PEs' latencies and costs them with
-/// their units (the DE10-Nano's `fix_pe`: ADD 627 ALM, MULTI 416 ALM + 2 DSP), simulating each
+/// their units (the DE10-Nano's `fix_pe`: ADD 602 ALM, MULTI 415 ALM + 2 DSP), simulating each
 /// placement in the input domain.
 #[test]
 fn sweep_times_and_costs_a_fixed_point_function_with_its_pes() {
@@ -358,7 +411,7 @@ fn sweep_times_and_costs_a_fixed_point_function_with_its_pes() {
         let n = row["n"].as_u64().unwrap() as f64;
         // n fixed ADD + n MULTI units, 3 ALM per PE memory, the crossbar (8.125 ALM per write
         // port and source: 2n memories × 2 ports × 4n sources) and the control (469)
-        let alm = n * 627.0 + n * 416.0 + 2.0 * n * 3.0 + 8.125 * 2.0 * n * 2.0 * 4.0 * n + 469.0;
+        let alm = n * 602.0 + n * 415.0 + 2.0 * n * 3.0 + 8.125 * 2.0 * n * 2.0 * 4.0 * n + 469.0;
         assert_eq!(row["alm"].as_f64().unwrap(), alm.ceil(), "N={n}");
         assert_eq!(row["dsp"].as_f64().unwrap(), 2.0 * n, "N={n}: two DSP blocks per 32 × 32 product");
     }

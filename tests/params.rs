@@ -53,7 +53,7 @@ fn a_parameter_of_the_other_back_end_is_bad_usage_naming_its_back_end() {
     let o = opt(&[PENDULUM, "-passes=atomise,place<pe=2>,codegen<fpga;lanes=4>", "-o", "/dev/null"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("unknown parameter `lanes` (valid: back-end, out, format, resources)"),
+        stderr(&o).contains("unknown parameter `lanes` (valid: back-end, out, format, resources, interconnect)"),
         "{}",
         stderr(&o)
     );

@@ -158,9 +158,14 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             PeKind::Binary32 => "binary32",
             PeKind::Fixed => "fixed point: the 32-bit two's complement integer k of a value k·2^-f (each load's and output's `fraction`)",
         },
-        "fix": "fixed-point PEs: per PE and cycle, [0,6) align (bits the aligned operand is shifted left), bit 6 align b (else a), \
-            [7,14) s (two's complement): s > 0 rounds (K + 2^(s-1)) >> s, s <= 0 shifts left by -s",
     });
+    let mut layout = layout;
+    if d.pe_kind == PeKind::Fixed {
+        layout["fix"] = serde_json::json!(
+            "per PE and cycle, [0,6) align (bits the aligned operand is shifted left), bit 6 align b (else a), \
+            [7,14) s (two's complement): s > 0 rounds (K + 2^(s-1)) >> s, s <= 0 shifts left by -s"
+        );
+    }
     let v = serde_json::json!({
         "format": "robovec-fpga/1",
         "function": d.function,
@@ -179,12 +184,14 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "hdl": hdl,
         "pes": pes,
         "inputs": d.inputs,
-        "input_fractions": d.input_fractions,
         "loads": d.loads,
         "output_loads": d.output_loads,
         "outputs": d.outputs,
     });
     let mut v = v;
+    if d.pe_kind == PeKind::Fixed {
+        v["input_fractions"] = serde_json::json!(d.input_fractions);
+    }
     if let Some(r) = routes {
         v["routes"] = serde_json::Value::Array(r);
     }

@@ -32,8 +32,8 @@
 //! | `datapath.fp64_add` | 886 ALM, 0 DSP | Intel, *Floating-Point IP Cores User Guide* (UG-01058), "FP_FUNCTIONS Resource Utilization": double-precision Add on Arria V (the same 28 nm ALM and variable-precision DSP block as Cyclone V; its single-precision Add is the seed's 360 ALM) |
 //! | `datapath.fp64_mul` | 250 ALM, 4 DSP | estimate: a 53 × 53 mantissa product tiles into four 27 × 27 blocks (the "54 × 54: four blocks" row of Intel's variable-precision DSP tables); ALM 2.5 × the seed's binary32 MULTI (exponent, rounding and normalisation twice as wide, plus the tiles' adder). No datasheet figure at hand |
 //! | `datapath.convert_alm` | 100 ALM per conversion | estimate: a conversion between fixed and floating point (or binary32 and binary64) is a leading-zero count and a barrel shift of the word, of the order of the seed's MULTI PE logic (100 ALM) |
-//! | `fix_pe.add` | latency 4 cycles = 2 stages + 2; 627 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`) in two pipeline stages (the issue's "1–2 stages"; declared, not timed: the ECP5 place and route measures a clock); ALM from Yosys 0.23 `synth_intel_alm` of that module by [`crate::resources`]' packing bound (251 LUT6, 744 smaller LUTs and carry bits): its two barrel shifters (any alignment, either rounding direction) cost more than the seed's hardened binary32 adder (360 ALM) |
-//! | `fix_pe.mul` | latency 5 cycles = 3 stages + 2; 416 ALM, 2 DSP | a 32 × 32 signed product (Cyclone V: 36 × 36 takes two variable-precision blocks, the `datapath` row) with its input and output registers, and the rounding shift; ALM from Yosys as above (168 LUT6, 495 smaller LUTs and carry bits; Yosys tiles the product over four multipliers of 18 × 18 and 27 × 27, which Quartus packs in two blocks) |
+//! | `fix_pe.add` | latency 4 cycles = 2 stages + 2; 602 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`) in two pipeline stages, the exact sum registered before its rounding (the issue's "1–2 stages"; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` by [`crate::resources`]' packing bound (199 LUT6, 806 smaller LUTs and carry bits): its two barrel shifters (any alignment, either rounding direction) cost more than the seed's hardened binary32 adder (360 ALM) |
+//! | `fix_pe.mul` | latency 5 cycles = 3 stages + 2; 415 ALM, 2 DSP | a 32 × 32 signed product as four registered 16 × 16 partial products (four 18 × 19 multipliers, two per Cyclone V variable-precision block: 2 blocks), their sum, and the rounding shift; ALM from Yosys as above at `LATENCY = 3` (85 LUT6, 660 smaller LUTs and carry bits; 4 `MISTRAL_MUL18X18`) |
 //! | `output_word_alm` | 16 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are 32-bit registers read asynchronously, 32 registers at two per ALM = 16 ALM a word, which is also the slope Yosys measures per PE ([`crate::resources`]). Used only where the output words are known (the FPGA back end's estimate); optional in a JSON target (default 0: not counted) |
 //!
 //!
@@ -90,8 +90,8 @@
 //!     "convert_alm": 100
 //!   },
 //!   "fix_pe": {
-//!     "add": { "latency": 4, "alm": 627, "dsp": 0, "m10k": 0 },
-//!     "mul": { "latency": 5, "alm": 416, "dsp": 2, "m10k": 0 }
+//!     "add": { "latency": 4, "alm": 602, "dsp": 0, "m10k": 0 },
+//!     "mul": { "latency": 5, "alm": 415, "dsp": 2, "m10k": 0 }
 //!   }
 //! }
 //! ```
@@ -230,8 +230,8 @@ impl Default for FixPe {
     /// The DE10-Nano's (module doc).
     fn default() -> Self {
         FixPe {
-            add: FixUnit { latency: 4, alm: 627.0, dsp: 0, m10k: 0 },
-            mul: FixUnit { latency: 5, alm: 416.0, dsp: 2, m10k: 0 },
+            add: FixUnit { latency: 4, alm: 602.0, dsp: 0, m10k: 0 },
+            mul: FixUnit { latency: 5, alm: 415.0, dsp: 2, m10k: 0 },
         }
     }
 }

@@ -22,9 +22,11 @@
 // of every value: the result fits its w <= 32 bits, so y is K's low 32 bits after rounding).
 // The multiplier is a 32 x 32 signed product: DSP blocks on the device (Cyclone V: two
 // variable-precision blocks for 36 x 36; ECP5: four MULT18X18D). y is the result of the
-// operands presented LATENCY rising edges earlier: the exact result in the first clock, its
-// rounding in the second, then a delay line (measured on the ECP5-85F, nextpnr: the double
-// pendulum's 2 + 2 design at 58 MHz with the rounding in the product's clock; docs/fpga.md).
+// operands presented LATENCY rising edges earlier: the exact result in the first clock (the
+// product in two: its partial products, then their sum), its rounding in the next, then a delay
+// line (measured on the ECP5-85F with nextpnr, the double pendulum's 2 + 2 design: 58 MHz with
+// the rounding in the product's clock, 77 MHz split, 88 MHz with the partial products
+// registered; docs/fpga.md).
 
 // Rounding of the exact result K by s bits (see above).
 module fix_round (
@@ -89,7 +91,9 @@ module fix_add_sub #(parameter integer LATENCY = 1) (
   fix_stages #(.LATENCY(LATENCY)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
 endmodule
 
-// The MULTI PE's unit: y = round(a * b), LATENCY clocks after the operands.
+// The MULTI PE's unit: y = round(a * b), LATENCY clocks after the operands. With LATENCY >= 2
+// the product is split in four 16 x 16 partial products (one MULT18X18D each on the ECP5, one
+// 18 x 19 half block each on the Cyclone V), registered, then summed in the next clock.
 module fix_mul #(parameter integer LATENCY = 2) (
     input  wire        clk,
     input  wire [31:0] a,
@@ -97,8 +101,39 @@ module fix_mul #(parameter integer LATENCY = 2) (
     input  wire [13:0] sh,
     output wire [31:0] y
 );
-  wire signed [31:0] sa = a;
-  wire signed [31:0] sb = b;
-  wire signed [63:0] k = sa * sb;
-  fix_stages #(.LATENCY(LATENCY)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
+  generate
+    if (LATENCY >= 2) begin : g_split
+      // a = ah·2^16 + al with ah signed and al unsigned (b likewise)
+      wire signed [15:0] ah = a[31:16];
+      wire signed [15:0] bh = b[31:16];
+      wire signed [16:0] al = {1'b0, a[15:0]};
+      wire signed [16:0] bl = {1'b0, b[15:0]};
+      reg  signed [31:0] hh;
+      reg  signed [32:0] hl, lh;
+      reg  signed [33:0] ll;
+      reg         [6:0]  s1;
+      initial begin
+        hh = 0;
+        hl = 0;
+        lh = 0;
+        ll = 0;
+        s1 = 0;
+      end
+      always @(posedge clk) begin
+        hh <= ah * bh;
+        hl <= ah * bl;
+        lh <= al * bh;
+        ll <= al * bl;
+        s1 <= sh[13:7];
+      end
+      wire signed [63:0] k = ({{32{hh[31]}}, hh} <<< 32) + ({{31{hl[32]}}, hl} <<< 16)
+                             + ({{31{lh[32]}}, lh} <<< 16) + {{30{ll[33]}}, ll};
+      fix_stages #(.LATENCY(LATENCY - 1)) st (.clk(clk), .k(k), .s(s1), .y(y));
+    end else begin : g_whole
+      wire signed [31:0] sa = a;
+      wire signed [31:0] sb = b;
+      wire signed [63:0] k = sa * sb;
+      fix_stages #(.LATENCY(LATENCY)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
+    end
+  endgenerate
 endmodule
