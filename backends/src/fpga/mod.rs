@@ -1,4 +1,4 @@
-//! `codegen<fpga;out=DIR;format=mif|hex|both;resources=auto|yosys|estimate>`: the seed's
+//! `codegen<fpga;out=DIR;format=mif|hex|both;resources=auto|yosys|estimate;interconnect=crossbar|specialised>`: the seed's
 //! architecture (ch. 1, §2.3; SPEC §5) for a placed function, as files an FPGA engineer loads,
 //! simulates and sizes (issue 12).
 //!
@@ -19,6 +19,15 @@
 //! - `simulate` (executable, Python 3 standard library + Icarus Verilog): `DIR/simulate
 //!   INPUTS.json` runs the design and prints `{"cycles", "clocks", "outputs", "bits"}`.
 //! - `resources.json`: ALM / M10K / DSP, fit, cycles, clock, µs ([`robovec_machine::resources`]).
+//!
+//! ## Issue 49: the interconnect and the PEs
+//! - `interconnect=crossbar` (default) writes the seed's crossbar: any program of the same PEs
+//!   loads; `interconnect=specialised` gives each write port a multiplexer over the sources its
+//!   program routes ([`robovec_machine::design::routes`], which also says which programs such a
+//!   design accepts).
+//! - The PEs follow the function's formats ([`robovec_machine::program::fixed`]): binary32 PEs
+//!   for a function without numeric formats, fixed-point PEs (`hdl/fix_units.v`, a shift memory
+//!   per PE) when every value is `fix<w ≤ 32, f>`; anything else is refused naming a value.
 //!
 //! ## Design choices (where the issue is silent)
 //! - The images are written from the machine program's encoding; the design's RTL

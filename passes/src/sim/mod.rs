@@ -391,7 +391,7 @@ fn compare<T: Float>(
 /// Registry entry.
 pub const INFO: PassInfo = PassInfo {
     name: "sim",
-    doc: "simulate each placement cycle by cycle and check its outputs against the interpreter (f32 and f64)",
+    doc: "simulate each placement cycle by cycle and check its outputs against the interpreter (f32 and f64; fixed-point PEs: their integers at points of the input domain)",
     params: &[ParamInfo {
         name: "seeds",
         kind: ParamKind::U32 { default: 3, min: 1, max: 10_000 },
