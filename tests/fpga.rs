@@ -39,15 +39,21 @@ fn fp_units_equal_c_float_bit_for_bit_on_random_and_edge_operands() {
     // 20000 random pairs plus every pair of the 26 edge values for 3 ops
     assert_eq!(n, 20000 + 26 * 26 * 3);
     std::fs::write(d.join("vec.hex"), &vec.stdout).unwrap();
+    check_vectors(&d, n, "fp_check_tb.v", &["fp_units.v"]);
+}
+
+/// Runs testbench `tb` (tests/inputs/fpga) on the units of `hdl_files` in Icarus over the `n`
+/// vectors of `d/vec.hex`, and asserts it reports no mismatch.
+fn check_vectors(d: &Path, n: usize, tb: &str, hdl_files: &[&str]) {
     let st = Command::new("iverilog")
-        .current_dir(&d)
+        .current_dir(d)
         .args(["-g2005", &format!("-DN={n}"), "-DVEC=\"vec.hex\"", "-o", "tb.vvp"])
-        .arg(inputs_dir().join("fp_check_tb.v"))
-        .arg(hdl("fp_units.v"))
+        .arg(inputs_dir().join(tb))
+        .args(hdl_files.iter().map(|f| hdl(f)))
         .status()
         .expect("iverilog runs");
     assert!(st.success());
-    let out = Command::new("vvp").current_dir(&d).args(["-n", "tb.vvp"]).output().expect("vvp runs");
+    let out = Command::new("vvp").current_dir(d).args(["-n", "tb.vvp"]).output().expect("vvp runs");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains(&format!("checked {n} vectors, 0 mismatches")), "{text}");
 }
@@ -59,7 +65,7 @@ fn fp_units_equal_c_float_bit_for_bit_on_random_and_edge_operands() {
 /// it) is drawn again.
 #[test]
 fn fixed_point_units_equal_the_model_bit_for_bit_on_random_operands() {
-    use robovec_ir::machine::FixShifts;
+    use robovec_ir::machine::{FixShifts, MachineOp};
     tool("iverilog");
     let d = tmp("fix_units");
     let mut rng = robovec_ir::rng::SplitMix64::new(49);
@@ -75,61 +81,36 @@ fn fixed_point_units_equal_the_model_bit_for_bit_on_random_operands() {
             align_b: rng.below(2) == 1,
             shift: rng.below(83) as i8 - 20,
         };
-        let (a, b) = (i128::from(a), i128::from(b));
-        let (xa, xb) = if sh.align_b { (a, b << sh.align) } else { (a << sh.align, b) };
-        let k = match op {
-            0 => xa + xb,
-            1 => xa - xb,
-            _ => a * b,
-        };
-        if k.abs() >= 1 << 62 {
+        let unit = [MachineOp::Add, MachineOp::Sub, MachineOp::Mul][op as usize].clone();
+        // the exact intermediate within robovec's 62-bit bound (the range proof's)
+        let exact = FixShifts { shift: 0, ..sh }.apply(&unit, a, b).unwrap();
+        if exact.abs() >= 1 << 62 {
             continue;
         }
-        let Ok(y) = i32::try_from(sh.round(k)) else { continue };
-        let w = |x: i128| x as i32 as u32;
+        let Ok(y) = i32::try_from(sh.apply(&unit, a, b).unwrap()) else { continue };
+        let w = |x: i64| x as i32 as u32;
         lines += &format!("{op:01x}{:08x}{:08x}{:08x}{:08x}\n", w(a), w(b), sh.word(), y as u32);
         n += 1;
     }
     std::fs::write(d.join("vec.hex"), lines).unwrap();
-    let st = Command::new("iverilog")
-        .current_dir(&d)
-        .args(["-g2005", &format!("-DN={n}"), "-DVEC=\"vec.hex\"", "-o", "tb.vvp"])
-        .arg(inputs_dir().join("fix_check_tb.v"))
-        .arg(hdl("fix_units.v"))
-        .arg(hdl("fp_units.v"))
-        .status()
-        .expect("iverilog runs");
-    assert!(st.success());
-    let out = Command::new("vvp").current_dir(&d).args(["-n", "tb.vvp"]).output().expect("vvp runs");
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains(&format!("checked {n} vectors, 0 mismatches")), "{text}");
+    check_vectors(&d, n, "fix_check_tb.v", &["fix_units.v", "fp_units.v"]);
 }
 
 #[test]
 fn fp_units_and_pe_library_pass_verilator_lint() {
     tool("verilator");
-    let out = Command::new("verilator")
-        .args(["--lint-only", "-Wno-fatal", "-Wno-WIDTH", "-Wno-DECLFILENAME", "--top-module", "rv_pe"])
-        .arg(hdl("fp_units.v"))
-        .arg(hdl("rv_mem.v"))
-        .arg(hdl("rv_lib.v"))
-        .output()
-        .expect("verilator runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    // the fixed-point PE (issue 49): an ADD and a MULTI PE with their shift memories
-    for mul in ["0", "1"] {
+    // the binary32 PE, then the fixed-point ADD and MULTI PEs with their shift memories (issue 49)
+    let binary32: &[&str] = &[];
+    for params in [binary32, &["-GFIX=1", "-GIS_MUL=0", "-GLAT=4"], &["-GFIX=1", "-GIS_MUL=1", "-GLAT=4"]] {
         let out = Command::new("verilator")
             .args(["--lint-only", "-Wno-fatal", "-Wno-WIDTH", "-Wno-DECLFILENAME", "--top-module", "rv_pe"])
-            .args(["-GFIX=1", &format!("-GIS_MUL={mul}"), "-GLAT=4"])
-            .arg(hdl("fp_units.v"))
-            .arg(hdl("fix_units.v"))
-            .arg(hdl("rv_mem.v"))
-            .arg(hdl("rv_lib.v"))
+            .args(params)
+            .args(["fp_units.v", "fix_units.v", "rv_mem.v", "rv_lib.v"].map(hdl))
             .output()
             .expect("verilator runs");
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(out.status.success(), "{err}");
-        assert!(!err.contains("%Error"), "{err}");
+        assert!(out.status.success(), "{params:?}: {err}");
+        assert!(!err.contains("%Error"), "{params:?}: {err}");
     }
 }
 

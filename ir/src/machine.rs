@@ -223,6 +223,21 @@ impl FixShifts {
             s => k << -s,
         }
     }
+
+    /// What a fixed-point PE computes for `op` on the operands' integers `a`, `b`: the exact
+    /// `(a << la) ± (b << lb)` or `a · b`, then [`FixShifts::round`]; `None` for an op no
+    /// fixed-point unit has (`div`, `call`). The executor and the units' tests use it.
+    pub fn apply(&self, op: &MachineOp, a: i64, b: i64) -> Option<i128> {
+        let (a, b) = (i128::from(a), i128::from(b));
+        let (xa, xb) = if self.align_b { (a, b << self.align) } else { (a << self.align, b) };
+        let k = match op {
+            MachineOp::Add => xa + xb,
+            MachineOp::Sub => xa - xb,
+            MachineOp::Mul => a * b,
+            MachineOp::Div | MachineOp::Call(_) => return None,
+        };
+        Some(self.round(k))
+    }
 }
 
 /// The fixed-point side of a program whose PEs compute in fixed point (issue 49): a function

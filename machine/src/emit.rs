@@ -178,7 +178,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "latency": {"add": d.lat_add, "mul": d.lat_mul},
         "interconnect": d.interconnect().as_str(),
         "pe_kind": d.pe_kind.as_str(),
-        "mux_inputs": mux_inputs(d),
+        "mux_inputs": d.mux_inputs(),
         "widths": w,
         "layout": layout,
         "hdl": hdl,
@@ -202,15 +202,6 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
 
 fn pe_name_of(d: &Design, slot: usize) -> String {
     d.pes.get(slot).map(|p| p.pe.clone()).unwrap_or_else(|| format!("pe{slot}"))
-}
-
-/// The 32-bit multiplexer inputs of the design's write ports: `2·n_pe` per port for the
-/// crossbar, the routes for a specialised interconnect ([`crate::design::routes::Routes::mux_inputs`]).
-pub fn mux_inputs(d: &Design) -> u64 {
-    match &d.routes {
-        Some(r) => r.mux_inputs(),
-        None => 2 * (2 * d.n_pe() as u64) * d.n_pe() as u64,
-    }
 }
 
 /// The design, resource estimate and files of function `f` placed by `p`, on a target of

@@ -85,7 +85,7 @@ pub fn execute_fixed_until(
     mut input: impl FnMut(&str) -> f64,
     stop: &dyn Fn() -> bool,
 ) -> Result<Executed<f64>, MachineError> {
-    use crate::program::fixed::{constant_word, word_of};
+    use crate::program::fixed::{constant_word, value_of, word_of};
     let fx = p.fixed.as_ref().ok_or_else(|| MachineError::new(K::Formats, "the program is not for fixed-point PEs"))?;
     let mut inputs: HashMap<String, f64> = HashMap::new();
     let load = |w: &Word| -> Result<i64, String> {
@@ -93,9 +93,7 @@ pub fn execute_fixed_until(
         let mut stored = |n: &str| -> Result<f64, String> {
             let x = *inputs.entry(n.to_string()).or_insert_with(|| input(n));
             let f = fx.inputs.get(n).copied().ok_or_else(|| format!("input `{n}` has no fixed-point format"))?;
-            word_of(x, f)
-                .map(|k| k as f64 * (-f64::from(f)).exp2())
-                .ok_or_else(|| format!("input `{n}` = {x} overflows its format"))
+            word_of(x, f).map(|k| value_of(k, f)).ok_or_else(|| format!("input `{n}` = {x} overflows its format"))
         };
         let k = match w {
             Word::Input(n) => word_of(stored(n)?, frac),
@@ -108,20 +106,11 @@ pub fn execute_fixed_until(
     let op = |i: &Instr, slot: usize, cycle: usize, args: &[i64]| -> Result<i64, String> {
         let sh = fx.shifts.get(slot).and_then(|c| c.get(cycle)).copied().flatten().ok_or("an op without shifts")?;
         let [a, b] = args else { return Err(format!("{:?} reads {} words", i.op, args.len())) };
-        let (a, b) = (i128::from(*a), i128::from(*b));
-        let (xa, xb) = if sh.align_b { (a, b << sh.align) } else { (a << sh.align, b) };
-        let k = match i.op {
-            MachineOp::Add => xa + xb,
-            MachineOp::Sub => xa - xb,
-            MachineOp::Mul => a * b,
-            _ => return Err(format!("{:?} has no fixed-point unit", i.op)),
-        };
-        let r = sh.round(k);
+        let r = sh.apply(&i.op, *a, *b).ok_or_else(|| format!("{:?} has no fixed-point unit", i.op))?;
         i32::try_from(r).map(i64::from).map_err(|_| format!("the result {r} overflows the 32-bit word"))
     };
     let x = run(p, load, op, stop)?;
-    let outputs =
-        x.outputs.into_iter().zip(&fx.outputs).map(|((n, k), &f)| (n, k as f64 * (-f64::from(f)).exp2())).collect();
+    let outputs = x.outputs.into_iter().zip(&fx.outputs).map(|((n, k), &f)| (n, value_of(k, f))).collect();
     Ok(Executed { outputs, cycles: x.cycles })
 }
 

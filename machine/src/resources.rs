@@ -421,11 +421,8 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
         Some(y) => ("yosys", y.alm(), y.dsp),
         None => {
             let n = (na + nm) as f64;
-            let mux_inputs = match &d.routes {
-                Some(r) => r.mux_inputs() as f64,
-                None => n * f64::from(m.writes) * 2.0 * n,
-            };
-            let a = m.crossbar_alm * mux_inputs
+            // a design has two write ports per PE memory (`codegen<fpga>` refuses other targets)
+            let a = m.crossbar_alm * d.mux_inputs() as f64
                 + m.pe_memory_alm * n
                 + m.control_alm
                 + m.output_word_alm * output_words(d) as f64;

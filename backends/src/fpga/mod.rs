@@ -65,7 +65,7 @@ use serde::Serialize;
 use robovec_machine::design::build::{DesignError, Limits};
 use robovec_machine::design::Design;
 use robovec_machine::design::routes::Interconnect;
-use robovec_machine::emit::{emit_until, mux_inputs, DesignFile, EmitOptions};
+use robovec_machine::emit::{emit_until, DesignFile, EmitOptions};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
 use robovec_passes::params::{word_enum, ParamKind};
@@ -297,7 +297,7 @@ impl CodegenFpga {
             cycles: d.cycles,
             interconnect: d.interconnect().as_str(),
             pe_kind: d.pe_kind.as_str(),
-            mux_inputs: mux_inputs(&d),
+            mux_inputs: d.mux_inputs(),
             clock_mhz: model.clock_mhz,
             us: r.us,
             resources: r,

@@ -256,6 +256,17 @@ impl Design {
         self
     }
 
+    /// The 32-bit multiplexer inputs of the design's write ports (two per PE memory): `2·n_pe`
+    /// per port for the crossbar, the routes for a specialised interconnect
+    /// ([`Routes::mux_inputs`]).
+    pub fn mux_inputs(&self) -> u64 {
+        let n = self.n_pe() as u64;
+        match &self.routes {
+            Some(r) => r.mux_inputs(),
+            None => n * 2 * (2 * n),
+        }
+    }
+
     /// PE `slot`'s crossbar memory as the crossbar's selects ([`crate::encode`]'s words),
     /// whatever the interconnect.
     pub fn crossbar_words(&self, slot: usize) -> Vec<u64> {

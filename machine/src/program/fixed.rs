@@ -154,6 +154,11 @@ pub fn word_of(x: f64, fraction: i32) -> Option<i64> {
     fmt.mantissa(stored)
 }
 
+/// The value `k · 2^-fraction` of a word (exact: `|k| < 2^32`).
+pub fn value_of(k: i64, fraction: i32) -> f64 {
+    k as f64 * (-f64::from(fraction)).exp2()
+}
+
 /// A constant's word: [`robovec_ir::format::fix_constant`]'s integer.
 pub fn constant_word(c: f64) -> Option<i64> {
     robovec_ir::format::fix_constant(c).map(|(k, _)| k)

@@ -299,13 +299,7 @@ fn compare_fixed(
             robovec_ir::Operand::Const(c) => c,
         };
         if s.to_bits() != e.to_bits() {
-            return Err(SimError::new(
-                SimErrorKind::Mismatch,
-                format!("simulated {s:?} but the interpreter gives {e:?} (fixed point, seed {seed})"),
-            )
-            .at(When::End)
-            .of(format!("output `{name}`"))
-            .src(o.span));
+            return Err(mismatch(name, *s, e, &format!("fixed point, seed {seed}"), o.span));
         }
     }
     Ok(statistics(m, occ, x.outputs))
@@ -376,16 +370,19 @@ fn compare<T: Float>(
     for (((name, s), (_, e)), o) in sim.outputs.iter().zip(&reference).zip(&f.outputs) {
         let (s, e) = (s.to_f64(), e.to_f64());
         if s.to_bits() != e.to_bits() && !(s.is_nan() && e.is_nan()) {
-            return Err(SimError::new(
-                SimErrorKind::Mismatch,
-                format!("simulated {s:?} but the interpreter gives {e:?} ({precision}, seed {seed})"),
-            )
-            .at(When::End)
-            .of(format!("output `{name}`"))
-            .src(o.span));
+            return Err(mismatch(name, s, e, &format!("{precision}, seed {seed}"), o.span));
         }
     }
     Ok(sim)
+}
+
+/// Output `name` simulated as `s` where the interpreter gives `e` (`what`: the precision and
+/// seed), located at the output's line.
+fn mismatch(name: &str, s: f64, e: f64, what: &str, span: robovec_ir::Span) -> SimError {
+    SimError::new(SimErrorKind::Mismatch, format!("simulated {s:?} but the interpreter gives {e:?} ({what})"))
+        .at(When::End)
+        .of(format!("output `{name}`"))
+        .src(span)
 }
 
 /// Registry entry.
