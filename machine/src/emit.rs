@@ -251,8 +251,27 @@ pub fn emit_until(
             // `auto` within the limit: Yosys when it can be run, else the estimate.
             _ => resources::yosys_cells(&d)?,
         };
-    let r = resources::estimate(&d, model, cells);
-    let man = manifest(&d, &model.target, model.clock_mhz, format);
-    let files = design_files(&d, format, &r, &man);
+    let mut r = resources::estimate(&d, model, cells);
+    let mut pnr_files = Vec::new();
+    if logic == Logic::Pnr {
+        let Some(part) = &model.pnr else {
+            return Err(format!(
+                "`resources=pnr` places and routes with nextpnr-ecp5, and target `{}` is not an ECP5 one (`-target=ecp5-85f`, or a target file with `\"family\": \"ecp5\"` and `pnr`)",
+                model.target
+            )
+            .into());
+        };
+        let run = crate::pnr::place_and_route(&d, part, model.clock_mhz)
+            .map_err(|e| format!("function @{}: place and route for `{}`: {e}", f.name, model.target))?;
+        r = resources::with_pnr(r, model, run.figures);
+        pnr_files = run.files;
+    }
+    let man = manifest(&d, &model.target, r.clock_mhz, format);
+    let mut files = design_files(&d, format, &r, &man);
+    files.extend(pnr_files.into_iter().map(|(name, bytes)| DesignFile {
+        path: format!("pnr/{name}"),
+        bytes,
+        executable: false,
+    }));
     Ok((d, r, files))
 }

@@ -92,7 +92,8 @@ use serde::Serialize;
 #[cfg(doc)]
 use crate::design::routes::Routes;
 use crate::design::{Design, HDL_LIBRARY, SYNTH_STUBS};
-use crate::target::{m10k_blocks, M10kFit, Target};
+use crate::pnr::PnrFigures;
+use crate::target::{m10k_blocks, Family, M10kFit, PeMemory, Target, Units};
 
 /// Cost of one unit in device resources.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -110,6 +111,9 @@ pub struct UnitCost {
 pub struct CostModel {
     /// Target name.
     pub target: String,
+    /// The target's FPGA family: the units of every figure, its block-RAM configurations and
+    /// how PE memories are built.
+    pub family: Family,
     /// Device capacity: ALMs, M10K blocks, DSP blocks.
     pub capacity: UnitCost,
     /// One ADD PE's floating-point unit.
@@ -124,6 +128,8 @@ pub struct CostModel {
     pub crossbar_alm: f64,
     /// Analytic logic: ALMs per PE memory.
     pub pe_memory_alm: f64,
+    /// Analytic logic: ALMs per PE-memory word.
+    pub pe_word_alm: f64,
     /// Analytic logic: control ALMs.
     pub control_alm: f64,
     /// Analytic logic: ALMs per output-memory word (32 registers).
@@ -132,6 +138,8 @@ pub struct CostModel {
     pub writes: u32,
     /// Clock, MHz.
     pub clock_mhz: f64,
+    /// The part `resources=pnr` places for (the target's `pnr`).
+    pub pnr: Option<crate::pnr::PnrPart>,
 }
 
 /// One memory's M10K count.
@@ -172,51 +180,75 @@ impl YosysCells {
     }
 }
 
-/// The estimate (`DIR/resources.json`, the report's `fpga.resources`).
+/// The estimate (`DIR/resources.json`, the report's `fpga.resources`). The three counts are
+/// in the target family's units ([`Resources::units`]: ALM, M10K, DSP blocks on the Cyclone V;
+/// LUT4, EBR, MULT18X18D on the ECP5), under SPEC §8's keys `alm`, `m10k`, `dsp`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Resources {
-    /// ALMs: logic + FP units.
+    /// Logic (ALMs on the Cyclone V, LUT4 slots on the ECP5): logic + FP units.
     pub alm: u64,
-    /// M10K blocks: memories + FP units.
+    /// Block RAMs (M10K, or EBR): memories + FP units.
     pub m10k: u64,
-    /// DSP blocks: FP units + logic.
+    /// DSP blocks (or MULT18X18D): FP units + logic.
     pub dsp: u64,
+    /// What `alm`, `m10k` and `dsp` count.
+    pub units: Units,
     /// True when all three are within the device.
     pub fits: bool,
     /// Cycles per evaluation (the program's last cycle, SPEC §4).
     pub cycles: u32,
-    /// Clock, MHz.
+    /// Clock, MHz: the target's declared clock, or with `resources=pnr` the Fmax nextpnr
+    /// measured.
     pub clock_mhz: f64,
     /// Time per evaluation, µs: `cycles / clock_mhz`.
     pub us: f64,
+    /// `resources=pnr`: the Fmax of `clk` nextpnr-ecp5 measured after routing, MHz.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fmax_mhz: Option<f64>,
     /// Device capacity.
     pub capacity: UnitCost,
-    /// `yosys` (logic synthesized) or `estimate` (no yosys on PATH: analytic crossbar cost).
+    /// `yosys` (logic synthesized), `estimate` (no yosys on PATH: analytic crossbar cost) or
+    /// `pnr` (the whole design synthesized, placed and routed: every count is nextpnr's).
     pub logic_from: &'static str,
     /// Logic ALMs (from Yosys or the estimate).
     pub logic_alm: u64,
     /// Yosys' cells when it ran.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub yosys: Option<YosysCells>,
+    /// `resources=pnr`: the place-and-route figures.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pnr: Option<PnrFigures>,
     /// FP unit ALMs / DSP (target's per-unit costs).
     pub fp_units: UnitCost,
     /// Per memory M10K.
     pub memories: Vec<MemoryCost>,
 }
 
-/// Every M10K memory of the design and its blocks.
-pub fn memory_costs(d: &Design) -> Vec<MemoryCost> {
+/// Every block-RAM memory of the design and its blocks in `family`'s configurations. A PE memory
+/// is one true dual-port memory ([`PeMemory::DoublePumped`]) or four simple dual-port banks
+/// ([`PeMemory::LiveValueTable`]: the memory's blocks are four banks').
+pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
     let mut v = Vec::new();
+    let (pe_tdp, banks) = match d.pe_memory {
+        PeMemory::DoublePumped => (true, 1),
+        PeMemory::LiveValueTable => (false, 4),
+    };
     for p in &d.pes {
-        let fixed = p.fix.iter().map(|i| (i, false));
-        let all = [(&p.instr, false), (&p.xbar, false), (&p.bufi, false), (&p.capt, false), (&p.data, true)];
-        for (img, tdp) in all.into_iter().chain(fixed) {
+        let fixed = p.fix.iter().map(|i| (i, false, 1));
+        let all = [
+            (&p.instr, false, 1),
+            (&p.xbar, false, 1),
+            (&p.bufi, false, 1),
+            (&p.capt, false, 1),
+            (&p.data, pe_tdp, banks),
+        ];
+        for (img, true_dual_port, banks) in all.into_iter().chain(fixed) {
             let words = img.words.len().max(1) as u64;
             v.push(MemoryCost {
                 name: img.name.clone(),
                 words,
                 width: img.width,
-                m10k: m10k_blocks(words, img.width, M10kFit::Configurations { true_dual_port: tdp }),
+                m10k: banks * m10k_blocks(words, img.width, M10kFit::Configurations { true_dual_port, family }),
             });
         }
     }
@@ -233,6 +265,7 @@ pub fn cost_model(t: &Target) -> CostModel {
     };
     CostModel {
         target: t.name.clone(),
+        family: t.family,
         capacity: UnitCost { alm: u64::from(t.alm), m10k: u64::from(t.m10k), dsp: u64::from(t.dsp) },
         fp_add: unit(&t.fp_add),
         fp_mul: unit(&t.fp_mul),
@@ -248,10 +281,12 @@ pub fn cost_model(t: &Target) -> CostModel {
         },
         crossbar_alm: t.crossbar_alm,
         pe_memory_alm: t.pe_memory_alm,
+        pe_word_alm: t.pe_word_alm,
         control_alm: t.control_alm,
         output_word_alm: t.output_word_alm,
         writes: t.writes,
         clock_mhz: t.clock_mhz,
+        pnr: t.pnr.clone(),
     }
 }
 
@@ -273,11 +308,15 @@ pub enum Logic {
     Yosys,
     /// The analytic estimate (deterministic and fast).
     Estimate,
+    /// The whole design synthesized (Yosys `synth_ecp5`), placed and routed (nextpnr-ecp5) and
+    /// packed into a bitstream (ecppack): measured LUT4, EBR, MULT18X18D and Fmax
+    /// ([`crate::pnr`]). ECP5 targets only.
+    Pnr,
 }
 
 impl Logic {
     /// Every word of `resources=`, in the variants' order.
-    pub const WORDS: &'static [&'static str] = &["auto", "yosys", "estimate"];
+    pub const WORDS: &'static [&'static str] = &["auto", "yosys", "estimate", "pnr"];
 
     /// The value's word (`resources=auto`).
     pub const fn as_str(self) -> &'static str {
@@ -285,19 +324,21 @@ impl Logic {
             Logic::Auto => "auto",
             Logic::Yosys => "yosys",
             Logic::Estimate => "estimate",
+            Logic::Pnr => "pnr",
         }
     }
 
     /// The value written `word`, if any.
     pub fn from_word(word: &str) -> Option<Logic> {
-        [Logic::Auto, Logic::Yosys, Logic::Estimate].into_iter().find(|l| l.as_str() == word)
+        [Logic::Auto, Logic::Yosys, Logic::Estimate, Logic::Pnr].into_iter().find(|l| l.as_str() == word)
     }
 
     /// True when a design of `n_pes` PEs (ADD + MULTI) gets the analytic estimate without
-    /// trying Yosys: `Estimate`, or `Auto` beyond [`AUTO_YOSYS_MAX_PES`].
+    /// trying Yosys' hierarchical count: `Estimate`, `Auto` beyond [`AUTO_YOSYS_MAX_PES`], and
+    /// `Pnr` (whose figures are the flow's, [`crate::pnr`]).
     pub fn skips_yosys(self, n_pes: u32) -> bool {
         match self {
-            Logic::Estimate => true,
+            Logic::Estimate | Logic::Pnr => true,
             Logic::Auto => n_pes > AUTO_YOSYS_MAX_PES,
             Logic::Yosys => false,
         }
@@ -415,7 +456,7 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
         dsp: na * add.dsp + nm * mul.dsp,
         m10k: na * add.m10k + nm * mul.m10k,
     };
-    let memories = memory_costs(d);
+    let memories = memory_costs(d, m.family);
     let mem_m10k: u64 = memories.iter().map(|c| c.m10k).sum();
     let (logic_from, logic_alm, logic_dsp) = match &yosys {
         Some(y) => ("yosys", y.alm(), y.dsp),
@@ -424,6 +465,7 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
             // a design has two write ports per PE memory (`codegen<fpga>` refuses other targets)
             let a = m.crossbar_alm * d.mux_inputs() as f64
                 + m.pe_memory_alm * n
+                + m.pe_word_alm * d.pes.iter().map(|p| p.data.words.len().max(1) as f64).sum::<f64>()
                 + m.control_alm
                 + m.output_word_alm * output_words(d) as f64;
             ("estimate", a.ceil() as u64, 0)
@@ -436,24 +478,50 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
         alm,
         m10k,
         dsp,
+        units: m.family.units(),
         fits: alm <= m.capacity.alm && m10k <= m.capacity.m10k && dsp <= m.capacity.dsp,
         cycles: d.cycles,
         clock_mhz: m.clock_mhz,
         us: f64::from(d.cycles) / m.clock_mhz,
+        fmax_mhz: None,
         capacity: m.capacity,
         logic_from,
         logic_alm,
         yosys,
+        pnr: None,
         fp_units: fp,
         memories,
     }
 }
 
+/// The estimate `r` with place and route's figures in place of its counts (`resources=pnr`):
+/// logic, block RAM and multipliers as nextpnr counted them (the whole design: `logic_alm` is
+/// all of it and `fp_units` zero), fit as placed and within the device, and the time at the
+/// measured Fmax (the declared clock when the design was not placed). `memories` stays the
+/// analytic count of each memory's blocks.
+pub fn with_pnr(r: Resources, m: &CostModel, p: PnrFigures) -> Resources {
+    let clock_mhz = p.fmax_mhz.unwrap_or(m.clock_mhz);
+    Resources {
+        alm: p.lut4,
+        m10k: p.ebr,
+        dsp: p.mult18,
+        fits: p.placed && p.lut4 <= m.capacity.alm && p.ebr <= m.capacity.m10k && p.mult18 <= m.capacity.dsp,
+        clock_mhz,
+        us: f64::from(r.cycles) / clock_mhz,
+        fmax_mhz: p.fmax_mhz,
+        logic_from: "pnr",
+        logic_alm: p.lut4,
+        fp_units: UnitCost { alm: 0, dsp: 0, m10k: 0 },
+        pnr: Some(p),
+        ..r
+    }
+}
+
 /// A folder under the system's temporary folder, removed on drop.
-struct TempDir(PathBuf);
+pub(crate) struct TempDir(pub(crate) PathBuf);
 
 impl TempDir {
-    fn new() -> Option<TempDir> {
+    pub(crate) fn new() -> Option<TempDir> {
         use std::sync::atomic::{AtomicU32, Ordering};
         static N: AtomicU32 = AtomicU32::new(0);
         let base = std::env::temp_dir();

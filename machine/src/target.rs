@@ -53,8 +53,33 @@
 //! architecture is designed for and that a top with a proper PLL pair can run at; the as-built
 //! 25 MHz is `examples/targets/de10-nano-as-built.json`.
 //!
+//! # The built-in `ecp5-85f` (issue 49 item 4)
+//! The Lattice ECP5-85F (LFE5U-85F, CABGA381), the device of the open flow: Yosys `synth_ecp5`,
+//! nextpnr-ecp5 and ecppack ([`crate::pnr`], `codegen<fpga;resources=pnr>`). Family
+//! [`Family::Ecp5`]: `alm` counts LUT4 slots, `m10k` EBR blocks, `dsp` MULT18X18D multipliers.
+//! Its clock and unit costs are Yosys' and nextpnr's measurements of robovec's own Verilog
+//! (YoWASP Yosys 0.70 and nextpnr 0.11.1, docs/fpga.md), not a datasheet's; with
+//! `resources=pnr` every figure of a design is measured instead.
+//!
+//! | field | value | source |
+//! |---|---|---|
+//! | `family` | `ecp5` | |
+//! | `alm`, `m10k`, `dsp`, `m10k_bits` | 83 640 LUT4, 208 EBR, 156 MULT18X18D, 18 432 bits | Lattice FPGA-DS-02012, *ECP5 and ECP5-5G Family Data Sheet*, LFE5U-85 column (84K LUTs, 208 sysMEM blocks of 18 Kbit, 156 18 × 18 multipliers); 83 640 is nextpnr's count of `TRELLIS_COMB` slots on the device |
+//! | `pnr` | `85k`, `CABGA381` | nextpnr-ecp5's `--85k` and the package of the ECP5 evaluation board and the ULX3S |
+//! | `clock_mhz` | 80 MHz | declared, for estimates without place and route: fixed-point designs of the double pendulum placed and routed at 75–88 MHz (binary32 ones at 18.5 MHz: `fp_units.v`'s combinational cores); `resources=pnr` replaces it by the measured Fmax |
+//! | `latencies`, `fix_pe.*.latency` | as the DE10-Nano's | the same Verilog units and pipeline (SPEC §1's + 2) |
+//! | `pe_words` | 512 | a PE memory as four simple dual-port banks of one EBR each (512 × 36, `PDPW16KD`) and its live-value table ([`PeMemory::LiveValueTable`]) |
+//! | `fp_add`, `fp_mul` | 1 675 LUT4; 1 261 LUT4 + 4 MULT18X18D | Yosys `synth_ecp5` of `fp_add_sub` (`LATENCY = 10`) and `fp_mul` (5) alone: LUT4 + 2 × CCU2C |
+//! | `fix_pe.add`, `fix_pe.mul` | 2 106 LUT4; 1 488 LUT4 + 4 MULT18X18D | the same of `fix_add_sub` (2) and `fix_mul` (3) with their shifts as free inputs: an upper bound, since in a whole design the shift memory is a ROM and Yosys keeps only the shifts it holds (the 1 + 1 PE pendulum places in 2 316 LUT4 in all) |
+//! | `pe_memory_alm`, `pe_word_alm` | 314 LUT4 + 4.1 LUT4 per word | Yosys of `rv_pe_mem_lvt` at 64, 512 and 1 024 words (575, 2 403, 4 445 LUT4): the bypass and bank choice, and the live-value table (a bit a word, two write and two read ports) in logic |
+//! | `crossbar_alm` | 60 LUT4 per multiplexer input | Yosys of `rv_mux` with 17 sources (1 011 LUT4 + 5 CCU2C: 60 a source; 9 sources: 44) |
+//! | `output_word_alm` | 16 LUT4 | estimate: the DE10-Nano's per-word figure (32 registers and their read multiplexer) |
+//! | `control_alm` | 469 | the DE10-Nano's |
+//! | `datapath` | 9 × 9 (two a block), 18 × 18; 1 LUT4 a bit of adder; binary64 units 3 500 LUT4 (add), 2 500 LUT4 + 9 MULT18X18D (mul); conversion 200 LUT4 | the multiplier modes of the sysDSP slice (FPGA-DS-02012, "sysDSP"); a CCU2C adds two bits in two LUT4 slots; the binary64 and conversion figures are estimates scaled from the binary32 units above (no measurement) |
+//!
 //! # The JSON format (`-target=FILE.json`)
-//! One object, every key required except `output_word_alm` (default 0), `latencies.div` and
+//! One object, every key required except `family` (default `cyclone-v`), `pnr` (ECP5 only),
+//! `pe_word_alm` (default 0), `output_word_alm` (default 0), `latencies.div` and
 //! `latencies.call` (default: the `add` latency, as they run on ADD PEs), `datapath` (each
 //! of its fields defaults to the DE10-Nano's, the table above) and `fix_pe` (the DE10-Nano's
 //! when left out); an unknown key
@@ -142,6 +167,82 @@
 use robovec_ir::analysis::Latencies;
 use robovec_ir::placement::PeArray;
 
+/// The FPGA family of a target: what its `alm`, `m10k` and `dsp` capacities and costs count
+/// ([`Family::units`]), the block-RAM configurations a memory maps onto
+/// ([`M10kFit::Configurations`]) and how the design builds its PE memories
+/// ([`Family::pe_memory`]). JSON: `"family": "cyclone-v"` (the default) or `"ecp5"`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Family {
+    /// Intel Cyclone V (the DE10-Nano): ALM, M10K (10 Kbit), variable-precision DSP blocks.
+    #[default]
+    CycloneV,
+    /// Lattice ECP5: LUT4 slots (nextpnr's `TRELLIS_COMB`, a `CCU2C` carry cell taking two),
+    /// EBR (DP16KD, 18 Kbit), MULT18X18D multipliers.
+    Ecp5,
+}
+
+/// The names of a family's three resources, as reports print them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct Units {
+    /// Logic: `ALM` or `LUT4`.
+    pub logic: &'static str,
+    /// Block RAM: `M10K` or `EBR`.
+    pub bram: &'static str,
+    /// Multipliers: `DSP` (a variable-precision block) or `MULT18X18D`.
+    pub dsp: &'static str,
+}
+
+/// How a design builds each PE memory (two reads and two writes per cycle, `hdl/rv_mem.v`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PeMemory {
+    /// One true dual-port block RAM at twice the PE clock (seed §1.1.2: the M10K double-pumped;
+    /// `rv_pe_mem`).
+    DoublePumped,
+    /// Four simple dual-port banks (one per write port × read port) and a live-value table
+    /// (LaForest & Steffan, FPGA 2010; `rv_pe_mem_lvt`): for block RAMs that cannot run at twice
+    /// the clock, the ECP5's.
+    LiveValueTable,
+}
+
+impl Family {
+    /// The resource names of the family.
+    pub const fn units(self) -> Units {
+        match self {
+            Family::CycloneV => Units { logic: "ALM", bram: "M10K", dsp: "DSP" },
+            Family::Ecp5 => Units { logic: "LUT4", bram: "EBR", dsp: "MULT18X18D" },
+        }
+    }
+
+    /// The family's word (`cyclone-v`, `ecp5`).
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Family::CycloneV => "cyclone-v",
+            Family::Ecp5 => "ecp5",
+        }
+    }
+
+    /// How its designs build a PE memory.
+    pub const fn pe_memory(self) -> PeMemory {
+        match self {
+            Family::CycloneV => PeMemory::DoublePumped,
+            Family::Ecp5 => PeMemory::LiveValueTable,
+        }
+    }
+
+    /// The block-RAM configurations `(depth, width)` of one block, and the widest a true
+    /// dual-port memory may use: Cyclone V M10K 8K×1 … 256×40 (true dual-port up to ×20; Cyclone V
+    /// device handbook, "Embedded Memory Blocks"); ECP5 DP16KD 16K×1 … 1K×18 true dual-port and
+    /// 512×36 as the pseudo dual-port PDPW16KD (Lattice TN1264, *ECP5 and ECP5-5G Memory Usage
+    /// Guide*, tables of DP16KD and PDPW16KD).
+    pub const fn bram_configurations(self) -> (&'static [(u64, u64)], u64) {
+        match self {
+            Family::CycloneV => (&[(8192, 1), (4096, 2), (2048, 5), (1024, 10), (512, 20), (256, 40)], 20),
+            Family::Ecp5 => (&[(16384, 1), (8192, 2), (4096, 4), (2048, 9), (1024, 18), (512, 36)], 18),
+        }
+    }
+}
+
 /// What one floating-point unit (with its PE wrapper) costs, per PE (seed Table 1.4).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -159,6 +260,9 @@ pub struct UnitCost {
 pub struct Target {
     /// Name (`de10-nano`, or the JSON file's `name`).
     pub name: String,
+    /// The FPGA family: what `alm`, `m10k`, `dsp` and the unit costs count (ALM, M10K and DSP
+    /// blocks on the Cyclone V; LUT4, EBR and MULT18X18D on the ECP5: [`Family::units`]).
+    pub family: Family,
     /// PE clock, MHz (one cycle of the placement = one period).
     pub clock_mhz: f64,
     /// Latencies, cycles from issue to a result written in the target PE memory (SPEC §1).
@@ -187,6 +291,9 @@ pub struct Target {
     pub fp_mul: UnitCost,
     /// ALM of the logic around one PE memory.
     pub pe_memory_alm: f64,
+    /// ALM per word of a PE memory (the live-value table of [`PeMemory::LiveValueTable`], one
+    /// bit a word with two write and two read ports, in logic; 0 on the Cyclone V).
+    pub pe_word_alm: f64,
     /// ALM per PE-memory write port per crossbar source.
     pub crossbar_alm: f64,
     /// ALM of the control (cycle counter, start/done) shared by the whole design.
@@ -199,6 +306,9 @@ pub struct Target {
     /// The fixed-point PEs (issue 49): their latencies and costs, for a function whose values
     /// are all `fix<w ≤ 32, f>` ([`crate::program::fixed::pe_kind`]).
     pub fix_pe: FixPe,
+    /// The part nextpnr-ecp5 places for (`codegen<fpga;resources=pnr>`, [`crate::pnr`]); ECP5
+    /// targets only, `None` where the open flow does not go.
+    pub pnr: Option<crate::pnr::PnrPart>,
 }
 
 /// One fixed-point PE's unit: its latency (cycles from issue to a result written, the `+ 2` of
@@ -388,6 +498,8 @@ struct LatenciesFile {
 #[serde(deny_unknown_fields)]
 struct TargetFile {
     name: String,
+    #[serde(default)]
+    family: Family,
     clock_mhz: f64,
     latencies: LatenciesFile,
     writes: u32,
@@ -402,6 +514,8 @@ struct TargetFile {
     fp_add: UnitCost,
     fp_mul: UnitCost,
     pe_memory_alm: f64,
+    #[serde(default)]
+    pe_word_alm: f64,
     crossbar_alm: f64,
     control_alm: f64,
     #[serde(default)]
@@ -410,6 +524,8 @@ struct TargetFile {
     datapath: Datapath,
     #[serde(default)]
     fix_pe: FixPe,
+    #[serde(default)]
+    pnr: Option<crate::pnr::PnrPart>,
 }
 
 /// How a memory is mapped onto M10K blocks (module doc, "M10K blocks").
@@ -421,15 +537,18 @@ pub enum M10kFit {
         /// Bits of one block (the target's `m10k_bits`; 10 240 on the DE10-Nano).
         block_bits: u32,
     },
-    /// The fewest blocks over the Cyclone V M10K configurations (8K×1, 4K×2, 2K×5, 1K×10,
-    /// 512×20, 256×40): ⌈words/d⌉·⌈width/w⌉ minimised over the configurations `d × w`, 0 for a
-    /// memory without words or width (the FPGA back end's estimate,
-    /// [`crate::resources::memory_costs`]).
+    /// The fewest blocks over the family's block-RAM configurations
+    /// ([`Family::bram_configurations`]; Cyclone V: 8K×1, 4K×2, 2K×5, 1K×10, 512×20, 256×40):
+    /// ⌈words/d⌉·⌈width/w⌉ minimised over the configurations `d × w`, 0 for a memory without
+    /// words or width (the FPGA back end's estimate, [`crate::resources::memory_costs`]).
     Configurations {
-        /// Excludes the ×40 configuration (simple dual-port and ROM only): the PE memory's two
-        /// read and two write ports per cycle use both ports of the block at twice the clock
-        /// (seed §1.3), which gives the seed's 7 M10K for a 2048 × 32 PE memory.
+        /// Excludes the configurations wider than the family's true dual-port width (the
+        /// Cyclone V's ×40, simple dual-port and ROM only): the PE memory's two read and two
+        /// write ports per cycle use both ports of the block at twice the clock (seed §1.3),
+        /// which gives the seed's 7 M10K for a 2048 × 32 PE memory.
         true_dual_port: bool,
+        /// Whose blocks.
+        family: Family,
     },
 }
 
@@ -441,14 +560,14 @@ pub fn m10k_blocks(words: u64, width: u32, fit: M10kFit) -> u64 {
             let bits = words * u64::from(width);
             bits.div_ceil(u64::from(block_bits)).max(1)
         }
-        M10kFit::Configurations { true_dual_port } => {
+        M10kFit::Configurations { true_dual_port, family } => {
             if words == 0 || width == 0 {
                 return 0;
             }
-            let configs: &[(u64, u64)] = &[(8192, 1), (4096, 2), (2048, 5), (1024, 10), (512, 20), (256, 40)];
+            let (configs, tdp_width) = family.bram_configurations();
             configs
                 .iter()
-                .filter(|&&(_, w)| !(true_dual_port && w == 40))
+                .filter(|&&(_, w)| !(true_dual_port && w > tdp_width))
                 .map(|&(d, w)| words.div_ceil(d) * u64::from(width).div_ceil(w))
                 .min()
                 .unwrap_or(0)
@@ -467,12 +586,13 @@ pub fn address_bits(n: u32) -> u32 {
 
 impl Target {
     /// The names of the built-in targets, for diagnostics.
-    pub const BUILT_IN: &'static [&'static str] = &["de10-nano"];
+    pub const BUILT_IN: &'static [&'static str] = &["de10-nano", "ecp5-85f"];
 
     /// The DE10-Nano of the seed (module doc: every value and its source).
     pub fn de10_nano() -> Target {
         Target {
             name: "de10-nano".into(),
+            family: Family::CycloneV,
             clock_mhz: 120.0,
             latencies: Latencies { add: 12, mul: 7, div: 12, call: 12 },
             writes: 2,
@@ -487,11 +607,53 @@ impl Target {
             fp_add: UnitCost { alm: 360.0, dsp: 2, m10k: 0 },
             fp_mul: UnitCost { alm: 100.0, dsp: 3, m10k: 0 },
             pe_memory_alm: 3.0,
+            pe_word_alm: 0.0,
             crossbar_alm: 8.125,
             control_alm: 469.0,
             output_word_alm: 16.0,
             datapath: Datapath::default(),
             fix_pe: FixPe::default(),
+            pnr: None,
+        }
+    }
+
+    /// The Lattice ECP5-85F (LFE5U-85F) of issue 49 item 4, for the open flow (Yosys
+    /// `synth_ecp5`, nextpnr-ecp5, ecppack; `codegen<fpga;resources=pnr>`): the module doc,
+    /// "The built-in `ecp5-85f`", gives every value and its source.
+    pub fn ecp5_85f() -> Target {
+        Target {
+            name: "ecp5-85f".into(),
+            family: Family::Ecp5,
+            clock_mhz: 80.0,
+            latencies: Latencies { add: 12, mul: 7, div: 12, call: 12 },
+            writes: 2,
+            pe_words: 512,
+            buffer_words: 16,
+            instr_words: 65536,
+            instr_width: 52,
+            alm: 83_640,
+            m10k: 208,
+            dsp: 156,
+            m10k_bits: 18_432,
+            fp_add: UnitCost { alm: 1675.0, dsp: 0, m10k: 0 },
+            fp_mul: UnitCost { alm: 1261.0, dsp: 4, m10k: 0 },
+            pe_memory_alm: 314.0,
+            pe_word_alm: 4.1,
+            crossbar_alm: 60.0,
+            control_alm: 469.0,
+            output_word_alm: 16.0,
+            datapath: Datapath {
+                dsp_modes: vec![DspMode { a: 9, b: 9, per_block: 2 }, DspMode { a: 18, b: 18, per_block: 1 }],
+                fix_alm_per_bit: 1.0,
+                fp64_add: UnitCost { alm: 3500.0, dsp: 0, m10k: 0 },
+                fp64_mul: UnitCost { alm: 2500.0, dsp: 9, m10k: 0 },
+                convert_alm: 200.0,
+            },
+            fix_pe: FixPe {
+                add: FixUnit { latency: 4, alm: 2106.0, dsp: 0, m10k: 0 },
+                mul: FixUnit { latency: 5, alm: 1488.0, dsp: 4, m10k: 0 },
+            },
+            pnr: Some(crate::pnr::PnrPart { device: "85k".into(), package: "CABGA381".into() }),
         }
     }
 
@@ -499,6 +661,7 @@ impl Target {
     pub fn built_in(name: &str) -> Option<Target> {
         match name {
             "de10-nano" => Some(Target::de10_nano()),
+            "ecp5-85f" => Some(Target::ecp5_85f()),
             _ => None,
         }
     }
@@ -517,6 +680,7 @@ impl Target {
         })?;
         let t = Target {
             name: f.name,
+            family: f.family,
             clock_mhz: f.clock_mhz,
             latencies: Latencies {
                 add: f.latencies.add,
@@ -536,11 +700,13 @@ impl Target {
             fp_add: f.fp_add,
             fp_mul: f.fp_mul,
             pe_memory_alm: f.pe_memory_alm,
+            pe_word_alm: f.pe_word_alm,
             crossbar_alm: f.crossbar_alm,
             control_alm: f.control_alm,
             output_word_alm: f.output_word_alm,
             datapath: f.datapath,
             fix_pe: f.fix_pe,
+            pnr: f.pnr,
         };
         t.validate().map_err(|message| TargetError::Value { path: path.to_string(), message })?;
         Ok(t)
@@ -574,6 +740,12 @@ impl Target {
     pub fn validate(&self) -> Result<(), String> {
         if self.name.trim().is_empty() {
             return Err("`name` must not be empty".into());
+        }
+        if self.pnr.is_some() && self.family != Family::Ecp5 {
+            return Err(format!(
+                "`pnr` (nextpnr-ecp5's device and package) needs `\"family\": \"ecp5\"`, not `{}`",
+                self.family.as_str()
+            ));
         }
         if !(self.clock_mhz.is_finite() && self.clock_mhz > 0.0) {
             return Err(format!("`clock_mhz` must be a positive number of MHz, got {}", self.clock_mhz));
@@ -615,6 +787,7 @@ impl Target {
             ("fp_add.alm", self.fp_add.alm),
             ("fp_mul.alm", self.fp_mul.alm),
             ("pe_memory_alm", self.pe_memory_alm),
+            ("pe_word_alm", self.pe_word_alm),
             ("crossbar_alm", self.crossbar_alm),
             ("control_alm", self.control_alm),
             ("output_word_alm", self.output_word_alm),
@@ -676,7 +849,7 @@ impl Target {
         let sources = 2 * n_pe;
         let alm = f64::from(n_add) * self.fp_add.alm
             + f64::from(n_mul) * self.fp_mul.alm
-            + n_pe as f64 * self.pe_memory_alm
+            + n_pe as f64 * (self.pe_memory_alm + self.pe_word_alm * f64::from(self.pe_words))
             + self.crossbar_alm * (n_pe * u64::from(self.writes) * sources) as f64
             + self.control_alm;
         let dsp = u64::from(n_add) * u64::from(self.fp_add.dsp) + u64::from(n_mul) * u64::from(self.fp_mul.dsp);
@@ -838,8 +1011,8 @@ mod tests {
     #[test]
     fn m10k_fits_agree_on_the_seed_memories_and_differ_where_no_configuration_packs() {
         let bits = M10kFit::Bits { block_bits: 10_240 };
-        let rom = M10kFit::Configurations { true_dual_port: false };
-        let tdp = M10kFit::Configurations { true_dual_port: true };
+        let rom = M10kFit::Configurations { true_dual_port: false, family: Family::CycloneV };
+        let tdp = M10kFit::Configurations { true_dual_port: true, family: Family::CycloneV };
         // seed §1.3.1: a 2048 × 32 PE memory takes 7 M10K (2K×5, ⌈32/5⌉ = 7; bits 65536 → 7)
         assert_eq!((m10k_blocks(2048, 32, bits), m10k_blocks(2048, 32, tdp)), (7, 7));
         // a ROM of 988 × 52: 1K×10 → 6 blocks; 256×40 → 4·2 = 8; 512×20 → 2·3 = 6; bits 51376 → 6
@@ -857,6 +1030,30 @@ mod tests {
                 assert!(m10k_blocks(words, width, rom) >= m10k_blocks(words, width, bits), "{words} × {width}");
             }
         }
+    }
+
+    #[test]
+    fn the_ecp5_85f_is_built_in_with_the_lfe5u_85f_capacities_and_its_ebr_configurations() {
+        let t = Target::resolve("ecp5-85f").unwrap();
+        assert_eq!(t.family, Family::Ecp5);
+        // Lattice FPGA-DS-02012 (ECP5 family data sheet), LFE5U-85F: 84K LUTs (83 640 LUT4 in
+        // nextpnr's chip database), 208 EBR of 18 Kbit, 156 18 × 18 multipliers.
+        assert_eq!((t.alm, t.m10k, t.dsp, t.m10k_bits), (83_640, 208, 156, 18 * 1024));
+        assert_eq!(t.family.units(), Units { logic: "LUT4", bram: "EBR", dsp: "MULT18X18D" });
+        assert_eq!(t.pnr.as_ref().map(|p| (p.device.as_str(), p.package.as_str())), Some(("85k", "CABGA381")));
+        assert_eq!(Target::from_json("x.json", &serde_json::to_string(&t).unwrap()).unwrap(), t);
+        t.validate().unwrap();
+        // DP16KD: true dual-port up to 1K × 18, so a 2048 × 32 memory takes 4 blocks (2K × 9:
+        // 1 deep · 4 wide; 1K × 18: 2 deep · 2 wide); a simple dual-port one may use 512 × 36:
+        // 64 × 32 in one block (true dual-port: 2, at 1K × 18).
+        let ecp5 = |tdp| M10kFit::Configurations { true_dual_port: tdp, family: Family::Ecp5 };
+        assert_eq!(m10k_blocks(2048, 32, ecp5(true)), 4);
+        assert_eq!(m10k_blocks(64, 32, ecp5(false)), 1);
+        assert_eq!(m10k_blocks(64, 32, ecp5(true)), 2);
+        assert_eq!(m10k_blocks(16384, 1, ecp5(true)), 1);
+        // `pnr` belongs to ECP5 targets only
+        let wrong = Target { pnr: t.pnr.clone(), ..Target::de10_nano() };
+        assert!(wrong.validate().unwrap_err().contains("ecp5"));
     }
 
     #[test]

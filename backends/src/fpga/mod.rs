@@ -63,8 +63,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use robovec_machine::design::build::{DesignError, Limits};
-use robovec_machine::design::Design;
 use robovec_machine::design::routes::Interconnect;
+use robovec_machine::design::Design;
 use robovec_machine::emit::{emit_until, DesignFile, EmitOptions};
 use robovec_machine::resources::{cost_model, CostModel, Logic, Resources, AUTO_YOSYS_MAX_PES};
 
@@ -99,7 +99,7 @@ pub const FORMAT: ParamInfo = ParamInfo {
 pub const RESOURCES: ParamInfo = ParamInfo {
     name: "resources",
     kind: ParamKind::Choice { choices: Logic::WORDS, default: Logic::Auto.as_str() },
-    doc: "FPGA: logic ALMs from Yosys (auto: when on PATH and at most 8 PEs) or the analytic estimate",
+    doc: "FPGA: logic from Yosys (auto: when on PATH and at most 32 + 32 PEs), the analytic estimate, or (pnr, ECP5 targets) the whole design synthesized, placed and routed with Yosys and nextpnr-ecp5: measured LUT4, EBR, MULT18X18D, Fmax and a bitstream (issue 49)",
 };
 
 /// `interconnect=crossbar|specialised`.
@@ -177,11 +177,14 @@ pub struct FpgaReport {
     pub pe_kind: &'static str,
     /// 32-bit multiplexer inputs of all write ports (crossbar: `2·n_pe` per port).
     pub mux_inputs: u64,
-    /// Clock, MHz.
+    /// Clock, MHz: the target's declared clock, or with `resources=pnr` the measured Fmax.
     pub clock_mhz: f64,
+    /// `resources=pnr`: the Fmax nextpnr measured, MHz (then `clock_mhz` and `us` are at it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fmax_mhz: Option<f64>,
     /// µs per evaluation.
     pub us: f64,
-    /// ALM / M10K / DSP, fit.
+    /// ALM / M10K / DSP (in the target family's units, `resources.units`), fit.
     pub resources: Resources,
 }
 
@@ -208,18 +211,25 @@ impl Artifact for FpgaArtifact {
         let mut s = String::new();
         for (f, r, _) in self.functions.iter().filter(|(f, _, _)| function.is_none_or(|x| x == f)) {
             let x = &r.resources;
+            let u = x.units;
+            let clock = match r.fmax_mhz {
+                Some(fmax) => format!("{fmax} MHz (Fmax, nextpnr)"),
+                None => format!("{} MHz", r.clock_mhz),
+            };
             s += &format!(
-                "fpga @{f}: {} ADD + {} MULTI {} PEs, {} interconnect, {} cycles, {:.3} us at {} MHz; {} ALM, {} M10K, {} DSP ({}; {})\n",
+                "fpga @{f}: {} ADD + {} MULTI {} PEs, {} interconnect, {} cycles, {:.3} us at {clock}; {} {}, {} {}, {} {} ({}; {})\n",
                 r.n_add,
                 r.n_mul,
                 r.pe_kind,
                 r.interconnect,
                 r.cycles,
                 r.us,
-                r.clock_mhz,
                 x.alm,
+                u.logic,
                 x.m10k,
+                u.bram,
                 x.dsp,
+                u.dsp,
                 if x.fits { "fits" } else { "does not fit" },
                 x.logic_from
             );
@@ -298,7 +308,8 @@ impl CodegenFpga {
             interconnect: d.interconnect().as_str(),
             pe_kind: d.pe_kind.as_str(),
             mux_inputs: d.mux_inputs(),
-            clock_mhz: model.clock_mhz,
+            clock_mhz: r.clock_mhz,
+            fmax_mhz: r.fmax_mhz,
             us: r.us,
             resources: r,
         };
@@ -316,6 +327,15 @@ impl Pass for CodegenFpga {
     /// ends the run with [`PassError::TimeLimit`] (nothing written).
     fn run(&self, m: &mut robovec_ir::Module, cx: &mut PassContext) -> Result<(), PassError> {
         robovec_passes::require_phase("codegen", m, robovec_ir::Phase::Atomised)?;
+        if self.resources == Logic::Pnr && cx.target.pnr.is_none() {
+            return Err(PassError::BadParameter {
+                pass: "codegen<fpga>".into(),
+                message: format!(
+                    "`resources=pnr` places and routes with nextpnr-ecp5, and target `{}` has no ECP5 part (`-target=ecp5-85f`, or a target file with `\"family\": \"ecp5\"` and `pnr`)",
+                    cx.target.name
+                ),
+            });
+        }
         let (limits, model) = (Limits::of(&cx.target), cost_model(&cx.target));
         let mut estimated = Vec::new();
         let functions = try_each_function(

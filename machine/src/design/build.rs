@@ -12,7 +12,9 @@ use robovec_ir::Span;
 use super::images::Image;
 use super::{addr_bits, Design, LoadWord, OutputWord, PeImages, PeKind, Source, Widths};
 use crate::encode::{self, Layout};
-use crate::target::Target;
+#[cfg(doc)]
+use crate::target::Family;
+use crate::target::{PeMemory, Target};
 
 /// The target's limits the design must fit (from [`Target`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -27,6 +29,8 @@ pub struct Limits {
     pub instr_width: u32,
     /// Write ports per PE memory per cycle.
     pub writes: u32,
+    /// How the design builds its PE memories (the target family's, [`Family::pe_memory`]).
+    pub pe_memory: PeMemory,
 }
 
 impl Limits {
@@ -38,6 +42,7 @@ impl Limits {
             instr_words: t.instr_words,
             instr_width: t.instr_width,
             writes: t.writes,
+            pe_memory: t.family.pe_memory(),
         }
     }
 }
@@ -301,6 +306,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
             })
             .collect(),
         routes: None,
+        pe_memory: limits.pe_memory,
         pe_kind: if fx.is_some() { PeKind::Fixed } else { PeKind::Binary32 },
     })
 }

@@ -16,6 +16,7 @@ use images::Image;
 use routes::{selects, Interconnect, Routes};
 
 pub use crate::program::fixed::PeKind;
+use crate::target::PeMemory;
 
 /// Bit widths of the design's words (the encoding of [`crate::encode`], LSB first).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -192,6 +193,9 @@ pub struct Design {
     /// The kind of PEs: binary32 (the seed's) or fixed point (issue 49; words are the values'
     /// 32-bit integers, [`crate::program::fixed`]).
     pub pe_kind: PeKind,
+    /// How each PE memory is built: the seed's double-pumped block RAM (`rv_pe_mem`) or banks
+    /// with a live-value table (`rv_pe_mem_lvt`, the ECP5's), the same behaviour cycle for cycle.
+    pub pe_memory: PeMemory,
 }
 
 /// The fixed Verilog files, `(name, text)`: the FP unit models, the memories and the PE.
@@ -371,10 +375,13 @@ impl Design {
             let f = |i: &Image| format!("\"{dir}{}.hex\"", i.name);
             let (src0, n0, sw0) = self.port_sources(p.slot, 0);
             let (src1, n1, sw1) = self.port_sources(p.slot, 1);
-            let fix = match &p.fix {
+            let mut fix = match &p.fix {
                 Some(img) => format!(".FIX(1), .FIX_FILE({}), ", f(img)),
                 None => String::new(),
             };
+            if self.pe_memory == PeMemory::LiveValueTable {
+                fix += ".LVT(1), ";
+            }
             let _ = writeln!(
                 s,
                 "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .IW({iw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}),\n        .INSTR_FILE({fi}), .XBAR_FILE({fx}), .BUFI_FILE({fb}), .CAPT_FILE({fc}),\n        .DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .src0({src0}), .src1({src1}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",

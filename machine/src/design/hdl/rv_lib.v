@@ -24,6 +24,7 @@
 module rv_pe #(
     parameter integer IS_MUL = 0,      // 0: ADD PE (fp_add_sub), 1: MULTI PE (fp_mul)
     parameter integer FIX = 0,         // 1: fixed-point PE (fix_add_sub / fix_mul, shift memory)
+    parameter integer LVT = 0,         // 1: the PE memory as banks and a live-value table (rv_pe_mem_lvt)
     parameter FIX_FILE = "",           // its shift memory image (14-bit words, fix_units.v)
     parameter integer LAT = 12,        // cycles from issue to arrival (>= 3)
     parameter integer N0 = 4,          // sources of write port 0 (crossbar: 2 NPE)
@@ -88,9 +89,17 @@ module rv_pe #(
   rv_mux #(.N(N1), .SW(SW1)) u_x1 (.sources(src1), .sel(sel1), .y(wd1));
 
   wire [31:0] qa, qb;
-  rv_pe_mem #(.AW(AW), .DEPTH(MEM_DEPTH), .FILE(DATA_FILE)) u_mem (
-      .clk(clk), .we0(we0), .wa0(wa0), .wd0(wd0), .we1(we1), .wa1(wa1), .wd1(wd1),
-      .ra(ra), .rb(rb), .qa(qa), .qb(qb));
+  generate
+    if (LVT) begin : g_lvt
+      rv_pe_mem_lvt #(.AW(AW), .DEPTH(MEM_DEPTH), .FILE(DATA_FILE)) u_mem (
+          .clk(clk), .we0(we0), .wa0(wa0), .wd0(wd0), .we1(we1), .wa1(wa1), .wd1(wd1),
+          .ra(ra), .rb(rb), .qa(qa), .qb(qb));
+    end else begin : g_mem
+      rv_pe_mem #(.AW(AW), .DEPTH(MEM_DEPTH), .FILE(DATA_FILE)) u_mem (
+          .clk(clk), .we0(we0), .wa0(wa0), .wd0(wd0), .we1(we1), .wa1(wa1), .wd1(wd1),
+          .ra(ra), .rb(rb), .qa(qa), .qb(qb));
+    end
+  endgenerate
 
   reg sub_q;
   initial sub_q = 0;

@@ -36,3 +36,8 @@ module rv_pe_mem #(parameter integer AW = 11, parameter integer DEPTH = 1, param
     input wire we1, input wire [AW-1:0] wa1, input wire [31:0] wd1,
     input wire [AW-1:0] ra, input wire [AW-1:0] rb, output wire [31:0] qa, output wire [31:0] qb);
 endmodule
+module rv_pe_mem_lvt #(parameter integer AW = 11, parameter integer DEPTH = 1, parameter FILE = "") (
+    input wire clk, input wire we0, input wire [AW-1:0] wa0, input wire [31:0] wd0,
+    input wire we1, input wire [AW-1:0] wa1, input wire [31:0] wd1,
+    input wire [AW-1:0] ra, input wire [AW-1:0] rb, output wire [31:0] qa, output wire [31:0] qb);
+endmodule
