@@ -99,9 +99,15 @@ fn fixed_point_units_equal_the_model_bit_for_bit_on_random_operands() {
 #[test]
 fn fp_units_and_pe_library_pass_verilator_lint() {
     tool("verilator");
-    // the binary32 PE, then the fixed-point ADD and MULTI PEs with their shift memories (issue 49)
+    // the binary32 PE, then the fixed-point ADD and MULTI PEs with their shift memories (issue 49),
+    // and a PE whose memory is the ECP5's banks with a live-value table
     let binary32: &[&str] = &[];
-    for params in [binary32, &["-GFIX=1", "-GIS_MUL=0", "-GLAT=4"], &["-GFIX=1", "-GIS_MUL=1", "-GLAT=4"]] {
+    for params in [
+        binary32,
+        &["-GFIX=1", "-GIS_MUL=0", "-GLAT=4"],
+        &["-GFIX=1", "-GIS_MUL=1", "-GLAT=4"],
+        &["-GLVT=1", "-GMEM_DEPTH=8", "-GAW=3"],
+    ] {
         let out = Command::new("verilator")
             .args(["--lint-only", "-Wno-fatal", "-Wno-WIDTH", "-Wno-DECLFILENAME", "--top-module", "rv_pe"])
             .args(params)
