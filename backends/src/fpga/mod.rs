@@ -179,8 +179,12 @@ pub struct FpgaReport {
     pub mux_inputs: u64,
     /// Clock, MHz.
     pub clock_mhz: f64,
-    /// µs per evaluation.
+    /// µs per evaluation (the latency).
     pub us: f64,
+    /// States one evaluation computes (`Function::states`, issue 49 item 3).
+    pub states: u32,
+    /// ns per state: `cycles / clock_mhz · 1000 / states` (the throughput figure).
+    pub ns_per_state: f64,
     /// ALM / M10K / DSP, fit.
     pub resources: Resources,
 }
@@ -209,7 +213,7 @@ impl Artifact for FpgaArtifact {
         for (f, r, _) in self.functions.iter().filter(|(f, _, _)| function.is_none_or(|x| x == f)) {
             let x = &r.resources;
             s += &format!(
-                "fpga @{f}: {} ADD + {} MULTI {} PEs, {} interconnect, {} cycles, {:.3} us at {} MHz; {} ALM, {} M10K, {} DSP ({}; {})\n",
+                "fpga @{f}: {} ADD + {} MULTI {} PEs, {} interconnect, {} cycles, {:.3} us at {} MHz{}; {} ALM, {} M10K, {} DSP ({}; {})\n",
                 r.n_add,
                 r.n_mul,
                 r.pe_kind,
@@ -217,6 +221,7 @@ impl Artifact for FpgaArtifact {
                 r.cycles,
                 r.us,
                 r.clock_mhz,
+                robovec_passes::summary::per_state(r.states, r.ns_per_state),
                 x.alm,
                 x.m10k,
                 x.dsp,
@@ -300,6 +305,8 @@ impl CodegenFpga {
             mux_inputs: d.mux_inputs(),
             clock_mhz: model.clock_mhz,
             us: r.us,
+            states: f.states,
+            ns_per_state: robovec_passes::place::report::ns_per_state(d.cycles, model.clock_mhz, f.states),
             resources: r,
         };
         Ok((d, report, files))
