@@ -112,7 +112,11 @@ fn the_report_gives_latency_and_time_per_state() {
     for k in [1u32, 2, 4] {
         let (r, m) = opt_to_ir(
             &d,
-            &[PENDULUM, &format!("-passes=atomise,cse,interleave<states={k}>,place<pe=2;restarts=0;search=0>"), "-stats"],
+            &[
+                PENDULUM,
+                &format!("-passes=atomise,cse,interleave<states={k}>,place<pe=2;restarts=0;search=0>"),
+                "-stats",
+            ],
         );
         assert_eq!(m.functions[0].states, k);
         let p = &r["placement"];
@@ -129,10 +133,25 @@ fn the_report_gives_latency_and_time_per_state() {
         }
     }
     // -stats says it beside the latency when there are several states.
-    let o = opt(&[PENDULUM, "-passes=atomise,cse,interleave<states=4>,place<pe=2;restarts=0;search=0>", "-stats", "-o", "/dev/null"]);
+    let o = opt(&[
+        PENDULUM,
+        "-passes=atomise,cse,interleave<states=4>,place<pe=2;restarts=0;search=0>",
+        "-stats",
+        "-o",
+        "/dev/null",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let line = stderr(&o).lines().find(|l| l.contains("placed on")).unwrap().to_string();
     assert!(line.contains(" MHz (4 states: ") && line.contains(" ns per state)"), "{line}");
+    // `sweep`'s rows too.
+    let (r, _) = opt_to_ir(&d, &[PENDULUM, "-passes=atomise,interleave<states=3>,sweep<pe=1,2>"]);
+    let rows = r["sweep"].as_array().expect("sweep rows");
+    assert!(!rows.is_empty());
+    for row in rows {
+        assert_eq!(row["states"], 3);
+        let want = row["us"].as_f64().unwrap() * 1000.0 / 3.0;
+        assert!((row["ns_per_state"].as_f64().unwrap() - want).abs() <= 1e-9 * want, "{row}");
+    }
 }
 
 const PENDULUM_RANGES: &str = r#"{"q[*]": [-3.2, 3.2], "qd[*]": [-10, 10], "qdd[*]": [-10, 10], "g[3]": [-9.81, -9.81],
