@@ -99,6 +99,12 @@ fn bad_states_parameters_are_usage_errors() {
         assert_eq!(o.status.code(), Some(2), "states={bad}: {}", stderr(&o));
         assert!(stderr(&o).contains("states"), "states={bad}: {}", stderr(&o));
     }
+    // A Robotran signature takes one state: refused, naming the way out; abi=plain takes them all.
+    let o = opt(&[PENDULUM, "-passes=atomise,interleave<states=2>,codegen<c;abi=robotran>", "-o", "/dev/null"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("evaluates 2 states") && stderr(&o).contains("abi=plain"), "{}", stderr(&o));
+    let o = opt(&[PENDULUM, "-passes=atomise,interleave<states=2>,codegen<c;abi=plain>", "-o", "/dev/null"]);
+    assert!(o.status.success(), "{}", stderr(&o));
     // K = 1 is the identity.
     let d = tmp("identity");
     let (_, a) = opt_to_ir(&d, &[PENDULUM, "-passes=atomise,cse"]);
