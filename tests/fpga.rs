@@ -188,6 +188,46 @@ fn placed_designs_simulate_in_iverilog_bit_for_bit_like_the_binary32_evaluation(
     }
 }
 
+/// Throughput (issue 49 item 3): the pendulum interleaved into two states, placed, checked by
+/// `sim` bit for bit, and its design simulated in Icarus with distinct inputs per state gives
+/// `-eval-precision=f32`'s outputs of both states bit for bit.
+#[test]
+fn interleaved_states_simulate_in_iverilog_like_the_binary32_evaluation() {
+    tool("iverilog");
+    let d = tmp("interleaved");
+    let inputs = d.join("inputs.json");
+    std::fs::write(&inputs, r#"{"q[1]": 0.75, "q[1]#1": -0.5, "qd[2]": -1.25, "qd[2]#1": 2.0, "qdd[1]#1": 3.0e-3}"#)
+        .unwrap();
+    let dir = d.join("design");
+    let passes = format!(
+        "-passes=atomise,cse,interleave<states=2>,place<pe=2;restarts=0;search=0>,sim,codegen<fpga;out={};resources=estimate>",
+        dir.display()
+    );
+    let rep = d.join("report.json");
+    let o = opt(&[
+        PENDULUM,
+        &passes,
+        &format!("-eval={}", inputs.display()),
+        "-eval-precision=f32",
+        &format!("-report={}", rep.display()),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let eval: serde_json::Value = serde_json::from_slice(&o.stdout).expect("eval JSON");
+    let outputs = eval["outputs"].as_object().unwrap();
+    assert!(outputs.contains_key("Qq[1]") && outputs.contains_key("Qq[1]#1"), "{outputs:?}");
+    assert_ne!(outputs["Qq[1]"], outputs["Qq[1]#1"], "the states have distinct inputs");
+    let sim = simulate(&dir, &inputs);
+    same_outputs("pendulum, 2 states", &eval, &sim);
+    // The report's fpga entry gives both the latency and the time per state.
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(rep).unwrap()).unwrap();
+    let f = &r["fpga"];
+    assert_eq!(f["states"], 2);
+    let (cycles, clock) = (f["cycles"].as_f64().unwrap(), f["clock_mhz"].as_f64().unwrap());
+    assert_eq!(sim["cycles"].as_f64().unwrap(), cycles);
+    let want = cycles / clock * 1000.0 / 2.0;
+    assert!((f["ns_per_state"].as_f64().unwrap() - want).abs() <= 1e-9 * want, "{f}");
+}
+
 /// The distinct non-zero selects of each write port in a crossbar design's `peS_xbar.hex`
 /// images, read from the files (`sw` select bits per port): what a specialised interconnect
 /// must route, counted here without robovec's `Routes`.

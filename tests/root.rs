@@ -27,6 +27,7 @@ mod filetests;
 mod formats;
 mod fpga;
 mod inline_specialize;
+mod interleave;
 mod numerics;
 #[cfg(unix)]
 mod outputs;

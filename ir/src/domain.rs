@@ -14,6 +14,9 @@
 //! one bracketed index or any run of characters without `[` or `]` (`qd[*]` matches `qd[4]`,
 //! not `qdd[4]` nor `qd[1][2]`; `In[*][*]` matches every `In`). An exact key beats a glob;
 //! of several globs matching one input the one with fewer `*` wins, then the later in the file.
+//! A state copy of an input made by `interleave` (`q[3]#2`: state 2's `q[3]`) has its base
+//! input's range: keys and defaults are matched against base names, and [`Domain::get`] maps
+//! a suffixed name to its base (every state ranges over the same domain).
 //! Units are the input's (rad, m, rad/s, N·m, kg …). Bounds are binary64 numbers, finite,
 //! `lo ≤ hi` (`[x, x]` fixes an input at `x`). A glob that matches no input is allowed (one
 //! file serves a family of models: `qdd[*]` for `dirdyna` and `invdyna`); an exact name that
@@ -49,14 +52,20 @@ pub struct Domain {
 }
 
 impl Domain {
-    /// The range of input `name`, if the domain gives one.
+    /// The range of input `name`, if the domain gives one. A state copy of an input
+    /// (`q[4]#2`, made by `interleave`; [`crate::function::split_state`]) has its base name's
+    /// range unless the domain names the copy itself: every state ranges over the same domain.
+    /// The one place a domain is looked up by name.
     pub fn get(&self, name: &str) -> Option<&Range> {
-        self.ranges.get(name)
+        self.ranges.get(name).or_else(|| match crate::function::split_state(name) {
+            (base, k) if k > 0 => self.ranges.get(base),
+            _ => None,
+        })
     }
 
     /// The inputs of `f` the domain gives no range for, in input order.
     pub fn missing<'f>(&self, f: &'f Function) -> Vec<&'f str> {
-        f.inputs.iter().map(|&v| f.name_of(v)).filter(|n| !self.ranges.contains_key(*n)).collect()
+        f.inputs.iter().map(|&v| f.name_of(v)).filter(|n| self.get(n).is_none()).collect()
     }
 
     /// `f`'s inputs with their ranges, in input order (those without a range left out).
@@ -198,7 +207,11 @@ pub fn resolve<'a>(
     file: Option<(&str, &[RangeKey])>,
     inputs: impl IntoIterator<Item = &'a str>,
 ) -> Result<Domain, SourceError> {
-    let inputs: Vec<&str> = inputs.into_iter().collect();
+    // A state copy (`q[4]#2`) ranges as its base input: the domain holds base names only and
+    // [`Domain::get`] maps a suffixed name to its base.
+    let mut inputs: Vec<&str> = inputs.into_iter().map(|n| crate::function::split_state(n).0).collect();
+    let mut seen = std::collections::HashSet::new();
+    inputs.retain(|n| seen.insert(*n));
     let mut ranges = BTreeMap::new();
     for &name in &inputs {
         if let Some(r) = defaults.get(name) {
@@ -275,6 +288,22 @@ mod tests {
         assert_eq!(dom.get("m[1]").unwrap().interval, Interval::new(1.0, 2.0), "the file overrides a default");
         assert_eq!(dom.get("g[3]").unwrap().interval, Interval::point(-9.81));
         assert!(dom.get("qd[1]").is_none());
+    }
+
+    #[test]
+    fn state_copies_range_as_their_base_input() {
+        let keys = parse_ranges(r#"{"q[*]": [-1, 1], "m[1]": [2, 3]}"#).unwrap();
+        // The names of an interleaved function: base names and their state copies.
+        let dom = resolve(&BTreeMap::new(), Some(("r.json", &keys)), ["q[1]", "q[1]#1", "m[1]#2", "m[1]"]).unwrap();
+        assert_eq!(dom.ranges.len(), 2, "the domain holds base names only");
+        assert_eq!(dom.get("q[1]#1").unwrap().interval, Interval::new(-1.0, 1.0));
+        assert_eq!(dom.get("m[1]#2").unwrap().interval, Interval::new(2.0, 3.0));
+        assert_eq!(dom.get("m[1]#2").unwrap().source, "r.json: m[1]");
+        assert!(dom.get("qd[1]#1").is_none());
+        // An exact key of a base name that only state copies carry still names an input.
+        let keys = parse_ranges(r#"{"m[1]": [2, 3]}"#).unwrap();
+        let dom = resolve(&BTreeMap::new(), Some(("r.json", &keys)), ["m[1]#1"]).unwrap();
+        assert!(dom.get("m[1]#1").is_some());
     }
 
     #[test]

@@ -12,6 +12,14 @@
 //! - **outputs**: named results (`M[1][2]`, `c[3]`, `Qq[1]`, `sens.P[1]`), each a value or a
 //!   constant.
 //!
+//! - **states** ([`Function::states`], default 1): how many independent states one evaluation
+//!   computes. `interleave<states=K>` copies every input, value and output of a function K
+//!   times for throughput (issue 49 item 3); state 0 keeps every name, state `k ≥ 1`'s names
+//!   carry the suffix `#k` (`%q[4]#2`, `output Qq[1]#2`; [`state_name`], [`split_state`]),
+//!   which no front end nor pass writes otherwise. The text form prints `states K` after
+//!   `equations N` when K > 1; the verifier rejects `states 0`. The input domain gives a
+//!   suffixed input its base name's range ([`domain::Domain::get`]).
+//!
 //! # SSA rules
 //! Every value has one definition and a name unique in its function (Robotran names are kept;
 //! values made by passes get names derived from the value they serve, `AF24.1`). A value is
@@ -56,7 +64,7 @@ pub mod verifier;
 pub use count::OpCounts;
 pub use diagnostic::SourceError;
 pub use entities::Value;
-pub use function::{Function, Module};
+pub use function::{split_state, state_name, Function, Module};
 pub use interval::Interval;
 pub use intrinsic::Intrinsic;
 pub use span::Span;

@@ -116,6 +116,7 @@ pub fn inline_within(f: &Function, max_uses: u32, max_size: u32, ticker: &Ticker
         .collect();
     let mut out = Function::new(f.name.clone(), Phase::Atomised);
     out.equations = f.equations;
+    out.states = f.states;
     out.span = f.span;
     let mut cx = Copier {
         out,

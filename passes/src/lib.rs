@@ -18,6 +18,7 @@ pub mod each;
 pub mod eqsat;
 pub mod error_bound;
 pub mod inline;
+pub mod interleave;
 pub mod manager;
 pub mod params;
 pub mod pipeline;
@@ -612,6 +613,7 @@ pub const PASSES: Registry = Registry {
         &tree_height::swap::INFO,
         &tree_height::balance::INFO,
         &inline::INFO,
+        &interleave::INFO,
         &tree_height::distribute::INFO,
         &recurrence::INFO,
         &rotate_3m::INFO,

@@ -105,6 +105,16 @@ pub fn figures(module: &Module, cx: &PassContext, function: Option<&str>) -> Vec
     module.functions.iter().filter(|f| function.is_none_or(|n| n == f.name)).map(|f| Figures::of(f, cx)).collect()
 }
 
+/// What `-stats` says of a placement's time per state after its latency: nothing for one
+/// state, ` (4 states: 273 ns per state)` for several (issue 49 item 3).
+pub fn per_state(states: u32, ns_per_state: f64) -> String {
+    if states > 1 {
+        format!(" ({states} states: {ns_per_state:.0} ns per state)")
+    } else {
+        String::new()
+    }
+}
+
 /// The `-stats` lines on stderr: each rewriting pass's note, then per function of `figures`
 /// (see [`figures`]; artifacts' lines are restricted to `function` when given) its figures (equations, ops by kind, inputs, outputs, critical path in
 /// ops and cycles, number Y) and, when placed, its placement's (cycles, lower bound, rate, PE
@@ -145,7 +155,7 @@ pub fn stats_text(figures: &[Figures], cx: &PassContext, function: Option<&str>)
                 out,
                 "@{}: placed on {} ADD + {} MULTI PEs: {} cycles, lower bound {} (x{:.3}), parallelisation rate {:.3}, \
                  PE memory up to {} words, buffer up to {} words, writes {} direct / {} indirect; \
-                 {:.3} µs at {} MHz (latencies add {}, mul {})",
+                 {:.3} µs at {} MHz{} (latencies add {}, mul {})",
                 g.function,
                 p.n_add,
                 p.n_mul,
@@ -159,6 +169,7 @@ pub fn stats_text(figures: &[Figures], cx: &PassContext, function: Option<&str>)
                 p.writes_indirect,
                 p.us,
                 p.clock_mhz,
+                per_state(p.states, p.ns_per_state),
                 p.lat_add,
                 p.lat_mul
             );

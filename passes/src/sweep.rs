@@ -11,7 +11,8 @@
 //!
 //! Placements use the pipeline's latencies (the target's, or those a pass before gave
 //! explicitly, `PassContext::latencies_for`) and the target's write ports. Each row also gives
-//! `us` (cycles at the target's clock) and the analytic resource estimate
+//! `us` (cycles at the target's clock), `states` and `ns_per_state` (the time per state of a
+//! function of several states, `interleave`), and the analytic resource estimate
 //! (`robovec_machine::target::Target::estimate`; `fits` also needs the placement's memories within
 //! the target's). A second artifact, [`SweepFit`] (report `sweep_fit`, lines after the table),
 //! names per function the smallest N whose placement reaches the critical path (cycles =
@@ -68,8 +69,14 @@ pub struct SweepRow {
     pub select: String,
     /// Cycles of the placement.
     pub cycles: u32,
-    /// `cycles` in µs at the target's clock.
+    /// `cycles` in µs at the target's clock (the latency of one evaluation).
     pub us: f64,
+    /// States one evaluation computes (`Function::states`: K after `interleave<states=K>`).
+    #[serde(default = "one_state")]
+    pub states: u32,
+    /// ns per state: `cycles / clock_mhz · 1000 / states` (issue 49 item 3).
+    #[serde(default)]
+    pub ns_per_state: f64,
     /// SPEC §4 lower bound, cycles.
     pub lower_bound: u32,
     /// The tighter bound of [`crate::place::tight_lower_bound`] (no placement beats it either),
@@ -109,6 +116,11 @@ pub struct SweepRow {
     /// True when the estimate is within the device's capacity and the placement's memories
     /// within the target's (`place::report::fits_memories`).
     pub fits: bool,
+}
+
+/// The default of [`SweepRow::states`] (a report written before it).
+fn one_state() -> u32 {
+    1
 }
 
 impl SweepRow {
@@ -333,6 +345,8 @@ impl Pass for Sweep {
                             select: sname.to_string(),
                             cycles: c,
                             us: target.us(c),
+                            states: f.states,
+                            ns_per_state: crate::place::report::ns_per_state(c, target.clock_mhz, f.states),
                             lower_bound: lower_bound(f, &o.arch),
                             tight_lower_bound: tight_lower_bound(f, &o.arch),
                             resource_bound: side(n_add_side, o.arch.lat.add).max(side(n_mul, o.arch.lat.mul)),
@@ -404,12 +418,12 @@ pub fn to_csv(rows: &[SweepRow]) -> String {
         "function,n,priority,select,cycles,lower_bound,resource_bound,critical_path,y,parallelisation_rate,\
          pe_words_add_min,pe_words_add_mean,pe_words_add_max,pe_words_mul_min,pe_words_mul_mean,pe_words_mul_max,\
          buffer_words_add_min,buffer_words_add_mean,buffer_words_add_max,buffer_words_mul_min,buffer_words_mul_mean,\
-         buffer_words_mul_max,writes_direct,writes_indirect,tight_lower_bound,us,lat_add,lat_mul,alm,m10k,dsp,fits\n",
+         buffer_words_mul_max,writes_direct,writes_indirect,tight_lower_bound,us,lat_add,lat_mul,alm,m10k,dsp,fits,states,ns_per_state\n",
     );
     for r in rows {
         let w = |x: &WordStats| format!("{},{:.2},{}", x.min, x.mean, x.max);
         s += &format!(
-            "{},{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{},{},{},{},{:.6},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{:.4},{},{},{},{},{},{},{},{:.6},{},{},{},{},{},{},{},{:.3}\n",
             r.function,
             r.n,
             r.priority,
@@ -433,7 +447,9 @@ pub fn to_csv(rows: &[SweepRow]) -> String {
             r.alm,
             r.m10k,
             r.dsp,
-            r.fits
+            r.fits,
+            r.states,
+            r.ns_per_state
         );
     }
     s

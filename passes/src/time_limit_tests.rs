@@ -55,6 +55,7 @@ const EVERY_PASS: &[(&str, AtTimeLimit)] = &[
     ("swap", AtTimeLimit::Skip),
     ("balance", AtTimeLimit::Skip),
     ("inline", AtTimeLimit::Skip),
+    ("interleave", AtTimeLimit::Required),
     ("distribute", AtTimeLimit::Skip),
     ("recurrence", AtTimeLimit::Skip),
     ("rotate-3m", AtTimeLimit::Skip),

@@ -134,7 +134,8 @@ fn split_base(name: &str) -> (&str, &str) {
 ///
 /// # Errors
 /// [`PassError::Failed`] for a function kind with no known Robotran signature, an input that
-/// is no `MbsData` field, or an output that is no output parameter of the signature.
+/// is no `MbsData` field, an output that is no output parameter of the signature, or a
+/// function of several states (`interleave`).
 pub(crate) fn function(
     o: &CodegenC,
     f: &Function,
@@ -144,6 +145,13 @@ pub(crate) fn function(
 ) -> Result<Emitted, PassError> {
     let fail =
         |message: String| PassError::Failed { pass: "codegen".into(), message: format!("@{}: {message}", f.name) };
+    if f.states > 1 {
+        return Err(fail(format!(
+            "evaluates {} states (`interleave`), and a Robotran signature takes one MbsData: use abi=plain, whose \
+             inputs and outputs are the states' in order",
+            f.states
+        )));
+    }
     let sens = sensor(f);
     let (params, outs): (String, Vec<&str>) = match sens {
         Some(_) => ("MbsSensor *sens, MbsData *s".into(), vec!["sens"]),

@@ -182,8 +182,12 @@ pub struct FpgaReport {
     /// `resources=pnr`: the Fmax nextpnr measured, MHz (then `clock_mhz` and `us` are at it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fmax_mhz: Option<f64>,
-    /// µs per evaluation.
+    /// µs per evaluation (the latency).
     pub us: f64,
+    /// States one evaluation computes (`Function::states`, issue 49 item 3).
+    pub states: u32,
+    /// ns per state: `cycles / clock_mhz · 1000 / states` (the throughput figure).
+    pub ns_per_state: f64,
     /// ALM / M10K / DSP (in the target family's units, `resources.units`), fit.
     pub resources: Resources,
 }
@@ -217,13 +221,14 @@ impl Artifact for FpgaArtifact {
                 None => format!("{} MHz", r.clock_mhz),
             };
             s += &format!(
-                "fpga @{f}: {} ADD + {} MULTI {} PEs, {} interconnect, {} cycles, {:.3} us at {clock}; {} {}, {} {}, {} {} ({}; {})\n",
+                "fpga @{f}: {} ADD + {} MULTI {} PEs, {} interconnect, {} cycles, {:.3} us at {clock}{}; {} {}, {} {}, {} {} ({}; {})\n",
                 r.n_add,
                 r.n_mul,
                 r.pe_kind,
                 r.interconnect,
                 r.cycles,
                 r.us,
+                robovec_passes::summary::per_state(r.states, r.ns_per_state),
                 x.alm,
                 u.logic,
                 x.m10k,
@@ -311,6 +316,8 @@ impl CodegenFpga {
             clock_mhz: r.clock_mhz,
             fmax_mhz: r.fmax_mhz,
             us: r.us,
+            states: f.states,
+            ns_per_state: robovec_passes::place::report::ns_per_state(d.cycles, r.clock_mhz, f.states),
             resources: r,
         };
         Ok((d, report, files))

@@ -23,6 +23,11 @@ pub struct Function {
     /// Number of equations of the source (SPEC §1: assignments except trig initial variables),
     /// carried through passes for reports; `None` when unknown.
     pub equations: Option<u32>,
+    /// How many independent states one evaluation computes (≥ 1; 1 unless `interleave`
+    /// made copies: state `k ≥ 1`'s inputs, values and outputs carry the suffix `#k`, see
+    /// [`state_name`]). Printed as `states K` when K > 1; the verifier rejects 0.
+    /// Reports divide a placement's time by it (ns per state).
+    pub states: u32,
     /// Value arena: index = `Value::index()`.
     pub values: Vec<ValueData>,
     /// Input values, in first-use order.
@@ -41,6 +46,33 @@ pub struct Function {
     formats: Formats,
     names: NameIndex,
     outputs_by_name: OutputIndex,
+}
+
+/// The name of `base`'s copy in state `k` of an interleaved function (`interleave`): `base`
+/// itself for state 0, `base#k` for `k ≥ 1` (`q[4]#2`, `AF24.1#3`, output `Qq[1]#1`). `#`
+/// appears in no Robotran, Matlab, Python or URDF name nor in any name a pass makes, and the
+/// `.rvir` lexer accepts one `#k` at the end of a value or output name, so state names never
+/// collide with other names. `base` is a name without a suffix ([`split_state`]).
+pub fn state_name(base: &str, k: u32) -> String {
+    if k == 0 {
+        base.to_string()
+    } else {
+        format!("{base}#{k}")
+    }
+}
+
+/// A name's base and state: `("q[4]", 2)` for `q[4]#2`, `(name, 0)` for a name without a
+/// state suffix (the inverse of [`state_name`]). What the input domain looks a suffixed input
+/// up by ([`crate::domain::Domain::get`]).
+pub fn split_state(name: &str) -> (&str, u32) {
+    if let Some((base, k)) = name.rsplit_once('#') {
+        if !base.is_empty() && !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()) {
+            if let Ok(k) = k.parse::<u32>() {
+                return (base, k);
+            }
+        }
+    }
+    (name, 0)
 }
 
 /// A set of functions from one input file.
@@ -99,6 +131,7 @@ impl Function {
             name: name.into(),
             phase,
             equations: None,
+            states: 1,
             values: Vec::new(),
             inputs: Vec::new(),
             body: Vec::new(),

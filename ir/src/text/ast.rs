@@ -13,6 +13,8 @@ pub struct FuncAst<'a> {
     pub phase: Option<Phase>,
     /// `equations N` line.
     pub equations: Option<u32>,
+    /// `states K` line (1 when absent).
+    pub states: Option<u32>,
     /// Body lines in order.
     pub items: Vec<ItemAst<'a>>,
     /// The placement block, if any.

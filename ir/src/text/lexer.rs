@@ -22,6 +22,9 @@ pub enum Tok<'a> {
     /// `equations`
     #[token("equations")]
     Equations,
+    /// `states`
+    #[token("states")]
+    States,
     /// `input`
     #[token("input")]
     Input,
@@ -101,14 +104,16 @@ pub enum Tok<'a> {
     /// checked by the grammar ([`crate::format::Format`]).
     #[regex(r":[ \t]*[A-Za-z0-9_]*(<[^>\n]*>)?", |lex| lex.slice()[1..].trim_start())]
     Format(&'a str),
-    /// A value name after `%` (`%AlF15` → `AlF15`, `%frc[2][11].1`).
-    #[regex(r"%[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+|\[[0-9]+\])*", |lex| &lex.slice()[1..])]
+    /// A value name after `%` (`%AlF15` → `AlF15`, `%frc[2][11].1`), with its state suffix
+    /// `#k` when it belongs to state `k ≥ 1` of an interleaved function (`%q[4]#2`).
+    #[regex(r"%[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+|\[[0-9]+\])*(#[0-9]+)?", |lex| &lex.slice()[1..])]
     Local(&'a str),
     /// A function or callee name after `@` (`@dirdyna`, `@user_ExtForces.1[3]`).
     #[regex(r"@[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+|\[[0-9]+\])*", |lex| &lex.slice()[1..])]
     Global(&'a str),
-    /// A bare name: output names (`M[1][2]`, `sens.P[1]`) and attribute keys.
-    #[regex(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+|\[[0-9]+\])*")]
+    /// A bare name: output names (`M[1][2]`, `sens.P[1]`, `Qq[1]#2` for state 2 of an
+    /// interleaved function) and attribute keys.
+    #[regex(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+|\[[0-9]+\])*(#[0-9]+)?")]
     Name(&'a str),
     /// An unsigned number as written (`2.0`, `12`, `1e-7`); parsed by the grammar.
     #[regex(r"[0-9]+(\.[0-9]*)?([eE][+-]?[0-9]+)?")]

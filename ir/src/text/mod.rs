@@ -11,6 +11,9 @@
 //!   output Qq[1] = %AF12
 //! }
 //! ```
+//! An interleaved function (`interleave<states=K>`) says `states K` after `equations N`, and
+//! its state copies' names end in `#k` (`%q[2]#1`, `output Qq[1]#1`): the lexer accepts one
+//! such suffix at the end of a value or output name.
 //! Parsed-phase definitions are infix expressions: `%x = -%a*%b + (%c - 2.0)`; a unary minus
 //! stands at the start of a sum and covers the product term after it (SPEC §3).
 

@@ -45,6 +45,7 @@ pub fn parse(src: &str) -> Result<Module, Vec<ParseError>> {
 fn resolve(f: FuncAst<'_>, errors: &mut Vec<ParseError>) -> Function {
     let mut func = Function::new(f.name, f.phase.unwrap_or(Phase::Parsed));
     func.equations = f.equations;
+    func.states = f.states.unwrap_or(1);
     func.span = f.span;
     for item in f.items {
         match item {

@@ -134,6 +134,9 @@ pub fn write_function(out: &mut impl Write, f: &Function) -> fmt::Result {
     if let Some(n) = f.equations {
         writeln!(out, "  equations {n}")?;
     }
+    if f.states != 1 {
+        writeln!(out, "  states {}", f.states)?;
+    }
     for &v in &f.inputs {
         write!(out, "  input %{}", f.name_of(v))?;
         write_format(out, f, v)?;

@@ -64,6 +64,7 @@ fn take<'a>(src: &mut Cow<'a, Function>, v: Value) -> (Cow<'a, str>, Cow<'a, Def
 pub fn atomise_within(mut src: Cow<'_, Function>, ticker: &Ticker) -> Option<Function> {
     let mut out = Function::new(src.name.clone(), Phase::Atomised);
     out.equations = src.equations;
+    out.states = src.states;
     out.span = src.span;
     let mut map: Vec<Operand> = vec![Operand::Const(f64::NAN); src.values.len()];
     // The atomised function's exact size (SPEC §3's count of each equation), reserved at once.

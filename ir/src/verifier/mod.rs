@@ -7,7 +7,8 @@
 //!   once in `inputs ∪ body`;
 //! - `inputs` hold exactly the `Def::Input` values;
 //! - value names are unique and the name index agrees with the arena;
-//! - output names are unique.
+//! - output names are unique;
+//! - `states` (how many states one evaluation computes) is at least 1.
 //!
 //! SSA
 //! - every operand is an input or a body value defined earlier (definition before use);
@@ -147,6 +148,9 @@ pub fn verify_function_until(f: &Function, stop: &mut dyn FnMut() -> bool) -> Op
     let mut err = |loc: Location, span: Span, message: String| {
         errs.push(VerifierError { function: f.name.clone(), location: loc, message, span })
     };
+    if f.states == 0 {
+        err(Location::Function, f.span, "`states 0`: a function computes at least one state".into());
+    }
     let n = f.values.len();
     // Structure: indexes first, so later checks can index infallibly.
     let mut placed = vec![false; n];

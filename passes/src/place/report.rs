@@ -25,6 +25,14 @@ pub struct PlacementReport {
     pub us: f64,
     /// The target's clock, MHz; extra key.
     pub clock_mhz: f64,
+    /// States one evaluation computes (`Function::states`: K after `interleave<states=K>`,
+    /// issue 49 item 3); extra key (1 when read from a report without it).
+    #[serde(default = "one_state")]
+    pub states: u32,
+    /// Time per state, ns: `cycles / clock_mhz · 1000 / states`, the throughput figure beside
+    /// the latency `us` (the two agree for one state); extra key.
+    #[serde(default)]
+    pub ns_per_state: f64,
     /// Lower bound LB (SPEC §4), cycles.
     pub lower_bound: u32,
     /// cycles / LB (1 is optimal).
@@ -53,6 +61,17 @@ pub struct PlacementReport {
     /// blocks), with `fits` also requiring the placement's memories to fit the target's
     /// ([`fits_memories`]); extra key. The FPGA back end gives Yosys' figures instead.
     pub estimate: Resources,
+}
+
+/// The default of [`PlacementReport::states`].
+fn one_state() -> u32 {
+    1
+}
+
+/// Time per state of one evaluation of `cycles` at `clock_mhz` computing `states` states, ns:
+/// `cycles / clock_mhz · 1000 / states` (issue 49 item 3; `states` 0 is taken as 1).
+pub fn ns_per_state(cycles: u32, clock_mhz: f64, states: u32) -> f64 {
+    f64::from(cycles) / clock_mhz * 1000.0 / f64::from(states.max(1))
 }
 
 /// True when the placement's memories fit the target's: every PE memory within `pe_words`,
@@ -168,6 +187,8 @@ pub fn placement_report(f: &Function, target: &Target) -> Option<PlacementReport
         cycles: c,
         us: target.us(c),
         clock_mhz: target.clock_mhz,
+        states: f.states,
+        ns_per_state: ns_per_state(c, target.clock_mhz, f.states),
         lower_bound: lb,
         cycles_over_lower_bound: if lb == 0 { 1.0 } else { c as f64 / lb as f64 },
         tight_lower_bound: tight_lower_bound(f, a),

@@ -34,6 +34,7 @@ pub(super) fn round(
     };
     let mut b = Builder::new(&f.name, lat);
     b.out.equations = f.equations;
+    b.out.states = f.states;
     b.out.span = f.span;
     let mut r = Round {
         f,

@@ -261,6 +261,7 @@ fn apply(f: &Function, picks: &[Pick]) -> Function {
     }
     let mut out = Function::new(f.name.clone(), Phase::Atomised);
     out.equations = f.equations;
+    out.states = f.states;
     out.span = f.span;
     let mut map: Vec<Operand> = vec![Operand::Const(f64::NAN); f.values.len()];
     let m = |o: Operand, map: &[Operand]| match o {

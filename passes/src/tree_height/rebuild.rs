@@ -96,6 +96,7 @@ pub fn rebuild(
     }
     let mut out = Function::new(f.name.clone(), Phase::Atomised);
     out.equations = f.equations;
+    out.states = f.states;
     out.span = f.span;
     let mut e = Engine {
         f,
