@@ -12,8 +12,10 @@
 //! - **Inputs**: the top, the Verilog library and every memory image, written into a temporary
 //!   folder that the tools run in (the top's `$readmemh` names are relative to it).
 //! - **nextpnr**: `--<device> --package <package> --freq <target clock> --timing-allow-fail
-//!   --seed 1`: the Fmax reached is the figure, a timing failure against the declared clock is
-//!   not an error; seed 1 makes a run repeatable. A design that does not fit (nextpnr stops with a
+//!   --seed 1 --router router2`: the Fmax reached is the figure, a timing failure against the
+//!   declared clock is not an error; seed 1 makes a run repeatable; router2 (nextpnr's
+//!   negotiated-congestion router) because router1 had not routed the Jeep `dirdyna` at 8 + 8
+//!   fixed-point PEs (74 % of the LUT4) after 19 minutes, 208k wires still overused. A design that does not fit (nextpnr stops with a
 //!   utilisation above 100 %) is not an error either: its figures are the utilisation nextpnr
 //!   printed, `placed` false, and no Fmax or bitstream.
 //! - **Cost**: minutes, not seconds — Yosys and nextpnr on one core each; the 1 + 1 PE
@@ -162,6 +164,8 @@ pub fn place_and_route(d: &Design, part: &PnrPart, freq_mhz: f64) -> Result<PnrR
         "--timing-allow-fail",
         "--seed",
         "1",
+        "--router",
+        "router2",
         "--report",
         "report.json",
         "--textcfg",

@@ -120,8 +120,11 @@ pub fn enclose_with(
         x[v.index()] = domain.get(f.name_of(v)).expect("no input is missing").interval;
     }
     let mut sweep = affine.map(|cap| super::affine::AffineSweep::new(f, domain, cap));
+    // The cap of one state's ops: K interleaved states are K independent copies, enclosed as
+    // tightly as one (the same formats verify after `interleave`), for K times one's work.
+    let ops_per_state = f.body.len().div_ceil(f.states.max(1) as usize);
     let mut harmonic =
-        affine.and_then(|_| super::harmonic::HarmonicSweep::new(f, domain, super::harmonic::range_atoms(f.body.len())));
+        affine.and_then(|_| super::harmonic::HarmonicSweep::new(f, domain, super::harmonic::range_atoms(ops_per_state)));
     for (k, &v) in f.body.iter().enumerate() {
         if tick() {
             return Err(EncloseError::Stopped(k));

@@ -67,6 +67,8 @@ pub const ADJOINT_ATOM_WORK: u64 = 1 << 37;
 /// 1,024 atoms) for O(ops · cap²) time, which is why the cap falls as the function grows:
 /// 1,024 atoms up to 1,024 ops (an arm: +0.02 s), 264 at Talos's 3,969, 48 from 21,845 ops on
 /// (a humanoid's `dirdyna`, where the sweep already takes a fifth of a second). docs/accuracy.md.
+/// `ops` is one state's (`Function::states`): interleaved states are independent copies, each
+/// enclosed as one alone.
 pub fn range_atoms(ops: usize) -> usize {
     (RANGE_ATOM_WORK / ops.max(1)).clamp(MIN_ATOMS, MAX_ATOMS)
 }
