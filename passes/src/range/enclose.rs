@@ -123,8 +123,8 @@ pub fn enclose_with(
     // The cap of one state's ops: K interleaved states are K independent copies, enclosed as
     // tightly as one (the same formats verify after `interleave`), for K times one's work.
     let ops_per_state = f.body.len().div_ceil(f.states.max(1) as usize);
-    let mut harmonic =
-        affine.and_then(|_| super::harmonic::HarmonicSweep::new(f, domain, super::harmonic::range_atoms(ops_per_state)));
+    let mut harmonic = affine
+        .and_then(|_| super::harmonic::HarmonicSweep::new(f, domain, super::harmonic::range_atoms(ops_per_state)));
     for (k, &v) in f.body.iter().enumerate() {
         if tick() {
             return Err(EncloseError::Stopped(k));
