@@ -180,24 +180,27 @@ pub fn place_and_route(d: &Design, part: &PnrPart, freq_mhz: f64) -> Result<PnrR
         vec![("synth.log".to_string(), read("synth.log")), ("pnr.log".to_string(), log.clone().into_bytes())];
     let tool_names = [tools.yosys.clone(), tools.nextpnr.clone(), tools.ecppack.clone()];
     let secs = |a: Instant, b: Instant| ((b - a).as_secs_f64() * 10.0).round() / 10.0;
+    // The figures of a run from nextpnr's utilisation: placed with its Fmax, or not (no Fmax).
+    let figures = |fmax_mhz: Option<f64>, used: &[Utilisation], seconds: [f64; 3]| {
+        let get = |k: &str| used.iter().find(|u| u.cell == k).map_or(0, |u| u.used);
+        PnrFigures {
+            part: part.clone(),
+            placed: fmax_mhz.is_some(),
+            fmax_mhz,
+            lut4: get("TRELLIS_COMB"),
+            ff: get("TRELLIS_FF"),
+            ebr: get("DP16KD"),
+            mult18: get("MULT18X18D"),
+            lutram: get("TRELLIS_RAMW"),
+            io: get("TRELLIS_IO"),
+            seconds,
+            tools: tool_names.clone(),
+        }
+    };
     if !pnr.status.success() {
         let used = utilisation_of_log(&log);
         if used.iter().any(|u| u.used > u.available) {
-            let get = |k: &str| used.iter().find(|u| u.cell == k).map_or(0, |u| u.used);
-            let figures = PnrFigures {
-                part: part.clone(),
-                placed: false,
-                fmax_mhz: None,
-                lut4: get("TRELLIS_COMB"),
-                ff: get("TRELLIS_FF"),
-                ebr: get("DP16KD"),
-                mult18: get("MULT18X18D"),
-                lutram: get("TRELLIS_RAMW"),
-                io: get("TRELLIS_IO"),
-                seconds: [secs(t0, t1), secs(t1, t2), 0.0],
-                tools: tool_names,
-            };
-            return Ok(PnrRun { figures, files });
+            return Ok(PnrRun { figures: figures(None, &used, [secs(t0, t1), secs(t1, t2), 0.0]), files });
         }
         return Err(format!("nextpnr-ecp5 failed:\n{}", errors_of(&log)));
     }
@@ -209,20 +212,7 @@ pub fn place_and_route(d: &Design, part: &PnrPart, freq_mhz: f64) -> Result<PnrR
     if !pack.status.success() || bit.is_empty() {
         return Err(format!("ecppack failed:\n{}", String::from_utf8_lossy(&pack.stderr)));
     }
-    let get = |k: &str| used.iter().find(|u| u.cell == k).map_or(0, |u| u.used);
-    let figures = PnrFigures {
-        part: part.clone(),
-        placed: true,
-        fmax_mhz: Some(fmax),
-        lut4: get("TRELLIS_COMB"),
-        ff: get("TRELLIS_FF"),
-        ebr: get("DP16KD"),
-        mult18: get("MULT18X18D"),
-        lutram: get("TRELLIS_RAMW"),
-        io: get("TRELLIS_IO"),
-        seconds: [secs(t0, t1), secs(t1, t2), secs(t2, t3)],
-        tools: tool_names,
-    };
+    let figures = figures(Some(fmax), &used, [secs(t0, t1), secs(t1, t2), secs(t2, t3)]);
     files.push(("robovec_top.bit".into(), bit));
     files.push(("nextpnr_report.json".into(), report));
     Ok(PnrRun { figures, files })
