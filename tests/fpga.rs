@@ -222,6 +222,9 @@ fn interleaved_states_simulate_in_iverilog_like_the_binary32_evaluation() {
     let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(rep).unwrap()).unwrap();
     let f = &r["fpga"];
     assert_eq!(f["states"], 2);
+    let man: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(man["states"], 2, "the manifest says how many states a run computes");
     let (cycles, clock) = (f["cycles"].as_f64().unwrap(), f["clock_mhz"].as_f64().unwrap());
     assert_eq!(sim["cycles"].as_f64().unwrap(), cycles);
     let want = cycles / clock * 1000.0 / 2.0;

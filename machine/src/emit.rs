@@ -173,6 +173,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "clock_mhz": clock_mhz,
         "images": format,
         "cycles": d.cycles,
+        "states": d.states,
         "n_add": d.n_add,
         "n_mul": d.n_mul,
         "latency": {"add": d.lat_add, "mul": d.lat_mul},

@@ -316,8 +316,8 @@ impl CodegenFpga {
             clock_mhz: r.clock_mhz,
             fmax_mhz: r.fmax_mhz,
             us: r.us,
-            states: f.states,
-            ns_per_state: robovec_passes::place::report::ns_per_state(d.cycles, r.clock_mhz, f.states),
+            states: d.states,
+            ns_per_state: robovec_passes::place::report::ns_per_state(d.cycles, r.clock_mhz, d.states),
             resources: r,
         };
         Ok((d, report, files))

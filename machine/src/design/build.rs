@@ -307,6 +307,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
             .collect(),
         routes: None,
         pe_memory: limits.pe_memory,
+        states: f.states,
         pe_kind: if fx.is_some() { PeKind::Fixed } else { PeKind::Binary32 },
     })
 }

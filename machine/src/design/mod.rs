@@ -196,6 +196,9 @@ pub struct Design {
     /// How each PE memory is built: the seed's double-pumped block RAM (`rv_pe_mem`) or banks
     /// with a live-value table (`rv_pe_mem_lvt`, the ECP5's), the same behaviour cycle for cycle.
     pub pe_memory: PeMemory,
+    /// Independent states one run computes (the function's `states`, issue 49 item 3: state
+    /// k's inputs and outputs are named `name#k`).
+    pub states: u32,
 }
 
 /// The fixed Verilog files, `(name, text)`: the FP unit models, the memories and the PE.
