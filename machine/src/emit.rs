@@ -255,13 +255,7 @@ pub fn emit_until(
     let mut r = resources::estimate(&d, model, cells);
     let mut pnr_files = Vec::new();
     if logic == Logic::Pnr {
-        let Some(part) = &model.pnr else {
-            return Err(format!(
-                "`resources=pnr` places and routes with nextpnr-ecp5, and target `{}` is not an ECP5 one (`-target=ecp5-85f`, or a target file with `\"family\": \"ecp5\"` and `pnr`)",
-                model.target
-            )
-            .into());
-        };
+        let part = crate::pnr::part_of(&model.target, model.pnr.as_ref())?;
         let run = crate::pnr::place_and_route(&d, part, model.clock_mhz)
             .map_err(|e| format!("function @{}: place and route for `{}`: {e}", f.name, model.target))?;
         r = resources::with_pnr(r, model, run.figures);

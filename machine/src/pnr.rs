@@ -79,6 +79,19 @@ pub struct PnrRun {
     pub files: Vec<(String, Vec<u8>)>,
 }
 
+/// The part of target `target` that `resources=pnr` places for.
+///
+/// # Errors
+/// The diagnostic for a target without one (not an ECP5: the DE10-Nano's flow is Quartus).
+pub fn part_of<'a>(target: &str, part: Option<&'a PnrPart>) -> Result<&'a PnrPart, String> {
+    part.ok_or_else(|| {
+        format!(
+            "`resources=pnr` places and routes with nextpnr-ecp5, and target `{target}` has no ECP5 part \
+             (`-target=ecp5-85f`, or a target file with `\"family\": \"ecp5\"` and `pnr`)"
+        )
+    })
+}
+
 /// The three programs of the flow.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Tools {

@@ -334,14 +334,9 @@ impl Pass for CodegenFpga {
     /// ends the run with [`PassError::TimeLimit`] (nothing written).
     fn run(&self, m: &mut robovec_ir::Module, cx: &mut PassContext) -> Result<(), PassError> {
         robovec_passes::require_phase("codegen", m, robovec_ir::Phase::Atomised)?;
-        if self.resources == Logic::Pnr && cx.target.pnr.is_none() {
-            return Err(PassError::BadParameter {
-                pass: "codegen<fpga>".into(),
-                message: format!(
-                    "`resources=pnr` places and routes with nextpnr-ecp5, and target `{}` has no ECP5 part (`-target=ecp5-85f`, or a target file with `\"family\": \"ecp5\"` and `pnr`)",
-                    cx.target.name
-                ),
-            });
+        if self.resources == Logic::Pnr {
+            robovec_machine::pnr::part_of(&cx.target.name, cx.target.pnr.as_ref())
+                .map_err(|message| PassError::BadParameter { pass: "codegen<fpga>".into(), message })?;
         }
         let (limits, model) = (Limits::of(&cx.target), cost_model(&cx.target));
         let mut estimated = Vec::new();
