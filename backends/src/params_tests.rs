@@ -40,6 +40,6 @@ fn word_parameters_are_read_as_their_enums() {
     round_trip(&[Precision::F64, Precision::F32]);
     round_trip(&[Trig::Libm, Trig::Input, Trig::Inline]);
     round_trip(&[Format::Both, Format::Mif, Format::Hex]);
-    round_trip(&[Logic::Auto, Logic::Yosys, Logic::Estimate]);
+    round_trip(&[Logic::Auto, Logic::Yosys, Logic::Estimate, Logic::Pnr]);
     assert_eq!(serde_json::to_string(&Abi::Robotran).unwrap(), "\"robotran\"");
 }
