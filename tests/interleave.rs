@@ -196,32 +196,16 @@ fn fixed_point_states_are_simulated_in_the_domain_of_their_base_inputs() {
 /// The formats `precision` certified for one state verify after `interleave`: the verifier's
 /// fixed-point range check encloses each state as tightly as one alone (the harmonic forms'
 /// atom cap is one state's, `range::harmonic::range_atoms`). On the Jeep `dirdyna` (8k ops)
-/// over a generous domain the cap of the doubled function, 64 atoms against one state's 128,
+/// over the generous domain the cap of the doubled function, 64 atoms against one state's 128,
 /// enclosed a value of state 0 beyond the format precision had given it.
 #[test]
 fn formats_certified_for_one_state_verify_after_interleaving() {
     let d = tmp("formats_per_state");
     let jeep = crate::common::corpus_dir().join("c/jeep__mbs_dirdyna_Jeep.c").display().to_string();
-    let none = write(&d, "none.json", "{}");
-    let o = opt(&[&jeep, "-passes=atomise", &format!("-eval={}", none.display()), "-o", "/dev/null"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let inputs: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    // joint angles a full turn, rates ±10, forces ±100, parameters at -eval's points (masses
-    // and inertias positive)
-    let mut ranges = serde_json::Map::new();
-    for (name, x) in inputs["inputs"].as_object().unwrap() {
-        let x = x.as_f64().unwrap();
-        let family = name.split('[').next().unwrap();
-        let r = match family {
-            "q" => [-3.2, 3.2],
-            "qd" => [-10.0, 10.0],
-            "frc" | "trq" => [-100.0, 100.0],
-            "m" => [1.0 + x.abs(); 2],
-            "In" => [0.1 + x.abs(); 2],
-            _ => [x, x],
-        };
-        ranges.insert(name.clone(), serde_json::json!(r));
-    }
+    let (m, _) = robovec::driver::load(&jeep).unwrap_or_else(|f| panic!("{}", f.message()));
+    let dom = crate::range::generous_domain(&m.functions[0]);
+    let ranges: serde_json::Map<String, serde_json::Value> =
+        dom.ranges.iter().map(|(name, r)| (name.clone(), serde_json::json!([r.interval.lo, r.interval.hi]))).collect();
     let file = write(&d, "ranges.json", &serde_json::Value::Object(ranges).to_string());
     let o = opt(&[
         &jeep,
