@@ -625,12 +625,7 @@ impl Target {
             name: "ecp5-85f".into(),
             family: Family::Ecp5,
             clock_mhz: 80.0,
-            latencies: Latencies { add: 12, mul: 7, div: 12, call: 12 },
-            writes: 2,
             pe_words: 512,
-            buffer_words: 16,
-            instr_words: 65536,
-            instr_width: 52,
             alm: 83_640,
             m10k: 208,
             dsp: 156,
@@ -640,8 +635,6 @@ impl Target {
             pe_memory_alm: 314.0,
             pe_word_alm: 4.1,
             crossbar_alm: 60.0,
-            control_alm: 469.0,
-            output_word_alm: 16.0,
             datapath: Datapath {
                 dsp_modes: vec![DspMode { a: 9, b: 9, per_block: 2 }, DspMode { a: 18, b: 18, per_block: 1 }],
                 fix_alm_per_bit: 1.0,
@@ -654,6 +647,10 @@ impl Target {
                 mul: FixUnit { latency: 5, alm: 1488.0, dsp: 4, m10k: 0 },
             },
             pnr: Some(crate::pnr::PnrPart { device: "85k".into(), package: "CABGA381".into() }),
+            // The same Verilog units, pipeline, instruction word and control as the DE10-Nano's:
+            // latencies, write ports, buffer and instruction depths, `control_alm`,
+            // `output_word_alm` (module doc).
+            ..Target::de10_nano()
         }
     }
 
