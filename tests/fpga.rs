@@ -45,9 +45,15 @@ fn fp_units_equal_c_float_bit_for_bit_on_random_and_edge_operands() {
 /// Runs testbench `tb` (tests/inputs/fpga) on the units of `hdl_files` in Icarus over the `n`
 /// vectors of `d/vec.hex`, and asserts it reports no mismatch.
 fn check_vectors(d: &Path, n: usize, tb: &str, hdl_files: &[&str]) {
+    check_vectors_with(d, n, tb, hdl_files, &[]);
+}
+
+/// [`check_vectors`] with the testbench's macros `defines` (`("DW", 27)`).
+fn check_vectors_with(d: &Path, n: usize, tb: &str, hdl_files: &[&str], defines: &[(&str, u32)]) {
     let st = Command::new("iverilog")
         .current_dir(d)
         .args(["-g2005", &format!("-DN={n}"), "-DVEC=\"vec.hex\"", "-o", "tb.vvp"])
+        .args(defines.iter().map(|(k, v)| format!("-D{k}={v}")))
         .arg(inputs_dir().join(tb))
         .args(hdl_files.iter().map(|f| hdl(f)))
         .status()
@@ -96,6 +102,65 @@ fn fixed_point_units_equal_the_model_bit_for_bit_on_random_operands() {
     check_vectors(&d, n, "fix_check_tb.v", &["fix_units.v", "fp_units.v"]);
 }
 
+/// Narrow words (issue 49: `precision<word=W>`): the fixed-point units at DW = 27, 20 and 16 bits
+/// with the exact intermediate of [`intermediate_bits`] — the width the generator gives each PE
+/// from the shifts of its program — against robovec's model, batch by batch: each batch draws
+/// its own largest alignment and rounding shift, so its intermediate is as narrow as its ops
+/// allow; a quarter of the operands are the word's extremes (−2^(DW−1), 2^(DW−1) − 1), where a
+/// bit too few would wrap. A vector whose rounded result does not fit DW bits (the range proof
+/// excludes it) is drawn again.
+///
+/// [`intermediate_bits`]: robovec_machine::design::build::intermediate_bits
+#[test]
+fn narrow_fixed_point_units_with_the_generators_intermediate_width_equal_the_model() {
+    use robovec_ir::machine::{FixShifts, MachineOp};
+    use robovec_machine::design::build::intermediate_bits;
+    tool("iverilog");
+    let mut rng = robovec_ir::rng::SplitMix64::new(4927);
+    for dw in [27u32, 20, 16] {
+        for batch in 0..3 {
+            let d = tmp(&format!("fix_units_dw{dw}_{batch}"));
+            let (max_align, max_shift) = (rng.below(24) as i64 + 1, rng.below(2 * u64::from(dw)) as i64 + 1);
+            let (lo, hi) = (-(1i64 << (dw - 1)), (1i64 << (dw - 1)) - 1);
+            let (mut lines, mut n) = (String::new(), 0usize);
+            let (mut adds, mut muls) = (Vec::new(), Vec::new());
+            while n < 1500 {
+                let op = rng.below(3);
+                let mut draw = || match rng.below(8) {
+                    0 => lo,
+                    1 => hi,
+                    _ => lo + rng.below((hi - lo + 1) as u64) as i64,
+                };
+                let (a, b) = (draw(), draw());
+                let sh = FixShifts {
+                    align: if op == 2 { 0 } else { rng.below(max_align as u64 + 1) as u8 },
+                    align_b: rng.below(2) == 1,
+                    shift: (rng.below((max_shift + 11) as u64) as i64 - 10) as i8,
+                };
+                let unit = [MachineOp::Add, MachineOp::Sub, MachineOp::Mul][op as usize].clone();
+                let Some(y) = sh.apply(&unit, a, b).and_then(|y| i64::try_from(y).ok()) else { continue };
+                if !(lo..=hi).contains(&y) {
+                    continue;
+                }
+                if op == 2 {
+                    muls.push(sh)
+                } else {
+                    adds.push(sh)
+                }
+                let w = |x: i64| x as i32 as u32;
+                lines += &format!("{op:01x}{:08x}{:08x}{:08x}{:08x}\n", w(a), w(b), sh.word(), w(y));
+                n += 1;
+            }
+            let (kwa, kwm) = (intermediate_bits(dw, false, adds), intermediate_bits(dw, true, muls));
+            // narrower than the 32-bit word's 64 bits: the test exercises the narrowing
+            assert!(kwa < 64 && kwm < 64, "dw {dw}: intermediates {kwa}, {kwm}");
+            std::fs::write(d.join("vec.hex"), lines).unwrap();
+            let defines = [("DW", dw), ("KWA", kwa), ("KWM", kwm)];
+            check_vectors_with(&d, n, "fix_check_tb.v", &["fix_units.v", "fp_units.v"], &defines);
+        }
+    }
+}
+
 #[test]
 fn fp_units_and_pe_library_pass_verilator_lint() {
     tool("verilator");
@@ -107,6 +172,10 @@ fn fp_units_and_pe_library_pass_verilator_lint() {
         &["-GFIX=1", "-GIS_MUL=0", "-GLAT=4"],
         &["-GFIX=1", "-GIS_MUL=1", "-GLAT=4"],
         &["-GLVT=1", "-GMEM_DEPTH=8", "-GAW=3"],
+        // narrow words (precision<word=W>): a 27-bit MULTI PE (one DSP product), a 20-bit ADD
+        // PE on the live-value-table memory
+        &["-GFIX=1", "-GIS_MUL=1", "-GLAT=5", "-GDW=27", "-GKW=55"],
+        &["-GFIX=1", "-GIS_MUL=0", "-GLAT=4", "-GDW=20", "-GKW=37", "-GLVT=1", "-GMEM_DEPTH=8", "-GAW=3"],
     ] {
         let out = Command::new("verilator")
             .args(["--lint-only", "-Wno-fatal", "-Wno-WIDTH", "-Wno-DECLFILENAME", "--top-module", "rv_pe"])
@@ -413,6 +482,95 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
             assert_eq!(f64::from(bits as i32) * (-(f as f64)).exp2(), e, "{interconnect}: {k}");
         }
     }
+}
+
+/// Narrow words (issue 49): `precision<target=mcu;word=W>` gives the pendulum `fix<W,f>` values;
+/// the design's data path is W bits wide (manifest `word_bits`, the PE memory images' words of
+/// ⌈W/4⌉ hex digits, `.DW(W)` on every PE with an intermediate under 64 bits), it simulates in
+/// Icarus to `-eval`'s values exactly, and each MULTI PE's product is one DSP block of the
+/// DE10-Nano (27 × 27 mode) instead of the 32-bit word's two.
+#[test]
+fn narrow_fixed_point_words_simulate_bit_for_bit_and_take_one_dsp_block_a_product() {
+    tool("iverilog");
+    let d = tmp("narrow_words");
+    let ranges = d.join("ranges.json");
+    std::fs::write(&ranges, PENDULUM_RANGES).unwrap();
+    let point = d.join("point.json");
+    std::fs::write(&point, PENDULUM_POINT).unwrap();
+    let mut dsp = Vec::new();
+    for word in [32u32, 27, 18] {
+        let dir = d.join(format!("w{word}"));
+        let rep = d.join(format!("w{word}.json"));
+        let o = opt(&[
+            PENDULUM,
+            &format!("-ranges={}", ranges.display()),
+            &format!(
+                "-passes=atomise,cse,precision<budget=1e-3;target=mcu;word={word}>,place<pe=2;restarts=0;search=0>,sim,\
+                 codegen<fpga;out={};resources=estimate;interconnect=specialised>",
+                dir.display()
+            ),
+            &format!("-eval={}", point.display()),
+            &format!("-report={}", rep.display()),
+        ]);
+        assert!(o.status.success(), "word={word}: {}", stderr(&o));
+        let eval: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let man: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+        assert_eq!(man["word_bits"], word, "the widest format is the word");
+        let data = std::fs::read_to_string(dir.join("hex/pe0_data.hex")).unwrap();
+        assert!(data.lines().all(|l| l.len() == word.div_ceil(4) as usize), "word={word}: {data}");
+        let top = std::fs::read_to_string(dir.join("hdl/robovec_top.v")).unwrap();
+        let kws: Vec<u32> =
+            top.match_indices(".KW(").map(|(i, _)| top[i + 4..].split(')').next().unwrap().parse().unwrap()).collect();
+        assert_eq!(kws.len(), 4, "one intermediate width per PE");
+        assert_eq!(top.matches(&format!(".DW({word})")).count(), 4);
+        if word < 32 {
+            assert!(kws.iter().all(|&k| k < 64), "word={word}: intermediates {kws:?}");
+        }
+        let sim = simulate(&dir, &point);
+        let (want, got) = (eval["outputs"].as_object().unwrap(), sim["outputs"].as_object().unwrap());
+        assert_eq!(want.len(), got.len());
+        for (k, v) in want {
+            let (e, s) = (v.as_f64().unwrap(), got[k].as_f64().unwrap());
+            assert_eq!(e.to_bits(), s.to_bits(), "word={word}: output {k}: simulated {s}, -eval {e}");
+        }
+        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+        dsp.push(r["fpga"]["resources"]["fp_units"]["dsp"].as_u64().unwrap());
+    }
+    // two MULTI PEs: 2 blocks each for 32-bit words (four 18 × 19 partial products), 1 at 27 and 18
+    assert_eq!(dsp, [4, 2, 2]);
+}
+
+/// The multiplier a narrow word's MULTI PE needs is one DSP block, as Yosys maps it: 27 × 27
+/// words are one `MISTRAL_MUL27X27` on the Cyclone V, 32 × 32 words four `MISTRAL_MUL18X18`
+/// (two blocks): the DSP counts [`robovec_machine::resources::fixed_unit`] charges.
+#[test]
+fn yosys_maps_a_27_bit_product_to_one_dsp_block_and_a_32_bit_one_to_two() {
+    tool("yosys");
+    let d = tmp("mul27");
+    let count = |dw: u32, kw: u32| -> (u64, u64) {
+        let script = format!(
+            "read_verilog {} {}; chparam -set LATENCY 3 -set DW {dw} -set KW {kw} fix_mul; \
+             synth_intel_alm -family cyclonev -top fix_mul; tee -q -o stat{dw}.json stat -json",
+            hdl("fp_units.v").display(),
+            hdl("fix_units.v").display()
+        );
+        let o = Command::new("yosys").current_dir(&d).args(["-q", "-p", &script]).output().expect("yosys runs");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let stat: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join(format!("stat{dw}.json"))).unwrap()).unwrap();
+        let cells = &stat["modules"]["\\fix_mul"]["num_cells_by_type"];
+        (cells["MISTRAL_MUL27X27"].as_u64().unwrap_or(0), cells["MISTRAL_MUL18X18"].as_u64().unwrap_or(0))
+    };
+    assert_eq!(count(27, 55), (1, 0));
+    assert_eq!(count(32, 64), (0, 4));
+    let t = robovec_machine::target::Target::de10_nano();
+    let m = robovec_machine::resources::cost_model(&t);
+    assert_eq!(robovec_machine::resources::fixed_unit(&m, 27, true, 55).dsp, 1);
+    assert_eq!(robovec_machine::resources::fixed_unit(&m, 32, true, 64).dsp, 2);
+    let e = robovec_machine::resources::cost_model(&robovec_machine::target::Target::ecp5_85f());
+    assert_eq!(robovec_machine::resources::fixed_unit(&e, 18, true, 37).dsp, 1);
+    assert_eq!(robovec_machine::resources::fixed_unit(&e, 27, true, 55).dsp, 4);
 }
 
 /// `PATH` with the open ECP5 flow's YoWASP tools first (`scripts/test.sh` installs them into

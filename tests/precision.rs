@@ -189,6 +189,52 @@ fn a_budget_file_gives_absolute_budgets_per_output() {
     assert!(stderr(&o).contains("cannot read budget file `nowhere.json`"), "{}", stderr(&o));
 }
 
+/// `word=W` (issue 49: fixed-point PEs whose products fit one DSP multiplier): `target=mcu`'s
+/// words are then `fix<W,f>` and `error-bound` still proves the budget; a narrower word's bound is
+/// no smaller than a wider one's. `word` with another target, or outside 8..=32, is bad usage.
+#[test]
+fn target_mcu_takes_the_fixed_point_word_it_is_given() {
+    let dir = crate::common::tmp("precision_word");
+    let (ranges, report) = (dir.join("r.json"), dir.join("report.json"));
+    std::fs::write(&ranges, r#"{"q[*]": [-3.2, 3.2], "qd[*]": [-10, 10], "qdd[*]": [-10, 10]}"#).unwrap();
+    let run = |params: &str| {
+        opt(&[
+            "examples/three_link_arm/three_link_arm.urdf",
+            "-function=invdyna",
+            &format!("-ranges={}", ranges.display()),
+            &format!("-passes=atomise,precision<budget=1e-3;{params}>,error-bound"),
+            &format!("-report={}", report.display()),
+            "-o",
+            "/dev/null",
+        ])
+    };
+    let mut worst = Vec::new();
+    for word in [32, 24, 20] {
+        let o = run(&format!("target=mcu;word={word}"));
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        let formats = r["precision"]["formats"].as_object().unwrap();
+        let fix: Vec<&String> = formats.keys().filter(|k| k.starts_with("fix<")).collect();
+        assert!(!fix.is_empty(), "word={word}: {formats:?}");
+        assert!(fix.iter().all(|k| k.starts_with(&format!("fix<{word},"))), "word={word}: {formats:?}");
+        let mut w = 0.0f64;
+        for (name, o) in r["precision"]["outputs"].as_object().unwrap() {
+            let budget = o["budget"].as_f64().unwrap();
+            // error-bound's own proof after the pass, against the budget precision was given
+            let proved = r["error_bound"]["outputs"][name]["abs"].as_f64().unwrap();
+            assert!(proved <= budget, "word={word}: {name}: bound {proved}, budget {budget}");
+            w = w.max(proved / budget);
+        }
+        worst.push(w);
+    }
+    assert!(worst[0] <= worst[1] && worst[1] <= worst[2], "narrower words, larger bounds: {worst:?}");
+    for bad in ["target=c;word=20", "target=fpga;word=27", "target=mcu;word=40", "target=mcu;word=7"] {
+        let o = run(bad);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
+        assert!(stderr(&o).contains("word"), "{bad}: {}", stderr(&o));
+    }
+}
+
 /// A stop inside the search keeps the formats accepted so far: still within every budget.
 #[test]
 fn a_stopped_search_keeps_accepted_formats() {
@@ -289,7 +335,17 @@ fn the_segway_gets_narrow_fixed_point_words_on_the_fpga() {
     let mut last: Option<(f64, f64)> = None;
     for (k, budget) in [1e-7, 1e-5, 1e-3, 1e-2].into_iter().enumerate() {
         let budgets = vec![robovec_passes::precision::budget::Budget::Rel(budget); f.outputs.len()];
-        let c = robovec_passes::precision::choose_on(&f, &x, &budgets, Target::Fpga, &device, robovec_passes::error_bound::TrigImpl::Libm, || false).unwrap();
+        let c = robovec_passes::precision::choose_on(
+            &f,
+            &x,
+            &budgets,
+            Target::Fpga,
+            &device,
+            robovec_passes::error_bound::TrigImpl::Libm,
+            32,
+            || false,
+        )
+        .unwrap();
         let mut g = f.clone();
         for &(v, fmt) in &c.formats {
             g.set_format(v, fmt);

@@ -242,10 +242,14 @@ impl FixShifts {
 
 /// The fixed-point side of a program whose PEs compute in fixed point (issue 49): a function
 /// whose every op is an integer op of `fix<w,f>` values with `w ≤ 32`. Words are the values'
-/// integers `k` (32-bit two's complement); the fractions say what each loaded word and output
-/// means (`k · 2^-f`).
+/// integers `k` (`word_bits`-bit two's complement); the fractions say what each loaded word and
+/// output means (`k · 2^-f`).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FixedProgram {
+    /// Bits of the PEs' data word: the widest `fix<w,f>` of the function, or more when a
+    /// constant's word ([`crate::format::fix_constant`]) needs more (≤ 32; 0 in a default
+    /// record, which nothing lowers to).
+    pub word_bits: u32,
     /// Per PE slot, per cycle `0..=cycles`: the shifts of the op issued there.
     pub shifts: Vec<Vec<Option<FixShifts>>>,
     /// Fractional bits of each input's format, by canonical name.

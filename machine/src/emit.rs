@@ -156,7 +156,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "capt": format!("[0,{o}) output-memory address, bit {o} enable", o = w.ow),
         "data": match d.pe_kind {
             PeKind::Binary32 => "binary32",
-            PeKind::Fixed => "fixed point: the 32-bit two's complement integer k of a value k·2^-f (each load's and output's `fraction`)",
+            PeKind::Fixed => "fixed point: the `word_bits`-bit two's complement integer k of a value k·2^-f (each load's and output's `fraction`); out_data sign-extends it to 32 bits",
         },
     });
     let mut layout = layout;
@@ -179,6 +179,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "latency": {"add": d.lat_add, "mul": d.lat_mul},
         "interconnect": d.interconnect().as_str(),
         "pe_kind": d.pe_kind.as_str(),
+        "word_bits": d.word_bits,
         "mux_inputs": d.mux_inputs(),
         "widths": w,
         "layout": layout,

@@ -16,9 +16,12 @@
 //!   `crossbar_alm` times its multiplexer inputs, [`Routes::mux_inputs`], in place of the first
 //!   term), the last term the output memories (32-bit registers:
 //!   16 ALM a word on the DE10-Nano, the slope Yosys measures per PE: 16.0 ALM per word over
-//!   the Segway's 4 + 4 PEs holding 1 to 33 output words each).
+//!   the Segway's 4 + 4 PEs holding 1 to 33 output words each). With fixed-point PEs of
+//!   narrower words (`word_bits` < 32, issue 49) the multiplexer and output-word terms take
+//!   `word_bits / 32` of those costs.
 //! - **FP units**: the target's per-unit costs (seed §1.3.1 / Table 1.4: ADD PE 360 ALM, 2 DSP;
-//!   MULTI PE 100 ALM, 3 DSP) times the PEs of each type.
+//!   MULTI PE 100 ALM, 3 DSP) times the PEs of each type; fixed-point PEs per PE, by their word
+//!   and intermediate widths ([`fixed_unit`]).
 //! - **Memories**: every PE memory, instruction, crossbar, buffer-instruction and capture memory
 //!   as M10K blocks from its size ([`crate::target::m10k_blocks`] by the block configurations,
 //!   [`M10kFit::Configurations`]; PE memories true dual-port).
@@ -444,17 +447,45 @@ pub fn parse_stat(json: &str) -> Result<YosysCells, String> {
     Ok(y)
 }
 
+/// One fixed-point PE's unit for `dw`-bit words and a `kw`-bit exact intermediate
+/// ([`crate::design::build::intermediate_bits`]): the target's `fix_pe` cost, which is the
+/// 32-bit word's with a 64-bit intermediate, with its logic scaled by `kw / 64` (the shifters,
+/// the adder and the rounding are `kw` bits wide; Yosys 0.23 `synth_intel_alm` of
+/// `fix_add_sub` at (DW, KW) = (32, 64), (27, 51), (27, 40), (20, 37), (16, 29): 603, 500, 410,
+/// 340, 260 ALM, within 8 % of the scaling; of `fix_mul` at (27, 55), (20, 41): 281, 189 ALM,
+/// under the scaling's 357 and 266: docs/fpga.md "Narrow words"), and a MULTI PE's multipliers
+/// by the family's DSP modes: on the Cyclone V one variable-precision block for a product of
+/// words of at most 27 bits (27 × 27 mode: Yosys maps it to one `MISTRAL_MUL27X27`), on the
+/// ECP5 one MULT18X18D for words of at most 18 bits; wider products take the target's
+/// `fix_pe.mul.dsp` (the four 16 × 16 partial products of `hdl/fix_units.v`).
+pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32) -> UnitCost {
+    let unit = if is_mul { m.fix_mul } else { m.fix_add };
+    let alm = (unit.alm as f64 * f64::from(kw.min(64)) / 64.0).ceil() as u64;
+    let one_block = match m.family {
+        Family::CycloneV => 27,
+        Family::Ecp5 => 18,
+    };
+    let dsp = if is_mul && unit.dsp > 0 && dw <= one_block { 1 } else { unit.dsp };
+    UnitCost { alm, dsp, m10k: unit.m10k }
+}
+
 /// The estimate for `d` under `m`, with Yosys' cells when it ran.
 pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resources {
     let (na, nm) = (u64::from(d.n_add), u64::from(d.n_mul));
-    let (add, mul) = match d.pe_kind {
-        crate::design::PeKind::Binary32 => (m.fp_add, m.fp_mul),
-        crate::design::PeKind::Fixed => (m.fix_add, m.fix_mul),
-    };
-    let fp = UnitCost {
-        alm: na * add.alm + nm * mul.alm,
-        dsp: na * add.dsp + nm * mul.dsp,
-        m10k: na * add.m10k + nm * mul.m10k,
+    let fp = match d.pe_kind {
+        crate::design::PeKind::Binary32 => UnitCost {
+            alm: na * m.fp_add.alm + nm * m.fp_mul.alm,
+            dsp: na * m.fp_add.dsp + nm * m.fp_mul.dsp,
+            m10k: na * m.fp_add.m10k + nm * m.fp_mul.m10k,
+        },
+        crate::design::PeKind::Fixed => {
+            let units = d.pes.iter().map(|p| fixed_unit(m, d.word_bits, p.is_mul, d.intermediate_bits(p.slot)));
+            units.fold(UnitCost { alm: 0, dsp: 0, m10k: 0 }, |a, u| UnitCost {
+                alm: a.alm + u.alm,
+                dsp: a.dsp + u.dsp,
+                m10k: a.m10k + u.m10k,
+            })
+        }
     };
     let memories = memory_costs(d, m.family);
     let mem_m10k: u64 = memories.iter().map(|c| c.m10k).sum();
@@ -462,12 +493,15 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
         Some(y) => ("yosys", y.alm(), y.dsp),
         None => {
             let n = (na + nm) as f64;
+            // The multiplexers and output words are costed for 32-bit words: a narrower word
+            // (fixed-point PEs, `word_bits`) takes its share.
+            let word = f64::from(d.word_bits) / 32.0;
             // a design has two write ports per PE memory (`codegen<fpga>` refuses other targets)
-            let a = m.crossbar_alm * d.mux_inputs() as f64
+            let a = m.crossbar_alm * d.mux_inputs() as f64 * word
                 + m.pe_memory_alm * n
                 + m.pe_word_alm * d.pes.iter().map(|p| p.data.words.len().max(1) as f64).sum::<f64>()
                 + m.control_alm
-                + m.output_word_alm * output_words(d) as f64;
+                + m.output_word_alm * output_words(d) as f64 * word;
             ("estimate", a.ceil() as u64, 0)
         }
     };

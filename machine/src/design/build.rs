@@ -3,7 +3,7 @@
 //! (the layout of its module doc, LSB first), checked against the target's memories first so
 //! that every problem is reported with the figures needed and available.
 
-use robovec_ir::machine::{MachineOp, MachineProgram, Word};
+use robovec_ir::machine::{FixShifts, MachineOp, MachineProgram, Word};
 use robovec_ir::placement::{PeArray, Placement};
 use robovec_ir::syntax::TrigFn;
 use robovec_ir::Function;
@@ -77,9 +77,41 @@ fn constant_bits(c: f64, fixed: Option<&robovec_ir::machine::FixedProgram>) -> u
 
 fn initial_word(w: &Option<Word>, fixed: Option<&robovec_ir::machine::FixedProgram>) -> u64 {
     match w {
-        Some(Word::Const(c)) => u64::from(constant_bits(*c, fixed)),
+        Some(Word::Const(c)) => u64::from(constant_bits(*c, fixed)) & word_mask(word_bits_of(fixed)),
         _ => 0,
     }
+}
+
+/// Bits of the data word: the fixed-point program's `word_bits`, 32 for binary32 PEs.
+fn word_bits_of(fixed: Option<&robovec_ir::machine::FixedProgram>) -> u32 {
+    fixed.map_or(32, |x| x.word_bits)
+}
+
+/// The low `bits` bits set.
+fn word_mask(bits: u32) -> u64 {
+    if bits >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << bits) - 1
+    }
+}
+
+/// Bits of the exact intermediate K (`hdl/fix_units.v`) that a fixed-point PE of `dw`-bit words
+/// needs for the ops whose shifts are `shifts`: an ADD PE's aligned sum `dw + align + 1` bits
+/// and one more for the rounding constant's addition, a MULTI PE's product `2·dw` and one more;
+/// at least `s + 2` for a rounding by `s` bits (its constant `2^(s−1)` positive); at most 64
+/// (robovec's `INTEGER_BITS` bound of 62 bits on every exact intermediate, with the range
+/// proof, `robovec_ir::format`).
+pub fn intermediate_bits(dw: u32, is_mul: bool, shifts: impl IntoIterator<Item = FixShifts>) -> u32 {
+    let base = if is_mul { 2 * dw + 1 } else { dw + 2 };
+    shifts
+        .into_iter()
+        .map(|sh| {
+            let exact = if is_mul { 2 * dw + 1 } else { dw + u32::from(sh.align) + 2 };
+            exact.max(u32::try_from(sh.shift).unwrap_or(0) + 2)
+        })
+        .fold(base, u32::max)
+        .min(64)
 }
 
 /// What the target cannot hold or the hardware cannot do, one line each with the figures
@@ -274,8 +306,8 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
             xbar: img("xbar", widths.xbar(), im.crossbar[s].clone()),
             bufi: img("bufi", widths.bufi(), im.buffer[s].clone()),
             capt: img("capt", widths.capt(), im.capture[s].clone()),
-            data: img("data", 32, data),
-            out: img("out", 32, out),
+            data: img("data", word_bits_of(fx), data),
+            out: img("out", word_bits_of(fx), out),
             buffer_words: m.buffer_words[s],
             fix,
         });
@@ -309,6 +341,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
         pe_memory: limits.pe_memory,
         states: f.states,
         pe_kind: if fx.is_some() { PeKind::Fixed } else { PeKind::Binary32 },
+        word_bits: word_bits_of(fx),
     })
 }
 

@@ -199,6 +199,10 @@ pub struct Design {
     /// Independent states one run computes (the function's `states`, issue 49 item 3: state
     /// k's inputs and outputs are named `name#k`).
     pub states: u32,
+    /// Bits of the data word (PE memories, interconnect, buffers, output memories, units): 32
+    /// for binary32 PEs, the function's widest format for fixed-point ones
+    /// ([`crate::program::fixed::word_bits`]).
+    pub word_bits: u32,
 }
 
 /// The fixed Verilog files, `(name, text)`: the FP unit models, the memories and the PE.
@@ -295,13 +299,13 @@ impl Design {
     /// The Verilog expression of port `port`'s multiplexer sources on PE `slot` (most
     /// significant word first), their count and select bits: the whole bus `sources` for the
     /// crossbar, the routed words for a specialised design (`32'h0` alone for a port without
-    /// routes: its select is always 0).
+    /// routes: its select is always 0; `DW'h0` with the design's word bits).
     fn port_sources(&self, slot: usize, port: usize) -> (String, usize, u32) {
         let n = self.n_pe();
         let Some(r) = &self.routes else { return ("sources".into(), 2 * n, self.widths.sw) };
         let list = &r.ports[slot][port];
         if list.is_empty() {
-            return ("32'h0".into(), 1, r.select_bits(slot, port));
+            return (format!("{}'h0", self.word_bits), 1, r.select_bits(slot, port));
         }
         let words: Vec<String> = list
             .iter()
@@ -316,6 +320,20 @@ impl Design {
             })
             .collect();
         (format!("{{{}}}", words.join(", ")), list.len(), r.select_bits(slot, port))
+    }
+
+    /// Bits of the exact intermediate of PE `slot`'s fixed-point unit
+    /// ([`build::intermediate_bits`] over the shifts of its program); 64 for binary32 PEs.
+    pub fn intermediate_bits(&self, slot: usize) -> u32 {
+        let p = &self.pes[slot];
+        match &p.fix {
+            Some(img) => build::intermediate_bits(
+                self.word_bits,
+                p.is_mul,
+                img.words.iter().map(|&w| robovec_ir::machine::FixShifts::from_word(w)),
+            ),
+            None => 64,
+        }
     }
 
     /// Bits of the output read port's PE select.
@@ -355,8 +373,9 @@ impl Design {
             "  rv_control #(.CW({}), .CYCLES({})) ctl (.clk(clk), .rst(rst), .start(start), .run(run), .done(done), .pc(pc), .fetch(fetch));",
             w.cw, self.cycles
         );
+        let dw = self.word_bits;
         for p in &self.pes {
-            let _ = writeln!(s, "  wire [31:0] result{0}, buffer{0}, out{0};", p.slot);
+            let _ = writeln!(s, "  wire [{1}:0] result{0}, buffer{0}, out{0};", p.slot, dw - 1);
         }
         if self.routes.is_some() {
             s += "  // specialised interconnect: each write port multiplexes only the results and buffer reads\n";
@@ -371,7 +390,7 @@ impl Design {
                 2 * n,
                 n + 1
             );
-            let _ = writeln!(s, "  wire [{}:0] sources = {{{}}};", 64 * n - 1, bus.join(", "));
+            let _ = writeln!(s, "  wire [{}:0] sources = {{{}}};", 2 * dw as usize * n - 1, bus.join(", "));
         }
         for p in &self.pes {
             let lat = if p.is_mul { self.lat_mul } else { self.lat_add };
@@ -379,7 +398,9 @@ impl Design {
             let (src0, n0, sw0) = self.port_sources(p.slot, 0);
             let (src1, n1, sw1) = self.port_sources(p.slot, 1);
             let mut fix = match &p.fix {
-                Some(img) => format!(".FIX(1), .FIX_FILE({}), ", f(img)),
+                Some(img) => {
+                    format!(".FIX(1), .FIX_FILE({}), .DW({dw}), .KW({}), ", f(img), self.intermediate_bits(p.slot))
+                }
                 None => String::new(),
             };
             if self.pe_memory == PeMemory::LiveValueTable {
@@ -409,8 +430,13 @@ impl Design {
             );
         }
         s += "  always @* begin\n    case (out_pe)\n";
+        // a narrower word is read out sign-extended to 32 bits
+        let extend = |k: usize| match dw {
+            32 => format!("out{k}"),
+            _ => format!("{{{{{}{{out{k}[{}]}}}}, out{k}}}", 32 - dw, dw - 1),
+        };
         for p in &self.pes {
-            let _ = writeln!(s, "      {}: out_data = out{};", p.slot, p.slot);
+            let _ = writeln!(s, "      {}: out_data = {};", p.slot, extend(p.slot));
         }
         s += "      default: out_data = 32'h0;\n    endcase\n  end\nendmodule\n";
         s

@@ -112,11 +112,11 @@ def number(b):
     return x if math.isfinite(x) else None
 
 
-def fix_word(x, f):
-    """The integer of x stored in fix<32,f>: floor(x * 2^f + 1/2), exactly (ties toward +inf)."""
+def fix_word(x, f, bits=32):
+    """The integer of x stored in fix<bits,f>: floor(x * 2^f + 1/2), exactly (ties toward +inf)."""
     k = math.floor(fractions.Fraction(x) * fractions.Fraction(2) ** f + fractions.Fraction(1, 2))
-    if not -(1 << 31) <= k < (1 << 31):
-        fail("%r does not fit a 32-bit word at %d fractional bits" % (x, f))
+    if not -(1 << (bits - 1)) <= k < (1 << (bits - 1)):
+        fail("%r does not fit a %d-bit word at %d fractional bits" % (x, bits, f))
     return k
 
 
@@ -152,22 +152,24 @@ def main(argv):
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             fail("input `%s` must be a number, found %s" % (k, json.dumps(v)))
     fixed = man.get("pe_kind") == "fixed"
+    dw = man.get("word_bits", 32)
+    mask = (1 << dw) - 1
     word = {}
     stored = {}
     for n in man["inputs"]:
         x = float(given[n]) if n in given else pseudo_random_input(n)
         if fixed:
             f = man["input_fractions"][n]
-            stored[n] = fix_value(fix_word(x, f), f)
+            stored[n] = fix_value(fix_word(x, f, dw), f)
         else:
             word[n] = f32_bits(x)
 
     def load_bits(l):
         if fixed and "input" in l:
-            return fix_word(stored[l["input"]], l["fraction"]) & 0xFFFFFFFF
+            return fix_word(stored[l["input"]], l["fraction"], dw) & mask
         if fixed and "trig" in l:
             y = (math.sin if l["trig"] == "sin" else math.cos)(stored[l["of"]])
-            return fix_word(y, l["fraction"]) & 0xFFFFFFFF
+            return fix_word(y, l["fraction"], dw) & mask
         if "input" in l:
             return word[l["input"]]
         if "trig" in l:
@@ -199,7 +201,7 @@ def main(argv):
         for pe in man["pes"]:
             for key in ("data", "out"):
                 with open(os.path.join(tmp, pe["memories"][key]["file"] + ".hex"), "w") as f:
-                    f.write("".join("%08x\n" % w for w in images[pe["slot"]][key]))
+                    f.write("".join("%0*x\n" % ((dw + 3) // 4, w & mask) for w in images[pe["slot"]][key]))
         # The sources are compiled from copies in the temporary folder, under their own names:
         # iverilog quotes each path in its `line directives, so a folder name holding `"`
         # (or other characters it does not escape) broke the compilation.
@@ -227,6 +229,8 @@ def main(argv):
     for o in man["outputs"]:
         b = outs[o["slot"]][o["addr"]]
         if fixed:
+            # a word of dw bits, sign-extended to 32 (what out_data reads)
+            b = (b - (1 << dw) if b >> (dw - 1) & 1 else b) & 0xFFFFFFFF
             result["outputs"][o["name"]] = fix_value(signed32(b), o["fraction"])
         else:
             result["outputs"][o["name"]] = number(b)

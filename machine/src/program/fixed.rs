@@ -109,8 +109,11 @@ pub fn attach(f: &Function, m: &mut MachineProgram) -> Result<(), MachineError> 
         Format::Fix { fraction, .. } => fraction,
         _ => 0,
     };
-    let mut fx =
-        FixedProgram { shifts: m.pes.iter().map(|p| vec![None; p.steps.len()]).collect(), ..FixedProgram::default() };
+    let mut fx = FixedProgram {
+        shifts: m.pes.iter().map(|p| vec![None; p.steps.len()]).collect(),
+        word_bits: word_bits(f),
+        ..FixedProgram::default()
+    };
     for &v in &f.inputs {
         fx.inputs.insert(f.name_of(v).to_string(), frac(v));
     }
@@ -144,6 +147,30 @@ pub fn attach(f: &Function, m: &mut MachineProgram) -> Result<(), MachineError> 
     fx.outputs = m.outputs.iter().map(|o| by_name.get(o.name.as_str()).copied().unwrap_or(0)).collect();
     m.fixed = Some(fx);
     Ok(())
+}
+
+/// Bits of the data word of `f`'s fixed-point PEs: its widest `fix<w,f>`, or more when a constant
+/// operand's or output's word ([`robovec_ir::format::fix_constant`]: up to 32 bits) needs more;
+/// at least 2. The PE memories, interconnect and units are this wide (issue 49: a product of
+/// words of at most 27 bits takes one Cyclone V DSP block, docs/fpga.md).
+pub fn word_bits(f: &Function) -> u32 {
+    let constant = |c: f64| robovec_ir::format::fix_constant(c).map_or(FIX_WORD_BITS, |(k, _)| signed_bits(k));
+    let values = f.inputs.iter().chain(&f.body).map(|&v| match f.format(v) {
+        Format::Fix { width, .. } => width,
+        _ => FIX_WORD_BITS,
+    });
+    let operands = f.body.iter().flat_map(|&v| f.value(v).def.operands()).chain(f.outputs.iter().map(|o| o.value));
+    let constants = operands.filter_map(|o| match o {
+        robovec_ir::Operand::Const(c) => Some(constant(c)),
+        robovec_ir::Operand::Value(_) => None,
+    });
+    values.chain(constants).fold(2, u32::max).min(FIX_WORD_BITS)
+}
+
+/// Bits of `k` in two's complement (the sign bit included): 1 for 0 and −1.
+pub fn signed_bits(k: i64) -> u32 {
+    let m = if k < 0 { !k } else { k };
+    65 - m.leading_zeros()
 }
 
 /// The integer word of a loaded value `x` in `fix<·,fraction>`: `⌊x·2^f + ½⌋` computed exactly

@@ -51,6 +51,11 @@ pub enum Select {
     Naive,
     /// Best operand-location preference (Table 2.1), then lowest index.
     Preferential,
+    /// Best operand-location preference (Table 2.1), then the fewest new interconnect routes
+    /// (sources — a PE's result or buffer read — not yet written into the chosen PE's memory):
+    /// for `codegen<fpga;interconnect=specialised>`, whose multiplexers have an input per route
+    /// (issue 49), then lowest index.
+    Routes,
 }
 
 /// Options of one placement.
@@ -135,7 +140,11 @@ fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
             buffer: p.flag("buffer")?,
         },
         priority: if p.choice("priority")? == "mobility" { Priority::Mobility } else { Priority::Classical },
-        select: if p.choice("select")? == "naive" { Select::Naive } else { Select::Preferential },
+        select: match p.choice("select")? {
+            "naive" => Select::Naive,
+            "routes" => Select::Routes,
+            _ => Select::Preferential,
+        },
         improve: p.u32("improve")?,
         restarts: p.u32("restarts")?,
         search: p.u32("search")?,
@@ -316,8 +325,9 @@ pub const INFO: PassInfo = PassInfo {
         },
         ParamInfo {
             name: "select",
-            kind: ParamKind::Choice { choices: &["naive", "preferential"], default: "preferential" },
-            doc: "naive (first free PE) | preferential (Table 2.1)",
+            kind: ParamKind::Choice { choices: &["naive", "preferential", "routes"], default: "preferential" },
+            doc: "naive (first free PE) | preferential (Table 2.1) | routes (Table 2.1, then the fewest new \
+                  interconnect routes: smaller multiplexers for codegen<fpga;interconnect=specialised>)",
         },
         ParamInfo {
             name: "improve",

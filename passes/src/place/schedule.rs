@@ -145,6 +145,9 @@ struct Ctx<'a> {
     located: Located,
     ports: Ports,
     bookings: Vec<Booking>,
+    /// `routed[q · 2n + s]`: source `s` (PE `p`'s result `p`, its buffer read `n + p`) is
+    /// already written into memory `q` ([`Select::Routes`]).
+    routed: Vec<bool>,
 }
 
 /// Writes and buffer reads that earlier operands of the same op plan, not yet booked.
@@ -209,6 +212,31 @@ impl Ctx<'_> {
         true
     }
 
+    /// The interconnect source of a write by `route` of node `v` (`p` for PE `p`'s result, `n + p`
+    /// for its buffer read), `None` for an operand already in the memory.
+    fn source(&self, v: Node, route: Route) -> Option<usize> {
+        let p = self.issue[v as usize].0 as usize;
+        match route {
+            Route::Pe => None,
+            Route::Direct => Some(p),
+            Route::Indirect(_) => Some(self.arch.n_pe() + p),
+        }
+    }
+
+    /// Sources that `routes` of operands `ops` would add to memory `q`'s routes (an op has at
+    /// most a few operands: the distinct ones are found by a scan).
+    fn new_routes(&self, ops: &[Node], routes: &[Route], q: usize) -> u32 {
+        let n2 = 2 * self.arch.n_pe();
+        let fresh: Vec<usize> = ops
+            .iter()
+            .zip(routes)
+            .filter(|(&v, _)| v != NO_NODE)
+            .filter_map(|(&v, &r)| self.source(v, r))
+            .filter(|&s| !self.routed[q * n2 + s])
+            .collect();
+        fresh.iter().enumerate().filter(|&(i, s)| !fresh[..i].contains(s)).count() as u32
+    }
+
     fn commit(&mut self, ops: &[Node], routes: &[Route], q: usize) {
         for (&v, &r) in ops.iter().zip(routes) {
             if v == NO_NODE {
@@ -221,6 +249,10 @@ impl Ctx<'_> {
             };
             if self.located.contains(v, q) {
                 continue; // the same value twice in one op
+            }
+            if let Some(s) = self.source(v, r).filter(|_| !self.routed.is_empty()) {
+                let n2 = 2 * self.arch.n_pe();
+                self.routed[q * n2 + s] = true;
             }
             self.ports.add_write(q, cycle);
             if indirect {
@@ -288,6 +320,7 @@ pub fn schedule_until(
         located: Located::new(n),
         ports: Ports { writes: vec![Vec::new(); arch.n_pe()], buffer_read: vec![Vec::new(); arch.n_pe()] },
         bookings: Vec::new(),
+        routed: if select == Select::Routes { vec![false; 2 * arch.n_pe() * arch.n_pe()] } else { Vec::new() },
     };
     let mut ready = ready_lists(keys);
     for v in 0..n as Node {
@@ -348,17 +381,25 @@ pub fn schedule_until(
                     if !ctx.routes(operands, q, t, &mut planned, &mut routes) {
                         continue;
                     }
+                    let table = || {
+                        let at = |j: usize| routes.get(j).copied().unwrap_or(Route::Pe);
+                        preference(at(0), at(1)) + routes.iter().skip(2).filter(|r| **r != Route::Pe).count() as u32
+                    };
+                    // Routes: Table 2.1 first, the new routes (at most one per operand) break ties.
                     let score = match select {
                         Select::Naive => 0,
-                        Select::Preferential => {
-                            let at = |j: usize| routes.get(j).copied().unwrap_or(Route::Pe);
-                            preference(at(0), at(1)) + routes.iter().skip(2).filter(|r| **r != Route::Pe).count() as u32
-                        }
+                        Select::Preferential => table(),
+                        Select::Routes => table() * 64 + ctx.new_routes(operands, &routes, q).min(63),
                     };
                     if best.is_none_or(|(s, _)| score < s) {
                         best = Some((score, i));
                         std::mem::swap(&mut routes, &mut best_routes);
-                        if score <= 1 && select == Select::Preferential || select == Select::Naive {
+                        let done = match select {
+                            Select::Naive => true,
+                            Select::Preferential => score <= 1,
+                            Select::Routes => score <= 64,
+                        };
+                        if done {
                             break;
                         }
                     }

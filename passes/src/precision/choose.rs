@@ -145,13 +145,16 @@ pub fn choose(
     target: Target,
     stop: impl FnMut() -> bool,
 ) -> Result<Choice, String> {
-    choose_on(f, x, budgets, target, &Device::de10_nano(), TrigImpl::Libm, stop)
+    choose_on(f, x, budgets, target, &Device::de10_nano(), TrigImpl::Libm, MCU_WORD, stop)
 }
 
 /// [`choose`] for the target description `device` (what `target=fpga` costs against: its DSP
 /// blocks, ALM and [`robovec_machine::target::Datapath`]; the other targets ignore it) and the
 /// `sin`/`cos` the code will call (`trig`: [`TrigImpl::Inline`] for `codegen<c;trig=inline>`,
-/// whose binary32 kernel is allowed 1 ulp where the C library is allowed 4).
+/// whose binary32 kernel is allowed 1 ulp where the C library is allowed 4) and, for
+/// `target=mcu`, the fixed-point word (`word`, bits: `fix<word,f>`; [`MCU_WORD`] = 32 is a
+/// microcontroller's register, narrower words are for fixed-point PEs whose products fit one
+/// DSP multiplier, docs/fpga.md; the other targets ignore it).
 ///
 /// # Errors
 /// As [`choose`].
@@ -162,8 +165,10 @@ pub fn choose_on(
     target: Target,
     device: &Device,
     trig: TrigImpl,
+    word: u32,
     mut stop: impl FnMut() -> bool,
 ) -> Result<Choice, String> {
+    assert!(MCU_WORDS.contains(&word), "word {word} outside {MCU_WORDS:?}");
     assert_eq!(budgets.len(), f.outputs.len(), "one budget per output");
     let mut g = f_with_default(f);
     let values: Vec<Value> = f.inputs.iter().chain(&f.body).copied().collect();
@@ -234,9 +239,10 @@ pub fn choose_on(
         }
     };
     let accepts = |h: &Function, sweeps: &mut usize| check(h, sweeps).ok();
-    let phases: &[fn(f64, f64) -> Option<Format>] = match target {
-        Target::C | Target::Fpga => &[binary32],
-        Target::Mcu => &[fix32, binary32],
+    let fix_word = move |m: f64, err: f64| fix_in(word, m, err);
+    let phases: &[&dyn Fn(f64, f64) -> Option<Format>] = match target {
+        Target::C | Target::Fpga => &[&binary32],
+        Target::Mcu => &[&fix_word, &binary32],
     };
     let mut stopped = false;
     let reached: Vec<Value> = outs.iter().filter(|(n, ..)| unreachable.contains(n)).map(|o| o.1).collect();
@@ -312,9 +318,7 @@ pub fn choose_on(
             // A fixed-point candidate gets one more integer bit; one that has it already (or
             // another format) leaves the ranking.
             match candidates[j].format {
-                Format::Fix { width, fraction }
-                    if fraction > *FIX_FRACTION_RANGE.start() && !candidates[j].widened =>
-                {
+                Format::Fix { width, fraction } if fraction > *FIX_FRACTION_RANGE.start() && !candidates[j].widened => {
                     candidates[j].format = Format::fix(width, fraction - 1).expect("a narrower fraction is a format");
                     candidates[j].widened = true;
                 }
@@ -401,17 +405,23 @@ fn binary32(m: f64, err: f64) -> Option<Format> {
     (m + err < f32::MAX as f64 / 2.0).then_some(Format::Binary32)
 }
 
-/// `fix<32,f>` for a value of magnitude `m` and error `err`: the fewest integer bits (the sign
+/// `target=mcu`'s default word: 32 bits (a microcontroller's register).
+pub const MCU_WORD: u32 = 32;
+
+/// The words `target=mcu` takes (`precision<word=W>`), bits.
+pub const MCU_WORDS: std::ops::RangeInclusive<u32> = 8..=32;
+
+/// `fix<word,f>` for a value of magnitude `m` and error `err`: the fewest integer bits (the sign
 /// included) that hold `(m + err)·(1 + 2⁻¹⁰)` and at least 2⁻¹⁶ — the margin for the error the
 /// formats add; a value the bound still finds may overflow gets one more integer bit
 /// ([`choose_on`]'s repair).
-fn fix32(m: f64, err: f64) -> Option<Format> {
+fn fix_in(word: u32, m: f64, err: f64) -> Option<Format> {
     // At least 2⁻¹⁶ of range: a value near 0 still holds the error its operands' roundings add.
     let top = ((m + err) * (1.0 + 2f64.powi(-10))).max(2f64.powi(-16));
     // |x| ≤ top < 2^(int_bits − 1): int_bits = ⌊log₂ top⌋ + 2.
     let int_bits = if top < f64::MIN_POSITIVE { -60 } else { top.log2().floor() as i32 + 2 };
-    let fraction = 32 - int_bits;
-    FIX_FRACTION_RANGE.contains(&fraction).then(|| Format::fix(32, fraction)).flatten()
+    let fraction = word as i32 - int_bits;
+    FIX_FRACTION_RANGE.contains(&fraction).then(|| Format::fix(word, fraction)).flatten()
 }
 
 /// `mcu`'s estimated cycles of one conversion between formats: a fixed-point store from

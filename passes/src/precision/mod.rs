@@ -19,7 +19,7 @@
 //! finds the longest prefix of that ranking whose formats the certified bound accepts (each
 //! step one O(ops) sweep, about log₂(values) of them). Targets:
 //! - `c`: binary32 where the bound allows (twice the lanes of a vector of binary64);
-//! - `mcu`: 32-bit fixed point first (`fix<32,f>`, the fewest integer bits that hold the
+//! - `mcu`: 32-bit fixed point first (`fix<32,f>`, or `fix<word,f>` with `word=`, the fewest integer bits that hold the
 //!   value's range and binary64 error widened by 2⁻¹⁰; a value the bound finds may overflow
 //!   gets one more: integer arithmetic on a microcontroller without a floating-point unit),
 //!   then binary32 among the rest;
@@ -76,11 +76,32 @@ pub const INFO: PassInfo = PassInfo {
                   (a microcontroller without FPU); fpga: fixed-point words as narrow as the budget allows, then \
                   binary32, costed in DSP blocks and ALM of the -target description",
         },
+        ParamInfo {
+            name: "word",
+            kind: ParamKind::U32 {
+                default: choose::MCU_WORD,
+                min: *choose::MCU_WORDS.start(),
+                max: *choose::MCU_WORDS.end(),
+            },
+            doc: "target=mcu: the fixed-point word, bits (fix<word,f>); 32 is a microcontroller's register, narrower \
+                  words are for fixed-point PEs whose products fit one DSP multiplier (27 on the Cyclone V, 18 on the \
+                  ECP5; docs/fpga.md)",
+        },
         crate::range::RANGES,
         crate::error_bound::TRIG,
     ],
     build: |p: &Params| {
         let (target, trig): (Target, TrigImpl) = (p.word("target")?, p.word("trig")?);
+        let word = p.u32("word")?;
+        if word != choose::MCU_WORD && target != Target::Mcu {
+            return Err(PassError::BadParameter {
+                pass: "precision".into(),
+                message: format!(
+                    "word={word} is target=mcu's fixed-point word; target={} chooses its own formats",
+                    target.as_str()
+                ),
+            });
+        }
         if trig == TrigImpl::Inline && target != Target::C {
             return Err(PassError::BadParameter {
                 pass: "precision".into(),
@@ -91,7 +112,7 @@ pub const INFO: PassInfo = PassInfo {
                 ),
             });
         }
-        Ok(Box::new(PrecisionPass { budget: p.f64_or_path("budget")?, target, ranges: p.path("ranges")?, trig }))
+        Ok(Box::new(PrecisionPass { budget: p.f64_or_path("budget")?, target, ranges: p.path("ranges")?, trig, word }))
     },
     props: crate::Props {
         requires: Some(robovec_ir::Phase::Atomised),
@@ -115,6 +136,8 @@ pub struct PrecisionPass {
     pub ranges: Option<String>,
     /// The `sin`/`cos` the code will call (`trig=inline` with `target=c` only).
     pub trig: TrigImpl,
+    /// `target=mcu`'s fixed-point word, bits (`word=`, [`choose::MCU_WORDS`]).
+    pub word: u32,
 }
 
 impl Pass for PrecisionPass {
@@ -157,7 +180,8 @@ impl Pass for PrecisionPass {
                         file.resolve(&names).map_err(|e| failed(format!("@{}: budget file: {e}", f.name)))?
                     }
                 };
-                let c = choose_on(f, &x, &budgets, target, device, self.trig, || ticker.tick()).map_err(failed)?;
+                let c = choose_on(f, &x, &budgets, target, device, self.trig, self.word, || ticker.tick())
+                    .map_err(failed)?;
                 if c.stopped {
                     let note = format!(
                         "searching @{} early (the formats accepted so far kept, every budget met): {}",

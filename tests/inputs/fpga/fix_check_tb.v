@@ -2,33 +2,44 @@
 // PEs (tests/fpga.rs: exact integer ops, then FixShifts::round). Each line of VEC holds 33 hex
 // digits: [131:128] op (0 add, 1 sub, 2 mul), [127:96] a, [95:64] b, [63:32] the shift word
 // (14 bits used), [31:0] the expected y. One vector at a time: the operands are held for the
-// unit's latency, then y is compared.
+// unit's latency, then y is compared. `DW (default 32) is the units' word: the operands are the
+// fields' low DW bits and the low DW bits of y are compared; `KWA` and `KWM` (default 64) are the
+// ADD and MULTI units' intermediate bits.
 `timescale 1ns/1ps
+`ifndef DW
+`define DW 32
+`endif
+`ifndef KWA
+`define KWA 64
+`endif
+`ifndef KWM
+`define KWM 64
+`endif
 module fix_check_tb;
   localparam integer LADD = 2, LMUL = 3;
   reg clk = 0;
   always #5 clk = ~clk;
   reg [131:0] vec [0:`N-1];
-  reg [31:0] a = 0, b = 0;
+  reg [`DW-1:0] a = 0, b = 0;
   reg [13:0] sh = 0;
   reg sub = 0;
-  wire [31:0] y_add, y_mul;
-  fix_add_sub #(.LATENCY(LADD)) u_add (.clk(clk), .a(a), .b(b), .sub(sub), .sh(sh), .y(y_add));
-  fix_mul #(.LATENCY(LMUL)) u_mul (.clk(clk), .a(a), .b(b), .sh(sh), .y(y_mul));
+  wire [`DW-1:0] y_add, y_mul;
+  fix_add_sub #(.LATENCY(LADD), .DW(`DW), .KW(`KWA)) u_add (.clk(clk), .a(a), .b(b), .sub(sub), .sh(sh), .y(y_add));
+  fix_mul #(.LATENCY(LMUL), .DW(`DW), .KW(`KWM)) u_mul (.clk(clk), .a(a), .b(b), .sh(sh), .y(y_mul));
   integer i, k, bad;
   reg [3:0] op;
-  reg [31:0] want, got;
+  reg [`DW-1:0] want, got;
   initial begin
     $readmemh(`VEC, vec);
     bad = 0;
     for (i = 0; i < `N; i = i + 1) begin
       @(negedge clk);
       op = vec[i][131:128];
-      a = vec[i][127:96];
-      b = vec[i][95:64];
+      a = vec[i][96+`DW-1:96];
+      b = vec[i][64+`DW-1:64];
       sh = vec[i][45:32];
       sub = (op == 4'd1);
-      want = vec[i][31:0];
+      want = vec[i][`DW-1:0];
       for (k = 0; k < ((op == 4'd2) ? LMUL : LADD); k = k + 1) @(negedge clk);
       got = (op == 4'd2) ? y_mul : y_add;
       if (got !== want) begin

@@ -182,17 +182,17 @@ module fp_mul_comb (
   end
 endmodule
 
-// LATENCY-deep delay line of 32-bit words (LATENCY = 0: a wire).
-module fp_delay #(parameter integer LATENCY = 1) (
-    input  wire        clk,
-    input  wire [31:0] d,
-    output wire [31:0] q
+// LATENCY-deep delay line of W-bit words (LATENCY = 0: a wire).
+module fp_delay #(parameter integer LATENCY = 1, parameter integer W = 32) (
+    input  wire         clk,
+    input  wire [W-1:0] d,
+    output wire [W-1:0] q
 );
   generate
     if (LATENCY == 0) begin : g_wire
       assign q = d;
     end else begin : g_pipe
-      reg [31:0] r [0:LATENCY-1];
+      reg [W-1:0] r [0:LATENCY-1];
       integer k;
       always @(posedge clk) begin
         r[0] <= d;

@@ -26,6 +26,8 @@ module rv_pe #(
     parameter integer FIX = 0,         // 1: fixed-point PE (fix_add_sub / fix_mul, shift memory)
     parameter integer LVT = 0,         // 1: the PE memory as banks and a live-value table (rv_pe_mem_lvt)
     parameter FIX_FILE = "",           // its shift memory image (14-bit words, fix_units.v)
+    parameter integer DW = 32,         // data word bits (32 for binary32 PEs; fixed point: the widest format)
+    parameter integer KW = 64,         // fixed-point PEs: bits of the exact intermediate (fix_units.v)
     parameter integer LAT = 12,        // cycles from issue to arrival (>= 3)
     parameter integer N0 = 4,          // sources of write port 0 (crossbar: 2 NPE)
     parameter integer SW0 = 3,         // its select bits
@@ -50,12 +52,12 @@ module rv_pe #(
     input  wire                 clk,
     input  wire                 run,       // executing cycle `pc` of the program
     input  wire [CW-1:0]        fetch,     // the cycle whose words are fetched at this edge
-    input  wire [32*N0-1:0]     src0,      // port 0's sources (crossbar: {buffer reads, results})
-    input  wire [32*N1-1:0]     src1,      // port 1's sources
-    output reg  [31:0]          result,    // the result arriving this cycle
-    output wire [31:0]          buf_read,  // this cycle's buffer read
+    input  wire [DW*N0-1:0]     src0,      // port 0's sources (crossbar: {buffer reads, results})
+    input  wire [DW*N1-1:0]     src1,      // port 1's sources
+    output reg  [DW-1:0]        result,    // the result arriving this cycle
+    output wire [DW-1:0]        buf_read,  // this cycle's buffer read
     input  wire [OW-1:0]        out_addr,  // output memory read port
-    output wire [31:0]          out_data
+    output wire [DW-1:0]        out_data
 );
   localparam integer XW = SW0 + SW1;
   localparam integer BIW = 2 * BW + 2;
@@ -84,18 +86,18 @@ module rv_pe #(
   // result of slot s-1, NPE+1..2NPE = buffer read of slot s-NPE-1)
   wire [SW0-1:0] sel0 = xbar[SW0-1:0];
   wire [SW1-1:0] sel1 = xbar[SW0+SW1-1:SW0];
-  wire [31:0] wd0, wd1;
-  rv_mux #(.N(N0), .SW(SW0)) u_x0 (.sources(src0), .sel(sel0), .y(wd0));
-  rv_mux #(.N(N1), .SW(SW1)) u_x1 (.sources(src1), .sel(sel1), .y(wd1));
+  wire [DW-1:0] wd0, wd1;
+  rv_mux #(.N(N0), .SW(SW0), .DW(DW)) u_x0 (.sources(src0), .sel(sel0), .y(wd0));
+  rv_mux #(.N(N1), .SW(SW1), .DW(DW)) u_x1 (.sources(src1), .sel(sel1), .y(wd1));
 
-  wire [31:0] qa, qb;
+  wire [DW-1:0] qa, qb;
   generate
     if (LVT) begin : g_lvt
-      rv_pe_mem_lvt #(.AW(AW), .DEPTH(MEM_DEPTH), .FILE(DATA_FILE)) u_mem (
+      rv_pe_mem_lvt #(.AW(AW), .DEPTH(MEM_DEPTH), .DW(DW), .FILE(DATA_FILE)) u_mem (
           .clk(clk), .we0(we0), .wa0(wa0), .wd0(wd0), .we1(we1), .wa1(wa1), .wd1(wd1),
           .ra(ra), .rb(rb), .qa(qa), .qb(qb));
     end else begin : g_mem
-      rv_pe_mem #(.AW(AW), .DEPTH(MEM_DEPTH), .FILE(DATA_FILE)) u_mem (
+      rv_pe_mem #(.AW(AW), .DEPTH(MEM_DEPTH), .DW(DW), .FILE(DATA_FILE)) u_mem (
           .clk(clk), .we0(we0), .wa0(wa0), .wd0(wd0), .we1(we1), .wa1(wa1), .wd1(wd1),
           .ra(ra), .rb(rb), .qa(qa), .qb(qb));
     end
@@ -105,7 +107,7 @@ module rv_pe #(
   initial sub_q = 0;
   always @(posedge clk) sub_q <= sub;
 
-  wire [31:0] y;
+  wire [DW-1:0] y;
   generate
     if (FIX != 0) begin : g_fix
       // the op's shift word, fetched with the instruction and registered with the operands
@@ -115,9 +117,9 @@ module rv_pe #(
       rv_rom #(.WIDTH(14), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(FIX_FILE)) u_fix (.clk(clk), .addr(fetch), .q(sh));
       always @(posedge clk) sh_q <= sh;
       if (IS_MUL != 0) begin : g_mul
-        fix_mul #(.LATENCY(LAT - 2)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
+        fix_mul #(.LATENCY(LAT - 2), .DW(DW), .KW(KW)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
       end else begin : g_add
-        fix_add_sub #(.LATENCY(LAT - 2)) u_fx (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .sh(sh_q), .y(y));
+        fix_add_sub #(.LATENCY(LAT - 2), .DW(DW), .KW(KW)) u_fx (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .sh(sh_q), .y(y));
       end
     end else if (IS_MUL != 0) begin : g_mul
       fp_mul #(.LATENCY(LAT - 2)) u_fp (.clk(clk), .a(qa), .b(qb), .y(y));
@@ -134,7 +136,7 @@ module rv_pe #(
   wire [BW-1:0] st    = bufi[BW-1:0];
   wire [BW-1:0] rd    = bufi[2*BW-1:BW];
   wire          st_en = bufi[2*BW] & run;
-  reg [31:0] bmem [0:BUF_DEPTH-1];
+  reg [DW-1:0] bmem [0:BUF_DEPTH-1];
   assign buf_read = (st_en && st == rd) ? result : bmem[rd];
   always @(posedge clk) if (st_en) bmem[st] <= result;
 
@@ -142,51 +144,52 @@ module rv_pe #(
   // constants
   wire [OW-1:0] oa   = capt[OW-1:0];
   wire          o_en = capt[OW] & run;
-  reg [31:0] omem [0:OUT_DEPTH-1];
+  reg [DW-1:0] omem [0:OUT_DEPTH-1];
   initial if (OUT_FILE != "") $readmemh(OUT_FILE, omem);
   always @(posedge clk) if (o_en) omem[oa] <= result;
   assign out_data = omem[out_addr];
 endmodule
 
-// One write port's multiplexer: y = 0 for sel = 0 or sel > N, else the 32-bit word sel - 1 of
+// One write port's multiplexer: y = 0 for sel = 0 or sel > N, else the DW-bit word sel - 1 of
 // `sources` (a crossbar port has N = 2 NPE sources, a specialised one its routes). Written as a
 // balanced tree of 2:1 multiplexers on the bits of sel - 1 (level k decides on bit k) over 2^SW
-// leaves, gated by `valid`, so that synthesis sees 32 (2^SW - 1) multiplexers that it packs
+// leaves, gated by `valid`, so that synthesis sees DW (2^SW - 1) multiplexers that it packs
 // four data inputs to a LUT6, and not a variable shift of the whole bus (the form
-// `sources[32*(sel-1) +: 32]`, which Yosys maps as a barrel shifter first: its time exploded
+// `sources[DW*(sel-1) +: DW]`, which Yosys maps as a barrel shifter first: its time exploded
 // beyond 4 + 4 PEs). The crossbar's ports share one module (parameters N and SW only): a
 // hierarchical synthesis maps it once.
 module rv_mux #(
     parameter integer N = 4,
-    parameter integer SW = 3
+    parameter integer SW = 3,
+    parameter integer DW = 32
 ) (
-    input  wire [32*N-1:0] sources,
+    input  wire [DW*N-1:0] sources,
     input  wire [SW-1:0]   sel,
-    output wire [31:0]     y
+    output wire [DW-1:0]   y
 );
   localparam integer L = 1 << SW;
   wire [SW-1:0] idx = sel - 1'b1;
   wire valid = sel != 0 && sel <= N;
   // level k holds L >> k words; level 0 are the leaves (source j at leaf j, zeros beyond N)
-  wire [32*L-1:0] lv [0:SW];
+  wire [DW*L-1:0] lv [0:SW];
   genvar k, j;
   generate
     for (j = 0; j < L; j = j + 1) begin : g_leaf
       if (j < N) begin : g_src
-        assign lv[0][32*j +: 32] = sources[32*j +: 32];
+        assign lv[0][DW*j +: DW] = sources[DW*j +: DW];
       end else begin : g_zero
-        assign lv[0][32*j +: 32] = 32'h0;
+        assign lv[0][DW*j +: DW] = {DW{1'b0}};
       end
     end
     for (k = 0; k < SW; k = k + 1) begin : g_level
       for (j = 0; j < (L >> (k + 1)); j = j + 1) begin : g_mux
-        assign lv[k+1][32*j +: 32] = idx[k] ? lv[k][32*(2*j+1) +: 32] : lv[k][32*(2*j) +: 32];
+        assign lv[k+1][DW*j +: DW] = idx[k] ? lv[k][DW*(2*j+1) +: DW] : lv[k][DW*(2*j) +: DW];
       end
       // the upper words of a level are unused: tie them off
-      assign lv[k+1][32*L-1:32*(L >> (k + 1))] = {(32*L - 32*(L >> (k + 1))){1'b0}};
+      assign lv[k+1][DW*L-1:DW*(L >> (k + 1))] = {(DW*L - DW*(L >> (k + 1))){1'b0}};
     end
   endgenerate
-  assign y = valid ? lv[SW][31:0] : 32'h0;
+  assign y = valid ? lv[SW][DW-1:0] : {DW{1'b0}};
 endmodule
 
 // Program counter, start/done. `fetch` is the cycle whose words the ROMs register at the next

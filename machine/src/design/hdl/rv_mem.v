@@ -22,27 +22,28 @@ module rv_rom #(
   always @(posedge clk) q <= (addr < DEPTH) ? mem[addr] : {WIDTH{1'b0}};
 endmodule
 
-// PE memory: binary32 words, two write ports and two read ports per cycle (the seed's
+// PE memory: DW-bit words (binary32, or the fixed-point PEs' word), two write ports and two read ports per cycle (the seed's
 // double-pumped M10K), write-first: reads of a clock see the writes of the same clock.
 // `host_*` writes a word while the design is idle (to change inputs between runs).
 module rv_pe_mem #(
     parameter integer AW = 11,
     parameter integer DEPTH = 1,
+    parameter integer DW = 32,
     parameter FILE = ""
 ) (
     input  wire          clk,
     input  wire          we0,
     input  wire [AW-1:0] wa0,
-    input  wire [31:0]   wd0,
+    input  wire [DW-1:0] wd0,
     input  wire          we1,
     input  wire [AW-1:0] wa1,
-    input  wire [31:0]   wd1,
+    input  wire [DW-1:0] wd1,
     input  wire [AW-1:0] ra,
     input  wire [AW-1:0] rb,
-    output reg  [31:0]   qa,
-    output reg  [31:0]   qb
+    output reg  [DW-1:0] qa,
+    output reg  [DW-1:0] qb
 );
-  reg [31:0] mem [0:DEPTH-1];
+  reg [DW-1:0] mem [0:DEPTH-1];
   initial begin
     if (FILE != "") $readmemh(FILE, mem);
     qa = 0;
@@ -67,26 +68,27 @@ endmodule
 module rv_pe_mem_lvt #(
     parameter integer AW = 11,
     parameter integer DEPTH = 1,
+    parameter integer DW = 32,
     parameter FILE = ""
 ) (
     input  wire          clk,
     input  wire          we0,
     input  wire [AW-1:0] wa0,
-    input  wire [31:0]   wd0,
+    input  wire [DW-1:0] wd0,
     input  wire          we1,
     input  wire [AW-1:0] wa1,
-    input  wire [31:0]   wd1,
+    input  wire [DW-1:0] wd1,
     input  wire [AW-1:0] ra,
     input  wire [AW-1:0] rb,
-    output wire [31:0]   qa,
-    output wire [31:0]   qb
+    output wire [DW-1:0] qa,
+    output wire [DW-1:0] qb
 );
-  reg [31:0] m0a [0:DEPTH-1];
-  reg [31:0] m0b [0:DEPTH-1];
-  reg [31:0] m1a [0:DEPTH-1];
-  reg [31:0] m1b [0:DEPTH-1];
+  reg [DW-1:0] m0a [0:DEPTH-1];
+  reg [DW-1:0] m0b [0:DEPTH-1];
+  reg [DW-1:0] m1a [0:DEPTH-1];
+  reg [DW-1:0] m1b [0:DEPTH-1];
   reg        lvt [0:DEPTH-1];
-  reg [31:0] r0a, r0b, r1a, r1b, fwd_a, fwd_b;
+  reg [DW-1:0] r0a, r0b, r1a, r1b, fwd_a, fwd_b;
   reg        live_a, live_b, by_a, by_b;
   integer i;
   initial begin

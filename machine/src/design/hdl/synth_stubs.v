@@ -14,14 +14,14 @@ module fp_mul #(parameter integer LATENCY = 5) (
 endmodule
 
 (* blackbox *)
-module fix_add_sub #(parameter integer LATENCY = 2) (
-    input wire clk, input wire [31:0] a, input wire [31:0] b, input wire sub, input wire [13:0] sh,
-    output wire [31:0] y);
+module fix_add_sub #(parameter integer LATENCY = 2, parameter integer DW = 32, parameter integer KW = 64) (
+    input wire clk, input wire [DW-1:0] a, input wire [DW-1:0] b, input wire sub, input wire [13:0] sh,
+    output wire [DW-1:0] y);
 endmodule
 
 (* blackbox *)
-module fix_mul #(parameter integer LATENCY = 3) (
-    input wire clk, input wire [31:0] a, input wire [31:0] b, input wire [13:0] sh, output wire [31:0] y);
+module fix_mul #(parameter integer LATENCY = 3, parameter integer DW = 32, parameter integer KW = 64) (
+    input wire clk, input wire [DW-1:0] a, input wire [DW-1:0] b, input wire [13:0] sh, output wire [DW-1:0] y);
 endmodule
 
 (* blackbox *)
@@ -31,13 +31,15 @@ module rv_rom #(parameter integer WIDTH = 8, parameter integer DEPTH = 1, parame
 endmodule
 
 (* blackbox *)
-module rv_pe_mem #(parameter integer AW = 11, parameter integer DEPTH = 1, parameter FILE = "") (
-    input wire clk, input wire we0, input wire [AW-1:0] wa0, input wire [31:0] wd0,
-    input wire we1, input wire [AW-1:0] wa1, input wire [31:0] wd1,
-    input wire [AW-1:0] ra, input wire [AW-1:0] rb, output wire [31:0] qa, output wire [31:0] qb);
+module rv_pe_mem #(parameter integer AW = 11, parameter integer DEPTH = 1, parameter integer DW = 32,
+    parameter FILE = "") (
+    input wire clk, input wire we0, input wire [AW-1:0] wa0, input wire [DW-1:0] wd0,
+    input wire we1, input wire [AW-1:0] wa1, input wire [DW-1:0] wd1,
+    input wire [AW-1:0] ra, input wire [AW-1:0] rb, output wire [DW-1:0] qa, output wire [DW-1:0] qb);
 endmodule
-module rv_pe_mem_lvt #(parameter integer AW = 11, parameter integer DEPTH = 1, parameter FILE = "") (
-    input wire clk, input wire we0, input wire [AW-1:0] wa0, input wire [31:0] wd0,
-    input wire we1, input wire [AW-1:0] wa1, input wire [31:0] wd1,
-    input wire [AW-1:0] ra, input wire [AW-1:0] rb, output wire [31:0] qa, output wire [31:0] qb);
+module rv_pe_mem_lvt #(parameter integer AW = 11, parameter integer DEPTH = 1, parameter integer DW = 32,
+    parameter FILE = "") (
+    input wire clk, input wire we0, input wire [AW-1:0] wa0, input wire [DW-1:0] wd0,
+    input wire we1, input wire [AW-1:0] wa1, input wire [DW-1:0] wd1,
+    input wire [AW-1:0] ra, input wire [AW-1:0] rb, output wire [DW-1:0] qa, output wire [DW-1:0] qb);
 endmodule
