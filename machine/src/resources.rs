@@ -14,16 +14,17 @@
 //!   `crossbar_alm · n_pe · writes · 2n_pe + pe_memory_alm · n_pe + control_alm +
 //!   output_word_alm · output words` (a specialised interconnect, [`crate::design::routes`]:
 //!   `crossbar_alm` times its multiplexer inputs, [`Routes::mux_inputs`], in place of the first
-//!   term), the last term the output memories (32-bit registers:
-//!   16 ALM a word on the DE10-Nano, the slope Yosys measures per PE: 16.0 ALM per word over
-//!   the Segway's 4 + 4 PEs holding 1 to 33 output words each). With fixed-point PEs of
-//!   narrower words (`word_bits` < 32, issue 49) the multiplexer and output-word terms take
-//!   `word_bits / 32` of those costs.
+//!   term). The last term is 0 on the built-in targets: the output memories are block RAM
+//!   (`rv_out_mem`, counted with the memories below; they were 32-bit registers with an
+//!   asynchronous read multiplexer, 16 ALM a word on the DE10-Nano, until issue 49 — on the
+//!   Jeep's `dirdyna` at 20 + 20 PEs, Yosys' logic fell from 24,246 to 21,393 ALM). With
+//!   fixed-point PEs of narrower words (`word_bits` < 32, issue 49) the multiplexer and
+//!   output-word terms take `word_bits / 32` of those costs.
 //! - **FP units**: the target's per-unit costs (seed §1.3.1 / Table 1.4: ADD PE 360 ALM, 2 DSP;
 //!   MULTI PE 100 ALM, 3 DSP) times the PEs of each type; fixed-point PEs per PE, by their word
 //!   and intermediate widths ([`fixed_unit`]).
-//! - **Memories**: every PE memory, instruction, crossbar, buffer-instruction and capture memory
-//!   as M10K blocks from its size ([`crate::target::m10k_blocks`] by the block configurations,
+//! - **Memories**: every PE memory, instruction, crossbar, buffer-instruction and capture memory,
+//!   and the output memory of each PE that holds outputs, as M10K blocks from its size ([`crate::target::m10k_blocks`] by the block configurations,
 //!   [`M10kFit::Configurations`]; PE memories true dual-port).
 //!
 //! ## Hierarchical synthesis
@@ -238,6 +239,10 @@ pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
     };
     for p in &d.pes {
         let fixed = p.fix.iter().map(|i| (i, false, 1));
+        // the output memory (`rv_out_mem`) of a PE that holds outputs: one simple dual-port
+        // memory (a PE without outputs has a constant one, which synthesis removes)
+        let holds = d.outputs.iter().any(|o| o.slot == p.slot) || d.output_loads.iter().any(|l| l.slot == p.slot);
+        let out = holds.then_some((&p.out, false, 1));
         let all = [
             (&p.instr, false, 1),
             (&p.xbar, false, 1),
@@ -245,7 +250,7 @@ pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
             (&p.capt, false, 1),
             (&p.data, pe_tdp, banks),
         ];
-        for (img, true_dual_port, banks) in all.into_iter().chain(fixed) {
+        for (img, true_dual_port, banks) in all.into_iter().chain(fixed).chain(out) {
             let words = img.words.len().max(1) as u64;
             v.push(MemoryCost {
                 name: img.name.clone(),
@@ -399,10 +404,8 @@ pub fn yosys_cells_with(d: &Design, how: Synthesis) -> Result<Option<YosysCells>
              synth_intel_alm -family cyclonev{map_flag} -top robovec_top\n{after_map}tee -q -o stat.json stat -json\n"
         ),
     ));
-    // the output memories are registers initialised from their images
-    let outs: Vec<(String, String)> = d.pes.iter().map(|p| (format!("{}.hex", p.out.name), p.out.to_hex())).collect();
-    for (n, t) in files.iter().map(|(n, t)| (n.to_string(), t)).chain(outs.iter().map(|(n, t)| (n.clone(), t))) {
-        if std::fs::write(dir.0.join(&n), t).is_err() {
+    for (n, t) in &files {
+        if std::fs::write(dir.0.join(n), t).is_err() {
             return Ok(None);
         }
     }

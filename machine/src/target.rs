@@ -34,7 +34,7 @@
 //! | `datapath.convert_alm` | 100 ALM per conversion | estimate: a conversion between fixed and floating point (or binary32 and binary64) is a leading-zero count and a barrel shift of the word, of the order of the seed's MULTI PE logic (100 ALM) |
 //! | `fix_pe.add` | latency 4 cycles = 2 stages + 2; 602 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`) in two pipeline stages, the exact sum registered before its rounding (the issue's "1–2 stages"; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` by [`crate::resources`]' packing bound (199 LUT6, 806 smaller LUTs and carry bits): its two barrel shifters (any alignment, either rounding direction) cost more than the seed's hardened binary32 adder (360 ALM) |
 //! | `fix_pe.mul` | latency 5 cycles = 3 stages + 2; 415 ALM, 2 DSP | a 32 × 32 signed product as four registered 16 × 16 partial products (four 18 × 19 multipliers, two per Cyclone V variable-precision block: 2 blocks), their sum, and the rounding shift; ALM from Yosys as above at `LATENCY = 3` (85 LUT6, 660 smaller LUTs and carry bits; 4 `MISTRAL_MUL18X18`) |
-//! | `output_word_alm` | 16 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are 32-bit registers read asynchronously, 32 registers at two per ALM = 16 ALM a word, which is also the slope Yosys measures per PE ([`crate::resources`]). Used only where the output words are known (the FPGA back end's estimate); optional in a JSON target (default 0: not counted) |
+//! | `output_word_alm` | 0 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are block RAM with a registered read port (`rv_out_mem`), counted as M10K blocks, so they take no logic a word. (Until issue 49 they were 32-bit registers read asynchronously: 16 ALM a word, the slope Yosys measured per PE, [`crate::resources`].) The key stays for a design whose output words cost logic; optional in a JSON target (default 0) |
 //!
 //!
 //! The `datapath` record (issue 48 item 5, `precision<target=fpga>`) costs a datapath of one
@@ -73,7 +73,7 @@
 //! | `fix_pe.add`, `fix_pe.mul` | 2 106 LUT4; 1 488 LUT4 + 4 MULT18X18D | the same of `fix_add_sub` (2) and `fix_mul` (3) with their shifts as free inputs: an upper bound, since in a whole design the shift memory is a ROM and Yosys keeps only the shifts it holds (the 1 + 1 PE pendulum places in 2 316 LUT4 in all) |
 //! | `pe_memory_alm`, `pe_word_alm` | 314 LUT4 + 4.1 LUT4 per word | Yosys of `rv_pe_mem_lvt` at 64, 512 and 1 024 words (575, 2 403, 4 445 LUT4): the bypass and bank choice, and the live-value table (a bit a word, two write and two read ports) in logic |
 //! | `crossbar_alm` | 60 LUT4 per multiplexer input | Yosys of `rv_mux` with 17 sources (1 011 LUT4 + 5 CCU2C: 60 a source; 9 sources: 44) |
-//! | `output_word_alm` | 16 LUT4 | estimate: the DE10-Nano's per-word figure (32 registers and their read multiplexer) |
+//! | `output_word_alm` | 0 | the DE10-Nano's: output memories are block RAM (EBR) |
 //! | `control_alm` | 469 | the DE10-Nano's |
 //! | `datapath` | 9 × 9 (two a block), 18 × 18; 1 LUT4 a bit of adder; binary64 units 3 500 LUT4 (add), 2 500 LUT4 + 9 MULT18X18D (mul); conversion 200 LUT4 | the multiplier modes of the sysDSP slice (FPGA-DS-02012, "sysDSP"); a CCU2C adds two bits in two LUT4 slots; the binary64 and conversion figures are estimates scaled from the binary32 units above (no measurement) |
 //!
@@ -105,7 +105,7 @@
 //!   "pe_memory_alm": 3,
 //!   "crossbar_alm": 8.125,
 //!   "control_alm": 469,
-//!   "output_word_alm": 16,
+//!   "output_word_alm": 0,
 //!   "datapath": {
 //!     "dsp_modes": [{ "a": 9, "b": 9, "per_block": 3 }, { "a": 18, "b": 19, "per_block": 2 },
 //!                   { "a": 27, "b": 27, "per_block": 1 }],
@@ -610,7 +610,7 @@ impl Target {
             pe_word_alm: 0.0,
             crossbar_alm: 8.125,
             control_alm: 469.0,
-            output_word_alm: 16.0,
+            output_word_alm: 0.0,
             datapath: Datapath::default(),
             fix_pe: FixPe::default(),
             pnr: None,

@@ -342,8 +342,8 @@ impl Design {
     }
 
     /// The generated top `robovec_top` (synthesizable Verilog-2005): control, one `rv_pe` per
-    /// PE, the crossbar bus and an output read port (`out_pe`, `out_addr` → `out_data`, read
-    /// after `done`). `dir` prefixes the image file names (`""`: the simulator's working folder).
+    /// PE, the crossbar bus and an output read port (`out_pe`, `out_addr` → `out_data` one clock
+    /// later, read after `done`). `dir` prefixes the image file names (`""`: the simulator's working folder).
     pub fn top(&self, dir: &str) -> String {
         let w = self.widths;
         let n = self.n_pe();
@@ -359,7 +359,8 @@ impl Design {
             self.interconnect().as_str()
         );
         s += "// Ports: start (one clock high while idle) runs the program once; done rises after its last\n";
-        s += "// cycle; the outputs are then read through out_pe / out_addr (manifest.json's output map).\n";
+        s += "// cycle; the outputs are then read through out_pe / out_addr (manifest.json's output map):\n";
+        s += "// out_data is the word they named at the previous clock edge (block-RAM output memories).\n";
         s += "// host_* is not provided: new inputs are written into the PE memory images (load map).\n";
         let _ = writeln!(
             s,
@@ -429,7 +430,13 @@ impl Design {
                 k = p.slot,
             );
         }
-        s += "  always @* begin\n    case (out_pe)\n";
+        // the output memories read in a clock (block RAM): the PE select is registered with them
+        let _ = writeln!(
+            s,
+            "  reg [{}:0] out_pe_q;\n  initial out_pe_q = 0;\n  always @(posedge clk) out_pe_q <= out_pe;",
+            self.pe_bits() - 1
+        );
+        s += "  always @* begin\n    case (out_pe_q)\n";
         // a narrower word is read out sign-extended to 32 bits
         let extend = |k: usize| match dw {
             32 => format!("out{k}"),
@@ -458,7 +465,7 @@ impl Design {
         s += "  always #5 clk = ~clk;\n  always @(posedge clk) if (busy) clocks = clocks + 1;\n";
         s += "  initial begin\n    @(negedge clk); start = 1; @(negedge clk); start = 0;\n    while (!done) @(negedge clk);\n";
         for p in &self.pes {
-            let _ = writeln!(s, "    $writememh(\"captured{}.hex\", dut.{}.omem);", p.slot, p.pe);
+            let _ = writeln!(s, "    $writememh(\"captured{}.hex\", dut.{}.u_out.mem);", p.slot, p.pe);
         }
         s += "    $display(\"robovec-done %0d %0d\", clocks - 1, clocks);\n    $finish;\n  end\n";
         let _ = writeln!(

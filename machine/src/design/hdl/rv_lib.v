@@ -56,7 +56,7 @@ module rv_pe #(
     input  wire [DW*N1-1:0]     src1,      // port 1's sources
     output reg  [DW-1:0]        result,    // the result arriving this cycle
     output wire [DW-1:0]        buf_read,  // this cycle's buffer read
-    input  wire [OW-1:0]        out_addr,  // output memory read port
+    input  wire [OW-1:0]        out_addr,  // output memory read port (its word on out_data a clock later)
     output wire [DW-1:0]        out_data
 );
   localparam integer XW = SW0 + SW1;
@@ -140,14 +140,11 @@ module rv_pe #(
   assign buf_read = (st_en && st == rd) ? result : bmem[rd];
   always @(posedge clk) if (st_en) bmem[st] <= result;
 
-  // output memory: captures the arriving result; initial contents: outputs that are inputs or
-  // constants
+  // output memory (rv_mem.v): captures the arriving result; read by the host after `done`
   wire [OW-1:0] oa   = capt[OW-1:0];
   wire          o_en = capt[OW] & run;
-  reg [DW-1:0] omem [0:OUT_DEPTH-1];
-  initial if (OUT_FILE != "") $readmemh(OUT_FILE, omem);
-  always @(posedge clk) if (o_en) omem[oa] <= result;
-  assign out_data = omem[out_addr];
+  rv_out_mem #(.DW(DW), .DEPTH(OUT_DEPTH), .AW(OW), .FILE(OUT_FILE)) u_out (
+      .clk(clk), .we(o_en), .wa(oa), .wd(result), .ra(out_addr), .q(out_data));
 endmodule
 
 // One write port's multiplexer: y = 0 for sel = 0 or sel > N, else the DW-bit word sel - 1 of

@@ -129,3 +129,31 @@ module rv_pe_mem_lvt #(
   assign qa = by_a ? fwd_a : live_a ? r1a : r0a;
   assign qb = by_b ? fwd_b : live_b ? r1b : r0b;
 endmodule
+
+// Output memory: captures the arriving results of the PE's outputs (one write port) and gives
+// them to the host after `done` through a registered read port (the word at `ra` one clock
+// later): a simple dual-port block RAM (M10K, EBR) instead of registers and a read multiplexer
+// in logic (issue 49). Initial contents: outputs that are inputs or constants.
+module rv_out_mem #(
+    parameter integer DW = 32,
+    parameter integer DEPTH = 1,
+    parameter integer AW = 1,
+    parameter FILE = ""
+) (
+    input  wire          clk,
+    input  wire          we,
+    input  wire [AW-1:0] wa,
+    input  wire [DW-1:0] wd,
+    input  wire [AW-1:0] ra,
+    output reg  [DW-1:0] q
+);
+  reg [DW-1:0] mem [0:DEPTH-1];
+  initial begin
+    if (FILE != "") $readmemh(FILE, mem);
+    q = 0;
+  end
+  always @(posedge clk) begin
+    if (we) mem[wa] <= wd;
+    q <= mem[ra];
+  end
+endmodule

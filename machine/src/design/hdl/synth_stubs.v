@@ -43,3 +43,9 @@ module rv_pe_mem_lvt #(parameter integer AW = 11, parameter integer DEPTH = 1, p
     input wire we1, input wire [AW-1:0] wa1, input wire [DW-1:0] wd1,
     input wire [AW-1:0] ra, input wire [AW-1:0] rb, output wire [DW-1:0] qa, output wire [DW-1:0] qb);
 endmodule
+(* blackbox *)
+module rv_out_mem #(parameter integer DW = 32, parameter integer DEPTH = 1, parameter integer AW = 1,
+    parameter FILE = "") (
+    input wire clk, input wire we, input wire [AW-1:0] wa, input wire [DW-1:0] wd,
+    input wire [AW-1:0] ra, output wire [DW-1:0] q);
+endmodule
