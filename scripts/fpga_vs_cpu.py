@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Issue 49's proof table: robovec's FPGA designs against robovec's own C, side by side in one run.
 
-    scripts/fpga_vs_cpu.py [--pes=8,12,14,16] [--states=1,4] [--pnr] [--yosys] [MODEL...]
+    scripts/fpga_vs_cpu.py [--pes=8,16,22,18+26] [--states=1,4] [--pnr] [--yosys] [MODEL...]
 
 For each model (a corpus `dirdyna` named by its file's prefix: `jeep`, `tricycle`, `mazda_mx5`,
 `coman_longarms`, `walkman`; default: every corpus `dirdyna` of at least 5k ops, the issue's
@@ -9,14 +9,19 @@ set), over the *generous* domain (`q` +-3.2 rad, `qd`, `qdd` +-10, forces +-100,
 points; docs/accuracy.md):
 
 1. the binary32 certified bound of every output (`error-bound<format=f32>`) becomes the budget
-   of `precision<budget=FILE;target=mcu>`, whose fixed-point formats the FPGA runs (fixed-point
-   PEs, issue 49 item 1): the design is no less accurate than a binary32 one, and the table
-   gives the largest ratio of an output's certified bound to its budget (<= 1: met);
+   of `precision<budget=FILE;target=mcu;word=W>`, whose fixed-point formats the FPGA runs
+   (fixed-point PEs, issue 49 item 1): the design is no less accurate than a binary32 one, and
+   the table gives the largest ratio of an output's certified bound to its budget (<= 1: met).
+   W is, per target, the narrowest word from the one whose products take one DSP multiplier
+   (27 bits on the DE10-Nano's Cyclone V, 18 on the ECP5) up to 32 for which every value gets a
+   fixed-point format (the PE array has no floating-point unit beside them);
 2. for each target (`de10-nano` at its declared 120 MHz, `ecp5-85f` at 80 MHz or, with `--pnr`,
-   at the Fmax nextpnr measures), each N of `--pes` and each K of `--states`
-   (`interleave<states=K>`, issue 49 item 3), the design with the specialised interconnect:
-   cycles, us (latency), ns per state, logic / block RAM / DSP and fit (the analytic estimate;
-   `--yosys`: Yosys' count on the DE10-Nano; `--pnr`: nextpnr's on the ECP5);
+   at the Fmax nextpnr measures), each configuration of `--pes` (N: N ADD + N MULTI PEs; A+M:
+   A ADD and M MULTI PEs) and each K of `--states` (`interleave<states=K>`, issue 49 item 3),
+   the design placed for the fewest interconnect routes (`place<select=routes>`) with the
+   specialised interconnect: cycles, us (latency), ns per state, logic / block RAM / DSP and fit
+   (the analytic estimate; `--yosys`: Yosys' count on the DE10-Nano; `--pnr`: nextpnr's on the
+   ECP5);
 3. robovec's fastest C of the same model (`atomise,cse,zero-removal,cse,contract,schedule-cpu`,
    `codegen<c;abi=plain;trig=inline>`, binary64, `-O3 -march=native`), one state per call and
    `batch=4`, timed by `-report-dir` on this machine in the same run (src/cpu_time.rs: median
@@ -45,6 +50,14 @@ MODELS = {
 }
 # The fixed-point PEs' latencies (the target's fix_pe) for the rewrites that balance for them.
 PRE = "atomise,cse,zero-removal,balance<lat-add=4;lat-mul=5>,cse,recurrence<pe=16;lat-add=4;lat-mul=5>,cse"
+# Per target: the widest word whose product takes one DSP multiplier (docs/fpga.md "Narrow words").
+ONE_BLOCK_WORD = {"de10-nano": 27, "ecp5-85f": 18}
+
+
+def config(text):
+    """`N` (N ADD + N MULTI PEs) or `A+M` as (add, mul)."""
+    a, _, m = text.partition("+")
+    return (int(a), int(m or a))
 CPU = "atomise,cse,zero-removal,cse,contract,schedule-cpu,sweep<pe=1>"
 
 
@@ -92,10 +105,10 @@ def report(args, work, name, env=None):
 
 
 def main():
-    pes, states, pnr, yosys, models, json_out = [8, 12, 14, 16], [1], False, False, [], None
+    pes, states, pnr, yosys, models, json_out = [(8, 8), (16, 16), (22, 22), (18, 26)], [1], False, False, [], None
     for a in sys.argv[1:]:
         if a.startswith("--pes="):
-            pes = [int(x) for x in a[6:].split(",")]
+            pes = [config(x) for x in a[6:].split(",")]
         elif a.startswith("--states="):
             states = [int(x) for x in a[9:].split(",")]
         elif a == "--pnr":
@@ -124,27 +137,47 @@ def main():
         budget = os.path.join(work, "budget.json")
         with open(budget, "w") as f:
             json.dump({k: {"abs": v["abs"]} for k, v in eb["outputs"].items() if v["abs"] is not None}, f)
-        prec = report([path, f"-ranges={ranges}", f"-passes={PRE},precision<budget={budget};target=mcu>"], work, "fix")
-        p = prec["precision"]
-        worst = max(o["bound"] / o["budget"] for o in p["outputs"].values() if o.get("budget"))
-        formats = ", ".join(sorted({k.split(",")[0] + ",*>" for k in p["formats"]}))
+        # the narrowest word, from the target's one-DSP width, then 27 up to 32 bits (each tried once)
+        words, all_fixed = {}, {}
+        for target, first in ONE_BLOCK_WORD.items():
+            for w in [first] + [x for x in range(27, 33) if x > first]:
+                if w not in all_fixed:
+                    prec = report(
+                        [path, f"-ranges={ranges}", f"-passes={PRE},precision<budget={budget};target=mcu;word={w}>"],
+                        work,
+                        f"fix{w}",
+                    )
+                    all_fixed[w] = all(k.startswith("fix<") for k in prec["precision"]["formats"])
+                if all_fixed[w]:
+                    words[target] = w
+                    break
+            else:
+                sys.exit(f"{model}: no fixed-point word up to 32 bits meets binary32's bound")
         cpu_dir = os.path.join(work, "cpu")
         run([path, f"-ranges={ranges}", f"-passes={CPU}", f"-report-dir={cpu_dir}", "-o", "/dev/null"])
         with open(os.path.join(cpu_dir, "report.json")) as f:
             cpu = json.load(f)["cpu"]
         one, batched = cpu["one_state_us"] * 1000, cpu["batched_us"] * 1000
         for target in ["de10-nano", "ecp5-85f"]:
+            w = words[target]
+            with open(os.path.join(work, f"fix{w}.json")) as f:
+                prec = json.load(f)
+            p = prec["precision"]
+            worst = max(o["bound"] / o["budget"] for o in p["outputs"].values() if o.get("budget"))
+            formats = ", ".join(sorted({k.split(",")[0] + ",*>" for k in p["formats"]}))
             resources = "estimate"
             if target == "ecp5-85f" and pnr:
                 resources = "pnr"
             if target == "de10-nano" and yosys:
                 resources = "yosys"
             for k in states:
-                for n in pes:
+                for na, nm in pes:
+                    n = f"{na}" if na == nm else f"{na}+{nm}"
                     inter = f"interleave<states={k}>," if k > 1 else ""
                     out = os.path.join(work, f"{target}-{n}-{k}")
                     passes = (
-                        f"{PRE},precision<budget={budget};target=mcu>,{inter}place<pe={n}>,"
+                        f"{PRE},precision<budget={budget};target=mcu;word={w}>,{inter}"
+                        f"place<add={na};mul={nm};select=routes>,"
                         f"codegen<fpga;out={out};resources={resources};interconnect=specialised;format=hex>"
                     )
                     fp = report([path, f"-target={target}", f"-ranges={ranges}", f"-passes={passes}"], work, "fpga", env)

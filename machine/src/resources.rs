@@ -464,11 +464,7 @@ pub fn parse_stat(json: &str) -> Result<YosysCells, String> {
 pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32) -> UnitCost {
     let unit = if is_mul { m.fix_mul } else { m.fix_add };
     let alm = (unit.alm as f64 * f64::from(kw.min(64)) / 64.0).ceil() as u64;
-    let one_block = match m.family {
-        Family::CycloneV => 27,
-        Family::Ecp5 => 18,
-    };
-    let dsp = if is_mul && unit.dsp > 0 && dw <= one_block { 1 } else { unit.dsp };
+    let dsp = if is_mul && unit.dsp > 0 && dw <= m.family.one_multiplier_word() { 1 } else { unit.dsp };
     UnitCost { alm, dsp, m10k: unit.m10k }
 }
 

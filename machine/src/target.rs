@@ -222,6 +222,17 @@ impl Family {
         }
     }
 
+    /// The widest fixed-point word whose product is one DSP multiplier of the family, bits:
+    /// the Cyclone V's variable-precision block in 27 × 27 mode (Intel, *Cyclone V Device
+    /// Overview*; Yosys maps it to one `MISTRAL_MUL27X27`), the ECP5's MULT18X18D (FPGA-DS-02012,
+    /// "sysDSP"). Wider words take the target's `fix_pe.mul` (partial products).
+    pub const fn one_multiplier_word(self) -> u32 {
+        match self {
+            Family::CycloneV => 27,
+            Family::Ecp5 => 18,
+        }
+    }
+
     /// How its designs build a PE memory.
     pub const fn pe_memory(self) -> PeMemory {
         match self {
@@ -332,7 +343,8 @@ pub struct FixUnit {
 pub struct FixPe {
     /// The ADD PE's aligned adder/subtractor with its rounding (`hdl/fix_units.v`, `fix_add_sub`).
     pub add: FixUnit,
-    /// The MULTI PE's 32 × 32 multiplier with its rounding (`fix_mul`).
+    /// The MULTI PE's 32 × 32 multiplier with its rounding (`fix_mul`; narrower words:
+    /// [`FixPe::latencies_for`] and `resources::fixed_unit`).
     pub mul: FixUnit,
 }
 
@@ -350,6 +362,18 @@ impl FixPe {
     /// The latencies of a fixed-point PE array (`div`, `call`: the ADD PE's; they have no unit).
     pub fn latencies(&self) -> Latencies {
         Latencies { add: self.add.latency, mul: self.mul.latency, div: self.add.latency, call: self.add.latency }
+    }
+
+    /// The latencies of a fixed-point PE array of `word_bits`-bit words on `family`: a product
+    /// that is one DSP multiplier ([`Family::one_multiplier_word`]) has no partial products to
+    /// sum, so the MULTI PE takes one stage fewer than `mul.latency` (the product, then its
+    /// rounding: the ADD PE's two stages; `hdl/fix_units.v`), and never under 3 cycles.
+    pub fn latencies_for(&self, family: Family, word_bits: u32) -> Latencies {
+        let mut l = self.latencies();
+        if word_bits <= family.one_multiplier_word() {
+            l.mul = l.mul.saturating_sub(1).max(3);
+        }
+        l
     }
 }
 

@@ -277,17 +277,18 @@ pub struct PassContext {
 
 /// The latencies function `f` runs with on `target`'s PE array (issue 49): `pipeline` (the
 /// pass's, [`PassContext::latencies_for`]) for binary32 PEs; for a function on fixed-point PEs
-/// ([`robovec_machine::program::fixed::pe_kind`]) the target's `fix_pe` latencies with those
-/// `given` on the pass applied. `asap-alap` and `place` time each function with it.
+/// ([`robovec_machine::program::fixed::pe_kind`]) the target's `fix_pe` latencies for its word
+/// ([`robovec_machine::target::FixPe::latencies_for`]: a MULTI PE one stage shorter when a
+/// product is one DSP multiplier) with those `given` on the pass applied. `asap-alap` and `place` time each function with it.
 pub fn function_latencies(
     target: &Target,
     f: &robovec_ir::Function,
     pipeline: Latencies,
     given: &LatencyOverride,
 ) -> Latencies {
-    use robovec_machine::program::fixed::{pe_kind, PeKind};
+    use robovec_machine::program::fixed::{pe_kind, word_bits, PeKind};
     match pe_kind(f) {
-        Ok(PeKind::Fixed) => given.apply(&target.fix_pe.latencies()),
+        Ok(PeKind::Fixed) => given.apply(&target.fix_pe.latencies_for(target.family, word_bits(f))),
         _ => pipeline,
     }
 }

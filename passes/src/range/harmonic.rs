@@ -724,7 +724,6 @@ fn put_own(atoms: &mut Vec<Atom>, own: u32, e: f64) {
 }
 
 impl HarmonicSweep<'_> {
-
     /// The enclosures of `∂out/∂z` for every value `z` (by value index: `sup` its magnitude,
     /// 0 where `out` does not depend on `z`) and, per operand read of each op, `sup|∂out/∂z| ·
     /// max|∂z/∂operand|` (what a conversion at that read weighs); `None` when a value on the
