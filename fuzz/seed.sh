@@ -12,8 +12,10 @@ cd "$(dirname "$0")"
 SHARED=${SHARED:-../../shared/corpus/robotran}
 MAX=${MAX:-8192}
 test -d "$SHARED" || { echo "no Robotran corpus at $SHARED (set SHARED=...)" >&2; exit 1; }
-mkdir -p corpus/parse_text corpus/roundtrip corpus/front_c corpus/front_matlab corpus/front_python corpus/front_urdf
+mkdir -p corpus/parse_text corpus/roundtrip corpus/front_c corpus/front_matlab corpus/front_python corpus/front_urdf corpus/target_json
 cp ../examples/*/*.urdf corpus/front_urdf/
+# target descriptions: 4 bytes of PE counts, word and flags, then the JSON
+for f in ../examples/targets/*.json; do { printf '\x07\x07\x1a\x01'; cat "$f"; } > "corpus/target_json/$(basename "$f")"; done
 
 for f in "$SHARED"/c/*.c ../examples/*/*.c; do
     b=$(basename "$f" .c)
@@ -33,7 +35,7 @@ cargo build --quiet --release --manifest-path ../Cargo.toml --bin robovec-opt
 BIN=../target/release/robovec-opt
 for f in ../examples/*/*.c "$SHARED"/c/*.c "$SHARED"/matlab/*.m "$SHARED"/python/*.py; do
     [ "$(stat -c %s "$f")" -le 8192 ] || continue
-    for p in "" atomise atomise,asap-alap; do
+    for p in "" atomise atomise,asap-alap "atomise,interleave<states=2>"; do
         out="corpus/parse_text/$(basename "$f").${p:-parsed}.rvir"
         "$BIN" "$f" -passes="$p" -o "$out" 2>/dev/null || rm -f "$out"
     done

@@ -917,6 +917,23 @@ mod tests {
         serde_json::to_string_pretty(&Target::de10_nano()).unwrap()
     }
 
+    /// A MULTI PE whose product is one DSP multiplier (27-bit words on the Cyclone V, 18 on the
+    /// ECP5) is one stage shorter, never under 3 cycles; the ADD PE and wider words keep theirs.
+    #[test]
+    fn one_multiplier_words_shorten_the_multi_pe_by_a_stage() {
+        let de10 = Target::de10_nano();
+        let lat = |t: &Target, w: u32| {
+            let l = t.fix_pe.latencies_for(t.family, w);
+            (l.add, l.mul)
+        };
+        assert_eq!([lat(&de10, 32), lat(&de10, 28), lat(&de10, 27), lat(&de10, 16)], [(4, 5), (4, 5), (4, 4), (4, 4)]);
+        let ecp5 = Target::ecp5_85f();
+        assert_eq!([lat(&ecp5, 27), lat(&ecp5, 19), lat(&ecp5, 18)], [(4, 5), (4, 5), (4, 4)]);
+        let mut short = Target::de10_nano();
+        short.fix_pe.mul.latency = 3;
+        assert_eq!(lat(&short, 20), (4, 3), "one unit stage + 2 is the least");
+    }
+
     #[test]
     fn built_in_round_trips_through_json() {
         let t = Target::from_json("x.json", &de10_json()).unwrap();
