@@ -61,8 +61,14 @@ def config(text):
 CPU = "atomise,cse,zero-removal,cse,contract,schedule-cpu,sweep<pe=1>"
 
 
-def run(args, env=None):
+class Refused(Exception):
+    """robovec-opt refused a configuration (exit 1): its diagnostic's last line."""
+
+
+def run(args, env=None, refusal_ok=False):
     p = subprocess.run([OPT] + args, capture_output=True, text=True, env=env)
+    if p.returncode == 1 and refusal_ok:
+        raise Refused(p.stderr.strip().splitlines()[-1])
     if p.returncode != 0:
         sys.exit(f"robovec-opt {' '.join(args)}\n{p.stderr}")
     return p
@@ -97,9 +103,9 @@ def generous_domain(path, work):
     return out
 
 
-def report(args, work, name, env=None):
+def report(args, work, name, env=None, refusal_ok=False):
     rep = os.path.join(work, name + ".json")
-    run(args + ["-o", "/dev/null", f"-report={rep}"], env)
+    run(args + ["-o", "/dev/null", f"-report={rep}"], env, refusal_ok)
     with open(rep) as f:
         return json.load(f)
 
@@ -128,7 +134,7 @@ def main():
     env = dict(os.environ)
     venv = os.path.join(ROOT, "target/ecp5-venv/bin")
     env["PATH"] = venv + os.pathsep + env.get("PATH", "")
-    rows = []
+    rows, refused = [], []
     for model in models or list(MODELS):
         path = os.path.join(CORPUS, MODELS[model])
         work = tempfile.mkdtemp(prefix=f"fpga-vs-cpu-{model}-")
@@ -180,7 +186,20 @@ def main():
                         f"place<add={na};mul={nm};select=routes>,"
                         f"codegen<fpga;out={out};resources={resources};interconnect=specialised;format=hex>"
                     )
-                    fp = report([path, f"-target={target}", f"-ranges={ranges}", f"-passes={passes}"], work, "fpga", env)
+                    try:
+                        fp = report(
+                            [path, f"-target={target}", f"-ranges={ranges}", f"-passes={passes}"],
+                            work,
+                            "fpga",
+                            env,
+                            refusal_ok=True,
+                        )
+                    except Refused as why:
+                        # a configuration the target cannot hold (a buffer deeper than its
+                        # buffers, ...): a row that says so
+                        refused.append(f"{model} {target} N={n} K={k}: {why}")
+                        print(refused[-1], file=sys.stderr)
+                        continue
                     fp = fp["fpga"]
                     r = fp["resources"]
                     u = r["units"]
@@ -226,6 +245,8 @@ def main():
             f" {'yes' if r['fits'] else 'no'} ({r['resources']}) | {r['cpu_one_ns']:.0f} | {r['cpu_batch4_ns']:.0f} |"
             f" {r['latency_ratio']:.2f} | {r['throughput_ratio']:.2f} | {r['bound_over_budget']:.2g} |"
         )
+    for r in refused:
+        print(f"\nnot built: {r}")
     if json_out:
         with open(json_out, "w") as f:
             json.dump(rows, f, indent=1)
