@@ -522,7 +522,8 @@ fn placing_for_fewer_routes_shrinks_the_specialised_interconnect_and_keeps_the_b
 /// the design's data path is W bits wide (manifest `word_bits`, the PE memory images' words of
 /// ⌈W/4⌉ hex digits, `.DW(W)` on every PE with an intermediate under 64 bits), it simulates in
 /// Icarus to `-eval`'s values exactly, and each MULTI PE's product is one DSP block of the
-/// DE10-Nano (27 × 27 mode) instead of the 32-bit word's two, one pipeline stage shorter.
+/// DE10-Nano (27 × 27 mode) instead of the 32-bit word's two, one pipeline stage shorter; at
+/// 18 bits on the ECP5 (live-value-table PE memories) one MULT18X18D instead of four.
 #[test]
 fn narrow_fixed_point_words_simulate_bit_for_bit_and_take_one_dsp_block_a_product() {
     tool("iverilog");
@@ -532,11 +533,14 @@ fn narrow_fixed_point_words_simulate_bit_for_bit_and_take_one_dsp_block_a_produc
     let point = d.join("point.json");
     std::fs::write(&point, PENDULUM_POINT).unwrap();
     let mut dsp = Vec::new();
-    for word in [32u32, 27, 18] {
-        let dir = d.join(format!("w{word}"));
-        let rep = d.join(format!("w{word}.json"));
+    // the DE10-Nano at 32, 27 and 18 bits; the ECP5 (live-value-table memories) at 18 bits, its
+    // one-MULT18X18D word
+    for (target, word) in [("de10-nano", 32u32), ("de10-nano", 27), ("de10-nano", 18), ("ecp5-85f", 18)] {
+        let dir = d.join(format!("{target}-w{word}"));
+        let rep = d.join(format!("{target}-w{word}.json"));
         let o = opt(&[
             PENDULUM,
+            &format!("-target={target}"),
             &format!("-ranges={}", ranges.display()),
             &format!(
                 "-passes=atomise,cse,precision<budget=1e-3;target=mcu;word={word}>,place<pe=2;restarts=0;search=0>,sim,\
@@ -552,7 +556,8 @@ fn narrow_fixed_point_words_simulate_bit_for_bit_and_take_one_dsp_block_a_produc
             serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
         assert_eq!(man["word_bits"], word, "the widest format is the word");
         // a product that is one DSP block has no partial products to sum: MULTI 4 cycles, not 5
-        let mul = if word <= 27 { 4 } else { 5 };
+        let one_multiplier = if target == "ecp5-85f" { 18 } else { 27 };
+        let mul = if word <= one_multiplier { 4 } else { 5 };
         assert_eq!(man["latency"], serde_json::json!({"add": 4, "mul": mul}), "word={word}");
         let data = std::fs::read_to_string(dir.join("hex/pe0_data.hex")).unwrap();
         assert!(data.lines().all(|l| l.len() == word.div_ceil(4) as usize), "word={word}: {data}");
@@ -574,8 +579,9 @@ fn narrow_fixed_point_words_simulate_bit_for_bit_and_take_one_dsp_block_a_produc
         let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
         dsp.push(r["fpga"]["resources"]["fp_units"]["dsp"].as_u64().unwrap());
     }
-    // two MULTI PEs: 2 blocks each for 32-bit words (four 18 × 19 partial products), 1 at 27 and 18
-    assert_eq!(dsp, [4, 2, 2]);
+    // two MULTI PEs: 2 blocks each for 32-bit words (four 18 × 19 partial products), 1 at 27 and
+    // 18; on the ECP5 one MULT18X18D each at 18 bits
+    assert_eq!(dsp, [4, 2, 2, 2]);
 }
 
 /// The multiplier a narrow word's MULTI PE needs is one DSP block, as Yosys maps it: 27 × 27
