@@ -191,7 +191,8 @@ fn a_budget_file_gives_absolute_budgets_per_output() {
 
 /// `word=W` (issue 49: fixed-point PEs whose products fit one DSP multiplier): `target=mcu`'s
 /// words are then `fix<W,f>` and `error-bound` still proves the budget; a narrower word's bound is
-/// no smaller than a wider one's. `word` with another target, or outside 8..=32, is bad usage.
+/// no smaller than a wider one's; `word` alone selects `target=mcu`. `word` with another target,
+/// or outside 8..=32, is bad usage.
 #[test]
 fn target_mcu_takes_the_fixed_point_word_it_is_given() {
     let dir = crate::common::tmp("precision_word");
@@ -228,6 +229,12 @@ fn target_mcu_takes_the_fixed_point_word_it_is_given() {
         worst.push(w);
     }
     assert!(worst[0] <= worst[1] && worst[1] <= worst[2], "narrower words, larger bounds: {worst:?}");
+    // `word` alone selects target=mcu
+    let o = run("word=24");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["precision"]["target"], "mcu");
+    assert!(r["precision"]["formats"].as_object().unwrap().keys().any(|k| k.starts_with("fix<24,")));
     for bad in ["target=c;word=20", "target=fpga;word=27", "target=mcu;word=40", "target=mcu;word=7"] {
         let o = run(bad);
         assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));

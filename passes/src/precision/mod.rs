@@ -83,16 +83,21 @@ pub const INFO: PassInfo = PassInfo {
                 min: *choose::MCU_WORDS.start(),
                 max: *choose::MCU_WORDS.end(),
             },
-            doc: "target=mcu: the fixed-point word, bits (fix<word,f>); 32 is a microcontroller's register, narrower \
-                  words are for fixed-point PEs whose products fit one DSP multiplier (27 on the Cyclone V, 18 on the \
-                  ECP5; docs/fpga.md)",
+            doc:
+                "target=mcu's fixed-point word, bits (fix<word,f>; given without target, it selects target=mcu); 32 is \
+                  a microcontroller's register, narrower words are for fixed-point PEs whose products fit one DSP \
+                  multiplier (27 on the Cyclone V, 18 on the ECP5; docs/fpga.md)",
         },
         crate::range::RANGES,
         crate::error_bound::TRIG,
     ],
     build: |p: &Params| {
-        let (target, trig): (Target, TrigImpl) = (p.word("target")?, p.word("trig")?);
+        let (mut target, trig): (Target, TrigImpl) = (p.word("target")?, p.word("trig")?);
         let word = p.u32("word")?;
+        // `word` is target=mcu's: given alone it selects that target
+        if p.get("word").is_some() && p.get("target").is_none() {
+            target = Target::Mcu;
+        }
         if word != choose::MCU_WORD && target != Target::Mcu {
             return Err(PassError::BadParameter {
                 pass: "precision".into(),
