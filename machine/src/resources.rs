@@ -470,28 +470,23 @@ pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32) -> UnitCost {
 
 /// The estimate for `d` under `m`, with Yosys' cells when it ran.
 pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resources {
-    let (na, nm) = (u64::from(d.n_add), u64::from(d.n_mul));
-    let fp = match d.pe_kind {
-        crate::design::PeKind::Binary32 => UnitCost {
-            alm: na * m.fp_add.alm + nm * m.fp_mul.alm,
-            dsp: na * m.fp_add.dsp + nm * m.fp_mul.dsp,
-            m10k: na * m.fp_add.m10k + nm * m.fp_mul.m10k,
-        },
-        crate::design::PeKind::Fixed => {
-            let units = d.pes.iter().map(|p| fixed_unit(m, d.word_bits, p.is_mul, d.intermediate_bits(p.slot)));
-            units.fold(UnitCost { alm: 0, dsp: 0, m10k: 0 }, |a, u| UnitCost {
-                alm: a.alm + u.alm,
-                dsp: a.dsp + u.dsp,
-                m10k: a.m10k + u.m10k,
-            })
-        }
+    // each PE's unit: binary32 ones the target's, fixed-point ones by their word and intermediate
+    let unit = |p: &crate::design::PeImages| match (d.pe_kind, p.is_mul) {
+        (crate::design::PeKind::Binary32, false) => m.fp_add,
+        (crate::design::PeKind::Binary32, true) => m.fp_mul,
+        (crate::design::PeKind::Fixed, is_mul) => fixed_unit(m, d.word_bits, is_mul, d.intermediate_bits(p.slot)),
     };
+    let fp = d.pes.iter().map(unit).fold(UnitCost { alm: 0, dsp: 0, m10k: 0 }, |a, u| UnitCost {
+        alm: a.alm + u.alm,
+        dsp: a.dsp + u.dsp,
+        m10k: a.m10k + u.m10k,
+    });
     let memories = memory_costs(d, m.family);
     let mem_m10k: u64 = memories.iter().map(|c| c.m10k).sum();
     let (logic_from, logic_alm, logic_dsp) = match &yosys {
         Some(y) => ("yosys", y.alm(), y.dsp),
         None => {
-            let n = (na + nm) as f64;
+            let n = d.n_pe() as f64;
             // The multiplexers and output words are costed for 32-bit words: a narrower word
             // (fixed-point PEs, `word_bits`) takes its share.
             let word = f64::from(d.word_bits) / 32.0;

@@ -279,7 +279,8 @@ pub struct PassContext {
 /// pass's, [`PassContext::latencies_for`]) for binary32 PEs; for a function on fixed-point PEs
 /// ([`robovec_machine::program::fixed::pe_kind`]) the target's `fix_pe` latencies for its word
 /// ([`robovec_machine::target::FixPe::latencies_for`]: a MULTI PE one stage shorter when a
-/// product is one DSP multiplier) with those `given` on the pass applied. `asap-alap` and `place` time each function with it.
+/// product is one DSP multiplier) with those `given` on the pass applied. `asap-alap` and
+/// `place` time each function with it.
 pub fn function_latencies(
     target: &Target,
     f: &robovec_ir::Function,

@@ -223,18 +223,16 @@ impl Ctx<'_> {
         }
     }
 
-    /// Sources that `routes` of operands `ops` would add to memory `q`'s routes (an op has at
-    /// most a few operands: the distinct ones are found by a scan).
+    /// Sources that `routes` of operands `ops` would add to memory `q`'s routes. It runs for
+    /// every free PE of every op placed, so it allocates nothing: an op has a few operands,
+    /// and a source counts once, at its first operand.
     fn new_routes(&self, ops: &[Node], routes: &[Route], q: usize) -> u32 {
         let n2 = 2 * self.arch.n_pe();
-        let fresh: Vec<usize> = ops
-            .iter()
-            .zip(routes)
-            .filter(|(&v, _)| v != NO_NODE)
-            .filter_map(|(&v, &r)| self.source(v, r))
-            .filter(|&s| !self.routed[q * n2 + s])
-            .collect();
-        fresh.iter().enumerate().filter(|&(i, s)| !fresh[..i].contains(s)).count() as u32
+        let source = |i: usize| (ops[i] != NO_NODE).then(|| self.source(ops[i], routes[i])).flatten();
+        let fresh = |i: usize| source(i).filter(|&s| !self.routed[q * n2 + s]);
+        (0..ops.len().min(routes.len()))
+            .filter(|&i| fresh(i).is_some_and(|s| (0..i).all(|j| source(j) != Some(s))))
+            .count() as u32
     }
 
     fn commit(&mut self, ops: &[Node], routes: &[Route], q: usize) {
