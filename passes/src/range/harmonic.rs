@@ -477,6 +477,11 @@ pub struct HarmonicSweep<'f> {
     /// The angle number of each input read by `sin`/`cos` (by value index), if of nonzero width.
     angle: Vec<Option<u32>>,
     hs: Harmonics,
+    /// The number of values `n`, which numbers the noise symbols: `[0, n)` the values' own
+    /// (inputs' and roundings'), `[n, 2n)` the error of a division's reciprocal, `[2n, 5n)` the
+    /// adjoint sweep's (a partial's approximation, a quotient's roundings, an adjoint's own);
+    /// `None` when `5n` would reach [`CENTRE`] (no division gets a form, no adjoint is taken).
+    n: Option<u32>,
 }
 
 impl<'f> HarmonicSweep<'f> {
@@ -528,7 +533,8 @@ impl<'f> HarmonicSweep<'f> {
             }
             forms[v.index()] = Some(interval_form(i, v.index() as u32));
         }
-        Some(HarmonicSweep { f, cap: cap.max(4), forms, uses, angle, hs: Harmonics::new(angle_ranges, cap.max(4)) })
+        let n = u32::try_from(f.values.len()).ok().filter(|n| n.checked_mul(5).is_some_and(|m| m < CENTRE));
+        Some(HarmonicSweep { f, cap: cap.max(4), forms, uses, angle, hs: Harmonics::new(angle_ranges, cap.max(4)), n })
     }
 
     fn form(&self, o: &Operand) -> Option<HForm> {
@@ -577,8 +583,12 @@ impl<'f> HarmonicSweep<'f> {
                     BinOp::Sub if same => Some(Vec::new()),
                     BinOp::Sub => Some(lin(&fs[0], 1.0, &fs[1], -1.0, &mut slack)),
                     BinOp::Mul => Some(self.hs.mul(&fs[0], &fs[1], same, &mut slack)),
-                    BinOp::Div => reciprocal_line(interval_of(b)).map(|(alpha, zeta, delta)| {
-                        let recip = affine_of(&fs[1], alpha, zeta, delta, own);
+                    BinOp::Div => reciprocal_line(interval_of(b)).zip(self.n).map(|((alpha, zeta, delta), n)| {
+                        // The approximation's error on a symbol of its own, not on `own`: the
+                        // product spreads it over every harmonic of the dividend, and `put_own`
+                        // may flip the sign of `own`'s constant atom, which is sound only for a
+                        // symbol with that one atom.
+                        let recip = affine_of(&fs[1], alpha, zeta, delta, n + own);
                         self.hs.mul(&fs[0], &recip, false, &mut slack)
                     }),
                 };
@@ -732,7 +742,7 @@ impl HarmonicSweep<'_> {
     /// over the domain.
     pub fn adjoints(&mut self, out: Value, x: &[Interval]) -> Option<Adjoints> {
         let f = self.f;
-        let n = f.values.len() as u32;
+        let n = self.n?;
         let mut lam: Vec<Option<HForm>> = vec![None; f.values.len()];
         lam[out.index()] = Some(constant(1.0));
         let mut adj = Adjoints { sup: vec![0.0; f.values.len()], conversion_weight: vec![[0.0; 3]; f.values.len()] };
@@ -765,7 +775,7 @@ impl HarmonicSweep<'_> {
                                 TrigFn::Sin => x[a.index()].cos(),
                                 TrigFn::Cos => -x[a.index()].sin(),
                             };
-                            interval_form(i, n + z.index() as u32)
+                            interval_form(i, 2 * n + z.index() as u32)
                         }
                     };
                     parts.push((Operand::Value(*a), Some(partial), 1.0));
@@ -793,9 +803,11 @@ impl HarmonicSweep<'_> {
                             };
                             let (alpha, zeta, delta) = reciprocal_line(of(x, b))?;
                             let mut slack = FastUp::zero();
-                            let recip = affine_of(&xb, alpha, zeta, delta, n + z.index() as u32);
+                            let recip = affine_of(&xb, alpha, zeta, delta, 2 * n + z.index() as u32);
                             let mut quotient = self.hs.mul(&xz, &recip, false, &mut slack);
-                            put_own(&mut quotient, n + z.index() as u32, slack.total());
+                            // The product's roundings on a fresh symbol: `2n + z` now has atoms
+                            // on several harmonics (see `step`'s division).
+                            put_own(&mut quotient, 3 * n + z.index() as u32, slack.total());
                             parts.push((*a, Some(recip), 1.0));
                             parts.push((*b, Some(HForm { atoms: quotient }), -1.0));
                         }
@@ -806,7 +818,7 @@ impl HarmonicSweep<'_> {
                         // ∂√a/∂a = 1/(2√a) = ½ · 1/z.
                         let xz = self.form(&Operand::Value(z))?;
                         let (alpha, zeta, delta) = reciprocal_line(x[z.index()])?;
-                        let recip = affine_of(&xz, alpha, zeta, delta, n + z.index() as u32);
+                        let recip = affine_of(&xz, alpha, zeta, delta, 2 * n + z.index() as u32);
                         parts.push((args[0], Some(recip), 0.5));
                     }
                     Some(i) => {
@@ -841,7 +853,7 @@ impl HarmonicSweep<'_> {
                     None => lin(&HForm::default(), 1.0, &HForm { atoms: contribution }, sign, &mut slack),
                 };
                 self.hs.cap_atoms(self.cap, &mut atoms, &mut slack);
-                put_own(&mut atoms, 2 * n + a.index() as u32, slack.total());
+                put_own(&mut atoms, 4 * n + a.index() as u32, slack.total());
                 if !atoms.iter().all(|t| t.c.is_finite()) {
                     return None;
                 }
