@@ -103,24 +103,32 @@ fn fixed_point_units_equal_the_model_bit_for_bit_on_random_operands() {
 }
 
 /// Narrow words (issue 49: `precision<word=W>`): the fixed-point units at DW = 27, 20 and 16 bits
-/// with the exact intermediate of [`intermediate_bits`] — the width the generator gives each PE
-/// from the shifts of its program — against robovec's model, batch by batch: each batch draws
-/// its own largest alignment and rounding shift, so its intermediate is as narrow as its ops
-/// allow; a quarter of the operands are the word's extremes (−2^(DW−1), 2^(DW−1) − 1), where a
-/// bit too few would wrap. A vector whose rounded result does not fit DW bits (the range proof
-/// excludes it) is drawn again.
+/// with the exact intermediate of [`intermediate_bits`] and the shifters of [`shift_ranges`] —
+/// the widths and shift ranges the generator gives each PE from the shifts of its program —
+/// against robovec's model, batch by batch: each batch draws its own largest alignment and a
+/// window of rounding shifts per unit (some all positive, as a MULTI PE's, some reaching left
+/// shifts), so its intermediate and shifters are as narrow as its ops allow; a quarter of the
+/// operands are the word's extremes (−2^(DW−1), 2^(DW−1) − 1), where a bit too few would wrap. A
+/// vector whose rounded result does not fit DW bits (the range proof excludes it) is drawn again.
 ///
 /// [`intermediate_bits`]: robovec_machine::design::build::intermediate_bits
+/// [`shift_ranges`]: robovec_machine::design::build::shift_ranges
 #[test]
 fn narrow_fixed_point_units_with_the_generators_intermediate_width_equal_the_model() {
     use robovec_ir::machine::{FixShifts, MachineOp};
-    use robovec_machine::design::build::intermediate_bits;
+    use robovec_machine::design::build::{intermediate_bits, shift_ranges};
     tool("iverilog");
     let mut rng = robovec_ir::rng::SplitMix64::new(4927);
     for dw in [27u32, 20, 16] {
-        for batch in 0..3 {
+        for batch in 0..4 {
             let d = tmp(&format!("fix_units_dw{dw}_{batch}"));
-            let (max_align, max_shift) = (rng.below(24) as i64 + 1, rng.below(2 * u64::from(dw)) as i64 + 1);
+            let max_align = rng.below(24) as i64 + 1;
+            // each unit's window of rounding shifts: from −10 … 2·DW, 1 to 40 amounts wide
+            let mut window = || {
+                let lo = rng.below(2 * u64::from(dw) + 11) as i64 - 10;
+                (lo, (lo + rng.below(40) as i64).min(2 * i64::from(dw)))
+            };
+            let (add_window, mul_window) = (window(), window());
             let (lo, hi) = (-(1i64 << (dw - 1)), (1i64 << (dw - 1)) - 1);
             let (mut lines, mut n) = (String::new(), 0usize);
             let (mut adds, mut muls) = (Vec::new(), Vec::new());
@@ -132,10 +140,11 @@ fn narrow_fixed_point_units_with_the_generators_intermediate_width_equal_the_mod
                     _ => lo + rng.below((hi - lo + 1) as u64) as i64,
                 };
                 let (a, b) = (draw(), draw());
+                let (lo_s, hi_s) = if op == 2 { mul_window } else { add_window };
                 let sh = FixShifts {
                     align: if op == 2 { 0 } else { rng.below(max_align as u64 + 1) as u8 },
                     align_b: rng.below(2) == 1,
-                    shift: (rng.below((max_shift + 11) as u64) as i64 - 10) as i8,
+                    shift: (lo_s + rng.below((hi_s - lo_s + 1) as u64) as i64) as i8,
                 };
                 let unit = [MachineOp::Add, MachineOp::Sub, MachineOp::Mul][op as usize].clone();
                 let Some(y) = sh.apply(&unit, a, b).and_then(|y| i64::try_from(y).ok()) else { continue };
@@ -151,11 +160,23 @@ fn narrow_fixed_point_units_with_the_generators_intermediate_width_equal_the_mod
                 lines += &format!("{op:01x}{:08x}{:08x}{:08x}{:08x}\n", w(a), w(b), sh.word(), w(y));
                 n += 1;
             }
+            let (ra, rm) = (shift_ranges(adds.iter().copied()), shift_ranges(muls.iter().copied()));
             let (kwa, kwm) = (intermediate_bits(dw, false, adds), intermediate_bits(dw, true, muls));
             // narrower than the 32-bit word's 64 bits: the test exercises the narrowing
             assert!(kwa < 64 && kwm < 64, "dw {dw}: intermediates {kwa}, {kwm}");
             std::fs::write(d.join("vec.hex"), lines).unwrap();
-            let defines = [("DW", dw), ("KWA", kwa), ("KWM", kwm)];
+            // the shift bounds as 7-bit two's complement (Verilog macros are unsigned here)
+            let b7 = |x: i8| u32::from(x as u8 & 127);
+            let defines = [
+                ("DW", dw),
+                ("KWA", kwa),
+                ("KWM", kwm),
+                ("AMAX", u32::from(ra.align_max)),
+                ("SMINA7", b7(ra.shift_min)),
+                ("SMAXA7", b7(ra.shift_max)),
+                ("SMINM7", b7(rm.shift_min)),
+                ("SMAXM7", b7(rm.shift_max)),
+            ];
             check_vectors_with(&d, n, "fix_check_tb.v", &["fix_units.v", "fp_units.v"], &defines);
         }
     }
@@ -609,11 +630,12 @@ fn yosys_maps_a_27_bit_product_to_one_dsp_block_and_a_32_bit_one_to_two() {
     assert_eq!(count(32, 64), (0, 4));
     let t = robovec_machine::target::Target::de10_nano();
     let m = robovec_machine::resources::cost_model(&t);
-    assert_eq!(robovec_machine::resources::fixed_unit(&m, 27, true, 55).dsp, 1);
-    assert_eq!(robovec_machine::resources::fixed_unit(&m, 32, true, 64).dsp, 2);
+    let full = robovec_machine::resources::FULL_SHIFTS;
+    assert_eq!(robovec_machine::resources::fixed_unit(&m, 27, true, 55, full).dsp, 1);
+    assert_eq!(robovec_machine::resources::fixed_unit(&m, 32, true, 64, full).dsp, 2);
     let e = robovec_machine::resources::cost_model(&robovec_machine::target::Target::ecp5_85f());
-    assert_eq!(robovec_machine::resources::fixed_unit(&e, 18, true, 37).dsp, 1);
-    assert_eq!(robovec_machine::resources::fixed_unit(&e, 27, true, 55).dsp, 4);
+    assert_eq!(robovec_machine::resources::fixed_unit(&e, 18, true, 37, full).dsp, 1);
+    assert_eq!(robovec_machine::resources::fixed_unit(&e, 27, true, 55, full).dsp, 4);
 }
 
 /// `PATH` with the open ECP5 flow's YoWASP tools first (`scripts/test.sh` installs them into
@@ -734,9 +756,9 @@ fn sweep_times_and_costs_a_fixed_point_function_with_its_pes() {
     for row in rows {
         assert_eq!((row["lat_add"].as_u64(), row["lat_mul"].as_u64()), (Some(4), Some(5)), "{row}");
         let n = row["n"].as_u64().unwrap() as f64;
-        // n fixed ADD + n MULTI units, 3 ALM per PE memory, the crossbar (8.125 ALM per write
+        // n fixed ADD + n MULTI full-range units (the target's fix_pe), 3 ALM per PE memory, the crossbar (8.125 ALM per write
         // port and source: 2n memories × 2 ports × 4n sources) and the control (469)
-        let alm = n * 602.0 + n * 415.0 + 2.0 * n * 3.0 + 8.125 * 2.0 * n * 2.0 * 4.0 * n + 469.0;
+        let alm = n * 390.0 + n * 299.0 + 2.0 * n * 3.0 + 8.125 * 2.0 * n * 2.0 * 4.0 * n + 469.0;
         assert_eq!(row["alm"].as_f64().unwrap(), alm.ceil(), "N={n}");
         assert_eq!(row["dsp"].as_f64().unwrap(), 2.0 * n, "N={n}: two DSP blocks per 32 × 32 product");
     }

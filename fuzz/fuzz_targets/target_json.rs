@@ -6,6 +6,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
+use robovec_machine::design::build::ShiftRanges;
 use robovec_machine::resources::{cost_model, fixed_unit};
 use robovec_machine::target::Target;
 
@@ -22,5 +23,7 @@ fuzz_target!(|data: &[u8]| {
     let _ = t.estimate(n_add, n_mul, u32::from(head[3]) * 16);
     let _ = t.fix_pe.latencies_for(t.family, word);
     let m = cost_model(&t);
-    let _ = fixed_unit(&m, word, head[3] & 2 == 2, word + u32::from(head[3] % 40));
+    let ranges =
+        ShiftRanges { align_max: head[3] % 64, shift_min: -((head[3] % 65) as i8), shift_max: (head[3] % 63) as i8 };
+    let _ = fixed_unit(&m, word, head[3] & 2 == 2, word + u32::from(head[3] % 40), ranges);
 });

@@ -93,6 +93,7 @@ use std::process::Command;
 
 use serde::Serialize;
 
+use crate::design::build::ShiftRanges;
 #[cfg(doc)]
 use crate::design::routes::Routes;
 use crate::design::{Design, HDL_LIBRARY, SYNTH_STUBS};
@@ -450,20 +451,61 @@ pub fn parse_stat(json: &str) -> Result<YosysCells, String> {
     Ok(y)
 }
 
-/// One fixed-point PE's unit for `dw`-bit words and a `kw`-bit exact intermediate
-/// ([`crate::design::build::intermediate_bits`]): the target's `fix_pe` cost, which is the
-/// 32-bit word's with a 64-bit intermediate, with its logic scaled by `kw / 64` (the shifters,
-/// the adder and the rounding are `kw` bits wide; Yosys 0.23 `synth_intel_alm` of
-/// `fix_add_sub` at (DW, KW) = (32, 64), (27, 51), (27, 40), (20, 37), (16, 29): 603, 500, 410,
-/// 340, 260 ALM, within 8 % of the scaling; of `fix_mul` at (27, 55), (20, 41): 281, 189 ALM,
-/// under the scaling's 357 and 266: docs/fpga.md "Narrow words"), and a MULTI PE's multipliers
-/// by the family's DSP modes: on the Cyclone V one variable-precision block for a product of
-/// words of at most 27 bits (27 × 27 mode: Yosys maps it to one `MISTRAL_MUL27X27`), on the
-/// ECP5 one MULT18X18D for words of at most 18 bits; wider products take the target's
-/// `fix_pe.mul.dsp` (the four 16 × 16 partial products of `hdl/fix_units.v`).
-pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32) -> UnitCost {
+/// The shifts of the full-range unit the target's `fix_pe` costs describe: any alignment
+/// (6 levels), any 7-bit rounding shift.
+pub const FULL_SHIFTS: ShiftRanges = ShiftRanges { align_max: 63, shift_min: -64, shift_max: 63 };
+
+/// Levels of a shifter over `span + 1` shift amounts: ⌈log₂(span + 1)⌉ (0 for one amount).
+fn levels(span: i32) -> f64 {
+    if span <= 0 {
+        0.0
+    } else {
+        f64::from(32 - (span as u32).leading_zeros())
+    }
+}
+
+/// The structure of a fixed-point unit (`hdl/fix_units.v`) of `dw`-bit words, a `kw`-bit exact
+/// intermediate and the shifts `r`, in ALM of the Cyclone V: least squares on Yosys 0.23
+/// `synth_intel_alm` of the units at `LATENCY` 2 (one-multiplier products) or 3 (split ones),
+/// 27 ADD and 14 MULTI configurations of DW 16–32, KW 29–64 (docs/fpga.md "Units sized to
+/// their shifts"):
+/// - ADD: `0.64·(KW + DW)` (registers, the aligned adder, the rounding's increment)
+///   `+ 0.30·KW·La` (the alignment shifter, `La = ⌈log₂(AMAX + 1)⌉` levels)
+///   `+ 0.82·(DW + 1)·Ls` (the rounding shifter, `Ls = ⌈log₂(SMAX − SMIN + 1)⌉`; it keeps the
+///   result's DW + 1 bits); within 15 % of Yosys on the configurations generated designs have;
+/// - MULTI: `0.38·(KW + DW) + 0.6·(DW + 1)·(Ls − 1)`, plus `1.3·KW` for a product split in four
+///   partial products (their sum); within 20 ALM of Yosys where `Ls ≤ 4` (a design's MULTI PEs
+///   round by 3 to 9 amounts), 30 % under it at the full range.
+fn unit_structure(dw: u32, is_mul: bool, kw: u32, r: ShiftRanges, family: Family) -> f64 {
+    let (dw, kw) = (f64::from(dw.min(64)), f64::from(kw.min(64)));
+    let ls = levels(i32::from(r.shift_max) - i32::from(r.shift_min));
+    if is_mul {
+        let split = if dw > f64::from(family.one_multiplier_word()) { 1.3 * kw } else { 0.0 };
+        0.38 * (kw + dw) + 0.6 * (dw + 1.0) * (ls - 1.0).max(0.0) + split
+    } else {
+        let la = levels(i32::from(r.align_max));
+        0.64 * (kw + dw) + 0.30 * kw * la + 0.82 * (dw + 1.0) * ls
+    }
+}
+
+/// One fixed-point PE's unit for `dw`-bit words, a `kw`-bit exact intermediate
+/// ([`crate::design::build::intermediate_bits`]) and the shifts `r` of its program
+/// ([`crate::design::build::shift_ranges`]): the target's `fix_pe` cost, which is the 32-bit
+/// word's with a 64-bit intermediate and [`FULL_SHIFTS`], scaled by the unit's structure
+/// against that one's (`unit_structure`: registers and adders grow with the widths, each
+/// shifter with its levels). The same ratio holds on both families: Yosys measures a typical
+/// ADD PE (27-bit words, KW 51, aligning by ≤ 31, rounding by −16 … 14) at 0.59 of the full
+/// unit on the Cyclone V and 0.55 on the ECP5 (`synth_ecp5`, LUT4), the structure at 0.66.
+/// A MULTI PE's multipliers follow the family's DSP modes: on the Cyclone V one
+/// variable-precision block for a product of words of at most 27 bits (27 × 27 mode: Yosys maps
+/// it to one `MISTRAL_MUL27X27`), on the ECP5 one MULT18X18D for words of at most 18 bits;
+/// wider products take the target's `fix_pe.mul.dsp` (the four 16 × 16 partial products of
+/// `hdl/fix_units.v`).
+pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32, r: ShiftRanges) -> UnitCost {
     let unit = if is_mul { m.fix_mul } else { m.fix_add };
-    let alm = (unit.alm as f64 * f64::from(kw.min(64)) / 64.0).ceil() as u64;
+    let full = unit_structure(32, is_mul, 64, FULL_SHIFTS, m.family);
+    let this = unit_structure(dw, is_mul, kw, r, m.family);
+    let alm = (unit.alm as f64 * this / full).ceil().max(0.0) as u64;
     let dsp = if is_mul && unit.dsp > 0 && dw <= m.family.one_multiplier_word() { 1 } else { unit.dsp };
     UnitCost { alm, dsp, m10k: unit.m10k }
 }
@@ -474,7 +516,9 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
     let unit = |p: &crate::design::PeImages| match (d.pe_kind, p.is_mul) {
         (crate::design::PeKind::Binary32, false) => m.fp_add,
         (crate::design::PeKind::Binary32, true) => m.fp_mul,
-        (crate::design::PeKind::Fixed, is_mul) => fixed_unit(m, d.word_bits, is_mul, d.intermediate_bits(p.slot)),
+        (crate::design::PeKind::Fixed, is_mul) => {
+            fixed_unit(m, d.word_bits, is_mul, d.intermediate_bits(p.slot), p.shift_ranges.unwrap_or(FULL_SHIFTS))
+        }
     };
     let fp = d.pes.iter().map(unit).fold(UnitCost { alm: 0, dsp: 0, m10k: 0 }, |a, u| UnitCost {
         alm: a.alm + u.alm,

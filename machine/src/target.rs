@@ -32,8 +32,8 @@
 //! | `datapath.fp64_add` | 886 ALM, 0 DSP | Intel, *Floating-Point IP Cores User Guide* (UG-01058), "FP_FUNCTIONS Resource Utilization": double-precision Add on Arria V (the same 28 nm ALM and variable-precision DSP block as Cyclone V; its single-precision Add is the seed's 360 ALM) |
 //! | `datapath.fp64_mul` | 250 ALM, 4 DSP | estimate: a 53 × 53 mantissa product tiles into four 27 × 27 blocks (the "54 × 54: four blocks" row of Intel's variable-precision DSP tables); ALM 2.5 × the seed's binary32 MULTI (exponent, rounding and normalisation twice as wide, plus the tiles' adder). No datasheet figure at hand |
 //! | `datapath.convert_alm` | 100 ALM per conversion | estimate: a conversion between fixed and floating point (or binary32 and binary64) is a leading-zero count and a barrel shift of the word, of the order of the seed's MULTI PE logic (100 ALM) |
-//! | `fix_pe.add` | latency 4 cycles = 2 stages + 2; 602 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`) in two pipeline stages, the exact sum registered before its rounding (the issue's "1–2 stages"; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` by [`crate::resources`]' packing bound (199 LUT6, 806 smaller LUTs and carry bits): its two barrel shifters (any alignment, either rounding direction) cost more than the seed's hardened binary32 adder (360 ALM) |
-//! | `fix_pe.mul` | latency 5 cycles = 3 stages + 2; 415 ALM, 2 DSP | a 32 × 32 signed product as four registered 16 × 16 partial products (four 18 × 19 multipliers, two per Cyclone V variable-precision block: 2 blocks), their sum, and the rounding shift; ALM from Yosys as above at `LATENCY = 3` (85 LUT6, 660 smaller LUTs and carry bits; 4 `MISTRAL_MUL18X18`) |
+//! | `fix_pe.add` | latency 4 cycles = 2 stages + 2; 390 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`) in two pipeline stages, the exact sum registered before its rounding (the issue's "1–2 stages"; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` with 32-bit words, KW = 64 and any shift (`AMAX = 63`, `SMIN = −64`, `SMAX = 63`: [`crate::resources::FULL_SHIFTS`]) by [`crate::resources`]' packing bound (164 LUT6, 346 smaller LUTs, 106 carry bits); a design's PEs are sized to their own shifts and widths (`resources::fixed_unit`: a typical Jeep ADD PE 231 ALM) |
+//! | `fix_pe.mul` | latency 5 cycles = 3 stages + 2; 299 ALM, 2 DSP | a 32 × 32 signed product as four registered 16 × 16 partial products (four 18 × 19 multipliers, two per Cyclone V variable-precision block: 2 blocks), their sum, and the rounding shift (any shift); ALM from Yosys as above at `LATENCY = 3` (41 LUT6, 474 smaller LUTs, 41 carry bits; 4 `MISTRAL_MUL18X18`); a 27-bit MULTI PE rounding by 24 to 26 bits, as the Jeep's, is one 27 × 27 block and 36 ALM |
 //! | `output_word_alm` | 0 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are block RAM with a registered read port (`rv_out_mem`), counted as M10K blocks, so they take no logic a word. (Until issue 49 they were 32-bit registers read asynchronously: 16 ALM a word, the slope Yosys measured per PE, [`crate::resources`].) The key stays for a design whose output words cost logic; optional in a JSON target (default 0) |
 //!
 //!
@@ -70,7 +70,7 @@
 //! | `latencies`, `fix_pe.*.latency` | as the DE10-Nano's | the same Verilog units and pipeline (SPEC §1's + 2) |
 //! | `pe_words` | 512 | a PE memory as four simple dual-port banks of one EBR each (512 × 36, `PDPW16KD`) and its live-value table ([`PeMemory::LiveValueTable`]) |
 //! | `fp_add`, `fp_mul` | 1 675 LUT4; 1 261 LUT4 + 4 MULT18X18D | Yosys `synth_ecp5` of `fp_add_sub` (`LATENCY = 10`) and `fp_mul` (5) alone: LUT4 + 2 × CCU2C |
-//! | `fix_pe.add`, `fix_pe.mul` | 2 106 LUT4; 1 488 LUT4 + 4 MULT18X18D | the same of `fix_add_sub` (2) and `fix_mul` (3) with their shifts as free inputs: an upper bound, since in a whole design the shift memory is a ROM and Yosys keeps only the shifts it holds (the 1 + 1 PE pendulum places in 2 316 LUT4 in all) |
+//! | `fix_pe.add`, `fix_pe.mul` | 1 494 LUT4; 2 129 LUT4 + 4 MULT18X18D | Yosys `synth_ecp5` of the same full-range units (LUT4 + 2 × CCU2C; `fix_add_sub` at `LATENCY = 2`, `fix_mul` at 3); a design's PEs are sized to their shifts (`resources::fixed_unit`: a typical ADD PE, 27-bit words aligning by ≤ 31 and rounding by −16 … 14, is 823 LUT4; a 27-bit MULTI PE rounding by 24 to 26 bits, 230 LUT4) |
 //! | `pe_memory_alm`, `pe_word_alm` | 314 LUT4 + 4.1 LUT4 per word | Yosys of `rv_pe_mem_lvt` at 64, 512 and 1 024 words (575, 2 403, 4 445 LUT4): the bypass and bank choice, and the live-value table (a bit a word, two write and two read ports) in logic |
 //! | `crossbar_alm` | 60 LUT4 per multiplexer input | Yosys of `rv_mux` with 17 sources (1 011 LUT4 + 5 CCU2C: 60 a source; 9 sources: 44) |
 //! | `output_word_alm` | 0 | the DE10-Nano's: output memories are block RAM (EBR) |
@@ -115,8 +115,8 @@
 //!     "convert_alm": 100
 //!   },
 //!   "fix_pe": {
-//!     "add": { "latency": 4, "alm": 602, "dsp": 0, "m10k": 0 },
-//!     "mul": { "latency": 5, "alm": 415, "dsp": 2, "m10k": 0 }
+//!     "add": { "latency": 4, "alm": 390, "dsp": 0, "m10k": 0 },
+//!     "mul": { "latency": 5, "alm": 299, "dsp": 2, "m10k": 0 }
 //!   }
 //! }
 //! ```
@@ -352,8 +352,8 @@ impl Default for FixPe {
     /// The DE10-Nano's (module doc).
     fn default() -> Self {
         FixPe {
-            add: FixUnit { latency: 4, alm: 602.0, dsp: 0, m10k: 0 },
-            mul: FixUnit { latency: 5, alm: 415.0, dsp: 2, m10k: 0 },
+            add: FixUnit { latency: 4, alm: 390.0, dsp: 0, m10k: 0 },
+            mul: FixUnit { latency: 5, alm: 299.0, dsp: 2, m10k: 0 },
         }
     }
 }
@@ -667,8 +667,8 @@ impl Target {
                 convert_alm: 200.0,
             },
             fix_pe: FixPe {
-                add: FixUnit { latency: 4, alm: 2106.0, dsp: 0, m10k: 0 },
-                mul: FixUnit { latency: 5, alm: 1488.0, dsp: 4, m10k: 0 },
+                add: FixUnit { latency: 4, alm: 1494.0, dsp: 0, m10k: 0 },
+                mul: FixUnit { latency: 5, alm: 2129.0, dsp: 4, m10k: 0 },
             },
             pnr: Some(crate::pnr::PnrPart { device: "85k".into(), package: "CABGA381".into() }),
             // The same Verilog units, pipeline, instruction word and control as the DE10-Nano's:

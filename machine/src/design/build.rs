@@ -114,6 +114,34 @@ pub fn intermediate_bits(dw: u32, is_mul: bool, shifts: impl IntoIterator<Item =
         .min(64)
 }
 
+/// The shifts a fixed-point PE's program uses: the largest alignment and the range of the
+/// rounding shifts (`hdl/fix_units.v`'s `AMAX`, `SMIN`, `SMAX`). The unit's shifters cover only
+/// these, so their levels are ⌈log₂(AMAX + 1)⌉ and ⌈log₂(SMAX − SMIN + 1)⌉ instead of 6 and 7
+/// (on the Jeep's `dirdyna` at 16 + 16 PEs, a MULTI PE rounds by 24 to 26 bits, an ADD PE aligns
+/// by at most 11 to 32 bits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShiftRanges {
+    /// The largest alignment (bits, 0..=63).
+    pub align_max: u8,
+    /// The smallest rounding shift (bits; negative: a left shift).
+    pub shift_min: i8,
+    /// The largest rounding shift (bits).
+    pub shift_max: i8,
+}
+
+/// The [`ShiftRanges`] of the ops whose shifts are `shifts` (the issued ops of one PE; none:
+/// `AMAX = 0`, `SMIN = SMAX = 0`).
+pub fn shift_ranges(shifts: impl IntoIterator<Item = FixShifts>) -> ShiftRanges {
+    let mut r: Option<ShiftRanges> = None;
+    for sh in shifts {
+        let x = r.get_or_insert(ShiftRanges { align_max: 0, shift_min: sh.shift, shift_max: sh.shift });
+        x.align_max = x.align_max.max(sh.align & 63);
+        x.shift_min = x.shift_min.min(sh.shift);
+        x.shift_max = x.shift_max.max(sh.shift);
+    }
+    r.unwrap_or(ShiftRanges { align_max: 0, shift_min: 0, shift_max: 0 })
+}
+
 /// What the target cannot hold or the hardware cannot do, one line each with the figures
 /// needed and available (empty: the program fits).
 pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
@@ -292,6 +320,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
         let img = |k: &str, width: u32, words: Vec<u64>| Image { name: format!("pe{s}_{k}"), width, words };
         let mut data: Vec<u64> = pe.init.iter().map(|w| initial_word(w, fx)).collect();
         let mut out: Vec<u64> = pe.output_init.iter().map(|w| initial_word(w, fx)).collect();
+        let shift_ranges = fx.map(|x| shift_ranges(x.shifts[s].iter().flatten().copied()));
         let fix = fx.map(|x| {
             let words = x.shifts[s].iter().map(|sh| sh.map_or(0, |sh| sh.word())).collect();
             img("fix", robovec_ir::machine::FixShifts::BITS, words)
@@ -310,6 +339,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
             out: img("out", word_bits_of(fx), out),
             buffer_words: m.buffer_words[s],
             fix,
+            shift_ranges,
         });
     }
     Ok(Design {

@@ -148,6 +148,9 @@ pub struct PeImages {
     /// Fixed-point PEs (issue 49): the shift memory, one [`robovec_ir::machine::FixShifts`]
     /// word per cycle (14 bits).
     pub fix: Option<Image>,
+    /// Fixed-point PEs: the shifts its issued ops use ([`build::shift_ranges`]), which size its
+    /// unit's shifters.
+    pub shift_ranges: Option<build::ShiftRanges>,
 }
 
 impl PeImages {
@@ -400,7 +403,16 @@ impl Design {
             let (src1, n1, sw1) = self.port_sources(p.slot, 1);
             let mut fix = match &p.fix {
                 Some(img) => {
-                    format!(".FIX(1), .FIX_FILE({}), .DW({dw}), .KW({}), ", f(img), self.intermediate_bits(p.slot))
+                    let r =
+                        p.shift_ranges.unwrap_or(build::ShiftRanges { align_max: 63, shift_min: -64, shift_max: 63 });
+                    format!(
+                        ".FIX(1), .FIX_FILE({}), .DW({dw}), .KW({}), .AMAX({}), .SMIN({}), .SMAX({}), ",
+                        f(img),
+                        self.intermediate_bits(p.slot),
+                        r.align_max,
+                        r.shift_min,
+                        r.shift_max
+                    )
                 }
                 None => String::new(),
             };

@@ -4,7 +4,9 @@
 // (14 bits used), [31:0] the expected y. One vector at a time: the operands are held for the
 // unit's latency, then y is compared. `DW (default 32) is the units' word: the operands are the
 // fields' low DW bits and the low DW bits of y are compared; `KWA` and `KWM` (default 64) are the
-// ADD and MULTI units' intermediate bits.
+// ADD and MULTI units' intermediate bits; `AMAX` (default 63) the ADD unit's largest alignment and
+// `SMINA7`, `SMAXA7` (ADD), `SMINM7`, `SMAXM7` (MULTI) their rounding shifts' bounds as 7-bit two's
+// complement (default -64 ... 63: any shift), as the generator sizes a PE's shifters.
 `timescale 1ns/1ps
 `ifndef DW
 `define DW 32
@@ -15,8 +17,28 @@
 `ifndef KWM
 `define KWM 64
 `endif
+`ifndef AMAX
+`define AMAX 63
+`endif
+`ifndef SMINA7
+`define SMINA7 64
+`endif
+`ifndef SMAXA7
+`define SMAXA7 63
+`endif
+`ifndef SMINM7
+`define SMINM7 64
+`endif
+`ifndef SMAXM7
+`define SMAXM7 63
+`endif
 module fix_check_tb;
   localparam integer LADD = 2, LMUL = 3;
+  // the 7-bit two's complement bounds as integers
+  localparam integer SMINA = (`SMINA7 >= 64) ? `SMINA7 - 128 : `SMINA7;
+  localparam integer SMAXA = (`SMAXA7 >= 64) ? `SMAXA7 - 128 : `SMAXA7;
+  localparam integer SMINM = (`SMINM7 >= 64) ? `SMINM7 - 128 : `SMINM7;
+  localparam integer SMAXM = (`SMAXM7 >= 64) ? `SMAXM7 - 128 : `SMAXM7;
   reg clk = 0;
   always #5 clk = ~clk;
   reg [131:0] vec [0:`N-1];
@@ -24,8 +46,8 @@ module fix_check_tb;
   reg [13:0] sh = 0;
   reg sub = 0;
   wire [`DW-1:0] y_add, y_mul;
-  fix_add_sub #(.LATENCY(LADD), .DW(`DW), .KW(`KWA)) u_add (.clk(clk), .a(a), .b(b), .sub(sub), .sh(sh), .y(y_add));
-  fix_mul #(.LATENCY(LMUL), .DW(`DW), .KW(`KWM)) u_mul (.clk(clk), .a(a), .b(b), .sh(sh), .y(y_mul));
+  fix_add_sub #(.LATENCY(LADD), .DW(`DW), .KW(`KWA), .AMAX(`AMAX), .SMIN(SMINA), .SMAX(SMAXA)) u_add (.clk(clk), .a(a), .b(b), .sub(sub), .sh(sh), .y(y_add));
+  fix_mul #(.LATENCY(LMUL), .DW(`DW), .KW(`KWM), .SMIN(SMINM), .SMAX(SMAXM)) u_mul (.clk(clk), .a(a), .b(b), .sh(sh), .y(y_mul));
   integer i, k, bad;
   reg [3:0] op;
   reg [`DW-1:0] want, got;

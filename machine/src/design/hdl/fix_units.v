@@ -32,25 +32,42 @@
 // the rounding in the product's clock, 77 MHz split, 88 MHz with the partial products
 // registered; docs/fpga.md).
 
-// Rounding of the exact result K by s bits (see above).
-module fix_round #(parameter integer DW = 32, parameter integer KW = 64) (
+// Rounding of the exact result K by s bits (see above), for the shifts SMIN <= s <= SMAX of the
+// PE's program (the generator's `shift_ranges`; the defaults take any 7-bit s). One shifter:
+//   t = K >>> (s - 1)  (K << (1 - s) when s <= 0),  y = (t + [s >= 1]) >>> 1,
+// which is (K + 2^(s-1)) >>> s for s >= 1 (floor((floor(K / 2^(s-1)) + 1) / 2) is
+// floor((K + 2^(s-1)) / 2^s)) and K << -s for s <= 0. Only the low DW + 1 bits of t are used,
+// so the shifter keeps DW + 1 outputs, and it shifts by s - SMIN (ceil(log2(SMAX - SMIN + 1))
+// levels) after a constant shift: a MULTI PE whose products round by 24 to 26 bits has a
+// two-level shifter, where any s took two 6-level ones and a KW-bit adder.
+module fix_round #(parameter integer DW = 32, parameter integer KW = 64,
+                   parameter integer SMIN = -64, parameter integer SMAX = 63) (
     input  wire signed [KW-1:0] k,
     input  wire        [6:0]    s,
     output wire        [DW-1:0] y
 );
-  wire        neg = s[6];
-  wire [5:0]  right = s[5:0];
-  wire [5:0]  left = 6'd0 - s[5:0];
-  wire signed [KW-1:0] one = 1;
-  wire signed [KW-1:0] half = (right == 6'd0) ? {KW{1'b0}} : (one <<< (right - 6'd1));
-  wire signed [KW-1:0] r = neg ? (k <<< left) : ((k + half) >>> right);
-  assign y = r[DW-1:0];
+  // room on the right for the left shifts (s <= 0), the constant part of the shift, its span
+  localparam integer P = (SMIN <= 0) ? 1 - SMIN : 0;
+  localparam integer C0 = SMIN - 1 + P;
+  localparam integer SPAN = SMAX - SMIN;
+  localparam integer BB = (SPAN <= 0) ? 1 : $clog2(SPAN + 1);
+  localparam integer EW = KW + P;
+  wire signed [EW-1:0] ke = k;  // sign-extends
+  wire signed [EW-1:0] e = (ke <<< P) >>> C0;
+  wire        [6:0]    smin7 = SMIN;
+  wire        [6:0]    b7 = s - smin7;
+  wire        [BB-1:0] b = (SPAN <= 0) ? {BB{1'b0}} : b7[BB-1:0];
+  wire signed [EW-1:0] t = e >>> b;
+  wire                 up = ~s[6] & (s != 7'd0);
+  wire        [DW:0]   r = t[DW:0] + {{DW{1'b0}}, up};
+  assign y = r[DW:1];
 endmodule
 
 // The stages after the exact result K: with LATENCY >= 1, K and the shift are registered
 // before the rounding (the arithmetic and the rounding in separate clocks), then LATENCY - 1
 // delay stages; with LATENCY = 0, combinational.
-module fix_stages #(parameter integer LATENCY = 1, parameter integer DW = 32, parameter integer KW = 64) (
+module fix_stages #(parameter integer LATENCY = 1, parameter integer DW = 32, parameter integer KW = 64,
+                    parameter integer SMIN = -64, parameter integer SMAX = 63) (
     input  wire                 clk,
     input  wire signed [KW-1:0] k,
     input  wire        [6:0]    s,
@@ -59,7 +76,7 @@ module fix_stages #(parameter integer LATENCY = 1, parameter integer DW = 32, pa
   wire [DW-1:0] r;
   generate
     if (LATENCY == 0) begin : g_comb
-      fix_round #(.DW(DW), .KW(KW)) rnd (.k(k), .s(s), .y(r));
+      fix_round #(.DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) rnd (.k(k), .s(s), .y(r));
       assign y = r;
     end else begin : g_split
       reg signed [KW-1:0] k_q;
@@ -72,14 +89,18 @@ module fix_stages #(parameter integer LATENCY = 1, parameter integer DW = 32, pa
         k_q <= k;
         s_q <= s;
       end
-      fix_round #(.DW(DW), .KW(KW)) rnd (.k(k_q), .s(s_q), .y(r));
+      fix_round #(.DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) rnd (.k(k_q), .s(s_q), .y(r));
       fp_delay #(.LATENCY(LATENCY - 1), .W(DW)) line (.clk(clk), .d(r), .q(y));
     end
   endgenerate
 endmodule
 
-// The ADD PE's unit: y = round(align(a) +- align(b)), LATENCY clocks after the operands.
-module fix_add_sub #(parameter integer LATENCY = 1, parameter integer DW = 32, parameter integer KW = 64) (
+// The ADD PE's unit: y = round(align(a) +- align(b)), LATENCY clocks after the operands. One
+// operand is aligned (sh[6] says which), by at most AMAX bits (the PE program's largest
+// alignment): the two operands are swapped so that one shifter of ceil(log2(AMAX + 1)) levels
+// serves both, and a - b negates whichever side b took (x - y = x + ~y + 1).
+module fix_add_sub #(parameter integer LATENCY = 1, parameter integer DW = 32, parameter integer KW = 64,
+                     parameter integer AMAX = 63, parameter integer SMIN = -64, parameter integer SMAX = 63) (
     input  wire          clk,
     input  wire [DW-1:0] a,
     input  wire [DW-1:0] b,
@@ -87,16 +108,19 @@ module fix_add_sub #(parameter integer LATENCY = 1, parameter integer DW = 32, p
     input  wire [13:0]   sh,
     output wire [DW-1:0] y
 );
+  localparam integer AB = (AMAX <= 0) ? 1 : $clog2(AMAX + 1);
+  wire side = sh[6];
   // signed assignments to wider wires sign-extend
-  wire signed [DW-1:0] sa = a;
-  wire signed [DW-1:0] sb = b;
-  wire signed [KW-1:0] ea = sa;
-  wire signed [KW-1:0] eb = sb;
-  wire [5:0] al = sh[5:0];
-  wire signed [KW-1:0] xa = sh[6] ? ea : (ea <<< al);
-  wire signed [KW-1:0] xb = sh[6] ? (eb <<< al) : eb;
-  wire signed [KW-1:0] k = sub ? (xa - xb) : (xa + xb);
-  fix_stages #(.LATENCY(LATENCY), .DW(DW), .KW(KW)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
+  wire signed [DW-1:0] sp = side ? b : a;
+  wire signed [DW-1:0] sq = side ? a : b;
+  wire signed [KW-1:0] ep = sp;
+  wire signed [KW-1:0] eq = sq;
+  wire [AB-1:0] al = (AMAX <= 0) ? {AB{1'b0}} : sh[AB-1:0];
+  wire signed [KW-1:0] xp = ep <<< al;
+  wire negp = sub & side;
+  wire negq = sub & ~side;
+  wire signed [KW-1:0] k = (xp ^ {KW{negp}}) + (eq ^ {KW{negq}}) + {{(KW-1){1'b0}}, sub};
+  fix_stages #(.LATENCY(LATENCY), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
 endmodule
 
 // The MULTI PE's unit: y = round(a * b), LATENCY clocks after the operands. For DW <= 27 the
@@ -105,7 +129,8 @@ endmodule
 // products of the (DW - 16)-bit signed high and 16-bit unsigned low halves (one MULT18X18D each
 // on the ECP5, one 18 x 19 half block each on the Cyclone V), registered, then summed in the
 // next clock.
-module fix_mul #(parameter integer LATENCY = 2, parameter integer DW = 32, parameter integer KW = 64) (
+module fix_mul #(parameter integer LATENCY = 2, parameter integer DW = 32, parameter integer KW = 64,
+                 parameter integer SMIN = -64, parameter integer SMAX = 63) (
     input  wire          clk,
     input  wire [DW-1:0] a,
     input  wire [DW-1:0] b,
@@ -144,13 +169,13 @@ module fix_mul #(parameter integer LATENCY = 2, parameter integer DW = 32, param
       wire signed [KW-1:0] elh = lh;
       wire signed [KW-1:0] ell = ll;
       wire signed [KW-1:0] k = (ehh <<< 32) + (ehl <<< 16) + (elh <<< 16) + ell;
-      fix_stages #(.LATENCY(LATENCY - 1), .DW(DW), .KW(KW)) st (.clk(clk), .k(k), .s(s1), .y(y));
+      fix_stages #(.LATENCY(LATENCY - 1), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) st (.clk(clk), .k(k), .s(s1), .y(y));
     end else begin : g_whole
       wire signed [DW-1:0]   sa = a;
       wire signed [DW-1:0]   sb = b;
       wire signed [2*DW-1:0] p = sa * sb;
       wire signed [KW-1:0]   k = p;  // sign-extends (or keeps the low KW >= the product's bits)
-      fix_stages #(.LATENCY(LATENCY), .DW(DW), .KW(KW)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
+      fix_stages #(.LATENCY(LATENCY), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
     end
   endgenerate
 endmodule

@@ -28,6 +28,9 @@ module rv_pe #(
     parameter FIX_FILE = "",           // its shift memory image (14-bit words, fix_units.v)
     parameter integer DW = 32,         // data word bits (32 for binary32 PEs; fixed point: the widest format)
     parameter integer KW = 64,         // fixed-point PEs: bits of the exact intermediate (fix_units.v)
+    parameter integer AMAX = 63,       // fixed-point PEs: the program's largest alignment (fix_units.v)
+    parameter integer SMIN = -64,      // fixed-point PEs: the program's rounding shifts, SMIN..SMAX
+    parameter integer SMAX = 63,
     parameter integer LAT = 12,        // cycles from issue to arrival (>= 3)
     parameter integer N0 = 4,          // sources of write port 0 (crossbar: 2 NPE)
     parameter integer SW0 = 3,         // its select bits
@@ -117,9 +120,9 @@ module rv_pe #(
       rv_rom #(.WIDTH(14), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(FIX_FILE)) u_fix (.clk(clk), .addr(fetch), .q(sh));
       always @(posedge clk) sh_q <= sh;
       if (IS_MUL != 0) begin : g_mul
-        fix_mul #(.LATENCY(LAT - 2), .DW(DW), .KW(KW)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
+        fix_mul #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
       end else begin : g_add
-        fix_add_sub #(.LATENCY(LAT - 2), .DW(DW), .KW(KW)) u_fx (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .sh(sh_q), .y(y));
+        fix_add_sub #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .AMAX(AMAX), .SMIN(SMIN), .SMAX(SMAX)) u_fx (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .sh(sh_q), .y(y));
       end
     end else if (IS_MUL != 0) begin : g_mul
       fp_mul #(.LATENCY(LAT - 2)) u_fp (.clk(clk), .a(qa), .b(qb), .y(y));
