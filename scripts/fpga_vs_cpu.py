@@ -49,7 +49,7 @@ MODELS = {
     "walkman": "matlab/walkman__mbs_dirdyna_walkman_robotran.m",
 }
 # The fixed-point PEs' latencies (the target's fix_pe) for the rewrites that balance for them.
-PRE = "atomise,cse,zero-removal,balance<lat-add=4;lat-mul=5>,cse,recurrence<pe=16;lat-add=4;lat-mul=5>,cse"
+PRE = "atomise,cse,zero-removal,balance<lat-add=3;lat-mul=3>,cse,recurrence<pe=16;lat-add=3;lat-mul=3>,cse"
 # Per target: the widest word whose product takes one DSP multiplier (docs/fpga.md "Narrow words").
 ONE_BLOCK_WORD = {"de10-nano": 27, "ecp5-85f": 18}
 

@@ -190,13 +190,26 @@ fn fp_units_and_pe_library_pass_verilator_lint() {
     let binary32: &[&str] = &[];
     for params in [
         binary32,
-        &["-GFIX=1", "-GIS_MUL=0", "-GLAT=4"],
+        &["-GFIX=1", "-GIS_MUL=0", "-GLAT=3"],
         &["-GFIX=1", "-GIS_MUL=1", "-GLAT=4"],
         &["-GLVT=1", "-GMEM_DEPTH=8", "-GAW=3"],
         // narrow words (precision<word=W>): a 27-bit MULTI PE (one DSP product), a 20-bit ADD
         // PE on the live-value-table memory
-        &["-GFIX=1", "-GIS_MUL=1", "-GLAT=5", "-GDW=27", "-GKW=55"],
-        &["-GFIX=1", "-GIS_MUL=0", "-GLAT=4", "-GDW=20", "-GKW=37", "-GLVT=1", "-GMEM_DEPTH=8", "-GAW=3"],
+        // with the shifters sized to a program's shifts (a MULTI PE rounding by 24 to 26 bits)
+        &["-GFIX=1", "-GIS_MUL=1", "-GLAT=3", "-GDW=27", "-GKW=55", "-GSMIN=24", "-GSMAX=26"],
+        &[
+            "-GFIX=1",
+            "-GIS_MUL=0",
+            "-GLAT=3",
+            "-GDW=20",
+            "-GKW=37",
+            "-GAMAX=11",
+            "-GSMIN=-2",
+            "-GSMAX=12",
+            "-GLVT=1",
+            "-GMEM_DEPTH=8",
+            "-GAW=3",
+        ],
     ] {
         let out = Command::new("verilator")
             .args(["--lint-only", "-Wno-fatal", "-Wno-WIDTH", "-Wno-DECLFILENAME", "--top-module", "rv_pe"])
@@ -480,7 +493,7 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
         let man: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
         assert_eq!(man["pe_kind"], "fixed");
-        assert_eq!(man["latency"], serde_json::json!({"add": 4, "mul": 5}), "the target's fix_pe latencies");
+        assert_eq!(man["latency"], serde_json::json!({"add": 3, "mul": 4}), "the target's fix_pe latencies");
         assert_eq!(rep["sim"]["precisions"], serde_json::json!(["fixed point"]));
         // the same ops (precision changes formats, not ops) at shorter latencies: fewer cycles
         let (c_fix, c_float) = (man["cycles"].as_u64().unwrap(), float_rep["fpga"]["cycles"].as_u64().unwrap());
@@ -576,10 +589,10 @@ fn narrow_fixed_point_words_simulate_bit_for_bit_and_take_one_dsp_block_a_produc
         let man: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
         assert_eq!(man["word_bits"], word, "the widest format is the word");
-        // a product that is one DSP block has no partial products to sum: MULTI 4 cycles, not 5
+        // a product that is one DSP block has no partial products to sum: MULTI 3 cycles, not 4
         let one_multiplier = if target == "ecp5-85f" { 18 } else { 27 };
-        let mul = if word <= one_multiplier { 4 } else { 5 };
-        assert_eq!(man["latency"], serde_json::json!({"add": 4, "mul": mul}), "word={word}");
+        let mul = if word <= one_multiplier { 3 } else { 4 };
+        assert_eq!(man["latency"], serde_json::json!({"add": 3, "mul": mul}), "word={word}");
         let data = std::fs::read_to_string(dir.join("hex/pe0_data.hex")).unwrap();
         assert!(data.lines().all(|l| l.len() == word.div_ceil(4) as usize), "word={word}: {data}");
         let top = std::fs::read_to_string(dir.join("hdl/robovec_top.v")).unwrap();
@@ -754,7 +767,7 @@ fn sweep_times_and_costs_a_fixed_point_function_with_its_pes() {
     let rows = r["sweep"].as_array().unwrap();
     assert!(!rows.is_empty());
     for row in rows {
-        assert_eq!((row["lat_add"].as_u64(), row["lat_mul"].as_u64()), (Some(4), Some(5)), "{row}");
+        assert_eq!((row["lat_add"].as_u64(), row["lat_mul"].as_u64()), (Some(3), Some(4)), "{row}");
         let n = row["n"].as_u64().unwrap() as f64;
         // n fixed ADD + n MULTI full-range units (the target's fix_pe), 3 ALM per PE memory, the crossbar (8.125 ALM per write
         // port and source: 2n memories × 2 ports × 4n sources) and the control (469)

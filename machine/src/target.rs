@@ -32,8 +32,8 @@
 //! | `datapath.fp64_add` | 886 ALM, 0 DSP | Intel, *Floating-Point IP Cores User Guide* (UG-01058), "FP_FUNCTIONS Resource Utilization": double-precision Add on Arria V (the same 28 nm ALM and variable-precision DSP block as Cyclone V; its single-precision Add is the seed's 360 ALM) |
 //! | `datapath.fp64_mul` | 250 ALM, 4 DSP | estimate: a 53 × 53 mantissa product tiles into four 27 × 27 blocks (the "54 × 54: four blocks" row of Intel's variable-precision DSP tables); ALM 2.5 × the seed's binary32 MULTI (exponent, rounding and normalisation twice as wide, plus the tiles' adder). No datasheet figure at hand |
 //! | `datapath.convert_alm` | 100 ALM per conversion | estimate: a conversion between fixed and floating point (or binary32 and binary64) is a leading-zero count and a barrel shift of the word, of the order of the seed's MULTI PE logic (100 ALM) |
-//! | `fix_pe.add` | latency 4 cycles = 2 stages + 2; 390 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`) in two pipeline stages, the exact sum registered before its rounding (the issue's "1–2 stages"; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` with 32-bit words, KW = 64 and any shift (`AMAX = 63`, `SMIN = −64`, `SMAX = 63`: [`crate::resources::FULL_SHIFTS`]) by [`crate::resources`]' packing bound (164 LUT6, 346 smaller LUTs, 106 carry bits); a design's PEs are sized to their own shifts and widths (`resources::fixed_unit`: a typical Jeep ADD PE 231 ALM) |
-//! | `fix_pe.mul` | latency 5 cycles = 3 stages + 2; 299 ALM, 2 DSP | a 32 × 32 signed product as four registered 16 × 16 partial products (four 18 × 19 multipliers, two per Cyclone V variable-precision block: 2 blocks), their sum, and the rounding shift (any shift); ALM from Yosys as above at `LATENCY = 3` (41 LUT6, 474 smaller LUTs, 41 carry bits; 4 `MISTRAL_MUL18X18`); a 27-bit MULTI PE rounding by 24 to 26 bits, as the Jeep's, is one 27 × 27 block and 36 ALM |
+//! | `fix_pe.add` | latency 3 cycles = 1 stage + 2; 390 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`): the exact sum registered, its rounding computed in the next clock straight into the PE's result register (the issue's "1–2 stages"; until the units were sized to their shifts a second, empty stage delayed the rounded result by a clock for nothing: every register-to-register path is the same without it; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` with 32-bit words, KW = 64 and any shift (`AMAX = 63`, `SMIN = −64`, `SMAX = 63`: [`crate::resources::FULL_SHIFTS`]) by [`crate::resources`]' packing bound (164 LUT6, 346 smaller LUTs, 106 carry bits); a design's PEs are sized to their own shifts and widths (`resources::fixed_unit`: a typical Jeep ADD PE 231 ALM) |
+//! | `fix_pe.mul` | latency 4 cycles = 2 stages + 2; 299 ALM, 2 DSP | a 32 × 32 signed product as four registered 16 × 16 partial products (four 18 × 19 multipliers, two per Cyclone V variable-precision block: 2 blocks), their sum registered, and the rounding shift (any shift) into the result register; a product that is one DSP multiplier is registered and rounded: 3 cycles ([`FixPe::latencies_for`]); ALM from Yosys as above at `LATENCY = 3` (41 LUT6, 474 smaller LUTs, 41 carry bits; 4 `MISTRAL_MUL18X18`); a 27-bit MULTI PE rounding by 24 to 26 bits, as the Jeep's, is one 27 × 27 block and 36 ALM |
 //! | `output_word_alm` | 0 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are block RAM with a registered read port (`rv_out_mem`), counted as M10K blocks, so they take no logic a word. (Until issue 49 they were 32-bit registers read asynchronously: 16 ALM a word, the slope Yosys measured per PE, [`crate::resources`].) The key stays for a design whose output words cost logic; optional in a JSON target (default 0) |
 //!
 //!
@@ -115,8 +115,8 @@
 //!     "convert_alm": 100
 //!   },
 //!   "fix_pe": {
-//!     "add": { "latency": 4, "alm": 390, "dsp": 0, "m10k": 0 },
-//!     "mul": { "latency": 5, "alm": 299, "dsp": 2, "m10k": 0 }
+//!     "add": { "latency": 3, "alm": 390, "dsp": 0, "m10k": 0 },
+//!     "mul": { "latency": 4, "alm": 299, "dsp": 2, "m10k": 0 }
 //!   }
 //! }
 //! ```
@@ -352,8 +352,8 @@ impl Default for FixPe {
     /// The DE10-Nano's (module doc).
     fn default() -> Self {
         FixPe {
-            add: FixUnit { latency: 4, alm: 390.0, dsp: 0, m10k: 0 },
-            mul: FixUnit { latency: 5, alm: 299.0, dsp: 2, m10k: 0 },
+            add: FixUnit { latency: 3, alm: 390.0, dsp: 0, m10k: 0 },
+            mul: FixUnit { latency: 4, alm: 299.0, dsp: 2, m10k: 0 },
         }
     }
 }
@@ -667,8 +667,8 @@ impl Target {
                 convert_alm: 200.0,
             },
             fix_pe: FixPe {
-                add: FixUnit { latency: 4, alm: 1494.0, dsp: 0, m10k: 0 },
-                mul: FixUnit { latency: 5, alm: 2129.0, dsp: 4, m10k: 0 },
+                add: FixUnit { latency: 3, alm: 1494.0, dsp: 0, m10k: 0 },
+                mul: FixUnit { latency: 4, alm: 2129.0, dsp: 4, m10k: 0 },
             },
             pnr: Some(crate::pnr::PnrPart { device: "85k".into(), package: "CABGA381".into() }),
             // The same Verilog units, pipeline, instruction word and control as the DE10-Nano's:
@@ -926,12 +926,12 @@ mod tests {
             let l = t.fix_pe.latencies_for(t.family, w);
             (l.add, l.mul)
         };
-        assert_eq!([lat(&de10, 32), lat(&de10, 28), lat(&de10, 27), lat(&de10, 16)], [(4, 5), (4, 5), (4, 4), (4, 4)]);
+        assert_eq!([lat(&de10, 32), lat(&de10, 28), lat(&de10, 27), lat(&de10, 16)], [(3, 4), (3, 4), (3, 3), (3, 3)]);
         let ecp5 = Target::ecp5_85f();
-        assert_eq!([lat(&ecp5, 27), lat(&ecp5, 19), lat(&ecp5, 18)], [(4, 5), (4, 5), (4, 4)]);
+        assert_eq!([lat(&ecp5, 27), lat(&ecp5, 19), lat(&ecp5, 18)], [(3, 4), (3, 4), (3, 3)]);
         let mut short = Target::de10_nano();
         short.fix_pe.mul.latency = 3;
-        assert_eq!(lat(&short, 20), (4, 3), "one unit stage + 2 is the least");
+        assert_eq!(lat(&short, 20), (3, 3), "one unit stage + 2 is the least");
     }
 
     #[test]

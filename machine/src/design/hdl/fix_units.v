@@ -7,10 +7,13 @@
 // computed exactly on the operands' integers, aligned by a constant shift, then rounded once to
 // the result's format: what `-eval` computes and the C back end writes as `int64_t` arithmetic.
 //
-//   fix_add_sub #(.LATENCY(L), .DW(w), .KW(k)) u (.clk, .a, .b, .sub, .sh, .y);   ADD PE
-//   fix_mul     #(.LATENCY(L), .DW(w), .KW(k)) u (.clk, .a, .b, .sh, .y);         MULTI PE
+//   fix_add_sub #(.LATENCY(L), .DW(w), .KW(k), .AMAX(a), .SMIN(s0), .SMAX(s1)) u (.clk, .a, .b, .sub, .sh, .y);
+//   fix_mul     #(.LATENCY(L), .DW(w), .KW(k), .SMIN(s0), .SMAX(s1)) u (.clk, .a, .b, .sh, .y);
 //
-// The exact result is registered before its rounding (`fix_stages`), then a delay line.
+// The exact result is registered before its rounding (`fix_stages`), then a delay line when
+// L > 1 (robovec's PEs take L = 1: the rounding goes straight into the PE's result register).
+// AMAX, SMIN and SMAX bound the alignments and rounding shifts of the PE's program (the
+// generator's `shift_ranges`): the shifters cover only those.
 // `sh` is the op's shift word (the PE's shift memory `peS_fix`, one word per cycle, registered
 // with the operands):
 //   [0,6)  align: the bits the aligned operand is shifted left (the two operands' fractions
@@ -26,9 +29,9 @@
 // fits its w <= DW bits, so y is the low DW bits after rounding. The multiplier is a DW x DW
 // signed product: one 27 x 27 variable-precision DSP block on the Cyclone V for DW <= 27, two
 // beyond; on the ECP5 one MULT18X18D for DW <= 18, four beyond. y is the result of the
-// operands presented LATENCY rising edges earlier: the exact result in the first clock (the
+// operands presented LATENCY rising edges earlier: the exact result in the first clock (a split
 // product in two: its partial products, then their sum), its rounding in the next, then a delay
-// line (measured on the ECP5-85F with nextpnr, the double pendulum's 2 + 2 design: 58 MHz with
+// line of LATENCY - 1 clocks (measured on the ECP5-85F with nextpnr, the double pendulum's 2 + 2 design: 58 MHz with
 // the rounding in the product's clock, 77 MHz split, 88 MHz with the partial products
 // registered; docs/fpga.md).
 
