@@ -42,7 +42,7 @@ pub fn design_files(d: &Design, format: &str, r: &Resources, manifest: &str) -> 
     let mut v: Vec<DesignFile> = Vec::new();
     let mut add = |path: String, bytes: Vec<u8>, executable: bool| v.push(DesignFile { path, bytes, executable });
     for p in &d.pes {
-        for img in p.images() {
+        for img in d.images_of(p.slot) {
             if format != "mif" {
                 add(format!("hex/{}.hex", img.name), img.to_hex().into_bytes(), false);
             }
@@ -80,6 +80,19 @@ struct ManifestPe<'a> {
     latency: u32,
     buffer_words: u32,
     memories: std::collections::BTreeMap<&'static str, ManifestMemory>,
+    /// The control memory the HDL reads (`Design::control`): the same fields as `instr`,
+    /// `xbar`, `bufi`, `capt` and `fix`, one word per cycle in lanes.
+    control: ManifestControl,
+}
+
+#[derive(Clone, Debug, Serialize)]
+struct ManifestControl {
+    /// Bits of each address field.
+    pa: u32,
+    /// Bits of the word.
+    width: u32,
+    /// The lanes, bit 0 of the word in the first.
+    lanes: Vec<ManifestMemory>,
 }
 
 /// The manifest (`manifest.json`): everything a host or a script needs to load and read the
@@ -101,7 +114,10 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             .into_iter()
             .chain(p.fix.as_ref().map(|i| ("fix", m(i))))
             .collect();
+            let c = d.control(p.slot);
+            let control = ManifestControl { pa: c.pa, width: c.width, lanes: c.lanes.iter().map(m).collect() };
             ManifestPe {
+                control,
                 slot: p.slot,
                 pe: &p.pe,
                 kind: if p.is_mul { "mul" } else { "add" },
@@ -154,6 +170,9 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "bufi": format!("[0,{b}) store address, [{b},{}) read address, bit {} store enable, bit {} read enable",
             2 * w.bw, 2 * w.bw, 2 * w.bw + 1, b = w.bw),
         "capt": format!("[0,{o}) output-memory address, bit {o} enable", o = w.ow),
+        "control": "per PE (`control`): one word per cycle, from bit 0: the instruction's four addresses `pa` bits each \
+            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word; the `capt` word; \
+            on fixed-point PEs the `fix` word; split into `lanes` (the HDL's control memories; the other images hold the same fields)",
         "data": match d.pe_kind {
             PeKind::Binary32 => "binary32",
             PeKind::Fixed => "fixed point: the `word_bits`-bit two's complement integer k of a value k·2^-f (each load's and output's `fraction`); out_data sign-extends it to 32 bits",

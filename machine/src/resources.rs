@@ -239,19 +239,15 @@ pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
         PeMemory::LiveValueTable => (false, 4),
     };
     for p in &d.pes {
-        let fixed = p.fix.iter().map(|i| (i, false, 1));
+        // the control memory's lanes (`Design::control`): the instruction, selects, buffer and
+        // capture words and the shift word, fetched together
+        let control = d.control(p.slot).lanes;
+        let lanes = control.iter().map(|i| (i, false, 1));
         // the output memory (`rv_out_mem`) of a PE that holds outputs: one simple dual-port
         // memory (a PE without outputs has a constant one, which synthesis removes)
         let holds = d.outputs.iter().any(|o| o.slot == p.slot) || d.output_loads.iter().any(|l| l.slot == p.slot);
         let out = holds.then_some((&p.out, false, 1));
-        let all = [
-            (&p.instr, false, 1),
-            (&p.xbar, false, 1),
-            (&p.bufi, false, 1),
-            (&p.capt, false, 1),
-            (&p.data, pe_tdp, banks),
-        ];
-        for (img, true_dual_port, banks) in all.into_iter().chain(fixed).chain(out) {
+        for (img, true_dual_port, banks) in lanes.chain([(&p.data, pe_tdp, banks)]).chain(out) {
             let words = img.words.len().max(1) as u64;
             v.push(MemoryCost {
                 name: img.name.clone(),

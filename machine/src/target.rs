@@ -247,6 +247,20 @@ impl Family {
     /// 512×36 as the pseudo dual-port PDPW16KD (Lattice TN1264, *ECP5 and ECP5-5G Memory Usage
     /// Guide*, tables of DP16KD and PDPW16KD).
     pub const fn bram_configurations(self) -> (&'static [(u64, u64)], u64) {
+        self.bram_modes()
+    }
+
+    /// Bits of the widest word of one block RAM (40 on the Cyclone V's M10K, 256 × 40; 36 on the
+    /// ECP5's 512 × 36): the lanes of a PE's control memory (`crate::design::Design::control`),
+    /// since every narrower configuration's width divides it.
+    pub const fn bram_word(self) -> u32 {
+        match self {
+            Family::CycloneV => 40,
+            Family::Ecp5 => 36,
+        }
+    }
+
+    const fn bram_modes(self) -> (&'static [(u64, u64)], u64) {
         match self {
             Family::CycloneV => (&[(8192, 1), (4096, 2), (2048, 5), (1024, 10), (512, 20), (256, 40)], 20),
             Family::Ecp5 => (&[(16384, 1), (8192, 2), (4096, 4), (2048, 9), (1024, 18), (512, 36)], 18),

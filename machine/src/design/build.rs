@@ -31,6 +31,8 @@ pub struct Limits {
     pub writes: u32,
     /// How the design builds its PE memories (the target family's, [`Family::pe_memory`]).
     pub pe_memory: PeMemory,
+    /// Bits of a control-memory lane: the family's widest block-RAM word ([`Family::bram_word`]).
+    pub control_lane_bits: u32,
 }
 
 impl Limits {
@@ -43,6 +45,7 @@ impl Limits {
             instr_width: t.instr_width,
             writes: t.writes,
             pe_memory: t.family.pe_memory(),
+            control_lane_bits: t.family.bram_word(),
         }
     }
 }
@@ -286,6 +289,18 @@ pub fn from_placement_until(
 pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result<Design, String> {
     let layout = Layout::new(m, limits.pe_words, limits.buffer_words, limits.instr_width).map_err(|e| e.to_string())?;
     let im = encode::encode(m, &layout).map_err(|e| e.to_string())?;
+    // the control word (`Design::control`) at its widest, the crossbar's selects: four lanes
+    let control_bits = layout.instr_bits()
+        + layout.crossbar_bits()
+        + layout.buffer_bits()
+        + layout.capture_bits()
+        + if m.fixed.is_some() { robovec_ir::machine::FixShifts::BITS } else { 0 };
+    if control_bits > 4 * limits.control_lane_bits {
+        return Err(format!(
+            "a PE's control word needs {control_bits} bits, more than the four {}-bit lanes of its control memory",
+            limits.control_lane_bits
+        ));
+    }
     let widths = Widths {
         aw: layout.aw,
         bw: layout.bw,
@@ -369,6 +384,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
             .collect(),
         routes: None,
         pe_memory: limits.pe_memory,
+        control_lane_bits: limits.control_lane_bits,
         states: f.states,
         pe_kind: if fx.is_some() { PeKind::Fixed } else { PeKind::Binary32 },
         word_bits: word_bits_of(fx),

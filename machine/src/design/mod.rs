@@ -206,6 +206,23 @@ pub struct Design {
     /// for binary32 PEs, the function's widest format for fixed-point ones
     /// ([`crate::program::fixed::word_bits`]).
     pub word_bits: u32,
+    /// Bits of a lane of the PE control memories ([`Design::control`]): the family's widest
+    /// block-RAM word.
+    pub control_lane_bits: u32,
+}
+
+/// A PE's control memory ([`Design::control`]): one word per cycle holding the instruction (its
+/// four addresses `pa` bits each), the write-port selects, the buffer instruction, the output
+/// capture and the shift word, split into lanes of the family's widest block-RAM word.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Control {
+    /// Bits of each address field of the instruction: the PE memory's address bits.
+    pub pa: u32,
+    /// Bits of the whole word (`4·pa + 4` + selects + buffer + capture [+ 14 shift bits]).
+    pub width: u32,
+    /// The lanes, bit 0 of the word in lane 0 (`peS_ctrlK`), each `control_lane_bits` wide but
+    /// the last.
+    pub lanes: Vec<Image>,
 }
 
 /// The fixed Verilog files, `(name, text)`: the FP unit models, the memories and the PE.
@@ -339,6 +356,68 @@ impl Design {
         }
     }
 
+    /// PE `slot`'s control memory: per cycle its instruction word with each address field cut
+    /// to the PE memory's address bits (`[0,pa)` read A, `[pa,2pa)` read B, `[2pa,3pa)` write-0
+    /// address, `[3pa,4pa)` write-1 address, then we0, we1, issue valid, sub), its write-port
+    /// selects (the `xbar` image, `xbar.width` bits), its buffer instruction (`bufi`), its output
+    /// capture (`capt`) and, on fixed-point PEs, its shift word (`fix`, 14 bits), in that order from
+    /// bit 0; split into lanes of [`Design::control_lane_bits`] (`peS_ctrl0`, `peS_ctrl1`, …). The
+    /// separate images are the same fields one memory each (the manifest's `memories`); the HDL
+    /// reads the lanes: every field is fetched at the same cycle, so one memory of the word's
+    /// width holds them in ⌈width / lane⌉ blocks (at most 256 cycles on the Cyclone V) where
+    /// five memories took a block each and the 52-bit instruction two.
+    pub fn control(&self, slot: usize) -> Control {
+        let p = &self.pes[slot];
+        let aw = self.widths.aw;
+        let pa = addr_bits(p.data.words.len().max(1) as u64).min(aw);
+        let mut fields: Vec<(&Image, u32)> =
+            vec![(&p.xbar, p.xbar.width), (&p.bufi, p.bufi.width), (&p.capt, p.capt.width)];
+        fields.extend(p.fix.iter().map(|f| (f, f.width)));
+        let width = 4 * pa + 4 + fields.iter().map(|f| f.1).sum::<u32>();
+        let lane = self.control_lane_bits.max(1);
+        let n_lanes = width.div_ceil(lane) as usize;
+        let cycles = p.instr.words.len();
+        let mut lanes: Vec<Image> = (0..n_lanes)
+            .map(|k| Image {
+                name: format!("pe{slot}_ctrl{k}"),
+                width: lane.min(width - k as u32 * lane),
+                words: vec![0; cycles],
+            })
+            .collect();
+        let mask = |bits: u32| if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
+        for c in 0..cycles {
+            let mut at = 0u32;
+            let mut put = |value: u64, bits: u32| {
+                for i in 0..bits {
+                    if value >> i & 1 == 1 {
+                        let b = at + i;
+                        lanes[(b / lane) as usize].words[c] |= 1 << (b % lane);
+                    }
+                }
+                at += bits;
+            };
+            let w = p.instr.words[c];
+            for k in 0..4 {
+                let field = w >> (k * aw) & mask(aw);
+                debug_assert!(field <= mask(pa), "an address beyond the PE memory's words");
+                put(field & mask(pa), pa);
+            }
+            put(w >> (4 * aw) & 0xf, 4);
+            for (img, bits) in &fields {
+                put(img.words.get(c).copied().unwrap_or(0), *bits);
+            }
+        }
+        Control { pa, width, lanes }
+    }
+
+    /// Every image of PE `slot` the design writes: [`PeImages::images`] and its control lanes
+    /// ([`Design::control`]).
+    pub fn images_of(&self, slot: usize) -> Vec<Image> {
+        let mut v: Vec<Image> = self.pes[slot].images().into_iter().cloned().collect();
+        v.extend(self.control(slot).lanes);
+        v
+    }
+
     /// Bits of the output read port's PE select.
     fn pe_bits(&self) -> u32 {
         addr_bits(self.n_pe() as u64)
@@ -402,12 +481,11 @@ impl Design {
             let (src0, n0, sw0) = self.port_sources(p.slot, 0);
             let (src1, n1, sw1) = self.port_sources(p.slot, 1);
             let mut fix = match &p.fix {
-                Some(img) => {
+                Some(_) => {
                     let r =
                         p.shift_ranges.unwrap_or(build::ShiftRanges { align_max: 63, shift_min: -64, shift_max: 63 });
                     format!(
-                        ".FIX(1), .FIX_FILE({}), .DW({dw}), .KW({}), .AMAX({}), .SMIN({}), .SMAX({}), ",
-                        f(img),
+                        ".FIX(1), .DW({dw}), .KW({}), .AMAX({}), .SMIN({}), .SMAX({}), ",
                         self.intermediate_bits(p.slot),
                         r.align_max,
                         r.shift_min,
@@ -419,23 +497,24 @@ impl Design {
             if self.pe_memory == PeMemory::LiveValueTable {
                 fix += ".LVT(1), ";
             }
+            let control = self.control(p.slot);
+            let lanes: String =
+                control.lanes.iter().enumerate().map(|(k, l)| format!(".CTRL{k}_FILE({}), ", f(l))).collect();
             let _ = writeln!(
                 s,
-                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .IW({iw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}),\n        .INSTR_FILE({fi}), .XBAR_FILE({fx}), .BUFI_FILE({fb}), .CAPT_FILE({fc}),\n        .DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .src0({src0}), .src1({src1}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
+                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}), .PA({pa}), .CTW({ctw}), .LANE({lane}),\n        {lanes}.DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .src0({src0}), .src1({src1}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
                 mul = u8::from(p.is_mul),
                 aw = w.aw,
                 bw = w.bw,
                 ow = w.ow,
                 cw = w.cw,
-                iw = w.instr,
                 c = self.cycles,
+                pa = control.pa,
+                ctw = control.width,
+                lane = self.control_lane_bits,
                 md = p.data.words.len().max(1),
                 bd = p.buffer_words.max(1),
                 od = p.out.words.len().max(1),
-                fi = f(&p.instr),
-                fx = f(&p.xbar),
-                fb = f(&p.bufi),
-                fc = f(&p.capt),
                 fd = f(&p.data),
                 fo = f(&p.out),
                 name = p.pe,

@@ -180,7 +180,7 @@ def main(argv):
         fail("Icarus Verilog is not installed (`iverilog`, `vvp`; Debian package `iverilog`)")
     with tempfile.TemporaryDirectory(prefix="robovec-sim-") as tmp:
         for pe in man["pes"]:
-            for m in pe["memories"].values():
+            for m in list(pe["memories"].values()) + pe["control"]["lanes"]:
                 src = os.path.join(HERE, "hex", m["file"] + ".hex")
                 if os.path.exists(src):
                     shutil.copy(src, os.path.join(tmp, m["file"] + ".hex"))

@@ -25,7 +25,6 @@ module rv_pe #(
     parameter integer IS_MUL = 0,      // 0: ADD PE (fp_add_sub), 1: MULTI PE (fp_mul)
     parameter integer FIX = 0,         // 1: fixed-point PE (fix_add_sub / fix_mul, shift memory)
     parameter integer LVT = 0,         // 1: the PE memory as banks and a live-value table (rv_pe_mem_lvt)
-    parameter FIX_FILE = "",           // its shift memory image (14-bit words, fix_units.v)
     parameter integer DW = 32,         // data word bits (32 for binary32 PEs; fixed point: the widest format)
     parameter integer KW = 64,         // fixed-point PEs: bits of the exact intermediate (fix_units.v)
     parameter integer AMAX = 63,       // fixed-point PEs: the program's largest alignment (fix_units.v)
@@ -40,15 +39,17 @@ module rv_pe #(
     parameter integer BW = 4,          // buffer address bits
     parameter integer OW = 1,          // output memory address bits
     parameter integer CW = 1,          // program counter bits
-    parameter integer IW = 52,         // instruction word bits
     parameter integer CYCLES = 0,      // last cycle of the program
     parameter integer MEM_DEPTH = 1,   // PE memory words
     parameter integer BUF_DEPTH = 1,   // buffer words
     parameter integer OUT_DEPTH = 1,   // output memory words
-    parameter INSTR_FILE = "",
-    parameter XBAR_FILE = "",
-    parameter BUFI_FILE = "",
-    parameter CAPT_FILE = "",
+    parameter integer PA = 11,         // bits of each address field of the control word (<= AW)
+    parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + 2 * BW + 2 + OW + 1 + (FIX != 0 ? 14 : 0),  // control word bits
+    parameter integer LANE = 40,       // bits of a control-memory lane (the widest block-RAM word)
+    parameter CTRL0_FILE = "",         // the control memory's lanes (robovec's `Design::control`),
+    parameter CTRL1_FILE = "",         // bit 0 of the word in lane 0; at most four lanes
+    parameter CTRL2_FILE = "",
+    parameter CTRL3_FILE = "",
     parameter DATA_FILE = "",
     parameter OUT_FILE = ""
 ) (
@@ -67,23 +68,49 @@ module rv_pe #(
   localparam integer OCW = OW + 1;
   localparam integer ROM_DEPTH = CYCLES + 1;
 
-  wire [IW-1:0]  instr;
-  wire [XW-1:0]  xbar;
-  wire [BIW-1:0] bufi;
-  wire [OCW-1:0] capt;
-  rv_rom #(.WIDTH(IW),  .DEPTH(ROM_DEPTH), .AW(CW), .FILE(INSTR_FILE)) u_instr (.clk(clk), .addr(fetch), .q(instr));
-  rv_rom #(.WIDTH(XW),  .DEPTH(ROM_DEPTH), .AW(CW), .FILE(XBAR_FILE))  u_xbar  (.clk(clk), .addr(fetch), .q(xbar));
-  rv_rom #(.WIDTH(BIW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(BUFI_FILE))  u_bufi  (.clk(clk), .addr(fetch), .q(bufi));
-  rv_rom #(.WIDTH(OCW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CAPT_FILE))  u_capt  (.clk(clk), .addr(fetch), .q(capt));
+  // The control memory: one word per cycle (the instruction with PA-bit addresses, the
+  // write-port selects, the buffer instruction, the output capture, the shift word), fetched
+  // at once from lanes of LANE bits, each one block-RAM memory.
+  localparam integer NL = (CTW + LANE - 1) / LANE;
+  wire [4*LANE-1:0] lanes;
+  genvar ln;
+  generate
+    for (ln = 0; ln < 4; ln = ln + 1) begin : g_lane
+      localparam integer LW = (ln < NL) ? ((CTW - ln * LANE < LANE) ? CTW - ln * LANE : LANE) : 1;
+      if (ln < NL) begin : g_rom
+        wire [LW-1:0] q;
+        if (ln == 0) begin : g0
+          rv_rom #(.WIDTH(LW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CTRL0_FILE)) u_rom (.clk(clk), .addr(fetch), .q(q));
+        end else if (ln == 1) begin : g1
+          rv_rom #(.WIDTH(LW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CTRL1_FILE)) u_rom (.clk(clk), .addr(fetch), .q(q));
+        end else if (ln == 2) begin : g2
+          rv_rom #(.WIDTH(LW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CTRL2_FILE)) u_rom (.clk(clk), .addr(fetch), .q(q));
+        end else begin : g3
+          rv_rom #(.WIDTH(LW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CTRL3_FILE)) u_rom (.clk(clk), .addr(fetch), .q(q));
+        end
+        assign lanes[ln*LANE +: LW] = q;
+        if (LW < LANE) begin : g_pad
+          assign lanes[ln*LANE+LW +: LANE-LW] = {(LANE - LW){1'b0}};
+        end
+      end else begin : g_none
+        assign lanes[ln*LANE +: LANE] = {LANE{1'b0}};
+      end
+    end
+  endgenerate
+  wire [CTW-1:0] ctrl = lanes[CTW-1:0];
+  localparam integer IB = 4 * PA + 4;
 
-  // instruction word fields
-  wire [AW-1:0] ra  = instr[AW-1:0];
-  wire [AW-1:0] rb  = instr[2*AW-1:AW];
-  wire [AW-1:0] wa0 = instr[3*AW-1:2*AW];
-  wire [AW-1:0] wa1 = instr[4*AW-1:3*AW];
-  wire          we0 = instr[4*AW] & run;
-  wire          we1 = instr[4*AW+1] & run;
-  wire          sub = instr[4*AW+3];
+  // instruction fields (the addresses zero-extended to the PE memory's AW bits)
+  wire [AW-1:0] ra  = ctrl[PA-1:0];
+  wire [AW-1:0] rb  = ctrl[2*PA-1:PA];
+  wire [AW-1:0] wa0 = ctrl[3*PA-1:2*PA];
+  wire [AW-1:0] wa1 = ctrl[4*PA-1:3*PA];
+  wire          we0 = ctrl[4*PA] & run;
+  wire          we1 = ctrl[4*PA+1] & run;
+  wire          sub = ctrl[4*PA+3];
+  wire [XW-1:0]  xbar = ctrl[IB +: XW];
+  wire [BIW-1:0] bufi = ctrl[IB+XW +: BIW];
+  wire [OCW-1:0] capt = ctrl[IB+XW+BIW +: OCW];
 
   // write-port selects: 0 = none, i = word i-1 of the port's sources (crossbar: 1..NPE =
   // result of slot s-1, NPE+1..2NPE = buffer read of slot s-NPE-1)
@@ -114,10 +141,9 @@ module rv_pe #(
   generate
     if (FIX != 0) begin : g_fix
       // the op's shift word, fetched with the instruction and registered with the operands
-      wire [13:0] sh;
+      wire [13:0] sh = ctrl[IB+XW+BIW+OCW +: 14];
       reg  [13:0] sh_q;
       initial sh_q = 0;
-      rv_rom #(.WIDTH(14), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(FIX_FILE)) u_fix (.clk(clk), .addr(fetch), .q(sh));
       always @(posedge clk) sh_q <= sh;
       if (IS_MUL != 0) begin : g_mul
         fix_mul #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
