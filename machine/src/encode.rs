@@ -360,9 +360,6 @@ pub fn decode_step(l: &Layout, slot: usize, cycle: usize, words: [u64; 4]) -> Re
                 } else {
                     return Err(err("crossbar", format!("select {s} of port {p} beyond 2·{n}")));
                 };
-                if p == 1 && writes.is_empty() {
-                    return Err(err("instruction", "port 1 writes while port 0 does not".into()));
-                }
                 writes.push(MemWrite { addr, src });
             }
         }

@@ -267,6 +267,11 @@ impl Design {
                 self.routes = None;
             }
             Interconnect::Specialised => {
+                // each source on one write port where the cycles allow it (fewer inputs)
+                let mut global = global;
+                for (p, words) in self.pes.iter_mut().zip(global.iter_mut()) {
+                    routes::assign_write_ports(&mut p.instr.words, words, self.widths.aw, self.widths.sw);
+                }
                 let refs: Vec<&[u64]> = global.iter().map(|w| w.as_slice()).collect();
                 let r = Routes::of_crossbar(self.n_pe(), self.widths.sw, &refs);
                 for (s, (p, words)) in self.pes.iter_mut().zip(&global).enumerate() {
