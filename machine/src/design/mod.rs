@@ -392,14 +392,17 @@ impl Design {
         let mask = |bits: u32| if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
         for c in 0..cycles {
             let mut at = 0u32;
+            // `bits` low bits of `value` at bit `at` of the word, split where a lane ends
             let mut put = |value: u64, bits: u32| {
-                for i in 0..bits {
-                    if value >> i & 1 == 1 {
-                        let b = at + i;
-                        lanes[(b / lane) as usize].words[c] |= 1 << (b % lane);
-                    }
+                let (mut value, mut bits) = (value & mask(bits), bits);
+                while bits > 0 {
+                    let (k, off) = ((at / lane) as usize, at % lane);
+                    let take = bits.min(lane - off);
+                    lanes[k].words[c] |= (value & mask(take)) << off;
+                    value = if take >= 64 { 0 } else { value >> take };
+                    bits -= take;
+                    at += take;
                 }
-                at += bits;
             };
             let w = p.instr.words[c];
             for k in 0..4 {

@@ -81,72 +81,74 @@ pub fn selects(word: u64, sw: u32) -> [u64; 2] {
 /// inputs as the lowering numbered the writes, 1,792 distinct (memory, source) pairs, the
 /// floor this reaches when the graphs are bipartite.
 pub fn assign_write_ports(instr: &mut [u64], xbar: &mut [u64], aw: u32, sw: u32) {
-    use std::collections::HashMap;
     let mask = |bits: u32| (1u64 << bits) - 1;
+    // per source (a select below 2^sw): its neighbours, whether it takes both ports, its colour
+    let n_sel = 1usize << sw;
     let we = |i: u64, p: u32| i >> (4 * aw + p) & 1 == 1;
     // the sources (crossbar selects) written each cycle, in port order
     let writes = |c: usize| -> Vec<u64> {
         let sel = selects(xbar[c], sw);
         (0..2u32).filter(|&p| we(instr[c], p)).map(|p| sel[p as usize]).collect()
     };
-    let mut adjacent: HashMap<u64, Vec<u64>> = HashMap::new();
-    let mut both: HashMap<u64, bool> = HashMap::new();
+    let mut adjacent: Vec<Vec<u64>> = vec![Vec::new(); n_sel];
+    let mut used = vec![false; n_sel];
+    let mut both = vec![false; n_sel];
     for c in 0..instr.len() {
         let w = writes(c);
         for &g in &w {
-            adjacent.entry(g).or_default();
+            used[g as usize] = true;
         }
         if let [a, b] = w[..] {
             if a == b {
-                both.insert(a, true);
+                both[a as usize] = true;
             } else {
-                adjacent.entry(a).or_default().push(b);
-                adjacent.entry(b).or_default().push(a);
+                adjacent[a as usize].push(b);
+                adjacent[b as usize].push(a);
             }
         }
     }
     // breadth-first 2-colouring, sources in ascending order (deterministic)
-    let mut sources: Vec<u64> = adjacent.keys().copied().collect();
-    sources.sort_unstable();
-    let mut colour: HashMap<u64, u32> = HashMap::new();
+    let sources: Vec<u64> = (0..n_sel as u64).filter(|&g| used[g as usize]).collect();
+    let mut colour: Vec<Option<u32>> = vec![None; n_sel];
     for &g in &sources {
-        if colour.contains_key(&g) {
+        if colour[g as usize].is_some() {
             continue;
         }
-        colour.insert(g, 0);
+        colour[g as usize] = Some(0);
         let mut queue = std::collections::VecDeque::from([g]);
         while let Some(a) = queue.pop_front() {
-            for &b in &adjacent[&a] {
-                if !colour.contains_key(&b) {
-                    colour.insert(b, 1 - colour[&a]);
+            let ca = colour[a as usize].unwrap_or(0);
+            for &b in &adjacent[a as usize] {
+                if colour[b as usize].is_none() {
+                    colour[b as usize] = Some(1 - ca);
                     queue.push_back(b);
                 }
             }
         }
     }
+    let colour: Vec<u32> = colour.into_iter().map(|c| c.unwrap_or(0)).collect();
     // conflicts the colouring leaves: both ports for the source in the most of them, repeatedly
     loop {
         let mut worst: Option<(usize, u64)> = None;
         for &a in &sources {
-            if both.get(&a).copied().unwrap_or(false) {
+            if both[a as usize] {
                 continue;
             }
-            let bad = adjacent[&a]
+            let bad = adjacent[a as usize]
                 .iter()
-                .filter(|&&b| colour[&b] == colour[&a] && !both.get(&b).copied().unwrap_or(false))
+                .filter(|&&b| colour[b as usize] == colour[a as usize] && !both[b as usize])
                 .count();
             if bad > 0 && worst.is_none_or(|(n, _)| bad > n) {
                 worst = Some((bad, a));
             }
         }
         match worst {
-            Some((_, a)) => {
-                both.insert(a, true);
-            }
+            Some((_, a)) => both[a as usize] = true,
             None => break,
         }
     }
-    let is_both = |g: u64| both.get(&g).copied().unwrap_or(false);
+    let is_both = |g: u64| both[g as usize];
+    let colour = |g: u64| colour[g as usize];
     for c in 0..instr.len() {
         let (i, x) = (instr[c], xbar[c]);
         let sel = selects(x, sw);
@@ -155,11 +157,11 @@ pub fn assign_write_ports(instr: &mut [u64], xbar: &mut [u64], aw: u32, sw: u32)
         // the port of each write
         let ports: Vec<u32> = match fields[..] {
             [] => continue,
-            [(a, _)] => vec![if is_both(a) { 0 } else { colour[&a] }],
+            [(a, _)] => vec![if is_both(a) { 0 } else { colour(a) }],
             [(a, _), (b, _)] => {
                 let pa = match (is_both(a), is_both(b)) {
-                    (false, _) => colour[&a],
-                    (true, false) => 1 - colour[&b],
+                    (false, _) => colour(a),
+                    (true, false) => 1 - colour(b),
                     (true, true) => 0,
                 };
                 vec![pa, 1 - pa]
@@ -279,6 +281,73 @@ impl Routes {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Writes of one PE memory (`aw` = 4, `sw` = 3): `(select, address)` per port, `None`: no
+    /// write; the words [`assign_write_ports`] reads.
+    fn program_words(cycles: &[[Option<(u64, u64)>; 2]]) -> (Vec<u64>, Vec<u64>) {
+        let (aw, sw) = (4, 3);
+        cycles
+            .iter()
+            .map(|ports| {
+                let (mut i, mut x) = (0u64, 0u64);
+                for (p, w) in ports.iter().enumerate() {
+                    if let Some((g, a)) = w {
+                        i |= a << ((2 + p as u32) * aw) | 1 << (4 * aw + p as u32);
+                        x |= g << (p as u32 * sw);
+                    }
+                }
+                (i, x)
+            })
+            .unzip()
+    }
+
+    #[test]
+    fn write_ports_take_one_source_each_where_the_cycles_allow() {
+        let (aw, sw) = (4, 3);
+        // sources 1, 2, 3 written in pairs around an odd cycle (1-2, 2-3, 3-1), 4 with 1 and
+        // alone on port 1, 5 alone: a 2-colouring fails on the triangle, so one of 1, 2, 3
+        // takes both ports, every other source one
+        let w = |g, a| Some((g, a));
+        let cycles = [
+            [w(1, 1), w(2, 2)],
+            [w(3, 3), w(2, 4)],
+            [w(1, 5), w(3, 6)],
+            [w(4, 7), w(1, 8)],
+            [None, w(4, 9)],
+            [w(5, 10), None],
+            [None, None],
+        ];
+        let (mut instr, mut xbar) = program_words(&cycles);
+        let before = (instr.clone(), xbar.clone());
+        assign_write_ports(&mut instr, &mut xbar, aw, sw);
+        let writes = |i: u64, x: u64| -> Vec<(u64, u64, u32)> {
+            (0..2u32)
+                .filter(|&p| i >> (4 * aw + p) & 1 == 1)
+                .map(|p| (x >> (p * sw) & 7, i >> ((2 + p) * aw) & 15, p))
+                .collect()
+        };
+        let mut ports: Vec<std::collections::BTreeSet<u32>> = vec![Default::default(); 8];
+        for c in 0..cycles.len() {
+            let (old, new) = (writes(before.0[c], before.1[c]), writes(instr[c], xbar[c]));
+            let key = |v: &[(u64, u64, u32)]| {
+                let mut k: Vec<(u64, u64)> = v.iter().map(|w| (w.0, w.1)).collect();
+                k.sort_unstable();
+                k
+            };
+            assert_eq!(key(&old), key(&new), "cycle {c}: the same writes");
+            if let [a, b] = new[..] {
+                assert_ne!(a.2, b.2, "cycle {c}: two writes, two ports");
+            }
+            for (g, _, p) in new {
+                ports[g as usize].insert(p);
+            }
+        }
+        let on_both: Vec<usize> = (1..6).filter(|&g| ports[g].len() == 2).collect();
+        assert_eq!(on_both.len(), 1, "{ports:?}");
+        assert!(on_both[0] <= 3, "a source of the triangle: {ports:?}");
+        let r = Routes::of_crossbar(2, sw, &[&xbar]);
+        assert_eq!(r.ports[0][0].len() + r.ports[0][1].len(), 6, "five sources, one on both ports");
+    }
 
     #[test]
     fn routes_are_the_selects_used_per_port_and_local_selects_invert() {
