@@ -54,7 +54,6 @@ def pre(r=16):
     return f"atomise,cse,zero-removal,balance<lat-add=3;lat-mul=3>,cse,recurrence<pe={r};lat-add=3;lat-mul=3>,cse"
 
 
-PRE = pre()
 # Per target: the widest word whose product takes one DSP multiplier (docs/fpga.md "Narrow words").
 ONE_BLOCK_WORD = {"de10-nano": 27, "ecp5-85f": 18}
 
@@ -117,10 +116,10 @@ def report(args, work, name, env=None, refusal_ok=False):
 
 def main():
     pes, states, pnr, yosys, models, json_out = [(8, 8), (16, 16), (22, 22), (18, 26)], [1], False, False, [], None
+    prefix = pre()
     for a in sys.argv[1:]:
         if a.startswith("--recurrence="):
-            global PRE
-            PRE = pre(int(a[len("--recurrence="):]))
+            prefix = pre(int(a[len("--recurrence="):]))
         elif a.startswith("--pes="):
             pes = [config(x) for x in a[6:].split(",")]
         elif a.startswith("--states="):
@@ -147,7 +146,7 @@ def main():
         path = os.path.join(CORPUS, MODELS[model])
         work = tempfile.mkdtemp(prefix=f"fpga-vs-cpu-{model}-")
         ranges = generous_domain(path, work)
-        eb = report([path, f"-ranges={ranges}", f"-passes={PRE},error-bound<format=f32>"], work, "f32")["error_bound"]
+        eb = report([path, f"-ranges={ranges}", f"-passes={prefix},error-bound<format=f32>"], work, "f32")["error_bound"]
         budget = os.path.join(work, "budget.json")
         with open(budget, "w") as f:
             json.dump({k: {"abs": v["abs"]} for k, v in eb["outputs"].items() if v["abs"] is not None}, f)
@@ -157,7 +156,7 @@ def main():
             for w in [first] + [x for x in range(27, 33) if x > first]:
                 if w not in all_fixed:
                     prec = report(
-                        [path, f"-ranges={ranges}", f"-passes={PRE},precision<budget={budget};target=mcu;word={w}>"],
+                        [path, f"-ranges={ranges}", f"-passes={prefix},precision<budget={budget};target=mcu;word={w}>"],
                         work,
                         f"fix{w}",
                     )
@@ -193,7 +192,7 @@ def main():
                     inter = f"interleave<states={k}>," if k > 1 else ""
                     out = os.path.join(work, f"{target}-{n}-{k}")
                     passes = (
-                        f"{PRE},precision<budget={budget};target=mcu;word={w}>,{inter}"
+                        f"{prefix},precision<budget={budget};target=mcu;word={w}>,{inter}"
                         f"place<add={na};mul={nm};select=routes>,"
                         f"codegen<fpga;out={out};resources={resources};interconnect=specialised;format=hex>"
                     )

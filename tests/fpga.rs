@@ -737,7 +737,7 @@ fn yosys_maps_a_27_bit_product_to_one_dsp_block_and_a_32_bit_one_to_two() {
     assert_eq!(count(32, 64), (0, 4));
     let t = robovec_machine::target::Target::de10_nano();
     let m = robovec_machine::resources::cost_model(&t);
-    let full = robovec_machine::resources::FULL_SHIFTS;
+    let full = robovec_machine::design::build::ShiftRanges::FULL;
     assert_eq!(robovec_machine::resources::fixed_unit(&m, 27, true, 55, full).dsp, 1);
     assert_eq!(robovec_machine::resources::fixed_unit(&m, 32, true, 64, full).dsp, 2);
     let e = robovec_machine::resources::cost_model(&robovec_machine::target::Target::ecp5_85f());

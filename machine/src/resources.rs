@@ -447,10 +447,6 @@ pub fn parse_stat(json: &str) -> Result<YosysCells, String> {
     Ok(y)
 }
 
-/// The shifts of the full-range unit the target's `fix_pe` costs describe: any alignment
-/// (6 levels), any 7-bit rounding shift.
-pub const FULL_SHIFTS: ShiftRanges = ShiftRanges { align_max: 63, shift_min: -64, shift_max: 63 };
-
 /// Levels of a shifter over `span + 1` shift amounts: ⌈log₂(span + 1)⌉ (0 for one amount).
 fn levels(span: i32) -> f64 {
     if span <= 0 {
@@ -487,7 +483,7 @@ fn unit_structure(dw: u32, is_mul: bool, kw: u32, r: ShiftRanges, family: Family
 /// One fixed-point PE's unit for `dw`-bit words, a `kw`-bit exact intermediate
 /// ([`crate::design::build::intermediate_bits`]) and the shifts `r` of its program
 /// ([`crate::design::build::shift_ranges`]): the target's `fix_pe` cost, which is the 32-bit
-/// word's with a 64-bit intermediate and [`FULL_SHIFTS`], scaled by the unit's structure
+/// word's with a 64-bit intermediate and [`ShiftRanges::FULL`], scaled by the unit's structure
 /// against that one's (`unit_structure`: registers and adders grow with the widths, each
 /// shifter with its levels). The same ratio holds on both families: Yosys measures a typical
 /// ADD PE (27-bit words, KW 51, aligning by ≤ 31, rounding by −16 … 14) at 0.59 of the full
@@ -499,7 +495,7 @@ fn unit_structure(dw: u32, is_mul: bool, kw: u32, r: ShiftRanges, family: Family
 /// `hdl/fix_units.v`).
 pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32, r: ShiftRanges) -> UnitCost {
     let unit = if is_mul { m.fix_mul } else { m.fix_add };
-    let full = unit_structure(32, is_mul, 64, FULL_SHIFTS, m.family);
+    let full = unit_structure(32, is_mul, 64, ShiftRanges::FULL, m.family);
     let this = unit_structure(dw, is_mul, kw, r, m.family);
     let alm = (unit.alm as f64 * this / full).ceil().max(0.0) as u64;
     let dsp = if is_mul && unit.dsp > 0 && dw <= m.family.one_multiplier_word() { 1 } else { unit.dsp };
@@ -513,7 +509,7 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
         (crate::design::PeKind::Binary32, false) => m.fp_add,
         (crate::design::PeKind::Binary32, true) => m.fp_mul,
         (crate::design::PeKind::Fixed, is_mul) => {
-            fixed_unit(m, d.word_bits, is_mul, d.intermediate_bits(p.slot), p.shift_ranges.unwrap_or(FULL_SHIFTS))
+            fixed_unit(m, d.word_bits, is_mul, d.intermediate_bits(p.slot), p.shift_ranges.unwrap_or(ShiftRanges::FULL))
         }
     };
     let fp = d.pes.iter().map(unit).fold(UnitCost { alm: 0, dsp: 0, m10k: 0 }, |a, u| UnitCost {

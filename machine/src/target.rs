@@ -32,7 +32,7 @@
 //! | `datapath.fp64_add` | 886 ALM, 0 DSP | Intel, *Floating-Point IP Cores User Guide* (UG-01058), "FP_FUNCTIONS Resource Utilization": double-precision Add on Arria V (the same 28 nm ALM and variable-precision DSP block as Cyclone V; its single-precision Add is the seed's 360 ALM) |
 //! | `datapath.fp64_mul` | 250 ALM, 4 DSP | estimate: a 53 × 53 mantissa product tiles into four 27 × 27 blocks (the "54 × 54: four blocks" row of Intel's variable-precision DSP tables); ALM 2.5 × the seed's binary32 MULTI (exponent, rounding and normalisation twice as wide, plus the tiles' adder). No datasheet figure at hand |
 //! | `datapath.convert_alm` | 100 ALM per conversion | estimate: a conversion between fixed and floating point (or binary32 and binary64) is a leading-zero count and a barrel shift of the word, of the order of the seed's MULTI PE logic (100 ALM) |
-//! | `fix_pe.add` | latency 3 cycles = 1 stage + 2; 390 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`): the exact sum registered, its rounding computed in the next clock straight into the PE's result register (the issue's "1–2 stages"; until the units were sized to their shifts a second, empty stage delayed the rounded result by a clock for nothing: every register-to-register path is the same without it; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` with 32-bit words, KW = 64 and any shift (`AMAX = 63`, `SMIN = −64`, `SMAX = 63`: [`crate::resources::FULL_SHIFTS`]) by [`crate::resources`]' packing bound (164 LUT6, 346 smaller LUTs, 106 carry bits); a design's PEs are sized to their own shifts and widths (`resources::fixed_unit`: a typical Jeep ADD PE 231 ALM) |
+//! | `fix_pe.add` | latency 3 cycles = 1 stage + 2; 390 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`): the exact sum registered, its rounding computed in the next clock straight into the PE's result register (the issue's "1–2 stages"; until the units were sized to their shifts a second, empty stage delayed the rounded result by a clock for nothing: every register-to-register path is the same without it; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` with 32-bit words, KW = 64 and any shift (`AMAX = 63`, `SMIN = −64`, `SMAX = 63`: [`crate::design::build::ShiftRanges::FULL`]) by [`crate::resources`]' packing bound (164 LUT6, 346 smaller LUTs, 106 carry bits); a design's PEs are sized to their own shifts and widths (`resources::fixed_unit`: a typical Jeep ADD PE 231 ALM) |
 //! | `fix_pe.mul` | latency 4 cycles = 2 stages + 2; 299 ALM, 2 DSP | a 32 × 32 signed product as four registered 16 × 16 partial products (four 18 × 19 multipliers, two per Cyclone V variable-precision block: 2 blocks), their sum registered, and the rounding shift (any shift) into the result register; a product that is one DSP multiplier is registered and rounded: 3 cycles ([`FixPe::latencies_for`]); ALM from Yosys as above at `LATENCY = 3` (41 LUT6, 474 smaller LUTs, 41 carry bits; 4 `MISTRAL_MUL18X18`); a 27-bit MULTI PE rounding by 24 to 26 bits, as the Jeep's, is one 27 × 27 block and 36 ALM |
 //! | `output_word_alm` | 0 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are block RAM with a registered read port (`rv_out_mem`), counted as M10K blocks, so they take no logic a word. (Until issue 49 they were 32-bit registers read asynchronously: 16 ALM a word, the slope Yosys measured per PE, [`crate::resources`].) The key stays for a design whose output words cost logic; optional in a JSON target (default 0) |
 //!
@@ -247,7 +247,10 @@ impl Family {
     /// 512×36 as the pseudo dual-port PDPW16KD (Lattice TN1264, *ECP5 and ECP5-5G Memory Usage
     /// Guide*, tables of DP16KD and PDPW16KD).
     pub const fn bram_configurations(self) -> (&'static [(u64, u64)], u64) {
-        self.bram_modes()
+        match self {
+            Family::CycloneV => (&[(8192, 1), (4096, 2), (2048, 5), (1024, 10), (512, 20), (256, 40)], 20),
+            Family::Ecp5 => (&[(16384, 1), (8192, 2), (4096, 4), (2048, 9), (1024, 18), (512, 36)], 18),
+        }
     }
 
     /// Bits of the widest word of one block RAM (40 on the Cyclone V's M10K, 256 × 40; 36 on the
@@ -257,13 +260,6 @@ impl Family {
         match self {
             Family::CycloneV => 40,
             Family::Ecp5 => 36,
-        }
-    }
-
-    const fn bram_modes(self) -> (&'static [(u64, u64)], u64) {
-        match self {
-            Family::CycloneV => (&[(8192, 1), (4096, 2), (2048, 5), (1024, 10), (512, 20), (256, 40)], 20),
-            Family::Ecp5 => (&[(16384, 1), (8192, 2), (4096, 4), (2048, 9), (1024, 18), (512, 36)], 18),
         }
     }
 }

@@ -132,6 +132,12 @@ pub struct ShiftRanges {
     pub shift_max: i8,
 }
 
+impl ShiftRanges {
+    /// Any shift a shift word holds: alignments up to 63 bits (6 levels), any 7-bit rounding
+    /// shift. The unit the target's `fix_pe` costs describe, and the HDL's defaults.
+    pub const FULL: ShiftRanges = ShiftRanges { align_max: 63, shift_min: -64, shift_max: 63 };
+}
+
 /// The [`ShiftRanges`] of the ops whose shifts are `shifts` (the issued ops of one PE; none:
 /// `AMAX = 0`, `SMIN = SMAX = 0`).
 pub fn shift_ranges(shifts: impl IntoIterator<Item = FixShifts>) -> ShiftRanges {

@@ -375,10 +375,9 @@ impl Design {
         let p = &self.pes[slot];
         let aw = self.widths.aw;
         let pa = addr_bits(p.data.words.len().max(1) as u64).min(aw);
-        let mut fields: Vec<(&Image, u32)> =
-            vec![(&p.xbar, p.xbar.width), (&p.bufi, p.bufi.width), (&p.capt, p.capt.width)];
-        fields.extend(p.fix.iter().map(|f| (f, f.width)));
-        let width = 4 * pa + 4 + fields.iter().map(|f| f.1).sum::<u32>();
+        let mut fields: Vec<&Image> = vec![&p.xbar, &p.bufi, &p.capt];
+        fields.extend(&p.fix);
+        let width = 4 * pa + 4 + fields.iter().map(|f| f.width).sum::<u32>();
         let lane = self.control_lane_bits.max(1);
         let n_lanes = width.div_ceil(lane) as usize;
         let cycles = p.instr.words.len();
@@ -411,8 +410,8 @@ impl Design {
                 put(field & mask(pa), pa);
             }
             put(w >> (4 * aw) & 0xf, 4);
-            for (img, bits) in &fields {
-                put(img.words.get(c).copied().unwrap_or(0), *bits);
+            for img in &fields {
+                put(img.words.get(c).copied().unwrap_or(0), img.width);
             }
         }
         Control { pa, width, lanes }
@@ -490,8 +489,7 @@ impl Design {
             let (src1, n1, sw1) = self.port_sources(p.slot, 1);
             let mut fix = match &p.fix {
                 Some(_) => {
-                    let r =
-                        p.shift_ranges.unwrap_or(build::ShiftRanges { align_max: 63, shift_min: -64, shift_max: 63 });
+                    let r = p.shift_ranges.unwrap_or(build::ShiftRanges::FULL);
                     format!(
                         ".FIX(1), .DW({dw}), .KW({}), .AMAX({}), .SMIN({}), .SMAX({}), ",
                         self.intermediate_bits(p.slot),
