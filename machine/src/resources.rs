@@ -10,7 +10,12 @@
 //!   holds two registers; a Yosys MLAB cell (32 × 1 bit) is half an ALM of a 640-bit MLAB, so
 //!   `alm = max(LUT6 + ⌈(LUT2…LUT5 + ARITH)/2⌉, ⌈FF/2⌉) + ⌈MLAB/2⌉`. Yosys' DSP cells
 //!   (`MISTRAL_MUL*`) count as DSP blocks. Without `yosys` (or with `resources=estimate`) the
-//!   logic is the target's analytic model ([`crate::target`], seed Table 1.4):
+//!   logic is the target's analytic model of a design in its family's Yosys flow
+//!   (`design_logic`, [`design_logic_alm`]: per write port by its multiplexer inputs, per PE by
+//!   its buffer words, at the design's word; measured and checked against Yosys as
+//!   [`crate::target::Family::design_logic`] says, at or above it) plus `pe_word_alm` per PE-memory
+//!   word and `output_word_alm` per output word; a target without `design_logic` (the ECP5)
+//!   keeps the seed-form model ([`crate::target`], seed Table 1.4):
 //!   `crossbar_alm · n_pe · writes · 2n_pe + pe_memory_alm · n_pe + control_alm +
 //!   output_word_alm · output words` (a specialised interconnect, [`crate::design::routes`]:
 //!   `crossbar_alm` times its multiplexer inputs, [`Routes::mux_inputs`], in place of the first
@@ -139,6 +144,9 @@ pub struct CostModel {
     pub control_alm: f64,
     /// Analytic logic: ALMs per output-memory word (32 registers).
     pub output_word_alm: f64,
+    /// Analytic logic of a generated design in the family's Yosys flow (the target's
+    /// `design_logic`): used in place of `crossbar_alm`, `pe_memory_alm` and `control_alm`.
+    pub design_logic: Option<crate::target::DesignLogic>,
     /// Write ports per PE memory.
     pub writes: u32,
     /// Clock, MHz.
@@ -289,6 +297,7 @@ pub fn cost_model(t: &Target) -> CostModel {
         pe_word_alm: t.pe_word_alm,
         control_alm: t.control_alm,
         output_word_alm: t.output_word_alm,
+        design_logic: t.design_logic,
         writes: t.writes,
         clock_mhz: t.clock_mhz,
         pnr: t.pnr.clone(),
@@ -502,6 +511,19 @@ pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32, r: ShiftRanges)
     UnitCost { alm, dsp, m10k: unit.m10k }
 }
 
+/// The logic of design `d` by the family's Yosys-flow figures `l`, in the family's units
+/// ([`crate::target::DesignLogic`]: each write port by its multiplexer inputs, each PE by its
+/// buffer words, at the design's word bits); without the per-word terms.
+pub fn design_logic_alm(d: &Design, l: &crate::target::DesignLogic) -> f64 {
+    let dw = f64::from(d.word_bits);
+    let ports: f64 = (0..d.n_pe())
+        .flat_map(|slot| (0..2).map(move |port| (slot, port)))
+        .map(|(slot, port)| l.mux_input_bit * d.port_inputs(slot, port) as f64 + l.mux_port_bit)
+        .sum();
+    let pes: f64 = d.pes.iter().map(|p| l.pe_bit + l.buffer_word_bit * (p.buffer_words.max(1) - 1) as f64).sum();
+    dw * (ports + pes)
+}
+
 /// The estimate for `d` under `m`, with Yosys' cells when it ran.
 pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resources {
     // each PE's unit: binary32 ones the target's, fixed-point ones by their word and intermediate
@@ -526,12 +548,14 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
             // The multiplexers and output words are costed for 32-bit words: a narrower word
             // (fixed-point PEs, `word_bits`) takes its share.
             let word = f64::from(d.word_bits) / 32.0;
-            // a design has two write ports per PE memory (`codegen<fpga>` refuses other targets)
-            let a = m.crossbar_alm * d.mux_inputs() as f64 * word
-                + m.pe_memory_alm * n
-                + m.pe_word_alm * d.pes.iter().map(|p| p.data.words.len().max(1) as f64).sum::<f64>()
-                + m.control_alm
+            let words = m.pe_word_alm * d.pes.iter().map(|p| p.data.words.len().max(1) as f64).sum::<f64>()
                 + m.output_word_alm * output_words(d) as f64 * word;
+            let a = match m.design_logic {
+                // the family's Yosys flow, port by port and PE by PE
+                Some(l) => design_logic_alm(d, &l) + words,
+                // a design has two write ports per PE memory (`codegen<fpga>` refuses other targets)
+                None => m.crossbar_alm * d.mux_inputs() as f64 * word + m.pe_memory_alm * n + m.control_alm + words,
+            };
             ("estimate", a.ceil() as u64, 0)
         }
     };

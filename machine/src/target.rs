@@ -35,6 +35,7 @@
 //! | `fix_pe.add` | latency 3 cycles = 1 stage + 2; 390 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`): the exact sum registered, its rounding computed in the next clock straight into the PE's result register (the issue's "1–2 stages"; until the units were sized to their shifts a second, empty stage delayed the rounded result by a clock for nothing: every register-to-register path is the same without it; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` with 32-bit words, KW = 64 and any shift (`AMAX = 63`, `SMIN = −64`, `SMAX = 63`: [`crate::design::build::ShiftRanges::FULL`]) by [`crate::resources`]' packing bound (164 LUT6, 346 smaller LUTs, 106 carry bits); a design's PEs are sized to their own shifts and widths (`resources::fixed_unit`: a typical Jeep ADD PE 231 ALM) |
 //! | `fix_pe.mul` | latency 4 cycles = 2 stages + 2; 299 ALM, 2 DSP | a 32 × 32 signed product as four registered 16 × 16 partial products (four 18 × 19 multipliers, two per Cyclone V variable-precision block: 2 blocks), their sum registered, and the rounding shift (any shift) into the result register; a product that is one DSP multiplier is registered and rounded: 3 cycles ([`FixPe::latencies_for`]); ALM from Yosys as above at `LATENCY = 3` (41 LUT6, 474 smaller LUTs, 41 carry bits; 4 `MISTRAL_MUL18X18`); a 27-bit MULTI PE rounding by 24 to 26 bits, as the Jeep's, is one 27 × 27 block and 36 ALM |
 //! | `output_word_alm` | 0 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are block RAM with a registered read port (`rv_out_mem`), counted as M10K blocks, so they take no logic a word. (Until issue 49 they were 32-bit registers read asynchronously: 16 ALM a word, the slope Yosys measured per PE, [`crate::resources`].) The key stays for a design whose output words cost logic; optional in a JSON target (default 0) |
+//! | `design_logic` | 0.35 ALM per multiplexer input bit, 0.4 per write-port bit, 1.35 per PE bit, 1.2 per further buffer-word bit | not the seed's: Yosys 0.23 `synth_intel_alm` of robovec's generated designs, which the FPGA back end's analytic estimate predicts in place of the seed-form `crossbar_alm`, `pe_memory_alm` and `control_alm` (Quartus' figures of the seed's design, below Yosys' of these designs); measured and fitted as [`Family::design_logic`] says |
 //!
 //!
 //! The `datapath` record (issue 48 item 5, `precision<target=fpga>`) costs a datapath of one
@@ -79,7 +80,8 @@
 //!
 //! # The JSON format (`-target=FILE.json`)
 //! One object, every key required except `family` (default `cyclone-v`), `pnr` (ECP5 only),
-//! `pe_word_alm` (default 0), `output_word_alm` (default 0), `latencies.div` and
+//! `pe_word_alm` (default 0), `output_word_alm` (default 0), `design_logic` (default: the
+//! family's, [`Family::design_logic`]), `latencies.div` and
 //! `latencies.call` (default: the `add` latency, as they run on ADD PEs), `datapath` (each
 //! of its fields defaults to the DE10-Nano's, the table above) and `fix_pe` (the DE10-Nano's
 //! when left out); an unknown key
@@ -193,6 +195,33 @@ pub struct Units {
     pub dsp: &'static str,
 }
 
+/// The logic of a generated design (`codegen<fpga>`) as the family's Yosys flow maps it, in
+/// the family's logic units per bit of the design's word (`word_bits`: 32 for binary32 PEs,
+/// the fixed-point PEs' word): what the FPGA back end's analytic estimate
+/// ([`crate::resources::estimate`] without Yosys) charges instead of the seed's per-PE figures
+/// (`crossbar_alm`, `pe_memory_alm`, `control_alm`), which [`Target::estimate`] keeps. For a
+/// word of `DW` bits:
+/// `Σ_ports DW·(mux_input_bit·k + mux_port_bit) + Σ_PEs DW·(pe_bit + buffer_word_bit·(b − 1))`
+/// over each write port's `k` multiplexer inputs and each PE's `b` buffer words, plus the
+/// target's `pe_word_alm` per PE-memory word and `output_word_alm` per output word.
+/// JSON: `design_logic` (optional; a target without it takes its family's,
+/// [`Family::design_logic`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DesignLogic {
+    /// Per multiplexer input of a write port, per bit (`rv_mux`).
+    pub mux_input_bit: f64,
+    /// Per write port, per bit (`rv_mux`'s gating to 0 and the tree's last level).
+    pub mux_port_bit: f64,
+    /// Per PE, per bit: its logic outside the unit, the multiplexer and the memories (the
+    /// buffer's first word, the result and operand registers, the control decoding) and its
+    /// share of the top's output read multiplexer.
+    pub pe_bit: f64,
+    /// Per buffer word beyond the first, per bit (the buffer's registers or MLAB and its read
+    /// multiplexer).
+    pub buffer_word_bit: f64,
+}
+
 /// How a design builds each PE memory (two reads and two writes per cycle, `hdl/rv_mem.v`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PeMemory {
@@ -206,6 +235,24 @@ pub enum PeMemory {
 }
 
 impl Family {
+    /// The logic of a generated design in this family's Yosys flow ([`DesignLogic`]), where it
+    /// was measured: the Cyclone V's (Yosys 0.23 `synth_intel_alm`, the ALM packing bound of
+    /// [`crate::resources`]). `rv_mux` alone at 16-bit words and 1 to 64 inputs gives
+    /// 0.35 ALM per input bit and 0.4 per port bit (within 10 % from 2 inputs up); the rest,
+    /// fitted on the Jeep's fixed-point designs at 4 + 4 to 36 + 42 PEs and its binary32 ones at
+    /// 8 + 8 (crossbar and specialised), 1.35 ALM per PE bit and 1.2 per further buffer word
+    /// bit. The model is above Yosys on all of them: by 1–3 % from 8 + 8 PEs up, by 15 % at
+    /// 4 + 4 (docs/fpga.md, "The estimate against Yosys"). The ECP5: `None` (the seed-form
+    /// model with its LUT4 figures, above what nextpnr places; `resources=pnr` measures it).
+    pub const fn design_logic(self) -> Option<DesignLogic> {
+        match self {
+            Family::CycloneV => {
+                Some(DesignLogic { mux_input_bit: 0.35, mux_port_bit: 0.4, pe_bit: 1.35, buffer_word_bit: 1.2 })
+            }
+            Family::Ecp5 => None,
+        }
+    }
+
     /// The resource names of the family.
     pub const fn units(self) -> Units {
         match self {
@@ -322,6 +369,9 @@ pub struct Target {
     /// ALM per output-memory word (32-bit registers the outputs are captured in; the FPGA back
     /// end's analytic estimate, which knows the output words per PE).
     pub output_word_alm: f64,
+    /// The logic of a generated design in the family's Yosys flow, for the FPGA back end's
+    /// analytic estimate (`None`: the seed-form figures above).
+    pub design_logic: Option<DesignLogic>,
     /// What the operators of a datapath in per-value formats cost (`precision<target=fpga>`).
     pub datapath: Datapath,
     /// The fixed-point PEs (issue 49): their latencies and costs, for a function whose values
@@ -555,6 +605,8 @@ struct TargetFile {
     #[serde(default)]
     output_word_alm: f64,
     #[serde(default)]
+    design_logic: Option<DesignLogic>,
+    #[serde(default)]
     datapath: Datapath,
     #[serde(default)]
     fix_pe: FixPe,
@@ -645,6 +697,7 @@ impl Target {
             crossbar_alm: 8.125,
             control_alm: 469.0,
             output_word_alm: 0.0,
+            design_logic: Family::CycloneV.design_logic(),
             datapath: Datapath::default(),
             fix_pe: FixPe::default(),
             pnr: None,
@@ -669,6 +722,7 @@ impl Target {
             pe_memory_alm: 314.0,
             pe_word_alm: 4.1,
             crossbar_alm: 60.0,
+            design_logic: Family::Ecp5.design_logic(),
             datapath: Datapath {
                 dsp_modes: vec![DspMode { a: 9, b: 9, per_block: 2 }, DspMode { a: 18, b: 18, per_block: 1 }],
                 fix_alm_per_bit: 1.0,
@@ -735,6 +789,7 @@ impl Target {
             crossbar_alm: f.crossbar_alm,
             control_alm: f.control_alm,
             output_word_alm: f.output_word_alm,
+            design_logic: f.design_logic.or(f.family.design_logic()),
             datapath: f.datapath,
             fix_pe: f.fix_pe,
             pnr: f.pnr,
@@ -830,6 +885,15 @@ impl Target {
             ("datapath.fp64_mul.alm", d.fp64_mul.alm),
             ("datapath.convert_alm", d.convert_alm),
         ]);
+        let logic = self.design_logic.map(|l| {
+            [
+                ("design_logic.mux_input_bit", l.mux_input_bit),
+                ("design_logic.mux_port_bit", l.mux_port_bit),
+                ("design_logic.pe_bit", l.pe_bit),
+                ("design_logic.buffer_word_bit", l.buffer_word_bit),
+            ]
+        });
+        let costs = costs.chain(logic.into_iter().flatten());
         for (k, v) in costs {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("`{k}` must be a non-negative number of ALM, got {v}"));

@@ -303,6 +303,16 @@ impl Design {
         }
     }
 
+    /// Multiplexer inputs of write port `port` (0 or 1) of PE `slot`'s memory: `2·n_pe` for the
+    /// crossbar, the port's routes for a specialised interconnect (at least 1: a port without
+    /// routes is a constant 0).
+    pub fn port_inputs(&self, slot: usize, port: usize) -> usize {
+        match &self.routes {
+            Some(r) => r.ports[slot][port].len().max(1),
+            None => 2 * self.n_pe(),
+        }
+    }
+
     /// PE `slot`'s crossbar memory as the crossbar's selects ([`crate::encode`]'s words),
     /// whatever the interconnect.
     pub fn crossbar_words(&self, slot: usize) -> Vec<u64> {
