@@ -125,9 +125,14 @@
 //!
 //! # The analytic resource estimate ([`Target::estimate`])
 //! For `n_add` ADD and `n_mul` MULTI PEs (`n_pe = n_add + n_mul`) running `cycles` cycles:
-//! - ALM = `n_add·fp_add.alm + n_mul·fp_mul.alm + n_pe·pe_memory_alm
+//! - ALM = `n_add·fp_add.alm + n_mul·fp_mul.alm` plus the logic around the units. In the
+//!   seed's form (a target without `design_logic`): `n_pe·pe_memory_alm
 //!   + crossbar_alm·n_pe·writes·(2·n_pe) + control_alm` (the crossbar: one multiplexer per
-//!   PE-memory write port over the `2·n_pe` sources, each result and each buffer read);
+//!   PE-memory write port over the `2·n_pe` sources, each result and each buffer read). With
+//!   `design_logic` (the built-ins' Cyclone V; [`Target::estimate_with`]): robovec's crossbar
+//!   design as Yosys maps it, `DW·(n_pe·writes·(mux_input_bit·2·n_pe + mux_port_bit)
+//!   + Σ_PEs (pe_bit + buffer_word_bit·(b − 1)))` for `DW`-bit words and each PE's `b` buffer
+//!   words (`place` and `sweep` give the placement's word and buffers);
 //! - DSP = `n_add·fp_add.dsp + n_mul·fp_mul.dsp`;
 //! - M10K = per PE, `fp_*.m10k` plus each of its memories as ⌈bits / m10k_bits⌉ (at least 1;
 //!   [`M10kFit::Bits`], see "M10K blocks" below):
@@ -137,11 +142,16 @@
 //!   `sw = ⌈log2(2·n_pe + 1)⌉` (the encoding of issue 12). Memories are sized by the target
 //!   (the fixed 2048-word PE memory of Table 1.4), not by what a placement uses.
 //!
-//! On the seed's own configuration (4 + 4 PE, 987 cycles, §1.3.1) this gives 4413 ALM and
-//! 20 DSP (Table 1.4, by construction of `control_alm`) and 128 M10K against the table's 120:
-//! the bit count puts a 988 × 52-bit instruction memory in 6 blocks where the seed reports 3–4,
-//! and the crossbar memories in 8 where it reports 20. The FPGA back end replaces this estimate
-//! by Yosys' figures for one N; `sweep` uses it to say which N fit.
+//! On the seed's own configuration (4 + 4 PE, 987 cycles, §1.3.1) the seed's form gives 4413
+//! ALM and 20 DSP (Table 1.4, by construction of `control_alm`) and 128 M10K against the
+//! table's 120: the bit count puts a 988 × 52-bit instruction memory in 6 blocks where the seed
+//! reports 3–4, and the crossbar memories in 8 where it reports 20. Those are Quartus' figures
+//! of the seed's design; robovec's design maps to more under Yosys (a crossbar input of 32 bits
+//! is 11.2 ALM, not 8.125), so the built-in target estimates with `design_logic` (5,258 ALM for
+//! the same 4 + 4 PEs with one buffer word each), which does not fall below Yosys: a design
+//! `place` and `sweep` say fits does. The FPGA back end replaces this estimate by its own
+//! design's ([`crate::resources`]: its routes and buffers) or Yosys' figures for one N; `sweep`
+//! uses it to say which N fit.
 //!
 //! # M10K blocks ([`m10k_blocks`])
 //! One function counts the M10K blocks of a memory for both estimates, with the model as a
@@ -938,15 +948,46 @@ impl Target {
     }
 
     /// The analytic resource estimate of `n_add` ADD and `n_mul` MULTI PEs running `cycles`
-    /// cycles (module doc: the model and its figures against seed Table 1.4).
+    /// cycles with binary32 words and one buffer word a PE ([`Target::estimate_with`]).
     pub fn estimate(&self, n_add: u32, n_mul: u32, cycles: u32) -> Resources {
+        self.estimate_with(n_add, n_mul, cycles, 32, &[])
+    }
+
+    /// The analytic resource estimate of `n_add` ADD and `n_mul` MULTI PEs running `cycles`
+    /// cycles (module doc: the model and its figures against seed Table 1.4), for a crossbar
+    /// design of `word_bits`-bit words whose PEs' buffers hold `buffer_words` words (slot
+    /// order; a PE not listed, one word). The logic is the seed-form model where the target
+    /// has no `design_logic`; with it (the built-ins' Cyclone V), the crossbar design as the
+    /// family's Yosys flow maps it: `writes` ports per PE memory of `2·n_pe` multiplexer
+    /// inputs, and each PE by its buffer (the figures of [`DesignLogic`]), plus
+    /// `pe_word_alm` per PE-memory word of the target.
+    pub fn estimate_with(
+        &self,
+        n_add: u32,
+        n_mul: u32,
+        cycles: u32,
+        word_bits: u32,
+        buffer_words: &[u32],
+    ) -> Resources {
         let n_pe = u64::from(n_add) + u64::from(n_mul);
         let sources = 2 * n_pe;
-        let alm = f64::from(n_add) * self.fp_add.alm
-            + f64::from(n_mul) * self.fp_mul.alm
-            + n_pe as f64 * (self.pe_memory_alm + self.pe_word_alm * f64::from(self.pe_words))
-            + self.crossbar_alm * (n_pe * u64::from(self.writes) * sources) as f64
-            + self.control_alm;
+        let units = f64::from(n_add) * self.fp_add.alm + f64::from(n_mul) * self.fp_mul.alm;
+        let words = n_pe as f64 * self.pe_word_alm * f64::from(self.pe_words);
+        let logic = match self.design_logic {
+            None => {
+                n_pe as f64 * self.pe_memory_alm
+                    + self.crossbar_alm * (n_pe * u64::from(self.writes) * sources) as f64
+                    + self.control_alm
+            }
+            Some(l) => {
+                let ports =
+                    (n_pe * u64::from(self.writes)) as f64 * (l.mux_input_bit * sources as f64 + l.mux_port_bit);
+                let buffer = |slot: u64| buffer_words.get(slot as usize).copied().unwrap_or(1).max(1) - 1;
+                let pes: f64 = (0..n_pe).map(|s| l.pe_bit + l.buffer_word_bit * f64::from(buffer(s))).sum();
+                f64::from(word_bits) * (ports + pes)
+            }
+        };
+        let alm = units + words + logic;
         let dsp = u64::from(n_add) * u64::from(self.fp_add.dsp) + u64::from(n_mul) * u64::from(self.fp_mul.dsp);
         let depth = u64::from(cycles) + 1;
         let bw = self.buffer_address_bits();
@@ -1170,7 +1211,8 @@ mod tests {
 
     #[test]
     fn estimate_of_the_seed_design_matches_table_1_4() {
-        let t = Target::de10_nano();
+        // the seed-form logic (no `design_logic`): Quartus' figures of the seed's design
+        let t = Target { design_logic: None, ..Target::de10_nano() };
         let r = t.estimate(4, 4, 987);
         // Table 1.4 totals: 4413 ALM, 20 DSP.
         assert_eq!(r.alm, 4413);
@@ -1182,5 +1224,15 @@ mod tests {
         // 23 + 23 PE need 23·2 + 23·3 = 115 DSP > 112.
         assert!(!t.estimate(23, 23, 100).fits);
         assert_eq!(t.estimate(22, 22, 100).dsp, 110);
+        // The built-in's logic is robovec's crossbar design in Yosys' figures: 8 PE memories ×
+        // 2 ports of 16 inputs at 0.35 ALM an input bit and 0.4 a port bit, 1.35 a PE bit, in
+        // 32-bit words: 1840 + 32 · (16 · 6.0 + 8 · 1.35) = 5257.6; three buffer words on PE 0
+        // add 2 · 1.2 · 32.
+        let built_in = Target::de10_nano();
+        assert_eq!(built_in.estimate(4, 4, 987).alm, 5258);
+        assert_eq!(built_in.estimate_with(4, 4, 987, 32, &[3]).alm, (5257.6f64 + 76.8).ceil() as u32);
+        // narrower words take their share of it
+        assert_eq!(built_in.estimate_with(4, 4, 987, 16, &[]).alm, (1840.0 + 16.0 * 106.8f64).ceil() as u32);
+        assert_eq!(built_in.estimate(4, 4, 987).m10k, 128, "the memories are counted as before");
     }
 }

@@ -278,6 +278,7 @@ impl Pass for Sweep {
                 // a function on fixed-point PEs (issue 49): their latencies and units
                 let latencies = crate::function_latencies(&target, f, latencies, &crate::LatencyOverride::default());
                 let target = crate::place::report::units_of(f, &target);
+                let word_bits = crate::place::report::word_bits_of(f);
                 let ops = f.op_counts().total;
                 let cp_now = compute_timing(f, &latencies).1.asap_cycle;
                 let (n_add_side, n_mul) = ops_per_side(f);
@@ -337,7 +338,7 @@ impl Pass for Sweep {
                         let side = |k: u64, lat: u32| if k == 0 { 0 } else { (k.div_ceil(n as u64) - 1) as u32 + lat };
                         let na = n as usize;
                         let indirect = p.writes.iter().filter(|w| w.buffer_addr.is_some()).count() as u64;
-                        let est = crate::place::report::estimate(p, c, &target);
+                        let est = crate::place::report::estimate(p, c, &target, word_bits);
                         rows.push(SweepRow {
                             function: f.name.clone(),
                             n,

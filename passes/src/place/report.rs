@@ -92,9 +92,19 @@ pub fn units_of(f: &Function, target: &Target) -> Target {
     }
 }
 
-/// The estimate of [`PlacementReport::estimate`].
-pub fn estimate(p: &robovec_ir::placement::Placement, cycles: u32, target: &Target) -> Resources {
-    let r = target.estimate(p.arch.n_add, p.arch.n_mul, cycles);
+/// The word bits of the design `f` runs on: the fixed-point PEs' word
+/// ([`robovec_machine::program::fixed::word_bits`]) or binary32's 32.
+pub fn word_bits_of(f: &Function) -> u32 {
+    match robovec_machine::program::fixed::pe_kind(f) {
+        Ok(robovec_machine::program::fixed::PeKind::Fixed) => robovec_machine::program::fixed::word_bits(f),
+        _ => 32,
+    }
+}
+
+/// The estimate of [`PlacementReport::estimate`]: the crossbar design of the placement
+/// ([`Target::estimate_with`], each PE's buffer as placed) in `word_bits`-bit words.
+pub fn estimate(p: &robovec_ir::placement::Placement, cycles: u32, target: &Target, word_bits: u32) -> Resources {
+    let r = target.estimate_with(p.arch.n_add, p.arch.n_mul, cycles, word_bits, &p.buffer_words);
     Resources { fits: r.fits && fits_memories(p, cycles, target), ..r }
 }
 
@@ -199,6 +209,6 @@ pub fn placement_report(f: &Function, target: &Target) -> Option<PlacementReport
         writes_indirect: indirect,
         occupation: Occupation { add: occupation(&add, a.n_add, 50), mul: occupation(&mul, a.n_mul, 50) },
         timeline: timeline(f, p, c),
-        estimate: estimate(p, c, &units_of(f, target)),
+        estimate: estimate(p, c, &units_of(f, target), word_bits_of(f)),
     })
 }
