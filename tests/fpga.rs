@@ -167,8 +167,11 @@ fn narrow_fixed_point_units_with_the_generators_intermediate_width_equal_the_mod
             std::fs::write(d.join("vec.hex"), lines).unwrap();
             // the shift bounds as 7-bit two's complement (Verilog macros are unsigned here)
             let b7 = |x: i8| u32::from(x as u8 & 127);
+            // odd batches on the ECP5's 18-bit multipliers: a 20- or 27-bit product split in four
+            let one = if batch % 2 == 1 { 18 } else { 27 };
             let defines = [
                 ("DW", dw),
+                ("ONE", one),
                 ("KWA", kwa),
                 ("KWM", kwm),
                 ("AMAX", u32::from(ra.align_max)),

@@ -33,6 +33,10 @@ pub struct Limits {
     pub pe_memory: PeMemory,
     /// Bits of a control-memory lane: the family's widest block-RAM word ([`Family::bram_word`]).
     pub control_lane_bits: u32,
+    /// The widest word whose product is one of the family's DSP multipliers
+    /// ([`Family::one_multiplier_word`]: 27 on the Cyclone V, 18 on the ECP5): a fixed-point
+    /// MULTI PE of a wider word registers its partial products (`hdl/fix_units.v`).
+    pub multiplier_word: u32,
 }
 
 impl Limits {
@@ -46,6 +50,7 @@ impl Limits {
             writes: t.writes,
             pe_memory: t.family.pe_memory(),
             control_lane_bits: t.family.bram_word(),
+            multiplier_word: t.family.one_multiplier_word(),
         }
     }
 }
@@ -391,6 +396,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
         routes: None,
         pe_memory: limits.pe_memory,
         control_lane_bits: limits.control_lane_bits,
+        multiplier_word: limits.multiplier_word,
         states: f.states,
         pe_kind: if fx.is_some() { PeKind::Fixed } else { PeKind::Binary32 },
         word_bits: word_bits_of(fx),

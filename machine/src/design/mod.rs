@@ -209,6 +209,10 @@ pub struct Design {
     /// Bits of a lane of the PE control memories ([`Design::control`]): the family's widest
     /// block-RAM word.
     pub control_lane_bits: u32,
+    /// The widest word whose product is one DSP multiplier of the family (27 on the Cyclone V,
+    /// 18 on the ECP5): a fixed-point MULTI PE of a wider word registers four partial products
+    /// before their sum (`fix_mul`'s `ONE`).
+    pub multiplier_word: u32,
 }
 
 /// A PE's control memory ([`Design::control`]): one word per cycle holding the instruction (its
@@ -501,11 +505,12 @@ impl Design {
                 Some(_) => {
                     let r = p.shift_ranges.unwrap_or(build::ShiftRanges::FULL);
                     format!(
-                        ".FIX(1), .DW({dw}), .KW({}), .AMAX({}), .SMIN({}), .SMAX({}), ",
+                        ".FIX(1), .DW({dw}), .KW({}), .AMAX({}), .SMIN({}), .SMAX({}), .ONE({}), ",
                         self.intermediate_bits(p.slot),
                         r.align_max,
                         r.shift_min,
-                        r.shift_max
+                        r.shift_max,
+                        self.multiplier_word
                     )
                 }
                 None => String::new(),

@@ -6,7 +6,8 @@
 // fields' low DW bits and the low DW bits of y are compared; `KWA` and `KWM` (default 64) are the
 // ADD and MULTI units' intermediate bits; `AMAX` (default 63) the ADD unit's largest alignment and
 // `SMINA7`, `SMAXA7` (ADD), `SMINM7`, `SMAXM7` (MULTI) their rounding shifts' bounds as 7-bit two's
-// complement (default -64 ... 63: any shift), as the generator sizes a PE's shifters.
+// complement (default -64 ... 63: any shift), as the generator sizes a PE's shifters; `ONE`
+// (default 27, the Cyclone V's; 18 the ECP5's) the widest word whose product is one multiplier.
 `timescale 1ns/1ps
 `ifndef DW
 `define DW 32
@@ -19,6 +20,9 @@
 `endif
 `ifndef AMAX
 `define AMAX 63
+`endif
+`ifndef ONE
+`define ONE 27
 `endif
 `ifndef SMINA7
 `define SMINA7 64
@@ -47,7 +51,7 @@ module fix_check_tb;
   reg sub = 0;
   wire [`DW-1:0] y_add, y_mul;
   fix_add_sub #(.LATENCY(LADD), .DW(`DW), .KW(`KWA), .AMAX(`AMAX), .SMIN(SMINA), .SMAX(SMAXA)) u_add (.clk(clk), .a(a), .b(b), .sub(sub), .sh(sh), .y(y_add));
-  fix_mul #(.LATENCY(LMUL), .DW(`DW), .KW(`KWM), .SMIN(SMINM), .SMAX(SMAXM)) u_mul (.clk(clk), .a(a), .b(b), .sh(sh), .y(y_mul));
+  fix_mul #(.LATENCY(LMUL), .DW(`DW), .KW(`KWM), .SMIN(SMINM), .SMAX(SMAXM), .ONE(`ONE)) u_mul (.clk(clk), .a(a), .b(b), .sh(sh), .y(y_mul));
   integer i, k, bad;
   reg [3:0] op;
   reg [`DW-1:0] want, got;

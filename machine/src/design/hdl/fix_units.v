@@ -126,14 +126,15 @@ module fix_add_sub #(parameter integer LATENCY = 1, parameter integer DW = 32, p
   fix_stages #(.LATENCY(LATENCY), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
 endmodule
 
-// The MULTI PE's unit: y = round(a * b), LATENCY clocks after the operands. For DW <= 27 the
-// product is one DSP multiplier (a Cyclone V block in 27 x 27 mode), registered, then rounded
-// in the next clock. For wider words with LATENCY >= 2 the product is split in four partial
-// products of the (DW - 16)-bit signed high and 16-bit unsigned low halves (one MULT18X18D each
-// on the ECP5, one 18 x 19 half block each on the Cyclone V), registered, then summed in the
-// next clock.
+// The MULTI PE's unit: y = round(a * b), LATENCY clocks after the operands. For DW <= ONE (the
+// family's widest one-multiplier word: 27 on the Cyclone V, a block in 27 x 27 mode; 18 on the
+// ECP5, a MULT18X18D) the product is one DSP multiplier, registered, then rounded in the next
+// clock. For wider words with LATENCY >= 2 the product is split in four partial products of
+// the (DW - 16)-bit signed high and 16-bit unsigned low halves (one MULT18X18D each on the
+// ECP5, one 18 x 19 half block each on the Cyclone V), registered, then summed in the next
+// clock.
 module fix_mul #(parameter integer LATENCY = 2, parameter integer DW = 32, parameter integer KW = 64,
-                 parameter integer SMIN = -64, parameter integer SMAX = 63) (
+                 parameter integer SMIN = -64, parameter integer SMAX = 63, parameter integer ONE = 27) (
     input  wire          clk,
     input  wire [DW-1:0] a,
     input  wire [DW-1:0] b,
@@ -141,7 +142,7 @@ module fix_mul #(parameter integer LATENCY = 2, parameter integer DW = 32, param
     output wire [DW-1:0] y
 );
   generate
-    if (LATENCY >= 2 && DW > 27) begin : g_split
+    if (LATENCY >= 2 && DW > ONE) begin : g_split
       localparam integer HW = DW - 16;
       // a = ah·2^16 + al with ah signed and al unsigned (b likewise)
       wire signed [HW-1:0] ah = a[DW-1:16];

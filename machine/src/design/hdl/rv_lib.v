@@ -30,6 +30,7 @@ module rv_pe #(
     parameter integer AMAX = 63,       // fixed-point PEs: the program's largest alignment (fix_units.v)
     parameter integer SMIN = -64,      // fixed-point PEs: the program's rounding shifts, SMIN..SMAX
     parameter integer SMAX = 63,
+    parameter integer ONE = 27,        // fixed-point MULTI PEs: the widest word that is one DSP product (fix_units.v)
     parameter integer LAT = 12,        // cycles from issue to arrival (>= 3)
     parameter integer N0 = 4,          // sources of write port 0 (crossbar: 2 NPE)
     parameter integer SW0 = 3,         // its select bits
@@ -146,7 +147,7 @@ module rv_pe #(
       initial sh_q = 0;
       always @(posedge clk) sh_q <= sh;
       if (IS_MUL != 0) begin : g_mul
-        fix_mul #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
+        fix_mul #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX), .ONE(ONE)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
       end else begin : g_add
         fix_add_sub #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .AMAX(AMAX), .SMIN(SMIN), .SMAX(SMAX)) u_fx (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .sh(sh_q), .y(y));
       end

@@ -22,7 +22,7 @@ endmodule
 
 (* blackbox *)
 module fix_mul #(parameter integer LATENCY = 3, parameter integer DW = 32, parameter integer KW = 64,
-                 parameter integer SMIN = -64, parameter integer SMAX = 63) (
+                 parameter integer SMIN = -64, parameter integer SMAX = 63, parameter integer ONE = 27) (
     input wire clk, input wire [DW-1:0] a, input wire [DW-1:0] b, input wire [13:0] sh, output wire [DW-1:0] y);
 endmodule
 
