@@ -515,13 +515,8 @@ pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32, r: ShiftRanges)
 /// ([`crate::target::DesignLogic`]: each write port by its multiplexer inputs, each PE by its
 /// buffer words, at the design's word bits); without the per-word terms.
 pub fn design_logic_alm(d: &Design, l: &crate::target::DesignLogic) -> f64 {
-    let dw = f64::from(d.word_bits);
-    let ports: f64 = (0..d.n_pe())
-        .flat_map(|slot| (0..2).map(move |port| (slot, port)))
-        .map(|(slot, port)| l.mux_input_bit * d.port_inputs(slot, port) as f64 + l.mux_port_bit)
-        .sum();
-    let pes: f64 = d.pes.iter().map(|p| l.pe_bit + l.buffer_word_bit * (p.buffer_words.max(1) - 1) as f64).sum();
-    dw * (ports + pes)
+    let ports = (0..d.n_pe()).flat_map(|slot| (0..2).map(move |port| d.port_inputs(slot, port) as u64));
+    l.alm(d.word_bits, ports, d.pes.iter().map(|p| p.buffer_words))
 }
 
 /// The estimate for `d` under `m`, with Yosys' cells when it ran.

@@ -232,6 +232,22 @@ pub struct DesignLogic {
     pub buffer_word_bit: f64,
 }
 
+impl DesignLogic {
+    /// The logic of a design of `word_bits`-bit words whose write ports have `ports`
+    /// multiplexer inputs each and whose PEs' buffers hold `buffers` words each (a buffer of 0
+    /// words costs as one), in the family's units.
+    pub fn alm(
+        &self,
+        word_bits: u32,
+        ports: impl IntoIterator<Item = u64>,
+        buffers: impl IntoIterator<Item = u32>,
+    ) -> f64 {
+        let ports: f64 = ports.into_iter().map(|k| self.mux_input_bit * k as f64 + self.mux_port_bit).sum();
+        let pes: f64 = buffers.into_iter().map(|b| self.pe_bit + self.buffer_word_bit * f64::from(b.max(1) - 1)).sum();
+        f64::from(word_bits) * (ports + pes)
+    }
+}
+
 /// How a design builds each PE memory (two reads and two writes per cycle, `hdl/rv_mem.v`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PeMemory {
@@ -980,11 +996,9 @@ impl Target {
                     + self.control_alm
             }
             Some(l) => {
-                let ports =
-                    (n_pe * u64::from(self.writes)) as f64 * (l.mux_input_bit * sources as f64 + l.mux_port_bit);
-                let buffer = |slot: u64| buffer_words.get(slot as usize).copied().unwrap_or(1).max(1) - 1;
-                let pes: f64 = (0..n_pe).map(|s| l.pe_bit + l.buffer_word_bit * f64::from(buffer(s))).sum();
-                f64::from(word_bits) * (ports + pes)
+                let ports = (0..n_pe * u64::from(self.writes)).map(|_| sources);
+                let buffers = (0..n_pe).map(|s| buffer_words.get(s as usize).copied().unwrap_or(1));
+                l.alm(word_bits, ports, buffers)
             }
         };
         let alm = units + words + logic;
