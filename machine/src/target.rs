@@ -208,9 +208,9 @@ pub struct Units {
 /// The logic of a generated design (`codegen<fpga>`) as the family's Yosys flow maps it, in
 /// the family's logic units per bit of the design's word (`word_bits`: 32 for binary32 PEs,
 /// the fixed-point PEs' word): what the FPGA back end's analytic estimate
-/// ([`crate::resources::estimate`] without Yosys) charges instead of the seed's per-PE figures
-/// (`crossbar_alm`, `pe_memory_alm`, `control_alm`), which [`Target::estimate`] keeps. For a
-/// word of `DW` bits:
+/// ([`crate::resources::estimate`] without Yosys) and [`Target::estimate_with`] (`place`,
+/// `sweep`) charge instead of the seed's per-PE figures (`crossbar_alm`, `pe_memory_alm`,
+/// `control_alm`), which a target without it keeps. For a word of `DW` bits:
 /// `Σ_ports DW·(mux_input_bit·k + mux_port_bit) + Σ_PEs DW·(pe_bit + buffer_word_bit·(b − 1))`
 /// over each write port's `k` multiplexer inputs and each PE's `b` buffer words, plus the
 /// target's `pe_word_alm` per PE-memory word and `output_word_alm` per output word.
@@ -267,7 +267,7 @@ impl Family {
     /// 0.35 ALM per input bit and 0.4 per port bit (within 10 % from 2 inputs up); the rest,
     /// fitted on the Jeep's fixed-point designs at 4 + 4 to 36 + 42 PEs and its binary32 ones at
     /// 8 + 8 (crossbar and specialised), 1.35 ALM per PE bit and 1.2 per further buffer word
-    /// bit. The model is above Yosys on all of them: by 1–3 % from 8 + 8 PEs up, by 15 % at
+    /// bit. The model is above Yosys on all of them: by 1–7 % from 8 + 8 PEs up, by 18 % at
     /// 4 + 4 (docs/fpga.md, "The estimate against Yosys"). The ECP5: `None` (the seed-form
     /// model with its LUT4 figures, above what nextpnr places; `resources=pnr` measures it).
     pub const fn design_logic(self) -> Option<DesignLogic> {

@@ -338,13 +338,15 @@ impl Design {
     /// The Verilog expression of port `port`'s multiplexer sources on PE `slot` (most
     /// significant word first), their count and select bits: the whole bus `sources` for the
     /// crossbar, the routed words for a specialised design (`32'h0` alone for a port without
-    /// routes: its select is always 0; `DW'h0` with the design's word bits).
+    /// routes: its select is always 0; `DW'h0` with the design's word bits); the count is
+    /// [`Design::port_inputs`].
     fn port_sources(&self, slot: usize, port: usize) -> (String, usize, u32) {
         let n = self.n_pe();
-        let Some(r) = &self.routes else { return ("sources".into(), 2 * n, self.widths.sw) };
+        let k = self.port_inputs(slot, port);
+        let Some(r) = &self.routes else { return ("sources".into(), k, self.widths.sw) };
         let list = &r.ports[slot][port];
         if list.is_empty() {
-            return (format!("{}'h0", self.word_bits), 1, r.select_bits(slot, port));
+            return (format!("{}'h0", self.word_bits), k, r.select_bits(slot, port));
         }
         let words: Vec<String> = list
             .iter()
@@ -358,7 +360,7 @@ impl Design {
                 }
             })
             .collect();
-        (format!("{{{}}}", words.join(", ")), list.len(), r.select_bits(slot, port))
+        (format!("{{{}}}", words.join(", ")), k, r.select_bits(slot, port))
     }
 
     /// Bits of the exact intermediate of PE `slot`'s fixed-point unit

@@ -76,8 +76,8 @@ pub fn selects(word: u64, sw: u32) -> [u64; 2] {
 /// costs two inputs where one would do. The sources written in one cycle must take different
 /// ports: the ports are a 2-colouring of that conflict graph (breadth first, then improved as
 /// a maximum cut is: a source whose same-coloured neighbours outnumber the others changes
-/// colour, until none does); where an odd cycle forbids one, the source with the most same-coloured neighbours takes both ports, and
-/// so on until every conflict is met. A cycle's writes then go to their sources' ports (a
+/// colour, until none does); where an odd cycle forbids one, the source with the most
+/// same-coloured neighbours takes both ports, and so on until every conflict is met. A cycle's writes then go to their sources' ports (a
 /// single write may use port 1 alone). The Jeep's `dirdyna` at 32 + 32 PEs: 2,949 multiplexer
 /// inputs as the lowering numbered the writes, 1,792 distinct (memory, source) pairs, the
 /// floor this reaches when the graphs are bipartite; at 36 + 42 (`recurrence<pe=40>`) the
