@@ -64,6 +64,27 @@ fn check_vectors_with(d: &Path, n: usize, tb: &str, hdl_files: &[&str], defines:
     assert!(text.contains(&format!("checked {n} vectors, 0 mismatches")), "{text}");
 }
 
+/// The control memories are fetched two cycles ahead of the program counter (the block RAM's
+/// output registered again in each PE, issue 49: the ECP5's critical path began at that
+/// output): the word of cycle k is the PE's during clock k, for a start after idle clocks and
+/// one in the clock after `done`, with the program counter's wrap (`CW` bits, cycles up to
+/// 2^CW) and a one-cycle program.
+#[test]
+fn control_words_arrive_in_their_cycle_when_fetched_two_ahead() {
+    tool("iverilog");
+    for (cw, cycles) in [(3u32, 5u32), (3, 7), (3, 6), (1, 0), (1, 1)] {
+        let d = tmp(&format!("control_{cw}_{cycles}"));
+        let n = 3 * (cycles as usize + 1);
+        check_vectors_with(
+            &d,
+            n,
+            "control_tb.v",
+            &["rv_lib.v", "rv_mem.v", "fp_units.v", "fix_units.v"],
+            &[("CW", cw), ("CYCLES", cycles)],
+        );
+    }
+}
+
 /// The fixed-point units (`hdl/fix_units.v`, issue 49) against robovec's model of the PEs on
 /// 20,000 random operand pairs and shift words: `a ± b` with one operand aligned by up to 40
 /// bits, `a · b` (the split 16 × 16 partial products), rounded by −20 … 62 bits, operands of
@@ -292,6 +313,56 @@ fn placed_designs_simulate_in_iverilog_bit_for_bit_like_the_binary32_evaluation(
             same_outputs(&format!("{name} N={n}"), &eval, &sim);
         }
     }
+}
+
+/// A write through the producer's buffer in the cycle its value arrives (the machine's "a store
+/// of the same clock is seen": `robovec_ir::machine`), which `place` never emits but a placement
+/// file may: the design fetches each buffer read a clock early (`rv_pe`'s `buf_q`), so its
+/// bypass of this clock's store is what makes the word right. The pendulum's placement with one
+/// direct write turned into such a write passes `sim` and simulates in Icarus as `-eval`.
+#[test]
+fn a_buffer_read_in_its_values_arrival_cycle_simulates_bit_for_bit() {
+    tool("iverilog");
+    let d = tmp("buffer_same_cycle");
+    let placed = d.join("placed.rvir");
+    let o = opt(&[PENDULUM, "-passes=atomise,place<pe=2;restarts=0;search=0>", "-o", placed.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&placed).unwrap();
+    assert!(!text.contains(" buffer "), "the placement uses no buffer");
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    // the first direct write of a value produced by an op (not a load), and its producer's PE
+    let issue_pe = |v: &str| -> Option<String> {
+        lines.iter().find_map(|l| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            (t.len() == 4 && t[0] == "issue" && t[1] == v).then(|| t[2].to_string())
+        })
+    };
+    let (k, producer) = lines
+        .iter()
+        .enumerate()
+        .find_map(|(k, l)| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            (t.len() == 5 && t[0] == "write").then(|| issue_pe(t[1]).map(|pe| (k, pe))).flatten()
+        })
+        .expect("a write");
+    lines[k] += " buffer 0";
+    let b = lines.iter().position(|l| l.trim_start().starts_with("buffers ")).expect("the buffers line");
+    lines[b] = lines[b].replace(&format!("{producer}=0"), &format!("{producer}=1"));
+    let edited = d.join("edited.rvir");
+    std::fs::write(&edited, lines.join("\n") + "\n").unwrap();
+    let inputs = d.join("inputs.json");
+    std::fs::write(&inputs, r#"{"q[1]": 0.75, "qd[2]": -1.25, "qdd[1]": 3.0e-3}"#).unwrap();
+    let dir = d.join("fpga");
+    let passes = format!("-passes=sim,codegen<fpga;out={};resources=estimate>", dir.display());
+    let o = opt(&[edited.to_str().unwrap(), &passes, &format!("-eval={}", inputs.display()), "-eval-precision=f32"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let eval: serde_json::Value = serde_json::from_slice(&o.stdout).expect("eval JSON");
+    // the buffer instruction reads the address it stores in one cycle
+    let man: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    let slot = man["pes"].as_array().unwrap().iter().find(|p| p["pe"] == producer.as_str()).unwrap();
+    assert_eq!(slot["buffer_words"], 1, "{producer}'s buffer");
+    same_outputs("a same-cycle buffer read", &eval, &simulate(&dir, &inputs));
 }
 
 /// Throughput (issue 49 item 3): the pendulum interleaved into two states, placed, checked by

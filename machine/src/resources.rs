@@ -513,10 +513,14 @@ pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32, r: ShiftRanges)
 
 /// The logic of design `d` by the family's Yosys-flow figures `l`, in the family's units
 /// ([`crate::target::DesignLogic`]: each write port by its multiplexer inputs, each PE by its
-/// buffer words, at the design's word bits); without the per-word terms.
+/// buffer words, at the design's word bits), at least half its flip-flops ([`Design::flip_flops`]:
+/// the packing bound of a design too small for its logic to fill the ALMs its registers need);
+/// without the per-word terms.
 pub fn design_logic_alm(d: &Design, l: &crate::target::DesignLogic) -> f64 {
     let ports = (0..d.n_pe()).flat_map(|slot| (0..2).map(move |port| d.port_inputs(slot, port) as u64));
-    l.alm(d.word_bits, ports, d.pes.iter().map(|p| p.buffer_words))
+    let luts = l.alm(d.word_bits, ports, d.pes.iter().map(|p| p.buffer_words));
+    // a small design's ALMs are set by its registers, two a half ALM (the packing bound's)
+    luts.max(d.flip_flops().div_ceil(2) as f64)
 }
 
 /// The estimate for `d` under `m`, with Yosys' cells when it ran.

@@ -390,10 +390,9 @@ impl Design {
     pub fn control(&self, slot: usize) -> Control {
         let p = &self.pes[slot];
         let aw = self.widths.aw;
-        let pa = addr_bits(p.data.words.len().max(1) as u64).min(aw);
+        let (pa, width) = self.control_width(slot);
         let mut fields: Vec<&Image> = vec![&p.xbar, &p.bufi, &p.capt];
         fields.extend(&p.fix);
-        let width = 4 * pa + 4 + fields.iter().map(|f| f.width).sum::<u32>();
         let lane = self.control_lane_bits.max(1);
         let n_lanes = width.div_ceil(lane) as usize;
         let cycles = p.instr.words.len();
@@ -431,6 +430,28 @@ impl Design {
             }
         }
         Control { pa, width, lanes }
+    }
+
+    /// PE `slot`'s control word without building it: `(pa, width)` of [`Design::control`], the
+    /// bits of each address field and of the whole word.
+    pub fn control_width(&self, slot: usize) -> (u32, u32) {
+        let p = &self.pes[slot];
+        let pa = addr_bits(p.data.words.len().max(1) as u64).min(self.widths.aw);
+        let fields = p.xbar.width + p.bufi.width + p.capt.width + p.fix.as_ref().map_or(0, |f| f.width);
+        (pa, 4 * pa + 4 + fields)
+    }
+
+    /// The flip-flops of the design outside its units and memories (`hdl/rv_lib.v`), an upper
+    /// estimate: per PE its registered control word ([`Design::control_width`]), four words
+    /// (the result, the buffer read fetched a clock early and the result it may bypass to, and a
+    /// one-word buffer's register) and 24 bits of flags, shift word and bypass decisions; and the
+    /// program counter with `run` and `done`. Counted in bits; the Cyclone V's ALM packs two a
+    /// half ([`crate::resources::YosysCells::alm`]).
+    pub fn flip_flops(&self) -> u64 {
+        let per_pe: u64 = (0..self.n_pe())
+            .map(|slot| u64::from(self.control_width(slot).1) + 4 * u64::from(self.word_bits) + 24)
+            .sum();
+        per_pe + u64::from(self.widths.cw) + 2
     }
 
     /// Every image of PE `slot` the design writes: [`PeImages::images`] and its control lanes

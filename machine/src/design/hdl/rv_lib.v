@@ -6,7 +6,10 @@
 //
 // Timing (machine cycle k of the program = clock k of the run, counted from `start`):
 //   * the instruction, crossbar, buffer-instruction and output-capture words of cycle k are
-//     registered ROM outputs during clock k (fetched at the edge before it);
+//     flip-flops during clock k: the control memory (block RAM) registers the word of cycle k
+//     at the edge ending clock k - 2 and the PE registers it again at the next edge (rv_pe's
+//     `ctrl`; the buffer's read address of cycle k is used a clock early, from the block RAM's
+//     output);
 //   * during clock k the result of an op issued at k - LAT arrives (`result`, the register
 //     after the crossbar: the seed's "+2" = one clock for the PE-memory read register, one for the
 //     interconnect register); the buffer stores it (`store`) and is read (`read`, a store of the
@@ -56,7 +59,7 @@ module rv_pe #(
 ) (
     input  wire                 clk,
     input  wire                 run,       // executing cycle `pc` of the program
-    input  wire [CW-1:0]        fetch,     // the cycle whose words are fetched at this edge
+    input  wire [CW-1:0]        fetch,     // the cycle whose control word the block RAM registers at this edge
     input  wire [DW*N0-1:0]     src0,      // port 0's sources (crossbar: {buffer reads, results})
     input  wire [DW*N1-1:0]     src1,      // port 1's sources
     output reg  [DW-1:0]        result,    // the result arriving this cycle
@@ -98,7 +101,15 @@ module rv_pe #(
       end
     end
   endgenerate
-  wire [CTW-1:0] ctrl = lanes[CTW-1:0];
+  // The block RAM's output is the word of the next cycle (`fetch` runs two cycles ahead of
+  // the program): it is registered once more here, so that every field of the running cycle
+  // leaves a flip-flop, not the block RAM's slow clock-to-output (5.6 ns on the ECP5's DP16KD,
+  // the start of the critical path nextpnr reported), and the buffer's read address is known a
+  // clock early (below).
+  wire [CTW-1:0] ctrl_next = lanes[CTW-1:0];
+  reg  [CTW-1:0] ctrl;
+  initial ctrl = 0;
+  always @(posedge clk) ctrl <= ctrl_next;
   localparam integer IB = 4 * PA + 4;
 
   // instruction fields (the addresses zero-extended to the PE memory's AW bits)
@@ -162,13 +173,35 @@ module rv_pe #(
   initial result = 0;
   always @(posedge clk) result <= y;
 
-  // buffer: store the arriving result at `st`, read `rd` in the same clock (store first)
+  // buffer: store the arriving result at `st`, read `rd` in the same clock (store first).
+  // The read is fetched a clock early, from the next cycle's word, into flip-flops: `buf_q`
+  // the word at `rd` before this clock's store, `res_q` this clock's result, `fwd_q` that this
+  // clock stores to that address, `byp_q` that the next cycle does (its word is then that
+  // cycle's `result`). So `buf_read` is a 3:1 choice between flip-flops (one 5-input LUT a
+  // bit, as the 2:1 choice after the address decoding it replaces), not the buffer's address
+  // decoding after the control memory's output (issue 49: the ECP5's critical path).
   wire [BW-1:0] st    = bufi[BW-1:0];
-  wire [BW-1:0] rd    = bufi[2*BW-1:BW];
   wire          st_en = bufi[2*BW] & run;
+  wire [BIW-1:0] bufi_next = ctrl_next[IB+XW +: BIW];
+  wire [BW-1:0] st_next = bufi_next[BW-1:0];
+  wire [BW-1:0] rd_next = bufi_next[2*BW-1:BW];
   reg [DW-1:0] bmem [0:BUF_DEPTH-1];
-  assign buf_read = (st_en && st == rd) ? result : bmem[rd];
-  always @(posedge clk) if (st_en) bmem[st] <= result;
+  reg [DW-1:0] buf_q, res_q;
+  reg          fwd_q, byp_q;
+  initial begin
+    buf_q = 0;
+    res_q = 0;
+    fwd_q = 0;
+    byp_q = 0;
+  end
+  always @(posedge clk) begin
+    if (st_en) bmem[st] <= result;
+    buf_q <= bmem[rd_next];
+    res_q <= result;
+    fwd_q <= st_en && st == rd_next;
+    byp_q <= bufi_next[2*BW] && st_next == rd_next;
+  end
+  assign buf_read = byp_q ? result : fwd_q ? res_q : buf_q;
 
   // output memory (rv_mem.v): captures the arriving result; read by the host after `done`
   wire [OW-1:0] oa   = capt[OW-1:0];
@@ -219,8 +252,8 @@ module rv_mux #(
   assign y = valid ? lv[SW][DW-1:0] : {DW{1'b0}};
 endmodule
 
-// Program counter, start/done. `fetch` is the cycle whose words the ROMs register at the next
-// edge; `run` is high during clocks 0..CYCLES of the program.
+// Program counter, start/done. `fetch` is the cycle whose control word the block RAMs register
+// at the next edge (two ahead of `pc`); `run` is high during clocks 0..CYCLES of the program.
 module rv_control #(
     parameter integer CW = 1,
     parameter integer CYCLES = 0
@@ -233,7 +266,11 @@ module rv_control #(
     output reg  [CW-1:0] pc,
     output wire [CW-1:0] fetch
 );
-  assign fetch = run ? pc + 1'b1 : {CW{1'b0}};
+  // Two cycles ahead: the control memories' block RAMs register the word of cycle pc + 2 at
+  // the edge ending cycle pc and the PE registers it once more (rv_pe's `ctrl`). While idle the
+  // word of cycle 0 is fetched, and that of cycle 1 in the clock `start` is high; the last
+  // cycle fetches cycle 0 again, so that a program can start at the clock after `done`.
+  assign fetch = run ? (pc == CYCLES ? {CW{1'b0}} : pc + 2'd2) : (start ? {CW{1'b0}} + 1'b1 : {CW{1'b0}});
   initial begin
     run = 0;
     done = 0;
