@@ -438,9 +438,14 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
     let d = tmp("specialised");
     let none = d.join("none.json");
     std::fs::write(&none, "{}").unwrap();
-    let cases = [(PENDULUM.to_string(), "pendulum"), (corpus("m454__mbs_dirdyna_m454_project.c"), "m454-dirdyna")];
-    for (src, name) in &cases {
-        for n in [2u32, 4] {
+    let cases = [
+        (PENDULUM.to_string(), "pendulum", &[2u32, 4][..]),
+        // at 8 + 8 one memory has a shared multiplexer (`routes::assign_write_ports`)
+        (corpus("m454__mbs_dirdyna_m454_project.c"), "m454-dirdyna", &[2, 4, 8][..]),
+    ];
+    let mut shared_seen = 0;
+    for (src, name, ns) in &cases {
+        for &n in *ns {
             let what = format!("{name} N={n}");
             let xdir = d.join(format!("{name}-{n}-crossbar"));
             let sdir = d.join(format!("{name}-{n}-specialised"));
@@ -482,13 +487,19 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
             assert_eq!(routes.len(), n_pe);
             for (s, r) in routes.iter().enumerate() {
                 let mut carried = std::collections::BTreeSet::new();
+                // a shared multiplexer's sources, whose output is one more input of both ports
+                let shared = r["shared"].as_array().unwrap();
+                carried.extend(shared.iter().map(|v| v.as_str().unwrap().to_string()));
+                shared_seen += usize::from(!shared.is_empty());
+                let bits_for =
+                    |k: usize, bits: u64| 1u64 << bits > k as u64 && (bits <= 1 || 1u64 << (bits - 1) <= k as u64);
+                assert!(bits_for(shared.len(), r["select_bits"][2].as_u64().unwrap()) || shared.is_empty());
                 for port in 0..2 {
                     let names = r[format!("port{port}")].as_array().unwrap();
+                    assert!(names.iter().all(|g| !shared.contains(g)), "{what} slot {s}: a shared source on a port");
                     carried.extend(names.iter().map(|v| v.as_str().unwrap().to_string()));
                     let bits = r["select_bits"][port].as_u64().unwrap();
-                    assert!(
-                        1u64 << bits > names.len() as u64 && (bits == 1 || 1u64 << (bits - 1) <= names.len() as u64)
-                    );
+                    assert!(bits_for(names.len() + usize::from(!shared.is_empty()), bits));
                 }
                 {
                     let want: std::collections::BTreeSet<String> = union[s]
@@ -518,12 +529,21 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
                 serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap()
             };
             let (rx, rs) = (res(&xdir), res(&sdir));
-            let per_bit = robovec_machine::target::Family::CycloneV.design_logic().unwrap().mux_input_bit;
+            let logic = robovec_machine::target::Family::CycloneV.design_logic().unwrap();
+            let per_bit = logic.mux_input_bit;
             let kept: usize = routes
                 .iter()
-                .flat_map(|r| (0..2).map(move |p| r[format!("port{p}")].as_array().unwrap().len().max(1)))
+                .map(|r| {
+                    let shared = r["shared"].as_array().unwrap().len();
+                    let port =
+                        |p: usize| (r[format!("port{p}")].as_array().unwrap().len() + usize::from(shared > 0)).max(1);
+                    port(0) + port(1) + shared
+                })
                 .sum();
-            let saved = per_bit * 32.0 * (4 * n_pe * n_pe - kept) as f64;
+            // a shared multiplexer is a multiplexer more (`mux_port_bit` a bit)
+            let shared_muxes = routes.iter().filter(|r| !r["shared"].as_array().unwrap().is_empty()).count();
+            let saved =
+                per_bit * 32.0 * (4 * n_pe * n_pe - kept) as f64 - logic.mux_port_bit * 32.0 * shared_muxes as f64;
             let dl = rx["logic_alm"].as_f64().unwrap() - rs["logic_alm"].as_f64().unwrap();
             assert!(
                 (dl - saved).abs() <= 1.0,
@@ -535,6 +555,7 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
             assert!(rs["m10k"].as_u64() <= rx["m10k"].as_u64(), "{what}: {} → {} M10K", rx["m10k"], rs["m10k"]);
         }
     }
+    assert!(shared_seen > 0, "a design with a shared multiplexer was simulated");
 }
 
 /// The double pendulum's domain and one point of it, every input given (the parameters at

@@ -141,7 +141,9 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             s = w.sw
         ),
         Some(_) => "per PE (its memory's `width`): port-0 select in the low bits (`routes[slot].select_bits[0]`), \
-            port-1 select above: 0 none, i the port's i-th route (`routes[slot].port0` / `port1`, 1-based)"
+            port-1 select above, then the shared multiplexer's select (`select_bits[2]` bits, none when 0): a port's \
+            0 is no write, i its i-th route (`routes[slot].port0` / `port1`, 1-based), one more the shared \
+            multiplexer's output when the memory has one; the shared select's i is `routes[slot].shared`'s i-th"
             .to_string(),
     };
     let routes = d.routes.as_ref().map(|r| {
@@ -157,7 +159,8 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
                     "pe": pe_name_of(d, slot),
                     "port0": names(0),
                     "port1": names(1),
-                    "select_bits": [r.select_bits(slot, 0), r.select_bits(slot, 1)],
+                    "shared": r.shared[slot].iter().map(|&g| r.source_name(g, |k| pe_name_of(d, k))).collect::<Vec<_>>(),
+                    "select_bits": [r.select_bits(slot, 0), r.select_bits(slot, 1), r.shared_bits(slot)],
                 })
             })
             .collect::<Vec<_>>()

@@ -517,7 +517,11 @@ pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32, r: ShiftRanges)
 /// the packing bound of a design too small for its logic to fill the ALMs its registers need);
 /// without the per-word terms.
 pub fn design_logic_alm(d: &Design, l: &crate::target::DesignLogic) -> f64 {
-    let ports = (0..d.n_pe()).flat_map(|slot| (0..2).map(move |port| d.port_inputs(slot, port) as u64));
+    // each write port by its inputs (the shared output included), and each shared multiplexer
+    let ports = (0..d.n_pe()).flat_map(|slot| {
+        let shared = d.shared_inputs(slot) as u64;
+        (0..2).map(move |port| d.port_inputs(slot, port) as u64).chain((shared > 0).then_some(shared))
+    });
     let luts = l.alm(d.word_bits, ports, d.pes.iter().map(|p| p.buffer_words));
     // a small design's ALMs are set by its registers, two a half ALM (the packing bound's)
     luts.max(d.flip_flops().div_ceil(2) as f64)

@@ -271,22 +271,25 @@ impl Design {
                 self.routes = None;
             }
             Interconnect::Specialised => {
-                // each source on one write port where the cycles allow it (fewer inputs)
+                // each source on one write port, or the shared multiplexer, where the cycles
+                // allow it (fewer inputs)
                 let mut global = global;
-                for (p, words) in self.pes.iter_mut().zip(global.iter_mut()) {
-                    routes::assign_write_ports(&mut p.instr.words, words, self.widths.aw, self.widths.sw);
-                }
+                let shared: Vec<Vec<u32>> = self
+                    .pes
+                    .iter_mut()
+                    .zip(global.iter_mut())
+                    .map(|(p, words)| {
+                        routes::assign_write_ports(&mut p.instr.words, words, self.widths.aw, self.widths.sw)
+                    })
+                    .collect();
                 let refs: Vec<&[u64]> = global.iter().map(|w| w.as_slice()).collect();
-                let r = Routes::of_crossbar(self.n_pe(), self.widths.sw, &refs);
+                let r = Routes::of_crossbar(self.n_pe(), self.widths.sw, &refs, &shared);
                 for (s, (p, words)) in self.pes.iter_mut().zip(&global).enumerate() {
-                    let b0 = r.select_bits(s, 0);
-                    p.xbar.width = b0 + r.select_bits(s, 1);
+                    p.xbar.width = r.word_bits(s);
                     p.xbar.words = words
                         .iter()
                         .map(|&w| {
-                            let [g0, g1] = selects(w, self.widths.sw);
-                            let local = |port, g| r.local(s, port, g).expect("every select of the image is a route");
-                            local(0, g0) | (local(1, g1) << b0)
+                            r.encode(s, selects(w, self.widths.sw)).expect("every select of the image is a route")
                         })
                         .collect();
                 }
@@ -312,9 +315,15 @@ impl Design {
     /// routes is a constant 0).
     pub fn port_inputs(&self, slot: usize, port: usize) -> usize {
         match &self.routes {
-            Some(r) => r.ports[slot][port].len().max(1),
+            Some(r) => r.port_inputs(slot, port).max(1),
             None => 2 * self.n_pe(),
         }
+    }
+
+    /// Inputs of PE `slot`'s shared multiplexer ([`routes::assign_write_ports`]): 0 without one
+    /// (and for the crossbar).
+    pub fn shared_inputs(&self, slot: usize) -> usize {
+        self.routes.as_ref().map_or(0, |r| r.shared[slot].len())
     }
 
     /// PE `slot`'s crossbar memory as the crossbar's selects ([`crate::encode`]'s words),
@@ -322,15 +331,13 @@ impl Design {
     pub fn crossbar_words(&self, slot: usize) -> Vec<u64> {
         let p = &self.pes[slot];
         let Some(r) = &self.routes else { return p.xbar.words.clone() };
-        let b0 = r.select_bits(slot, 0);
         let sw = self.widths.sw;
         p.xbar
             .words
             .iter()
             .map(|&w| {
-                let [l0, l1] = [w & ((1 << b0) - 1), w >> b0];
-                let global = |port, l| r.global(slot, port, l).expect("a route index within the port's routes");
-                global(0, l0) | (global(1, l1) << sw)
+                let [g0, g1] = r.decode(slot, w).expect("a route index within the port's routes");
+                g0 | (g1 << sw)
             })
             .collect()
     }
@@ -338,16 +345,26 @@ impl Design {
     /// The Verilog expression of port `port`'s multiplexer sources on PE `slot` (most
     /// significant word first), their count and select bits: the whole bus `sources` for the
     /// crossbar, the routed words for a specialised design (`32'h0` alone for a port without
-    /// routes: its select is always 0; `DW'h0` with the design's word bits); the count is
-    /// [`Design::port_inputs`].
+    /// routes: its select is always 0; `DW'h0` with the design's word bits); the count is the
+    /// port's own sources (at least 1 without a shared multiplexer, whose output `rv_pe` adds:
+    /// [`Design::port_inputs`] counts it).
     fn port_sources(&self, slot: usize, port: usize) -> (String, usize, u32) {
-        let n = self.n_pe();
         let k = self.port_inputs(slot, port);
         let Some(r) = &self.routes else { return ("sources".into(), k, self.widths.sw) };
         let list = &r.ports[slot][port];
+        // a port's own sources; with a shared multiplexer a port may have none (`rv_pe` adds
+        // the shared output as its last input)
+        let k_own = if r.has_shared(slot) { list.len() } else { list.len().max(1) };
         if list.is_empty() {
-            return (format!("{}'h0", self.word_bits), k, r.select_bits(slot, port));
+            return (format!("{}'h0", self.word_bits), k_own, r.select_bits(slot, port));
         }
+        (self.source_words(list), k_own, r.select_bits(slot, port))
+    }
+
+    /// The Verilog concatenation of crossbar selects `list` (most significant word first):
+    /// `resultS` / `bufferS` per select.
+    fn source_words(&self, list: &[u32]) -> String {
+        let n = self.n_pe();
         let words: Vec<String> = list
             .iter()
             .rev()
@@ -360,7 +377,15 @@ impl Design {
                 }
             })
             .collect();
-        (format!("{{{}}}", words.join(", ")), k, r.select_bits(slot, port))
+        format!("{{{}}}", words.join(", "))
+    }
+
+    /// PE `slot`'s shared multiplexer for the top: its sources' concatenation, count and select
+    /// bits; `None` without one.
+    fn shared_sources(&self, slot: usize) -> Option<(String, usize, u32)> {
+        let r = self.routes.as_ref()?;
+        let list = &r.shared[slot];
+        (!list.is_empty()).then(|| (self.source_words(list), list.len(), r.shared_bits(slot)))
     }
 
     /// Bits of the exact intermediate of PE `slot`'s fixed-point unit
@@ -506,7 +531,8 @@ impl Design {
         }
         if self.routes.is_some() {
             s += "  // specialised interconnect: each write port multiplexes only the results and buffer reads\n";
-            s += "  // its program routes (manifest.json's `routes`; select 0 = no write, i = the i-th source)\n";
+            s += "  // its program routes (manifest.json's `routes`; select 0 = no write, i = the i-th source),\n";
+            s += "  // and a memory's shared multiplexer (`shared`, src2) is the last input of both its ports\n";
         } else {
             let mut bus: Vec<String> = (0..n).rev().map(|i| format!("buffer{i}")).collect();
             bus.extend((0..n).rev().map(|i| format!("result{i}")));
@@ -524,6 +550,7 @@ impl Design {
             let f = |i: &Image| format!("\"{dir}{}.hex\"", i.name);
             let (src0, n0, sw0) = self.port_sources(p.slot, 0);
             let (src1, n1, sw1) = self.port_sources(p.slot, 1);
+            let (src2, n2, sw2) = self.shared_sources(p.slot).unwrap_or_else(|| (format!("{dw}'h0"), 0, 0));
             let mut fix = match &p.fix {
                 Some(_) => {
                     let r = p.shift_ranges.unwrap_or(build::ShiftRanges::FULL);
@@ -546,7 +573,7 @@ impl Design {
                 control.lanes.iter().enumerate().map(|(k, l)| format!(".CTRL{k}_FILE({}), ", f(l))).collect();
             let _ = writeln!(
                 s,
-                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}), .PA({pa}), .CTW({ctw}), .LANE({lane}),\n        {lanes}.DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .src0({src0}), .src1({src1}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
+                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .N2({n2}), .SW2({sw2}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}), .PA({pa}), .CTW({ctw}), .LANE({lane}),\n        {lanes}.DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .src0({src0}), .src1({src1}), .src2({src2}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
                 mul = u8::from(p.is_mul),
                 aw = w.aw,
                 bw = w.bw,

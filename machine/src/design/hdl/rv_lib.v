@@ -39,6 +39,8 @@ module rv_pe #(
     parameter integer SW0 = 3,         // its select bits
     parameter integer N1 = 4,          // sources of write port 1
     parameter integer SW1 = 3,         // its select bits
+    parameter integer N2 = 0,          // sources of the shared multiplexer (0: none), whose output is
+    parameter integer SW2 = 0,         // the last input of both ports (N0 + 1, N1 + 1); its select bits
     parameter integer AW = 11,         // PE memory address bits
     parameter integer BW = 4,          // buffer address bits
     parameter integer OW = 1,          // output memory address bits
@@ -48,7 +50,7 @@ module rv_pe #(
     parameter integer BUF_DEPTH = 1,   // buffer words
     parameter integer OUT_DEPTH = 1,   // output memory words
     parameter integer PA = 11,         // bits of each address field of the control word (<= AW)
-    parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + 2 * BW + 2 + OW + 1 + (FIX != 0 ? 14 : 0),  // control word bits
+    parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + SW2 + 2 * BW + 2 + OW + 1 + (FIX != 0 ? 14 : 0),  // control word bits
     parameter integer LANE = 40,       // bits of a control-memory lane (the widest block-RAM word)
     parameter CTRL0_FILE = "",         // the control memory's lanes (robovec's `Design::control`),
     parameter CTRL1_FILE = "",         // bit 0 of the word in lane 0; at most four lanes
@@ -60,14 +62,15 @@ module rv_pe #(
     input  wire                 clk,
     input  wire                 run,       // executing cycle `pc` of the program
     input  wire [CW-1:0]        fetch,     // the cycle whose control word the block RAM registers at this edge
-    input  wire [DW*N0-1:0]     src0,      // port 0's sources (crossbar: {buffer reads, results})
-    input  wire [DW*N1-1:0]     src1,      // port 1's sources
+    input  wire [DW*(N0 > 0 ? N0 : 1)-1:0] src0,  // port 0's sources (crossbar: {buffer reads, results})
+    input  wire [DW*(N1 > 0 ? N1 : 1)-1:0] src1,  // port 1's sources
+    input  wire [DW*(N2 > 0 ? N2 : 1)-1:0] src2,  // the shared multiplexer's sources
     output reg  [DW-1:0]        result,    // the result arriving this cycle
     output wire [DW-1:0]        buf_read,  // this cycle's buffer read
     input  wire [OW-1:0]        out_addr,  // output memory read port (its word on out_data a clock later)
     output wire [DW-1:0]        out_data
 );
-  localparam integer XW = SW0 + SW1;
+  localparam integer XW = SW0 + SW1 + SW2;
   localparam integer BIW = 2 * BW + 2;
   localparam integer OCW = OW + 1;
   localparam integer ROM_DEPTH = CYCLES + 1;
@@ -129,8 +132,31 @@ module rv_pe #(
   wire [SW0-1:0] sel0 = xbar[SW0-1:0];
   wire [SW1-1:0] sel1 = xbar[SW0+SW1-1:SW0];
   wire [DW-1:0] wd0, wd1;
-  rv_mux #(.N(N0), .SW(SW0), .DW(DW)) u_x0 (.sources(src0), .sel(sel0), .y(wd0));
-  rv_mux #(.N(N1), .SW(SW1), .DW(DW)) u_x1 (.sources(src1), .sel(sel1), .y(wd1));
+  generate
+    if (N2 > 0) begin : g_shared
+      // the shared multiplexer (select N + 1 of a port of N own sources takes its output)
+      wire [SW2-1:0] sel2 = xbar[XW-1:SW0+SW1];
+      wire [DW-1:0] ys;
+      rv_mux #(.N(N2), .SW(SW2), .DW(DW)) u_x2 (.sources(src2), .sel(sel2), .y(ys));
+      wire [DW*(N0+1)-1:0] bus0;
+      wire [DW*(N1+1)-1:0] bus1;
+      if (N0 > 0) begin : g_b0
+        assign bus0 = {ys, src0};
+      end else begin : g_b0_only
+        assign bus0 = ys;
+      end
+      if (N1 > 0) begin : g_b1
+        assign bus1 = {ys, src1};
+      end else begin : g_b1_only
+        assign bus1 = ys;
+      end
+      rv_mux #(.N(N0 + 1), .SW(SW0), .DW(DW)) u_x0 (.sources(bus0), .sel(sel0), .y(wd0));
+      rv_mux #(.N(N1 + 1), .SW(SW1), .DW(DW)) u_x1 (.sources(bus1), .sel(sel1), .y(wd1));
+    end else begin : g_ports
+      rv_mux #(.N(N0), .SW(SW0), .DW(DW)) u_x0 (.sources(src0), .sel(sel0), .y(wd0));
+      rv_mux #(.N(N1), .SW(SW1), .DW(DW)) u_x1 (.sources(src1), .sel(sel1), .y(wd1));
+    end
+  endgenerate
 
   wire [DW-1:0] qa, qb;
   generate
