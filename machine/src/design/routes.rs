@@ -137,8 +137,14 @@ pub fn assign_write_ports(instr: &mut [u64], xbar: &mut [u64], aw: u32, sw: u32)
     let sources: Vec<u64> = (0..n_sel as u64).filter(|&g| used[g as usize]).collect();
     // colours: 0 and 1 the ports, SHARED the shared multiplexer, BOTH both ports
     let (two, two_cost) = two_colouring(&sources, &adjacent, &twice);
-    let (three, three_cost) = three_colouring(&sources, &adjacent, &twice);
-    let colour = if three_cost < two_cost { three } else { two };
+    // a shared output costs two inputs: worth trying only where three sources are on both ports
+    let colour = match two_cost >= sources.len() + 3 {
+        true => match three_colouring(&sources, &adjacent, &twice) {
+            (three, three_cost) if three_cost < two_cost => three,
+            _ => two,
+        },
+        false => two,
+    };
     let c = |g: u64| colour[g as usize];
     for cy in 0..instr.len() {
         let (i, x) = (instr[cy], xbar[cy]);
