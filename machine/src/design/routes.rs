@@ -136,13 +136,18 @@ pub fn assign_write_ports(instr: &mut [u64], xbar: &mut [u64], aw: u32, sw: u32)
     }
     let sources: Vec<u64> = (0..n_sel as u64).filter(|&g| used[g as usize]).collect();
     // colours: 0 and 1 the ports, SHARED the shared multiplexer, BOTH both ports
-    let (two, two_cost) = two_colouring(&sources, &adjacent, &twice);
+    let two = two_colouring(&sources, &adjacent, &twice);
+    let two_cost = inputs(&sources, &two);
     // a shared output costs two inputs: worth trying only where three sources are on both ports
     let colour = match two_cost >= sources.len() + 3 {
-        true => match three_colouring(&sources, &adjacent, &twice) {
-            (three, three_cost) if three_cost < two_cost => three,
-            _ => two,
-        },
+        true => {
+            let three = three_colouring(&sources, &adjacent, &twice);
+            if inputs(&sources, &three) < two_cost {
+                three
+            } else {
+                two
+            }
+        }
         false => two,
     };
     let c = |g: u64| colour[g as usize];
@@ -189,8 +194,8 @@ const BOTH: u32 = 3;
 
 /// The 2-colouring of [`assign_write_ports`] (breadth first, a maximum cut's local search, then
 /// both ports for the sources in the most conflicts left, and for those written twice in a
-/// cycle): the colour of each select and the multiplexer inputs it costs.
-fn two_colouring(sources: &[u64], adjacent: &[Vec<u64>], twice: &[bool]) -> (Vec<u32>, usize) {
+/// cycle): the colour of each select.
+fn two_colouring(sources: &[u64], adjacent: &[Vec<u64>], twice: &[bool]) -> Vec<u32> {
     let mut colour: Vec<Option<u32>> = vec![None; adjacent.len()];
     for &g in sources {
         if colour[g as usize].is_some() {
@@ -245,16 +250,22 @@ fn two_colouring(sources: &[u64], adjacent: &[Vec<u64>], twice: &[bool]) -> (Vec
             None => break,
         }
     }
-    let cost = sources.iter().map(|&g| if colour[g as usize] == BOTH { 2 } else { 1 }).sum();
-    (colour, cost)
+    colour
+}
+
+/// The multiplexer inputs a colouring of [`assign_write_ports`] costs: one a source, two a
+/// source on both ports, and two for the shared output into both ports when a source is shared.
+fn inputs(sources: &[u64], colour: &[u32]) -> usize {
+    let c = |g: &u64| colour[*g as usize];
+    let shared = sources.iter().any(|g| c(g) == SHARED);
+    sources.iter().map(|g| if c(g) == BOTH { 2 } else { 1 }).sum::<usize>() + if shared { 2 } else { 0 }
 }
 
 /// The 3-colouring of [`assign_write_ports`] by saturation (DSatur, Brélaz 1979): the uncoloured
 /// source with the most distinct colours among its neighbours (then the most neighbours, then
 /// the lowest select) takes the lowest colour none of them has, a source written twice in a
-/// cycle only [`SHARED`]; one that cannot takes both ports. The colour of each select and the
-/// multiplexer inputs it costs (two more for the shared output when a source is shared).
-fn three_colouring(sources: &[u64], adjacent: &[Vec<u64>], twice: &[bool]) -> (Vec<u32>, usize) {
+/// cycle only [`SHARED`]; one that cannot takes both ports. The colour of each select.
+fn three_colouring(sources: &[u64], adjacent: &[Vec<u64>], twice: &[bool]) -> Vec<u32> {
     const NONE: u32 = u32::MAX;
     let mut colour = vec![NONE; adjacent.len()];
     // per source: the colours among its coloured neighbours (bit k: colour k)
@@ -279,11 +290,7 @@ fn three_colouring(sources: &[u64], adjacent: &[Vec<u64>], twice: &[bool]) -> (V
             }
         }
     }
-    let mut cost: usize = sources.iter().map(|&g| if colour[g as usize] == BOTH { 2 } else { 1 }).sum();
-    if sources.iter().any(|&g| colour[g as usize] == SHARED) {
-        cost += 2;
-    }
-    (colour, cost)
+    colour
 }
 
 impl Routes {
@@ -451,10 +458,9 @@ impl Routes {
 mod tests {
     use super::*;
 
-    /// Writes of one PE memory (`aw` = 4, `sw` = 3): `(select, address)` per port, `None`: no
-    /// write; the words [`assign_write_ports`] reads.
-    fn program_words(cycles: &[[Option<(u64, u64)>; 2]]) -> (Vec<u64>, Vec<u64>) {
-        let (aw, sw) = (4, 3);
+    /// Writes of one PE memory (`aw` address bits, `sw` select bits): `(select, address)` per
+    /// port, `None`: no write; the words [`assign_write_ports`] reads.
+    fn program_words(cycles: &[[Option<(u64, u64)>; 2]], aw: u32, sw: u32) -> (Vec<u64>, Vec<u64>) {
         cycles
             .iter()
             .map(|ports| {
@@ -468,6 +474,22 @@ mod tests {
                 (i, x)
             })
             .unzip()
+    }
+
+    /// The writes of instruction word `i` and crossbar word `x`: `(select, address, port)`.
+    fn writes_of(i: u64, x: u64, aw: u32, sw: u32) -> Vec<(u64, u64, u32)> {
+        (0..2u32)
+            .filter(|&p| i >> (4 * aw + p) & 1 == 1)
+            .map(|p| (x >> (p * sw) & ((1 << sw) - 1), i >> ((2 + p) * aw) & ((1 << aw) - 1), p))
+            .collect()
+    }
+
+    /// The `(select, address)` pairs of [`writes_of`], sorted: what a memory receives whatever
+    /// the ports.
+    fn received(i: u64, x: u64, aw: u32, sw: u32) -> Vec<(u64, u64)> {
+        let mut k: Vec<(u64, u64)> = writes_of(i, x, aw, sw).iter().map(|w| (w.0, w.1)).collect();
+        k.sort_unstable();
+        k
     }
 
     #[test]
@@ -486,24 +508,17 @@ mod tests {
             [w(5, 10), None],
             [None, None],
         ];
-        let (mut instr, mut xbar) = program_words(&cycles);
+        let (mut instr, mut xbar) = program_words(&cycles, aw, sw);
         let before = (instr.clone(), xbar.clone());
         assert!(assign_write_ports(&mut instr, &mut xbar, aw, sw).is_empty(), "a shared output costs two inputs");
-        let writes = |i: u64, x: u64| -> Vec<(u64, u64, u32)> {
-            (0..2u32)
-                .filter(|&p| i >> (4 * aw + p) & 1 == 1)
-                .map(|p| (x >> (p * sw) & 7, i >> ((2 + p) * aw) & 15, p))
-                .collect()
-        };
         let mut ports: Vec<std::collections::BTreeSet<u32>> = vec![Default::default(); 8];
         for c in 0..cycles.len() {
-            let (old, new) = (writes(before.0[c], before.1[c]), writes(instr[c], xbar[c]));
-            let key = |v: &[(u64, u64, u32)]| {
-                let mut k: Vec<(u64, u64)> = v.iter().map(|w| (w.0, w.1)).collect();
-                k.sort_unstable();
-                k
-            };
-            assert_eq!(key(&old), key(&new), "cycle {c}: the same writes");
+            let new = writes_of(instr[c], xbar[c], aw, sw);
+            assert_eq!(
+                received(before.0[c], before.1[c], aw, sw),
+                received(instr[c], xbar[c], aw, sw),
+                "cycle {c}: the same writes"
+            );
             if let [a, b] = new[..] {
                 assert_ne!(a.2, b.2, "cycle {c}: two writes, two ports");
             }
@@ -534,22 +549,7 @@ mod tests {
         }
         cycles.push([w(13, 7), w(13, 8)]);
         cycles.push([w(13, 9), w(1, 10)]);
-        let words = |cycles: &[[Option<(u64, u64)>; 2]]| -> (Vec<u64>, Vec<u64>) {
-            cycles
-                .iter()
-                .map(|ports| {
-                    let (mut i, mut x) = (0u64, 0u64);
-                    for (p, wr) in ports.iter().enumerate() {
-                        if let Some((g, a)) = wr {
-                            i |= a << ((2 + p as u32) * aw) | 1 << (4 * aw + p as u32);
-                            x |= g << (p as u32 * sw);
-                        }
-                    }
-                    (i, x)
-                })
-                .unzip()
-        };
-        let (mut instr, mut xbar) = words(&cycles);
+        let (mut instr, mut xbar) = program_words(&cycles, aw, sw);
         let before = (instr.clone(), xbar.clone());
         let shared = assign_write_ports(&mut instr, &mut xbar, aw, sw);
         assert!(shared.contains(&13), "written twice in a cycle: shared ({shared:?})");
@@ -558,16 +558,12 @@ mod tests {
         for p in 0..2 {
             assert!(r.ports[0][p].iter().all(|g| !shared.contains(g)), "a shared source is on no port");
         }
-        let writes = |i: u64, x: u64| -> Vec<(u64, u64)> {
-            let mut v: Vec<(u64, u64)> = (0..2u32)
-                .filter(|&p| i >> (4 * aw + p) & 1 == 1)
-                .map(|p| (x >> (p * sw) & 15, i >> ((2 + p) * aw) & 31))
-                .collect();
-            v.sort_unstable();
-            v
-        };
         for c in 0..cycles.len() {
-            assert_eq!(writes(instr[c], xbar[c]), writes(before.0[c], before.1[c]), "cycle {c}: the same writes");
+            assert_eq!(
+                received(instr[c], xbar[c], aw, sw),
+                received(before.0[c], before.1[c], aw, sw),
+                "cycle {c}: the same writes"
+            );
             let sel = selects(xbar[c], sw);
             let word = r.encode(0, sel).expect("every cycle encodes: at most one shared source");
             assert!(word >> r.word_bits(0) == 0);
@@ -638,7 +634,7 @@ mod tests {
         assert!(e.contains("select 2 into port 0 of PE slot 0"), "{e}");
         // a shared source serves both ports; a program's shared source needs both
         let sh = Routes { n_pe: 2, ports: vec![[vec![1], vec![]], [vec![], vec![4]]], shared: vec![vec![2], vec![]] };
-        assert!(sh.admits(&Routes { shared: none(), ..other.clone() }).is_err());
+        assert!(sh.admits(&other).is_err());
         let wants = Routes { n_pe: 2, ports: vec![[vec![2], vec![2]], [vec![], vec![4]]], shared: none() };
         assert!(sh.admits(&wants).is_ok());
         let wants = Routes { shared: vec![vec![1], vec![]], ..wants };
