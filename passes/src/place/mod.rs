@@ -12,7 +12,10 @@
 //! … Indirect/Indirect = 9). Then `improve` rounds of forward-backward improvement re-run the
 //! list scheduler with the start times of a backward (right-justified) schedule as priorities,
 //! keeping the best result (Tormos & Lova 2001; Valls et al. 2005): it recovers the idle cycles
-//! that ALAP order leaves when both PE types are saturated. Then [`memory`] assigns addresses
+//! that ALAP order leaves when both PE types are saturated. With `select=routes`, [`rebind`]
+//! then moves ops between PEs of their type (and within their slack), never lengthening the
+//! schedule, to fewer interconnect routes
+//! (`rebind=R` rounds, 64 by default). Then [`memory`] assigns addresses
 //! and sizes.
 //!
 //! Contract: never changes the function; every placement it returns passes `sim`. Cost:
@@ -23,6 +26,7 @@ pub mod dag;
 pub mod feed;
 pub mod memory;
 pub mod ready;
+pub mod rebind;
 pub mod report;
 pub mod schedule;
 pub mod search;
@@ -77,6 +81,10 @@ pub struct PlaceOptions {
     /// [`tight_lower_bound`] or 5% above [`lower_bound`] (when the tight bound allows it); at
     /// most about 10⁶ op schedulings in all. 0 = none. See [`search`].
     pub restarts: u32,
+    /// Rounds of interconnect-aware rebinding of the schedule kept ([`rebind`]; only with
+    /// [`Select::Routes`]): ops move between PEs of their type in their own cycle while that
+    /// lowers the routes. 0 = none.
+    pub rebind: u32,
     /// Iterations of key-mutation search after the restarts, under the same condition (see
     /// [`search`]); at most about 1.2·10⁷ op schedulings in all. 0 = none.
     pub search: u32,
@@ -148,6 +156,7 @@ fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
         improve: p.u32("improve")?,
         restarts: p.u32("restarts")?,
         search: p.u32("search")?,
+        rebind: p.u32("rebind")?,
         deadline: None,
         grace: None,
         tick_budget: None,
@@ -197,20 +206,26 @@ pub fn try_place_function_progress(
     if required.check() {
         return Err(PlaceError::Stopped);
     }
-    // The memories of the schedule kept: required, within the grace.
-    let build =
-        |best: &schedule::Schedule| memory::build(f, &dag, a, best, &|| required.tick()).ok_or(PlaceError::Stopped);
+    // The schedule kept, rebound to fewer routes (optional: up to the deadline), then its
+    // memories: required, within the grace.
+    let build = |mut best: schedule::Schedule| {
+        if opts.select == Select::Routes && opts.rebind > 0 {
+            let optional = crate::Ticker::new(opts.deadline, opts.tick_budget);
+            rebind::rebind(&dag, a, &mut best, opts.rebind, &|| optional.tick());
+        }
+        memory::build(f, &dag, a, &best, &|| required.tick()).ok_or(PlaceError::Stopped)
+    };
     if cut {
-        return Ok((build(&best)?, true));
+        return Ok((build(best)?, true));
     }
     let spec = lower_bound(f, a) as u64;
     // Within 2% of SPEC §4's bound (hence of the tight bound too): nothing to search for, and
     // the tight bound (O(n log n) but not free) is not computed.
     if (opts.restarts > 0 || opts.search > 0) && end(&best) as u64 * 100 > spec * 102 {
         let (best, stopped) = search::restarts_and_search(f, &dag, opts, seed, best, progress)?;
-        return Ok((build(&best)?, stopped));
+        return Ok((build(best)?, stopped));
     }
-    Ok((build(&best)?, false))
+    Ok((build(best)?, false))
 }
 
 /// Cycles of a schedule: the largest arrival.
@@ -343,6 +358,12 @@ pub const INFO: PassInfo = PassInfo {
             name: "search",
             kind: ParamKind::U32 { default: 5000, min: 0, max: 1_000_000 },
             doc: "key-mutation search iterations after the restarts, same condition (0 = none)",
+        },
+        ParamInfo {
+            name: "rebind",
+            kind: ParamKind::U32 { default: 64, min: 0, max: 4096 },
+            doc: "with select=routes: rounds of rebinding ops to other PEs of their type (in their cycle, or in \
+                  their slack) while the interconnect routes do not grow; the cycles stay (0 = none)",
         },
         crate::params::LAT_ADD,
         crate::params::LAT_MUL,
