@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Issue 49's proof table: robovec's FPGA designs against robovec's own C, side by side in one run.
 
-    scripts/fpga_vs_cpu.py [--pes=8,16,22,18+26] [--states=1,4] [--recurrence=16] [--pnr] [--yosys] [MODEL...]
+    scripts/fpga_vs_cpu.py [--pes=8,16,22,18+26] [--states=1,4] [--recurrence=16] [--rebind=64] [--pnr] [--yosys] [MODEL...]
 
 For each model (a corpus `dirdyna` named by its file's prefix: `jeep`, `tricycle`, `mazda_mx5`,
 `coman_longarms`, `walkman`; default: every corpus `dirdyna` of at least 5k ops, the issue's
@@ -18,8 +18,8 @@ points; docs/accuracy.md):
 2. for each target (`de10-nano` at its declared 120 MHz, `ecp5-85f` at 80 MHz or, with `--pnr`,
    at the Fmax nextpnr measures), each configuration of `--pes` (N: N ADD + N MULTI PEs; A+M:
    A ADD and M MULTI PEs) and each K of `--states` (`interleave<states=K>`, issue 49 item 3),
-   the design placed for the fewest interconnect routes (`place<select=routes>`) with the
-   specialised interconnect: cycles, us (latency), ns per state, logic / block RAM / DSP and fit
+   the design placed for the fewest interconnect routes (`place<select=routes>`, rebound for
+   `--rebind` rounds: `rebind=R`, 64 by default) with the specialised interconnect: cycles, us (latency), ns per state, logic / block RAM / DSP and fit
    (the analytic estimate; `--yosys`: Yosys' count on the DE10-Nano; `--pnr`: nextpnr's on the
    ECP5);
 3. robovec's fastest C of the same model (`atomise,cse,zero-removal,cse,contract,schedule-cpu`,
@@ -116,12 +116,15 @@ def report(args, work, name, env=None, refusal_ok=False):
 
 def main():
     pes, states, pnr, yosys, models, json_out = [(8, 8), (16, 16), (22, 22), (18, 26)], [1], False, False, [], None
+    rebind = None
     prefix = pre()
     for a in sys.argv[1:]:
         if a.startswith("--recurrence="):
             prefix = pre(int(a[len("--recurrence="):]))
         elif a.startswith("--pes="):
             pes = [config(x) for x in a[6:].split(",")]
+        elif a.startswith("--rebind="):
+            rebind = int(a[len("--rebind="):])
         elif a.startswith("--states="):
             states = [int(x) for x in a[9:].split(",")]
         elif a == "--pnr":
@@ -193,7 +196,7 @@ def main():
                     out = os.path.join(work, f"{target}-{n}-{k}")
                     passes = (
                         f"{prefix},precision<budget={budget};target=mcu;word={w}>,{inter}"
-                        f"place<add={na};mul={nm};select=routes>,"
+                        f"place<add={na};mul={nm};select=routes{'' if rebind is None else f';rebind={rebind}'}>,"
                         f"codegen<fpga;out={out};resources={resources};interconnect=specialised;format=hex>"
                     )
                     try:
