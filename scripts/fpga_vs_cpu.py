@@ -19,9 +19,9 @@ points; docs/accuracy.md):
    at the Fmax nextpnr measures), each configuration of `--pes` (N: N ADD + N MULTI PEs; A+M:
    A ADD and M MULTI PEs) and each K of `--states` (`interleave<states=K>`, issue 49 item 3),
    the design placed for the fewest interconnect routes (`place<select=routes>`, rebound for
-   `--rebind` rounds: `rebind=R`, 64 by default) with the specialised interconnect: cycles, us (latency), ns per state, logic / block RAM / DSP and fit
-   (the analytic estimate; `--yosys`: Yosys' count on the DE10-Nano; `--pnr`: nextpnr's on the
-   ECP5);
+   `--rebind` rounds: `rebind=R`, 64 by default) with the specialised interconnect: cycles, us
+   (latency), ns per state, logic / block RAM / DSP and fit (the analytic estimate; `--yosys`:
+   Yosys' count on the DE10-Nano; `--pnr`: nextpnr's on the ECP5);
 3. robovec's fastest C of the same model (`atomise,cse,zero-removal,cse,contract,schedule-cpu`,
    `codegen<c;abi=plain;trig=inline>`, binary64, `-O3 -march=native`), one state per call and
    `batch=4`, timed by `-report-dir` on this machine in the same run (src/cpu_time.rs: median

@@ -14,9 +14,8 @@
 //! keeping the best result (Tormos & Lova 2001; Valls et al. 2005): it recovers the idle cycles
 //! that ALAP order leaves when both PE types are saturated. With `select=routes`, [`rebind`]
 //! then moves ops between PEs of their type (and within their slack), never lengthening the
-//! schedule, to fewer interconnect routes
-//! (`rebind=R` rounds, 64 by default). Then [`memory`] assigns addresses
-//! and sizes.
+//! schedule, to fewer interconnect routes (`rebind=R` rounds, 64 by default). Then [`memory`]
+//! assigns addresses and sizes.
 //!
 //! Contract: never changes the function; every placement it returns passes `sim`. Cost:
 //! O(n log n + n·N) for n ops and N PEs per type.
@@ -82,8 +81,8 @@ pub struct PlaceOptions {
     /// most about 10⁶ op schedulings in all. 0 = none. See [`search`].
     pub restarts: u32,
     /// Rounds of interconnect-aware rebinding of the schedule kept ([`rebind`]; only with
-    /// [`Select::Routes`]): ops move between PEs of their type in their own cycle while that
-    /// lowers the routes. 0 = none.
+    /// [`Select::Routes`]): ops move to other PEs of their type, in their cycle or within their
+    /// slack, while the routes do not grow; the schedule's length stays. 0 = none.
     pub rebind: u32,
     /// Iterations of key-mutation search after the restarts, under the same condition (see
     /// [`search`]); at most about 1.2·10⁷ op schedulings in all. 0 = none.

@@ -37,7 +37,7 @@ pub struct Rebound {
     pub routes_before: u32,
     /// Distinct routes after.
     pub routes_after: u32,
-    /// Moves and swaps kept.
+    /// Moves, swaps and retimes kept.
     pub moves: u32,
     /// Rounds run.
     pub rounds: u32,
@@ -304,13 +304,9 @@ impl<'a> State<'a> {
 
     /// Issues `x` on slot `to` (same cycle); its result's writes follow.
     fn set_slot(&mut self, x: Node, to: u32) {
-        let (from, t) = self.issue[x as usize];
+        let t = self.issue[x as usize].1;
         self.occupy_result(x, false);
-        if self.busy[from as usize].get(t as usize) == Some(&(x + 1)) {
-            self.busy[from as usize][t as usize] = 0;
-        }
-        self.issue[x as usize].0 = to;
-        *at(&mut self.busy[to as usize], t) = x + 1;
+        self.place_at(x, to, t);
         self.occupy_result(x, true);
     }
 
@@ -340,7 +336,8 @@ impl<'a> State<'a> {
         }
     }
 
-    /// Issues `x` (whose result has no live writes) on `(q, t)`.
+    /// Issues `x` on `(q, t)`, its result's writes left as they are (none live, or occupied
+    /// again by the caller).
     fn place_at(&mut self, x: Node, q: u32, t: u32) {
         let (p, t0) = self.issue[x as usize];
         if self.busy[p as usize].get(t0 as usize) == Some(&(x + 1)) {
@@ -376,15 +373,11 @@ impl<'a> State<'a> {
             return false;
         }
         // One write per memory its users read it in, by the earliest of them there.
-        let users = self.dag.users_of(x);
-        for (k, &y) in users.iter().enumerate() {
-            let m = self.issue[y as usize].0;
-            if users[..k].iter().any(|&z| self.issue[z as usize].0 == m) {
-                continue;
-            }
-            let by =
-                users[k..].iter().filter(|&&z| self.issue[z as usize].0 == m).map(|&z| self.issue[z as usize].1).min();
-            let Some(b) = by.and_then(|by| self.best_booking(x, m as usize, by)) else { return false };
+        let mut by: Vec<(u32, u32)> = self.dag.users_of(x).iter().map(|&y| self.issue[y as usize]).collect();
+        by.sort_unstable();
+        by.dedup_by_key(|&mut (m, _)| m);
+        for (m, t) in by {
+            let Some(b) = self.best_booking(x, m as usize, t) else { return false };
             self.push(b);
         }
         self.legal()
