@@ -1376,3 +1376,75 @@ fn a_corrupted_placement_is_located_at_its_line() {
     }
     assert!(!out.exists(), "nothing written");
 }
+
+/// Fused multiply-adds in fixed point (issue 49): `contract` after `precision<target=mcu>` fuses
+/// the pendulum's products into their sums where each fused op stays an integer op and the
+/// range check holds; the MULTI PEs run them (a multiply-accumulate: the product plus the
+/// aligned addend, rounded once), `sim` runs the placement bit for bit as `-eval` at points of
+/// the domain, the certified bound of every output is at most the unfused function's, fewer
+/// results cross the interconnect, and `codegen<fpga>`, which has no MAC unit yet, says so
+/// (exit 1).
+#[test]
+fn fused_multiply_adds_run_on_the_multi_pes_bit_for_bit() {
+    let d = tmp("fixed_mac");
+    let ranges = d.join("ranges.json");
+    std::fs::write(&ranges, PENDULUM_RANGES).unwrap();
+    let run = |contract: &str, tag: &str| {
+        let rep = d.join(format!("{tag}.json"));
+        let ir = d.join(format!("{tag}.rvir"));
+        let o = opt(&[
+            PENDULUM,
+            &format!("-ranges={}", ranges.display()),
+            &format!(
+                "-passes=atomise,cse,precision<budget=1e-3;target=mcu;word=27>,{contract}error-bound,\
+                 place<pe=2;restarts=0;search=0>,sim<seeds=8>"
+            ),
+            &format!("-report={}", rep.display()),
+            "-o",
+            ir.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{tag}: {}", stderr(&o));
+        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+        (r, std::fs::read_to_string(&ir).unwrap())
+    };
+    let (plain, _) = run("", "plain");
+    let (fused, text) = run("contract,", "fused");
+    let n_fused = text
+        .lines()
+        .filter(|l| l.contains("call @fma(") || l.contains("call @fms(") || l.contains("call @fnma("))
+        .count();
+    assert!(n_fused >= 8, "the pendulum's sums of products fuse: {n_fused}\n{text}");
+    assert_eq!(fused["sim"]["bit_exact"], true);
+    assert_eq!(fused["sim"]["precisions"], serde_json::json!(["fixed point"]));
+    // the MULTI PEs take the fused ops: as many ops there as products before, fewer on the ADD side
+    let count = |r: &serde_json::Value, k: &str| r["stats"]["ops"][k].as_u64().unwrap_or(0);
+    assert_eq!(count(&fused, "call"), n_fused as u64);
+    // fewer ops and fewer results through the interconnect (the products stay in their PE)
+    assert!(count(&fused, "total") < count(&plain, "total"));
+    let writes = |r: &serde_json::Value| {
+        r["placement"]["writes_direct"].as_u64().unwrap() + r["placement"]["writes_indirect"].as_u64().unwrap()
+    };
+    assert!(writes(&fused) < writes(&plain), "{} against {}", writes(&fused), writes(&plain));
+    // a MAC keeps the partial-product stage: MULTI 4 cycles at 27 bits (3 without fused ops)
+    assert_eq!(
+        (fused["stats"]["latencies"]["mul"].as_u64(), plain["stats"]["latencies"]["mul"].as_u64()),
+        (Some(4), Some(3))
+    );
+    for o in ["Qq[1]", "Qq[2]"] {
+        let (a, b) = (&fused["error_bound"]["outputs"][o]["abs"], &plain["error_bound"]["outputs"][o]["abs"]);
+        assert!(a.as_f64().unwrap() <= b.as_f64().unwrap(), "{o}: fused bound {a}, unfused {b}");
+    }
+    let o = opt(&[
+        PENDULUM,
+        &format!("-ranges={}", ranges.display()),
+        &format!(
+            "-passes=atomise,cse,precision<budget=1e-3;target=mcu;word=27>,contract,place<pe=2>,codegen<fpga;out={};resources=estimate>",
+            d.join("design").display()
+        ),
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("fused multiply-add(s) on MULTI PEs"), "{}", stderr(&o));
+    assert!(!d.join("design").exists(), "nothing written");
+}

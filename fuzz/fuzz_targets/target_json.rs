@@ -21,7 +21,8 @@ fuzz_target!(|data: &[u8]| {
     let word = u32::from(head[2] % 32) + 1;
     let _ = t.pe_array(n_add, n_mul, head[3] & 1 == 1);
     let _ = t.estimate(n_add, n_mul, u32::from(head[3]) * 16);
-    let _ = t.fix_pe.latencies_for(t.family, word);
+    let _ = t.fix_pe.latencies_for(t.family, word, false);
+    let _ = t.fix_pe.latencies_for(t.family, word, true);
     let m = cost_model(&t);
     let ranges =
         ShiftRanges { align_max: head[3] % 64, shift_min: -((head[3] % 65) as i8), shift_max: (head[3] % 63) as i8 };

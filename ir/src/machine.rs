@@ -93,7 +93,7 @@ pub enum Word {
     Const(f64),
 }
 
-/// The operation an instruction issues. `Add`/`Sub` run on ADD PEs, `Mul` on MULTI PEs; `Div`
+/// The operation an instruction issues. `Add`/`Sub` run on ADD PEs, `Mul` and `Mac` on MULTI PEs; `Div`
 /// and `Call` (ADD PEs) exist in the machine model for `sim` but not on the FPGA.
 #[derive(Clone, Debug, PartialEq)]
 pub enum MachineOp {
@@ -107,6 +107,10 @@ pub enum MachineOp {
     Div,
     /// A call (ADD PE; no FPGA unit), reading all its operands in its issue cycle.
     Call(Box<Callee>),
+    /// A fused multiply-add in fixed point (`fma`, `fms`, `fnma`; MULTI PE, issue 49): the
+    /// product of the first two operands plus or minus the third, all three read in the issue
+    /// cycle, rounded once ([`FixShifts::apply_fused`]); the MULTI latency.
+    Mac(Box<Callee>),
 }
 
 /// One instruction: the op issued this cycle and the addresses of its operands in the issuing
@@ -234,9 +238,23 @@ impl FixShifts {
             MachineOp::Add => xa + xb,
             MachineOp::Sub => xa - xb,
             MachineOp::Mul => a * b,
-            MachineOp::Div | MachineOp::Call(_) => return None,
+            MachineOp::Div | MachineOp::Call(_) | MachineOp::Mac(_) => return None,
         };
         Some(self.round(k))
+    }
+
+    /// What a fixed-point MULTI PE computes for a fused multiply-add on the operands' integers
+    /// `a`, `b`, `c`: the exact `±(a·b << lp) ± (c << lc)` (`align_b`: the addend `c` is
+    /// shifted, else the product), then [`FixShifts::round`]; `negate_product` for `fnma`,
+    /// `negate_addend` for `fms` ([`crate::format::integer_op`]'s terms, so `-eval` computes the
+    /// same integer).
+    pub fn apply_fused(&self, negate_product: bool, negate_addend: bool, a: i64, b: i64, c: i64) -> i128 {
+        let p = i128::from(a) * i128::from(b);
+        let c = i128::from(c);
+        let (xp, xc) = if self.align_b { (p, c << self.align) } else { (p << self.align, c) };
+        let xp = if negate_product { -xp } else { xp };
+        let xc = if negate_addend { -xc } else { xc };
+        self.round(xp + xc)
     }
 }
 
@@ -310,7 +328,7 @@ impl MachineProgram {
         let l = &self.arch.lat;
         match op {
             MachineOp::Add | MachineOp::Sub => l.add,
-            MachineOp::Mul => l.mul,
+            MachineOp::Mul | MachineOp::Mac(_) => l.mul,
             MachineOp::Div => l.div,
             MachineOp::Call(_) => l.call,
         }

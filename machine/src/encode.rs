@@ -267,6 +267,9 @@ pub fn encode_step(l: &Layout, slot: usize, cycle: u32, s: &Step) -> Result<[u64
             MachineOp::Sub => 1,
             MachineOp::Div => return Err(EncodeError::NoUnit { slot, cycle, op: "div".into() }),
             MachineOp::Call(c) => return Err(EncodeError::NoUnit { slot, cycle, op: format!("call @{}", c.name) }),
+            MachineOp::Mac(c) => {
+                return Err(EncodeError::NoUnit { slot, cycle, op: format!("multiply-add @{}", c.name) })
+            }
         };
         if reads.len() != 2 {
             return Err(EncodeError::Reads { slot, cycle, reads: reads.len() });

@@ -7,6 +7,7 @@
 use std::collections::HashMap;
 
 use robovec_ir::interp::{eval_binop, eval_call, Float};
+use robovec_ir::intrinsic::Intrinsic;
 use robovec_ir::machine::{Instr, MachineOp, MachineProgram, Source, Word};
 use robovec_ir::syntax::{BinOp, TrigFn};
 
@@ -64,7 +65,7 @@ pub fn execute_until<T: Float>(
             MachineOp::Sub => binary(BinOp::Sub),
             MachineOp::Mul => binary(BinOp::Mul),
             MachineOp::Div => binary(BinOp::Div),
-            MachineOp::Call(callee) => Ok(eval_call(callee, args)),
+            MachineOp::Call(callee) | MachineOp::Mac(callee) => Ok(eval_call(callee, args)),
         }
     };
     run(p, load, op, stop)
@@ -105,8 +106,19 @@ pub fn execute_fixed_until(
     };
     let op = |i: &Instr, slot: usize, cycle: usize, args: &[i64]| -> Result<i64, String> {
         let sh = fx.shifts.get(slot).and_then(|c| c.get(cycle)).copied().flatten().ok_or("an op without shifts")?;
-        let [a, b] = args else { return Err(format!("{:?} reads {} words", i.op, args.len())) };
-        let r = sh.apply(&i.op, *a, *b).ok_or_else(|| format!("{:?} has no fixed-point unit", i.op))?;
+        let r = match (&i.op, args) {
+            (MachineOp::Mac(callee), [a, b, c]) => {
+                let (negate_product, negate_addend) = match Intrinsic::of(callee, 3) {
+                    Some(Intrinsic::Fma) => (false, false),
+                    Some(Intrinsic::Fms) => (false, true),
+                    Some(Intrinsic::Fnma) => (true, false),
+                    _ => return Err(format!("{:?} has no fixed-point unit", i.op)),
+                };
+                sh.apply_fused(negate_product, negate_addend, *a, *b, *c)
+            }
+            (_, [a, b]) => sh.apply(&i.op, *a, *b).ok_or_else(|| format!("{:?} has no fixed-point unit", i.op))?,
+            _ => return Err(format!("{:?} reads {} words", i.op, args.len())),
+        };
         i32::try_from(r).map(i64::from).map_err(|_| format!("the result {r} overflows the 32-bit word"))
     };
     let x = run(p, load, op, stop)?;

@@ -453,10 +453,13 @@ impl FixPe {
     /// The latencies of a fixed-point PE array of `word_bits`-bit words on `family`: a product
     /// that is one DSP multiplier ([`Family::one_multiplier_word`]) has no partial products to
     /// sum, so the MULTI PE takes one stage fewer than `mul.latency` (the product, then its
-    /// rounding: the ADD PE's two stages; `hdl/fix_units.v`), and never under 3 cycles.
-    pub fn latencies_for(&self, family: Family, word_bits: u32) -> Latencies {
+    /// rounding: the ADD PE's two stages; `hdl/fix_units.v`), and never under 3 cycles. With
+    /// `mac` (the function has fused multiply-adds, which MULTI PEs compute: issue 49) the
+    /// MULTI PE keeps `mul.latency`: the addend is aligned and added in the stage that sums
+    /// a wide product's partial products.
+    pub fn latencies_for(&self, family: Family, word_bits: u32, mac: bool) -> Latencies {
         let mut l = self.latencies();
-        if word_bits <= family.one_multiplier_word() {
+        if word_bits <= family.one_multiplier_word() && !mac {
             l.mul = l.mul.saturating_sub(1).max(3);
         }
         l
@@ -1052,7 +1055,7 @@ mod tests {
     fn one_multiplier_words_shorten_the_multi_pe_by_a_stage() {
         let de10 = Target::de10_nano();
         let lat = |t: &Target, w: u32| {
-            let l = t.fix_pe.latencies_for(t.family, w);
+            let l = t.fix_pe.latencies_for(t.family, w, false);
             (l.add, l.mul)
         };
         assert_eq!([lat(&de10, 32), lat(&de10, 28), lat(&de10, 27), lat(&de10, 16)], [(3, 4), (3, 4), (3, 3), (3, 3)]);
@@ -1061,6 +1064,12 @@ mod tests {
         let mut short = Target::de10_nano();
         short.fix_pe.mul.latency = 3;
         assert_eq!(lat(&short, 20), (3, 3), "one unit stage + 2 is the least");
+        let mac = |t: &Target, w: u32| t.fix_pe.latencies_for(t.family, w, true).mul;
+        assert_eq!(
+            [mac(&de10, 27), mac(&de10, 32), mac(&ecp5, 18)],
+            [4, 4, 4],
+            "a MAC keeps the partial-product stage for its addend"
+        );
     }
 
     #[test]

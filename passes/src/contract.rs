@@ -18,9 +18,25 @@
 //! `m = a·b`. Multiplies are taken in statement order (GCC's order): an addition of two
 //! products absorbs the earlier one, which leaves the other as its addend, unfused.
 //!
+//! # In fixed point (issue 49)
+//! After `precision<target=mcu>` (a function with formats) the fused op takes the addition's
+//! format, and a multiply is fused only when each fused op stays an integer op
+//! ([`robovec_ir::format::integer_op`]: the exact `±a·b ± c`, then one rounding, within 62
+//! bits): the product's own rounding is gone and nothing else changes (on the pendulum every
+//! output's certified bound falls or stays; `error-bound` after this pass certifies the fused
+//! function). With the run's domain the verifier's range check must still hold: each round
+//! fuses, checks, and keeps unfused the products of the fused ops at and above the first value
+//! that may overflow (4 operand levels), up to 64 rounds, else nothing is fused. Such a fused
+//! op runs on a MULTI PE as a multiply-accumulate ([`robovec_ir::Function::op_kind`]: a `mul`
+//! for the PE array); `sim` runs it bit for bit; `codegen<fpga>` does not build that unit yet.
+//!
 //! Runs on the atomised phase and keeps it; clears timing attributes. A fused op is a `call`
-//! (SPEC §3 counts it as one op of kind `call`), which `place` runs as a call and
-//! `codegen<fpga>` rejects: this pass is for CPU back ends. Cost: O(values + operands).
+//! (SPEC §3 counts it as one op of kind `call`); a binary one is run by `place` as a call on
+//! an ADD PE, which `codegen<fpga>` rejects: for binary formats this pass is for CPU back
+//! ends. Cost: O(values + operands); in fixed point with a domain, up to 64 times that plus
+//! the range check.
+
+use std::collections::HashSet;
 
 use robovec_ir::{BinOp, Def, Function, Intrinsic, Module, Operand, Value};
 
@@ -32,7 +48,13 @@ pub const INFO: PassInfo = PassInfo {
     doc: "fuse a*b +/- c into one fused multiply-add (@fma, @fms, @fnma; one rounding) where every use of the multiply is an add/sub: C's -ffp-contract in the IR, for CPUs with FMA",
     params: &[],
     build: |_: &Params| Ok(Box::new(Contract)),
-    props: crate::Props { requires: Some(robovec_ir::Phase::Atomised), at_time_limit: crate::AtTimeLimit::Skip, exact_in_reals: true, ..crate::Props::DEFAULT },
+    props: crate::Props {
+        requires: Some(robovec_ir::Phase::Atomised),
+        at_time_limit: crate::AtTimeLimit::Skip,
+        exact_in_reals: true,
+        formats: true,
+        ..crate::Props::DEFAULT
+    },
 };
 
 /// The `contract` pass.
@@ -60,6 +82,11 @@ pub fn contract_function(f: &mut Function) -> Contracted {
 /// [`contract_function`] that stops fusing when `ticker` says so (`-time-limit`; one tick per
 /// value): the multiplies fused so far stay fused, the later ones are kept as they are.
 pub fn contract_within(f: &mut Function, ticker: &Ticker) -> Contracted {
+    contract_except(f, ticker, &HashSet::new())
+}
+
+/// [`contract_within`] that leaves the multiplies named in `keep` unfused.
+fn contract_except(f: &mut Function, ticker: &Ticker, keep: &HashSet<String>) -> Contracted {
     let n = f.values.len();
     // Every use of every value: the additions that read it once, and whether anything else
     // (an output, another op, an addition reading it twice) does.
@@ -101,20 +128,37 @@ pub fn contract_within(f: &mut Function, ticker: &Ticker) -> Contracted {
         let m = f.body[k];
         let Def::Binary(BinOp::Mul, a, b) = f.value(m).def else { continue };
         let uses = &adds_of[m.index()];
-        if other_use[m.index()] || uses.is_empty() || uses.iter().any(|u| converted[u.index()]) {
+        if other_use[m.index()]
+            || uses.is_empty()
+            || uses.iter().any(|u| converted[u.index()])
+            || (!keep.is_empty() && keep.contains(f.name_of(m)))
+        {
+            continue;
+        }
+        let fused_of = |op: BinOp, x: Operand, y: Operand| {
+            let first = x == Operand::Value(m);
+            let addend = if first { y } else { x };
+            let fused = match (op, first) {
+                (BinOp::Add, _) => Intrinsic::Fma,
+                (_, true) => Intrinsic::Fms,
+                _ => Intrinsic::Fnma,
+            };
+            (fused, Def::Call(Box::new(fused.callee()), vec![a, b, addend]))
+        };
+        // In fixed point a fused op must stay an integer op (exact, then rounded once): tried
+        // on every use first, the multiply is kept when one would not be.
+        if f.has_formats() && !uses.iter().all(|&u| fixed_fusion_exact(f, u, &fused_of)) {
             continue;
         }
         for &u in uses {
             let Def::Binary(op, x, y) = f.value(u).def else { unreachable!("an addition") };
-            let first = x == Operand::Value(m);
-            let addend = if first { y } else { x };
-            let (fused, count) = match (op, first) {
-                (BinOp::Add, _) => (Intrinsic::Fma, &mut out.fma),
-                (_, true) => (Intrinsic::Fms, &mut out.fms),
-                _ => (Intrinsic::Fnma, &mut out.fnma),
-            };
-            *count += 1;
-            f.value_mut(u).def = Def::Call(Box::new(fused.callee()), vec![a, b, addend]);
+            let (fused, def) = fused_of(op, x, y);
+            *match fused {
+                Intrinsic::Fma => &mut out.fma,
+                Intrinsic::Fms => &mut out.fms,
+                _ => &mut out.fnma,
+            } += 1;
+            f.value_mut(u).def = def;
             converted[u.index()] = true;
         }
         removed[m.index()] = true;
@@ -127,6 +171,122 @@ pub fn contract_within(f: &mut Function, ticker: &Ticker) -> Contracted {
     out
 }
 
+/// True when addition `u` of a function with formats, fused by `fused_of`, is an integer op
+/// ([`robovec_ir::format::integer_op`]) or keeps a non-fixed format (computed in its format
+/// as before). Tried in place and undone.
+fn fixed_fusion_exact(
+    f: &mut Function,
+    u: Value,
+    fused_of: &dyn Fn(BinOp, Operand, Operand) -> (Intrinsic, Def),
+) -> bool {
+    if !matches!(f.format(u), robovec_ir::format::Format::Fix { .. }) {
+        return true;
+    }
+    let Def::Binary(op, x, y) = f.value(u).def else { return false };
+    let before = std::mem::replace(&mut f.value_mut(u).def, fused_of(op, x, y).1);
+    let exact = robovec_ir::format::integer_op(f, u).is_some();
+    f.value_mut(u).def = before;
+    exact
+}
+
+/// Most rounds of [`contract_in_range`]: each unfuses one multiply.
+const RANGE_ROUNDS: usize = 64;
+
+/// [`contract_within`] on a function with fixed-point formats over `domain`, kept only where the
+/// verifier's range check ([`crate::error_bound::bound::check_fixed_formats`]) still holds: a
+/// fused op's enclosure may be wider than the sum's was (the harmonic forms of a product of
+/// trig values are not carried through the fused op), and `precision` leaves no headroom bit.
+/// Each round fuses, checks, and keeps unfused the multiplies of the fused ops among the first
+/// value that may overflow and its operands up to [`CONE_DEPTH`] levels; up to
+/// [`RANGE_ROUNDS`] rounds, then (or when that cone holds no fused op, or the ticker stops)
+/// nothing is fused. Returns what was fused and the multiplies kept for
+/// range. Cost: O(rounds · (ops + the range check)).
+fn contract_in_range(f: &mut Function, domain: &robovec_ir::domain::Domain, ticker: &Ticker) -> (Contracted, usize) {
+    let mut keep = HashSet::new();
+    for _ in 0..RANGE_ROUNDS {
+        let mut g = f.clone();
+        let c = contract_except(&mut g, ticker, &keep);
+        if ticker.tick() {
+            break;
+        }
+        let x =
+            match crate::range::enclose_with(&g, domain, Some(crate::range::affine::DEFAULT_TERMS), || ticker.tick()) {
+                Ok(x) => x,
+                Err(_) => break,
+            };
+        match crate::error_bound::bound::bound(&g, &x, crate::error_bound::bound::Formats::Mixed, || ticker.tick()) {
+            Ok(_) => {
+                *f = g;
+                return (c, keep.len());
+            }
+            Err(crate::error_bound::bound::BoundError::FixOverflow { value, .. }) => {
+                // the multiply the failing fused op absorbed, in the unfused function
+                // the fused op itself, or else the fused ops it reads (their enclosures feed it)
+                let muls: Vec<String> = g
+                    .lookup(&value)
+                    .map_or(vec![], |w| fused_cone(&g, w, CONE_DEPTH))
+                    .iter()
+                    .filter_map(|c| absorbed_mul(f, &g, c))
+                    .collect();
+                if muls.is_empty() {
+                    break;
+                }
+                keep.extend(muls);
+            }
+            Err(_) => break,
+        }
+    }
+    (Contracted::default(), 0)
+}
+
+/// Operand levels [`contract_in_range`] searches above a value that may overflow for the fused
+/// ops to keep unfused.
+const CONE_DEPTH: usize = 4;
+
+/// The names of the fused ops among `v` and the values it reads, up to `depth` operand levels.
+fn fused_cone(g: &Function, v: Value, depth: usize) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut level = vec![v];
+    let mut seen = HashSet::new();
+    for _ in 0..=depth {
+        let mut next = Vec::new();
+        for w in level {
+            if !seen.insert(w) {
+                continue;
+            }
+            if g.is_fixed_mac(w) {
+                out.push(g.name_of(w).to_string());
+            }
+            g.value(w).def.for_each_value(|o| next.push(o));
+        }
+        level = next;
+    }
+    out
+}
+
+/// The name of the multiply that fused op `name` of `fused` absorbed: the operand of the same
+/// addition in `f` that is a `mul` of the fused op's first two operands.
+fn absorbed_mul(f: &Function, fused: &Function, name: &str) -> Option<String> {
+    let (u, w) = (f.lookup(name)?, fused.lookup(name)?);
+    if !fused.is_fixed_mac(w) {
+        return None;
+    }
+    let (Def::Binary(_, x, y), Def::Call(_, args)) = (&f.value(u).def, &fused.value(w).def) else { return None };
+    // operands by name: the two functions number their values alike up to the removed muls
+    let same = |o: &Operand, p: &Operand| match (o, p) {
+        (Operand::Value(a), Operand::Value(b)) => f.name_of(*a) == fused.name_of(*b),
+        (Operand::Const(a), Operand::Const(b)) => a.to_bits() == b.to_bits(),
+        _ => false,
+    };
+    [x, y].into_iter().find_map(|o| match *o {
+        Operand::Value(m) => match &f.value(m).def {
+            Def::Binary(BinOp::Mul, a, b) if same(a, &args[0]) && same(b, &args[1]) => Some(f.name_of(m).to_string()),
+            _ => None,
+        },
+        _ => None,
+    })
+}
+
 impl Pass for Contract {
     fn name(&self) -> &'static str {
         "contract"
@@ -134,9 +294,15 @@ impl Pass for Contract {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let skipped = |f: &robovec_ir::Function, _| Some(format!("before @{}", f.name));
+        let domain = cx.domain.clone();
         let parts = each_function(m, cx, "contract", Before::Ticked, skipped, |f, _, ticker| {
-            let c = contract_within(f, ticker);
-            let part = format!(
+            let fixed = f.has_formats()
+                && f.body.iter().any(|&v| matches!(f.format(v), robovec_ir::format::Format::Fix { .. }));
+            let (c, kept) = match &domain {
+                Some(d) if fixed && d.missing(f).is_empty() => contract_in_range(f, d, ticker),
+                _ => (contract_within(f, ticker), 0),
+            };
+            let mut part = format!(
                 "@{} {} fused (fma {}, fms {}, fnma {}), {} mul removed",
                 f.name,
                 c.fma + c.fms + c.fnma,
@@ -145,6 +311,9 @@ impl Pass for Contract {
                 c.fnma,
                 c.muls_removed
             );
+            if kept > 0 {
+                part += &format!(", {kept} kept unfused for the fixed-point range check");
+            }
             if ticker.stopped() {
                 let what = format!("in @{} ({} multiplies fused, the later ones kept)", f.name, c.muls_removed);
                 return Step::Stopped { what, kept: Some(part) };

@@ -279,7 +279,8 @@ pub struct PassContext {
 /// pass's, [`PassContext::latencies_for`]) for binary32 PEs; for a function on fixed-point PEs
 /// ([`robovec_machine::program::fixed::pe_kind`]) the target's `fix_pe` latencies for its word
 /// ([`robovec_machine::target::FixPe::latencies_for`]: a MULTI PE one stage shorter when a
-/// product is one DSP multiplier) with those `given` on the pass applied. `asap-alap` and
+/// product is one DSP multiplier and the function has no fused multiply-add) with those `given`
+/// on the pass applied. `asap-alap` and
 /// `place` time each function with it.
 pub fn function_latencies(
     target: &Target,
@@ -289,7 +290,10 @@ pub fn function_latencies(
 ) -> Latencies {
     use robovec_machine::program::fixed::{pe_kind, word_bits, PeKind};
     match pe_kind(f) {
-        Ok(PeKind::Fixed) => given.apply(&target.fix_pe.latencies_for(target.family, word_bits(f))),
+        Ok(PeKind::Fixed) => {
+            let mac = f.body.iter().any(|&v| f.is_fixed_mac(v));
+            given.apply(&target.fix_pe.latencies_for(target.family, word_bits(f), mac))
+        }
         _ => pipeline,
     }
 }

@@ -52,7 +52,7 @@ fn sweep(f: &Function, timing: &mut [Option<Timing>], lat: &Latencies) -> Timing
     let level = |t: &Option<Timing>| t.map_or((0, 0), |t| (t.asap, t.asap_cycle));
     for &v in &f.body {
         let def = &f.value(v).def;
-        let Some(kind) = def.op_kind() else { continue };
+        let Some(kind) = f.op_kind(v) else { continue };
         let (mut a, mut c) = (0, 0);
         def.for_each_value(|p| {
             let (pa, pc) = level(&timing[p.index()]);
@@ -66,7 +66,7 @@ fn sweep(f: &Function, timing: &mut [Option<Timing>], lat: &Latencies) -> Timing
     }
     for &v in f.body.iter().rev() {
         let def = &f.value(v).def;
-        let Some(kind) = def.op_kind() else { continue };
+        let Some(kind) = f.op_kind(v) else { continue };
         let t = timing[v.index()].as_mut().expect("ops have a level");
         t.alap = t.alap.min(sum.asap);
         t.alap_cycle = t.alap_cycle.min(sum.asap_cycle);

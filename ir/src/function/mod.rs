@@ -326,10 +326,37 @@ impl Function {
         self.outputs_by_name.probes
     }
 
-    /// The operation kind of `v`'s definition, or `None` for inputs, trig variables and
-    /// (parsed-phase) expressions.
+    /// The operation kind of `v`'s definition as a PE array runs it, or `None` for inputs,
+    /// trig variables and (parsed-phase) expressions: [`Def::op_kind`], except that a fused
+    /// multiply-add in fixed point ([`Function::is_fixed_mac`]) is a `Mul`, the op of a MULTI
+    /// PE with its addend (issue 49: a multiply-accumulate PE). Op counts (SPEC §3) keep
+    /// [`Def::op_kind`]'s `call`.
     pub fn op_kind(&self, v: Value) -> Option<OpKind> {
+        if self.is_fixed_mac(v) {
+            return Some(OpKind::Mul);
+        }
         self.value(v).def.op_kind()
+    }
+
+    /// True when `v` is a fused multiply-add (`fma`, `fms`, `fnma`: `contract`'s ops) whose
+    /// result is fixed point: a MULTI PE computes it, the product of its first two operands
+    /// plus or minus the third aligned to it, rounded once (`robovec_machine`'s fixed-point
+    /// PEs; [`crate::format::integer_op`]).
+    pub fn is_fixed_mac(&self, v: Value) -> bool {
+        match &self.value(v).def {
+            Def::Call(c, args) => {
+                matches!(self.format(v), crate::format::Format::Fix { .. })
+                    && matches!(
+                        crate::intrinsic::Intrinsic::of(c, args.len()),
+                        Some(
+                            crate::intrinsic::Intrinsic::Fma
+                                | crate::intrinsic::Intrinsic::Fms
+                                | crate::intrinsic::Intrinsic::Fnma
+                        )
+                    )
+            }
+            _ => false,
+        }
     }
 
     /// Counts the operations of the function; expressions count as SPEC §3 atomises them.

@@ -103,7 +103,7 @@ fn op_matches(op: &MachineOp, def: &Def) -> bool {
         | (MachineOp::Sub, Def::Binary(BinOp::Sub, _, _))
         | (MachineOp::Mul, Def::Binary(BinOp::Mul, _, _))
         | (MachineOp::Div, Def::Binary(BinOp::Div, _, _)) => true,
-        (MachineOp::Call(c), Def::Call(d, _)) => c == d,
+        (MachineOp::Call(c) | MachineOp::Mac(c), Def::Call(d, _)) => c == d,
         _ => false,
     }
 }

@@ -174,12 +174,13 @@ pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
             ));
         }
     }
-    let mut unsupported = Vec::new();
+    let (mut unsupported, mut mac) = (Vec::new(), Vec::new());
     for (s, pe) in m.pes.iter().enumerate() {
         for (c, st) in pe.steps.iter().enumerate() {
             match st.issue.as_ref().map(|i| &i.op) {
                 Some(MachineOp::Div) => unsupported.push(format!("div on {} at cycle {c}", name(s))),
                 Some(MachineOp::Call(_)) => unsupported.push(format!("call on {} at cycle {c}", name(s))),
+                Some(MachineOp::Mac(_)) => mac.push(format!("multiply-add on {} at cycle {c}", name(s))),
                 _ => {}
             }
             if st.writes.len() > 2 {
@@ -197,6 +198,14 @@ pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
             unsupported.len(),
             unsupported.iter().take(4).cloned().collect::<Vec<_>>().join(", "),
             if unsupported.len() > 4 { ", …" } else { "" }
+        ));
+    }
+    if !mac.is_empty() {
+        out.push(format!(
+            "{} fused multiply-add(s) on MULTI PEs, which `codegen<fpga>` does not build yet (a MULTI PE with a third read and an addend; `sim` runs them): {}{}",
+            mac.len(),
+            mac.iter().take(4).cloned().collect::<Vec<_>>().join(", "),
+            if mac.len() > 4 { ", …" } else { "" }
         ));
     }
     let worst = |v: &[u32]| v.iter().enumerate().max_by_key(|&(i, &w)| (w, std::cmp::Reverse(i))).map(|(i, &w)| (i, w));

@@ -42,7 +42,7 @@ impl PeKind {
 
 fn refuse(f: &Function, v: Value, why: &str) -> String {
     format!(
-        "@{}: `%{}` ({}) {why}; a PE array is of one kind: binary32 PEs for a function without numeric formats, fixed-point PEs when every value is fix<w,f> with w <= {FIX_WORD_BITS} and every op an integer add, sub or mul (precision<target=mcu> chooses such formats)",
+        "@{}: `%{}` ({}) {why}; a PE array is of one kind: binary32 PEs for a function without numeric formats, fixed-point PEs when every value is fix<w,f> with w <= {FIX_WORD_BITS} and every op an integer add, sub, mul or fused multiply-add (precision<target=mcu> chooses such formats)",
         f.name,
         f.name_of(v),
         f.format(v)
@@ -72,13 +72,27 @@ pub fn pe_kind(f: &Function) -> Result<PeKind, String> {
                     return Err(refuse(f, v, "is not an integer op (its operands are not all fixed point or constants, or its intermediate is beyond 62 bits)"));
                 }
             }
-            _ => return Err(refuse(f, v, "is not an add, sub or mul: the fixed-point PEs have no unit for it")),
+            Def::Call(..) if f.is_fixed_mac(v) => {
+                if shifts(f, v).is_none() {
+                    return Err(refuse(f, v, "is not an integer op (its operands are not all fixed point or constants, or its intermediate is beyond 62 bits)"));
+                }
+            }
+            _ => {
+                return Err(refuse(
+                    f,
+                    v,
+                    "is not an add, sub, mul or fused multiply-add: the fixed-point PEs have no unit for it",
+                ))
+            }
         }
     }
     Ok(PeKind::Fixed)
 }
 
-/// The shifts of fixed-point op `v` ([`FixShifts`]), from its integer op.
+/// The shifts of fixed-point op `v` ([`FixShifts`]), from its integer op: for `a ± b` the
+/// operand aligned to the finer fraction; for a fused multiply-add (`±a·b ± c`, its terms the
+/// product and the addend) `align_b` means the addend is aligned to the product's fraction,
+/// else the product to the addend's.
 ///
 /// # Panics
 /// Never for a function [`pe_kind`] calls fixed.
@@ -122,7 +136,7 @@ pub fn attach(f: &Function, m: &mut MachineProgram) -> Result<(), MachineError> 
             Def::Trig(t, x) => {
                 fx.trig.insert((*t, f.name_of(*x).to_string()), frac(v));
             }
-            Def::Binary(..) => {
+            Def::Binary(..) | Def::Call(..) => {
                 let Some((slot, c)) = m.issue_of.get(v.index()).copied().flatten() else { continue };
                 let sh = shifts(f, v).ok_or_else(|| {
                     MachineError::new(MachineErrorKind::Formats, format!("no integer op for `%{}`", f.name_of(v)))
@@ -218,7 +232,7 @@ mod tests {
         assert!(pe_kind(&wide).unwrap_err().contains("`%a` (fix<40,20>) is wider than the PE word of 32 bits"));
         let quotient =
             func("func @f { phase atomised input %a : fix<32,20> %x = div %a, %a : fix<32,10> output o = %x }");
-        assert!(pe_kind(&quotient).unwrap_err().contains("is not an add, sub or mul"));
+        assert!(pe_kind(&quotient).unwrap_err().contains("is not an add, sub, mul or fused multiply-add"));
     }
 
     #[test]

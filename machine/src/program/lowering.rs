@@ -206,6 +206,7 @@ fn machine_op(f: &Function, item: &IssueItem) -> MachineOp {
         Some(BinOp::Mul) => MachineOp::Mul,
         Some(BinOp::Div) => MachineOp::Div,
         None => match &f.value(item.value).def {
+            Def::Call(callee, _) if f.is_fixed_mac(item.value) => MachineOp::Mac(callee.clone()),
             Def::Call(callee, _) => MachineOp::Call(callee.clone()),
             _ => unreachable!("ops are binary or calls"),
         },

@@ -524,7 +524,7 @@ impl Run<'_> {
         for &v in &f.body {
             r.poll()?;
             let def = &f.value(v).def;
-            if let Some(kind) = def.op_kind() {
+            if let Some(kind) = f.op_kind(v) {
                 let is = issue(v);
                 let bin = match def {
                     Def::Binary(op, _, _) => Some(*op),
