@@ -1425,6 +1425,8 @@ fn fused_multiply_adds_run_on_the_multi_pes_bit_for_bit() {
         r["placement"]["writes_direct"].as_u64().unwrap() + r["placement"]["writes_indirect"].as_u64().unwrap()
     };
     assert!(writes(&fused) < writes(&plain), "{} against {}", writes(&fused), writes(&plain));
+    // the lower bound counts the fused ops on the MULTI side and stays below the schedule
+    assert!(fused["placement"]["lower_bound"].as_u64() <= fused["placement"]["cycles"].as_u64());
     // a MAC keeps the partial-product stage: MULTI 4 cycles at 27 bits (3 without fused ops)
     assert_eq!(
         (fused["stats"]["latencies"]["mul"].as_u64(), plain["stats"]["latencies"]["mul"].as_u64()),

@@ -189,102 +189,64 @@ fn fixed_fusion_exact(
     exact
 }
 
-/// Most rounds of [`contract_in_range`]: each unfuses one multiply.
-const RANGE_ROUNDS: usize = 64;
+/// Most rounds of [`contract_in_range`]: each gives one value one integer bit more.
+const RANGE_ROUNDS: usize = 512;
 
-/// [`contract_within`] on a function with fixed-point formats over `domain`, kept only where the
-/// verifier's range check ([`crate::error_bound::bound::check_fixed_formats`]) still holds: a
-/// fused op's enclosure may be wider than the sum's was (the harmonic forms of a product of
-/// trig values are not carried through the fused op), and `precision` leaves no headroom bit.
-/// Each round fuses, checks, and keeps unfused the multiplies of the fused ops among the first
-/// value that may overflow and its operands up to [`CONE_DEPTH`] levels; up to
-/// [`RANGE_ROUNDS`] rounds, then (or when that cone holds no fused op, or the ticker stops)
-/// nothing is fused. Returns what was fused and the multiplies kept for
-/// range. Cost: O(rounds · (ops + the range check)).
+/// [`contract_within`] on a function with fixed-point formats over `domain`, and the formats
+/// refitted where the verifier's range check ([`crate::error_bound::bound::check_fixed_formats`])
+/// would fail: the fused function computes the same reals, but its enclosures are not the
+/// unfused one's (the harmonic forms of a rotation `C·x + S·y` whose `x`, `y` are fused ops
+/// fold more of their atoms into slack: WALK-MAN's `%AlF238` 2.23e6 against 2.02e6), and
+/// `precision` leaves no headroom bit. Each round finds the first value that may overflow and
+/// gives it one integer bit more at the same width (one fraction bit fewer); the enclosures are
+/// computed once (they do not depend on the formats). When a round would leave an op that is
+/// not an integer op, or after [`RANGE_ROUNDS`] rounds, or when the ticker stops, nothing is
+/// fused. Returns what was fused and the values refitted. `error-bound` after this pass
+/// certifies the result (the refitted values round to a coarser step). Cost:
+/// O(ops + the enclosures + rounds · the bound's sweep).
 fn contract_in_range(f: &mut Function, domain: &robovec_ir::domain::Domain, ticker: &Ticker) -> (Contracted, usize) {
-    let mut keep = HashSet::new();
+    use crate::error_bound::bound::{bound, BoundError, Formats};
+    use robovec_ir::format::{integer_op, Format, FIX_FRACTION_RANGE};
+    let mut g = f.clone();
+    let c = contract_within(&mut g, ticker);
+    if ticker.stopped() {
+        return (Contracted::default(), 0);
+    }
+    let Ok(x) = crate::range::enclose_with(&g, domain, Some(crate::range::affine::DEFAULT_TERMS), || ticker.tick())
+    else {
+        return (Contracted::default(), 0);
+    };
+    let mut refitted = HashSet::new();
     for _ in 0..RANGE_ROUNDS {
-        let mut g = f.clone();
-        let c = contract_except(&mut g, ticker, &keep);
-        if ticker.tick() {
-            break;
-        }
-        let x =
-            match crate::range::enclose_with(&g, domain, Some(crate::range::affine::DEFAULT_TERMS), || ticker.tick()) {
-                Ok(x) => x,
-                Err(_) => break,
-            };
-        match crate::error_bound::bound::bound(&g, &x, crate::error_bound::bound::Formats::Mixed, || ticker.tick()) {
+        match bound(&g, &x, Formats::Mixed, || ticker.tick()) {
             Ok(_) => {
                 *f = g;
-                return (c, keep.len());
+                return (c, refitted.len());
             }
-            Err(crate::error_bound::bound::BoundError::FixOverflow { value, .. }) => {
-                // the multiply the failing fused op absorbed, in the unfused function
-                // the fused op itself, or else the fused ops it reads (their enclosures feed it)
-                let muls: Vec<String> = g
-                    .lookup(&value)
-                    .map_or(vec![], |w| fused_cone(&g, w, CONE_DEPTH))
-                    .iter()
-                    .filter_map(|c| absorbed_mul(f, &g, c))
-                    .collect();
-                if muls.is_empty() {
+            Err(BoundError::FixOverflow { value, .. }) => {
+                let Some(v) = g.lookup(&value) else { break };
+                let Format::Fix { width, fraction } = g.format(v) else { break };
+                let Some(coarser) = Format::fix(width, fraction - 1).filter(|_| fraction > *FIX_FRACTION_RANGE.start())
+                else {
+                    break;
+                };
+                g.set_format(v, coarser);
+                // the value and the ops that read it must stay integer ops
+                let mut exact = g.op_kind(v).is_none() || integer_op(&g, v).is_some();
+                for &u in &g.body {
+                    if exact && g.value(u).def.operands().contains(&Operand::Value(v)) {
+                        exact = integer_op(&g, u).is_some() || !matches!(g.format(u), Format::Fix { .. });
+                    }
+                }
+                if !exact {
                     break;
                 }
-                keep.extend(muls);
+                refitted.insert(v);
             }
             Err(_) => break,
         }
     }
     (Contracted::default(), 0)
-}
-
-/// Operand levels [`contract_in_range`] searches above a value that may overflow for the fused
-/// ops to keep unfused.
-const CONE_DEPTH: usize = 4;
-
-/// The names of the fused ops among `v` and the values it reads, up to `depth` operand levels.
-fn fused_cone(g: &Function, v: Value, depth: usize) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut level = vec![v];
-    let mut seen = HashSet::new();
-    for _ in 0..=depth {
-        let mut next = Vec::new();
-        for w in level {
-            if !seen.insert(w) {
-                continue;
-            }
-            if g.is_fixed_mac(w) {
-                out.push(g.name_of(w).to_string());
-            }
-            g.value(w).def.for_each_value(|o| next.push(o));
-        }
-        level = next;
-    }
-    out
-}
-
-/// The name of the multiply that fused op `name` of `fused` absorbed: the operand of the same
-/// addition in `f` that is a `mul` of the fused op's first two operands.
-fn absorbed_mul(f: &Function, fused: &Function, name: &str) -> Option<String> {
-    let (u, w) = (f.lookup(name)?, fused.lookup(name)?);
-    if !fused.is_fixed_mac(w) {
-        return None;
-    }
-    let (Def::Binary(_, x, y), Def::Call(_, args)) = (&f.value(u).def, &fused.value(w).def) else { return None };
-    // operands by name: the two functions number their values alike up to the removed muls
-    let same = |o: &Operand, p: &Operand| match (o, p) {
-        (Operand::Value(a), Operand::Value(b)) => f.name_of(*a) == fused.name_of(*b),
-        (Operand::Const(a), Operand::Const(b)) => a.to_bits() == b.to_bits(),
-        _ => false,
-    };
-    [x, y].into_iter().find_map(|o| match *o {
-        Operand::Value(m) => match &f.value(m).def {
-            Def::Binary(BinOp::Mul, a, b) if same(a, &args[0]) && same(b, &args[1]) => Some(f.name_of(m).to_string()),
-            _ => None,
-        },
-        _ => None,
-    })
 }
 
 impl Pass for Contract {
@@ -312,7 +274,7 @@ impl Pass for Contract {
                 c.muls_removed
             );
             if kept > 0 {
-                part += &format!(", {kept} kept unfused for the fixed-point range check");
+                part += &format!(", {kept} value(s) given an integer bit more for the fixed-point range check");
             }
             if ticker.stopped() {
                 let what = format!("in @{} ({} multiplies fused, the later ones kept)", f.name, c.muls_removed);

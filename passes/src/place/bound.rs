@@ -22,10 +22,12 @@ use robovec_ir::analysis::compute_timing;
 use robovec_ir::placement::PeArray;
 use robovec_ir::{Function, OpKind, Value};
 
-/// Ops that run on the ADD side (add, sub, div, call) and on the MULTI side.
+/// Ops that run on the ADD side (add, sub, div, call) and on the MULTI side (mul, and the
+/// fused multiply-adds in fixed point: [`Function::op_kind`]).
 pub fn ops_per_side(f: &Function) -> (u64, u64) {
     let c = f.op_counts();
-    (c.add + c.sub + c.div + c.call, c.mul)
+    let mac = f.body.iter().filter(|&&v| f.is_fixed_mac(v)).count() as u64;
+    (c.add + c.sub + c.div + c.call - mac, c.mul + mac)
 }
 
 /// The lower bound LB of SPEC §4: max(ASAPCycle critical path, ⌈n_add_side/N_add⌉ − 1 + lat_add,

@@ -306,12 +306,11 @@ impl<'f> AffineSweep<'f> {
                 let r = match Intrinsic::of(callee, args.len()) {
                     Some(Intrinsic::Sqrt) => sqrt(&forms[0], interval_of(&args[0]), &mut slack),
                     Some(i) => {
-                        let (ma, mb) = match i {
-                            Intrinsic::Fnma => (negate(&forms[0]), &forms[1]),
-                            _ => (forms[0].clone(), &forms[1]),
-                        };
-                        let (c0, t) = mul(&ma, mb, spreads[0], spreads[1], false, &mut slack);
+                        // a square (`fma(x, x, c)`) as `x · x`: its product is the square
+                        let same = super::enclose::same_pair(&args[0], &args[1]);
+                        let (c0, t) = mul(&forms[0], &forms[1], spreads[0], spreads[1], same, &mut slack);
                         let p = Form { centre: c0, terms: t };
+                        let p = if i == Intrinsic::Fnma { negate(&p) } else { p };
                         let sign = if i == Intrinsic::Fms { -1.0 } else { 1.0 };
                         combine(&p, 1.0, &forms[2], sign, 0.0, &mut slack)
                     }

@@ -178,10 +178,26 @@ fn enclose_value(f: &Function, v: Value, x: &[Interval]) -> Result<Interval, Enc
                     range: a,
                 })?
             }
+            // a square's product is its square (`fma(x, x, c)`: the dependency is exact, as for
+            // `x · x`), then the sum, each outward-rounded
+            Some(i @ (Intrinsic::Fma | Intrinsic::Fms | Intrinsic::Fnma)) if same_pair(&args[0], &args[1]) => {
+                let p = of(x, &args[0]).sqr();
+                let c = of(x, &args[2]);
+                match i {
+                    Intrinsic::Fma => p + c,
+                    Intrinsic::Fms => p - c,
+                    _ => c - p,
+                }
+            }
             Some(Intrinsic::Fma) => of(x, &args[0]).fma(of(x, &args[1]), of(x, &args[2])),
             Some(Intrinsic::Fms) => of(x, &args[0]).fma(of(x, &args[1]), -of(x, &args[2])),
             Some(Intrinsic::Fnma) => (-of(x, &args[0])).fma(of(x, &args[1]), of(x, &args[2])),
             None => Interval::ENTIRE,
         },
     })
+}
+
+/// True when `a` and `b` are the same value (`x · x`: a square).
+pub(crate) fn same_pair(a: &Operand, b: &Operand) -> bool {
+    matches!((a, b), (Operand::Value(p), Operand::Value(q)) if p == q)
 }

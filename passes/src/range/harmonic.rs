@@ -602,8 +602,12 @@ impl<'f> HarmonicSweep<'f> {
                     Some(Intrinsic::Sqrt) => sqrt_line(interval_of(&args[0]))
                         .map(|(alpha, zeta, delta)| affine_of(&fs[0], alpha, zeta, delta, own).atoms),
                     Some(i) => {
-                        let a = if i == Intrinsic::Fnma { negate(&fs[0]) } else { fs[0].clone() };
-                        let p = HForm { atoms: self.hs.mul(&a, &fs[1], false, &mut slack) };
+                        // a square (`fma(x, x, c)`) as `x · x`: its product is the square
+                        let same = super::enclose::same_pair(&args[0], &args[1]);
+                        let mut atoms = self.hs.mul(&fs[0], &fs[1], same, &mut slack);
+                        self.hs.cap_atoms(self.cap, &mut atoms, &mut slack);
+                        let p = HForm { atoms };
+                        let p = if i == Intrinsic::Fnma { negate(&p) } else { p };
                         let sign = if i == Intrinsic::Fms { -1.0 } else { 1.0 };
                         Some(lin(&p, 1.0, &fs[2], sign, &mut slack))
                     }
