@@ -22,19 +22,19 @@
 //! After `precision<target=mcu>` (a function with formats) the fused op takes the addition's
 //! format, and a multiply is fused only when each fused op stays an integer op
 //! ([`robovec_ir::format::integer_op`]: the exact `±a·b ± c`, then one rounding, within 62
-//! bits): the product's own rounding is gone and nothing else changes (on the pendulum every
-//! output's certified bound falls or stays; `error-bound` after this pass certifies the fused
-//! function). With the run's domain the verifier's range check must still hold: each round
-//! fuses, checks, and keeps unfused the products of the fused ops at and above the first value
-//! that may overflow (4 operand levels), up to 64 rounds, else nothing is fused. Such a fused
+//! bits). The product's own rounding is gone. With the run's domain the verifier's range check
+//! must still hold: a value it says may overflow gets one integer bit more at its width
+//! (`contract_in_range`; the remark counts them), else nothing is fused. `error-bound` after
+//! this pass certifies the result (on the pendulum every output's bound falls or stays; on
+//! the corpus models of issue 49 the largest bound over binary32's is unchanged). Such a fused
 //! op runs on a MULTI PE as a multiply-accumulate ([`robovec_ir::Function::op_kind`]: a `mul`
 //! for the PE array); `sim` runs it bit for bit; `codegen<fpga>` does not build that unit yet.
 //!
 //! Runs on the atomised phase and keeps it; clears timing attributes. A fused op is a `call`
 //! (SPEC §3 counts it as one op of kind `call`); a binary one is run by `place` as a call on
 //! an ADD PE, which `codegen<fpga>` rejects: for binary formats this pass is for CPU back
-//! ends. Cost: O(values + operands); in fixed point with a domain, up to 64 times that plus
-//! the range check.
+//! ends. Cost: O(values + operands); in fixed point with a domain, plus the enclosures and up
+//! to 512 sweeps of the bound.
 
 use std::collections::HashSet;
 
