@@ -1382,8 +1382,8 @@ fn a_corrupted_placement_is_located_at_its_line() {
 /// range check holds; the MULTI PEs run them (a multiply-accumulate: the product plus the
 /// aligned addend, rounded once), `sim` runs the placement bit for bit as `-eval` at points of
 /// the domain, the certified bound of every output is at most the unfused function's, fewer
-/// results cross the interconnect, and `codegen<fpga>`, which has no MAC unit yet, says so
-/// (exit 1).
+/// results cross the interconnect, and `codegen<fpga>` writes the design (its MULTI PEs with
+/// the multiply-add unit: [`fused_multiply_adds_simulate_in_icarus_bit_for_bit`]).
 #[test]
 fn fused_multiply_adds_run_on_the_multi_pes_bit_for_bit() {
     let d = tmp("fixed_mac");
@@ -1446,7 +1446,91 @@ fn fused_multiply_adds_run_on_the_multi_pes_bit_for_bit() {
         "-o",
         "/dev/null",
     ]);
-    assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("fused multiply-add(s) on MULTI PEs"), "{}", stderr(&o));
-    assert!(!d.join("design").exists(), "nothing written");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(d.join("design/manifest.json").exists(), "the design is written");
+}
+
+/// The MULTI PEs' multiply-add unit (`fix_mac`, `rv_pe`'s `MAC = 1`; issue 49): the pendulum
+/// with `contract` at 27-bit words, on 2 + 2 PEs with a specialised interconnect and with the
+/// crossbar, simulates in Icarus to `-eval`'s outputs bit for bit at points of the domain; each
+/// MULTI PE that issues fused ops is a MAC PE in the manifest (`mac`, its control word `pa + 2`
+/// bits wider) and the Verilog (`.MAC(1)`), the ADD PEs are not; the instruction image holds
+/// the fused ops' fields (61-bit words) and the estimate counts the third read's memory.
+#[test]
+fn fused_multiply_adds_simulate_in_icarus_bit_for_bit() {
+    tool("iverilog");
+    let d = tmp("fixed_mac_hdl");
+    let ranges = d.join("ranges.json");
+    std::fs::write(&ranges, PENDULUM_RANGES).unwrap();
+    let points = [
+        PENDULUM_POINT.to_string(),
+        PENDULUM_POINT.replace("0.75", "-2.9").replace("2.5", "9.5").replace("-7.5", "-9.75"),
+        PENDULUM_POINT.replace("-1.1", "3.1").replace("-4.0", "-10").replace("3.0", "10"),
+    ];
+    for interconnect in ["specialised", "crossbar"] {
+        let dir = d.join(interconnect);
+        for (i, text) in points.iter().enumerate() {
+            let point = d.join(format!("point{i}.json"));
+            std::fs::write(&point, text).unwrap();
+            let o = opt(&[
+                PENDULUM,
+                &format!("-ranges={}", ranges.display()),
+                &format!(
+                    "-passes=atomise,cse,precision<budget=1e-3;target=mcu;word=27>,contract,\
+                     place<pe=2;restarts=0;search=0>,sim,codegen<fpga;out={};resources=estimate;interconnect={interconnect}>",
+                    dir.display()
+                ),
+                &format!("-eval={}", point.display()),
+                "-stats",
+            ]);
+            assert!(o.status.success(), "{interconnect}: {}", stderr(&o));
+            let eval: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            let sim = simulate(&dir, &point);
+            let (want, got) = (eval["outputs"].as_object().unwrap(), sim["outputs"].as_object().unwrap());
+            assert_eq!(want.len(), got.len());
+            assert!(!want.is_empty());
+            for (k, v) in want {
+                let (e, s) = (v.as_f64().unwrap(), got[k].as_f64().unwrap());
+                assert_eq!(e.to_bits(), s.to_bits(), "{interconnect} point {i}: output {k}: simulated {s}, -eval {e}");
+            }
+        }
+        let man: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+        let aw = man["widths"]["aw"].as_u64().unwrap();
+        assert_eq!(man["widths"]["instr"].as_u64().unwrap(), 5 * aw + 6, "the instruction word holds the mac fields");
+        assert!(man["layout"]["instr"].as_str().unwrap().contains("read C"));
+        let top = std::fs::read_to_string(dir.join("hdl/robovec_top.v")).unwrap();
+        let pes = man["pes"].as_array().unwrap();
+        let mut macs = 0;
+        for pe in pes {
+            let name = pe["pe"].as_str().unwrap();
+            let mac = pe["mac"].as_bool().unwrap_or(false);
+            // the PE's instance in the top: its parameters up to its name
+            let at = top.find(&format!("\n    {name} (")).unwrap();
+            let params = &top[top[..at].rfind("rv_pe #(").unwrap()..at];
+            assert_eq!(params.contains(".MAC(1)"), mac, "{name}: {params}");
+            if pe["kind"] == "add" {
+                assert!(!mac, "{name}: an ADD PE has no multiply-add");
+                continue;
+            }
+            // the instruction image: a MULTI PE issuing fused ops has words with the mac bit
+            let instr = std::fs::read_to_string(
+                dir.join(format!("hex/{}.hex", pe["memories"]["instr"]["file"].as_str().unwrap())),
+            )
+            .unwrap();
+            let fused = instr.lines().any(|l| u64::from_str_radix(l.trim(), 16).unwrap() >> (5 * aw + 5) & 1 == 1);
+            assert_eq!(fused, mac, "{name}");
+            macs += usize::from(mac);
+        }
+        assert!(macs >= 1, "{interconnect}: a MULTI PE takes the fused ops");
+        let res: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
+        let copies = res["memories"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|m| m["name"].as_str().unwrap().ends_with("_data_c"))
+            .count();
+        assert_eq!(copies, macs, "one more PE memory copy per MAC PE");
+    }
 }

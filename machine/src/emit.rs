@@ -77,6 +77,9 @@ struct ManifestPe<'a> {
     slot: usize,
     pe: &'a str,
     kind: &'static str,
+    /// A MULTI PE with the multiply-add unit (`rv_pe`'s `MAC = 1`; omitted when false).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    mac: bool,
     latency: u32,
     buffer_words: u32,
     memories: std::collections::BTreeMap<&'static str, ManifestMemory>,
@@ -121,6 +124,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
                 slot: p.slot,
                 pe: &p.pe,
                 kind: if p.is_mul { "mul" } else { "add" },
+                mac: p.mac,
                 latency: if p.is_mul { d.lat_mul } else { d.lat_add },
                 buffer_words: p.buffer_words,
                 memories,
@@ -182,6 +186,22 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         },
     });
     let mut layout = layout;
+    if d.pes.iter().any(|p| p.mac) {
+        // fused multiply-adds (`crate::encode`): three more instruction fields after the seed
+        // word's, and the same after the shift word in a MAC PE's control word
+        layout["instr"] = serde_json::json!(format!(
+            "[0,{a}) read A, [{a},{b}) read B, [{b},{c}) write-0 address, [{c},{e}) write-1 address, \
+            bit {e} we0, bit {} we1, bit {} issue valid, bit {} sub (ADD PE: 1 = a - b; MULTI PE with the mac bit: negate the addend), \
+            [{},{f}) read C (the addend of a multiply-add), bit {f} negate product, bit {} mac (MULTI PE: ±a·b ± c; 0 = a·b), zero up to {}",
+            e + 1, e + 2, e + 3, e + 4, 5 * w.aw + 5, w.instr, a = w.aw, b = 2 * w.aw, c = 3 * w.aw, f = 5 * w.aw + 4
+        ));
+        layout["control"] = serde_json::json!(
+            "per PE (`control`): one word per cycle, from bit 0: the instruction's four addresses `pa` bits each \
+            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word; the `capt` word; \
+            on fixed-point PEs the `fix` word; on PEs with `mac` then read C (`pa` bits), negate product, mac; \
+            split into `lanes` (the HDL's control memories; the other images hold the same fields)"
+        );
+    }
     if d.pe_kind == PeKind::Fixed {
         layout["fix"] = serde_json::json!(
             "per PE and cycle, [0,6) align (bits the aligned operand is shifted left), bit 6 align b (else a), \

@@ -23,11 +23,22 @@
 //! | `4aw`           | we0: port 0 writes                                         |
 //! | `4aw + 1`       | we1: port 1 writes                                         |
 //! | `4aw + 2`       | issue valid                                                |
-//! | `4aw + 3`       | sub: 1 = `a − b` on an ADD PE; always 0 on a MULTI PE       |
+//! | `4aw + 3`       | sub: 1 = `a − b` on an ADD PE; on a MULTI PE 1 only for a multiply-add: negate the addend (`fms`) |
 //! | `[4aw + 4, instr_width)` | 0 (with `aw` = 11: 48 bits used of 52)            |
 //!
-//! The op is implied by the PE type (ADD: add/sub, MULTI: mul). A write port's data comes from
-//! the crossbar word of the same memory and cycle.
+//! A program with a fused multiply-add ([`MachineOp::Mac`], fixed-point MULTI PEs; [`Layout::mac`])
+//! has three more fields after those, and an instruction word of at least `5aw + 6` bits (61 on
+//! the DE10-Nano, which widens its 52-bit word for such a program):
+//!
+//! | bits            | field                                                      |
+//! |-----------------|------------------------------------------------------------|
+//! | `[4aw + 4, 5aw + 4)` | read address C (the addend)                           |
+//! | `5aw + 4`       | negate product (`fnma`)                                    |
+//! | `5aw + 5`       | mac: the op is `±a·b ± c` (with sub = negate addend); 0 = `a·b` |
+//!
+//! so that a program without one has the same words as before. The op is implied by the PE
+//! type and these bits (ADD: add/sub, MULTI: mul, or with the mac bit `fma`, `fms`, `fnma`).
+//! A write port's data comes from the crossbar word of the same memory and cycle.
 //!
 //! ## Crossbar word (per PE memory, per cycle; `2·sw` bits)
 //! `[0, sw)` select of port 0, `[sw, 2sw)` select of port 1, each: 0 = none,
@@ -48,9 +59,13 @@
 //!
 //! [`decode`] inverts [`encode`] exactly: `decode(encode(p)) == steps of p` for every program
 //! `encode` accepts; it rejects words with bits set outside their fields, a select beyond
-//! `2·n_pe`, a write enable without a select (or the reverse), or a sub bit on a MULTI PE.
+//! `2·n_pe`, a write enable without a select (or the reverse), a sub bit on a MULTI PE without the
+//! mac bit, or the mac fields on an ADD PE.
 
-use robovec_ir::machine::{BufferOp, Instr, MachineOp, MachineProgram, MemWrite, Source, Step, StepWrites, Word};
+use robovec_ir::intrinsic::Intrinsic;
+use robovec_ir::machine::{
+    BufferOp, Instr, MachineOp, MachineProgram, MemWrite, ReadAddrs, Source, Step, StepWrites, Word,
+};
 use robovec_ir::TrigFn;
 
 /// Field widths of the four image words, bits.
@@ -68,8 +83,12 @@ pub struct Layout {
     pub ow: u32,
     /// Crossbar select bits.
     pub sw: u32,
-    /// Instruction-memory word width, bits (≥ `4aw + 4`, ≤ 64).
+    /// Instruction-memory word width, bits (≥ [`Layout::instr_bits`], ≤ 64).
     pub instr_width: u32,
+    /// The program issues fused multiply-adds ([`MachineOp::Mac`]): the instruction word has the
+    /// read address C, negate-product and mac fields after its `4aw + 4` bits (module doc).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub mac: bool,
 }
 
 /// ⌈log2 n⌉, at least 1: the address bits of an `n`-word memory.
@@ -84,23 +103,29 @@ pub fn bits_for(n: u64) -> u32 {
 impl Layout {
     /// The layout for program `p` on a target with PE memories of `pe_words` words, buffers of
     /// `buffer_words` words and `instr_width`-bit instruction words (seed §1.3.1: 2048, —, 52).
+    /// A program with fused multiply-adds gets the mac fields and a word of at least their
+    /// `5aw + 6` bits ([`Layout::mac`]).
     ///
     /// # Errors
     /// [`EncodeError::WordTooWide`] when the instruction word needs more than `instr_width` bits
     /// or any word more than 64.
     pub fn new(p: &MachineProgram, pe_words: u32, buffer_words: u32, instr_width: u32) -> Result<Layout, EncodeError> {
         let n_pe = p.n_pe();
+        let mac =
+            p.pes.iter().flat_map(|pe| &pe.steps).any(|s| matches!(s.issue, Some(Instr { op: MachineOp::Mac(_), .. })));
+        let aw = bits_for(pe_words as u64);
         let l = Layout {
             n_pe,
             n_add: p.arch.n_add as usize,
-            aw: bits_for(pe_words as u64),
+            aw,
             bw: bits_for(buffer_words as u64),
             ow: bits_for(p.output_words.iter().copied().max().unwrap_or(0) as u64),
             sw: bits_for(2 * n_pe as u64 + 1),
-            instr_width,
+            instr_width: if mac { instr_width.max(5 * aw + 6) } else { instr_width },
+            mac,
         };
         let need = [
-            ("instruction", l.instr_bits(), instr_width.min(64)),
+            ("instruction", l.instr_bits(), l.instr_width.min(64)),
             ("crossbar", l.crossbar_bits(), 64),
             ("buffer instruction", l.buffer_bits(), 64),
             ("output capture", l.capture_bits(), 64),
@@ -113,9 +138,13 @@ impl Layout {
         Ok(l)
     }
 
-    /// Used bits of an instruction word: `4aw + 4`.
+    /// Used bits of an instruction word: `4aw + 4`, `5aw + 6` with the mac fields.
     pub fn instr_bits(&self) -> u32 {
-        4 * self.aw + 4
+        if self.mac {
+            5 * self.aw + 6
+        } else {
+            4 * self.aw + 4
+        }
     }
 
     /// Bits of a crossbar word: `2sw`.
@@ -153,8 +182,9 @@ pub struct Images {
 /// What [`encode`]/[`Layout::new`] reject: what the FPGA's words cannot express.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum EncodeError {
-    /// An op with no FPGA unit (`div`, `call`): the instruction word has only add/sub and mul.
-    #[error("cycle {cycle}, PE slot {slot}: `{op}` has no unit on the FPGA (only add, sub and mul)")]
+    /// An op with no FPGA unit (`div`, `call`, a multiply-add in a layout without the mac
+    /// fields or on an ADD PE): the instruction word has only add/sub, mul and multiply-add.
+    #[error("cycle {cycle}, PE slot {slot}: `{op}` has no unit on the FPGA (only add, sub, mul and, on MULTI PEs, fma, fms, fnma)")]
     NoUnit {
         /// PE slot.
         slot: usize,
@@ -175,8 +205,8 @@ pub enum EncodeError {
         /// Writes in that cycle.
         writes: usize,
     },
-    /// An instruction with other than two read addresses.
-    #[error("cycle {cycle}, PE slot {slot}: an instruction reads {reads} operands; the word has 2 read addresses")]
+    /// An instruction with other than two read addresses (three for a multiply-add).
+    #[error("cycle {cycle}, PE slot {slot}: an instruction reads {reads} operands; the word has 2 read addresses (3 for a multiply-add)")]
     Reads {
         /// PE slot.
         slot: usize,
@@ -262,22 +292,37 @@ pub fn encode_step(l: &Layout, slot: usize, cycle: u32, s: &Step) -> Result<[u64
     let mut instr = 0u64;
     let mut xbar = 0u64;
     if let Some(Instr { op, reads }) = &s.issue {
-        let sub = match op {
-            MachineOp::Add | MachineOp::Mul => 0,
-            MachineOp::Sub => 1,
+        // (sub, negate product, mac)
+        let (sub, negp, mac) = match op {
+            MachineOp::Add | MachineOp::Mul => (0, 0, false),
+            MachineOp::Sub => (1, 0, false),
             MachineOp::Div => return Err(EncodeError::NoUnit { slot, cycle, op: "div".into() }),
             MachineOp::Call(c) => return Err(EncodeError::NoUnit { slot, cycle, op: format!("call @{}", c.name) }),
             MachineOp::Mac(c) => {
-                return Err(EncodeError::NoUnit { slot, cycle, op: format!("multiply-add @{}", c.name) })
+                let no_unit = || EncodeError::NoUnit { slot, cycle, op: format!("multiply-add @{}", c.name) };
+                if !l.mac || slot < l.n_add {
+                    return Err(no_unit());
+                }
+                match Intrinsic::of(c, reads.len()) {
+                    Some(Intrinsic::Fma) => (0, 0, true),
+                    Some(Intrinsic::Fms) => (1, 0, true),
+                    Some(Intrinsic::Fnma) => (0, 1, true),
+                    _ => return Err(no_unit()),
+                }
             }
         };
-        if reads.len() != 2 {
+        if reads.len() != if mac { 3 } else { 2 } {
             return Err(EncodeError::Reads { slot, cycle, reads: reads.len() });
         }
         instr |= field("read address", reads[0] as u64, aw, slot, cycle)?;
         instr |= field("read address", reads[1] as u64, aw, slot, cycle)? << aw;
         instr |= 1 << (4 * aw + 2);
         instr |= sub << (4 * aw + 3);
+        if mac {
+            instr |= field("read address", reads[2] as u64, aw, slot, cycle)? << (4 * aw + 4);
+            instr |= negp << (5 * aw + 4);
+            instr |= 1 << (5 * aw + 5);
+        }
     }
     for (port, w) in s.writes.iter().enumerate() {
         let p = port as u32;
@@ -326,18 +371,44 @@ pub fn decode_step(l: &Layout, slot: usize, cycle: usize, words: [u64; 4]) -> Re
         }
     }
     let is_add = slot < l.n_add;
+    // the mac fields (only in a layout that has them: else they are beyond the used bits)
+    let (rc, negp, mac) = if l.mac {
+        (get(instr, 4 * aw + 4, aw), bit(instr, 5 * aw + 4), bit(instr, 5 * aw + 5))
+    } else {
+        (0, false, false)
+    };
     let issue = if bit(instr, 4 * aw + 2) {
         let sub = bit(instr, 4 * aw + 3);
-        let op = match (is_add, sub) {
-            (true, false) => MachineOp::Add,
-            (true, true) => MachineOp::Sub,
-            (false, false) => MachineOp::Mul,
-            (false, true) => return Err(err("instruction", "sub bit set on a MULTI PE".into())),
-        };
-        Some(Instr { op, reads: [get(instr, 0, aw) as u32, get(instr, aw, aw) as u32].into() })
+        let (a, b) = (get(instr, 0, aw) as u32, get(instr, aw, aw) as u32);
+        if mac {
+            let fused = match (is_add, negp, sub) {
+                (true, ..) => return Err(err("instruction", "mac bit set on an ADD PE".into())),
+                (false, false, false) => Intrinsic::Fma,
+                (false, false, true) => Intrinsic::Fms,
+                (false, true, false) => Intrinsic::Fnma,
+                (false, true, true) => return Err(err("instruction", "negate-product and sub bits both set".into())),
+            };
+            Some(Instr {
+                op: MachineOp::Mac(Box::new(fused.callee())),
+                reads: ReadAddrs::from_slice(&[a, b, rc as u32]),
+            })
+        } else {
+            if rc != 0 || negp {
+                return Err(err("instruction", "read address C or negate-product bit without the mac bit".into()));
+            }
+            let op = match (is_add, sub) {
+                (true, false) => MachineOp::Add,
+                (true, true) => MachineOp::Sub,
+                (false, false) => MachineOp::Mul,
+                (false, true) => {
+                    return Err(err("instruction", "sub bit set on a MULTI PE without the mac bit".into()))
+                }
+            };
+            Some(Instr { op, reads: [a, b].into() })
+        }
     } else {
-        if get(instr, 0, 2 * aw) != 0 || bit(instr, 4 * aw + 3) {
-            return Err(err("instruction", "read addresses or sub bit without issue valid".into()));
+        if get(instr, 0, 2 * aw) != 0 || bit(instr, 4 * aw + 3) || rc != 0 || negp || mac {
+            return Err(err("instruction", "read addresses, sub or mac fields without issue valid".into()));
         }
         None
     };
@@ -489,7 +560,11 @@ mod tests {
     use super::*;
 
     fn layout(n_pe: usize, n_add: usize) -> Layout {
-        Layout { n_pe, n_add, aw: 11, bw: 4, ow: 3, sw: bits_for(2 * n_pe as u64 + 1), instr_width: 52 }
+        Layout { n_pe, n_add, aw: 11, bw: 4, ow: 3, sw: bits_for(2 * n_pe as u64 + 1), instr_width: 52, mac: false }
+    }
+
+    fn mac_layout(n_pe: usize, n_add: usize) -> Layout {
+        Layout { mac: true, instr_width: 61, ..layout(n_pe, n_add) }
     }
 
     #[test]
@@ -547,11 +622,47 @@ mod tests {
         assert!(decode_step(&l, 0, 0, [1 << 44, 0, 0, 0]).unwrap_err().message.contains("selects no source"));
     }
 
+    #[test]
+    fn multiply_adds_take_read_c_and_two_bits_after_the_seed_word() {
+        let (l, plain) = (mac_layout(2, 1), layout(2, 1));
+        assert_eq!(l.instr_bits(), 61);
+        let mac = |i: Intrinsic| Step {
+            issue: Some(Instr {
+                op: MachineOp::Mac(Box::new(i.callee())),
+                reads: ReadAddrs::from_slice(&[3, 4, 2047]),
+            }),
+            ..Step::default()
+        };
+        // read C at 44..55, negate product at 55, mac at 56; sub (47) negates the addend
+        let base = 3 | (4 << 11) | (1 << 46) | (2047u64 << 48) | (1 << 60);
+        for (i, bits) in [(Intrinsic::Fma, 0), (Intrinsic::Fms, 1u64 << 47), (Intrinsic::Fnma, 1 << 59)] {
+            let w = encode_step(&l, 1, 0, &mac(i)).unwrap();
+            assert_eq!(w, [base | bits, 0, 0, 0], "{i:?}");
+            assert_eq!(decode_step(&l, 1, 0, w).unwrap(), mac(i));
+        }
+        // a program without multiply-adds keeps the seed's word; a multiply-add needs the
+        // mac fields and a MULTI PE
+        let mul = Step { issue: Some(Instr { op: MachineOp::Mul, reads: [1, 2].into() }), ..Step::default() };
+        assert_eq!(encode_step(&l, 1, 0, &mul).unwrap(), encode_step(&plain, 1, 0, &mul).unwrap());
+        assert!(matches!(encode_step(&plain, 1, 0, &mac(Intrinsic::Fma)), Err(EncodeError::NoUnit { .. })));
+        assert!(matches!(encode_step(&l, 0, 0, &mac(Intrinsic::Fma)), Err(EncodeError::NoUnit { .. })));
+        // decode: the mac bit on an ADD PE, negate product with sub, C without the mac bit
+        assert!(decode_step(&l, 0, 0, [base, 0, 0, 0]).unwrap_err().message.contains("ADD"));
+        assert!(decode_step(&l, 1, 0, [base | 1 << 47 | 1 << 59, 0, 0, 0]).is_err());
+        assert!(decode_step(&l, 1, 0, [base & !(1 << 60), 0, 0, 0]).unwrap_err().message.contains("without the mac"));
+        assert!(decode_step(&plain, 1, 0, [base, 0, 0, 0]).unwrap_err().message.contains("beyond"));
+    }
+
     use proptest::prelude::*;
 
     /// Any step a program on `layout(n_pe, n_add)` can hold on an ADD (`is_add`) or MULTI PE: 0–2 writes from
     /// any source, optional issue of the PE's ops, buffer and capture instructions.
     fn any_step(n_pe: usize, is_add: bool) -> impl Strategy<Value = Step> {
+        any_step_of(n_pe, is_add, false)
+    }
+
+    /// [`any_step`] with fused multiply-adds on a MULTI PE when `mac` (a [`mac_layout`]).
+    fn any_step_of(n_pe: usize, is_add: bool, mac: bool) -> impl Strategy<Value = Step> {
         let addr = 0u32..2048;
         let src = (any::<bool>(), 0..n_pe).prop_map(|(b, s)| if b { Source::Buffer(s) } else { Source::Result(s) });
         let write = (addr.clone(), src).prop_map(|(addr, src)| MemWrite { addr, src });
@@ -560,8 +671,14 @@ mod tests {
         } else {
             Just(MachineOp::Mul).boxed()
         };
-        let issue =
-            proptest::option::of((op, addr.clone(), addr).prop_map(|(op, a, b)| Instr { op, reads: [a, b].into() }));
+        let fused = prop_oneof![Just(Intrinsic::Fma), Just(Intrinsic::Fms), Just(Intrinsic::Fnma)];
+        let fused = (fused, addr.clone(), addr.clone(), addr.clone()).prop_map(|(i, a, b, c)| Instr {
+            op: MachineOp::Mac(Box::new(i.callee())),
+            reads: ReadAddrs::from_slice(&[a, b, c]),
+        });
+        let binary = (op, addr.clone(), addr.clone()).prop_map(|(op, a, b)| Instr { op, reads: [a, b].into() });
+        let instr = if mac && !is_add { prop_oneof![binary, fused].boxed() } else { binary.boxed() };
+        let issue = proptest::option::of(instr);
         let small = || proptest::option::of(0u32..16);
         (issue, proptest::collection::vec(write, 0..=2), small(), small(), proptest::option::of(0u32..8)).prop_map(
             |(issue, writes, store, read, capture)| Step {
@@ -584,6 +701,18 @@ mod tests {
         ) {
             let l = layout(n_pe, n_pe.div_ceil(2));
             let w = encode_step(&l, slot, 0, &step).unwrap();
+            prop_assert_eq!(decode_step(&l, slot, 0, w).unwrap(), step);
+        }
+
+        #[test]
+        fn decode_inverts_encode_on_any_step_with_multiply_adds(
+            (n_pe, slot, step) in (2usize..=8)
+                .prop_flat_map(|n| (Just(n), 0..n))
+                .prop_flat_map(|(n, s)| (Just(n), Just(s), any_step_of(n, s < n.div_ceil(2), true)))
+        ) {
+            let l = mac_layout(n_pe, n_pe.div_ceil(2));
+            let w = encode_step(&l, slot, 0, &step).unwrap();
+            prop_assert!(w[0] >> l.instr_bits() == 0);
             prop_assert_eq!(decode_step(&l, slot, 0, w).unwrap(), step);
         }
     }

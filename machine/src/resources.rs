@@ -242,7 +242,7 @@ pub struct Resources {
 /// ([`PeMemory::LiveValueTable`]: the memory's blocks are four banks').
 pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
     let mut v = Vec::new();
-    let (pe_tdp, banks) = match d.pe_memory {
+    let (pe_tdp, banks): (bool, u64) = match d.pe_memory {
         PeMemory::DoublePumped => (true, 1),
         PeMemory::LiveValueTable => (false, 4),
     };
@@ -255,10 +255,15 @@ pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
         // memory (a PE without outputs has a constant one, which synthesis removes)
         let holds = d.outputs.iter().any(|o| o.slot == p.slot) || d.output_loads.iter().any(|l| l.slot == p.slot);
         let out = holds.then_some((&p.out, false, 1));
-        for (img, true_dual_port, banks) in lanes.chain([(&p.data, pe_tdp, banks)]).chain(out) {
+        // a MAC PE's third read (`rv_pe`'s MAC = 1): a copy of the PE memory taking the same
+        // writes, one read port used (the live-value table's copy keeps two of its four banks)
+        let copy = p.mac.then_some((&p.data, pe_tdp, banks.div_ceil(2), "_c"));
+        let lanes = lanes.map(|(i, t, b)| (i, t, b, ""));
+        let out = out.map(|(i, t, b)| (i, t, b, ""));
+        for (img, true_dual_port, banks, suffix) in lanes.chain([(&p.data, pe_tdp, banks, "")]).chain(copy).chain(out) {
             let words = img.words.len().max(1) as u64;
             v.push(MemoryCost {
-                name: img.name.clone(),
+                name: format!("{}{suffix}", img.name),
                 words,
                 width: img.width,
                 m10k: banks * m10k_blocks(words, img.width, M10kFit::Configurations { true_dual_port, family }),
@@ -511,6 +516,26 @@ pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32, r: ShiftRanges)
     UnitCost { alm, dsp, m10k: unit.m10k }
 }
 
+/// A fixed-point MULTI PE's unit with fused multiply-adds (`fix_mac` in `hdl/fix_units.v`) for
+/// `dw`-bit words, a `kw`-bit exact intermediate
+/// ([`crate::design::build::mac_intermediate_bits`]) and the shifts `r` of its program: the
+/// MULTI unit ([`fixed_unit`]) plus the addend's path — its register, the swap of the aligned
+/// term, the alignment shifter (`La = ⌈log₂(AMAX + 1)⌉` levels), the two negations and the
+/// `kw`-bit adder — costed like the ADD unit (the target's `fix_pe.add` scaled by
+/// `unit_structure`) at `2.25·KW + 0.42·KW·La` structure units: on the Cyclone V
+/// `2.4·KW + 0.45·KW·La` ALM, fitted to Yosys 0.23 `synth_intel_alm` of `fix_mac` less `fix_mul`
+/// at `LATENCY = 2`, 27-bit words, rounding by 25 to 30 bits (KW 64: 155, 278, 317 ALM more for
+/// AMAX 0, 15, 47; KW 56, AMAX 15: 268), within 13 % of those. The same DSP blocks as the
+/// product's.
+pub fn fixed_mac_unit(m: &CostModel, dw: u32, kw: u32, r: ShiftRanges) -> UnitCost {
+    let mul = fixed_unit(m, dw, true, kw, r);
+    let full = unit_structure(32, false, 64, ShiftRanges::FULL, m.family);
+    let kwf = f64::from(kw.min(64));
+    let adder = 2.25 * kwf + 0.42 * kwf * levels(i32::from(r.align_max));
+    let alm = (m.fix_add.alm as f64 * adder / full).ceil().max(0.0) as u64;
+    UnitCost { alm: mul.alm + alm, dsp: mul.dsp, m10k: mul.m10k }
+}
+
 /// The logic of design `d` by the family's Yosys-flow figures `l`, in the family's units
 /// ([`crate::target::DesignLogic`]: each write port by its multiplexer inputs, each PE by its
 /// buffer words, at the design's word bits), at least half its flip-flops ([`Design::flip_flops`]:
@@ -533,6 +558,9 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
     let unit = |p: &crate::design::PeImages| match (d.pe_kind, p.is_mul) {
         (crate::design::PeKind::Binary32, false) => m.fp_add,
         (crate::design::PeKind::Binary32, true) => m.fp_mul,
+        (crate::design::PeKind::Fixed, true) if p.mac => {
+            fixed_mac_unit(m, d.word_bits, d.intermediate_bits(p.slot), p.shift_ranges.unwrap_or(ShiftRanges::FULL))
+        }
         (crate::design::PeKind::Fixed, is_mul) => {
             fixed_unit(m, d.word_bits, is_mul, d.intermediate_bits(p.slot), p.shift_ranges.unwrap_or(ShiftRanges::FULL))
         }

@@ -122,6 +122,24 @@ pub fn intermediate_bits(dw: u32, is_mul: bool, shifts: impl IntoIterator<Item =
         .min(64)
 }
 
+/// Bits of the exact intermediate K of a MULTI PE with the multiply-add unit (`fix_mac` in
+/// `hdl/fix_units.v`) for `dw`-bit words and the shifts `shifts` of its program (fused ops and
+/// products): the aligned sum `±(a·b << lp) ± (c << lc)` takes `max(2·dw + lp, dw + lc) + 1`
+/// bits and one more for the rounding constant, at least `s + 2` for a rounding by `s` bits and
+/// the product's `2·dw + 1`; at most 64 (robovec's `INTEGER_BITS` bound of 62 bits on every
+/// exact intermediate, `robovec_ir::format`, so the sum is exact modulo 2^64 and fits).
+pub fn mac_intermediate_bits(dw: u32, shifts: impl IntoIterator<Item = FixShifts>) -> u32 {
+    shifts
+        .into_iter()
+        .map(|sh| {
+            let align = u32::from(sh.align & 63);
+            let (lp, lc) = if sh.align_b { (0, align) } else { (align, 0) };
+            ((2 * dw + lp).max(dw + lc) + 2).max(u32::try_from(sh.shift).unwrap_or(0) + 2)
+        })
+        .fold(2 * dw + 1, u32::max)
+        .min(64)
+}
+
 /// The shifts a fixed-point PE's program uses: the largest alignment and the range of the
 /// rounding shifts (`hdl/fix_units.v`'s `AMAX`, `SMIN`, `SMAX`). The unit's shifters cover only
 /// these, so their levels are ⌈log₂(AMAX + 1)⌉ and ⌈log₂(SMAX − SMIN + 1)⌉ instead of 6 and 7
@@ -174,13 +192,13 @@ pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
             ));
         }
     }
-    let (mut unsupported, mut mac) = (Vec::new(), Vec::new());
+    let (mut unsupported, mut mac) = (Vec::new(), false);
     for (s, pe) in m.pes.iter().enumerate() {
         for (c, st) in pe.steps.iter().enumerate() {
             match st.issue.as_ref().map(|i| &i.op) {
                 Some(MachineOp::Div) => unsupported.push(format!("div on {} at cycle {c}", name(s))),
                 Some(MachineOp::Call(_)) => unsupported.push(format!("call on {} at cycle {c}", name(s))),
-                Some(MachineOp::Mac(_)) => mac.push(format!("multiply-add on {} at cycle {c}", name(s))),
+                Some(MachineOp::Mac(_)) => mac = true,
                 _ => {}
             }
             if st.writes.len() > 2 {
@@ -198,14 +216,6 @@ pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
             unsupported.len(),
             unsupported.iter().take(4).cloned().collect::<Vec<_>>().join(", "),
             if unsupported.len() > 4 { ", …" } else { "" }
-        ));
-    }
-    if !mac.is_empty() {
-        out.push(format!(
-            "{} fused multiply-add(s) on MULTI PEs, which `codegen<fpga>` does not build yet (a MULTI PE with a third read and an addend; `sim` runs them): {}{}",
-            mac.len(),
-            mac.iter().take(4).cloned().collect::<Vec<_>>().join(", "),
-            if mac.len() > 4 { ", …" } else { "" }
         ));
     }
     let worst = |v: &[u32]| v.iter().enumerate().max_by_key(|&(i, &w)| (w, std::cmp::Reverse(i))).map(|(i, &w)| (i, w));
@@ -236,6 +246,12 @@ pub fn problems(m: &MachineProgram, limits: &Limits) -> Vec<String> {
             "the instruction word needs {} bits (4 addresses of {aw} bits + 4 flags); the target's is {} bits",
             4 * aw + 4,
             limits.instr_width
+        ));
+    } else if mac && 5 * aw + 6 > 64 {
+        // a program with multiply-adds widens the word to 5aw + 6 bits (`crate::encode`)
+        out.push(format!(
+            "the instruction word of a program with fused multiply-adds needs {} bits (5 addresses of {aw} bits + 6 flags); the images hold at most 64",
+            5 * aw + 6
         ));
     }
     out
@@ -362,7 +378,9 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
         });
         data.resize(data.len().max(1), 0);
         out.resize(out.len().max(1), 0);
+        let mac = pe.steps.iter().any(|st| matches!(st.issue.as_ref().map(|i| &i.op), Some(MachineOp::Mac(_))));
         pes.push(PeImages {
+            mac,
             slot: s,
             pe: pname,
             is_mul: s >= m.arch.n_add as usize,

@@ -128,6 +128,10 @@ pub struct PeImages {
     pub pe: String,
     /// True for a MULTI PE.
     pub is_mul: bool,
+    /// True for a MULTI PE that issues fused multiply-adds (fixed point, [`crate::encode`]'s mac
+    /// fields): its unit is `fix_mac` (`rv_pe`'s `MAC = 1`), its PE memory has a third read and
+    /// its control word the read address C, negate-product and mac bits after the shift word.
+    pub mac: bool,
     /// Instruction memory, one word per cycle `0..=cycles`.
     pub instr: Image,
     /// Crossbar memory (this PE memory's two write selects), one word per cycle: the
@@ -222,7 +226,8 @@ pub struct Design {
 pub struct Control {
     /// Bits of each address field of the instruction: the PE memory's address bits.
     pub pa: u32,
-    /// Bits of the whole word (`4·pa + 4` + selects + buffer + capture [+ 14 shift bits]).
+    /// Bits of the whole word (`4·pa + 4` + selects + buffer + capture [+ 14 shift bits]
+    /// [+ `pa + 2` mac fields]).
     pub width: u32,
     /// The lanes, bit 0 of the word in lane 0 (`peS_ctrlK`), each `control_lane_bits` wide but
     /// the last.
@@ -393,6 +398,10 @@ impl Design {
     pub fn intermediate_bits(&self, slot: usize) -> u32 {
         let p = &self.pes[slot];
         match &p.fix {
+            Some(img) if p.mac => build::mac_intermediate_bits(
+                self.word_bits,
+                img.words.iter().map(|&w| robovec_ir::machine::FixShifts::from_word(w)),
+            ),
             Some(img) => build::intermediate_bits(
                 self.word_bits,
                 p.is_mul,
@@ -407,7 +416,8 @@ impl Design {
     /// address, `[3pa,4pa)` write-1 address, then we0, we1, issue valid, sub), its write-port
     /// selects (the `xbar` image, `xbar.width` bits), its buffer instruction (`bufi`), its output
     /// capture (`capt`) and, on fixed-point PEs, its shift word (`fix`, 14 bits), in that order from
-    /// bit 0; split into lanes of [`Design::control_lane_bits`] (`peS_ctrl0`, `peS_ctrl1`, …). The
+    /// bit 0, then on a PE with fused multiply-adds ([`PeImages::mac`]) the read address C (`pa`
+    /// bits), the negate-product bit and the mac bit (the instruction's `[4aw+4, 5aw+6)`); split into lanes of [`Design::control_lane_bits`] (`peS_ctrl0`, `peS_ctrl1`, …). The
     /// separate images are the same fields one memory each (the manifest's `memories`); the HDL
     /// reads the lanes: every field is fetched at the same cycle, so one memory of the word's
     /// width holds them in ⌈width / lane⌉ blocks (at most 256 cycles on the Cyclone V) where
@@ -453,6 +463,12 @@ impl Design {
             for img in &fields {
                 put(img.words.get(c).copied().unwrap_or(0), img.width);
             }
+            if p.mac {
+                let rc = w >> (4 * aw + 4) & mask(aw);
+                debug_assert!(rc <= mask(pa), "an address beyond the PE memory's words");
+                put(rc & mask(pa), pa);
+                put(w >> (5 * aw + 4) & 3, 2);
+            }
         }
         Control { pa, width, lanes }
     }
@@ -463,7 +479,8 @@ impl Design {
         let p = &self.pes[slot];
         let pa = addr_bits(p.data.words.len().max(1) as u64).min(self.widths.aw);
         let fields = p.xbar.width + p.bufi.width + p.capt.width + p.fix.as_ref().map_or(0, |f| f.width);
-        (pa, 4 * pa + 4 + fields)
+        let mac = if p.mac { pa + 2 } else { 0 };
+        (pa, 4 * pa + 4 + fields + mac)
     }
 
     /// The flip-flops of the design outside its units and memories (`hdl/rv_lib.v`), an upper
@@ -567,6 +584,9 @@ impl Design {
             };
             if self.pe_memory == PeMemory::LiveValueTable {
                 fix += ".LVT(1), ";
+            }
+            if p.mac {
+                fix += ".MAC(1), ";
             }
             let control = self.control(p.slot);
             let lanes: String =

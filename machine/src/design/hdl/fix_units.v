@@ -9,6 +9,7 @@
 //
 //   fix_add_sub #(.LATENCY(L), .DW(w), .KW(k), .AMAX(a), .SMIN(s0), .SMAX(s1)) u (.clk, .a, .b, .sub, .sh, .y);
 //   fix_mul     #(.LATENCY(L), .DW(w), .KW(k), .SMIN(s0), .SMAX(s1)) u (.clk, .a, .b, .sh, .y);
+//   fix_mac     #(.LATENCY(L), .DW(w), .KW(k), .AMAX(a), .SMIN(s0), .SMAX(s1)) u (.clk, .a, .b, .c, .mac, .negp, .sub, .sh, .y);
 //
 // The exact result is registered before its rounding (`fix_stages`), then a delay line when
 // L > 1 (robovec's PEs take L = 1: the rounding goes straight into the PE's result register).
@@ -182,4 +183,117 @@ module fix_mul #(parameter integer LATENCY = 2, parameter integer DW = 32, param
       fix_stages #(.LATENCY(LATENCY), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
     end
   endgenerate
+endmodule
+
+// The MULTI PE's unit with fused multiply-adds (`rv_pe`'s MAC = 1; robovec's `contract` after
+// `precision<target=mcu>`): y = round(+-(a * b << lp) +- (c << lc)), LATENCY clocks after the
+// operands, exactly robovec's `FixShifts::apply_fused` (ir/src/machine.rs): with sh[6] (align b)
+// the addend c is shifted left by sh[5:0], else the product; `negp` negates the product (fnma),
+// `sub` the addend (fms); then the rounding by sh[13:7] of fix_round. With `mac` low the op is a
+// plain product (the addend, its alignment and the negations gated off): y = round(a * b).
+// LATENCY >= 2: the product is registered first (a DSP multiplier's output register, or the four
+// partial products of a word wider than ONE, as fix_mul), with the addend and the op's fields;
+// the aligned sum is registered in the next clock (fix_stages), then rounded, then a delay line
+// of LATENCY - 2 clocks. KW covers the aligned sum (robovec's `mac_intermediate_bits`, at most
+// 64 bits: every exact intermediate of an integer op is at most 62 bits).
+module fix_mac #(parameter integer LATENCY = 2, parameter integer DW = 32, parameter integer KW = 64,
+                 parameter integer AMAX = 63, parameter integer SMIN = -64, parameter integer SMAX = 63,
+                 parameter integer ONE = 27) (
+    input  wire          clk,
+    input  wire [DW-1:0] a,
+    input  wire [DW-1:0] b,
+    input  wire [DW-1:0] c,
+    input  wire          mac,
+    input  wire          negp,
+    input  wire          sub,
+    input  wire [13:0]   sh,
+    output wire [DW-1:0] y
+);
+  localparam integer AB = (AMAX <= 0) ? 1 : $clog2(AMAX + 1);
+  localparam integer LS = (LATENCY >= 2) ? LATENCY - 1 : LATENCY;  // the stages after the product
+  wire signed [KW-1:0] p;   // the product, sign-extended to KW bits
+  wire signed [DW-1:0] c1;  // the addend and the op's fields, of the product's clock
+  wire                 mac1, negp1, sub1;
+  wire        [13:0]   sh1;
+  generate
+    if (LATENCY >= 2) begin : g_reg
+      reg signed [DW-1:0] c_q;
+      reg                 mac_q, negp_q, sub_q;
+      reg        [13:0]   sh_q;
+      initial begin
+        c_q = 0;
+        {mac_q, negp_q, sub_q} = 0;
+        sh_q = 0;
+      end
+      always @(posedge clk) begin
+        c_q <= c;
+        mac_q <= mac;
+        negp_q <= negp;
+        sub_q <= sub;
+        sh_q <= sh;
+      end
+      assign c1 = c_q;
+      assign {mac1, negp1, sub1} = {mac_q, negp_q, sub_q};
+      assign sh1 = sh_q;
+      if (DW > ONE) begin : g_split
+        localparam integer HW = DW - 16;
+        // a = ah·2^16 + al with ah signed and al unsigned (b likewise), as fix_mul
+        wire signed [HW-1:0] ah = a[DW-1:16];
+        wire signed [HW-1:0] bh = b[DW-1:16];
+        wire signed [16:0]   al = {1'b0, a[15:0]};
+        wire signed [16:0]   bl = {1'b0, b[15:0]};
+        reg  signed [2*HW-1:0] hh;
+        reg  signed [HW+16:0]  hl, lh;
+        reg  signed [33:0]     ll;
+        initial begin
+          hh = 0;
+          hl = 0;
+          lh = 0;
+          ll = 0;
+        end
+        always @(posedge clk) begin
+          hh <= ah * bh;
+          hl <= ah * bl;
+          lh <= al * bh;
+          ll <= al * bl;
+        end
+        // signed assignments to wider wires sign-extend
+        wire signed [KW-1:0] ehh = hh;
+        wire signed [KW-1:0] ehl = hl;
+        wire signed [KW-1:0] elh = lh;
+        wire signed [KW-1:0] ell = ll;
+        assign p = (ehh <<< 32) + (ehl <<< 16) + (elh <<< 16) + ell;
+      end else begin : g_whole
+        wire signed [DW-1:0]   sa = a;
+        wire signed [DW-1:0]   sb = b;
+        reg  signed [2*DW-1:0] p_q;
+        initial p_q = 0;
+        always @(posedge clk) p_q <= sa * sb;
+        assign p = p_q;  // sign-extends
+      end
+    end else begin : g_comb
+      wire signed [DW-1:0]   sa = a;
+      wire signed [DW-1:0]   sb = b;
+      wire signed [2*DW-1:0] pc = sa * sb;
+      assign p = pc;
+      assign c1 = c;
+      assign {mac1, negp1, sub1} = {mac, negp, sub};
+      assign sh1 = sh;
+    end
+  endgenerate
+  wire side = sh1[6];
+  wire [AB-1:0] al = (AMAX <= 0 || !mac1) ? {AB{1'b0}} : sh1[AB-1:0];
+  wire signed [KW-1:0] ce = c1;  // sign-extends
+  wire signed [KW-1:0] ec = mac1 ? ce : {KW{1'b0}};
+  wire np = mac1 & negp1;
+  wire nc = mac1 & sub1;
+  // one shifter for both sides (as fix_add_sub): the aligned term first, each negated as
+  // x ^ {KW{n}} plus n
+  wire signed [KW-1:0] sp = side ? ec : p;
+  wire signed [KW-1:0] sq = side ? p : ec;
+  wire signed [KW-1:0] xs = sp <<< al;
+  wire ns = side ? nc : np;
+  wire nq = side ? np : nc;
+  wire signed [KW-1:0] k = (xs ^ {KW{ns}}) + (sq ^ {KW{nq}}) + {{(KW-2){1'b0}}, ns & nq, ns ^ nq};
+  fix_stages #(.LATENCY(LS), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) st (.clk(clk), .k(k), .s(sh1[13:7]), .y(y));
 endmodule

@@ -28,6 +28,8 @@ module rv_pe #(
     parameter integer IS_MUL = 0,      // 0: ADD PE (fp_add_sub), 1: MULTI PE (fp_mul)
     parameter integer FIX = 0,         // 1: fixed-point PE (fix_add_sub / fix_mul, shift memory)
     parameter integer LVT = 0,         // 1: the PE memory as banks and a live-value table (rv_pe_mem_lvt)
+    parameter integer MAC = 0,         // 1: fixed-point MULTI PE with fused multiply-adds (fix_mac): a third
+                                       //    read (the addend) and PA + 2 more control bits after the shift word
     parameter integer DW = 32,         // data word bits (32 for binary32 PEs; fixed point: the widest format)
     parameter integer KW = 64,         // fixed-point PEs: bits of the exact intermediate (fix_units.v)
     parameter integer AMAX = 63,       // fixed-point PEs: the program's largest alignment (fix_units.v)
@@ -50,7 +52,7 @@ module rv_pe #(
     parameter integer BUF_DEPTH = 1,   // buffer words
     parameter integer OUT_DEPTH = 1,   // output memory words
     parameter integer PA = 11,         // bits of each address field of the control word (<= AW)
-    parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + SW2 + 2 * BW + 2 + OW + 1 + (FIX != 0 ? 14 : 0),  // control word bits
+    parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + SW2 + 2 * BW + 2 + OW + 1 + (FIX != 0 ? 14 : 0) + (MAC != 0 ? PA + 2 : 0),  // control word bits
     parameter integer LANE = 40,       // bits of a control-memory lane (the widest block-RAM word)
     parameter CTRL0_FILE = "",         // the control memory's lanes (robovec's `Design::control`),
     parameter CTRL1_FILE = "",         // bit 0 of the word in lane 0; at most four lanes
@@ -158,8 +160,26 @@ module rv_pe #(
     end
   endgenerate
 
-  wire [DW-1:0] qa, qb;
+  wire [DW-1:0] qa, qb, qc;
+  // MAC PEs: the multiply-add's fields after the shift word (read address C, negate product, mac)
+  localparam integer MB = IB + XW + BIW + OCW + 14;
   generate
+    if (MAC != 0) begin : g_rc
+      // The third read (the addend): a second copy of the PE memory taking the same writes, read
+      // at rc with the same write-first forwarding (its second read port is left open).
+      wire [AW-1:0] rc = ctrl[MB +: PA];
+      if (LVT) begin : g_lvt
+        rv_pe_mem_lvt #(.AW(AW), .DEPTH(MEM_DEPTH), .DW(DW), .FILE(DATA_FILE)) u_mem_c (
+            .clk(clk), .we0(we0), .wa0(wa0), .wd0(wd0), .we1(we1), .wa1(wa1), .wd1(wd1),
+            .ra(rc), .rb(rc), .qa(qc), .qb());
+      end else begin : g_mem
+        rv_pe_mem #(.AW(AW), .DEPTH(MEM_DEPTH), .DW(DW), .FILE(DATA_FILE)) u_mem_c (
+            .clk(clk), .we0(we0), .wa0(wa0), .wd0(wd0), .we1(we1), .wa1(wa1), .wd1(wd1),
+            .ra(rc), .rb(rc), .qa(qc), .qb());
+      end
+    end else begin : g_no_rc
+      assign qc = {DW{1'b0}};
+    end
     if (LVT) begin : g_lvt
       rv_pe_mem_lvt #(.AW(AW), .DEPTH(MEM_DEPTH), .DW(DW), .FILE(DATA_FILE)) u_mem (
           .clk(clk), .we0(we0), .wa0(wa0), .wd0(wd0), .we1(we1), .wa1(wa1), .wd1(wd1),
@@ -183,7 +203,20 @@ module rv_pe #(
       reg  [13:0] sh_q;
       initial sh_q = 0;
       always @(posedge clk) sh_q <= sh;
-      if (IS_MUL != 0) begin : g_mul
+      if (IS_MUL != 0 && MAC != 0) begin : g_mac
+        // negate product and mac, registered with the operands (sub_q negates the addend)
+        reg negp_q, mac_q;
+        initial begin
+          negp_q = 0;
+          mac_q = 0;
+        end
+        always @(posedge clk) begin
+          negp_q <= ctrl[MB+PA];
+          mac_q <= ctrl[MB+PA+1];
+        end
+        fix_mac #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .AMAX(AMAX), .SMIN(SMIN), .SMAX(SMAX), .ONE(ONE)) u_fx (
+            .clk(clk), .a(qa), .b(qb), .c(qc), .mac(mac_q), .negp(negp_q), .sub(sub_q), .sh(sh_q), .y(y));
+      end else if (IS_MUL != 0) begin : g_mul
         fix_mul #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX), .ONE(ONE)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
       end else begin : g_add
         fix_add_sub #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .AMAX(AMAX), .SMIN(SMIN), .SMAX(SMAX)) u_fx (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .sh(sh_q), .y(y));

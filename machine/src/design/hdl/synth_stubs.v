@@ -27,6 +27,14 @@ module fix_mul #(parameter integer LATENCY = 3, parameter integer DW = 32, param
 endmodule
 
 (* blackbox *)
+module fix_mac #(parameter integer LATENCY = 2, parameter integer DW = 32, parameter integer KW = 64,
+                 parameter integer AMAX = 63, parameter integer SMIN = -64, parameter integer SMAX = 63,
+                 parameter integer ONE = 27) (
+    input wire clk, input wire [DW-1:0] a, input wire [DW-1:0] b, input wire [DW-1:0] c, input wire mac,
+    input wire negp, input wire sub, input wire [13:0] sh, output wire [DW-1:0] y);
+endmodule
+
+(* blackbox *)
 module rv_rom #(parameter integer WIDTH = 8, parameter integer DEPTH = 1, parameter integer AW = 1,
                 parameter FILE = "") (
     input wire clk, input wire [AW-1:0] addr, output wire [WIDTH-1:0] q);
