@@ -12,9 +12,11 @@ points; docs/accuracy.md):
    of `precision<budget=FILE;target=mcu;word=W>`, whose fixed-point formats the FPGA runs
    (fixed-point PEs, issue 49 item 1): the design is no less accurate than a binary32 one, and
    the table gives the largest ratio of an output's certified bound to its budget (<= 1: met).
-   W is, per target, the narrowest word from the one whose products take one DSP multiplier
-   (27 bits on the DE10-Nano's Cyclone V, 18 on the ECP5) up to 32 for which every value gets a
-   fixed-point format (the PE array has no floating-point unit beside them);
+   W is, per target, the narrowest word for which every value gets a fixed-point format (the PE
+   array has no floating-point unit beside them): from the one whose products take one DSP
+   multiplier (27 bits on the DE10-Nano's Cyclone V, 18 on the ECP5) down to 16 while every
+   value stays fixed point (narrower memories, multiplexers and adders), or up to 32 when it
+   does not;
 2. for each target (`de10-nano` at its declared 120 MHz, `ecp5-85f` at 80 MHz or, with `--pnr`,
    at the Fmax nextpnr measures), each configuration of `--pes` (N: N ADD + N MULTI PEs; A+M:
    A ADD and M MULTI PEs) and each K of `--states` (`interleave<states=K>`, issue 49 item 3),
@@ -59,6 +61,8 @@ def pre(r=16):
 
 # Per target: the widest word whose product takes one DSP multiplier (docs/fpga.md "Narrow words").
 ONE_BLOCK_WORD = {"de10-nano": 27, "ecp5-85f": 18}
+# The narrowest word tried below a target's one-DSP word.
+MIN_WORD = 16
 
 
 def config(text):
@@ -159,23 +163,37 @@ def main():
         budget = os.path.join(work, "budget.json")
         with open(budget, "w") as f:
             json.dump({k: {"abs": v["abs"]} for k, v in eb["outputs"].items() if v["abs"] is not None}, f)
-        # the narrowest word, from the target's one-DSP width, then 27 up to 32 bits (each tried once)
+        # The narrowest word at which every value is fixed point (each tried once): from the
+        # target's one-DSP width down while it holds (a narrower word still takes one DSP
+        # multiplier a product, and narrows the memories, multiplexers and adders: coman holds
+        # at 25 bits, the MX-5 and WALK-MAN at 26), or up to 32 bits when it does not.
         words, all_fixed = {}, {}
+
+        def fixed(w):
+            if w not in all_fixed:
+                prec = report(
+                    [path, f"-ranges={ranges}", f"-passes={prefix},precision<budget={budget};target=mcu;word={w}>"],
+                    work,
+                    f"fix{w}",
+                )
+                all_fixed[w] = all(k.startswith("fix<") for k in prec["precision"]["formats"])
+            return all_fixed[w]
+
         for target, first in ONE_BLOCK_WORD.items():
-            for w in [first] + [x for x in range(27, 33) if x > first]:
-                if w not in all_fixed:
-                    prec = report(
-                        [path, f"-ranges={ranges}", f"-passes={prefix},precision<budget={budget};target=mcu;word={w}>"],
-                        work,
-                        f"fix{w}",
-                    )
-                    all_fixed[w] = all(k.startswith("fix<") for k in prec["precision"]["formats"])
-                if all_fixed[w]:
-                    words[target] = w
-                    break
-            else:
+            if fixed(first):
+                w = first
+                while w - 1 >= MIN_WORD and fixed(w - 1):
+                    w -= 1
+                words[target] = w
+                continue
+            up = [x for x in range(first + 1, 33) if x >= 27 or x in all_fixed]
+            found = next((x for x in up if fixed(x)), None)
+            if found is None:
                 # a row that says so, and the other models' rows still printed
                 refused.append(f"{model} {target}: no fixed-point word up to 32 bits meets binary32's bound")
+            else:
+                # a narrower all-fixed word found for another target serves this one too
+                words[target] = min([found] + [x for x, ok in all_fixed.items() if ok and x > first])
         if len(words) < len(ONE_BLOCK_WORD):
             continue
         cpu_dir = os.path.join(work, "cpu")
