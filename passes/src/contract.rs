@@ -28,7 +28,7 @@
 //! this pass certifies the result (on the pendulum every output's bound falls or stays; on
 //! the corpus models of issue 49 the largest bound over binary32's is unchanged). Such a fused
 //! op runs on a MULTI PE as a multiply-accumulate ([`robovec_ir::Function::op_kind`]: a `mul`
-//! for the PE array); `sim` runs it bit for bit; `codegen<fpga>` does not build that unit yet.
+//! for the PE array); `sim` runs it bit for bit and `codegen<fpga>` builds that unit (`fix_mac`).
 //!
 //! Runs on the atomised phase and keeps it; clears timing attributes. A fused op is a `call`
 //! (SPEC §3 counts it as one op of kind `call`); a binary one is run by `place` as a call on
@@ -82,11 +82,6 @@ pub fn contract_function(f: &mut Function) -> Contracted {
 /// [`contract_function`] that stops fusing when `ticker` says so (`-time-limit`; one tick per
 /// value): the multiplies fused so far stay fused, the later ones are kept as they are.
 pub fn contract_within(f: &mut Function, ticker: &Ticker) -> Contracted {
-    contract_except(f, ticker, &HashSet::new())
-}
-
-/// [`contract_within`] that leaves the multiplies named in `keep` unfused.
-fn contract_except(f: &mut Function, ticker: &Ticker, keep: &HashSet<String>) -> Contracted {
     let n = f.values.len();
     // Every use of every value: the additions that read it once, and whether anything else
     // (an output, another op, an addition reading it twice) does.
@@ -128,11 +123,7 @@ fn contract_except(f: &mut Function, ticker: &Ticker, keep: &HashSet<String>) ->
         let m = f.body[k];
         let Def::Binary(BinOp::Mul, a, b) = f.value(m).def else { continue };
         let uses = &adds_of[m.index()];
-        if other_use[m.index()]
-            || uses.is_empty()
-            || uses.iter().any(|u| converted[u.index()])
-            || (!keep.is_empty() && keep.contains(f.name_of(m)))
-        {
+        if other_use[m.index()] || uses.is_empty() || uses.iter().any(|u| converted[u.index()]) {
             continue;
         }
         let fused_of = |op: BinOp, x: Operand, y: Operand| {

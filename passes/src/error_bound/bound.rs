@@ -676,7 +676,7 @@ fn propagate(
         Def::Binary(op_kind, a, b) => {
             let (ia, ea) = rd.operand(a, x, e);
             let (ib, eb) = rd.operand(b, x, e);
-            let same = matches!((a, b), (Operand::Value(p), Operand::Value(q)) if p == q);
+            let same = crate::range::enclose::same_pair(a, b);
             reads = vec![ea, eb];
             match op_kind {
                 // `a − a` is 0 while the computed `a` is finite (∞ − ∞ is NaN).

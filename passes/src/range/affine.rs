@@ -274,7 +274,7 @@ impl<'f> AffineSweep<'f> {
                 }
             }
             Def::Binary(op, a, b) => {
-                let same = matches!((a, b), (Operand::Value(p), Operand::Value(q)) if p == q);
+                let same = super::enclose::same_pair(a, b);
                 let (fa, fb) = (self.form(a), self.form(b));
                 let r = match op {
                     BinOp::Add => combine(&fa, 1.0, &fb, 1.0, 0.0, &mut slack),

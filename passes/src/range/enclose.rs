@@ -150,7 +150,7 @@ fn enclose_value(f: &Function, v: Value, x: &[Interval]) -> Result<Interval, Enc
             TrigFn::Cos => x[a.index()].cos(),
         },
         Def::Binary(op, a, b) => {
-            let same = matches!((a, b), (Operand::Value(p), Operand::Value(q)) if p == q);
+            let same = same_pair(a, b);
             let (ia, ib) = (of(x, a), of(x, b));
             match op {
                 BinOp::Add => ia + ib,

@@ -577,7 +577,7 @@ impl<'f> HarmonicSweep<'f> {
                 None => None,
             },
             (Def::Binary(op, a, b), Some(fs)) => {
-                let same = matches!((a, b), (Operand::Value(p), Operand::Value(q)) if p == q);
+                let same = super::enclose::same_pair(a, b);
                 let r = match op {
                     BinOp::Add => Some(lin(&fs[0], 1.0, &fs[1], 1.0, &mut slack)),
                     BinOp::Sub if same => Some(Vec::new()),
@@ -604,6 +604,7 @@ impl<'f> HarmonicSweep<'f> {
                     Some(i) => {
                         // a square (`fma(x, x, c)`) as `x · x`: its product is the square
                         let same = super::enclose::same_pair(&args[0], &args[1]);
+                        // capped as a separate product's form would be before the sum
                         let mut atoms = self.hs.mul(&fs[0], &fs[1], same, &mut slack);
                         self.hs.cap_atoms(self.cap, &mut atoms, &mut slack);
                         let p = HForm { atoms };
@@ -785,7 +786,7 @@ impl HarmonicSweep<'_> {
                     parts.push((Operand::Value(*a), Some(partial), 1.0));
                 }
                 Def::Binary(op, a, b) => {
-                    let same = matches!((a, b), (Operand::Value(p), Operand::Value(q)) if p == q);
+                    let same = super::enclose::same_pair(a, b);
                     match op {
                         BinOp::Add => {
                             parts.push((*a, None, 1.0));

@@ -127,6 +127,45 @@ module fix_add_sub #(parameter integer LATENCY = 1, parameter integer DW = 32, p
   fix_stages #(.LATENCY(LATENCY), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
 endmodule
 
+// A signed DW x DW product as four registered partial products of the (DW - 16)-bit signed high
+// and 16-bit unsigned low halves (one MULT18X18D each on the ECP5, one 18 x 19 half block each
+// on the Cyclone V), summed after the register and sign-extended to KW bits: p is the product
+// of the a, b of the previous clock. fix_mul's and fix_mac's product for words wider than ONE.
+module fix_split_product #(parameter integer DW = 32, parameter integer KW = 64) (
+    input  wire                 clk,
+    input  wire        [DW-1:0] a,
+    input  wire        [DW-1:0] b,
+    output wire signed [KW-1:0] p
+);
+  localparam integer HW = DW - 16;
+  // a = ah·2^16 + al with ah signed and al unsigned (b likewise)
+  wire signed [HW-1:0] ah = a[DW-1:16];
+  wire signed [HW-1:0] bh = b[DW-1:16];
+  wire signed [16:0]   al = {1'b0, a[15:0]};
+  wire signed [16:0]   bl = {1'b0, b[15:0]};
+  reg  signed [2*HW-1:0] hh;
+  reg  signed [HW+16:0]  hl, lh;
+  reg  signed [33:0]     ll;
+  initial begin
+    hh = 0;
+    hl = 0;
+    lh = 0;
+    ll = 0;
+  end
+  always @(posedge clk) begin
+    hh <= ah * bh;
+    hl <= ah * bl;
+    lh <= al * bh;
+    ll <= al * bl;
+  end
+  // signed assignments to wider wires sign-extend
+  wire signed [KW-1:0] ehh = hh;
+  wire signed [KW-1:0] ehl = hl;
+  wire signed [KW-1:0] elh = lh;
+  wire signed [KW-1:0] ell = ll;
+  assign p = (ehh <<< 32) + (ehl <<< 16) + (elh <<< 16) + ell;
+endmodule
+
 // The MULTI PE's unit: y = round(a * b), LATENCY clocks after the operands. For DW <= ONE (the
 // family's widest one-multiplier word: 27 on the Cyclone V, a block in 27 x 27 mode; 18 on the
 // ECP5, a MULT18X18D) the product is one DSP multiplier, registered, then rounded in the next
@@ -144,36 +183,11 @@ module fix_mul #(parameter integer LATENCY = 2, parameter integer DW = 32, param
 );
   generate
     if (LATENCY >= 2 && DW > ONE) begin : g_split
-      localparam integer HW = DW - 16;
-      // a = ah·2^16 + al with ah signed and al unsigned (b likewise)
-      wire signed [HW-1:0] ah = a[DW-1:16];
-      wire signed [HW-1:0] bh = b[DW-1:16];
-      wire signed [16:0]   al = {1'b0, a[15:0]};
-      wire signed [16:0]   bl = {1'b0, b[15:0]};
-      reg  signed [2*HW-1:0] hh;
-      reg  signed [HW+16:0]  hl, lh;
-      reg  signed [33:0]     ll;
-      reg         [6:0]      s1;
-      initial begin
-        hh = 0;
-        hl = 0;
-        lh = 0;
-        ll = 0;
-        s1 = 0;
-      end
-      always @(posedge clk) begin
-        hh <= ah * bh;
-        hl <= ah * bl;
-        lh <= al * bh;
-        ll <= al * bl;
-        s1 <= sh[13:7];
-      end
-      // signed assignments to wider wires sign-extend
-      wire signed [KW-1:0] ehh = hh;
-      wire signed [KW-1:0] ehl = hl;
-      wire signed [KW-1:0] elh = lh;
-      wire signed [KW-1:0] ell = ll;
-      wire signed [KW-1:0] k = (ehh <<< 32) + (ehl <<< 16) + (elh <<< 16) + ell;
+      wire signed [KW-1:0] k;
+      reg         [6:0]    s1;
+      initial s1 = 0;
+      always @(posedge clk) s1 <= sh[13:7];
+      fix_split_product #(.DW(DW), .KW(KW)) pp (.clk(clk), .a(a), .b(b), .p(k));
       fix_stages #(.LATENCY(LATENCY - 1), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) st (.clk(clk), .k(k), .s(s1), .y(y));
     end else begin : g_whole
       wire signed [DW-1:0]   sa = a;
@@ -236,33 +250,7 @@ module fix_mac #(parameter integer LATENCY = 2, parameter integer DW = 32, param
       assign {mac1, negp1, sub1} = {mac_q, negp_q, sub_q};
       assign sh1 = sh_q;
       if (DW > ONE) begin : g_split
-        localparam integer HW = DW - 16;
-        // a = ah·2^16 + al with ah signed and al unsigned (b likewise), as fix_mul
-        wire signed [HW-1:0] ah = a[DW-1:16];
-        wire signed [HW-1:0] bh = b[DW-1:16];
-        wire signed [16:0]   al = {1'b0, a[15:0]};
-        wire signed [16:0]   bl = {1'b0, b[15:0]};
-        reg  signed [2*HW-1:0] hh;
-        reg  signed [HW+16:0]  hl, lh;
-        reg  signed [33:0]     ll;
-        initial begin
-          hh = 0;
-          hl = 0;
-          lh = 0;
-          ll = 0;
-        end
-        always @(posedge clk) begin
-          hh <= ah * bh;
-          hl <= ah * bl;
-          lh <= al * bh;
-          ll <= al * bl;
-        end
-        // signed assignments to wider wires sign-extend
-        wire signed [KW-1:0] ehh = hh;
-        wire signed [KW-1:0] ehl = hl;
-        wire signed [KW-1:0] elh = lh;
-        wire signed [KW-1:0] ell = ll;
-        assign p = (ehh <<< 32) + (ehl <<< 16) + (elh <<< 16) + ell;
+        fix_split_product #(.DW(DW), .KW(KW)) pp (.clk(clk), .a(a), .b(b), .p(p));
       end else begin : g_whole
         wire signed [DW-1:0]   sa = a;
         wire signed [DW-1:0]   sb = b;
