@@ -628,10 +628,43 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
                 }
                 assert_eq!(cut(w, 4 * pa, 4), cut(instr[cycle], 4 * aw, 4), "{what} cycle {cycle}: flags");
                 let mut lo = 4 * pa + 4;
-                for k in ["xbar", "bufi", "capt", "fix"] {
-                    let Some(img) = words_of(k) else { continue };
-                    assert_eq!(cut(w, lo, width_of(k)), img[cycle], "{what} cycle {cycle}: {k}");
-                    lo += width_of(k);
+                let xw = width_of("xbar");
+                assert_eq!(cut(w, lo, xw), words_of("xbar").unwrap()[cycle], "{what} cycle {cycle}: xbar");
+                lo += xw;
+                // the buffer instruction and the capture word with their addresses cut to pb, po
+                let (pb, po) = (c["pb"].as_u64().unwrap() as u32, c["po"].as_u64().unwrap() as u32);
+                let (bw, ow) = (man["widths"]["bw"].as_u64().unwrap() as u32, man["widths"]["ow"].as_u64().unwrap() as u32);
+                let bufi = words_of("bufi").unwrap()[cycle];
+                for (k, (at, bits)) in [(0, pb), (bw, pb), (2 * bw, 2)].into_iter().enumerate() {
+                    assert_eq!(cut(w, lo, bits), cut(bufi, at, bits), "{what} cycle {cycle}: bufi field {k}");
+                    lo += bits;
+                }
+                assert_eq!(cut(bufi, 0, bw) >> pb, 0, "{what}: a store address beyond pb bits");
+                assert_eq!(cut(bufi, bw, bw) >> pb, 0, "{what}: a read address beyond pb bits");
+                let capt = words_of("capt").unwrap()[cycle];
+                assert_eq!(cut(capt, 0, ow) >> po, 0, "{what}: an output address beyond po bits");
+                assert_eq!(cut(w, lo, po), cut(capt, 0, po), "{what} cycle {cycle}: capture address");
+                assert_eq!(cut(w, lo + po, 1), cut(capt, ow, 1), "{what} cycle {cycle}: capture enable");
+                lo += po + 1;
+                if let Some(fix) = words_of("fix") {
+                    // the 14-bit shift word ([0,6) align, bit 6 align b, [7,14) s) cut to the PE's shifts
+                    let f = &c["fix"];
+                    let ab = f["align_bits"].as_u64().unwrap() as u32;
+                    let alb = u32::from(f["align_b"].as_bool().unwrap());
+                    let (sb, smin) = (f["shift_bits"].as_u64().unwrap() as u32, f["shift_min"].as_i64().unwrap());
+                    let word = fix[cycle];
+                    let s = ((word >> 7) & 127) as i64 - if word >> 13 & 1 == 1 { 128 } else { 0 };
+                    let issues = cut(instr[cycle], 4 * aw + 2, 1) == 1;
+                    let expect = if issues {
+                        assert!(cut(word, 0, 6) < 1 << ab || cut(word, 0, 6) == 0, "{what}: an alignment beyond the field");
+                        assert!(alb == 1 || cut(word, 6, 1) == 0, "{what}: align b on a PE without the bit");
+                        assert!(s >= smin && s - smin < 1 << sb, "{what}: a shift {s} outside {smin} + {sb} bits");
+                        cut(word, 0, ab) | cut(word, 6, alb) << ab | ((s - smin) as u128) << (ab + alb)
+                    } else {
+                        0
+                    };
+                    assert_eq!(cut(w, lo, ab + alb + sb), expect, "{what} cycle {cycle}: shift word");
+                    lo += ab + alb + sb;
                 }
                 assert_eq!(lo, width);
             }

@@ -92,10 +92,27 @@ struct ManifestPe<'a> {
 struct ManifestControl {
     /// Bits of each address field.
     pa: u32,
+    /// Bits of each buffer address (the `bufi` word's addresses cut to them).
+    pb: u32,
+    /// Bits of the output-memory address (the `capt` word's, cut to them).
+    po: u32,
+    /// On fixed-point PEs, the shift word's fields (`Design::control`'s `FixField`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    fix: Option<ManifestFixField>,
     /// Bits of the word.
     width: u32,
     /// The lanes, bit 0 of the word in the first.
     lanes: Vec<ManifestMemory>,
+}
+
+/// The shift word in a control word: `align_bits` of alignment, the align-b bit when
+/// `align_b`, the rounding shift less `shift_min` in `shift_bits`.
+#[derive(Clone, Debug, Serialize)]
+struct ManifestFixField {
+    align_bits: u32,
+    align_b: bool,
+    shift_bits: u32,
+    shift_min: i32,
 }
 
 /// The manifest (`manifest.json`): everything a host or a script needs to load and read the
@@ -118,7 +135,14 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             .chain(p.fix.as_ref().map(|i| ("fix", m(i))))
             .collect();
             let c = d.control(p.slot);
-            let control = ManifestControl { pa: c.pa, width: c.width, lanes: c.lanes.iter().map(m).collect() };
+            let fix = c.fix.map(|f| ManifestFixField {
+                align_bits: f.align_bits,
+                align_b: f.align_b,
+                shift_bits: f.shift_bits,
+                shift_min: f.shift_min,
+            });
+            let control =
+                ManifestControl { pa: c.pa, pb: c.pb, po: c.po, fix, width: c.width, lanes: c.lanes.iter().map(m).collect() };
             ManifestPe {
                 control,
                 slot: p.slot,
@@ -178,8 +202,11 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             2 * w.bw, 2 * w.bw, 2 * w.bw + 1, b = w.bw),
         "capt": format!("[0,{o}) output-memory address, bit {o} enable", o = w.ow),
         "control": "per PE (`control`): one word per cycle, from bit 0: the instruction's four addresses `pa` bits each \
-            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word; the `capt` word; \
-            on fixed-point PEs the `fix` word; split into `lanes` (the HDL's control memories; the other images hold the same fields)",
+            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word with its addresses cut to \
+            `pb` bits each (store address, read address, store enable, read enable); the `capt` word with its address cut to `po` \
+            bits (address, enable); on fixed-point PEs the `fix` word cut to the PE's shifts (`control.fix`: `align_bits` of \
+            alignment, the align-b bit when `align_b`, the rounding shift less `shift_min` in `shift_bits`; zero on a cycle \
+            that issues nothing); split into `lanes` (the HDL's control memories)",
         "data": match d.pe_kind {
             PeKind::Binary32 => "binary32",
             PeKind::Fixed => "fixed point: the `word_bits`-bit two's complement integer k of a value k·2^-f (each load's and output's `fraction`); out_data sign-extends it to 32 bits",
@@ -197,9 +224,10 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         ));
         layout["control"] = serde_json::json!(
             "per PE (`control`): one word per cycle, from bit 0: the instruction's four addresses `pa` bits each \
-            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word; the `capt` word; \
-            on fixed-point PEs the `fix` word; on PEs with `mac` then read C (`pa` bits), negate product, mac; \
-            split into `lanes` (the HDL's control memories; the other images hold the same fields)"
+            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word with its addresses cut to \
+            `pb` bits each; the `capt` word with its address cut to `po` bits; on fixed-point PEs the `fix` word cut to the PE's \
+            shifts (`control.fix`); on PEs with `mac` then read C (`pa` bits), negate product, mac; \
+            split into `lanes` (the HDL's control memories)"
         );
     }
     if d.pe_kind == PeKind::Fixed {

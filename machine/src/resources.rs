@@ -238,12 +238,12 @@ pub struct Resources {
 }
 
 /// Every block-RAM memory of the design and its blocks in `family`'s configurations. A PE memory
-/// is one true dual-port memory ([`PeMemory::DoublePumped`]) or four simple dual-port banks
-/// ([`PeMemory::LiveValueTable`]: the memory's blocks are four banks').
+/// is one simple dual-port memory at twice the clock ([`PeMemory::DoublePumped`]) or four simple
+/// dual-port banks ([`PeMemory::LiveValueTable`]: the memory's blocks are four banks').
 pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
     let mut v = Vec::new();
     let (pe_tdp, banks): (bool, u64) = match d.pe_memory {
-        PeMemory::DoublePumped => (true, 1),
+        PeMemory::DoublePumped => (false, 1),
         PeMemory::LiveValueTable => (false, 4),
     };
     for p in &d.pes {

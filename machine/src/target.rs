@@ -172,9 +172,9 @@
 //! configuration packs the memory: shallow and wide (100 × 52: 1 by bits, 2 by
 //! configurations, as 256×40 needs two blocks side by side), or widths that fill a
 //! configuration badly (1500 × 6: 1 by bits, 2 by configurations). They agree on the seed's
-//! memories, 2048 × 32 (7, true dual-port), 16 × 32 (1) and 988 × 52 (6), and on every memory
-//! 5, 10, 20 or 40 bits wide (2K×5, 1K×10, 512×20 and 256×40 hold exactly 10 240 bits; ×40 not
-//! true dual-port).
+//! memories, 2048 × 32 (7), 16 × 32 (1) and 988 × 52 (6), and on every memory 5, 10, 20 or 40
+//! bits wide (2K×5, 1K×10, 512×20 and 256×40 hold exactly 10 240 bits; ×40 simple dual-port
+//! and ROM only).
 
 use robovec_ir::analysis::Latencies;
 use robovec_ir::placement::PeArray;
@@ -251,8 +251,12 @@ impl DesignLogic {
 /// How a design builds each PE memory (two reads and two writes per cycle, `hdl/rv_mem.v`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PeMemory {
-    /// One true dual-port block RAM at twice the PE clock (seed §1.1.2: the M10K double-pumped;
-    /// `rv_pe_mem`).
+    /// One block RAM at twice the PE clock (seed §1.1.2 and §1.3: the M10K double-pumped, at
+    /// most 240 MHz, so the PE clock at most 120 MHz; `rv_pe_mem`), in simple dual-port mode: a
+    /// write and a read each half cycle give the two writes and two reads of a PE cycle (the
+    /// same-cycle bypass is `rv_pe_mem`'s logic), so the ×40 configuration serves words of up
+    /// to 40 bits 256 deep in one block. (Until issue 49's clusters it was counted in true
+    /// dual-port mode, ×20 at most: a 26-bit PE memory took two blocks for the same accesses.)
     DoublePumped,
     /// Four simple dual-port banks (one per write port × read port) and a live-value table
     /// (LaForest & Steffan, FPGA 2010; `rv_pe_mem_lvt`): for block RAMs that cannot run at twice
@@ -658,9 +662,10 @@ pub enum M10kFit {
     /// words or width (the FPGA back end's estimate, [`crate::resources::memory_costs`]).
     Configurations {
         /// Excludes the configurations wider than the family's true dual-port width (the
-        /// Cyclone V's ×40, simple dual-port and ROM only): the PE memory's two read and two
-        /// write ports per cycle use both ports of the block at twice the clock (seed §1.3),
-        /// which gives the seed's 7 M10K for a 2048 × 32 PE memory.
+        /// Cyclone V's ×40, simple dual-port and ROM only). The generated designs' memories are
+        /// all simple dual-port or ROM: the PE memory's two reads and two writes per cycle use
+        /// the block's write and read port at twice the clock ([`PeMemory::DoublePumped`]);
+        /// either mode gives the seed's 7 M10K for a 2048 × 32 PE memory.
         true_dual_port: bool,
         /// Whose blocks.
         family: Family,

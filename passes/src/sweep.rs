@@ -310,8 +310,8 @@ impl Pass for Sweep {
                         let verified = match try_place_function_within(f, &o) {
                             Ok((p, _)) => crate::sim::verify_in(f, &p, &[1], domain.as_ref(), &ticker).map(|_| p),
                             Err(PlaceError::Stopped) => Err(SimError::stopped()),
-                            Err(PlaceError::Stuck(e)) => {
-                                return Err(PassError::Failed { pass: "sweep".into(), message: e })
+                            Err(e @ (PlaceError::Stuck(_) | PlaceError::Partition(_))) => {
+                                return Err(PassError::Failed { pass: "sweep".into(), message: e.to_string() })
                             }
                         };
                         let p = match verified {

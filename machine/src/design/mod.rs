@@ -226,12 +226,58 @@ pub struct Design {
 pub struct Control {
     /// Bits of each address field of the instruction: the PE memory's address bits.
     pub pa: u32,
-    /// Bits of the whole word (`4·pa + 4` + selects + buffer + capture [+ 14 shift bits]
-    /// [+ `pa + 2` mac fields]).
+    /// Bits of each buffer address of the buffer instruction: the PE's buffer's (at least 1).
+    pub pb: u32,
+    /// Bits of the output-memory address of the capture word: the PE's output memory's (at
+    /// least 1).
+    pub po: u32,
+    /// The shift word's fields on a fixed-point PE ([`FixField`]).
+    pub fix: Option<FixField>,
+    /// Bits of the whole word (`4·pa + 4` + selects + `2·pb + 2` buffer + `po + 1` capture [+
+    /// the shift word's [`FixField::bits`]] [+ `pa + 2` mac fields]).
     pub width: u32,
     /// The lanes, bit 0 of the word in lane 0 (`peS_ctrlK`), each `control_lane_bits` wide but
     /// the last.
     pub lanes: Vec<Image>,
+}
+
+/// The shift word of a fixed-point PE in its control word, cut to the shifts its program uses
+/// ([`build::ShiftRanges`], `rv_pe`'s `AMAX`, `SMIN`, `SMAX`): from bit 0, the alignment
+/// (`align_bits`, none on a MULTI PE without fused ops, which never aligns), the align-b bit
+/// (on the PEs that align), the rounding shift less `shift_min` (`shift_bits`, at least 1).
+/// The `fix` image keeps the full 14-bit word.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FixField {
+    /// Bits of the alignment: ⌈log₂(AMAX + 1)⌉, at least 1, on the PEs that align (ADD PEs,
+    /// PEs with fused multiply-adds); 0 on the others.
+    pub align_bits: u32,
+    /// Whether the align-b bit is there (ADD PEs and PEs with fused multiply-adds).
+    pub align_b: bool,
+    /// Bits of `s − shift_min`: ⌈log₂(SMAX − SMIN + 1)⌉, at least 1.
+    pub shift_bits: u32,
+    /// The smallest rounding shift (SMIN), the field's zero.
+    pub shift_min: i32,
+}
+
+impl FixField {
+    /// Bits of the field in the control word.
+    pub fn bits(&self) -> u32 {
+        self.align_bits + u32::from(self.align_b) + self.shift_bits
+    }
+
+    /// The field of a 14-bit shift word `w` (`fix` image: `[0,6)` align, bit 6 align b, `[7,14)`
+    /// s in two's complement).
+    pub fn pack(&self, w: u64) -> u64 {
+        let align = w & 63;
+        let align_b = w >> 6 & 1;
+        let s = ((w >> 7 & 127) as i64 ^ 64) - 64;
+        let at = self.align_bits + u32::from(self.align_b);
+        let shift = (s - i64::from(self.shift_min)) as u64;
+        debug_assert!(align < 1 << self.align_bits || align == 0, "an alignment beyond the PE's range");
+        debug_assert!(shift < 1 << self.shift_bits, "a rounding shift beyond the PE's range");
+        let b = if self.align_b { align_b << self.align_bits } else { 0 };
+        (align & ((1 << self.align_bits) - 1)) | b | shift << at
+    }
 }
 
 /// The fixed Verilog files, `(name, text)`: the FP unit models, the memories and the PE.
@@ -426,8 +472,8 @@ impl Design {
         let p = &self.pes[slot];
         let aw = self.widths.aw;
         let (pa, width) = self.control_width(slot);
-        let mut fields: Vec<&Image> = vec![&p.xbar, &p.bufi, &p.capt];
-        fields.extend(&p.fix);
+        let (pb, po, fix) = self.control_fields(slot);
+        let (bw, ow) = (self.widths.bw, self.widths.ow);
         let lane = self.control_lane_bits.max(1);
         let n_lanes = width.div_ceil(lane) as usize;
         let cycles = p.instr.words.len();
@@ -460,8 +506,21 @@ impl Design {
                 put(field & mask(pa), pa);
             }
             put(w >> (4 * aw) & 0xf, 4);
-            for img in &fields {
-                put(img.words.get(c).copied().unwrap_or(0), img.width);
+            put(p.xbar.words[c], p.xbar.width);
+            // the buffer instruction and the capture word with their addresses cut to pb and po
+            let b = p.bufi.words[c];
+            debug_assert!(b & mask(2 * bw) <= mask(pb) | mask(pb) << bw, "a buffer address beyond the buffer");
+            put(b, pb);
+            put(b >> bw, pb);
+            put(b >> (2 * bw), 2);
+            let o = p.capt.words[c];
+            debug_assert!(o & mask(ow) <= mask(po), "an output address beyond the output memory");
+            put(o, po);
+            put(o >> ow, 1);
+            if let (Some(img), Some(fx)) = (&p.fix, fix) {
+                // an idle cycle's shift word is 0, maybe outside the issued ops' ranges
+                let issues = w >> (4 * aw + 2) & 1 == 1;
+                put(if issues { fx.pack(img.words[c]) } else { 0 }, fx.bits());
             }
             if p.mac {
                 let rc = w >> (4 * aw + 4) & mask(aw);
@@ -470,7 +529,23 @@ impl Design {
                 put(w >> (5 * aw + 4) & 3, 2);
             }
         }
-        Control { pa, width, lanes }
+        Control { pa, pb, po, fix, width, lanes }
+    }
+
+    /// PE `slot`'s buffer-address bits `pb`, output-address bits `po` and shift field in its
+    /// control word ([`Control`]).
+    pub fn control_fields(&self, slot: usize) -> (u32, u32, Option<FixField>) {
+        let p = &self.pes[slot];
+        let pb = addr_bits(u64::from(p.buffer_words.max(1))).clamp(1, self.widths.bw.max(1));
+        let po = addr_bits(p.out.words.len().max(1) as u64).clamp(1, self.widths.ow.max(1));
+        let fix = p.fix.as_ref().map(|_| {
+            let r = p.shift_ranges.unwrap_or(build::ShiftRanges::FULL);
+            let aligns = !p.is_mul || p.mac;
+            let align_bits = if aligns { addr_bits(u64::from(r.align_max) + 1) } else { 0 };
+            let span = (i32::from(r.shift_max) - i32::from(r.shift_min)) as u64 + 1;
+            FixField { align_bits, align_b: aligns, shift_bits: addr_bits(span).max(1), shift_min: i32::from(r.shift_min) }
+        });
+        (pb, po, fix)
     }
 
     /// PE `slot`'s control word without building it: `(pa, width)` of [`Design::control`], the
@@ -478,7 +553,8 @@ impl Design {
     pub fn control_width(&self, slot: usize) -> (u32, u32) {
         let p = &self.pes[slot];
         let pa = addr_bits(p.data.words.len().max(1) as u64).min(self.widths.aw);
-        let fields = p.xbar.width + p.bufi.width + p.capt.width + p.fix.as_ref().map_or(0, |f| f.width);
+        let (pb, po, fix) = self.control_fields(slot);
+        let fields = p.xbar.width + 2 * pb + 2 + po + 1 + fix.map_or(0, |f| f.bits());
         let mac = if p.mac { pa + 2 } else { 0 };
         (pa, 4 * pa + 4 + fields + mac)
     }
@@ -589,11 +665,14 @@ impl Design {
                 fix += ".MAC(1), ";
             }
             let control = self.control(p.slot);
+            if let Some(fx) = control.fix {
+                fix += &format!(".FAB({}), .FALB({}), .FSB({}), ", fx.align_bits, u8::from(fx.align_b), fx.shift_bits);
+            }
             let lanes: String =
                 control.lanes.iter().enumerate().map(|(k, l)| format!(".CTRL{k}_FILE({}), ", f(l))).collect();
             let _ = writeln!(
                 s,
-                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .N2({n2}), .SW2({sw2}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}), .PA({pa}), .CTW({ctw}), .LANE({lane}),\n        {lanes}.DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .src0({src0}), .src1({src1}), .src2({src2}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
+                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .N2({n2}), .SW2({sw2}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}), .PA({pa}), .PB({pb}), .PO({po}), .CTW({ctw}), .LANE({lane}),\n        {lanes}.DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .src0({src0}), .src1({src1}), .src2({src2}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
                 mul = u8::from(p.is_mul),
                 aw = w.aw,
                 bw = w.bw,
@@ -601,6 +680,8 @@ impl Design {
                 cw = w.cw,
                 c = self.cycles,
                 pa = control.pa,
+                pb = control.pb,
+                po = control.po,
                 ctw = control.width,
                 lane = self.control_lane_bits,
                 md = p.data.words.len().max(1),

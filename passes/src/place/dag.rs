@@ -46,6 +46,10 @@ pub struct OpDag {
     users: Vec<Node>,
     /// Distinct op operands per node.
     pub(crate) n_distinct: Vec<u32>,
+    /// PE clusters ([`super::cluster`]; 1 = none).
+    clusters: u32,
+    /// The cluster each node is bound to (empty with one cluster).
+    cluster: Vec<u32>,
 }
 
 impl OpDag {
@@ -110,7 +114,7 @@ impl OpDag {
                 n_users[a as usize] += 1;
             }
         }
-        OpDag { ops, node_of, kind, operand_at, operands, user_at, users, n_distinct }
+        OpDag { ops, node_of, kind, operand_at, operands, user_at, users, n_distinct, clusters: 1, cluster: Vec::new() }
     }
 
     /// Number of ops (nodes).
@@ -156,6 +160,27 @@ impl OpDag {
     /// True for an op of the MULTI side.
     pub fn is_mul(&self, j: Node) -> bool {
         self.kind[j as usize] == OpKind::Mul
+    }
+
+    /// Binds the nodes to `clusters` PE clusters, `part` (indexed by node, each `< clusters`)
+    /// giving each node's ([`super::cluster::partition`]).
+    ///
+    /// # Panics
+    /// If `part` is not one cluster per node below `clusters`.
+    pub fn set_clusters(&mut self, clusters: u32, part: Vec<u32>) {
+        assert!(part.len() == self.len() && part.iter().all(|&c| c < clusters.max(1)));
+        self.clusters = clusters.max(1);
+        self.cluster = if self.clusters == 1 { Vec::new() } else { part };
+    }
+
+    /// Number of PE clusters (1 without `place<clusters=G>`).
+    pub fn clusters(&self) -> u32 {
+        self.clusters
+    }
+
+    /// The PE cluster node `j` is bound to (0 with one cluster).
+    pub fn cluster(&self, j: Node) -> u32 {
+        self.cluster.get(j as usize).copied().unwrap_or(0)
     }
 
     /// The kind of node `j`.

@@ -21,6 +21,7 @@
 //! O(n log n + n·N) for n ops and N PEs per type.
 
 pub mod bound;
+pub mod cluster;
 pub mod dag;
 pub mod feed;
 pub mod memory;
@@ -80,6 +81,12 @@ pub struct PlaceOptions {
     /// [`tight_lower_bound`] or 5% above [`lower_bound`] (when the tight bound allows it); at
     /// most about 10⁶ op schedulings in all. 0 = none. See [`search`].
     pub restarts: u32,
+    /// PE clusters ([`cluster`]): each side's PEs split into this many clusters, the ops
+    /// partitioned into as many parts with few values crossing (METIS), each op issued only on
+    /// its part's cluster — for `codegen<fpga;interconnect=specialised>`, whose multiplexers
+    /// then have inputs mostly from their own cluster. 1 = none (any op on any PE of its type).
+    /// At most the smaller side's PE count.
+    pub clusters: u32,
     /// Rounds of interconnect-aware rebinding of the schedule kept ([`rebind`]; only with
     /// [`Select::Routes`]): ops move to other PEs of their type, in their cycle or within their
     /// slack, while the routes do not grow; the schedule's length stays. 0 = none.
@@ -108,6 +115,8 @@ pub enum PlaceError {
     /// [`PlaceOptions::grace`] (or the test budget) was reached in the first list schedule or
     /// while building the memories of the schedule kept.
     Stopped,
+    /// The partitioner ([`cluster::partition`], METIS) failed.
+    Partition(String),
 }
 
 impl std::fmt::Display for PlaceError {
@@ -115,6 +124,7 @@ impl std::fmt::Display for PlaceError {
         match self {
             PlaceError::Stuck(m) => f.write_str(m),
             PlaceError::Stopped => f.write_str("stopped in the first list schedule or its memories: time limit"),
+            PlaceError::Partition(m) => write!(f, "partitioning the ops into PE clusters: {m}"),
         }
     }
 }
@@ -156,6 +166,20 @@ fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
         restarts: p.u32("restarts")?,
         search: p.u32("search")?,
         rebind: p.u32("rebind")?,
+        clusters: {
+            let (g, n_add, n_mul) = (p.u32("clusters")?, p.u32("add")?, p.u32("mul")?);
+            if g > n_add.min(n_mul) {
+                return Err(PassError::BadParameter {
+                    pass: "place".into(),
+                    message: format!(
+                        "clusters={g}: at most the smaller side's PEs ({}: add={n_add}, mul={n_mul}); every cluster \
+                         has an ADD and a MULTI PE",
+                        n_add.min(n_mul)
+                    ),
+                });
+            }
+            g
+        },
         deadline: None,
         grace: None,
         tick_budget: None,
@@ -196,7 +220,11 @@ pub fn try_place_function_progress(
     let seed = schedule::seed_keys(f, a, opts.priority);
     // Nodes in the seed's priority order: the schedules take ops mostly in that order, and
     // their per-op arrays are indexed by node (see `dag`).
-    let dag = dag::OpDag::ordered(f, &seed);
+    let mut dag = dag::OpDag::ordered(f, &seed);
+    if opts.clusters > 1 {
+        let part = cluster::partition(&dag, a.n_add, a.n_mul, opts.clusters).map_err(PlaceError::Partition)?;
+        dag.set_clusters(opts.clusters, part);
+    }
     let seed = dag.gather(&seed);
     if required.check() {
         return Err(PlaceError::Stopped);
@@ -359,6 +387,13 @@ pub const INFO: PassInfo = PassInfo {
             doc: "key-mutation search iterations after the restarts, same condition (0 = none)",
         },
         ParamInfo {
+            name: "clusters",
+            kind: ParamKind::U32 { default: 1, min: 1, max: 4096 },
+            doc: "G: the PEs in G clusters, the ops partitioned (METIS) so that few values cross between \
+                  clusters, each op issued on its cluster's PEs: fewer multiplexer inputs for \
+                  codegen<fpga;interconnect=specialised> (1 = none; at most min(add, mul))",
+        },
+        ParamInfo {
             name: "rebind",
             kind: ParamKind::U32 { default: 64, min: 0, max: 4096 },
             doc: "with select=routes: rounds of rebinding ops to other PEs of their type (in their cycle, or in \
@@ -436,7 +471,7 @@ impl Pass for Place {
                         let what = format!("in @{} in its first list schedule or its memories", f.name);
                         return Ok(Step::Stopped { what, kept: None });
                     }
-                    Err(PlaceError::Stuck(e)) => {
+                    Err(e @ (PlaceError::Stuck(_) | PlaceError::Partition(_))) => {
                         return Err(PassError::Failed { pass: "place".into(), message: format!("@{}: {e}", f.name) })
                     }
                 };

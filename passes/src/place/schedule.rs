@@ -23,6 +23,7 @@ use robovec_ir::analysis::compute_timing;
 use robovec_ir::placement::{Pe, PeArray};
 use robovec_ir::{Function, Operand, Value};
 
+use super::cluster::pe_cluster;
 use super::dag::{Key, Node, OpDag, NO_NODE};
 use super::feed::Feed;
 use super::ready::ReadyQueue;
@@ -277,11 +278,17 @@ pub fn seed_keys(f: &Function, arch: &PeArray, priority: Priority) -> Vec<Key> {
         .collect()
 }
 
-/// The two ready lists (ADD side, MULTI side) for `keys`.
-fn ready_lists(keys: &[Key]) -> [ReadyQueue; 2] {
+/// The ready lists for `keys`: per PE cluster of `dag` ([`OpDag::clusters`]), the ADD side's
+/// and the MULTI side's.
+fn ready_lists(dag: &OpDag, keys: &[Key]) -> Vec<[ReadyQueue; 2]> {
     let max_first = keys.iter().map(|k| k.0).max().unwrap_or(0);
     let cap = keys.len() + 1024;
-    [ReadyQueue::new(max_first, cap), ReadyQueue::new(max_first, cap)]
+    (0..dag.clusters()).map(|_| [ReadyQueue::new(max_first, cap), ReadyQueue::new(max_first, cap)]).collect()
+}
+
+/// The ready list of node `v`: its cluster's, its side's.
+fn ready_of<'r>(ready: &'r mut [[ReadyQueue; 2]], dag: &OpDag, v: Node) -> &'r mut ReadyQueue {
+    &mut ready[dag.cluster(v) as usize][dag.is_mul(v) as usize]
 }
 
 /// Schedules every op of `dag` on `arch`, ready ops taken in increasing `keys` order (indexed
@@ -320,21 +327,25 @@ pub fn schedule_until(
         bookings: Vec::new(),
         routed: if select == Select::Routes { vec![false; 2 * arch.n_pe() * arch.n_pe()] } else { Vec::new() },
     };
-    let mut ready = ready_lists(keys);
+    let mut ready = ready_lists(dag, keys);
     for v in 0..n as Node {
         if pending[v as usize] == 0 {
-            ready[dag.is_mul(v) as usize].push(feed.key[v as usize], v);
+            ready_of(&mut ready, dag, v).push(feed.key[v as usize], v);
         }
     }
     let mut arrivals: BinaryHeap<Reverse<(u32, Node)>> = BinaryHeap::new();
-    let pes_of = |mul: bool| -> Vec<usize> {
+    // PE slots per cluster and side (`cluster::pe_cluster`).
+    let g = dag.clusters();
+    let pes_of = |c: u32, mul: bool| -> Vec<usize> {
         if mul {
-            (0..arch.n_mul).map(|i| Pe::Mul(i).slot(arch.n_add)).collect()
+            let n = arch.n_mul;
+            (0..n).filter(|&i| pe_cluster(i, n, g) == c).map(|i| Pe::Mul(i).slot(arch.n_add)).collect()
         } else {
-            (0..arch.n_add).map(|i| Pe::Add(i).slot(arch.n_add)).collect()
+            let n = arch.n_add;
+            (0..n).filter(|&i| pe_cluster(i, n, g) == c).map(|i| Pe::Add(i).slot(arch.n_add)).collect()
         }
     };
-    let pes = [pes_of(false), pes_of(true)];
+    let pes: Vec<[Vec<usize>; 2]> = (0..g).map(|c| [pes_of(c, false), pes_of(c, true)]).collect();
     let (mut planned, mut routes, mut best_routes) = (Planned::default(), Vec::new(), Vec::new());
     let mut free: Vec<usize> = Vec::new();
     let mut deferred = Vec::new();
@@ -353,23 +364,23 @@ pub fn schedule_until(
             for &u in dag.users_of(v) {
                 pending[u as usize] -= 1;
                 if pending[u as usize] == 0 {
-                    ready[dag.is_mul(u) as usize].push(feed.key[u as usize], u);
+                    ready_of(&mut ready, dag, u).push(feed.key[u as usize], u);
                 }
             }
         }
         let mut progress = false;
-        for ty in 0..2 {
-            if pes[ty].is_empty() {
+        for (ty, c) in (0..2).flat_map(|ty| (0..g as usize).map(move |c| (ty, c))) {
+            if pes[c][ty].is_empty() {
                 continue;
             }
             free.clear();
-            free.extend_from_slice(&pes[ty]);
+            free.extend_from_slice(&pes[c][ty]);
             deferred.clear();
             while !free.is_empty() {
                 if stop() {
                     return Ok(None);
                 }
-                let Some((k, v)) = ready[ty].pop() else { break };
+                let Some((k, v)) = ready[c][ty].pop() else { break };
                 if k != feed.key[v as usize] || ctx.issued(v) {
                     continue; // stale entry (the key was lowered since)
                 }
@@ -415,7 +426,7 @@ pub fn schedule_until(
                         feed.issued(dag, |u| ctx.issued(u), v, &mut lowered);
                         for (k, u) in lowered.drain(..) {
                             if pending[u as usize] == 0 {
-                                ready[dag.is_mul(u) as usize].push(k, u);
+                                ready_of(&mut ready, dag, u).push(k, u);
                             }
                         }
                         free.sort_unstable();
@@ -424,7 +435,7 @@ pub fn schedule_until(
                 }
             }
             for (k, v) in deferred.drain(..) {
-                ready[ty].push(k, v);
+                ready[c][ty].push(k, v);
             }
         }
         if progress {
@@ -441,7 +452,7 @@ pub fn schedule_until(
         }
         // Next cycle; skip idle stretches when nothing is ready.
         t += 1;
-        if ready[0].is_empty() && ready[1].is_empty() {
+        if ready.iter().flatten().all(ReadyQueue::is_empty) {
             if let Some(&Reverse((c, _))) = arrivals.peek() {
                 t = t.max(c);
             }
@@ -489,8 +500,14 @@ pub fn backward_starts(dag: &OpDag, n_add: u32, n_mul: u32, lat: &Latencies, key
             waiting.push(Reverse((lat.of(dag.kind(v)), v)));
         }
     }
-    let mut ready = ready_lists(keys);
-    let caps = [n_add as usize, n_mul as usize];
+    let mut ready = ready_lists(dag, keys);
+    let g = dag.clusters();
+    let caps: Vec<[usize; 2]> = (0..g)
+        .map(|c| {
+            let count = |n: u32| (0..n).filter(|&i| pe_cluster(i, n, g) == c).count();
+            [count(n_add), count(n_mul)]
+        })
+        .collect();
     let mut done = 0;
     let mut t = 0u32;
     while done < n {
@@ -500,12 +517,12 @@ pub fn backward_starts(dag: &OpDag, n_add: u32, n_mul: u32, lat: &Latencies, key
             }
             waiting.pop();
             in_ready[v as usize] = true;
-            ready[dag.is_mul(v) as usize].push(feed.key[v as usize], v);
+            ready_of(&mut ready, dag, v).push(feed.key[v as usize], v);
         }
-        for ty in 0..2 {
+        for (ty, c) in (0..2).flat_map(|ty| (0..g as usize).map(move |c| (ty, c))) {
             let mut issued = 0;
-            while issued < caps[ty] {
-                let Some((k, v)) = ready[ty].pop() else { break };
+            while issued < caps[c][ty] {
+                let Some((k, v)) = ready[c][ty].pop() else { break };
                 if k != feed.key[v as usize] || placed[v as usize] {
                     continue; // stale entry (the key was lowered since)
                 }
@@ -516,7 +533,7 @@ pub fn backward_starts(dag: &OpDag, n_add: u32, n_mul: u32, lat: &Latencies, key
                 feed.issued(dag, |u| placed[u as usize], v, &mut lowered);
                 for (k, u) in lowered.drain(..) {
                     if in_ready[u as usize] {
-                        ready[dag.is_mul(u) as usize].push(k, u);
+                        ready_of(&mut ready, dag, u).push(k, u);
                     }
                 }
                 // Operands: ready in reverse time once every user is placed, after their latency.
@@ -531,7 +548,7 @@ pub fn backward_starts(dag: &OpDag, n_add: u32, n_mul: u32, lat: &Latencies, key
             }
         }
         t += 1;
-        if ready[0].is_empty() && ready[1].is_empty() {
+        if ready.iter().flatten().all(ReadyQueue::is_empty) {
             if let Some(&Reverse((c, _))) = waiting.peek() {
                 t = t.max(c);
             }

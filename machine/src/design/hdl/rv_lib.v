@@ -52,7 +52,12 @@ module rv_pe #(
     parameter integer BUF_DEPTH = 1,   // buffer words
     parameter integer OUT_DEPTH = 1,   // output memory words
     parameter integer PA = 11,         // bits of each address field of the control word (<= AW)
-    parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + SW2 + 2 * BW + 2 + OW + 1 + (FIX != 0 ? 14 : 0) + (MAC != 0 ? PA + 2 : 0),  // control word bits
+    parameter integer PB = BW,         // bits of each buffer address in the control word (<= BW)
+    parameter integer PO = OW,         // bits of the output-memory address in the control word (<= OW)
+    parameter integer FAB = 6,         // fixed-point PEs: bits of the shift word's alignment (0: never aligns)
+    parameter integer FALB = 1,        // fixed-point PEs: 1 when the shift word has the align-b bit
+    parameter integer FSB = 7,         // fixed-point PEs: bits of the rounding shift less SMIN
+    parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + SW2 + 2 * PB + 2 + PO + 1 + (FIX != 0 ? FAB + FALB + FSB : 0) + (MAC != 0 ? PA + 2 : 0),  // control word bits
     parameter integer LANE = 40,       // bits of a control-memory lane (the widest block-RAM word)
     parameter CTRL0_FILE = "",         // the control memory's lanes (robovec's `Design::control`),
     parameter CTRL1_FILE = "",         // bit 0 of the word in lane 0; at most four lanes
@@ -73,8 +78,9 @@ module rv_pe #(
     output wire [DW-1:0]        out_data
 );
   localparam integer XW = SW0 + SW1 + SW2;
-  localparam integer BIW = 2 * BW + 2;
-  localparam integer OCW = OW + 1;
+  localparam integer BIW = 2 * PB + 2;   // the buffer instruction in the control word
+  localparam integer OCW = PO + 1;       // the capture word in the control word
+  localparam integer FW = (FIX != 0) ? FAB + FALB + FSB : 0;  // the shift word in the control word
   localparam integer ROM_DEPTH = CYCLES + 1;
 
   // The control memory: one word per cycle (the instruction with PA-bit addresses, the
@@ -162,7 +168,7 @@ module rv_pe #(
 
   wire [DW-1:0] qa, qb, qc;
   // MAC PEs: the multiply-add's fields after the shift word (read address C, negate product, mac)
-  localparam integer MB = IB + XW + BIW + OCW + 14;
+  localparam integer MB = IB + XW + BIW + OCW + FW;
   generate
     if (MAC != 0) begin : g_rc
       // The third read (the addend): a second copy of the PE memory taking the same writes, read
@@ -198,8 +204,26 @@ module rv_pe #(
   wire [DW-1:0] y;
   generate
     if (FIX != 0) begin : g_fix
-      // the op's shift word, fetched with the instruction and registered with the operands
-      wire [13:0] sh = ctrl[IB+XW+BIW+OCW +: 14];
+      // the op's shift word, fetched with the instruction and registered with the operands:
+      // the control word holds it cut to the PE's shifts (FAB alignment bits, the align-b bit
+      // when FALB, the rounding shift less SMIN in FSB bits), widened back to the 14-bit word
+      // ([0,6) align, bit 6 align b, [7,14) s) that the units read
+      wire [FW-1:0] shf = ctrl[IB+XW+BIW+OCW +: FW];
+      wire [5:0] al;
+      wire       alb;
+      if (FAB > 0) begin : g_al
+        assign al = shf[FAB-1:0];
+      end else begin : g_no_al
+        assign al = 6'd0;
+      end
+      if (FALB != 0) begin : g_alb
+        assign alb = shf[FAB];
+      end else begin : g_no_alb
+        assign alb = 1'b0;
+      end
+      wire [7:0] s_off = shf[FW-1:FAB+FALB];
+      wire [7:0] s_abs = s_off + SMIN;
+      wire [13:0] sh = {s_abs[6:0], alb, al};
       reg  [13:0] sh_q;
       initial sh_q = 0;
       always @(posedge clk) sh_q <= sh;
@@ -239,11 +263,12 @@ module rv_pe #(
   // cycle's `result`). So `buf_read` is a 3:1 choice between flip-flops (one 5-input LUT a
   // bit, as the 2:1 choice after the address decoding it replaces), not the buffer's address
   // decoding after the control memory's output (issue 49: the ECP5's critical path).
-  wire [BW-1:0] st    = bufi[BW-1:0];
-  wire          st_en = bufi[2*BW] & run;
+  // (the addresses zero-extended from the control word's PB bits)
+  wire [BW-1:0] st    = bufi[PB-1:0];
+  wire          st_en = bufi[2*PB] & run;
   wire [BIW-1:0] bufi_next = ctrl_next[IB+XW +: BIW];
-  wire [BW-1:0] st_next = bufi_next[BW-1:0];
-  wire [BW-1:0] rd_next = bufi_next[2*BW-1:BW];
+  wire [BW-1:0] st_next = bufi_next[PB-1:0];
+  wire [BW-1:0] rd_next = bufi_next[2*PB-1:PB];
   reg [DW-1:0] bmem [0:BUF_DEPTH-1];
   reg [DW-1:0] buf_q, res_q;
   reg          fwd_q, byp_q;
@@ -258,13 +283,13 @@ module rv_pe #(
     buf_q <= bmem[rd_next];
     res_q <= result;
     fwd_q <= st_en && st == rd_next;
-    byp_q <= bufi_next[2*BW] && st_next == rd_next;
+    byp_q <= bufi_next[2*PB] && st_next == rd_next;
   end
   assign buf_read = byp_q ? result : fwd_q ? res_q : buf_q;
 
   // output memory (rv_mem.v): captures the arriving result; read by the host after `done`
-  wire [OW-1:0] oa   = capt[OW-1:0];
-  wire          o_en = capt[OW] & run;
+  wire [OW-1:0] oa   = capt[PO-1:0];
+  wire          o_en = capt[PO] & run;
   rv_out_mem #(.DW(DW), .DEPTH(OUT_DEPTH), .AW(OW), .FILE(OUT_FILE)) u_out (
       .clk(clk), .we(o_en), .wa(oa), .wd(result), .ra(out_addr), .q(out_data));
 endmodule

@@ -1,0 +1,120 @@
+//! PE clusters (`place<clusters=G>`): the PEs split into G clusters, the ops partitioned into G
+//! parts with few values crossing between them, and each op bound to its part's cluster.
+//!
+//! Why (issue 49): the specialised interconnect of `codegen<fpga>` has a multiplexer input per
+//! route (a source, PE result or buffer read, written into a PE memory). The list scheduler
+//! binds each op to whatever PE of its type is free, so on a saturated array every memory ends
+//! up receiving from almost every PE: WALK-MAN's `dirdyna` at 29 + 29 PEs had 3,112 inputs for
+//! 58 memories, three quarters of the design's logic. Its data-flow graph is local, though: cut
+//! into 58 parts by METIS, 86 % of its operand edges stay inside a part and a part reads from
+//! 9 others on average. Binding each part to its own PEs makes the interconnect follow that
+//! locality — a clustered VLIW's cluster assignment before scheduling (Capitanio, Dutt &
+//! Nicolau, MICRO 1992), with a graph partitioner (METIS, Karypis & Kumar 1998) choosing the
+//! parts.
+//!
+//! The partition: ops are the vertices, operand edges (undirected, counted once) the edges;
+//! two balance constraints, ADD-side and MULTI-side ops (a fixed-point fused multiply-add is a
+//! MULTI op), each part's share that of its cluster's PEs of the side; METIS' k-way
+//! partitioning with the minimum-connectivity objective (`MINCONN`: the fewest neighbouring
+//! parts, i.e. the fewest sources per memory), a fixed seed (deterministic). Cluster `c` holds
+//! the PEs `i` of each side with `⌊i·G/N⌋ = c` ([`pe_cluster`]).
+//!
+//! Cost: METIS' multilevel partitioning, O(ops + edges) per level; the schedulers then keep a
+//! ready list per cluster and side.
+
+use super::dag::{Node, OpDag};
+
+/// The cluster of the `i`-th PE of a side of `n` PEs among `g` clusters (`⌊i·g/n⌋`: the
+/// clusters' sizes differ by at most one).
+pub fn pe_cluster(i: u32, n: u32, g: u32) -> u32 {
+    if n == 0 {
+        0
+    } else {
+        (u64::from(i) * u64::from(g) / u64::from(n)) as u32
+    }
+}
+
+/// PEs of a side of `n` in cluster `c` of `g`.
+fn pes_in(c: u32, n: u32, g: u32) -> u32 {
+    (0..n).filter(|&i| pe_cluster(i, n, g) == c).count() as u32
+}
+
+/// The part of each node of `dag` (indexed by [`Node`], `0..g`) for `g` clusters over `n_add`
+/// ADD and `n_mul` MULTI PEs (`1 ≤ g ≤ min(n_add, n_mul)`, checked by the pass). All zeros for
+/// `g = 1` or fewer ops than `2·g`.
+///
+/// # Errors
+/// METIS' own failure (out of memory, or a graph it rejects), as text.
+pub fn partition(dag: &OpDag, n_add: u32, n_mul: u32, g: u32) -> Result<Vec<u32>, String> {
+    let n = dag.len();
+    if g <= 1 || n < 2 * g as usize {
+        return Ok(vec![0; n]);
+    }
+    // Undirected adjacency in compressed rows (METIS wants both directions, no self-loops,
+    // no repeated neighbour).
+    let mut degree = vec![0 as metis::Idx; n];
+    for j in 0..n as Node {
+        for a in dag.distinct_operands(j) {
+            degree[j as usize] += 1;
+            degree[a as usize] += 1;
+        }
+    }
+    let mut xadj = Vec::with_capacity(n + 1);
+    xadj.push(0 as metis::Idx);
+    for d in &degree {
+        xadj.push(xadj.last().copied().unwrap_or(0) + d);
+    }
+    let mut fill: Vec<metis::Idx> = xadj[..n].to_vec();
+    let mut adjncy = vec![0 as metis::Idx; xadj[n] as usize];
+    for j in 0..n as Node {
+        for a in dag.distinct_operands(j) {
+            adjncy[fill[j as usize] as usize] = a as metis::Idx;
+            fill[j as usize] += 1;
+            adjncy[fill[a as usize] as usize] = j as metis::Idx;
+            fill[a as usize] += 1;
+        }
+    }
+    // Balance constraints: one per side that has ops, each part's target share its cluster's
+    // PEs of that side.
+    let sides: Vec<(bool, u32)> =
+        [(false, n_add), (true, n_mul)].into_iter().filter(|&(mul, _)| (0..n as Node).any(|j| dag.is_mul(j) == mul)).collect();
+    let ncon = sides.len();
+    let mut vwgt = vec![0 as metis::Idx; n * ncon];
+    for j in 0..n as Node {
+        if let Some(k) = sides.iter().position(|&(mul, _)| mul == dag.is_mul(j)) {
+            vwgt[j as usize * ncon + k] = 1;
+        }
+    }
+    let mut tpwgts = vec![0.0 as metis::Real; g as usize * ncon];
+    for c in 0..g {
+        for (k, &(_, pes)) in sides.iter().enumerate() {
+            tpwgts[c as usize * ncon + k] = pes_in(c, pes, g) as metis::Real / pes as metis::Real;
+        }
+    }
+    let mut part = vec![0 as metis::Idx; n];
+    metis::Graph::new(ncon as metis::Idx, g as metis::Idx, &xadj, &adjncy)
+        .map_err(|e| format!("METIS: {e}"))?
+        .set_vwgt(&vwgt)
+        .set_tpwgts(&tpwgts)
+        .set_option(metis::option::MinConn(true))
+        .set_option(metis::option::Seed(1))
+        .part_kway(&mut part)
+        .map_err(|e| format!("METIS: {e}"))?;
+    Ok(part.into_iter().map(|p| p as u32).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clusters_split_a_side_within_one_pe() {
+        for n in 1..40 {
+            for g in 1..=n {
+                let sizes: Vec<u32> = (0..g).map(|c| pes_in(c, n, g)).collect();
+                assert_eq!(sizes.iter().sum::<u32>(), n);
+                assert!(sizes.iter().max().unwrap() - sizes.iter().min().unwrap() <= 1, "{n} {g}: {sizes:?}");
+            }
+        }
+    }
+}
