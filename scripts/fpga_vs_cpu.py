@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Issue 49's proof table: robovec's FPGA designs against robovec's own C, side by side in one run.
 
-    scripts/fpga_vs_cpu.py [--pes=8,16,22,18+26] [--states=1,4] [--recurrence=16] [--rebind=64] [--mac] [--pnr] [--yosys] [MODEL...]
+    scripts/fpga_vs_cpu.py [--pes=8,16,22,18+26,57+57/19] [--states=1,4] [--recurrence=16] [--rebind=64] [--mac] [--pnr] [--yosys] [MODEL...]
 
 For each model (a corpus `dirdyna` named by its file's prefix: `jeep`, `tricycle`, `mazda_mx5`,
 `coman_longarms`, `walkman`; default: every corpus `dirdyna` of at least 5k ops, the issue's
@@ -19,7 +19,7 @@ points; docs/accuracy.md):
    does not;
 2. for each target (`de10-nano` at its declared 120 MHz, `ecp5-85f` at 80 MHz or, with `--pnr`,
    at the Fmax nextpnr measures), each configuration of `--pes` (N: N ADD + N MULTI PEs; A+M:
-   A ADD and M MULTI PEs) and each K of `--states` (`interleave<states=K>`, issue 49 item 3),
+   A ADD and M MULTI PEs; a `/G` suffix: in G PE clusters, `place<clusters=G>`) and each K of `--states` (`interleave<states=K>`, issue 49 item 3),
    the design placed for the fewest interconnect routes (`place<select=routes>`, rebound for
    `--rebind` rounds: `rebind=R`, 64 by default) with the specialised interconnect: cycles, us
    (latency), ns per state, logic / block RAM / DSP and fit (the analytic estimate; `--yosys`:
@@ -66,9 +66,10 @@ MIN_WORD = 16
 
 
 def config(text):
-    """`N` (N ADD + N MULTI PEs) or `A+M` as (add, mul)."""
+    """`N` (N ADD + N MULTI PEs) or `A+M`, then `/G` for G PE clusters, as (add, mul, clusters)."""
+    text, _, g = text.partition("/")
     a, _, m = text.partition("+")
-    return (int(a), int(m or a))
+    return (int(a), int(m or a), int(g or 1))
 CPU = "atomise,cse,zero-removal,cse,contract,schedule-cpu,sweep<pe=1>"
 
 
@@ -122,7 +123,7 @@ def report(args, work, name, env=None, refusal_ok=False):
 
 
 def main():
-    pes, states, pnr, yosys, models, json_out = [(8, 8), (16, 16), (22, 22), (18, 26)], [1], False, False, [], None
+    pes, states, pnr, yosys, models, json_out = [(8, 8, 1), (16, 16, 1), (22, 22, 1), (18, 26, 1)], [1], False, False, [], None
     rebind = None
     mac = False
     prefix = pre()
@@ -214,13 +215,14 @@ def main():
             if target == "de10-nano" and yosys:
                 resources = "yosys"
             for k in states:
-                for na, nm in pes:
-                    n = f"{na}" if na == nm else f"{na}+{nm}"
+                for na, nm, g in pes:
+                    n = (f"{na}" if na == nm else f"{na}+{nm}") + (f"/{g}" if g > 1 else "")
                     inter = f"interleave<states={k}>," if k > 1 else ""
                     out = os.path.join(work, f"{target}-{n}-{k}")
                     passes = (
                         f"{prefix},precision<budget={budget};target=mcu;word={w}>,{'contract,error-bound,' if mac else ''}{inter}"
-                        f"place<add={na};mul={nm};select=routes{'' if rebind is None else f';rebind={rebind}'}>,"
+                        f"place<add={na};mul={nm};select=routes{'' if rebind is None else f';rebind={rebind}'}"
+                        f"{'' if g == 1 else f';clusters={g}'}>,"
                         f"codegen<fpga;out={out};resources={resources};interconnect=specialised;format=hex>"
                     )
                     try:
