@@ -428,6 +428,42 @@ fn routed_selects(dir: &Path, n_pe: usize, sw: u32) -> Vec<[std::collections::BT
         .collect()
 }
 
+/// `place<clusters=G>` (issue 49): m454's `dirdyna` at 8 + 8 binary32 PEs in 4 clusters
+/// simulates in Icarus bit for bit as `-eval` computes, with the specialised interconnect and
+/// with the crossbar (the same placement: `place` is deterministic), and its specialised
+/// interconnect has fewer multiplexer inputs than the unclustered placement's.
+#[test]
+fn clustered_placements_simulate_in_icarus_bit_for_bit() {
+    tool("iverilog");
+    let d = tmp("clusters");
+    let none = d.join("none.json");
+    std::fs::write(&none, "{}").unwrap();
+    let src = corpus("m454__mbs_dirdyna_m454_project.c");
+    let build = |clusters: u32, interconnect: &str| -> (PathBuf, serde_json::Value) {
+        let dir = d.join(format!("g{clusters}-{interconnect}"));
+        let passes = format!(
+            "-passes=atomise,place<pe=8;select=routes;clusters={clusters};restarts=0;search=0>,sim,\
+             codegen<fpga;out={};resources=estimate;interconnect={interconnect}>",
+            dir.display()
+        );
+        let o = opt(&[&src, &passes, &format!("-eval={}", none.display()), "-eval-precision=f32"]);
+        assert!(o.status.success(), "clusters={clusters} {interconnect}: {}", stderr(&o));
+        (dir, serde_json::from_slice(&o.stdout).expect("eval JSON"))
+    };
+    let manifest = |dir: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap()
+    };
+    let (sdir, eval) = build(4, "specialised");
+    let (xdir, eval_x) = build(4, "crossbar");
+    assert_eq!(eval, eval_x);
+    let (sim_s, sim_x) = (simulate(&sdir, &none), simulate(&xdir, &none));
+    same_outputs("m454 8 + 8 in 4 clusters, specialised", &eval, &sim_s);
+    assert_eq!(sim_s["bits"], sim_x["bits"], "the two interconnects compute the same bits");
+    let (flat, _) = build(1, "specialised");
+    let (a, b) = (manifest(&flat)["mux_inputs"].as_u64().unwrap(), manifest(&sdir)["mux_inputs"].as_u64().unwrap());
+    assert!(b < a, "{b} multiplexer inputs in 4 clusters, {a} without");
+}
+
 /// `interconnect=specialised` (issue 49 item 2): each write port multiplexes only the sources
 /// its program routes. The design simulates in Icarus bit for bit like the crossbar design and
 /// `-eval`; its multiplexers are the selects the crossbar images use (counted from the files),
