@@ -300,7 +300,7 @@ endmodule
 // leaves, gated by `valid`, so that synthesis sees DW (2^SW - 1) multiplexers that it packs
 // four data inputs to a LUT6, and not a variable shift of the whole bus (the form
 // `sources[DW*(sel-1) +: DW]`, which Yosys maps as a barrel shifter first: its time exploded
-// beyond 4 + 4 PEs). The crossbar's ports share one module (parameters N and SW only): a
+// beyond 4 + 4 PEs). That form is what simulators read (no `SYNTHESIS` macro): the same word. The crossbar's ports share one module (parameters N and SW only): a
 // hierarchical synthesis maps it once.
 module rv_mux #(
     parameter integer N = 4,
@@ -314,39 +314,40 @@ module rv_mux #(
   localparam integer L = 1 << SW;
   wire [SW-1:0] idx = sel - 1'b1;
   wire valid = sel != 0 && sel <= N;
-  // node j of level k (L >> (k + 1) nodes) chooses between nodes 2j and 2j + 1 of level k - 1
-  // (level 0: sources 2j and 2j + 1, zeros beyond N). Each node is a wire of its own: Icarus
-  // re-evaluates a whole vector net on a change of any part of it, so the levels as slices of
-  // one array made a simulation of the Jeep at 8 + 8 PEs take 4 clocks a second.
-  genvar k, j;
+`ifdef SYNTHESIS
+  // Level k + 1 of the tree from level k: word m chooses between words 2m and 2m + 1 by bit k
+  // (upper words zero), one net a level.
+  function [DW*L-1:0] level_up;
+    input [DW*L-1:0] v;
+    input b;
+    integer m;
+    begin
+      level_up = {(DW*L){1'b0}};
+      for (m = 0; m < L / 2; m = m + 1)
+        level_up[DW*m +: DW] = b ? v[DW*(2*m+1) +: DW] : v[DW*(2*m) +: DW];
+    end
+  endfunction
+  genvar k;
   generate
-    if (SW == 0) begin : g_one
-      assign y = valid ? sources[DW-1:0] : {DW{1'b0}};
-    end else begin : g_tree
-      for (k = 0; k < SW; k = k + 1) begin : g_level
-        for (j = 0; j < (L >> (k + 1)); j = j + 1) begin : g_mux
-          wire [DW-1:0] lo, hi, w;
-          if (k == 0) begin : g_leaves
-            if (2 * j < N) begin : g_lo
-              assign lo = sources[DW*(2*j) +: DW];
-            end else begin : g_lo_zero
-              assign lo = {DW{1'b0}};
-            end
-            if (2 * j + 1 < N) begin : g_hi
-              assign hi = sources[DW*(2*j+1) +: DW];
-            end else begin : g_hi_zero
-              assign hi = {DW{1'b0}};
-            end
-          end else begin : g_inner
-            assign lo = g_level[k-1].g_mux[2*j].w;
-            assign hi = g_level[k-1].g_mux[2*j+1].w;
-          end
-          assign w = idx[k] ? hi : lo;
-        end
+    for (k = 0; k <= SW; k = k + 1) begin : g_level
+      // level 0: the leaves, source j at word j, zeros beyond N
+      wire [DW*L-1:0] v;
+      if (k == 0) begin : g_leaves
+        assign v = sources;
+      end else begin : g_up
+        assign v = level_up(g_level[k-1].v, idx[k-1]);
       end
-      assign y = valid ? g_level[SW-1].g_mux[0].w : {DW{1'b0}};
     end
   endgenerate
+  assign y = valid ? g_level[SW].v[DW-1:0] : {DW{1'b0}};
+`else
+  // Simulators (Icarus, Verilator: no `SYNTHESIS`) read the same word directly. The tree's
+  // forms cost them dearly on large designs: levels as slices of one net re-evaluated the whole
+  // net on every change (the Jeep at 8 + 8 PEs simulated at 4 clocks a second), a wire per
+  // node took Icarus minutes to elaborate at 144 PEs, a function per level 10x the run time.
+  // `tests/fpga.rs` proves the two forms equal with Yosys.
+  assign y = valid ? sources[DW*idx +: DW] : {DW{1'b0}};
+`endif
 endmodule
 
 // Program counter, start/done. `fetch` is the cycle whose control word the block RAMs register
