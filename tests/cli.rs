@@ -30,6 +30,22 @@ fn unknown_passes_and_parameters_are_usage_errors_listing_valid_ones() {
     assert_eq!(o.status.code(), Some(2));
 }
 
+/// `place<clusters=G>` beyond the smaller side's PEs conflicts with `add`/`mul`, which each take
+/// their whole range alone: the pass refuses it when it runs, as bad usage (exit 2), and the
+/// output file is left as it was.
+#[test]
+fn clusters_beyond_the_pes_are_bad_usage() {
+    let d = tmp("clusters_usage");
+    let out = d.join("out.rvir");
+    std::fs::write(&out, "kept").unwrap();
+    let o = opt(&[&segway(), "-passes=atomise,place<add=4;mul=2;clusters=3>", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("clusters=3: at most the smaller side's PEs (2: add=4, mul=2)"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "kept");
+    let o = opt(&[&segway(), "-passes=atomise,place<add=4;mul=2;clusters=2>,sim", "-o", "/dev/null"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 /// Named pipelines (issue 31 item 3): `--print-passes` lists them with their expansion; inside a
 /// pipeline they run the passes they stand for (`-time-passes` names each, the IR is what the
 /// spelled-out pipeline writes); an unknown one is bad usage.

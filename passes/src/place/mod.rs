@@ -166,20 +166,7 @@ fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
         restarts: p.u32("restarts")?,
         search: p.u32("search")?,
         rebind: p.u32("rebind")?,
-        clusters: {
-            let (g, n_add, n_mul) = (p.u32("clusters")?, p.u32("add")?, p.u32("mul")?);
-            if g > n_add.min(n_mul) {
-                return Err(PassError::BadParameter {
-                    pass: "place".into(),
-                    message: format!(
-                        "clusters={g}: at most the smaller side's PEs ({}: add={n_add}, mul={n_mul}); every cluster \
-                         has an ADD and a MULTI PE",
-                        n_add.min(n_mul)
-                    ),
-                });
-            }
-            g
-        },
+        clusters: p.u32("clusters")?,
         deadline: None,
         grace: None,
         tick_budget: None,
@@ -445,6 +432,19 @@ impl Pass for Place {
     }
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
+        // (checked here, not when the pipeline is built: each of `clusters`, `add` and `mul`
+        // alone takes its whole range)
+        let (g, n_add, n_mul) = (self.opts.clusters, self.opts.arch.n_add, self.opts.arch.n_mul);
+        if g > n_add.min(n_mul) {
+            return Err(PassError::BadParameter {
+                pass: "place".into(),
+                message: format!(
+                    "clusters={g}: at most the smaller side's PEs ({}: add={n_add}, mul={n_mul}); every cluster has an \
+                     ADD and a MULTI PE",
+                    n_add.min(n_mul)
+                ),
+            });
+        }
         let lat = cx.latencies_for("place", &self.lat);
         let arch = PeArray { lat, writes: self.writes.unwrap_or(cx.target.writes), ..self.opts.arch };
         // `-time-limit`: the first list schedule, which the placement needs, runs to the
