@@ -7,7 +7,8 @@
 //! Algorithm ([`schedule`]): cycle by cycle, ready ops (every operand op arrived) sorted by
 //! priority — **classical**: ALAPCycle, then ASAPCycle; **mobility**: ALAPCycle − ASAPCycle,
 //! then ALAPCycle (seed §2.3.1, with latency-weighted attributes) — are assigned to a free PE of
-//! their type where both operands can be in its memory: **naive** selection takes the first such
+//! their type (with `clusters=G`, of the PE cluster [`cluster`] binds the op to) where both
+//! operands can be in its memory: **naive** selection takes the first such
 //! PE, **preferential** the one with the best operand-location pair of seed Table 2.1 (PE/PE = 1
 //! … Indirect/Indirect = 9). Then `improve` rounds of forward-backward improvement re-run the
 //! list scheduler with the start times of a backward (right-justified) schedule as priorities,

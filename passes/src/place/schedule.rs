@@ -1,7 +1,8 @@
 //! List scheduling with operand routing (seed §2.3; SPEC §5): cycle by cycle, ready ops in
-//! priority order are assigned to a free PE of their type on which both operands can be in the
-//! PE memory at the issue cycle — already there, written directly at the operand's arrival, or
-//! written later from the producer's buffer.
+//! priority order are assigned to a free PE of their type (of their PE cluster with
+//! `place<clusters=G>`, [`super::cluster`]: one ready list per cluster and side) on which both
+//! operands can be in the PE memory at the issue cycle — already there, written directly at the
+//! operand's arrival, or written later from the producer's buffer.
 //!
 //! Ready rule: an op is ready at cycle `t` when every operand op has arrived (`issue + latency
 //! ≤ t`). Writes are booked when the consumer is placed, at the producer's arrival cycle `a`
@@ -478,7 +479,8 @@ pub fn initial_operands(f: &Function, v: Value) -> Vec<Operand> {
 
 /// Backward ("right-justified") list schedule in the pure resource model of SPEC §5 (PEs and
 /// latencies, no memories): ops are issued in reverse time, an op as soon as all its users are,
-/// taken in increasing `keys` order (indexed by node). Returns each op's reverse issue cycle
+/// taken in increasing `keys` order (indexed by node), each on its PE cluster's PEs of its side
+/// ([`OpDag::clusters`]; one cluster: all `n_add` or `n_mul`). Returns each op's reverse issue cycle
 /// `r` (`s = T − r` is a forward start of a schedule that ends together for every sink),
 /// indexed by node.
 ///
