@@ -503,9 +503,6 @@ fn run_passes(
         let ran = session.run(stderr, &mut dumps).map_err(|e| match e {
             PassError::Output { message } => output_failure(message),
             PassError::Log(e) => stderr_failure(e),
-            // parameters that only conflict together (`place`'s `clusters` against its PEs)
-            // are checked when the pass runs: still bad usage
-            e @ PassError::BadParameter { .. } => Failure::Usage(format!("error: {e}\n")),
             e => pass_failure(e, src),
         });
         if let Err(f) = ran {
