@@ -708,7 +708,8 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
                 lo += xw;
                 // the buffer instruction and the capture word with their addresses cut to pb, po
                 let (pb, po) = (c["pb"].as_u64().unwrap() as u32, c["po"].as_u64().unwrap() as u32);
-                let (bw, ow) = (man["widths"]["bw"].as_u64().unwrap() as u32, man["widths"]["ow"].as_u64().unwrap() as u32);
+                let (bw, ow) =
+                    (man["widths"]["bw"].as_u64().unwrap() as u32, man["widths"]["ow"].as_u64().unwrap() as u32);
                 let bufi = words_of("bufi").unwrap()[cycle];
                 for (k, (at, bits)) in [(0, pb), (bw, pb), (2 * bw, 2)].into_iter().enumerate() {
                     assert_eq!(cut(w, lo, bits), cut(bufi, at, bits), "{what} cycle {cycle}: bufi field {k}");
@@ -731,7 +732,10 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
                     let s = ((word >> 7) & 127) as i64 - if word >> 13 & 1 == 1 { 128 } else { 0 };
                     let issues = cut(instr[cycle], 4 * aw + 2, 1) == 1;
                     let expect = if issues {
-                        assert!(cut(word, 0, 6) < 1 << ab || cut(word, 0, 6) == 0, "{what}: an alignment beyond the field");
+                        assert!(
+                            cut(word, 0, 6) < 1 << ab || cut(word, 0, 6) == 0,
+                            "{what}: an alignment beyond the field"
+                        );
                         assert!(alb == 1 || cut(word, 6, 1) == 0, "{what}: align b on a PE without the bit");
                         assert!(s >= smin && s - smin < 1 << sb, "{what}: a shift {s} outside {smin} + {sb} bits");
                         cut(word, 0, ab) | cut(word, 6, alb) << ab | ((s - smin) as u128) << (ab + alb)

@@ -98,21 +98,11 @@ struct ManifestControl {
     po: u32,
     /// On fixed-point PEs, the shift word's fields (`Design::control`'s `FixField`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    fix: Option<ManifestFixField>,
+    fix: Option<crate::design::FixField>,
     /// Bits of the word.
     width: u32,
     /// The lanes, bit 0 of the word in the first.
     lanes: Vec<ManifestMemory>,
-}
-
-/// The shift word in a control word: `align_bits` of alignment, the align-b bit when
-/// `align_b`, the rounding shift less `shift_min` in `shift_bits`.
-#[derive(Clone, Debug, Serialize)]
-struct ManifestFixField {
-    align_bits: u32,
-    align_b: bool,
-    shift_bits: u32,
-    shift_min: i32,
 }
 
 /// The manifest (`manifest.json`): everything a host or a script needs to load and read the
@@ -135,14 +125,14 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             .chain(p.fix.as_ref().map(|i| ("fix", m(i))))
             .collect();
             let c = d.control(p.slot);
-            let fix = c.fix.map(|f| ManifestFixField {
-                align_bits: f.align_bits,
-                align_b: f.align_b,
-                shift_bits: f.shift_bits,
-                shift_min: f.shift_min,
-            });
-            let control =
-                ManifestControl { pa: c.pa, pb: c.pb, po: c.po, fix, width: c.width, lanes: c.lanes.iter().map(m).collect() };
+            let control = ManifestControl {
+                pa: c.pa,
+                pb: c.pb,
+                po: c.po,
+                fix: c.fix,
+                width: c.width,
+                lanes: c.lanes.iter().map(m).collect(),
+            };
             ManifestPe {
                 control,
                 slot: p.slot,

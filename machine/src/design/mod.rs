@@ -246,7 +246,7 @@ pub struct Control {
 /// (`align_bits`, none on a MULTI PE without fused ops, which never aligns), the align-b bit
 /// (on the PEs that align), the rounding shift less `shift_min` (`shift_bits`, at least 1).
 /// The `fix` image keeps the full 14-bit word.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct FixField {
     /// Bits of the alignment: ⌈log₂(AMAX + 1)⌉, at least 1, on the PEs that align (ADD PEs,
     /// PEs with fused multiply-adds); 0 on the others.
@@ -543,7 +543,12 @@ impl Design {
             let aligns = !p.is_mul || p.mac;
             let align_bits = if aligns { addr_bits(u64::from(r.align_max) + 1) } else { 0 };
             let span = (i32::from(r.shift_max) - i32::from(r.shift_min)) as u64 + 1;
-            FixField { align_bits, align_b: aligns, shift_bits: addr_bits(span).max(1), shift_min: i32::from(r.shift_min) }
+            FixField {
+                align_bits,
+                align_b: aligns,
+                shift_bits: addr_bits(span).max(1),
+                shift_min: i32::from(r.shift_min),
+            }
         });
         (pb, po, fix)
     }

@@ -34,18 +34,35 @@ pub fn pe_cluster(i: u32, n: u32, g: u32) -> u32 {
     }
 }
 
-/// PEs of a side of `n` in cluster `c` of `g`.
-fn pes_in(c: u32, n: u32, g: u32) -> u32 {
-    (0..n).filter(|&i| pe_cluster(i, n, g) == c).count() as u32
+/// The PEs (indices `i` of a side of `n`) of cluster `c` of `g`: those with
+/// [`pe_cluster`]`(i, n, g) = c`, in increasing order.
+pub fn pes_in(c: u32, n: u32, g: u32) -> impl Iterator<Item = u32> {
+    (0..n).filter(move |&i| pe_cluster(i, n, g) == c)
+}
+
+/// Whether `g` clusters fit `n_add` ADD and `n_mul` MULTI PEs: every cluster needs a PE of each
+/// side, so `g ≤ min(n_add, n_mul)`.
+///
+/// # Errors
+/// The limit and the PE counts, as text (`clusters=G: at most the smaller side's PEs …`).
+pub fn check(g: u32, n_add: u32, n_mul: u32) -> Result<(), String> {
+    if g > n_add.min(n_mul) {
+        return Err(format!(
+            "clusters={g}: at most the smaller side's PEs ({}: add={n_add}, mul={n_mul}); every cluster has an ADD \
+             and a MULTI PE",
+            n_add.min(n_mul)
+        ));
+    }
+    Ok(())
 }
 
 /// The part of each node of `dag` (indexed by [`Node`], `0..g`) for `g` clusters over `n_add`
-/// ADD and `n_mul` MULTI PEs (`1 ≤ g ≤ min(n_add, n_mul)`, checked by the pass). All zeros for
-/// `g = 1` or fewer ops than `2·g`.
+/// ADD and `n_mul` MULTI PEs. All zeros for `g = 1` or fewer ops than `2·g`.
 ///
 /// # Errors
-/// METIS' own failure (out of memory, or a graph it rejects), as text.
+/// [`check`]'s, or METIS' own failure (out of memory, or a graph it rejects), as text.
 pub fn partition(dag: &OpDag, n_add: u32, n_mul: u32, g: u32) -> Result<Vec<u32>, String> {
+    check(g, n_add, n_mul)?;
     let n = dag.len();
     if g <= 1 || n < 2 * g as usize {
         return Ok(vec![0; n]);
@@ -76,8 +93,10 @@ pub fn partition(dag: &OpDag, n_add: u32, n_mul: u32, g: u32) -> Result<Vec<u32>
     }
     // Balance constraints: one per side that has ops, each part's target share its cluster's
     // PEs of that side.
-    let sides: Vec<(bool, u32)> =
-        [(false, n_add), (true, n_mul)].into_iter().filter(|&(mul, _)| (0..n as Node).any(|j| dag.is_mul(j) == mul)).collect();
+    let sides: Vec<(bool, u32)> = [(false, n_add), (true, n_mul)]
+        .into_iter()
+        .filter(|&(mul, _)| (0..n as Node).any(|j| dag.is_mul(j) == mul))
+        .collect();
     let ncon = sides.len();
     let mut vwgt = vec![0 as metis::Idx; n * ncon];
     for j in 0..n as Node {
@@ -88,7 +107,7 @@ pub fn partition(dag: &OpDag, n_add: u32, n_mul: u32, g: u32) -> Result<Vec<u32>
     let mut tpwgts = vec![0.0 as metis::Real; g as usize * ncon];
     for c in 0..g {
         for (k, &(_, pes)) in sides.iter().enumerate() {
-            tpwgts[c as usize * ncon + k] = pes_in(c, pes, g) as metis::Real / pes as metis::Real;
+            tpwgts[c as usize * ncon + k] = pes_in(c, pes, g).count() as metis::Real / pes as metis::Real;
         }
     }
     let mut part = vec![0 as metis::Idx; n];
@@ -111,7 +130,7 @@ mod tests {
     fn clusters_split_a_side_within_one_pe() {
         for n in 1..40 {
             for g in 1..=n {
-                let sizes: Vec<u32> = (0..g).map(|c| pes_in(c, n, g)).collect();
+                let sizes: Vec<u32> = (0..g).map(|c| pes_in(c, n, g).count() as u32).collect();
                 assert_eq!(sizes.iter().sum::<u32>(), n);
                 assert!(sizes.iter().max().unwrap() - sizes.iter().min().unwrap() <= 1, "{n} {g}: {sizes:?}");
             }

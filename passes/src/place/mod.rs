@@ -436,16 +436,7 @@ impl Pass for Place {
         // (checked here, not when the pipeline is built: each of `clusters`, `add` and `mul`
         // alone takes its whole range)
         let (g, n_add, n_mul) = (self.opts.clusters, self.opts.arch.n_add, self.opts.arch.n_mul);
-        if g > n_add.min(n_mul) {
-            return Err(PassError::BadParameter {
-                pass: "place".into(),
-                message: format!(
-                    "clusters={g}: at most the smaller side's PEs ({}: add={n_add}, mul={n_mul}); every cluster has an \
-                     ADD and a MULTI PE",
-                    n_add.min(n_mul)
-                ),
-            });
-        }
+        cluster::check(g, n_add, n_mul).map_err(|message| PassError::BadParameter { pass: "place".into(), message })?;
         let lat = cx.latencies_for("place", &self.lat);
         let arch = PeArray { lat, writes: self.writes.unwrap_or(cx.target.writes), ..self.opts.arch };
         // `-time-limit`: the first list schedule, which the placement needs, runs to the

@@ -24,7 +24,7 @@ use robovec_ir::analysis::compute_timing;
 use robovec_ir::placement::{Pe, PeArray};
 use robovec_ir::{Function, Operand, Value};
 
-use super::cluster::pe_cluster;
+use super::cluster::pes_in;
 use super::dag::{Key, Node, OpDag, NO_NODE};
 use super::feed::Feed;
 use super::ready::ReadyQueue;
@@ -335,15 +335,13 @@ pub fn schedule_until(
         }
     }
     let mut arrivals: BinaryHeap<Reverse<(u32, Node)>> = BinaryHeap::new();
-    // PE slots per cluster and side (`cluster::pe_cluster`).
+    // PE slots per cluster and side (`cluster::pes_in`).
     let g = dag.clusters();
     let pes_of = |c: u32, mul: bool| -> Vec<usize> {
         if mul {
-            let n = arch.n_mul;
-            (0..n).filter(|&i| pe_cluster(i, n, g) == c).map(|i| Pe::Mul(i).slot(arch.n_add)).collect()
+            pes_in(c, arch.n_mul, g).map(|i| Pe::Mul(i).slot(arch.n_add)).collect()
         } else {
-            let n = arch.n_add;
-            (0..n).filter(|&i| pe_cluster(i, n, g) == c).map(|i| Pe::Add(i).slot(arch.n_add)).collect()
+            pes_in(c, arch.n_add, g).map(|i| Pe::Add(i).slot(arch.n_add)).collect()
         }
     };
     let pes: Vec<[Vec<usize>; 2]> = (0..g).map(|c| [pes_of(c, false), pes_of(c, true)]).collect();
@@ -504,12 +502,7 @@ pub fn backward_starts(dag: &OpDag, n_add: u32, n_mul: u32, lat: &Latencies, key
     }
     let mut ready = ready_lists(dag, keys);
     let g = dag.clusters();
-    let caps: Vec<[usize; 2]> = (0..g)
-        .map(|c| {
-            let count = |n: u32| (0..n).filter(|&i| pe_cluster(i, n, g) == c).count();
-            [count(n_add), count(n_mul)]
-        })
-        .collect();
+    let caps: Vec<[usize; 2]> = (0..g).map(|c| [pes_in(c, n_add, g).count(), pes_in(c, n_mul, g).count()]).collect();
     let mut done = 0;
     let mut t = 0u32;
     while done < n {
