@@ -48,6 +48,14 @@ pub enum ParamKind {
         /// Largest accepted value.
         max: u32,
     },
+    /// An integer in `min..=max`, or nothing when not given (a feature that is off unless a
+    /// value is given: `place<steal=S>`); read with [`Params::u32_given`].
+    U32Opt {
+        /// Smallest accepted value.
+        min: u32,
+        /// Largest accepted value.
+        max: u32,
+    },
     /// An integer in `min..=max` whose default is the target's (`-target`): a latency or the
     /// write ports. [`Params::u32`] returns `builtin` (the `de10-nano` value) when it is not
     /// given; passes read the target's through [`Params::latency_override`] /
@@ -191,6 +199,7 @@ impl ParamInfo {
         match self.kind {
             ParamKind::U32 { default, .. } => default.to_string(),
             ParamKind::U32Or { fallback, .. } => format!("`{fallback}`"),
+            ParamKind::U32Opt { .. } => "none".to_string(),
             ParamKind::U32Target { builtin, .. } => format!("the target's, de10-nano {builtin}"),
             ParamKind::U64 { default, .. } => default.to_string(),
             ParamKind::F64 { default, .. } | ParamKind::F64OrPath { default, .. } => format!("{default}"),
@@ -209,6 +218,7 @@ impl ParamInfo {
         !matches!(
             self.kind,
             ParamKind::U32Or { .. }
+                | ParamKind::U32Opt { .. }
                 | ParamKind::U32Target { .. }
                 | ParamKind::Path
                 | ParamKind::OutputFolder
@@ -221,6 +231,7 @@ impl ParamInfo {
         match self.kind {
             ParamKind::U32 { min, max, .. }
             | ParamKind::U32Or { min, max, .. }
+            | ParamKind::U32Opt { min, max }
             | ParamKind::U32Target { min, max, .. } => format!("{min}..={max}"),
             ParamKind::U64 { min, max, .. } => format!("{min}..={max}"),
             ParamKind::F64 { min, max, .. } => format!("{min}..={max}"),
@@ -261,6 +272,7 @@ impl ParamInfo {
         match self.kind {
             ParamKind::U32 { min, max, .. }
             | ParamKind::U32Or { min, max, .. }
+            | ParamKind::U32Opt { min, max }
             | ParamKind::U32Target { min, max, .. } => Some((min.to_string(), max.to_string())),
             ParamKind::U64 { min, max, .. } => Some((min.to_string(), max.to_string())),
             ParamKind::F64 { min, max, .. } | ParamKind::F64OrPath { min, max, .. } => {
@@ -275,6 +287,7 @@ impl ParamInfo {
         match self.kind {
             ParamKind::U32 { min, max, .. }
             | ParamKind::U32Or { min, max, .. }
+            | ParamKind::U32Opt { min, max }
             | ParamKind::U32Target { min, max, .. } => {
                 let mut v: Vec<String> = min.checked_sub(1).map(|x| x.to_string()).into_iter().collect();
                 v.push((max as u64 + 1).to_string());

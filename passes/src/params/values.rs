@@ -201,9 +201,13 @@ impl Params {
     /// # Errors
     /// [`PassError::BadParameter`] when the value is out of range.
     pub fn u32_given(&self, key: &str) -> Result<Option<u32>, PassError> {
-        match self.get(key) {
-            Some(_) => self.u32(key).map(Some),
-            None => Ok(None),
+        match (self.get(key), self.decl(key)) {
+            (Some(v), ParamKind::U32Opt { min, max }) => match v.parse::<u32>() {
+                Ok(x) if (min..=max).contains(&x) => Ok(Some(x)),
+                _ => Err(self.bad(key, format!("an integer in {min}..={max}"), v)),
+            },
+            (Some(_), _) => self.u32(key).map(Some),
+            (None, _) => Ok(None),
         }
     }
 

@@ -50,6 +50,8 @@ pub struct OpDag {
     clusters: u32,
     /// The cluster each node is bound to (empty with one cluster).
     cluster: Vec<u32>,
+    /// `place<steal=S>`: the slack below which a ready op may leave its cluster.
+    steal: Option<u32>,
 }
 
 impl OpDag {
@@ -114,7 +116,19 @@ impl OpDag {
                 n_users[a as usize] += 1;
             }
         }
-        OpDag { ops, node_of, kind, operand_at, operands, user_at, users, n_distinct, clusters: 1, cluster: Vec::new() }
+        OpDag {
+            ops,
+            node_of,
+            kind,
+            operand_at,
+            operands,
+            user_at,
+            users,
+            n_distinct,
+            clusters: 1,
+            cluster: Vec::new(),
+            steal: None,
+        }
     }
 
     /// Number of ops (nodes).
@@ -171,6 +185,19 @@ impl OpDag {
         assert!(part.len() == self.len() && part.iter().all(|&c| c < clusters.max(1)));
         self.clusters = clusters.max(1);
         self.cluster = if self.clusters == 1 { Vec::new() } else { part };
+    }
+
+    /// Lets a ready op whose first key component (its latest start, in cycles: the ALAP cycle
+    /// or the backward pass's) is at most `slack` cycles after the current cycle issue on a PE
+    /// its own cluster leaves idle in another cluster (`place<steal=S>`; `None`: never). Only
+    /// with more than one cluster.
+    pub fn set_steal(&mut self, slack: Option<u32>) {
+        self.steal = slack;
+    }
+
+    /// The slack of [`OpDag::set_steal`] (`None` with one cluster).
+    pub fn steal(&self) -> Option<u32> {
+        self.steal.filter(|_| self.clusters > 1)
     }
 
     /// Number of PE clusters (1 without `place<clusters=G>`).

@@ -88,6 +88,10 @@ pub struct PlaceOptions {
     /// then have inputs mostly from their own cluster. 1 = none (any op on any PE of its type).
     /// At most the smaller side's PE count.
     pub clusters: u32,
+    /// With clusters: a ready op whose latest start is at most this many cycles away may issue
+    /// on an idle PE of another cluster when that adds at most one interconnect route (work
+    /// stealing for the ops the partition left waiting on a busy cluster; `None`: never).
+    pub steal: Option<u32>,
     /// Rounds of interconnect-aware rebinding of the schedule kept ([`rebind`]; only with
     /// [`Select::Routes`]): ops move to other PEs of their type, in their cycle or within their
     /// slack, while the routes do not grow; the schedule's length stays. 0 = none.
@@ -168,6 +172,7 @@ fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
         search: p.u32("search")?,
         rebind: p.u32("rebind")?,
         clusters: p.u32("clusters")?,
+        steal: p.u32_given("steal")?,
         deadline: None,
         grace: None,
         tick_budget: None,
@@ -212,6 +217,7 @@ pub fn try_place_function_progress(
     if opts.clusters > 1 {
         let part = cluster::partition(&dag, a.n_add, a.n_mul, opts.clusters).map_err(PlaceError::Partition)?;
         dag.set_clusters(opts.clusters, part);
+        dag.set_steal(opts.steal);
     }
     let seed = dag.gather(&seed);
     if required.check() {
@@ -380,6 +386,12 @@ pub const INFO: PassInfo = PassInfo {
             doc: "G: the PEs in G clusters, the ops partitioned (METIS) so that few values cross between \
                   clusters, each op issued on its cluster's PEs: fewer multiplexer inputs for \
                   codegen<fpga;interconnect=specialised> (1 = none; at most min(add, mul))",
+        },
+        ParamInfo {
+            name: "steal",
+            kind: ParamKind::U32Opt { min: 0, max: 4096 },
+            doc: "S, with clusters: a ready op within S cycles of its latest start may issue on an idle PE of \
+                  another cluster when that adds at most one interconnect route (none when not given)",
         },
         ParamInfo {
             name: "rebind",

@@ -292,6 +292,46 @@ fn ready_of<'r>(ready: &'r mut [[ReadyQueue; 2]], dag: &OpDag, v: Node) -> &'r m
     &mut ready[dag.cluster(v) as usize][dag.is_mul(v) as usize]
 }
 
+/// New interconnect routes (sources a PE memory did not receive yet) an op may add when it
+/// leaves its cluster (`place<steal=S>`, with `select=routes`): one. Measured on the MX-5's
+/// `dirdyna` at 72 + 72 PEs in 24 clusters, `steal=16`: no limit, 166 cycles and 2,058
+/// multiplexer inputs; one, 160 and 1,643; none, 170 and 1,626 (no stealing: 176 and 1,535).
+const STEAL_ROUTES: u32 = 1;
+
+/// What issuing an op updates besides [`Ctx`]: the arrival queue and the feeding bonus.
+struct Issued<'a, 'k> {
+    arrivals: &'a mut BinaryHeap<Reverse<(u32, Node)>>,
+    feed: &'a mut Feed<'k>,
+    lowered: &'a mut Vec<(Key, Node)>,
+}
+
+impl Issued<'_, '_> {
+    /// Issues node `v` on slot `q` at cycle `t` (its operands' writes already committed): its
+    /// arrival queued, and the ready users whose keys the feeding bonus lowered re-queued.
+    #[allow(clippy::too_many_arguments)]
+    fn issue(
+        &mut self,
+        ctx: &mut Ctx<'_>,
+        dag: &OpDag,
+        v: Node,
+        q: usize,
+        t: u32,
+        pending: &[u32],
+        ready: &mut [[ReadyQueue; 2]],
+    ) {
+        let lat = ctx.arch.lat.of(dag.kind(v));
+        ctx.issue[v as usize] = (q as u32, t);
+        ctx.arrival[v as usize] = t + lat;
+        self.arrivals.push(Reverse((t + lat, v)));
+        self.feed.issued(dag, |u| ctx.issued(u), v, self.lowered);
+        for (k, u) in self.lowered.drain(..) {
+            if pending[u as usize] == 0 {
+                ready_of(ready, dag, u).push(k, u);
+            }
+        }
+    }
+}
+
 /// Schedules every op of `dag` on `arch`, ready ops taken in increasing `keys` order (indexed
 /// by node; ties by node), with the feeding bonus `feed` in cycles (see [`Feed`]; 0 = the
 /// seed's static order).
@@ -347,6 +387,8 @@ pub fn schedule_until(
     let pes: Vec<[Vec<usize>; 2]> = (0..g).map(|c| [pes_of(c, false), pes_of(c, true)]).collect();
     let (mut planned, mut routes, mut best_routes) = (Planned::default(), Vec::new(), Vec::new());
     let mut free: Vec<usize> = Vec::new();
+    // each cluster's and side's PEs left idle in the current cycle (for `steal`)
+    let mut idle: Vec<[Vec<usize>; 2]> = vec![[Vec::new(), Vec::new()]; g as usize];
     let mut deferred = Vec::new();
     let mut placed = 0usize;
     let mut t: u32 = 0;
@@ -416,18 +458,10 @@ pub fn schedule_until(
                     Some((_, i)) => {
                         let q = free.swap_remove(i);
                         ctx.commit(operands, &best_routes, q);
-                        let lat = arch.lat.of(dag.kind(v));
-                        ctx.issue[v as usize] = (q as u32, t);
-                        ctx.arrival[v as usize] = t + lat;
-                        arrivals.push(Reverse((t + lat, v)));
+                        let mut s = Issued { arrivals: &mut arrivals, feed: &mut feed, lowered: &mut lowered };
+                        s.issue(&mut ctx, dag, v, q, t, &pending, &mut ready);
                         placed += 1;
                         progress = true;
-                        feed.issued(dag, |u| ctx.issued(u), v, &mut lowered);
-                        for (k, u) in lowered.drain(..) {
-                            if pending[u as usize] == 0 {
-                                ready_of(&mut ready, dag, u).push(k, u);
-                            }
-                        }
                         free.sort_unstable();
                     }
                     None => deferred.push((k, v)),
@@ -435,6 +469,58 @@ pub fn schedule_until(
             }
             for (k, v) in deferred.drain(..) {
                 ready[c][ty].push(k, v);
+            }
+            idle[c][ty].clone_from(&free);
+        }
+        // Urgent ops of other clusters on the PEs their own clusters left idle (`steal`).
+        if let Some(slack) = dag.steal() {
+            for (ty, c) in (0..2).flat_map(|ty| (0..g as usize).map(move |c| (ty, c))) {
+                let mut free = std::mem::take(&mut idle[c][ty]);
+                for o in (1..g as usize).map(|d| (c + d) % g as usize) {
+                    if free.is_empty() {
+                        break;
+                    }
+                    deferred.clear();
+                    while !free.is_empty() {
+                        if stop() {
+                            return Ok(None);
+                        }
+                        let Some((k, v)) = ready[o][ty].pop() else { break };
+                        if k != feed.key[v as usize] || ctx.issued(v) {
+                            continue; // stale entry
+                        }
+                        if k.0 > t.saturating_add(slack) {
+                            deferred.push((k, v)); // the rest of that list is less urgent
+                            break;
+                        }
+                        let operands = dag.operands_of(v);
+                        let mut best: Option<(u32, usize)> = None;
+                        for (i, &q) in free.iter().enumerate() {
+                            if !ctx.routes(operands, q, t, &mut planned, &mut routes) {
+                                continue;
+                            }
+                            let fresh = if select == Select::Routes { ctx.new_routes(operands, &routes, q) } else { 0 };
+                            if fresh <= STEAL_ROUTES && best.is_none_or(|(s, _)| fresh < s) {
+                                best = Some((fresh, i));
+                                std::mem::swap(&mut routes, &mut best_routes);
+                            }
+                        }
+                        match best {
+                            Some((_, i)) => {
+                                let q = free.swap_remove(i);
+                                ctx.commit(operands, &best_routes, q);
+                                let mut s = Issued { arrivals: &mut arrivals, feed: &mut feed, lowered: &mut lowered };
+                                s.issue(&mut ctx, dag, v, q, t, &pending, &mut ready);
+                                placed += 1;
+                                progress = true;
+                            }
+                            None => deferred.push((k, v)),
+                        }
+                    }
+                    for (k, v) in deferred.drain(..) {
+                        ready[o][ty].push(k, v);
+                    }
+                }
             }
         }
         if progress {
