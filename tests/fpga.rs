@@ -1190,6 +1190,12 @@ fn yosys_sizes_the_design_and_resources_json_has_the_figures() {
     // the M10K count is the memories' sum
     let m10k: u64 = r["memories"].as_array().unwrap().iter().map(|m| m["m10k"].as_u64().unwrap()).sum();
     assert_eq!(r["m10k"].as_u64().unwrap(), m10k);
+    // the output memories in LUT RAM are synthesised: at least their bits in MLAB cells of 32
+    // words × 1 bit (the buffers may take more), not flip-flops
+    let lutram = r["memories"].as_array().unwrap().iter().filter(|m| m["lutram"] == true);
+    let cells: u64 = lutram.map(|m| m["words"].as_u64().unwrap().div_ceil(32) * m["width"].as_u64().unwrap()).sum();
+    assert!(cells > 0, "the pendulum has an output memory in LUT RAM");
+    assert!(r["yosys"]["mlab"].as_u64().unwrap() >= cells, "{} MLAB cells, {cells} wanted", r["yosys"]["mlab"]);
 }
 
 /// `resources=auto` gives Yosys only designs of at most `AUTO_YOSYS_MAX_PES` PEs (the module
@@ -1212,11 +1218,13 @@ fn auto_resources_leave_large_designs_to_the_estimate_with_a_note() {
     assert!(err.contains(&format!("{} PEs: resources from the analytic estimate", 2 * per_side)), "{err}");
 }
 
-/// The analytic estimate counts the output memories as block RAM (`rv_out_mem`, issue 49): one
-/// simple dual-port memory for each PE that holds outputs (found here from the manifest's output
-/// map), of the image's words, and no logic a word (`output_word_alm` is 0 on the DE10-Nano).
+/// The analytic estimate counts the output memories (issue 49): one for each PE that holds
+/// outputs (found here from the manifest's output map), of the image's words; on the
+/// DE10-Nano in LUT RAM (MLAB: no M10K, 16 ALMs for 32-bit words of up to 32 words) when it has
+/// at most 32 words and no initial contents (no output load on the PE), else one simple
+/// dual-port M10K; and no logic a word (`output_word_alm` is 0 on the DE10-Nano).
 #[test]
-fn the_analytic_estimate_counts_the_output_memories_as_block_ram() {
+fn the_analytic_estimate_counts_the_output_memories() {
     let d = tmp("estimate_outputs");
     let dir = d.join("out");
     let passes = format!(
@@ -1232,17 +1240,27 @@ fn the_analytic_estimate_counts_the_output_memories_as_block_ram() {
     let holding: std::collections::BTreeSet<u64> =
         man["outputs"].as_array().unwrap().iter().map(|o| o["slot"].as_u64().unwrap()).collect();
     assert!(!holding.is_empty(), "the pendulum's outputs are captured");
+    let loaded: std::collections::BTreeSet<u64> =
+        man["output_loads"].as_array().unwrap().iter().map(|o| o["slot"].as_u64().unwrap()).collect();
     let memories = r["memories"].as_array().unwrap();
+    let mut lutram_alm = 0.0;
     for k in 0..4u64 {
         let m = memories.iter().find(|m| m["name"] == format!("pe{k}_out"));
         assert_eq!(m.is_some(), holding.contains(&k), "PE {k}: an output memory is counted iff it holds outputs");
         if let Some(m) = m {
             // its words: one per line of its image (at least one)
             let t = std::fs::read_to_string(dir.join("hex").join(format!("pe{k}_out.hex"))).unwrap();
-            assert_eq!(m["words"].as_u64().unwrap(), t.lines().filter(|l| !l.trim().is_empty()).count() as u64);
-            assert_eq!(m["m10k"], 1, "a few words: one M10K");
+            let words = t.lines().filter(|l| !l.trim().is_empty()).count() as u64;
+            assert_eq!(m["words"].as_u64().unwrap(), words);
+            let lutram = words <= 32 && !loaded.contains(&k);
+            assert_eq!(m["lutram"], lutram, "PE {k}: {words} words, loaded: {}", loaded.contains(&k));
+            assert_eq!(m["m10k"], if lutram { 0 } else { 1 }, "a few words: MLAB or one M10K");
+            if lutram {
+                lutram_alm += 16.0; // 32 MLAB cells of 32 words, two an ALM
+            }
         }
     }
+    assert!(lutram_alm > 0.0, "some output memory of the pendulum is in LUT RAM");
     // the Cyclone V's Yosys-flow figures for 4 PEs of 32-bit words, and nothing per output
     // word: 8 crossbar ports of 8 inputs, each PE by its buffer words (the manifest's)
     let l = robovec_machine::target::Family::CycloneV.design_logic().unwrap();
@@ -1253,7 +1271,7 @@ fn the_analytic_estimate_counts_the_output_memories_as_block_ram() {
         .iter()
         .map(|p| l.pe_bit + l.buffer_word_bit * (p["buffer_words"].as_u64().unwrap().max(1) - 1) as f64)
         .sum();
-    let want = (32.0 * (ports + pes)).ceil() as u64;
+    let want = (32.0 * (ports + pes) + lutram_alm).ceil() as u64;
     assert_eq!(r["logic_alm"].as_u64().unwrap(), want);
 }
 
@@ -1319,7 +1337,9 @@ fn hierarchical_yosys_agrees_with_flat_synthesis() {
     // `rv_mux` with a source bus per port (issue 49), then 949 against 1193 (−20 %) for the
     // same logic: ABC's LUT mapping of the flat netlist moved by 28 % with the names and ports
     // alone (Yosys 0.23), the hierarchical one by 5 %. The tool's own spread sets the bound.
-    assert_eq!(h.ff, flat.ff);
+    // The registers: the same until the output memories went into LUT RAM (issue 49), whose
+    // read registers the flat netlist merges a little further (865 against 868): at most 1 %.
+    assert!(flat.ff <= h.ff && (h.ff - flat.ff) * 100 <= h.ff, "hierarchical {} FF, flat {}", h.ff, flat.ff);
     let (a, b) = (h.alm() as f64, flat.alm() as f64);
     assert!((a - b).abs() <= 0.30 * b, "hierarchical {a} ALM, flat {b} ALM");
     assert!(b > 100.0, "the crossbar takes logic: {b}");

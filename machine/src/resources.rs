@@ -164,8 +164,18 @@ pub struct MemoryCost {
     pub words: u64,
     /// Bits per word.
     pub width: u32,
-    /// M10K blocks.
+    /// M10K blocks (0 for a memory in LUT RAM).
     pub m10k: u64,
+    /// True for a memory built in the family's LUT RAM ([`crate::design::Design::out_in_lutram`]:
+    /// the Cyclone V's MLAB), whose ALMs are logic: Yosys counts its cells, the analytic
+    /// estimate [`lutram_alm`] of it.
+    pub lutram: bool,
+}
+
+/// ALMs of a `words` × `width` memory in MLAB cells (32 words × 1 bit, two an ALM: Yosys
+/// `synth_intel_alm`'s `MISTRAL_MLAB`, [`YosysCells::alm`]): `⌈⌈words/32⌉·width / 2⌉`.
+pub fn lutram_alm(words: u64, width: u32) -> u64 {
+    (words.max(1).div_ceil(32) * u64::from(width)).div_ceil(2)
 }
 
 /// Yosys' cell counts for the logic around the black boxes.
@@ -253,8 +263,10 @@ pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
         let lanes = control.iter().map(|i| (i, false, 1));
         // the output memory (`rv_out_mem`) of a PE that holds outputs: one simple dual-port
         // memory (a PE without outputs has a constant one, which synthesis removes)
+        // (or LUT RAM, `Design::out_in_lutram`: no block)
         let holds = d.outputs.iter().any(|o| o.slot == p.slot) || d.output_loads.iter().any(|l| l.slot == p.slot);
         let out = holds.then_some((&p.out, false, 1));
+        let lutram = |img: &crate::design::images::Image| std::ptr::eq(img, &p.out) && d.out_in_lutram(p);
         // a MAC PE's third read (`rv_pe`'s MAC = 1): a copy of the PE memory taking the same
         // writes, one read port used (the live-value table's copy keeps two of its four banks)
         let copy = p.mac.then_some((&p.data, pe_tdp, banks.div_ceil(2), "_c"));
@@ -262,11 +274,17 @@ pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
         let out = out.map(|(i, t, b)| (i, t, b, ""));
         for (img, true_dual_port, banks, suffix) in lanes.chain([(&p.data, pe_tdp, banks, "")]).chain(copy).chain(out) {
             let words = img.words.len().max(1) as u64;
+            let lutram = lutram(img);
             v.push(MemoryCost {
                 name: format!("{}{suffix}", img.name),
                 words,
                 width: img.width,
-                m10k: banks * m10k_blocks(words, img.width, M10kFit::Configurations { true_dual_port, family }),
+                m10k: if lutram {
+                    0
+                } else {
+                    banks * m10k_blocks(words, img.width, M10kFit::Configurations { true_dual_port, family })
+                },
+                lutram,
             });
         }
     }
@@ -579,8 +597,11 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
             // The multiplexers and output words are costed for 32-bit words: a narrower word
             // (fixed-point PEs, `word_bits`) takes its share.
             let word = f64::from(d.word_bits) / 32.0;
+            // the memories in LUT RAM (Yosys counts their cells when it runs)
+            let lutram: u64 = memories.iter().filter(|c| c.lutram).map(|c| lutram_alm(c.words, c.width)).sum();
             let words = m.pe_word_alm * d.pes.iter().map(|p| p.data.words.len().max(1) as f64).sum::<f64>()
-                + m.output_word_alm * output_words(d) as f64 * word;
+                + m.output_word_alm * output_words(d) as f64 * word
+                + lutram as f64;
             let a = match m.design_logic {
                 // the family's Yosys flow, port by port and PE by PE
                 Some(l) => design_logic_alm(d, &l) + words,

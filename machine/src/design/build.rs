@@ -37,6 +37,8 @@ pub struct Limits {
     /// ([`Family::one_multiplier_word`]: 27 on the Cyclone V, 18 on the ECP5): a fixed-point
     /// MULTI PE of a wider word registers its partial products (`hdl/fix_units.v`).
     pub multiplier_word: u32,
+    /// The deepest output memory built in LUT RAM ([`Family::lutram_words`]; 0: none).
+    pub out_lutram_words: u32,
 }
 
 impl Limits {
@@ -51,6 +53,7 @@ impl Limits {
             pe_memory: t.family.pe_memory(),
             control_lane_bits: t.family.bram_word(),
             multiplier_word: t.family.one_multiplier_word(),
+            out_lutram_words: t.family.lutram_words(),
         }
     }
 }
@@ -424,6 +427,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
         pe_memory: limits.pe_memory,
         control_lane_bits: limits.control_lane_bits,
         multiplier_word: limits.multiplier_word,
+        out_lutram_words: limits.out_lutram_words,
         states: f.states,
         pe_kind: if fx.is_some() { PeKind::Fixed } else { PeKind::Binary32 },
         word_bits: word_bits_of(fx),

@@ -217,6 +217,10 @@ pub struct Design {
     /// 18 on the ECP5): a fixed-point MULTI PE of a wider word registers four partial products
     /// before their sum (`fix_mul`'s `ONE`).
     pub multiplier_word: u32,
+    /// The deepest output memory built in the family's LUT RAM (`rv_out_lutram`, the Cyclone
+    /// V's MLAB: [`crate::target::Family::lutram_words`]); deeper ones, and all with 0, are block
+    /// RAM (`rv_out_mem`).
+    pub out_lutram_words: u32,
 }
 
 /// A PE's control memory ([`Design::control`]): one word per cycle holding the instruction (its
@@ -298,6 +302,15 @@ impl Design {
     /// PEs of both types.
     pub fn n_pe(&self) -> usize {
         (self.n_add + self.n_mul) as usize
+    }
+
+    /// Whether PE `p`'s output memory is built in LUT RAM (`rv_out_lutram`): its image has at
+    /// most [`Design::out_lutram_words`] words and no initial contents (no output of the PE is
+    /// an input or a constant: Yosys 0.23 maps no initialised memory to MLAB cells). Else block
+    /// RAM (`rv_out_mem`).
+    pub fn out_in_lutram(&self, p: &PeImages) -> bool {
+        p.out.words.len().max(1) as u64 <= u64::from(self.out_lutram_words)
+            && !self.output_loads.iter().any(|l| l.slot == p.slot)
     }
 
     /// The interconnect the design has.
@@ -567,12 +580,18 @@ impl Design {
     /// The flip-flops of the design outside its units and memories (`hdl/rv_lib.v`), an upper
     /// estimate: per PE its registered control word ([`Design::control_width`]), four words
     /// (the result, the buffer read fetched a clock early and the result it may bypass to, and a
-    /// one-word buffer's register) and 24 bits of flags, shift word and bypass decisions; and the
+    /// one-word buffer's register) and 24 bits of flags, shift word and bypass decisions, and the
+    /// read register of an output memory in LUT RAM ([`Design::out_in_lutram`]: a word); and the
     /// program counter with `run` and `done`. Counted in bits; the Cyclone V's ALM packs two a
     /// half ([`crate::resources::YosysCells::alm`]).
     pub fn flip_flops(&self) -> u64 {
-        let per_pe: u64 = (0..self.n_pe())
-            .map(|slot| u64::from(self.control_width(slot).1) + 4 * u64::from(self.word_bits) + 24)
+        let per_pe: u64 = self
+            .pes
+            .iter()
+            .map(|p| {
+                let words = 4 + u64::from(self.out_in_lutram(p));
+                u64::from(self.control_width(p.slot).1) + words * u64::from(self.word_bits) + 24
+            })
             .sum();
         per_pe + u64::from(self.widths.cw) + 2
     }
@@ -669,6 +688,9 @@ impl Design {
             if p.mac {
                 fix += ".MAC(1), ";
             }
+            if self.out_in_lutram(p) {
+                fix += ".OUT_LUTRAM(1), ";
+            }
             let control = self.control(p.slot);
             if let Some(fx) = control.fix {
                 fix += &format!(".FAB({}), .FALB({}), .FSB({}), ", fx.align_bits, u8::from(fx.align_b), fx.shift_bits);
@@ -733,7 +755,8 @@ impl Design {
         s += "  always #5 clk = ~clk;\n  always @(posedge clk) if (busy) clocks = clocks + 1;\n";
         s += "  initial begin\n    @(negedge clk); start = 1; @(negedge clk); start = 0;\n    while (!done) @(negedge clk);\n";
         for p in &self.pes {
-            let _ = writeln!(s, "    $writememh(\"captured{}.hex\", dut.{}.u_out.mem);", p.slot, p.pe);
+            let out = if self.out_in_lutram(p) { "g_out_lutram" } else { "g_out_bram" };
+            let _ = writeln!(s, "    $writememh(\"captured{}.hex\", dut.{}.{out}.u_out.mem);", p.slot, p.pe);
         }
         s += "    $display(\"robovec-done %0d %0d\", clocks - 1, clocks);\n    $finish;\n  end\n";
         let _ = writeln!(

@@ -51,6 +51,7 @@ module rv_pe #(
     parameter integer MEM_DEPTH = 1,   // PE memory words
     parameter integer BUF_DEPTH = 1,   // buffer words
     parameter integer OUT_DEPTH = 1,   // output memory words
+    parameter integer OUT_LUTRAM = 0,  // 1: the output memory in LUT RAM (rv_out_lutram: the Cyclone V's MLAB), else block RAM
     parameter integer PA = 11,         // bits of each address field of the control word (<= AW)
     parameter integer PB = BW,         // bits of each buffer address in the control word (<= BW)
     parameter integer PO = OW,         // bits of the output-memory address in the control word (<= OW)
@@ -290,8 +291,15 @@ module rv_pe #(
   // output memory (rv_mem.v): captures the arriving result; read by the host after `done`
   wire [OW-1:0] oa   = capt[PO-1:0];
   wire          o_en = capt[PO] & run;
-  rv_out_mem #(.DW(DW), .DEPTH(OUT_DEPTH), .AW(OW), .FILE(OUT_FILE)) u_out (
-      .clk(clk), .we(o_en), .wa(oa), .wd(result), .ra(out_addr), .q(out_data));
+  generate
+    if (OUT_LUTRAM != 0) begin : g_out_lutram
+      rv_out_lutram #(.DW(DW), .DEPTH(OUT_DEPTH), .AW(OW), .FILE(OUT_FILE)) u_out (
+          .clk(clk), .we(o_en), .wa(oa), .wd(result), .ra(out_addr), .q(out_data));
+    end else begin : g_out_bram
+      rv_out_mem #(.DW(DW), .DEPTH(OUT_DEPTH), .AW(OW), .FILE(OUT_FILE)) u_out (
+          .clk(clk), .we(o_en), .wa(oa), .wd(result), .ra(out_addr), .q(out_data));
+    end
+  endgenerate
 endmodule
 
 // One write port's multiplexer: y = 0 for sel = 0 or sel > N, else the DW-bit word sel - 1 of
@@ -389,5 +397,38 @@ module rv_control #(
         done <= 1;
       end else pc <= pc + 1'b1;
     end
+  end
+endmodule
+
+// Output memory in LUT RAM (`OUT_LUTRAM`, the Cyclone V's MLAB, issue 49): rv_mem.v's `rv_out_mem` for a
+// memory of at most 32 words without initial contents (every word it gives the host was
+// captured during the run). A few ALMs instead of an M10K: Yosys `synth_intel_alm` maps it to
+// MISTRAL_MLAB cells (32 words x 1 bit) and the read register; Quartus to an MLAB by the
+// attribute. Here, not in rv_mem.v: the resource estimate's Yosys run synthesises it (rv_mem.v's
+// block RAMs are black boxes there).
+module rv_out_lutram #(
+    parameter integer DW = 32,
+    parameter integer DEPTH = 1,
+    parameter integer AW = 1,
+    parameter FILE = ""
+) (
+    input  wire          clk,
+    input  wire          we,
+    input  wire [AW-1:0] wa,
+    input  wire [DW-1:0] wd,
+    input  wire [AW-1:0] ra,
+    output reg  [DW-1:0] q
+);
+  (* ramstyle = "MLAB" *) reg [DW-1:0] mem [0:DEPTH-1];
+  initial q = 0;
+`ifndef SYNTHESIS
+  // (simulators: zeros, as the block RAM's; synthesis: no initial contents, which Yosys 0.23
+  // would not map to MLAB cells)
+  integer i;
+  initial for (i = 0; i < DEPTH; i = i + 1) mem[i] = 0;
+`endif
+  always @(posedge clk) begin
+    if (we) mem[wa] <= wd;
+    q <= mem[ra];
   end
 endmodule
