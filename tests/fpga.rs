@@ -288,6 +288,12 @@ fn the_multiplexer_simulators_read_is_the_tree_synthesis_maps() {
 
 const PENDULUM: &str = "examples/double_pendulum/mbs_invdyna_double_pendulum.c";
 
+/// The JSON file at `path` (a manifest, `resources.json`, a report); panics when it cannot be
+/// read or parsed.
+fn read_json(path: impl AsRef<Path>) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
 fn corpus(name: &str) -> String {
     crate::common::corpus_dir().join("c").join(name).display().to_string()
 }
@@ -345,8 +351,7 @@ fn placed_designs_simulate_in_iverilog_bit_for_bit_like_the_binary32_evaluation(
             let dir = d.join(format!("{name}-{n}"));
             let eval = emit(src, n, &dir, "", inputs);
             let sim = simulate(&dir, inputs);
-            let man: serde_json::Value =
-                serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+            let man: serde_json::Value = read_json(dir.join("manifest.json"));
             assert_eq!(sim["cycles"], man["cycles"], "{name} N={n}: the hardware ran the program's cycles");
             assert_eq!(sim["clocks"].as_u64().unwrap(), man["cycles"].as_u64().unwrap() + 1);
             same_outputs(&format!("{name} N={n}"), &eval, &sim);
@@ -397,8 +402,7 @@ fn a_buffer_read_in_its_values_arrival_cycle_simulates_bit_for_bit() {
     assert!(o.status.success(), "{}", stderr(&o));
     let eval: serde_json::Value = serde_json::from_slice(&o.stdout).expect("eval JSON");
     // the buffer instruction reads the address it stores in one cycle
-    let man: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    let man: serde_json::Value = read_json(dir.join("manifest.json"));
     let slot = man["pes"].as_array().unwrap().iter().find(|p| p["pe"] == producer.as_str()).unwrap();
     assert_eq!(slot["buffer_words"], 1, "{producer}'s buffer");
     same_outputs("a same-cycle buffer read", &eval, &simulate(&dir, &inputs));
@@ -435,11 +439,10 @@ fn interleaved_states_simulate_in_iverilog_like_the_binary32_evaluation() {
     let sim = simulate(&dir, &inputs);
     same_outputs("pendulum, 2 states", &eval, &sim);
     // The report's fpga entry gives both the latency and the time per state.
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(rep).unwrap()).unwrap();
+    let r: serde_json::Value = read_json(rep);
     let f = &r["fpga"];
     assert_eq!(f["states"], 2);
-    let man: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    let man: serde_json::Value = read_json(dir.join("manifest.json"));
     assert_eq!(man["states"], 2, "the manifest says how many states a run computes");
     let (cycles, clock) = (f["cycles"].as_f64().unwrap(), f["clock_mhz"].as_f64().unwrap());
     assert_eq!(sim["cycles"].as_f64().unwrap(), cycles);
@@ -489,9 +492,7 @@ fn clustered_placements_simulate_in_icarus_bit_for_bit() {
         assert!(o.status.success(), "clusters={clusters} {interconnect}: {}", stderr(&o));
         (dir, serde_json::from_slice(&o.stdout).expect("eval JSON"))
     };
-    let manifest = |dir: &Path| -> serde_json::Value {
-        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap()
-    };
+    let manifest = |dir: &Path| -> serde_json::Value { read_json(dir.join("manifest.json")) };
     let (sdir, eval) = build(4, "specialised");
     let (xdir, eval_x) = build(4, "crossbar");
     assert_eq!(eval, eval_x);
@@ -532,9 +533,7 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
             assert_eq!(sim_x["bits"], sim_s["bits"], "{what}: the two interconnects compute the same bits");
             assert_eq!(sim_x["cycles"], sim_s["cycles"]);
 
-            let read = |dir: &Path| -> serde_json::Value {
-                serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap()
-            };
+            let read = |dir: &Path| -> serde_json::Value { read_json(dir.join("manifest.json")) };
             let (mx, ms) = (read(&xdir), read(&sdir));
             assert_eq!(
                 (mx["interconnect"].as_str(), ms["interconnect"].as_str()),
@@ -600,9 +599,7 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
             }
             // the analytic estimate (the Cyclone V's Yosys-flow figures): `mux_input_bit` per
             // input bit of 32-bit words saved, a port without routes being one constant input
-            let res = |dir: &Path| -> serde_json::Value {
-                serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap()
-            };
+            let res = |dir: &Path| -> serde_json::Value { read_json(dir.join("resources.json")) };
             let (rx, rs) = (res(&xdir), res(&sdir));
             let logic = robovec_machine::target::Family::CycloneV.design_logic().unwrap();
             let per_bit = logic.mux_input_bit;
@@ -661,8 +658,7 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
         );
         let o = opt(&[PENDULUM, &format!("-ranges={}", ranges.display()), &passes, "-o", "/dev/null"]);
         assert!(o.status.success(), "{what}: {}", stderr(&o));
-        let man: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+        let man: serde_json::Value = read_json(dir.join("manifest.json"));
         let aw = man["widths"]["aw"].as_u64().unwrap() as u32;
         let hex = |file: &str| -> Vec<u128> {
             std::fs::read_to_string(dir.join("hex").join(format!("{file}.hex")))
@@ -749,8 +745,7 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
             }
         }
         // the estimate's memories: the lanes, the PE memory and output memories, nothing else
-        let res: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
+        let res: serde_json::Value = read_json(dir.join("resources.json"));
         for m in res["memories"].as_array().unwrap() {
             let name = m["name"].as_str().unwrap();
             assert!(["_ctrl", "_data", "_out"].iter().any(|k| name.contains(k)), "{what}: {name} counted");
@@ -782,7 +777,7 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
         ]);
         assert!(o.status.success(), "{pipeline}: {}", stderr(&o));
         let eval: serde_json::Value = serde_json::from_slice(&o.stdout).expect("eval JSON");
-        (eval, serde_json::from_str(&std::fs::read_to_string(rep).unwrap()).unwrap())
+        (eval, read_json(rep))
     };
     let place = "place<pe=2;restarts=0;search=0>";
     let float_dir = d.join("binary32");
@@ -797,8 +792,7 @@ fn fixed_point_pes_compute_the_formatted_evaluation_bit_for_bit() {
             ),
             &dir,
         );
-        let man: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+        let man: serde_json::Value = read_json(dir.join("manifest.json"));
         assert_eq!(man["pe_kind"], "fixed");
         assert_eq!(man["latency"], serde_json::json!({"add": 3, "mul": 4}), "the target's fix_pe latencies");
         assert_eq!(rep["sim"]["precisions"], serde_json::json!(["fixed point"]));
@@ -849,8 +843,7 @@ fn placing_for_fewer_routes_shrinks_the_specialised_interconnect_and_keeps_the_b
             assert!(o.status.success(), "N={n} {select}: {}", stderr(&o));
             let eval: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
             same_outputs(&format!("m454 N={n} select={select}"), &eval, &simulate(&dir, &none));
-            let man: serde_json::Value =
-                serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+            let man: serde_json::Value = read_json(dir.join("manifest.json"));
             figures.push((man["cycles"].as_u64().unwrap(), man["mux_inputs"].as_u64().unwrap()));
         }
         let [(c_pref, m_pref), (c_routes, m_routes)] = [figures[0], figures[1]];
@@ -893,8 +886,7 @@ fn narrow_fixed_point_words_simulate_bit_for_bit_and_take_one_dsp_block_a_produc
         ]);
         assert!(o.status.success(), "word={word}: {}", stderr(&o));
         let eval: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        let man: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+        let man: serde_json::Value = read_json(dir.join("manifest.json"));
         assert_eq!(man["word_bits"], word, "the widest format is the word");
         // a product that is one DSP block has no partial products to sum: MULTI 3 cycles, not 4
         let one_multiplier = if target == "ecp5-85f" { 18 } else { 27 };
@@ -917,7 +909,7 @@ fn narrow_fixed_point_words_simulate_bit_for_bit_and_take_one_dsp_block_a_produc
             let (e, s) = (v.as_f64().unwrap(), got[k].as_f64().unwrap());
             assert_eq!(e.to_bits(), s.to_bits(), "word={word}: output {k}: simulated {s}, -eval {e}");
         }
-        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+        let r: serde_json::Value = read_json(&rep);
         dsp.push(r["fpga"]["resources"]["fp_units"]["dsp"].as_u64().unwrap());
     }
     // two MULTI PEs: 2 blocks each for 32-bit words (four 18 × 19 partial products), 1 at 27 and
@@ -941,8 +933,7 @@ fn yosys_maps_a_27_bit_product_to_one_dsp_block_and_a_32_bit_one_to_two() {
         );
         let o = Command::new("yosys").current_dir(&d).args(["-q", "-p", &script]).output().expect("yosys runs");
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let stat: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(d.join(format!("stat{dw}.json"))).unwrap()).unwrap();
+        let stat: serde_json::Value = read_json(d.join(format!("stat{dw}.json")));
         let cells = &stat["modules"]["\\fix_mul"]["num_cells_by_type"];
         (cells["MISTRAL_MUL27X27"].as_u64().unwrap_or(0), cells["MISTRAL_MUL18X18"].as_u64().unwrap_or(0))
     };
@@ -1004,7 +995,7 @@ fn ecp5_place_and_route_measures_fmax_and_resources_and_packs_a_bitstream() {
         .output()
         .expect("robovec-opt runs");
     assert!(o.status.success(), "{}", stderr(&o));
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let report: serde_json::Value = read_json(&rep);
     let f = &report["fpga"];
     let r = &f["resources"];
     assert_eq!(r["logic_from"], "pnr");
@@ -1070,7 +1061,7 @@ fn sweep_times_and_costs_a_fixed_point_function_with_its_pes() {
         "/dev/null",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let r: serde_json::Value = read_json(&rep);
     let rows = r["sweep"].as_array().unwrap();
     assert!(!rows.is_empty());
     for row in rows {
@@ -1172,8 +1163,7 @@ fn yosys_sizes_the_design_and_resources_json_has_the_figures() {
         format!("-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=yosys>", dir.display());
     let o = opt(&[PENDULUM, &passes, &format!("-report={}", rep.display()), "-o", "/dev/null"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
+    let r: serde_json::Value = read_json(dir.join("resources.json"));
     assert_eq!(r["logic_from"], "yosys");
     let fp_alm = 2 * 360 + 2 * 100;
     assert_eq!(r["fp_units"]["alm"], fp_alm, "target's per-unit costs (seed Table 1.4)");
@@ -1184,7 +1174,7 @@ fn yosys_sizes_the_design_and_resources_json_has_the_figures() {
     assert_eq!(r["fits"], true);
     let cycles = r["cycles"].as_f64().unwrap();
     assert!((r["us"].as_f64().unwrap() - cycles / r["clock_mhz"].as_f64().unwrap()).abs() < 1e-12);
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let report: serde_json::Value = read_json(&rep);
     assert_eq!(report["fpga"]["resources"]["alm"], r["alm"], "the report's fpga entry is resources.json's");
     assert_eq!(report["fpga"]["cycles"], r["cycles"]);
     // the M10K count is the memories' sum
@@ -1211,8 +1201,7 @@ fn auto_resources_leave_large_designs_to_the_estimate_with_a_note() {
         format!("-passes=atomise,place<pe={per_side};restarts=0;search=0>,codegen<fpga;out={}>", dir.display());
     let o = opt(&[PENDULUM, &passes, "-stats", "-o", "/dev/null"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
+    let r: serde_json::Value = read_json(dir.join("resources.json"));
     assert_eq!(r["logic_from"], "estimate");
     let err = stderr(&o);
     assert!(err.contains(&format!("{} PEs: resources from the analytic estimate", 2 * per_side)), "{err}");
@@ -1233,10 +1222,8 @@ fn the_analytic_estimate_counts_the_output_memories() {
     );
     let o = opt(&[PENDULUM, &passes, "-o", "/dev/null"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
-    let man: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    let r: serde_json::Value = read_json(dir.join("resources.json"));
+    let man: serde_json::Value = read_json(dir.join("manifest.json"));
     let holding: std::collections::BTreeSet<u64> =
         man["outputs"].as_array().unwrap().iter().map(|o| o["slot"].as_u64().unwrap()).collect();
     assert!(!holding.is_empty(), "the pendulum's outputs are captured");
@@ -1306,8 +1293,7 @@ fn the_analytic_logic_is_not_below_yosys() {
             }
             let o = opt(&args);
             assert!(o.status.success(), "{}", stderr(&o));
-            let r: serde_json::Value =
-                serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
+            let r: serde_json::Value = read_json(dir.join("resources.json"));
             assert_eq!(r["logic_from"], res);
             r["logic_alm"].as_u64().unwrap()
         };
@@ -1536,7 +1522,7 @@ fn fused_multiply_adds_run_on_the_multi_pes_bit_for_bit() {
             ir.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{tag}: {}", stderr(&o));
-        let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+        let r: serde_json::Value = read_json(&rep);
         (r, std::fs::read_to_string(&ir).unwrap())
     };
     let (plain, _) = run("", "plain");
@@ -1626,8 +1612,7 @@ fn fused_multiply_adds_simulate_in_icarus_bit_for_bit() {
                 assert_eq!(e.to_bits(), s.to_bits(), "{interconnect} point {i}: output {k}: simulated {s}, -eval {e}");
             }
         }
-        let man: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+        let man: serde_json::Value = read_json(dir.join("manifest.json"));
         let aw = man["widths"]["aw"].as_u64().unwrap();
         assert_eq!(man["widths"]["instr"].as_u64().unwrap(), 5 * aw + 6, "the instruction word holds the mac fields");
         assert!(man["layout"]["instr"].as_str().unwrap().contains("read C"));
@@ -1655,8 +1640,7 @@ fn fused_multiply_adds_simulate_in_icarus_bit_for_bit() {
             macs += usize::from(mac);
         }
         assert!(macs >= 1, "{interconnect}: a MULTI PE takes the fused ops");
-        let res: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("resources.json")).unwrap()).unwrap();
+        let res: serde_json::Value = read_json(dir.join("resources.json"));
         let copies = res["memories"]
             .as_array()
             .unwrap()
