@@ -306,7 +306,7 @@ struct Issued<'a, 'k> {
 }
 
 impl Issued<'_, '_> {
-    /// Issues node `v` on slot `q` at cycle `t` (its operands' writes already committed): its
+    /// Issues node `v` on slot `q` at cycle `t`: its operands' `routes` committed (booked), its
     /// arrival queued, and the ready users whose keys the feeding bonus lowered re-queued.
     #[allow(clippy::too_many_arguments)]
     fn issue(
@@ -314,11 +314,13 @@ impl Issued<'_, '_> {
         ctx: &mut Ctx<'_>,
         dag: &OpDag,
         v: Node,
+        routes: &[Route],
         q: usize,
         t: u32,
         pending: &[u32],
         ready: &mut [[ReadyQueue; 2]],
     ) {
+        ctx.commit(dag.operands_of(v), routes, q);
         let lat = ctx.arch.lat.of(dag.kind(v));
         ctx.issue[v as usize] = (q as u32, t);
         ctx.arrival[v as usize] = t + lat;
@@ -457,9 +459,8 @@ pub fn schedule_until(
                 match best {
                     Some((_, i)) => {
                         let q = free.swap_remove(i);
-                        ctx.commit(operands, &best_routes, q);
                         let mut s = Issued { arrivals: &mut arrivals, feed: &mut feed, lowered: &mut lowered };
-                        s.issue(&mut ctx, dag, v, q, t, &pending, &mut ready);
+                        s.issue(&mut ctx, dag, v, &best_routes, q, t, &pending, &mut ready);
                         placed += 1;
                         progress = true;
                         free.sort_unstable();
@@ -470,7 +471,9 @@ pub fn schedule_until(
             for (k, v) in deferred.drain(..) {
                 ready[c][ty].push(k, v);
             }
-            idle[c][ty].clone_from(&free);
+            if dag.steal().is_some() {
+                idle[c][ty].clone_from(&free);
+            }
         }
         // Urgent ops of other clusters on the PEs their own clusters left idle (`steal`).
         if let Some(slack) = dag.steal() {
@@ -508,9 +511,8 @@ pub fn schedule_until(
                         match best {
                             Some((_, i)) => {
                                 let q = free.swap_remove(i);
-                                ctx.commit(operands, &best_routes, q);
                                 let mut s = Issued { arrivals: &mut arrivals, feed: &mut feed, lowered: &mut lowered };
-                                s.issue(&mut ctx, dag, v, q, t, &pending, &mut ready);
+                                s.issue(&mut ctx, dag, v, &best_routes, q, t, &pending, &mut ready);
                                 placed += 1;
                                 progress = true;
                             }
