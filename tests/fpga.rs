@@ -124,32 +124,40 @@ fn fixed_point_units_equal_the_model_bit_for_bit_on_random_operands() {
 }
 
 /// Narrow words (issue 49: `precision<word=W>`): the fixed-point units at DW = 27, 20 and 16 bits
-/// with the exact intermediate of [`intermediate_bits`] and the shifters of [`shift_ranges`] —
+/// with the intermediate of [`intermediate_bits`] and the shifters of [`shift_ranges`] (the ADD
+/// unit's of [`floored_shift_ranges`]) —
 /// the widths and shift ranges the generator gives each PE from the shifts of its program —
 /// against robovec's model, batch by batch: each batch draws its own largest alignment and a
 /// window of rounding shifts per unit (some all positive, as a MULTI PE's, some reaching left
-/// shifts), so its intermediate and shifters are as narrow as its ops allow; a quarter of the
+/// shifts; an ADD op's relative to its alignment), so its intermediate and shifters are as narrow as its ops allow; a quarter of the
 /// operands are the word's extremes (−2^(DW−1), 2^(DW−1) − 1), where a bit too few would wrap. A
 /// vector whose rounded result does not fit DW bits (the range proof excludes it) is drawn again.
 ///
 /// [`intermediate_bits`]: robovec_machine::design::build::intermediate_bits
 /// [`shift_ranges`]: robovec_machine::design::build::shift_ranges
+/// [`floored_shift_ranges`]: robovec_machine::design::build::floored_shift_ranges
 #[test]
 fn narrow_fixed_point_units_with_the_generators_intermediate_width_equal_the_model() {
     use robovec_ir::machine::{FixShifts, MachineOp};
-    use robovec_machine::design::build::{intermediate_bits, shift_ranges};
+    use robovec_machine::design::build::{floored_shift_ranges, intermediate_bits, shift_ranges};
     tool("iverilog");
     let mut rng = robovec_ir::rng::SplitMix64::new(4927);
     for dw in [27u32, 20, 16] {
         for batch in 0..4 {
             let d = tmp(&format!("fix_units_dw{dw}_{batch}"));
             let max_align = rng.below(24) as i64 + 1;
-            // each unit's window of rounding shifts: from −10 … 2·DW, 1 to 40 amounts wide
-            let mut window = || {
+            // the MULTI unit's window of rounding shifts: from −10 … 2·DW, 1 to 40 amounts wide
+            let mul_window = {
                 let lo = rng.below(2 * u64::from(dw) + 11) as i64 - 10;
                 (lo, (lo + rng.below(40) as i64).min(2 * i64::from(dw)))
             };
-            let (add_window, mul_window) = (window(), window());
+            // an ADD op's rounding is drawn around its alignment (S = A + offset, offsets in a
+            // window of −10 … 15, as a sum rounds to about its coarser operand's grid): its
+            // floored form then floors by up to A, and rounds by up to 15 or shifts left
+            let add_window = {
+                let lo = rng.below(15) as i64 - 10;
+                (lo, lo + rng.below(12) as i64)
+            };
             let (lo, hi) = (-(1i64 << (dw - 1)), (1i64 << (dw - 1)) - 1);
             let (mut lines, mut n) = (String::new(), 0usize);
             let (mut adds, mut muls) = (Vec::new(), Vec::new());
@@ -162,10 +170,11 @@ fn narrow_fixed_point_units_with_the_generators_intermediate_width_equal_the_mod
                 };
                 let (a, b) = (draw(), draw());
                 let (lo_s, hi_s) = if op == 2 { mul_window } else { add_window };
+                let align = if op == 2 { 0 } else { rng.below(max_align as u64 + 1) as i64 };
                 let sh = FixShifts {
-                    align: if op == 2 { 0 } else { rng.below(max_align as u64 + 1) as u8 },
+                    align: align as u8,
                     align_b: rng.below(2) == 1,
-                    shift: (lo_s + rng.below((hi_s - lo_s + 1) as u64) as i64) as i8,
+                    shift: (lo_s + rng.below((hi_s - lo_s + 1) as u64) as i64 + align).clamp(-64, 63) as i8,
                 };
                 let unit = [MachineOp::Add, MachineOp::Sub, MachineOp::Mul][op as usize].clone();
                 let Some(y) = sh.apply(&unit, a, b).and_then(|y| i64::try_from(y).ok()) else { continue };
@@ -181,7 +190,7 @@ fn narrow_fixed_point_units_with_the_generators_intermediate_width_equal_the_mod
                 lines += &format!("{op:01x}{:08x}{:08x}{:08x}{:08x}\n", w(a), w(b), sh.word(), w(y));
                 n += 1;
             }
-            let (ra, rm) = (shift_ranges(adds.iter().copied()), shift_ranges(muls.iter().copied()));
+            let (ra, rm) = (floored_shift_ranges(adds.iter().copied()), shift_ranges(muls.iter().copied()));
             let (kwa, kwm) = (intermediate_bits(dw, false, adds), intermediate_bits(dw, true, muls));
             // narrower than the 32-bit word's 64 bits: the test exercises the narrowing
             assert!(kwa < 64 && kwm < 64, "dw {dw}: intermediates {kwa}, {kwm}");
@@ -195,6 +204,7 @@ fn narrow_fixed_point_units_with_the_generators_intermediate_width_equal_the_mod
                 ("ONE", one),
                 ("KWA", kwa),
                 ("KWM", kwm),
+                ("RMAX", u32::from(ra.floor_max)),
                 ("AMAX", u32::from(ra.align_max)),
                 ("SMINA7", b7(ra.shift_min)),
                 ("SMAXA7", b7(ra.shift_max)),
@@ -691,11 +701,17 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
             let instr = words_of("instr").unwrap();
             assert_eq!(words.len(), instr.len());
             let cut = |x: u128, lo: u32, bits: u32| (x >> lo) & ((1u128 << bits) - 1);
+            // an ADD PE in floored form reads its finer operand at A: an op aligning a (align-b
+            // bit 0) has its reads swapped
+            let floors = c["fix"].get("floors").is_some_and(|f| f.as_bool().unwrap());
             for (cycle, &w) in words.iter().enumerate() {
+                let issues = cut(instr[cycle], 4 * aw + 2, 1) == 1;
+                let swapped = floors && issues && words_of("fix").unwrap()[cycle] >> 6 & 1 == 0;
                 for k in 0..4 {
                     let field = cut(instr[cycle], k * aw, aw);
                     assert!(field < depth.max(1) || field == 0, "{what}: an address beyond the memory");
-                    assert_eq!(cut(w, k * pa, pa), field, "{what} cycle {cycle}: address field {k}");
+                    let at = if swapped && k < 2 { 1 - k } else { k };
+                    assert_eq!(cut(w, at * pa, pa), field, "{what} cycle {cycle}: address field {k}");
                 }
                 assert_eq!(cut(w, 4 * pa, 4), cut(instr[cycle], 4 * aw, 4), "{what} cycle {cycle}: flags");
                 let mut lo = 4 * pa + 4;
@@ -719,27 +735,33 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
                 assert_eq!(cut(w, lo + po, 1), cut(capt, ow, 1), "{what} cycle {cycle}: capture enable");
                 lo += po + 1;
                 if let Some(fix) = words_of("fix") {
-                    // the 14-bit shift word ([0,6) align, bit 6 align b, [7,14) s) cut to the PE's shifts
+                    // the 14-bit shift word ([0,6) align, bit 6 align b, [7,14) s) cut to the PE's
+                    // shifts; on an ADD PE in floored form, the floor r = min(A, S − 1) (0 when
+                    // S ≤ 0) first, then the lift A − r and the rounding S − r
                     let f = &c["fix"];
+                    let rb = f["floor_bits"].as_u64().unwrap() as u32;
                     let ab = f["align_bits"].as_u64().unwrap() as u32;
                     let alb = u32::from(f["align_b"].as_bool().unwrap());
                     let (sb, smin) = (f["shift_bits"].as_u64().unwrap() as u32, f["shift_min"].as_i64().unwrap());
                     let word = fix[cycle];
+                    let a = cut(word, 0, 6) as i64;
                     let s = ((word >> 7) & 127) as i64 - if word >> 13 & 1 == 1 { 128 } else { 0 };
-                    let issues = cut(instr[cycle], 4 * aw + 2, 1) == 1;
+                    let r = if floors && s >= 1 { a.min(s - 1) } else { 0 };
+                    let (a, s) = (a - r, s - r);
                     let expect = if issues {
-                        assert!(
-                            cut(word, 0, 6) < 1 << ab || cut(word, 0, 6) == 0,
-                            "{what}: an alignment beyond the field"
-                        );
+                        assert!(r < 1 << rb || r == 0, "{what}: a floor beyond the field");
+                        assert!(a < 1 << ab || a == 0, "{what}: an alignment beyond the field");
                         assert!(alb == 1 || cut(word, 6, 1) == 0, "{what}: align b on a PE without the bit");
                         assert!(s >= smin && s - smin < 1 << sb, "{what}: a shift {s} outside {smin} + {sb} bits");
-                        cut(word, 0, ab) | cut(word, 6, alb) << ab | ((s - smin) as u128) << (ab + alb)
+                        r as u128
+                            | (a as u128) << rb
+                            | cut(word, 6, alb) << (rb + ab)
+                            | ((s - smin) as u128) << (rb + ab + alb)
                     } else {
                         0
                     };
-                    assert_eq!(cut(w, lo, ab + alb + sb), expect, "{what} cycle {cycle}: shift word");
-                    lo += ab + alb + sb;
+                    assert_eq!(cut(w, lo, rb + ab + alb + sb), expect, "{what} cycle {cycle}: shift word");
+                    lo += rb + ab + alb + sb;
                 }
                 assert_eq!(lo, width);
             }

@@ -24,7 +24,11 @@ fuzz_target!(|data: &[u8]| {
     let _ = t.fix_pe.latencies_for(t.family, word, false);
     let _ = t.fix_pe.latencies_for(t.family, word, true);
     let m = cost_model(&t);
-    let ranges =
-        ShiftRanges { align_max: head[3] % 64, shift_min: -((head[3] % 65) as i8), shift_max: (head[3] % 63) as i8 };
+    let ranges = ShiftRanges {
+        align_max: head[3] % 64,
+        shift_min: -((head[3] % 65) as i8),
+        shift_max: (head[3] % 63) as i8,
+        floor_max: head[3] % 63,
+    };
     let _ = fixed_unit(&m, word, head[3] & 2 == 2, word + u32::from(head[3] % 40), ranges);
 });

@@ -194,9 +194,11 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "control": "per PE (`control`): one word per cycle, from bit 0: the instruction's four addresses `pa` bits each \
             (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word with its addresses cut to \
             `pb` bits each (store address, read address, store enable, read enable); the `capt` word with its address cut to `po` \
-            bits (address, enable); on fixed-point PEs the `fix` word cut to the PE's shifts (`control.fix`: `align_bits` of \
-            alignment, the align-b bit when `align_b`, the rounding shift less `shift_min` in `shift_bits`; zero on a cycle \
-            that issues nothing); split into `lanes` (the HDL's control memories)",
+            bits (address, enable); on fixed-point PEs the `fix` word cut to the PE's shifts (`control.fix`: `floor_bits` of \
+            floor r, `align_bits` of alignment, the align-b bit when `align_b`, the rounding shift less `shift_min` in \
+            `shift_bits`; zero on a cycle that issues nothing; on ADD PEs, `floors`, the op's floored form: r = min(align, \
+            s - 1) for s >= 1 (else 0), the alignment less r, s less r, and an op whose align-b bit is 0 reads A and B \
+            swapped, so the finer operand is read at A); split into `lanes` (the HDL's control memories)",
         "data": match d.pe_kind {
             PeKind::Binary32 => "binary32",
             PeKind::Fixed => "fixed point: the `word_bits`-bit two's complement integer k of a value k·2^-f (each load's and output's `fraction`); out_data sign-extends it to 32 bits",

@@ -488,15 +488,17 @@ fn levels(span: i32) -> f64 {
     }
 }
 
-/// The structure of a fixed-point unit (`hdl/fix_units.v`) of `dw`-bit words, a `kw`-bit exact
+/// The structure of a fixed-point unit (`hdl/fix_units.v`) of `dw`-bit words, a `kw`-bit
 /// intermediate and the shifts `r`, in ALM of the Cyclone V: least squares on Yosys 0.23
-/// `synth_intel_alm` of the units at `LATENCY` 2 (one-multiplier products) or 3 (split ones),
-/// 27 ADD and 14 MULTI configurations of DW 16–32, KW 29–64 (docs/fpga.md "Units sized to
-/// their shifts"):
-/// - ADD: `0.64·(KW + DW)` (registers, the aligned adder, the rounding's increment)
-///   `+ 0.30·KW·La` (the alignment shifter, `La = ⌈log₂(AMAX + 1)⌉` levels)
-///   `+ 0.82·(DW + 1)·Ls` (the rounding shifter, `Ls = ⌈log₂(SMAX − SMIN + 1)⌉`; it keeps the
-///   result's DW + 1 bits); within 15 % of Yosys on the configurations generated designs have;
+/// `synth_intel_alm` of the units at `LATENCY` 2 (one-multiplier products) or 3 (split ones):
+/// - ADD, in its floored form (`fix_add_sub`, [`crate::design::build::FloorShifts`]; 36
+///   configurations of DW 16–32, floors up to 0–62 bits, lifts up to 0–63, roundings of 1 to
+///   128 amounts): `1.36·(KW + DW)` (registers, the adder, the rounding's increment)
+///   `+ 0.50·KW·Lr` (the floor shifter, `Lr = ⌈log₂(RMAX + 1)⌉` levels)
+///   `+ 0.26·KW·La` (the lift shifter, `La = ⌈log₂(AMAX + 1)⌉`)
+///   `+ 0.25·(DW + 1)·Ls` (the rounding shifter, `Ls = ⌈log₂(SMAX − SMIN + 1)⌉`)
+///   `+ 0.32·DW` when it floors (the carry in of a negated floored operand); from 13 % under to
+///   31 % over Yosys, 11 % RMS (docs/fpga.md "ADD units in floored form");
 /// - MULTI: `0.38·(KW + DW) + 0.6·(DW + 1)·(Ls − 1)`, plus `1.3·KW` for a product split in four
 ///   partial products (their sum); within 20 ALM of Yosys where `Ls ≤ 4` (a design's MULTI PEs
 ///   round by 3 to 9 amounts), 30 % under it at the full range.
@@ -507,8 +509,10 @@ fn unit_structure(dw: u32, is_mul: bool, kw: u32, r: ShiftRanges, family: Family
         let split = if dw > f64::from(family.one_multiplier_word()) { 1.3 * kw } else { 0.0 };
         0.38 * (kw + dw) + 0.6 * (dw + 1.0) * (ls - 1.0).max(0.0) + split
     } else {
+        let lr = levels(i32::from(r.floor_max));
         let la = levels(i32::from(r.align_max));
-        0.64 * (kw + dw) + 0.30 * kw * la + 0.82 * (dw + 1.0) * ls
+        let sticky = if r.floor_max > 0 { 0.32 * dw } else { 0.0 };
+        1.36 * (kw + dw) + 0.50 * kw * lr + 0.26 * kw * la + 0.25 * (dw + 1.0) * ls + sticky
     }
 }
 
@@ -517,9 +521,11 @@ fn unit_structure(dw: u32, is_mul: bool, kw: u32, r: ShiftRanges, family: Family
 /// ([`crate::design::build::shift_ranges`]): the target's `fix_pe` cost, which is the 32-bit
 /// word's with a 64-bit intermediate and [`ShiftRanges::FULL`], scaled by the unit's structure
 /// against that one's (`unit_structure`: registers and adders grow with the widths, each
-/// shifter with its levels). The same ratio holds on both families: Yosys measures a typical
-/// ADD PE (27-bit words, KW 51, aligning by ≤ 31, rounding by −16 … 14) at 0.59 of the full
-/// unit on the Cyclone V and 0.55 on the ECP5 (`synth_ecp5`, LUT4), the structure at 0.66.
+/// shifter with its levels). On the ECP5 the target's `fix_pe.add` is the reference that
+/// scales to Yosys' `synth_ecp5` LUT4 counts of the ADD PEs designs have (the full-range unit
+/// itself maps to 3,177 LUT4: its two 6-level shifters over 64 bits cost more in LUT4 than the
+/// structure says; a typical WALK-MAN ADD PE, 26-bit words flooring by ≤ 18, lifting by ≤ 1,
+/// rounding by 0 … 1, is 435 LUT4 and 157 ALM).
 /// A MULTI PE's multipliers follow the family's DSP modes: on the Cyclone V one
 /// variable-precision block for a product of words of at most 27 bits (27 × 27 mode: Yosys maps
 /// it to one `MISTRAL_MUL27X27`), on the ECP5 one MULT18X18D for words of at most 18 bits;
@@ -540,7 +546,7 @@ pub fn fixed_unit(m: &CostModel, dw: u32, is_mul: bool, kw: u32, r: ShiftRanges)
 /// MULTI unit ([`fixed_unit`]) plus the addend's path — its register, the swap of the aligned
 /// term, the alignment shifter (`La = ⌈log₂(AMAX + 1)⌉` levels), the two negations and the
 /// `kw`-bit adder — costed like the ADD unit (the target's `fix_pe.add` scaled by
-/// `unit_structure`) at `2.25·KW + 0.42·KW·La` structure units: on the Cyclone V
+/// `unit_structure`) at `2.48·KW + 0.46·KW·La` structure units: on the Cyclone V
 /// `2.4·KW + 0.45·KW·La` ALM, fitted to Yosys 0.23 `synth_intel_alm` of `fix_mac` less `fix_mul`
 /// at `LATENCY = 2`, 27-bit words, rounding by 25 to 30 bits (KW 64: 155, 278, 317 ALM more for
 /// AMAX 0, 15, 47; KW 56, AMAX 15: 268), within 13 % of those. The same DSP blocks as the
@@ -549,7 +555,7 @@ pub fn fixed_mac_unit(m: &CostModel, dw: u32, kw: u32, r: ShiftRanges) -> UnitCo
     let mul = fixed_unit(m, dw, true, kw, r);
     let full = unit_structure(32, false, 64, ShiftRanges::FULL, m.family);
     let kwf = f64::from(kw.min(64));
-    let adder = 2.25 * kwf + 0.42 * kwf * levels(i32::from(r.align_max));
+    let adder = 2.48 * kwf + 0.46 * kwf * levels(i32::from(r.align_max));
     let alm = (m.fix_add.alm as f64 * adder / full).ceil().max(0.0) as u64;
     UnitCost { alm: mul.alm + alm, dsp: mul.dsp, m10k: mul.m10k }
 }

@@ -32,7 +32,7 @@
 //! | `datapath.fp64_add` | 886 ALM, 0 DSP | Intel, *Floating-Point IP Cores User Guide* (UG-01058), "FP_FUNCTIONS Resource Utilization": double-precision Add on Arria V (the same 28 nm ALM and variable-precision DSP block as Cyclone V; its single-precision Add is the seed's 360 ALM) |
 //! | `datapath.fp64_mul` | 250 ALM, 4 DSP | estimate: a 53 × 53 mantissa product tiles into four 27 × 27 blocks (the "54 × 54: four blocks" row of Intel's variable-precision DSP tables); ALM 2.5 × the seed's binary32 MULTI (exponent, rounding and normalisation twice as wide, plus the tiles' adder). No datasheet figure at hand |
 //! | `datapath.convert_alm` | 100 ALM per conversion | estimate: a conversion between fixed and floating point (or binary32 and binary64) is a leading-zero count and a barrel shift of the word, of the order of the seed's MULTI PE logic (100 ALM) |
-//! | `fix_pe.add` | latency 3 cycles = 1 stage + 2; 390 ALM, 0 DSP | issue 49: a 64-bit aligned add and the rounding shift (`hdl/fix_units.v`, `fix_add_sub`): the exact sum registered, its rounding computed in the next clock straight into the PE's result register (the issue's "1–2 stages"; until the units were sized to their shifts a second, empty stage delayed the rounded result by a clock for nothing: every register-to-register path is the same without it; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design at 88 MHz, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` with 32-bit words, KW = 64 and any shift (`AMAX = 63`, `SMIN = −64`, `SMAX = 63`: [`crate::design::build::ShiftRanges::FULL`]) by [`crate::resources`]' packing bound (164 LUT6, 346 smaller LUTs, 106 carry bits); a design's PEs are sized to their own shifts and widths (`resources::fixed_unit`: a typical Jeep ADD PE 231 ALM) |
+//! | `fix_pe.add` | latency 3 cycles = 1 stage + 2; 477 ALM, 0 DSP | issue 49: the floored sum and its rounding (`hdl/fix_units.v`, `fix_add_sub`: the finer operand floored, the coarser lifted, the sum rounded by the few bits left, [`crate::design::build::FloorShifts`]): the sum registered, its rounding computed in the next clock straight into the PE's result register (the issue's "1–2 stages"; until the units were sized to their shifts a second, empty stage delayed the rounded result by a clock for nothing: every register-to-register path is the same without it; declared for the DE10-Nano, whose clock the M10K sets; on the ECP5-85F nextpnr measures the design, docs/fpga.md); ALM from Yosys 0.23 `synth_intel_alm` of that module at `LATENCY = 2` with 32-bit words, KW = 64 and any shift (`RMAX = 62`, `AMAX = 63`, `SMIN = −64`, `SMAX = 63`: [`crate::design::build::ShiftRanges::FULL`]) by [`crate::resources`]' packing bound; a design's PEs are sized to their own shifts and widths (`resources::fixed_unit`: a typical WALK-MAN ADD PE, 26-bit words flooring by ≤ 18 and rounding by 0 … 1, 157 ALM, where the aligned form took 240) |
 //! | `fix_pe.mul` | latency 4 cycles = 2 stages + 2; 299 ALM, 2 DSP | a 32 × 32 signed product as four registered 16 × 16 partial products (four 18 × 19 multipliers, two per Cyclone V variable-precision block: 2 blocks), their sum registered, and the rounding shift (any shift) into the result register; a product that is one DSP multiplier is registered and rounded: 3 cycles ([`FixPe::latencies_for`]); ALM from Yosys as above at `LATENCY = 3` (41 LUT6, 474 smaller LUTs, 41 carry bits; 4 `MISTRAL_MUL18X18`); a 27-bit MULTI PE rounding by 24 to 26 bits, as the Jeep's, is one 27 × 27 block and 36 ALM |
 //! | `output_word_alm` | 0 ALM per output-memory word | not in the seed (its outputs are read from the PE memories); the FPGA back end's output memories are block RAM with a registered read port (`rv_out_mem`), counted as M10K blocks, so they take no logic a word. (Until issue 49 they were 32-bit registers read asynchronously: 16 ALM a word, the slope Yosys measured per PE, [`crate::resources`].) The key stays for a design whose output words cost logic; optional in a JSON target (default 0) |
 //! | `design_logic` | 0.35 ALM per multiplexer input bit, 0.4 per write-port bit, 1.35 per PE bit, 1.2 per further buffer-word bit | not the seed's: Yosys 0.23 `synth_intel_alm` of robovec's generated designs, which the FPGA back end's analytic estimate predicts in place of the seed-form `crossbar_alm`, `pe_memory_alm` and `control_alm` (Quartus' figures of the seed's design, below Yosys' of these designs); measured and fitted as [`Family::design_logic`] says |
@@ -71,7 +71,7 @@
 //! | `latencies`, `fix_pe.*.latency` | as the DE10-Nano's | the same Verilog units and pipeline (SPEC §1's + 2) |
 //! | `pe_words` | 512 | a PE memory as four simple dual-port banks of one EBR each (512 × 36, `PDPW16KD`) and its live-value table ([`PeMemory::LiveValueTable`]) |
 //! | `fp_add`, `fp_mul` | 1 675 LUT4; 1 261 LUT4 + 4 MULT18X18D | Yosys `synth_ecp5` of `fp_add_sub` (`LATENCY = 10`) and `fp_mul` (5) alone: LUT4 + 2 × CCU2C |
-//! | `fix_pe.add`, `fix_pe.mul` | 1 494 LUT4; 2 129 LUT4 + 4 MULT18X18D | Yosys `synth_ecp5` of the same full-range units (LUT4 + 2 × CCU2C; `fix_add_sub` at `LATENCY = 2`, `fix_mul` at 3); a design's PEs are sized to their shifts (`resources::fixed_unit`: a typical ADD PE, 27-bit words aligning by ≤ 31 and rounding by −16 … 14, is 823 LUT4; a 27-bit MULTI PE rounding by 24 to 26 bits, 230 LUT4) |
+//! | `fix_pe.add`, `fix_pe.mul` | 1 400 LUT4; 2 129 LUT4 + 4 MULT18X18D | Yosys `synth_ecp5` (LUT4 + 2 × CCU2C): `fix_mul` of the full range at 3; `fix_add_sub` (floored form) the reference that scales ([`crate::resources`]) to the ADD PEs designs have (seven configurations of 16–32-bit words: 309 to 978 LUT4, a typical WALK-MAN ADD PE 435; the full-range unit itself is 3 177); a 27-bit MULTI PE rounding by 24 to 26 bits is 230 LUT4 |
 //! | `pe_memory_alm`, `pe_word_alm` | 314 LUT4 + 4.1 LUT4 per word | Yosys of `rv_pe_mem_lvt` at 64, 512 and 1 024 words (575, 2 403, 4 445 LUT4): the bypass and bank choice, and the live-value table (a bit a word, two write and two read ports) in logic |
 //! | `crossbar_alm` | 60 LUT4 per multiplexer input | Yosys of `rv_mux` with 17 sources (1 011 LUT4 + 5 CCU2C: 60 a source; 9 sources: 44) |
 //! | `output_word_alm` | 0 | the DE10-Nano's: output memories are block RAM (EBR) |
@@ -117,7 +117,7 @@
 //!     "convert_alm": 100
 //!   },
 //!   "fix_pe": {
-//!     "add": { "latency": 3, "alm": 390, "dsp": 0, "m10k": 0 },
+//!     "add": { "latency": 3, "alm": 477, "dsp": 0, "m10k": 0 },
 //!     "mul": { "latency": 4, "alm": 299, "dsp": 2, "m10k": 0 }
 //!   }
 //! }
@@ -456,7 +456,7 @@ impl Default for FixPe {
     /// The DE10-Nano's (module doc).
     fn default() -> Self {
         FixPe {
-            add: FixUnit { latency: 3, alm: 390.0, dsp: 0, m10k: 0 },
+            add: FixUnit { latency: 3, alm: 477.0, dsp: 0, m10k: 0 },
             mul: FixUnit { latency: 4, alm: 299.0, dsp: 2, m10k: 0 },
         }
     }
@@ -779,7 +779,7 @@ impl Target {
                 convert_alm: 200.0,
             },
             fix_pe: FixPe {
-                add: FixUnit { latency: 3, alm: 1494.0, dsp: 0, m10k: 0 },
+                add: FixUnit { latency: 3, alm: 1400.0, dsp: 0, m10k: 0 },
                 mul: FixUnit { latency: 4, alm: 2129.0, dsp: 4, m10k: 0 },
             },
             pnr: Some(crate::pnr::PnrPart { device: "85k".into(), package: "CABGA381".into() }),

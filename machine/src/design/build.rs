@@ -107,22 +107,75 @@ fn word_mask(bits: u32) -> u64 {
     }
 }
 
-/// Bits of the exact intermediate K (`hdl/fix_units.v`) that a fixed-point PE of `dw`-bit words
-/// needs for the ops whose shifts are `shifts`: an ADD PE's aligned sum `dw + align + 1` bits
-/// and one more for the rounding constant's addition, a MULTI PE's product `2·dw` and one more;
-/// at least `s + 2` for a rounding by `s` bits (its constant `2^(s−1)` positive); at most 64
-/// (robovec's `INTEGER_BITS` bound of 62 bits on every exact intermediate, with the range
-/// proof, `robovec_ir::format`).
+/// Bits of the intermediate K (`hdl/fix_units.v`) that a fixed-point PE of `dw`-bit words
+/// needs for the ops whose shifts are `shifts`:
+/// - a MULTI PE's product: `2·dw` bits and one more, at least `s + 2` for a rounding by `s` bits
+///   (its constant `2^(s−1)` positive);
+/// - an ADD PE's floored sum ([`FloorShifts`]): `dw + max(D, 1)` bits for its largest rounding
+///   `D` — the sum is computed modulo `2^KW`, which is exact for the bits the rounding keeps, since
+///   the range proof puts every result within `dw` bits (`round_D(Z)`'s low `dw` bits are those of
+///   `Z + 2^(D−1)`'s bits `D … dw + D − 1`; a left shift, `D ≤ 0`, keeps bits below `dw`).
+///
+/// At most 64 (robovec's `INTEGER_BITS` bound of 62 bits on every exact intermediate, with the
+/// range proof, `robovec_ir::format`).
 pub fn intermediate_bits(dw: u32, is_mul: bool, shifts: impl IntoIterator<Item = FixShifts>) -> u32 {
-    let base = if is_mul { 2 * dw + 1 } else { dw + 2 };
+    if !is_mul {
+        let d = shifts.into_iter().map(|sh| i32::from(FloorShifts::of(sh).round)).fold(1, i32::max);
+        return (dw + d as u32).min(64);
+    }
     shifts
         .into_iter()
-        .map(|sh| {
-            let exact = if is_mul { 2 * dw + 1 } else { dw + u32::from(sh.align) + 2 };
-            exact.max(u32::try_from(sh.shift).unwrap_or(0) + 2)
-        })
-        .fold(base, u32::max)
+        .map(|sh| (2 * dw + 1).max(u32::try_from(sh.shift).unwrap_or(0) + 2))
+        .fold(2 * dw + 1, u32::max)
         .min(64)
+}
+
+/// An ADD op's shifts as the ADD unit applies them (`fix_add_sub` in `hdl/fix_units.v`): the
+/// finer operand floored by `floor` bits, the coarser lifted by `lift` bits, their sum rounded
+/// by `round` bits (a left shift when `round ≤ 0`).
+///
+/// The op's exact sum is `K = x_f ± (x_c << A)` (`A` = [`FixShifts::align`], `x_f` the operand
+/// not aligned), rounded by `S` = [`FixShifts::shift`]. With `r = min(A, S − 1)` for `S ≥ 1`
+/// (else 0), `(x_c << A) + 2^(S−1)` is a multiple of `2^r`, so
+/// `round_S(K) = round_(S−r)(⌊±x_f / 2^r⌋ ± (x_c << (A − r)))`: the floor drops only bits
+/// below the grid the rounding keeps. The unit then adds words of about the result's width,
+/// not the aligned sum's `dw + A + 2` bits, and its rounding shifts by `S − r`, which is 0 or 1
+/// for nearly every op (a sum rounds to the coarser operand's grid or one bit coarser):
+/// WALK-MAN's 20,475 ADD ops at 26-bit words need `D ∈ {−3, −1, 0, 1}` where `S` took 0 … 24.
+/// (The same reformulation as the smaller multiply-add, docs/fpga.md.)
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FloorShifts {
+    /// Bits the finer operand is floored (`r`, 0 ≤ r ≤ A).
+    pub floor: u8,
+    /// Bits the coarser operand is shifted left (`A − r`).
+    pub lift: u8,
+    /// Bits the sum is rounded (`S − r`; negative: a left shift).
+    pub round: i8,
+}
+
+impl FloorShifts {
+    /// The floored form of an ADD op's shifts `sh` (see the type).
+    pub fn of(sh: FixShifts) -> FloorShifts {
+        let (a, s) = (i32::from(sh.align & 63), i32::from(sh.shift));
+        let r = if s >= 1 { a.min(s - 1) } else { 0 };
+        FloorShifts { floor: r as u8, lift: (a - r) as u8, round: (s - r) as i8 }
+    }
+
+    /// `K`'s rounding computed the unit's way (the model the HDL is checked against):
+    /// `⌊±x_f / 2^r⌋ ± (x_c << l)` rounded by `D` (ties toward +∞), for `a ± b` with `sh`'s
+    /// operand order and alignment (`None` when an intermediate leaves 64 bits).
+    pub fn apply(sh: FixShifts, sub: bool, a: i64, b: i64) -> Option<i64> {
+        let f = FloorShifts::of(sh);
+        // the finer operand and the coarser, each with its sign in the op
+        let (xf, xc) = if sh.align_b {
+            (i128::from(a), if sub { -i128::from(b) } else { i128::from(b) })
+        } else {
+            (if sub { -i128::from(b) } else { i128::from(b) }, i128::from(a))
+        };
+        let z = (xf >> f.floor) + (xc << f.lift);
+        let y = if f.round >= 1 { (z + (1i128 << (f.round - 1))) >> f.round } else { z << -i32::from(f.round) };
+        i64::try_from(y).ok()
+    }
 }
 
 /// Bits of the exact intermediate K of a MULTI PE with the multiply-add unit (`fix_mac` in
@@ -156,25 +209,45 @@ pub struct ShiftRanges {
     pub shift_min: i8,
     /// The largest rounding shift (bits).
     pub shift_max: i8,
+    /// The largest floor of the finer operand (bits; ADD PEs, whose ranges are those of the
+    /// ops' [`FloorShifts`]: `align_max` their largest lift, `shift_min … shift_max` their
+    /// roundings; 0 on MULTI PEs).
+    pub floor_max: u8,
 }
 
 impl ShiftRanges {
     /// Any shift a shift word holds: alignments up to 63 bits (6 levels), any 7-bit rounding
-    /// shift. The unit the target's `fix_pe` costs describe, and the HDL's defaults.
-    pub const FULL: ShiftRanges = ShiftRanges { align_max: 63, shift_min: -64, shift_max: 63 };
+    /// shift, floors up to 62 bits. The unit the target's `fix_pe` costs describe, and the
+    /// HDL's defaults.
+    pub const FULL: ShiftRanges = ShiftRanges { align_max: 63, shift_min: -64, shift_max: 63, floor_max: 62 };
 }
 
 /// The [`ShiftRanges`] of the ops whose shifts are `shifts` (the issued ops of one PE; none:
-/// `AMAX = 0`, `SMIN = SMAX = 0`).
+/// `AMAX = 0`, `SMIN = SMAX = 0`) on a MULTI PE (`floor_max` 0).
 pub fn shift_ranges(shifts: impl IntoIterator<Item = FixShifts>) -> ShiftRanges {
     let mut r: Option<ShiftRanges> = None;
     for sh in shifts {
-        let x = r.get_or_insert(ShiftRanges { align_max: 0, shift_min: sh.shift, shift_max: sh.shift });
+        let x = r.get_or_insert(ShiftRanges { align_max: 0, shift_min: sh.shift, shift_max: sh.shift, floor_max: 0 });
         x.align_max = x.align_max.max(sh.align & 63);
         x.shift_min = x.shift_min.min(sh.shift);
         x.shift_max = x.shift_max.max(sh.shift);
     }
-    r.unwrap_or(ShiftRanges { align_max: 0, shift_min: 0, shift_max: 0 })
+    r.unwrap_or(ShiftRanges { align_max: 0, shift_min: 0, shift_max: 0, floor_max: 0 })
+}
+
+/// The [`ShiftRanges`] of an ADD PE whose ops' shifts are `shifts`: those of their
+/// [`FloorShifts`] (the largest lift as `align_max`, the roundings, the largest floor).
+pub fn floored_shift_ranges(shifts: impl IntoIterator<Item = FixShifts>) -> ShiftRanges {
+    let mut r: Option<ShiftRanges> = None;
+    for sh in shifts {
+        let f = FloorShifts::of(sh);
+        let x = r.get_or_insert(ShiftRanges { align_max: 0, shift_min: f.round, shift_max: f.round, floor_max: 0 });
+        x.align_max = x.align_max.max(f.lift);
+        x.shift_min = x.shift_min.min(f.round);
+        x.shift_max = x.shift_max.max(f.round);
+        x.floor_max = x.floor_max.max(f.floor);
+    }
+    r.unwrap_or(ShiftRanges { align_max: 0, shift_min: 0, shift_max: 0, floor_max: 0 })
 }
 
 /// What the target cannot hold or the hardware cannot do, one line each with the figures
@@ -374,7 +447,15 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
         let img = |k: &str, width: u32, words: Vec<u64>| Image { name: format!("pe{s}_{k}"), width, words };
         let mut data: Vec<u64> = pe.init.iter().map(|w| initial_word(w, fx)).collect();
         let mut out: Vec<u64> = pe.output_init.iter().map(|w| initial_word(w, fx)).collect();
-        let shift_ranges = fx.map(|x| shift_ranges(x.shifts[s].iter().flatten().copied()));
+        let is_add = s < m.arch.n_add as usize;
+        let shift_ranges = fx.map(|x| {
+            let ops = x.shifts[s].iter().flatten().copied();
+            if is_add {
+                floored_shift_ranges(ops)
+            } else {
+                shift_ranges(ops)
+            }
+        });
         let fix = fx.map(|x| {
             let words = x.shifts[s].iter().map(|sh| sh.map_or(0, |sh| sh.word())).collect();
             img("fix", robovec_ir::machine::FixShifts::BITS, words)
@@ -386,7 +467,7 @@ pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result
             mac,
             slot: s,
             pe: pname,
-            is_mul: s >= m.arch.n_add as usize,
+            is_mul: !is_add,
             instr: img("instr", widths.instr, im.instr[s].clone()),
             xbar: img("xbar", widths.xbar(), im.crossbar[s].clone()),
             bufi: img("bufi", widths.bufi(), im.buffer[s].clone()),
@@ -440,5 +521,57 @@ pub fn pe_name(arch: &PeArray, s: usize) -> String {
         format!("add{s}")
     } else {
         format!("mul{}", s - arch.n_add as usize)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 4096, max_global_rejects: 1 << 16, ..ProptestConfig::default() })]
+        /// The floored form computes every ADD op's rounding exactly (the identity of
+        /// [`FloorShifts`]), the HDL's ranges cover it, and the intermediate is wide enough:
+        /// against [`FixShifts::apply`] on any operands, alignment and rounding (within the
+        /// 62-bit exact bound) whose result fits `dw` bits, also computed modulo `2^KW`.
+        #[test]
+        fn floored_adds_equal_the_exact_rounding(
+            dw in 8u32..=32,
+            (a, ba) in (any::<i64>(), 1u32..=32),
+            (b, bb) in (any::<i64>(), 1u32..=32),
+            align in 0u8..=40,
+            align_b in any::<bool>(),
+            delta in -24i8..=22,
+            sub in any::<bool>(),
+        ) {
+            // operands of any magnitude within dw bits; roundings around the alignment (where
+            // results fit the word), from left shifts to well past it
+            let (a, b) = (a >> (64 - ba.min(dw)), b >> (64 - bb.min(dw)));
+            let sh = FixShifts { align, align_b, shift: (align as i8 + delta).max(-20) };
+            let op = if sub { MachineOp::Sub } else { MachineOp::Add };
+            let exact = FixShifts { shift: 0, ..sh }.apply(&op, a, b).unwrap();
+            prop_assume!(exact.abs() < 1 << 62);
+            let want = sh.apply(&op, a, b).unwrap();
+            prop_assume!(want >= -(1i128 << (dw - 1)) && want < 1i128 << (dw - 1));
+            prop_assert_eq!(FloorShifts::apply(sh, sub, a, b).map(i128::from), Some(want));
+            let f = FloorShifts::of(sh);
+            let r = floored_shift_ranges([sh]);
+            prop_assert!(f.floor <= r.floor_max && f.lift <= r.align_max);
+            prop_assert!(r.shift_min <= f.round && f.round <= r.shift_max);
+            prop_assert_eq!(i32::from(f.floor) + i32::from(f.lift), i32::from(align));
+            // modulo 2^KW, as the unit adds: the rounded result's low dw bits are the same
+            let kw = intermediate_bits(dw, false, [sh]);
+            let wrap = |x: i128| if kw >= 64 { x as i64 as i128 } else { (x << (128 - kw)) >> (128 - kw) };
+            let (xf, xc) = if align_b {
+                (i128::from(a), if sub { -i128::from(b) } else { i128::from(b) })
+            } else {
+                (if sub { -i128::from(b) } else { i128::from(b) }, i128::from(a))
+            };
+            let z = wrap((xf >> f.floor) + wrap(xc << f.lift));
+            let y = if f.round >= 1 { (z + (1i128 << (f.round - 1))) >> f.round } else { z << -i32::from(f.round) };
+            let low = |x: i128| x & ((1i128 << dw) - 1);
+            prop_assert_eq!(low(y), low(want));
+        }
     }
 }

@@ -246,12 +246,19 @@ pub struct Control {
 }
 
 /// The shift word of a fixed-point PE in its control word, cut to the shifts its program uses
-/// ([`build::ShiftRanges`], `rv_pe`'s `AMAX`, `SMIN`, `SMAX`): from bit 0, the alignment
-/// (`align_bits`, none on a MULTI PE without fused ops, which never aligns), the align-b bit
-/// (on the PEs that align), the rounding shift less `shift_min` (`shift_bits`, at least 1).
-/// The `fix` image keeps the full 14-bit word.
+/// ([`build::ShiftRanges`], `rv_pe`'s `RMAX`, `AMAX`, `SMIN`, `SMAX`): from bit 0, on an ADD PE
+/// the floor of its finer operand (`floor_bits`, [`build::FloorShifts`]), the alignment
+/// (`align_bits`: an ADD PE's lift of the coarser operand; none on a MULTI PE without fused ops,
+/// which never aligns), the align-b bit (on the PEs that align), the rounding shift less
+/// `shift_min` (`shift_bits`, at least 1; an ADD PE's rounding of the floored sum). The `fix`
+/// image keeps the full 14-bit word.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct FixField {
+    /// Whether the PE applies its ops' [`build::FloorShifts`] (ADD PEs): the field holds the
+    /// floor, the lift and the floored sum's rounding instead of the alignment and rounding.
+    pub floors: bool,
+    /// Bits of the floor: ⌈log₂(RMAX + 1)⌉ (0 when no op floors, and on MULTI PEs).
+    pub floor_bits: u32,
     /// Bits of the alignment: ⌈log₂(AMAX + 1)⌉, at least 1, on the PEs that align (ADD PEs,
     /// PEs with fused multiply-adds); 0 on the others.
     pub align_bits: u32,
@@ -266,21 +273,35 @@ pub struct FixField {
 impl FixField {
     /// Bits of the field in the control word.
     pub fn bits(&self) -> u32 {
-        self.align_bits + u32::from(self.align_b) + self.shift_bits
+        self.floor_bits + self.align_bits + u32::from(self.align_b) + self.shift_bits
     }
 
     /// The field of a 14-bit shift word `w` (`fix` image: `[0,6)` align, bit 6 align b, `[7,14)`
-    /// s in two's complement).
+    /// s in two's complement), in [`build::FloorShifts`] form on an ADD PE.
     pub fn pack(&self, w: u64) -> u64 {
-        let align = w & 63;
-        let align_b = w >> 6 & 1;
-        let s = ((w >> 7 & 127) as i64 ^ 64) - 64;
-        let at = self.align_bits + u32::from(self.align_b);
+        let sh = robovec_ir::machine::FixShifts::from_word(w);
+        let (floor, align, s) = if self.floors {
+            let f = build::FloorShifts::of(sh);
+            (u64::from(f.floor), u64::from(f.lift), i64::from(f.round))
+        } else {
+            (0, u64::from(sh.align & 63), i64::from(sh.shift))
+        };
         let shift = (s - i64::from(self.shift_min)) as u64;
+        debug_assert!(floor < 1 << self.floor_bits || floor == 0, "a floor beyond the PE's range");
         debug_assert!(align < 1 << self.align_bits || align == 0, "an alignment beyond the PE's range");
         debug_assert!(shift < 1 << self.shift_bits, "a rounding shift beyond the PE's range");
-        let b = if self.align_b { align_b << self.align_bits } else { 0 };
-        (align & ((1 << self.align_bits) - 1)) | b | shift << at
+        let mut at = 0;
+        let mut out = 0u64;
+        for (v, bits) in [
+            (floor, self.floor_bits),
+            (align, self.align_bits),
+            (u64::from(sh.align_b), u32::from(self.align_b)),
+            (shift, self.shift_bits),
+        ] {
+            out |= (v & ((1 << bits) - 1)) << at;
+            at += bits;
+        }
+        out
     }
 }
 
@@ -474,7 +495,8 @@ impl Design {
     /// to the PE memory's address bits (`[0,pa)` read A, `[pa,2pa)` read B, `[2pa,3pa)` write-0
     /// address, `[3pa,4pa)` write-1 address, then we0, we1, issue valid, sub), its write-port
     /// selects (the `xbar` image, `xbar.width` bits), its buffer instruction (`bufi`), its output
-    /// capture (`capt`) and, on fixed-point PEs, its shift word (`fix`, 14 bits), in that order from
+    /// capture (`capt`) and, on fixed-point PEs, its shift word (`fix` cut to the PE's shifts,
+    /// [`FixField`]; on an ADD PE an op whose `b` is the finer operand reads A and B swapped), in that order from
     /// bit 0, then on a PE with fused multiply-adds ([`PeImages::mac`]) the read address C (`pa`
     /// bits), the negate-product bit and the mac bit (the instruction's `[4aw+4, 5aw+6)`); split into lanes of [`Design::control_lane_bits`] (`peS_ctrl0`, `peS_ctrl1`, …). The
     /// separate images are the same fields one memory each (the manifest's `memories`); the HDL
@@ -513,8 +535,16 @@ impl Design {
                 }
             };
             let w = p.instr.words[c];
+            // An ADD PE reads its finer operand at A and the coarser at B (`fix_add_sub` floors
+            // one and lifts the other): an op that aligns `a` (`b` the finer) reads them swapped,
+            // and the align-b bit of its shift field says which one `sub` negates.
+            let swap = match (&p.fix, fix) {
+                (Some(img), Some(fx)) => fx.floors && w >> (4 * aw + 2) & 1 == 1 && img.words[c] >> 6 & 1 == 0,
+                _ => false,
+            };
             for k in 0..4 {
-                let field = w >> (k * aw) & mask(aw);
+                let k_read = if swap && k < 2 { 1 - k } else { k };
+                let field = w >> (k_read * aw) & mask(aw);
                 debug_assert!(field <= mask(pa), "an address beyond the PE memory's words");
                 put(field & mask(pa), pa);
             }
@@ -556,7 +586,10 @@ impl Design {
             let aligns = !p.is_mul || p.mac;
             let align_bits = if aligns { addr_bits(u64::from(r.align_max) + 1) } else { 0 };
             let span = (i32::from(r.shift_max) - i32::from(r.shift_min)) as u64 + 1;
+            let floors = !p.is_mul;
             FixField {
+                floors,
+                floor_bits: if floors && r.floor_max > 0 { addr_bits(u64::from(r.floor_max) + 1) } else { 0 },
                 align_bits,
                 align_b: aligns,
                 shift_bits: addr_bits(span).max(1),
@@ -671,8 +704,9 @@ impl Design {
             let mut fix = match &p.fix {
                 Some(_) => {
                     let r = p.shift_ranges.unwrap_or(build::ShiftRanges::FULL);
+                    let floor = if p.is_mul { String::new() } else { format!(".RMAX({}), ", r.floor_max) };
                     format!(
-                        ".FIX(1), .DW({dw}), .KW({}), .AMAX({}), .SMIN({}), .SMAX({}), .ONE({}), ",
+                        ".FIX(1), .DW({dw}), .KW({}), {floor}.AMAX({}), .SMIN({}), .SMAX({}), .ONE({}), ",
                         self.intermediate_bits(p.slot),
                         r.align_max,
                         r.shift_min,
@@ -693,6 +727,9 @@ impl Design {
             }
             let control = self.control(p.slot);
             if let Some(fx) = control.fix {
+                if fx.floors {
+                    fix += &format!(".FRB({}), ", fx.floor_bits);
+                }
                 fix += &format!(".FAB({}), .FALB({}), .FSB({}), ", fx.align_bits, u8::from(fx.align_b), fx.shift_bits);
             }
             let lanes: String =

@@ -4,7 +4,9 @@
 // (14 bits used), [31:0] the expected y. One vector at a time: the operands are held for the
 // unit's latency, then y is compared. `DW (default 32) is the units' word: the operands are the
 // fields' low DW bits and the low DW bits of y are compared; `KWA` and `KWM` (default 64) are the
-// ADD and MULTI units' intermediate bits; `AMAX` (default 63) the ADD unit's largest alignment and
+// ADD and MULTI units' intermediate bits; `RMAX` (default 62) the ADD unit's largest floor, `AMAX`
+// (default 63) its largest lift (robovec's FloorShifts: the tb converts each ADD vector's shift
+// word to that form and reads the finer operand at a, as the generator's control word does) and
 // `SMINA7`, `SMAXA7` (ADD), `SMINM7`, `SMAXM7` (MULTI) their rounding shifts' bounds as 7-bit two's
 // complement (default -64 ... 63: any shift), as the generator sizes a PE's shifters; `ONE`
 // (default 27, the Cyclone V's; 18 the ECP5's) the widest word whose product is one multiplier.
@@ -20,6 +22,9 @@
 `endif
 `ifndef AMAX
 `define AMAX 63
+`endif
+`ifndef RMAX
+`define RMAX 62
 `endif
 `ifndef ONE
 `define ONE 27
@@ -46,13 +51,14 @@ module fix_check_tb;
   reg clk = 0;
   always #5 clk = ~clk;
   reg [131:0] vec [0:`N-1];
-  reg [`DW-1:0] a = 0, b = 0;
+  reg [`DW-1:0] a = 0, b = 0, fa = 0, cb = 0;
   reg [13:0] sh = 0;
+  reg [19:0] fsh = 0;
   reg sub = 0;
   wire [`DW-1:0] y_add, y_mul;
-  fix_add_sub #(.LATENCY(LADD), .DW(`DW), .KW(`KWA), .AMAX(`AMAX), .SMIN(SMINA), .SMAX(SMAXA)) u_add (.clk(clk), .a(a), .b(b), .sub(sub), .sh(sh), .y(y_add));
+  fix_add_sub #(.LATENCY(LADD), .DW(`DW), .KW(`KWA), .RMAX(`RMAX), .AMAX(`AMAX), .SMIN(SMINA), .SMAX(SMAXA)) u_add (.clk(clk), .a(fa), .b(cb), .sub(sub), .sh(fsh), .y(y_add));
   fix_mul #(.LATENCY(LMUL), .DW(`DW), .KW(`KWM), .SMIN(SMINM), .SMAX(SMAXM), .ONE(`ONE)) u_mul (.clk(clk), .a(a), .b(b), .sh(sh), .y(y_mul));
-  integer i, k, bad;
+  integer i, k, bad, al, s, r;
   reg [3:0] op;
   reg [`DW-1:0] want, got;
   initial begin
@@ -65,6 +71,13 @@ module fix_check_tb;
       b = vec[i][64+`DW-1:64];
       sh = vec[i][45:32];
       sub = (op == 4'd1);
+      // the floored form: r = min(A, S - 1) for S >= 1, else 0; the finer operand at a
+      al = sh[5:0];
+      s = (sh[13] ? -128 : 0) + sh[13:7];
+      r = (s >= 1) ? ((al < s - 1) ? al : s - 1) : 0;
+      fsh = {r[5:0], s[6:0] - r[6:0], sh[6], al[5:0] - r[5:0]};
+      fa = sh[6] ? a : b;
+      cb = sh[6] ? b : a;
       want = vec[i][`DW-1:0];
       for (k = 0; k < ((op == 4'd2) ? LMUL : LADD); k = k + 1) @(negedge clk);
       got = (op == 4'd2) ? y_mul : y_add;

@@ -7,7 +7,7 @@
 // computed exactly on the operands' integers, aligned by a constant shift, then rounded once to
 // the result's format: what `-eval` computes and the C back end writes as `int64_t` arithmetic.
 //
-//   fix_add_sub #(.LATENCY(L), .DW(w), .KW(k), .AMAX(a), .SMIN(s0), .SMAX(s1)) u (.clk, .a, .b, .sub, .sh, .y);
+//   fix_add_sub #(.LATENCY(L), .DW(w), .KW(k), .RMAX(r), .AMAX(a), .SMIN(s0), .SMAX(s1)) u (.clk, .a, .b, .sub, .sh, .y);
 //   fix_mul     #(.LATENCY(L), .DW(w), .KW(k), .SMIN(s0), .SMAX(s1)) u (.clk, .a, .b, .sh, .y);
 //   fix_mac     #(.LATENCY(L), .DW(w), .KW(k), .AMAX(a), .SMIN(s0), .SMAX(s1)) u (.clk, .a, .b, .c, .mac, .negp, .sub, .sh, .y);
 //
@@ -16,7 +16,7 @@
 // AMAX, SMIN and SMAX bound the alignments and rounding shifts of the PE's program (the
 // generator's `shift_ranges`): the shifters cover only those.
 // `sh` is the op's shift word (the PE's shift memory `peS_fix`, one word per cycle, registered
-// with the operands):
+// with the operands; the ADD unit takes it in its floored form, see fix_add_sub):
 //   [0,6)  align: the bits the aligned operand is shifted left (the two operands' fractions
 //          differ by it);
 //   bit 6  1: align b, 0: align a (ADD PE only; a MULTI PE's product is not aligned);
@@ -25,7 +25,7 @@
 //          by -s.
 // The exact intermediate K is computed in KW <= 64 bits: the generator gives each PE the
 // width its program needs (robovec's `machine/src/design/build.rs`, `intermediate_bits`: the
-// aligned sum's DW + align + 2 bits, the product's 2 DW + 1, and the rounding constant's
+// floored sum's DW + max(D, 1) bits, the product's 2 DW + 1, and the rounding constant's
 // s + 2), within robovec's `INTEGER_BITS` bound; with the range proof of every value the result
 // fits its w <= DW bits, so y is the low DW bits after rounding. The multiplier is a DW x DW
 // signed product: one 27 x 27 variable-precision DSP block on the Cyclone V for DW <= 27, two
@@ -99,31 +99,56 @@ module fix_stages #(parameter integer LATENCY = 1, parameter integer DW = 32, pa
   endgenerate
 endmodule
 
-// The ADD PE's unit: y = round(align(a) +- align(b)), LATENCY clocks after the operands. One
-// operand is aligned (sh[6] says which), by at most AMAX bits (the PE program's largest
-// alignment): the two operands are swapped so that one shifter of ceil(log2(AMAX + 1)) levels
-// serves both, and a - b negates whichever side b took (x - y = x + ~y + 1).
+// The ADD PE's unit: y = round(a +- b) of two operands on different grids, LATENCY clocks after
+// the operands, in robovec's floored form (`FloorShifts`, machine/src/design/build.rs): a is the
+// finer operand, floored by r bits (an arithmetic right shift: floor(a / 2^r)), b the coarser,
+// shifted left by l bits, and their sum rounded by D bits (fix_round; a left shift when D <= 0).
+// With r = min(A, S - 1) of the op's alignment A and rounding S (0 when S <= 0), l = A - r and
+// D = S - r this is exactly the rounding by S of the aligned sum (the floor drops only bits below
+// the grid the rounding keeps), and D is 0 or 1 for nearly every op: the adder and the rounding
+// are about the result's width, not the aligned sum's DW + A + 2 bits. The generator reads the
+// finer operand at port A (it swaps the reads of an op whose b is the finer) and sh[6] says
+// which side `sub` negates: 1 the coarser (a - b with b coarser), 0 the finer. A negated finer
+// operand is floored as floor(-a / 2^r) = floor(~a / 2^r) + [a mod 2^r = 0] (the carry in).
+// `sh` (20 bits, rv_pe's shift word): [0,6) l, bit 6 which side is negated, [7,14) D in two's
+// complement, [14,20) r. RMAX, AMAX (the largest l), SMIN and SMAX (D's range) bound the
+// program's shifts (the generator's `floored_shift_ranges`): the shifters cover only those. KW
+// is the sum's width, DW + max(DMAX, 1) (the generator's `intermediate_bits`): the sum is exact
+// modulo 2^KW in the bits the rounding keeps.
 module fix_add_sub #(parameter integer LATENCY = 1, parameter integer DW = 32, parameter integer KW = 64,
-                     parameter integer AMAX = 63, parameter integer SMIN = -64, parameter integer SMAX = 63) (
+                     parameter integer RMAX = 62, parameter integer AMAX = 63, parameter integer SMIN = -64,
+                     parameter integer SMAX = 63) (
     input  wire          clk,
     input  wire [DW-1:0] a,
     input  wire [DW-1:0] b,
     input  wire          sub,
-    input  wire [13:0]   sh,
+    input  wire [19:0]   sh,
     output wire [DW-1:0] y
 );
-  localparam integer AB = (AMAX <= 0) ? 1 : $clog2(AMAX + 1);
-  wire side = sh[6];
+  localparam integer RB = (RMAX <= 0) ? 1 : $clog2(RMAX + 1);
+  localparam integer LB = (AMAX <= 0) ? 1 : $clog2(AMAX + 1);
+  wire [RB-1:0] r = (RMAX <= 0) ? {RB{1'b0}} : sh[14 +: RB];
+  wire [LB-1:0] l = (AMAX <= 0) ? {LB{1'b0}} : sh[LB-1:0];
+  wire nega = sub & ~sh[6];
+  wire negb = sub & sh[6];
   // signed assignments to wider wires sign-extend
-  wire signed [DW-1:0] sp = side ? b : a;
-  wire signed [DW-1:0] sq = side ? a : b;
-  wire signed [KW-1:0] ep = sp;
-  wire signed [KW-1:0] eq = sq;
-  wire [AB-1:0] al = (AMAX <= 0) ? {AB{1'b0}} : sh[AB-1:0];
-  wire signed [KW-1:0] xp = ep <<< al;
-  wire negp = sub & side;
-  wire negq = sub & ~side;
-  wire signed [KW-1:0] k = (xp ^ {KW{negp}}) + (eq ^ {KW{negq}}) + {{(KW-1){1'b0}}, sub};
+  wire signed [KW-1:0] ea = $signed(a);
+  wire signed [KW-1:0] eb = $signed(b);
+  wire signed [KW-1:0] na = ea ^ {KW{nega}};
+  wire signed [KW-1:0] xa = na >>> r;
+  wire signed [KW-1:0] xb = (eb <<< l) ^ {KW{negb}};
+  // the carry in: -b = ~b + 1; floor(-a / 2^r) = floor(~a / 2^r) + 1 when a's low r bits are 0
+  wire zlow;
+  generate
+    if (RMAX <= 0) begin : g_no_floor
+      assign zlow = 1'b1;
+    end else begin : g_floor
+      wire [DW-1:0] low = ~({DW{1'b1}} << r);
+      assign zlow = ~|(a & low);
+    end
+  endgenerate
+  wire cin = nega ? zlow : negb;
+  wire signed [KW-1:0] k = xa + xb + {{(KW-1){1'b0}}, cin};
   fix_stages #(.LATENCY(LATENCY), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX)) st (.clk(clk), .k(k), .s(sh[13:7]), .y(y));
 endmodule
 

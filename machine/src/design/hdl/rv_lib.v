@@ -32,7 +32,8 @@ module rv_pe #(
                                        //    read (the addend) and PA + 2 more control bits after the shift word
     parameter integer DW = 32,         // data word bits (32 for binary32 PEs; fixed point: the widest format)
     parameter integer KW = 64,         // fixed-point PEs: bits of the exact intermediate (fix_units.v)
-    parameter integer AMAX = 63,       // fixed-point PEs: the program's largest alignment (fix_units.v)
+    parameter integer RMAX = 62,       // fixed-point ADD PEs: the program's largest floor (fix_add_sub)
+    parameter integer AMAX = 63,       // fixed-point PEs: the program's largest alignment (ADD PEs: lift) (fix_units.v)
     parameter integer SMIN = -64,      // fixed-point PEs: the program's rounding shifts, SMIN..SMAX
     parameter integer SMAX = 63,
     parameter integer ONE = 27,        // fixed-point MULTI PEs: the widest word that is one DSP product (fix_units.v)
@@ -55,10 +56,11 @@ module rv_pe #(
     parameter integer PA = 11,         // bits of each address field of the control word (<= AW)
     parameter integer PB = BW,         // bits of each buffer address in the control word (<= BW)
     parameter integer PO = OW,         // bits of the output-memory address in the control word (<= OW)
+    parameter integer FRB = 0,         // fixed-point ADD PEs: bits of the shift word's floor (0: never floors)
     parameter integer FAB = 6,         // fixed-point PEs: bits of the shift word's alignment (0: never aligns)
     parameter integer FALB = 1,        // fixed-point PEs: 1 when the shift word has the align-b bit
     parameter integer FSB = 7,         // fixed-point PEs: bits of the rounding shift less SMIN
-    parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + SW2 + 2 * PB + 2 + PO + 1 + (FIX != 0 ? FAB + FALB + FSB : 0) + (MAC != 0 ? PA + 2 : 0),  // control word bits
+    parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + SW2 + 2 * PB + 2 + PO + 1 + (FIX != 0 ? FRB + FAB + FALB + FSB : 0) + (MAC != 0 ? PA + 2 : 0),  // control word bits
     parameter integer LANE = 40,       // bits of a control-memory lane (the widest block-RAM word)
     parameter CTRL0_FILE = "",         // the control memory's lanes (robovec's `Design::control`),
     parameter CTRL1_FILE = "",         // bit 0 of the word in lane 0; at most four lanes
@@ -81,7 +83,7 @@ module rv_pe #(
   localparam integer XW = SW0 + SW1 + SW2;
   localparam integer BIW = 2 * PB + 2;   // the buffer instruction in the control word
   localparam integer OCW = PO + 1;       // the capture word in the control word
-  localparam integer FW = (FIX != 0) ? FAB + FALB + FSB : 0;  // the shift word in the control word
+  localparam integer FW = (FIX != 0) ? FRB + FAB + FALB + FSB : 0;  // the shift word in the control word
   localparam integer ROM_DEPTH = CYCLES + 1;
 
   // The control memory: one word per cycle (the instruction with PA-bit addresses, the
@@ -206,26 +208,33 @@ module rv_pe #(
   generate
     if (FIX != 0) begin : g_fix
       // the op's shift word, fetched with the instruction and registered with the operands:
-      // the control word holds it cut to the PE's shifts (FAB alignment bits, the align-b bit
-      // when FALB, the rounding shift less SMIN in FSB bits), widened back to the 14-bit word
-      // ([0,6) align, bit 6 align b, [7,14) s) that the units read
+      // the control word holds it cut to the PE's shifts (FRB floor bits on an ADD PE, FAB
+      // alignment bits, the align-b bit when FALB, the rounding shift less SMIN in FSB bits),
+      // widened back to the 20-bit word ([0,6) align, bit 6 align b, [7,14) s, [14,20) floor)
+      // that the units read (fix_mul and fix_mac its low 14 bits)
       wire [FW-1:0] shf = ctrl[IB+XW+BIW+OCW +: FW];
+      wire [5:0] fl;
       wire [5:0] al;
       wire       alb;
+      if (FRB > 0) begin : g_fl
+        assign fl = shf[FRB-1:0];
+      end else begin : g_no_fl
+        assign fl = 6'd0;
+      end
       if (FAB > 0) begin : g_al
-        assign al = shf[FAB-1:0];
+        assign al = shf[FRB+FAB-1:FRB];
       end else begin : g_no_al
         assign al = 6'd0;
       end
       if (FALB != 0) begin : g_alb
-        assign alb = shf[FAB];
+        assign alb = shf[FRB+FAB];
       end else begin : g_no_alb
         assign alb = 1'b0;
       end
-      wire [7:0] s_off = shf[FW-1:FAB+FALB];
+      wire [7:0] s_off = shf[FW-1:FRB+FAB+FALB];
       wire [7:0] s_abs = s_off + SMIN;
-      wire [13:0] sh = {s_abs[6:0], alb, al};
-      reg  [13:0] sh_q;
+      wire [19:0] sh = {fl, s_abs[6:0], alb, al};
+      reg  [19:0] sh_q;
       initial sh_q = 0;
       always @(posedge clk) sh_q <= sh;
       if (IS_MUL != 0 && MAC != 0) begin : g_mac
@@ -240,11 +249,11 @@ module rv_pe #(
           mac_q <= ctrl[MB+PA+1];
         end
         fix_mac #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .AMAX(AMAX), .SMIN(SMIN), .SMAX(SMAX), .ONE(ONE)) u_fx (
-            .clk(clk), .a(qa), .b(qb), .c(qc), .mac(mac_q), .negp(negp_q), .sub(sub_q), .sh(sh_q), .y(y));
+            .clk(clk), .a(qa), .b(qb), .c(qc), .mac(mac_q), .negp(negp_q), .sub(sub_q), .sh(sh_q[13:0]), .y(y));
       end else if (IS_MUL != 0) begin : g_mul
-        fix_mul #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX), .ONE(ONE)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q), .y(y));
+        fix_mul #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .SMIN(SMIN), .SMAX(SMAX), .ONE(ONE)) u_fx (.clk(clk), .a(qa), .b(qb), .sh(sh_q[13:0]), .y(y));
       end else begin : g_add
-        fix_add_sub #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .AMAX(AMAX), .SMIN(SMIN), .SMAX(SMAX)) u_fx (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .sh(sh_q), .y(y));
+        fix_add_sub #(.LATENCY(LAT - 2), .DW(DW), .KW(KW), .RMAX(RMAX), .AMAX(AMAX), .SMIN(SMIN), .SMAX(SMAX)) u_fx (.clk(clk), .a(qa), .b(qb), .sub(sub_q), .sh(sh_q), .y(y));
       end
     end else if (IS_MUL != 0) begin : g_mul
       fp_mul #(.LATENCY(LAT - 2)) u_fp (.clk(clk), .a(qa), .b(qb), .y(y));

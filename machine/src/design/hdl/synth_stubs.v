@@ -15,8 +15,9 @@ endmodule
 
 (* blackbox *)
 module fix_add_sub #(parameter integer LATENCY = 2, parameter integer DW = 32, parameter integer KW = 64,
-                     parameter integer AMAX = 63, parameter integer SMIN = -64, parameter integer SMAX = 63) (
-    input wire clk, input wire [DW-1:0] a, input wire [DW-1:0] b, input wire sub, input wire [13:0] sh,
+                     parameter integer RMAX = 62, parameter integer AMAX = 63, parameter integer SMIN = -64,
+                     parameter integer SMAX = 63) (
+    input wire clk, input wire [DW-1:0] a, input wire [DW-1:0] b, input wire sub, input wire [19:0] sh,
     output wire [DW-1:0] y);
 endmodule
 
