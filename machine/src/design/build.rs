@@ -161,9 +161,10 @@ impl FloorShifts {
         FloorShifts { floor: r as u8, lift: (a - r) as u8, round: (s - r) as i8 }
     }
 
-    /// `K`'s rounding computed the unit's way (the model the HDL is checked against):
-    /// `⌊±x_f / 2^r⌋ ± (x_c << l)` rounded by `D` (ties toward +∞), for `a ± b` with `sh`'s
-    /// operand order and alignment (`None` when an intermediate leaves 64 bits).
+    /// `K`'s rounding computed the unit's way, the identity's right-hand side (the property
+    /// test of this module compares it with [`FixShifts::apply`]): `⌊±x_f / 2^r⌋ ± (x_c << l)`
+    /// rounded by `D` (ties toward +∞), for `a ± b` with `sh`'s operand order and alignment
+    /// (`None` when the result leaves 64 bits).
     pub fn apply(sh: FixShifts, sub: bool, a: i64, b: i64) -> Option<i64> {
         let f = FloorShifts::of(sh);
         // the finer operand and the coarser, each with its sign in the op
