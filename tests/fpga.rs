@@ -699,6 +699,9 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
             let width_of = |k: &str| mem[k]["width"].as_u64().unwrap() as u32;
             let depth = mem["data"]["words"].as_u64().unwrap() as u128;
             let instr = words_of("instr").unwrap();
+            // each image read once, not once a cycle
+            let (xbar, bufis, capts, fixes) =
+                (words_of("xbar").unwrap(), words_of("bufi").unwrap(), words_of("capt").unwrap(), words_of("fix"));
             assert_eq!(words.len(), instr.len());
             let cut = |x: u128, lo: u32, bits: u32| (x >> lo) & ((1u128 << bits) - 1);
             // an ADD PE in floored form reads its finer operand at A: an op aligning a (align-b
@@ -706,7 +709,7 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
             let floors = c["fix"].get("floors").is_some_and(|f| f.as_bool().unwrap());
             for (cycle, &w) in words.iter().enumerate() {
                 let issues = cut(instr[cycle], 4 * aw + 2, 1) == 1;
-                let swapped = floors && issues && words_of("fix").unwrap()[cycle] >> 6 & 1 == 0;
+                let swapped = floors && issues && fixes.as_ref().unwrap()[cycle] >> 6 & 1 == 0;
                 for k in 0..4 {
                     let field = cut(instr[cycle], k * aw, aw);
                     assert!(field < depth.max(1) || field == 0, "{what}: an address beyond the memory");
@@ -716,25 +719,25 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
                 assert_eq!(cut(w, 4 * pa, 4), cut(instr[cycle], 4 * aw, 4), "{what} cycle {cycle}: flags");
                 let mut lo = 4 * pa + 4;
                 let xw = width_of("xbar");
-                assert_eq!(cut(w, lo, xw), words_of("xbar").unwrap()[cycle], "{what} cycle {cycle}: xbar");
+                assert_eq!(cut(w, lo, xw), xbar[cycle], "{what} cycle {cycle}: xbar");
                 lo += xw;
                 // the buffer instruction and the capture word with their addresses cut to pb, po
                 let (pb, po) = (c["pb"].as_u64().unwrap() as u32, c["po"].as_u64().unwrap() as u32);
                 let (bw, ow) =
                     (man["widths"]["bw"].as_u64().unwrap() as u32, man["widths"]["ow"].as_u64().unwrap() as u32);
-                let bufi = words_of("bufi").unwrap()[cycle];
+                let bufi = bufis[cycle];
                 for (k, (at, bits)) in [(0, pb), (bw, pb), (2 * bw, 2)].into_iter().enumerate() {
                     assert_eq!(cut(w, lo, bits), cut(bufi, at, bits), "{what} cycle {cycle}: bufi field {k}");
                     lo += bits;
                 }
                 assert_eq!(cut(bufi, 0, bw) >> pb, 0, "{what}: a store address beyond pb bits");
                 assert_eq!(cut(bufi, bw, bw) >> pb, 0, "{what}: a read address beyond pb bits");
-                let capt = words_of("capt").unwrap()[cycle];
+                let capt = capts[cycle];
                 assert_eq!(cut(capt, 0, ow) >> po, 0, "{what}: an output address beyond po bits");
                 assert_eq!(cut(w, lo, po), cut(capt, 0, po), "{what} cycle {cycle}: capture address");
                 assert_eq!(cut(w, lo + po, 1), cut(capt, ow, 1), "{what} cycle {cycle}: capture enable");
                 lo += po + 1;
-                if let Some(fix) = words_of("fix") {
+                if let Some(fix) = &fixes {
                     // the 14-bit shift word ([0,6) align, bit 6 align b, [7,14) s) cut to the PE's
                     // shifts; on an ADD PE in floored form, the floor r = min(A, S − 1) (0 when
                     // S ≤ 0) first, then the lift A − r and the rounding S − r

@@ -167,15 +167,24 @@ impl FloorShifts {
     /// (`None` when the result leaves 64 bits).
     pub fn apply(sh: FixShifts, sub: bool, a: i64, b: i64) -> Option<i64> {
         let f = FloorShifts::of(sh);
-        // the finer operand and the coarser, each with its sign in the op
-        let (xf, xc) = if sh.align_b {
-            (i128::from(a), if sub { -i128::from(b) } else { i128::from(b) })
+        let (xf, xc) = FloorShifts::terms(sh, sub, a, b);
+        i64::try_from(f.round_sum((xf >> f.floor) + (xc << f.lift))).ok()
+    }
+
+    /// The finer operand and the coarser of `a ± b` under `sh`, each with its sign in the op.
+    fn terms(sh: FixShifts, sub: bool, a: i64, b: i64) -> (i128, i128) {
+        let (a, b) = (i128::from(a), i128::from(b));
+        let b = if sub { -b } else { b };
+        if sh.align_b {
+            (a, b)
         } else {
-            (if sub { -i128::from(b) } else { i128::from(b) }, i128::from(a))
-        };
-        let z = (xf >> f.floor) + (xc << f.lift);
-        let y = if f.round >= 1 { (z + (1i128 << (f.round - 1))) >> f.round } else { z << -i32::from(f.round) };
-        i64::try_from(y).ok()
+            (b, a)
+        }
+    }
+
+    /// The floored sum `z` rounded by `round` bits ([`FixShifts::round`]).
+    fn round_sum(&self, z: i128) -> i128 {
+        FixShifts { align: 0, align_b: false, shift: self.round }.round(z)
     }
 }
 
@@ -226,27 +235,24 @@ impl ShiftRanges {
 /// The [`ShiftRanges`] of the ops whose shifts are `shifts` (the issued ops of one PE; none:
 /// `AMAX = 0`, `SMIN = SMAX = 0`) on a MULTI PE (`floor_max` 0).
 pub fn shift_ranges(shifts: impl IntoIterator<Item = FixShifts>) -> ShiftRanges {
-    let mut r: Option<ShiftRanges> = None;
-    for sh in shifts {
-        let x = r.get_or_insert(ShiftRanges { align_max: 0, shift_min: sh.shift, shift_max: sh.shift, floor_max: 0 });
-        x.align_max = x.align_max.max(sh.align & 63);
-        x.shift_min = x.shift_min.min(sh.shift);
-        x.shift_max = x.shift_max.max(sh.shift);
-    }
-    r.unwrap_or(ShiftRanges { align_max: 0, shift_min: 0, shift_max: 0, floor_max: 0 })
+    ranges_of(shifts.into_iter().map(|sh| (sh.align & 63, sh.shift, 0)))
 }
 
 /// The [`ShiftRanges`] of an ADD PE whose ops' shifts are `shifts`: those of their
 /// [`FloorShifts`] (the largest lift as `align_max`, the roundings, the largest floor).
 pub fn floored_shift_ranges(shifts: impl IntoIterator<Item = FixShifts>) -> ShiftRanges {
+    ranges_of(shifts.into_iter().map(FloorShifts::of).map(|f| (f.lift, f.round, f.floor)))
+}
+
+/// The [`ShiftRanges`] of ops' `(alignment, rounding, floor)` shifts (none: all 0).
+fn ranges_of(ops: impl Iterator<Item = (u8, i8, u8)>) -> ShiftRanges {
     let mut r: Option<ShiftRanges> = None;
-    for sh in shifts {
-        let f = FloorShifts::of(sh);
-        let x = r.get_or_insert(ShiftRanges { align_max: 0, shift_min: f.round, shift_max: f.round, floor_max: 0 });
-        x.align_max = x.align_max.max(f.lift);
-        x.shift_min = x.shift_min.min(f.round);
-        x.shift_max = x.shift_max.max(f.round);
-        x.floor_max = x.floor_max.max(f.floor);
+    for (align, shift, floor) in ops {
+        let x = r.get_or_insert(ShiftRanges { align_max: 0, shift_min: shift, shift_max: shift, floor_max: 0 });
+        x.align_max = x.align_max.max(align);
+        x.shift_min = x.shift_min.min(shift);
+        x.shift_max = x.shift_max.max(shift);
+        x.floor_max = x.floor_max.max(floor);
     }
     r.unwrap_or(ShiftRanges { align_max: 0, shift_min: 0, shift_max: 0, floor_max: 0 })
 }
@@ -564,13 +570,8 @@ mod tests {
             // modulo 2^KW, as the unit adds: the rounded result's low dw bits are the same
             let kw = intermediate_bits(dw, false, [sh]);
             let wrap = |x: i128| if kw >= 64 { x as i64 as i128 } else { (x << (128 - kw)) >> (128 - kw) };
-            let (xf, xc) = if align_b {
-                (i128::from(a), if sub { -i128::from(b) } else { i128::from(b) })
-            } else {
-                (if sub { -i128::from(b) } else { i128::from(b) }, i128::from(a))
-            };
-            let z = wrap((xf >> f.floor) + wrap(xc << f.lift));
-            let y = if f.round >= 1 { (z + (1i128 << (f.round - 1))) >> f.round } else { z << -i32::from(f.round) };
+            let (xf, xc) = FloorShifts::terms(sh, sub, a, b);
+            let y = f.round_sum(wrap((xf >> f.floor) + wrap(xc << f.lift)));
             let low = |x: i128| x & ((1i128 << dw) - 1);
             prop_assert_eq!(low(y), low(want));
         }

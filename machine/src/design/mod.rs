@@ -535,11 +535,12 @@ impl Design {
                 }
             };
             let w = p.instr.words[c];
+            let issues = w >> (4 * aw + 2) & 1 == 1;
             // An ADD PE reads its finer operand at A and the coarser at B (`fix_add_sub` floors
             // one and lifts the other): an op that aligns `a` (`b` the finer) reads them swapped,
             // and the align-b bit of its shift field says which one `sub` negates.
             let swap = match (&p.fix, fix) {
-                (Some(img), Some(fx)) => fx.floors && w >> (4 * aw + 2) & 1 == 1 && img.words[c] >> 6 & 1 == 0,
+                (Some(img), Some(fx)) => fx.floors && issues && img.words[c] >> 6 & 1 == 0,
                 _ => false,
             };
             for k in 0..4 {
@@ -562,7 +563,6 @@ impl Design {
             put(o >> ow, 1);
             if let (Some(img), Some(fx)) = (&p.fix, fix) {
                 // an idle cycle's shift word is 0, maybe outside the issued ops' ranges
-                let issues = w >> (4 * aw + 2) & 1 == 1;
                 put(if issues { fx.pack(img.words[c]) } else { 0 }, fx.bits());
             }
             if p.mac {
