@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Issue 49's proof table: robovec's FPGA designs against robovec's own C, side by side in one run.
 
-    scripts/fpga_vs_cpu.py [--pes=8,16,22,18+26,57+57/19] [--states=1,4] [--recurrence=16] [--rebind=64] [--steal=S] [--mac] [--pnr] [--yosys] [MODEL...]
+    scripts/fpga_vs_cpu.py [--pes=8,16,22,18+26,57+57/19] [--states=1,4] [--recurrence=16] [--rebind=64] [--steal=S] [--windows=W] [--mac] [--pnr] [--yosys] [MODEL...]
 
 For each model (a corpus `dirdyna` named by its file's prefix: `jeep`, `tricycle`, `mazda_mx5`,
 `coman_longarms`, `walkman`; default: every corpus `dirdyna` of at least 5k ops, the issue's
@@ -22,7 +22,8 @@ points; docs/accuracy.md):
    A ADD and M MULTI PEs; a `/G` suffix: in G PE clusters, `place<clusters=G>`) and each K of `--states` (`interleave<states=K>`, issue 49 item 3),
    the design placed for the fewest interconnect routes (`place<select=routes>`, rebound for
    `--rebind` rounds: `rebind=R`, 64 by default; with clusters and `--steal=S`, `steal=S`: urgent
-   ops may leave their cluster) with the specialised interconnect: cycles, us
+   ops may leave their cluster; with clusters and `--windows=W`, `windows=W`: each cluster gets
+   its share of the ops of W time windows) with the specialised interconnect: cycles, us
    (latency), ns per state, logic / block RAM / DSP and fit (the analytic estimate; `--yosys`:
    Yosys' count on the DE10-Nano; `--pnr`: nextpnr's on the ECP5);
    With `--mac` the products are fused into their sums after `precision` (`contract`: the MULTI
@@ -127,6 +128,7 @@ def main():
     pes, states, pnr, yosys, models, json_out = [(8, 8, 1), (16, 16, 1), (22, 22, 1), (18, 26, 1)], [1], False, False, [], None
     rebind = None
     steal = None
+    windows = None
     mac = False
     prefix = pre()
     for a in sys.argv[1:]:
@@ -138,6 +140,8 @@ def main():
             rebind = int(a[len("--rebind="):])
         elif a.startswith("--steal="):
             steal = int(a[len("--steal="):])
+        elif a.startswith("--windows="):
+            windows = int(a[len("--windows="):])
         elif a.startswith("--states="):
             states = [int(x) for x in a[9:].split(",")]
         elif a == "--mac":
@@ -227,7 +231,8 @@ def main():
                         f"{prefix},precision<budget={budget};target=mcu;word={w}>,{'contract,error-bound,' if mac else ''}{inter}"
                         f"place<add={na};mul={nm};select=routes{'' if rebind is None else f';rebind={rebind}'}"
                         f"{'' if g == 1 else f';clusters={g}'}"
-                        f"{'' if g == 1 or steal is None else f';steal={steal}'}>,"
+                        f"{'' if g == 1 or steal is None else f';steal={steal}'}"
+                        f"{'' if g == 1 or windows is None else f';windows={windows}'}>,"
                         f"codegen<fpga;out={out};resources={resources};interconnect=specialised;format=hex>"
                     )
                     try:

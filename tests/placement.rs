@@ -239,16 +239,19 @@ proptest::proptest! {
         n_mul in 1u32..9,
         g_pick in 0u32..64,
         steal in proptest::option::weighted(0.43, 0u32..40),
+        windows in 1u32..5,
         buffer in proptest::bool::ANY,
     ) {
         let f = robovec_testkit::dag_gen::generate(n_ops, seed);
         let g = 1 + g_pick % n_add.min(n_mul);
         let mut o = PlaceOptions::with_pes(1);
-        (o.arch.n_add, o.arch.n_mul, o.arch.buffer, o.select, o.clusters, o.steal) =
-            (n_add, n_mul, buffer, Select::Routes, g, steal);
+        (o.arch.n_add, o.arch.n_mul, o.arch.buffer, o.select, o.clusters, o.steal, o.windows) =
+            (n_add, n_mul, buffer, Select::Routes, g, steal, windows);
         let keys = schedule::seed_keys(&f, &o.arch, Priority::Classical);
         let mut dag = OpDag::ordered(&f, &keys);
-        let part = cluster::partition(&dag, n_add, n_mul, g).expect("METIS partitions");
+        let alap: Vec<u32> = dag.gather(&keys).iter().map(|k| k.0).collect();
+        let shape = cluster::Shape { n_add, n_mul, clusters: g, windows };
+        let part = cluster::partition(&dag, &alap, shape).expect("METIS partitions");
         proptest::prop_assert_eq!(part.len(), dag.len());
         proptest::prop_assert!(part.iter().all(|&c| c < g));
         dag.set_clusters(g, part.clone());
@@ -325,7 +328,9 @@ fn clusters_cut_the_routes_on_a_corpus_function() {
     // the parts' balance, counted here from the partition
     let keys = schedule::seed_keys(&f, &o.arch, Priority::Classical);
     let dag = OpDag::ordered(&f, &keys);
-    let part = cluster::partition(&dag, 12, 12, 4).unwrap();
+    let alap: Vec<u32> = dag.gather(&keys).iter().map(|k| k.0).collect();
+    let part =
+        cluster::partition(&dag, &alap, cluster::Shape { n_add: 12, n_mul: 12, clusters: 4, windows: 1 }).unwrap();
     for mul in [false, true] {
         let side: Vec<usize> = (0..dag.len()).filter(|&j| dag.is_mul(j as u32) == mul).collect();
         for c in 0..4 {
@@ -333,6 +338,61 @@ fn clusters_cut_the_routes_on_a_corpus_function() {
             assert!(here * 4 * 100 <= side.len() * 110, "part {c}: {here} of {} ops (mul: {mul})", side.len());
         }
     }
+}
+
+/// `place<windows=W>` (issue 49): on the Jeep's `dirdyna` at 24 + 24 PEs in 24 clusters
+/// (`steal=16`), four time windows spread the ops due in each quarter of the function (by
+/// latest start) over the clusters — the most any part holds of a quarter's ops of a side,
+/// against its share, falls — so the schedule takes at least 10 % fewer cycles; each part's
+/// whole load stays within 10 % of its share, and the placement simulates bit for bit.
+#[test]
+fn time_windows_spread_each_stretch_of_ops_over_the_clusters() {
+    let src = crate::common::corpus_dir().join("c").join("jeep__mbs_dirdyna_Jeep.c");
+    let (m, _) = robovec::driver::load(src.to_str().unwrap()).unwrap_or_else(|f| panic!("{}", f.message()));
+    let f = atomise_function(m.functions.iter().find(|f| f.name == "dirdyna").expect("@dirdyna"));
+    let g = 24;
+    let mut o = PlaceOptions::with_pes(g);
+    o.arch.lat = robovec_ir::latency::Latencies { add: 3, mul: 3, div: 3, call: 3 };
+    (o.select, o.restarts, o.search, o.clusters, o.steal) = (Select::Routes, 0, 0, g, Some(16));
+    let one = place_function(&f, &o);
+    o.windows = 4;
+    let four = place_function(&f, &o);
+    let (c1, c4) = (cycles(&f, &one), cycles(&f, &four));
+    println!("Jeep dirdyna 24 + 24 in 24 clusters: {c1} cycles with one window, {c4} with four");
+    assert!(c4 * 10 <= c1 * 9, "{c1} cycles with one window, {c4} with four");
+    let mut h = f.clone();
+    h.placement = Some(four);
+    verify_placement(&h, &[1, 2]).unwrap_or_else(|e| panic!("{e}"));
+    // Each part's overload of a quarter: its ops of a side among that side's quarter (by latest
+    // start, from the function's own timing), times G, over the quarter's ops.
+    let (timing, _) = robovec_ir::analysis::compute_timing(&f, &o.arch.lat);
+    let keys = schedule::seed_keys(&f, &o.arch, Priority::Classical);
+    let dag = OpDag::ordered(&f, &keys);
+    let latest: Vec<u32> = dag.ops.iter().map(|v| timing[v.index()].expect("an op's timing").alap_cycle).collect();
+    let overload = |windows: u32| {
+        let shape = cluster::Shape { n_add: g, n_mul: g, clusters: g, windows };
+        let part = cluster::partition(&dag, &latest, shape).expect("METIS partitions");
+        let mut worst = 0.0f64;
+        for mul in [false, true] {
+            let mut side: Vec<usize> = (0..dag.len()).filter(|&j| dag.is_mul(j as u32) == mul).collect();
+            let total = side.len();
+            for c in 0..g {
+                let here = side.iter().filter(|&&j| part[j] == c).count();
+                assert!(here * g as usize * 100 <= total * 110, "windows={windows}: part {c} holds {here} of {total}");
+            }
+            side.sort_by_key(|&j| latest[j]);
+            for quarter in side.chunks(total.div_ceil(4)) {
+                for c in 0..g {
+                    let here = quarter.iter().filter(|&&j| part[j] == c).count();
+                    worst = worst.max(here as f64 * f64::from(g) / quarter.len() as f64);
+                }
+            }
+        }
+        worst
+    };
+    let (w1, w4) = (overload(1), overload(4));
+    println!("  the most a part holds of a quarter, against its share: {w1:.2} with one window, {w4:.2} with four");
+    assert!(w4 < w1, "overload {w4:.2} with four windows, {w1:.2} with one");
 }
 
 /// On m454's `dirdyna` at 8 + 8 PEs (27-bit words are not needed: the routes are the

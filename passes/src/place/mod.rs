@@ -92,6 +92,10 @@ pub struct PlaceOptions {
     /// on an idle PE of another cluster when that adds at most one interconnect route (work
     /// stealing for the ops the partition left waiting on a busy cluster; `None`: never).
     pub steal: Option<u32>,
+    /// With clusters: the partition balances each cluster's share of the ops of each of this
+    /// many time windows (per side, the ops split by latest start into windows of equal op
+    /// count; [`cluster::partition`]). 1: one balance per side over the whole function.
+    pub windows: u32,
     /// Rounds of interconnect-aware rebinding of the schedule kept ([`rebind`]; only with
     /// [`Select::Routes`]): ops move to other PEs of their type, in their cycle or within their
     /// slack, while the routes do not grow; the schedule's length stays. 0 = none.
@@ -173,6 +177,7 @@ fn options_from(p: &Params) -> Result<PlaceOptions, PassError> {
         rebind: p.u32("rebind")?,
         clusters: p.u32("clusters")?,
         steal: p.u32_given("steal")?,
+        windows: p.u32("windows")?,
         deadline: None,
         grace: None,
         tick_budget: None,
@@ -215,7 +220,17 @@ pub fn try_place_function_progress(
     // their per-op arrays are indexed by node (see `dag`).
     let mut dag = dag::OpDag::ordered(f, &seed);
     if opts.clusters > 1 {
-        let part = cluster::partition(&dag, a.n_add, a.n_mul, opts.clusters).map_err(PlaceError::Partition)?;
+        // the latest start of each node (the first or second component of the seed's key)
+        let alap: Vec<u32> = dag
+            .gather(&seed)
+            .iter()
+            .map(|k| match opts.priority {
+                Priority::Classical => k.0,
+                Priority::Mobility => k.1,
+            })
+            .collect();
+        let shape = cluster::Shape { n_add: a.n_add, n_mul: a.n_mul, clusters: opts.clusters, windows: opts.windows };
+        let part = cluster::partition(&dag, &alap, shape).map_err(PlaceError::Partition)?;
         dag.set_clusters(opts.clusters, part);
         dag.set_steal(opts.steal);
     }
@@ -392,6 +407,12 @@ pub const INFO: PassInfo = PassInfo {
             kind: ParamKind::U32Opt { min: 0, max: 4096 },
             doc: "S, with clusters: a ready op within S cycles of its latest start may issue on an idle PE of \
                   another cluster when that adds at most one interconnect route (none when not given)",
+        },
+        ParamInfo {
+            name: "windows",
+            kind: ParamKind::U32 { default: 1, min: 1, max: 16 },
+            doc: "W, with clusters: the partition gives each cluster its share of each of W time windows' ops \
+                  (latest-start quantiles): fewer cycles lost to a busy cluster, more interconnect routes",
         },
         ParamInfo {
             name: "rebind",
