@@ -647,12 +647,13 @@ const PENDULUM_RANGES: &str = r#"{"q[*]": [-3.2, 3.2], "qd[*]": [-10, 10], "qdd[
 const PENDULUM_POINT: &str = r#"{"q[1]": 0.75, "q[2]": -1.1, "qd[1]": 2.5, "qd[2]": -4.0, "qdd[1]": 3.0, "qdd[2]": -7.5,
   "g[3]": -9.81, "dpt[2][2]": 0.5, "m[1]": 1, "m[2]": 1, "l[2][1]": 0.25, "l[2][2]": 0.25, "In[1][1]": 0.1, "In[1][2]": 0.1}"#;
 
-/// The control memory the HDL reads (`Design::control`, issue 49): each PE's lanes, read back
-/// from the files and cut at the manifest's `pa` and `width`, hold exactly the fields of its
-/// separate images — the instruction's four addresses (each below the PE memory's words), its
+/// The control memory the HDL reads (`Design::control_lanes`, issue 49): the lanes the PEs
+/// share, read back from the files, hold each PE's word at its `offset` (the PEs' words in slot
+/// order, back to back), and that word, cut at the manifest's `pa` and `width`, holds exactly
+/// the fields of the PE's separate images — the instruction's four addresses (each below the PE memory's words), its
 /// flags, the write-port selects, the buffer instruction, the capture word and the shift word —
 /// on a fixed-point design with a specialised interconnect and a binary32 crossbar one; and the
-/// estimate counts the lanes' blocks, not the five memories'.
+/// estimate counts the lanes' blocks, each once, not the five memories'.
 #[test]
 fn control_lanes_hold_the_fields_of_the_separate_images() {
     let d = tmp("control_lanes");
@@ -677,23 +678,34 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
                 .map(|l| u128::from_str_radix(l.trim(), 16).unwrap())
                 .collect()
         };
+        // the control memory: its lanes side by side (bit 0 of the design's word in lane 0)
+        let mut lanes: Vec<(u32, Vec<u128>)> = Vec::new();
+        for lane in man["control_lanes"].as_array().unwrap() {
+            let (w, ws) = (lane["width"].as_u64().unwrap() as u32, hex(lane["file"].as_str().unwrap()));
+            assert!(ws.iter().all(|y| y >> w == 0), "{what}: a lane word wider than its lane");
+            lanes.push((w, ws));
+        }
+        let bit = |cycle: usize, mut i: u32| -> u128 {
+            for (w, ws) in &lanes {
+                if i < *w {
+                    return ws.get(cycle).map_or(0, |y| y >> i & 1);
+                }
+                i -= w;
+            }
+            panic!("{what}: bit beyond the control lanes");
+        };
+        let total: u32 = lanes.iter().map(|(w, _)| w).sum();
+        let mut next = 0;
         for pe in man["pes"].as_array().unwrap() {
             let c = &pe["control"];
             let (pa, width) = (c["pa"].as_u64().unwrap() as u32, c["width"].as_u64().unwrap() as u32);
-            let lanes = c["lanes"].as_array().unwrap();
-            // the words, lanes concatenated (bit 0 of the word in lane 0)
-            let mut words: Vec<u128> = Vec::new();
-            let mut at = 0;
-            for lane in lanes {
-                let (w, ws) = (lane["width"].as_u64().unwrap() as u32, hex(lane["file"].as_str().unwrap()));
-                words.resize(ws.len(), 0);
-                for (x, y) in words.iter_mut().zip(ws) {
-                    assert!(y >> w == 0, "{what}: a lane word wider than its lane");
-                    *x |= y << at;
-                }
-                at += w;
-            }
-            assert_eq!(at, width, "{what}: the lanes add up to the word");
+            // the PEs' words follow each other in slot order, with nothing between them
+            let offset = c["offset"].as_u64().unwrap() as u32;
+            assert_eq!(offset, next, "{what}: the control word of slot {} starts at {offset}", pe["slot"]);
+            next += width;
+            let cycles = lanes[0].1.len();
+            let words: Vec<u128> =
+                (0..cycles).map(|cy| (0..width).map(|b| bit(cy, offset + b) << b).fold(0, |a, x| a | x)).collect();
             let mem = &pe["memories"];
             let words_of = |k: &str| mem.get(k).map(|m| hex(m["file"].as_str().unwrap()));
             let width_of = |k: &str| mem[k]["width"].as_u64().unwrap() as u32;
@@ -769,12 +781,19 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
                 assert_eq!(lo, width);
             }
         }
+        assert_eq!(next, total, "{what}: the lanes hold the PEs' words and nothing more");
         // the estimate's memories: the lanes, the PE memory and output memories, nothing else
         let res: serde_json::Value = read_json(dir.join("resources.json"));
+        let mut counted_lanes = 0;
         for m in res["memories"].as_array().unwrap() {
             let name = m["name"].as_str().unwrap();
-            assert!(["_ctrl", "_data", "_out"].iter().any(|k| name.contains(k)), "{what}: {name} counted");
+            counted_lanes += usize::from(name.starts_with("ctrl"));
+            assert!(
+                name.starts_with("ctrl") || ["_data", "_out"].iter().any(|k| name.contains(k)),
+                "{what}: {name} counted"
+            );
         }
+        assert_eq!(counted_lanes, lanes.len(), "{what}: the estimate counts each lane once");
     }
 }
 

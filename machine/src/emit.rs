@@ -41,14 +41,12 @@ pub struct DesignFile {
 pub fn design_files(d: &Design, format: &str, r: &Resources, manifest: &str) -> Vec<DesignFile> {
     let mut v: Vec<DesignFile> = Vec::new();
     let mut add = |path: String, bytes: Vec<u8>, executable: bool| v.push(DesignFile { path, bytes, executable });
-    for p in &d.pes {
-        for img in d.images_of(p.slot) {
-            if format != "mif" {
-                add(format!("hex/{}.hex", img.name), img.to_hex().into_bytes(), false);
-            }
-            if format != "hex" {
-                add(format!("mif/{}.mif", img.name), img.to_mif().into_bytes(), false);
-            }
+    for img in d.images() {
+        if format != "mif" {
+            add(format!("hex/{}.hex", img.name), img.to_hex().into_bytes(), false);
+        }
+        if format != "hex" {
+            add(format!("mif/{}.mif", img.name), img.to_mif().into_bytes(), false);
         }
     }
     for (n, t) in HDL_LIBRARY {
@@ -101,8 +99,8 @@ struct ManifestControl {
     fix: Option<crate::design::FixField>,
     /// Bits of the word.
     width: u32,
-    /// The lanes, bit 0 of the word in the first.
-    lanes: Vec<ManifestMemory>,
+    /// Its first bit in the design's control word (`control_lanes`).
+    offset: u32,
 }
 
 /// The manifest (`manifest.json`): everything a host or a script needs to load and read the
@@ -125,14 +123,8 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             .chain(p.fix.as_ref().map(|i| ("fix", m(i))))
             .collect();
             let c = d.control(p.slot);
-            let control = ManifestControl {
-                pa: c.pa,
-                pb: c.pb,
-                po: c.po,
-                fix: c.fix,
-                width: c.width,
-                lanes: c.lanes.iter().map(m).collect(),
-            };
+            let control =
+                ManifestControl { pa: c.pa, pb: c.pb, po: c.po, fix: c.fix, width: c.width, offset: c.offset };
             ManifestPe {
                 control,
                 slot: p.slot,
@@ -198,7 +190,8 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             floor r, `align_bits` of alignment, the align-b bit when `align_b`, the rounding shift less `shift_min` in \
             `shift_bits`; zero on a cycle that issues nothing; on ADD PEs, `floors`, the op's floored form: r = min(align, \
             s - 1) for s >= 1 (else 0), the alignment less r, s less r, and an op whose align-b bit is 0 reads A and B \
-            swapped, so the finer operand is read at A); split into `lanes` (the HDL's control memories)",
+            swapped, so the finer operand is read at A); at bits [`offset`, `offset` + `width`) of the design's control word \
+            (`control_lanes`)",
         "data": match d.pe_kind {
             PeKind::Binary32 => "binary32",
             PeKind::Fixed => "fixed point: the `word_bits`-bit two's complement integer k of a value k·2^-f (each load's and output's `fraction`); out_data sign-extends it to 32 bits",
@@ -219,7 +212,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word with its addresses cut to \
             `pb` bits each; the `capt` word with its address cut to `po` bits; on fixed-point PEs the `fix` word cut to the PE's \
             shifts (`control.fix`); on PEs with `mac` then read C (`pa` bits), negate product, mac; \
-            split into `lanes` (the HDL's control memories)"
+            at bits [`offset`, `offset` + `width`) of the design's control word (`control_lanes`)"
         );
     }
     if d.pe_kind == PeKind::Fixed {
@@ -247,6 +240,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "layout": layout,
         "hdl": hdl,
         "pes": pes,
+        "control_lanes": d.control_lanes().iter().map(|i| ManifestMemory { file: i.name.clone(), words: i.words.len().max(1), width: i.width }).collect::<Vec<_>>(),
         "inputs": d.inputs,
         "loads": d.loads,
         "output_loads": d.output_loads,

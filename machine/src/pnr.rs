@@ -148,10 +148,8 @@ pub fn place_and_route(d: &Design, part: &PnrPart, freq_mhz: f64) -> Result<PnrR
     }
     write("robovec_top.v", d.top("").as_bytes())?;
     sources.push("robovec_top.v");
-    for p in &d.pes {
-        for img in d.images_of(p.slot) {
-            write(&format!("{}.hex", img.name), img.to_hex().as_bytes())?;
-        }
+    for img in d.images() {
+        write(&format!("{}.hex", img.name), img.to_hex().as_bytes())?;
     }
     let script = format!(
         "read_verilog {}\nsynth_ecp5 -top robovec_top -json out.json\ntee -q -o stat.json stat -json\n",

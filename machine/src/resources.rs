@@ -256,11 +256,19 @@ pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
         PeMemory::DoublePumped => (false, 1),
         PeMemory::LiveValueTable => (false, 4),
     };
+    // the control memory's lanes (`Design::control_lanes`): every PE's instruction, selects,
+    // buffer and capture words and shift word, fetched together
+    for img in d.control_lanes() {
+        let words = img.words.len().max(1) as u64;
+        v.push(MemoryCost {
+            name: img.name.clone(),
+            words,
+            width: img.width,
+            m10k: m10k_blocks(words, img.width, M10kFit::Configurations { true_dual_port: false, family }),
+            lutram: false,
+        });
+    }
     for p in &d.pes {
-        // the control memory's lanes (`Design::control`): the instruction, selects, buffer and
-        // capture words and the shift word, fetched together
-        let control = d.control(p.slot).lanes;
-        let lanes = control.iter().map(|i| (i, false, 1));
         // the output memory (`rv_out_mem`) of a PE that holds outputs: one simple dual-port
         // memory (a PE without outputs has a constant one, which synthesis removes)
         // (or LUT RAM, `Design::out_in_lutram`: no block)
@@ -270,9 +278,8 @@ pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
         // a MAC PE's third read (`rv_pe`'s MAC = 1): a copy of the PE memory taking the same
         // writes, one read port used (the live-value table's copy keeps two of its four banks)
         let copy = p.mac.then_some((&p.data, pe_tdp, banks.div_ceil(2), "_c"));
-        let lanes = lanes.map(|(i, t, b)| (i, t, b, ""));
         let out = out.map(|(i, t, b)| (i, t, b, ""));
-        for (img, true_dual_port, banks, suffix) in lanes.chain([(&p.data, pe_tdp, banks, "")]).chain(copy).chain(out) {
+        for (img, true_dual_port, banks, suffix) in [(&p.data, pe_tdp, banks, "")].into_iter().chain(copy).chain(out) {
             let words = img.words.len().max(1) as u64;
             let lutram = lutram(img);
             v.push(MemoryCost {

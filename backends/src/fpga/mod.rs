@@ -7,10 +7,11 @@
 //!   `peS_instr` (instruction memory, one word per cycle `0..=cycles`), `peS_xbar` (crossbar
 //!   memory: the two write selects of PE memory `S`), `peS_bufi` (buffer instructions),
 //!   `peS_capt` (output capture), `peS_data` (initial PE memory: constants, input words 0),
-//!   `peS_out` (initial output memory), `peS_fix` (fixed-point PEs: shift words), and
-//!   `peS_ctrl0`, `peS_ctrl1`, … (the control memory the HDL reads: the instruction, crossbar,
-//!   buffer, capture and shift words of a cycle in one word, in lanes of the family's widest
-//!   block-RAM word; the manifest's `control`). Word layouts: [`robovec_machine::encode`]'s
+//!   `peS_out` (initial output memory), `peS_fix` (fixed-point PEs: shift words); and
+//!   `ctrl0`, `ctrl1`, … (the control memory the HDL reads, which all PEs share: per cycle
+//!   every PE's instruction, crossbar, buffer, capture and shift words, PE after PE, in lanes
+//!   of the family's widest block-RAM word; the manifest's `control_lanes` and each PE's
+//!   `control`). Word layouts: [`robovec_machine::encode`]'s
 //!   module doc and the manifest's `widths` and `layout`.
 //! - `manifest.json`: sizes, widths, the load map (input / trig value / constant → PE slot,
 //!   address), the output map (output → PE slot, output-memory address), target, cycles.

@@ -408,18 +408,6 @@ pub fn from_placement_until(
 pub fn from_program(f: &Function, m: &MachineProgram, limits: &Limits) -> Result<Design, String> {
     let layout = Layout::new(m, limits.pe_words, limits.buffer_words, limits.instr_width).map_err(|e| e.to_string())?;
     let im = encode::encode(m, &layout).map_err(|e| e.to_string())?;
-    // the control word (`Design::control`) at its widest, the crossbar's selects: four lanes
-    let control_bits = layout.instr_bits()
-        + layout.crossbar_bits()
-        + layout.buffer_bits()
-        + layout.capture_bits()
-        + if m.fixed.is_some() { robovec_ir::machine::FixShifts::BITS } else { 0 };
-    if control_bits > 4 * limits.control_lane_bits {
-        return Err(format!(
-            "a PE's control word needs {control_bits} bits, more than the four {}-bit lanes of its control memory",
-            limits.control_lane_bits
-        ));
-    }
     let widths = Widths {
         aw: layout.aw,
         bw: layout.bw,

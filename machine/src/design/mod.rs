@@ -223,9 +223,10 @@ pub struct Design {
     pub out_lutram_words: u32,
 }
 
-/// A PE's control memory ([`Design::control`]): one word per cycle holding the instruction (its
-/// four addresses `pa` bits each), the write-port selects, the buffer instruction, the output
-/// capture and the shift word, split into lanes of the family's widest block-RAM word.
+/// A PE's control word ([`Design::control`]): per cycle the instruction (its four addresses
+/// `pa` bits each), the write-port selects, the buffer instruction, the output capture and the
+/// shift word, at bits `[offset, offset + width)` of the design's control memory
+/// ([`Design::control_lanes`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Control {
     /// Bits of each address field of the instruction: the PE memory's address bits.
@@ -240,9 +241,9 @@ pub struct Control {
     /// Bits of the whole word (`4·pa + 4` + selects + `2·pb + 2` buffer + `po + 1` capture [+
     /// the shift word's [`FixField::bits`]] [+ `pa + 2` mac fields]).
     pub width: u32,
-    /// The lanes, bit 0 of the word in lane 0 (`peS_ctrlK`), each `control_lane_bits` wide but
-    /// the last.
-    pub lanes: Vec<Image>,
+    /// The bit of the design's control word where this PE's starts: the widths of the PEs
+    /// before it in slot order ([`Design::control_offsets`]).
+    pub offset: u32,
 }
 
 /// The shift word of a fixed-point PE in its control word, cut to the shifts its program uses
@@ -491,37 +492,70 @@ impl Design {
         }
     }
 
-    /// PE `slot`'s control memory: per cycle its instruction word with each address field cut
+    /// PE `slot`'s control word: per cycle its instruction word with each address field cut
     /// to the PE memory's address bits (`[0,pa)` read A, `[pa,2pa)` read B, `[2pa,3pa)` write-0
     /// address, `[3pa,4pa)` write-1 address, then we0, we1, issue valid, sub), its write-port
     /// selects (the `xbar` image, `xbar.width` bits), its buffer instruction (`bufi`), its output
     /// capture (`capt`) and, on fixed-point PEs, its shift word (`fix` cut to the PE's shifts,
-    /// [`FixField`]; on an ADD PE an op whose `b` is the finer operand reads A and B swapped), in that order from
-    /// bit 0, then on a PE with fused multiply-adds ([`PeImages::mac`]) the read address C (`pa`
-    /// bits), the negate-product bit and the mac bit (the instruction's `[4aw+4, 5aw+6)`); split into lanes of [`Design::control_lane_bits`] (`peS_ctrl0`, `peS_ctrl1`, …). The
-    /// separate images are the same fields one memory each (the manifest's `memories`); the HDL
-    /// reads the lanes: every field is fetched at the same cycle, so one memory of the word's
-    /// width holds them in ⌈width / lane⌉ blocks (at most 256 cycles on the Cyclone V) where
-    /// five memories took a block each and the 52-bit instruction two.
+    /// [`FixField`]; on an ADD PE an op whose `b` is the finer operand reads A and B swapped), in
+    /// that order from bit 0, then on a PE with fused multiply-adds ([`PeImages::mac`]) the read
+    /// address C (`pa` bits), the negate-product bit and the mac bit (the instruction's
+    /// `[4aw+4, 5aw+6)`). The separate images are the same fields one memory each (the
+    /// manifest's `memories`); the HDL reads the word from the design's control memory
+    /// ([`Design::control_lanes`]), at bit [`Control::offset`].
     pub fn control(&self, slot: usize) -> Control {
+        let (pa, width) = self.control_width(slot);
+        let (pb, po, fix) = self.control_fields(slot);
+        Control { pa, pb, po, fix, width, offset: self.control_offsets().0[slot] }
+    }
+
+    /// The bit of the design's control word where each PE's word starts (indexed by slot: the
+    /// widths of the PEs before it, [`Design::control_width`]), and the word's width in bits.
+    pub fn control_offsets(&self) -> (Vec<u32>, u32) {
+        let mut at = 0u32;
+        let offsets = (0..self.pes.len())
+            .map(|slot| {
+                let o = at;
+                at += self.control_width(slot).1;
+                o
+            })
+            .collect();
+        (offsets, at)
+    }
+
+    /// The design's control memory: per cycle every PE's control word ([`Design::control`])
+    /// side by side in slot order, split into lanes of [`Design::control_lane_bits`] (`ctrl0`,
+    /// `ctrl1`, …; bit 0 of the word in lane 0), each one block-RAM memory addressed by the
+    /// program counter. Every PE steps through the same cycle, so the PEs share the lanes: a
+    /// block holds whole lanes of the family's widest word at any depth, where one memory per
+    /// PE wasted the rest of its last block (WALK-MAN's 50-bit words at 299 cycles took three
+    /// 20-bit-wide M10K a PE, two and a half shared).
+    pub fn control_lanes(&self) -> Vec<Image> {
+        let (offsets, width) = self.control_offsets();
+        let lane = self.control_lane_bits.max(1);
+        let cycles = self.pes.iter().map(|p| p.instr.words.len()).max().unwrap_or(0);
+        let mut lanes: Vec<Image> = (0..width.div_ceil(lane))
+            .map(|k| Image { name: format!("ctrl{k}"), width: lane.min(width - k * lane), words: vec![0; cycles] })
+            .collect();
+        for (slot, &base) in offsets.iter().enumerate() {
+            self.write_control(slot, base, &mut lanes);
+        }
+        lanes
+    }
+
+    /// Writes PE `slot`'s control word ([`Design::control`]) at bit `base` of `lanes` (each
+    /// [`Design::control_lane_bits`] wide but the last).
+    fn write_control(&self, slot: usize, base: u32, lanes: &mut [Image]) {
         let p = &self.pes[slot];
         let aw = self.widths.aw;
-        let (pa, width) = self.control_width(slot);
+        let (pa, _) = self.control_width(slot);
         let (pb, po, fix) = self.control_fields(slot);
         let (bw, ow) = (self.widths.bw, self.widths.ow);
         let lane = self.control_lane_bits.max(1);
-        let n_lanes = width.div_ceil(lane) as usize;
         let cycles = p.instr.words.len();
-        let mut lanes: Vec<Image> = (0..n_lanes)
-            .map(|k| Image {
-                name: format!("pe{slot}_ctrl{k}"),
-                width: lane.min(width - k as u32 * lane),
-                words: vec![0; cycles],
-            })
-            .collect();
         let mask = |bits: u32| if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
         for c in 0..cycles {
-            let mut at = 0u32;
+            let mut at = base;
             // `bits` low bits of `value` at bit `at` of the word, split where a lane ends
             let mut put = |value: u64, bits: u32| {
                 let (mut value, mut bits) = (value & mask(bits), bits);
@@ -572,7 +606,6 @@ impl Design {
                 put(w >> (5 * aw + 4) & 3, 2);
             }
         }
-        Control { pa, pb, po, fix, width, lanes }
     }
 
     /// PE `slot`'s buffer-address bits `pb`, output-address bits `po` and shift field in its
@@ -629,11 +662,11 @@ impl Design {
         per_pe + u64::from(self.widths.cw) + 2
     }
 
-    /// Every image of PE `slot` the design writes: [`PeImages::images`] and its control lanes
-    /// ([`Design::control`]).
-    pub fn images_of(&self, slot: usize) -> Vec<Image> {
-        let mut v: Vec<Image> = self.pes[slot].images().into_iter().cloned().collect();
-        v.extend(self.control(slot).lanes);
+    /// Every image the design writes: each PE's ([`PeImages::images`], in slot order), then
+    /// the control memory's lanes ([`Design::control_lanes`]).
+    pub fn images(&self) -> Vec<Image> {
+        let mut v: Vec<Image> = self.pes.iter().flat_map(|p| p.images().into_iter().cloned()).collect();
+        v.extend(self.control_lanes());
         v
     }
 
@@ -695,6 +728,21 @@ impl Design {
             );
             let _ = writeln!(s, "  wire [{}:0] sources = {{{}}};", 2 * dw as usize * n - 1, bus.join(", "));
         }
+        // the control memory (`Design::control_lanes`): every PE's control word side by side,
+        // one block-RAM lane of `control_lane_bits` bits after the other, read at `fetch`
+        let (_, ctrl_bits) = self.control_offsets();
+        let _ = writeln!(s, "  wire [{}:0] ctrl_word;", ctrl_bits.max(1) - 1);
+        let lane = self.control_lane_bits.max(1);
+        for k in 0..ctrl_bits.div_ceil(lane) {
+            let width = lane.min(ctrl_bits - k * lane);
+            let _ = writeln!(
+                s,
+                "  rv_rom #(.WIDTH({width}), .DEPTH({}), .AW({}), .FILE(\"{dir}ctrl{k}.hex\")) u_ctrl{k} (.clk(clk), .addr(fetch), .q(ctrl_word[{} +: {width}]));",
+                self.cycles + 1,
+                w.cw,
+                k * lane
+            );
+        }
         for p in &self.pes {
             let lat = if p.is_mul { self.lat_mul } else { self.lat_add };
             let f = |i: &Image| format!("\"{dir}{}.hex\"", i.name);
@@ -732,11 +780,9 @@ impl Design {
                 }
                 fix += &format!(".FAB({}), .FALB({}), .FSB({}), ", fx.align_bits, u8::from(fx.align_b), fx.shift_bits);
             }
-            let lanes: String =
-                control.lanes.iter().enumerate().map(|(k, l)| format!(".CTRL{k}_FILE({}), ", f(l))).collect();
             let _ = writeln!(
                 s,
-                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .N2({n2}), .SW2({sw2}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}), .PA({pa}), .PB({pb}), .PO({po}), .CTW({ctw}), .LANE({lane}),\n        {lanes}.DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .fetch(fetch), .src0({src0}), .src1({src1}), .src2({src2}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
+                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .N2({n2}), .SW2({sw2}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}), .PA({pa}), .PB({pb}), .PO({po}), .CTW({ctw}),\n        .DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .ctrl_word(ctrl_word[{off} +: {ctw}]), .src0({src0}), .src1({src1}), .src2({src2}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
                 mul = u8::from(p.is_mul),
                 aw = w.aw,
                 bw = w.bw,
@@ -747,7 +793,7 @@ impl Design {
                 pb = control.pb,
                 po = control.po,
                 ctw = control.width,
-                lane = self.control_lane_bits,
+                off = control.offset,
                 md = p.data.words.len().max(1),
                 bd = p.buffer_words.max(1),
                 od = p.out.words.len().max(1),

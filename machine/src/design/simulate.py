@@ -179,15 +179,15 @@ def main(argv):
     if shutil.which("iverilog") is None or shutil.which("vvp") is None:
         fail("Icarus Verilog is not installed (`iverilog`, `vvp`; Debian package `iverilog`)")
     with tempfile.TemporaryDirectory(prefix="robovec-sim-") as tmp:
-        for pe in man["pes"]:
-            for m in list(pe["memories"].values()) + pe["control"]["lanes"]:
-                src = os.path.join(HERE, "hex", m["file"] + ".hex")
-                if os.path.exists(src):
-                    shutil.copy(src, os.path.join(tmp, m["file"] + ".hex"))
-                else:
-                    words = read_mif(os.path.join(HERE, "mif", m["file"] + ".mif"))
-                    with open(os.path.join(tmp, m["file"] + ".hex"), "w") as f:
-                        f.write("".join("%x\n" % w for w in words))
+        # every PE's memories, then the control memory's lanes the PEs share
+        for m in [m for pe in man["pes"] for m in pe["memories"].values()] + man["control_lanes"]:
+            src = os.path.join(HERE, "hex", m["file"] + ".hex")
+            if os.path.exists(src):
+                shutil.copy(src, os.path.join(tmp, m["file"] + ".hex"))
+            else:
+                words = read_mif(os.path.join(HERE, "mif", m["file"] + ".mif"))
+                with open(os.path.join(tmp, m["file"] + ".hex"), "w") as f:
+                    f.write("".join("%x\n" % w for w in words))
         images = {}
         for pe in man["pes"]:
             images[pe["slot"]] = {

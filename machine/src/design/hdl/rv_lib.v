@@ -6,8 +6,8 @@
 //
 // Timing (machine cycle k of the program = clock k of the run, counted from `start`):
 //   * the instruction, crossbar, buffer-instruction and output-capture words of cycle k are
-//     flip-flops during clock k: the control memory (block RAM) registers the word of cycle k
-//     at the edge ending clock k - 2 and the PE registers it again at the next edge (rv_pe's
+//     flip-flops during clock k: the control memory (block RAM lanes in the top, shared by all
+//     PEs) registers the word of cycle k at the edge ending clock k - 2 and the PE registers it again at the next edge (rv_pe's
 //     `ctrl`; the buffer's read address of cycle k is used a clock early, from the block RAM's
 //     output);
 //   * during clock k the result of an op issued at k - LAT arrives (`result`, the register
@@ -21,8 +21,9 @@
 //   * the floating-point unit takes the operands during clock k + 1 and has LAT - 2 stages, so
 //     its result is in `result` during clock k + LAT.
 
-// One PE: instruction memory, crossbar memory, PE memory, floating-point unit, buffer (with its
-// instruction memory) and output memory (with its capture memory). Word layouts: see the
+// One PE: its control word (instruction, crossbar selects, buffer instruction, output capture,
+// shift word: its bits of the control memory the top shares between all PEs, robovec's
+// `Design::control_lanes`), PE memory, floating-point unit, buffer and output memory. Word layouts: see the
 // manifest's `layout` and the `machine` module doc (LSB first).
 module rv_pe #(
     parameter integer IS_MUL = 0,      // 0: ADD PE (fp_add_sub), 1: MULTI PE (fp_mul)
@@ -61,17 +62,13 @@ module rv_pe #(
     parameter integer FALB = 1,        // fixed-point PEs: 1 when the shift word has the align-b bit
     parameter integer FSB = 7,         // fixed-point PEs: bits of the rounding shift less SMIN
     parameter integer CTW = 4 * PA + 4 + SW0 + SW1 + SW2 + 2 * PB + 2 + PO + 1 + (FIX != 0 ? FRB + FAB + FALB + FSB : 0) + (MAC != 0 ? PA + 2 : 0),  // control word bits
-    parameter integer LANE = 40,       // bits of a control-memory lane (the widest block-RAM word)
-    parameter CTRL0_FILE = "",         // the control memory's lanes (robovec's `Design::control`),
-    parameter CTRL1_FILE = "",         // bit 0 of the word in lane 0; at most four lanes
-    parameter CTRL2_FILE = "",
-    parameter CTRL3_FILE = "",
     parameter DATA_FILE = "",
     parameter OUT_FILE = ""
 ) (
     input  wire                 clk,
     input  wire                 run,       // executing cycle `pc` of the program
-    input  wire [CW-1:0]        fetch,     // the cycle whose control word the block RAM registers at this edge
+    input  wire [CTW-1:0]       ctrl_word, // this PE's bits of the control memory's output (robovec's
+                                           // `Design::control_lanes`, read at `fetch` in the top): the word of the next cycle
     input  wire [DW*(N0 > 0 ? N0 : 1)-1:0] src0,  // port 0's sources (crossbar: {buffer reads, results})
     input  wire [DW*(N1 > 0 ? N1 : 1)-1:0] src1,  // port 1's sources
     input  wire [DW*(N2 > 0 ? N2 : 1)-1:0] src2,  // the shared multiplexer's sources
@@ -84,43 +81,13 @@ module rv_pe #(
   localparam integer BIW = 2 * PB + 2;   // the buffer instruction in the control word
   localparam integer OCW = PO + 1;       // the capture word in the control word
   localparam integer FW = (FIX != 0) ? FRB + FAB + FALB + FSB : 0;  // the shift word in the control word
-  localparam integer ROM_DEPTH = CYCLES + 1;
 
-  // The control memory: one word per cycle (the instruction with PA-bit addresses, the
-  // write-port selects, the buffer instruction, the output capture, the shift word), fetched
-  // at once from lanes of LANE bits, each one block-RAM memory.
-  localparam integer NL = (CTW + LANE - 1) / LANE;
-  wire [4*LANE-1:0] lanes;
-  genvar ln;
-  generate
-    for (ln = 0; ln < 4; ln = ln + 1) begin : g_lane
-      localparam integer LW = (ln < NL) ? ((CTW - ln * LANE < LANE) ? CTW - ln * LANE : LANE) : 1;
-      if (ln < NL) begin : g_rom
-        wire [LW-1:0] q;
-        if (ln == 0) begin : g0
-          rv_rom #(.WIDTH(LW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CTRL0_FILE)) u_rom (.clk(clk), .addr(fetch), .q(q));
-        end else if (ln == 1) begin : g1
-          rv_rom #(.WIDTH(LW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CTRL1_FILE)) u_rom (.clk(clk), .addr(fetch), .q(q));
-        end else if (ln == 2) begin : g2
-          rv_rom #(.WIDTH(LW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CTRL2_FILE)) u_rom (.clk(clk), .addr(fetch), .q(q));
-        end else begin : g3
-          rv_rom #(.WIDTH(LW), .DEPTH(ROM_DEPTH), .AW(CW), .FILE(CTRL3_FILE)) u_rom (.clk(clk), .addr(fetch), .q(q));
-        end
-        assign lanes[ln*LANE +: LW] = q;
-        if (LW < LANE) begin : g_pad
-          assign lanes[ln*LANE+LW +: LANE-LW] = {(LANE - LW){1'b0}};
-        end
-      end else begin : g_none
-        assign lanes[ln*LANE +: LANE] = {LANE{1'b0}};
-      end
-    end
-  endgenerate
   // The block RAM's output is the word of the next cycle (`fetch` runs two cycles ahead of
   // the program): it is registered once more here, so that every field of the running cycle
   // leaves a flip-flop, not the block RAM's slow clock-to-output (5.6 ns on the ECP5's DP16KD,
   // the start of the critical path nextpnr reported), and the buffer's read address is known a
   // clock early (below).
-  wire [CTW-1:0] ctrl_next = lanes[CTW-1:0];
+  wire [CTW-1:0] ctrl_next = ctrl_word;
   reg  [CTW-1:0] ctrl;
   initial ctrl = 0;
   always @(posedge clk) ctrl <= ctrl_next;
