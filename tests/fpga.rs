@@ -1203,9 +1203,17 @@ fn yosys_sizes_the_design_and_resources_json_has_the_figures() {
     let d = tmp("yosys");
     let dir = d.join("out");
     let rep = d.join("report.json");
-    let passes =
-        format!("-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=yosys>", dir.display());
-    let o = opt(&[PENDULUM, &passes, &format!("-report={}", rep.display()), "-o", "/dev/null"]);
+    // a DE10-Nano one M10K short of the design's estimate with every output memory in block
+    // RAM, so that an output memory goes to LUT RAM (MLAB)
+    let passes = |res: &str| {
+        format!("-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources={res}>", dir.display())
+    };
+    let o = opt(&[PENDULUM, &passes("estimate"), "-o", "/dev/null"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let all = read_json(dir.join("resources.json"))["m10k"].as_u64().unwrap();
+    let short = target_with(&d, "m10k", serde_json::json!(all - 1));
+    let target = format!("-target={}", short.display());
+    let o = opt(&[PENDULUM, &passes("yosys"), &target, &format!("-report={}", rep.display()), "-o", "/dev/null"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let r: serde_json::Value = read_json(dir.join("resources.json"));
     assert_eq!(r["logic_from"], "yosys");
@@ -1252,46 +1260,72 @@ fn auto_resources_leave_large_designs_to_the_estimate_with_a_note() {
 }
 
 /// The analytic estimate counts the output memories (issue 49): one for each PE that holds
-/// outputs (found here from the manifest's output map), of the image's words; on the
-/// DE10-Nano in LUT RAM (MLAB: no M10K, 16 ALMs for 32-bit words of up to 32 words) when it has
-/// at most 32 words and no initial contents (no output load on the PE), else one simple
-/// dual-port M10K; and no logic a word (`output_word_alm` is 0 on the DE10-Nano).
+/// outputs (found here from the manifest's output map), of the image's words. On the DE10-Nano,
+/// which has block RAM to spare for the pendulum, each is one simple dual-port M10K; on a
+/// DE10-Nano with as many M10K fewer as the pendulum has output memories of at most 32 words
+/// and no initial contents (no output load on the PE), exactly those are in LUT RAM (MLAB: no
+/// M10K, 16 ALMs for 32-bit words of up to 32 words) and the design's M10K fit; and no logic a
+/// word (`output_word_alm` is 0 on the DE10-Nano).
 #[test]
 fn the_analytic_estimate_counts_the_output_memories() {
     let d = tmp("estimate_outputs");
     let dir = d.join("out");
-    let passes = format!(
-        "-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=estimate>",
-        dir.display()
-    );
-    let o = opt(&[PENDULUM, &passes, "-o", "/dev/null"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let r: serde_json::Value = read_json(dir.join("resources.json"));
-    let man: serde_json::Value = read_json(dir.join("manifest.json"));
-    let holding: std::collections::BTreeSet<u64> =
-        man["outputs"].as_array().unwrap().iter().map(|o| o["slot"].as_u64().unwrap()).collect();
-    assert!(!holding.is_empty(), "the pendulum's outputs are captured");
-    let loaded: std::collections::BTreeSet<u64> =
-        man["output_loads"].as_array().unwrap().iter().map(|o| o["slot"].as_u64().unwrap()).collect();
-    let memories = r["memories"].as_array().unwrap();
-    let mut lutram_alm = 0.0;
-    for k in 0..4u64 {
-        let m = memories.iter().find(|m| m["name"] == format!("pe{k}_out"));
-        assert_eq!(m.is_some(), holding.contains(&k), "PE {k}: an output memory is counted iff it holds outputs");
-        if let Some(m) = m {
-            // its words: one per line of its image (at least one)
-            let t = std::fs::read_to_string(dir.join("hex").join(format!("pe{k}_out.hex"))).unwrap();
-            let words = t.lines().filter(|l| !l.trim().is_empty()).count() as u64;
-            assert_eq!(m["words"].as_u64().unwrap(), words);
-            let lutram = words <= 32 && !loaded.contains(&k);
-            assert_eq!(m["lutram"], lutram, "PE {k}: {words} words, loaded: {}", loaded.contains(&k));
-            assert_eq!(m["m10k"], if lutram { 0 } else { 1 }, "a few words: MLAB or one M10K");
-            if lutram {
-                lutram_alm += 16.0; // 32 MLAB cells of 32 words, two an ALM
+    let run = |target: Option<&Path>| {
+        let passes = format!(
+            "-passes=atomise,place<pe=2;restarts=0;search=0>,codegen<fpga;out={};resources=estimate>",
+            dir.display()
+        );
+        let t = target.map(|t| format!("-target={}", t.display()));
+        let mut args = vec![PENDULUM, &passes, "-o", "/dev/null"];
+        args.extend(t.as_deref());
+        let o = opt(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let r: serde_json::Value = read_json(dir.join("resources.json"));
+        let man: serde_json::Value = read_json(dir.join("manifest.json"));
+        (r, man)
+    };
+    // the output memories (PE, words, whether LUT RAM may hold it) and each memory's blocks
+    let outputs = |r: &serde_json::Value, man: &serde_json::Value| -> Vec<(u64, u64, bool, serde_json::Value)> {
+        let holding: std::collections::BTreeSet<u64> =
+            man["outputs"].as_array().unwrap().iter().map(|o| o["slot"].as_u64().unwrap()).collect();
+        assert!(!holding.is_empty(), "the pendulum's outputs are captured");
+        let loaded: std::collections::BTreeSet<u64> =
+            man["output_loads"].as_array().unwrap().iter().map(|o| o["slot"].as_u64().unwrap()).collect();
+        let memories = r["memories"].as_array().unwrap();
+        let mut v = Vec::new();
+        for k in 0..4u64 {
+            let m = memories.iter().find(|m| m["name"] == format!("pe{k}_out"));
+            assert_eq!(m.is_some(), holding.contains(&k), "PE {k}: an output memory is counted iff it holds outputs");
+            if let Some(m) = m {
+                // its words: one per line of its image (at least one)
+                let t = std::fs::read_to_string(dir.join("hex").join(format!("pe{k}_out.hex"))).unwrap();
+                let words = t.lines().filter(|l| !l.trim().is_empty()).count() as u64;
+                assert_eq!(m["words"].as_u64().unwrap(), words);
+                v.push((k, words, words <= 32 && !loaded.contains(&k), m.clone()));
             }
         }
+        v
+    };
+    let (r, man) = run(None);
+    let eligible = outputs(&r, &man).iter().filter(|o| o.2).count() as u64;
+    assert!(eligible > 0, "some output memory of the pendulum may be in LUT RAM");
+    for (k, _, _, m) in outputs(&r, &man) {
+        assert_eq!(m["lutram"], false, "PE {k}: block RAM to spare");
+        assert_eq!(m["m10k"], 1, "PE {k}: a few words, one M10K");
     }
-    assert!(lutram_alm > 0.0, "some output memory of the pendulum is in LUT RAM");
+    // a device short of exactly those blocks
+    let all = r["m10k"].as_u64().unwrap();
+    let short = target_with(&d, "m10k", serde_json::json!(all - eligible));
+    let (r, man) = run(Some(&short));
+    assert!(r["m10k"].as_u64().unwrap() <= all - eligible, "the M10K fit the smaller device");
+    let mut lutram_alm = 0.0;
+    for (k, words, may, m) in outputs(&r, &man) {
+        assert_eq!(m["lutram"], may, "PE {k}: {words} words, in LUT RAM iff it may be");
+        assert_eq!(m["m10k"], if may { 0 } else { 1 }, "a few words: MLAB or one M10K");
+        if may {
+            lutram_alm += 16.0; // 32 MLAB cells of 32 words, two an ALM
+        }
+    }
     // the Cyclone V's Yosys-flow figures for 4 PEs of 32-bit words, and nothing per output
     // word: 8 crossbar ports of 8 inputs, each PE by its buffer words (the manifest's)
     let l = robovec_machine::target::Family::CycloneV.design_logic().unwrap();

@@ -279,6 +279,28 @@ pub fn emit(
     emit_until(f, p, limits, model, opts, &|| false).map_err(|e| e.message)
 }
 
+/// `d` with its output memories in LUT RAM only as far as the block RAM needs (issue 49): the
+/// smallest depth `t` up to the family's [`Design::out_lutram_words`] (0: every output memory in
+/// block RAM) at which the estimate's block RAMs fit `model`'s device, the output memories of
+/// at most `t` words built in LUT RAM ([`Design::out_in_lutram`]); the family's depth when none
+/// fits. An output memory in the Cyclone V's MLAB costs about 13 ALMs for 26-bit words (Yosys:
+/// a `MISTRAL_MLAB` cell a bit, two an ALM) that a spare M10K saves: the MX-5 at 81 + 81 PEs
+/// has 106 of them, 1,196 ALMs, and 213 M10K to spare. Cost: an estimate per distinct depth.
+fn lutram_where_block_ram_is_short(mut d: Design, model: &CostModel) -> Design {
+    let most = d.out_lutram_words;
+    let mut depths: Vec<u32> = d.pes.iter().map(|p| p.out.words.len().max(1) as u32).filter(|&w| w <= most).collect();
+    depths.sort_unstable();
+    depths.dedup();
+    for t in std::iter::once(0).chain(depths) {
+        d.out_lutram_words = t;
+        if t == most || resources::estimate(&d, model, None).m10k <= model.capacity.m10k {
+            return d;
+        }
+    }
+    d.out_lutram_words = most;
+    d
+}
+
 /// [`emit`] whose lowering gives up when `stop` returns true ([`from_placement_until`]; the
 /// caller's time limit). The encoding, Yosys and the estimate after it are not interrupted.
 ///
@@ -300,6 +322,7 @@ pub fn emit_until(
             span: e.span,
         })?
         .with_interconnect(opts.interconnect);
+    let d = lutram_where_block_ram_is_short(d, model);
     let cells =
         match logic {
             _ if logic.skips_yosys(d.n_add + d.n_mul) => None,

@@ -314,9 +314,9 @@ impl Family {
     /// words: the Cyclone V's MLAB, a LAB of 10 ALMs used as 32 words × 20 bits (Cyclone V device
     /// handbook, "Embedded Memory Blocks"; Yosys `synth_intel_alm` maps such a memory to
     /// `MISTRAL_MLAB` cells of 32 words × 1 bit, two an ALM). The PE output memories that fit
-    /// it are built there (`rv_out_lutram`, issue 49): a few ALMs each instead of an M10K each
-    /// (WALK-MAN at 57 + 57 PEs: 114 of its 549 M10K). 0 on the ECP5: its output memories stay
-    /// in block RAM.
+    /// it may be built there (`rv_out_lutram`, issue 49): a few ALMs each instead of an M10K each
+    /// (WALK-MAN at 57 + 57 PEs: 114 of its 549 M10K), as far as the design's block RAM needs
+    /// (`codegen<fpga>`: `emit`'s choice). 0 on the ECP5: its output memories stay in block RAM.
     pub const fn lutram_words(self) -> u32 {
         match self {
             Family::CycloneV => 32,
