@@ -633,7 +633,7 @@ fn a_specialised_interconnect_computes_the_crossbars_bits_with_only_the_routed_s
                 rx["logic_alm"],
                 rs["logic_alm"]
             );
-            // the narrower selects shorten the control words (`Design::control`): never more blocks
+            // the narrower selects shorten the control words (`Design::controls`): never more blocks
             assert!(rs["m10k"].as_u64() <= rx["m10k"].as_u64(), "{what}: {} → {} M10K", rx["m10k"], rs["m10k"]);
         }
     }

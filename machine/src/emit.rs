@@ -81,8 +81,9 @@ struct ManifestPe<'a> {
     latency: u32,
     buffer_words: u32,
     memories: std::collections::BTreeMap<&'static str, ManifestMemory>,
-    /// The control memory the HDL reads (`Design::control`): the same fields as `instr`,
-    /// `xbar`, `bufi`, `capt` and `fix`, one word per cycle in lanes.
+    /// The PE's control word (`Design::controls`): the same fields as `instr`, `xbar`, `bufi`,
+    /// `capt` and `fix`, one word per cycle at `offset` of the control memory the HDL reads
+    /// (`control_lanes`).
     control: ManifestControl,
 }
 
@@ -94,7 +95,7 @@ struct ManifestControl {
     pb: u32,
     /// Bits of the output-memory address (the `capt` word's, cut to them).
     po: u32,
-    /// On fixed-point PEs, the shift word's fields (`Design::control`'s `FixField`).
+    /// On fixed-point PEs, the shift word's fields (`Design::controls`' `FixField`).
     #[serde(skip_serializing_if = "Option::is_none")]
     fix: Option<crate::design::FixField>,
     /// Bits of the word.
@@ -106,11 +107,12 @@ struct ManifestControl {
 /// The manifest (`manifest.json`): everything a host or a script needs to load and read the
 /// design. `target` is the target's name, `clock_mhz` its clock.
 pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> String {
+    let m = |i: &Image| ManifestMemory { file: i.name.clone(), words: i.words.len().max(1), width: i.width };
     let pes: Vec<ManifestPe> = d
         .pes
         .iter()
-        .map(|p| {
-            let m = |i: &Image| ManifestMemory { file: i.name.clone(), words: i.words.len().max(1), width: i.width };
+        .zip(d.controls())
+        .map(|(p, c)| {
             let memories = [
                 ("instr", m(&p.instr)),
                 ("xbar", m(&p.xbar)),
@@ -122,7 +124,6 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             .into_iter()
             .chain(p.fix.as_ref().map(|i| ("fix", m(i))))
             .collect();
-            let c = d.control(p.slot);
             let control =
                 ManifestControl { pa: c.pa, pb: c.pb, po: c.po, fix: c.fix, width: c.width, offset: c.offset };
             ManifestPe {
@@ -240,7 +241,7 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         "layout": layout,
         "hdl": hdl,
         "pes": pes,
-        "control_lanes": d.control_lanes().iter().map(|i| ManifestMemory { file: i.name.clone(), words: i.words.len().max(1), width: i.width }).collect::<Vec<_>>(),
+        "control_lanes": d.control_lanes().iter().map(m).collect::<Vec<_>>(),
         "inputs": d.inputs,
         "loads": d.loads,
         "output_loads": d.output_loads,

@@ -258,13 +258,14 @@ pub fn memory_costs(d: &Design, family: Family) -> Vec<MemoryCost> {
     };
     // the control memory's lanes (`Design::control_lanes`): every PE's instruction, selects,
     // buffer and capture words and shift word, fetched together
-    for img in d.control_lanes() {
-        let words = img.words.len().max(1) as u64;
+    // (their shapes only: their words are not needed to count blocks)
+    let words = u64::from(d.cycles) + 1;
+    for (k, width) in d.control_lane_widths().into_iter().enumerate() {
         v.push(MemoryCost {
-            name: img.name.clone(),
+            name: Design::control_lane_name(k),
             words,
-            width: img.width,
-            m10k: m10k_blocks(words, img.width, M10kFit::Configurations { true_dual_port: false, family }),
+            width,
+            m10k: m10k_blocks(words, width, M10kFit::Configurations { true_dual_port: false, family }),
             lutram: false,
         });
     }

@@ -345,7 +345,7 @@ impl Family {
     }
 
     /// Bits of the widest word of one block RAM (40 on the Cyclone V's M10K, 256 × 40; 36 on the
-    /// ECP5's 512 × 36): the lanes of a PE's control memory (`crate::design::Design::control`),
+    /// ECP5's 512 × 36): the lanes of a design's control memory (`crate::design::Design::control_lanes`),
     /// since every narrower configuration's width divides it.
     pub const fn bram_word(self) -> u32 {
         match self {

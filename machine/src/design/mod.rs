@@ -210,7 +210,7 @@ pub struct Design {
     /// for binary32 PEs, the function's widest format for fixed-point ones
     /// ([`crate::program::fixed::word_bits`]).
     pub word_bits: u32,
-    /// Bits of a lane of the PE control memories ([`Design::control`]): the family's widest
+    /// Bits of a lane of the control memory ([`Design::control_lanes`]): the family's widest
     /// block-RAM word.
     pub control_lane_bits: u32,
     /// The widest word whose product is one DSP multiplier of the family (27 on the Cyclone V,
@@ -223,7 +223,7 @@ pub struct Design {
     pub out_lutram_words: u32,
 }
 
-/// A PE's control word ([`Design::control`]): per cycle the instruction (its four addresses
+/// A PE's control word ([`Design::controls`]): per cycle the instruction (its four addresses
 /// `pa` bits each), the write-port selects, the buffer instruction, the output capture and the
 /// shift word, at bits `[offset, offset + width)` of the design's control memory
 /// ([`Design::control_lanes`]).
@@ -492,7 +492,7 @@ impl Design {
         }
     }
 
-    /// PE `slot`'s control word: per cycle its instruction word with each address field cut
+    /// Each PE's control word, in slot order: per cycle its instruction word with each address field cut
     /// to the PE memory's address bits (`[0,pa)` read A, `[pa,2pa)` read B, `[2pa,3pa)` write-0
     /// address, `[3pa,4pa)` write-1 address, then we0, we1, issue valid, sub), its write-port
     /// selects (the `xbar` image, `xbar.width` bits), its buffer instruction (`bufi`), its output
@@ -503,10 +503,17 @@ impl Design {
     /// `[4aw+4, 5aw+6)`). The separate images are the same fields one memory each (the
     /// manifest's `memories`); the HDL reads the word from the design's control memory
     /// ([`Design::control_lanes`]), at bit [`Control::offset`].
-    pub fn control(&self, slot: usize) -> Control {
-        let (pa, width) = self.control_width(slot);
-        let (pb, po, fix) = self.control_fields(slot);
-        Control { pa, pb, po, fix, width, offset: self.control_offsets().0[slot] }
+    pub fn controls(&self) -> Vec<Control> {
+        let (offsets, _) = self.control_offsets();
+        offsets
+            .into_iter()
+            .enumerate()
+            .map(|(slot, offset)| {
+                let (pa, width) = self.control_width(slot);
+                let (pb, po, fix) = self.control_fields(slot);
+                Control { pa, pb, po, fix, width, offset }
+            })
+            .collect()
     }
 
     /// The bit of the design's control word where each PE's word starts (indexed by slot: the
@@ -523,7 +530,7 @@ impl Design {
         (offsets, at)
     }
 
-    /// The design's control memory: per cycle every PE's control word ([`Design::control`])
+    /// The design's control memory: per cycle every PE's control word ([`Design::controls`])
     /// side by side in slot order, split into lanes of [`Design::control_lane_bits`] (`ctrl0`,
     /// `ctrl1`, …; bit 0 of the word in lane 0), each one block-RAM memory addressed by the
     /// program counter. Every PE steps through the same cycle, so the PEs share the lanes: a
@@ -531,19 +538,34 @@ impl Design {
     /// PE wasted the rest of its last block (WALK-MAN's 50-bit words at 299 cycles took three
     /// 20-bit-wide M10K a PE, two and a half shared).
     pub fn control_lanes(&self) -> Vec<Image> {
-        let (offsets, width) = self.control_offsets();
-        let lane = self.control_lane_bits.max(1);
-        let cycles = self.pes.iter().map(|p| p.instr.words.len()).max().unwrap_or(0);
-        let mut lanes: Vec<Image> = (0..width.div_ceil(lane))
-            .map(|k| Image { name: format!("ctrl{k}"), width: lane.min(width - k * lane), words: vec![0; cycles] })
+        let depth = self.cycles as usize + 1;
+        let mut lanes: Vec<Image> = self
+            .control_lane_widths()
+            .into_iter()
+            .enumerate()
+            .map(|(k, width)| Image { name: Design::control_lane_name(k), width, words: vec![0; depth] })
             .collect();
-        for (slot, &base) in offsets.iter().enumerate() {
+        for (slot, &base) in self.control_offsets().0.iter().enumerate() {
             self.write_control(slot, base, &mut lanes);
         }
         lanes
     }
 
-    /// Writes PE `slot`'s control word ([`Design::control`]) at bit `base` of `lanes` (each
+    /// The widths of the control memory's lanes ([`Design::control_lanes`], without their
+    /// words): [`Design::control_lane_bits`] each but the last. Each lane has a word per cycle
+    /// `0..=cycles`.
+    pub fn control_lane_widths(&self) -> Vec<u32> {
+        let (_, width) = self.control_offsets();
+        let lane = self.control_lane_bits.max(1);
+        (0..width.div_ceil(lane)).map(|k| lane.min(width - k * lane)).collect()
+    }
+
+    /// The image name of the control memory's lane `k` (`ctrlK`).
+    pub fn control_lane_name(k: usize) -> String {
+        format!("ctrl{k}")
+    }
+
+    /// Writes PE `slot`'s control word ([`Design::controls`]) at bit `base` of `lanes` (each
     /// [`Design::control_lane_bits`] wide but the last).
     fn write_control(&self, slot: usize, base: u32, lanes: &mut [Image]) {
         let p = &self.pes[slot];
@@ -632,7 +654,7 @@ impl Design {
         (pb, po, fix)
     }
 
-    /// PE `slot`'s control word without building it: `(pa, width)` of [`Design::control`], the
+    /// PE `slot`'s control word without building it: `(pa, width)` of [`Design::controls`], the
     /// bits of each address field and of the whole word.
     pub fn control_width(&self, slot: usize) -> (u32, u32) {
         let p = &self.pes[slot];
@@ -730,20 +752,20 @@ impl Design {
         }
         // the control memory (`Design::control_lanes`): every PE's control word side by side,
         // one block-RAM lane of `control_lane_bits` bits after the other, read at `fetch`
-        let (_, ctrl_bits) = self.control_offsets();
-        let _ = writeln!(s, "  wire [{}:0] ctrl_word;", ctrl_bits.max(1) - 1);
-        let lane = self.control_lane_bits.max(1);
-        for k in 0..ctrl_bits.div_ceil(lane) {
-            let width = lane.min(ctrl_bits - k * lane);
+        let widths = self.control_lane_widths();
+        let _ = writeln!(s, "  wire [{}:0] ctrl_word;", widths.iter().sum::<u32>().max(1) - 1);
+        let mut at = 0;
+        for (k, width) in widths.into_iter().enumerate() {
             let _ = writeln!(
                 s,
-                "  rv_rom #(.WIDTH({width}), .DEPTH({}), .AW({}), .FILE(\"{dir}ctrl{k}.hex\")) u_ctrl{k} (.clk(clk), .addr(fetch), .q(ctrl_word[{} +: {width}]));",
+                "  rv_rom #(.WIDTH({width}), .DEPTH({}), .AW({}), .FILE(\"{dir}{}.hex\")) u_ctrl{k} (.clk(clk), .addr(fetch), .q(ctrl_word[{at} +: {width}]));",
                 self.cycles + 1,
                 w.cw,
-                k * lane
+                Design::control_lane_name(k)
             );
+            at += width;
         }
-        for p in &self.pes {
+        for (p, control) in self.pes.iter().zip(self.controls()) {
             let lat = if p.is_mul { self.lat_mul } else { self.lat_add };
             let f = |i: &Image| format!("\"{dir}{}.hex\"", i.name);
             let (src0, n0, sw0) = self.port_sources(p.slot, 0);
@@ -773,7 +795,6 @@ impl Design {
             if self.out_in_lutram(p) {
                 fix += ".OUT_LUTRAM(1), ";
             }
-            let control = self.control(p.slot);
             if let Some(fx) = control.fix {
                 if fx.floors {
                     fix += &format!(".FRB({}), ", fx.floor_bits);
@@ -782,13 +803,11 @@ impl Design {
             }
             let _ = writeln!(
                 s,
-                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .N2({n2}), .SW2({sw2}), .AW({aw}), .BW({bw}), .OW({ow}), .CW({cw}), .CYCLES({c}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}), .PA({pa}), .PB({pb}), .PO({po}), .CTW({ctw}),\n        .DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .ctrl_word(ctrl_word[{off} +: {ctw}]), .src0({src0}), .src1({src1}), .src2({src2}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
+                "  rv_pe #({fix}.IS_MUL({mul}), .LAT({lat}), .N0({n0}), .SW0({sw0}), .N1({n1}), .SW1({sw1}), .N2({n2}), .SW2({sw2}), .AW({aw}), .BW({bw}), .OW({ow}),\n        .MEM_DEPTH({md}), .BUF_DEPTH({bd}), .OUT_DEPTH({od}), .PA({pa}), .PB({pb}), .PO({po}), .CTW({ctw}),\n        .DATA_FILE({fd}), .OUT_FILE({fo}))\n    {name} (.clk(clk), .run(run), .ctrl_word(ctrl_word[{off} +: {ctw}]), .src0({src0}), .src1({src1}), .src2({src2}), .result(result{k}), .buf_read(buffer{k}),\n        .out_addr(out_addr), .out_data(out{k}));",
                 mul = u8::from(p.is_mul),
                 aw = w.aw,
                 bw = w.bw,
                 ow = w.ow,
-                cw = w.cw,
-                c = self.cycles,
                 pa = control.pa,
                 pb = control.pb,
                 po = control.po,

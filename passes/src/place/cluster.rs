@@ -73,7 +73,6 @@ pub struct Shape {
 /// METIS' load imbalance tolerance of a side's whole load: its default.
 pub const SIDE_IMBALANCE: metis::Real = 1.03;
 
-/// METIS' load imbalance tolerance of a side's ops in one time window.
 /// METIS' load imbalance tolerance of a side's ops in one time window: looser than the whole
 /// load's, since a window's share need only be about right for the list scheduler to spread it
 /// (each cluster's whole load stays within 3 %). On the MX-5's `dirdyna` at 81 + 81 PEs in 27

@@ -6,9 +6,9 @@
 //
 // Timing (machine cycle k of the program = clock k of the run, counted from `start`):
 //   * the instruction, crossbar, buffer-instruction and output-capture words of cycle k are
-//     flip-flops during clock k: the control memory (block RAM lanes in the top, shared by all
-//     PEs) registers the word of cycle k at the edge ending clock k - 2 and the PE registers it again at the next edge (rv_pe's
-//     `ctrl`; the buffer's read address of cycle k is used a clock early, from the block RAM's
+//     flip-flops during clock k: the control memory (block-RAM lanes in the top, shared by all
+//     PEs) registers the word of cycle k at the edge ending clock k - 2 and the PE registers it
+//     again at the next edge (rv_pe's `ctrl`; the buffer's read address of cycle k is used a clock early, from the block RAM's
 //     output);
 //   * during clock k the result of an op issued at k - LAT arrives (`result`, the register
 //     after the crossbar: the seed's "+2" = one clock for the PE-memory read register, one for the
@@ -23,8 +23,8 @@
 
 // One PE: its control word (instruction, crossbar selects, buffer instruction, output capture,
 // shift word: its bits of the control memory the top shares between all PEs, robovec's
-// `Design::control_lanes`), PE memory, floating-point unit, buffer and output memory. Word layouts: see the
-// manifest's `layout` and the `machine` module doc (LSB first).
+// `Design::control_lanes`), PE memory, floating-point unit, buffer and output memory. Word
+// layouts: see the manifest's `layout` and the `machine` module doc (LSB first).
 module rv_pe #(
     parameter integer IS_MUL = 0,      // 0: ADD PE (fp_add_sub), 1: MULTI PE (fp_mul)
     parameter integer FIX = 0,         // 1: fixed-point PE (fix_add_sub / fix_mul, shift memory)
@@ -48,8 +48,6 @@ module rv_pe #(
     parameter integer AW = 11,         // PE memory address bits
     parameter integer BW = 4,          // buffer address bits
     parameter integer OW = 1,          // output memory address bits
-    parameter integer CW = 1,          // program counter bits
-    parameter integer CYCLES = 0,      // last cycle of the program
     parameter integer MEM_DEPTH = 1,   // PE memory words
     parameter integer BUF_DEPTH = 1,   // buffer words
     parameter integer OUT_DEPTH = 1,   // output memory words
