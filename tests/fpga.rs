@@ -716,6 +716,26 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
                 (words_of("xbar").unwrap(), words_of("bufi").unwrap(), words_of("capt").unwrap(), words_of("fix"));
             assert_eq!(words.len(), instr.len());
             let cut = |x: u128, lo: u32, bits: u32| (x >> lo) & ((1u128 << bits) - 1);
+            // the selects' bits in the xbar image (1-based, 0 none: the crossbar's `sw` each, or
+            // the routes' `select_bits`) and in the control word (the inputs' ⌈log2 k⌉)
+            let bits_for = |k: u64| if k <= 2 { 1 } else { 64 - (k - 1).leading_zeros() };
+            let slot = pe["slot"].as_u64().unwrap() as usize;
+            let (image_bits, want_lane) = match man["routes"].get(slot) {
+                Some(r) => {
+                    let b: Vec<u32> = (0..3).map(|k| r["select_bits"][k].as_u64().unwrap() as u32).collect();
+                    let shared = r["shared"].as_array().unwrap().len() as u64;
+                    let inputs = |port: &str| (r[port].as_array().unwrap().len() as u64 + u64::from(shared > 0)).max(1);
+                    let sb = if shared > 0 { bits_for(shared) } else { 0 };
+                    ([b[0], b[1], b[2]], [bits_for(inputs("port0")), bits_for(inputs("port1")), sb])
+                }
+                None => {
+                    let sw = man["widths"]["sw"].as_u64().unwrap() as u32;
+                    let n = man["pes"].as_array().unwrap().len() as u64;
+                    ([sw, sw, 0], [bits_for(2 * n), bits_for(2 * n), 0])
+                }
+            };
+            let lane_bits: Vec<u32> = (0..3).map(|k| c["select_bits"][k].as_u64().unwrap() as u32).collect();
+            assert_eq!(lane_bits, want_lane, "{what}: slot {slot}'s select bits");
             // an ADD PE in floored form reads its finer operand at A: an op aligning a (align-b
             // bit 0) has its reads swapped
             let floors = c["fix"].get("floors").is_some_and(|f| f.as_bool().unwrap());
@@ -730,9 +750,24 @@ fn control_lanes_hold_the_fields_of_the_separate_images() {
                 }
                 assert_eq!(cut(w, 4 * pa, 4), cut(instr[cycle], 4 * aw, 4), "{what} cycle {cycle}: flags");
                 let mut lo = 4 * pa + 4;
-                let xw = width_of("xbar");
-                assert_eq!(cut(w, lo, xw), xbar[cycle], "{what} cycle {cycle}: xbar");
-                lo += xw;
+                // the selects 0-based (0 where the port does not write), each in the bits of its
+                // port's inputs: ⌈log2 k⌉ for k inputs (at least 1)
+                assert_eq!(width_of("xbar"), image_bits.iter().sum::<u32>());
+                let mut image_lo = 0;
+                for k in 0..3 {
+                    let (ib, lb) = (image_bits[k], lane_bits[k]);
+                    let g = cut(xbar[cycle], image_lo, ib);
+                    image_lo += ib;
+                    assert_eq!(cut(w, lo, lb), g.saturating_sub(1), "{what} cycle {cycle}: select {k}");
+                    if k < 2 && g == 0 {
+                        assert_eq!(
+                            cut(instr[cycle], 4 * aw + k as u32, 1),
+                            0,
+                            "{what} cycle {cycle}: a write without a source"
+                        );
+                    }
+                    lo += lb;
+                }
                 // the buffer instruction and the capture word with their addresses cut to pb, po
                 let (pb, po) = (c["pb"].as_u64().unwrap() as u32, c["po"].as_u64().unwrap() as u32);
                 let (bw, ow) =
@@ -991,6 +1026,83 @@ fn yosys_maps_a_27_bit_product_to_one_dsp_block_and_a_32_bit_one_to_two() {
     let e = robovec_machine::resources::cost_model(&robovec_machine::target::Target::ecp5_85f());
     assert_eq!(robovec_machine::resources::fixed_unit(&e, 18, true, 37, full).dsp, 1);
     assert_eq!(robovec_machine::resources::fixed_unit(&e, 27, true, 55, full).dsp, 4);
+}
+
+/// With Yosys, a fixed-point design's units are Yosys' count, not the fit (issue 49): each PE's
+/// `fix_add_sub` / `fix_mul`, with the parameters the generated top gives its `rv_pe`, mapped by
+/// this test on its own and packed into ALMs as `resources.rs` says, sums to `fp_units`; each
+/// 26-bit product is one DSP block; `alm` is the logic plus the units.
+#[test]
+fn yosys_counts_each_fixed_point_unit() {
+    tool("yosys");
+    let d = tmp("units_yosys");
+    let ranges = d.join("ranges.json");
+    std::fs::write(&ranges, PENDULUM_RANGES).unwrap();
+    let dir = d.join("out");
+    let o = opt(&[
+        PENDULUM,
+        &format!("-ranges={}", ranges.display()),
+        &format!(
+            "-passes=atomise,cse,precision<budget=1e-3;target=mcu;word=26>,place<pe=2;restarts=0;search=0>,\
+             codegen<fpga;out={};resources=yosys;interconnect=specialised>",
+            dir.display()
+        ),
+        "-o",
+        "/dev/null",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = read_json(dir.join("resources.json"));
+    assert_eq!(r["logic_from"], "yosys");
+    assert_eq!(r["units_from"], "yosys");
+    let top = std::fs::read_to_string(dir.join("hdl/robovec_top.v")).unwrap();
+    let (mut alm, mut dsp, mut pes) = (0, 0, 0);
+    for inst in top.split("rv_pe #(").skip(1) {
+        let params = inst.split(")\n").next().unwrap();
+        let param = |name: &str| -> Option<i64> {
+            let at = params.find(&format!(".{name}("))? + name.len() + 2;
+            params[at..].split(')').next()?.parse().ok()
+        };
+        let mul = param("IS_MUL") == Some(1);
+        let names: &[&str] =
+            if mul { &["DW", "KW", "SMIN", "SMAX", "ONE"] } else { &["DW", "KW", "RMAX", "AMAX", "SMIN", "SMAX"] };
+        let mut given = vec![format!(".LATENCY({})", param("LAT").unwrap() - 2)];
+        given.extend(names.iter().map(|n| format!(".{n}({})", param(n).unwrap_or_else(|| panic!("{n} in {params}")))));
+        let (unit, ports, conn) = if mul {
+            ("fix_mul", "input [25:0] a, b, input [13:0] sh", ".a(a), .b(b), .sh(sh)")
+        } else {
+            ("fix_add_sub", "input [25:0] a, b, input sub, input [19:0] sh", ".a(a), .b(b), .sub(sub), .sh(sh)")
+        };
+        std::fs::write(
+            d.join(format!("unit{pes}.v")),
+            format!(
+                "module unit{pes} (input clk, {ports}, output [25:0] y);\n {unit} #({}) u (.clk(clk), {conn}, .y(y));\nendmodule\n",
+                given.join(", ")
+            ),
+        )
+        .unwrap();
+        let script = format!(
+            "read_verilog {} {} unit{pes}.v; synth_intel_alm -family cyclonev -top unit{pes}; tee -q -o stat{pes}.json stat -json",
+            hdl("fp_units.v").display(),
+            hdl("fix_units.v").display()
+        );
+        let o = Command::new("yosys").current_dir(&d).args(["-q", "-p", &script]).output().expect("yosys runs");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let stat: serde_json::Value = read_json(d.join(format!("stat{pes}.json")));
+        let cells = stat["design"]["num_cells_by_type"].as_object().unwrap();
+        let n = |k: &str| cells.get(k).and_then(|v| v.as_u64()).unwrap_or(0);
+        let small: u64 = ["MISTRAL_ALUT2", "MISTRAL_ALUT3", "MISTRAL_ALUT4", "MISTRAL_ALUT5", "MISTRAL_NOT"]
+            .iter()
+            .map(|k| n(k))
+            .sum();
+        alm += (n("MISTRAL_ALUT6") + (small + n("MISTRAL_ALUT_ARITH")).div_ceil(2)).max(n("MISTRAL_FF").div_ceil(2));
+        dsp += n("MISTRAL_MUL27X27");
+        pes += 1;
+    }
+    assert_eq!(pes, 4);
+    assert_eq!(r["fp_units"]["alm"], alm, "the units as Yosys maps them one by one");
+    assert_eq!(r["fp_units"]["dsp"], 2, "one 27 x 27 block a product");
+    assert_eq!(dsp, 2);
+    assert_eq!(r["alm"].as_u64().unwrap(), r["logic_alm"].as_u64().unwrap() + alm);
 }
 
 /// `PATH` with the open ECP5 flow's YoWASP tools first (`scripts/test.sh` installs them into

@@ -98,6 +98,9 @@ struct ManifestControl {
     /// On fixed-point PEs, the shift word's fields (`Design::controls`' `FixField`).
     #[serde(skip_serializing_if = "Option::is_none")]
     fix: Option<crate::design::FixField>,
+    /// Bits of the 0-based write-port selects: port 0, port 1, the shared multiplexer's
+    /// (`Design::lane_select_bits`).
+    select_bits: [u32; 3],
     /// Bits of the word.
     width: u32,
     /// Its first bit in the design's control word (`control_lanes`).
@@ -124,8 +127,15 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             .into_iter()
             .chain(p.fix.as_ref().map(|i| ("fix", m(i))))
             .collect();
-            let control =
-                ManifestControl { pa: c.pa, pb: c.pb, po: c.po, fix: c.fix, width: c.width, offset: c.offset };
+            let control = ManifestControl {
+                pa: c.pa,
+                pb: c.pb,
+                po: c.po,
+                fix: c.fix,
+                select_bits: c.select_bits,
+                width: c.width,
+                offset: c.offset,
+            };
             ManifestPe {
                 control,
                 slot: p.slot,
@@ -185,8 +195,9 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             2 * w.bw, 2 * w.bw, 2 * w.bw + 1, b = w.bw),
         "capt": format!("[0,{o}) output-memory address, bit {o} enable", o = w.ow),
         "control": "per PE (`control`): one word per cycle, from bit 0: the instruction's four addresses `pa` bits each \
-            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word with its addresses cut to \
-            `pb` bits each (store address, read address, store enable, read enable); the `capt` word with its address cut to `po` \
+            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word's selects (port 0, port 1, shared) \
+            each one less, 0-based (0 when the port does not write: we0 and we1 say which do), in `control.select_bits` bits each; \
+            the `bufi` word with its addresses cut to `pb` bits each (store address, read address, store enable, read enable); the `capt` word with its address cut to `po` \
             bits (address, enable); on fixed-point PEs the `fix` word cut to the PE's shifts (`control.fix`: `floor_bits` of \
             floor r, `align_bits` of alignment, the align-b bit when `align_b`, the rounding shift less `shift_min` in \
             `shift_bits`; zero on a cycle that issues nothing; on ADD PEs, `floors`, the op's floored form: r = min(align, \
@@ -210,8 +221,8 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
         ));
         layout["control"] = serde_json::json!(
             "per PE (`control`): one word per cycle, from bit 0: the instruction's four addresses `pa` bits each \
-            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word; the `bufi` word with its addresses cut to \
-            `pb` bits each; the `capt` word with its address cut to `po` bits; on fixed-point PEs the `fix` word cut to the PE's \
+            (read A, read B, write-0, write-1), we0, we1, issue valid, sub; the `xbar` word's selects 0-based in \
+            `control.select_bits` bits each; the `bufi` word with its addresses cut to `pb` bits each; the `capt` word with its address cut to `po` bits; on fixed-point PEs the `fix` word cut to the PE's \
             shifts (`control.fix`); on PEs with `mac` then read C (`pa` bits), negate product, mac; \
             at bits [`offset`, `offset` + `width`) of the design's control word (`control_lanes`)"
         );
@@ -327,11 +338,11 @@ pub fn emit_until(
     let cells =
         match logic {
             _ if logic.skips_yosys(d.n_add + d.n_mul) => None,
-            Logic::Yosys => Some(resources::yosys_cells(&d)?.ok_or(
+            Logic::Yosys => Some(resources::yosys_design(&d)?.ok_or(
                 "`resources=yosys` but `yosys` cannot be run (Debian package `yosys`); use resources=estimate",
             )?),
             // `auto` within the limit: Yosys when it can be run, else the estimate.
-            _ => resources::yosys_cells(&d)?,
+            _ => resources::yosys_design(&d)?,
         };
     let mut r = resources::estimate(&d, model, cells);
     let mut pnr_files = Vec::new();

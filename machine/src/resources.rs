@@ -9,7 +9,8 @@
 //!   6-input LUT fills an ALM, two smaller LUTs or two arithmetic bits share one, and an ALM
 //!   holds two registers; a Yosys MLAB cell (32 × 1 bit) is half an ALM of a 640-bit MLAB, so
 //!   `alm = max(LUT6 + ⌈(LUT2…LUT5 + ARITH)/2⌉, ⌈FF/2⌉) + ⌈MLAB/2⌉`. Yosys' DSP cells
-//!   (`MISTRAL_MUL*`) count as DSP blocks. Without `yosys` (or with `resources=estimate`) the
+//!   count as DSP blocks (`MISTRAL_MUL27X27` one, `MISTRAL_MUL18X18` half, `MISTRAL_MUL9X9`
+//!   a third). Without `yosys` (or with `resources=estimate`) the
 //!   logic is the target's analytic model of a design in its family's Yosys flow
 //!   (`design_logic`, [`design_logic_alm`]: per write port by its multiplexer inputs, per PE by
 //!   its buffer words, at the design's word; measured and checked against Yosys as
@@ -26,8 +27,10 @@
 //!   fixed-point PEs of narrower words (`word_bits` < 32, issue 49) the multiplexer and
 //!   output-word terms take `word_bits / 32` of those costs.
 //! - **FP units**: the target's per-unit costs (seed §1.3.1 / Table 1.4: ADD PE 360 ALM, 2 DSP;
-//!   MULTI PE 100 ALM, 3 DSP) times the PEs of each type; fixed-point PEs per PE, by their word
-//!   and intermediate widths ([`fixed_unit`]).
+//!   MULTI PE 100 ALM, 3 DSP) times the PEs of each type; fixed-point PEs per PE: where Yosys
+//!   runs, its count of the PE's unit ([`yosys_unit_cells`]: each distinct configuration of
+//!   `hdl/fix_units.v` mapped once, `units_from: "yosys"`), else the fit by their word,
+//!   intermediate widths and shifts ([`fixed_unit`]).
 //! - **Memories**: every PE memory, instruction, crossbar, buffer-instruction and capture memory,
 //!   and the output memory of each PE that holds outputs, as M10K blocks from its size ([`crate::target::m10k_blocks`] by the block configurations,
 //!   [`M10kFit::Configurations`]; PE memories true dual-port).
@@ -235,13 +238,19 @@ pub struct Resources {
     pub logic_from: &'static str,
     /// Logic ALMs (from Yosys or the estimate).
     pub logic_alm: u64,
+    /// `yosys` when Yosys mapped every fixed-point unit ([`yosys_unit_cells`]), else
+    /// `estimate` (the target's costs or their fit; `pnr`: the flow counted the whole design).
+    pub units_from: &'static str,
     /// Yosys' cells when it ran.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub yosys: Option<YosysCells>,
     /// `resources=pnr`: the place-and-route figures.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pnr: Option<PnrFigures>,
-    /// FP unit ALMs / DSP (target's per-unit costs).
+    /// The PEs' units, ALMs / DSP / M10K: the target's per-unit costs (binary32, seed Table
+    /// 1.4), the fit of [`fixed_unit`] (fixed point), or Yosys' count of each ([`units_from`]).
+    ///
+    /// [`units_from`]: Resources::units_from
     pub fp_units: UnitCost,
     /// Per memory M10K.
     pub memories: Vec<MemoryCost>,
@@ -415,6 +424,25 @@ pub fn yosys_cells(d: &Design) -> Result<Option<YosysCells>, String> {
     yosys_cells_with(d, Synthesis::Hierarchical)
 }
 
+/// Yosys' counts of a design (`codegen<fpga;resources=yosys>`, or `auto` within its limit).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct YosysDesign {
+    /// The logic around the black boxes ([`yosys_cells`]).
+    pub logic: YosysCells,
+    /// Each PE's fixed-point unit by slot ([`yosys_unit_cells`]); `None` with binary32 PEs,
+    /// whose units are the target's costs.
+    pub units: Option<Vec<YosysCells>>,
+}
+
+/// [`yosys_cells`] and [`yosys_unit_cells`] of `d`; `None` when Yosys cannot be run.
+///
+/// # Errors
+/// As [`yosys_cells`].
+pub fn yosys_design(d: &Design) -> Result<Option<YosysDesign>, String> {
+    let Some(logic) = yosys_cells(d)? else { return Ok(None) };
+    Ok(Some(YosysDesign { logic, units: yosys_unit_cells(d)? }))
+}
+
 /// [`yosys_cells`] with the mapping chosen.
 ///
 /// # Errors
@@ -422,10 +450,7 @@ pub fn yosys_cells(d: &Design) -> Result<Option<YosysCells>, String> {
 pub fn yosys_cells_with(d: &Design, how: Synthesis) -> Result<Option<YosysCells>, String> {
     let Some(dir) = TempDir::new() else { return Ok(None) };
     let mut files = vec![("synth_stubs.v", SYNTH_STUBS.to_string())];
-    files.push((
-        "rv_lib.v",
-        HDL_LIBRARY.iter().find(|(n, _)| *n == "rv_lib.v").map(|x| x.1.to_string()).unwrap_or_default(),
-    ));
+    files.push(("rv_lib.v", hdl_file("rv_lib.v")));
     files.push(("robovec_top.v", d.top("")));
     // Hierarchical: map each distinct module once, then flatten the mapped netlist (a copy of
     // its cells, seconds) so that `stat -json` has one module: Yosys 0.23's `stat -json` writes
@@ -434,14 +459,22 @@ pub fn yosys_cells_with(d: &Design, how: Synthesis) -> Result<Option<YosysCells>
         Synthesis::Hierarchical => (" -noflatten", "flatten\n"),
         Synthesis::Flat => ("", ""),
     };
-    files.push((
-        "synth.ys",
-        format!(
-            "read_verilog synth_stubs.v\nread_verilog rv_lib.v\nread_verilog robovec_top.v\nhierarchy -top robovec_top\n\
-             synth_intel_alm -family cyclonev{map_flag} -top robovec_top\n{after_map}tee -q -o stat.json stat -json\n"
-        ),
-    ));
-    for (n, t) in &files {
+    let script = format!(
+        "read_verilog synth_stubs.v\nread_verilog rv_lib.v\nread_verilog robovec_top.v\nhierarchy -top robovec_top\n\
+         synth_intel_alm -family cyclonev{map_flag} -top robovec_top\n{after_map}tee -q -o stat.json stat -json\n"
+    );
+    run_yosys(&dir, &files, &script)
+}
+
+/// The text of `hdl/NAME` (empty when the library has no such file).
+fn hdl_file(name: &str) -> String {
+    HDL_LIBRARY.iter().find(|(n, _)| *n == name).map(|x| x.1.to_string()).unwrap_or_default()
+}
+
+/// Writes `files` into `dir`, runs Yosys' `script` there, which writes `stat.json`, and parses
+/// it; `None` when a file cannot be written or `yosys` cannot be started.
+fn run_yosys(dir: &TempDir, files: &[(&str, String)], script: &str) -> Result<Option<YosysCells>, String> {
+    for (n, t) in files.iter().map(|(n, t)| (*n, t.as_str())).chain([("synth.ys", script)]) {
         if std::fs::write(dir.0.join(n), t).is_err() {
             return Ok(None);
         }
@@ -460,6 +493,118 @@ pub fn yosys_cells_with(d: &Design, how: Synthesis) -> Result<Option<YosysCells>
     parse_stat(&stat).map(Some)
 }
 
+/// A fixed-point PE's unit as `rv_pe` instantiates it (`hdl/fix_units.v`): the module and its
+/// parameters. The PEs of one configuration have the same unit, which Yosys maps once.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct UnitConfig {
+    /// `fix_add_sub`, `fix_mul` or `fix_mac`.
+    pub module: &'static str,
+    /// The module's parameters by name, in `rv_pe`'s order (`LATENCY` in cycles, widths in
+    /// bits, shifts in bits).
+    pub params: Vec<(&'static str, i64)>,
+}
+
+impl UnitConfig {
+    /// The unit of PE `p` of `d` with the parameters `rv_pe` gives it ([`Design::top`]);
+    /// `None` for a binary32 PE (its unit is costed from the target, seed Table 1.4).
+    pub fn of(d: &Design, p: &crate::design::PeImages) -> Option<UnitConfig> {
+        p.fix.as_ref()?;
+        let r = p.shift_ranges.unwrap_or(ShiftRanges::FULL);
+        let latency = i64::from(if p.is_mul { d.lat_mul } else { d.lat_add }) - 2;
+        let (dw, kw) = (i64::from(d.word_bits), i64::from(d.intermediate_bits(p.slot)));
+        let (amax, smin, smax, one) =
+            (i64::from(r.align_max), i64::from(r.shift_min), i64::from(r.shift_max), i64::from(d.multiplier_word));
+        let head = [("LATENCY", latency), ("DW", dw), ("KW", kw)];
+        let (module, tail): (&'static str, Vec<(&'static str, i64)>) = match (p.is_mul, p.mac) {
+            (true, true) => ("fix_mac", vec![("AMAX", amax), ("SMIN", smin), ("SMAX", smax), ("ONE", one)]),
+            (true, false) => ("fix_mul", vec![("SMIN", smin), ("SMAX", smax), ("ONE", one)]),
+            (false, _) => {
+                ("fix_add_sub", vec![("RMAX", i64::from(r.floor_max)), ("AMAX", amax), ("SMIN", smin), ("SMAX", smax)])
+            }
+        };
+        Some(UnitConfig { module, params: head.into_iter().chain(tail).collect() })
+    }
+
+    /// A top module `name` around the unit, every port of it a port of the top (the unit's
+    /// inputs free, so nothing is folded away that its PE might drive).
+    fn wrapper(&self, name: &str) -> String {
+        let dw = self.params.iter().find(|(n, _)| *n == "DW").map_or(32, |x| x.1);
+        let (ports, conn) = match self.module {
+            "fix_mac" => (
+                "input wire [DW-1:0] a, input wire [DW-1:0] b, input wire [DW-1:0] c, input wire mac, input wire negp, input wire sub, input wire [13:0] sh",
+                ".a(a), .b(b), .c(c), .mac(mac), .negp(negp), .sub(sub), .sh(sh)",
+            ),
+            "fix_mul" => ("input wire [DW-1:0] a, input wire [DW-1:0] b, input wire [13:0] sh", ".a(a), .b(b), .sh(sh)"),
+            _ => (
+                "input wire [DW-1:0] a, input wire [DW-1:0] b, input wire sub, input wire [19:0] sh",
+                ".a(a), .b(b), .sub(sub), .sh(sh)",
+            ),
+        };
+        let params = self.params.iter().map(|(n, v)| format!(".{n}({v})")).collect::<Vec<_>>().join(", ");
+        format!(
+            "module {name} #(parameter integer DW = {dw}) (input wire clk, {ports}, output wire [DW-1:0] y);\n  {} #({params}) u (.clk(clk), {conn}, .y(y));\nendmodule\n",
+            self.module
+        )
+    }
+}
+
+/// Yosys' cells of each PE's fixed-point unit (`resources=yosys`, issue 49): every distinct
+/// [`UnitConfig`] of `d` mapped once by `synth_intel_alm` on its own (on as many threads as
+/// the machine has cores; a configuration already mapped by this process is not mapped again),
+/// indexed by PE slot. The analytic [`fixed_unit`] is a fit within 15 % on typical ADD units;
+/// this is the count itself: on the MX-5's `dirdyna` at 81 + 81 PEs (26-bit words) 14,459 ALM
+/// in 45 distinct units against the fit's 17,320. The unit's inputs are the wrapper's ports, so
+/// the count is the unit's whole logic (in the design its PE may hold some inputs constant).
+/// `None` when `d` has binary32 PEs or Yosys cannot be run.
+///
+/// # Errors
+/// A message when Yosys runs but fails, or its statistics do not parse.
+pub fn yosys_unit_cells(d: &Design) -> Result<Option<Vec<YosysCells>>, String> {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    static MAPPED: OnceLock<Mutex<HashMap<UnitConfig, YosysCells>>> = OnceLock::new();
+    let Some(configs) = d.pes.iter().map(|p| UnitConfig::of(d, p)).collect::<Option<Vec<_>>>() else {
+        return Ok(None);
+    };
+    let mapped = MAPPED.get_or_init(|| Mutex::new(HashMap::new()));
+    let mut todo: Vec<UnitConfig> = {
+        let known = mapped.lock().map_err(|_| "yosys unit cache poisoned")?;
+        configs.iter().filter(|c| !known.contains_key(c)).cloned().collect()
+    };
+    todo.sort();
+    todo.dedup();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(todo.len()).max(1);
+    let results: Vec<Result<Option<()>, String>> = std::thread::scope(|s| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                s.spawn(|| -> Result<Option<()>, String> {
+                    let Some(dir) = TempDir::new() else { return Ok(None) };
+                    let library = [("fp_units.v", hdl_file("fp_units.v")), ("fix_units.v", hdl_file("fix_units.v"))];
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(c) = todo.get(i) else { return Ok(Some(())) };
+                        let mut files = library.to_vec();
+                        files.push(("unit.v", c.wrapper("robovec_unit")));
+                        let script = "read_verilog fp_units.v\nread_verilog fix_units.v\nread_verilog unit.v\n\
+                                      synth_intel_alm -family cyclonev -top robovec_unit\ntee -q -o stat.json stat -json\n";
+                        let Some(cells) = run_yosys(&dir, &files, script)? else { return Ok(None) };
+                        mapped.lock().map_err(|_| "yosys unit cache poisoned")?.insert(c.clone(), cells);
+                    }
+                })
+            })
+            .collect();
+        workers.into_iter().map(|w| w.join().unwrap_or_else(|_| Err("a yosys worker panicked".into()))).collect()
+    });
+    for r in results {
+        if r?.is_none() {
+            return Ok(None);
+        }
+    }
+    let known = mapped.lock().map_err(|_| "yosys unit cache poisoned")?;
+    Ok(configs.iter().map(|c| known.get(c).cloned()).collect())
+}
+
 /// Cell counts from `stat -json` (the `design` totals: for a hierarchical design, every
 /// module's cells times its instances, black boxes included as cells).
 ///
@@ -472,6 +617,9 @@ pub fn parse_stat(json: &str) -> Result<YosysCells, String> {
         .and_then(|c| c.as_object())
         .ok_or("yosys statistics: no design.num_cells_by_type")?;
     let mut y = YosysCells::default();
+    // DSP blocks in sixths: a Cyclone V variable-precision block is one 27 × 27 multiplier, two
+    // 18 × 18 or three 9 × 9 (Cyclone V Device Handbook, "Variable Precision DSP Blocks")
+    let mut sixths = 0;
     for (k, n) in cells {
         let n = n.as_u64().unwrap_or(0);
         match k.as_str() {
@@ -480,10 +628,13 @@ pub fn parse_stat(json: &str) -> Result<YosysCells, String> {
             "MISTRAL_ALUT_ARITH" => y.arith += n,
             "MISTRAL_FF" => y.ff += n,
             "MISTRAL_MLAB" => y.mlab += n,
-            k if k.starts_with("MISTRAL_MUL") => y.dsp += n,
+            "MISTRAL_MUL9X9" => sixths += 2 * n,
+            "MISTRAL_MUL18X18" => sixths += 3 * n,
+            k if k.starts_with("MISTRAL_MUL") => sixths += 6 * n,
             _ => {}
         }
     }
+    y.dsp = u64::div_ceil(sixths, 6);
     Ok(y)
 }
 
@@ -584,8 +735,9 @@ pub fn design_logic_alm(d: &Design, l: &crate::target::DesignLogic) -> f64 {
     luts.max(d.flip_flops().div_ceil(2) as f64)
 }
 
-/// The estimate for `d` under `m`, with Yosys' cells when it ran.
-pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resources {
+/// The estimate for `d` under `m`, with Yosys' cells when it ran: its logic in place of the
+/// analytic model's, and its fixed-point units' cells in place of [`fixed_unit`]'s fit.
+pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysDesign>) -> Resources {
     // each PE's unit: binary32 ones the target's, fixed-point ones by their word and intermediate
     let unit = |p: &crate::design::PeImages| match (d.pe_kind, p.is_mul) {
         (crate::design::PeKind::Binary32, false) => m.fp_add,
@@ -597,11 +749,18 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
             fixed_unit(m, d.word_bits, is_mul, d.intermediate_bits(p.slot), p.shift_ranges.unwrap_or(ShiftRanges::FULL))
         }
     };
-    let fp = d.pes.iter().map(unit).fold(UnitCost { alm: 0, dsp: 0, m10k: 0 }, |a, u| UnitCost {
+    let measured = yosys.as_ref().and_then(|y| y.units.as_ref());
+    let units: Vec<UnitCost> = match measured {
+        Some(cells) => cells.iter().map(|c| UnitCost { alm: c.alm(), dsp: c.dsp, m10k: 0 }).collect(),
+        None => d.pes.iter().map(unit).collect(),
+    };
+    let fp = units.into_iter().fold(UnitCost { alm: 0, dsp: 0, m10k: 0 }, |a, u| UnitCost {
         alm: a.alm + u.alm,
         dsp: a.dsp + u.dsp,
         m10k: a.m10k + u.m10k,
     });
+    let units_from = if measured.is_some() { "yosys" } else { "estimate" };
+    let yosys = yosys.map(|y| y.logic);
     let memories = memory_costs(d, m.family);
     let mem_m10k: u64 = memories.iter().map(|c| c.m10k).sum();
     let (logic_from, logic_alm, logic_dsp) = match &yosys {
@@ -641,6 +800,7 @@ pub fn estimate(d: &Design, m: &CostModel, yosys: Option<YosysCells>) -> Resourc
         capacity: m.capacity,
         logic_from,
         logic_alm,
+        units_from,
         yosys,
         pnr: None,
         fp_units: fp,
@@ -665,6 +825,7 @@ pub fn with_pnr(r: Resources, m: &CostModel, p: PnrFigures) -> Resources {
         fmax_mhz: p.fmax_mhz,
         logic_from: "pnr",
         logic_alm: p.lut4,
+        units_from: "pnr",
         fp_units: UnitCost { alm: 0, dsp: 0, m10k: 0 },
         pnr: Some(p),
         ..r

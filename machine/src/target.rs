@@ -221,7 +221,7 @@ pub struct Units {
 pub struct DesignLogic {
     /// Per multiplexer input of a write port, per bit (`rv_mux`).
     pub mux_input_bit: f64,
-    /// Per write port, per bit (`rv_mux`'s gating to 0 and the tree's last level).
+    /// Per write port, per bit (the tree's rounding up to whole LUTs).
     pub mux_port_bit: f64,
     /// Per PE, per bit: its logic outside the unit, the multiplexer and the memories (the
     /// buffer's first word, the result and operand registers, the control decoding) and its
@@ -267,8 +267,9 @@ pub enum PeMemory {
 impl Family {
     /// The logic of a generated design in this family's Yosys flow ([`DesignLogic`]), where it
     /// was measured: the Cyclone V's (Yosys 0.23 `synth_intel_alm`, the ALM packing bound of
-    /// [`crate::resources`]). `rv_mux` alone at 16-bit words and 1 to 64 inputs gives
-    /// 0.35 ALM per input bit and 0.4 per port bit (within 10 % from 2 inputs up); the rest,
+    /// [`crate::resources`]). `rv_mux` alone at 16-bit words and 2 to 64 inputs is at most
+    /// 0.35 ALM per input bit and 0.05 per port bit (0.34 and −0.19 by least squares; 0.4 a port
+    /// bit before its selects became 0-based and ungated, issue 49); the rest,
     /// fitted on the Jeep's fixed-point designs at 4 + 4 to 36 + 42 PEs and its binary32 ones at
     /// 8 + 8 (crossbar and specialised), 1.35 ALM per PE bit and 1.2 per further buffer word
     /// bit. The model is above Yosys on all of them: by 1–7 % from 8 + 8 PEs up, by 18 % at
@@ -277,7 +278,7 @@ impl Family {
     pub const fn design_logic(self) -> Option<DesignLogic> {
         match self {
             Family::CycloneV => {
-                Some(DesignLogic { mux_input_bit: 0.35, mux_port_bit: 0.4, pe_bit: 1.35, buffer_word_bit: 1.2 })
+                Some(DesignLogic { mux_input_bit: 0.35, mux_port_bit: 0.05, pe_bit: 1.35, buffer_word_bit: 1.2 })
             }
             Family::Ecp5 => None,
         }

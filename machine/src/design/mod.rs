@@ -238,6 +238,9 @@ pub struct Control {
     pub po: u32,
     /// The shift word's fields on a fixed-point PE ([`FixField`]).
     pub fix: Option<FixField>,
+    /// Bits of the write-port selects (port 0, port 1, the shared multiplexer's; 0: none):
+    /// [`Design::lane_select_bits`].
+    pub select_bits: [u32; 3],
     /// Bits of the whole word (`4·pa + 4` + selects + `2·pb + 2` buffer + `po + 1` capture [+
     /// the shift word's [`FixField::bits`]] [+ `pa + 2` mac fields]).
     pub width: u32,
@@ -436,15 +439,57 @@ impl Design {
     /// [`Design::port_inputs`] counts it).
     fn port_sources(&self, slot: usize, port: usize) -> (String, usize, u32) {
         let k = self.port_inputs(slot, port);
-        let Some(r) = &self.routes else { return ("sources".into(), k, self.widths.sw) };
+        let bits = self.lane_select_bits(slot)[port];
+        let Some(r) = &self.routes else { return ("sources".into(), k, bits) };
         let list = &r.ports[slot][port];
         // a port's own sources; with a shared multiplexer a port may have none (`rv_pe` adds
         // the shared output as its last input)
         let k_own = if r.has_shared(slot) { list.len() } else { list.len().max(1) };
         if list.is_empty() {
-            return (format!("{}'h0", self.word_bits), k_own, r.select_bits(slot, port));
+            return (format!("{}'h0", self.word_bits), k_own, bits);
         }
-        (self.source_words(list), k_own, r.select_bits(slot, port))
+        (self.source_words(list), k_own, bits)
+    }
+
+    /// The bits of PE `slot`'s write-port selects in its control word (port 0, port 1, the
+    /// shared multiplexer's): `rv_mux` takes the 0-based index of its input, so a port of `k`
+    /// inputs ([`Design::port_inputs`], the shared output included) has `⌈log₂ k⌉` bits (at
+    /// least 1), the shared multiplexer of `k` sources `⌈log₂ k⌉` (at least 1; 0 without one),
+    /// and the crossbar's port `⌈log₂(2·n_pe)⌉`. There is no "none" code: the instruction's
+    /// write enables say which ports write. The separate `xbar` image keeps its 1-based selects
+    /// with 0 for none ([`Design::image_selects`]); a 2^j-input port takes j bits, not j + 1,
+    /// and its multiplexer needs no gate (issue 49: WALK-MAN's 305 multiplexers, 23,380 → about
+    /// 19,490 ALM by Yosys).
+    pub fn lane_select_bits(&self, slot: usize) -> [u32; 3] {
+        match &self.routes {
+            None => {
+                let b = addr_bits(2 * self.n_pe() as u64);
+                [b, b, 0]
+            }
+            Some(r) => {
+                let shared = match r.shared[slot].len() {
+                    0 => 0,
+                    k => addr_bits(k as u64),
+                };
+                [addr_bits(self.port_inputs(slot, 0) as u64), addr_bits(self.port_inputs(slot, 1) as u64), shared]
+            }
+        }
+    }
+
+    /// The selects of PE `slot`'s `xbar` image word `word`: port 0's, port 1's and the shared
+    /// multiplexer's, each 1-based with 0 for none (the crossbar's selects `1..=2·n_pe`, or a
+    /// specialised design's route indices, [`Routes::encode`]).
+    pub fn image_selects(&self, slot: usize, word: u64) -> [u64; 3] {
+        match &self.routes {
+            None => {
+                let [g0, g1] = selects(word, self.widths.sw);
+                [g0, g1, 0]
+            }
+            Some(r) => {
+                let (b0, b1) = (r.select_bits(slot, 0), r.select_bits(slot, 1));
+                [word & ((1 << b0) - 1), word >> b0 & ((1 << b1) - 1), word >> (b0 + b1)]
+            }
+        }
     }
 
     /// The Verilog concatenation of crossbar selects `list` (most significant word first):
@@ -471,7 +516,7 @@ impl Design {
     fn shared_sources(&self, slot: usize) -> Option<(String, usize, u32)> {
         let r = self.routes.as_ref()?;
         let list = &r.shared[slot];
-        (!list.is_empty()).then(|| (self.source_words(list), list.len(), r.shared_bits(slot)))
+        (!list.is_empty()).then(|| (self.source_words(list), list.len(), self.lane_select_bits(slot)[2]))
     }
 
     /// Bits of the exact intermediate of PE `slot`'s fixed-point unit
@@ -511,7 +556,7 @@ impl Design {
             .map(|(slot, offset)| {
                 let (pa, width) = self.control_width(slot);
                 let (pb, po, fix) = self.control_fields(slot);
-                Control { pa, pb, po, fix, width, offset }
+                Control { pa, pb, po, fix, select_bits: self.lane_select_bits(slot), width, offset }
             })
             .collect()
     }
@@ -606,7 +651,12 @@ impl Design {
                 put(field & mask(pa), pa);
             }
             put(w >> (4 * aw) & 0xf, 4);
-            put(p.xbar.words[c], p.xbar.width);
+            // each select 0-based (`rv_mux` has no "none" code: the write enables say which
+            // ports write, and a port that does not write reads its first input)
+            let selects = self.image_selects(slot, p.xbar.words[c]);
+            for (l, bits) in selects.into_iter().zip(self.lane_select_bits(slot)) {
+                put(l.saturating_sub(1), bits);
+            }
             // the buffer instruction and the capture word with their addresses cut to pb and po
             let b = p.bufi.words[c];
             debug_assert!(b & mask(2 * bw) <= mask(pb) | mask(pb) << bw, "a buffer address beyond the buffer");
@@ -660,7 +710,8 @@ impl Design {
         let p = &self.pes[slot];
         let pa = addr_bits(p.data.words.len().max(1) as u64).min(self.widths.aw);
         let (pb, po, fix) = self.control_fields(slot);
-        let fields = p.xbar.width + 2 * pb + 2 + po + 1 + fix.map_or(0, |f| f.bits());
+        let selects: u32 = self.lane_select_bits(slot).iter().sum();
+        let fields = selects + 2 * pb + 2 + po + 1 + fix.map_or(0, |f| f.bits());
         let mac = if p.mac { pa + 2 } else { 0 };
         (pa, 4 * pa + 4 + fields + mac)
     }

@@ -103,14 +103,15 @@ module rv_pe #(
   wire [BIW-1:0] bufi = ctrl[IB+XW +: BIW];
   wire [OCW-1:0] capt = ctrl[IB+XW+BIW +: OCW];
 
-  // write-port selects: 0 = none, i = word i-1 of the port's sources (crossbar: 1..NPE =
-  // result of slot s-1, NPE+1..2NPE = buffer read of slot s-NPE-1)
+  // write-port selects, 0-based: word i of the port's sources (crossbar: 0..NPE-1 = result of
+  // slot i, NPE..2NPE-1 = buffer read of slot i-NPE; a port with a shared multiplexer: its own
+  // sources, then the shared output); we0/we1 say whether the port writes
   wire [SW0-1:0] sel0 = xbar[SW0-1:0];
   wire [SW1-1:0] sel1 = xbar[SW0+SW1-1:SW0];
   wire [DW-1:0] wd0, wd1;
   generate
     if (N2 > 0) begin : g_shared
-      // the shared multiplexer (select N + 1 of a port of N own sources takes its output)
+      // the shared multiplexer (select N of a port of N own sources takes its output)
       wire [SW2-1:0] sel2 = xbar[XW-1:SW0+SW1];
       wire [DW-1:0] ys;
       rv_mux #(.N(N2), .SW(SW2), .DW(DW)) u_x2 (.sources(src2), .sel(sel2), .y(ys));
@@ -276,26 +277,28 @@ module rv_pe #(
   endgenerate
 endmodule
 
-// One write port's multiplexer: y = 0 for sel = 0 or sel > N, else the DW-bit word sel - 1 of
-// `sources` (a crossbar port has N = 2 NPE sources, a specialised one its routes). Written as a
-// balanced tree of 2:1 multiplexers on the bits of sel - 1 (level k decides on bit k) over 2^SW
-// leaves, gated by `valid`, so that synthesis sees DW (2^SW - 1) multiplexers that it packs
-// four data inputs to a LUT6, and not a variable shift of the whole bus (the form
-// `sources[DW*(sel-1) +: DW]`, which Yosys maps as a barrel shifter first: its time exploded
-// beyond 4 + 4 PEs). That form is what simulators read (no `SYNTHESIS` macro): the same word. The crossbar's ports share one module (parameters N and SW only): a
+// One write port's multiplexer: y = the DW-bit word `sel` (0-based) of `sources`, the last one
+// for sel >= N (a crossbar port has N = 2 NPE sources, a specialised one its routes; the port's
+// write enable, not a select code, says whether it writes). Written as a balanced tree of 2:1
+// multiplexers on the bits of sel (level k decides on bit k) over 2^SW leaves, so that synthesis
+// sees DW (2^SW - 1) multiplexers that it packs four data inputs to a LUT6, and not a variable
+// shift of the whole bus (the form `sources[DW*sel +: DW]`, which Yosys maps as a barrel shifter
+// first: its time exploded beyond 4 + 4 PEs). That form is what simulators read (no `SYNTHESIS`
+// macro): the same word. The crossbar's ports share one module (parameters N and SW only): a
 // hierarchical synthesis maps it once.
 module rv_mux #(
     parameter integer N = 4,
-    parameter integer SW = 3,
+    parameter integer SW = 2,
     parameter integer DW = 32
 ) (
     input  wire [DW*N-1:0] sources,
     input  wire [SW-1:0]   sel,
     output wire [DW-1:0]   y
 );
+  // `sel` is the 0-based index of the source (issue 49: no "none" code and no gate to zero; the
+  // PE memory's write enable says whether the port writes, and a select beyond N - 1 reads the
+  // last source). So 2^j sources take j select bits, and a LUT6 takes four of them a bit.
   localparam integer L = 1 << SW;
-  wire [SW-1:0] idx = sel - 1'b1;
-  wire valid = sel != 0 && sel <= N;
 `ifdef SYNTHESIS
   // Level k + 1 of the tree from level k: word m chooses between words 2m and 2m + 1 by bit k
   // (upper words zero), one net a level.
@@ -309,26 +312,29 @@ module rv_mux #(
         level_up[DW*m +: DW] = b ? v[DW*(2*m+1) +: DW] : v[DW*(2*m) +: DW];
     end
   endfunction
-  genvar k;
+  genvar k, j;
   generate
     for (k = 0; k <= SW; k = k + 1) begin : g_level
-      // level 0: the leaves, source j at word j, zeros beyond N
       wire [DW*L-1:0] v;
       if (k == 0) begin : g_leaves
-        assign v = sources;
+        // the leaves: source j at word j, the last source again beyond N
+        for (j = 0; j < L; j = j + 1) begin : g_leaf
+          assign v[DW*j +: DW] = sources[DW*(j < N ? j : N - 1) +: DW];
+        end
       end else begin : g_up
-        assign v = level_up(g_level[k-1].v, idx[k-1]);
+        assign v = level_up(g_level[k-1].v, sel[k-1]);
       end
     end
   endgenerate
-  assign y = valid ? g_level[SW].v[DW-1:0] : {DW{1'b0}};
+  assign y = g_level[SW].v[DW-1:0];
 `else
   // Simulators (Icarus, Verilator: no `SYNTHESIS`) read the same word directly. The tree's
   // forms cost them dearly on large designs: levels as slices of one net re-evaluated the whole
   // net on every change (the Jeep at 8 + 8 PEs simulated at 4 clocks a second), a wire per
   // node took Icarus minutes to elaborate at 144 PEs, a function per level 10x the run time.
   // `tests/fpga.rs` proves the two forms equal with Yosys.
-  assign y = valid ? sources[DW*idx +: DW] : {DW{1'b0}};
+  wire [SW:0] idx = sel < N ? {1'b0, sel} : N - 1;
+  assign y = sources[DW*idx +: DW];
 `endif
 endmodule
 
