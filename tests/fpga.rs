@@ -1225,7 +1225,7 @@ fn sweep_times_and_costs_a_fixed_point_function_with_its_pes() {
         let n = row["n"].as_u64().unwrap() as f64;
         // n fixed ADD + n MULTI full-range units (the target's fix_pe: 477 and 299 ALM) and the crossbar design
         // in the Cyclone V's Yosys figures, 32-bit words: 2n memories × 2 ports of 4n inputs
-        // (0.35 ALM an input bit, 0.4 a port bit), 1.35 a PE bit, 1.2 a bit of each buffer
+        // (0.35 ALM an input bit, 0.05 a port bit), 1.35 a PE bit, 1.2 a bit of each buffer
         // word beyond a PE's first (the row's buffer statistics: exact when every buffer has a
         // word, or none has two)
         let l = robovec_machine::target::Family::CycloneV.design_logic().unwrap();

@@ -153,13 +153,13 @@ fn microseconds_and_the_estimate_on_the_built_in_target() {
     assert_eq!(p["cycles"], 26);
     assert!((p["us"].as_f64().unwrap() - 26.0 / 120.0).abs() < 1e-12);
     // 1 ADD + 1 MULTI: ALM 360 + 100 + the crossbar design in the Cyclone V's Yosys figures,
-    // 32-bit words: 2 PE memories · 2 ports of 4 inputs (0.35 ALM an input bit, 0.4 a port
+    // 32-bit words: 2 PE memories · 2 ports of 4 inputs (0.35 ALM an input bit, 0.05 a port
     // bit), 1.35 a PE bit, 1.2 a bit of each buffer word beyond a PE's first (as placed);
     // DSP 2 + 3 = 5; M10K per PE: PE memory 2048·32/10240 → 7, buffer 16·32 → 1,
     // instructions 27·52 → 1, buffer instructions 27·10 → 1, crossbar 27·2·3 → 1: 11, × 2 = 22.
     let buffers: f64 =
         p["buffer_words"].as_array().unwrap().iter().map(|b| b.as_u64().unwrap().max(1) as f64 - 1.0).sum();
-    let alm = 460.0 + 32.0 * (4.0 * (0.35 * 4.0 + 0.4) + 2.0 * 1.35 + 1.2 * buffers);
+    let alm = 460.0 + 32.0 * (4.0 * (0.35 * 4.0 + 0.05) + 2.0 * 1.35 + 1.2 * buffers);
     let e = &p["estimate"];
     assert_eq!((e["alm"].as_f64(), e["dsp"].as_u64(), e["m10k"].as_u64()), (Some(alm.ceil()), Some(5), Some(22)));
     assert_eq!(e["fits"], true);
