@@ -47,7 +47,9 @@
 //! - the write-port multiplexer is its own module `rv_mux` (`hdl/rv_lib.v`): a balanced
 //!   tree of 2:1 multiplexers on the bits of `sel - 1`, gated to 0 outside `1..=2n_pe`, which
 //!   Yosys packs four data inputs to a LUT6 (17-way × 32 bits: 161 LUT6 + 32 small LUTs, the
-//!   barrel-shifter form gave 160 + 33 after minutes);
+//!   barrel-shifter form gave 160 + 33 after minutes); since issue 49 the tree is on the bits
+//!   of a 0-based `sel` and ungated (the write enable says whether the port writes), a 2^j-way
+//!   port j select bits;
 //! - Yosys maps the design without flattening (`-noflatten`): each distinct module once (the
 //!   crossbar port is one module for all `2·n_pe` ports; each PE is its own module since its
 //!   images differ), then the mapped netlist is flattened only to count its cells (`stat`

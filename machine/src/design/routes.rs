@@ -8,7 +8,9 @@
 //! program routes to it. The **specialised** interconnect gives each write port a multiplexer
 //! over exactly those sources ([`Routes`]), and its crossbar memory a select of
 //! `⌈log2(k + 1)⌉` bits for `k` sources (0: no write, `i`: the port's `i`-th source), where the
-//! crossbar's select has `⌈log2(2·n_pe + 1)⌉` bits.
+//! crossbar's select has `⌈log2(2·n_pe + 1)⌉` bits. (These are the `xbar` images' selects; the
+//! control word the HDL reads holds each one less, 0-based, in `⌈log2 k⌉` bits:
+//! `Design::lane_select_bits`.)
 //!
 //! A memory whose writes cannot give each source one port (an odd cycle of sources written
 //! together) may also have a **shared multiplexer** over some of its sources, whose output is
