@@ -84,27 +84,7 @@ struct ManifestPe<'a> {
     /// The PE's control word (`Design::controls`): the same fields as `instr`, `xbar`, `bufi`,
     /// `capt` and `fix`, one word per cycle at `offset` of the control memory the HDL reads
     /// (`control_lanes`).
-    control: ManifestControl,
-}
-
-#[derive(Clone, Debug, Serialize)]
-struct ManifestControl {
-    /// Bits of each address field.
-    pa: u32,
-    /// Bits of each buffer address (the `bufi` word's addresses cut to them).
-    pb: u32,
-    /// Bits of the output-memory address (the `capt` word's, cut to them).
-    po: u32,
-    /// On fixed-point PEs, the shift word's fields (`Design::controls`' `FixField`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    fix: Option<crate::design::FixField>,
-    /// Bits of the 0-based write-port selects: port 0, port 1, the shared multiplexer's
-    /// (`Design::lane_select_bits`).
-    select_bits: [u32; 3],
-    /// Bits of the word.
-    width: u32,
-    /// Its first bit in the design's control word (`control_lanes`).
-    offset: u32,
+    control: crate::design::Control,
 }
 
 /// The manifest (`manifest.json`): everything a host or a script needs to load and read the
@@ -127,17 +107,8 @@ pub fn manifest(d: &Design, target: &str, clock_mhz: f64, format: &str) -> Strin
             .into_iter()
             .chain(p.fix.as_ref().map(|i| ("fix", m(i))))
             .collect();
-            let control = ManifestControl {
-                pa: c.pa,
-                pb: c.pb,
-                po: c.po,
-                fix: c.fix,
-                select_bits: c.select_bits,
-                width: c.width,
-                offset: c.offset,
-            };
             ManifestPe {
-                control,
+                control: c,
                 slot: p.slot,
                 pe: &p.pe,
                 kind: if p.is_mul { "mul" } else { "add" },

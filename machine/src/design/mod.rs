@@ -227,7 +227,7 @@ pub struct Design {
 /// `pa` bits each), the write-port selects, the buffer instruction, the output capture and the
 /// shift word, at bits `[offset, offset + width)` of the design's control memory
 /// ([`Design::control_lanes`]).
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct Control {
     /// Bits of each address field of the instruction: the PE memory's address bits.
     pub pa: u32,
@@ -237,6 +237,7 @@ pub struct Control {
     /// least 1).
     pub po: u32,
     /// The shift word's fields on a fixed-point PE ([`FixField`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub fix: Option<FixField>,
     /// Bits of the write-port selects (port 0, port 1, the shared multiplexer's; 0: none):
     /// [`Design::lane_select_bits`].
@@ -485,10 +486,7 @@ impl Design {
                 let [g0, g1] = selects(word, self.widths.sw);
                 [g0, g1, 0]
             }
-            Some(r) => {
-                let (b0, b1) = (r.select_bits(slot, 0), r.select_bits(slot, 1));
-                [word & ((1 << b0) - 1), word >> b0 & ((1 << b1) - 1), word >> (b0 + b1)]
-            }
+            Some(r) => r.fields(slot, word),
         }
     }
 
@@ -540,7 +538,8 @@ impl Design {
     /// Each PE's control word, in slot order: per cycle its instruction word with each address field cut
     /// to the PE memory's address bits (`[0,pa)` read A, `[pa,2pa)` read B, `[2pa,3pa)` write-0
     /// address, `[3pa,4pa)` write-1 address, then we0, we1, issue valid, sub), its write-port
-    /// selects (the `xbar` image, `xbar.width` bits), its buffer instruction (`bufi`), its output
+    /// selects (the `xbar` image's, each one less: 0-based in [`Design::lane_select_bits`]
+    /// bits, 0 where the port does not write), its buffer instruction (`bufi`), its output
     /// capture (`capt`) and, on fixed-point PEs, its shift word (`fix` cut to the PE's shifts,
     /// [`FixField`]; on an ADD PE an op whose `b` is the finer operand reads A and B swapped), in
     /// that order from bit 0, then on a PE with fused multiply-adds ([`PeImages::mac`]) the read
@@ -619,6 +618,7 @@ impl Design {
         let (pb, po, fix) = self.control_fields(slot);
         let (bw, ow) = (self.widths.bw, self.widths.ow);
         let lane = self.control_lane_bits.max(1);
+        let select_bits = self.lane_select_bits(slot);
         let cycles = p.instr.words.len();
         let mask = |bits: u32| if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
         for c in 0..cycles {
@@ -654,7 +654,7 @@ impl Design {
             // each select 0-based (`rv_mux` has no "none" code: the write enables say which
             // ports write, and a port that does not write reads its first input)
             let selects = self.image_selects(slot, p.xbar.words[c]);
-            for (l, bits) in selects.into_iter().zip(self.lane_select_bits(slot)) {
+            for (l, bits) in selects.into_iter().zip(select_bits) {
                 put(l.saturating_sub(1), bits);
             }
             // the buffer instruction and the capture word with their addresses cut to pb and po

@@ -379,14 +379,21 @@ impl Routes {
         Some(l0 | l1 << b0 | shared << (b0 + b1))
     }
 
+    /// The three selects of specialised word `word` on `slot` as [`Routes::encode`] packs them:
+    /// port 0's and port 1's route index (0 none, `i` the `i`-th route, `k + 1` the shared
+    /// output) and the shared select (0 none, `i` the `i`-th shared source).
+    pub fn fields(&self, slot: usize, word: u64) -> [u64; 3] {
+        let (b0, b1) = (self.select_bits(slot, 0), self.select_bits(slot, 1));
+        [word & ((1 << b0) - 1), word >> b0 & ((1 << b1) - 1), word >> (b0 + b1)]
+    }
+
     /// The crossbar selects `[g0, g1]` of specialised word `word` on `slot` (inverse of
     /// [`Routes::encode`]); `None` beyond a port's inputs or the shared sources.
     pub fn decode(&self, slot: usize, word: u64) -> Option<[u64; 2]> {
         if word >> self.word_bits(slot) != 0 {
             return None;
         }
-        let (b0, b1) = (self.select_bits(slot, 0), self.select_bits(slot, 1));
-        let (l0, l1, ls) = (word & ((1 << b0) - 1), word >> b0 & ((1 << b1) - 1), word >> (b0 + b1));
+        let [l0, l1, ls] = self.fields(slot, word);
         let global = |port: usize, l: u64| -> Option<u64> {
             let list = self.ports.get(slot)?.get(port)?;
             match l {
