@@ -18,6 +18,7 @@ mod corpus;
 mod cse;
 mod depth_bound;
 mod diagnostics;
+mod diff;
 mod eqsat;
 mod error_bound;
 mod error_reference;

@@ -13,6 +13,7 @@ pub mod atomise;
 pub mod contract;
 pub mod cse;
 pub mod dce;
+pub mod diff;
 pub mod depth_bound;
 pub mod each;
 pub mod eqsat;
@@ -620,6 +621,7 @@ pub const PASSES: Registry = Registry {
         &tree_height::balance::INFO,
         &inline::INFO,
         &interleave::INFO,
+        &diff::INFO,
         &tree_height::distribute::INFO,
         &recurrence::INFO,
         &rotate_3m::INFO,

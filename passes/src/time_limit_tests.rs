@@ -56,6 +56,7 @@ const EVERY_PASS: &[(&str, AtTimeLimit)] = &[
     ("balance", AtTimeLimit::Skip),
     ("inline", AtTimeLimit::Skip),
     ("interleave", AtTimeLimit::Required),
+    ("diff<wrt=q>", AtTimeLimit::Required),
     ("distribute", AtTimeLimit::Skip),
     ("recurrence", AtTimeLimit::Skip),
     ("rotate-3m", AtTimeLimit::Skip),
