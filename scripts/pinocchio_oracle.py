@@ -105,6 +105,11 @@ def main():
         mass = upper + np.triu(upper, 1).T
         nle = pin.nonLinearEffects(model, data, q, v)
         aba = pin.aba(model, data, q, v, tau)
+        # Derivatives along the tangent space (issue 50): ∂τ/∂q, ∂τ/∂v at (q, v, a), and
+        # ∂q̈/∂q, ∂q̈/∂v, M⁻¹ at (q, v, τ) (Pinocchio fills M⁻¹'s upper triangle only).
+        dtau_dq, dtau_dv, _ = (np.array(x) for x in pin.computeRNEADerivatives(model, data, q, v, a))
+        ddq_dq, ddq_dv, minv = (np.array(x) for x in pin.computeABADerivatives(model, data, q, v, tau))
+        minv = np.triu(minv) + np.triu(minv, 1).T
         out["states"].append({
             "q": coords,
             "q_pinocchio": list(map(float, q)),
@@ -114,6 +119,11 @@ def main():
             "M": [list(map(float, row)) for row in mass],
             "nle": list(map(float, nle)),
             "aba": list(map(float, aba)),
+            "dtau_dq": [list(map(float, row)) for row in dtau_dq],
+            "dtau_dv": [list(map(float, row)) for row in dtau_dv],
+            "ddq_dq": [list(map(float, row)) for row in ddq_dq],
+            "ddq_dv": [list(map(float, row)) for row in ddq_dv],
+            "Minv": [list(map(float, row)) for row in minv],
         })
     json.dump(out, sys.stdout)
 

@@ -46,6 +46,14 @@ pub(crate) struct State {
     pub(crate) mass: Vec<Vec<f64>>,
     pub(crate) nle: Vec<f64>,
     pub(crate) aba: Vec<f64>,
+    /// `computeRNEADerivatives`' ∂τ/∂q and ∂τ/∂v at (q, v, a), row-major nv × nv.
+    pub(crate) dtau_dq: Vec<Vec<f64>>,
+    pub(crate) dtau_dv: Vec<Vec<f64>>,
+    /// `computeABADerivatives`' ∂q̈/∂q, ∂q̈/∂v and M⁻¹ (both triangles) at (q, v, τ).
+    pub(crate) ddq_dq: Vec<Vec<f64>>,
+    pub(crate) ddq_dv: Vec<Vec<f64>>,
+    #[serde(rename = "Minv")]
+    pub(crate) minv: Vec<Vec<f64>>,
 }
 
 /// `scripts/pinocchio_oracle.py`'s JSON.
