@@ -30,8 +30,10 @@
 //!
 //! **Modes.** `forward` sweeps the body once, carrying each value's derivatives with respect to
 //! every `wrt` input that reaches it: ops in O(ops × inputs). `reverse` sweeps the body backwards
-//! once per output, accumulating adjoints: O(ops × outputs). `auto` (the default) takes forward
-//! when the function has no more `wrt` inputs than outputs that depend on them, else reverse.
+//! once per output, accumulating adjoints: O(ops × outputs). `auto` (the default) takes the
+//! mode that carries fewer derivative terms: forward's are, over the values, the `wrt` inputs
+//! that reach each one, reverse's the outputs each one reaches (bit sets, one linear sweep
+//! each way; see `sweep_terms`).
 //! Both give the same derivatives in exact arithmetic (and the same ops up to order when an
 //! output has one input); the rounding differs.
 //!
@@ -68,7 +70,8 @@ pub const INFO: PassInfo = PassInfo {
         ParamInfo {
             name: "mode",
             kind: ParamKind::Choice { choices: MODES, default: "auto" },
-            doc: "forward (ops x inputs), reverse (ops x outputs), or auto: forward when inputs <= outputs",
+            doc:
+                "forward (ops x inputs), reverse (ops x outputs), or auto: the one that carries fewer derivative terms",
         },
     ],
     build: |p: &Params| {
@@ -401,6 +404,59 @@ fn chain(b: &mut Builder, t: Option<Tan>, p: &Partial) -> Option<Tan> {
     }
 }
 
+/// What `auto` compares: the derivative terms each mode carries, `(Σ over values of the wrt
+/// inputs that reach it, Σ over values of the outputs it reaches)`, the first the forward
+/// sweep's tangents, the second the reverse sweeps' adjoints. Bit sets of inputs (outputs) per
+/// value: O(values × ⌈inputs / 64⌉ + values × ⌈outputs / 64⌉) words and time.
+fn sweep_terms(f: &Function, xs: &[Value], depends: &[bool]) -> (u64, u64) {
+    let n = depends.len();
+    let words = xs.len().div_ceil(64).max(1);
+    let mut reach = vec![0u64; n * words];
+    for (j, x) in xs.iter().enumerate() {
+        reach[x.index() * words + j / 64] |= 1 << (j % 64);
+    }
+    let mut forward = 0u64;
+    for &v in &f.body {
+        if !depends[v.index()] {
+            continue;
+        }
+        f.value(v).def.for_each_value(|a| {
+            for w in 0..words {
+                reach[v.index() * words + w] |= reach[a.index() * words + w];
+            }
+        });
+        forward +=
+            reach[v.index() * words..(v.index() + 1) * words].iter().map(|w| u64::from(w.count_ones())).sum::<u64>();
+    }
+    let outs: Vec<Value> = f
+        .outputs
+        .iter()
+        .filter_map(|o| match o.value {
+            Operand::Value(v) if depends[v.index()] => Some(v),
+            _ => None,
+        })
+        .collect();
+    let words = outs.len().div_ceil(64).max(1);
+    let mut reached = vec![0u64; n * words];
+    for (k, v) in outs.iter().enumerate() {
+        reached[v.index() * words + k / 64] |= 1 << (k % 64);
+    }
+    let mut reverse = 0u64;
+    for &v in f.body.iter().rev() {
+        if !depends[v.index()] {
+            continue;
+        }
+        reverse +=
+            reached[v.index() * words..(v.index() + 1) * words].iter().map(|w| u64::from(w.count_ones())).sum::<u64>();
+        f.value(v).def.for_each_value(|a| {
+            for w in 0..words {
+                reached[a.index() * words + w] |= reached[v.index() * words + w];
+            }
+        });
+    }
+    (forward, reverse)
+}
+
 /// Differentiates `f` (atomised, verified) in place: the derivative outputs of the module doc
 /// for the inputs `wrt` names, in `mode` (`None`: by shape). Returns the mode used.
 ///
@@ -433,12 +489,19 @@ pub fn differentiate(f: &mut Function, wrt: &[String], mode: Option<Mode>, ticke
         if let Def::Trig(fun, x) = d {
             trig_of.entry((*x, *fun == TrigFn::Sin)).or_insert(v);
         }
-        depends[v.index()] = d.operands().iter().any(|o| matches!(o, Operand::Value(a) if depends[a.index()]))
-            || matches!(d, Def::Trig(_, x) if depends[x.index()]);
+        let mut any = false;
+        d.for_each_value(|a| any |= depends[a.index()]);
+        depends[v.index()] = any;
     }
     let outputs: Vec<(String, Operand)> = f.outputs.iter().map(|o| (o.name.clone(), o.value)).collect();
-    let live_outputs = outputs.iter().filter(|(_, o)| matches!(o, Operand::Value(v) if depends[v.index()])).count();
-    let mode = mode.unwrap_or(if xs.len() <= live_outputs { Mode::Forward } else { Mode::Reverse });
+    let mode = mode.unwrap_or_else(|| {
+        let (forward, reverse) = sweep_terms(f, &xs, &depends);
+        if forward <= reverse {
+            Mode::Forward
+        } else {
+            Mode::Reverse
+        }
+    });
     for (o, _) in &outputs {
         for &x in &xs {
             if split_state(o).1 == split_state(f.name_of(x)).1 {
