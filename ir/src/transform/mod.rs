@@ -6,3 +6,4 @@
 
 pub mod atomise;
 pub mod cse;
+pub mod diff;

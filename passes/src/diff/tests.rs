@@ -1,4 +1,7 @@
 use super::*;
+use robovec_ir::time_limit::Ticker;
+use robovec_ir::{split_state, Def, Function, Module, Operand, TrigFn};
+use std::collections::HashMap;
 use proptest::prelude::*;
 use robovec_ir::interp::{eval, pseudo_random_input};
 use robovec_ir::text::parse;
