@@ -74,8 +74,10 @@ fn corpus_jacobians_match_central_finite_differences_in_both_modes() {
 /// `diff` on the URDF generator's functions (fixed base, parameters folded) against Pinocchio's
 /// analytical derivatives on random states: `invdyna` differentiated with respect to `q, qd`
 /// is `computeRNEADerivatives`' ∂τ/∂q, ∂τ/∂v; `fordyna` with respect to `q, qd, Qq` is
-/// `computeABADerivatives`' ∂q̈/∂q, ∂q̈/∂v and M⁻¹. Each matrix within 1e-9 relative (∞-norm of
-/// the difference over Pinocchio's ∞-norm).
+/// `computeABADerivatives`' ∂q̈/∂q, ∂q̈/∂v and M⁻¹; and the generator's `rnea_derivatives`,
+/// `aba_derivatives` and `minv` (`-function=`, Pinocchio's output names) through `default<ops>`
+/// give the same. Each matrix within 1e-9 relative (∞-norm of the difference over Pinocchio's
+/// ∞-norm).
 #[test]
 fn robot_derivatives_match_pinocchio() {
     use crate::pinocchio::{oracle, python, Base};
@@ -97,7 +99,7 @@ fn robot_derivatives_match_pinocchio() {
                 given.insert(format!("q[{}]", i + 1), s.q[i].into());
                 given.insert(format!("qd[{}]", i + 1), s.qd[i].into());
             }
-            let run = |function: &str, wrt: &str, extra: &[(&str, &Vec<f64>)]| {
+            let run = |function: &str, passes: &str, extra: &[(&str, &Vec<f64>)]| {
                 let mut given = given.clone();
                 for (family, x) in extra {
                     for i in 0..n {
@@ -110,7 +112,7 @@ fn robot_derivatives_match_pinocchio() {
                     &o.path,
                     "--fold-params",
                     &format!("-function={function}"),
-                    &format!("-passes=atomise,cse,diff<wrt={wrt}>"),
+                    &format!("-passes={passes}"),
                     &format!("-eval={}", file.display()),
                     "-o",
                     "/dev/null",
@@ -133,13 +135,98 @@ fn robot_derivatives_match_pinocchio() {
                 assert!(rel <= 1e-9, "{urdf} state {k} {prefix}: relative error {rel:e}");
                 eprintln!("{urdf} state {k} {prefix}: {rel:.1e}");
             };
-            let rnea = run("invdyna", "q,qd", &[("qdd", &s.qdd)]);
+            let rnea = run("invdyna", "atomise,cse,diff<wrt=q,qd>", &[("qdd", &s.qdd)]);
             check(&rnea, "dQq_dq", &s.dtau_dq);
             check(&rnea, "dQq_dqd", &s.dtau_dv);
-            let aba = run("fordyna", "q,qd,Qq", &[("Qq", &s.tau)]);
+            let aba = run("fordyna", "atomise,cse,diff<wrt=q,qd,Qq>", &[("Qq", &s.tau)]);
             check(&aba, "dqdd_dq", &s.ddq_dq);
             check(&aba, "dqdd_dqd", &s.ddq_dv);
             check(&aba, "dqdd_dQq", &s.minv);
+            // The generator's derivative functions under Pinocchio's names, through `default<ops>`.
+            let rnea = run("rnea_derivatives", "default<ops>", &[("qdd", &s.qdd)]);
+            assert_eq!(rnea.len(), 2 * n * n, "{urdf}: rnea_derivatives' outputs");
+            check(&rnea, "dtau_dq", &s.dtau_dq);
+            check(&rnea, "dtau_dv", &s.dtau_dv);
+            let aba = run("aba_derivatives", "default<ops>", &[("Qq", &s.tau)]);
+            assert_eq!(aba.len(), 3 * n * n, "{urdf}: aba_derivatives' outputs");
+            check(&aba, "ddq_dq", &s.ddq_dq);
+            check(&aba, "ddq_dv", &s.ddq_dv);
+            check(&aba, "Minv", &s.minv);
+            let minv = run("minv", "default<ops>", &[]);
+            assert_eq!(minv.len(), n * n, "{urdf}: minv's outputs");
+            check(&minv, "Minv", &s.minv);
+        }
+    }
+}
+
+/// `codegen<c;abi=pinocchio>` on the generator's derivative functions: UR5's
+/// `model_rnea_derivatives(q, v, a, dtau_dq, dtau_dv)`, `model_aba_derivatives(q, v, tau,
+/// ddq_dq, ddq_dv, Minv)` and `model_minv(q, Minv)` (three files, linked together), compiled by
+/// the system compiler at -O1 and called with Pinocchio's vectors, against Pinocchio within 1e-9.
+#[test]
+fn pinocchio_abi_derivative_functions_in_c_match_pinocchio() {
+    use crate::pinocchio::{oracle, python, Base};
+    let Some(py) = python() else { return };
+    let dir = tmp("pinocchio_c");
+    let o = oracle(&py, "erd:ur_description/urdf/ur5_robot.urdf", 2, 5, Base::Fixed);
+    let mut files = vec!["main.c".to_string()];
+    for function in ["rnea_derivatives", "aba_derivatives", "minv"] {
+        let c = dir.join(format!("{function}.c"));
+        let out = crate::common::opt(&[
+            &o.path,
+            "--fold-params",
+            &format!("-function={function}"),
+            "-passes=default<ops>,codegen<c;abi=pinocchio>",
+            "-o",
+            c.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{function}: {}", crate::common::stderr(&out));
+        files.push(format!("{function}.c"));
+    }
+    let n = o.states[0].qd.len();
+    let list = |x: &[f64]| x.iter().map(|v| format!("{v:e}")).collect::<Vec<_>>().join(", ");
+    let mut main = String::from(
+        "#include <stdio.h>\n#include \"rnea_derivatives.h\"\n#include \"aba_derivatives.h\"\n#include \"minv.h\"\n\
+         static void put(const double *x, int n) { for (int i = 0; i < n; i++) printf(\"%.17g\\n\", x[i]); }\nint main(void)\n{\n",
+    );
+    for s in &o.states {
+        main += &format!(
+            "  {{\n    const double q[] = {{{}}}, v[] = {{{}}}, a[] = {{{}}}, tau[] = {{{}}};\n    \
+             double dq[{nn}], dv[{nn}], ddq[{nn}], ddv[{nn}], mi[{nn}], mi2[{nn}];\n    \
+             model_rnea_derivatives(q, v, a, dq, dv);\n    model_aba_derivatives(q, v, tau, ddq, ddv, mi);\n    model_minv(q, mi2);\n    \
+             put(dq, {nn}); put(dv, {nn}); put(ddq, {nn}); put(ddv, {nn}); put(mi, {nn}); put(mi2, {nn});\n  }}\n",
+            list(&s.q),
+            list(&s.qd),
+            list(&s.qdd),
+            list(&s.tau),
+            nn = n * n
+        );
+    }
+    main += "  return 0;\n}\n";
+    std::fs::write(dir.join("main.c"), main).unwrap();
+    let files: Vec<&str> = files.iter().map(String::as_str).collect();
+    let exe = crate::common::compile_c(&dir, &["-O1", "-std=c99", "-Wall", "-Werror"], &files);
+    let out = std::process::Command::new(&exe).output().unwrap();
+    assert!(out.status.success());
+    let got: Vec<f64> = String::from_utf8(out.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+    assert_eq!(got.len(), o.states.len() * 6 * n * n);
+    for (k, (s, chunk)) in o.states.iter().zip(got.chunks(6 * n * n)).enumerate() {
+        for (m, (label, want)) in [
+            ("dtau_dq", &s.dtau_dq),
+            ("dtau_dv", &s.dtau_dv),
+            ("ddq_dq", &s.ddq_dq),
+            ("ddq_dv", &s.ddq_dv),
+            ("Minv", &s.minv),
+            ("minv's Minv", &s.minv),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let flat: Vec<f64> = want.iter().flatten().copied().collect();
+            let norm = flat.iter().fold(0.0f64, |x, y| x.max(y.abs()));
+            let c = &chunk[m * n * n..(m + 1) * n * n];
+            let diff = c.iter().zip(&flat).fold(0.0f64, |x, (a, b)| x.max((a - b).abs()));
+            assert!(diff / norm <= 1e-9, "state {k} {label}: relative error {:e}", diff / norm);
         }
     }
 }

@@ -399,6 +399,71 @@ fn writer(f: &(&str, Writer, Writer, bool), formulation: Formulation) -> Writer 
 /// `fordyna`.
 pub const FUNCTION_NAMES: [&str; 3] = [FUNCTIONS[0].0, FUNCTIONS[1].0, FUNCTIONS[2].0];
 
+/// One derivative function (issue 50 item 2): its name, the written function it differentiates
+/// ([`FUNCTIONS`]), the inputs it differentiates with respect to, and its outputs: each
+/// derivative family of [`robovec_ir::transform::diff`] renamed to Pinocchio's (`dQq_dq[i][j]` →
+/// `dtau_dq[i][j]`); the function's own outputs are dropped.
+type Derived = (&'static str, &'static str, &'static [&'static str], &'static [(&'static str, &'static str)]);
+
+/// The derivative functions, written only when asked for (`-function=NAME`), after the others
+/// in module order. Every matrix is `nv × nq`, row `i` the output, column `j` the coordinate
+/// (row-major as Pinocchio's); with respect to `q` they are derivatives along robovec's
+/// coordinates, which on a fixed base are Pinocchio's tangent space:
+/// - `rnea_derivatives`: `invdyna` (`Qq` from `q`, `qd`, `qdd`) with respect to `q, qd`:
+///   `dtau_dq` = ∂τ/∂q, `dtau_dv` = ∂τ/∂v (Pinocchio's `computeRNEADerivatives`);
+/// - `aba_derivatives`: `fordyna` (`qdd` from `q`, `qd`, `Qq`) with respect to `q, qd, Qq`:
+///   `ddq_dq`, `ddq_dv` and `Minv` = ∂q̈/∂τ (`computeABADerivatives`);
+/// - `minv`: `fordyna` with respect to `Qq`: `Minv` (`computeMinverse`, both triangles).
+const DERIVED: [Derived; 3] = [
+    ("rnea_derivatives", "invdyna", &["q", "qd"], &[("dQq_dq", "dtau_dq"), ("dQq_dqd", "dtau_dv")]),
+    (
+        "aba_derivatives",
+        "fordyna",
+        &["q", "qd", "Qq"],
+        &[("dqdd_dq", "ddq_dq"), ("dqdd_dqd", "ddq_dv"), ("dqdd_dQq", "Minv")],
+    ),
+    ("minv", "fordyna", &["Qq"], &[("dqdd_dQq", "Minv")]),
+];
+
+/// Every function name `-function=` accepts for a URDF: [`FUNCTION_NAMES`], then the
+/// derivative functions (`rnea_derivatives`, `aba_derivatives`, `minv`).
+pub const GENERATED_NAMES: [&str; 6] =
+    [FUNCTIONS[0].0, FUNCTIONS[1].0, FUNCTIONS[2].0, DERIVED[0].0, DERIVED[1].0, DERIVED[2].0];
+
+/// Derivative function `d` of `base` (parsed, as written): atomised, common subexpressions
+/// merged, differentiated ([`robovec_ir::transform::diff::differentiate`], the mode by its
+/// count of terms), its derivative outputs renamed and everything else dropped. `None` at the
+/// ticker's stop.
+fn derive(
+    base: &robovec_ir::Function,
+    d: &Derived,
+    ticker: &robovec_ir::time_limit::Ticker,
+) -> Option<robovec_ir::Function> {
+    use robovec_ir::transform::{atomise, cse, diff};
+    let mut f = atomise::atomise_until(base, ticker)?;
+    cse::cse_within(&mut f, ticker);
+    let wrt: Vec<String> = d.2.iter().map(|s| s.to_string()).collect();
+    match diff::differentiate(&mut f, &wrt, None, ticker) {
+        Ok(_) => {}
+        Err(diff::Failure::Stopped) => return None,
+        // The generator writes no callback and no name of the form `d…_d…`.
+        Err(diff::Failure::Message(m)) => unreachable!("{}: {m}", d.0),
+    }
+    let outputs = std::mem::take(&mut f.outputs);
+    for o in outputs {
+        let renamed = d.3.iter().find_map(|(from, to)| {
+            o.name.strip_prefix(from).filter(|rest| rest.starts_with('[')).map(|rest| format!("{to}{rest}"))
+        });
+        if let Some(name) = renamed {
+            f.set_output(name, o.value, o.span);
+        }
+    }
+    let live = f.live_values(&[]);
+    f.retain(|_, v| live[v.index()]);
+    f.name = d.0.to_string();
+    Some(f)
+}
+
 /// Generates `invdyna` and `dirdyna` for `model`; `fold` folds every parameter into the
 /// equations. [`generate_with`] with every function and no time limit.
 pub fn generate(model: &Model, fold: bool) -> Generated {
@@ -498,7 +563,10 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
         .collect();
     let mut functions: Vec<robovec_ir::Function> = Vec::new();
     let mut singular = None;
-    for f in FUNCTIONS.iter().filter(|f| request.wants(f.0)) {
+    let derived: Vec<&Derived> = DERIVED.iter().filter(|d| request.wants(d.0)).collect();
+    // The written functions the derivative functions asked for need, not kept themselves.
+    let mut bases: Vec<robovec_ir::Function> = Vec::new();
+    for f in FUNCTIONS.iter().filter(|f| request.wants(f.0) || derived.iter().any(|d| d.1 == f.0)) {
         let (name, write) = (f.0, writer(f, request.formulation));
         let mut b = Builder::new(name, consts.clone());
         b.deadline = request.deadline;
@@ -514,13 +582,30 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
             }
         };
         match written {
-            Ok(f) => functions.push(f),
+            Ok(f) if request.wants(name) => functions.push(f),
+            Ok(f) => bases.push(f),
             Err(stop) => {
-                functions.into_iter().for_each(abandon);
+                functions.into_iter().chain(bases).for_each(abandon);
                 return Err(stop);
             }
         }
     }
+    let ticker = robovec_ir::time_limit::Ticker::new(request.deadline, request.tick_budget);
+    for d in derived {
+        let base = functions.iter().chain(&bases).find(|f| f.name == d.1).expect("written above");
+        match derive(base, d, &ticker) {
+            Some(f) => functions.push(f),
+            None => {
+                functions.into_iter().chain(bases).for_each(abandon);
+                return Err(Stopped {
+                    function: d.0.to_string(),
+                    at: Reached::Step("differentiating"),
+                    seconds: request.deadline.map_or(0.0, |d| d.seconds),
+                });
+            }
+        }
+    }
+    bases.into_iter().for_each(|f| drop_later(f, request.deadline.is_some()));
     let params = (!request.fold).then(|| {
         // Only the parameters some function reads.
         layout.nonzero().into_iter().filter(|(k, _)| functions.iter().any(|f| f.lookup(k).is_some())).collect()

@@ -8,6 +8,13 @@
 //! | `dirdyna`'s `M` | `void NAME_crba(const double *q, double *M)` | `crba(model, data, q)`, both triangles |
 //! | `dirdyna`'s `c` | `void NAME_nle(const double *q, const double *v, double *nle)` | `nonLinearEffects(model, data, q, v)` |
 //! | `fordyna` | `void NAME_aba(const double *q, const double *v, const double *tau, double *qdd)` | `aba(model, data, q, v, tau)` |
+//! | `rnea_derivatives` | `void NAME_rnea_derivatives(const double *q, const double *v, const double *a, double *dtau_dq, double *dtau_dv)` | `computeRNEADerivatives(model, data, q, v, a)` |
+//! | `aba_derivatives` | `void NAME_aba_derivatives(const double *q, const double *v, const double *tau, double *ddq_dq, double *ddq_dv, double *Minv)` | `computeABADerivatives(model, data, q, v, tau)`, `Minv` both triangles |
+//! | `minv` | `void NAME_minv(const double *q, double *Minv)` | `computeMinverse(model, data, q)`, both triangles |
+//!
+//! The last three are the generator's derivative functions (`-function=rnea_derivatives`, …;
+//! issue 50): each matrix row-major, `nv × nq` for a derivative with respect to `q` (`…_dq`),
+//! `nv × nv` otherwise.
 //!
 //! `dirdyna` gives two functions, each the backward slice of its outputs (the mass matrix
 //! depends on `q` only, so `NAME_crba` takes no velocity). `fordyna` exists when the URDF is
@@ -75,6 +82,23 @@ enum Algo {
     Crba,
     Nle,
     Aba,
+    RneaDerivatives,
+    AbaDerivatives,
+    Minv,
+}
+
+/// Every algorithm, in the order of the module doc's table.
+const ALGOS: [Algo; 7] =
+    [Algo::Rnea, Algo::Crba, Algo::Nle, Algo::Aba, Algo::RneaDerivatives, Algo::AbaDerivatives, Algo::Minv];
+
+/// The IR's output arrays that are matrices (`base[i][j]`), and how many columns one has: `nq`
+/// for a derivative with respect to `q`, else `nv`.
+fn matrix_columns(base: &str, nq: usize, nv: usize) -> Option<usize> {
+    match base {
+        "dtau_dq" | "ddq_dq" => Some(nq),
+        "M" | "dtau_dv" | "ddq_dv" | "Minv" => Some(nv),
+        _ => None,
+    }
 }
 
 impl Algo {
@@ -85,16 +109,28 @@ impl Algo {
             Algo::Crba => "crba",
             Algo::Nle => "nle",
             Algo::Aba => "aba",
+            Algo::RneaDerivatives => "rnea_derivatives",
+            Algo::AbaDerivatives => "aba_derivatives",
+            Algo::Minv => "minv",
         }
     }
 
-    /// Input arrays `(C name, the IR's array)`, then the output array `(C name, the IR's array)`.
-    fn arrays(self) -> (&'static [(&'static str, &'static str)], (&'static str, &'static str)) {
+    /// Input arrays `(C name, the IR's array)`, then the output arrays `(C name, the IR's array)`.
+    #[allow(clippy::type_complexity, reason = "two static tables of name pairs")]
+    fn arrays(self) -> (&'static [(&'static str, &'static str)], &'static [(&'static str, &'static str)]) {
         match self {
-            Algo::Rnea => (&[("q", "q"), ("v", "qd"), ("a", "qdd")], ("tau", "Qq")),
-            Algo::Crba => (&[("q", "q")], ("M", "M")),
-            Algo::Nle => (&[("q", "q"), ("v", "qd")], ("nle", "c")),
-            Algo::Aba => (&[("q", "q"), ("v", "qd"), ("tau", "Qq")], ("qdd", "qdd")),
+            Algo::Rnea => (&[("q", "q"), ("v", "qd"), ("a", "qdd")], &[("tau", "Qq")]),
+            Algo::Crba => (&[("q", "q")], &[("M", "M")]),
+            Algo::Nle => (&[("q", "q"), ("v", "qd")], &[("nle", "c")]),
+            Algo::Aba => (&[("q", "q"), ("v", "qd"), ("tau", "Qq")], &[("qdd", "qdd")]),
+            Algo::RneaDerivatives => {
+                (&[("q", "q"), ("v", "qd"), ("a", "qdd")], &[("dtau_dq", "dtau_dq"), ("dtau_dv", "dtau_dv")])
+            }
+            Algo::AbaDerivatives => (
+                &[("q", "q"), ("v", "qd"), ("tau", "Qq")],
+                &[("ddq_dq", "ddq_dq"), ("ddq_dv", "ddq_dv"), ("Minv", "Minv")],
+            ),
+            Algo::Minv => (&[("q", "q")], &[("Minv", "Minv")]),
         }
     }
 
@@ -105,6 +141,9 @@ impl Algo {
             Algo::Crba => "M = crba(model, data, q), both triangles, row-major",
             Algo::Nle => "nle = nonLinearEffects(model, data, q, v)",
             Algo::Aba => "qdd = aba(model, data, q, v, tau)",
+            Algo::RneaDerivatives => "computeRNEADerivatives(model, data, q, v, a): dtau_dq, dtau_dv",
+            Algo::AbaDerivatives => "computeABADerivatives(model, data, q, v, tau): ddq_dq, ddq_dv, Minv",
+            Algo::Minv => "Minv = computeMinverse(model, data, q), both triangles",
         }
     }
 }
@@ -133,10 +172,14 @@ fn algorithms(f: &Function) -> Result<Vec<(Algo, &'static [&'static str])>, Pass
         "invdyna" => Ok(vec![(Algo::Rnea, &["Qq"])]),
         "dirdyna" => Ok(vec![(Algo::Crba, &["M"]), (Algo::Nle, &["c"])]),
         "fordyna" => Ok(vec![(Algo::Aba, &["qdd"])]),
+        "rnea_derivatives" => Ok(vec![(Algo::RneaDerivatives, &["dtau_dq", "dtau_dv"])]),
+        "aba_derivatives" => Ok(vec![(Algo::AbaDerivatives, &["ddq_dq", "ddq_dv", "Minv"])]),
+        "minv" => Ok(vec![(Algo::Minv, &["Minv"])]),
         _ => Err(failed(
             f,
-            "abi=pinocchio writes the URDF generator's @invdyna (NAME_rnea), @dirdyna (NAME_crba, NAME_nle) and \
-             @fordyna (NAME_aba); this function is none of them (use abi=plain)"
+            "abi=pinocchio writes the URDF generator's @invdyna (NAME_rnea), @dirdyna (NAME_crba, NAME_nle), \
+             @fordyna (NAME_aba), @rnea_derivatives, @aba_derivatives and @minv (NAME_rnea_derivatives, …); this \
+             function is none of them (use abi=plain)"
                 .into(),
         )),
     }
@@ -187,14 +230,29 @@ fn check(f: &Function) -> Result<(usize, usize), PassError> {
     let outs: Vec<&str> = algos.iter().flat_map(|(_, o)| o.iter().copied()).collect();
     for o in &f.outputs {
         match indexed(&o.name) {
-            Some(("M", idx)) if idx.len() == 2 && outs.contains(&"M") => nv = nv.max(idx[0]).max(idx[1]),
+            Some((base, idx)) if idx.len() == 2 && outs.contains(&base) && matrix_columns(base, 0, 0).is_some() => {
+                nv = nv.max(idx[0]);
+                if base.ends_with("_dq") {
+                    nq = nq.max(idx[1]);
+                } else {
+                    nv = nv.max(idx[1]);
+                }
+            }
             Some((base, idx)) if idx.len() == 1 && outs.contains(&base) => nv = nv.max(idx[0]),
             _ => {
                 return Err(failed(
                     f,
                     format!("output `{}` has no place in Pinocchio's signature (abi=pinocchio writes {})", o.name, {
-                        let list: Vec<String> =
-                            outs.iter().map(|b| if *b == "M" { "M[i][j]".into() } else { format!("{b}[i]") }).collect();
+                        let list: Vec<String> = outs
+                            .iter()
+                            .map(|b| {
+                                if matrix_columns(b, 0, 0).is_some() {
+                                    format!("{b}[i][j]")
+                                } else {
+                                    format!("{b}[i]")
+                                }
+                            })
+                            .collect();
                         list.join(", ")
                     }),
                 ))
@@ -217,7 +275,7 @@ fn slice(f: &Function, keep: &[&str]) -> Function {
 /// The symbols' prefix: `name=` or [`DEFAULT_NAME`], checked so that every symbol is free.
 fn prefix(o: &CodegenC) -> Result<String, PassError> {
     let n = o.name.clone().unwrap_or_else(|| DEFAULT_NAME.to_string());
-    for s in [Algo::Rnea, Algo::Crba, Algo::Nle, Algo::Aba].map(|a| format!("{n}_{}", a.suffix())) {
+    for s in ALGOS.map(|a| format!("{n}_{}", a.suffix())) {
         if let Some(why) = reserved_symbol_reason(&s) {
             return Err(PassError::BadParameter {
                 pass: "codegen".into(),
@@ -267,10 +325,9 @@ pub(crate) fn emit(
     let w = o.batch as usize;
     let mut emitted = Vec::with_capacity(jobs.len());
     for ((a, f), symbol) in jobs.iter().zip(&symbols) {
-        let (ins, (out_c, out_ir)) = a.arrays();
+        let (ins, outs) = a.arrays();
         let mut params: Vec<(&str, bool)> = ins.iter().map(|x| (x.0, false)).collect();
-        params.push((out_c, true));
-        let out_param = params.len() - 1;
+        params.extend(outs.iter().map(|x| (x.0, true)));
         let mut inputs = Vec::with_capacity(f.inputs.len());
         for &v in &f.inputs {
             let n = f.name_of(v);
@@ -285,40 +342,45 @@ pub(crate) fn emit(
                 Source::Elem(p, idx[0] - 1)
             });
         }
+        // Each output array's length: rows × columns for a matrix, nv for a vector.
+        let len = |base: &str| matrix_columns(base, nq, nv).map_or(nv, |c| nv * c);
         // Outputs: one element each, M mirrored where the IR has one triangle only.
         let mut outputs = Vec::with_capacity(f.outputs.len());
-        let mut covered = vec![false; if *a == Algo::Crba { nv * nv } else { nv }];
+        let mut covered: Vec<Vec<bool>> = outs.iter().map(|x| vec![false; len(x.1)]).collect();
         let present: HashSet<&str> = f.outputs.iter().map(|x| x.name.as_str()).collect();
         for x in &f.outputs {
-            let (_, idx) = indexed(&x.name).expect("checked");
+            let (base, idx) = indexed(&x.name).expect("checked");
+            let k = outs.iter().position(|o| o.1 == base).expect("checked");
+            let param = ins.len() + k;
             let mut dest = Vec::with_capacity(2);
-            if *a == Algo::Crba {
+            if let Some(cols) = matrix_columns(base, nq, nv) {
                 let (i, j) = (idx[0] - 1, idx[1] - 1);
-                dest.push((out_param, i * nv + j));
-                if i != j && !present.contains(format!("M[{}][{}]", j + 1, i + 1).as_str()) {
-                    dest.push((out_param, j * nv + i));
+                dest.push((param, i * cols + j));
+                if base == "M" && i != j && !present.contains(format!("M[{}][{}]", j + 1, i + 1).as_str()) {
+                    dest.push((param, j * nv + i));
                 }
             } else {
-                dest.push((out_param, idx[0] - 1));
+                dest.push((param, idx[0] - 1));
             }
             for &(_, e) in &dest {
-                covered[e] = true;
+                covered[k][e] = true;
             }
             outputs.push(dest);
         }
-        if let Some(e) = covered.iter().position(|c| !c) {
-            let missing = if *a == Algo::Crba {
-                format!("M[{}][{}]", e / nv + 1, e % nv + 1)
-            } else {
-                format!("{out_ir}[{}]", e + 1)
-            };
-            return Err(failed(
-                f,
-                format!(
-                    "{symbol} writes {out_c}[0..{}) but the function has no output {missing} (nv = {nv}; was it removed by dce?)",
-                    covered.len()
-                ),
-            ));
+        for (k, &(out_c, out_ir)) in outs.iter().enumerate() {
+            if let Some(e) = covered[k].iter().position(|c| !c) {
+                let missing = match matrix_columns(out_ir, nq, nv) {
+                    Some(c) => format!("{out_ir}[{}][{}]", e / c + 1, e % c + 1),
+                    None => format!("{out_ir}[{}]", e + 1),
+                };
+                return Err(failed(
+                    f,
+                    format!(
+                        "{symbol} writes {out_c}[0..{}) but the function has no output {missing} (nv = {nv}; was it removed by dce?)",
+                        covered[k].len()
+                    ),
+                ));
+            }
         }
         let layout = Layout { params, inputs, outputs, float_arrays: false };
         let comment = format!("@{} as {symbol}: Pinocchio's {}", f.name, a.pinocchio());
@@ -332,24 +394,30 @@ pub(crate) fn emit(
             let n = if base == "q" { nq } else { nv };
             in_names.extend((1..=n).map(|k| format!("{base}[{k}]")));
         }
-        let out_names: Vec<String> = if *a == Algo::Crba {
-            (1..=nv).flat_map(|i| (1..=nv).map(move |j| format!("M[{i}][{j}]"))).collect()
-        } else {
-            (1..=nv).map(|k| format!("{out_ir}[{k}]")).collect()
-        };
+        let mut out_names: Vec<String> = Vec::new();
+        for &(_, base) in outs {
+            match matrix_columns(base, nq, nv) {
+                Some(c) => out_names.extend((1..=nv).flat_map(|i| (1..=c).map(move |j| format!("{base}[{i}][{j}]")))),
+                None => out_names.extend((1..=nv).map(|k| format!("{base}[{k}]"))),
+            }
+        }
         let iface = Interface { inputs: in_names, outputs: out_names, ..super::interface(o, f, symbol) };
         let mut proto = format!("/* @{} as {symbol}: Pinocchio's {}.\n *", f.name, a.pinocchio());
         for &(c, base) in ins {
             let n = if base == "q" { "NQ" } else { "NV" };
             let _ = write!(proto, " {c}[0..{name}_{n}) = {base}[1..],");
         }
-        let size = if *a == Algo::Crba { format!("{name}_NV*{name}_NV") } else { format!("{name}_NV") };
-        let _ = write!(proto, " {out_c}[0..{size}) = {out_ir}");
-        if *a == Algo::Crba {
-            proto += "[i+1][j+1] at i*NV + j";
-        } else {
-            proto += "[1..]";
-        }
+        let described: Vec<String> = outs
+            .iter()
+            .map(|&(out_c, out_ir)| match matrix_columns(out_ir, nq, nv) {
+                Some(_) => {
+                    let c = if out_ir.ends_with("_dq") { "NQ" } else { "NV" };
+                    format!(" {out_c}[0..{name}_NV*{name}_{c}) = {out_ir}[i+1][j+1] at i*{c} + j")
+                }
+                None => format!(" {out_c}[0..{name}_NV) = {out_ir}[1..]"),
+            })
+            .collect();
+        proto += &described.join(",");
         if w > 1 {
             let _ = write!(proto, ";\n * {w} states per call: lane l of element k of every array at [k*{w} + l]");
         }
@@ -367,8 +435,9 @@ pub(crate) fn emit(
         ""
     };
     let preface = format!(
-        "/* Pinocchio's vectors (0-based): q has NQ elements, v, a, tau, nle, qdd NV, M NV*NV (row-major, both\n \
-         * triangles){gravity}. The output array must not overlap an input. */\n\
+        "/* Pinocchio's vectors (0-based): q has NQ elements, v, a, tau, nle, qdd NV, M and Minv NV*NV (row-major,\n \
+         * both triangles), a derivative NV*NQ (..._dq) or NV*NV (row-major){gravity}. No output array may overlap an\n \
+         * input. */\n\
          #define {name}_NQ {nq}\n#define {name}_NV {nv}\n\n"
     );
     Ok((symbols, emitted, preface))

@@ -44,7 +44,7 @@ impl FrontEnd for Urdf {
     }
 
     fn function_names(&self) -> Option<&'static [&'static str]> {
-        Some(&robovec_dynamics::FUNCTION_NAMES)
+        Some(&robovec_dynamics::GENERATED_NAMES)
     }
 
     fn requires_utf8(&self) -> bool {
