@@ -84,6 +84,7 @@ pub mod robot;
 pub mod robotran_c;
 
 pub mod sym;
+pub mod tangent;
 pub mod topology;
 pub mod urdf_out;
 
@@ -434,9 +435,12 @@ pub const GENERATED_NAMES: [&str; 6] =
 /// merged, differentiated ([`robovec_ir::transform::diff::differentiate`], the mode by its
 /// count of terms), its derivative outputs renamed and everything else dropped. `None` at the
 /// ticker's stop.
+/// On the free flyer (`free_flyer`) the rows with respect to `q` are mapped to Pinocchio's tangent
+/// space ([`tangent::free_flyer_tangent`]).
 fn derive(
     base: &robovec_ir::Function,
     d: &Derived,
+    free_flyer: bool,
     ticker: &robovec_ir::time_limit::Ticker,
 ) -> Option<robovec_ir::Function> {
     use robovec_ir::transform::{atomise, cse, diff};
@@ -448,6 +452,10 @@ fn derive(
         Err(diff::Failure::Stopped) => return None,
         // The generator writes no callback and no name of the form `d…_d…`.
         Err(diff::Failure::Message(m)) => unreachable!("{}: {m}", d.0),
+    }
+    if free_flyer {
+        let along_q: Vec<&str> = d.3.iter().map(|r| r.0).filter(|from| from.ends_with("_dq")).collect();
+        tangent::free_flyer_tangent(&mut f, &along_q);
     }
     let outputs = std::mem::take(&mut f.outputs);
     for o in outputs {
@@ -593,7 +601,8 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
     let ticker = robovec_ir::time_limit::Ticker::new(request.deadline, request.tick_budget);
     for d in derived {
         let base = functions.iter().chain(&bases).find(|f| f.name == d.1).expect("written above");
-        match derive(base, d, &ticker) {
+        let free_flyer = model.robot.joints.iter().any(|j| j.kind == robot::JointKind::FreeFlyer);
+        match derive(base, d, free_flyer, &ticker) {
             Some(f) => functions.push(f),
             None => {
                 functions.into_iter().chain(bases).for_each(abandon);

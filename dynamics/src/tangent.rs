@@ -1,0 +1,139 @@
+//! Derivatives with respect to `q` along Pinocchio's tangent space on the free flyer (issue 50:
+//! `computeRNEADerivatives` and `computeABADerivatives` differentiate along
+//! `pinocchio.integrate(model, q, dq)`, `dq ∈ R^nv`, at `dq = 0`).
+//!
+//! The free flyer's configuration is `q[1..7]`: the position `p`, then the unit quaternion
+//! `(x, y, z, w)`; its velocity `qd[1..6]` is linear then angular, in the base frame.
+//! `integrate` moves the base by `exp(dq)` in its own frame, so to first order at `dq = 0`:
+//! - `∂p/∂dq_k = R e_k` for the linear `k = 1..3` (`R` the quaternion's rotation), and `p` does
+//!   not move with the angular ones (the coupling of SE(3)'s exponential is second order);
+//! - `∂quat/∂dq_{3+a} = quat ⊗ (e_a / 2, 0)` for the angular `a = 1..3`: vector part
+//!   `(w e_a + u × e_a) / 2`, scalar `−u_a / 2` (`u = (x, y, z)`);
+//! - every other joint's coordinate `q[j + 1]` is its velocity coordinate `j ≥ 7`.
+//!
+//! So a derivative row `∂o/∂q[1..nq]` (along robovec's coordinates, as `diff` writes it)
+//! becomes `∂o/∂dq[1..nv] = ∂o/∂q · J(q)` with that `nq × nv` Jacobian `J`. Zero entries are
+//! skipped, so the map costs about 30 ops a row.
+
+use std::collections::BTreeMap;
+
+use robovec_ir::{BinOp, Def, Function, Operand, Output, Span};
+
+/// Writes `a op b`, folding the structural zeros and ones.
+fn op(f: &mut Function, o: BinOp, a: Operand, b: Operand) -> Operand {
+    let zero = |x: Operand| x == Operand::Const(0.0);
+    let one = |x: Operand| x == Operand::Const(1.0);
+    match o {
+        BinOp::Mul if zero(a) || zero(b) => return Operand::Const(0.0),
+        BinOp::Mul if one(a) => return b,
+        BinOp::Mul if one(b) => return a,
+        BinOp::Add if zero(a) => return b,
+        BinOp::Add | BinOp::Sub if zero(b) => return a,
+        _ => {}
+    }
+    Operand::Value(f.define_fresh("ff_tangent", Def::Binary(o, a, b), Span::DUMMY))
+}
+
+/// `Σ terms[i].0 · terms[i].1 · sign`: the sum of products, zeros skipped.
+fn dot(f: &mut Function, terms: &[(Operand, Operand, bool)]) -> Operand {
+    let mut acc = Operand::Const(0.0);
+    for &(a, b, negative) in terms {
+        let p = op(f, BinOp::Mul, a, b);
+        if p == Operand::Const(0.0) {
+            continue;
+        }
+        acc = if negative { op(f, BinOp::Sub, acc, p) } else { op(f, BinOp::Add, acc, p) };
+    }
+    acc
+}
+
+/// Replaces every output `<family>[…][m]` (`m` the coordinate `q[m]`, `1..=nq`) of each of
+/// `families` by `<family>[…][k]`, `k = 1..=nq − 1`, along Pinocchio's tangent space (the
+/// module doc). `f` is atomised, with inputs `q[4..7]` the free flyer's quaternion (values of
+/// `f`, or absent when no derivative reads them: then they are added as inputs).
+pub fn free_flyer_tangent(f: &mut Function, families: &[&str]) {
+    let quat: Vec<Operand> = (4..=7)
+        .map(|i| {
+            let n = format!("q[{i}]");
+            Operand::Value(f.lookup(&n).unwrap_or_else(|| f.add_input(n, Span::DUMMY).expect("free")))
+        })
+        .collect();
+    let (x, y, z, w) = (quat[0], quat[1], quat[2], quat[3]);
+    // R's entries, written when first needed: 2·(a·b ± c·d) or 1 − 2·(a² + b²).
+    let mut rot: Option<[[Operand; 3]; 3]> = None;
+    let outputs = std::mem::take(&mut f.outputs);
+    // The rows: family and row indices → (position of the row's first output, its coordinates).
+    let mut rows: BTreeMap<usize, (String, BTreeMap<usize, Operand>)> = BTreeMap::new();
+    let mut row_at: BTreeMap<String, usize> = BTreeMap::new();
+    let mut kept: Vec<(usize, Output)> = Vec::new();
+    for (pos, o) in outputs.into_iter().enumerate() {
+        let row = families.iter().find(|fam| o.name.starts_with(*fam) && o.name[fam.len()..].starts_with('['));
+        let split =
+            row.and_then(|_| o.name.rfind('[')).map(|i| (o.name[..i].to_string(), &o.name[i + 1..o.name.len() - 1]));
+        match split.and_then(|(r, m)| m.parse::<usize>().ok().map(|m| (r, m))) {
+            Some((r, m)) => {
+                let first = *row_at.entry(r.clone()).or_insert(pos);
+                rows.entry(first).or_insert_with(|| (r, BTreeMap::new())).1.insert(m, o.value);
+            }
+            None => kept.push((pos, o)),
+        }
+    }
+    let mut written: Vec<(usize, Output)> = Vec::new();
+    for (pos, (row, raw)) in rows {
+        let nq = raw.keys().copied().max().unwrap_or(0);
+        let d = |m: usize| raw.get(&m).copied().unwrap_or(Operand::Const(0.0));
+        let mut cols: Vec<Operand> = Vec::with_capacity(nq.saturating_sub(1));
+        let needs_rot = (1..=3).any(|m| d(m) != Operand::Const(0.0));
+        if needs_rot && rot.is_none() {
+            let two = Operand::Const(2.0);
+            let one = Operand::Const(1.0);
+            let mut pair = |a: Operand, b: Operand, c: Operand, e: Operand, plus: bool| {
+                let s = dot(f, &[(a, b, false), (c, e, !plus)]);
+                op(f, BinOp::Mul, two, s)
+            };
+            let xy_m_zw = pair(x, y, z, w, false);
+            let xz_p_yw = pair(x, z, y, w, true);
+            let xy_p_zw = pair(x, y, z, w, true);
+            let yz_m_xw = pair(y, z, x, w, false);
+            let xz_m_yw = pair(x, z, y, w, false);
+            let yz_p_xw = pair(y, z, x, w, true);
+            let mut diag = |a: Operand, b: Operand| {
+                let s = dot(f, &[(a, a, false), (b, b, false)]);
+                let t = op(f, BinOp::Mul, two, s);
+                op(f, BinOp::Sub, one, t)
+            };
+            let (r11, r22, r33) = (diag(y, z), diag(x, z), diag(x, y));
+            rot = Some([[r11, xy_m_zw, xz_p_yw], [xy_p_zw, r22, yz_m_xw], [xz_m_yw, yz_p_xw, r33]]);
+        }
+        for k in 0..3 {
+            let terms: Vec<(Operand, Operand, bool)> = match &rot {
+                Some(r) => (0..3).map(|m| (d(m + 1), r[m][k], false)).collect(),
+                None => vec![],
+            };
+            cols.push(dot(f, &terms));
+        }
+        // ∂quat/∂ω_a · 2: (w, z, −y, −x), (−z, w, x, −y), (y, −x, w, −z) for a = 1, 2, 3.
+        let tables: [[(Operand, bool); 4]; 3] = [
+            [(w, false), (z, false), (y, true), (x, true)],
+            [(z, true), (w, false), (x, false), (y, true)],
+            [(y, false), (x, true), (w, false), (z, true)],
+        ];
+        for t in tables {
+            let terms: Vec<(Operand, Operand, bool)> = (0..4).map(|c| (d(4 + c), t[c].0, t[c].1)).collect();
+            let s = dot(f, &terms);
+            cols.push(op(f, BinOp::Mul, Operand::Const(0.5), s));
+        }
+        for m in 8..=nq {
+            cols.push(d(m));
+        }
+        for (k, value) in cols.into_iter().enumerate() {
+            written.push((pos, Output { name: format!("{row}[{}]", k + 1), value, span: Span::DUMMY }));
+        }
+    }
+    // Rows where their first output was; the other outputs in place.
+    let mut all: Vec<(usize, Output)> = kept.into_iter().chain(written).collect();
+    all.sort_by_key(|(p, _)| *p);
+    for (_, o) in all {
+        f.set_output(o.name, o.value, o.span);
+    }
+}
