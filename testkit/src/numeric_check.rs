@@ -178,6 +178,7 @@ mod tests {
                 "sweep",
                 "accuracy",
                 "interleave",
+                "diff",
                 "depth-bound",
                 "range",
                 "error-bound"
