@@ -161,72 +161,84 @@ fn robot_derivatives_match_pinocchio() {
 
 /// `codegen<c;abi=pinocchio>` on the generator's derivative functions: UR5's
 /// `model_rnea_derivatives(q, v, a, dtau_dq, dtau_dv)`, `model_aba_derivatives(q, v, tau,
-/// ddq_dq, ddq_dv, Minv)` and `model_minv(q, Minv)` (three files, linked together), compiled by
-/// the system compiler at -O1 and called with Pinocchio's vectors, against Pinocchio within 1e-9.
+/// ddq_dq, ddq_dv, Minv)` and `model_minv(q, Minv)` (three files, linked together), one state a
+/// call and `batch=4` (lane `l` of element `k` at `[k*4 + l]`), compiled by the system compiler
+/// at -O1 and called with Pinocchio's vectors, against Pinocchio within 1e-9.
 #[test]
 fn pinocchio_abi_derivative_functions_in_c_match_pinocchio() {
     use crate::pinocchio::{oracle, python, Base};
     let Some(py) = python() else { return };
-    let dir = tmp("pinocchio_c");
-    let o = oracle(&py, "erd:ur_description/urdf/ur5_robot.urdf", 2, 5, Base::Fixed);
-    let mut files = vec!["main.c".to_string()];
-    for function in ["rnea_derivatives", "aba_derivatives", "minv"] {
-        let c = dir.join(format!("{function}.c"));
-        let out = crate::common::opt(&[
-            &o.path,
-            "--fold-params",
-            &format!("-function={function}"),
-            "-passes=default<ops>,codegen<c;abi=pinocchio>",
-            "-o",
-            c.to_str().unwrap(),
-        ]);
-        assert!(out.status.success(), "{function}: {}", crate::common::stderr(&out));
-        files.push(format!("{function}.c"));
-    }
+    let o = oracle(&py, "erd:ur_description/urdf/ur5_robot.urdf", 4, 5, Base::Fixed);
     let n = o.states[0].qd.len();
-    let list = |x: &[f64]| x.iter().map(|v| format!("{v:e}")).collect::<Vec<_>>().join(", ");
-    let mut main = String::from(
-        "#include <stdio.h>\n#include \"rnea_derivatives.h\"\n#include \"aba_derivatives.h\"\n#include \"minv.h\"\n\
-         static void put(const double *x, int n) { for (int i = 0; i < n; i++) printf(\"%.17g\\n\", x[i]); }\nint main(void)\n{\n",
-    );
-    for s in &o.states {
-        main += &format!(
-            "  {{\n    const double q[] = {{{}}}, v[] = {{{}}}, a[] = {{{}}}, tau[] = {{{}}};\n    \
-             double dq[{nn}], dv[{nn}], ddq[{nn}], ddv[{nn}], mi[{nn}], mi2[{nn}];\n    \
-             model_rnea_derivatives(q, v, a, dq, dv);\n    model_aba_derivatives(q, v, tau, ddq, ddv, mi);\n    model_minv(q, mi2);\n    \
-             put(dq, {nn}); put(dv, {nn}); put(ddq, {nn}); put(ddv, {nn}); put(mi, {nn}); put(mi2, {nn});\n  }}\n",
-            list(&s.q),
-            list(&s.qd),
-            list(&s.qdd),
-            list(&s.tau),
-            nn = n * n
+    let nn = n * n;
+    for w in [1usize, 4] {
+        let dir = tmp(&format!("pinocchio_c_{w}"));
+        let mut files = vec!["main.c".to_string()];
+        for function in ["rnea_derivatives", "aba_derivatives", "minv"] {
+            let c = dir.join(format!("{function}.c"));
+            let out = crate::common::opt(&[
+                &o.path,
+                "--fold-params",
+                &format!("-function={function}"),
+                &format!("-passes=default<ops>,codegen<c;abi=pinocchio;batch={w}>"),
+                "-o",
+                c.to_str().unwrap(),
+            ]);
+            assert!(out.status.success(), "{function}: {}", crate::common::stderr(&out));
+            files.push(format!("{function}.c"));
+        }
+        // The states' vectors, lane-interleaved: group g holds states g*w .. g*w + w.
+        let lanes = |x: fn(&crate::pinocchio::State) -> &Vec<f64>, g: usize| -> String {
+            let len = x(&o.states[0]).len();
+            let v: Vec<String> = (0..len)
+                .flat_map(|k| (0..w).map(move |l| (k, l)))
+                .map(|(k, l)| format!("{:e}", x(&o.states[g * w + l])[k]))
+                .collect();
+            v.join(", ")
+        };
+        let mut main = format!(
+            "#include <stdio.h>\n#include \"rnea_derivatives.h\"\n#include \"aba_derivatives.h\"\n#include \"minv.h\"\n\
+             enum {{ W = {w}, NN = {nn} }};\n\
+             static void put(const double *x, int l) {{ for (int i = 0; i < NN; i++) printf(\"%.17g\\n\", x[i * W + l]); }}\nint main(void)\n{{\n"
         );
-    }
-    main += "  return 0;\n}\n";
-    std::fs::write(dir.join("main.c"), main).unwrap();
-    let files: Vec<&str> = files.iter().map(String::as_str).collect();
-    let exe = crate::common::compile_c(&dir, &["-O1", "-std=c99", "-Wall", "-Werror"], &files);
-    let out = std::process::Command::new(&exe).output().unwrap();
-    assert!(out.status.success());
-    let got: Vec<f64> = String::from_utf8(out.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
-    assert_eq!(got.len(), o.states.len() * 6 * n * n);
-    for (k, (s, chunk)) in o.states.iter().zip(got.chunks(6 * n * n)).enumerate() {
-        for (m, (label, want)) in [
-            ("dtau_dq", &s.dtau_dq),
-            ("dtau_dv", &s.dtau_dv),
-            ("ddq_dq", &s.ddq_dq),
-            ("ddq_dv", &s.ddq_dv),
-            ("Minv", &s.minv),
-            ("minv's Minv", &s.minv),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            let flat: Vec<f64> = want.iter().flatten().copied().collect();
-            let norm = flat.iter().fold(0.0f64, |x, y| x.max(y.abs()));
-            let c = &chunk[m * n * n..(m + 1) * n * n];
-            let diff = c.iter().zip(&flat).fold(0.0f64, |x, (a, b)| x.max((a - b).abs()));
-            assert!(diff / norm <= 1e-9, "state {k} {label}: relative error {:e}", diff / norm);
+        for g in 0..o.states.len() / w {
+            main += &format!(
+                "  {{\n    const double q[] = {{{}}}, v[] = {{{}}}, a[] = {{{}}}, tau[] = {{{}}};\n    \
+                 static double dq[NN * W], dv[NN * W], ddq[NN * W], ddv[NN * W], mi[NN * W], mi2[NN * W];\n    \
+                 model_rnea_derivatives(q, v, a, dq, dv);\n    model_aba_derivatives(q, v, tau, ddq, ddv, mi);\n    model_minv(q, mi2);\n    \
+                 for (int l = 0; l < W; l++) {{ put(dq, l); put(dv, l); put(ddq, l); put(ddv, l); put(mi, l); put(mi2, l); }}\n  }}\n",
+                lanes(|s| &s.q, g),
+                lanes(|s| &s.qd, g),
+                lanes(|s| &s.qdd, g),
+                lanes(|s| &s.tau, g),
+            );
+        }
+        main += "  return 0;\n}\n";
+        std::fs::write(dir.join("main.c"), main).unwrap();
+        let files: Vec<&str> = files.iter().map(String::as_str).collect();
+        let exe = crate::common::compile_c(&dir, &["-O1", "-std=c99", "-Wall", "-Werror"], &files);
+        let out = std::process::Command::new(&exe).output().unwrap();
+        assert!(out.status.success());
+        let got: Vec<f64> = String::from_utf8(out.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+        assert_eq!(got.len(), o.states.len() * 6 * nn);
+        for (k, (s, chunk)) in o.states.iter().zip(got.chunks(6 * nn)).enumerate() {
+            for (m, (label, want)) in [
+                ("dtau_dq", &s.dtau_dq),
+                ("dtau_dv", &s.dtau_dv),
+                ("ddq_dq", &s.ddq_dq),
+                ("ddq_dv", &s.ddq_dv),
+                ("Minv", &s.minv),
+                ("minv's Minv", &s.minv),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let flat: Vec<f64> = want.iter().flatten().copied().collect();
+                let norm = flat.iter().fold(0.0f64, |x, y| x.max(y.abs()));
+                let c = &chunk[m * nn..(m + 1) * nn];
+                let diff = c.iter().zip(&flat).fold(0.0f64, |x, (a, b)| x.max((a - b).abs()));
+                assert!(diff / norm <= 1e-9, "batch={w} state {k} {label}: relative error {:e}", diff / norm);
+            }
         }
     }
 }
