@@ -5,7 +5,8 @@
 //! For every output `o` of a function and every input `x` named by `wrt`, a new output holds
 //! `∂o/∂x`, computed by new ops appended to the body (the original values and outputs are kept
 //! bit for bit). `wrt` is a comma-separated list; an entry names one input (`q[4]`) or a family
-//! (`q` takes `q[1]`, `q[2]`, …, as `dce<outputs=…>` names outputs). An entry that matches no
+//! (`q` takes `q[1]`, `q[2]`, …, as `dce<outputs=…>` names outputs); without `wrt`, every input
+//! (the full Jacobian, as `dce` keeps every output without `outputs`). An entry that matches no
 //! input of any function is an error.
 //!
 //! **Names.** `∂o/∂x` is the output `d<O>_d<X><o's indices><x's indices>`, where `O` and `X`
@@ -357,7 +358,8 @@ fn sweep_terms(f: &Function, xs: &[Value], depends: &[bool]) -> (u64, u64) {
 }
 
 /// Differentiates `f` (atomised, verified) in place: the derivative outputs of the module doc
-/// for the inputs `wrt` names, in `mode` (`None`: by shape). Returns the mode used.
+/// for the inputs `wrt` names (every input when `wrt` is empty, by family then index), in
+/// `mode` (`None`: by shape). Returns the mode used.
 ///
 /// # Errors
 /// A user callback on a path from a `wrt` input, a derivative output name already taken
@@ -369,7 +371,10 @@ pub fn differentiate(f: &mut Function, wrt: &[String], mode: Option<Mode>, ticke
     let mut xs: Vec<(usize, Vec<u64>, Value)> = f
         .inputs
         .iter()
-        .filter_map(|&v| wrt.iter().position(|e| matches(e, f.name_of(v))).map(|k| (k, indices(f.name_of(v)), v)))
+        .filter_map(|&v| {
+            let k = if wrt.is_empty() { Some(0) } else { wrt.iter().position(|e| matches(e, f.name_of(v))) };
+            k.map(|k| (k, indices(f.name_of(v)), v))
+        })
         .collect();
     xs.sort_by(|a, b| (a.0, &a.1, f.name_of(a.2)).cmp(&(b.0, &b.1, f.name_of(b.2))));
     let xs: Vec<Value> = xs.into_iter().map(|x| x.2).collect();

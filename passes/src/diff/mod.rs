@@ -26,7 +26,7 @@ pub const INFO: PassInfo = PassInfo {
             name: "wrt",
             kind: ParamKind::Names,
             doc: "inputs to differentiate with respect to: names (`q[4]`) or families (`q,qd`), comma-separated; \
-                  required",
+                  every input when not given (the full Jacobian)",
         },
         ParamInfo {
             name: "mode",
@@ -69,11 +69,6 @@ impl Pass for Diff {
 
     fn run(&self, m: &mut Module, cx: &mut PassContext) -> Result<(), PassError> {
         let bad = |message: String| PassError::BadParameter { pass: "diff".into(), message };
-        if self.wrt.is_empty() {
-            return Err(bad(
-                "`wrt` is required: the inputs to differentiate with respect to (`wrt=q` or `wrt=q,qd`)".into()
-            ));
-        }
         for e in &self.wrt {
             if !m.functions.iter().any(|f| f.inputs.iter().any(|&v| matches(e, f.name_of(v)))) {
                 let mut names: Vec<&str> =
@@ -108,4 +103,3 @@ impl Pass for Diff {
         Ok(())
     }
 }
-

@@ -1,11 +1,11 @@
 use super::*;
-use robovec_ir::time_limit::Ticker;
-use robovec_ir::{split_state, Def, Function, Module, Operand, TrigFn};
-use std::collections::HashMap;
 use proptest::prelude::*;
 use robovec_ir::interp::{eval, pseudo_random_input};
 use robovec_ir::text::parse;
+use robovec_ir::time_limit::Ticker;
 use robovec_ir::verifier::verify_function;
+use robovec_ir::{split_state, Def, Function, Module, Operand, TrigFn};
+use std::collections::HashMap;
 
 /// Every rule of the module doc: trig with and without the other trig variable, `+ − × /`,
 /// `sqrt`, the fused family, a constant output, an input used directly as an output.
@@ -181,12 +181,14 @@ fn interleaved_states_are_differentiated_per_state() {
 }
 
 #[test]
-fn the_pass_refuses_an_unknown_family_and_a_missing_wrt() {
+fn the_pass_refuses_an_unknown_family_and_takes_every_input_without_wrt() {
     let mut m = parse(SRC).unwrap();
     let e = Diff { wrt: vec!["qdd".into()], mode: None }.run(&mut m, &mut PassContext::default()).unwrap_err();
     assert!(e.to_string().contains("no input matches `qdd`"), "{e}");
-    let e = Diff { wrt: vec![], mode: None }.run(&mut m, &mut PassContext::default()).unwrap_err();
-    assert!(e.to_string().contains("`wrt` is required"), "{e}");
+    // Without wrt: every input, the full Jacobian (6 outputs × 4 inputs).
+    Diff { wrt: vec![], mode: None }.run(&mut m, &mut PassContext::default()).unwrap();
+    assert_eq!(m.functions[0].outputs.len(), 6 + 24);
+    assert!(m.functions[0].outputs.iter().any(|o| o.name == "dQq_dm[1]"));
 }
 
 proptest! {
