@@ -207,9 +207,8 @@ fn indices(name: &str) -> Vec<u64> {
     family(name).1.split(['[', ']']).filter_map(|s| s.parse().ok()).collect()
 }
 
-/// Partial derivatives of one definition with respect to its value operands: `(operand, ∂)`
-/// pairs, `∂` as a [`Tan`] (`None` for `1`), for the chain rule. `value` is the defined value,
-/// `twice_sqrt` the memo of `2·√a` values.
+/// One partial derivative `∂v/∂a` of a definition `v` with respect to one of its operands `a`,
+/// for the chain rule ([`partials`] lists them, [`chain`] applies one).
 enum Partial {
     /// `∂v/∂a = 1` (sign aside).
     One(bool),
@@ -289,6 +288,26 @@ fn partials(
             }
         },
     })
+}
+
+/// Each value's partials, made once when first needed (a reverse sweep per output meets a value
+/// once for every output that reaches it), with the trig variables and `2·√a` values they made.
+struct Partials {
+    of: Vec<Option<Vec<(Operand, Partial)>>>,
+    trig_of: HashMap<(Value, bool), Value>,
+    twice: HashMap<Value, Operand>,
+}
+
+impl Partials {
+    /// The partials of `v` ([`partials`]); the error names the function.
+    fn get(&mut self, f: &mut Function, v: Value) -> Result<&[(Operand, Partial)], Failure> {
+        if self.of[v.index()].is_none() {
+            let ps = partials(f, v, &mut self.trig_of, &mut self.twice)
+                .map_err(|m| Failure::Message(format!("@{}: {m}", f.name)))?;
+            self.of[v.index()] = Some(ps);
+        }
+        Ok(self.of[v.index()].as_deref().expect("made above"))
+    }
 }
 
 /// `t · ∂` for one partial.
@@ -398,6 +417,11 @@ pub fn differentiate(f: &mut Function, wrt: &[String], mode: Option<Mode>, ticke
         depends[v.index()] = any;
     }
     let outputs: Vec<(String, Operand)> = f.outputs.iter().map(|o| (o.name.clone(), o.value)).collect();
+    // Per output, the `xs` it is differentiated with respect to: its own state's.
+    let columns: Vec<Vec<usize>> = outputs
+        .iter()
+        .map(|(o, _)| (0..xs.len()).filter(|&j| split_state(o).1 == split_state(f.name_of(xs[j])).1).collect())
+        .collect();
     let mode = mode.unwrap_or_else(|| {
         let (forward, reverse) = sweep_terms(f, &xs, &depends);
         if forward <= reverse {
@@ -406,25 +430,24 @@ pub fn differentiate(f: &mut Function, wrt: &[String], mode: Option<Mode>, ticke
             Mode::Reverse
         }
     });
-    for (o, _) in &outputs {
-        for &x in &xs {
-            if split_state(o).1 == split_state(f.name_of(x)).1 {
-                let name = derivative_name(o, f.name_of(x));
-                if f.output_position(&name).is_some() || f.lookup(&name).is_some_and(|v| f.value(v).def == Def::Input) {
-                    return Err(Failure::Message(format!(
-                        "@{}: `{name}`, the derivative of `{o}` with respect to `{}`, is already a name of the function",
-                        f.name,
-                        f.name_of(x)
-                    )));
-                }
+    for ((o, _), cols) in outputs.iter().zip(&columns) {
+        for &j in cols {
+            let name = derivative_name(o, f.name_of(xs[j]));
+            if f.output_position(&name).is_some() || f.lookup(&name).is_some_and(|v| f.value(v).def == Def::Input) {
+                return Err(Failure::Message(format!(
+                    "@{}: `{name}`, the derivative of `{o}` with respect to `{}`, is already a name of the function",
+                    f.name,
+                    f.name_of(xs[j])
+                )));
             }
         }
     }
-    let mut twice = HashMap::new();
+    let twice = HashMap::new();
     let body: Vec<Value> = f.body.clone();
     let n = f.values.len();
-    // The derivative outputs, as (output, input, derivative), written at the end.
-    let mut results: Vec<(String, Value, Option<Tan>)> = Vec::new();
+    let mut partial_of = Partials { of: (0..n).map(|_| None).collect(), trig_of, twice };
+    // The derivative of each output with respect to each of its columns, written at the end.
+    let mut results: Vec<Vec<Option<Tan>>> = Vec::with_capacity(outputs.len());
     match mode {
         Mode::Forward => {
             // tangents[v]: (slot, ∂v/∂x_slot), sorted by slot, for every value v.
@@ -439,11 +462,10 @@ pub fn differentiate(f: &mut Function, wrt: &[String], mode: Option<Mode>, ticke
                 if !depends[v.index()] {
                     continue;
                 }
-                let ps = partials(f, v, &mut trig_of, &mut twice)
-                    .map_err(|m| Failure::Message(format!("@{}: {m}", f.name)))?;
+                let ps = partial_of.get(f, v)?;
                 let mut b = Builder::new(f, format!("d_{}", plain(f.name_of(v))));
                 let mut acc: Vec<(u32, Option<Tan>)> = Vec::new();
-                for (a, p) in &ps {
+                for (a, p) in ps {
                     let Operand::Value(a) = *a else { continue };
                     for &(j, t) in &tangents[a.index()] {
                         let term = chain(&mut b, Some(t), p);
@@ -455,20 +477,13 @@ pub fn differentiate(f: &mut Function, wrt: &[String], mode: Option<Mode>, ticke
                 }
                 tangents[v.index()] = acc.into_iter().filter_map(|(j, t)| t.map(|t| (j, t))).collect();
             }
-            for (o, ov) in &outputs {
-                for &x in &xs {
-                    if split_state(o).1 != split_state(f.name_of(x)).1 {
-                        continue;
-                    }
-                    let t = match ov {
-                        Operand::Value(v) => {
-                            let ts = &tangents[v.index()];
-                            ts.binary_search_by_key(&slot[x.index()], |e| e.0).ok().map(|i| ts[i].1)
-                        }
-                        Operand::Const(_) => None,
-                    };
-                    results.push((o.clone(), x, t));
-                }
+            for ((_, ov), cols) in outputs.iter().zip(&columns) {
+                let ts: &[(u32, Tan)] = match ov {
+                    Operand::Value(v) => &tangents[v.index()],
+                    Operand::Const(_) => &[],
+                };
+                let at = |j: usize| ts.binary_search_by_key(&(j as u32), |e| e.0).ok().map(|i| ts[i].1);
+                results.push(cols.iter().map(|&j| at(j)).collect());
             }
         }
         Mode::Reverse => {
@@ -478,7 +493,7 @@ pub fn differentiate(f: &mut Function, wrt: &[String], mode: Option<Mode>, ticke
                 pos[v.index()] = i;
             }
             let mut adjoint: Vec<Option<Tan>> = vec![None; n];
-            for (o, ov) in &outputs {
+            for ((o, ov), cols) in outputs.iter().zip(&columns) {
                 let mut found: Vec<Option<Tan>> = vec![None; xs.len()];
                 if let Operand::Value(ov) = *ov {
                     if depends[ov.index()] {
@@ -495,10 +510,9 @@ pub fn differentiate(f: &mut Function, wrt: &[String], mode: Option<Mode>, ticke
                                 }
                                 let v = body[k];
                                 let Some(t) = adjoint[v.index()] else { continue };
-                                let ps = partials(f, v, &mut trig_of, &mut twice)
-                                    .map_err(|m| Failure::Message(format!("@{}: {m}", f.name)))?;
+                                let ps = partial_of.get(f, v)?;
                                 let mut b = Builder::new(f, format!("d_{}_d_{}", plain(o), plain(f.name_of(v))));
-                                for (a, p) in &ps {
+                                for (a, p) in ps {
                                     let Operand::Value(a) = *a else { continue };
                                     if !depends[a.index()] {
                                         continue;
@@ -520,19 +534,17 @@ pub fn differentiate(f: &mut Function, wrt: &[String], mode: Option<Mode>, ticke
                         }
                     }
                 }
-                for (j, &x) in xs.iter().enumerate() {
-                    if split_state(o).1 == split_state(f.name_of(x)).1 {
-                        results.push((o.clone(), x, found[j]));
-                    }
-                }
+                results.push(cols.iter().map(|&j| found[j]).collect());
             }
         }
     }
     let mut b = Builder::new(f, "d_out".into());
-    for (o, x, t) in results {
-        let name = derivative_name(&o, b.f.name_of(x));
-        let value = b.materialise(t);
-        b.f.set_output(name, value, Span::DUMMY);
+    for (((o, _), cols), ds) in outputs.iter().zip(&columns).zip(results) {
+        for (&j, t) in cols.iter().zip(ds) {
+            let name = derivative_name(o, b.f.name_of(xs[j]));
+            let value = b.materialise(t);
+            b.f.set_output(name, value, Span::DUMMY);
+        }
     }
     Ok(mode)
 }
