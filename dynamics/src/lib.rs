@@ -434,8 +434,7 @@ pub const GENERATED_NAMES: [&str; 6] =
 /// Derivative function `d` of `base` (parsed, as written): atomised, common subexpressions
 /// merged, differentiated ([`robovec_ir::transform::diff::differentiate`], the mode by its
 /// count of terms), its derivative outputs renamed and everything else dropped. `None` at the
-/// ticker's stop.
-/// On the free flyer (`free_flyer`) the rows with respect to `q` are mapped to Pinocchio's tangent
+/// ticker's stop. On the free flyer (`free_flyer`) the rows with respect to `q` are mapped to Pinocchio's tangent
 /// space ([`tangent::free_flyer_tangent`]).
 fn derive(
     base: &robovec_ir::Function,
@@ -599,9 +598,9 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
         }
     }
     let ticker = robovec_ir::time_limit::Ticker::new(request.deadline, request.tick_budget);
+    let free_flyer = model.robot.joints.iter().any(|j| j.kind == robot::JointKind::FreeFlyer);
     for d in derived {
         let base = functions.iter().chain(&bases).find(|f| f.name == d.1).expect("written above");
-        let free_flyer = model.robot.joints.iter().any(|j| j.kind == robot::JointKind::FreeFlyer);
         match derive(base, d, free_flyer, &ticker) {
             Some(f) => functions.push(f),
             None => {

@@ -165,16 +165,16 @@ fn failed(f: &Function, message: String) -> PassError {
     PassError::Failed { pass: "codegen".into(), message: format!("@{}: {message}", f.name) }
 }
 
-/// The C functions of `f` (with the IR's outputs each keeps), or the error for a function that
-/// is not one of the generator's.
-fn algorithms(f: &Function) -> Result<Vec<(Algo, &'static [&'static str])>, PassError> {
+/// The C functions of `f` (each keeps the IR's output arrays of [`Algo::arrays`]), or the
+/// error for a function that is not one of the generator's.
+fn algorithms(f: &Function) -> Result<Vec<Algo>, PassError> {
     match f.name.as_str() {
-        "invdyna" => Ok(vec![(Algo::Rnea, &["Qq"])]),
-        "dirdyna" => Ok(vec![(Algo::Crba, &["M"]), (Algo::Nle, &["c"])]),
-        "fordyna" => Ok(vec![(Algo::Aba, &["qdd"])]),
-        "rnea_derivatives" => Ok(vec![(Algo::RneaDerivatives, &["dtau_dq", "dtau_dv"])]),
-        "aba_derivatives" => Ok(vec![(Algo::AbaDerivatives, &["ddq_dq", "ddq_dv", "Minv"])]),
-        "minv" => Ok(vec![(Algo::Minv, &["Minv"])]),
+        "invdyna" => Ok(vec![Algo::Rnea]),
+        "dirdyna" => Ok(vec![Algo::Crba, Algo::Nle]),
+        "fordyna" => Ok(vec![Algo::Aba]),
+        "rnea_derivatives" => Ok(vec![Algo::RneaDerivatives]),
+        "aba_derivatives" => Ok(vec![Algo::AbaDerivatives]),
+        "minv" => Ok(vec![Algo::Minv]),
         _ => Err(failed(
             f,
             "abi=pinocchio writes the URDF generator's @invdyna (NAME_rnea), @dirdyna (NAME_crba, NAME_nle), \
@@ -189,7 +189,7 @@ fn algorithms(f: &Function) -> Result<Vec<(Algo, &'static [&'static str])>, Pass
 /// index and largest velocity index.
 fn check(f: &Function) -> Result<(usize, usize), PassError> {
     let algos = algorithms(f)?;
-    let allowed: Vec<&str> = algos.iter().flat_map(|(a, _)| a.arrays().0.iter().map(|x| x.1)).chain(["g"]).collect();
+    let allowed: Vec<&str> = algos.iter().flat_map(|a| a.arrays().0.iter().map(|x| x.1)).chain(["g"]).collect();
     let (mut nq, mut nv) = (0, 0);
     let mut params = Vec::new();
     for &v in &f.inputs {
@@ -227,7 +227,7 @@ fn check(f: &Function) -> Result<(usize, usize), PassError> {
             ),
         ));
     }
-    let outs: Vec<&str> = algos.iter().flat_map(|(_, o)| o.iter().copied()).collect();
+    let outs: Vec<&str> = algos.iter().flat_map(|a| a.arrays().1.iter().map(|x| x.1)).collect();
     for o in &f.outputs {
         match indexed(&o.name) {
             Some((base, idx)) if idx.len() == 2 && outs.contains(&base) && matrix_columns(base, 0, 0).is_some() => {
@@ -262,11 +262,12 @@ fn check(f: &Function) -> Result<(usize, usize), PassError> {
     Ok((nq, nv))
 }
 
-/// `f` with only the outputs of `keep` (arrays) and what they need: the backward slice, unused
+/// `f` with only the output arrays of `a` and what they need: the backward slice, unused
 /// inputs dropped.
-fn slice(f: &Function, keep: &[&str]) -> Function {
+fn slice(f: &Function, a: Algo) -> Function {
+    let keep = a.arrays().1;
     let mut g = f.clone();
-    g.outputs.retain(|o| indexed(&o.name).is_some_and(|(b, _)| keep.contains(&b)));
+    g.outputs.retain(|o| indexed(&o.name).is_some_and(|(b, _)| keep.iter().any(|x| x.1 == b)));
     let live = g.live_values(&[]);
     g.retain(|_, v| live[v.index()]);
     g
@@ -309,9 +310,10 @@ pub(crate) fn emit(
     nq = nq.max(nv);
     let mut jobs: Vec<(Algo, Function)> = Vec::new();
     for f in &m.functions {
-        for (a, keep) in algorithms(f)? {
-            // invdyna and fordyna have only their own outputs: no copy.
-            jobs.push((a, if a == Algo::Crba || a == Algo::Nle { slice(f, keep) } else { f.clone() }));
+        let algos = algorithms(f)?;
+        for &a in &algos {
+            // A function of one algorithm has only its own outputs: no slice.
+            jobs.push((a, if algos.len() > 1 { slice(f, a) } else { f.clone() }));
         }
     }
     let mut seen = HashSet::new();
