@@ -71,6 +71,54 @@ fn corpus_jacobians_match_central_finite_differences_in_both_modes() {
     }
 }
 
+/// An `-eval` input file at `path` for oracle state `s`: gravity, `q` (all of Pinocchio's
+/// configuration coordinates robovec takes), `qd`, `qdd` and `Qq` (τ); each function reads what
+/// it needs of them.
+fn state_file(path: &std::path::Path, gravity: &[f64], s: &crate::pinocchio::State) -> std::path::PathBuf {
+    let mut given = serde_json::Map::new();
+    let mut put = |family: &str, x: &[f64]| {
+        for (i, v) in x.iter().enumerate() {
+            given.insert(format!("{family}[{}]", i + 1), (*v).into());
+        }
+    };
+    put("g", gravity);
+    put("q", &s.q);
+    put("qd", &s.qd);
+    put("qdd", &s.qdd);
+    put("Qq", &s.tau);
+    std::fs::write(path, serde_json::Value::Object(given).to_string()).unwrap();
+    path.to_path_buf()
+}
+
+/// The outputs of `robovec-opt URDF --fold-params FLAGS -function=FUNCTION -passes=PASSES
+/// -eval=FILE`.
+fn eval_urdf(urdf: &str, flags: &[&str], function: &str, passes: &str, file: &std::path::Path) -> HashMap<String, f64> {
+    let (function_arg, passes_arg, eval_arg) =
+        (format!("-function={function}"), format!("-passes={passes}"), format!("-eval={}", file.display()));
+    let mut args = vec![urdf, "--fold-params"];
+    args.extend_from_slice(flags);
+    args.extend([function_arg.as_str(), passes_arg.as_str(), eval_arg.as_str(), "-o", "/dev/null"]);
+    let out = crate::common::opt(&args);
+    assert!(out.status.success(), "{urdf} {function}: {}", crate::common::stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    v["outputs"].as_object().unwrap().iter().map(|(k, x)| (k.clone(), x.as_f64().unwrap())).collect()
+}
+
+/// The ∞-norm of `prefix[i][j]` − `want[i-1][j-1]` over `want`'s ∞-norm; an output missing
+/// panics, naming it.
+fn matrix_error(got: &HashMap<String, f64>, prefix: &str, want: &[Vec<f64>]) -> f64 {
+    let norm = want.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut diff = 0.0f64;
+    for (i, row) in want.iter().enumerate() {
+        for (j, w) in row.iter().enumerate() {
+            let name = format!("{prefix}[{}][{}]", i + 1, j + 1);
+            let d = got.get(&name).unwrap_or_else(|| panic!("no output {name}"));
+            diff = diff.max((d - w).abs());
+        }
+    }
+    diff / norm.max(f64::MIN_POSITIVE)
+}
+
 /// `diff` on the URDF generator's functions (fixed base, parameters folded) against Pinocchio's
 /// analytical derivatives on random states: `invdyna` differentiated with respect to `q, qd`
 /// is `computeRNEADerivatives`' ∂τ/∂q, ∂τ/∂v; `fordyna` with respect to `q, qd, Qq` is
@@ -91,68 +139,31 @@ fn robot_derivatives_match_pinocchio() {
         let o = oracle(&py, urdf, 3, 11, Base::Fixed);
         for (k, s) in o.states.iter().enumerate() {
             let n = s.qd.len();
-            let mut given = serde_json::Map::new();
-            for (i, g) in o.gravity.iter().enumerate() {
-                given.insert(format!("g[{}]", i + 1), (*g).into());
-            }
-            for i in 0..n {
-                given.insert(format!("q[{}]", i + 1), s.q[i].into());
-                given.insert(format!("qd[{}]", i + 1), s.qd[i].into());
-            }
-            let run = |function: &str, passes: &str, extra: &[(&str, &Vec<f64>)]| {
-                let mut given = given.clone();
-                for (family, x) in extra {
-                    for i in 0..n {
-                        given.insert(format!("{family}[{}]", i + 1), x[i].into());
-                    }
-                }
-                let file = dir.join(format!("{function}{k}.json"));
-                std::fs::write(&file, serde_json::Value::Object(given).to_string()).unwrap();
-                let out = crate::common::opt(&[
-                    &o.path,
-                    "--fold-params",
-                    &format!("-function={function}"),
-                    &format!("-passes={passes}"),
-                    &format!("-eval={}", file.display()),
-                    "-o",
-                    "/dev/null",
-                ]);
-                assert!(out.status.success(), "{urdf} {function}: {}", crate::common::stderr(&out));
-                let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-                v["outputs"].as_object().unwrap().iter().map(|(k, x)| (k.clone(), x.as_f64().unwrap())).collect()
-            };
+            let file = state_file(&dir.join(format!("state{k}.json")), &o.gravity, s);
+            let run = |function: &str, passes: &str| eval_urdf(&o.path, &[], function, passes, &file);
             let check = |got: &HashMap<String, f64>, prefix: &str, want: &Vec<Vec<f64>>| {
-                let norm = want.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-                let mut diff = 0.0f64;
-                for i in 0..n {
-                    for j in 0..n {
-                        let name = format!("{prefix}[{}][{}]", i + 1, j + 1);
-                        let d = got.get(&name).unwrap_or_else(|| panic!("{urdf}: no output {name}"));
-                        diff = diff.max((d - want[i][j]).abs());
-                    }
-                }
-                let rel = diff / norm.max(f64::MIN_POSITIVE);
+                let rel = matrix_error(got, prefix, want);
                 assert!(rel <= 1e-9, "{urdf} state {k} {prefix}: relative error {rel:e}");
                 eprintln!("{urdf} state {k} {prefix}: {rel:.1e}");
             };
-            let rnea = run("invdyna", "atomise,cse,diff<wrt=q,qd>", &[("qdd", &s.qdd)]);
+            let rnea = run("invdyna", "atomise,cse,diff<wrt=q,qd>");
             check(&rnea, "dQq_dq", &s.dtau_dq);
             check(&rnea, "dQq_dqd", &s.dtau_dv);
-            let aba = run("fordyna", "atomise,cse,diff<wrt=q,qd,Qq>", &[("Qq", &s.tau)]);
+            let aba = run("fordyna", "atomise,cse,diff<wrt=q,qd,Qq>");
             check(&aba, "dqdd_dq", &s.ddq_dq);
             check(&aba, "dqdd_dqd", &s.ddq_dv);
             check(&aba, "dqdd_dQq", &s.minv);
             // The generator's derivative functions under Pinocchio's names, through `default<ops>`.
-            let rnea = run("rnea_derivatives", "default<ops>", &[("qdd", &s.qdd)]);
+            let rnea = run("rnea_derivatives", "default<ops>");
             assert_eq!(rnea.len(), 2 * n * n, "{urdf}: rnea_derivatives' outputs");
             check(&rnea, "dtau_dq", &s.dtau_dq);
             check(&rnea, "dtau_dv", &s.dtau_dv);
-            let aba = run("aba_derivatives", "default<ops>", &[("Qq", &s.tau)]);
+            let aba = run("aba_derivatives", "default<ops>");
             assert_eq!(aba.len(), 3 * n * n, "{urdf}: aba_derivatives' outputs");
             check(&aba, "ddq_dq", &s.ddq_dq);
             check(&aba, "ddq_dv", &s.ddq_dv);
             check(&aba, "Minv", &s.minv);
-            let minv = run("minv", "default<ops>", &[]);
+            let minv = run("minv", "default<ops>");
             assert_eq!(minv.len(), n * n, "{urdf}: minv's outputs");
             check(&minv, "Minv", &s.minv);
         }
@@ -256,50 +267,17 @@ fn free_flyer_derivatives_are_along_pinocchios_tangent_space() {
     for (k, s) in o.states.iter().enumerate() {
         let nv = s.qd.len();
         assert_eq!(s.q.len(), nv + 1);
-        let mut given = serde_json::Map::new();
-        for (i, g) in o.gravity.iter().enumerate() {
-            given.insert(format!("g[{}]", i + 1), (*g).into());
-        }
-        for (i, q) in s.q.iter().enumerate() {
-            given.insert(format!("q[{}]", i + 1), (*q).into());
-        }
-        for i in 0..nv {
-            given.insert(format!("qd[{}]", i + 1), s.qd[i].into());
-            given.insert(format!("qdd[{}]", i + 1), s.qdd[i].into());
-            given.insert(format!("Qq[{}]", i + 1), s.tau[i].into());
-        }
-        let file = dir.join(format!("state{k}.json"));
-        std::fs::write(&file, serde_json::Value::Object(given).to_string()).unwrap();
+        let file = state_file(&dir.join(format!("state{k}.json")), &o.gravity, s);
         for (function, checks) in [
             ("rnea_derivatives", vec![("dtau_dq", &s.dtau_dq), ("dtau_dv", &s.dtau_dv)]),
             ("aba_derivatives", vec![("ddq_dq", &s.ddq_dq), ("ddq_dv", &s.ddq_dv), ("Minv", &s.minv)]),
         ] {
-            let out = crate::common::opt(&[
-                &o.path,
-                "--fold-params",
-                "--free-flyer",
-                &format!("-function={function}"),
-                "-passes=default<ops>",
-                &format!("-eval={}", file.display()),
-                "-o",
-                "/dev/null",
-            ]);
-            assert!(out.status.success(), "{function}: {}", crate::common::stderr(&out));
-            let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-            let got = v["outputs"].as_object().unwrap();
+            let got = eval_urdf(&o.path, &["--free-flyer"], function, "default<ops>", &file);
             assert_eq!(got.len(), checks.len() * nv * nv, "{function}: nv × nv matrices");
             for (prefix, want) in checks {
-                let norm = want.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-                let mut diff = 0.0f64;
-                for i in 0..nv {
-                    for j in 0..nv {
-                        let name = format!("{prefix}[{}][{}]", i + 1, j + 1);
-                        let d = got.get(&name).and_then(|x| x.as_f64()).unwrap_or_else(|| panic!("no output {name}"));
-                        diff = diff.max((d - want[i][j]).abs());
-                    }
-                }
-                assert!(diff / norm <= 1e-9, "state {k} {prefix}: relative error {:e}", diff / norm);
-                eprintln!("free flyer state {k} {prefix}: {:.1e}", diff / norm);
+                let rel = matrix_error(&got, prefix, want);
+                assert!(rel <= 1e-9, "state {k} {prefix}: relative error {rel:e}");
+                eprintln!("free flyer state {k} {prefix}: {rel:.1e}");
             }
         }
     }
