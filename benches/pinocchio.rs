@@ -1,7 +1,9 @@
 //! robovec's generated C against Pinocchio's C++ (issue 14) and against Pinocchio's own code
-//! generator, CppADCodeGen (issue 30), side by side in one process.
+//! generator, CppADCodeGen (issue 30), side by side in one process: the dynamics and (issue 50)
+//! their derivatives.
 //!
-//! `cargo bench --bench pinocchio -- [ROBOT…] [--reps=N] [--runs=K] [--base=composite|free-flyer]`
+//! `cargo bench --bench pinocchio -- [ROBOT…] [--reps=N] [--runs=K] [--base=composite|free-flyer]
+//! [--functions=dynamics|derivatives|all]`
 //!
 //! Robots (default: all): `ur5`, `panda` (fixed base), `solo12`, `talos`, `tiago_pro` (floating
 //! base: `--base=free-flyer`, the default, is Pinocchio's `JointModelFreeFlyer` and robovec's
@@ -85,15 +87,29 @@ const VARIANTS: [(&str, &str, u32, &str); 6] = [
 /// The variants whose bits of error the summary shows: without and with fused multiply-adds.
 const BITS_OF: [&str; 2] = ["1 state, trig=libm", "batch=8, trig=inline, fma"];
 
-/// The four comparisons (the harness's groups, in its order): label, robovec function, outputs
-/// kept (`dce`), Pinocchio's side, CppADCodeGen's function (`cg_export.cpp`; none computes `M`
-/// and `c` together).
-const GROUPS: [(&str, &str, Keep, &str, Option<&str>); 4] = [
+/// The comparisons (the harness's groups, in its order): label, robovec function, outputs kept
+/// (`dce`), Pinocchio's side, CppADCodeGen's function (`cg_export.cpp`; none computes `M` and `c`
+/// together). The first four are the dynamics (issues 14, 30), the last three the derivatives
+/// (issue 50: the derivatives with respect to `q` along Pinocchio's tangent space).
+const GROUPS: [(&str, &str, Keep, &str, Option<&str>); 7] = [
     ("inverse dynamics", "invdyna", Keep::All, "rnea", Some("rnea")),
     ("mass matrix", "dirdyna", Keep::UpperM, "crba", Some("crba")),
     ("M and c", "dirdyna", Keep::UpperMAndC, "crba + nonLinearEffects", None),
     ("forward dynamics", "fordyna", Keep::All, "aba", Some("aba")),
+    ("∇ inverse dynamics", "rnea_derivatives", Keep::All, "computeRNEADerivatives", Some("rnea_derivatives")),
+    ("∇ forward dynamics", "aba_derivatives", Keep::All, "computeABADerivatives", Some("aba_derivatives")),
+    ("inverse mass matrix", "minv", Keep::UpperMinv, "computeMinverse", Some("minv")),
 ];
+
+/// The groups `--functions=` selects: `dynamics` (0–3), `derivatives` (4–6) or `all`.
+fn parse_functions(s: &str) -> Vec<usize> {
+    match s {
+        "dynamics" => (0..4).collect(),
+        "derivatives" => (4..7).collect(),
+        "all" => (0..GROUPS.len()).collect(),
+        _ => panic!("--functions={s}: dynamics, derivatives or all"),
+    }
+}
 
 /// CppADCodeGen's builds of each of its functions: label, `cc` flags. `-Ofast` is Pinocchio's
 /// default (`CodeGenBase::compileLib`), here with `-march=native` as every contestant; `-O3
@@ -147,17 +163,23 @@ enum Keep {
     UpperM,
     /// That and `c`.
     UpperMAndC,
+    /// `Minv[i][j]`, `i ≤ j`: what `computeMinverse` fills.
+    UpperMinv,
 }
 
 impl Keep {
     /// The pipeline's `dce<outputs=…>,` (empty for [`Keep::All`]) for `nv` coordinates, and
     /// its short label.
     fn dce(self, nv: usize) -> (String, &'static str) {
-        let upper: Vec<String> = (1..=nv).flat_map(|i| (i..=nv).map(move |j| format!("M[{i}][{j}]"))).collect();
+        let upper = |m: &str| -> String {
+            let entries: Vec<String> = (1..=nv).flat_map(|i| (i..=nv).map(move |j| format!("{m}[{i}][{j}]"))).collect();
+            entries.join(",")
+        };
         match self {
             Keep::All => (String::new(), ""),
-            Keep::UpperM => (format!("dce<outputs={}>,", upper.join(",")), "dce<outputs=M upper>,"),
-            Keep::UpperMAndC => (format!("dce<outputs={},c>,", upper.join(",")), "dce<outputs=M upper,c>,"),
+            Keep::UpperM => (format!("dce<outputs={}>,", upper("M")), "dce<outputs=M upper>,"),
+            Keep::UpperMAndC => (format!("dce<outputs={},c>,", upper("M")), "dce<outputs=M upper,c>,"),
+            Keep::UpperMinv => (format!("dce<outputs={}>,", upper("Minv")), "dce<outputs=Minv upper>,"),
         }
     }
 }
@@ -222,7 +244,37 @@ impl Baseline {
 /// One contestant's median ns in one run and its median paired ratio against each [`Baseline`].
 type RunFigures = (f64, [Option<f64>; 2]);
 
-fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -> (usize, Vec<Figures>) {
+/// gcc -O2 compile time of one generated C file of each side: `cc -O2 -c`, the two sides
+/// alternating, 3 times each; median seconds per side, (CG, robovec).
+type CompileTimes = (f64, f64);
+
+fn compile_seconds(cg: &[std::path::PathBuf], robovec: &std::path::Path, dir: &std::path::Path) -> CompileTimes {
+    let obj = dir.join("compile-time.o");
+    let time = |srcs: &[&std::path::Path]| {
+        let t0 = std::time::Instant::now();
+        for src in srcs {
+            run(Command::new("cc").args(["-O2", "-c"]).arg(src).arg("-o").arg(&obj));
+        }
+        t0.elapsed().as_secs_f64()
+    };
+    let cg: Vec<&std::path::Path> = cg.iter().map(|p| p.as_path()).collect();
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for _ in 0..3 {
+        a.push(time(&cg));
+        b.push(time(&[robovec]));
+    }
+    (side::median(&a), side::median(&b))
+}
+
+/// The figures of one robot: nv, every contestant's, and per group with a CG contestant the
+/// compile times of [`compile_seconds`].
+fn bench_robot(
+    env: &Env,
+    robot: &Robot,
+    base: Base,
+    groups: &[usize],
+    (reps, runs): (u32, u32),
+) -> (usize, Vec<Figures>, BTreeMap<usize, CompileTimes>) {
     let work = env.work.join(robot.name);
     std::fs::create_dir_all(&work).unwrap();
     eprintln!("== {}", robot.name);
@@ -250,24 +302,34 @@ fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -
 
     // CppADCodeGen's C (`cg_sources.py`: its exporter compiled once, its sources written once per
     // model), one copy per (function, build) with the function renamed and the flags in a comment.
+    let cg_functions: Vec<&str> = groups.iter().filter_map(|&g| GROUPS[g].4).collect();
     let cg: serde_json::Value = serde_json::from_str(&run(Command::new(&env.python)
         .arg(env.root.join("benches/pinocchio/cg_sources.py"))
         .arg(work.join("model.txt"))
-        .arg(work.join("cg"))))
+        .arg(work.join("cg"))
+        .args(&cg_functions)))
     .expect("cg_sources.py's JSON");
     assert_eq!(cg["nv"].as_u64(), Some(nv as u64));
     let mut sources: Vec<(std::path::PathBuf, &[&str])> = Vec::new();
     let mut cg_decls = String::new();
     let mut cg_entries = Vec::new();
-    for (g, (.., cg_fn)) in GROUPS.iter().enumerate() {
-        let Some(f) = cg_fn else { continue };
-        let text = std::fs::read_to_string(cg[f].as_str().unwrap()).unwrap();
+    for &g in groups {
+        let Some(f) = GROUPS[g].4 else { continue };
+        let parts = cg_parts(std::path::Path::new(cg[f].as_str().unwrap()));
+        let stem = format!("cg_{f}_forward_zero");
         for (tag, flags) in CG_BUILDS {
             let symbol = format!("cg_{f}_{tag}");
-            let src = work.join(format!("{symbol}.c"));
-            let head = format!("/* cc {} */\n#define cg_{f}_forward_zero {symbol}\n", flags.join(" "));
-            side::write_if_changed(&src, (head + &text).as_bytes());
-            sources.push((src, flags));
+            let mut head = format!("/* cc {} */\n", flags.join(" "));
+            for k in 0..parts.len() {
+                let suffix = if k == 0 { String::new() } else { format!("__{k}") };
+                let _ = writeln!(head, "#define {stem}{suffix} {symbol}{suffix}");
+            }
+            for (k, part) in parts.iter().enumerate() {
+                let src = work.join(format!("{symbol}{}.c", if k == 0 { String::new() } else { format!("__{k}") }));
+                let text = std::fs::read_to_string(part).unwrap();
+                side::write_if_changed(&src, (head.clone() + &text).as_bytes());
+                sources.push((src, flags));
+            }
             let _ = writeln!(
                 cg_decls,
                 "void {symbol}(double const *const *in, double *const *out, struct LangCAtomicFun atomic);"
@@ -280,7 +342,8 @@ fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -
     let mut columns: Vec<String> = Vec::new();
     let mut entries = Vec::new();
     let mut decls = String::new();
-    for (g, (_, function, keep, ..)) in GROUPS.iter().enumerate() {
+    for &g in groups {
+        let (_, function, keep, ..) = GROUPS[g];
         let (prefix, short) = keep.dce(nv);
         for (v, (label, pipeline, batch, trig)) in VARIANTS.iter().enumerate() {
             let i = g * VARIANTS.len() + v;
@@ -337,9 +400,10 @@ fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -
     table += "typedef struct { const char *label; rv_fn fn; int group, batch, n_in, n_out; const int *in_map, *out_map; } RvVariant;\n";
     let _ = writeln!(
         table,
-        "const int RV_NSETS = {NSETS}, RV_NCOLS = {}, RV_NVARIANTS = {};",
+        "const int RV_NSETS = {NSETS}, RV_NCOLS = {}, RV_NVARIANTS = {}, RV_GROUPS = {};",
         columns.len(),
-        entries.len()
+        entries.len(),
+        groups.iter().map(|g| 1 << g).sum::<u32>()
     );
     table += "const double RV_SETS[] = {\n";
     for s in 0..NSETS {
@@ -383,7 +447,7 @@ fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -
                 _ => {}
             }
         }
-        for (g, ..) in GROUPS.iter().enumerate() {
+        for &g in groups {
             let members: Vec<usize> = names.iter().filter(|(_, (gg, _))| *gg == g).map(|(c, _)| *c).collect();
             // Each side's baseline in this run: its fastest contestant (median) for the group.
             let bases = Baseline::ALL.map(|b| {
@@ -405,7 +469,7 @@ fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -
         }
         eprintln!("   run {} of {runs} done", r + 1);
     }
-    let errors = side::errors(&work.join("values.bin"), &names, nv, NSETS);
+    let errors = side::errors(&work.join("values.bin"), &names, groups, nv, NSETS);
     let figures: Vec<Figures> = names
         .iter()
         .map(|(c, (g, name))| {
@@ -438,8 +502,37 @@ fn bench_robot(env: &Env, robot: &Robot, base: Base, (reps, runs): (u32, u32)) -
             f.errors.relative
         );
     }
-    (nv, figures)
+    // The compile time of each side's one-state file of each function CG has.
+    let mut compile = BTreeMap::new();
+    for &g in groups {
+        let Some(f) = GROUPS[g].4 else { continue };
+        let v = VARIANTS.iter().position(|v| v.0 == COMPILE_TIMED).expect("the timed variant");
+        let rv = work.join(format!("rv{}.c", g * VARIANTS.len() + v));
+        let parts = cg_parts(std::path::Path::new(cg[f].as_str().unwrap()));
+        compile.insert(g, compile_seconds(&parts, &rv, &work));
+    }
+    (nv, figures, compile)
 }
+
+/// A CppADCodeGen function's sources: `cg_F_forward_zero.c` and, for a large function, the parts
+/// it calls (`cg_F_forward_zero__1.c`, …, in order).
+fn cg_parts(main: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let stem = main.file_stem().unwrap().to_string_lossy().into_owned();
+    let mut parts: Vec<(usize, std::path::PathBuf)> = std::fs::read_dir(main.parent().unwrap())
+        .unwrap()
+        .filter_map(|e| {
+            let p = e.ok()?.path();
+            let name = p.file_name()?.to_str()?.to_string();
+            let k = name.strip_prefix(&format!("{stem}__"))?.strip_suffix(".c")?.parse().ok()?;
+            Some((k, p))
+        })
+        .collect();
+    parts.sort();
+    std::iter::once(main.to_path_buf()).chain(parts.into_iter().map(|p| p.1)).collect()
+}
+
+/// robovec's variant whose gcc -O2 compile time is measured against CG's file.
+const COMPILE_TIMED: &str = "1 state, trig=inline, fma";
 
 /// One row of the summary: a side's fastest contestant (Pinocchio's run-time algorithm or
 /// CppADCodeGen's build) against each robovec variant; `None` when the function has no such
@@ -476,9 +569,12 @@ fn main() {
     let mut wanted = Vec::new();
     let (mut reps, mut runs) = (101, 5);
     let mut base = Base::FreeFlyer;
+    let mut groups = parse_functions("all");
     for a in std::env::args().skip(1) {
         if let Some(b) = a.strip_prefix("--base=") {
             base = Base::parse(b);
+        } else if let Some(f) = a.strip_prefix("--functions=") {
+            groups = parse_functions(f);
         } else if let Some(r) = a.strip_prefix("--reps=") {
             reps = r.parse().expect("--reps=N");
         } else if let Some(r) = a.strip_prefix("--runs=") {
@@ -517,11 +613,22 @@ fn main() {
     summary += &"---:|".repeat(VARIANTS.len());
     summary += &"---|".repeat(1 + BITS_OF.len());
     summary += "\n";
+    let mut compile_table =
+        String::from("| robot | dof | function | CG s | robovec s | CG ÷ robovec |\n|---|---:|---|---:|---:|---:|\n");
     let mut detail = format!(
         "| robot | dof | function | contestant | ns/state median over {runs} runs (min–max) | Pinocchio ÷ this (paired) | CG ÷ this (paired) | bits of error mean / max | worst relative error |\n|---|---:|---|---|---:|---:|---:|---|---:|\n"
     );
     for robot in ROBOTS.iter().filter(|r| wanted.is_empty() || wanted.iter().any(|w| w == r.name)) {
-        let (nv, figs) = bench_robot(&env, robot, base, (reps, runs));
+        let (nv, figs, compile) = bench_robot(&env, robot, base, &groups, (reps, runs));
+        for (g, (cg, rv)) in compile {
+            let _ = writeln!(
+                compile_table,
+                "| {} | {nv} | {} | {cg:.2} | {rv:.2} | {:.2}× |",
+                robot.name,
+                GROUPS[g].0,
+                cg / rv
+            );
+        }
         for f in &figs {
             let ratio = |k: usize| f.ratio[k].map_or("–".to_string(), |r| format!("{r:.2}×"));
             let _ = writeln!(
@@ -540,7 +647,7 @@ fn main() {
                 f.errors.relative
             );
         }
-        for g in 0..GROUPS.len() {
+        for &g in &groups {
             for baseline in Baseline::ALL {
                 if let Some(row) = summary_row(robot.name, nv, g, baseline, &figs, mhz) {
                     summary += &row;
@@ -549,7 +656,10 @@ fn main() {
             }
         }
     }
-    let out = format!("{summary}\nEvery contestant:\n\n{detail}");
+    let out = format!(
+        "{summary}\ngcc -O2 compile time (`cc -O2 -c`, s, median of 3, alternating) of CG's file and robovec's \
+         `{COMPILE_TIMED}` file:\n\n{compile_table}\nEvery contestant:\n\n{detail}"
+    );
     print!("{out}");
     let path = env.work.join("table.md");
     std::fs::write(&path, &out).unwrap();

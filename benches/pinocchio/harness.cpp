@@ -1,6 +1,7 @@
-// Timing and value harness of `cargo bench --bench pinocchio` (issues 14, 30): Pinocchio's C++
-// `rnea`, `crba`, `crba` + `nonLinearEffects` and `aba` against Pinocchio's CppADCodeGen C (`rnea`,
-// `crba`, `aba`) and robovec's generated C, on the same states.
+// Timing and value harness of `cargo bench --bench pinocchio` (issues 14, 30, 50): Pinocchio's C++
+// `rnea`, `crba`, `crba` + `nonLinearEffects`, `aba`, `computeRNEADerivatives`,
+// `computeABADerivatives` and `computeMinverse` against Pinocchio's CppADCodeGen C (`cg_export.cpp`:
+// all but `crba` + `nonLinearEffects`) and robovec's generated C, on the same states.
 //
 //   harness MODEL.txt STATES.txt VALUES.bin REPS
 //
@@ -8,18 +9,26 @@
 // script). robovec's side is linked in from `table.c` (written by the bench): `RV_SETS` holds every
 // robovec input of every state (`RV_NCOLS` columns), `RV_VARIANTS` the generated functions with
 // their group (0: inverse dynamics vs `rnea`; 1: `M` vs `crba`; 2: `M`, `c` vs `crba` +
-// `nonLinearEffects`; 3: forward dynamics vs `aba`), lanes per call, and maps: input k reads column
-// `in_map[k]` (a negative `-1 - i`: the generalised force `tau[i]` of the state, the ABA's input,
-// computed here), output k is entry `out_map[k]` of the group's layout (0: `tau[i]`; 1: `M[i][j]`
-// at `i*nv + j`; 2: that, then `c[i]` at `nv*nv + i`; 3: `qdd[i]`; robovec's `M` is the upper
-// triangle, as `crba`'s, and both are mirrored into the lower one). `CG_VARIANTS` (also in
-// `table.c`) are CppADCodeGen's functions, each compiled on its own (`cg_F_forward_zero` renamed
-// per build): group 0 reads (q, v, a), 1 q, 3 (q, v, tau) in Pinocchio's layout, one state per call;
-// group 1's output is the upper triangle of `M` row by row (`M(i, j)`, `j >= i`).
+// `nonLinearEffects`; 3: forward dynamics vs `aba`; 4: `dtau_dq`, `dtau_dv` vs
+// `computeRNEADerivatives`; 5: `ddq_dq`, `ddq_dv`, `Minv` vs `computeABADerivatives`; 6: `M^-1` vs
+// `computeMinverse`), lanes per call, and maps: input k reads column `in_map[k]` (a negative
+// `-1 - i`: the generalised force `tau[i]` of the state, the ABA's input, computed here), output
+// k is entry `out_map[k]` of the group's layout (0: `tau[i]`; 1: `M[i][j]` at `i*nv + j`; 2: that,
+// then `c[i]` at `nv*nv + i`; 3: `qdd[i]`; 4: `dtau_dq`, then `dtau_dv`, each nv x nv row-major;
+// 5: `ddq_dq`, `ddq_dv`, `Minv` likewise; 6: `Minv[i][j]` at `i*nv + j`). In groups 1, 2 and 6
+// every side computes the upper triangle (`crba`'s and `computeMinverse`'s) and the lower one is
+// mirrored from it. `RV_GROUPS` (a bit per group) says which groups run: the others have no
+// contestant and no values. `CG_VARIANTS` (also in `table.c`) are CppADCodeGen's functions, each
+// compiled on its own (`cg_F_forward_zero` renamed per build), one state per call: groups 0 and 4
+// read (q, v, a), 1 and 6 q, 3 and 5 (q, v, tau) in Pinocchio's layout; the outputs of groups 1
+// and 6 are the upper triangle row by row (`M(i, j)`, `j >= i`), those of 4 and 5 the group's
+// layout.
 //
 // The ABA's input `tau` of a state is the reference inverse dynamics of that state (below) rounded
 // to double, the same for every contestant; its reference is the `long double` ABA from it, so
 // `qdd` is close to the state's accelerations.
+//
+// The derivatives with respect to `q` are Pinocchio's: along the tangent space on a free flyer.
 //
 // Prints `contestant\tINDEX\tGROUP\tNAME` per contestant, then `time\tINDEX\tREP\tNS_PER_STATE` for
 // every rep: in each rep every contestant of a group is timed once, the group's order rotated by
@@ -27,9 +36,11 @@
 // lanes takes W consecutive states). Writes VALUES.bin, native f64: per group, the reference
 // (Pinocchio on `long double`, its 64-bit significand, rounded to f64 once), then each
 // contestant's values in index order, each block `nsets x group size`.
+#include "pinocchio/algorithm/aba-derivatives.hpp"
 #include "pinocchio/algorithm/aba.hpp"
 #include "pinocchio/algorithm/crba.hpp"
 #include "pinocchio/algorithm/joint-configuration.hpp"
+#include "pinocchio/algorithm/rnea-derivatives.hpp"
 #include "pinocchio/algorithm/rnea.hpp"
 #include "pinocchio/multibody.hpp"
 #include "pinocchio/serialization.hpp"
@@ -56,7 +67,7 @@ typedef struct {
   const int *in_map;
   const int *out_map;
 } RvVariant;
-extern const int RV_NSETS, RV_NCOLS, RV_NVARIANTS;
+extern const int RV_NSETS, RV_NCOLS, RV_NVARIANTS, RV_GROUPS;
 extern const double RV_SETS[];
 extern const RvVariant RV_VARIANTS[];
 
@@ -133,8 +144,11 @@ int main(int argc, char **argv) {
     return 1;
   }
   const int reps = std::atoi(argv[4]);
-  const int ngroups = 4;
-  const int sizes[ngroups] = {nv, nv * nv, nv * nv + nv, nv};
+  const int ngroups = 7;
+  const int sizes[ngroups] = {nv, nv * nv, nv * nv + nv, nv, 2 * nv * nv, 3 * nv * nv, nv * nv};
+  auto runs = [](int gi) { return (RV_GROUPS >> gi) & 1; };
+  // Groups whose matrix is the upper triangle, mirrored into the lower one.
+  auto upper = [](int gi) { return gi == 1 || gi == 2 || gi == 6; };
 
   // The reference: Pinocchio on long double, each configuration rebuilt from the exact
   // coordinates (a continuous joint's cos, sin in long double, not Pinocchio's rounded doubles;
@@ -143,6 +157,7 @@ int main(int argc, char **argv) {
   pinocchio::DataTpl<long double> data_l(model_l);
   std::vector<std::vector<double>> ref(ngroups, std::vector<double>());
   for (int gi = 0; gi < ngroups; gi++) ref[gi].resize((size_t)n * sizes[gi]);
+  MatL dl1(nv, nv), dl2(nv, nv), dl3(nv, nv);
   // The ABA's input: the reference `tau` rounded to double.
   std::vector<Eigen::VectorXd> tau_d(n, Eigen::VectorXd(nv));
   for (int s = 0; s < n; s++) {
@@ -172,6 +187,29 @@ int main(int argc, char **argv) {
         ref[1][(size_t)s * sizes[1] + i * nv + j] = mij;
         ref[2][(size_t)s * sizes[2] + i * nv + j] = mij;
       }
+    }
+    if (runs(4)) {
+      dl1.setZero(), dl2.setZero(), dl3.setZero();
+      pinocchio::computeRNEADerivatives(model_l, data_l, ql, vl, al, dl1, dl2, dl3);
+      for (int k = 0; k < nv * nv; k++) {
+        ref[4][(size_t)s * sizes[4] + k] = (double)dl1(k / nv, k % nv);
+        ref[4][(size_t)s * sizes[4] + nv * nv + k] = (double)dl2(k / nv, k % nv);
+      }
+    }
+    if (runs(5)) {
+      dl1.setZero(), dl2.setZero(), dl3.setZero();
+      pinocchio::computeABADerivatives(model_l, data_l, ql, vl, VecL(tau_d[s].cast<long double>()), dl1, dl2, dl3);
+      for (int k = 0; k < nv * nv; k++) {
+        ref[5][(size_t)s * sizes[5] + k] = (double)dl1(k / nv, k % nv);
+        ref[5][(size_t)s * sizes[5] + nv * nv + k] = (double)dl2(k / nv, k % nv);
+        ref[5][(size_t)s * sizes[5] + 2 * nv * nv + k] = (double)dl3(k / nv, k % nv);
+      }
+    }
+    if (runs(6)) {
+      pinocchio::computeMinverse(model_l, data_l, ql);
+      for (int i = 0; i < nv; i++)
+        for (int j = 0; j < nv; j++)
+          ref[6][(size_t)s * sizes[6] + i * nv + j] = (double)(i <= j ? data_l.Minv(i, j) : data_l.Minv(j, i));
     }
   }
 
@@ -212,30 +250,60 @@ int main(int argc, char **argv) {
                     for (int i = 0; i < nv; i++) out[i] = d[i];
                   }});
   }
+  Eigen::MatrixXd d1 = Eigen::MatrixXd::Zero(nv, nv), d2 = d1, d3 = d1;
+  cs.push_back({"pinocchio computeRNEADerivatives", 4, 1,
+                [&](int k) { pinocchio::computeRNEADerivatives(model, data, q[k], v[k], a[k], d1, d2, d3); },
+                [&](int s, double *out) {
+                  pinocchio::computeRNEADerivatives(model, data, q[s], v[s], a[s], d1, d2, d3);
+                  for (int k = 0; k < nv * nv; k++) out[k] = d1(k / nv, k % nv), out[nv * nv + k] = d2(k / nv, k % nv);
+                }});
+  cs.push_back({"pinocchio computeABADerivatives", 5, 1,
+                [&](int k) { pinocchio::computeABADerivatives(model, data, q[k], v[k], tau_d[k], d1, d2, d3); },
+                [&](int s, double *out) {
+                  pinocchio::computeABADerivatives(model, data, q[s], v[s], tau_d[s], d1, d2, d3);
+                  for (int k = 0; k < nv * nv; k++)
+                    out[k] = d1(k / nv, k % nv), out[nv * nv + k] = d2(k / nv, k % nv),
+                    out[2 * nv * nv + k] = d3(k / nv, k % nv);
+                }});
+  cs.push_back({"pinocchio computeMinverse", 6, 1, [&](int k) { pinocchio::computeMinverse(model, data, q[k]); },
+                [&](int s, double *out) {
+                  pinocchio::computeMinverse(model, data, q[s]);
+                  for (int i = 0; i < nv; i++)
+                    for (int j = 0; j < nv; j++) out[i * nv + j] = i <= j ? data.Minv(i, j) : data.Minv(j, i);
+                }});
+  // Only the groups that run keep their contestants.
+  {
+    std::vector<Contestant> kept;
+    for (auto &c : cs)
+      if (runs(c.group)) kept.push_back(c);
+    cs.swap(kept);
+  }
   // CppADCodeGen: each state's input vector packed once per group, one call per state.
   const struct LangCAtomicFun no_atomic = {nullptr, nullptr, nullptr};
   std::vector<std::vector<double>> cg_in(ngroups);
   std::vector<int> cg_n_in(ngroups, 0), cg_n_out(ngroups, 0);
-  cg_n_in[0] = cg_n_in[3] = nq + 2 * nv;
-  cg_n_in[1] = nq;
+  cg_n_in[0] = cg_n_in[3] = cg_n_in[4] = cg_n_in[5] = nq + 2 * nv;
+  cg_n_in[1] = cg_n_in[6] = nq;
   cg_n_out[0] = cg_n_out[3] = nv;
-  cg_n_out[1] = nv * (nv + 1) / 2;
-  for (int gi : {0, 1, 3}) {
+  cg_n_out[1] = cg_n_out[6] = nv * (nv + 1) / 2;
+  cg_n_out[4] = 2 * nv * nv;
+  cg_n_out[5] = 3 * nv * nv;
+  for (int gi : {0, 1, 3, 4, 5, 6}) {
     cg_in[gi].resize((size_t)n * cg_n_in[gi]);
     for (int s = 0; s < n; s++) {
       double *x = cg_in[gi].data() + (size_t)s * cg_n_in[gi];
       for (int i = 0; i < nq; i++) x[i] = q[s][i];
-      if (gi == 1) continue;
+      if (gi == 1 || gi == 6) continue;
       for (int i = 0; i < nv; i++) {
         x[nq + i] = v[s][i];
-        x[nq + nv + i] = gi == 0 ? a[s][i] : tau_d[s][i];
+        x[nq + nv + i] = gi == 0 || gi == 4 ? a[s][i] : tau_d[s][i];
       }
     }
   }
   std::vector<std::vector<double>> cg_out(CG_NVARIANTS);
   for (int ci = 0; ci < CG_NVARIANTS; ci++) {
     const int gi = CG_VARIANTS[ci].group;
-    if (gi != 0 && gi != 1 && gi != 3) {
+    if (gi < 0 || gi >= ngroups || gi == 2 || !runs(gi)) {
       std::fprintf(stderr, "CppADCodeGen variant %s: group %d\n", CG_VARIANTS[ci].label, gi);
       return 1;
     }
@@ -251,8 +319,8 @@ int main(int argc, char **argv) {
                     std::vector<double> o(cg_n_out[gi]);
                     double *outs[1] = {o.data()};
                     CG_VARIANTS[ci].fn(ins, outs, no_atomic);
-                    if (gi != 1) {
-                      for (int i = 0; i < nv; i++) out[i] = o[i];
+                    if (!upper(gi)) {
+                      for (int i = 0; i < cg_n_out[gi]; i++) out[i] = o[i];
                       return;
                     }
                     int k = 0;
@@ -283,15 +351,16 @@ int main(int argc, char **argv) {
                     const RvVariant &r = RV_VARIANTS[vi];
                     r.fn(packed[vi].data() + (size_t)k * r.n_in * r.batch, outbuf[vi].data());
                   },
-                  [&, vi, nv](int s, double *out) {
+                  [&, vi, nv, upper](int s, double *out) {
                     const RvVariant &r = RV_VARIANTS[vi];
                     const int b = s / r.batch, lane = s % r.batch;
                     std::vector<double> o((size_t)r.n_out * r.batch);
                     r.fn(packed[vi].data() + (size_t)b * r.n_in * r.batch, o.data());
                     for (int k = 0; k < r.n_out; k++)
                       if (r.out_map[k] >= 0) out[r.out_map[k]] = o[(size_t)k * r.batch + lane];
-                    // robovec's M is the upper triangle, as crba's: mirrored like crba's.
-                    if (r.group == 1 || r.group == 2)
+                    // robovec's M and M^-1 are the upper triangle, as crba's and
+                    // computeMinverse's: mirrored like theirs.
+                    if (upper(r.group))
                       for (int i = 0; i < nv; i++)
                         for (int j = 0; j < i; j++) out[i * nv + j] = out[j * nv + i];
                   }});
@@ -301,6 +370,7 @@ int main(int argc, char **argv) {
   {
     std::ofstream f(argv[3], std::ios::binary);
     for (int gi = 0; gi < ngroups; gi++) {
+      if (!runs(gi)) continue;
       f.write((const char *)ref[gi].data(), ref[gi].size() * sizeof(double));
       for (size_t c = 0; c < cs.size(); c++) {
         if (cs[c].group != gi) continue;
@@ -328,6 +398,7 @@ int main(int argc, char **argv) {
   }
   for (int rep = 0; rep < reps; rep++) {
     for (int gi = 0; gi < ngroups; gi++) {
+      if (!runs(gi)) continue;
       std::vector<size_t> members;
       for (size_t c = 0; c < cs.size(); c++)
         if (cs[c].group == gi) members.push_back(c);

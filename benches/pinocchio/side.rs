@@ -228,16 +228,27 @@ pub fn robovec_inputs(name: &str, st: &States, s: usize) -> f64 {
 }
 
 /// Slot of robovec output `name` in the harness's layout of group `g` (0: `Qq[i]` → `i − 1`;
-/// 1, 2: `M[i][j]` → `(i − 1)·nv + j − 1`; 2: `c[i]` → `nv² + i − 1`; 3: `qdd[i]` → `i − 1`).
+/// 1, 2: `M[i][j]` → `(i − 1)·nv + j − 1`; 2: `c[i]` → `nv² + i − 1`; 3: `qdd[i]` → `i − 1`;
+/// 4: `dtau_dq`, `dtau_dv`, 5: `ddq_dq`, `ddq_dv`, `Minv`, 6: `Minv`, each matrix's `[i][j]` →
+/// `k·nv² + (i − 1)·nv + j − 1` for the `k`-th matrix of the group).
 pub fn output_slot(name: &str, g: usize, nv: usize) -> usize {
     let idx: Vec<usize> = name.split('[').skip(1).filter_map(|p| p.trim_end_matches(']').parse().ok()).collect();
+    let matrix = |k: usize, i: usize, j: usize| k * nv * nv + (i - 1) * nv + j - 1;
     match (name.split('[').next().unwrap(), g, idx.as_slice()) {
         ("Qq", 0, [i]) => i - 1,
         ("M", 1 | 2, [i, j]) => (i - 1) * nv + j - 1,
         ("c", 2, [i]) => nv * nv + i - 1,
         ("qdd", 3, [i]) => i - 1,
+        ("dtau_dq", 4, [i, j]) | ("ddq_dq", 5, [i, j]) | ("Minv", 6, [i, j]) => matrix(0, *i, *j),
+        ("dtau_dv", 4, [i, j]) | ("ddq_dv", 5, [i, j]) => matrix(1, *i, *j),
+        ("Minv", 5, [i, j]) => matrix(2, *i, *j),
         _ => panic!("robovec output {name} in group {g}"),
     }
+}
+
+/// Entries per state of each group's layout in the harness (see [`output_slot`]).
+fn group_size(g: usize, nv: usize) -> usize {
+    [nv, nv * nv, nv * nv + nv, nv, 2 * nv * nv, 3 * nv * nv, nv * nv][g]
 }
 
 /// Error figures of one contestant on one function.
@@ -250,22 +261,25 @@ pub struct Errors {
     pub relative: f64,
 }
 
-/// [`Errors`] of each contestant's values in the harness's `values.bin` against the
-/// `long double` reference; for `M` the upper triangle only (the lower one is a copy on both
-/// sides).
+/// [`Errors`] of each contestant's values in the harness's `values.bin` (the blocks of `groups`,
+/// in increasing order) against the `long double` reference; for `M` and `M⁻¹` of groups 1, 2
+/// and 6 the upper triangle only (the lower one is a copy on every side).
 pub fn errors(
     path: &Path,
     names: &BTreeMap<usize, (usize, String)>,
+    groups: &[usize],
     nv: usize,
     nsets: usize,
 ) -> BTreeMap<usize, Errors> {
     let bytes = std::fs::read(path).unwrap();
     let vals: Vec<f64> = bytes.chunks_exact(8).map(|c| f64::from_ne_bytes(c.try_into().unwrap())).collect();
-    let sizes = [nv, nv * nv, nv * nv + nv, nv];
-    let counted = |g: usize, k: usize| g == 0 || g == 3 || k >= nv * nv || k / nv <= k % nv;
+    let counted = |g: usize, k: usize| !matches!(g, 1 | 2 | 6) || k >= nv * nv || k / nv <= k % nv;
     let mut at = 0;
     let mut out = BTreeMap::new();
-    for (g, &size) in sizes.iter().enumerate() {
+    let mut sorted = groups.to_vec();
+    sorted.sort_unstable();
+    for g in sorted {
+        let size = group_size(g, nv);
         let block = nsets * size;
         let reference = &vals[at..at + block];
         at += block;

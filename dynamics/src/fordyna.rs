@@ -185,6 +185,18 @@ fn factorisation_ops(lambda: &[usize]) -> u64 {
 /// [`Stopped`] at the builder's deadline (checked per body and per row of the factorisation
 /// and of the substitutions).
 pub(crate) fn ltdl_by(model: &Model, layout: &Layout, b: &mut Builder, parts: &mut Parts<'_>) -> Result<(), Stopped> {
+    ltdl_with(model, layout, b, parts, false)
+}
+
+/// [`ltdl_by`], then with `with_inverse` the outputs `Minv[a][c]` from the same factors
+/// ([`inverse`]).
+fn ltdl_with(
+    model: &Model,
+    layout: &Layout,
+    b: &mut Builder,
+    parts: &mut Parts<'_>,
+    with_inverse: bool,
+) -> Result<(), Stopped> {
     let nq = layout.nv;
     let drive = Drive::inputs(b, nq, false);
     let forces: Vec<Term> = (1..=nq).map(|i| b.input(&format!("Qq[{i}]"))).collect();
@@ -203,34 +215,7 @@ pub(crate) fn ltdl_by(model: &Model, layout: &Layout, b: &mut Builder, parts: &m
     }
     let ancestors = |k: usize| ancestors(&lambda, k);
     let at = |k: usize| Reached::Row { row: k, rows: nq };
-    // LᵀDL, leaves to root (Featherstone 2005, Table 2): `H[k][i]` becomes `L[k][i]`, `H[k][k]`
-    // stays `D[k]`.
-    let mut inv_d: Vec<Term> = vec![ZERO; nq + 1];
-    for k in (1..=nq).rev() {
-        b.check_at(at(k))?;
-        let d = h.remove(&(k, k)).unwrap_or(ZERO);
-        inv_d[k] = reciprocal(b, k, &format!("D{k}"), &format!("iD{k}"), d);
-        let anc: Vec<usize> = ancestors(k).collect();
-        for (n, &i) in anc.iter().enumerate() {
-            let hki = h.remove(&(k, i)).unwrap_or(ZERO);
-            if hki == ZERO {
-                continue;
-            }
-            let a = b.bind(&format!("L{k}_{i}"), mul(hki.clone(), inv_d[k].clone()));
-            // `H[i][j] −= a·H[k][j]` for `j = i` and its ancestors (whose `H[k][j]` are not yet
-            // turned into `L[k][j]`: they come later in this walk up).
-            for &j in std::iter::once(&i).chain(&anc[n + 1..]) {
-                let hkj = if j == i { hki.clone() } else { h.get(&(k, j)).cloned().unwrap_or(ZERO) };
-                if hkj == ZERO {
-                    continue;
-                }
-                let old = h.remove(&(i, j)).unwrap_or(ZERO);
-                let new = b.bind(&format!("H{i}_{j}"), sub(old, mul(a.clone(), hkj)));
-                h.insert((i, j), new);
-            }
-            h.insert((k, i), a);
-        }
-    }
+    let inv_d = factor(b, &mut h, &lambda)?;
     // x ← L⁻ᵀ x (leaves to root), x ← D⁻¹ x, x ← L⁻¹ x (root to leaves).
     for i in (1..=nq).rev() {
         b.check_at(at(i))?;
@@ -258,7 +243,145 @@ pub(crate) fn ltdl_by(model: &Model, layout: &Layout, b: &mut Builder, parts: &m
     for (i, t) in x.into_iter().enumerate() {
         b.output(&format!("qdd[{}]", i + 1), &format!("qdd{}", i + 1), t);
     }
+    if with_inverse {
+        inverse(b, &h, &inv_d, &lambda)?;
+    }
     Ok(())
+}
+
+/// `M = LᵀDL` in place, leaves to root (Featherstone 2005, Table 2): `h` holds `M`'s entries
+/// `H[k][i]` (`i` an ancestor of `k` or `k` itself, 1-based) and ends holding `L[k][i]` for the
+/// ancestors; returns `1/D[k]` (index 0 unused). `lambda` is the coordinate parent array.
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per row).
+fn factor(b: &mut Builder, h: &mut FxHashMap<(usize, usize), Term>, lambda: &[usize]) -> Result<Vec<Term>, Stopped> {
+    let nq = lambda.len() - 1;
+    let ancestors = |k: usize| ancestors(lambda, k);
+    let at = |k: usize| Reached::Row { row: k, rows: nq };
+    let mut inv_d: Vec<Term> = vec![ZERO; nq + 1];
+    for k in (1..=nq).rev() {
+        b.check_at(at(k))?;
+        let d = h.remove(&(k, k)).unwrap_or(ZERO);
+        inv_d[k] = reciprocal(b, k, &format!("D{k}"), &format!("iD{k}"), d);
+        let anc: Vec<usize> = ancestors(k).collect();
+        for (n, &i) in anc.iter().enumerate() {
+            let hki = h.remove(&(k, i)).unwrap_or(ZERO);
+            if hki == ZERO {
+                continue;
+            }
+            let a = b.bind(&format!("L{k}_{i}"), mul(hki.clone(), inv_d[k].clone()));
+            // `H[i][j] −= a·H[k][j]` for `j = i` and its ancestors (whose `H[k][j]` are not yet
+            // turned into `L[k][j]`: they come later in this walk up).
+            for &j in std::iter::once(&i).chain(&anc[n + 1..]) {
+                let hkj = if j == i { hki.clone() } else { h.get(&(k, j)).cloned().unwrap_or(ZERO) };
+                if hkj == ZERO {
+                    continue;
+                }
+                let old = h.remove(&(i, j)).unwrap_or(ZERO);
+                let new = b.bind(&format!("H{i}_{j}"), sub(old, mul(a.clone(), hkj)));
+                h.insert((i, j), new);
+            }
+            h.insert((k, i), a);
+        }
+    }
+    Ok(inv_d)
+}
+
+/// The outputs `Minv[a][c]`, `a, c = 1..=nq` row by row, from the factors of [`factor`]:
+/// `M⁻¹ = L⁻¹ D⁻¹ L⁻ᵀ = Uᵀ D⁻¹ U` with `U = L⁻ᵀ`, whose column `a` is nonzero only on `a` and
+/// its ancestors (no fill-in on a tree), so `M⁻¹[a][c] = Σ U[i][a] U[i][c] / D[i]` over the
+/// common ancestors-or-self `i` of `a` and `c`. Column `a` of `U` is `L⁻ᵀ e_a` by the
+/// substitution of [`ltdl_by`] on a unit vector: `dₐ(dₐ − 1)/2` multiply–adds for `a` at
+/// depth `dₐ` (no op where the unit's 1 multiplies); each entry of the upper triangle then
+/// costs one multiply–add per common ancestor, and the lower one is a copy (0 ops).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per column).
+fn inverse(
+    b: &mut Builder,
+    h: &FxHashMap<(usize, usize), Term>,
+    inv_d: &[Term],
+    lambda: &[usize],
+) -> Result<(), Stopped> {
+    let nq = lambda.len() - 1;
+    let at = |k: usize| Reached::Row { row: k, rows: nq };
+    let one = Term::C(1.0);
+    // `u[a]`: column `a` of `U` as (ancestor-or-self `i`, U[i][a]), `a` first; `w[a]` the
+    // same entries times `1/D[i]`.
+    let mut u: Vec<Vec<(usize, Term)>> = vec![Vec::new(); nq + 1];
+    let mut w: Vec<Vec<(usize, Term)>> = vec![Vec::new(); nq + 1];
+    for a in 1..=nq {
+        b.check_at(at(a))?;
+        let path: Vec<usize> = std::iter::once(a).chain(ancestors(lambda, a)).collect();
+        let mut x: FxHashMap<usize, Term> = FxHashMap::default();
+        x.insert(a, one.clone());
+        for &i in &path {
+            let xi = x.remove(&i).unwrap_or(ZERO);
+            let xi = if i == a { xi } else { b.bind(&format!("U{i}_{a}"), xi) };
+            for j in ancestors(lambda, i) {
+                if let Some(l) = h.get(&(i, j)) {
+                    let old = x.remove(&j).unwrap_or(ZERO);
+                    x.insert(j, sub(old, mul(l.clone(), xi.clone())));
+                }
+            }
+            u[a].push((i, xi));
+        }
+        for (i, t) in &u[a] {
+            let scaled = mul(t.clone(), inv_d[*i].clone());
+            w[a].push((*i, b.bind(&format!("W{i}_{a}"), scaled)));
+        }
+    }
+    let mut mark: Vec<Option<Term>> = vec![None; nq + 1];
+    let mut upper: FxHashMap<(usize, usize), Term> = FxHashMap::default();
+    for a in 1..=nq {
+        b.check_at(at(a))?;
+        for (i, t) in &w[a] {
+            mark[*i] = Some(t.clone());
+        }
+        for c in a..=nq {
+            let terms = u[c].iter().filter_map(|(i, t)| mark[*i].clone().map(|wa| mul(wa, t.clone())));
+            let t = crate::sym::sum(terms);
+            upper.insert((a, c), b.bind(&format!("MI{a}_{c}"), t));
+        }
+        for (i, _) in &w[a] {
+            mark[*i] = None;
+        }
+    }
+    for a in 1..=nq {
+        for c in 1..=nq {
+            let t = upper.get(&(a.min(c), a.max(c))).cloned().unwrap_or(ZERO);
+            b.output_with(format!("Minv[{a}][{c}]"), || format!("Minv{a}_{c}"), t);
+        }
+    }
+    Ok(())
+}
+
+/// Writes `minv` (outputs `Minv[a][c]`, `a, c = 1..=nq`, both triangles; Pinocchio's
+/// `computeMinverse`) into `b`: `M` by the CRBA, its `LᵀDL` ([`factor`]) and the product of the
+/// inverted factors over common ancestors ([`inverse`]). Inputs: `q` (and the parameters).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub fn minv(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+    let motions = motions(model, layout, b);
+    let lambda = coordinate_parents(model, layout);
+    let mut h: FxHashMap<(usize, usize), Term> = FxHashMap::default();
+    for ((i, j), t) in crba::mass_matrix(model, layout, b, &motions)? {
+        h.insert((j, i), t);
+    }
+    let inv_d = factor(b, &mut h, &lambda)?;
+    inverse(b, &h, &inv_d, &lambda)
+}
+
+/// Writes `fordyna` by the CRBA and `LᵀDL` ([`ltdl_by`]) and, from the same factors, `M⁻¹`
+/// ([`inverse`]): outputs `qdd[1..nq]`, then `Minv[a][c]`. What the forward dynamics'
+/// derivatives through the inverse dynamics read ([`crate::implicit`]).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub fn fordyna_and_inverse(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+    ltdl_with(model, layout, b, &mut crba_rnea(model, layout), true)
 }
 
 #[cfg(test)]

@@ -77,6 +77,7 @@ pub mod depth;
 pub mod dirdyna;
 pub mod fordyna;
 pub mod frames;
+mod implicit;
 pub mod lump;
 pub mod origins;
 pub mod rnea;
@@ -570,23 +571,37 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
         .collect();
     let mut functions: Vec<robovec_ir::Function> = Vec::new();
     let mut singular = None;
-    let derived: Vec<&Derived> = DERIVED.iter().filter(|d| request.wants(d.0)).collect();
-    // The written functions the derivative functions asked for need, not kept themselves.
-    let mut bases: Vec<robovec_ir::Function> = Vec::new();
-    for f in FUNCTIONS.iter().filter(|f| request.wants(f.0) || derived.iter().any(|d| d.1 == f.0)) {
-        let (name, write) = (f.0, writer(f, request.formulation));
+    // One function written by `write` under `name` (parsed, compacted).
+    let write_one = |name: &str, write: Writer| -> Result<(robovec_ir::Function, Option<sym::Singular>), Stopped> {
         let mut b = Builder::new(name, consts.clone());
         b.deadline = request.deadline;
         b.tick_budget = request.tick_budget;
-        let written = match write(model, &layout, &mut b) {
+        match write(model, &layout, &mut b) {
             Ok(()) => {
-                singular = singular.or(b.singular.map(|s| (name.to_string(), s)));
-                b.finish_until()
+                let s = b.singular;
+                b.finish_until().map(|f| (f, s))
             }
             Err(stop) => {
                 abandon(b.f);
                 Err(stop)
             }
+        }
+    };
+    let derived: Vec<&Derived> = DERIVED.iter().filter(|d| request.wants(d.0)).collect();
+    // The written functions the derivative functions asked for need, not kept themselves.
+    let mut bases: Vec<robovec_ir::Function> = Vec::new();
+    // `aba_derivatives` is also tried through `invdyna`'s partials ([`implicit`]).
+    let needed = |f: &str| derived.iter().any(|d| d.1 == f || (d.0 == DERIVED[1].0 && f == FUNCTIONS[0].0));
+    for f in FUNCTIONS.iter().filter(|f| request.wants(f.0) || needed(f.0)) {
+        let (name, write) = (f.0, writer(f, request.formulation));
+        let written = match write_one(name, write) {
+            Ok((f, s)) => {
+                if singular.is_none() {
+                    singular = s.map(|s| (name.to_string(), s));
+                }
+                Ok(f)
+            }
+            Err(stop) => Err(stop),
         };
         match written {
             Ok(f) if request.wants(name) => functions.push(f),
@@ -601,7 +616,37 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
     let free_flyer = model.robot.joints.iter().any(|j| j.kind == robot::JointKind::FreeFlyer);
     for d in derived {
         let base = functions.iter().chain(&bases).find(|f| f.name == d.1).expect("written above");
-        match derive(base, d, free_flyer, &ticker) {
+        let mut written = derive(base, d, free_flyer, &ticker);
+        // The other formulation of `aba_derivatives` (−M⁻¹·∂τ_ID, [`implicit`]) and of `minv`
+        // (the inverted `LᵀDL` factors, [`fordyna::minv`]): the fewer ops after `atomise,cse`
+        // is kept (`diff`'s on a tie).
+        let other = match (d.0, &written) {
+            (_, None) => None,
+            ("aba_derivatives", Some(_)) => {
+                let invdyna = functions.iter().chain(&bases).find(|f| f.name == FUNCTIONS[0].0).expect("written above");
+                match write_one(d.0, fordyna::fordyna_and_inverse) {
+                    Ok((solved, _)) => implicit::aba_derivatives(invdyna, &solved, &DERIVED[0], free_flyer, &ticker),
+                    Err(stop) => {
+                        functions.into_iter().chain(bases).for_each(abandon);
+                        return Err(stop);
+                    }
+                }
+            }
+            ("minv", Some(_)) => match write_one(d.0, fordyna::minv) {
+                Ok((f, _)) => implicit::compact(&f, &ticker),
+                Err(stop) => {
+                    functions.into_iter().chain(bases).for_each(abandon);
+                    return Err(stop);
+                }
+            },
+            _ => None,
+        };
+        if let (Some(a), Some(b)) = (&written, &other) {
+            if b.op_counts().total < a.op_counts().total {
+                written = other;
+            }
+        }
+        match written {
             Some(f) => functions.push(f),
             None => {
                 functions.into_iter().chain(bases).for_each(abandon);

@@ -19,32 +19,46 @@ use std::collections::BTreeMap;
 
 use robovec_ir::{BinOp, Def, Function, Operand, Output, Span};
 
-/// Writes `a op b`, folding the structural zeros and ones.
-fn op(f: &mut Function, o: BinOp, a: Operand, b: Operand) -> Operand {
-    let zero = |x: Operand| x == Operand::Const(0.0);
-    let one = |x: Operand| x == Operand::Const(1.0);
-    match o {
-        BinOp::Mul if zero(a) || zero(b) => return Operand::Const(0.0),
-        BinOp::Mul if one(a) => return b,
-        BinOp::Mul if one(b) => return a,
-        BinOp::Add if zero(a) => return b,
-        BinOp::Add | BinOp::Sub if zero(b) => return a,
-        _ => {}
-    }
-    Operand::Value(f.define_fresh("ff_tangent", Def::Binary(o, a, b), Span::DUMMY))
+/// Writes ops into a function under one name prefix (`ff_tangent`, `ff_tangent.1`, …; linear in
+/// the ops, [`Function::define_counted`]), folding structural zeros and ones.
+pub(crate) struct Ops<'f> {
+    pub(crate) f: &'f mut Function,
+    prefix: &'static str,
+    count: u32,
 }
 
-/// `Σ terms[i].0 · terms[i].1 · sign`: the sum of products, zeros skipped.
-fn dot(f: &mut Function, terms: &[(Operand, Operand, bool)]) -> Operand {
-    let mut acc = Operand::Const(0.0);
-    for &(a, b, negative) in terms {
-        let p = op(f, BinOp::Mul, a, b);
-        if p == Operand::Const(0.0) {
-            continue;
-        }
-        acc = if negative { op(f, BinOp::Sub, acc, p) } else { op(f, BinOp::Add, acc, p) };
+impl<'f> Ops<'f> {
+    pub(crate) fn new(f: &'f mut Function, prefix: &'static str) -> Ops<'f> {
+        Ops { f, prefix, count: 0 }
     }
-    acc
+
+    /// `a op b`, folding `0·x`, `1·x`, `0 + x` and `x ± 0`.
+    pub(crate) fn op(&mut self, o: BinOp, a: Operand, b: Operand) -> Operand {
+        let zero = |x: Operand| x == Operand::Const(0.0);
+        let one = |x: Operand| x == Operand::Const(1.0);
+        match o {
+            BinOp::Mul if zero(a) || zero(b) => return Operand::Const(0.0),
+            BinOp::Mul if one(a) => return b,
+            BinOp::Mul if one(b) => return a,
+            BinOp::Add if zero(a) => return b,
+            BinOp::Add | BinOp::Sub if zero(b) => return a,
+            _ => {}
+        }
+        Operand::Value(self.f.define_counted(self.prefix, &mut self.count, Def::Binary(o, a, b), Span::DUMMY))
+    }
+
+    /// `Σ terms[i].0 · terms[i].1 · (−1 if terms[i].2)`: the sum of products, zeros skipped.
+    pub(crate) fn dot(&mut self, terms: &[(Operand, Operand, bool)]) -> Operand {
+        let mut acc = Operand::Const(0.0);
+        for &(a, b, negative) in terms {
+            let p = self.op(BinOp::Mul, a, b);
+            if p == Operand::Const(0.0) {
+                continue;
+            }
+            acc = if negative { self.op(BinOp::Sub, acc, p) } else { self.op(BinOp::Add, acc, p) };
+        }
+        acc
+    }
 }
 
 /// Replaces every output `<family>[…][m]` (`m` the coordinate `q[m]`, `1..=nq`) of each of
@@ -52,16 +66,17 @@ fn dot(f: &mut Function, terms: &[(Operand, Operand, bool)]) -> Operand {
 /// module doc). `f` is atomised, with inputs `q[4..7]` the free flyer's quaternion (values of
 /// `f`, or absent when no derivative reads them: then they are added as inputs).
 pub fn free_flyer_tangent(f: &mut Function, families: &[&str]) {
+    let mut ops = Ops::new(f, "ff_tangent");
     let quat: Vec<Operand> = (4..=7)
         .map(|i| {
             let n = format!("q[{i}]");
-            Operand::Value(f.lookup(&n).unwrap_or_else(|| f.add_input(n, Span::DUMMY).expect("free")))
+            Operand::Value(ops.f.lookup(&n).unwrap_or_else(|| ops.f.add_input(n, Span::DUMMY).expect("free")))
         })
         .collect();
     let (x, y, z, w) = (quat[0], quat[1], quat[2], quat[3]);
     // R's entries, written when first needed: 2·(a·b ± c·d) or 1 − 2·(a² + b²).
     let mut rot: Option<[[Operand; 3]; 3]> = None;
-    let outputs = std::mem::take(&mut f.outputs);
+    let outputs = std::mem::take(&mut ops.f.outputs);
     // The rows: family and row indices → (position of the row's first output, its coordinates).
     let mut rows: BTreeMap<usize, (String, BTreeMap<usize, Operand>)> = BTreeMap::new();
     let mut row_at: BTreeMap<String, usize> = BTreeMap::new();
@@ -88,8 +103,8 @@ pub fn free_flyer_tangent(f: &mut Function, families: &[&str]) {
             let two = Operand::Const(2.0);
             let one = Operand::Const(1.0);
             let mut pair = |a: Operand, b: Operand, c: Operand, e: Operand, plus: bool| {
-                let s = dot(f, &[(a, b, false), (c, e, !plus)]);
-                op(f, BinOp::Mul, two, s)
+                let s = ops.dot(&[(a, b, false), (c, e, !plus)]);
+                ops.op(BinOp::Mul, two, s)
             };
             let xy_m_zw = pair(x, y, z, w, false);
             let xz_p_yw = pair(x, z, y, w, true);
@@ -98,9 +113,9 @@ pub fn free_flyer_tangent(f: &mut Function, families: &[&str]) {
             let xz_m_yw = pair(x, z, y, w, false);
             let yz_p_xw = pair(y, z, x, w, true);
             let mut diag = |a: Operand, b: Operand| {
-                let s = dot(f, &[(a, a, false), (b, b, false)]);
-                let t = op(f, BinOp::Mul, two, s);
-                op(f, BinOp::Sub, one, t)
+                let s = ops.dot(&[(a, a, false), (b, b, false)]);
+                let t = ops.op(BinOp::Mul, two, s);
+                ops.op(BinOp::Sub, one, t)
             };
             let (r11, r22, r33) = (diag(y, z), diag(x, z), diag(x, y));
             rot = Some([[r11, xy_m_zw, xz_p_yw], [xy_p_zw, r22, yz_m_xw], [xz_m_yw, yz_p_xw, r33]]);
@@ -110,7 +125,7 @@ pub fn free_flyer_tangent(f: &mut Function, families: &[&str]) {
                 Some(r) => (0..3).map(|m| (d(m + 1), r[m][k], false)).collect(),
                 None => vec![],
             };
-            cols.push(dot(f, &terms));
+            cols.push(ops.dot(&terms));
         }
         // ∂quat/∂ω_a · 2: (w, z, −y, −x), (−z, w, x, −y), (y, −x, w, −z) for a = 1, 2, 3.
         let tables: [[(Operand, bool); 4]; 3] = [
@@ -120,8 +135,8 @@ pub fn free_flyer_tangent(f: &mut Function, families: &[&str]) {
         ];
         for t in tables {
             let terms: Vec<(Operand, Operand, bool)> = (0..4).map(|c| (d(4 + c), t[c].0, t[c].1)).collect();
-            let s = dot(f, &terms);
-            cols.push(op(f, BinOp::Mul, Operand::Const(0.5), s));
+            let s = ops.dot(&terms);
+            cols.push(ops.op(BinOp::Mul, Operand::Const(0.5), s));
         }
         for m in 8..=nq {
             cols.push(d(m));
@@ -134,6 +149,6 @@ pub fn free_flyer_tangent(f: &mut Function, families: &[&str]) {
     let mut all: Vec<(usize, Output)> = kept.into_iter().chain(written).collect();
     all.sort_by_key(|(p, _)| *p);
     for (_, o) in all {
-        f.set_output(o.name, o.value, o.span);
+        ops.f.set_output(o.name, o.value, o.span);
     }
 }

@@ -277,6 +277,19 @@ impl Function {
         self.define(name, def, span).expect("fresh name is free")
     }
 
+    /// [`Function::define_fresh`] for many values under one `base`: `base`, then `base.1`,
+    /// `base.2`, … from where `counter` (start it at 0) left off, so `n` definitions cost O(n)
+    /// lookups where `define_fresh`'s search from 1 costs O(n²).
+    pub fn define_counted(&mut self, base: &str, counter: &mut u32, def: Def, span: Span) -> Value {
+        loop {
+            let name = if *counter == 0 { base.to_string() } else { format!("{base}.{counter}") };
+            *counter += 1;
+            if self.lookup(&name).is_none() {
+                return self.define(name, def, span).expect("a free name");
+            }
+        }
+    }
+
     /// Sets output `name` to `value`, replacing an earlier output of that name (read-modify-write).
     /// Cost: O(1) expected (a hash lookup; see [`Function::output_probes`]).
     pub fn set_output(&mut self, name: impl Into<String>, value: Operand, span: Span) {

@@ -111,14 +111,7 @@ impl<'f> Builder<'f> {
     }
 
     fn emit(&mut self, op: BinOp, a: Operand, b: Operand) -> Operand {
-        let def = Def::Binary(op, a, b);
-        loop {
-            let name = if self.count == 0 { self.base.clone() } else { format!("{}.{}", self.base, self.count) };
-            self.count += 1;
-            if self.f.lookup(&name).is_none() {
-                return Operand::Value(self.f.define(name, def, Span::DUMMY).expect("a free name"));
-            }
-        }
+        Operand::Value(self.f.define_counted(&self.base, &mut self.count, Def::Binary(op, a, b), Span::DUMMY))
     }
 
     /// `t · x` for an operand `x` of the function.

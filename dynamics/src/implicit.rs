@@ -1,0 +1,122 @@
+//! The forward dynamics' derivatives through the inverse dynamics' (issue 50 item 2: "∂q̈ =
+//! −M⁻¹ ∂(τ_ID)/∂(q, v) at q̈ reuses the factors instead of recomputing them").
+//!
+//! `fordyna` solves `M(q) q̈ = τ − c(q, v)`. Differentiating that identity at the solution gives
+//! `∂q̈/∂q = −M⁻¹ · ∂τ_ID/∂q` and `∂q̈/∂v = −M⁻¹ · ∂τ_ID/∂v`, the partials of the inverse
+//! dynamics `τ_ID(q, v, a)` taken at `a = q̈` (Carpentier & Mansard, RSS 2018, §IV; Pinocchio's
+//! `computeABADerivatives` does the same), and `∂q̈/∂τ = M⁻¹`. [`aba_derivatives`] writes that
+//! function: `fordyna` by the `LᵀDL` with `M⁻¹` from the same factors
+//! ([`crate::fordyna::fordyna_and_inverse`]: `q̈` and `M⁻¹` share the CRBA and the
+//! factorisation), the partials of `invdyna` (`rnea_derivatives`, free-flyer rows along the tangent space) with
+//! its `qdd` inputs read from `q̈`, and the two products `−M⁻¹ · ∂τ_ID`, dense (`nv²·(2nv − 1)`
+//! ops each at most; structural zeros skipped).
+//!
+//! Which of this and `diff` through the whole of `fordyna` has fewer ops depends on the robot:
+//! the products grow as `nv³`, `diff` through the factorisation roughly as ops × inputs. The
+//! generator writes both and keeps the smaller (`crate::generate_with`); likewise for `minv`,
+//! `diff` along `τ` or the inverted factors ([`crate::fordyna::minv`], through [`compact`]).
+
+use std::collections::{BTreeMap, HashMap};
+
+use robovec_ir::time_limit::Ticker;
+use robovec_ir::transform::{atomise, cse};
+use robovec_ir::{Def, Function, Operand, Span};
+
+use crate::tangent::Ops;
+
+/// Names of the values this module writes.
+const PREFIX: &str = "implicit";
+
+/// `f` atomised with its repeated ops merged (`atomise,cse`): how the generator's derivative
+/// functions are handed on, so that their ops compare. `None` at the ticker's stop.
+pub(crate) fn compact(f: &Function, ticker: &Ticker) -> Option<Function> {
+    let mut f = atomise::atomise_until(f, ticker)?;
+    cse::cse_within(&mut f, ticker);
+    Some(f)
+}
+
+/// `aba_derivatives` as `−M⁻¹ · ∂τ_ID` (module doc): `invdyna` as the generator wrote it and
+/// `solved`, the same robot's `fordyna` with `M⁻¹` ([`crate::fordyna::fordyna_and_inverse`]:
+/// outputs `qdd[i]`, `Minv[i][j]`), `rnea` the derivative entry of `rnea_derivatives`
+/// (`crate::DERIVED`). Outputs `ddq_dq[i][j]`, `ddq_dv[i][j]` and `Minv[i][j]` (`i, j =
+/// 1..=nv`), row by row as `diff` groups them. `None` at the ticker's stop.
+pub(crate) fn aba_derivatives(
+    invdyna: &Function,
+    solved: &Function,
+    rnea: &crate::Derived,
+    free_flyer: bool,
+    ticker: &Ticker,
+) -> Option<Function> {
+    let partials = crate::derive(invdyna, rnea, free_flyer, ticker)?;
+    let mut f = compact(solved, ticker)?;
+    // q̈ and M⁻¹.
+    let outputs = std::mem::take(&mut f.outputs);
+    let qdd: HashMap<String, Operand> =
+        outputs.iter().filter(|o| o.name.starts_with("qdd[")).map(|o| (o.name.clone(), o.value)).collect();
+    let minv = matrix(outputs.iter().map(|o| (o.name.as_str(), o.value)), "Minv");
+    // The partials' body, appended: `qdd[i]` is q̈, every other input `fordyna`'s own.
+    let mut map: Vec<Option<Operand>> = vec![None; partials.values.len()];
+    for &v in &partials.inputs {
+        let name = partials.name_of(v);
+        map[v.index()] = Some(match qdd.get(name) {
+            Some(&x) => x,
+            None => Operand::Value(match f.lookup(name) {
+                Some(x) => x,
+                None => f.add_input(name.to_string(), Span::DUMMY).expect("a free name"),
+            }),
+        });
+    }
+    let at = |map: &[Option<Operand>], x: Operand| match x {
+        Operand::Value(v) => map[v.index()].expect("defined before use"),
+        c => c,
+    };
+    let mut count = 0;
+    for &v in &partials.body {
+        let def = match &partials.value(v).def {
+            Def::Binary(o, a, b) => Def::Binary(*o, at(&map, *a), at(&map, *b)),
+            Def::Trig(t, x) => match at(&map, Operand::Value(*x)) {
+                Operand::Value(y) => Def::Trig(*t, y),
+                c => unreachable!("a trig variable of the constant {c:?}"),
+            },
+            Def::Call(callee, args) => Def::Call(callee.clone(), args.iter().map(|&a| at(&map, a)).collect()),
+            Def::Input | Def::Expr(_) => unreachable!("an atomised body"),
+        };
+        map[v.index()] = Some(Operand::Value(f.define_counted(PREFIX, &mut count, def, Span::DUMMY)));
+    }
+    let renamed = partials.outputs.iter().map(|o| (o.name.as_str(), at(&map, o.value)));
+    let renamed: Vec<(&str, Operand)> = renamed.collect();
+    let dq = matrix(renamed.iter().copied(), "dtau_dq");
+    let dv = matrix(renamed.iter().copied(), "dtau_dv");
+    let nv = qdd.len();
+    let mut w = Ops::new(&mut f, PREFIX);
+    let entry = |m: &BTreeMap<(usize, usize), Operand>, i, j| m.get(&(i, j)).copied().unwrap_or(Operand::Const(0.0));
+    for i in 1..=nv {
+        for (name, d) in [("ddq_dq", &dq), ("ddq_dv", &dv)] {
+            for j in 1..=nv {
+                let terms: Vec<(Operand, Operand, bool)> =
+                    (1..=nv).map(|k| (entry(&minv, i, k), entry(d, k, j), true)).collect();
+                let value = w.dot(&terms);
+                w.f.set_output(format!("{name}[{i}][{j}]"), value, Span::DUMMY);
+            }
+        }
+        for j in 1..=nv {
+            w.f.set_output(format!("Minv[{i}][{j}]"), entry(&minv, i, j), Span::DUMMY);
+        }
+    }
+    let live = f.live_values(&[]);
+    f.retain(|_, v| live[v.index()]);
+    cse::cse_within(&mut f, ticker);
+    f.name = "aba_derivatives".to_string();
+    Some(f)
+}
+
+/// The entries `family[i][j]` among `outputs`, by `(i, j)`.
+fn matrix<'a>(outputs: impl Iterator<Item = (&'a str, Operand)>, family: &str) -> BTreeMap<(usize, usize), Operand> {
+    outputs
+        .filter_map(|(name, value)| {
+            let rest = name.strip_prefix(family)?.strip_prefix('[')?.strip_suffix(']')?;
+            let (i, j) = rest.split_once("][")?;
+            Some(((i.parse().ok()?, j.parse().ok()?), value))
+        })
+        .collect()
+}
