@@ -15,7 +15,11 @@
 //!    the oracle builds it (or on the free-flyer), saved with `saveToText`, and 64 random states
 //!    (the oracle's distribution; a free-flyer's quaternion uniform on the sphere) shared by all;
 //! 2. runs `benches/pinocchio/cg_sources.py`: CppADCodeGen's C of `rnea`, `crba` (the upper
-//!    triangle of `M`) and `aba` for that model (`cg_export.cpp`, compiled once and cached in
+//!    triangle of `M`) and `aba`, and of `rnea_derivatives` (`CodeGenRNEADerivatives`' tape
+//!    with the outputs `dtau_dq`, `dtau_dv`: robovec's function has no `dtau_da = M`),
+//!    `aba_derivatives` (`CodeGenABADerivatives`) and `minv` (`CodeGenMinv`, the upper
+//!    triangle) for that model (`--functions=` picks the groups; a large function comes in
+//!    parts, `cg_F_forward_zero__k.c`, each compiled on its own) (`cg_export.cpp`, compiled once and cached in
 //!    `target/pinocchio_bench/cg_export-HASH`, 5–9 min; the sources rewritten only when the model
 //!    changes), each compiled twice as its own object ([`CG_BUILDS`]: `-O3 -march=native` and
 //!    `-Ofast -march=native`, Pinocchio's default), its function renamed per build;
@@ -26,7 +30,12 @@
 //!    and `c` (against `crba` then `nonLinearEffects`): both sides compute and store the same
 //!    entries (Robotran's `M[j][i] = M[i][j]` copies of the lower triangle are 0 ops but 1.9× the
 //!    stores: 13% of `M`'s time on TIAGo Pro at `batch=8`), and `fordyna` (against
-//!    `pinocchio::aba`, from the `tau` of the reference inverse dynamics of each state);
+//!    `pinocchio::aba`, from the `tau` of the reference inverse dynamics of each state), and the
+//!    derivative functions `rnea_derivatives` (against `computeRNEADerivatives`),
+//!    `aba_derivatives` (against `computeABADerivatives`, from the same `tau`) and `minv` cut
+//!    by `dce<outputs=…>` to the upper triangle (against `computeMinverse`, which fills that
+//!    triangle only); the derivatives with respect to `q` are along Pinocchio's tangent space on
+//!    the free flyer;
 //! 4. builds one binary: `benches/pinocchio/harness.cpp` (Pinocchio header-only, instantiated
 //!    for `double` and `long double`, `g++ -O3 -march=native -DNDEBUG`; compiled once and cached
 //!    in `target/pinocchio_bench/` under the hash of its source and flags: 3–9 min), CG's objects,
@@ -43,8 +52,12 @@
 //!    Pinocchio evaluated on `long double` (64-bit significand) from the exact coordinates;
 //!    for `M` only the upper triangle counts (the lower one is a copy on every side).
 //!
+//! 7. times `cc -O2 -c` of CG's one-state source (all its parts) and robovec's
+//!    [`COMPILE_TIMED`] file of each function, alternating, 3 times each (median).
+//!
 //! Prints a Markdown table (per function one row against Pinocchio's run-time algorithm and,
-//! where CG has the function, one against CG) and writes it to `target/pinocchio_bench/table.md`.
+//! where CG has the function, one against CG), the compile times, and every contestant, and
+//! writes them to `target/pinocchio_bench/table.md`.
 //! Needs `cc`, `g++` and the Pinocchio venv at `target/pinocchio-venv` (or
 //! `ROBOVEC_PINOCCHIO_PYTHON`) with `cmeel-eigen`, `cmeel-cppad` and `cmeel-cppadcodegen`; fails
 //! with the commands to create it otherwise.

@@ -254,30 +254,38 @@ fn pinocchio_abi_derivative_functions_in_c_match_pinocchio() {
     }
 }
 
-/// On Pinocchio's free flyer (`--free-flyer`), the generator's `rnea_derivatives` and
-/// `aba_derivatives` differentiate along the tangent space (`integrate(model, q, dq)`): UR5 on a
-/// free flyer (q: 13 numbers, v: 12) against `computeRNEADerivatives` and
+/// Where a configuration coordinate is not a velocity coordinate, the generator's
+/// `rnea_derivatives` and `aba_derivatives` differentiate along Pinocchio's tangent space
+/// (`integrate(model, q, dq)`): UR5 on a free flyer (`--free-flyer`; q: 13 numbers, v: 12) and
+/// the three-link arm's continuous joints as `(cos θ, sin θ)` pairs (`--continuous=cos-sin`; q:
+/// 6 numbers, v: 3), each given Pinocchio's own `q`, against `computeRNEADerivatives` and
 /// `computeABADerivatives` entry for entry, within 1e-9 relative per matrix.
 #[test]
-fn free_flyer_derivatives_are_along_pinocchios_tangent_space() {
+fn derivatives_are_along_pinocchios_tangent_space() {
     use crate::pinocchio::{oracle, python, Base};
     let Some(py) = python() else { return };
-    let dir = tmp("free_flyer");
-    let o = oracle(&py, "erd:ur_description/urdf/ur5_robot.urdf", 3, 13, Base::FreeFlyer);
-    for (k, s) in o.states.iter().enumerate() {
-        let nv = s.qd.len();
-        assert_eq!(s.q.len(), nv + 1);
-        let file = state_file(&dir.join(format!("state{k}.json")), &o.gravity, s);
-        for (function, checks) in [
-            ("rnea_derivatives", vec![("dtau_dq", &s.dtau_dq), ("dtau_dv", &s.dtau_dv)]),
-            ("aba_derivatives", vec![("ddq_dq", &s.ddq_dq), ("ddq_dv", &s.ddq_dv), ("Minv", &s.minv)]),
-        ] {
-            let got = eval_urdf(&o.path, &["--free-flyer"], function, "default<ops>", &file);
-            assert_eq!(got.len(), checks.len() * nv * nv, "{function}: nv × nv matrices");
-            for (prefix, want) in checks {
-                let rel = matrix_error(&got, prefix, want);
-                assert!(rel <= 1e-9, "state {k} {prefix}: relative error {rel:e}");
-                eprintln!("free flyer state {k} {prefix}: {rel:.1e}");
+    let dir = tmp("tangent");
+    for (urdf, base, flag) in [
+        ("erd:ur_description/urdf/ur5_robot.urdf", Base::FreeFlyer, "--free-flyer"),
+        ("examples/three_link_arm/three_link_arm.urdf", Base::Fixed, "--continuous=cos-sin"),
+    ] {
+        let o = oracle(&py, urdf, 3, 13, base);
+        for (k, s) in o.states.iter().enumerate() {
+            let nv = s.qd.len();
+            assert!(s.q_pinocchio.len() > nv, "{urdf}: more configuration than velocity coordinates");
+            let state = crate::pinocchio::State { q: s.q_pinocchio.clone(), ..s.clone() };
+            let file = state_file(&dir.join(format!("state{k}.json")), &o.gravity, &state);
+            for (function, checks) in [
+                ("rnea_derivatives", vec![("dtau_dq", &s.dtau_dq), ("dtau_dv", &s.dtau_dv)]),
+                ("aba_derivatives", vec![("ddq_dq", &s.ddq_dq), ("ddq_dv", &s.ddq_dv), ("Minv", &s.minv)]),
+            ] {
+                let got = eval_urdf(&o.path, &[flag], function, "default<ops>", &file);
+                assert_eq!(got.len(), checks.len() * nv * nv, "{urdf} {function}: nv × nv matrices");
+                for (prefix, want) in checks {
+                    let rel = matrix_error(&got, prefix, want);
+                    assert!(rel <= 1e-9, "{urdf} state {k} {prefix}: relative error {rel:e}");
+                    eprintln!("{urdf} {flag} state {k} {prefix}: {rel:.1e}");
+                }
             }
         }
     }

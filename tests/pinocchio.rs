@@ -34,7 +34,7 @@ pub(crate) fn python() -> Option<PathBuf> {
 
 /// One state of `scripts/pinocchio_oracle.py`'s JSON: robovec's coordinates `q` (one angle per
 /// joint), Pinocchio's own configuration vector, and Pinocchio's results.
-#[derive(serde::Deserialize)]
+#[derive(Clone, serde::Deserialize)]
 pub(crate) struct State {
     pub(crate) q: Vec<f64>,
     /// Pinocchio's own configuration vector (a continuous joint's `(cos, sin)`).

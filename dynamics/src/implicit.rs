@@ -7,7 +7,7 @@
 //! `computeABADerivatives` does the same), and `∂q̈/∂τ = M⁻¹`. [`aba_derivatives`] writes that
 //! function: `fordyna` by the `LᵀDL` with `M⁻¹` from the same factors
 //! ([`crate::fordyna::fordyna_and_inverse`]: `q̈` and `M⁻¹` share the CRBA and the
-//! factorisation), the partials of `invdyna` (`rnea_derivatives`, free-flyer rows along the tangent space) with
+//! factorisation), the partials of `invdyna` (`rnea_derivatives`, rows along the tangent space) with
 //! its `qdd` inputs read from `q̈`, and the two products `−M⁻¹ · ∂τ_ID`, dense (`nv²·(2nv − 1)`
 //! ops each at most; structural zeros skipped).
 //!
@@ -44,10 +44,10 @@ pub(crate) fn aba_derivatives(
     invdyna: &Function,
     solved: &Function,
     rnea: &crate::Derived,
-    free_flyer: bool,
+    coords: Option<&[crate::tangent::Coordinate]>,
     ticker: &Ticker,
 ) -> Option<Function> {
-    let partials = crate::derive(invdyna, rnea, free_flyer, ticker)?;
+    let partials = crate::derive(invdyna, rnea, coords, ticker)?;
     let mut f = compact(solved, ticker)?;
     // q̈ and M⁻¹.
     let outputs = std::mem::take(&mut f.outputs);

@@ -435,12 +435,13 @@ pub const GENERATED_NAMES: [&str; 6] =
 /// Derivative function `d` of `base` (parsed, as written): atomised, common subexpressions
 /// merged, differentiated ([`robovec_ir::transform::diff::differentiate`], the mode by its
 /// count of terms), its derivative outputs renamed and everything else dropped. `None` at the
-/// ticker's stop. On the free flyer (`free_flyer`) the rows with respect to `q` are mapped to Pinocchio's tangent
-/// space ([`tangent::free_flyer_tangent`]).
+/// ticker's stop. With `coords` (a free flyer, `(cos, sin)` pairs: [`tangent::coordinates`])
+/// the rows with respect to `q` are mapped to Pinocchio's tangent space
+/// ([`tangent::to_tangent`]).
 fn derive(
     base: &robovec_ir::Function,
     d: &Derived,
-    free_flyer: bool,
+    coords: Option<&[tangent::Coordinate]>,
     ticker: &robovec_ir::time_limit::Ticker,
 ) -> Option<robovec_ir::Function> {
     use robovec_ir::transform::{atomise, cse, diff};
@@ -453,9 +454,9 @@ fn derive(
         // The generator writes no callback and no name of the form `d…_d…`.
         Err(diff::Failure::Message(m)) => unreachable!("{}: {m}", d.0),
     }
-    if free_flyer {
+    if let Some(coords) = coords {
         let along_q: Vec<&str> = d.3.iter().map(|r| r.0).filter(|from| from.ends_with("_dq")).collect();
-        tangent::free_flyer_tangent(&mut f, &along_q);
+        tangent::to_tangent(&mut f, &along_q, coords);
     }
     let outputs = std::mem::take(&mut f.outputs);
     for o in outputs {
@@ -613,10 +614,11 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
         }
     }
     let ticker = robovec_ir::time_limit::Ticker::new(request.deadline, request.tick_budget);
-    let free_flyer = model.robot.joints.iter().any(|j| j.kind == robot::JointKind::FreeFlyer);
+    let coords = tangent::coordinates(&model.robot, &layout);
+    let coords = coords.as_deref();
     for d in derived {
         let base = functions.iter().chain(&bases).find(|f| f.name == d.1).expect("written above");
-        let mut written = derive(base, d, free_flyer, &ticker);
+        let mut written = derive(base, d, coords, &ticker);
         // The other formulation of `aba_derivatives` (−M⁻¹·∂τ_ID, [`implicit`]) and of `minv`
         // (the inverted `LᵀDL` factors, [`fordyna::minv`]): the fewer ops after `atomise,cse`
         // is kept (`diff`'s on a tie).
@@ -625,7 +627,7 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
             ("aba_derivatives", Some(_)) => {
                 let invdyna = functions.iter().chain(&bases).find(|f| f.name == FUNCTIONS[0].0).expect("written above");
                 match write_one(d.0, fordyna::fordyna_and_inverse) {
-                    Ok((solved, _)) => implicit::aba_derivatives(invdyna, &solved, &DERIVED[0], free_flyer, &ticker),
+                    Ok((solved, _)) => implicit::aba_derivatives(invdyna, &solved, &DERIVED[0], coords, &ticker),
                     Err(stop) => {
                         functions.into_iter().chain(bases).for_each(abandon);
                         return Err(stop);
