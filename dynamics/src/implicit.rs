@@ -35,19 +35,13 @@ pub(crate) fn compact(f: &Function, ticker: &Ticker) -> Option<Function> {
     Some(f)
 }
 
-/// `aba_derivatives` as `−M⁻¹ · ∂τ_ID` (module doc): `invdyna` as the generator wrote it and
-/// `solved`, the same robot's `fordyna` with `M⁻¹` ([`crate::fordyna::fordyna_and_inverse`]:
-/// outputs `qdd[i]`, `Minv[i][j]`), `rnea` the derivative entry of `rnea_derivatives`
-/// (`crate::DERIVED`). Outputs `ddq_dq[i][j]`, `ddq_dv[i][j]` and `Minv[i][j]` (`i, j =
-/// 1..=nv`), row by row as `diff` groups them. `None` at the ticker's stop.
-pub(crate) fn aba_derivatives(
-    invdyna: &Function,
-    solved: &Function,
-    rnea: &crate::Derived,
-    coords: Option<&[crate::tangent::Coordinate]>,
-    ticker: &Ticker,
-) -> Option<Function> {
-    let partials = crate::derive(invdyna, rnea, coords, ticker)?;
+/// `aba_derivatives` as `−M⁻¹ · ∂τ_ID` (module doc): `partials` the same robot's
+/// `rnea_derivatives` (atomised; outputs `dtau_dq[i][j]`, `dtau_dv[i][j]` along the tangent
+/// space, inputs `q`, `qd`, `qdd`), `solved` its `fordyna` with `M⁻¹`
+/// ([`crate::fordyna::fordyna_and_inverse`]: outputs `qdd[i]`, `Minv[i][j]`). Outputs
+/// `ddq_dq[i][j]`, `ddq_dv[i][j]` and `Minv[i][j]` (`i, j = 1..=nv`), row by row as `diff`
+/// groups them. `None` at the ticker's stop.
+pub(crate) fn aba_derivatives(partials: &Function, solved: &Function, ticker: &Ticker) -> Option<Function> {
     let mut f = compact(solved, ticker)?;
     // q̈ and M⁻¹.
     let outputs = std::mem::take(&mut f.outputs);

@@ -81,6 +81,7 @@ mod implicit;
 pub mod lump;
 pub mod origins;
 pub mod rnea;
+pub mod rnea_derivatives;
 pub mod robot;
 pub mod robotran_c;
 
@@ -616,40 +617,59 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
     let ticker = robovec_ir::time_limit::Ticker::new(request.deadline, request.tick_budget);
     let coords = tangent::coordinates(&model.robot, &layout);
     let coords = coords.as_deref();
+    // Each derivative function by its formulations, the fewer ops after `atomise,cse` kept
+    // (`diff`'s on a tie): `diff` on the written function ([`derive`]); for `rnea_derivatives`
+    // the analytical recursions ([`rnea_derivatives`]); for `aba_derivatives` −M⁻¹·∂τ_ID
+    // ([`implicit`], from the `rnea_derivatives` kept); for `minv` the inverted `LᵀDL` factors
+    // ([`fordyna::minv`]). `None`: the ticker stopped.
+    let fewer = |a: Option<robovec_ir::Function>, b: Option<robovec_ir::Function>| match (a, b) {
+        (Some(a), Some(b)) if b.op_counts().total < a.op_counts().total => Some(b),
+        (a, _) => a,
+    };
+    let find = |fs: &[robovec_ir::Function], bs: &[robovec_ir::Function], name: &str| -> robovec_ir::Function {
+        fs.iter().chain(bs).find(|f| f.name == name).expect("written above").clone()
+    };
+    let mut rnea_kept: Option<robovec_ir::Function> = None;
     for d in derived {
-        let base = functions.iter().chain(&bases).find(|f| f.name == d.1).expect("written above");
-        let mut written = derive(base, d, coords, &ticker);
-        // The other formulation of `aba_derivatives` (−M⁻¹·∂τ_ID, [`implicit`]) and of `minv`
-        // (the inverted `LᵀDL` factors, [`fordyna::minv`]): the fewer ops after `atomise,cse`
-        // is kept (`diff`'s on a tie).
-        let other = match (d.0, &written) {
-            (_, None) => None,
-            ("aba_derivatives", Some(_)) => {
-                let invdyna = functions.iter().chain(&bases).find(|f| f.name == FUNCTIONS[0].0).expect("written above");
-                match write_one(d.0, fordyna::fordyna_and_inverse) {
-                    Ok((solved, _)) => implicit::aba_derivatives(invdyna, &solved, &DERIVED[0], coords, &ticker),
-                    Err(stop) => {
-                        functions.into_iter().chain(bases).for_each(abandon);
-                        return Err(stop);
-                    }
+        let base = find(&functions, &bases, d.1);
+        let best = |f: Option<robovec_ir::Function>| -> Result<Option<robovec_ir::Function>, Stopped> {
+            let Some(f) = f else { return Ok(None) };
+            let other = match d.0 {
+                "rnea_derivatives" => {
+                    implicit::compact(&write_one(d.0, rnea_derivatives::rnea_derivatives)?.0, &ticker)
                 }
-            }
-            ("minv", Some(_)) => match write_one(d.0, fordyna::minv) {
-                Ok((f, _)) => implicit::compact(&f, &ticker),
-                Err(stop) => {
-                    functions.into_iter().chain(bases).for_each(abandon);
-                    return Err(stop);
+                "aba_derivatives" => {
+                    let partials = match rnea_kept.clone() {
+                        Some(p) => Some(p),
+                        None => {
+                            let by_diff =
+                                derive(&find(&functions, &bases, FUNCTIONS[0].0), &DERIVED[0], coords, &ticker);
+                            let analytical = write_one(DERIVED[0].0, rnea_derivatives::rnea_derivatives)?.0;
+                            fewer(by_diff, implicit::compact(&analytical, &ticker))
+                        }
+                    };
+                    let solved = write_one(d.0, fordyna::fordyna_and_inverse)?.0;
+                    partials.and_then(|p| implicit::aba_derivatives(&p, &solved, &ticker))
                 }
-            },
-            _ => None,
+                "minv" => implicit::compact(&write_one(d.0, fordyna::minv)?.0, &ticker),
+                _ => None,
+            };
+            Ok(fewer(Some(f), other))
         };
-        if let (Some(a), Some(b)) = (&written, &other) {
-            if b.op_counts().total < a.op_counts().total {
-                written = other;
+        let written = match best(derive(&base, d, coords, &ticker)) {
+            Ok(w) => w,
+            Err(stop) => {
+                functions.into_iter().chain(bases).for_each(abandon);
+                return Err(stop);
             }
-        }
+        };
         match written {
-            Some(f) => functions.push(f),
+            Some(f) => {
+                if d.0 == DERIVED[0].0 {
+                    rnea_kept = Some(f.clone());
+                }
+                functions.push(f);
+            }
             None => {
                 functions.into_iter().chain(bases).for_each(abandon);
                 return Err(Stopped {

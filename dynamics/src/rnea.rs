@@ -30,7 +30,7 @@ pub type V3 = [Term; 3];
 /// A 3×3 matrix of terms (row-major).
 pub type M3 = [[Term; 3]; 3];
 
-pub(super) fn cross(a: &V3, b: &V3) -> V3 {
+pub(crate) fn cross(a: &V3, b: &V3) -> V3 {
     [
         sub(mul(a[1].clone(), b[2].clone()), mul(a[2].clone(), b[1].clone())),
         sub(mul(a[2].clone(), b[0].clone()), mul(a[0].clone(), b[2].clone())),
@@ -38,7 +38,7 @@ pub(super) fn cross(a: &V3, b: &V3) -> V3 {
     ]
 }
 
-pub(super) fn vadd(a: &V3, b: &V3) -> V3 {
+pub(crate) fn vadd(a: &V3, b: &V3) -> V3 {
     [add(a[0].clone(), b[0].clone()), add(a[1].clone(), b[1].clone()), add(a[2].clone(), b[2].clone())]
 }
 
@@ -51,7 +51,7 @@ pub(super) fn dot(a: &[f64; 3], b: &V3) -> Term {
 }
 
 /// `m·v` (or `mᵀ·v` when `transpose`).
-pub(super) fn matvec(m: &M3, v: &V3, transpose: bool) -> V3 {
+pub(crate) fn matvec(m: &M3, v: &V3, transpose: bool) -> V3 {
     let e = |i: usize, j: usize| if transpose { m[j][i].clone() } else { m[i][j].clone() };
     [0, 1, 2].map(|i| sum((0..3).map(|j| mul(e(i, j), v[j].clone()))))
 }

@@ -18,7 +18,7 @@ pub(super) const ROTATIONS: Network = Network::LadnerFischer(1);
 pub(super) const SUMS: Network = Network::Sklansky;
 
 /// `a·c` of two 3 × 3 matrices (entries summed left to right).
-pub(super) fn matmul(a: &M3, c: &M3) -> M3 {
+pub(crate) fn matmul(a: &M3, c: &M3) -> M3 {
     [0, 1, 2].map(|i| [0, 1, 2].map(|j| sum((0..3).map(|k| mul(a[i][k].clone(), c[k][j].clone())))))
 }
 
@@ -28,12 +28,12 @@ pub(super) fn matvec_num(m: &M3, k: &[f64; 3]) -> V3 {
 }
 
 /// `v·s`, entry by entry.
-pub(super) fn vscale(v: &V3, s: &Term) -> V3 {
+pub(crate) fn vscale(v: &V3, s: &Term) -> V3 {
     v.clone().map(|x| mul(x, s.clone()))
 }
 
 /// `a·c` for two vectors of terms.
-pub(super) fn vdot(a: &V3, c: &V3) -> Term {
+pub(crate) fn vdot(a: &V3, c: &V3) -> Term {
     sum((0..3).map(|k| mul(a[k].clone(), c[k].clone())))
 }
 
@@ -49,7 +49,7 @@ pub(super) fn bind_m3(b: &mut Builder, name: &str, n: impl std::fmt::Display, m:
 }
 
 /// Binds the entries of `v` as `{name}{k}_{n}`.
-pub(super) fn bind_v3(b: &mut Builder, name: &str, n: impl std::fmt::Display, v: V3) -> V3 {
+pub(crate) fn bind_v3(b: &mut Builder, name: &str, n: impl std::fmt::Display, v: V3) -> V3 {
     let [x, y, z] = v;
     [b.bind(&format!("{name}1_{n}"), x), b.bind(&format!("{name}2_{n}"), y), b.bind(&format!("{name}3_{n}"), z)]
 }

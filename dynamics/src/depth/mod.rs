@@ -55,7 +55,7 @@ pub mod kinematics;
 pub mod scan;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 use crate::dirdyna::dirdyna_by;
 use crate::rnea::{motions, Drive, Motion};

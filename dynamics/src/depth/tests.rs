@@ -27,7 +27,7 @@ fn function(robot: &Robot, name: &str, write: Writer) -> Function {
 
 /// Every revolute joint continuous and read as Pinocchio's `(cos θ, sin θ)` pair, so the trig
 /// values are inputs (the error budget has no `sin`/`cos`).
-fn cos_sin(mut robot: Robot) -> Robot {
+pub(crate) fn cos_sin(mut robot: Robot) -> Robot {
     for j in &mut robot.joints {
         j.continuous = j.kind == JointKind::Revolute;
     }
@@ -37,7 +37,7 @@ fn cos_sin(mut robot: Robot) -> Robot {
 
 /// A state drawn with `seed`: parameters at their values, `(cos θ, sin θ)` of a drawn angle,
 /// a unit quaternion, the rest uniform in ±3 (gravity in ±10).
-fn state(robot: &Robot, seed: u64) -> BTreeMap<String, f64> {
+pub(crate) fn state(robot: &Robot, seed: u64) -> BTreeMap<String, f64> {
     let layout = Layout::of(robot);
     let mut given = layout.values.clone();
     let draw = |name: &str| 3.0 * interp::pseudo_random_input(name, seed);

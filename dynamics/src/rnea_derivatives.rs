@@ -1,0 +1,405 @@
+//! The analytical derivatives of the inverse dynamics, ∂τ/∂q and ∂τ/∂v (issue 50 item 2: the
+//! recursions of Carpentier & Mansard, "Analytical derivatives of rigid body dynamics
+//! algorithms", RSS 2018, written by the generator), in the world frame.
+//!
+//! # Formulation
+//! Plücker coordinates in the world frame at the world origin: a motion `(v; ω)` (the velocity
+//! of the point at the origin, the angular velocity), a force `(F; N)` (the moment about the
+//! origin), their pairing `v·F + ω·N`. Joint column `S_j`: `(o × z; z)` for a revolute joint of
+//! world axis `z` through `o`, `(z; 0)` prismatic, the base frame's unit twists for a free flyer
+//! (Pinocchio's tangent space: the derivatives come out along it, with no map). Per body `k`
+//! (parent `λ`): `V_k = V_λ + Σ S_j q̇_j`, `A_k = A_λ + Σ S_j q̈_j + Σ (V_k × S_j) q̇_j` with
+//! `A_0 = (−g; 0)`, the spatial inertia `I_k` about the origin (mass `m`, first moment `h = m c`,
+//! second moment `J`), `f_k = I_k A_k + V_k ×* I_k V_k`. Per subtree: its inertia `Ic`, force
+//! `F`, momentum `Hc = Σ I_k V_k` and the rate of its inertia `İc = Σ ([V_k×*] I_k − I_k [V_k×])`
+//! (a spatial inertia with zero mass: `ḣ = m v + ω × h`, `J̇ = [ω]×J − J[ω]× − (h vᵀ + v hᵀ) +
+//! 2 (v·h) 1`).
+//!
+//! Moving `q_j` moves the subtree of `j` rigidly (`S_j ×`) and, beyond that, changes its bodies'
+//! velocities by `w_j = V_λ(j) × S_j` and accelerations by `p_j + w_j × V_k`, `p_j = A_λ(j) × S_j
+//! − w_j × V_λ(j)`; the rigid part cancels in `τ_i = S_i·F_i` when `S_i` moves with it. So, with
+//! `B x = İc x + x ×* Hc` (the rate of `Σ I_k (x × V_k) + x ×* I_k V_k + V_k ×* I_k x`):
+//! - `j` an ancestor-or-self of `i`: `∂τ_i/∂q_j = r1_i·p_j + r2_i·w_j` and
+//!   `∂τ_i/∂q̇_j = r1_i·(w_j + Ṡ_j) + r2_i·S_j`, with `r1_i = Ic_i S_i`, `r2_i = İc_i S_i −
+//!   S_i ×* Hc_i` (subtree of `i`) and `Ṡ_j = V_k × S_j` (`k` the body of `j`);
+//! - `i` a strict ancestor of `j`: `∂τ_i/∂q_j = S_i·(S_j ×* F_j + Ic_j p_j + B_j w_j)` and
+//!   `∂τ_i/∂q̇_j = S_i·(Ic_j (w_j + Ṡ_j) + B_j S_j)` (subtree of `j`);
+//! - 0 otherwise.
+//!
+//! Per pair two 6-vector pairings (one where `i` is above `j`), after a pass over the bodies.
+
+use crate::depth::kinematics::{bind_v3, vdot, vscale, Frames};
+use crate::rnea::{cross, matvec, motions, vadd, Drive, M3, V3};
+use crate::robot::JointKind;
+use crate::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
+use crate::{Layout, Model, Stopped};
+
+/// A spatial vector: linear part, angular part (a motion `(v; ω)` or a force `(F; N)`).
+type S6 = [V3; 2];
+
+fn zero3() -> V3 {
+    [ZERO, ZERO, ZERO]
+}
+
+fn zero6() -> S6 {
+    [zero3(), zero3()]
+}
+
+fn add6(a: &S6, b: &S6) -> S6 {
+    [vadd(&a[0], &b[0]), vadd(&a[1], &b[1])]
+}
+
+fn sub3(a: &V3, b: &V3) -> V3 {
+    [0, 1, 2].map(|k| sub(a[k].clone(), b[k].clone()))
+}
+
+fn scale6(a: &S6, s: &Term) -> S6 {
+    [vscale(&a[0], s), vscale(&a[1], s)]
+}
+
+/// Motion cross motion: `(ω₁ × v₂ + v₁ × ω₂; ω₁ × ω₂)`.
+fn mcross(a: &S6, b: &S6) -> S6 {
+    [vadd(&cross(&a[1], &b[0]), &cross(&a[0], &b[1])), cross(&a[1], &b[1])]
+}
+
+/// Motion cross force: `(ω × F; ω × N + v × F)`.
+fn fcross(m: &S6, f: &S6) -> S6 {
+    [cross(&m[1], &f[0]), vadd(&cross(&m[1], &f[1]), &cross(&m[0], &f[0]))]
+}
+
+/// The pairing of a motion and a force, `v·F + ω·N`.
+fn pair(m: &S6, f: &S6) -> Term {
+    add(vdot(&m[0], &f[0]), vdot(&m[1], &f[1]))
+}
+
+fn bind6(b: &mut Builder, name: &str, n: impl std::fmt::Display + Copy, x: S6) -> S6 {
+    let [l, a] = x;
+    [bind_v3(b, &format!("{name}l"), n, l), bind_v3(b, &format!("{name}a"), n, a)]
+}
+
+/// A spatial inertia about the world origin: mass, first moment `h = m c`, second moment `J`
+/// (symmetric). With `mass` zero it holds a rate of change (`İ`).
+#[derive(Clone)]
+struct Inertia {
+    mass: Term,
+    h: V3,
+    j: M3,
+}
+
+impl Inertia {
+    fn zero() -> Inertia {
+        Inertia { mass: ZERO, h: zero3(), j: Default::default() }
+    }
+
+    /// `I·(v; ω) = (m v − h × ω; h × v + J ω)`.
+    fn apply(&self, x: &S6) -> S6 {
+        let lin = sub3(&vscale(&x[0], &self.mass), &cross(&self.h, &x[1]));
+        let ang = vadd(&cross(&self.h, &x[0]), &matvec(&self.j, &x[1], false));
+        [lin, ang]
+    }
+
+    fn plus(&self, o: &Inertia) -> Inertia {
+        let j = [0, 1, 2].map(|r| [0, 1, 2].map(|c| add(self.j[r][c].clone(), o.j[r][c].clone())));
+        Inertia { mass: add(self.mass.clone(), o.mass.clone()), h: vadd(&self.h, &o.h), j }
+    }
+
+    /// Its entries bound (the upper triangle of `J`, mirrored).
+    fn bind(self, b: &mut Builder, name: &str, n: usize) -> Inertia {
+        let mass = b.bind(&format!("{name}m{n}"), self.mass);
+        let h = bind_v3(b, &format!("{name}h"), n, self.h);
+        let mut j: M3 = Default::default();
+        for r in 0..3 {
+            for c in r..3 {
+                let t = b.bind(&format!("{name}J{}{}_{n}", r + 1, c + 1), self.j[r][c].clone());
+                j[r][c] = t.clone();
+                j[c][r] = t;
+            }
+        }
+        Inertia { mass, h, j }
+    }
+}
+
+/// One velocity coordinate: its index (1-based), its body, its column `S`.
+struct Column {
+    index: usize,
+    body: usize,
+    s: S6,
+}
+
+/// Writes `rnea_derivatives` (outputs `dtau_dq[i][j]`, `dtau_dv[i][j]`, `i, j = 1..=nv`, row
+/// by row, along Pinocchio's tangent space) by the formulation of the module doc: inputs `q`,
+/// `qd`, `qdd`, `g` (and the parameters).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per body and per row).
+pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+    let robot = &model.robot;
+    let nv = layout.nv;
+    let drive = Drive::inputs(b, nv, true);
+    let motions = motions(model, layout, b);
+    let frames = Frames::of(model, layout, b, &motions)?;
+    let Frames { order, parent, moves, rw, z, o, .. } = &frames;
+    let nb = order.len();
+    // The columns, by velocity coordinate.
+    let mut columns: Vec<Column> = Vec::with_capacity(nv);
+    for (i, &jn) in order.iter().enumerate() {
+        let body = i + 1;
+        let Some(qi) = layout.v_index[i] else { continue };
+        match robot.joints[jn].kind {
+            JointKind::Revolute => {
+                let s = [bind_v3(b, "SL", body, cross(&o[body], &z[body])), z[body].clone()];
+                columns.push(Column { index: qi, body, s });
+            }
+            JointKind::Prismatic => columns.push(Column { index: qi, body, s: [z[body].clone(), zero3()] }),
+            JointKind::FreeFlyer => {
+                for k in 0..3 {
+                    let e = [0, 1, 2].map(|r| rw[body][r][k].clone());
+                    columns.push(Column { index: qi + k, body, s: [e, zero3()] });
+                }
+                for k in 0..3 {
+                    let e = [0, 1, 2].map(|r| rw[body][r][k].clone());
+                    let l = bind_v3(b, "SL", format_args!("{body}_{k}"), cross(&o[body], &e));
+                    columns.push(Column { index: qi + 3 + k, body, s: [l, e] });
+                }
+            }
+            JointKind::Fixed => {}
+        }
+    }
+    columns.sort_by_key(|c| c.index);
+    assert_eq!(columns.len(), nv, "one column per velocity coordinate");
+    let mut of_body: Vec<Vec<usize>> = vec![Vec::new(); nb + 1];
+    for (k, c) in columns.iter().enumerate() {
+        of_body[c.body].push(k);
+    }
+    // Forward: velocities and accelerations.
+    let mut vel: Vec<S6> = vec![zero6(); nb + 1];
+    let mut acc: Vec<S6> = vec![zero6(); nb + 1];
+    acc[0] = [drive.g.clone().map(neg), zero3()];
+    for body in 1..=nb {
+        b.check(body, nb)?;
+        let p = parent[body];
+        let mut v = vel[p].clone();
+        for &k in &of_body[body] {
+            v = add6(&v, &scale6(&columns[k].s, &drive.qd[columns[k].index - 1]));
+        }
+        let v = bind6(b, "V", body, v);
+        let mut a = acc[p].clone();
+        for &k in &of_body[body] {
+            let c = &columns[k];
+            a = add6(&a, &scale6(&c.s, &drive.qdd[c.index - 1]));
+            a = add6(&a, &scale6(&mcross(&v, &c.s), &drive.qd[c.index - 1]));
+        }
+        acc[body] = bind6(b, "A", body, a);
+        vel[body] = v;
+    }
+    // Per body: inertia about the origin, force, momentum, rate of inertia; then per subtree.
+    let mut ic: Vec<Inertia> = vec![Inertia::zero(); nb + 1];
+    let mut idot: Vec<Inertia> = vec![Inertia::zero(); nb + 1];
+    let mut force: Vec<S6> = vec![zero6(); nb + 1];
+    let mut momentum: Vec<S6> = vec![zero6(); nb + 1];
+    for body in (1..=nb).filter(|&x| moves[x]) {
+        b.check(body, nb)?;
+        let rot = &rw[body];
+        let mass = layout.param(b, &format!("m[{body}]"));
+        let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
+        let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
+        let c = bind_v3(b, "CW", body, vadd(&o[body], &matvec(rot, &l, false)));
+        let h = bind_v3(b, "HW", body, vscale(&c, &mass));
+        // J = R In Rᵀ + m (|c|² 1 − c cᵀ) = R In Rᵀ + (c·h) 1 − c hᵀ.
+        let r_in: M3 =
+            [0, 1, 2].map(|r| [0, 1, 2].map(|k| sum((0..3).map(|m| mul(rot[r][m].clone(), inn[m][k].clone())))));
+        let ch = vdot(&c, &h);
+        let ch = b.bind(&format!("CH{body}"), ch);
+        let j: M3 = [0, 1, 2].map(|r| {
+            [0, 1, 2].map(|k| {
+                let rot_part = sum((0..3).map(|m| mul(r_in[r][m].clone(), rot[k][m].clone())));
+                let diag = if r == k { ch.clone() } else { ZERO };
+                sub(add(rot_part, diag), mul(c[r].clone(), h[k].clone()))
+            })
+        });
+        let inertia = Inertia { mass, h, j }.bind(b, "IO", body);
+        let v = &vel[body];
+        let hk = bind6(b, "HK", body, inertia.apply(v));
+        let f = add6(&inertia.apply(&acc[body]), &fcross(v, &hk));
+        force[body] = f;
+        momentum[body] = hk;
+        // İ: ḣ = m v + ω × h, J̇ = [ω]×J − J[ω]× − (h vᵀ + v hᵀ) + 2 (v·h) 1.
+        let (lin, om) = (&v[0], &v[1]);
+        let hdot = vadd(&vscale(lin, &inertia.mass), &cross(om, &inertia.h));
+        let wj: M3 = [0, 1, 2].map(|k| cross(om, &[0, 1, 2].map(|r| inertia.j[r][k].clone())));
+        // `wj[k]` is column k of [ω]×J; (J[ω]×)[r][k] = −([ω]×J)[k][r] (J symmetric).
+        let vh = b.bind(&format!("VH{body}"), vdot(lin, &inertia.h));
+        let jdot: M3 = [0, 1, 2].map(|r| {
+            [0, 1, 2].map(|k| {
+                let rot_part = add(wj[k][r].clone(), wj[r][k].clone());
+                let outer = add(mul(inertia.h[r].clone(), lin[k].clone()), mul(lin[r].clone(), inertia.h[k].clone()));
+                let diag = if r == k { mul(Term::C(2.0), vh.clone()) } else { ZERO };
+                add(sub(rot_part, outer), diag)
+            })
+        });
+        idot[body] = Inertia { mass: ZERO, h: hdot, j: jdot }.bind(b, "ID", body);
+        ic[body] = inertia;
+    }
+    // Subtree sums, leaves to root (a body's index is above its parent's).
+    for body in (1..=nb).rev() {
+        b.check(body, nb)?;
+        if !moves[body] {
+            continue;
+        }
+        ic[body] = ic[body].clone().bind(b, "IC", body);
+        idot[body] = idot[body].clone().bind(b, "IDC", body);
+        force[body] = bind6(b, "FC", body, force[body].clone());
+        momentum[body] = bind6(b, "HC", body, momentum[body].clone());
+        let p = parent[body];
+        if p != 0 && moves[p] {
+            ic[p] = ic[p].plus(&ic[body]);
+            idot[p] = idot[p].plus(&idot[body]);
+            force[p] = add6(&force[p], &force[body]);
+            momentum[p] = add6(&momentum[p], &momentum[body]);
+        }
+    }
+    // Per column: w, Ṡ, p; r1, r2 (over its body's subtree); and the terms for its ancestors.
+    let mut w: Vec<S6> = Vec::with_capacity(nv);
+    let mut sdot: Vec<S6> = Vec::with_capacity(nv);
+    let mut pj: Vec<S6> = Vec::with_capacity(nv);
+    let mut r1: Vec<S6> = Vec::with_capacity(nv);
+    let mut r2: Vec<S6> = Vec::with_capacity(nv);
+    let mut g_q: Vec<S6> = Vec::with_capacity(nv);
+    let mut g_v: Vec<S6> = Vec::with_capacity(nv);
+    for (k, c) in columns.iter().enumerate() {
+        b.check_at(crate::Reached::Row { row: k + 1, rows: nv })?;
+        let (body, s) = (c.body, &c.s);
+        let p = parent[body];
+        let wk = bind6(b, "WJ", k + 1, mcross(&vel[p], s));
+        let sd = bind6(b, "SD", k + 1, mcross(&vel[body], s));
+        let pk = bind6(b, "PJ", k + 1, sub6(&mcross(&acc[p], s), &mcross(&wk, &vel[p])));
+        let (icb, idb, hc) = (&ic[body], &idot[body], &momentum[body]);
+        let r1k = bind6(b, "R1", k + 1, icb.apply(s));
+        let r2k = bind6(b, "R2", k + 1, sub6(&idb.apply(s), &fcross(s, hc)));
+        let bop = |x: &S6| add6(&idb.apply(x), &fcross(x, hc));
+        let gq = add6(&add6(&fcross(s, &force[body]), &icb.apply(&pk)), &bop(&wk));
+        let gv = add6(&icb.apply(&add6(&wk, &sd)), &bop(s));
+        g_q.push(bind6(b, "GQ", k + 1, gq));
+        g_v.push(bind6(b, "GV", k + 1, gv));
+        w.push(wk);
+        sdot.push(sd);
+        pj.push(pk);
+        r1.push(r1k);
+        r2.push(r2k);
+    }
+    // Whether body `a` is `x` or one of its ancestors.
+    let ancestor_or_self = |a: usize, mut x: usize| {
+        while x != 0 {
+            if x == a {
+                return true;
+            }
+            x = parent[x];
+        }
+        false
+    };
+    let mut rows: Vec<Vec<(Term, Term)>> = Vec::with_capacity(nv);
+    for i in 0..nv {
+        b.check_at(crate::Reached::Row { row: i + 1, rows: nv })?;
+        let bi = columns[i].body;
+        let mut row = Vec::with_capacity(nv);
+        for j in 0..nv {
+            let bj = columns[j].body;
+            let entry = if ancestor_or_self(bj, bi) {
+                let dq = add(pair(&pj[j], &r1[i]), pair(&w[j], &r2[i]));
+                let dv = add(pair(&add6(&w[j], &sdot[j]), &r1[i]), pair(&columns[j].s, &r2[i]));
+                (dq, dv)
+            } else if ancestor_or_self(bi, bj) {
+                (pair(&columns[i].s, &g_q[j]), pair(&columns[i].s, &g_v[j]))
+            } else {
+                (ZERO, ZERO)
+            };
+            row.push(entry);
+        }
+        rows.push(row);
+    }
+    for (i, row) in rows.iter().enumerate() {
+        for (j, (dq, _)) in row.iter().enumerate() {
+            b.output(&format!("dtau_dq[{}][{}]", i + 1, j + 1), &format!("dtau_dq{}_{}", i + 1, j + 1), dq.clone());
+        }
+        for (j, (_, dv)) in row.iter().enumerate() {
+            b.output(&format!("dtau_dv[{}][{}]", i + 1, j + 1), &format!("dtau_dv{}_{}", i + 1, j + 1), dv.clone());
+        }
+    }
+    Ok(())
+}
+
+fn sub6(a: &S6, b: &S6) -> S6 {
+    [sub3(&a[0], &b[0]), sub3(&a[1], &b[1])]
+}
+
+#[cfg(test)]
+mod tests {
+    use robovec_ir::interp;
+    use robovec_ir::time_limit::Ticker;
+
+    use crate::depth::tests::{cos_sin, state};
+    use crate::robot::{JointKind, Robot};
+    use crate::sym::Builder;
+    use crate::topology::{build, Topology};
+    use crate::{Layout, Model};
+
+    /// The worst `|analytical − diff| / (1 + max |diff|)` over three states: the analytical
+    /// ∂τ/∂q, ∂τ/∂v against `diff` on the body-frame RNEA (`invdyna`, checked against Pinocchio
+    /// and finite differences in `tests/diff.rs`) mapped to the tangent space, parameters as
+    /// inputs at their values.
+    fn worst(robot: Robot) -> f64 {
+        let model = Model { robot };
+        let layout = Layout::of(&model.robot);
+        let mut b = Builder::new("rnea_derivatives", Default::default());
+        super::rnea_derivatives(&model, &layout, &mut b).expect("no deadline");
+        let analytical = b.finish();
+        let mut b = Builder::new("invdyna", Default::default());
+        crate::rnea::invdyna(&model, &layout, &mut b).expect("no deadline");
+        let coords = crate::tangent::coordinates(&model.robot, &layout);
+        let by_diff = crate::derive(&b.finish(), &crate::DERIVED[0], coords.as_deref(), &Ticker::new(None, None))
+            .expect("no deadline");
+        assert_eq!(analytical.outputs.len(), 2 * layout.nv * layout.nv);
+        let mut worst: f64 = 0.0;
+        for seed in 1..=3 {
+            let given = state(&model.robot, seed);
+            let at = |name: &str| *given.get(name).unwrap_or_else(|| panic!("input {name}"));
+            let a: std::collections::BTreeMap<String, f64> = interp::eval::<f64>(&analytical, at).into_iter().collect();
+            let d: std::collections::BTreeMap<String, f64> = interp::eval::<f64>(&by_diff, at).into_iter().collect();
+            let scale = d.values().fold(0.0f64, |m, x| m.max(x.abs()));
+            // `diff` writes no column for a coordinate the function does not read: 0 there.
+            for (name, x) in &a {
+                worst = worst.max((x - d.get(name).copied().unwrap_or(0.0)).abs() / (1.0 + scale));
+            }
+            assert!(d.keys().all(|n| a.contains_key(n)), "every derivative of diff's is written");
+        }
+        worst
+    }
+
+    /// Every joint kind and base: revolute chains and trees, prismatic joints, Pinocchio's
+    /// free flyer, continuous joints as `(cos, sin)` pairs.
+    #[test]
+    fn analytical_derivatives_equal_diff_on_the_rnea() {
+        let mut prismatic = build(Topology::Serial, 7, 2);
+        for (k, j) in prismatic.joints.iter_mut().enumerate() {
+            if k % 3 == 1 && j.kind == JointKind::Revolute {
+                j.kind = JointKind::Prismatic;
+                j.continuous = false;
+            }
+        }
+        let cases = [
+            ("serial 7", build(Topology::Serial, 7, 1)),
+            ("semi-serial 9", build(Topology::SemiSerial, 9, 1)),
+            ("prismatic", prismatic),
+            ("parallel 9, free flyer", build(Topology::Parallel, 9, 3).with_free_flyer().expect("free names")),
+            ("semi-serial 9, cos-sin", cos_sin(build(Topology::SemiSerial, 9, 4))),
+            (
+                "serial 6, free flyer, cos-sin",
+                cos_sin(build(Topology::Serial, 6, 5)).with_free_flyer().expect("free names"),
+            ),
+        ];
+        for (label, robot) in cases {
+            let e = worst(robot);
+            assert!(e <= 1e-10, "{label}: {e:e}");
+        }
+    }
+}
