@@ -244,7 +244,7 @@ fn ltdl_with(
         b.output(&format!("qdd[{}]", i + 1), &format!("qdd{}", i + 1), t);
     }
     if with_inverse {
-        inverse(b, &h, &inv_d, &lambda)?;
+        inverse(b, &h, &inv_d, &lambda, true)?;
     }
     Ok(())
 }
@@ -303,6 +303,7 @@ fn inverse(
     h: &FxHashMap<(usize, usize), Term>,
     inv_d: &[Term],
     lambda: &[usize],
+    factors: bool,
 ) -> Result<(), Stopped> {
     let nq = lambda.len() - 1;
     let at = |k: usize| Reached::Row { row: k, rows: nq };
@@ -354,6 +355,17 @@ fn inverse(
             b.output_with(format!("Minv[{a}][{c}]"), || format!("Minv{a}_{c}"), t);
         }
     }
+    if factors {
+        // `U[i][a]` for the strict ancestors `i` of `a` (`U[a][a] = 1`), then `iD[i]` = 1/D[i].
+        for (a, column) in u.iter().enumerate().skip(1) {
+            for (i, t) in column.iter().filter(|(i, _)| *i != a) {
+                b.output_with(format!("U[{i}][{a}]"), || format!("Uo{i}_{a}"), t.clone());
+            }
+        }
+        for (i, t) in inv_d.iter().enumerate().skip(1) {
+            b.output_with(format!("iD[{i}]"), || format!("iDo{i}"), t.clone());
+        }
+    }
     Ok(())
 }
 
@@ -371,12 +383,13 @@ pub fn minv(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopp
         h.insert((j, i), t);
     }
     let inv_d = factor(b, &mut h, &lambda)?;
-    inverse(b, &h, &inv_d, &lambda)
+    inverse(b, &h, &inv_d, &lambda, false)
 }
 
 /// Writes `fordyna` by the CRBA and `LᵀDL` ([`ltdl_by`]) and, from the same factors, `M⁻¹`
-/// ([`inverse`]): outputs `qdd[1..nq]`, then `Minv[a][c]`. What the forward dynamics'
-/// derivatives through the inverse dynamics read ([`crate::implicit`]).
+/// ([`inverse`]): outputs `qdd[1..nq]`, `Minv[a][c]`, then the factors of `M⁻¹ = Uᵀ D⁻¹ U`:
+/// `U[i][a]` for each strict ancestor `i` of `a` and `iD[i] = 1/D[i]`. What the forward
+/// dynamics' derivatives through the inverse dynamics read ([`crate::implicit`]).
 ///
 /// # Errors
 /// [`Stopped`] at the builder's deadline.

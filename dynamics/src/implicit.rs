@@ -82,15 +82,50 @@ pub(crate) fn aba_derivatives(partials: &Function, solved: &Function, ticker: &T
     let dq = matrix(renamed.iter().copied(), "dtau_dq");
     let dv = matrix(renamed.iter().copied(), "dtau_dv");
     let nv = qdd.len();
+    // M⁻¹·x as Uᵀ·(D⁻¹·(U·x)) by the factors: `U[i][a]` only for `i` an ancestor-or-self of `a`.
+    let factors = matrix(outputs.iter().map(|o| (o.name.as_str(), o.value)), "U");
+    let inv_d: Vec<Operand> = (1..=nv)
+        .map(|i| outputs.iter().find(|o| o.name == format!("iD[{i}]")).map(|o| o.value).expect("iD written"))
+        .collect();
+    let mut below: Vec<Vec<(usize, Operand)>> = vec![Vec::new(); nv + 1];
+    let mut above: Vec<Vec<(usize, Operand)>> = vec![Vec::new(); nv + 1];
+    for a in 1..=nv {
+        below[a].push((a, Operand::Const(1.0)));
+        above[a].push((a, Operand::Const(1.0)));
+    }
+    for (&(i, a), &u) in &factors {
+        below[i].push((a, u));
+        above[a].push((i, u));
+    }
     let mut w = Ops::new(&mut f, PREFIX);
+    let neg_inv_d: Vec<Operand> = inv_d.iter().map(|&d| w.op(robovec_ir::BinOp::Sub, Operand::Const(0.0), d)).collect();
     let entry = |m: &BTreeMap<(usize, usize), Operand>, i, j| m.get(&(i, j)).copied().unwrap_or(Operand::Const(0.0));
+    // Column j of −M⁻¹·X for X = ∂τ/∂q, ∂τ/∂v.
+    let mut columns: BTreeMap<(&str, usize), Vec<Operand>> = BTreeMap::new();
+    for (name, d) in [("ddq_dq", &dq), ("ddq_dv", &dv)] {
+        for j in 1..=nv {
+            let y: Vec<Operand> = (1..=nv)
+                .map(|i| {
+                    let terms: Vec<(Operand, Operand, bool)> =
+                        below[i].iter().map(|&(a, u)| (u, entry(d, a, j), false)).collect();
+                    let s = w.dot(&terms);
+                    w.op(robovec_ir::BinOp::Mul, neg_inv_d[i - 1], s)
+                })
+                .collect();
+            let out: Vec<Operand> = (1..=nv)
+                .map(|a| {
+                    let terms: Vec<(Operand, Operand, bool)> =
+                        above[a].iter().map(|&(i, u)| (u, y[i - 1], false)).collect();
+                    w.dot(&terms)
+                })
+                .collect();
+            columns.insert((name, j), out);
+        }
+    }
     for i in 1..=nv {
-        for (name, d) in [("ddq_dq", &dq), ("ddq_dv", &dv)] {
+        for name in ["ddq_dq", "ddq_dv"] {
             for j in 1..=nv {
-                let terms: Vec<(Operand, Operand, bool)> =
-                    (1..=nv).map(|k| (entry(&minv, i, k), entry(d, k, j), true)).collect();
-                let value = w.dot(&terms);
-                w.f.set_output(format!("{name}[{i}][{j}]"), value, Span::DUMMY);
+                w.f.set_output(format!("{name}[{i}][{j}]"), columns[&(name, j)][i - 1], Span::DUMMY);
             }
         }
         for j in 1..=nv {
