@@ -290,3 +290,41 @@ fn derivatives_are_along_pinocchios_tangent_space() {
         }
     }
 }
+
+/// The derivative functions' trig variables keep their coordinate's names (`%C4 = cos %q[4]`,
+/// `%S4`), which `codegen<c;trig=input>` takes as inputs and the bench feeds by name: Panda's
+/// `aba_derivatives` reads `cos q[1]` through `rnea_derivatives` where its `fordyna` does not
+/// (its first axis is along gravity), and that variable was once named after the pass.
+#[test]
+fn derivative_functions_name_their_trig_variables_by_coordinate() {
+    use crate::pinocchio::{oracle, python, Base};
+    let Some(py) = python() else { return };
+    let o = oracle(&py, "erd:panda_description/urdf/panda.urdf", 1, 1, Base::Fixed);
+    let dir = tmp("trig_names");
+    for function in ["rnea_derivatives", "aba_derivatives", "minv"] {
+        let out_path = dir.join(format!("{function}.rvir"));
+        let function_arg = format!("-function={function}");
+        let out = crate::common::opt(&[
+            &o.path,
+            "--fold-params",
+            "-gravity=0,0,-9.81",
+            &function_arg,
+            "-passes=atomise,cse",
+            "-o",
+            out_path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{function}: {}", crate::common::stderr(&out));
+        let text = std::fs::read_to_string(&out_path).unwrap();
+        let mut seen = 0;
+        for line in text.lines() {
+            let Some((name, def)) = line.trim().split_once(" = ") else { continue };
+            for (fun, letter) in [("cos %q[", 'C'), ("sin %q[", 'S')] {
+                if let Some(i) = def.strip_prefix(fun).and_then(|r| r.strip_suffix(']')) {
+                    assert_eq!(name, format!("%{letter}{i}"), "{function}: {line}");
+                    seen += 1;
+                }
+            }
+        }
+        assert!(seen >= 12, "{function}: {seen} trig variables");
+    }
+}

@@ -65,13 +65,37 @@ pub(crate) fn aba_derivatives(partials: &Function, solved: &Function, ticker: &T
         c => c,
     };
     let mut count = 0;
+    // The trig variables `f` has (`C1 = cos q[1]`): the partials' own are these, or are added
+    // under their own names (`C4`, `S4`: what `trig=input` and the reports read them by).
+    let mut trig: HashMap<(robovec_ir::TrigFn, robovec_ir::Value), robovec_ir::Value> = f
+        .body
+        .iter()
+        .filter_map(|&v| match f.value(v).def {
+            Def::Trig(t, x) => Some(((t, x), v)),
+            _ => None,
+        })
+        .collect();
     for &v in &partials.body {
+        if let Def::Trig(t, x) = partials.value(v).def {
+            let Operand::Value(y) = at(&map, Operand::Value(x)) else { unreachable!("a trig variable of a constant") };
+            let existing = trig.get(&(t, y)).copied();
+            let value = existing.unwrap_or_else(|| {
+                let name = partials.name_of(v);
+                let def = Def::Trig(t, y);
+                let made = if f.lookup(name).is_none() {
+                    f.define(name.to_string(), def, Span::DUMMY).expect("a free name")
+                } else {
+                    f.define_counted(PREFIX, &mut count, def, Span::DUMMY)
+                };
+                trig.insert((t, y), made);
+                made
+            });
+            map[v.index()] = Some(Operand::Value(value));
+            continue;
+        }
         let def = match &partials.value(v).def {
             Def::Binary(o, a, b) => Def::Binary(*o, at(&map, *a), at(&map, *b)),
-            Def::Trig(t, x) => match at(&map, Operand::Value(*x)) {
-                Operand::Value(y) => Def::Trig(*t, y),
-                c => unreachable!("a trig variable of the constant {c:?}"),
-            },
+            Def::Trig(..) => unreachable!("handled above"),
             Def::Call(callee, args) => Def::Call(callee.clone(), args.iter().map(|&a| at(&map, a)).collect()),
             Def::Input | Def::Expr(_) => unreachable!("an atomised body"),
         };
