@@ -335,17 +335,17 @@ fn inverse(
     }
     let mut mark: Vec<Option<Term>> = vec![None; nq + 1];
     let mut upper: FxHashMap<(usize, usize), Term> = FxHashMap::default();
-    for a in 1..=nq {
+    for (a, wa) in w.iter().enumerate().skip(1) {
         b.check_at(at(a))?;
-        for (i, t) in &w[a] {
+        for (i, t) in wa {
             mark[*i] = Some(t.clone());
         }
-        for c in a..=nq {
-            let terms = u[c].iter().filter_map(|(i, t)| mark[*i].clone().map(|wa| mul(wa, t.clone())));
+        for (c, uc) in u.iter().enumerate().skip(a) {
+            let terms = uc.iter().filter_map(|(i, t)| mark[*i].clone().map(|x| mul(x, t.clone())));
             let t = crate::sym::sum(terms);
             upper.insert((a, c), b.bind(&format!("MI{a}_{c}"), t));
         }
-        for (i, _) in &w[a] {
+        for (i, _) in wa {
             mark[*i] = None;
         }
     }
@@ -370,8 +370,8 @@ fn inverse(
 }
 
 /// Writes `minv` (outputs `Minv[a][c]`, `a, c = 1..=nq`, both triangles; Pinocchio's
-/// `computeMinverse`) into `b`: `M` by the CRBA, its `LᵀDL` ([`factor`]) and the product of the
-/// inverted factors over common ancestors ([`inverse`]). Inputs: `q` (and the parameters).
+/// `computeMinverse`) into `b`: `M` by the CRBA, its `LᵀDL` (`factor`) and the product of the
+/// inverted factors over common ancestors (`inverse`). Inputs: `q` (and the parameters).
 ///
 /// # Errors
 /// [`Stopped`] at the builder's deadline.
@@ -386,10 +386,10 @@ pub fn minv(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopp
     inverse(b, &h, &inv_d, &lambda, false)
 }
 
-/// Writes `fordyna` by the CRBA and `LᵀDL` ([`ltdl_by`]) and, from the same factors, `M⁻¹`
-/// ([`inverse`]): outputs `qdd[1..nq]`, `Minv[a][c]`, then the factors of `M⁻¹ = Uᵀ D⁻¹ U`:
+/// Writes `fordyna` by the CRBA and `LᵀDL` (`ltdl_by`) and, from the same factors, `M⁻¹`
+/// (`inverse`): outputs `qdd[1..nq]`, `Minv[a][c]`, then the factors of `M⁻¹ = Uᵀ D⁻¹ U`:
 /// `U[i][a]` for each strict ancestor `i` of `a` and `iD[i] = 1/D[i]`. What the forward
-/// dynamics' derivatives through the inverse dynamics read ([`crate::implicit`]).
+/// dynamics' derivatives through the inverse dynamics read (`implicit.rs`).
 ///
 /// # Errors
 /// [`Stopped`] at the builder's deadline.

@@ -32,6 +32,8 @@ use crate::depth::kinematics::{bind_v3, vdot, vscale, Frames};
 use crate::rnea::{cross, matvec, motions, vadd, Drive, M3, V3};
 use crate::robot::JointKind;
 use crate::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
+use rustc_hash::FxHashMap;
+
 use crate::{Layout, Model, Stopped};
 
 /// A spatial vector: linear part, angular part (a motion `(v; ω)` or a force `(F; N)`).
@@ -107,14 +109,13 @@ impl Inertia {
     fn bind(self, b: &mut Builder, name: &str, n: usize) -> Inertia {
         let mass = b.bind(&format!("{name}m{n}"), self.mass);
         let h = bind_v3(b, &format!("{name}h"), n, self.h);
-        let mut j: M3 = Default::default();
-        for r in 0..3 {
-            for c in r..3 {
-                let t = b.bind(&format!("{name}J{}{}_{n}", r + 1, c + 1), self.j[r][c].clone());
-                j[r][c] = t.clone();
-                j[c][r] = t;
+        let mut upper: FxHashMap<(usize, usize), Term> = FxHashMap::default();
+        for (r, row) in self.j.iter().enumerate() {
+            for (c, x) in row.iter().enumerate().skip(r) {
+                upper.insert((r, c), b.bind(&format!("{name}J{}{}_{n}", r + 1, c + 1), x.clone()));
             }
         }
+        let j: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| upper[&(r.min(c), r.max(c))].clone()));
         Inertia { mass, h, j }
     }
 }
@@ -152,12 +153,12 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
             }
             JointKind::Prismatic => columns.push(Column { index: qi, body, s: [z[body].clone(), zero3()] }),
             JointKind::FreeFlyer => {
-                for k in 0..3 {
-                    let e = [0, 1, 2].map(|r| rw[body][r][k].clone());
-                    columns.push(Column { index: qi + k, body, s: [e, zero3()] });
+                // The base frame's axes in the world: the columns of its rotation.
+                let axes: [V3; 3] = [0, 1, 2].map(|k| [0, 1, 2].map(|r| rw[body][r][k].clone()));
+                for (k, e) in axes.iter().enumerate() {
+                    columns.push(Column { index: qi + k, body, s: [e.clone(), zero3()] });
                 }
-                for k in 0..3 {
-                    let e = [0, 1, 2].map(|r| rw[body][r][k].clone());
+                for (k, e) in axes.into_iter().enumerate() {
                     let l = bind_v3(b, "SL", format_args!("{body}_{k}"), cross(&o[body], &e));
                     columns.push(Column { index: qi + 3 + k, body, s: [l, e] });
                 }
