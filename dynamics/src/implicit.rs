@@ -7,12 +7,14 @@
 //! `computeABADerivatives` does the same), and `∂q̈/∂τ = M⁻¹`. [`aba_derivatives`] writes that
 //! function: `fordyna` by the `LᵀDL` with `M⁻¹` from the same factors
 //! ([`crate::fordyna::fordyna_and_inverse`]: `q̈` and `M⁻¹` share the CRBA and the
-//! factorisation), the partials of `invdyna` (`rnea_derivatives`, rows along the tangent space) with
-//! its `qdd` inputs read from `q̈`, and the two products `−M⁻¹ · ∂τ_ID`, dense (`nv²·(2nv − 1)`
-//! ops each at most; structural zeros skipped).
+//! factorisation), the partials of the inverse dynamics (the `rnea_derivatives` the generator
+//! kept, rows along the tangent space) with their `qdd` inputs read from `q̈`, and the two
+//! products `−M⁻¹ · ∂τ_ID` by the factors, `−Uᵀ·(D⁻¹·(U·x))` per column `x` (`U = L⁻ᵀ` has
+//! entries only on ancestors: about `4·Σ(dₖ + 1) + nv` ops a column for coordinates at depth
+//! `dₖ`, against `2nv²` for a dense `M⁻¹`; structural zeros skipped).
 //!
 //! Which of this and `diff` through the whole of `fordyna` has fewer ops depends on the robot:
-//! the products grow as `nv³`, `diff` through the factorisation roughly as ops × inputs. The
+//! the products grow as `nv·Σ dₖ`, `diff` through the factorisation roughly as ops × inputs. The
 //! generator writes both and keeps the smaller (`crate::generate_with`); likewise for `minv`,
 //! `diff` along `τ` or the inverted factors ([`crate::fordyna::minv`], through [`compact`]).
 
