@@ -29,7 +29,7 @@
 //! Per pair two 6-vector pairings (one where `i` is above `j`), after a pass over the bodies.
 
 use crate::depth::kinematics::{bind_v3, vdot, vscale, Frames};
-use crate::rnea::{cross, matvec, motions, vadd, Drive, M3, V3};
+use crate::rnea::{cross, matvec, motions, numeric, vadd, Drive, M3, V3};
 use crate::robot::JointKind;
 use crate::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
 use rustc_hash::FxHashMap;
@@ -137,7 +137,16 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
     let robot = &model.robot;
     let nv = layout.nv;
     let drive = Drive::inputs(b, nv, true);
-    let motions = motions(model, layout, b);
+    let mut motions = motions(model, layout, b);
+    // The inertial frame that coincides with a free-flying root body's frame at this instant:
+    // its rotation leaves every body's pose and is left only in gravity, `g' = Rᵀ g`.
+    let mut gravity = drive.g.clone();
+    let roots = robot.body_parents(&robot.dfs_joints());
+    if let Some(root) = (1..motions.len()).find(|&k| roots[k] == 0 && motions[k].free.is_some()) {
+        let identity = numeric(&[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+        let r = motions[root].free.replace(identity).expect("found above");
+        gravity = bind_v3(b, "GB", root, matvec(&r, &gravity, true));
+    }
     let frames = Frames::of(model, layout, b, &motions)?;
     let Frames { order, parent, moves, rw, z, o, .. } = &frames;
     let nb = order.len();
@@ -175,7 +184,7 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
     // Forward: velocities and accelerations.
     let mut vel: Vec<S6> = vec![zero6(); nb + 1];
     let mut acc: Vec<S6> = vec![zero6(); nb + 1];
-    acc[0] = [drive.g.clone().map(neg), zero3()];
+    acc[0] = [gravity.map(neg), zero3()];
     for body in 1..=nb {
         b.check(body, nb)?;
         let p = parent[body];
