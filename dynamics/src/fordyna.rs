@@ -397,6 +397,16 @@ pub fn fordyna_and_inverse(model: &Model, layout: &Layout, b: &mut Builder) -> R
     ltdl_with(model, layout, b, &mut crba_rnea(model, layout), true)
 }
 
+/// [`fordyna_and_inverse`] with `M` and `c` in the world frame of the analytical `∂τ`
+/// ([`crate::rnea_derivatives::world_parts`]): what `aba_derivatives` shares its kinematics,
+/// inertias and `r1 = Ic S` with the partials through (`implicit.rs`).
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline.
+pub fn world_fordyna_and_inverse(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
+    ltdl_with(model, layout, b, &mut crate::rnea_derivatives::world_parts(model, layout), true)
+}
+
 #[cfg(test)]
 mod tests {
     use std::collections::BTreeMap;
@@ -419,13 +429,14 @@ mod tests {
         match how {
             How::Ops(how) => fordyna_with(&model, &layout, &mut b, how),
             How::Depth => crate::depth::fordyna(&model, &layout, &mut b),
+            How::World => super::world_fordyna_and_inverse(&model, &layout, &mut b),
         }
         .expect("no deadline");
         let fd = &b.finish();
         let mut b = crate::sym::Builder::new("dirdyna", Default::default());
         crate::dirdyna::dirdyna(&model, &layout, &mut b).expect("no deadline");
         let dir = &b.finish();
-        let nq = fd.outputs.len();
+        let nq = fd.outputs.iter().filter(|o| o.name.starts_with("qdd[")).count();
         assert_eq!(nq, layout.nv);
         let mut worst: f64 = 0.0;
         for seed in 1..=4u64 {
@@ -436,7 +447,7 @@ mod tests {
             for i in 1..=layout.nq {
                 given.insert(format!("q[{i}]"), 3.0 * interp::pseudo_random_input(&format!("q[{i}]"), seed));
             }
-            if matches!(how, How::Depth) && layout.nq > layout.nv {
+            if matches!(how, How::Depth | How::World) && layout.nq > layout.nv {
                 let n = (4..=7).map(|i| given[&format!("q[{i}]")].powi(2)).sum::<f64>().sqrt();
                 (4..=7).for_each(|i| *given.get_mut(&format!("q[{i}]")).expect("drawn") /= n);
             }
@@ -469,6 +480,9 @@ mod tests {
         Ops(Formulation),
         /// The depth formulation's ([`crate::depth::fordyna`]: its `M` and `c`, then `LᵀDL`).
         Depth,
+        /// `M` and `c` in the analytical derivatives' world frame, with `M⁻¹`'s factors
+        /// ([`super::world_fordyna_and_inverse`]).
+        World,
     }
 
     /// `M qdd + c = Qq` to 1e-10 on every topology family (chains, branches, stars), on
@@ -476,10 +490,11 @@ mod tests {
     /// same block, the ABA's 6 × 6 root solve) and with joints fixed
     /// between moving ones (coordinates whose parent is not the previous body); for the depth
     /// formulation's `fordyna` too, whose `M` and `c` are not the ones it is checked against
-    /// (world-frame prefixes there, the body-frame CRBA and RNEA here).
+    /// (world-frame prefixes there, the body-frame CRBA and RNEA here), and for `M` and `c` in
+    /// the analytical derivatives' world frame.
     #[test]
     fn forward_dynamics_inverts_the_mass_matrix() {
-        for how in [How::Ops(Formulation::Ltdl), How::Ops(Formulation::Aba), How::Depth] {
+        for how in [How::Ops(Formulation::Ltdl), How::Ops(Formulation::Aba), How::Depth, How::World] {
             forward_dynamics_inverts_the_mass_matrix_by(how);
         }
     }

@@ -648,8 +648,16 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
                             fewer(by_diff, implicit::compact(&analytical, &ticker))
                         }
                     };
+                    // `fordyna` in the body frames, or in the analytical partials' world frame
+                    // (their kinematics and inertias then shared): the fewer ops.
                     let solved = write_one(d.0, fordyna::fordyna_and_inverse)?.0;
-                    partials.and_then(|p| implicit::aba_derivatives(&p, &solved, &ticker))
+                    let world = write_one(d.0, fordyna::world_fordyna_and_inverse)?.0;
+                    partials.and_then(|p| {
+                        fewer(
+                            implicit::aba_derivatives(&p, &solved, &ticker),
+                            implicit::aba_derivatives(&p, &world, &ticker),
+                        )
+                    })
                 }
                 "minv" => implicit::compact(&write_one(d.0, fordyna::minv)?.0, &ticker),
                 _ => None,

@@ -29,7 +29,7 @@
 //! Per pair two 6-vector pairings (one where `i` is above `j`), after a pass over the bodies.
 
 use crate::depth::kinematics::{bind_v3, vdot, vscale, Frames};
-use crate::rnea::{cross, matvec, motions, numeric, vadd, Drive, M3, V3};
+use crate::rnea::{cross, matvec, motions, vadd, Drive, Motion, M3, V3};
 use crate::robot::JointKind;
 use crate::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
 use rustc_hash::FxHashMap;
@@ -127,6 +127,190 @@ struct Column {
     s: S6,
 }
 
+/// The world-frame quantities that the analytical `∂τ` ([`rnea_derivatives`]) and the
+/// world-frame `M` and `c` ([`world_parts`]) both read. Both write them alike, so that a function
+/// built from both (`aba_derivatives`, `crate::implicit`) shares them after `cse`.
+struct World {
+    frames: Frames,
+    /// The columns, by velocity coordinate (0-based).
+    columns: Vec<Column>,
+    /// Each body's velocity and acceleration (index = body, 0 the base).
+    vel: Vec<S6>,
+    acc: Vec<S6>,
+    /// Each moving body's inertia about the origin, momentum `I V` and force `I A + V ×* I V`.
+    inertia: Vec<Inertia>,
+    momentum: Vec<S6>,
+    force: Vec<S6>,
+}
+
+impl World {
+    /// Writes the frames, the columns, the velocities and accelerations (with `drive.qdd`, zero
+    /// for `c`) and each moving body's inertia, momentum and force. Coordinates are those of
+    /// the inertial frame that coincides with the moving root's frame at this instant (the
+    /// lowest body above every moving joint): its pose leaves every body's, and its rotation is
+    /// left only in gravity, `g' = R_rootᵀ g`.
+    ///
+    /// # Errors
+    /// [`Stopped`] at the builder's deadline (checked per body).
+    fn of(
+        model: &Model,
+        layout: &Layout,
+        b: &mut Builder,
+        motions: &[Motion],
+        drive: &Drive,
+    ) -> Result<World, Stopped> {
+        let robot = &model.robot;
+        let nv = layout.nv;
+        let order = robot.dfs_joints();
+        let parents = robot.body_parents(&order);
+        let moving: Vec<usize> = (1..=order.len()).filter(|&k| layout.v_index[k - 1].is_some()).collect();
+        let under = |a: usize, mut x: usize| loop {
+            if x == a {
+                break true;
+            }
+            if x == 0 {
+                break false;
+            }
+            x = parents[x];
+        };
+        let root = moving.first().copied().filter(|&r| moving.iter().all(|&k| under(r, k)));
+        let (frames, r_root) = Frames::relative_to(model, layout, b, motions, root)?;
+        let gravity = match root {
+            Some(root) => bind_v3(b, "GB", root, matvec(&r_root, &drive.g, true)),
+            None => drive.g.clone(),
+        };
+        let Frames { order, parent, moves, rw, z, o, .. } = &frames;
+        let nb = order.len();
+        let mut columns: Vec<Column> = Vec::with_capacity(nv);
+        for (i, &jn) in order.iter().enumerate() {
+            let body = i + 1;
+            let Some(qi) = layout.v_index[i] else { continue };
+            match robot.joints[jn].kind {
+                JointKind::Revolute => {
+                    let s = [bind_v3(b, "SL", body, cross(&o[body], &z[body])), z[body].clone()];
+                    columns.push(Column { index: qi, body, s });
+                }
+                JointKind::Prismatic => columns.push(Column { index: qi, body, s: [z[body].clone(), zero3()] }),
+                JointKind::FreeFlyer => {
+                    // The base frame's axes: the columns of its rotation.
+                    let axes: [V3; 3] = [0, 1, 2].map(|k| [0, 1, 2].map(|r| rw[body][r][k].clone()));
+                    for (k, e) in axes.iter().enumerate() {
+                        columns.push(Column { index: qi + k, body, s: [e.clone(), zero3()] });
+                    }
+                    for (k, e) in axes.into_iter().enumerate() {
+                        let l = bind_v3(b, "SL", format_args!("{body}_{k}"), cross(&o[body], &e));
+                        columns.push(Column { index: qi + 3 + k, body, s: [l, e] });
+                    }
+                }
+                JointKind::Fixed => {}
+            }
+        }
+        columns.sort_by_key(|c| c.index);
+        assert_eq!(columns.len(), nv, "one column per velocity coordinate");
+        let mut of_body: Vec<Vec<usize>> = vec![Vec::new(); nb + 1];
+        for (k, c) in columns.iter().enumerate() {
+            of_body[c.body].push(k);
+        }
+        // Forward: velocities and accelerations.
+        let mut vel: Vec<S6> = vec![zero6(); nb + 1];
+        let mut acc: Vec<S6> = vec![zero6(); nb + 1];
+        acc[0] = [gravity.map(neg), zero3()];
+        for body in 1..=nb {
+            b.check(body, nb)?;
+            let p = parent[body];
+            let mut v = vel[p].clone();
+            for &k in &of_body[body] {
+                v = add6(&v, &scale6(&columns[k].s, &drive.qd[columns[k].index - 1]));
+            }
+            let v = bind6(b, "V", body, v);
+            let mut a = acc[p].clone();
+            for &k in &of_body[body] {
+                let c = &columns[k];
+                a = add6(&a, &scale6(&c.s, &drive.qdd[c.index - 1]));
+                a = add6(&a, &scale6(&mcross(&v, &c.s), &drive.qd[c.index - 1]));
+            }
+            acc[body] = bind6(b, "A", body, a);
+            vel[body] = v;
+        }
+        // Per body: inertia about the origin, momentum, force.
+        let mut inertia: Vec<Inertia> = vec![Inertia::zero(); nb + 1];
+        let mut force: Vec<S6> = vec![zero6(); nb + 1];
+        let mut momentum: Vec<S6> = vec![zero6(); nb + 1];
+        for body in (1..=nb).filter(|&x| moves[x]) {
+            b.check(body, nb)?;
+            let rot = &rw[body];
+            let mass = layout.param(b, &format!("m[{body}]"));
+            let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
+            let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
+            let c = bind_v3(b, "CW", body, vadd(&o[body], &matvec(rot, &l, false)));
+            let h = bind_v3(b, "HW", body, vscale(&c, &mass));
+            // J = R In Rᵀ + m (|c|² 1 − c cᵀ) = R In Rᵀ + (c·h) 1 − c hᵀ.
+            let r_in: M3 =
+                [0, 1, 2].map(|r| [0, 1, 2].map(|k| sum((0..3).map(|m| mul(rot[r][m].clone(), inn[m][k].clone())))));
+            let ch = vdot(&c, &h);
+            let ch = b.bind(&format!("CH{body}"), ch);
+            let j: M3 = [0, 1, 2].map(|r| {
+                [0, 1, 2].map(|k| {
+                    let rot_part = sum((0..3).map(|m| mul(r_in[r][m].clone(), rot[k][m].clone())));
+                    let diag = if r == k { ch.clone() } else { ZERO };
+                    sub(add(rot_part, diag), mul(c[r].clone(), h[k].clone()))
+                })
+            });
+            let io = Inertia { mass, h, j }.bind(b, "IO", body);
+            let v = &vel[body];
+            let hk = bind6(b, "HK", body, io.apply(v));
+            force[body] = add6(&io.apply(&acc[body]), &fcross(v, &hk));
+            momentum[body] = hk;
+            inertia[body] = io;
+        }
+        Ok(World { frames, columns, vel, acc, inertia, momentum, force })
+    }
+
+    /// Whether body `a` is `x` or one of its ancestors.
+    fn ancestor_or_self(&self, a: usize, mut x: usize) -> bool {
+        while x != 0 {
+            if x == a {
+                return true;
+            }
+            x = self.frames.parent[x];
+        }
+        false
+    }
+
+    /// The subtree sums of per-body inertias, bound under `name`, leaves to root (a body's
+    /// index is above its parent's).
+    fn subtree_inertias(&self, b: &mut Builder, mut per_body: Vec<Inertia>, name: &str) -> Vec<Inertia> {
+        let Frames { parent, moves, .. } = &self.frames;
+        for body in (1..per_body.len()).rev().filter(|&x| moves[x]) {
+            per_body[body] = per_body[body].clone().bind(b, name, body);
+            let p = parent[body];
+            if p != 0 && moves[p] {
+                per_body[p] = per_body[p].plus(&per_body[body]);
+            }
+        }
+        per_body
+    }
+
+    /// The subtree sums of per-body spatial vectors, bound under `name` (as
+    /// [`World::subtree_inertias`]).
+    fn subtree_sums(&self, b: &mut Builder, mut per_body: Vec<S6>, name: &str) -> Vec<S6> {
+        let Frames { parent, moves, .. } = &self.frames;
+        for body in (1..per_body.len()).rev().filter(|&x| moves[x]) {
+            per_body[body] = bind6(b, name, body, per_body[body].clone());
+            let p = parent[body];
+            if p != 0 && moves[p] {
+                per_body[p] = add6(&per_body[p], &per_body[body]);
+            }
+        }
+        per_body
+    }
+
+    /// `r1_j = Ic S_j` over the subtree of column `j`'s body, bound, by column.
+    fn r1(&self, b: &mut Builder, ic: &[Inertia]) -> Vec<S6> {
+        self.columns.iter().enumerate().map(|(k, c)| bind6(b, "R1", k + 1, ic[c.body].apply(&c.s))).collect()
+    }
+}
+
 /// Writes `rnea_derivatives` (outputs `dtau_dq[i][j]`, `dtau_dv[i][j]`, `i, j = 1..=nv`, row
 /// by row, along Pinocchio's tangent space) by the formulation of the module doc: inputs `q`,
 /// `qd`, `qdd`, `g` (and the parameters).
@@ -134,145 +318,44 @@ struct Column {
 /// # Errors
 /// [`Stopped`] at the builder's deadline (checked per body and per row).
 pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Result<(), Stopped> {
-    let robot = &model.robot;
     let nv = layout.nv;
     let drive = Drive::inputs(b, nv, true);
-    let mut motions = motions(model, layout, b);
-    // The inertial frame that coincides with a free-flying root body's frame at this instant:
-    // its rotation leaves every body's pose and is left only in gravity, `g' = Rᵀ g`.
-    let mut gravity = drive.g.clone();
-    let roots = robot.body_parents(&robot.dfs_joints());
-    if let Some(root) = (1..motions.len()).find(|&k| roots[k] == 0 && motions[k].free.is_some()) {
-        let identity = numeric(&[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
-        let r = motions[root].free.replace(identity).expect("found above");
-        gravity = bind_v3(b, "GB", root, matvec(&r, &gravity, true));
-    }
-    let frames = Frames::of(model, layout, b, &motions)?;
-    let Frames { order, parent, moves, rw, z, o, .. } = &frames;
+    let motions = motions(model, layout, b);
+    let world = World::of(model, layout, b, &motions, &drive)?;
+    let World { frames, columns, vel, acc, inertia, .. } = &world;
+    let Frames { order, parent, moves, .. } = frames;
     let nb = order.len();
-    // The columns, by velocity coordinate.
-    let mut columns: Vec<Column> = Vec::with_capacity(nv);
-    for (i, &jn) in order.iter().enumerate() {
-        let body = i + 1;
-        let Some(qi) = layout.v_index[i] else { continue };
-        match robot.joints[jn].kind {
-            JointKind::Revolute => {
-                let s = [bind_v3(b, "SL", body, cross(&o[body], &z[body])), z[body].clone()];
-                columns.push(Column { index: qi, body, s });
-            }
-            JointKind::Prismatic => columns.push(Column { index: qi, body, s: [z[body].clone(), zero3()] }),
-            JointKind::FreeFlyer => {
-                // The base frame's axes in the world: the columns of its rotation.
-                let axes: [V3; 3] = [0, 1, 2].map(|k| [0, 1, 2].map(|r| rw[body][r][k].clone()));
-                for (k, e) in axes.iter().enumerate() {
-                    columns.push(Column { index: qi + k, body, s: [e.clone(), zero3()] });
-                }
-                for (k, e) in axes.into_iter().enumerate() {
-                    let l = bind_v3(b, "SL", format_args!("{body}_{k}"), cross(&o[body], &e));
-                    columns.push(Column { index: qi + 3 + k, body, s: [l, e] });
-                }
-            }
-            JointKind::Fixed => {}
-        }
-    }
-    columns.sort_by_key(|c| c.index);
-    assert_eq!(columns.len(), nv, "one column per velocity coordinate");
-    let mut of_body: Vec<Vec<usize>> = vec![Vec::new(); nb + 1];
-    for (k, c) in columns.iter().enumerate() {
-        of_body[c.body].push(k);
-    }
-    // Forward: velocities and accelerations.
-    let mut vel: Vec<S6> = vec![zero6(); nb + 1];
-    let mut acc: Vec<S6> = vec![zero6(); nb + 1];
-    acc[0] = [gravity.map(neg), zero3()];
-    for body in 1..=nb {
-        b.check(body, nb)?;
-        let p = parent[body];
-        let mut v = vel[p].clone();
-        for &k in &of_body[body] {
-            v = add6(&v, &scale6(&columns[k].s, &drive.qd[columns[k].index - 1]));
-        }
-        let v = bind6(b, "V", body, v);
-        let mut a = acc[p].clone();
-        for &k in &of_body[body] {
-            let c = &columns[k];
-            a = add6(&a, &scale6(&c.s, &drive.qdd[c.index - 1]));
-            a = add6(&a, &scale6(&mcross(&v, &c.s), &drive.qd[c.index - 1]));
-        }
-        acc[body] = bind6(b, "A", body, a);
-        vel[body] = v;
-    }
-    // Per body: inertia about the origin, force, momentum, rate of inertia; then per subtree.
-    let mut ic: Vec<Inertia> = vec![Inertia::zero(); nb + 1];
+    // Per body: the rate of its inertia.
     let mut idot: Vec<Inertia> = vec![Inertia::zero(); nb + 1];
-    let mut force: Vec<S6> = vec![zero6(); nb + 1];
-    let mut momentum: Vec<S6> = vec![zero6(); nb + 1];
     for body in (1..=nb).filter(|&x| moves[x]) {
         b.check(body, nb)?;
-        let rot = &rw[body];
-        let mass = layout.param(b, &format!("m[{body}]"));
-        let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
-        let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
-        let c = bind_v3(b, "CW", body, vadd(&o[body], &matvec(rot, &l, false)));
-        let h = bind_v3(b, "HW", body, vscale(&c, &mass));
-        // J = R In Rᵀ + m (|c|² 1 − c cᵀ) = R In Rᵀ + (c·h) 1 − c hᵀ.
-        let r_in: M3 =
-            [0, 1, 2].map(|r| [0, 1, 2].map(|k| sum((0..3).map(|m| mul(rot[r][m].clone(), inn[m][k].clone())))));
-        let ch = vdot(&c, &h);
-        let ch = b.bind(&format!("CH{body}"), ch);
-        let j: M3 = [0, 1, 2].map(|r| {
-            [0, 1, 2].map(|k| {
-                let rot_part = sum((0..3).map(|m| mul(r_in[r][m].clone(), rot[k][m].clone())));
-                let diag = if r == k { ch.clone() } else { ZERO };
-                sub(add(rot_part, diag), mul(c[r].clone(), h[k].clone()))
-            })
-        });
-        let inertia = Inertia { mass, h, j }.bind(b, "IO", body);
-        let v = &vel[body];
-        let hk = bind6(b, "HK", body, inertia.apply(v));
-        let f = add6(&inertia.apply(&acc[body]), &fcross(v, &hk));
-        force[body] = f;
-        momentum[body] = hk;
+        let (v, io) = (&vel[body], &inertia[body]);
         // İ: ḣ = m v + ω × h, J̇ = [ω]×J − J[ω]× − (h vᵀ + v hᵀ) + 2 (v·h) 1.
         let (lin, om) = (&v[0], &v[1]);
-        let hdot = vadd(&vscale(lin, &inertia.mass), &cross(om, &inertia.h));
-        let wj: M3 = [0, 1, 2].map(|k| cross(om, &[0, 1, 2].map(|r| inertia.j[r][k].clone())));
+        let hdot = vadd(&vscale(lin, &io.mass), &cross(om, &io.h));
+        let wj: M3 = [0, 1, 2].map(|k| cross(om, &[0, 1, 2].map(|r| io.j[r][k].clone())));
         // `wj[k]` is column k of [ω]×J; (J[ω]×)[r][k] = −([ω]×J)[k][r] (J symmetric).
-        let vh = b.bind(&format!("VH{body}"), vdot(lin, &inertia.h));
+        let vh = b.bind(&format!("VH{body}"), vdot(lin, &io.h));
         let jdot: M3 = [0, 1, 2].map(|r| {
             [0, 1, 2].map(|k| {
                 let rot_part = add(wj[k][r].clone(), wj[r][k].clone());
-                let outer = add(mul(inertia.h[r].clone(), lin[k].clone()), mul(lin[r].clone(), inertia.h[k].clone()));
+                let outer = add(mul(io.h[r].clone(), lin[k].clone()), mul(lin[r].clone(), io.h[k].clone()));
                 let diag = if r == k { mul(Term::C(2.0), vh.clone()) } else { ZERO };
                 add(sub(rot_part, outer), diag)
             })
         });
         idot[body] = Inertia { mass: ZERO, h: hdot, j: jdot }.bind(b, "ID", body);
-        ic[body] = inertia;
     }
-    // Subtree sums, leaves to root (a body's index is above its parent's).
-    for body in (1..=nb).rev() {
-        b.check(body, nb)?;
-        if !moves[body] {
-            continue;
-        }
-        ic[body] = ic[body].clone().bind(b, "IC", body);
-        idot[body] = idot[body].clone().bind(b, "IDC", body);
-        force[body] = bind6(b, "FC", body, force[body].clone());
-        momentum[body] = bind6(b, "HC", body, momentum[body].clone());
-        let p = parent[body];
-        if p != 0 && moves[p] {
-            ic[p] = ic[p].plus(&ic[body]);
-            idot[p] = idot[p].plus(&idot[body]);
-            force[p] = add6(&force[p], &force[body]);
-            momentum[p] = add6(&momentum[p], &momentum[body]);
-        }
-    }
-    // Per column: w, Ṡ, p; r1, r2 (over its body's subtree); and the terms for its ancestors.
+    // Subtree sums, leaves to root.
+    let ic = world.subtree_inertias(b, inertia.clone(), "IC");
+    let idot = world.subtree_inertias(b, idot, "IDC");
+    let force = world.subtree_sums(b, world.force.clone(), "FC");
+    let momentum = world.subtree_sums(b, world.momentum.clone(), "HC");
+    let r1 = world.r1(b, &ic);
+    // Per column: w, Ṡ, p; r2 (over its body's subtree); and the terms for its ancestors.
     let mut w: Vec<S6> = Vec::with_capacity(nv);
     let mut sdot: Vec<S6> = Vec::with_capacity(nv);
     let mut pj: Vec<S6> = Vec::with_capacity(nv);
-    let mut r1: Vec<S6> = Vec::with_capacity(nv);
     let mut r2: Vec<S6> = Vec::with_capacity(nv);
     let mut g_q: Vec<S6> = Vec::with_capacity(nv);
     let mut g_v: Vec<S6> = Vec::with_capacity(nv);
@@ -284,7 +367,6 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
         let sd = bind6(b, "SD", k + 1, mcross(&vel[body], s));
         let pk = bind6(b, "PJ", k + 1, sub6(&mcross(&acc[p], s), &mcross(&wk, &vel[p])));
         let (icb, idb, hc) = (&ic[body], &idot[body], &momentum[body]);
-        let r1k = bind6(b, "R1", k + 1, icb.apply(s));
         let r2k = bind6(b, "R2", k + 1, sub6(&idb.apply(s), &fcross(s, hc)));
         let bop = |x: &S6| add6(&idb.apply(x), &fcross(x, hc));
         let gq = add6(&add6(&fcross(s, &force[body]), &icb.apply(&pk)), &bop(&wk));
@@ -294,19 +376,8 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
         w.push(wk);
         sdot.push(sd);
         pj.push(pk);
-        r1.push(r1k);
         r2.push(r2k);
     }
-    // Whether body `a` is `x` or one of its ancestors.
-    let ancestor_or_self = |a: usize, mut x: usize| {
-        while x != 0 {
-            if x == a {
-                return true;
-            }
-            x = parent[x];
-        }
-        false
-    };
     let mut rows: Vec<Vec<(Term, Term)>> = Vec::with_capacity(nv);
     for i in 0..nv {
         b.check_at(crate::Reached::Row { row: i + 1, rows: nv })?;
@@ -314,11 +385,11 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
         let mut row = Vec::with_capacity(nv);
         for j in 0..nv {
             let bj = columns[j].body;
-            let entry = if ancestor_or_self(bj, bi) {
+            let entry = if world.ancestor_or_self(bj, bi) {
                 let dq = add(pair(&pj[j], &r1[i]), pair(&w[j], &r2[i]));
                 let dv = add(pair(&add6(&w[j], &sdot[j]), &r1[i]), pair(&columns[j].s, &r2[i]));
                 (dq, dv)
-            } else if ancestor_or_self(bi, bj) {
+            } else if world.ancestor_or_self(bi, bj) {
                 (pair(&columns[i].s, &g_q[j]), pair(&columns[i].s, &g_v[j]))
             } else {
                 (ZERO, ZERO)
@@ -336,6 +407,40 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
         }
     }
     Ok(())
+}
+
+/// `M` and `c` ([`crate::dirdyna::Parts`]) in the world frame of [`rnea_derivatives`], written
+/// as it writes its shared quantities, so that `aba_derivatives` built from this `fordyna` and
+/// those partials ([`crate::implicit`]) computes them once: `M[i][j] = S_i·(Ic S_j)` (`Ic`
+/// over the subtree of `j`'s body, `i`'s an ancestor or the same, the CRBA's pairing) and
+/// `c_i = S_i·F_i` with the subtree force at `q̈ = 0` (the RNEA's), `i, j` velocity coordinates.
+///
+/// # Errors
+/// [`Stopped`] at the builder's deadline (checked per body).
+pub(crate) fn world_parts<'a>(
+    model: &'a Model,
+    layout: &'a Layout,
+) -> impl FnMut(&mut Builder, &[Motion], &Drive) -> crate::dirdyna::Parted + 'a {
+    move |b: &mut Builder, motions: &[Motion], drive: &Drive| {
+        let world = World::of(model, layout, b, motions, drive)?;
+        let ic = world.subtree_inertias(b, world.inertia.clone(), "IC");
+        let force = world.subtree_sums(b, world.force.clone(), "FC");
+        let r1 = world.r1(b, &ic);
+        let columns = &world.columns;
+        let mut entries = Vec::new();
+        for (j, cj) in columns.iter().enumerate() {
+            for ci in columns.iter().take(j + 1) {
+                if world.ancestor_or_self(ci.body, cj.body) {
+                    let t = pair(&ci.s, &r1[j]);
+                    if t != ZERO {
+                        entries.push(((ci.index, cj.index), t));
+                    }
+                }
+            }
+        }
+        let c = columns.iter().map(|ci| (ci.index, pair(&ci.s, &force[ci.body]))).collect();
+        Ok((entries, c))
+    }
 }
 
 fn sub6(a: &S6, b: &S6) -> S6 {

@@ -113,6 +113,26 @@ impl Frames {
     /// # Errors
     /// [`Stopped`] at the builder's deadline (checked per body).
     pub fn of(model: &Model, layout: &Layout, b: &mut Builder, motions: &[Motion]) -> Result<Frames, Stopped> {
+        Frames::relative_to(model, layout, b, motions, None).map(|(f, _)| f)
+    }
+
+    /// [`Frames::of`] in the coordinates of the inertial frame that coincides with body
+    /// `reference`'s frame at this instant (`x' = R_refᵀ (x − o_ref)`; `None`: the world's):
+    /// the reference's pose and its ancestors' are the identity there, so their rotations
+    /// leave every body's pose. Returns the frames and `R_ref` (reference → world, 3 × 3, the
+    /// identity for `None`), which maps world vectors such as gravity: `g' = R_refᵀ g`. Every
+    /// moving body should lie in the reference's subtree: one outside it is posed through the
+    /// reference's inverse, at a cost in ops.
+    ///
+    /// # Errors
+    /// [`Stopped`] at the builder's deadline (checked per body).
+    pub fn relative_to(
+        model: &Model,
+        layout: &Layout,
+        b: &mut Builder,
+        motions: &[Motion],
+        reference: Option<usize>,
+    ) -> Result<(Frames, M3), Stopped> {
         let robot = &model.robot;
         let order = robot.dfs_joints();
         let nb = order.len();
@@ -139,6 +159,19 @@ impl Frames {
                 Some(s) => vadd(&d, &matvec(&ro, s, false)),
                 None => d,
             };
+        }
+        // The reference and its ancestors: their rotation composed (root first), then the identity.
+        let mut r_ref = identity.clone();
+        if let Some(reference) = reference {
+            let mut path = vec![reference];
+            while parent[*path.last().expect("not empty")] != 0 {
+                path.push(parent[*path.last().expect("not empty")]);
+            }
+            for &a in path.iter().rev() {
+                r_ref = matmul(&r_ref, &e[a]);
+                e[a] = identity.clone();
+                t[a] = zero3();
+            }
         }
         let mut f = Frames {
             rw: vec![identity; nb + 1],
@@ -181,6 +214,6 @@ impl Frames {
                 }
             }
         }
-        Ok(f)
+        Ok((f, r_ref))
     }
 }
