@@ -491,7 +491,9 @@ mod tests {
     }
 
     /// Every joint kind and base: revolute chains and trees, prismatic joints, Pinocchio's
-    /// free flyer, continuous joints as `(cos, sin)` pairs.
+    /// free flyer, continuous joints as `(cos, sin)` pairs; in the moving root's coordinates
+    /// (a revolute or prismatic first joint, the free flyer) and in the world's (branches off
+    /// the fixed base).
     #[test]
     fn analytical_derivatives_equal_diff_on_the_rnea() {
         let mut prismatic = build(Topology::Serial, 7, 2);
@@ -505,6 +507,8 @@ mod tests {
             ("serial 7", build(Topology::Serial, 7, 1)),
             ("semi-serial 9", build(Topology::SemiSerial, 9, 1)),
             ("prismatic", prismatic),
+            // Several chains off the fixed base: no moving root, the world's own coordinates.
+            ("parallel 9", build(Topology::Parallel, 9, 2)),
             ("parallel 9, free flyer", build(Topology::Parallel, 9, 3).with_free_flyer().expect("free names")),
             ("semi-serial 9, cos-sin", cos_sin(build(Topology::SemiSerial, 9, 4))),
             (
