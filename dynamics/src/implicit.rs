@@ -7,7 +7,9 @@
 //! `computeABADerivatives` does the same), and `∂q̈/∂τ = M⁻¹`. [`aba_derivatives`] writes that
 //! function: `fordyna` by the `LᵀDL` with `M⁻¹` from the same factors
 //! ([`crate::fordyna::fordyna_and_inverse`]: `q̈` and `M⁻¹` share the CRBA and the
-//! factorisation), the partials of the inverse dynamics (the `rnea_derivatives` the generator
+//! factorisation; or [`crate::fordyna::world_fordyna_and_inverse`], whose `M` and `c` are
+//! written as the analytical partials write their kinematics and inertias, so that `cse` merges
+//! them: the generator tries both), the partials of the inverse dynamics (the `rnea_derivatives` the generator
 //! kept, rows along the tangent space) with their `qdd` inputs read from `q̈`, and the two
 //! products `−M⁻¹ · ∂τ_ID` by the factors, `−Uᵀ·(D⁻¹·(U·x))` per column `x` (`U = L⁻ᵀ` has
 //! entries only on ancestors: about `4·Σ(dₖ + 1) + nv` ops a column for coordinates at depth

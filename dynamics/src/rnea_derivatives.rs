@@ -1,15 +1,20 @@
 //! The analytical derivatives of the inverse dynamics, ∂τ/∂q and ∂τ/∂v (issue 50 item 2: the
 //! recursions of Carpentier & Mansard, "Analytical derivatives of rigid body dynamics
-//! algorithms", RSS 2018, written by the generator), in the world frame.
+//! algorithms", RSS 2018, written by the generator), in one inertial frame; and the world-frame
+//! `M` and `c` that `aba_derivatives` solves with ([`world_parts`]).
 //!
 //! # Formulation
-//! Plücker coordinates in the world frame at the world origin: a motion `(v; ω)` (the velocity
-//! of the point at the origin, the angular velocity), a force `(F; N)` (the moment about the
-//! origin), their pairing `v·F + ω·N`. Joint column `S_j`: `(o × z; z)` for a revolute joint of
-//! world axis `z` through `o`, `(z; 0)` prismatic, the base frame's unit twists for a free flyer
-//! (Pinocchio's tangent space: the derivatives come out along it, with no map). Per body `k`
-//! (parent `λ`): `V_k = V_λ + Σ S_j q̇_j`, `A_k = A_λ + Σ S_j q̈_j + Σ (V_k × S_j) q̇_j` with
-//! `A_0 = (−g; 0)`, the spatial inertia `I_k` about the origin (mass `m`, first moment `h = m c`,
+//! Plücker coordinates of the inertial frame that coincides, at this instant, with the frame of
+//! the *moving root* (the lowest body above every moving joint; the world's own frame when there
+//! is none): τ and its derivatives are the same in any inertial frame, and in this one the
+//! root's pose is the identity, so its rotation enters only gravity, `g' = R_rootᵀ g`, and the
+//! free flyer's columns are unit twists. Below, "world" means this frame. A motion `(v; ω)` (the
+//! velocity of the point at the origin, the angular velocity), a force `(F; N)` (the moment
+//! about the origin), their pairing `v·F + ω·N`. Joint column `S_j`: `(o × z; z)` for a revolute
+//! joint of world axis `z` through `o`, `(z; 0)` prismatic, the base frame's unit twists for a
+//! free flyer (Pinocchio's tangent space: the derivatives come out along it, with no map). Per
+//! body `k` (parent `λ`): `V_k = V_λ + Σ S_j q̇_j`, `A_k = A_λ + Σ S_j q̈_j + Σ (V_k × S_j) q̇_j`
+//! with `A_0 = (−g'; 0)`, the spatial inertia `I_k` about the origin (mass `m`, first moment `h = m c`,
 //! second moment `J`), `f_k = I_k A_k + V_k ×* I_k V_k`. Per subtree: its inertia `Ic`, force
 //! `F`, momentum `Hc = Σ I_k V_k` and the rate of its inertia `İc = Σ ([V_k×*] I_k − I_k [V_k×])`
 //! (a spatial inertia with zero mass: `ḣ = m v + ω × h`, `J̇ = [ω]×J − J[ω]× − (h vᵀ + v hᵀ) +
@@ -411,13 +416,11 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
 
 /// `M` and `c` ([`crate::dirdyna::Parts`]) in the world frame of [`rnea_derivatives`], written
 /// as it writes its shared quantities, so that `aba_derivatives` built from this `fordyna` and
-/// those partials ([`crate::implicit`]) computes them once: `M[i][j] = S_i·(Ic S_j)` (`Ic`
+/// those partials (`implicit.rs`) computes them once: `M[i][j] = S_i·(Ic S_j)` (`Ic`
 /// over the subtree of `j`'s body, `i`'s an ancestor or the same, the CRBA's pairing) and
 /// `c_i = S_i·F_i` with the subtree force at `q̈ = 0` (the RNEA's), `i, j` velocity coordinates.
-///
-/// # Errors
-/// [`Stopped`] at the builder's deadline (checked per body).
-pub(crate) fn world_parts<'a>(
+/// The closure returns [`Stopped`] at the builder's deadline (checked per body).
+pub fn world_parts<'a>(
     model: &'a Model,
     layout: &'a Layout,
 ) -> impl FnMut(&mut Builder, &[Motion], &Drive) -> crate::dirdyna::Parted + 'a {
