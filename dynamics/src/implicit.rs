@@ -177,3 +177,95 @@ fn matrix<'a>(outputs: impl Iterator<Item = (&'a str, Operand)>, family: &str) -
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use robovec_ir::interp;
+    use robovec_ir::time_limit::Ticker;
+
+    use crate::depth::tests::state;
+    use crate::robot::{JointKind, Robot};
+    use crate::sym::Builder;
+    use crate::topology::{build, Topology};
+    use crate::{Layout, Model, Writer};
+
+    /// One function written by `write`, parameters as inputs.
+    fn written(model: &Model, layout: &Layout, name: &str, write: Writer) -> robovec_ir::Function {
+        let mut b = Builder::new(name, Default::default());
+        write(model, layout, &mut b).expect("no deadline");
+        b.finish()
+    }
+
+    /// The worst `|x − y| / (1 + max |y|)` over the outputs of `y`, over three states (with
+    /// `Qq` drawn too).
+    fn worst(robot: &Robot, x: &robovec_ir::Function, y: &robovec_ir::Function) -> f64 {
+        let layout = Layout::of(robot);
+        let mut worst: f64 = 0.0;
+        for seed in 1..=3 {
+            let mut given = state(robot, seed);
+            for i in 1..=layout.nv {
+                given.insert(format!("Qq[{i}]"), 3.0 * interp::pseudo_random_input(&format!("Qq[{i}]"), seed));
+            }
+            let at = |name: &str| *given.get(name).unwrap_or_else(|| panic!("input {name}"));
+            let a: BTreeMap<String, f64> = interp::eval::<f64>(x, at).into_iter().collect();
+            let b: BTreeMap<String, f64> = interp::eval::<f64>(y, at).into_iter().collect();
+            let scale = b.values().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (name, v) in &b {
+                let got = a.get(name).unwrap_or_else(|| panic!("{name} written"));
+                worst = worst.max((got - v).abs() / (1.0 + scale));
+            }
+        }
+        worst
+    }
+
+    /// `aba_derivatives` as `−M⁻¹·∂τ_ID` with either `fordyna` (the body frames' CRBA and RNEA,
+    /// or `M` and `c` in the analytical partials' frame) equals `diff` through the whole of
+    /// `fordyna` (an independent formulation, mapped to the tangent space) within 1e-9, on
+    /// branches off a fixed base, a chain with prismatic joints and a free flyer over branches.
+    #[test]
+    fn aba_derivatives_agree_across_formulations() {
+        let mut prismatic = build(Topology::Serial, 6, 7);
+        for (k, j) in prismatic.joints.iter_mut().enumerate() {
+            if k % 2 == 1 && j.kind == JointKind::Revolute {
+                j.kind = JointKind::Prismatic;
+                j.continuous = false;
+            }
+        }
+        // A free base needs a mass of its own (a massless one turns with its first joint for
+        // free: `M` singular).
+        let mut floating = build(Topology::SemiSerial, 7, 3);
+        let root = floating.root;
+        floating.links[root].inertial = Some(crate::robot::Inertial {
+            mass: 4.5,
+            com: [0.05, -0.02, 0.1],
+            inertia: [[0.3, 0.01, -0.02], [0.01, 0.25, 0.03], [-0.02, 0.03, 0.2]],
+        });
+        let cases = [
+            ("semi-serial 8", build(Topology::SemiSerial, 8, 2)),
+            ("serial 6, prismatic", prismatic),
+            ("semi-serial 7, free flyer", floating.with_free_flyer().expect("free names")),
+        ];
+        let ticker = Ticker::new(None, None);
+        for (label, robot) in cases {
+            let model = Model { robot: robot.clone() };
+            let layout = Layout::of(&robot);
+            let partials = super::compact(
+                &written(&model, &layout, "rnea_derivatives", crate::rnea_derivatives::rnea_derivatives),
+                &ticker,
+            )
+            .expect("no deadline");
+            let coords = crate::tangent::coordinates(&robot, &layout);
+            let fordyna = written(&model, &layout, "fordyna", crate::fordyna::fordyna);
+            let by_diff = crate::derive(&fordyna, &crate::DERIVED[1], coords.as_deref(), &ticker).expect("no deadline");
+            for solve in [crate::fordyna::fordyna_and_inverse as Writer, crate::fordyna::world_fordyna_and_inverse] {
+                let solved = written(&model, &layout, "aba_derivatives", solve);
+                let f = super::aba_derivatives(&partials, &solved, &ticker).expect("no deadline");
+                assert_eq!(f.outputs.len(), 3 * layout.nv * layout.nv, "{label}");
+                let e = worst(&robot, &f, &by_diff);
+                assert!(e <= 1e-9, "{label}: {e:e}");
+            }
+        }
+    }
+}
