@@ -174,27 +174,39 @@ fn robot_derivatives_match_pinocchio() {
 /// `model_rnea_derivatives(q, v, a, dtau_dq, dtau_dv)`, `model_aba_derivatives(q, v, tau,
 /// ddq_dq, ddq_dv, Minv)` and `model_minv(q, Minv)` (three files, linked together), one state a
 /// call and `batch=4` (lane `l` of element `k` at `[k*4 + l]`), compiled by the system compiler
-/// at -O1 and called with Pinocchio's vectors, against Pinocchio within 1e-9.
+/// at -O1 and called with Pinocchio's vectors, against Pinocchio within 1e-9; on the fixed base
+/// and on the free flyer (`q`: 13 numbers, every matrix 12 × 12, along the tangent space).
 #[test]
 fn pinocchio_abi_derivative_functions_in_c_match_pinocchio() {
-    use crate::pinocchio::{oracle, python, Base};
+    use crate::pinocchio::{python, Base};
     let Some(py) = python() else { return };
-    let o = oracle(&py, "erd:ur_description/urdf/ur5_robot.urdf", 4, 5, Base::Fixed);
+    for (base, flag, label) in [(Base::Fixed, None, "fixed"), (Base::FreeFlyer, Some("--free-flyer"), "free")] {
+        pinocchio_abi_derivatives_in_c(&py, base, flag, label);
+    }
+}
+
+/// [`pinocchio_abi_derivative_functions_in_c_match_pinocchio`] on one base (`flag` robovec's).
+fn pinocchio_abi_derivatives_in_c(
+    py: &std::path::Path,
+    base: crate::pinocchio::Base,
+    flag: Option<&str>,
+    base_label: &str,
+) {
+    use crate::pinocchio::oracle;
+    let o = oracle(py, "erd:ur_description/urdf/ur5_robot.urdf", 4, 5, base);
     let n = o.states[0].qd.len();
     let nn = n * n;
     for w in [1usize, 4] {
-        let dir = tmp(&format!("pinocchio_c_{w}"));
+        let dir = tmp(&format!("pinocchio_c_{base_label}_{w}"));
         let mut files = vec!["main.c".to_string()];
         for function in ["rnea_derivatives", "aba_derivatives", "minv"] {
             let c = dir.join(format!("{function}.c"));
-            let out = crate::common::opt(&[
-                &o.path,
-                "--fold-params",
-                &format!("-function={function}"),
-                &format!("-passes=default<ops>,codegen<c;abi=pinocchio;batch={w}>"),
-                "-o",
-                c.to_str().unwrap(),
-            ]);
+            let (function_arg, passes_arg) =
+                (format!("-function={function}"), format!("-passes=default<ops>,codegen<c;abi=pinocchio;batch={w}>"));
+            let mut args = vec![o.path.as_str(), "--fold-params"];
+            args.extend(flag);
+            args.extend([function_arg.as_str(), passes_arg.as_str(), "-o", c.to_str().unwrap()]);
+            let out = crate::common::opt(&args);
             assert!(out.status.success(), "{function}: {}", crate::common::stderr(&out));
             files.push(format!("{function}.c"));
         }
@@ -248,7 +260,11 @@ fn pinocchio_abi_derivative_functions_in_c_match_pinocchio() {
                 let norm = flat.iter().fold(0.0f64, |x, y| x.max(y.abs()));
                 let c = &chunk[m * nn..(m + 1) * nn];
                 let diff = c.iter().zip(&flat).fold(0.0f64, |x, (a, b)| x.max((a - b).abs()));
-                assert!(diff / norm <= 1e-9, "batch={w} state {k} {label}: relative error {:e}", diff / norm);
+                assert!(
+                    diff / norm <= 1e-9,
+                    "{base_label} batch={w} state {k} {label}: relative error {:e}",
+                    diff / norm
+                );
             }
         }
     }

@@ -13,8 +13,9 @@
 //! | `minv` | `void NAME_minv(const double *q, double *Minv)` | `computeMinverse(model, data, q)`, both triangles |
 //!
 //! The last three are the generator's derivative functions (`-function=rnea_derivatives`, …;
-//! issue 50): each matrix row-major, `nv × nq` for a derivative with respect to `q` (`…_dq`),
-//! `nv × nv` otherwise.
+//! issue 50): each matrix row-major `nv × nv`, derivatives with respect to `q` (`…_dq`) too:
+//! the generator writes them along Pinocchio's tangent space (a free flyer's `nq = nv + 1`
+//! coordinates, a `(cos, sin)` pair's two, have `nv` directions), as Pinocchio returns them.
 //!
 //! `dirdyna` gives two functions, each the backward slice of its outputs (the mass matrix
 //! depends on `q` only, so `NAME_crba` takes no velocity). `fordyna` exists when the URDF is
@@ -91,12 +92,11 @@ enum Algo {
 const ALGOS: [Algo; 7] =
     [Algo::Rnea, Algo::Crba, Algo::Nle, Algo::Aba, Algo::RneaDerivatives, Algo::AbaDerivatives, Algo::Minv];
 
-/// The IR's output arrays that are matrices (`base[i][j]`), and how many columns one has: `nq`
-/// for a derivative with respect to `q`, else `nv`.
-fn matrix_columns(base: &str, nq: usize, nv: usize) -> Option<usize> {
+/// The IR's output arrays that are matrices (`base[i][j]`), and how many columns one has: `nv`
+/// (the derivatives with respect to `q` are along the tangent space: module doc).
+fn matrix_columns(base: &str, _nq: usize, nv: usize) -> Option<usize> {
     match base {
-        "dtau_dq" | "ddq_dq" => Some(nq),
-        "M" | "dtau_dv" | "ddq_dv" | "Minv" => Some(nv),
+        "dtau_dq" | "ddq_dq" | "M" | "dtau_dv" | "ddq_dv" | "Minv" => Some(nv),
         _ => None,
     }
 }
@@ -231,12 +231,7 @@ fn check(f: &Function) -> Result<(usize, usize), PassError> {
     for o in &f.outputs {
         match indexed(&o.name) {
             Some((base, idx)) if idx.len() == 2 && outs.contains(&base) && matrix_columns(base, 0, 0).is_some() => {
-                nv = nv.max(idx[0]);
-                if base.ends_with("_dq") {
-                    nq = nq.max(idx[1]);
-                } else {
-                    nv = nv.max(idx[1]);
-                }
+                nv = nv.max(idx[0]).max(idx[1]);
             }
             Some((base, idx)) if idx.len() == 1 && outs.contains(&base) => nv = nv.max(idx[0]),
             _ => {
