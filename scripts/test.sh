@@ -11,11 +11,12 @@
 # - Pinocchio and example-robot-data from PyPI, in the virtual environment
 #   `target/pinocchio-venv` (about 50 s; kept across runs): the numerical oracle of the URDF
 #   front end's tests (with Eigen's, CppAD's and CppADCodeGen's headers for
-#   `cargo bench --bench pinocchio`).
+#   `cargo bench --bench pinocchio`), and maturin and pytest for the Python module's wheel and
+#   tests, which run last.
 # Debian packages come from `apt-get` (as root, or through `sudo`). Then, called without
 # arguments, it builds the API docs with rustdoc's warnings as errors (a broken intra-doc link
 # fails the run), and it runs `cargo test --workspace --locked` with the arguments given
-# (`scripts/test.sh -p robovec-ir`).
+# (`scripts/test.sh -p robovec-ir`); without arguments, then the Python module's tests.
 # The tests read the Robotran corpus from `../shared` beside the repository and fail without it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -59,7 +60,7 @@ done
 venv=target/pinocchio-venv
 venv_ready() {
     "$venv/bin/python" -c "import pinocchio" >/dev/null 2>&1 \
-        && "$venv/bin/pip" show -q example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen >/dev/null 2>&1
+        && "$venv/bin/pip" show -q example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen maturin pytest >/dev/null 2>&1
 }
 if ! venv_ready; then
     if ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
@@ -68,7 +69,7 @@ if ! venv_ready; then
     echo "installing pin and example-robot-data into $venv" >&2
     rm -rf "$venv"
     python3 -m venv "$venv"
-    "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen
+    "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen maturin pytest
     venv_ready || { echo "pinocchio and example-robot-data did not install into $venv" >&2; exit 1; }
 fi
 
@@ -89,4 +90,15 @@ if [ $# = 0 ]; then
     RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked --quiet
 fi
 
-exec cargo test --workspace --locked "$@"
+cargo test --workspace --locked "$@"
+
+# The Python module (issue 51, docs/python.md): its wheel built from this clone, installed into
+# the Pinocchio venv, and its tests against Pinocchio (python/tests). Built with the dev profile
+# at the test profile's debug level, so that the crates `cargo test` just built are reused
+# (`--profile test` would build the library as a test harness, without its module symbol).
+if [ $# = 0 ]; then
+    rm -rf target/wheels
+    CARGO_PROFILE_DEV_DEBUG=line-tables-only "$venv/bin/maturin" build --locked --profile dev --out target/wheels
+    "$venv/bin/pip" install -q --force-reinstall --no-deps target/wheels/robovec-*.whl
+    "$venv/bin/python" -m pytest -q python/tests
+fi

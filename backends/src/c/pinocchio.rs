@@ -148,6 +148,54 @@ impl Algo {
     }
 }
 
+/// The size of one dimension of an array of a C function: `nq` (`q`) or `nv`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dim {
+    /// The configuration's size, `NAME_NQ`.
+    Nq,
+    /// The velocity's size, `NAME_NV`.
+    Nv,
+}
+
+/// One C function of this ABI as a caller sees it: the IR function it is written from, its
+/// symbol's suffix (`NAME_<suffix>`), its input arrays (name, length) and its output arrays
+/// (name, rows, columns: `None` for a vector) in argument order: the module doc's table.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Signature {
+    /// The URDF generator's function (`invdyna`, `dirdyna`, `fordyna`, `rnea_derivatives`, …).
+    pub function: &'static str,
+    /// The symbol's suffix: `rnea`, `crba`, `nle`, `aba`, `rnea_derivatives`, …
+    pub suffix: &'static str,
+    /// Input arrays: C name and length.
+    pub inputs: Vec<(&'static str, Dim)>,
+    /// Output arrays: C name, rows and columns (`None`: a vector of `rows`), row-major.
+    pub outputs: Vec<(&'static str, Dim, Option<Dim>)>,
+}
+
+/// The [`Signature`] of the C function `NAME_<suffix>` (Pinocchio's algorithm names: `rnea`,
+/// `crba`, `nle`, `aba`, `rnea_derivatives`, `aba_derivatives`, `minv`); `None` for another
+/// name. What a caller (the Python module) allocates and passes.
+pub fn signature(suffix: &str) -> Option<Signature> {
+    let a = ALGOS.into_iter().find(|a| a.suffix() == suffix)?;
+    let function = match a {
+        Algo::Rnea => "invdyna",
+        Algo::Crba | Algo::Nle => "dirdyna",
+        Algo::Aba => "fordyna",
+        Algo::RneaDerivatives => "rnea_derivatives",
+        Algo::AbaDerivatives => "aba_derivatives",
+        Algo::Minv => "minv",
+    };
+    let (ins, outs) = a.arrays();
+    let inputs = ins.iter().map(|&(c, ir)| (c, if ir == "q" { Dim::Nq } else { Dim::Nv })).collect();
+    let outputs = outs.iter().map(|&(c, ir)| (c, Dim::Nv, matrix_columns(ir, 0, 0).map(|_| Dim::Nv))).collect();
+    Some(Signature { function, suffix: a.suffix(), inputs, outputs })
+}
+
+/// Every suffix [`signature`] knows, in the module doc's order.
+pub fn suffixes() -> [&'static str; 7] {
+    ALGOS.map(Algo::suffix)
+}
+
 /// `M[2][3]` → (`M`, [2, 3]); `None` when the name is not `base[i]…` with 1-based integers.
 fn indexed(name: &str) -> Option<(&str, Vec<usize>)> {
     let i = name.find('[')?;
@@ -438,4 +486,36 @@ pub(crate) fn emit(
          #define {name}_NQ {nq}\n#define {name}_NV {nv}\n\n"
     );
     Ok((symbols, emitted, preface))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{signature, suffixes, Dim};
+
+    /// The table of the module doc, by hand: every function's IR source, argument order and
+    /// shapes (vectors `nv`, `q` `nq`, every matrix `nv × nv`).
+    #[test]
+    fn signatures_follow_the_module_docs_table() {
+        let s = signature("rnea").unwrap();
+        assert_eq!((s.function, s.suffix), ("invdyna", "rnea"));
+        assert_eq!(s.inputs, [("q", Dim::Nq), ("v", Dim::Nv), ("a", Dim::Nv)]);
+        assert_eq!(s.outputs, [("tau", Dim::Nv, None)]);
+        let s = signature("crba").unwrap();
+        assert_eq!((s.function, s.inputs.len()), ("dirdyna", 1));
+        assert_eq!(s.outputs, [("M", Dim::Nv, Some(Dim::Nv))]);
+        assert_eq!(signature("nle").unwrap().outputs, [("nle", Dim::Nv, None)]);
+        let s = signature("aba").unwrap();
+        assert_eq!(s.function, "fordyna");
+        assert_eq!(s.inputs, [("q", Dim::Nq), ("v", Dim::Nv), ("tau", Dim::Nv)]);
+        let s = signature("aba_derivatives").unwrap();
+        assert_eq!(
+            s.outputs,
+            [("ddq_dq", Dim::Nv, Some(Dim::Nv)), ("ddq_dv", Dim::Nv, Some(Dim::Nv)), ("Minv", Dim::Nv, Some(Dim::Nv))]
+        );
+        assert_eq!(signature("rnea_derivatives").unwrap().outputs.len(), 2);
+        assert_eq!(signature("minv").unwrap().inputs, [("q", Dim::Nq)]);
+        assert!(signature("invdyna").is_none() && signature("").is_none());
+        assert_eq!(suffixes().len(), 7);
+        assert!(suffixes().iter().all(|s| signature(s).is_some_and(|g| g.suffix == *s)));
+    }
 }
