@@ -306,6 +306,7 @@ fn cache_dir() -> PyResult<PathBuf> {
 /// A loaded shared object and its sizes (`NAME_NQ`, `NAME_NV`).
 struct Loaded {
     lib: libloading::Library,
+    path: PathBuf,
     nq: usize,
     nv: usize,
 }
@@ -337,7 +338,7 @@ fn shared_object(py: Python<'_>, key: &str, make: impl FnOnce() -> PyResult<Path
     // initialisers that run on loading.
     let lib = unsafe { libloading::Library::new(&so) }
         .map_err(|e| Error::new_err(format!("cannot load {}: {e}", so.display())))?;
-    let l = Arc::new(Loaded { lib, nq, nv });
+    let l = Arc::new(Loaded { lib, path: so, nq, nv });
     let _ = py;
     loaded().lock().expect("not poisoned").insert(key.to_string(), l.clone());
     Ok(l)
@@ -496,13 +497,17 @@ impl Compiled {
                 args.len()
             )));
         }
-        let np = py.import("numpy")?;
         let mut inputs: Vec<PyReadonlyArrayDyn<'py, f64>> = Vec::with_capacity(args.len());
         let mut states: Option<Option<usize>> = None;
         for (x, &(name, dim)) in args.iter().zip(&sig.inputs) {
-            let a = np.call_method1("ascontiguousarray", (x,))?;
-            let a = np.call_method("asarray", (a,), Some(&[("dtype", "float64")].into_py_dict(py)?))?;
-            let a: PyReadonlyArrayDyn<'py, f64> = a.extract()?;
+            // A float64 C-contiguous array is read in place; anything else converted.
+            let a: PyReadonlyArrayDyn<'py, f64> = match x.cast::<PyArrayDyn<f64>>() {
+                Ok(a) if a.is_c_contiguous() => a.readonly(),
+                _ => {
+                    let kw = [("dtype", "float64")].into_py_dict(py)?;
+                    py.import("numpy")?.call_method("ascontiguousarray", (x,), Some(&kw))?.extract()?
+                }
+            };
             let n = self.len(dim);
             let shape = a.shape().to_vec();
             let b = match shape.as_slice() {
@@ -552,29 +557,30 @@ impl Compiled {
         py.detach(|| {
             let mut s = 0;
             if let Some(lanes) = lanes {
-                // Full groups of `w` states, lane-contiguous (`x[k*w + l]`).
+                // Full groups of `w` states, lane-contiguous (`x[k*w + l]`): gathered into
+                // buffers made once, scattered back.
                 let mut ins: Vec<Vec<f64>> = in_len.iter().map(|&n| vec![0.0; n * w]).collect();
                 let mut outs: Vec<Vec<f64>> = out_len.iter().map(|&n| vec![0.0; n * w]).collect();
+                let mut args: Vec<*mut f64> = ins.iter_mut().map(|v| v.as_mut_ptr()).collect();
+                args.extend(outs.iter_mut().map(|v| v.as_mut_ptr()));
                 while s + w <= b {
                     for ((buf, &p), &n) in ins.iter_mut().zip(&in_ptr).zip(&in_len) {
-                        for l in 0..w {
-                            // SAFETY: row s + l of a (B, n) contiguous array.
-                            let row = unsafe { std::slice::from_raw_parts((p as *const f64).add((s + l) * n), n) };
-                            for (k, x) in row.iter().enumerate() {
-                                buf[k * w + l] = *x;
+                        // SAFETY: rows s .. s + w of a (B, n) contiguous array.
+                        let rows = unsafe { std::slice::from_raw_parts((p as *const f64).add(s * n), n * w) };
+                        for (l, row) in rows.chunks_exact(n).enumerate() {
+                            for (lanes_k, x) in buf.chunks_exact_mut(w).zip(row) {
+                                lanes_k[l] = *x;
                             }
                         }
                     }
-                    let mut args: Vec<*mut f64> = ins.iter_mut().map(|v| v.as_mut_ptr()).collect();
-                    args.extend(outs.iter_mut().map(|v| v.as_mut_ptr()));
                     // SAFETY: the function of this signature; every buffer holds `w` lanes.
                     unsafe { call(lanes, &args) };
                     for ((buf, &p), &n) in outs.iter().zip(&out_ptr).zip(&out_len) {
-                        for l in 0..w {
-                            // SAFETY: row s + l of a fresh (B, …) array.
-                            let row = unsafe { std::slice::from_raw_parts_mut((p as *mut f64).add((s + l) * n), n) };
-                            for (k, x) in row.iter_mut().enumerate() {
-                                *x = buf[k * w + l];
+                        // SAFETY: rows s .. s + w of a fresh (B, …) array.
+                        let rows = unsafe { std::slice::from_raw_parts_mut((p as *mut f64).add(s * n), n * w) };
+                        for (l, row) in rows.chunks_exact_mut(n).enumerate() {
+                            for (lanes_k, x) in buf.chunks_exact(w).zip(row) {
+                                *x = lanes_k[l];
                             }
                         }
                     }
@@ -582,10 +588,13 @@ impl Compiled {
                 }
             }
             // The rest one state at a time, in place.
+            let mut args: Vec<*mut f64> = vec![std::ptr::null_mut(); in_ptr.len() + out_ptr.len()];
             while s < b {
-                let mut args: Vec<*mut f64> =
-                    in_ptr.iter().zip(&in_len).map(|(&p, &n)| (p as *mut f64).wrapping_add(s * n)).collect();
-                args.extend(out_ptr.iter().zip(&out_len).map(|(&p, &n)| (p as *mut f64).wrapping_add(s * n)));
+                for (x, (&p, &n)) in
+                    args.iter_mut().zip(in_ptr.iter().chain(&out_ptr).zip(in_len.iter().chain(&out_len)))
+                {
+                    *x = (p as *mut f64).wrapping_add(s * n);
+                }
                 // SAFETY: the one-state function of this signature, on row s of every array.
                 unsafe { call(one, &args) };
                 s += 1;
@@ -609,6 +618,19 @@ impl Compiled {
     #[getter]
     fn nv(&self) -> usize {
         self.lib.nv
+    }
+
+    /// The shared object in the cache: symbols `rv1_NAME` (one state) and, with `batch=W`,
+    /// `rvw_NAME` (`W` states, lane-contiguous), `abi=pinocchio`'s signatures.
+    #[getter]
+    fn library(&self) -> PathBuf {
+        self.lib.path.clone()
+    }
+
+    /// `W`, the states of one call of the batched function (1: none).
+    #[getter]
+    fn batch(&self) -> usize {
+        self.batch
     }
 
     fn __repr__(&self) -> String {
