@@ -125,6 +125,17 @@ impl Inertia {
     }
 }
 
+/// Whether body `a` is body `x` or one of its ancestors (`parent` by body, 0 the base).
+fn ancestor_or_self(parent: &[usize], a: usize, mut x: usize) -> bool {
+    while x != 0 {
+        if x == a {
+            return true;
+        }
+        x = parent[x];
+    }
+    false
+}
+
 /// One velocity coordinate: its index (1-based), its body, its column `S`.
 struct Column {
     index: usize,
@@ -169,16 +180,7 @@ impl World {
         let order = robot.dfs_joints();
         let parents = robot.body_parents(&order);
         let moving: Vec<usize> = (1..=order.len()).filter(|&k| layout.v_index[k - 1].is_some()).collect();
-        let under = |a: usize, mut x: usize| loop {
-            if x == a {
-                break true;
-            }
-            if x == 0 {
-                break false;
-            }
-            x = parents[x];
-        };
-        let root = moving.first().copied().filter(|&r| moving.iter().all(|&k| under(r, k)));
+        let root = moving.first().copied().filter(|&r| moving.iter().all(|&k| ancestor_or_self(&parents, r, k)));
         let (frames, r_root) = Frames::relative_to(model, layout, b, motions, root)?;
         let gravity = match root {
             Some(root) => bind_v3(b, "GB", root, matvec(&r_root, &drive.g, true)),
@@ -272,14 +274,8 @@ impl World {
     }
 
     /// Whether body `a` is `x` or one of its ancestors.
-    fn ancestor_or_self(&self, a: usize, mut x: usize) -> bool {
-        while x != 0 {
-            if x == a {
-                return true;
-            }
-            x = self.frames.parent[x];
-        }
-        false
+    fn ancestor_or_self(&self, a: usize, x: usize) -> bool {
+        ancestor_or_self(&self.frames.parent, a, x)
     }
 
     /// The subtree sums of per-body inertias, bound under `name`, leaves to root (a body's

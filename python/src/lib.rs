@@ -280,7 +280,7 @@ impl Module {
         let mut h = std::collections::hash_map::DefaultHasher::new();
         (env!("CARGO_PKG_VERSION"), &model, flags, sig.suffix, pipeline, batch, trig, &cc, &cflags).hash(&mut h);
         let key = format!("{}-{:016x}", sig.suffix, h.finish());
-        let lib = shared_object(py, &key, || {
+        let lib = shared_object(&key, || {
             build(py, urdf, flags, &sig, pipeline, batch, trig, &cc, &cflags, self.time_limit, &key)
         })?;
         Compiled::new(lib, sig, batch)
@@ -319,7 +319,7 @@ fn loaded() -> &'static Mutex<HashMap<String, Arc<Loaded>>> {
 
 /// The shared object of `key`: loaded already, or in the cache, or built by `make` (which
 /// returns the path of the object it wrote into the cache).
-fn shared_object(py: Python<'_>, key: &str, make: impl FnOnce() -> PyResult<PathBuf>) -> PyResult<Arc<Loaded>> {
+fn shared_object(key: &str, make: impl FnOnce() -> PyResult<PathBuf>) -> PyResult<Arc<Loaded>> {
     if let Some(l) = loaded().lock().expect("not poisoned").get(key) {
         return Ok(l.clone());
     }
@@ -339,7 +339,6 @@ fn shared_object(py: Python<'_>, key: &str, make: impl FnOnce() -> PyResult<Path
     let lib = unsafe { libloading::Library::new(&so) }
         .map_err(|e| Error::new_err(format!("cannot load {}: {e}", so.display())))?;
     let l = Arc::new(Loaded { lib, path: so, nq, nv });
-    let _ = py;
     loaded().lock().expect("not poisoned").insert(key.to_string(), l.clone());
     Ok(l)
 }
