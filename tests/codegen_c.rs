@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use robovec_backends::c::{robotran, split_callee, Abi, CodegenC, Precision, Trig};
+use robovec_backends::c::{robotran, split_callee, Abi, BatchLayout, CodegenC, Precision, Trig};
 use robovec_backends::input_values;
 use robovec_ir::interp::{callback_standin, eval, pseudo_random_input, Float};
 use robovec_ir::{Callee, Def, Module, TrigFn};
@@ -282,28 +282,33 @@ fn check_plain_tol<T: Float>(
                     _ => T::from_f64(input_value(f.name_of(v), seed, lane)),
                 }
             };
-            for &v in &ins {
-                for lane in 0..w {
-                    let x = lane_value(v, lane);
-                    if f32 {
-                        inputs.extend((x.to_f64() as f32).to_le_bytes());
-                    } else {
-                        inputs.extend(x.to_f64().to_le_bytes());
-                    }
+            // Element i of lane l at i*W + l, or at l*n + i with `layout=rows` (n elements a
+            // state: the inputs, or the outputs).
+            let rows = w > 1 && o.layout == BatchLayout::Rows;
+            let order = |n: usize| -> Vec<(usize, u32)> {
+                if rows {
+                    (0..w).flat_map(|l| (0..n).map(move |i| (i, l))).collect()
+                } else {
+                    (0..n).flat_map(|i| (0..w).map(move |l| (i, l))).collect()
+                }
+            };
+            for (i, lane) in order(ins.len()) {
+                let x = lane_value(ins[i], lane);
+                if f32 {
+                    inputs.extend((x.to_f64() as f32).to_le_bytes());
+                } else {
+                    inputs.extend(x.to_f64().to_le_bytes());
                 }
             }
             let per_lane: Vec<Vec<(String, T)>> =
                 (0..w).map(|lane| eval::<T>(f, |name| input_value(name, seed, lane))).collect();
-            // Output j of lane l is printed at j*W + l.
             let mut mag = (0.0, 0usize);
-            for j in 0..no {
-                for (lane, outs) in per_lane.iter().enumerate() {
-                    let (n, x) = &outs[j];
-                    want.push((format!("{} @{} {n} lane {lane}", case.label, f.name), *x));
-                    group.push(scale.len());
-                    if x.to_f64().is_finite() {
-                        mag = (mag.0 + x.to_f64().abs(), mag.1 + 1);
-                    }
+            for (j, lane) in order(no) {
+                let (n, x) = &per_lane[lane as usize][j];
+                want.push((format!("{} @{} {n} lane {lane}", case.label, f.name), *x));
+                group.push(scale.len());
+                if x.to_f64().is_finite() {
+                    mag = (mag.0 + x.to_f64().abs(), mag.1 + 1);
                 }
             }
             scale.push(mag.0 / mag.1.max(1) as f64);
@@ -529,7 +534,7 @@ fn batch_cases() -> Vec<Case> {
 }
 
 #[test]
-fn batched_lanes_equal_the_interpreter_bit_for_bit_for_every_width_precision_and_trig() {
+fn batched_lanes_equal_the_interpreter_bit_for_bit_for_every_width_precision_trig_and_layout() {
     let cases = batch_cases();
     // Every width once, each pair of precision and trig mode once, and each vector width: the
     // one chosen for the compiler's target (SSE2 or NEON here: 16 bytes, several chunks of lanes
@@ -537,15 +542,17 @@ fn batched_lanes_equal_the_interpreter_bit_for_bit_for_every_width_precision_and
     // compiler splits (64 bytes, as with AVX-512). `split::split_batches_…` compiles the other
     // pairs of width and precision, the same lanes in parts (CI time: each pair is a compile of
     // every case).
+    // Half of them with `layout=rows` (state l's element i at `in[l*n + i]`).
     let combos = [
-        (2, false, false, ""),
-        (4, false, true, "-DROBOVEC_VBYTES=8"),
-        (8, true, false, "-DROBOVEC_VBYTES=64"),
-        (16, true, true, ""),
+        (2, false, false, "", false),
+        (4, false, true, "-DROBOVEC_VBYTES=8", true),
+        (8, true, false, "-DROBOVEC_VBYTES=64", false),
+        (16, true, true, "", true),
     ];
-    for (batch, f32, trig_input, width) in combos {
+    for (batch, f32, trig_input, width, rows) in combos {
         let dir = tmp(&format!("batch_{batch}_{f32}_{trig_input}"));
-        let o = plain(f32, batch, trig_input);
+        let layout = if rows { BatchLayout::Rows } else { BatchLayout::Lanes };
+        let o = CodegenC { layout, ..plain(f32, batch, trig_input) };
         let extra: Vec<&str> = [width].into_iter().filter(|w| !w.is_empty()).collect();
         let n = if f32 {
             check_plain_with::<f32>(&dir, &cases, &o, 4, &extra)

@@ -17,7 +17,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
 
-use robovec_backends::c::{pinocchio::GRAVITY, Abi, CodegenC, Trig};
+use robovec_backends::c::{pinocchio::GRAVITY, Abi, BatchLayout, CodegenC, Trig};
 use robovec_backends::literal::hex;
 use robovec_front::FrontOptions;
 use robovec_ir::interp::pseudo_random_input;
@@ -119,12 +119,14 @@ fn run_c(
     c += &table("T", states.iter().map(|s| &s.tau).collect(), nv);
     let _ = write!(
         c,
-        "int main(void)\n{{\n  enum {{ W = {w}, NQ = model_NQ, NV = model_NV }};\n  for (int s0 = 0; s0 < {}; s0 += W) {{\n    \
+        "/* Element k of state l of an array of n elements a state. */\n#define AT(k, l, n) {}\n\
+         int main(void)\n{{\n  enum {{ W = {w}, NQ = model_NQ, NV = model_NV }};\n  for (int s0 = 0; s0 < {}; s0 += W) {{\n    \
          static double q[NQ * W], v[NV * W], a[NV * W], t[NV * W], tau[NV * W], M[NV * NV * W], nle[NV * W], qdd[NV * W];\n    \
          memset(tau, 0xff, sizeof tau); memset(M, 0xff, sizeof M); memset(nle, 0xff, sizeof nle); memset(qdd, 0xff, sizeof qdd);\n    \
          for (int l = 0; l < W; l++) {{\n      \
-         for (int k = 0; k < NQ; k++) q[k * W + l] = Q[s0 + l][k];\n      \
-         for (int k = 0; k < NV; k++) {{ v[k * W + l] = V[s0 + l][k]; a[k * W + l] = A[s0 + l][k]; t[k * W + l] = T[s0 + l][k]; }}\n    }}\n",
+         for (int k = 0; k < NQ; k++) q[AT(k, l, NQ)] = Q[s0 + l][k];\n      \
+         for (int k = 0; k < NV; k++) {{ v[AT(k, l, NV)] = V[s0 + l][k]; a[AT(k, l, NV)] = A[s0 + l][k]; t[AT(k, l, NV)] = T[s0 + l][k]; }}\n    }}\n",
+        if o.layout == BatchLayout::Rows { "((l) * (n) + (k))" } else { "((k) * W + (l))" },
         states.len()
     );
     for (f, ins, out) in FUNCTIONS {
@@ -133,7 +135,7 @@ fn run_c(
     c += "    for (int l = 0; l < W; l++) {\n";
     for (_, _, out) in FUNCTIONS {
         let n = if *out == "M" { "NV * NV" } else { "NV" };
-        let _ = writeln!(c, "      for (int k = 0; k < {n}; k++) put({out}[k * W + l]);");
+        let _ = writeln!(c, "      for (int k = 0; k < {n}; k++) put({out}[AT(k, l, {n})]);");
     }
     c += "    }\n  }\n  return 0;\n}\n";
     std::fs::write(dir.join("main.c"), c).unwrap();
@@ -317,8 +319,9 @@ fn interpreted(m: &Module, s: &StateIn, nv: usize) -> Results {
 
 /// Without Pinocchio: the `abi=pinocchio` C equals robovec's interpreter bit for bit (the
 /// gravity it folds is the interpreter's `g`), for the three-link arm and a 9-dof tree, one state,
-/// `batch=4` with functions split into parts of 40 statements over two translation units, and
-/// `trig=inline` (robovec's own sin/cos: within 1e-12 of the output's magnitude).
+/// `batch=4` as rows (`layout=rows`) with functions split into parts of 40 statements over two
+/// translation units, and `trig=inline` (robovec's own sin/cos: within 1e-12 of the output's
+/// magnitude).
 #[test]
 fn pinocchio_abi_c_equals_the_interpreter_bit_for_bit() {
     use robovec_dynamics::topology::{build, Topology};
@@ -331,11 +334,13 @@ fn pinocchio_abi_c_equals_the_interpreter_bit_for_bit() {
         let m = load(path, "atomise,cse,zero-removal,balance");
         let states = random_states(8, n, n, 5);
         let want: Vec<Results> = states.iter().map(|s| interpreted(&m, s, n)).collect();
-        for (batch, chunk, units, trig, tol) in
-            [(1, 4000, 1, Trig::Libm, None), (4, 40, 2, Trig::Libm, None), (2, 4000, 1, Trig::Inline, Some(1e-12))]
-        {
+        for (batch, chunk, units, trig, tol, layout) in [
+            (1, 4000, 1, Trig::Libm, None, BatchLayout::Lanes),
+            (4, 40, 2, Trig::Libm, None, BatchLayout::Rows),
+            (2, 4000, 1, Trig::Inline, Some(1e-12), BatchLayout::Lanes),
+        ] {
             let d = tmp(&format!("eval_{label}_{batch}_{chunk}"));
-            let o = CodegenC { abi: Abi::Pinocchio, batch, chunk, units, trig, ..CodegenC::default() };
+            let o = CodegenC { abi: Abi::Pinocchio, batch, chunk, units, trig, layout, ..CodegenC::default() };
             let got = run_c(&d, &m, &o, n, n, &states, &["-O0"]);
             for (k, (g, w)) in got.iter().zip(&want).enumerate() {
                 for (what, x) in w {

@@ -212,11 +212,11 @@ struct IntegerOps {
 }
 
 /// The bit-exact campaign at `batch` lanes (each call evaluates `batch` points,
-/// lane-contiguous), compiled with `opt_level` (and `-march=native` in a batch of 8); with
+/// lane-contiguous for even seeds, as rows for odd ones), compiled with `opt_level` (and `-march=native` in a batch of 8); with
 /// `inline_trig`, `trig=inline` and each output within its `trig=inline` bound of the exact value.
 /// Returns the count of integer ops compiled (one state: by intermediate type).
 fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool, mix: Mix) -> IntegerOps {
-    use robovec_backends::c::CodegenC;
+    use robovec_backends::c::{BatchLayout, CodegenC};
     use robovec_ir::rng::SplitMix64;
     use robovec_ir::Operand;
     use std::fmt::Write as _;
@@ -250,7 +250,11 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool,
         }
         let m = Module { functions: vec![g.clone()] };
         let trig = if inline_trig { robovec_backends::c::Trig::Inline } else { robovec_backends::c::Trig::Libm };
-        let o = CodegenC { name: Some(format!("t{seed}")), batch: batch as u32, trig, ..CodegenC::default() };
+        // Odd seeds read and write their batch as rows (`layout=rows`: state k's element i at
+        // `[k*n + i]`), even ones lane-contiguous.
+        let rows = batch > 1 && seed % 2 == 1;
+        let layout = if rows { BatchLayout::Rows } else { BatchLayout::Lanes };
+        let o = CodegenC { name: Some(format!("t{seed}")), batch: batch as u32, trig, layout, ..CodegenC::default() };
         // With inline trig: the bound for robovec's own sin/cos (binary32 allowed 1 ulp), which
         // the C must meet against the certified exact value.
         let bounds = if inline_trig {
@@ -283,9 +287,15 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool,
         }
         let calls_made = points.len() / batch;
         for group in points.chunks_exact(batch) {
-            for i in 0..ni {
+            if rows {
                 for (point, _) in group {
-                    input_bytes.extend(point[i].to_le_bytes());
+                    input_bytes.extend(point.iter().flat_map(|x| x.to_le_bytes()));
+                }
+            } else {
+                for i in 0..ni {
+                    for (point, _) in group {
+                        input_bytes.extend(point[i].to_le_bytes());
+                    }
                 }
             }
             // The certified exact outputs at each point (inline trig only), by output name.
@@ -309,22 +319,29 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool,
             } else {
                 Vec::new()
             };
-            for (name, out) in iface.outputs.iter().zip(&g.outputs) {
-                for (k, (point, vals)) in group.iter().enumerate() {
-                    let (y, allowed) = match out.value {
-                        // Against the exact value, within the bound and the reference's half ulp
-                        // (an uncertified reference is not compared: allowed ∞).
-                        Operand::Value(v) if inline_trig => {
-                            match exact[k].iter().find(|(n, _)| n == name).and_then(|(_, r)| *r) {
-                                Some(r) => (r, bounds[v.index()] + r.abs() * f64::EPSILON / 2.0),
-                                None => (vals[v.index()], f64::INFINITY),
-                            }
+            // Output j of state k, in the order the C writes them: `[j*batch + k]`, or
+            // `[k*no + j]` as rows.
+            let order: Vec<(usize, usize)> = if rows {
+                (0..group.len()).flat_map(|k| (0..no).map(move |j| (j, k))).collect()
+            } else {
+                (0..no).flat_map(|j| (0..group.len()).map(move |k| (j, k))).collect()
+            };
+            for (j, k) in order {
+                let (name, out) = (&iface.outputs[j], &g.outputs[j]);
+                let (point, vals) = &group[k];
+                let (y, allowed) = match out.value {
+                    // Against the exact value, within the bound and the reference's half ulp
+                    // (an uncertified reference is not compared: allowed ∞).
+                    Operand::Value(v) if inline_trig => {
+                        match exact[k].iter().find(|(n, _)| n == name).and_then(|(_, r)| *r) {
+                            Some(r) => (r, bounds[v.index()] + r.abs() * f64::EPSILON / 2.0),
+                            None => (vals[v.index()], f64::INFINITY),
                         }
-                        Operand::Value(v) => (vals[v.index()], 0.0),
-                        Operand::Const(c) => (c, 0.0),
-                    };
-                    want.push((format!("seed {seed} {name} at {point:?}"), y, allowed));
-                }
+                    }
+                    Operand::Value(v) => (vals[v.index()], 0.0),
+                    Operand::Const(c) => (c, 0.0),
+                };
+                want.push((format!("seed {seed} {name} at {point:?}"), y, allowed));
             }
         }
         let _ = writeln!(

@@ -82,6 +82,10 @@ pub struct Interface {
     pub precision: Precision,
     /// States per call (lanes).
     pub batch: u32,
+    /// Where a batch's states are: `lanes` (SPEC §8's `in[i*W + lane]`; left out of the report)
+    /// or `rows` (`in[lane*n + i]`, `n` the array's elements per state).
+    #[serde(skip_serializing_if = "c::BatchLayout::is_lanes")]
+    pub layout: c::BatchLayout,
     /// `libm`, `input` or `inline`.
     pub trig: Trig,
     /// Canonical input names (SPEC §2), in argument order: `in[i]` (or `in[i*W + lane]`) is
@@ -211,7 +215,7 @@ mod tests {
         let e = build("codegen<frobnicate=1>").unwrap_err().to_string();
         assert_eq!(
             e,
-            "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, abi, precision, batch, trig, name, chunk, units)"
+            "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, abi, precision, batch, layout, trig, name, chunk, units)"
         );
     }
 
@@ -221,14 +225,14 @@ mod tests {
         let names: Vec<&str> = info.every_param().map(|p| p.name).collect();
         assert_eq!(
             names,
-            ["back-end", "abi", "precision", "batch", "trig", "name", "chunk", "units", "out", "format", "resources", "interconnect"]
+            ["back-end", "abi", "precision", "batch", "layout", "trig", "name", "chunk", "units", "out", "format", "resources", "interconnect"]
         );
         let members: Vec<(&str, Vec<&str>)> =
             super::BACK_ENDS.iter().map(|m| (m.name, m.params.iter().map(|p| p.name).collect())).collect();
         assert_eq!(
             members,
             [
-                ("c", vec!["abi", "precision", "batch", "trig", "name", "chunk", "units"]),
+                ("c", vec!["abi", "precision", "batch", "layout", "trig", "name", "chunk", "units"]),
                 ("fpga", vec!["out", "format", "resources", "interconnect"])
             ]
         );

@@ -16,9 +16,12 @@ folder; free flyer for solo12, talos, tiago_pro) or a URDF path. Needs the wheel
    batched function over the same states already in its lane-contiguous layout (and the
    one-state function for the remainder), as a C program would.
 
-Python and C alternate, `rounds` times; each figure is the median over the rounds of the
-median of its repetitions; ratios are C's time over Python's (1 = as fast as C).
+Python and C alternate at every repetition (`rounds` × 21 of each), in one process: the C
+harness is a shared object called through ctypes, once a repetition (1000 calls at B = 1, one
+pass over the 10^4 states). Each time is the median of its repetitions; each ratio, C's time
+over Python's (1 = as fast as C), is the median of the ratios of the pairs.
 """
+import ctypes
 import glob
 import os
 import statistics
@@ -40,45 +43,27 @@ ROBOTS = {
 }
 
 HARNESS = r"""
-#include <dlfcn.h>
-#include <stdio.h>
-#include <stdlib.h>
 #include <time.h>
-typedef void (*f3)(const double *, const double *, const double *, double *);
+typedef void (*f4)(const double *, const double *, const double *, double *);
 static double now(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return t.tv_sec * 1e9 + t.tv_nsec; }
-static int cmp(const void *a, const void *b) { double x = *(const double *)a, y = *(const double *)b; return (x > y) - (x < y); }
-/* argv: SO SUFFIX NQ NV W B REPS. Prints: ns per one-state call, ns for B states. */
-int main(int argc, char **argv)
+/* ns per call of the one-state function on one state, over `iters` calls. */
+double one_state(void *one, const double *q, const double *v, const double *a, double *tau, int iters)
 {
-    void *h = dlopen(argv[1], RTLD_NOW);
-    if (!h) { fprintf(stderr, "%s\n", dlerror()); return 1; }
-    char name[256];
-    snprintf(name, sizeof name, "rv1_%s", argv[2]);
-    f3 one = (f3)dlsym(h, name);
-    snprintf(name, sizeof name, "rvw_%s", argv[2]);
-    f3 lanes = (f3)dlsym(h, name);
-    int nq = atoi(argv[3]), nv = atoi(argv[4]), w = atoi(argv[5]), b = atoi(argv[6]), reps = atoi(argv[7]);
-    if (!one || (w > 1 && !lanes)) { fprintf(stderr, "no symbol\n"); return 1; }
-    double *q = malloc(sizeof(double) * nq * b), *v = malloc(sizeof(double) * nv * b), *a = malloc(sizeof(double) * nv * b);
-    double *tau = malloc(sizeof(double) * nv * b);
-    for (int i = 0; i < nq * b; i++) q[i] = (double)rand() / RAND_MAX - 0.5;
-    for (int i = 0; i < nv * b; i++) { v[i] = (double)rand() / RAND_MAX - 0.5; a[i] = (double)rand() / RAND_MAX - 0.5; }
-    double *t1 = malloc(sizeof(double) * reps), *tb = malloc(sizeof(double) * reps);
-    for (int r = 0; r < reps; r++) {
-        double t = now();
-        for (int k = 0; k < 1000; k++) one(q, v, a, tau);
-        t1[r] = (now() - t) / 1000;
-        t = now();
-        int s = 0;
-        if (w > 1)
-            for (; s + w <= b; s += w) lanes(q + s * nq, v + s * nv, a + s * nv, tau + s * nv);
-        for (; s < b; s++) one(q + s * nq, v + s * nv, a + s * nv, tau + s * nv);
-        tb[r] = now() - t;
-    }
-    qsort(t1, reps, sizeof(double), cmp);
-    qsort(tb, reps, sizeof(double), cmp);
-    printf("%.3f %.1f\n", t1[reps / 2], tb[reps / 2]);
-    return 0;
+    double t = now();
+    for (int k = 0; k < iters; k++) ((f4)one)(q, v, a, tau);
+    return (now() - t) / iters;
+}
+/* ns for `b` states of lane-contiguous arrays: groups of `w` through `lanes`, the rest through
+   `one`, as a C program over its own arrays would. */
+double states(void *one, void *lanes, const double *q, const double *v, const double *a, double *tau,
+              int nq, int nv, int w, int b)
+{
+    double t = now();
+    int s = 0;
+    if (w > 1)
+        for (; s + w <= b; s += w) ((f4)lanes)(q + s * nq, v + s * nv, a + s * nv, tau + s * nv);
+    for (; s < b; s++) ((f4)one)(q + s * nq, v + s * nv, a + s * nv, tau + s * nv);
+    return now() - t;
 }
 """
 
@@ -129,31 +114,43 @@ def main():
     work = tempfile.mkdtemp(prefix="robovec-bench-")
     with open(os.path.join(work, "harness.c"), "w") as h:
         h.write(HARNESS)
-    exe = os.path.join(work, "harness")
-    subprocess.run(["cc", "-O2", "-o", exe, os.path.join(work, "harness.c"), "-ldl"], check=True)
+    so = os.path.join(work, "harness.so")
+    subprocess.run(["cc", "-O2", "-shared", "-fPIC", "-o", so, os.path.join(work, "harness.c")], check=True)
+    harness = ctypes.CDLL(so)
+    p = ctypes.POINTER(ctypes.c_double)
+    harness.one_state.restype = harness.states.restype = ctypes.c_double
+    harness.one_state.argtypes = [ctypes.c_void_p, p, p, p, p, ctypes.c_int]
+    harness.states.argtypes = [ctypes.c_void_p, ctypes.c_void_p, p, p, p, p] + [ctypes.c_int] * 4
+    lib = ctypes.CDLL(str(f.library))
+    one = ctypes.cast(getattr(lib, f"rv1_{function}"), ctypes.c_void_p)
+    lanes = ctypes.cast(getattr(lib, f"rvw_{function}"), ctypes.c_void_p) if batch > 1 else None
     rng = np.random.default_rng(1)
     big = 10_000
     q1, v1, a1 = rng.uniform(-0.5, 0.5, f.nq), rng.uniform(-0.5, 0.5, f.nv), rng.uniform(-0.5, 0.5, f.nv)
     qb, vb, ab = rng.uniform(-0.5, 0.5, (big, f.nq)), rng.uniform(-0.5, 0.5, (big, f.nv)), rng.uniform(-0.5, 0.5, (big, f.nv))
+    tau1, taub = np.empty(f.nv), np.empty((big, f.nv))
+    ptr = lambda x: x.ctypes.data_as(p)
+    # Python and C alternate at every repetition, in one process: each pair sees the same
+    # machine state. A repetition at B = 1 is 1000 calls.
     py1, c1, pyb, cb = [], [], [], []
-    for _ in range(rounds):
-        py1.append(median_time(lambda: f(q1, v1, a1), 21, 1000))
-        pyb.append(median_time(lambda: f(qb, vb, ab), 21, 1))
-        out = subprocess.run([exe, str(f.library), function, str(f.nq), str(f.nv), str(batch), str(big), "21"],
-                             check=True, capture_output=True, text=True).stdout.split()
-        c1.append(float(out[0]))
-        cb.append(float(out[1]))
+    for _ in range(rounds * 21):
+        py1.append(median_time(lambda: f(q1, v1, a1), 1, 1000))
+        c1.append(harness.one_state(one, ptr(q1), ptr(v1), ptr(a1), ptr(tau1), 1000))
+        pyb.append(median_time(lambda: f(qb, vb, ab), 1, 1))
+        cb.append(harness.states(one, lanes, ptr(qb), ptr(vb), ptr(ab), ptr(taub), f.nq, f.nv, batch, big))
+    ratio1 = statistics.median(c / p for c, p in zip(c1, py1))
+    ratiob = statistics.median(c / p for c, p in zip(cb, pyb))
     py1, c1, pyb, cb = (statistics.median(x) for x in (py1, c1, pyb, cb))
     print(f"robot {robot} ({'free flyer' if free else 'fixed base'}), {function}, batch={batch}, trig={trig}, "
-          f"nq={f.nq} nv={f.nv}; {rounds} rounds, Python and C alternating")
+          f"nq={f.nq} nv={f.nv}; {rounds * 21} repetitions, Python and C alternating")
     print("| measure | Python | C | C ÷ Python |")
     print("|---|---:|---:|---:|")
-    print(f"| first compile (write C, cc -O2, load) | {first:.2f} s | | |")
+    print(f"| first compile (write C, cc with the default flags, load) | {first:.2f} s | | |")
     print(f"| cached compile, new process | {cached * 1e3:.1f} ms | | |")
     print(f"| cached compile, loaded already | {loaded * 1e6:.0f} µs | | |")
-    print(f"| one state (B = 1), ns per call | {py1:.0f} | {c1:.0f} | {c1 / py1:.3f} |")
+    print(f"| one state (B = 1), ns per call | {py1:.0f} | {c1:.0f} | {ratio1:.3f} |")
     print(f"| per-call overhead at B = 1 (Python − C) | {py1 - c1:.0f} ns | | |")
-    print(f"| B = 10⁴, ns per state | {pyb / big:.1f} | {cb / big:.1f} | {cb / pyb:.3f} |")
+    print(f"| B = 10⁴, ns per state | {pyb / big:.1f} | {cb / big:.1f} | {ratiob:.3f} |")
 
 
 if __name__ == "__main__":

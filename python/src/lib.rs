@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use clap::Parser as _;
-use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
@@ -274,11 +274,13 @@ impl Module {
         if ![1, 2, 4, 8, 16].contains(&batch) {
             return Err(UsageError::new_err(format!("compile: batch={batch}; expected 1, 2, 4, 8 or 16")));
         }
-        let cflags = cflags.unwrap_or_else(|| vec!["-O2".to_string()]);
+        let cflags = cflags.unwrap_or_else(default_cflags);
         let cc = std::env::var("CC").unwrap_or_else(|_| "cc".to_string());
         let model = std::fs::read(urdf).map_err(|e| InputError::new_err(format!("cannot read {urdf}: {e}")))?;
         let mut h = std::collections::hash_map::DefaultHasher::new();
-        (env!("CARGO_PKG_VERSION"), &model, flags, sig.suffix, pipeline, batch, trig, &cc, &cflags).hash(&mut h);
+        let cpu = native_cpu(&cflags);
+        (env!("CARGO_PKG_VERSION"), OBJECT_ABI, &model, flags, sig.suffix, pipeline, batch, trig, &cc, &cflags, cpu)
+            .hash(&mut h);
         let key = format!("{}-{:016x}", sig.suffix, h.finish());
         let lib = shared_object(&key, || {
             build(py, urdf, flags, &sig, pipeline, batch, trig, &cc, &cflags, self.time_limit, &key)
@@ -289,6 +291,37 @@ impl Module {
     fn __repr__(&self) -> String {
         format!("<robovec.Module functions={:?}>", self.functions())
     }
+}
+
+/// What the cache's shared objects hold, in the key: 2 since `rvw_NAME` takes `layout=rows`
+/// (1: lane-contiguous). An object of another value is never loaded.
+const OBJECT_ABI: u32 = 2;
+
+/// `compile`'s C flags when none are given: `-O2 -ffp-contract=off` (no contraction: the IR's
+/// operations in its order, as `codegen<c>`'s header asks), and on x86-64 `-march=native`, the
+/// vector width of this machine (UR5's `rnea` at `batch=4`: 39 ns a state with AVX2 against
+/// 107 with x86-64's baseline SSE2, docs/python.md).
+fn default_cflags() -> Vec<String> {
+    let mut f = vec!["-O2".to_string(), "-ffp-contract=off".to_string()];
+    if cfg!(target_arch = "x86_64") {
+        f.push("-march=native".to_string());
+    }
+    f
+}
+
+/// For flags that tune the code to this machine (`-march=native`, `-mcpu=native`,
+/// `-mtune=native`), its CPU as the kernel names it (the `model name` and `flags` lines of
+/// `/proc/cpuinfo`), so that a cache folder shared between machines never loads an object built
+/// for another CPU; empty otherwise, or where `/proc/cpuinfo` is not.
+fn native_cpu(cflags: &[String]) -> String {
+    if !cflags.iter().any(|f| f.ends_with("=native")) {
+        return String::new();
+    }
+    let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let field = |name: &str| {
+        info.lines().find(|l| l.split(':').next().is_some_and(|k| k.trim() == name)).unwrap_or_default().to_string()
+    };
+    field("model name") + "\n" + &field("flags")
 }
 
 /// The cache folder: `$ROBOVEC_CACHE_DIR`, else `$XDG_CACHE_HOME/robovec`, else
@@ -372,7 +405,9 @@ fn build(
         args.push("--fold-params".to_string());
         args.push(format!("-function={}", sig.function));
         let sep = if pipeline.is_empty() { "" } else { "," };
-        args.push(format!("-passes={pipeline}{sep}codegen<c;abi=pinocchio;name={name};batch={w};trig={trig}>"));
+        // The batched function reads and writes W rows of the (B, n) arrays in place.
+        let layout = if w > 1 { ";layout=rows" } else { "" };
+        args.push(format!("-passes={pipeline}{sep}codegen<c;abi=pinocchio;name={name};batch={w}{layout};trig={trig}>"));
         args.extend(limit_args(time_limit));
         args.extend(["-o".to_string(), c.display().to_string()]);
         opt(py, &args)?;
@@ -429,7 +464,7 @@ struct Compiled {
     sig: Signature,
     batch: usize,
     one: usize,
-    lanes: Option<usize>,
+    rows: Option<usize>,
 }
 
 impl Compiled {
@@ -442,8 +477,8 @@ impl Compiled {
             Ok(*f as usize)
         };
         let one = symbol("rv1")?;
-        let lanes = if batch > 1 { Some(symbol("rvw")?) } else { None };
-        Ok(Compiled { lib, sig, batch, one, lanes })
+        let rows = if batch > 1 { Some(symbol("rvw")?) } else { None };
+        Ok(Compiled { lib, sig, batch, one, rows })
     }
 
     fn len(&self, d: Dim) -> usize {
@@ -451,6 +486,44 @@ impl Compiled {
             Dim::Nq => self.lib.nq,
             Dim::Nv => self.lib.nv,
         }
+    }
+}
+
+/// The most arrays of an `abi=pinocchio` function, inputs and outputs (`aba_derivatives`: 3 + 3).
+const MAX_ARRAYS: usize = 6;
+
+/// From this many states on, a call releases the GIL while the C runs, as numpy's loops do past
+/// a size: below it, releasing and taking the GIL back costs more than the C (a fraction of a
+/// µs against UR5's `rnea` at about 0.1 µs a state).
+const DETACH_STATES: usize = 64;
+
+/// A fresh array's data address, and the array.
+fn fresh<'py, D: numpy::ndarray::Dimension>(a: Bound<'py, numpy::PyArray<f64, D>>) -> (usize, Bound<'py, PyAny>) {
+    (a.data() as usize, a.into_any())
+}
+
+/// Runs `b` states on the arrays in place: full groups of `w` through the batched function
+/// `rows` (`layout=rows`: `w` rows of each array), the rest one at a time through `one`.
+///
+/// # Safety
+/// `one` (and `rows` when `w > 1`) are functions of `ptr.len()` `double *` parameters, the
+/// inputs read, the outputs written; `ptr[i]` covers `b * len[i]` numbers, row-major
+/// `(b, len[i])`, and the outputs overlap nothing.
+unsafe fn run_states(one: usize, rows: Option<usize>, w: usize, b: usize, ptr: &[usize], len: &[usize]) {
+    let mut args = [std::ptr::null_mut::<f64>(); MAX_ARRAYS];
+    let args = &mut args[..ptr.len()];
+    let mut s = 0;
+    while s < b {
+        let (f, step) = match rows {
+            Some(f) if s + w <= b => (f, w),
+            _ => (one, 1),
+        };
+        for (x, (&p, &n)) in args.iter_mut().zip(ptr.iter().zip(len)) {
+            *x = (p as *mut f64).wrapping_add(s * n);
+        }
+        // SAFETY: the function of this signature on rows s .. s + step of every array.
+        unsafe { call(f, args) };
+        s += step;
     }
 }
 
@@ -496,23 +569,28 @@ impl Compiled {
                 args.len()
             )));
         }
-        let mut inputs: Vec<PyReadonlyArrayDyn<'py, f64>> = Vec::with_capacity(args.len());
+        // The arrays' addresses and lengths per state, inputs then outputs. The inputs are
+        // held (`held`) until the call returns; they are read through their pointers without
+        // numpy's borrow tracking (a Python thread writing into an input meanwhile races, as
+        // with numpy's own loops).
+        let mut held: [Option<Bound<'py, PyArrayDyn<f64>>>; MAX_ARRAYS] = Default::default();
+        let mut ptr = [0usize; MAX_ARRAYS];
+        let mut len = [0usize; MAX_ARRAYS];
         let mut states: Option<Option<usize>> = None;
-        for (x, &(name, dim)) in args.iter().zip(&sig.inputs) {
+        for (i, (x, &(name, dim))) in args.iter().zip(&sig.inputs).enumerate() {
             // A float64 C-contiguous array is read in place; anything else converted.
-            let a: PyReadonlyArrayDyn<'py, f64> = match x.cast::<PyArrayDyn<f64>>() {
-                Ok(a) if a.is_c_contiguous() => a.readonly(),
+            let a: Bound<'py, PyArrayDyn<f64>> = match x.cast::<PyArrayDyn<f64>>() {
+                Ok(a) if a.is_c_contiguous() => a.clone(),
                 _ => {
                     let kw = [("dtype", "float64")].into_py_dict(py)?;
                     py.import("numpy")?.call_method("ascontiguousarray", (x,), Some(&kw))?.extract()?
                 }
             };
             let n = self.len(dim);
-            let shape = a.shape().to_vec();
-            let b = match shape.as_slice() {
+            let b = match a.shape() {
                 [k] if *k == n => None,
                 [b, k] if *k == n => Some(*b),
-                _ => {
+                shape => {
                     return Err(PyValueError::new_err(format!(
                         "{}: `{name}` has shape {shape:?}; expected ({n},) or (B, {n})",
                         sig.suffix
@@ -523,8 +601,9 @@ impl Compiled {
                 None => states = Some(b),
                 Some(s) if s != b => {
                     return Err(PyValueError::new_err(format!(
-                        "{}: `{name}` has shape {shape:?}, the arrays before it {}",
+                        "{}: `{name}` has shape {:?}, the arrays before it {}",
                         sig.suffix,
+                        a.shape(),
                         match s {
                             Some(b) => format!("(B = {b}, …)"),
                             None => "one state".to_string(),
@@ -533,75 +612,43 @@ impl Compiled {
                 }
                 _ => {}
             }
-            inputs.push(a);
+            ptr[i] = a.data() as usize;
+            len[i] = n;
+            held[i] = Some(a);
         }
         let states = states.flatten();
         let b = states.unwrap_or(1);
-        let mut outputs: Vec<Bound<'py, PyArrayDyn<f64>>> = Vec::with_capacity(sig.outputs.len());
-        let mut out_len = Vec::with_capacity(sig.outputs.len());
-        for &(_, rows, cols) in &sig.outputs {
-            let mut shape: Vec<usize> = states.into_iter().collect();
-            shape.push(self.len(rows));
-            if let Some(c) = cols {
-                shape.push(self.len(c));
-            }
-            out_len.push(self.len(rows) * cols.map_or(1, |c| self.len(c)));
-            outputs.push(PyArrayDyn::<f64>::zeros(py, shape, false));
+        let inputs = sig.inputs.len();
+        let mut outputs: [Option<Bound<'py, PyAny>>; MAX_ARRAYS] = Default::default();
+        for (j, &(_, rows, cols)) in sig.outputs.iter().enumerate() {
+            let (r, c) = (self.len(rows), cols.map(|c| self.len(c)));
+            // SAFETY (each `new`): uninitialised, and every element is written below before
+            // the array is returned: `abi=pinocchio` writes every entry of every output (both
+            // triangles) for every state.
+            let (p, a) = match (states, c) {
+                (None, None) => fresh(unsafe { PyArray1::<f64>::new(py, [r], false) }),
+                (None, Some(c)) => fresh(unsafe { PyArray2::<f64>::new(py, [r, c], false) }),
+                (Some(b), None) => fresh(unsafe { PyArray2::<f64>::new(py, [b, r], false) }),
+                (Some(b), Some(c)) => fresh(unsafe { PyArray3::<f64>::new(py, [b, r, c], false) }),
+            };
+            ptr[inputs + j] = p;
+            len[inputs + j] = r * c.unwrap_or(1);
+            outputs[j] = Some(a);
         }
-        let in_len: Vec<usize> = sig.inputs.iter().map(|&(_, d)| self.len(d)).collect();
-        let in_ptr: Vec<usize> = inputs.iter().map(|a| a.as_array().as_ptr() as usize).collect();
-        // SAFETY: fresh arrays, written only here.
-        let out_ptr: Vec<usize> = outputs.iter().map(|a| unsafe { a.as_array_mut().as_mut_ptr() } as usize).collect();
-        let (one, lanes, w) = (self.one, self.lanes, self.batch);
-        py.detach(|| {
-            let mut s = 0;
-            if let Some(lanes) = lanes {
-                // Full groups of `w` states, lane-contiguous (`x[k*w + l]`): gathered into
-                // buffers made once, scattered back.
-                let mut ins: Vec<Vec<f64>> = in_len.iter().map(|&n| vec![0.0; n * w]).collect();
-                let mut outs: Vec<Vec<f64>> = out_len.iter().map(|&n| vec![0.0; n * w]).collect();
-                let mut args: Vec<*mut f64> = ins.iter_mut().map(|v| v.as_mut_ptr()).collect();
-                args.extend(outs.iter_mut().map(|v| v.as_mut_ptr()));
-                while s + w <= b {
-                    for ((buf, &p), &n) in ins.iter_mut().zip(&in_ptr).zip(&in_len) {
-                        // SAFETY: rows s .. s + w of a (B, n) contiguous array.
-                        let rows = unsafe { std::slice::from_raw_parts((p as *const f64).add(s * n), n * w) };
-                        for (l, row) in rows.chunks_exact(n).enumerate() {
-                            for (lanes_k, x) in buf.chunks_exact_mut(w).zip(row) {
-                                lanes_k[l] = *x;
-                            }
-                        }
-                    }
-                    // SAFETY: the function of this signature; every buffer holds `w` lanes.
-                    unsafe { call(lanes, &args) };
-                    for ((buf, &p), &n) in outs.iter().zip(&out_ptr).zip(&out_len) {
-                        // SAFETY: rows s .. s + w of a fresh (B, …) array.
-                        let rows = unsafe { std::slice::from_raw_parts_mut((p as *mut f64).add(s * n), n * w) };
-                        for (l, row) in rows.chunks_exact_mut(n).enumerate() {
-                            for (lanes_k, x) in buf.chunks_exact(w).zip(row) {
-                                *x = lanes_k[l];
-                            }
-                        }
-                    }
-                    s += w;
-                }
-            }
-            // The rest one state at a time, in place.
-            let mut args: Vec<*mut f64> = vec![std::ptr::null_mut(); in_ptr.len() + out_ptr.len()];
-            while s < b {
-                for (x, (&p, &n)) in
-                    args.iter_mut().zip(in_ptr.iter().chain(&out_ptr).zip(in_len.iter().chain(&out_len)))
-                {
-                    *x = (p as *mut f64).wrapping_add(s * n);
-                }
-                // SAFETY: the one-state function of this signature, on row s of every array.
-                unsafe { call(one, &args) };
-                s += 1;
-            }
-        });
-        drop(inputs);
-        if outputs.len() == 1 {
-            Ok(outputs.pop().expect("one").into_any().unbind())
+        let arrays = inputs + sig.outputs.len();
+        let (ptr, len) = (&ptr[..arrays], &len[..arrays]);
+        // SAFETY: `ptr` are `b` states of `len` numbers each, inputs then outputs, in this
+        // signature's order; the inputs are held, the outputs fresh.
+        let run = || unsafe { run_states(self.one, self.rows, self.batch, b, ptr, len) };
+        if b >= DETACH_STATES {
+            py.detach(run);
+        } else {
+            run();
+        }
+        drop(held);
+        let outputs = outputs.into_iter().take(sig.outputs.len()).map(|a| a.expect("made above"));
+        if sig.outputs.len() == 1 {
+            Ok(outputs.last().expect("one output").unbind())
         } else {
             Ok(PyTuple::new(py, outputs)?.into_any().unbind())
         }
@@ -620,7 +667,7 @@ impl Compiled {
     }
 
     /// The shared object in the cache: symbols `rv1_NAME` (one state) and, with `batch=W`,
-    /// `rvw_NAME` (`W` states, lane-contiguous), `abi=pinocchio`'s signatures.
+    /// `rvw_NAME` (`W` states as `W` rows of each array, `layout=rows`), `abi=pinocchio`'s signatures.
     #[getter]
     fn library(&self) -> PathBuf {
         self.lib.path.clone()

@@ -141,6 +141,22 @@ def test_dynamics_of_the_humanoid_and_the_mobile_manipulator_match_pinocchio(rob
     check(robot, True, ["rnea", "crba", "aba"], batch=8)
 
 
+def test_many_states_with_the_default_flags():
+    # 101 states: the GIL released (64 states or more), 25 groups of 4 rows and one left over,
+    # the C built with compile's default flags (-march=native on x86-64); and 0 states.
+    path = erd(ROBOTS["ur5"])
+    model = pinocchio_model(path, False)
+    data = model.createData()
+    rnea = robovec.load(path).compile("rnea", batch=4)
+    xs = states(model, 101, 5)
+    got = rnea(*[np.stack(c) for c in zip(*xs)])
+    assert got.shape == (101, model.nv)
+    for k, (q, v, a) in enumerate(xs):
+        assert relative(got[k], pin.rnea(model, data, q, v, a)) <= 1e-9, k
+    empty = np.zeros((0, model.nq))
+    assert rnea(empty, empty, empty).shape == (0, model.nv)
+
+
 def test_continuous_joints_as_pinocchio_pairs():
     check(ARM, False, ["rnea", "aba", "rnea_derivatives"])
 

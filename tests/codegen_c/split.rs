@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use robovec_backends::c::{Abi, CodegenC, Precision, Trig};
+use robovec_backends::c::{Abi, BatchLayout, CodegenC, Precision, Trig};
 
 use super::{batch_cases, check_plain, check_plain_tol, check_plain_with, corpus_cases, plain, run_pipeline, Case};
 use crate::common::{opt, stderr, tmp};
@@ -70,19 +70,22 @@ fn split_plain_code_equals_the_interpreter_for_tiny_chunks_in_one_file_and_in_se
 #[test]
 fn split_batches_equal_the_interpreter_for_every_width_precision_and_trig() {
     let cases = batch_cases();
-    // (batch, f32, trig=input, chunk, units, vector width)
+    // (batch, f32, trig=input, chunk, units, vector width, layout=rows)
     let combos = [
-        (2, false, false, 1, 1, ""),
-        (4, true, true, 7, 2, ""),
-        (4, false, true, 1, 3, "-DROBOVEC_VBYTES=8"),
-        (8, false, true, 7, 1, ""),
-        (8, true, false, 1, 2, "-DROBOVEC_VBYTES=64"),
-        (16, true, false, 7, 3, ""),
-        (16, false, true, 1, 1, "-DROBOVEC_VBYTES=64"),
+        (2, false, false, 1, 1, "", false),
+        (4, true, true, 7, 2, "", true),
+        (4, false, true, 1, 3, "-DROBOVEC_VBYTES=8", false),
+        (8, false, true, 7, 1, "", true),
+        (8, true, false, 1, 2, "-DROBOVEC_VBYTES=64", false),
+        (16, true, false, 7, 3, "", false),
+        (16, false, true, 1, 1, "-DROBOVEC_VBYTES=64", true),
     ];
-    for (batch, f32, trig_input, chunk, units, width) in combos {
-        let dir = tmp(&format!("batch_{batch}_{f32}_{trig_input}_{chunk}_{units}"));
-        let o = split(plain(f32, batch, trig_input), chunk, units);
+    for (batch, f32, trig_input, chunk, units, width, rows) in combos {
+        let dir = tmp(&format!("batch_{batch}_{f32}_{trig_input}_{chunk}_{units}_{rows}"));
+        let mut o = split(plain(f32, batch, trig_input), chunk, units);
+        if rows {
+            o.layout = BatchLayout::Rows;
+        }
         let extra: Vec<&str> = [width].into_iter().filter(|w| !w.is_empty()).collect();
         let n = if f32 {
             check_plain_with::<f32>(&dir, &cases, &o, 12, &extra)

@@ -7,7 +7,7 @@
 
 use std::process::Command;
 
-use robovec_backends::c::{robotran, Abi, CodegenC, Trig};
+use robovec_backends::c::{robotran, Abi, BatchLayout, CodegenC, Trig};
 
 use super::{batch_cases, check_plain_tol, check_plain_with, corpus_cases, plain, run_pipeline, Case};
 use crate::common::tmp;
@@ -42,7 +42,7 @@ fn every_configuration_compiles_warning_free_under_gcc_and_clang() {
         ("plain", CodegenC::default()),
         ("trig=inline", CodegenC { trig: Trig::Inline, ..CodegenC::default() }),
         ("batch=4", plain(false, 4, false)),
-        ("batch=8 f32 trig=input", plain(true, 8, true)),
+        ("batch=8 f32 trig=input layout=rows", CodegenC { layout: BatchLayout::Rows, ..plain(true, 8, true) }),
         ("batch=4 trig=inline chunk=300", CodegenC { batch: 4, trig: Trig::Inline, chunk: 300, ..CodegenC::default() }),
         ("chunk=300", CodegenC { chunk: 300, ..CodegenC::default() }),
         ("abi=robotran", CodegenC { abi: Abi::Robotran, ..CodegenC::default() }),

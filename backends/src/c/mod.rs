@@ -1,4 +1,4 @@
-//! `codegen<c;abi=plain|robotran|pinocchio;precision=f64|f32;batch=1|2|4|8|16;trig=libm|input|inline;name=…>`:
+//! `codegen<c;abi=plain|robotran|pinocchio;precision=f64|f32;batch=1|2|4|8|16;layout=lanes|rows;trig=libm|input|inline;name=…>`:
 //! the functions as C (issue 11, SPEC §8).
 //!
 //! Every IR operation becomes one C statement, in the IR's order, so that the compiled code
@@ -6,7 +6,8 @@
 //! when compiled without contraction (`-ffp-contract=off`; the file also says
 //! `#pragma STDC FP_CONTRACT OFF`). `batch=W` computes W independent states per call with
 //! GCC/Clang vector extensions (one source for SSE, AVX2, AVX-512 and NEON), lane-contiguous:
-//! element `i` of lane `l` is `in[i*W + l]`. With `trig=input` the `sin`/`cos` of the joint
+//! element `i` of lane `l` is `in[i*W + l]`; with `layout=rows`, `W` rows of a row-major `(B, n)`
+//! array: `in[l*n + i]`, `n` the array's elements per state (read and written lane by lane). With `trig=input` the `sin`/`cos` of the joint
 //! coordinates are inputs (after the IR's inputs); with `trig=libm` they are computed (per lane).
 //! With `trig=inline` they are computed by robovec's own branch-free sin/cos, written into the
 //! file ([`trig`]: vectorised over the lanes, one reduction for the sin and cos of one
@@ -47,7 +48,7 @@ use robovec_passes::{Member, ParamInfo, Params, Pass, PassContext, PassError};
 pub const BACK_END: Member = Member {
     name: "c",
     doc: "C (SPEC §8); `-o FILE` gets the code and FILE.h its prototypes",
-    params: &[ABI, PRECISION, BATCH, TRIG, NAME, CHUNK, UNITS],
+    params: &[ABI, PRECISION, BATCH, LAYOUT, TRIG, NAME, CHUNK, UNITS],
     build: |p| Ok(Box::new(CodegenC::from_params(p)?)),
     props: robovec_passes::Props {
         requires: Some(robovec_ir::Phase::Atomised),
@@ -77,6 +78,14 @@ pub const BATCH: ParamInfo = ParamInfo {
     name: "batch",
     kind: ParamKind::U32Set { default: 1, allowed: &[1, 2, 4, 8, 16] },
     doc: "C: states per call, lanes (`in[i*W + lane]`; every array likewise with `abi=pinocchio`); not with `abi=robotran`",
+};
+/// `layout=lanes|rows`.
+pub const LAYOUT: ParamInfo = ParamInfo {
+    name: "layout",
+    kind: ParamKind::Choice { choices: BatchLayout::WORDS, default: BatchLayout::Lanes.as_str() },
+    doc: "C: where a batch's states are in every array: `lanes` (element i of state l at `[i*W + l]`, one vector \
+          load each) or `rows` (at `[l*n + i]`, n the array's elements per state: W rows of a row-major (B, n) \
+          array, as numpy and Pinocchio's batches hold them; lane by lane); no effect with `batch=1`",
 };
 /// `trig=libm|input|inline`.
 pub const TRIG: ParamInfo = ParamInfo {
@@ -129,6 +138,23 @@ word_enum! {
 }
 
 word_enum! {
+    /// Where a batch's states are in the arrays (`layout=`).
+    pub enum BatchLayout {
+        /// `lanes`: element `i` of state `l` at `p[i*W + l]`.
+        Lanes = "lanes",
+        /// `rows`: element `i` of state `l` at `p[l*n + i]`, `n` the array's elements per state.
+        Rows = "rows",
+    }
+}
+
+impl BatchLayout {
+    /// True for `lanes`, the layout SPEC §8 describes (the report leaves it out).
+    pub fn is_lanes(&self) -> bool {
+        *self == BatchLayout::Lanes
+    }
+}
+
+word_enum! {
     /// The arithmetic of the generated code (`precision=`).
     pub enum Precision {
         /// `f64`: `double`.
@@ -159,6 +185,8 @@ pub struct CodegenC {
     pub precision: Precision,
     /// States per call, lanes (`batch=`: 1, 2, 4, 8 or 16).
     pub batch: u32,
+    /// Where a batch's states are in the arrays (`layout=`).
+    pub layout: BatchLayout,
     /// `trig=`.
     pub trig: Trig,
     /// The symbol (or prefix, with several functions); `None`: from the function's name.
@@ -175,6 +203,7 @@ impl Default for CodegenC {
             abi: Abi::Plain,
             precision: Precision::F64,
             batch: 1,
+            layout: BatchLayout::Lanes,
             trig: Trig::Libm,
             name: None,
             chunk: DEFAULT_CHUNK,
@@ -214,6 +243,7 @@ impl CodegenC {
             abi: p.word("abi")?,
             precision: p.word("precision")?,
             batch: p.u32("batch")?,
+            layout: p.word("layout")?,
             trig: p.word("trig")?,
             name: p.names("name")?.map(|n| n.join(",")),
             chunk: p.u32("chunk")?,
@@ -388,6 +418,7 @@ pub(crate) fn interface(o: &CodegenC, f: &Function, symbol: &str) -> Interface {
         abi: o.abi,
         precision: o.precision,
         batch: o.batch,
+        layout: if o.batch > 1 { o.layout } else { BatchLayout::Lanes },
         trig: o.trig,
         inputs: super::input_values(f, o.trig == Trig::Input).iter().map(|&v| f.name_of(v).to_string()).collect(),
         outputs: f.outputs.iter().map(|x| x.name.clone()).collect(),

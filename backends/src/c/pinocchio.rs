@@ -47,7 +47,9 @@
 //! `name=NAME` is the prefix of the symbols (default `model`, Pinocchio's name for the model
 //! argument: `model_rnea`); `batch=W` takes W states per call, lane-contiguous as in the plain
 //! ABI: element `k` of lane `l` of every array is `p[k*W + l]` (`M`'s element `(i-1)*nv + (j-1)`
-//! likewise). `trig=libm` and `trig=inline` as for the other ABIs; `chunk=` and `units=` too.
+//! likewise); with `layout=rows`, `W` rows of a row-major `(B, n)` array, as numpy's and
+//! Pinocchio's batches hold them: element `k` of state `l` is `p[l*n + k]`, `n` the array's
+//! elements per state (`nq` for `q`, `nv` for `v`, `nv·nv` for a matrix). `trig=libm` and `trig=inline` as for the other ABIs; `chunk=` and `units=` too.
 //! `precision=f32` and `trig=input` are refused ([`super::CodegenC::from_params`]): Pinocchio's
 //! vectors are doubles and its signatures take no sin/cos.
 //!
@@ -427,7 +429,10 @@ pub(crate) fn emit(
                 ));
             }
         }
-        let layout = Layout { params, inputs, outputs, float_arrays: false };
+        // Each array's elements per state (`layout=rows`).
+        let mut row_len: Vec<usize> = ins.iter().map(|x| if x.1 == "q" { nq } else { nv }).collect();
+        row_len.extend(outs.iter().map(|x| len(x.1)));
+        let layout = Layout { params, inputs, outputs, float_arrays: false, row_len };
         let comment = format!("@{} as {symbol}: Pinocchio's {}", f.name, a.pinocchio());
         let (entry, parts) = arrays(o, f, symbol, &taken, ticker, &layout, &comment);
         if ticker.stopped() {
@@ -455,15 +460,17 @@ pub(crate) fn emit(
         let described: Vec<String> = outs
             .iter()
             .map(|&(out_c, out_ir)| match matrix_columns(out_ir, nq, nv) {
-                Some(_) => {
-                    let c = if out_ir.ends_with("_dq") { "NQ" } else { "NV" };
-                    format!(" {out_c}[0..{name}_NV*{name}_{c}) = {out_ir}[i+1][j+1] at i*{c} + j")
-                }
+                Some(_) => format!(" {out_c}[0..{name}_NV*{name}_NV) = {out_ir}[i+1][j+1] at i*{name}_NV + j"),
                 None => format!(" {out_c}[0..{name}_NV) = {out_ir}[1..]"),
             })
             .collect();
         proto += &described.join(",");
-        if w > 1 {
+        if w > 1 && o.layout == super::BatchLayout::Rows {
+            let _ = write!(
+                proto,
+                ";\n * {w} states per call as rows: element k of state l of every array at [l*n + k], n its elements per state"
+            );
+        } else if w > 1 {
             let _ = write!(proto, ";\n * {w} states per call: lane l of element k of every array at [k*{w} + l]");
         }
         let args: Vec<String> = layout

@@ -2,7 +2,9 @@
 //!
 //! Input `i` (canonical names in [`crate::Interface::inputs`]) is `in[i]`, output `j`
 //! is `out[j]`; with `batch=W`, lane `l` of them is `in[i*W + l]` and `out[j*W + l]`, loaded
-//! and stored with `memcpy` (no alignment is assumed).
+//! and stored with `memcpy` (no alignment is assumed); with `layout=rows` they are
+//! `in[l*NI + i]` and `out[l*NO + j]` (`NI` inputs, `NO` outputs a state), read and written
+//! lane by lane.
 //!
 //! Order: each input is read just before the first statement that uses it and each output is
 //! written right after the statement that computes it (`in` and `out` are `restrict`, so
@@ -56,6 +58,7 @@ pub(crate) fn function(
         inputs: (0..iface.inputs.len()).map(|i| Source::Elem(0, i)).collect(),
         outputs: (0..f.outputs.len()).map(|j| vec![(1, j)]).collect(),
         float_arrays: io_f32,
+        row_len: vec![iface.inputs.len(), f.outputs.len()],
     };
     let comment =
         format!("@{}: {} inputs, {} outputs (order: see the header)", f.name, iface.inputs.len(), iface.outputs.len());
@@ -64,7 +67,14 @@ pub(crate) fn function(
     let w = o.batch as usize;
     let sig = format!("void {symbol}(const {real} *restrict in, {real} *restrict out)");
     let mut proto = format!("/* @{} as {symbol}", f.name);
-    if w > 1 {
+    if w > 1 && o.layout == super::BatchLayout::Rows {
+        let _ = write!(
+            proto,
+            ", {w} states per call as rows (element i of state l at in[l*{} + i], out[l*{} + i])",
+            iface.inputs.len(),
+            f.outputs.len()
+        );
+    } else if w > 1 {
         let _ = write!(proto, ", {w} states per call (lane l of element i at [i*{w} + l])");
     }
     proto += ".\n * Inputs:";
@@ -107,13 +117,16 @@ pub(crate) struct Layout<'a> {
     /// The arrays are `float` while the values compute in their formats (formats with
     /// `precision=f32`; the body's options are then `precision=f64`).
     pub float_arrays: bool,
+    /// Per parameter, its elements per state: with `batch=W;layout=rows` element `e` of state
+    /// `l` is `p[l*n + e]`.
+    pub row_len: Vec<usize>,
 }
 
 /// `f` as `symbol` over the arrays of `layout`: the definition of the entry point, opening with
 /// `/* {comment}. */` (split into parts of at most `o.chunk` statements when it has more; part
 /// names avoid `taken`, the file's other global names), and its parts. Element `e` of a
 /// parameter is `p[e]`, with `batch=W` lane `l` of it is `p[e*W + l]` (`memcpy`, no alignment
-/// assumed). Inputs are read just before their first use and outputs written right after the
+/// assumed), with `layout=rows` `p[l*n + e]` (`n` = [`Layout::row_len`], lane by lane). Inputs are read just before their first use and outputs written right after the
 /// statement that computes them (the module doc); outputs that are inputs or constants come last.
 pub(crate) fn arrays(
     o: &CodegenC,
@@ -159,9 +172,44 @@ pub(crate) fn arrays(
         }
     }
     let split = plan.parts() > 1;
-    // A batch: one pass of the body per chunk of ROBOVEC_VL lanes, at offset `at` in a block
-    // (a part gets its arrays at the chunk already).
-    let at = if split { "" } else { " + robovec_chunk * ROBOVEC_VL" };
+    let rows = w > 1 && o.layout == super::BatchLayout::Rows;
+    // A batch: one pass of the body per chunk of ROBOVEC_VL lanes, at the chunk's offset in a
+    // block (a part gets its arrays at the chunk already): `at(p)` for parameter `p`.
+    let at = |p: usize| -> String {
+        match (split, rows) {
+            (true, _) => String::new(),
+            (false, false) => " + robovec_chunk * ROBOVEC_VL".into(),
+            (false, true) => format!(" + robovec_chunk * ROBOVEC_VL * {}", layout.row_len[p]),
+        }
+    };
+    // Element `e` of parameter `p`, lanes into the vector `var`, or out of the vector `x`:
+    // `memcpy` of `w` adjacent lanes, or lane by lane from rows of `row_len[p]` elements.
+    let fill = |p: usize, e: usize, var: &str| -> String {
+        let name = layout.params[p].0;
+        if rows {
+            let n = layout.row_len[p];
+            format!(
+                "for (int robovec_lane = 0; robovec_lane < ROBOVEC_VL; robovec_lane++) {var}[robovec_lane] = \
+                 {name}[robovec_lane * {n} + {e}{}];",
+                at(p)
+            )
+        } else {
+            format!("memcpy(&{var}, {name} + {}{}, sizeof {var});", e * w, at(p))
+        }
+    };
+    let spill = |p: usize, e: usize, x: &str| -> String {
+        let name = layout.params[p].0;
+        if rows {
+            let n = layout.row_len[p];
+            format!(
+                "for (int robovec_lane = 0; robovec_lane < ROBOVEC_VL; robovec_lane++) \
+                 {name}[robovec_lane * {n} + {e}{}] = {x}[robovec_lane];",
+                at(p)
+            )
+        } else {
+            format!("memcpy({name} + {}{}, &{x}, sizeof {x});", e * w, at(p))
+        }
+    };
     // Part k has read value v when read[v] == k + 1.
     let mut read = vec![0u32; f.values.len()];
     let mut load = |s: &mut String, v: Value, k: usize| {
@@ -175,7 +223,6 @@ pub(crate) fn arrays(
             match layout.inputs[i] {
                 Source::Elem(p, e) if w > 1 && io_f32 => {
                     // A float array: the lanes as a robovec_vec32, then in the value's format.
-                    let p = layout.params[p].0;
                     let expr = if b.narrow(v) {
                         "robovec_in32".to_string()
                     } else {
@@ -183,27 +230,23 @@ pub(crate) fn arrays(
                     };
                     let _ = writeln!(
                         s,
-                        "  {vty} {n};\n  {{\n    robovec_vec32 robovec_in32;\n    memcpy(&robovec_in32, {p} + {}{at}, sizeof robovec_in32);\n    \
-                         {n} = {expr};\n  }}",
-                        e * w
+                        "  {vty} {n};\n  {{\n    robovec_vec32 robovec_in32;\n    {}\n    {n} = {expr};\n  }}",
+                        fill(p, e, "robovec_in32")
                     );
                 }
                 Source::Elem(p, e) if w > 1 && f.format(v).is_default() => {
-                    let p = layout.params[p].0;
-                    let _ = writeln!(s, "  {ty} {n};\n  memcpy(&{n}, {p} + {}{at}, sizeof {n});", e * w);
+                    let _ = writeln!(s, "  {ty} {n};\n  {}", fill(p, e, n));
                 }
-                Source::Elem(p, e) if w > 1 && b.narrow(v) => {
-                    let p = layout.params[p].0;
-                    let _ = writeln!(s, "  const {vty} {n} = robovec_load32({p} + {}{at});", e * w);
+                Source::Elem(p, e) if w > 1 && b.narrow(v) && !rows => {
+                    let _ =
+                        writeln!(s, "  const {vty} {n} = robovec_load32({} + {}{});", layout.params[p].0, e * w, at(p));
                 }
                 Source::Elem(p, e) if w > 1 => {
                     // The arrays are of the file's real type: load, then store in the format.
-                    let p = layout.params[p].0;
                     let _ = writeln!(
                         s,
-                        "  {vty} {n};\n  {{\n    {ty} robovec_in;\n    memcpy(&robovec_in, {p} + {}{at}, sizeof robovec_in);\n    \
-                         {n} = {};\n  }}",
-                        e * w,
+                        "  {vty} {n};\n  {{\n    {ty} robovec_in;\n    {}\n    {n} = {};\n  }}",
+                        fill(p, e, "robovec_in"),
                         b.stored(v, "robovec_in".into())
                     );
                 }
@@ -226,38 +269,49 @@ pub(crate) fn arrays(
     let store = |s: &mut String, j: usize, x: &Operand| {
         let e = b.operand_value(x);
         for &(p, el) in &layout.outputs[j] {
-            let p = layout.params[p].0;
             if w > 1 && io_f32 {
                 // Every output is binary32 or a constant exact in it (`check_formats`).
                 match x {
                     Operand::Value(v) => {
-                        let n = &names[v.index()];
-                        let _ = writeln!(s, "  memcpy({p} + {}{at}, &{n}, sizeof {n});", el * w);
+                        let _ = writeln!(s, "  {}", spill(p, el, &names[v.index()]));
                     }
                     Operand::Const(c) => {
                         let k = literal::operand(*c, true);
-                        let _ = writeln!(
-                            s,
-                            "  {{ const robovec_vec32 k = robovec_splat32({k}); memcpy({p} + {}{at}, &k, sizeof k); }}",
-                            el * w
-                        );
+                        let _ =
+                            writeln!(s, "  {{ const robovec_vec32 k = robovec_splat32({k}); {} }}", spill(p, el, "k"));
                     }
                 }
             } else if w > 1 {
                 match x {
+                    Operand::Value(v) if b.narrow(*v) && rows => {
+                        let k = "__builtin_convertvector(k32, robovec_vec)";
+                        let _ = writeln!(
+                            s,
+                            "  {{ const robovec_vec32 k32 = {}; const {ty} k = {k}; {} }}",
+                            names[v.index()],
+                            spill(p, el, "k")
+                        );
+                    }
                     Operand::Value(v) if b.narrow(*v) => {
-                        let _ = writeln!(s, "  robovec_store32({p} + {}{at}, {});", el * w, names[v.index()]);
+                        let _ = writeln!(
+                            s,
+                            "  robovec_store32({} + {}{}, {});",
+                            layout.params[p].0,
+                            el * w,
+                            at(p),
+                            names[v.index()]
+                        );
                     }
                     Operand::Value(v) if f.format(*v).is_default() => {
-                        let _ = writeln!(s, "  memcpy({p} + {}{at}, &{e}, sizeof {e});", el * w);
+                        let _ = writeln!(s, "  {}", spill(p, el, &e));
                     }
                     // A constant, or a fixed-point value's integers scaled.
                     _ => {
-                        let _ = writeln!(s, "  {{ const {ty} k = {e}; memcpy({p} + {}{at}, &k, sizeof k); }}", el * w);
+                        let _ = writeln!(s, "  {{ const {ty} k = {e}; {} }}", spill(p, el, "k"));
                     }
                 }
             } else {
-                let _ = writeln!(s, "  {p}[{el}] = {e};");
+                let _ = writeln!(s, "  {}[{el}] = {e};", layout.params[p].0);
             }
         }
     };
@@ -316,8 +370,18 @@ pub(crate) fn arrays(
         );
         let (indent, args) = if w > 1 {
             s += super::body::CHUNK_LOOP;
-            let a: Vec<String> =
-                layout.params.iter().map(|p| format!("{} + robovec_chunk * ROBOVEC_VL", p.0)).collect();
+            let a: Vec<String> = layout
+                .params
+                .iter()
+                .zip(&layout.row_len)
+                .map(|(p, n)| {
+                    if rows {
+                        format!("{} + robovec_chunk * ROBOVEC_VL * {n}", p.0)
+                    } else {
+                        format!("{} + robovec_chunk * ROBOVEC_VL", p.0)
+                    }
+                })
+                .collect();
             ("    ", a.join(", ") + ", live")
         } else {
             let a: Vec<&str> = layout.params.iter().map(|p| p.0).collect();
