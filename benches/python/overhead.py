@@ -9,11 +9,12 @@ folder; free flyer for solo12, talos, tiago_pro) or a URDF path. Needs the wheel
 (`pip install .`) in an environment with Pinocchio and example-robot-data (scripts/test.sh's
 `target/pinocchio-venv` has them) and a C compiler. Measures, in a fresh cache folder:
 
-1. the first `compile` (C written, compiled at -O2, loaded) and a cached one in a new process;
+1. the first `compile` (C written, compiled with compile's default flags, loaded) and a cached
+   one in a new process;
 2. per call at B = 1: the Python call `f(q, v, a)` against the same one-state C function
    called from C on the same state, and their difference (the per-call overhead);
 3. at B = 10^4: the Python call on (B, n) arrays against C calling the same shared object's
-   batched function over the same states already in its lane-contiguous layout (and the
+   batched function (`layout=rows`: W rows of the (B, n) arrays) over the same states (and the
    one-state function for the remainder), as a C program would.
 
 Python and C alternate at every repetition (`rounds` × 21 of each), in one process: the C
@@ -53,15 +54,15 @@ double one_state(void *one, const double *q, const double *v, const double *a, d
     for (int k = 0; k < iters; k++) ((f4)one)(q, v, a, tau);
     return (now() - t) / iters;
 }
-/* ns for `b` states of lane-contiguous arrays: groups of `w` through `lanes`, the rest through
+/* ns for `b` states of (b, n) arrays: groups of `w` rows through `batched`, the rest through
    `one`, as a C program over its own arrays would. */
-double states(void *one, void *lanes, const double *q, const double *v, const double *a, double *tau,
+double states(void *one, void *batched, const double *q, const double *v, const double *a, double *tau,
               int nq, int nv, int w, int b)
 {
     double t = now();
     int s = 0;
     if (w > 1)
-        for (; s + w <= b; s += w) ((f4)lanes)(q + s * nq, v + s * nv, a + s * nv, tau + s * nv);
+        for (; s + w <= b; s += w) ((f4)batched)(q + s * nq, v + s * nv, a + s * nv, tau + s * nv);
     for (; s < b; s++) ((f4)one)(q + s * nq, v + s * nv, a + s * nv, tau + s * nv);
     return now() - t;
 }
@@ -76,14 +77,12 @@ def erd(rel):
     sys.exit(f"example-robot-data file {rel} not found under {sys.prefix}")
 
 
-def median_time(f, reps, inner):
-    ts = []
-    for _ in range(reps):
-        t = time.perf_counter_ns()
-        for _ in range(inner):
-            f()
-        ts.append((time.perf_counter_ns() - t) / inner)
-    return statistics.median(ts)
+def per_call(f, calls):
+    """ns per call of `f` over `calls` calls."""
+    t = time.perf_counter_ns()
+    for _ in range(calls):
+        f()
+    return (time.perf_counter_ns() - t) / calls
 
 
 def main():
@@ -123,7 +122,7 @@ def main():
     harness.states.argtypes = [ctypes.c_void_p, ctypes.c_void_p, p, p, p, p] + [ctypes.c_int] * 4
     lib = ctypes.CDLL(str(f.library))
     one = ctypes.cast(getattr(lib, f"rv1_{function}"), ctypes.c_void_p)
-    lanes = ctypes.cast(getattr(lib, f"rvw_{function}"), ctypes.c_void_p) if batch > 1 else None
+    batched = ctypes.cast(getattr(lib, f"rvw_{function}"), ctypes.c_void_p) if batch > 1 else None
     rng = np.random.default_rng(1)
     big = 10_000
     q1, v1, a1 = rng.uniform(-0.5, 0.5, f.nq), rng.uniform(-0.5, 0.5, f.nv), rng.uniform(-0.5, 0.5, f.nv)
@@ -134,10 +133,10 @@ def main():
     # machine state. A repetition at B = 1 is 1000 calls.
     py1, c1, pyb, cb = [], [], [], []
     for _ in range(rounds * 21):
-        py1.append(median_time(lambda: f(q1, v1, a1), 1, 1000))
+        py1.append(per_call(lambda: f(q1, v1, a1), 1000))
         c1.append(harness.one_state(one, ptr(q1), ptr(v1), ptr(a1), ptr(tau1), 1000))
-        pyb.append(median_time(lambda: f(qb, vb, ab), 1, 1))
-        cb.append(harness.states(one, lanes, ptr(qb), ptr(vb), ptr(ab), ptr(taub), f.nq, f.nv, batch, big))
+        pyb.append(per_call(lambda: f(qb, vb, ab), 1))
+        cb.append(harness.states(one, batched, ptr(qb), ptr(vb), ptr(ab), ptr(taub), f.nq, f.nv, batch, big))
     ratio1 = statistics.median(c / p for c, p in zip(c1, py1))
     ratiob = statistics.median(c / p for c, p in zip(cb, pyb))
     py1, c1, pyb, cb = (statistics.median(x) for x in (py1, c1, pyb, cb))

@@ -271,8 +271,15 @@ impl Module {
                 pinocchio::suffixes().join(", ")
             ))
         })?;
-        if ![1, 2, 4, 8, 16].contains(&batch) {
-            return Err(UsageError::new_err(format!("compile: batch={batch}; expected 1, 2, 4, 8 or 16")));
+        // The widths `codegen<c;batch=…>` takes, from its parameter.
+        let robovec_passes::ParamKind::U32Set { allowed, .. } = robovec_backends::c::BATCH.kind else {
+            unreachable!("codegen<c>'s batch is a set of widths")
+        };
+        if !allowed.iter().any(|&w| w as usize == batch) {
+            return Err(UsageError::new_err(format!(
+                "compile: batch={batch}; expected one of {}",
+                robovec_backends::c::BATCH.range_text()
+            )));
         }
         let cflags = cflags.unwrap_or_else(default_cflags);
         let cc = std::env::var("CC").unwrap_or_else(|_| "cc".to_string());
@@ -313,15 +320,20 @@ fn default_cflags() -> Vec<String> {
 /// `-mtune=native`), its CPU as the kernel names it (the `model name` and `flags` lines of
 /// `/proc/cpuinfo`), so that a cache folder shared between machines never loads an object built
 /// for another CPU; empty otherwise, or where `/proc/cpuinfo` is not.
-fn native_cpu(cflags: &[String]) -> String {
+/// Read once per process: the CPU does not change under it, and `compile` of an object loaded
+/// already takes about 0.1 ms, which reading `/proc/cpuinfo` each time would double.
+fn native_cpu(cflags: &[String]) -> &'static str {
+    static CPU: OnceLock<String> = OnceLock::new();
     if !cflags.iter().any(|f| f.ends_with("=native")) {
-        return String::new();
+        return "";
     }
-    let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
-    let field = |name: &str| {
-        info.lines().find(|l| l.split(':').next().is_some_and(|k| k.trim() == name)).unwrap_or_default().to_string()
-    };
-    field("model name") + "\n" + &field("flags")
+    CPU.get_or_init(|| {
+        let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+        let field = |name: &str| {
+            info.lines().find(|l| l.split(':').next().is_some_and(|k| k.trim() == name)).unwrap_or_default().to_string()
+        };
+        field("model name") + "\n" + &field("flags")
+    })
 }
 
 /// The cache folder: `$ROBOVEC_CACHE_DIR`, else `$XDG_CACHE_HOME/robovec`, else
@@ -646,9 +658,9 @@ impl Compiled {
             run();
         }
         drop(held);
-        let outputs = outputs.into_iter().take(sig.outputs.len()).map(|a| a.expect("made above"));
+        let mut outputs = outputs.into_iter().take(sig.outputs.len()).map(|a| a.expect("made above"));
         if sig.outputs.len() == 1 {
-            Ok(outputs.last().expect("one output").unbind())
+            Ok(outputs.next().expect("one output").unbind())
         } else {
             Ok(PyTuple::new(py, outputs)?.into_any().unbind())
         }

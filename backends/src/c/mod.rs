@@ -7,8 +7,9 @@
 //! `#pragma STDC FP_CONTRACT OFF`). `batch=W` computes W independent states per call with
 //! GCC/Clang vector extensions (one source for SSE, AVX2, AVX-512 and NEON), lane-contiguous:
 //! element `i` of lane `l` is `in[i*W + l]`; with `layout=rows`, `W` rows of a row-major `(B, n)`
-//! array: `in[l*n + i]`, `n` the array's elements per state (read and written lane by lane). With `trig=input` the `sin`/`cos` of the joint
-//! coordinates are inputs (after the IR's inputs); with `trig=libm` they are computed (per lane).
+//! array: `in[l*n + i]`, `n` the array's elements per state (read and written lane by lane).
+//! With `trig=input` the `sin`/`cos` of the joint coordinates are inputs (after the IR's
+//! inputs); with `trig=libm` they are computed (per lane).
 //! With `trig=inline` they are computed by robovec's own branch-free sin/cos, written into the
 //! file ([`trig`]: vectorised over the lanes, one reduction for the sin and cos of one
 //! coordinate, within 1 ulp; one state's input coordinates in one block, a loop the C compiler

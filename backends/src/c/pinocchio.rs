@@ -49,7 +49,8 @@
 //! ABI: element `k` of lane `l` of every array is `p[k*W + l]` (`M`'s element `(i-1)*nv + (j-1)`
 //! likewise); with `layout=rows`, `W` rows of a row-major `(B, n)` array, as numpy's and
 //! Pinocchio's batches hold them: element `k` of state `l` is `p[l*n + k]`, `n` the array's
-//! elements per state (`nq` for `q`, `nv` for `v`, `nv·nv` for a matrix). `trig=libm` and `trig=inline` as for the other ABIs; `chunk=` and `units=` too.
+//! elements per state (`nq` for `q`, `nv` for `v`, `nv·nv` for a matrix). `trig=libm` and
+//! `trig=inline` as for the other ABIs; `chunk=` and `units=` too.
 //! `precision=f32` and `trig=input` are refused ([`super::CodegenC::from_params`]): Pinocchio's
 //! vectors are doubles and its signatures take no sin/cos.
 //!
@@ -440,8 +441,7 @@ pub(crate) fn emit(
         }
         // The interface: the arrays' elements in argument order.
         let mut in_names = Vec::new();
-        for &(_, base) in ins {
-            let n = if base == "q" { nq } else { nv };
+        for (&(_, base), &n) in ins.iter().zip(&layout.row_len) {
             in_names.extend((1..=n).map(|k| format!("{base}[{k}]")));
         }
         let mut out_names: Vec<String> = Vec::new();

@@ -126,8 +126,9 @@ pub(crate) struct Layout<'a> {
 /// `/* {comment}. */` (split into parts of at most `o.chunk` statements when it has more; part
 /// names avoid `taken`, the file's other global names), and its parts. Element `e` of a
 /// parameter is `p[e]`, with `batch=W` lane `l` of it is `p[e*W + l]` (`memcpy`, no alignment
-/// assumed), with `layout=rows` `p[l*n + e]` (`n` = [`Layout::row_len`], lane by lane). Inputs are read just before their first use and outputs written right after the
-/// statement that computes them (the module doc); outputs that are inputs or constants come last.
+/// assumed), with `layout=rows` `p[l*n + e]` (`n` = [`Layout::row_len`], lane by lane). Inputs
+/// are read just before their first use and outputs written right after the statement that
+/// computes them (the module doc); outputs that are inputs or constants come last.
 pub(crate) fn arrays(
     o: &CodegenC,
     f: &Function,
@@ -173,13 +174,21 @@ pub(crate) fn arrays(
     }
     let split = plan.parts() > 1;
     let rows = w > 1 && o.layout == super::BatchLayout::Rows;
-    // A batch: one pass of the body per chunk of ROBOVEC_VL lanes, at the chunk's offset in a
-    // block (a part gets its arrays at the chunk already): `at(p)` for parameter `p`.
+    // A batch: one pass of the body per chunk of ROBOVEC_VL lanes. `chunk(p)`: where the chunk
+    // starts in parameter `p`; `at(p)`: the body's offset (none in a part, whose entry point
+    // passes its arrays at the chunk already).
+    let chunk = |p: usize| -> String {
+        if rows {
+            format!(" + robovec_chunk * ROBOVEC_VL * {}", layout.row_len[p])
+        } else {
+            " + robovec_chunk * ROBOVEC_VL".into()
+        }
+    };
     let at = |p: usize| -> String {
-        match (split, rows) {
-            (true, _) => String::new(),
-            (false, false) => " + robovec_chunk * ROBOVEC_VL".into(),
-            (false, true) => format!(" + robovec_chunk * ROBOVEC_VL * {}", layout.row_len[p]),
+        if split {
+            String::new()
+        } else {
+            chunk(p)
         }
     };
     // Element `e` of parameter `p`, lanes into the vector `var`, or out of the vector `x`:
@@ -370,18 +379,8 @@ pub(crate) fn arrays(
         );
         let (indent, args) = if w > 1 {
             s += super::body::CHUNK_LOOP;
-            let a: Vec<String> = layout
-                .params
-                .iter()
-                .zip(&layout.row_len)
-                .map(|(p, n)| {
-                    if rows {
-                        format!("{} + robovec_chunk * ROBOVEC_VL * {n}", p.0)
-                    } else {
-                        format!("{} + robovec_chunk * ROBOVEC_VL", p.0)
-                    }
-                })
-                .collect();
+            let a: Vec<String> =
+                layout.params.iter().enumerate().map(|(k, p)| format!("{}{}", p.0, chunk(k))).collect();
             ("    ", a.join(", ") + ", live")
         } else {
             let a: Vec<&str> = layout.params.iter().map(|p| p.0).collect();
