@@ -92,13 +92,20 @@ fi
 
 cargo test --workspace --locked "$@"
 
-# The Python module (issue 51, docs/python.md): its wheel built from this clone, installed into
-# the Pinocchio venv, and its tests against Pinocchio (python/tests). Built with the dev profile
-# at the test profile's debug level, so that the crates `cargo test` just built are reused
-# (`--profile test` would build the library as a test harness, without its module symbol).
+# The Python module (issue 51, docs/python.md), then its tests against Pinocchio (python/tests).
+# The extension is built by the same Cargo resolution as the tests (`--workspace --tests`, the
+# dev profile at the test profile's debug level), so only PyO3, numpy and the module itself
+# compile: a wheel's build (`maturin`, its own resolution of `python/Cargo.toml`) rebuilt
+# every robovec crate and took 3.5 of CI's minutes. It is laid out as the wheel lays it out
+# (`robovec/__init__.py` beside `robovec/_robovec.abi3.so`) in `target/python-dev`, first on the
+# tests' `PYTHONPATH`. `scripts/wheel.sh` builds and installs the wheel itself (docs/python.md).
 if [ $# = 0 ]; then
-    rm -rf target/wheels
-    CARGO_PROFILE_DEV_DEBUG=line-tables-only "$venv/bin/maturin" build --locked --profile dev --out target/wheels
-    "$venv/bin/pip" install -q --force-reinstall --no-deps target/wheels/robovec-*.whl
-    "$venv/bin/python" -m pytest -q python/tests
+    PYO3_PYTHON="$PWD/$venv/bin/python" CARGO_PROFILE_DEV_DEBUG=line-tables-only \
+        cargo build --workspace --lib --tests --locked --quiet
+    stage=target/python-dev
+    rm -rf "$stage"
+    mkdir -p "$stage/robovec"
+    cp python/robovec/*.py "$stage/robovec/"
+    cp target/debug/lib_robovec.so "$stage/robovec/_robovec.abi3.so"
+    PYTHONPATH="$PWD/$stage" "$venv/bin/python" -m pytest -q python/tests
 fi
