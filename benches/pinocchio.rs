@@ -3,7 +3,7 @@
 //! their derivatives.
 //!
 //! `cargo bench --bench pinocchio -- [ROBOT…] [--reps=N] [--runs=K] [--base=composite|free-flyer]
-//! [--functions=dynamics|derivatives|all]`
+//! [--functions=dynamics|derivatives|all] [--compile-times=yes|no]`
 //!
 //! Robots (default: all): `ur5`, `panda` (fixed base), `solo12`, `talos`, `tiago_pro` (floating
 //! base: `--base=free-flyer`, the default, is Pinocchio's `JointModelFreeFlyer` and robovec's
@@ -53,7 +53,8 @@
 //!    for `M` only the upper triangle counts (the lower one is a copy on every side).
 //!
 //! 7. times `cc -O2 -c` of CG's one-state source (all its parts) and robovec's
-//!    [`COMPILE_TIMED`] file of each function, alternating, 3 times each (median).
+//!    [`COMPILE_TIMED`] file of each function, alternating, 3 times each (median); skipped
+//!    with `--compile-times=no` (on Talos and TIAGo Pro they take about 25 minutes of the run).
 //!
 //! Prints a Markdown table (per function one row against Pinocchio's run-time algorithm and,
 //! where CG has the function, one against CG), the compile times, and every contestant, and
@@ -287,6 +288,7 @@ fn bench_robot(
     base: Base,
     groups: &[usize],
     (reps, runs): (u32, u32),
+    compile_times: bool,
 ) -> (usize, Vec<Figures>, BTreeMap<usize, CompileTimes>) {
     let work = env.work.join(robot.name);
     std::fs::create_dir_all(&work).unwrap();
@@ -517,7 +519,7 @@ fn bench_robot(
     }
     // The compile time of each side's one-state file of each function CG has.
     let mut compile = BTreeMap::new();
-    for &g in groups {
+    for &g in groups.iter().filter(|_| compile_times) {
         let Some(f) = GROUPS[g].4 else { continue };
         let v = VARIANTS.iter().position(|v| v.0 == COMPILE_TIMED).expect("the timed variant");
         let rv = work.join(format!("rv{}.c", g * VARIANTS.len() + v));
@@ -583,11 +585,18 @@ fn main() {
     let (mut reps, mut runs) = (101, 5);
     let mut base = Base::FreeFlyer;
     let mut groups = parse_functions("all");
+    let mut compile_times = true;
     for a in std::env::args().skip(1) {
         if let Some(b) = a.strip_prefix("--base=") {
             base = Base::parse(b);
         } else if let Some(f) = a.strip_prefix("--functions=") {
             groups = parse_functions(f);
+        } else if let Some(c) = a.strip_prefix("--compile-times=") {
+            compile_times = match c {
+                "yes" => true,
+                "no" => false,
+                _ => panic!("--compile-times=yes|no"),
+            };
         } else if let Some(r) = a.strip_prefix("--reps=") {
             reps = r.parse().expect("--reps=N");
         } else if let Some(r) = a.strip_prefix("--runs=") {
@@ -632,7 +641,7 @@ fn main() {
         "| robot | dof | function | contestant | ns/state median over {runs} runs (min–max) | Pinocchio ÷ this (paired) | CG ÷ this (paired) | bits of error mean / max | worst relative error |\n|---|---:|---|---|---:|---:|---:|---|---:|\n"
     );
     for robot in ROBOTS.iter().filter(|r| wanted.is_empty() || wanted.iter().any(|w| w == r.name)) {
-        let (nv, figs, compile) = bench_robot(&env, robot, base, &groups, (reps, runs));
+        let (nv, figs, compile) = bench_robot(&env, robot, base, &groups, (reps, runs), compile_times);
         for (g, (cg, rv)) in compile {
             let _ = writeln!(
                 compile_table,

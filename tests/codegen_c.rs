@@ -43,6 +43,22 @@ fn corpus_cases(pipeline: &str, only_c: bool) -> Vec<Case> {
         .filter(|p| !is_loop_file(p) && (!only_c || p.extension().is_some_and(|e| e == "c")))
         .collect();
     assert!(files.len() >= 20, "corpus: {} straight-line files", files.len());
+    load_cases(&files, pipeline)
+}
+
+/// The C corpus files whose names start with one of `prefixes` (one file each, or the test
+/// fails), after `pipeline`; only those are loaded.
+fn named_corpus_cases(pipeline: &str, prefixes: &[&str]) -> Vec<Case> {
+    let files: Vec<PathBuf> = corpus_files()
+        .into_iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "c"))
+        .filter(|p| prefixes.iter().any(|w| p.file_name().unwrap().to_string_lossy().starts_with(w)))
+        .collect();
+    assert_eq!(files.len(), prefixes.len(), "corpus files named {prefixes:?}: {files:?}");
+    load_cases(&files, pipeline)
+}
+
+fn load_cases(files: &[PathBuf], pipeline: &str) -> Vec<Case> {
     files
         .iter()
         .map(|p| {
@@ -52,6 +68,13 @@ fn corpus_cases(pipeline: &str, only_c: bool) -> Vec<Case> {
         })
         .collect()
 }
+
+/// The corpus files of the batch and split tests: a forward dynamics (the `LᵀDL`'s divisions;
+/// m454's, 257 statements before `atomise`: the tricycle's, 7× as long, made most of these
+/// tests' C and of their CI time), native callbacks (the Segway's `extforces`), link forces
+/// with a square root (Jeep) and sensors (m454).
+const BATCH_FILES: [&str; 4] =
+    ["m454__mbs_dirdyna", "frank_segway__mbs_extforces", "jeep__mbs_link", "m454__mbs_sensor"];
 
 /// Compiles `files` in `dir` with `flags` (an optimisation level first, then e.g. a
 /// `-DROBOVEC_VBYTES=` vector width) into `dir/run`.
@@ -468,32 +491,31 @@ fn precision(f32: bool) -> Precision {
     }
 }
 
+// The three corpus-wide tests below each compile every file once (CI time: a corpus compile
+// is about 12 s of GCC), after one of the two pipelines whose IR differs most: `atomise` alone
+// (Robotran's own statements, split into ops) and with `zero-removal,balance` (negations
+// folded, sums rebalanced).
+
 #[test]
 fn plain_f64_equals_the_interpreter_bit_for_bit_on_every_corpus_file() {
-    for (k, pipeline) in ["atomise", "atomise,zero-removal,balance"].into_iter().enumerate() {
-        let cases = corpus_cases(pipeline, false);
-        let n = check_plain::<f64>(&tmp(&format!("plain_f64_{k}")), &cases, &plain(false, 1, false), 1);
-        assert!(n > 5_000, "{pipeline}: only {n} outputs compared");
-    }
+    let cases = corpus_cases("atomise", false);
+    let n = check_plain::<f64>(&tmp("plain_f64"), &cases, &plain(false, 1, false), 1);
+    assert!(n > 5_000, "only {n} outputs compared");
 }
 
 #[test]
 fn plain_f32_equals_the_interpreter_bit_for_bit_on_every_corpus_file() {
-    for (k, pipeline) in ["atomise", "atomise,zero-removal,balance"].into_iter().enumerate() {
-        let cases = corpus_cases(pipeline, false);
-        let n = check_plain::<f32>(&tmp(&format!("plain_f32_{k}")), &cases, &plain(true, 1, true), 2);
-        assert!(n > 5_000, "{pipeline}: only {n} outputs compared");
-    }
+    let cases = corpus_cases("atomise,zero-removal,balance", false);
+    let n = check_plain::<f32>(&tmp("plain_f32"), &cases, &plain(true, 1, true), 2);
+    assert!(n > 5_000, "only {n} outputs compared");
 }
 
 #[test]
 fn robotran_drop_in_equals_the_interpreter_bit_for_bit_on_every_c_corpus_file() {
-    for (k, pipeline) in ["atomise", "atomise,zero-removal,balance"].into_iter().enumerate() {
-        let cases = corpus_cases(pipeline, true);
-        let o = CodegenC { abi: Abi::Robotran, ..CodegenC::default() };
-        let n = check_plain::<f64>(&tmp(&format!("robotran_{k}")), &cases, &o, 3);
-        assert!(n > 3_000, "{pipeline}: only {n} outputs compared");
-    }
+    let cases = corpus_cases("atomise,zero-removal,balance", true);
+    let o = CodegenC { abi: Abi::Robotran, ..CodegenC::default() };
+    let n = check_plain::<f64>(&tmp("robotran"), &cases, &o, 3);
+    assert!(n > 3_000, "only {n} outputs compared");
 }
 
 /// The drop-in with `trig=inline` (robovec's own sin/cos in place of libm's, the one-state gain
@@ -512,17 +534,13 @@ fn robotran_drop_in_with_inline_trig_agrees_with_the_interpreter() {
     }
 }
 
+/// Fewer outputs than [`batch_cases`] has (410) per state: a floor the batch tests check that they
+/// compared (every lane's).
+const BATCH_OUTPUTS: usize = 350;
+
 /// Small corpus files (callbacks, sqrt, sensors, trig) and random DAGs, for the batched forms.
 fn batch_cases() -> Vec<Case> {
-    let mut cases: Vec<Case> = corpus_cases("atomise,zero-removal,balance", true)
-        .into_iter()
-        .filter(|c| {
-            ["tricycle__mbs_dirdyna", "frank_segway__mbs_extforces", "jeep__mbs_link", "m454__mbs_sensor"]
-                .iter()
-                .any(|p| c.label.starts_with(p))
-        })
-        .collect();
-    assert_eq!(cases.len(), 4, "the batch test's corpus files");
+    let mut cases = named_corpus_cases("atomise,zero-removal,balance", &BATCH_FILES);
     for seed in 0..6 {
         let f = robovec_testkit::dag_gen::generate(300, seed);
         cases.push(Case { label: format!("dag_gen seed {seed}"), m: Module { functions: vec![f] } });
@@ -559,7 +577,7 @@ fn batched_lanes_equal_the_interpreter_bit_for_bit_for_every_width_precision_tri
         } else {
             check_plain_with::<f64>(&dir, &cases, &o, 4, &extra)
         };
-        assert!(n > 600 * batch as usize, "batch {batch}: only {n} outputs compared");
+        assert!(n > BATCH_OUTPUTS * batch as usize, "batch {batch}: only {n} outputs compared");
     }
 }
 
@@ -570,7 +588,7 @@ fn scalar_forms_equal_the_interpreter_on_random_dags() {
         let dir = tmp(&format!("scalar_{f32}_{trig_input}"));
         let o = plain(f32, 1, trig_input);
         let n = if f32 { check_plain::<f32>(&dir, &cases, &o, 5) } else { check_plain::<f64>(&dir, &cases, &o, 5) };
-        assert!(n > 600, "only {n} outputs compared");
+        assert!(n > BATCH_OUTPUTS, "only {n} outputs compared");
     }
 }
 
@@ -596,7 +614,7 @@ fn contracted_functions_equal_the_interpreter_bit_for_bit() {
         } else {
             check_plain_with::<f64>(&dir, &cases, &o, 6, extra)
         };
-        assert!(n > 600 * batch as usize, "batch {batch}: only {n} outputs compared");
+        assert!(n > BATCH_OUTPUTS * batch as usize, "batch {batch}: only {n} outputs compared");
     }
 }
 
@@ -619,7 +637,7 @@ fn inline_trig_agrees_with_the_interpreter_to_a_small_relative_error() {
             check_plain_tol::<f64>(&dir, &cases, &o, 6, &extra, Some(tol))
         };
         eprintln!("trig=inline batch={batch} f32={f32}: {n} outputs, largest relative difference {worst:e}");
-        assert!(n > 600 * batch as usize, "only {n} outputs compared");
+        assert!(n > BATCH_OUTPUTS * batch as usize, "only {n} outputs compared");
         worsts.push(worst);
     }
     // Not bit-exact: some outputs do differ (else this would test nothing new). Not in every
