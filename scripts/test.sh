@@ -11,8 +11,8 @@
 # - Pinocchio and example-robot-data from PyPI, in the virtual environment
 #   `target/pinocchio-venv` (about 50 s; kept across runs): the numerical oracle of the URDF
 #   front end's tests (with Eigen's, CppAD's and CppADCodeGen's headers for
-#   `cargo bench --bench pinocchio`), and maturin and pytest for the Python module's wheel and
-#   tests, which run last.
+#   `cargo bench --bench pinocchio`), pytest for the Python module's tests, which run last, and
+#   maturin for `scripts/wheel.sh`.
 # Debian packages come from `apt-get` (as root, or through `sudo`). Then, called without
 # arguments, it builds the API docs with rustdoc's warnings as errors (a broken intra-doc link
 # fails the run), and it runs `cargo test --workspace --locked` with the arguments given

@@ -73,15 +73,15 @@ fn split_plain_code_equals_the_interpreter_for_tiny_chunks_in_one_file_and_in_se
 #[test]
 fn split_batches_equal_the_interpreter_for_every_width_precision_and_trig() {
     let cases = batch_cases();
-    // (batch, f32, trig=input, chunk, units, vector width, layout=rows)
+    // (batch, f32, trig=input, chunk, units, vector width, layout=rows): the pairs of width and
+    // precision `batched_lanes_…` does not compile, so that every pair is compiled once; each
+    // trig mode in both precisions, both chunks, every unit count, each vector width and both
+    // layouts (CI time: each line is a compile of every case in parts).
     let combos = [
-        (2, false, false, 1, 1, "", false),
-        (4, true, true, 7, 2, "", true),
-        (4, false, true, 1, 3, "-DROBOVEC_VBYTES=8", false),
-        (8, false, true, 7, 1, "", true),
-        (8, true, false, 1, 2, "-DROBOVEC_VBYTES=64", false),
-        (16, true, false, 7, 3, "", false),
-        (16, false, true, 1, 1, "-DROBOVEC_VBYTES=64", true),
+        (2, true, false, 1, 1, "", false),
+        (4, true, true, 7, 2, "-DROBOVEC_VBYTES=8", true),
+        (8, false, true, 1, 3, "-DROBOVEC_VBYTES=64", false),
+        (16, false, false, 7, 1, "", true),
     ];
     for (batch, f32, trig_input, chunk, units, width, rows) in combos {
         let dir = tmp(&format!("batch_{batch}_{f32}_{trig_input}_{chunk}_{units}_{rows}"));
