@@ -342,7 +342,7 @@ fn check_plain_tol<T: Float>(
     std::fs::write(dir.join("main.c"), main).unwrap();
     std::fs::write(dir.join("callbacks.c"), callbacks_c::<T>(&uses, f32, robotran_abi)).unwrap();
     let flags: Vec<&str> = ["-O0"].into_iter().chain(extra.iter().copied()).collect();
-    let exe = cc(dir, &files, &flags);
+    let exe = cc(dir, &grouped_units(dir, &files), &flags);
     let mut child =
         Command::new(&exe).stdin(std::process::Stdio::piped()).stdout(std::process::Stdio::piped()).spawn().unwrap();
     std::io::Write::write_all(child.stdin.as_mut().unwrap(), &inputs).unwrap();
@@ -366,6 +366,33 @@ fn check_plain_tol<T: Float>(
     }
     assert!(bad.is_empty(), "{} ({}): outputs differ from the interpreter:\n{}", dir.display(), real, bad.join("\n"));
     (want.len(), worst)
+}
+
+/// The cases' files `t{k}.c` and `t{k}_{u}.c` (unit `u` of case `k`) included into one
+/// translation unit per unit index, `unit{u}.c`, beside the other `files`: as a program that
+/// includes several generated files holds them (their helpers once, `ROBOVEC_HELPERS`), while
+/// each case's units stay in translation units of their own, linked together. Compiled one by
+/// one, each file's helpers (and `<immintrin.h>` in a batch) made most of the compile time of
+/// the many small cases (CI time).
+fn grouped_units(dir: &Path, files: &[String]) -> Vec<String> {
+    let mut groups: std::collections::BTreeMap<usize, String> = std::collections::BTreeMap::new();
+    let mut rest = Vec::new();
+    for f in files {
+        let unit = f
+            .strip_prefix('t')
+            .and_then(|r| r.strip_suffix(".c"))
+            .filter(|r| r.split('_').all(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit())))
+            .map(|r| r.split_once('_').map_or(0, |(_, u)| u.parse().unwrap()));
+        match unit {
+            Some(u) => *groups.entry(u).or_default() += &format!("#include \"{f}\"\n"),
+            None => rest.push(f.clone()),
+        }
+    }
+    for (u, text) in &groups {
+        std::fs::write(dir.join(format!("unit{u}.c")), text).unwrap();
+        rest.push(format!("unit{u}.c"));
+    }
+    rest
 }
 
 /// Largest index in any input or output name of the cases, plus one.
