@@ -519,12 +519,14 @@ fn bench_robot(
     }
     // The compile time of each side's one-state file of each function CG has.
     let mut compile = BTreeMap::new();
-    for &g in groups.iter().filter(|_| compile_times) {
-        let Some(f) = GROUPS[g].4 else { continue };
-        let v = VARIANTS.iter().position(|v| v.0 == COMPILE_TIMED).expect("the timed variant");
-        let rv = work.join(format!("rv{}.c", g * VARIANTS.len() + v));
-        let parts = cg_parts(std::path::Path::new(cg[f].as_str().unwrap()));
-        compile.insert(g, compile_seconds(&parts, &rv, &work));
+    if compile_times {
+        for &g in groups {
+            let Some(f) = GROUPS[g].4 else { continue };
+            let v = VARIANTS.iter().position(|v| v.0 == COMPILE_TIMED).expect("the timed variant");
+            let rv = work.join(format!("rv{}.c", g * VARIANTS.len() + v));
+            let parts = cg_parts(std::path::Path::new(cg[f].as_str().unwrap()));
+            compile.insert(g, compile_seconds(&parts, &rv, &work));
+        }
     }
     (nv, figures, compile)
 }

@@ -17,7 +17,7 @@ use robovec_ir::interp::{callback_standin, eval, pseudo_random_input, Float};
 use robovec_ir::{Callee, Def, Module, TrigFn};
 use robovec_passes::{Instrumentation, PassContext, PassManager};
 
-use crate::common::{corpus_files, is_loop_file, tmp};
+use crate::common::{corpus_files, including_unit, is_loop_file, tmp};
 
 mod split;
 mod trig;
@@ -239,7 +239,8 @@ fn check_plain_tol<T: Float>(
     let f32 = o.f32();
     let real = o.real();
     let w = o.batch;
-    let mut files = vec!["main.c".to_string(), "callbacks.c".to_string()];
+    // Per unit index, the cases' files: `t{k}.c` at 0, `t{k}_{u}.c` (unit `u` of case `k`) at `u`.
+    let mut units: Vec<Vec<String>> = vec![Vec::new()];
     let mut uses = Vec::new();
     let robotran_abi = o.abi == Abi::Robotran;
     let mut main = String::from("#include <stdio.h>\n#include <stdlib.h>\n#include <string.h>\n#include <stdint.h>\n");
@@ -257,12 +258,15 @@ fn check_plain_tol<T: Float>(
         let ok = CodegenC { name: Some(format!("t{k}")), ..o.clone() };
         let art = ok.emit(&case.m).unwrap_or_else(|e| panic!("{}: {e}", case.label));
         std::fs::write(dir.join(format!("t{k}.c")), &art.code.main).unwrap();
-        files.push(format!("t{k}.c"));
+        units[0].push(format!("t{k}.c"));
         // `units=K`: the further translation units, linked with the rest.
         for (u, text) in art.code.units.iter().enumerate() {
             let name = format!("t{k}_{}.c", u + 1);
             std::fs::write(dir.join(&name), text).unwrap();
-            files.push(name);
+            if units.len() <= u + 1 {
+                units.push(Vec::new());
+            }
+            units[u + 1].push(name);
         }
         callback_uses(&case.m, &mut uses);
         for (f, iface) in case.m.functions.iter().zip(&art.interfaces) {
@@ -342,7 +346,11 @@ fn check_plain_tol<T: Float>(
     std::fs::write(dir.join("main.c"), main).unwrap();
     std::fs::write(dir.join("callbacks.c"), callbacks_c::<T>(&uses, f32, robotran_abi)).unwrap();
     let flags: Vec<&str> = ["-O0"].into_iter().chain(extra.iter().copied()).collect();
-    let exe = cc(dir, &grouped_units(dir, &files), &flags);
+    // One translation unit per unit index: every case's main file in one, their second units in
+    // another, … (each case's units still linked across translation units).
+    let mut files = vec!["main.c".to_string(), "callbacks.c".to_string()];
+    files.extend(units.iter().enumerate().map(|(u, names)| including_unit(dir, &format!("unit{u}.c"), names)));
+    let exe = cc(dir, &files, &flags);
     let mut child =
         Command::new(&exe).stdin(std::process::Stdio::piped()).stdout(std::process::Stdio::piped()).spawn().unwrap();
     std::io::Write::write_all(child.stdin.as_mut().unwrap(), &inputs).unwrap();
@@ -366,33 +374,6 @@ fn check_plain_tol<T: Float>(
     }
     assert!(bad.is_empty(), "{} ({}): outputs differ from the interpreter:\n{}", dir.display(), real, bad.join("\n"));
     (want.len(), worst)
-}
-
-/// The cases' files `t{k}.c` and `t{k}_{u}.c` (unit `u` of case `k`) included into one
-/// translation unit per unit index, `unit{u}.c`, beside the other `files`: as a program that
-/// includes several generated files holds them (their helpers once, `ROBOVEC_HELPERS`), while
-/// each case's units stay in translation units of their own, linked together. Compiled one by
-/// one, each file's helpers (and `<immintrin.h>` in a batch) made most of the compile time of
-/// the many small cases (CI time).
-fn grouped_units(dir: &Path, files: &[String]) -> Vec<String> {
-    let mut groups: std::collections::BTreeMap<usize, String> = std::collections::BTreeMap::new();
-    let mut rest = Vec::new();
-    for f in files {
-        let unit = f
-            .strip_prefix('t')
-            .and_then(|r| r.strip_suffix(".c"))
-            .filter(|r| r.split('_').all(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit())))
-            .map(|r| r.split_once('_').map_or(0, |(_, u)| u.parse().unwrap()));
-        match unit {
-            Some(u) => *groups.entry(u).or_default() += &format!("#include \"{f}\"\n"),
-            None => rest.push(f.clone()),
-        }
-    }
-    for (u, text) in &groups {
-        std::fs::write(dir.join(format!("unit{u}.c")), text).unwrap();
-        rest.push(format!("unit{u}.c"));
-    }
-    rest
 }
 
 /// Largest index in any input or output name of the cases, plus one.

@@ -57,6 +57,16 @@ pub fn tmp(name: &str) -> PathBuf {
     d
 }
 
+/// Writes `dir/unit` as a translation unit that `#include`s `files` (in `dir`), as a program that
+/// holds several generated files in one does (their helpers once, `ROBOVEC_HELPERS`), and
+/// returns `unit`. Compiled one by one, each small generated file's helpers (and
+/// `<immintrin.h>` in a batch) were most of the C tests' compile time.
+pub fn including_unit(dir: &std::path::Path, unit: &str, files: &[String]) -> String {
+    let text: String = files.iter().map(|f| format!("#include \"{f}\"\n")).collect();
+    std::fs::write(dir.join(unit), text).unwrap();
+    unit.to_string()
+}
+
 /// Compiles `files` (C, in `dir`) with the system compiler, `flags` and `-lm` into `dir/run`,
 /// and returns its path; the compiler's message is the panic's when it fails.
 pub fn compile_c(dir: &std::path::Path, flags: &[&str], files: &[&str]) -> PathBuf {

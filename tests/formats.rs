@@ -367,13 +367,10 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool,
     if batch == 8 {
         flags.push("-march=native");
     }
-    // The functions' files in one translation unit beside `main.c`, as a program that includes
-    // several generated files holds them (their helpers once, `ROBOVEC_HELPERS`): compiled one
-    // by one, each file's helpers and `<immintrin.h>` made 48 compiles of ~0.85 s at `-O1
-    // -march=native`, 71 s of CI for a pair of widths; together they take ~2.7 s.
-    let unit: String = files[1..].iter().map(|f| format!("#include \"{f}\"\n")).collect();
-    std::fs::write(dir.join("functions.c"), unit).unwrap();
-    let exe = crate::common::compile_c(&dir, &flags, &["main.c", "functions.c"]);
+    // The functions' files in one translation unit beside `main.c`: one by one they were 48
+    // compiles of ~0.85 s at `-O1 -march=native` (71 s of CI for a pair of widths), together ~2.7 s.
+    let unit = crate::common::including_unit(&dir, "functions.c", &files[1..]);
+    let exe = crate::common::compile_c(&dir, &flags, &["main.c", &unit]);
     let got = crate::common::run_hex_lines(&exe, &input_bytes);
     assert_eq!(got.len(), want.len());
     let mut checked = 0;
