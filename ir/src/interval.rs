@@ -66,6 +66,7 @@ impl std::fmt::Display for Interval {
 }
 
 /// `a + b` rounded down (toward −∞).
+#[inline]
 fn add_down(a: f64, b: f64) -> f64 {
     let s = a + b;
     if s.is_nan() {
@@ -88,12 +89,14 @@ fn add_down(a: f64, b: f64) -> f64 {
 }
 
 /// `a + b` rounded up (toward +∞).
+#[inline]
 fn add_up(a: f64, b: f64) -> f64 {
     -add_down(-a, -b)
 }
 
 /// `a · b` rounded down; `0 · ±∞ = 0` (a zero endpoint is an exact zero, an infinite one an
 /// unbounded side: their product is bounded by 0).
+#[inline]
 fn mul_down(a: f64, b: f64) -> f64 {
     if a == 0.0 || b == 0.0 {
         return 0.0;
@@ -117,6 +120,7 @@ fn mul_down(a: f64, b: f64) -> f64 {
 }
 
 /// `a · b` rounded up.
+#[inline]
 fn mul_up(a: f64, b: f64) -> f64 {
     -mul_down(-a, b)
 }
@@ -158,12 +162,14 @@ impl Interval {
     ///
     /// # Panics
     /// When `lo > hi` or either is NaN (callers check values they read: [`crate::domain`]).
+    #[inline]
     pub fn new(lo: f64, hi: f64) -> Interval {
         assert!(lo <= hi, "an interval needs lo <= hi, got [{lo}, {hi}]");
         Interval { lo, hi }
     }
 
     /// The point interval `[x, x]` (a constant, a parameter at its value).
+    #[inline]
     pub fn point(x: f64) -> Interval {
         Interval { lo: x, hi: x }
     }
@@ -174,21 +180,25 @@ impl Interval {
     }
 
     /// True when `x` lies in the interval.
+    #[inline]
     pub fn contains(self, x: f64) -> bool {
         self.lo <= x && x <= self.hi
     }
 
     /// True when both ends are finite.
+    #[inline]
     pub fn is_bounded(self) -> bool {
         self.lo.is_finite() && self.hi.is_finite()
     }
 
     /// The smallest interval holding both.
+    #[inline]
     pub fn hull(self, o: Interval) -> Interval {
         Interval { lo: self.lo.min(o.lo), hi: self.hi.max(o.hi) }
     }
 
     /// `max(|lo|, |hi|)`: the largest magnitude of the enclosed values.
+    #[inline]
     pub fn mag(self) -> f64 {
         self.lo.abs().max(self.hi.abs())
     }
@@ -206,6 +216,7 @@ impl Interval {
     }
 
     /// An interval from two endpoints computed outward, NaN-free by construction.
+    #[inline]
     fn of(lo: f64, hi: f64) -> Interval {
         debug_assert!(!lo.is_nan() && !hi.is_nan() && lo <= hi, "[{lo}, {hi}]");
         Interval { lo, hi }
@@ -291,6 +302,7 @@ impl Interval {
 impl std::ops::Add for Interval {
     type Output = Interval;
     /// The enclosure of `a + b`.
+    #[inline]
     fn add(self, o: Interval) -> Interval {
         Interval::of(add_down(self.lo, o.lo), add_up(self.hi, o.hi))
     }
@@ -299,6 +311,7 @@ impl std::ops::Add for Interval {
 impl std::ops::Sub for Interval {
     type Output = Interval;
     /// The enclosure of `a − b`.
+    #[inline]
     fn sub(self, o: Interval) -> Interval {
         Interval::of(add_down(self.lo, -o.hi), add_up(self.hi, -o.lo))
     }
@@ -307,6 +320,7 @@ impl std::ops::Sub for Interval {
 impl std::ops::Neg for Interval {
     type Output = Interval;
     /// The enclosure of `−a` (exact).
+    #[inline]
     fn neg(self) -> Interval {
         Interval { lo: -self.hi, hi: -self.lo }
     }
@@ -314,12 +328,41 @@ impl std::ops::Neg for Interval {
 
 impl std::ops::Mul for Interval {
     type Output = Interval;
-    /// The enclosure of `a · b` (the four products of the ends, rounded outward).
+    /// The enclosure of `a · b`: the least and greatest products of the ends, rounded outward.
+    /// By the operands' signs (Moore's nine cases) the ends that give them are known, so one
+    /// product is rounded down and one up; only when both operands hold zero inside are all
+    /// four products compared. Directed rounding is monotone, so the rounded extreme products
+    /// are the extremes of the four rounded products (or inside them, and still enclosing,
+    /// where an exact zero meets a product that underflows).
+    #[inline]
     fn mul(self, o: Interval) -> Interval {
         let (a, b) = (self, o);
-        let lo = mul_down(a.lo, b.lo).min(mul_down(a.lo, b.hi)).min(mul_down(a.hi, b.lo)).min(mul_down(a.hi, b.hi));
-        let hi = mul_up(a.lo, b.lo).max(mul_up(a.lo, b.hi)).max(mul_up(a.hi, b.lo)).max(mul_up(a.hi, b.hi));
-        Interval::of(lo, hi)
+        let ((la, lb), (ha, hb)) = if a.lo >= 0.0 {
+            if b.lo >= 0.0 {
+                ((a.lo, b.lo), (a.hi, b.hi))
+            } else if b.hi <= 0.0 {
+                ((a.hi, b.lo), (a.lo, b.hi))
+            } else {
+                ((a.hi, b.lo), (a.hi, b.hi))
+            }
+        } else if a.hi <= 0.0 {
+            if b.lo >= 0.0 {
+                ((a.lo, b.hi), (a.hi, b.lo))
+            } else if b.hi <= 0.0 {
+                ((a.hi, b.hi), (a.lo, b.lo))
+            } else {
+                ((a.lo, b.hi), (a.lo, b.lo))
+            }
+        } else if b.lo >= 0.0 {
+            ((a.lo, b.hi), (a.hi, b.hi))
+        } else if b.hi <= 0.0 {
+            ((a.hi, b.lo), (a.lo, b.lo))
+        } else {
+            let lo = mul_down(a.lo, b.hi).min(mul_down(a.hi, b.lo));
+            let hi = mul_up(a.lo, b.lo).max(mul_up(a.hi, b.hi));
+            return Interval::of(lo, hi);
+        };
+        Interval::of(mul_down(la, lb), mul_up(ha, hb))
     }
 }
 
@@ -397,6 +440,50 @@ mod tests {
         assert_eq!(Interval::ENTIRE * Interval::point(0.0), Interval::point(0.0));
         let big = Interval::point(f64::MAX) + Interval::point(f64::MAX);
         assert_eq!((big.lo, big.hi), (f64::MAX, f64::INFINITY), "overflow stays enclosed");
+    }
+
+    /// An end drawn to hit the sign cases: zeros of both signs, infinities, ±1 and wide floats.
+    fn end() -> impl proptest::strategy::Strategy<Value = f64> {
+        use proptest::prelude::*;
+        prop_oneof![
+            Just(0.0),
+            Just(-0.0),
+            Just(f64::INFINITY),
+            Just(f64::NEG_INFINITY),
+            Just(1.0),
+            Just(-1.0),
+            -1e6..1e6f64,
+            proptest::num::f64::NORMAL,
+        ]
+    }
+
+    proptest::proptest! {
+        /// The product by sign cases is the four rounded products' min and max (Moore's
+        /// definition), and holds the products of the ends and of points inside.
+        #[test]
+        fn products_by_sign_cases_are_the_four_products_extremes(
+            (a0, a1, b0, b1) in (end(), end(), end(), end()), (s, t) in (0.0..=1.0f64, 0.0..=1.0f64)
+        ) {
+            let (a, b) = (Interval::new(a0.min(a1), a0.max(a1)), Interval::new(b0.min(b1), b0.max(b1)));
+            // Never `lo = +∞` nor `hi = −∞` (the type's invariant).
+            proptest::prop_assume!(a.lo < f64::INFINITY && a.hi > f64::NEG_INFINITY);
+            proptest::prop_assume!(b.lo < f64::INFINITY && b.hi > f64::NEG_INFINITY);
+            let p = a * b;
+            let ends = [(a.lo, b.lo), (a.lo, b.hi), (a.hi, b.lo), (a.hi, b.hi)];
+            let lo = ends.iter().map(|&(x, y)| mul_down(x, y)).fold(f64::INFINITY, f64::min);
+            let hi = ends.iter().map(|&(x, y)| mul_up(x, y)).fold(f64::NEG_INFINITY, f64::max);
+            let tiny = ends.iter().any(|&(x, y)| x != 0.0 && y != 0.0 && (x * y).abs() < TINY);
+            if tiny {
+                proptest::prop_assert!(p.lo >= lo && p.hi <= hi, "{a} · {b} = {p}, four products [{lo:e}, {hi:e}]");
+            } else {
+                proptest::prop_assert_eq!((p.lo, p.hi), (lo, hi), "{} · {}", a, b);
+            }
+            let inside = |i: Interval, s: f64| if i.is_bounded() { i.lo + s * (i.hi - i.lo) } else { i.lo.max(-1.0).min(i.hi) };
+            let (x, y) = (inside(a, s), inside(b, t));
+            if x.is_finite() && y.is_finite() {
+                proptest::prop_assert!(p.contains(x * y), "{x} · {y} outside {p}");
+            }
+        }
     }
 
     #[test]

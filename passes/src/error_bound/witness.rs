@@ -188,8 +188,28 @@ fn half_step(format: Format, r: f64) -> f64 {
         Format::Binary32 => (24, -126),
         Format::Fix { fraction, .. } => return 2f64.powi(-fraction - 1),
     };
-    let e = if r == 0.0 { min_exp } else { (r.abs().log2().floor() as i32).max(min_exp) };
-    2f64.powi(e - precision)
+    let e = binade(r).max(min_exp);
+    let k = e - precision;
+    if (-1022..=1023).contains(&k) {
+        // 2^k, a normal binary64: its biased exponent alone.
+        f64::from_bits(((k + 1023) as u64) << 52)
+    } else {
+        2f64.powi(k)
+    }
+}
+
+/// `⌊log₂|r|⌋` of a finite nonzero `r`, read from its exponent bits (a subnormal's from its
+/// leading bit); −1075 for 0 (below every binade), and 2048 for ±∞ and NaN (above every one:
+/// their half step is +∞).
+fn binade(r: f64) -> i32 {
+    let bits = r.abs().to_bits();
+    let biased = (bits >> 52) as i32;
+    match biased {
+        0 if bits == 0 => -1075,
+        0 => -1011 - bits.leading_zeros() as i32,
+        0x7ff => 2048,
+        _ => biased - 1023,
+    }
 }
 
 /// Every value of the execution whose rounding ops (`rounds`) each add `sign·sign(grad)`
@@ -275,5 +295,40 @@ pub fn local_partials(def: &Def, vals: &[f64], mut give: impl FnMut(Value, f64))
             None => {}
         },
         Def::Input | Def::Expr(_) => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The binade read from the bits is `⌊log₂|r|⌋` (computed here exactly, by halving and
+    /// doubling: powers of two are exact), and the half step is 2^(binade − precision).
+    #[test]
+    fn binades_and_half_steps_from_the_bits() {
+        let floor_log2 = |r: f64| {
+            let (mut m, mut e) = (r.abs(), 0i32);
+            while m >= 2.0 {
+                m /= 2.0;
+                e += 1;
+            }
+            while m < 1.0 {
+                m *= 2.0;
+                e -= 1;
+            }
+            e
+        };
+        let mut rng = robovec_ir::rng::SplitMix64::new(5);
+        let mut cases = vec![1.0, 2.0, 3.0, 0.75, f64::MAX, f64::MIN_POSITIVE, 5e-324, 1e-310, -7.5, 2f64.next_down()];
+        cases.extend((0..2000).map(|_| f64::from_bits(rng.next_u64() & !(0x7ffu64 << 52) | (rng.below(2046) + 1) << 52)));
+        cases.extend((0..200).map(|_| f64::from_bits(rng.next_u64() >> 12)).filter(|x| *x != 0.0));
+        for r in cases {
+            assert_eq!(binade(r), floor_log2(r), "{r:e}");
+            let e = floor_log2(r);
+            assert_eq!(half_step(Format::Binary64, r), 2f64.powi(e.max(-1022) - 53), "{r:e}");
+            assert_eq!(half_step(Format::Binary32, r), 2f64.powi(e.max(-126) - 24), "{r:e}");
+        }
+        assert_eq!(half_step(Format::Binary64, 0.0), 2f64.powi(-1022 - 53));
+        assert_eq!(half_step(Format::Binary64, f64::INFINITY), f64::INFINITY);
     }
 }

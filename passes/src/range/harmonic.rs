@@ -107,8 +107,11 @@ struct Atom {
 }
 
 impl Atom {
-    fn key(&self) -> (u32, u32, bool) {
-        (self.h, self.sym, self.sin)
+    /// The order of a form's atoms, `(h, sym, sin)` lexicographically, packed in one word for
+    /// the sorts (harmonic ids stay far below 2³¹: each is a combination the sweep interned).
+    fn key(&self) -> u64 {
+        debug_assert!(self.h < 1 << 31);
+        (u64::from(self.h) << 33) | (u64::from(self.sym) << 1) | u64::from(self.sin)
     }
 }
 
@@ -731,7 +734,7 @@ fn put_own(atoms: &mut Vec<Atom>, own: u32, e: f64) {
     if e.is_nan() || e <= 0.0 {
         return;
     }
-    let key = (0, own, false);
+    let key = Atom { h: 0, sym: own, sin: false, c: e }.key();
     match atoms.binary_search_by_key(&key, Atom::key) {
         Ok(k) => atoms[k].c = (Interval::point(atoms[k].c.abs()) + Interval::point(e)).hi,
         Err(k) => atoms.insert(k, Atom { h: 0, sym: own, sin: false, c: e }),
