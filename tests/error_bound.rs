@@ -11,7 +11,8 @@ use robovec_ir::format::Format;
 use robovec_ir::numerics::{RefValue, Reference, Tape};
 use robovec_ir::rng::SplitMix64;
 use robovec_ir::{Function, Operand};
-use robovec_passes::error_bound::{bound, Formats};
+use robovec_passes::error_bound::bound::{bound_with_adjoints, OutputAdjoints};
+use robovec_passes::error_bound::{bound, BoundError, Formats, TrigImpl};
 use robovec_passes::range::{enclose_with, EncloseError};
 
 use crate::common::{opt, stderr};
@@ -41,12 +42,37 @@ fn point(tape: &Tape, dom: &Domain, k: usize, rng: &mut SplitMix64) -> Vec<f64> 
     robovec_passes::error_bound::domain_point(&ranges, k as u64, rng)
 }
 
-/// Bounds `f` over `dom` in `formats` and compares with the error at `n` points of the domain
-/// (computed as `formats` says, against the certified exact value); panics on any error above
-/// its bound.
-fn check_sound(what: &str, f: &Function, dom: &Domain, formats: Formats, n: usize, seed: u64) -> Worst {
-    let x = enclose_with(f, dom, Some(16), || false).unwrap_or_else(|e| panic!("{what}: {e:?}"));
-    let e = bound(f, &x, formats, || false).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+/// What the bound of `f` over a domain reads in every format: its values' enclosures (as the
+/// pass computes them: 16 affine atoms) and its outputs' adjoints over them (which depend on
+/// the ops and the enclosures, not on the formats: `bound` is
+/// `bound_with_adjoints(OutputAdjoints::new(f, x))`, and `precision` shares them the same way).
+struct Enclosed {
+    x: Vec<robovec_ir::Interval>,
+    adjoints: Option<OutputAdjoints>,
+}
+
+impl Enclosed {
+    fn of(f: &Function, x: Vec<robovec_ir::Interval>) -> Enclosed {
+        let adjoints = OutputAdjoints::new(f, &x);
+        Enclosed { x, adjoints }
+    }
+
+    /// [`bound`] of `f` in `formats`.
+    fn bound(&self, f: &Function, formats: Formats) -> Result<Vec<f64>, BoundError> {
+        bound_with_adjoints(f, &self.x, formats, 0, self.adjoints.as_ref(), TrigImpl::Libm, || false)
+    }
+}
+
+/// [`Enclosed`] over `dom` (panics when `f` cannot be enclosed there).
+fn enclosure(what: &str, f: &Function, dom: &Domain) -> Enclosed {
+    Enclosed::of(f, enclose_with(f, dom, Some(16), || false).unwrap_or_else(|e| panic!("{what}: {e:?}")))
+}
+
+/// Bounds `f` over `dom` (enclosed as `x`) in `formats` and compares with the error
+/// at `n` points of the domain (computed as `formats` says, against the certified exact
+/// value); panics on any error above its bound.
+fn check_sound(what: &str, f: &Function, dom: &Domain, x: &Enclosed, formats: Formats, n: usize, seed: u64) -> Worst {
+    let e = x.bound(f, formats).unwrap_or_else(|e| panic!("{what}: {e:?}"));
     let tape = Tape::new(f);
     let mut reference = Reference::new();
     let mut refs = Vec::new();
@@ -145,10 +171,10 @@ fn random_formats(f: &Function, dom: &Domain, seed: u64, fix_only: bool) -> Func
 /// [`check_sound`] of `g` (in formats) in mode mixed, at 32 points; a fixed-point format the
 /// bound cannot prove wide enough is refused (`FixOverflow`), never bounded, and not checked.
 fn check_sound_formatted(what: &str, g: &Function, dom: &Domain, seed: u64) {
-    let x = enclose_with(g, dom, Some(16), || false).unwrap();
-    match bound(g, &x, Formats::Mixed, || false) {
+    let x = enclosure(what, g, dom);
+    match x.bound(g, Formats::Mixed) {
         Ok(_) => {
-            check_sound(what, g, dom, Formats::Mixed, 32, seed);
+            check_sound(what, g, dom, &x, Formats::Mixed, 32, seed);
         }
         Err(robovec_passes::error_bound::BoundError::FixOverflow { .. }) => {}
         Err(e) => panic!("{e:?}"),
@@ -176,8 +202,9 @@ proptest! {
     #[test]
     fn bounds_hold_on_random_functions(seed in any::<u64>(), ops in 1usize..60) {
         let (f, dom) = random_function(seed, ops);
+        let x = enclosure(&format!("seed {seed}"), &f, &dom);
         for formats in [Formats::F64, Formats::F32] {
-            check_sound(&format!("seed {seed}"), &f, &dom, formats, 32, seed);
+            check_sound(&format!("seed {seed}"), &f, &dom, &x, formats, 32, seed);
         }
     }
 
@@ -201,11 +228,14 @@ proptest! {
     #[test]
     fn bounds_hold_against_the_models_worst_executions(seed in any::<u64>(), ops in 1usize..50) {
         let (f, dom) = random_function(seed, ops);
+        let x = enclosure(&format!("seed {seed}"), &f, &dom);
         for formats in [Formats::F64, Formats::F32] {
-            check_witness(&format!("seed {seed}"), &f, &dom, formats, 16, seed);
+            check_witness(&format!("seed {seed}"), &f, &dom, &x, formats, 16, seed);
         }
-        check_witness(&format!("mixed seed {seed}"), &with_random_formats(&f, &dom, seed), &dom, Formats::Mixed, 16, seed);
-        check_witness(&format!("fixed seed {seed}"), &with_fixed_point_formats(&f, &dom, seed), &dom, Formats::Mixed, 16, seed);
+        for (what, g) in [("mixed", with_random_formats(&f, &dom, seed)), ("fixed", with_fixed_point_formats(&f, &dom, seed))] {
+            let what = format!("{what} seed {seed}");
+            check_witness(&what, &g, &dom, &enclosure(&what, &g, &dom), Formats::Mixed, 16, seed);
+        }
     }
 
     /// The same on the synthetic Robotran-like DAGs.
@@ -213,8 +243,9 @@ proptest! {
     fn bounds_hold_against_the_models_worst_executions_on_dags(seed in any::<u64>(), ops in 50usize..400) {
         let f = robovec_testkit::dag_gen::generate(ops, seed);
         let dom = crate::range::random_domain(&f, seed);
+        let x = enclosure(&format!("dag {seed}"), &f, &dom);
         for formats in [Formats::F64, Formats::F32] {
-            check_witness(&format!("dag {seed}"), &f, &dom, formats, 8, seed);
+            check_witness(&format!("dag {seed}"), &f, &dom, &x, formats, 8, seed);
         }
     }
 
@@ -247,21 +278,21 @@ proptest! {
     fn bounds_hold_on_robotran_like_dags(seed in any::<u64>(), ops in 50usize..600) {
         let f = robovec_testkit::dag_gen::generate(ops, seed);
         let dom = crate::range::random_domain(&f, seed);
+        let x = enclosure(&format!("dag {seed}"), &f, &dom);
         for formats in [Formats::F64, Formats::F32] {
-            check_sound(&format!("dag {seed}"), &f, &dom, formats, 16, seed);
+            check_sound(&format!("dag {seed}"), &f, &dom, &x, formats, 16, seed);
         }
     }
 }
 
-/// [`check_witness`] of `f` in `formats` at `n` points: no execution the rounding model allows
+/// [`check_witness`] of `f` (enclosed as `x`) in `formats` at `n` points: no execution the rounding model allows
 /// ([`robovec_passes::error_bound::witness`]: every rounding at its largest, aligned with the
 /// output's gradient) has an error above the bound. Far stronger than sampling: the witness is
 /// what sampling's random-signed roundings would take ~10⁵× more points to approach. Returns the
 /// number of (output, point) pairs compared.
-fn check_witness(what: &str, f: &Function, dom: &Domain, formats: Formats, n: usize, seed: u64) -> usize {
+fn check_witness(what: &str, f: &Function, dom: &Domain, x: &Enclosed, formats: Formats, n: usize, seed: u64) -> usize {
     use robovec_passes::error_bound::witness::Witness;
-    let x = enclose_with(f, dom, Some(16), || false).unwrap_or_else(|e| panic!("{what}: {e:?}"));
-    let e = match bound(f, &x, formats, || false) {
+    let e = match x.bound(f, formats) {
         Ok(e) => e,
         Err(robovec_passes::error_bound::BoundError::FixOverflow { .. }) => return 0,
         Err(err) => panic!("{what}: {err:?}"),
@@ -296,10 +327,8 @@ fn bounds_hold_against_the_models_worst_executions_on_the_corpus() {
     let (mut functions, mut compared) = (0, 0);
     for (name, f) in crate::tree_height::corpus_functions() {
         let dom = generous_domain(&f);
-        if enclose_with(&f, &dom, Some(16), || false).is_err() {
-            continue;
-        }
-        let n = check_witness(&name, &f, &dom, Formats::F32, 3, 7);
+        let Ok(x) = enclose_with(&f, &dom, Some(16), || false) else { continue };
+        let n = check_witness(&name, &f, &dom, &Enclosed::of(&f, x), Formats::F32, 3, 7);
         functions += usize::from(n > 0);
         compared += n;
     }
@@ -313,14 +342,14 @@ fn bounds_hold_on_the_corpus() {
     let (mut bounded, mut compared) = (0, 0);
     for (name, f) in crate::tree_height::corpus_functions() {
         let dom = generous_domain(&f);
-        match enclose_with(&f, &dom, Some(16), || false) {
-            Ok(_) => {}
+        let x = match enclose_with(&f, &dom, Some(16), || false) {
+            Ok(x) => Enclosed::of(&f, x),
             Err(EncloseError::DivisorHoldsZero { .. } | EncloseError::SqrtOfNegative { .. }) => continue,
             Err(e) => panic!("{name}: {e:?}"),
-        }
+        };
         let mut any = false;
         for formats in [Formats::F32, Formats::F64] {
-            any |= check_sound(&name, &f, &dom, formats, 24, 3).compared > 0;
+            any |= check_sound(&name, &f, &dom, &x, formats, 24, 3).compared > 0;
         }
         bounded += 1;
         compared += usize::from(any);

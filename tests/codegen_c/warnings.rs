@@ -15,9 +15,14 @@ use super::{
 };
 use crate::common::tmp;
 
-/// Both compilers, each with the flags of a strict project build.
-const COMPILERS: [&str; 2] = ["gcc", "clang"];
-const STRICT: [&str; 7] = ["-std=c99", "-O0", "-Wall", "-Wextra", "-pedantic", "-Werror", "-c"];
+/// Both compilers, each with the flags of a strict project build, and how far each goes.
+/// GCC compiles to an object: it reports unused static functions and constants only once
+/// its call graph is built, after the front end (`-fsyntax-only` misses them). Clang's
+/// warnings at `-O0` all come from its front end (unused functions included), so it stops
+/// there (`-fsyntax-only`): the same diagnostics at a fifth of the time. Clang's object code
+/// is compiled and run by `clang_builds_equal_the_interpreter`.
+const COMPILERS: [(&str, &str); 2] = [("gcc", "-c"), ("clang", "-fsyntax-only")];
+const STRICT: [&str; 6] = ["-std=c99", "-O0", "-Wall", "-Wextra", "-pedantic", "-Werror"];
 
 /// Corpus files that hold what warns: a value nothing reads (Jeep's `extforces` computes
 /// `Dz413` and never uses it), a function of constants with no input (car43's `link3D`),
@@ -63,11 +68,11 @@ fn every_configuration_compiles_warning_free_under_gcc_and_clang() {
                 let art = o.emit(&case.m).unwrap_or_else(|e| panic!("{} {label}: {e}", case.label));
                 let file = dir.join("t.c");
                 std::fs::write(&file, &art.code.main).unwrap();
-                for compiler in COMPILERS {
+                for (compiler, stage) in COMPILERS {
                     let out = Command::new(compiler)
                         .current_dir(&dir)
                         .args(STRICT)
-                        .args(["t.c", "-o", "t.o"])
+                        .args([stage, "t.c", "-o", "t.o"])
                         .output()
                         .unwrap_or_else(|e| panic!("{compiler} ({e}): scripts/test.sh installs gcc and clang"));
                     assert!(

@@ -129,6 +129,7 @@ impl Witness {
             rounds[z.index()] = DD::from_f64(actual[z.index()]) != r;
         }
         let mut out = Vec::with_capacity(self.outputs.len());
+        let (mut in_cone, mut cone) = (vec![false; n], Vec::new());
         for o in &self.outputs {
             for _ in 0..ticks_per_output {
                 if tick() {
@@ -145,9 +146,10 @@ impl Witness {
                 continue;
             }
             let grad = gradient(f, &exact_vals, o);
+            cone_of(f, o, &mut in_cone, &mut cone);
             let mut worst: Option<f64> = None;
             for sign in [1.0, -1.0] {
-                let w = execution(f, &actual, &rounds, &grad, sign)[o.index()];
+                let w = execution(f, &cone, &actual, &rounds, &grad, sign)[o.index()];
                 let e = (w - DD::from_f64(r.f64)).to_f64().abs();
                 let half_ulp = (r.f64.abs().next_up() - r.f64.abs()) / 2.0;
                 if e.is_finite() {
@@ -213,13 +215,15 @@ fn binade(r: f64) -> i32 {
 }
 
 /// Every value of the execution whose rounding ops (`rounds`) each add `sign·sign(grad)`
-/// times (just under) half a step of their result, in double-double; inputs as `actual`.
-fn execution(f: &Function, actual: &[f64], rounds: &[bool], grad: &[f64], sign: f64) -> Vec<DD> {
+/// times (just under) half a step of their result, in double-double; inputs as `actual`. Only
+/// the body values in `cone` (body order, closed under operands: [`cone_of`]) are computed,
+/// the rest are NaN.
+fn execution(f: &Function, cone: &[Value], actual: &[f64], rounds: &[bool], grad: &[f64], sign: f64) -> Vec<DD> {
     let mut w = vec![DD::from_f64(f64::NAN); f.values.len()];
     for &v in &f.inputs {
         w[v.index()] = DD::from_f64(actual[v.index()]);
     }
-    for &z in &f.body {
+    for &z in cone {
         let r = eval_def::<DD>(&f.value(z).def, |o| read(f, z, o, &|x: Value| w[x.index()]));
         w[z.index()] = if rounds[z.index()] {
             let s = if grad[z.index()] < 0.0 { -sign } else { sign };
@@ -229,6 +233,28 @@ fn execution(f: &Function, actual: &[f64], rounds: &[bool], grad: &[f64], sign: 
         };
     }
     w
+}
+
+/// The body values `out` depends on, `out` included, in body order, into `cone` (`in_cone`, by
+/// [`Value::index`], is scratch of `f.values.len()` entries, left all false). One backward
+/// sweep over the body: an output's execution computes its cone only (values outside it stay
+/// NaN and are never read), so a function's outputs cost the sum of their cones' sizes.
+fn cone_of(f: &Function, out: Value, in_cone: &mut [bool], cone: &mut Vec<Value>) {
+    cone.clear();
+    in_cone[out.index()] = true;
+    for &z in f.body.iter().rev() {
+        if in_cone[z.index()] {
+            cone.push(z);
+            f.value(z).def.for_each_value(|v| in_cone[v.index()] = true);
+        }
+    }
+    cone.reverse();
+    for &z in cone.iter() {
+        in_cone[z.index()] = false;
+    }
+    for &v in &f.inputs {
+        in_cone[v.index()] = false;
+    }
 }
 
 /// `∂out/∂z` for every value `z` of `f` (by [`Value::index`]) at the binary64 values `vals`,
