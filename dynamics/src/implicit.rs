@@ -180,13 +180,10 @@ fn matrix<'a>(outputs: impl Iterator<Item = (&'a str, Operand)>, family: &str) -
 
 #[cfg(test)]
 mod tests {
-    use std::collections::BTreeMap;
-
-    use robovec_ir::interp;
     use robovec_ir::time_limit::Ticker;
 
-    use crate::depth::tests::state;
-    use crate::robot::{JointKind, Robot};
+    use crate::depth::tests::worst_relative;
+    use crate::robot::JointKind;
     use crate::sym::Builder;
     use crate::topology::{build, Topology};
     use crate::{Layout, Model, Writer};
@@ -196,28 +193,6 @@ mod tests {
         let mut b = Builder::new(name, Default::default());
         write(model, layout, &mut b).expect("no deadline");
         b.finish()
-    }
-
-    /// The worst `|x − y| / (1 + max |y|)` over the outputs of `y`, over three states (with
-    /// `Qq` drawn too).
-    fn worst(robot: &Robot, x: &robovec_ir::Function, y: &robovec_ir::Function) -> f64 {
-        let layout = Layout::of(robot);
-        let mut worst: f64 = 0.0;
-        for seed in 1..=3 {
-            let mut given = state(robot, seed);
-            for i in 1..=layout.nv {
-                given.insert(format!("Qq[{i}]"), 3.0 * interp::pseudo_random_input(&format!("Qq[{i}]"), seed));
-            }
-            let at = |name: &str| *given.get(name).unwrap_or_else(|| panic!("input {name}"));
-            let a: BTreeMap<String, f64> = interp::eval::<f64>(x, at).into_iter().collect();
-            let b: BTreeMap<String, f64> = interp::eval::<f64>(y, at).into_iter().collect();
-            let scale = b.values().fold(0.0f64, |m, v| m.max(v.abs()));
-            for (name, v) in &b {
-                let got = a.get(name).unwrap_or_else(|| panic!("{name} written"));
-                worst = worst.max((got - v).abs() / (1.0 + scale));
-            }
-        }
-        worst
     }
 
     /// `aba_derivatives` as `−M⁻¹·∂τ_ID` with either `fordyna` (the body frames' CRBA and RNEA,
@@ -263,7 +238,7 @@ mod tests {
                 let solved = written(&model, &layout, "aba_derivatives", solve);
                 let f = super::aba_derivatives(&partials, &solved, &ticker).expect("no deadline");
                 assert_eq!(f.outputs.len(), 3 * layout.nv * layout.nv, "{label}");
-                let e = worst(&robot, &f, &by_diff);
+                let e = worst_relative(&robot, &f, &by_diff, true);
                 assert!(e <= 1e-9, "{label}: {e:e}");
             }
         }

@@ -448,10 +448,9 @@ fn sub6(a: &S6, b: &S6) -> S6 {
 
 #[cfg(test)]
 mod tests {
-    use robovec_ir::interp;
     use robovec_ir::time_limit::Ticker;
 
-    use crate::depth::tests::{cos_sin, state};
+    use crate::depth::tests::{cos_sin, worst_relative};
     use crate::robot::{JointKind, Robot};
     use crate::sym::Builder;
     use crate::topology::{build, Topology};
@@ -473,20 +472,7 @@ mod tests {
         let by_diff = crate::derive(&b.finish(), &crate::DERIVED[0], coords.as_deref(), &Ticker::new(None, None))
             .expect("no deadline");
         assert_eq!(analytical.outputs.len(), 2 * layout.nv * layout.nv);
-        let mut worst: f64 = 0.0;
-        for seed in 1..=3 {
-            let given = state(&model.robot, seed);
-            let at = |name: &str| *given.get(name).unwrap_or_else(|| panic!("input {name}"));
-            let a: std::collections::BTreeMap<String, f64> = interp::eval::<f64>(&analytical, at).into_iter().collect();
-            let d: std::collections::BTreeMap<String, f64> = interp::eval::<f64>(&by_diff, at).into_iter().collect();
-            let scale = d.values().fold(0.0f64, |m, x| m.max(x.abs()));
-            // `diff` writes no column for a coordinate the function does not read: 0 there.
-            for (name, x) in &a {
-                worst = worst.max((x - d.get(name).copied().unwrap_or(0.0)).abs() / (1.0 + scale));
-            }
-            assert!(d.keys().all(|n| a.contains_key(n)), "every derivative of diff's is written");
-        }
-        worst
+        worst_relative(&model.robot, &analytical, &by_diff, false)
     }
 
     /// Every joint kind and base: revolute chains and trees, prismatic joints, Pinocchio's

@@ -70,6 +70,34 @@ pub(crate) fn state(robot: &Robot, seed: u64) -> BTreeMap<String, f64> {
     given
 }
 
+/// The worst `|x − y| / (1 + max |y|)` over the outputs of `x` and three states ([`state`], with
+/// the torques `Qq` drawn too when `torques`), `y`'s output of the same name taken as 0 where
+/// `y` writes none (`diff` writes no column for a coordinate the function does not read).
+///
+/// # Panics
+/// When `y` writes an output `x` does not, or an input is missing.
+pub(crate) fn worst_relative(robot: &Robot, x: &Function, y: &Function, torques: bool) -> f64 {
+    let nv = Layout::of(robot).nv;
+    let mut worst: f64 = 0.0;
+    for seed in 1..=3 {
+        let mut given = state(robot, seed);
+        if torques {
+            for i in 1..=nv {
+                given.insert(format!("Qq[{i}]"), 3.0 * interp::pseudo_random_input(&format!("Qq[{i}]"), seed));
+            }
+        }
+        let at = |name: &str| *given.get(name).unwrap_or_else(|| panic!("input {name}"));
+        let a: BTreeMap<String, f64> = interp::eval::<f64>(x, at).into_iter().collect();
+        let b: BTreeMap<String, f64> = interp::eval::<f64>(y, at).into_iter().collect();
+        assert!(b.keys().all(|n| a.contains_key(n)), "every output of the reference is written");
+        let scale = b.values().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (name, v) in &a {
+            worst = worst.max((v - b.get(name).copied().unwrap_or(0.0)).abs() / (1.0 + scale));
+        }
+    }
+    worst
+}
+
 /// The outputs of `f` at `given` in binary64, each with a running error bound (J. H.
 /// Wilkinson's running error analysis, N. J. Higham, *Accuracy and Stability of Numerical
 /// Algorithms*, 2nd ed., §3.3, to first order in `u`): an op `z = fl(x ∘ y)` carries
