@@ -73,6 +73,11 @@ fn enclosure(what: &str, f: &Function, dom: &Domain) -> Enclosed {
 /// value); panics on any error above its bound.
 fn check_sound(what: &str, f: &Function, dom: &Domain, x: &Enclosed, formats: Formats, n: usize, seed: u64) -> Worst {
     let e = x.bound(f, formats).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+    check_bounds(what, f, dom, &e, formats, n, seed)
+}
+
+/// [`check_sound`] of the bounds `e` (by value index) already computed.
+fn check_bounds(what: &str, f: &Function, dom: &Domain, e: &[f64], formats: Formats, n: usize, seed: u64) -> Worst {
     let tape = Tape::new(f);
     let mut reference = Reference::new();
     let mut refs = Vec::new();
@@ -173,8 +178,8 @@ fn random_formats(f: &Function, dom: &Domain, seed: u64, fix_only: bool) -> Func
 fn check_sound_formatted(what: &str, g: &Function, dom: &Domain, seed: u64) {
     let x = enclosure(what, g, dom);
     match x.bound(g, Formats::Mixed) {
-        Ok(_) => {
-            check_sound(what, g, dom, &x, Formats::Mixed, 32, seed);
+        Ok(e) => {
+            check_bounds(what, g, dom, &e, Formats::Mixed, 32, seed);
         }
         Err(robovec_passes::error_bound::BoundError::FixOverflow { .. }) => {}
         Err(e) => panic!("{e:?}"),

@@ -65,6 +65,15 @@ impl std::fmt::Display for Interval {
     }
 }
 
+/// Where an interval lies with respect to 0: `lo ≥ 0`, `hi ≤ 0` (and not the first), or 0
+/// strictly inside.
+#[derive(Clone, Copy)]
+enum Sign {
+    Pos,
+    Neg,
+    Mixed,
+}
+
 /// `a + b` rounded down (toward −∞).
 #[inline]
 fn add_down(a: f64, b: f64) -> f64 {
@@ -222,6 +231,18 @@ impl Interval {
         Interval { lo, hi }
     }
 
+    /// Where the interval lies with respect to 0 (Moore's cases of a product).
+    #[inline]
+    fn sign(self) -> Sign {
+        if self.lo >= 0.0 {
+            Sign::Pos
+        } else if self.hi <= 0.0 {
+            Sign::Neg
+        } else {
+            Sign::Mixed
+        }
+    }
+
     /// The enclosure of `a · a` for one value `a` (not `a · b` with both in the same interval:
     /// the square is never negative, so `[−1, 2]²` is `[0, 4]`, not `[−2, 4]`).
     pub fn sqr(self) -> Interval {
@@ -336,31 +357,23 @@ impl std::ops::Mul for Interval {
     /// where an exact zero meets a product that underflows).
     #[inline]
     fn mul(self, o: Interval) -> Interval {
+        use Sign::{Mixed, Neg, Pos};
         let (a, b) = (self, o);
-        let ((la, lb), (ha, hb)) = if a.lo >= 0.0 {
-            if b.lo >= 0.0 {
-                ((a.lo, b.lo), (a.hi, b.hi))
-            } else if b.hi <= 0.0 {
-                ((a.hi, b.lo), (a.lo, b.hi))
-            } else {
-                ((a.hi, b.lo), (a.hi, b.hi))
+        // The ends whose products are the least and the greatest.
+        let ((la, lb), (ha, hb)) = match (a.sign(), b.sign()) {
+            (Pos, Pos) => ((a.lo, b.lo), (a.hi, b.hi)),
+            (Pos, Neg) => ((a.hi, b.lo), (a.lo, b.hi)),
+            (Pos, Mixed) => ((a.hi, b.lo), (a.hi, b.hi)),
+            (Neg, Pos) => ((a.lo, b.hi), (a.hi, b.lo)),
+            (Neg, Neg) => ((a.hi, b.hi), (a.lo, b.lo)),
+            (Neg, Mixed) => ((a.lo, b.hi), (a.lo, b.lo)),
+            (Mixed, Pos) => ((a.lo, b.hi), (a.hi, b.hi)),
+            (Mixed, Neg) => ((a.hi, b.lo), (a.lo, b.lo)),
+            (Mixed, Mixed) => {
+                let lo = mul_down(a.lo, b.hi).min(mul_down(a.hi, b.lo));
+                let hi = mul_up(a.lo, b.lo).max(mul_up(a.hi, b.hi));
+                return Interval::of(lo, hi);
             }
-        } else if a.hi <= 0.0 {
-            if b.lo >= 0.0 {
-                ((a.lo, b.hi), (a.hi, b.lo))
-            } else if b.hi <= 0.0 {
-                ((a.hi, b.hi), (a.lo, b.lo))
-            } else {
-                ((a.lo, b.hi), (a.lo, b.lo))
-            }
-        } else if b.lo >= 0.0 {
-            ((a.lo, b.hi), (a.hi, b.hi))
-        } else if b.hi <= 0.0 {
-            ((a.hi, b.lo), (a.lo, b.lo))
-        } else {
-            let lo = mul_down(a.lo, b.hi).min(mul_down(a.hi, b.lo));
-            let hi = mul_up(a.lo, b.lo).max(mul_up(a.hi, b.hi));
-            return Interval::of(lo, hi);
         };
         Interval::of(mul_down(la, lb), mul_up(ha, hb))
     }

@@ -102,12 +102,19 @@ impl Function {
                 live[v.index()] = true;
             }
         }
+        self.mark_operands(&mut live);
+        live
+    }
+
+    /// Marks in `marked` (indexed by `Value::index()`, `values.len()` entries) every value a
+    /// marked value reads, transitively: one backward sweep over the body. Cost:
+    /// O(values + operands).
+    pub fn mark_operands(&self, marked: &mut [bool]) {
         for &v in self.body.iter().rev() {
-            if live[v.index()] {
-                self.value(v).def.for_each_value(|a| live[a.index()] = true);
+            if marked[v.index()] {
+                self.value(v).def.for_each_value(|a| marked[a.index()] = true);
             }
         }
-        live
     }
 
     /// How many times each value is read (indexed by `Value::index()`): once per operand of a

@@ -129,7 +129,6 @@ impl Witness {
             rounds[z.index()] = DD::from_f64(actual[z.index()]) != r;
         }
         let mut out = Vec::with_capacity(self.outputs.len());
-        let (mut in_cone, mut cone) = (vec![false; n], Vec::new());
         for o in &self.outputs {
             for _ in 0..ticks_per_output {
                 if tick() {
@@ -146,7 +145,7 @@ impl Witness {
                 continue;
             }
             let grad = gradient(f, &exact_vals, o);
-            cone_of(f, o, &mut in_cone, &mut cone);
+            let cone = cone_of(f, o);
             let mut worst: Option<f64> = None;
             for sign in [1.0, -1.0] {
                 let w = execution(f, &cone, &actual, &rounds, &grad, sign)[o.index()];
@@ -235,26 +234,14 @@ fn execution(f: &Function, cone: &[Value], actual: &[f64], rounds: &[bool], grad
     w
 }
 
-/// The body values `out` depends on, `out` included, in body order, into `cone` (`in_cone`, by
-/// [`Value::index`], is scratch of `f.values.len()` entries, left all false). One backward
-/// sweep over the body: an output's execution computes its cone only (values outside it stay
-/// NaN and are never read), so a function's outputs cost the sum of their cones' sizes.
-fn cone_of(f: &Function, out: Value, in_cone: &mut [bool], cone: &mut Vec<Value>) {
-    cone.clear();
+/// The body values `out` depends on, `out` included, in body order: an output's execution
+/// computes its cone only (values outside it stay NaN and are never read), so a function's
+/// outputs cost the sum of their cones' sizes.
+fn cone_of(f: &Function, out: Value) -> Vec<Value> {
+    let mut in_cone = vec![false; f.values.len()];
     in_cone[out.index()] = true;
-    for &z in f.body.iter().rev() {
-        if in_cone[z.index()] {
-            cone.push(z);
-            f.value(z).def.for_each_value(|v| in_cone[v.index()] = true);
-        }
-    }
-    cone.reverse();
-    for &z in cone.iter() {
-        in_cone[z.index()] = false;
-    }
-    for &v in &f.inputs {
-        in_cone[v.index()] = false;
-    }
+    f.mark_operands(&mut in_cone);
+    f.body.iter().copied().filter(|z| in_cone[z.index()]).collect()
 }
 
 /// `∂out/∂z` for every value `z` of `f` (by [`Value::index`]) at the binary64 values `vals`,

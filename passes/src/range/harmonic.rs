@@ -734,10 +734,10 @@ fn put_own(atoms: &mut Vec<Atom>, own: u32, e: f64) {
     if e.is_nan() || e <= 0.0 {
         return;
     }
-    let key = Atom { h: 0, sym: own, sin: false, c: e }.key();
-    match atoms.binary_search_by_key(&key, Atom::key) {
+    let atom = Atom { h: 0, sym: own, sin: false, c: e };
+    match atoms.binary_search_by_key(&atom.key(), Atom::key) {
         Ok(k) => atoms[k].c = (Interval::point(atoms[k].c.abs()) + Interval::point(e)).hi,
-        Err(k) => atoms.insert(k, Atom { h: 0, sym: own, sin: false, c: e }),
+        Err(k) => atoms.insert(k, atom),
     }
 }
 
