@@ -143,7 +143,10 @@ fn ns_per_state_drawn(
     if !o.status.success() {
         return Err("the timed program failed".into());
     }
-    String::from_utf8_lossy(&o.stdout).trim().parse::<f64>().map_err(|e| format!("the timed program printed no time: {e}"))
+    String::from_utf8_lossy(&o.stdout)
+        .trim()
+        .parse::<f64>()
+        .map_err(|e| format!("the timed program printed no time: {e}"))
 }
 
 /// `cmd`'s output, the process killed when `deadline` comes first.

@@ -83,6 +83,18 @@ pub fn load_with(input: &str, opts: &FrontOptions) -> Result<(Loaded, SourceFile
     let loaded = fe
         .load(Path::new(input), &src.text, opts)
         .map_err(|errs| Failure::Input(src.render(&errs.iter().map(|e| e.to_diagnostic(())).collect::<Vec<_>>())))?;
+    if !loaded.warnings.is_empty() {
+        let diags: Vec<_> = loaded
+            .warnings
+            .iter()
+            .map(|w| {
+                let mut d = w.to_diagnostic(());
+                d.severity = codespan_reporting::diagnostic::Severity::Warning;
+                d
+            })
+            .collect();
+        eprint!("{}", src.render(&diags));
+    }
     let module = &loaded.module;
     if module.functions.is_empty() {
         // An empty or comment-only file is bad input, not a module to describe (issue 10).

@@ -324,7 +324,6 @@ fn check_witness(what: &str, f: &Function, dom: &Domain, x: &Enclosed, formats: 
     compared
 }
 
-
 /// Every corpus function that encloses over the generous domain, binary32, at 2 points (a
 /// corner and a uniform draw): no execution the rounding model allows is above the bound.
 #[test]
@@ -797,7 +796,6 @@ fn check_adjoints(what: &str, f: &Function, dom: &Domain, n: usize, seed: u64) -
     compared
 }
 
-
 /// The adjoints of the UR5's RNEA (`robovec-gen`'s `invdyna`, every joint over its URDF limits,
 /// a whole turn or two) enclose its derivatives at 200 points, and the adjoint bound is what
 /// certifies its 32-bit fixed point (issue 48's "Beyond RoboPrec" goal, 10⁻⁴ N·m): the forward
@@ -979,7 +977,12 @@ fn witness_tightness() {
         let urdf = crate::common::robot_urdf(rel).unwrap_or_else(|| panic!("{rel}"));
         let (r, m) = crate::common::opt_to_ir(
             &dir,
-            &[urdf.to_str().unwrap(), "-function=invdyna", "--fold-params", "-passes=default<ops>,error-bound<format=f32>"],
+            &[
+                urdf.to_str().unwrap(),
+                "-function=invdyna",
+                "--fold-params",
+                "-passes=default<ops>,error-bound<format=f32>",
+            ],
         );
         cases.push((name.to_string(), m.functions[0].clone(), report_domain(&r)));
     }
@@ -1016,7 +1019,9 @@ fn witness_tightness() {
             v.sort_by(f64::total_cmp);
             v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
         };
-        let share = |v: &[f64], p: &dyn Fn(f64) -> bool| 100.0 * v.iter().filter(|&&r| p(r)).count() as f64 / v.len().max(1) as f64;
+        let share = |v: &[f64], p: &dyn Fn(f64) -> bool| {
+            100.0 * v.iter().filter(|&&r| p(r)).count() as f64 / v.len().max(1) as f64
+        };
         let (over, within_b_s, within_b_w) =
             (share(&ws, &|r| r > 100.0), share(&bs, &|r| r <= 100.0), share(&bw, &|r| r <= 100.0));
         println!(
@@ -1071,7 +1076,12 @@ fn the_pass_reports_witnesses_below_the_bound() {
     let urdf = crate::common::robot_urdf("ur_description/urdf/ur5_robot.urdf").expect("UR5 from example-robot-data");
     let (r, _) = crate::common::opt_to_ir(
         &dir,
-        &[urdf.to_str().unwrap(), "-function=invdyna", "--fold-params", "-passes=default<ops>,error-bound<format=f32;witness=8>"],
+        &[
+            urdf.to_str().unwrap(),
+            "-function=invdyna",
+            "--fold-params",
+            "-passes=default<ops>,error-bound<format=f32;witness=8>",
+        ],
     );
     let outs = r["error_bound"]["outputs"].as_object().unwrap();
     assert_eq!(outs.len(), 6);
@@ -1139,7 +1149,13 @@ fn the_atom_cap_scales_with_the_function() {
         let p = robovec_passes::error_bound::domain_point(&ranges, k, &mut rng);
         for (o, e) in w.errors_at(&p).unwrap().into_iter().enumerate() {
             let e = e.unwrap();
-            assert!(e <= many[o] && e <= few[o], "{}: witness {e:e} above {:e} / {:e}", f.outputs[o].name, many[o], few[o]);
+            assert!(
+                e <= many[o] && e <= few[o],
+                "{}: witness {e:e} above {:e} / {:e}",
+                f.outputs[o].name,
+                many[o],
+                few[o]
+            );
         }
     }
 }
@@ -1153,10 +1169,8 @@ fn the_atom_cap_scales_with_the_function() {
 #[test]
 fn the_inline_trig_allowance_by_hand() {
     use robovec_passes::error_bound::bound::{bound_with_adjoints, TrigImpl};
-    let m = robovec_ir::text::parse(
-        "func @f {\n  phase atomised\n  input %x\n  %y = sin %x\n  output y = %y\n}\n",
-    )
-    .unwrap();
+    let m = robovec_ir::text::parse("func @f {\n  phase atomised\n  input %x\n  %y = sin %x\n  output y = %y\n}\n")
+        .unwrap();
     let f = &m.functions[0];
     let y = f.outputs[0].value;
     let Operand::Value(y) = y else { panic!() };
@@ -1169,7 +1183,11 @@ fn the_inline_trig_allowance_by_hand() {
     let (libm, inline) = (at(0.5, 1.0, TrigImpl::Libm), at(0.5, 1.0, TrigImpl::Inline));
     let expected = 3.0 * 2f64.powi(-23) * 1f64.sin();
     assert!(inline < libm, "{inline:e} vs {libm:e}");
-    assert!(((libm - inline) - expected).abs() <= 1e-6 * expected, "difference {:e}, expected {expected:e}", libm - inline);
+    assert!(
+        ((libm - inline) - expected).abs() <= 1e-6 * expected,
+        "difference {:e}, expected {expected:e}",
+        libm - inline
+    );
     let (libm, inline) = (at(3000.0, 3001.0, TrigImpl::Libm), at(3000.0, 3001.0, TrigImpl::Inline));
     assert_eq!(libm, inline);
 }
@@ -1185,7 +1203,12 @@ fn trig_inline_on_the_command_line() {
     let run = |trig: &str| {
         let (r, _) = crate::common::opt_to_ir(
             &dir,
-            &[urdf.to_str().unwrap(), "-function=invdyna", "--fold-params", &format!("-passes=default<ops>,error-bound<format=f32{trig}>")],
+            &[
+                urdf.to_str().unwrap(),
+                "-function=invdyna",
+                "--fold-params",
+                &format!("-passes=default<ops>,error-bound<format=f32{trig}>"),
+            ],
         );
         r["error_bound"].clone()
     };
@@ -1194,7 +1217,14 @@ fn trig_inline_on_the_command_line() {
     assert_eq!(inline["trig"], "inline");
     let (a, b) = (libm["max_abs"].as_f64().unwrap(), inline["max_abs"].as_f64().unwrap());
     assert!(b < a, "trig=inline {b:e} against libm {a:e}");
-    let o = opt(&[urdf.to_str().unwrap(), "-function=invdyna", "--fold-params", "-passes=default<ops>,precision<target=mcu;trig=inline>", "-o", "/dev/null"]);
+    let o = opt(&[
+        urdf.to_str().unwrap(),
+        "-function=invdyna",
+        "--fold-params",
+        "-passes=default<ops>,precision<target=mcu;trig=inline>",
+        "-o",
+        "/dev/null",
+    ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("trig=inline") && stderr(&o).contains("target=mcu"), "{}", stderr(&o));
 }

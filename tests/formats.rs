@@ -378,7 +378,10 @@ fn c_bit_exact(dir_name: &str, batch: usize, opt_level: &str, inline_trig: bool,
         let c = f64::from_bits(*g);
         let same = *g == y.to_bits() || (y.is_nan() && c.is_nan());
         if *allowed > 0.0 && allowed.is_finite() {
-            assert!((c - y).abs() <= *allowed, "batch={batch}: {what}: C gives {c:e}, -eval {y:e}, allowed {allowed:e}");
+            assert!(
+                (c - y).abs() <= *allowed,
+                "batch={batch}: {what}: C gives {c:e}, -eval {y:e}, allowed {allowed:e}"
+            );
             checked += 1;
         } else if *allowed == 0.0 {
             assert!(same, "batch={batch}: {what}: C gives {c:e}, -eval {y:e}");
@@ -407,7 +410,10 @@ fn c_refuses_formats_with_options_that_cannot_honour_them() {
     let o = opt(&[input.to_str().unwrap(), "-passes=codegen<c>", "-o", dir.join("f.c").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let c = std::fs::read_to_string(dir.join("f.c")).unwrap();
-    assert!(c.contains("robovec_fix_from(") && c.contains("const float t = (float)((double)s * 0x1p-2) / 0x1.8p+1f;"), "{c}");
+    assert!(
+        c.contains("robovec_fix_from(") && c.contains("const float t = (float)((double)s * 0x1p-2) / 0x1.8p+1f;"),
+        "{c}"
+    );
 }
 
 /// Formats with `abi=pinocchio` (Pinocchio's `double` vectors, the formats inside): a URDF's RNEA
@@ -473,13 +479,21 @@ fn formats_with_float_arrays_equal_eval() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let mut m = parse(&std::fs::read_to_string(&ir).unwrap()).unwrap();
     let g = &mut m.functions[0];
-    assert!(g.outputs.iter().all(|o| matches!(o.value, robovec_ir::Operand::Value(v) if g.format(v) == Format::Binary32)));
+    assert!(g
+        .outputs
+        .iter()
+        .all(|o| matches!(o.value, robovec_ir::Operand::Value(v) if g.format(v) == Format::Binary32)));
     let q1 = g.inputs.iter().copied().find(|&v| g.name_of(v) == "q[1]").unwrap();
     g.set_format(q1, Format::Binary64);
     let g = g.clone();
     let mut rng = robovec_ir::rng::SplitMix64::new(7);
     for batch in [1usize, 8] {
-        let o = CodegenC { name: Some("arm".into()), batch: batch as u32, precision: robovec_backends::c::Precision::F32, ..CodegenC::default() };
+        let o = CodegenC {
+            name: Some("arm".into()),
+            batch: batch as u32,
+            precision: robovec_backends::c::Precision::F32,
+            ..CodegenC::default()
+        };
         let art = o.emit(&m).unwrap();
         let iface = &art.interfaces[0];
         assert_eq!(iface.precision, robovec_backends::c::Precision::F32);
@@ -491,10 +505,24 @@ fn formats_with_float_arrays_equal_eval() {
         let mut want = Vec::new();
         let mut points = Vec::new();
         for _ in 0..calls * batch {
-            let p: Vec<f32> = iface.inputs.iter().map(|n| {
-                let u = rng.unit() as f32;
-                if n.starts_with("qd") { 6.0 * u - 3.0 } else if n.starts_with("qdd") { 20.0 * u - 10.0 } else if n.starts_with("q[") { 3.0 * u - 1.5 } else if n == "g[3]" { -9.81 } else { 0.0 }
-            }).collect();
+            let p: Vec<f32> = iface
+                .inputs
+                .iter()
+                .map(|n| {
+                    let u = rng.unit() as f32;
+                    if n.starts_with("qd") {
+                        6.0 * u - 3.0
+                    } else if n.starts_with("qdd") {
+                        20.0 * u - 10.0
+                    } else if n.starts_with("q[") {
+                        3.0 * u - 1.5
+                    } else if n == "g[3]" {
+                        -9.81
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
             points.push(p);
         }
         for call in points.chunks(batch) {
@@ -588,7 +616,13 @@ fn inline_trig_meets_its_one_ulp_allowance_in_the_bound() {
     robovec_ir::numerics::Reference::new().eval(&tape, &at, &mut refs);
     let dir = tmp("inline-trig-allowance");
     for (batch, flags) in [(1u32, &["-O1"][..]), (8, &["-O2", "-march=native"])] {
-        let o = CodegenC { name: Some("t".into()), batch, precision: Precision::F32, trig: Trig::Inline, ..CodegenC::default() };
+        let o = CodegenC {
+            name: Some("t".into()),
+            batch,
+            precision: Precision::F32,
+            trig: Trig::Inline,
+            ..CodegenC::default()
+        };
         let art = o.emit(&m).unwrap();
         let iface = &art.interfaces[0];
         std::fs::write(dir.join("t.c"), &art.code.main).unwrap();
@@ -625,7 +659,11 @@ fn inline_trig_meets_its_one_ulp_allowance_in_the_bound() {
             for l in 0..w {
                 let c = f64::from_bits(got[i * w + l]);
                 let err = (c - r.f64).abs() - r.f64.abs() * f64::EPSILON / 2.0;
-                assert!(err <= b, "batch={batch}: {name} lane {l}: {c:e} is {err:e} from the exact {:e}, bound {b:e}", r.f64);
+                assert!(
+                    err <= b,
+                    "batch={batch}: {name} lane {l}: {c:e} is {err:e} from the exact {:e}, bound {b:e}",
+                    r.f64
+                );
                 worst = worst.max(err / b);
             }
         }

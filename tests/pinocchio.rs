@@ -310,8 +310,10 @@ fn floating_base_matches_pinocchio_composite_root_joint() {
 /// velocity in its frame as `qd[1..6]`) against `buildModelFromUrdf(path, JointModelFreeFlyer())`
 /// at random states with random unit quaternions: the three-link arm (its root link's mass now
 /// moves), UR5 and Panda set free (arms without a floating base in practice, but the same
-/// equations), Solo-12 (6 + 12 velocity coordinates) and Talos (6 + 32): `Qq` (`rnea`), `M`,
-/// `c` (`crba`, `nonLinearEffects`) and `qdd` (`aba`) within 1e-10.
+/// equations), Solo-12 (6 + 12 velocity coordinates), Talos (6 + 32) and xArm 7, whose
+/// massless root `world` holds `link_base` by a fixed joint at its origin (the base's mass was
+/// once dropped there): `Qq` (`rnea`), `M`, `c` (`crba`, `nonLinearEffects`) and `qdd` (`aba`)
+/// within 1e-10.
 #[test]
 fn free_flyer_matches_pinocchio_free_flyer_root_joint() {
     for (urdf, joints) in [
@@ -320,6 +322,7 @@ fn free_flyer_matches_pinocchio_free_flyer_root_joint() {
         ("erd:panda_description/urdf/panda.urdf", 9),
         ("erd:solo_description/robots/solo12.urdf", 12),
         ("erd:talos_data/robots/talos_reduced.urdf", 32),
+        ("erd:xarm_description/urdf/xarm7.urdf", 7),
     ] {
         let e = compare_on(urdf, joints + 6, Base::FreeFlyer);
         eprintln!("{urdf} free flyer: worst relative error {e:e}");

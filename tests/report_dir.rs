@@ -52,8 +52,13 @@ fn every_figure_is_svg_and_draws_the_reports_numbers() {
     let (one, batched) = (num(&cpu["one_state_us"]), num(&cpu["batched_us"]));
     assert!(one > 0.0 && batched > 0.0 && num(&cpu["batch"]) == 4.0, "{cpu}");
     let us = std::fs::read_to_string(dir.join("microseconds.csv")).unwrap();
-    assert!(us.contains(&format!("cpu_one_state,,{one}\n")) && us.contains(&format!("cpu_batch4,,{batched}\n")), "{us}");
-    assert!(std::fs::read_to_string(dir.join("microseconds.svg")).unwrap().contains("one state per call (this machine)"));
+    assert!(
+        us.contains(&format!("cpu_one_state,,{one}\n")) && us.contains(&format!("cpu_batch4,,{batched}\n")),
+        "{us}"
+    );
+    assert!(std::fs::read_to_string(dir.join("microseconds.svg"))
+        .unwrap()
+        .contains("one state per call (this machine)"));
     // report.json is -report's text.
     assert_eq!(std::fs::read(dir.join("report.json")).unwrap(), std::fs::read(&report).unwrap());
     let r: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();

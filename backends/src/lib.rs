@@ -211,7 +211,10 @@ mod tests {
         }
         // A parameter no back end has lists the selected back end's.
         let e = build("codegen<fpga;frobnicate=1>").unwrap_err().to_string();
-        assert_eq!(e, "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, out, format, resources, interconnect)");
+        assert_eq!(
+            e,
+            "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, out, format, resources, interconnect)"
+        );
         let e = build("codegen<frobnicate=1>").unwrap_err().to_string();
         assert_eq!(
             e,
@@ -225,7 +228,21 @@ mod tests {
         let names: Vec<&str> = info.every_param().map(|p| p.name).collect();
         assert_eq!(
             names,
-            ["back-end", "abi", "precision", "batch", "layout", "trig", "name", "chunk", "units", "out", "format", "resources", "interconnect"]
+            [
+                "back-end",
+                "abi",
+                "precision",
+                "batch",
+                "layout",
+                "trig",
+                "name",
+                "chunk",
+                "units",
+                "out",
+                "format",
+                "resources",
+                "interconnect"
+            ]
         );
         let members: Vec<(&str, Vec<&str>)> =
             super::BACK_ENDS.iter().map(|m| (m.name, m.params.iter().map(|p| p.name).collect())).collect();

@@ -233,7 +233,8 @@ mod tests {
             .expect("no deadline");
             let coords = crate::tangent::coordinates(&robot, &layout);
             let fordyna = written(&model, &layout, "fordyna", crate::fordyna::fordyna);
-            let by_diff = crate::derive(&fordyna, &crate::DERIVED[1], coords.as_deref(), &ticker).expect("no deadline");
+            let by_diff =
+                crate::derive(&fordyna, &crate::DERIVED[1], &layout, coords.as_deref(), &ticker).expect("no deadline");
             for solve in [crate::fordyna::fordyna_and_inverse as Writer, crate::fordyna::world_fordyna_and_inverse] {
                 let solved = written(&model, &layout, "aba_derivatives", solve);
                 let f = super::aba_derivatives(&partials, &solved, &ticker).expect("no deadline");

@@ -438,16 +438,30 @@ pub const GENERATED_NAMES: [&str; 6] =
 /// count of terms), its derivative outputs renamed and everything else dropped. `None` at the
 /// ticker's stop. With `coords` (a free flyer, `(cos, sin)` pairs: [`tangent::coordinates`])
 /// the rows with respect to `q` are mapped to Pinocchio's tangent space
-/// ([`tangent::to_tangent`]).
+/// ([`tangent::to_tangent`]). `layout` gives each family's length (`q`: `nq`; `qd`, `Qq`:
+/// `nv`): a coordinate `base` does not read gets its column of zeros.
 fn derive(
     base: &robovec_ir::Function,
     d: &Derived,
+    layout: &Layout,
     coords: Option<&[tangent::Coordinate]>,
     ticker: &robovec_ir::time_limit::Ticker,
 ) -> Option<robovec_ir::Function> {
     use robovec_ir::transform::{atomise, cse, diff};
     let mut f = atomise::atomise_until(base, ticker)?;
     cse::cse_within(&mut f, ticker);
+    // Every coordinate of the families differentiated is an input, read or not, so that each
+    // matrix is whole (`nv × nv` along the tangent space, as Pinocchio's): a velocity no
+    // equation reads (a joint under massless links only) still has its column, of zeros.
+    for family in d.2 {
+        let n = if *family == "q" { layout.nq } else { layout.nv };
+        for k in 1..=n {
+            let name = format!("{family}[{k}]");
+            if f.lookup(&name).is_none() {
+                f.add_input(name, robovec_ir::Span::DUMMY).expect("a free name");
+            }
+        }
+    }
     let wrt: Vec<String> = d.2.iter().map(|s| s.to_string()).collect();
     match diff::differentiate(&mut f, &wrt, None, ticker) {
         Ok(_) => {}
@@ -642,8 +656,13 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
                     let partials = match rnea_kept.clone() {
                         Some(p) => Some(p),
                         None => {
-                            let by_diff =
-                                derive(&find(&functions, &bases, FUNCTIONS[0].0), &DERIVED[0], coords, &ticker);
+                            let by_diff = derive(
+                                &find(&functions, &bases, FUNCTIONS[0].0),
+                                &DERIVED[0],
+                                &layout,
+                                coords,
+                                &ticker,
+                            );
                             let analytical = write_one(DERIVED[0].0, rnea_derivatives::rnea_derivatives)?.0;
                             fewer(by_diff, implicit::compact(&analytical, &ticker))
                         }
@@ -664,7 +683,7 @@ fn generate_in_frames(model: &Model, request: &Request) -> Result<Generated, Sto
             };
             Ok(fewer(Some(f), other))
         };
-        let written = match best(derive(&base, d, coords, &ticker)) {
+        let written = match best(derive(&base, d, &layout, coords, &ticker)) {
             Ok(w) => w,
             Err(stop) => {
                 functions.into_iter().chain(bases).for_each(abandon);

@@ -98,10 +98,11 @@ pub fn contract_fixed(robot: &Robot) -> Option<(Robot, Vec<usize>)> {
         .iter()
         .map(|&l| {
             let own = &robot.links[l];
-            let inertial = if parts[l].len() == 1 && parts[l][0].0 == Origin::IDENTITY {
-                own.inertial
-            } else {
-                combine(&parts[l])
+            // One part at the identity is taken as it is: the link's own, or that of a link
+            // fixed to it at its origin when it has none (a massless `world` above the base).
+            let inertial = match parts[l].as_slice() {
+                [(at, one)] if *at == Origin::IDENTITY => Some(*one),
+                _ => combine(&parts[l]),
             };
             Link { name: own.name.clone(), inertial, span: own.span }
         })
@@ -154,6 +155,33 @@ mod tests {
         assert_eq!(after, moving);
         assert_eq!(body_of.len(), after.len() + 1);
         assert!(contract_fixed(&c).is_none(), "nothing left to contract");
+    }
+
+    /// A massless root link with one link fixed to it at its origin (xArm's `world` above
+    /// `link_base`) takes that link's mass properties: on a free flyer the root is body 1 and
+    /// its mass counts. (It once kept the root's own, none, and dropped the base's mass.)
+    #[test]
+    fn a_massless_root_takes_the_link_fixed_at_its_origin() {
+        let mut r = build(Topology::Serial, 3, 1);
+        let base = r.root;
+        let mass = Inertial {
+            mass: 0.9,
+            com: [0.1, -0.2, 0.3],
+            inertia: [[0.3, 0.01, 0.0], [0.01, 0.4, 0.02], [0.0, 0.02, 0.5]],
+        };
+        r.links[base].inertial = Some(mass);
+        r.links.push(Link { name: "world".into(), inertial: None, span: r.links[base].span });
+        let world = r.links.len() - 1;
+        let mut fixed = r.joints[0].clone();
+        (fixed.name, fixed.kind, fixed.parent, fixed.child, fixed.origin) =
+            ("world_joint".into(), JointKind::Fixed, world, base, Origin::IDENTITY);
+        r.joints.insert(0, fixed);
+        r.root = world;
+        let r = r.with_free_flyer().expect("free names");
+        let (c, _) = contract_fixed(&r).expect("a fixed joint");
+        let kept = c.links.iter().find(|l| l.name == "world").expect("the root is kept");
+        assert_eq!(kept.inertial, Some(mass));
+        assert_eq!(c.links.len(), r.links.len() - 1);
     }
 
     /// Mass properties add up: total mass, centre of mass, and the inertia about the common

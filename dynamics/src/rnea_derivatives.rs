@@ -33,10 +33,11 @@
 //!
 //! Per pair two 6-vector pairings (one where `i` is above `j`), after a pass over the bodies.
 
+use crate::depth::composite::{origin_inertia, OriginInertia};
 use crate::depth::kinematics::{bind_v3, vdot, vscale, Frames};
 use crate::rnea::{cross, matvec, motions, vadd, Drive, Motion, M3, V3};
 use crate::robot::JointKind;
-use crate::sym::{add, mul, neg, sub, sum, Builder, Term, ZERO};
+use crate::sym::{add, mul, neg, sub, Builder, Term, ZERO};
 use rustc_hash::FxHashMap;
 
 use crate::{Layout, Model, Stopped};
@@ -245,24 +246,9 @@ impl World {
         let mut momentum: Vec<S6> = vec![zero6(); nb + 1];
         for body in (1..=nb).filter(|&x| moves[x]) {
             b.check(body, nb)?;
-            let rot = &rw[body];
-            let mass = layout.param(b, &format!("m[{body}]"));
-            let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
-            let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
-            let c = bind_v3(b, "CW", body, vadd(&o[body], &matvec(rot, &l, false)));
-            let h = bind_v3(b, "HW", body, vscale(&c, &mass));
-            // J = R In Rᵀ + m (|c|² 1 − c cᵀ) = R In Rᵀ + (c·h) 1 − c hᵀ.
-            let r_in: M3 =
-                [0, 1, 2].map(|r| [0, 1, 2].map(|k| sum((0..3).map(|m| mul(rot[r][m].clone(), inn[m][k].clone())))));
-            let ch = vdot(&c, &h);
-            let ch = b.bind(&format!("CH{body}"), ch);
-            let j: M3 = [0, 1, 2].map(|r| {
-                [0, 1, 2].map(|k| {
-                    let rot_part = sum((0..3).map(|m| mul(r_in[r][m].clone(), rot[k][m].clone())));
-                    let diag = if r == k { ch.clone() } else { ZERO };
-                    sub(add(rot_part, diag), mul(c[r].clone(), h[k].clone()))
-                })
-            });
+            let OriginInertia { mass, h, j } = origin_inertia(layout, b, &rw[body], &o[body], body, "W");
+            let [j11, j12, j13, j22, j23, j33] = j;
+            let j: M3 = [[j11.clone(), j12.clone(), j13.clone()], [j12, j22.clone(), j23.clone()], [j13, j23, j33]];
             let io = Inertia { mass, h, j }.bind(b, "IO", body);
             let v = &vel[body];
             let hk = bind6(b, "HK", body, io.apply(v));
@@ -469,9 +455,11 @@ mod tests {
         let mut b = Builder::new("invdyna", Default::default());
         crate::rnea::invdyna(&model, &layout, &mut b).expect("no deadline");
         let coords = crate::tangent::coordinates(&model.robot, &layout);
-        let by_diff = crate::derive(&b.finish(), &crate::DERIVED[0], coords.as_deref(), &Ticker::new(None, None))
-            .expect("no deadline");
+        let by_diff =
+            crate::derive(&b.finish(), &crate::DERIVED[0], &layout, coords.as_deref(), &Ticker::new(None, None))
+                .expect("no deadline");
         assert_eq!(analytical.outputs.len(), 2 * layout.nv * layout.nv);
+        assert_eq!(by_diff.outputs.len(), 2 * layout.nv * layout.nv, "diff's matrices whole");
         worst_relative(&model.robot, &analytical, &by_diff, false)
     }
 
@@ -488,8 +476,14 @@ mod tests {
                 j.continuous = false;
             }
         }
+        // The last link massless: no equation reads the last velocity, whose column of `diff`'s
+        // `dtau_dv` (zeros) was once missing.
+        let mut light_tip = build(Topology::Serial, 5, 6);
+        let tip = light_tip.joints.iter().map(|j| j.child).max().expect("joints");
+        light_tip.links[tip].inertial = None;
         let cases = [
             ("serial 7", build(Topology::Serial, 7, 1)),
+            ("serial 5, massless tip", light_tip),
             ("semi-serial 9", build(Topology::SemiSerial, 9, 1)),
             ("prismatic", prismatic),
             // Several chains off the fixed base: no moving root, the world's own coordinates.

@@ -134,6 +134,10 @@ pub struct Loaded {
     /// free flyer, its parameters as point intervals (docs/accuracy.md, "Certified ranges");
     /// each range says where it came from. Empty for a Robotran file or IR.
     pub domain_defaults: BTreeMap<String, robovec_ir::domain::Range>,
+    /// What the input holds that is read but suspect (a URDF's inertia tensor that is not
+    /// positive semi-definite, used as written), located as errors are; the driver prints them
+    /// as warnings. Empty for most inputs.
+    pub warnings: Vec<FrontError>,
 }
 
 impl From<Module> for Loaded {
@@ -144,6 +148,7 @@ impl From<Module> for Loaded {
             input_defaults: BTreeMap::new(),
             defaults_source: "",
             domain_defaults: BTreeMap::new(),
+            warnings: Vec::new(),
         }
     }
 }

@@ -208,7 +208,8 @@ pub struct FormatError {
 /// The first value in program order whose result a fixed-point format cannot hold.
 pub fn eval_values(f: &crate::Function, mut input: impl FnMut(&str) -> f64) -> Result<Vec<f64>, FormatError> {
     let mut vals = vec![f64::NAN; f.values.len()];
-    let store = |v: crate::Value, x: f64| f.format(v).store(x).map_err(|error| FormatError { value: v, result: x, error });
+    let store =
+        |v: crate::Value, x: f64| f.format(v).store(x).map_err(|error| FormatError { value: v, result: x, error });
     for &v in &f.inputs {
         vals[v.index()] = store(v, input(f.name_of(v)))?;
     }
@@ -430,7 +431,12 @@ pub fn integer_op(f: &crate::Function, v: crate::Value) -> Option<IntegerOp> {
     // Rounding multiplies by 2^-shift (shift ≤ 0) or adds half a step (shift > 0), which
     // `|K| ≤ 2^62` and a shift ≤ 62 keep below 2^63: 2^62 + 2^61.
     let bits = if shift > 0 { sum } else { sum - shift as i64 };
-    (bits <= INTEGER_BITS as i64 && (-62..=62).contains(&shift)).then_some(IntegerOp { terms, fraction, shift, bits: bits as u32 })
+    (bits <= INTEGER_BITS as i64 && (-62..=62).contains(&shift)).then_some(IntegerOp {
+        terms,
+        fraction,
+        shift,
+        bits: bits as u32,
+    })
 }
 
 /// The op `def` of a binary32 value, on operands `get` gives in binary64 (module doc): each

@@ -61,7 +61,11 @@ pub fn measure(module: &robovec_ir::Module, cx: &mut PassContext, function: &str
             one_state_us: one / 1e3,
             batched_us: batched / 1e3,
             batch: BATCH,
-            build: format!("codegen<c;trig=inline>, {} {}", crate::cpu_time::compiler(), crate::cpu_time::FLAGS.join(" ")),
+            build: format!(
+                "codegen<c;trig=inline>, {} {}",
+                crate::cpu_time::compiler(),
+                crate::cpu_time::FLAGS.join(" ")
+            ),
         }),
         Err(e) => cx.note_stop("-report-dir: CPU time of the swept function", &format!("not measured: {e}")),
     }

@@ -536,9 +536,13 @@ impl<'a> Body<'a> {
                         let (sn, cn) = (&self.names[sin.index()], &self.names[cos.index()]);
                         if all32 {
                             let arg = self.read(&Operand::Value(*a), true);
-                            let _ = writeln!(s, "  robovec_vec32 {sn}, {cn};\n  robovec_sincos_inline32({arg}, &{sn}, &{cn});");
+                            let _ = writeln!(
+                                s,
+                                "  robovec_vec32 {sn}, {cn};\n  robovec_sincos_inline32({arg}, &{sn}, &{cn});"
+                            );
                         } else if self.f.format(sin).is_default() && self.f.format(cos).is_default() {
-                            let _ = writeln!(s, "  {real_ty} {sn}, {cn};\n  robovec_sincos_inline({arg}, &{sn}, &{cn});");
+                            let _ =
+                                writeln!(s, "  {real_ty} {sn}, {cn};\n  robovec_sincos_inline({arg}, &{sn}, &{cn});");
                         } else {
                             let _ = writeln!(
                                 s,

@@ -33,6 +33,59 @@ fn symvec(j: &[Term], v: &V3) -> V3 {
     [0, 1, 2].map(|r| sum((0..3).map(|c| mul(at(r, c), v[c].clone()))))
 }
 
+/// One body's spatial inertia about the world origin, in world axes.
+pub(crate) struct OriginInertia {
+    /// Mass `m` (the parameter `m[body]`).
+    pub mass: Term,
+    /// First moment `h = m c` (`c = o + R l` the centre of mass, bound as `C{tag}{k}_{body}`),
+    /// bound as `H{tag}{k}_{body}`.
+    pub h: V3,
+    /// Second moment about the origin `J = R In Rᵀ + m (|c|² 1 − c cᵀ)`, upper triangle
+    /// `[J₁₁, J₁₂, J₁₃, J₂₂, J₂₃, J₃₃]`, not bound.
+    pub j: [Term; 6],
+}
+
+/// Body `body`'s inertia about the world origin from its pose (`rot` its rotation to the world
+/// frame, `origin` its frame's origin) and its parameters (`m[body]`, `l[k][body]`, the inertia
+/// tensor about its centre of mass in its own axes): the one formula the depth formulation's
+/// `M` and the analytical `∂τ` (`crate::rnea_derivatives`) both write, so that a function built
+/// from both shares it after `cse`. `R In` is bound row by row as `RI{r}_{body}`; the shift
+/// `m (|c|² 1 − c cᵀ)` is written per entry, `h_x c_x + h_y c_y` on the diagonal (the other two
+/// axes) and `−h_r c_c` off it: 3 ops an entry, no `|c|²`.
+pub(crate) fn origin_inertia(
+    layout: &Layout,
+    b: &mut Builder,
+    rot: &M3,
+    origin: &V3,
+    body: usize,
+    tag: &str,
+) -> OriginInertia {
+    let mass = layout.param(b, &format!("m[{body}]"));
+    let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
+    let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
+    let c = bind_v3(b, &format!("C{tag}"), body, vadd(origin, &matvec(rot, &l, false)));
+    let h = bind_v3(b, &format!("H{tag}"), body, c.clone().map(|x| mul(mass.clone(), x)));
+    // R·In, then (R·In)·Rᵀ on the upper triangle.
+    let ri: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|k| sum((0..3).map(|m| mul(rot[r][m].clone(), inn[m][k].clone())))));
+    let ri = [0, 1, 2].map(|r| bind_v3(b, &format!("RI{}", r + 1), body, ri[r].clone()));
+    let mut j: [Term; 6] = Default::default();
+    let mut e = 0;
+    for r in 0..3 {
+        for cc in r..3 {
+            let rot_part = sum((0..3).map(|k| mul(ri[r][k].clone(), rot[cc][k].clone())));
+            let shift = if r == cc {
+                let (x, y) = ((r + 1) % 3, (r + 2) % 3);
+                add(mul(h[x].clone(), c[x].clone()), mul(h[y].clone(), c[y].clone()))
+            } else {
+                neg(mul(h[r].clone(), c[cc].clone()))
+            };
+            j[e] = add(rot_part, shift);
+            e += 1;
+        }
+    }
+    OriginInertia { mass, h, j }
+}
+
 /// The upper triangle of `M` (1-based `(i, j)`, `i ≤ j`, entries folding to 0 left out), each
 /// entry bound as `M{i}_{j}`.
 ///
@@ -47,33 +100,11 @@ pub fn mass_matrix(model: &Model, layout: &Layout, b: &mut Builder, frames: &Fra
     let mut own: Vec<Inertia> = vec![zero(); nb + 1];
     for body in (1..=nb).filter(|&x| moves[x]) {
         b.check(body, nb)?;
-        let rot = &rw[body];
-        let mass = layout.param(b, &format!("m[{body}]"));
-        let l: V3 = [1, 2, 3].map(|k| layout.param(b, &format!("l[{k}][{body}]")));
-        let inn: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|c| layout.param(b, &Layout::inertia_name(r, c, body))));
-        let c = bind_v3(b, "CG", body, vadd(&o[body], &matvec(rot, &l, false)));
-        let h = bind_v3(b, "HG", body, c.clone().map(|x| mul(mass.clone(), x)));
-        // R·In, then (R·In)·Rᵀ on the upper triangle.
-        let ri: M3 =
-            [0, 1, 2].map(|r| [0, 1, 2].map(|k| sum((0..3).map(|m| mul(rot[r][m].clone(), inn[m][k].clone())))));
-        let ri = [0, 1, 2].map(|r| bind_v3(b, &format!("RI{}", r + 1), body, ri[r].clone()));
-        let mut j6: Vec<Term> = Vec::with_capacity(6);
-        for r in 0..3 {
-            for cc in r..3 {
-                let rot_part = sum((0..3).map(|k| mul(ri[r][k].clone(), rot[cc][k].clone())));
-                let shift = if r == cc {
-                    let (x, y) = ((r + 1) % 3, (r + 2) % 3);
-                    add(mul(h[x].clone(), c[x].clone()), mul(h[y].clone(), c[y].clone()))
-                } else {
-                    neg(mul(h[r].clone(), c[cc].clone()))
-                };
-                j6.push(add(rot_part, shift));
-            }
-        }
+        let OriginInertia { mass, h, j } = origin_inertia(layout, b, &rw[body], &o[body], body, "G");
         let mut all: Inertia = zero();
         all[0] = mass;
         all[1..4].clone_from_slice(&h);
-        all[4..].clone_from_slice(&j6);
+        all[4..].clone_from_slice(&j);
         for (k, x) in all.iter_mut().enumerate() {
             *x = b.bind(&format!("KB{k}_{body}"), std::mem::take(x));
         }

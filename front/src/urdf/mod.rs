@@ -25,7 +25,7 @@ mod parse;
 
 use std::path::Path;
 
-pub use parse::{parse, parse_with_limits, Limit};
+pub use parse::{parse, parse_with_limits, Limit, Parsed};
 
 use robovec_dynamics::robot::JointKind;
 
@@ -57,15 +57,7 @@ impl FrontEnd for Urdf {
     }
 
     fn load(&self, _: &Path, text: &str, opts: &FrontOptions) -> Result<Loaded, Vec<FrontError>> {
-        let (robot, limits) = parse_with_limits(text).map_err(|e| vec![e])?;
-        if !robot.joints.iter().any(|j| j.kind != JointKind::Fixed) {
-            return Err(vec![FrontError::new(
-                robot.links[robot.root].span,
-                format!("robot `{}` has no moving joint", robot.name),
-                "root link",
-            )
-            .note("expected at least one revolute, continuous or prismatic joint")]);
-        }
+        let Parsed { robot, limits, warnings } = parse_with_limits(text).map_err(|e| vec![e])?;
         let mut robot = robot;
         robot.cos_sin = opts.continuous_cos_sin;
         let robot = if opts.floating_base {
@@ -81,6 +73,15 @@ impl FrontEnd for Urdf {
         } else {
             robot
         };
+        // A single rigid body moves on a free flyer or a floating base (a quadrotor).
+        if !robot.joints.iter().any(|j| j.kind != JointKind::Fixed) {
+            return Err(vec![FrontError::new(
+                robot.links[robot.root].span,
+                format!("robot `{}` has no moving joint", robot.name),
+                "root link",
+            )
+            .note("expected at least one revolute, continuous or prismatic joint, or a moving base (--free-flyer, --floating-base)")]);
+        }
         let request = robovec_dynamics::Request {
             gravity: opts.gravity,
             fold: opts.fold_params,
@@ -117,7 +118,7 @@ impl FrontEnd for Urdf {
             true => domain::defaults(&model.robot, &limits, &g.module, &input_defaults),
             false => Default::default(),
         };
-        Ok(Loaded { module: g.module, params: g.params, input_defaults, defaults_source, domain_defaults })
+        Ok(Loaded { module: g.module, params: g.params, input_defaults, defaults_source, domain_defaults, warnings })
     }
 }
 

@@ -70,7 +70,7 @@ fn child_elem<'a, 'i>(node: roxmltree::Node<'a, 'i>, tag: &str) -> Option<roxmlt
     node.children().find(|c| c.has_tag_name(tag))
 }
 
-fn inertial(node: roxmltree::Node) -> Result<Option<Inertial>, FrontError> {
+fn inertial(node: roxmltree::Node, warnings: &mut Vec<FrontError>) -> Result<Option<Inertial>, FrontError> {
     let Some(i) = child_elem(node, "inertial") else { return Ok(None) };
     let o = origin(i)?;
     let mass_el = child_elem(i, "mass").ok_or_else(|| {
@@ -101,11 +101,15 @@ fn inertial(node: roxmltree::Node) -> Result<Option<Inertial>, FrontError> {
     let psd = [ixx, iyy, izz].iter().all(|&x| x >= -tol)
         && [d2(0, 1), d2(0, 2), d2(1, 2)].iter().all(|&x| x >= -tol * tol.max(1.0))
         && det >= -tol * tol * tol.max(1.0);
+    // Not physical, but Pinocchio's reader takes it as written, and example-robot-data's robots
+    // have such tensors (TIAGo's `ixy² > ixx·iyy`, iCub's `ixx="-5.42101e-20"`, rounding noise
+    // on massless links): used as written, with a warning.
     if !psd {
-        return Err(FrontError::new(span_of(in_el.range()), "inertia tensor is not positive definite", "this tensor")
-            .note(
-                "expected a symmetric positive (semi-)definite tensor: ixx, iyy, izz ≥ 0 and every principal minor ≥ 0",
-            ));
+        warnings.push(
+            FrontError::new(span_of(in_el.range()), "inertia tensor is not positive semi-definite", "this tensor")
+                .note("a principal minor is negative: no rigid body has this tensor")
+                .note("used as written, as Pinocchio's URDF reader does"),
+        );
     }
     // The tensor in the link frame: R I Rᵀ with the inertial origin's rotation.
     Ok(Some(Inertial { mass, com: o.xyz, inertia: rotate_tensor(&o.rot, &m) }))
@@ -208,23 +212,36 @@ fn limit(j: roxmltree::Node) -> Result<Option<Limit>, FrontError> {
 /// element other than `<robot>`, a joint without `parent`/`child` or naming an unknown link, a
 /// link that is the child of two joints, no root link or a loop, a `planar` or `floating` joint
 /// (unsupported below the root; a floating base is modelled by the generator, not by a joint),
-/// a negative mass, an inertia tensor that is not positive definite, a non-finite number, an
+/// a negative mass, a non-finite number, an
 /// axis of length 0 or whose squared length overflows or underflows.
 ///
 /// Cost: linear in the text (names are found through hash maps, issue 28: a 20,000-link
 /// star spent 2 s comparing names).
 pub fn parse(text: &str) -> Result<Robot, FrontError> {
-    parse_with_limits(text).map(|(robot, _)| robot)
+    parse_with_limits(text).map(|p| p.robot)
+}
+
+/// What [`parse_with_limits`] reads from a URDF.
+pub struct Parsed {
+    /// The tree.
+    pub robot: Robot,
+    /// The `<limit>` of each joint that has one, by joint name.
+    pub limits: FxHashMap<String, Limit>,
+    /// What is read but suspect, in file order: an inertia tensor that is not positive
+    /// semi-definite (kept as written).
+    pub warnings: Vec<FrontError>,
 }
 
 /// [`parse`], with the `<limit>` of each joint that has one, by joint name (issue 48: the
-/// defaults of the input domain). A `<limit>` is checked ([`Limit`]) whatever the joint's type.
+/// defaults of the input domain), and the warnings. A `<limit>` is checked ([`Limit`])
+/// whatever the joint's type.
 ///
 /// # Errors
 /// As [`parse`], and a `<limit>` bound that is not a finite number, a negative velocity or
 /// effort, a lower bound above the upper one.
-pub fn parse_with_limits(text: &str) -> Result<(Robot, FxHashMap<String, Limit>), FrontError> {
+pub fn parse_with_limits(text: &str) -> Result<Parsed, FrontError> {
     let mut limits = FxHashMap::default();
+    let mut warnings = Vec::new();
     let doc = roxmltree::Document::parse(text).map_err(|e| {
         let at = offset_of(text, e.pos());
         FrontError::new(Span::new(at, at), format!("malformed XML: {e}"), "here")
@@ -245,7 +262,7 @@ pub fn parse_with_limits(text: &str) -> Result<(Robot, FxHashMap<String, Limit>)
                 "second definition",
             ));
         }
-        links.push(Link { name: n.to_string(), inertial: inertial(l)?, span: span_of(l.range()) });
+        links.push(Link { name: n.to_string(), inertial: inertial(l, &mut warnings)?, span: span_of(l.range()) });
     }
     let link_index = |node: roxmltree::Node, tag: &str| -> Result<usize, FrontError> {
         let el = child_elem(node, tag).ok_or_else(|| {
@@ -362,5 +379,5 @@ pub fn parse_with_limits(text: &str) -> Result<(Robot, FxHashMap<String, Limit>)
         )
         .note("a URDF is a tree with one root link: closed loops must be cut"));
     }
-    Ok((robot, limits))
+    Ok(Parsed { robot, limits, warnings })
 }

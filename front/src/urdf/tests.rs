@@ -63,11 +63,20 @@ fn senseless_mass_and_inertia() {
     let (msg, line) = err(t);
     assert_eq!(msg, "negative mass -2");
     assert_eq!(line, 2);
-    // ixy² > ixx·iyy: indefinite.
+    // ixy² > ixx·iyy: indefinite, as TIAGo's URDF has; used as written (Pinocchio's reader takes
+    // it), with a warning at the tensor.
     let t = "<robot name=\"r\"><link name=\"a\"><inertial><mass value=\"2\"/>\n<inertia ixx=\"1\" ixy=\"3\" iyy=\"1\" izz=\"1\"/></inertial></link></robot>";
-    let (msg, line) = err(t);
-    assert_eq!(msg, "inertia tensor is not positive definite");
-    assert_eq!(line, 2);
+    let p = parse_with_limits(t).expect("used as written");
+    assert_eq!(p.robot.links[0].inertial.expect("kept").inertia[0][1], 3.0);
+    assert_eq!(p.warnings.len(), 1);
+    assert_eq!(p.warnings[0].message, "inertia tensor is not positive semi-definite");
+    assert_eq!(robovec_ir::span::line_col(t, p.warnings[0].span.start as usize).0, 2);
+    // Rounding noise on massless links' zero tensors (iCub's `ixz="2.40741e-35"`,
+    // `ixx="-5.42101e-20"`): warnings too, one per tensor.
+    let t = "<robot name=\"r\"><link name=\"a\"><inertial><mass value=\"0\"/><inertia ixx=\"0\" ixz=\"2.4e-35\" iyy=\"0\" izz=\"0\"/></inertial></link>\n\
+             <link name=\"b\"><inertial><mass value=\"0\"/><inertia ixx=\"-5.4e-20\" iyy=\"-5.4e-20\" izz=\"0\"/></inertial></link>\n\
+             <joint name=\"j\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/></joint></robot>";
+    assert_eq!(parse_with_limits(t).expect("used as written").warnings.len(), 2);
     let t = "<robot name=\"r\"><link name=\"a\"><inertial><mass value=\"2\"/></inertial></link></robot>";
     assert_eq!(err(t).0, "`<inertial>` has no `<inertia>`");
 }
@@ -156,5 +165,27 @@ fn an_axis_that_cannot_be_normalised_is_refused_at_its_xyz() {
         let r = parse(&joint("revolute", xyz)).expect(xyz);
         let a = r.joints[0].axis;
         assert!(a.iter().zip(unit).all(|(x, y)| (x - y).abs() <= 4.0 * f64::EPSILON), "{xyz}: {a:?}");
+    }
+}
+
+/// A single rigid body (a quadrotor's URDF: one link, no joint) has nothing to move on a fixed
+/// base: refused at its root link. On a free flyer or a floating base it moves, as in
+/// Pinocchio (`buildModelFromUrdf(path, JointModelFreeFlyer())`): its six velocity coordinates.
+#[test]
+fn a_single_body_moves_only_on_a_moving_base() {
+    let t = "<robot name=\"r\">\n<link name=\"a\"><inertial><mass value=\"1.5\"/><inertia ixx=\"1\" iyy=\"2\" izz=\"3\"/></inertial></link></robot>";
+    let fixed = FrontOptions::default();
+    let errs = Urdf.load(Path::new("x.urdf"), t, &fixed).err().expect("nothing moves");
+    assert_eq!(errs[0].message, "robot `r` has no moving joint");
+    assert_eq!(robovec_ir::span::line_col(t, errs[0].span.start as usize).0, 2);
+    for opts in [
+        FrontOptions { free_flyer: true, ..FrontOptions::default() },
+        FrontOptions { floating_base: true, ..FrontOptions::default() },
+    ] {
+        let loaded = Urdf.load(Path::new("x.urdf"), t, &opts).expect("a moving base");
+        crate::verify_accepted(&loaded.module).expect("verifies");
+        let invdyna = loaded.module.functions.iter().find(|f| f.name == "invdyna").expect("invdyna");
+        let torques = invdyna.outputs.iter().filter(|o| o.name.starts_with("Qq[")).count();
+        assert_eq!(torques, 6, "six velocity coordinates");
     }
 }

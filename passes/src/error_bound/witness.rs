@@ -333,7 +333,9 @@ mod tests {
         };
         let mut rng = robovec_ir::rng::SplitMix64::new(5);
         let mut cases = vec![1.0, 2.0, 3.0, 0.75, f64::MAX, f64::MIN_POSITIVE, 5e-324, 1e-310, -7.5, 2f64.next_down()];
-        cases.extend((0..2000).map(|_| f64::from_bits(rng.next_u64() & !(0x7ffu64 << 52) | (rng.below(2046) + 1) << 52)));
+        cases.extend(
+            (0..2000).map(|_| f64::from_bits(rng.next_u64() & !(0x7ffu64 << 52) | (rng.below(2046) + 1) << 52)),
+        );
         cases.extend((0..200).map(|_| f64::from_bits(rng.next_u64() >> 12)).filter(|x| *x != 0.0));
         for r in cases {
             assert_eq!(binade(r), floor_log2(r), "{r:e}");
