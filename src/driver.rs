@@ -42,7 +42,9 @@ pub fn load(input: &str) -> Result<(Module, SourceFile), Failure> {
 /// input's extension ([`robovec_front::front_end_for`]); the driver names none. A front end
 /// that builds its functions (URDF) builds only `opts.functions` and stops at `opts.deadline`.
 /// At most [`INPUT_BOUND`] bytes are read (stdin, pipes and devices under the deadline too), and
-/// the module's verification stops at the deadline as well (issue 47).
+/// the module's verification stops at the deadline as well (issue 47). The front end's
+/// warnings ([`Loaded::warnings`]: a URDF's inertia tensor that is not positive semi-definite)
+/// are printed to stderr as codespan warnings, and returned with the rest.
 ///
 /// # Errors
 /// [`Failure::Usage`] for an extension no front end claims, or a requested function a front

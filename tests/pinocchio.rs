@@ -312,7 +312,7 @@ fn floating_base_matches_pinocchio_composite_root_joint() {
 /// moves), UR5 and Panda set free (arms without a floating base in practice, but the same
 /// equations), Solo-12 (6 + 12 velocity coordinates), Talos (6 + 32) and xArm 7, whose
 /// massless root `world` holds `link_base` by a fixed joint at its origin (the base's mass was
-/// once dropped there): `Qq` (`rnea`), `M`, `c` (`crba`, `nonLinearEffects`) and `qdd` (`aba`)
+/// once dropped there), and a quadrotor's single body: `Qq` (`rnea`), `M`, `c` (`crba`, `nonLinearEffects`) and `qdd` (`aba`)
 /// within 1e-10.
 #[test]
 fn free_flyer_matches_pinocchio_free_flyer_root_joint() {
@@ -323,9 +323,24 @@ fn free_flyer_matches_pinocchio_free_flyer_root_joint() {
         ("erd:solo_description/robots/solo12.urdf", 12),
         ("erd:talos_data/robots/talos_reduced.urdf", 32),
         ("erd:xarm_description/urdf/xarm7.urdf", 7),
+        // One rigid body, no joint (a quadrotor): only the free flyer moves it.
+        ("erd:hector_description/robots/quadrotor_base.urdf", 0),
     ] {
         let e = compare_on(urdf, joints + 6, Base::FreeFlyer);
         eprintln!("{urdf} free flyer: worst relative error {e:e}");
+    }
+}
+
+/// URDFs with inertia tensors no rigid body has, which Pinocchio's reader takes as written:
+/// TIAGo's (`ixy² > ixx·iyy`) and iCub's (`ixx="-5.42101e-20"` on massless links). robovec
+/// warns and uses them as written, and matches Pinocchio (they were refused).
+#[test]
+fn unphysical_inertia_tensors_are_used_as_pinocchio_uses_them() {
+    for (urdf, dof) in
+        [("erd:tiago_description/robots/tiago_no_hand.urdf", 12), ("erd:icub_description/robots/icub_reduced.urdf", 29)]
+    {
+        let e = compare(urdf, dof);
+        eprintln!("{urdf}: worst relative error {e:e}");
     }
 }
 

@@ -126,6 +126,30 @@ fn parameter_file_feeds_specialize_and_eval() {
     }
 }
 
+/// An inertia tensor no rigid body has (`ixy² > ixx·iyy`, as in TIAGo's URDF) is a located
+/// warning on stderr, and the run goes on with the tensor as written (exit 0), as Pinocchio's
+/// reader takes it.
+#[test]
+fn an_unphysical_inertia_tensor_is_a_located_warning() {
+    let d = tmp("unphysical");
+    let f = d.join("tensor.urdf");
+    std::fs::write(
+        &f,
+        "<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"b\"><inertial><mass value=\"1\"/>\n<inertia ixx=\"1\" ixy=\"3\" iyy=\"1\" izz=\"1\"/></inertial></link>\n\
+         <joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/></joint>\n</robot>\n",
+    )
+    .unwrap();
+    let out = d.join("out.rvir");
+    let o = opt(&[f.to_str().unwrap(), "-passes=atomise", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("warning: inertia tensor is not positive semi-definite") && e.contains("tensor.urdf:4:1"),
+        "{e}"
+    );
+    assert!(std::fs::read_to_string(&out).unwrap().contains("func @invdyna"));
+}
+
 #[test]
 fn bad_urdf_is_a_located_diagnostic() {
     let d = tmp("bad");
