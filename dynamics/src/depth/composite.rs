@@ -47,9 +47,9 @@ pub(crate) struct OriginInertia {
 
 /// Body `body`'s inertia about the world origin from its pose (`rot` its rotation to the world
 /// frame, `origin` its frame's origin) and its parameters (`m[body]`, `l[k][body]`, the inertia
-/// tensor about its centre of mass in its own axes): the one formula the depth formulation's
-/// `M` and the analytical `∂τ` (`crate::rnea_derivatives`) both write, so that a function built
-/// from both shares it after `cse`. `R In` is bound row by row as `RI{r}_{body}`; the shift
+/// tensor about its centre of mass in its own axes), `tag` naming what it binds: the one
+/// formula the depth formulation's `M` and the analytical `∂τ` (`crate::rnea_derivatives`)
+/// both write. `R In` is bound row by row as `RI{tag}{r}_{body}`; the shift
 /// `m (|c|² 1 − c cᵀ)` is written per entry, `h_x c_x + h_y c_y` on the diagonal (the other two
 /// axes) and `−h_r c_c` off it: 3 ops an entry, no `|c|²`.
 pub(crate) fn origin_inertia(
@@ -67,7 +67,7 @@ pub(crate) fn origin_inertia(
     let h = bind_v3(b, &format!("H{tag}"), body, c.clone().map(|x| mul(mass.clone(), x)));
     // R·In, then (R·In)·Rᵀ on the upper triangle.
     let ri: M3 = [0, 1, 2].map(|r| [0, 1, 2].map(|k| sum((0..3).map(|m| mul(rot[r][m].clone(), inn[m][k].clone())))));
-    let ri = [0, 1, 2].map(|r| bind_v3(b, &format!("RI{}", r + 1), body, ri[r].clone()));
+    let ri = [0, 1, 2].map(|r| bind_v3(b, &format!("RI{tag}{}", r + 1), body, ri[r].clone()));
     let mut j: [Term; 6] = Default::default();
     let mut e = 0;
     for r in 0..3 {
