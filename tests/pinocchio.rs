@@ -312,7 +312,8 @@ fn floating_base_matches_pinocchio_composite_root_joint() {
 /// moves), UR5 and Panda set free (arms without a floating base in practice, but the same
 /// equations), Solo-12 (6 + 12 velocity coordinates), Talos (6 + 32) and xArm 7, whose
 /// massless root `world` holds `link_base` by a fixed joint at its origin (the base's mass was
-/// once dropped there), and a quadrotor's single body: `Qq` (`rnea`), `M`, `c` (`crba`, `nonLinearEffects`) and `qdd` (`aba`)
+/// once dropped there), SO-101, whose joint rotations are written a few µrad from half and
+/// quarter turns, and a quadrotor's single body: `Qq` (`rnea`), `M`, `c` (`crba`, `nonLinearEffects`) and `qdd` (`aba`)
 /// within 1e-10.
 #[test]
 fn free_flyer_matches_pinocchio_free_flyer_root_joint() {
@@ -323,6 +324,10 @@ fn free_flyer_matches_pinocchio_free_flyer_root_joint() {
         ("erd:solo_description/robots/solo12.urdf", 12),
         ("erd:talos_data/robots/talos_reduced.urdf", 32),
         ("erd:xarm_description/urdf/xarm7.urdf", 7),
+        // Joint rotations a few µrad from a half or a quarter turn (`rpy="3.14159 4.18253e-17
+        // -3.14159"`): the body frames of `robovec_dynamics::frames` once turned 1.6e-11 rad
+        // away from the URDF's there (q̈ off by 2.4e-9).
+        ("erd:so_arm_description/urdf/so101.urdf", 6),
         // One rigid body, no joint (a quadrotor): only the free flyer moves it.
         ("erd:hector_description/robots/quadrotor_base.urdf", 0),
     ] {

@@ -184,12 +184,17 @@ mod tests {
     }
 
     fn assert_close(what: &str, a: &BTreeMap<String, f64>, b: &BTreeMap<String, f64>, n: usize) {
+        assert_within(what, a, b, n, 1e-12);
+    }
+
+    /// Every entry of `a` within `tol` times the largest of `b` of `b`'s (`n × n` entries each).
+    fn assert_within(what: &str, a: &BTreeMap<String, f64>, b: &BTreeMap<String, f64>, n: usize, tol: f64) {
         assert_eq!(a.len(), n * n, "{what}");
         assert_eq!(b.len(), n * n, "{what}");
         let norm = b.values().fold(0.0f64, |m, x| m.max(x.abs()));
         assert!(norm > 0.1, "{what}: M is not trivially zero");
         for (k, x) in a {
-            assert!((x - b[k]).abs() <= 1e-12 * norm, "{what} {k}: {x} vs {}", b[k]);
+            assert!((x - b[k]).abs() <= tol * norm, "{what} {k}: {x} vs {}", b[k]);
         }
     }
 
@@ -230,5 +235,30 @@ mod tests {
         assert_close("dense rpy, reframed, unit", &mass_matrix(&reframed, MassMatrix::UnitAcceleration), &crba, 7);
         let slid = crate::origins::slide(&reframed).expect("reframed joints turn about z");
         assert_close("dense rpy, reframed, slid", &mass_matrix(&slid, MassMatrix::Crba), &crba, 7);
+    }
+
+    /// Constant rotations near a half or a quarter turn (written to 6 digits, SO-101's
+    /// `rpy="3.14159 4.18253e-17 -3.14159"` among them: a tilt of 2.7·10⁻⁶ from the joint axis)
+    /// in the frames of `crate::frames`: the same `M` to 1e-15 of its largest entry. Reading the
+    /// z-x-z angle `δ` from the third row put a 1.6·10⁻¹¹ rad turn between frames there (`M` off by
+    /// 2·10⁻¹²).
+    #[test]
+    fn nearly_degenerate_rotations_reframe_to_rounding() {
+        let mut r = build(Topology::Serial, 6, 5);
+        let rpys = [
+            [3.14159, 4.18253e-17, -3.14159],
+            [-1.5708, -1.5708, 0.0],
+            [-3.63608e-16, 8.74301e-16, 1.5708],
+            [4.02456e-15, 8.67362e-16, -1.5708],
+            [1.5708, 0.0486795, 3.14159],
+            [1.5708, -5.24284e-08, -1.41553e-15],
+        ];
+        for (j, rpy) in r.joints.iter_mut().zip(rpys) {
+            j.origin = crate::robot::Origin::from_xyz_rpy(j.origin.xyz, rpy);
+            j.axis = [0.0, 0.0, 1.0];
+        }
+        let crba = mass_matrix(&r, MassMatrix::Crba);
+        let reframed = crate::frames::reframe(&r).expect("dense rotations below revolute joints");
+        assert_within("nearly degenerate, reframed", &mass_matrix(&reframed, MassMatrix::Crba), &crba, 6, 1e-15);
     }
 }

@@ -108,16 +108,22 @@ fn align_z(a: &Vec3) -> Mat {
     [[x[0], y[0], a[0]], [x[1], y[1], a[1]], [x[2], y[2], a[2]]]
 }
 
-/// z-x-z Euler angles `(γ, β, δ)` of a rotation: `k = Rz(γ)·Rx(β)·Rz(δ)`.
+/// z-x-z Euler angles `(γ, β, δ)` of a rotation: `k = Rz(γ)·Rx(β)·Rz(δ)` to within a few ulps
+/// of `k`'s entries.
+///
+/// Near β = 0 or π (`sin β` small) only `γ ± δ` is well conditioned: `γ` read from `k`'s third
+/// column carries an error of about (error of `k`'s entries) / `sin β`, so `δ` is not read
+/// from the third row but from the rest `Rx(β)ᵀ·Rz(γ)ᵀ·k`, which takes up `γ`'s error
+/// (SO-101's `shoulder_pan`, `rpy="3.14159 4.18253e-17 -3.14159"`: `sin β` = 2.7·10⁻⁶, and the
+/// pitch snapped out of one entry of `k` but not out of another put a 1.6·10⁻¹¹ rad turn between
+/// the link frames when `δ` was read from the third row). When the tilt is below 10⁻¹⁵, `γ` is
+/// the whole turn about `z` and `δ` what is left of it (0 up to rounding).
 fn zxz(k: &Mat) -> (f64, f64, f64) {
     let sb = k[2][0].hypot(k[2][1]);
     let beta = sb.atan2(k[2][2]);
-    if sb < 1e-12 {
-        // β = 0 or π: only γ ± δ is defined; δ = 0.
-        (k[1][0].atan2(k[0][0]), beta, 0.0)
-    } else {
-        (k[0][2].atan2(-k[1][2]), beta, k[2][0].atan2(k[2][1]))
-    }
+    let gamma = if sb < 1e-15 { k[1][0].atan2(k[0][0]) } else { k[0][2].atan2(-k[1][2]) };
+    let rest = mat_mul(&mat_mul(&transpose(&rot_x(beta)), &transpose(&rot_z(gamma))), k);
+    (gamma, beta, rest[1][0].atan2(rest[0][0]))
 }
 
 /// The robot in the frames of the module doc: joint origins, axes (`z` for reframed links) and
