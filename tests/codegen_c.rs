@@ -880,3 +880,56 @@ fn plain_code_reads_inputs_at_first_use_and_writes_outputs_when_computed() {
         assert_eq!(code.matches(load[1]).count(), 1, "y is read once: {code}");
     }
 }
+
+/// `slp=4` ([`robovec_backends::c`]'s packs of four isomorphic ops): the three-link arm's
+/// `aba_derivatives` on the free flyer (9 × 9 matrices: two packs of four columns a row to
+/// seed), in one function, and with `contract` (vector FMAs) in parts of 300 statements (a
+/// pack's vector read in its own part, its members gathered in a later one),
+/// equal the interpreter bit for bit, under GCC generic and `-march=native` (FMA, AVX) and
+/// under Clang; the files compile under both with `-std=c99 -Wall -Wextra -pedantic -Werror`;
+/// packs are written, vector FMAs among them. `slp=4` with `batch=4` or `precision=f32` is bad
+/// usage.
+#[test]
+fn slp_packs_equal_the_interpreter_bit_for_bit() {
+    let options = robovec_front::FrontOptions {
+        fold_params: true,
+        free_flyer: true,
+        functions: Some(vec!["aba_derivatives".into()]),
+        ..Default::default()
+    };
+    let (loaded, _) = robovec::driver::load_with("examples/three_link_arm/three_link_arm.urdf", &options)
+        .unwrap_or_else(|e| panic!("{}", e.message()));
+    for (pipeline, chunk) in [("default<ops>", 0), ("atomise,cse,zero-removal,contract,schedule-cpu", 300)] {
+        let m = run_pipeline(loaded.module.clone(), pipeline);
+        let cases = vec![Case { label: format!("three_link_arm after {pipeline}"), m }];
+        {
+            let o = CodegenC { slp: 4, chunk, ..CodegenC::default() };
+            let code = o.emit(&cases[0].m).unwrap().code.main;
+            let packs = code.matches("const robovec_v4 robovec_p").count() + code.matches("robovec_fma4(&").count();
+            assert!(packs >= 40, "{pipeline}, chunk={chunk}: {packs} packs");
+            if pipeline.contains("contract") {
+                assert!(code.contains("robovec_fma4(&"), "vector FMAs");
+            }
+            let dir = tmp(&format!("slp_{}_{chunk}", pipeline.len()));
+            std::fs::write(dir.join("t.c"), &code).unwrap();
+            for compiler in ["gcc", "clang"] {
+                let out = Command::new(compiler)
+                    .current_dir(&dir)
+                    .args(["-std=c99", "-O0", "-Wall", "-Wextra", "-pedantic", "-Werror", "-c", "t.c", "-o", "t.o"])
+                    .output()
+                    .unwrap_or_else(|e| panic!("{compiler} ({e}): scripts/test.sh installs gcc and clang"));
+                assert!(out.status.success(), "{compiler}:\n{}", String::from_utf8_lossy(&out.stderr));
+            }
+            for extra in [&["-O1"][..], &["-O1", "cc=clang", "-march=native"]] {
+                let n = check_plain_with::<f64>(&dir, &cases, &o, 3, extra);
+                assert!(n >= 3 * 9 * 9, "{n} outputs compared");
+            }
+        }
+    }
+    for bad in ["slp=4;batch=4", "slp=4;precision=f32"] {
+        let o = crate::common::opt(&[PENDULUM, &format!("-passes=atomise,codegen<c;{bad}>")]);
+        let err = crate::common::stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {err}");
+        assert!(err.contains("`slp=4`") && err.contains(bad.split(';').nth(1).unwrap()), "{err}");
+    }
+}

@@ -61,6 +61,23 @@ pub(crate) fn vector_helpers(real: &str, lanes: u32, f32: bool) -> String {
     s
 }
 
+/// The vector type and helper of `slp=4` ([`super::slp`]): `robovec_v4`, four `double`s (one
+/// AVX register, two SSE2 or NEON ones), and its fused multiply-add `robovec_fma4` (one
+/// instruction where the target has FMA, C99 `fma` per lane otherwise: the same bits). No
+/// vector crosses a function boundary (the helper takes pointers): a 32-byte vector argument
+/// changes the x86-64 ABI without AVX, which GCC warns about (`-Wpsabi`).
+pub(crate) fn slp_helpers() -> String {
+    "/* slp=4: four isomorphic ops of one state as one op on robovec_v4 (GCC/Clang vector extensions);\n \
+     * every lane computes its own scalar op, so the values are the scalar code's, bit for bit. */\n\
+     typedef double robovec_v4 __attribute__((vector_size(4 * sizeof(double))));\n\
+     #if defined(__FMA__) && defined(__AVX__)\n#include <immintrin.h>\n#endif\n\
+     static inline ROBOVEC_UNUSED __attribute__((always_inline)) void robovec_fma4(robovec_v4 *r, const robovec_v4 *a, \
+     const robovec_v4 *b, const robovec_v4 *c)\n{\n\
+     #if defined(__FMA__) && defined(__AVX__)\n  *r = (robovec_v4)_mm256_fmadd_pd((__m256d)*a, (__m256d)*b, (__m256d)*c);\n\
+     #else\n  for (int lane = 0; lane < 4; lane++) (*r)[lane] = fma((*a)[lane], (*b)[lane], (*c)[lane]);\n#endif\n}\n\n"
+        .to_string()
+}
+
 /// `static inline {ty} {name}({real} x)`: `x` in every one of the `lanes` (a macro) lanes.
 fn splat_helper(name: &str, ty: &str, real: &str, lanes: &str) -> String {
     format!(
@@ -230,6 +247,11 @@ pub(crate) struct Body<'a> {
     converted: std::cell::RefCell<std::collections::HashSet<(usize, bool)>>,
     /// Some value has a numeric format ([`Function::has_formats`], read once: it scans the values).
     formats: bool,
+    /// `slp=4`, one state of doubles without formats: the packs of [`super::slp`] (empty otherwise).
+    packs: super::slp::Packs,
+    /// The packs written by this [`Body::statements_with`] call (a part): a later pack of the
+    /// same part reads them as vectors, one of a later part gathers their members.
+    written: std::cell::RefCell<std::collections::HashSet<usize>>,
 }
 
 impl<'a> Body<'a> {
@@ -246,7 +268,25 @@ impl<'a> Body<'a> {
         let block = if o.trig == Trig::Inline && o.batch == 1 { TrigBlock::of(f) } else { None };
         let unused = f.use_counts().iter().map(|&n| n == 0).collect();
         let formats = f.has_formats();
-        Body { o, f, names, native, fused, block, ticker, unused, converted: Default::default(), formats }
+        let packs = if o.slp > 0 && o.batch == 1 && !o.f32() && !formats {
+            super::slp::Packs::find(f)
+        } else {
+            super::slp::Packs::default()
+        };
+        Body {
+            o,
+            f,
+            names,
+            native,
+            fused,
+            block,
+            ticker,
+            unused,
+            converted: Default::default(),
+            formats,
+            packs,
+            written: Default::default(),
+        }
     }
 
     /// The values that have a statement, in the order they are written, and for each whether
@@ -300,7 +340,107 @@ impl<'a> Body<'a> {
                 }
             }
         }
-        (order, attached)
+        if self.packs.members.is_empty() {
+            return (order, attached);
+        }
+        // `slp`: a pack's members together where its last member was, lane 0 first, the others
+        // attached (never cut apart by a part boundary).
+        let mut last = vec![usize::MAX; self.packs.members.len()];
+        for (p, v) in order.iter().enumerate() {
+            if let Some(&(id, _)) = self.packs.of.get(&v.index()) {
+                last[id] = p;
+            }
+        }
+        let (mut packed, mut packed_attached) = (Vec::with_capacity(order.len()), Vec::with_capacity(order.len()));
+        for (p, (v, a)) in order.into_iter().zip(attached).enumerate() {
+            match self.packs.of.get(&v.index()) {
+                Some(&(id, _)) if last[id] == p => {
+                    for (l, &w) in self.packs.members[id].iter().enumerate() {
+                        packed.push(w);
+                        packed_attached.push(l > 0);
+                    }
+                }
+                Some(_) => {}
+                None => {
+                    packed.push(v);
+                    packed_attached.push(a);
+                }
+            }
+        }
+        (packed, packed_attached)
+    }
+
+    /// `slp`: the statements of pack `id` (one vector op on its operands as vectors, then its
+    /// members as scalars), written at its lane 0. An operand position whose four operands are
+    /// a pack written earlier in this part, lane for lane, reads that vector; four equal ones
+    /// are one scalar (spread over the lanes by the vector extensions), other ones are gathered
+    /// (a compound literal).
+    fn write_pack(&self, s: &mut String, id: usize) {
+        let members = &self.packs.members[id];
+        let ops: Vec<Vec<Operand>> = members.iter().map(|&m| self.f.value(m).def.operands()).collect();
+        let pack = format!("robovec_p{}", members[0].index());
+        let group = |k: usize| -> Vec<Operand> { ops.iter().map(|o| o[k]).collect() };
+        // The pack written earlier in this part whose members are `g` lane for lane.
+        let earlier = |g: &[Operand]| -> Option<String> {
+            let q = self.packs.whole(g).filter(|q| self.written.borrow().contains(q))?;
+            Some(format!("robovec_p{}", self.packs.members[q][0].index()))
+        };
+        let lanes = |g: &[Operand], negate: bool| -> String {
+            let one = |x: &Operand| match (x, negate) {
+                (Operand::Const(c), true) => self.read(&Operand::Const(-c), false),
+                (_, true) => format!("-{}", self.read(x, false)),
+                (_, false) => self.read(x, false),
+            };
+            format!("(robovec_v4){{{}}}", g.iter().map(one).collect::<Vec<_>>().join(", "))
+        };
+        match &self.f.value(members[0]).def {
+            Def::Binary(op, ..) => {
+                let op = match op {
+                    BinOp::Add => '+',
+                    BinOp::Sub => '-',
+                    BinOp::Mul => '*',
+                    BinOp::Div => '/',
+                };
+                let (a, b) = (group(0), group(1));
+                let same = |g: &[Operand]| g.iter().all(|x| *x == g[0]);
+                // A scalar with a vector is spread over the lanes (two scalars would be one value).
+                let side = |g: &[Operand], scalar_ok: bool| {
+                    earlier(g).unwrap_or_else(|| {
+                        if scalar_ok && same(g) {
+                            self.read(&g[0], false)
+                        } else {
+                            lanes(g, false)
+                        }
+                    })
+                };
+                let expr = format!("{} {op} {}", side(&a, true), side(&b, !same(&a)));
+                let _ = writeln!(s, "  const robovec_v4 {pack} = {expr};");
+            }
+            Def::Call(c, args) => {
+                let i = Intrinsic::of(c, args.len()).expect("packs hold binary ops and fused intrinsics");
+                // `fms`, `fnma`: `fma` of a negated operand, exact (robovec_ir::intrinsic).
+                let neg = |k: usize| matches!((i, k), (Intrinsic::Fms, 2) | (Intrinsic::Fnma, 0));
+                let mut args = Vec::with_capacity(3);
+                for k in 0..3 {
+                    let g = group(k);
+                    let arg = match earlier(&g) {
+                        Some(name) if neg(k) => {
+                            let _ = writeln!(s, "  const robovec_v4 {pack}_n{k} = -{name};");
+                            format!("&{pack}_n{k}")
+                        }
+                        Some(name) => format!("&{name}"),
+                        None => format!("&{}", lanes(&g, neg(k))),
+                    };
+                    args.push(arg);
+                }
+                let _ = writeln!(s, "  robovec_v4 {pack};\n  robovec_fma4(&{pack}, {});", args.join(", "));
+            }
+            _ => unreachable!("packs hold binary ops and fused intrinsics"),
+        }
+        for (l, &m) in members.iter().enumerate() {
+            let _ = writeln!(s, "  ROBOVEC_UNUSED const double {} = {pack}[{l}];", self.names[m.index()]);
+        }
+        self.written.borrow_mut().insert(id);
     }
 
     /// An operand as a C expression (a constant exact in the precision: [`literal::operand`]),
@@ -487,13 +627,33 @@ impl<'a> Body<'a> {
         // Members of the trig block whose `after` waits for the block's statement.
         let mut waiting: Vec<Value> = Vec::new();
         self.converted.borrow_mut().clear();
+        self.written.borrow_mut().clear();
+        // `slp`: members of the pack just written, which follow its lane 0 in `order`.
+        let mut skip = 0;
         for &v in order {
+            if skip > 0 {
+                skip -= 1;
+                continue;
+            }
             if self.ticker.tick() {
                 return;
             }
             let name = &self.names[v.index()];
             let def = &self.f.value(v).def;
             before(s, v);
+            if let Some(&(id, 0)) = self.packs.of.get(&v.index()) {
+                let members = self.packs.members[id];
+                for &w in &members[1..] {
+                    before(s, w);
+                }
+                self.write_pack(s, id);
+                for &w in &members {
+                    self.mark_unused(s, w);
+                    after(s, w);
+                }
+                skip = members.len() - 1;
+                continue;
+            }
             // Not for callbacks (lane by lane) nor robovec's sin/cos (their own reads).
             // Nor integer ops: they read the fixed-point integers as they are.
             let integer = self.integer_op(v);

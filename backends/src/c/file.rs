@@ -208,11 +208,12 @@ impl CodegenC {
 
     fn options_text(&self) -> String {
         format!(
-            "codegen<c;abi={};precision={};batch={};trig={}>",
+            "codegen<c;abi={};precision={};batch={};trig={}{}>",
             self.abi.as_str(),
             self.precision.as_str(),
             self.batch,
-            self.trig.as_str()
+            self.trig.as_str(),
+            if self.slp > 0 { format!(";slp={}", self.slp) } else { String::new() }
         )
     }
 
@@ -251,7 +252,7 @@ impl CodegenC {
                 self.chunk, self.chunk
             );
         }
-        if self.batch > 1 || self.trig == Trig::Inline {
+        if self.batch > 1 || self.trig == Trig::Inline || self.slp > 0 {
             // The helpers below are `ROBOVEC_UNUSED`: a function uses some of them only.
             s += UNUSED_HELPERS;
         }
@@ -264,6 +265,9 @@ impl CodegenC {
             helpers += &body::format_vector_helpers(self.batch);
         } else if self.batch > 1 {
             helpers += &body::vector_helpers(self.real(), self.batch, self.f32());
+        }
+        if self.slp > 0 {
+            helpers += &body::slp_helpers();
         }
         if self.trig == Trig::Inline && formats && self.batch > 1 {
             helpers += &trig::helpers_halves();
@@ -406,12 +410,12 @@ fn shared_helpers(helpers: &str) -> String {
     // 32 bits: a preprocessor number in every dialect (`#if` computes in `intmax_t`).
     let h = content_hash([helpers]) & 0xFFFF_FFFF;
     format!(
-        "/* The helpers below are shared by the files robovec writes with the same batch=, precision= and trig=:\n \
+        "/* The helpers below are shared by the files robovec writes with the same batch=, precision=, trig= and slp=:\n \
          * a translation unit that #includes several holds them once. */\n\
          #if !defined(ROBOVEC_HELPERS)\n#define ROBOVEC_HELPERS 0x{h:08X}\n{helpers}\
          #elif ROBOVEC_HELPERS != 0x{h:08X}\n\
-         #error \"robovec: generated C files #included into one translation unit must share batch=, precision= and \
-         trig= (their helpers differ): compile them separately\"\n#endif\n\n"
+         #error \"robovec: generated C files #included into one translation unit must share batch=, precision=, \
+         trig= and slp= (their helpers differ): compile them separately\"\n#endif\n\n"
     )
 }
 

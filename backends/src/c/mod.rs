@@ -26,6 +26,7 @@ mod body;
 mod callbacks;
 mod file;
 mod native;
+mod slp;
 pub use callbacks::split_callee;
 pub mod pinocchio;
 pub mod plain;
@@ -49,7 +50,7 @@ use robovec_passes::{Member, ParamInfo, Params, Pass, PassContext, PassError};
 pub const BACK_END: Member = Member {
     name: "c",
     doc: "C (SPEC §8); `-o FILE` gets the code and FILE.h its prototypes",
-    params: &[ABI, PRECISION, BATCH, LAYOUT, TRIG, NAME, CHUNK, UNITS],
+    params: &[ABI, PRECISION, BATCH, LAYOUT, TRIG, NAME, CHUNK, UNITS, SLP],
     build: |p| Ok(Box::new(CodegenC::from_params(p)?)),
     props: robovec_passes::Props {
         requires: Some(robovec_ir::Phase::Atomised),
@@ -79,6 +80,14 @@ pub const BATCH: ParamInfo = ParamInfo {
     name: "batch",
     kind: ParamKind::U32Set { default: 1, allowed: &[1, 2, 4, 8, 16] },
     doc: "C: states per call, lanes (`in[i*W + lane]`; every array likewise with `abi=pinocchio`); not with `abi=robotran`",
+};
+/// `slp=0|4`.
+pub const SLP: ParamInfo = ParamInfo {
+    name: "slp",
+    kind: ParamKind::U32Set { default: 0, allowed: &[0, 4] },
+    doc: "C: one state's isomorphic ops four at a time as one vector op (`4`; packs seeded by four consecutive \
+          columns of an output matrix, bit for bit the scalar code's values), or none (`0`); `batch=1` and \
+          `precision=f64` only",
 };
 /// `layout=lanes|rows`.
 pub const LAYOUT: ParamInfo = ParamInfo {
@@ -196,6 +205,8 @@ pub struct CodegenC {
     pub chunk: u32,
     /// Translation units (`units=`; 1: one file).
     pub units: u32,
+    /// Lanes of the packs of one state's isomorphic ops (`slp=`: 0, none, or 4; [`slp`]).
+    pub slp: u32,
 }
 
 impl Default for CodegenC {
@@ -209,6 +220,7 @@ impl Default for CodegenC {
             name: None,
             chunk: DEFAULT_CHUNK,
             units: 1,
+            slp: 0,
         }
     }
 }
@@ -249,7 +261,15 @@ impl CodegenC {
             name: p.names("name")?.map(|n| n.join(",")),
             chunk: p.u32("chunk")?,
             units: p.u32("units")?,
+            slp: p.u32("slp")?,
         };
+        if o.slp > 0 && (o.batch > 1 || o.f32()) {
+            let clash = if o.batch > 1 { format!("batch={}", o.batch) } else { "precision=f32".into() };
+            return Err(bad(format!(
+                "`slp={}` packs the ops of one state of doubles into vectors; it cannot go with `{clash}`",
+                o.slp
+            )));
+        }
         if o.units > 1 && o.chunk == 0 {
             return Err(bad(format!(
                 "`units={}` spreads the parts of split functions over files; `chunk=0` makes no parts",
