@@ -42,8 +42,8 @@
 //!    robovec's C (`cc -O3 -march=native -ffp-contract=off`) and the table of inputs and maps
 //!    `table.c`;
 //! 5. runs it `runs` times (default 5, `reps` default 101): each rep times every contestant of a
-//!    function once, alternating, the order rotated each rep, ~0.3 ms per sample cycling over the
-//!    64 states; the ratios are built from **paired** samples against two baselines (the
+//!    function once, alternating, the order rotated each rep, ~0.3 ms per sample (`--sample-ms=`)
+//!    cycling over the 64 states; the ratios are built from **paired** samples against two baselines (the
 //!    baseline's ns over the contestant's in the same rep): Pinocchio's run-time algorithm (for
 //!    `crba` and `aba` the faster of the LOCAL and WORLD conventions in that run) and CG (the
 //!    faster of its two builds in that run), median per run, then median over the runs;
@@ -88,10 +88,12 @@ const NSETS: usize = 64;
 /// trig=inline` without it shows what the fusion gives. `zero-removal` before it (exact: it
 /// only moves signs) turns `0 − a·b` into a product with a negated constant where it can,
 /// instead of a fused `0 − a·b` (serial30's `M` −27 ops, TIAGo Pro's −52: 2.5 % and 3.5 %
-/// faster at `batch=8` on a Zen 3).
-const VARIANTS: [(&str, &str, u32, &str); 6] = [
+/// faster at `batch=8` on a Zen 3). `slp=4`: the one-state code with four isomorphic ops as one
+/// vector op (`codegen<c;slp=4>`, packs seeded by four columns of a derivative matrix).
+const VARIANTS: [(&str, &str, u32, &str); 7] = [
     ("1 state, trig=libm", "atomise,cse", 1, "libm"),
     ("1 state, trig=inline, fma", "atomise,cse,zero-removal,contract,schedule-cpu", 1, "inline"),
+    ("1 state, trig=inline, fma, slp=4", "atomise,cse,zero-removal,contract,schedule-cpu", 1, "inline;slp=4"),
     ("batch=4, trig=inline, fma", "atomise,cse,zero-removal,contract,schedule-cpu", 4, "inline"),
     ("batch=8, trig=inline", "atomise,cse,zero-removal,schedule-cpu", 8, "inline"),
     ("batch=8, trig=inline, fma", "atomise,cse,zero-removal,contract,schedule-cpu", 8, "inline"),
@@ -287,7 +289,7 @@ fn bench_robot(
     robot: &Robot,
     base: Base,
     groups: &[usize],
-    (reps, runs): (u32, u32),
+    (reps, runs, sample_ms): (u32, u32, f64),
     compile_times: bool,
 ) -> (usize, Vec<Figures>, BTreeMap<usize, CompileTimes>) {
     let work = env.work.join(robot.name);
@@ -450,7 +452,8 @@ fn bench_robot(
             .arg(work.join("model.txt"))
             .arg(work.join("states.txt"))
             .arg(&values)
-            .arg(reps.to_string()));
+            .arg(reps.to_string())
+            .arg(format!("{}", sample_ms * 1e6)));
         let mut times: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
         for line in out.lines() {
             let f: Vec<&str> = line.split('\t').collect();
@@ -585,6 +588,7 @@ fn summary_row(robot: &str, nv: usize, g: usize, baseline: Baseline, figs: &[Fig
 fn main() {
     let mut wanted = Vec::new();
     let (mut reps, mut runs) = (101, 5);
+    let mut sample_ms = 0.3;
     let mut base = Base::FreeFlyer;
     let mut groups = parse_functions("all");
     let mut compile_times = true;
@@ -603,6 +607,8 @@ fn main() {
             reps = r.parse().expect("--reps=N");
         } else if let Some(r) = a.strip_prefix("--runs=") {
             runs = r.parse().expect("--runs=N");
+        } else if let Some(r) = a.strip_prefix("--sample-ms=") {
+            sample_ms = r.parse().expect("--sample-ms=MS");
         } else if a.starts_with('-') {
             // cargo bench passes `--bench`.
         } else {
@@ -617,8 +623,8 @@ fn main() {
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     let (cpu, mhz) = side::clock();
     let mut summary = format!(
-        "{cpu} at {mhz} MHz (cycles = ns × that clock); load average before: {}; {runs} runs × {reps} reps, medians; \
-         floating base: {}; (×) = the row's baseline's ns ÷ robovec's, paired per rep\n\n",
+        "{cpu} at {mhz} MHz (cycles = ns × that clock); load average before: {}; {runs} runs × {reps} reps of \
+         {sample_ms} ms samples, medians; floating base: {}; (×) = the row's baseline's ns ÷ robovec's, paired per rep\n\n",
         load.trim(),
         match base {
             Base::Composite => "composite (PX PY PZ RX RY RZ)",
@@ -643,7 +649,7 @@ fn main() {
         "| robot | dof | function | contestant | ns/state median over {runs} runs (min–max) | Pinocchio ÷ this (paired) | CG ÷ this (paired) | bits of error mean / max | worst relative error |\n|---|---:|---|---|---:|---:|---:|---|---:|\n"
     );
     for robot in ROBOTS.iter().filter(|r| wanted.is_empty() || wanted.iter().any(|w| w == r.name)) {
-        let (nv, figs, compile) = bench_robot(&env, robot, base, &groups, (reps, runs), compile_times);
+        let (nv, figs, compile) = bench_robot(&env, robot, base, &groups, (reps, runs, sample_ms), compile_times);
         for (g, (cg, rv)) in compile {
             let _ = writeln!(
                 compile_table,
