@@ -205,7 +205,7 @@ pub struct CodegenC {
     pub chunk: u32,
     /// Translation units (`units=`; 1: one file).
     pub units: u32,
-    /// Lanes of the packs of one state's isomorphic ops (`slp=`: 0, none, or 4; [`slp`]).
+    /// Lanes of the packs of one state's isomorphic ops (`slp=`: 0, none, or 4; `backends/src/c/slp.rs`).
     pub slp: u32,
 }
 
