@@ -861,5 +861,5 @@ fn two_models_c_files_include_into_one_translation_unit() {
     let o = Command::new("cc").current_dir(&dir).args(["-c", "one.c", "-o", "one.o"]).output().unwrap();
     assert!(!o.status.success());
     let e = String::from_utf8_lossy(&o.stderr);
-    assert!(e.contains("must share batch=, precision= and trig="), "{e}");
+    assert!(e.contains("must share batch=, precision=, trig= and slp="), "{e}");
 }
