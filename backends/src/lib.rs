@@ -218,7 +218,7 @@ mod tests {
         let e = build("codegen<frobnicate=1>").unwrap_err().to_string();
         assert_eq!(
             e,
-            "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, abi, precision, batch, layout, trig, name, chunk, units)"
+            "pass `codegen`: unknown parameter `frobnicate` (valid: back-end, abi, precision, batch, layout, trig, name, chunk, units, slp)"
         );
     }
 
@@ -238,6 +238,7 @@ mod tests {
                 "name",
                 "chunk",
                 "units",
+                "slp",
                 "out",
                 "format",
                 "resources",
@@ -249,7 +250,7 @@ mod tests {
         assert_eq!(
             members,
             [
-                ("c", vec!["abi", "precision", "batch", "layout", "trig", "name", "chunk", "units"]),
+                ("c", vec!["abi", "precision", "batch", "layout", "trig", "name", "chunk", "units", "slp"]),
                 ("fpga", vec!["out", "format", "resources", "interconnect"])
             ]
         );
