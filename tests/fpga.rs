@@ -1117,6 +1117,20 @@ fn ecp5_path() -> String {
     format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default())
 }
 
+/// The ECP5 design in `dir` (its PE memories banks with a live-value table) simulated in Icarus
+/// at `point` computes the `-eval` JSON `stdout` of the same run, bit for bit.
+fn ecp5_design_equals_eval(dir: &Path, point: &Path, stdout: &[u8]) {
+    let eval: serde_json::Value = serde_json::from_slice(stdout).expect("eval JSON");
+    let top = std::fs::read_to_string(dir.join("hdl/robovec_top.v")).unwrap();
+    assert!(top.contains(".LVT(1)"), "ECP5 PE memories are banks with a live-value table");
+    let sim = simulate(dir, point);
+    let want = eval["outputs"].as_object().unwrap();
+    assert_eq!(want.len(), sim["outputs"].as_object().unwrap().len());
+    for (k, v) in want {
+        assert_eq!(v.as_f64().unwrap().to_bits(), sim["outputs"][k].as_f64().unwrap().to_bits(), "output {k}");
+    }
+}
+
 /// Issue 49 item 4, without place and route: the `-target=ecp5-85f` design (its PE memories as
 /// banks with a live-value table, the ECP5's) computes `-eval`'s values bit for bit in Icarus,
 /// and on another target `resources=pnr` is refused. Place and route itself is
@@ -1142,15 +1156,7 @@ fn ecp5_design_computes_eval_bit_for_bit() {
         &format!("-eval={}", point.display()),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let eval: serde_json::Value = serde_json::from_slice(&o.stdout).expect("eval JSON");
-    let top = std::fs::read_to_string(dir.join("hdl/robovec_top.v")).unwrap();
-    assert!(top.contains(".LVT(1)"), "ECP5 PE memories are banks with a live-value table");
-    let sim = simulate(&dir, &point);
-    let want = eval["outputs"].as_object().unwrap();
-    assert_eq!(want.len(), sim["outputs"].as_object().unwrap().len());
-    for (k, v) in want {
-        assert_eq!(v.as_f64().unwrap().to_bits(), sim["outputs"][k].as_f64().unwrap().to_bits(), "output {k}");
-    }
+    ecp5_design_equals_eval(&dir, &point, &o.stdout);
     // On the DE10-Nano (no open flow): a diagnostic, nothing written.
     let other = d.join("de10");
     let o = opt(&[
@@ -1228,15 +1234,7 @@ fn ecp5_place_and_route_measures_fmax_and_resources_and_packs_a_bitstream() {
     assert!(bit.windows(4).any(|w| w == [0x41, 0x11, 0x30, 0x43]), "no LFE5U-85F IDCODE");
     assert!(dir.join("pnr/pnr.log").exists() && dir.join("pnr/nextpnr_report.json").exists());
     // The design placed is the one Icarus runs: bit for bit the formatted evaluation.
-    let eval: serde_json::Value = serde_json::from_slice(&o.stdout).expect("eval JSON");
-    let top = std::fs::read_to_string(dir.join("hdl/robovec_top.v")).unwrap();
-    assert!(top.contains(".LVT(1)"), "ECP5 PE memories are banks with a live-value table");
-    let sim = simulate(&dir, &point);
-    let want = eval["outputs"].as_object().unwrap();
-    assert_eq!(want.len(), sim["outputs"].as_object().unwrap().len());
-    for (k, v) in want {
-        assert_eq!(v.as_f64().unwrap().to_bits(), sim["outputs"][k].as_f64().unwrap().to_bits(), "output {k}");
-    }
+    ecp5_design_equals_eval(&dir, &point, &o.stdout);
 }
 
 /// `sweep` places a fixed-point function with the fixed-point PEs' latencies and costs them with

@@ -78,6 +78,12 @@ pub(crate) fn slp_helpers() -> String {
         .to_string()
 }
 
+/// True when operand `k` of fused intrinsic `i` is written negated into C's `fma`: `fms` and
+/// `fnma` are `fma` of a negated operand, exactly (robovec_ir::intrinsic).
+fn fma_negates(i: Intrinsic, k: usize) -> bool {
+    matches!((i, k), (Intrinsic::Fms, 2) | (Intrinsic::Fnma, 0))
+}
+
 /// `static inline {ty} {name}({real} x)`: `x` in every one of the `lanes` (a macro) lanes.
 fn splat_helper(name: &str, ty: &str, real: &str, lanes: &str) -> String {
     format!(
@@ -377,9 +383,8 @@ impl<'a> Body<'a> {
     /// (a compound literal).
     fn write_pack(&self, s: &mut String, id: usize) {
         let members = &self.packs.members[id];
-        let ops: Vec<Vec<Operand>> = members.iter().map(|&m| self.f.value(m).def.operands()).collect();
         let pack = format!("robovec_p{}", members[0].index());
-        let group = |k: usize| -> Vec<Operand> { ops.iter().map(|o| o[k]).collect() };
+        let group = |k: usize| super::slp::operand_group(self.f, members, k);
         // The pack written earlier in this part whose members are `g` lane for lane.
         let earlier = |g: &[Operand]| -> Option<String> {
             let q = self.packs.whole(g).filter(|q| self.written.borrow().contains(q))?;
@@ -418,8 +423,7 @@ impl<'a> Body<'a> {
             }
             Def::Call(c, args) => {
                 let i = Intrinsic::of(c, args.len()).expect("packs hold binary ops and fused intrinsics");
-                // `fms`, `fnma`: `fma` of a negated operand, exact (robovec_ir::intrinsic).
-                let neg = |k: usize| matches!((i, k), (Intrinsic::Fms, 2) | (Intrinsic::Fnma, 0));
+                let neg = |k: usize| fma_negates(i, k);
                 let mut args = Vec::with_capacity(3);
                 for k in 0..3 {
                     let g = group(k);
@@ -763,8 +767,7 @@ impl<'a> Body<'a> {
                 }
                 Def::Call(c, args) if is_intrinsic(c, args.len()) => {
                     let i = Intrinsic::of(c, args.len()).expect("checked");
-                    // `fms`, `fnma`: `fma` of a negated operand, exact (robovec_ir::intrinsic).
-                    let neg = |k: usize| matches!((i, k), (Intrinsic::Fms, 2) | (Intrinsic::Fnma, 0));
+                    let neg = |k: usize| fma_negates(i, k);
                     let list: Vec<String> = args
                         .iter()
                         .enumerate()

@@ -28,8 +28,9 @@
 //! code computes bit for bit what the one-state code computes (the fused ops through one vector
 //! FMA instruction where the target has one, C99 `fma` per lane otherwise).
 //!
-//! Cost: O(values + operands) to seed and build (each value is claimed once), and each round of
-//! dissolution O(members + their readers).
+//! Cost: O(values + operands) to seed and build (each value is claimed once) and to dissolve
+//! (each pack is dissolved once; a dissolution looks again at the packs of its members'
+//! operands only).
 
 use std::collections::HashMap;
 
@@ -66,6 +67,11 @@ fn operands(f: &Function, v: Value) -> Vec<Operand> {
     f.value(v).def.operands()
 }
 
+/// Operand position `k` of four values, lane by lane.
+pub(crate) fn operand_group(f: &Function, lanes: &[Value; LANES], k: usize) -> Vec<Operand> {
+    lanes.iter().map(|&v| operands(f, v)[k]).collect()
+}
+
 /// The output name without its last index (`ddq_dq[3]` for `ddq_dq[3][7]`) and that index,
 /// when it ends in `[N]`.
 fn row_and_column(name: &str) -> Option<(&str, u64)> {
@@ -84,6 +90,7 @@ impl Packs {
             pos[v.index()] = p;
         }
         let mut claimed: Vec<Option<usize>> = vec![None; n];
+        let group = |lanes: &[Value; LANES], k: usize| operand_group(f, lanes, k);
         let mut packs: Vec<[Value; LANES]> = Vec::new();
         // A candidate: four distinct ops of one kind, none claimed.
         let fits = |lanes: &[Value; LANES], claimed: &[Option<usize>]| {
@@ -131,13 +138,12 @@ impl Packs {
                 claimed[v.index()] = Some(id);
             }
             packs.push(lanes);
-            let ops: Vec<Vec<Operand>> = lanes.iter().map(|&v| operands(f, v)).collect();
-            for k in 0..ops[0].len() {
-                let group: Vec<Operand> = ops.iter().map(|o| o[k]).collect();
-                if group.iter().all(|x| *x == group[0]) {
+            for k in 0..operands(f, lanes[0]).len() {
+                let g = group(&lanes, k);
+                if g.iter().all(|x| *x == g[0]) {
                     continue;
                 }
-                if let [Operand::Value(a), Operand::Value(b), Operand::Value(c), Operand::Value(d)] = group[..] {
+                if let [Operand::Value(a), Operand::Value(b), Operand::Value(c), Operand::Value(d)] = g[..] {
                     work.push_back([a, b, c, d]);
                 }
             }
@@ -150,11 +156,10 @@ impl Packs {
             live[q] && group.iter().enumerate().all(|(l, x)| *x == Operand::Value(packs[q][l]))
         };
         for id in (0..packs.len()).rev() {
-            let ops: Vec<Vec<Operand>> = packs[id].iter().map(|&v| operands(f, v)).collect();
-            let gathered = (0..ops[0].len())
+            let gathered = (0..operands(f, packs[id][0]).len())
                 .filter(|&k| {
-                    let group: Vec<Operand> = ops.iter().map(|o| o[k]).collect();
-                    !group.iter().all(|x| *x == group[0]) && !is_pack_operand(&group, &claimed, &live)
+                    let g = group(&packs[id], k);
+                    !g.iter().all(|x| *x == g[0]) && !is_pack_operand(&g, &claimed, &live)
                 })
                 .count();
             if gathered > 1 {
@@ -170,43 +175,43 @@ impl Packs {
                 }
             });
         }
-        // Dissolve packs read too early, until none is.
+        // Dissolve packs read too early, until none is. A worklist: a pack dissolved makes its
+        // members read their operands where they stand, so only the packs of those operands are
+        // looked at again (each pack is dissolved once: linear in members and their readers).
         let at = |id: usize| packs[id].iter().map(|v| pos[v.index()]).max().expect("four members");
-        loop {
-            let mut changed = false;
-            for id in 0..packs.len() {
-                if !live[id] {
-                    continue;
-                }
-                let here = at(id);
-                let early = packs[id].iter().enumerate().any(|(lane, m)| {
-                    readers[m.index()].iter().any(|&r| {
-                        let reader_pack = claimed[r.index()].filter(|&q| live[q]);
-                        let when = reader_pack.map_or(pos[r.index()], at);
-                        if let Some(q) = reader_pack {
-                            // Read lane for lane as a whole operand of pack q: ordered by construction.
-                            let lane_of_r = packs[q].iter().position(|x| *x == r).expect("a member");
-                            let whole = lane_of_r == lane
-                                && operands(f, r).iter().enumerate().any(|(k, x)| {
-                                    *x == Operand::Value(*m) && {
-                                        let group: Vec<Operand> = packs[q].iter().map(|&w| operands(f, w)[k]).collect();
-                                        is_pack_operand(&group, &claimed, &live)
-                                    }
-                                });
-                            if whole {
-                                return false;
-                            }
-                        }
-                        when <= here
-                    })
-                });
-                if early {
-                    live[id] = false;
-                    changed = true;
-                }
+        let mut work: Vec<usize> = (0..packs.len()).filter(|&id| live[id]).collect();
+        while let Some(id) = work.pop() {
+            if !live[id] {
+                continue;
             }
-            if !changed {
-                break;
+            let here = at(id);
+            let early = packs[id].iter().enumerate().any(|(lane, m)| {
+                readers[m.index()].iter().any(|&r| {
+                    let reader_pack = claimed[r.index()].filter(|&q| live[q]);
+                    let when = reader_pack.map_or(pos[r.index()], at);
+                    if let Some(q) = reader_pack {
+                        // Read lane for lane as a whole operand of pack q: ordered by construction.
+                        let lane_of_r = packs[q].iter().position(|x| *x == r).expect("a member");
+                        let whole = lane_of_r == lane
+                            && operands(f, r).iter().enumerate().any(|(k, x)| {
+                                *x == Operand::Value(*m) && is_pack_operand(&group(&packs[q], k), &claimed, &live)
+                            });
+                        if whole {
+                            return false;
+                        }
+                    }
+                    when <= here
+                })
+            });
+            if early {
+                live[id] = false;
+                for m in packs[id] {
+                    f.value(m).def.for_each_value(|x| {
+                        if let Some(q) = claimed[x.index()].filter(|&q| live[q]) {
+                            work.push(q);
+                        }
+                    });
+                }
             }
         }
         let mut out = Packs::default();
