@@ -151,6 +151,11 @@ struct World {
     frames: Frames,
     /// The columns, by velocity coordinate (0-based).
     columns: Vec<Column>,
+    /// Each body's columns (indices into `columns`; index = body, 0 the base).
+    of_body: Vec<Vec<usize>>,
+    /// Per column `w_j = V_λ(j) × S_j`, the change of its subtree's velocities per unit `q_j`
+    /// beyond the rigid motion (zero when `λ(j)` does not move).
+    w: Vec<S6>,
     /// Each body's velocity and acceleration (index = body, 0 the base).
     vel: Vec<S6>,
     acc: Vec<S6>,
@@ -220,8 +225,12 @@ impl World {
             of_body[c.body].push(k);
         }
         // Forward: velocities and accelerations.
+        // The bias acceleration of a body is `Σ (V_k × S_j) q̇_j = V_λ × Σ S_j q̇_j` (as `V_k × V_k
+        // = 0`), so `Σ w_j q̇_j` with `w_j = V_λ × S_j`, which the partials read too: zero on a
+        // body whose parent does not move (the free flyer's base).
         let mut vel: Vec<S6> = vec![zero6(); nb + 1];
         let mut acc: Vec<S6> = vec![zero6(); nb + 1];
+        let mut w: Vec<S6> = vec![zero6(); nv];
         acc[0] = [gravity.map(neg), zero3()];
         for body in 1..=nb {
             b.check(body, nb)?;
@@ -234,8 +243,9 @@ impl World {
             let mut a = acc[p].clone();
             for &k in &of_body[body] {
                 let c = &columns[k];
+                w[k] = bind6(b, "WJ", k + 1, mcross(&vel[p], &c.s));
                 a = add6(&a, &scale6(&c.s, &drive.qdd[c.index - 1]));
-                a = add6(&a, &scale6(&mcross(&v, &c.s), &drive.qd[c.index - 1]));
+                a = add6(&a, &scale6(&w[k], &drive.qd[c.index - 1]));
             }
             acc[body] = bind6(b, "A", body, a);
             vel[body] = v;
@@ -256,7 +266,7 @@ impl World {
             momentum[body] = hk;
             inertia[body] = io;
         }
-        Ok(World { frames, columns, vel, acc, inertia, momentum, force })
+        Ok(World { frames, columns, of_body, w, vel, acc, inertia, momentum, force })
     }
 
     /// Whether body `a` is `x` or one of its ancestors.
@@ -309,7 +319,7 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
     let drive = Drive::inputs(b, nv, true);
     let motions = motions(model, layout, b);
     let world = World::of(model, layout, b, &motions, &drive)?;
-    let World { frames, columns, vel, acc, inertia, .. } = &world;
+    let World { frames, columns, of_body, w, vel, acc, inertia, .. } = &world;
     let Frames { order, parent, moves, .. } = frames;
     let nb = order.len();
     // Per body: the rate of its inertia.
@@ -339,9 +349,8 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
     let force = world.subtree_sums(b, world.force.clone(), "FC");
     let momentum = world.subtree_sums(b, world.momentum.clone(), "HC");
     let r1 = world.r1(b, &ic);
-    // Per column: w, Ṡ, p; r2 (over its body's subtree); and the terms for its ancestors.
-    let mut w: Vec<S6> = Vec::with_capacity(nv);
-    let mut sdot: Vec<S6> = Vec::with_capacity(nv);
+    // Per column: `w + Ṡ`, p; r2 (over its body's subtree); and the terms for its ancestors.
+    let mut w_sdot: Vec<S6> = Vec::with_capacity(nv);
     let mut pj: Vec<S6> = Vec::with_capacity(nv);
     let mut r2: Vec<S6> = Vec::with_capacity(nv);
     let mut g_q: Vec<S6> = Vec::with_capacity(nv);
@@ -350,18 +359,23 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
         b.check_at(crate::Reached::Row { row: k + 1, rows: nv })?;
         let (body, s) = (c.body, &c.s);
         let p = parent[body];
-        let wk = bind6(b, "WJ", k + 1, mcross(&vel[p], s));
-        let sd = bind6(b, "SD", k + 1, mcross(&vel[body], s));
-        let pk = bind6(b, "PJ", k + 1, sub6(&mcross(&acc[p], s), &mcross(&wk, &vel[p])));
+        let wk = &w[k];
+        // `Ṡ_j = V_k × S_j`; on a body of one column `V_k = V_λ + S_j q̇_j`, so `Ṡ_j = w_j`.
+        let ws = if of_body[body].len() == 1 {
+            scale6(wk, &Term::C(2.0))
+        } else {
+            add6(wk, &mcross(&vel[body], s))
+        };
+        let ws = bind6(b, "WS", k + 1, ws);
+        let pk = bind6(b, "PJ", k + 1, sub6(&mcross(&acc[p], s), &mcross(wk, &vel[p])));
         let (icb, idb, hc) = (&ic[body], &idot[body], &momentum[body]);
         let r2k = bind6(b, "R2", k + 1, sub6(&idb.apply(s), &fcross(s, hc)));
         let bop = |x: &S6| add6(&idb.apply(x), &fcross(x, hc));
-        let gq = add6(&add6(&fcross(s, &force[body]), &icb.apply(&pk)), &bop(&wk));
-        let gv = add6(&icb.apply(&add6(&wk, &sd)), &bop(s));
+        let gq = add6(&add6(&fcross(s, &force[body]), &icb.apply(&pk)), &bop(wk));
+        let gv = add6(&icb.apply(&ws), &bop(s));
         g_q.push(bind6(b, "GQ", k + 1, gq));
         g_v.push(bind6(b, "GV", k + 1, gv));
-        w.push(wk);
-        sdot.push(sd);
+        w_sdot.push(ws);
         pj.push(pk);
         r2.push(r2k);
     }
@@ -374,7 +388,7 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
             let bj = columns[j].body;
             let entry = if world.ancestor_or_self(bj, bi) {
                 let dq = add(pair(&pj[j], &r1[i]), pair(&w[j], &r2[i]));
-                let dv = add(pair(&add6(&w[j], &sdot[j]), &r1[i]), pair(&columns[j].s, &r2[i]));
+                let dv = add(pair(&w_sdot[j], &r1[i]), pair(&columns[j].s, &r2[i]));
                 (dq, dv)
             } else if world.ancestor_or_self(bi, bj) {
                 (pair(&columns[i].s, &g_q[j]), pair(&columns[i].s, &g_v[j]))
