@@ -361,11 +361,7 @@ pub fn rnea_derivatives(model: &Model, layout: &Layout, b: &mut Builder) -> Resu
         let p = parent[body];
         let wk = &w[k];
         // `Ṡ_j = V_k × S_j`; on a body of one column `V_k = V_λ + S_j q̇_j`, so `Ṡ_j = w_j`.
-        let ws = if of_body[body].len() == 1 {
-            scale6(wk, &Term::C(2.0))
-        } else {
-            add6(wk, &mcross(&vel[body], s))
-        };
+        let ws = if of_body[body].len() == 1 { scale6(wk, &Term::C(2.0)) } else { add6(wk, &mcross(&vel[body], s)) };
         let ws = bind6(b, "WS", k + 1, ws);
         let pk = bind6(b, "PJ", k + 1, sub6(&mcross(&acc[p], s), &mcross(wk, &vel[p])));
         let (icb, idb, hc) = (&ic[body], &idot[body], &momentum[body]);
