@@ -244,12 +244,14 @@ impl CodegenC {
         if split {
             let _ = write!(
                 s,
-                "/* Functions of more than {} statements are split into parts (chunk={}): the entry point keeps\n \
+                "/* Functions of {} statements or more are split into parts of at most {} (chunk={}): the entry point keeps\n \
                  * its symbol and signature and calls its parts in order, passing the values one part computes\n \
                  * and a later one reads in an array on its own stack (nothing static: re-entrant). The parts\n \
                  * are never inlined into it, which would make one large function again. */\n\
                  #if defined(__GNUC__)\n#define ROBOVEC_NOINLINE __attribute__((noinline))\n#else\n#define ROBOVEC_NOINLINE\n#endif\n\n",
-                self.chunk, self.chunk
+                2 * u64::from(self.chunk),
+                self.chunk,
+                self.chunk
             );
         }
         if self.batch > 1 || self.trig == Trig::Inline || self.slp > 0 {

@@ -119,9 +119,9 @@ pub const DEFAULT_CHUNK: u32 = 4000;
 pub const CHUNK: ParamInfo = ParamInfo {
     name: "chunk",
     kind: ParamKind::U32 { default: DEFAULT_CHUNK, min: 0, max: u32::MAX },
-    doc: "C: a function of more statements (ops) is written as a chain of parts of at most about this many, \
-          which its entry point calls with its live values in an array on its stack (same symbol and signature; \
-          GCC's time and memory per function grow faster than its size); `0`: one function",
+    doc: "C: a function of at least twice this many statements (ops) is written as a chain of parts of at most \
+          about this many, which its entry point calls with its live values in an array on its stack (same symbol \
+          and signature; GCC's time and memory per function grow faster than its size); `0`: one function",
 };
 
 /// `units=K`.

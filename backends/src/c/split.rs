@@ -1,5 +1,6 @@
-//! `chunk=OPS`: a large function written as a chain of *parts*, functions of at most `OPS`
-//! statements each, that its entry point calls in order (issue 28, item 5).
+//! `chunk=OPS`: a large function (at least `2·OPS` statements) written as a chain of *parts*,
+//! functions of at most `OPS` statements each, that its entry point calls in order (issue 28,
+//! item 5).
 //!
 //! **Why.** GCC's time and memory per function grow faster than its size (register
 //! allocation, scheduling and the SSA passes work on the whole function): one 147k-statement
@@ -37,6 +38,26 @@
 //! well inside the goal; Jeep's `atomise`-only code is about 9 % slower split (the run-time
 //! price of the live values; `chunk=0` writes one function as before).
 //!
+//! **A function of fewer than `2·OPS` statements stays whole** (2026-11-29; before, every
+//! function of more than `OPS` was cut). Cutting such a function in two saves no compile time
+//! that could be measured and can cost a sixth of its run time. The derivative functions of
+//! the robots (`rnea_derivatives`, `aba_derivatives`, docs/derivatives.md) compute their
+//! per-body and per-column vectors first and pair them last, so 450 to 635 values are live at
+//! any cut between a fifth and four fifths of Solo-12's `rnea_derivatives` (6,164 statements
+//! after the bench's `atomise,cse,zero-removal,contract,schedule-cpu`). Measured on this
+//! machine, whole against two parts (paired medians of 41 alternating samples, `-O3
+//! -march=native -ffp-contract=off`, > 1: whole is faster): Solo-12 `rnea_derivatives`
+//! 1.03–1.05× one state and 1.14–1.15× at `batch=4`; Panda's 1.03–1.05× and 1.13–1.16×;
+//! Panda's `aba_derivatives` at `batch=4` 1.15–1.17×. `gcc -O2`, whole / two parts, two
+//! alternating runs each: Solo-12 `rnea_derivatives` 4.9–5.4 / 5.2–5.6 s, WALK-MAN `invdyna`
+//! (5,863 ops, `atomise,cse`) 2.3–2.5 / 2.0–2.6 s, the tricycle's `dirdyna` (5,509) 3.3–3.6 /
+//! 3.0–3.7 s. Longer functions are cut as before, into `⌈n/OPS⌉` parts of at most `OPS`: parts
+//! of up to `2·OPS` would cost compile time where GCC's time grows steeply, as on WALK-MAN ×
+//! K. There, `⌊n/OPS⌋` parts of 4.2k statements instead of ten of 3.8k took `gcc -O2` from
+//! 11.9 to 16.4 s at × 1 and 41.4 to 57.1 s at × 4 (this machine that evening, which compiled
+//! × 16 in 185 s at the default against 101 s on 2026-11-24), and `chunk=8000` (five parts of
+//! 7.5k) 16.6 s at × 1.
+//!
 //! **Live values.** A value computed in one part and read in a later one is *live* across
 //! the boundary. It goes through an array `live[]` that the entry point owns on its stack and
 //! passes to every part (`T *restrict live`; `T` is `double`, `float` or `robovec_vec`): the
@@ -55,7 +76,8 @@
 //! Parts are cut at about equal sizes (`⌈n / ⌈n/OPS⌉⌉` statements), never before an
 //! *attached* value ([`super::body::Body::order`]: the second of a fused sin/cos pair, a later
 //! element of a native callback), so a part may hold a few statements more than `OPS`. A
-//! function of at most `OPS` statements is written as one function, exactly as with `chunk=0`.
+//! function of fewer than `2·OPS` statements is written as one function, exactly as with
+//! `chunk=0`.
 
 use robovec_ir::{Function, Value};
 
@@ -80,8 +102,10 @@ pub(crate) struct Plan {
 
 impl Plan {
     /// The parts of `order` (the statements in writing order, [`super::body::Body::order`];
-    /// `attached[p]` forbids a cut before `order[p]`) with at most `chunk` statements each
-    /// (0: one part), and the slots of the values that cross a boundary. `pre`: values the
+    /// `attached[p]` forbids a cut before `order[p]`): for `n ≥ 2·chunk` statements, `⌈n /
+    /// chunk⌉` parts of about equal size (at most `chunk` each, plus what is attached to a
+    /// part's last statement), otherwise one part (also for `chunk` 0); and the slots of the
+    /// values that cross a boundary. `pre`: values the
     /// entry point stores into `live[]` before the first part (the inputs of `abi=robotran`,
     /// read before anything else); `end_uses`: values the last part reads after its statements
     /// (`abi=robotran`'s outputs, written last). O(statements + operands).
@@ -95,7 +119,9 @@ impl Plan {
     ) -> Plan {
         let n = order.len();
         let mut bounds = vec![0];
-        if chunk > 0 && n > chunk {
+        // A function of fewer than `2·chunk` statements stays whole (module doc: there, a
+        // boundary's live values cost more run time than the cut saves compile time).
+        if chunk > 0 && n >= 2 * chunk {
             let size = n.div_ceil(n.div_ceil(chunk));
             let mut p = size;
             while p < n {
