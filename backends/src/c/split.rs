@@ -333,7 +333,8 @@ mod tests {
 
     #[test]
     fn a_short_function_or_chunk_zero_is_one_part() {
-        for chunk in [0, 5, 100] {
+        // 5 statements: chunk 3 would cut them, before, into parts of 3 and 2.
+        for chunk in [0, 3, 5, 100] {
             let (_, p) = plan(CHAIN, chunk);
             assert_eq!((p.parts(), p.slots), (1, 0), "chunk={chunk}");
         }
@@ -342,9 +343,11 @@ mod tests {
     #[test]
     fn parts_have_about_equal_sizes_and_no_cut_before_an_attached_value() {
         let f = parse(CHAIN).unwrap().functions.remove(0);
-        // 5 statements, chunk 3: two parts, of ⌈5/2⌉ = 3 and 2.
+        // 5 statements, chunk 3: fewer than 2·3, one part. Chunk 2: ⌈5/2⌉ = 3 parts of
+        // ⌈5/3⌉ = 2 statements, the last one shorter.
         let none = vec![false; 5];
-        assert_eq!(Plan::new(&f, &f.body, &none, 3, &[], &[]).bounds, [0, 3, 5]);
+        assert_eq!(Plan::new(&f, &f.body, &none, 3, &[], &[]).bounds, [0, 5]);
+        assert_eq!(Plan::new(&f, &f.body, &none, 2, &[], &[]).bounds, [0, 2, 4, 5]);
         // Chunk 2 cuts at 2 and 4; with c (position 2) attached to b, the first cut moves to 3
         // and the next one (3 + 2) is the end.
         let mut att = none.clone();
