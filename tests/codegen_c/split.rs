@@ -1,6 +1,7 @@
 //! `codegen<c;chunk=OPS;units=K>` (issue 28, item 5): functions of at least `2·OPS` statements
-//! split into parts of at most `OPS` statements, the values one part computes and a later one reads passed through the
-//! entry point's `live[]` array, optionally spread over K translation units linked together.
+//! split into parts of at most `OPS` statements, the values one part computes and a later one
+//! reads passed through the entry point's `live[]` array, optionally spread over K translation
+//! units linked together.
 //!
 //! Every test compiles the split C (`cc -O0`, one at `-O1`, `-ffp-contract=off`) and compares
 //! every output with robovec's interpreter bit for bit, as the unsplit tests of

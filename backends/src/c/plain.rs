@@ -39,7 +39,7 @@ use crate::names::c_names;
 pub const RESERVED: &[&str] = &["in", "out", "live"];
 
 /// `f` as `symbol`: its definition (split into parts of at most `o.chunk` statements when it
-/// has more; part names avoid `taken`, the file's other global names), its prototype (with the
+/// has `2·o.chunk` or more, `split.rs`; part names avoid `taken`, the file's other global names), its prototype (with the
 /// documented input and output order, for the header) and its interface.
 pub(crate) fn function(
     o: &CodegenC,
@@ -123,8 +123,8 @@ pub(crate) struct Layout<'a> {
 }
 
 /// `f` as `symbol` over the arrays of `layout`: the definition of the entry point, opening with
-/// `/* {comment}. */` (split into parts of at most `o.chunk` statements when it has more; part
-/// names avoid `taken`, the file's other global names), and its parts. Element `e` of a
+/// `/* {comment}. */` (split into parts of at most `o.chunk` statements when it has `2·o.chunk`
+/// or more, `split.rs`; part names avoid `taken`, the file's other global names), and its parts. Element `e` of a
 /// parameter is `p[e]`, with `batch=W` lane `l` of it is `p[e*W + l]` (`memcpy`, no alignment
 /// assumed), with `layout=rows` `p[l*n + e]` (`n` = [`Layout::row_len`], lane by lane). Inputs
 /// are read just before their first use and outputs written right after the statement that

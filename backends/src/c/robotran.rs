@@ -124,7 +124,7 @@ fn split_base(name: &str) -> (&str, &str) {
 }
 
 /// The drop-in definition of `f` as `symbol` (split into parts of at most `o.chunk`
-/// statements when it has more; part names avoid `taken`, the file's other global names),
+/// statements when it has `2·o.chunk` or more, `split.rs`; part names avoid `taken`, the file's other global names),
 /// its prototype and its interface. A sensor gives a static function `robovec_<symbol>_<k>`;
 /// [`sensor_dispatch`] writes the switch.
 ///

@@ -105,10 +105,10 @@ impl Plan {
     /// `attached[p]` forbids a cut before `order[p]`): for `n ≥ 2·chunk` statements, `⌈n /
     /// chunk⌉` parts of about equal size (at most `chunk` each, plus what is attached to a
     /// part's last statement), otherwise one part (also for `chunk` 0); and the slots of the
-    /// values that cross a boundary. `pre`: values the
-    /// entry point stores into `live[]` before the first part (the inputs of `abi=robotran`,
-    /// read before anything else); `end_uses`: values the last part reads after its statements
-    /// (`abi=robotran`'s outputs, written last). O(statements + operands).
+    /// values that cross a boundary. `pre`: values the entry point stores into `live[]` before
+    /// the first part (the inputs of `abi=robotran`, read before anything else); `end_uses`:
+    /// values the last part reads after its statements (`abi=robotran`'s outputs, written
+    /// last). O(statements + operands).
     pub fn new(
         f: &Function,
         order: &[Value],
