@@ -61,13 +61,13 @@ done
 venv=target/pinocchio-venv
 venv_ready() {
     "$venv/bin/python" -c "import pinocchio" >/dev/null 2>&1 \
-        && "$venv/bin/pip" show -q example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen maturin pytest >/dev/null 2>&1
+        && "$venv/bin/pip" show -q example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen maturin pytest pytest-xdist >/dev/null 2>&1
 }
 install_pinocchio() {
     echo "installing pin and example-robot-data into $venv" >&2
     rm -rf "$venv"
     python3 -m venv "$venv"
-    "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen maturin pytest
+    "$venv/bin/pip" install -q pin example-robot-data cmeel-eigen cmeel-cppad cmeel-cppadcodegen maturin pytest pytest-xdist
     venv_ready || { echo "pinocchio and example-robot-data did not install into $venv" >&2; exit 1; }
 }
 
@@ -142,5 +142,6 @@ if [ $# = 0 ]; then
     mkdir -p "$stage/robovec"
     cp python/robovec/*.py "$stage/robovec/"
     cp target/debug/lib_robovec.so "$stage/robovec/_robovec.abi3.so"
-    PYTHONPATH="$PWD/$stage" "$venv/bin/python" -m pytest -q python/tests
+    # Two workers (pytest-xdist): the tests compile and run C one at a time, CI has two cores.
+    PYTHONPATH="$PWD/$stage" "$venv/bin/python" -m pytest -q -n 2 python/tests
 fi

@@ -81,6 +81,12 @@ fn corpus_placements_simulate_and_stay_near_the_lower_bound() {
                 if spec_ratio > worst_spec.0 {
                     worst_spec = (spec_ratio, name);
                 }
+                runs += 1;
+                // Naive selection, the baseline of issue 3's memory figures, at every other PE
+                // count (CI time: it places and simulates once more).
+                if !matches!(n, 1 | 4 | 16 | 64) {
+                    continue;
+                }
                 let (h, _) = placed_only(&f, n, Priority::Classical, Select::Naive);
                 verify_placement(&h, &[2]).unwrap_or_else(|e| panic!("{} @{} N={n} naive: {e}", p.display(), f.name));
                 let sum = |g: &Function, buf: bool| {
@@ -91,7 +97,6 @@ fn corpus_placements_simulate_and_stay_near_the_lower_bound() {
                 words_naive += sum(&h, false);
                 buf_pref += sum(&g, true);
                 buf_naive += sum(&h, true);
-                runs += 1;
             }
         }
     }
@@ -100,7 +105,7 @@ fn corpus_placements_simulate_and_stay_near_the_lower_bound() {
     println!("total PE memory words: preferential {words_pref}, naive {words_naive}; buffer words: preferential {buf_pref}, naive {buf_naive}");
     assert!(runs > 400);
     // Issue 3: preferential selection needs no more PE memory and buffer words than naive
-    // (measured: 306184 vs 309488 PE memory words, 2058 vs 21724 buffer words).
+    // (measured at N = 1, 4, 16, 64: 178351 vs 179779 PE memory words, 1002 vs 12953 buffer words).
     assert!(words_pref <= words_naive && buf_pref <= buf_naive, "preferential selection uses more memory than naive");
     println!("above 1.05 x tight lower bound:\n{}", above.join("\n"));
     assert!(above.is_empty(), "placements above 1.05 x tight LB:\n{}", above.join("\n"));
