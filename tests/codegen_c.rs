@@ -926,6 +926,38 @@ fn slp_packs_equal_the_interpreter_bit_for_bit() {
             }
         }
     }
+    // Mixed packs: four columns of different ops (a fused multiply-add, a product that is −0, a
+    // fused multiply-subtract, a fused negated multiply-add) as one vector FMA, the product
+    // with −0 for its addend (+0 would turn its −0 into +0), the last lane's product read
+    // through a vector of signs.
+    let mut t = String::from("func @mixed {\n  phase atomised\n  input %a0\n  input %b0\n");
+    for j in 1..=4 {
+        t += &format!("  input %x{j}\n  input %w{j}\n  input %r{j}\n");
+    }
+    t += "  %a = mul %a0, %a0\n  %b = mul %b0, %b0\n  %z = sub %x2, %x2\n  %m = sub %z, %b\n  \
+          %nz = mul %z, %m\n  %ww = mul %w2, %w2\n";
+    for (j, x, w) in [(1, "x1", "w1"), (2, "nz", "ww"), (3, "x3", "w3"), (4, "x4", "w4")] {
+        t += &format!("  %p{j} = mul %a, %{x}\n  %q{j} = mul %b, %{w}\n");
+    }
+    t += "  %y1 = call @fma(%p1, %q1, %r1)\n  %y2 = mul %p2, %q2\n  %y3 = call @fms(%p3, %q3, %r3)\n  \
+          %y4 = call @fnma(%p4, %q4, %r4)\n";
+    for j in 1..=4 {
+        t += &format!("  output y[1][{j}] = %y{j}\n");
+    }
+    t += "}\n";
+    let m = robovec_ir::text::parse(&t).unwrap_or_else(|e| panic!("{e:?}"));
+    let o = CodegenC { slp: 4, ..CodegenC::default() };
+    let code = o.emit(&m).unwrap().code.main;
+    assert!(code.contains("robovec_fma4(&"), "{code}");
+    assert!(code.contains("* (robovec_v4){1.0, 1.0, 1.0, -1.0}"), "{code}");
+    assert!(code.contains("(-0x0p+0)"), "{code}");
+    let cases = vec![Case { label: "mixed lanes".into(), m }];
+    let dir = tmp("slp_mixed");
+    for extra in [&["-O1"][..], &["-O1", "cc=clang", "-march=native"], &["-O1", "-march=native"]] {
+        for seed in 0..3 {
+            assert_eq!(check_plain_with::<f64>(&dir, &cases, &o, seed, extra), 4);
+        }
+    }
     for bad in ["slp=4;batch=4", "slp=4;precision=f32"] {
         let o = crate::common::opt(&[PENDULUM, &format!("-passes=atomise,codegen<c;{bad}>")]);
         let err = crate::common::stderr(&o);

@@ -378,68 +378,76 @@ impl<'a> Body<'a> {
 
     /// `slp`: the statements of pack `id` (one vector op on its operands as vectors, then its
     /// members as scalars), written at its lane 0. An operand position whose four operands are
-    /// a pack written earlier in this part, lane for lane, reads that vector; four equal ones
-    /// are one scalar (spread over the lanes by the vector extensions), other ones are gathered
-    /// (a compound literal).
+    /// a pack written earlier in this part, lane for lane, reads that vector (negated, or times
+    /// a vector of signs, where lanes read it negated: exact); four equal ones are one scalar
+    /// (spread over the lanes by the vector extensions), other ones are gathered (a compound
+    /// literal).
     fn write_pack(&self, s: &mut String, id: usize) {
+        use super::slp::{Arg, PackOp};
         let members = &self.packs.members[id];
+        let shape = &self.packs.shapes[id];
         let pack = format!("robovec_p{}", members[0].index());
-        let group = |k: usize| super::slp::operand_group(self.f, members, k);
         // The pack written earlier in this part whose members are `g` lane for lane.
         let earlier = |g: &[Operand]| -> Option<String> {
             let q = self.packs.whole(g).filter(|q| self.written.borrow().contains(q))?;
             Some(format!("robovec_p{}", self.packs.members[q][0].index()))
         };
-        let lanes = |g: &[Operand], negate: bool| -> String {
-            let one = |x: &Operand| match (x, negate) {
+        let lanes = |g: &[Arg]| -> String {
+            let one = |a: &Arg| match (a.x, a.neg) {
                 (Operand::Const(c), true) => self.read(&Operand::Const(-c), false),
-                (_, true) => format!("-{}", self.read(x, false)),
-                (_, false) => self.read(x, false),
+                (x, true) => format!("-{}", self.read(&x, false)),
+                (x, false) => self.read(&x, false),
             };
             format!("(robovec_v4){{{}}}", g.iter().map(one).collect::<Vec<_>>().join(", "))
         };
-        match &self.f.value(members[0]).def {
-            Def::Binary(op, ..) => {
+        match shape.op {
+            PackOp::Binary(op) => {
                 let op = match op {
                     BinOp::Add => '+',
                     BinOp::Sub => '-',
                     BinOp::Mul => '*',
                     BinOp::Div => '/',
                 };
-                let (a, b) = (group(0), group(1));
+                let (a, b) = (shape.operands(0), shape.operands(1));
                 let same = |g: &[Operand]| g.iter().all(|x| *x == g[0]);
                 // A scalar with a vector is spread over the lanes (two scalars would be one value).
-                let side = |g: &[Operand], scalar_ok: bool| {
+                let side = |k: usize, g: &[Operand], scalar_ok: bool| {
                     earlier(g).unwrap_or_else(|| {
                         if scalar_ok && same(g) {
                             self.read(&g[0], false)
                         } else {
-                            lanes(g, false)
+                            lanes(&shape.args[k])
                         }
                     })
                 };
-                let expr = format!("{} {op} {}", side(&a, true), side(&b, !same(&a)));
+                let expr = format!("{} {op} {}", side(0, &a, true), side(1, &b, !same(&a)));
                 let _ = writeln!(s, "  const robovec_v4 {pack} = {expr};");
             }
-            Def::Call(c, args) => {
-                let i = Intrinsic::of(c, args.len()).expect("packs hold binary ops and fused intrinsics");
-                let neg = |k: usize| fma_negates(i, k);
+            PackOp::Fma => {
                 let mut args = Vec::with_capacity(3);
                 for k in 0..3 {
-                    let g = group(k);
-                    let arg = match earlier(&g) {
-                        Some(name) if neg(k) => {
+                    let g = &shape.args[k];
+                    let arg = match earlier(&shape.operands(k)) {
+                        Some(name) if g.iter().all(|a| a.neg) => {
                             let _ = writeln!(s, "  const robovec_v4 {pack}_n{k} = -{name};");
                             format!("&{pack}_n{k}")
                         }
+                        Some(name) if g.iter().any(|a| a.neg) => {
+                            let signs: Vec<&str> = g.iter().map(|a| if a.neg { "-1.0" } else { "1.0" }).collect();
+                            let _ = writeln!(
+                                s,
+                                "  const robovec_v4 {pack}_n{k} = {name} * (robovec_v4){{{}}};",
+                                signs.join(", ")
+                            );
+                            format!("&{pack}_n{k}")
+                        }
                         Some(name) => format!("&{name}"),
-                        None => format!("&{}", lanes(&g, neg(k))),
+                        None => format!("&{}", lanes(g)),
                     };
                     args.push(arg);
                 }
                 let _ = writeln!(s, "  robovec_v4 {pack};\n  robovec_fma4(&{pack}, {});", args.join(", "));
             }
-            _ => unreachable!("packs hold binary ops and fused intrinsics"),
         }
         for (l, &m) in members.iter().enumerate() {
             let _ = writeln!(s, "  ROBOVEC_UNUSED const double {} = {pack}[{l}];", self.names[m.index()]);

@@ -8,15 +8,28 @@
 //! code on other inputs (the product `−M⁻¹·∂τ` of a limb's columns), so four columns can share
 //! one instruction stream.
 //!
-//! **Packs.** A *pack* is four values in lane order, all binary ops of the same operator or all
-//! the same fused multiply-add intrinsic (`@fma`, `@fms`, `@fnma`), distinct, each in at most one
-//! pack. Seeds are the outputs in their order, four at a time among those named `X[…][j]` that
-//! differ in the last index only (a row of a matrix, four consecutive columns). From a pack, each
-//! operand position gives four operands: equal ones are *broadcast* (a scalar, which the C
-//! vector extensions spread over the lanes), four ops of one kind become a pack in turn, and
-//! anything else is *gathered* lane by lane. A pack with more than one gathered operand position
-//! costs more than its four scalar ops and is dropped (children first, so a parent sees what its
-//! children became).
+//! **Packs.** A *pack* is four values in lane order, distinct, each in at most one pack, of one
+//! [`Shape`]: the same binary operator in every lane, or else each lane written as `a·b + c`
+//! with one rounding (*mixed packs*, below). Seeds are the outputs in their order, four at a
+//! time among those named `X[…][j]` that differ in the last index only (a row of a matrix, four
+//! consecutive columns). From a pack, each operand position gives four operands: equal ones
+//! are *broadcast* (a scalar, which the C vector extensions spread over the lanes), four ops
+//! that have a shape become a pack in turn, four constants are one vector constant, and
+//! anything else is *gathered* lane by lane. A pack with more than one gathered operand
+//! position costs more than its four scalar ops and is dropped (children first, so a parent
+//! sees what its children became).
+//!
+//! **Mixed packs.** `contract` fuses `a·b + c` where the columns' code allows it, and the
+//! columns of a derivative differ in which terms are structurally zero, so four columns often
+//! hold a fused op beside a product or a sum. Each lane is then one vector FMA's lane:
+//! `@fma(a, b, c)` as it is, `@fms(a, b, c)` as `a·b + (−c)`, `@fnma(a, b, c)` as `(−a)·b + c`,
+//! `x·y` as `x·y + (−0)`, `x + y` as `x·1 + y` and `x − y` as `x·1 + (−y)` (a sum or a
+//! difference either way round: the one whose addend is like the other lanes' is taken). Each
+//! is exact: `x·1` is `x`, negation is exact, and `x·y + (−0)` rounds the exact `x·y` once
+//! with the sign of a zero product kept (`+0 + −0 = +0`, `−0 + −0 = −0`; `+0` would turn a
+//! `−0` product into `+0`). A pack read with some lanes negated is multiplied by a vector of
+//! `±1` first (exact). On Talos' `aba_derivatives` after the bench's `contract` pipeline,
+//! mixed packs take the packs from 5,856 to 6,412.
 //!
 //! **Order.** A pack is written where its last member is in the body; its members are read as
 //! scalars from there on. A pack is kept only when every reader of a member that is not a pack
@@ -24,9 +37,10 @@
 //! where its own last member is); the others are dissolved, until none is left to dissolve (a
 //! dissolved pack's members are scalars again, where they were).
 //!
-//! **Bits.** Every lane computes the scalar op of its member on that member's operands, so the
-//! code computes bit for bit what the one-state code computes (the fused ops through one vector
-//! FMA instruction where the target has one, C99 `fma` per lane otherwise).
+//! **Bits.** Every lane computes the scalar op of its member on that member's operands (in a
+//! mixed pack, an FMA of the same bits), so the code computes bit for bit what the one-state
+//! code computes (the fused ops through one vector FMA instruction where the target has one,
+//! C99 `fma` per lane otherwise).
 //!
 //! Cost: O(values + operands) to seed and build (each value is claimed once) and to dissolve
 //! (each pack is dissolved once; a dissolution looks again at the packs of its members'
@@ -34,42 +48,106 @@
 
 use std::collections::HashMap;
 
-use robovec_ir::{Def, Function, Intrinsic, Operand, Value};
+use robovec_ir::{BinOp, Def, Function, Intrinsic, Operand, Value};
 
 /// Lanes of a pack.
 pub(crate) const LANES: usize = 4;
+
+/// One lane's operand of a pack's vector op: the operand, and whether the op reads it negated.
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub(crate) struct Arg {
+    /// The operand.
+    pub x: Operand,
+    /// Read as `−x` (exact).
+    pub neg: bool,
+}
+
+/// The vector op of a pack.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum PackOp {
+    /// One binary operator in every lane.
+    Binary(BinOp),
+    /// `a·b + c`, one rounding, in every lane (module doc, "Mixed packs").
+    Fma,
+}
+
+/// A pack's vector op and its operands: `args[k][l]` is operand position `k` of lane `l`.
+#[derive(Clone, Debug)]
+pub(crate) struct Shape {
+    /// The vector op.
+    pub op: PackOp,
+    /// Per operand position, its four lanes.
+    pub args: Vec<[Arg; LANES]>,
+}
+
+impl Shape {
+    /// Operand position `k`'s four operands, lane by lane, without their signs.
+    pub(crate) fn operands(&self, k: usize) -> [Operand; LANES] {
+        self.args[k].map(|a| a.x)
+    }
+}
 
 /// The packs of one function.
 #[derive(Debug, Default)]
 pub(crate) struct Packs {
     /// Each live pack's members, lane 0 first.
     pub members: Vec<[Value; LANES]>,
+    /// Each live pack's op and operands (beside `members`).
+    pub shapes: Vec<Shape>,
     /// By value index: the live pack and lane of a member.
     pub of: HashMap<usize, (usize, usize)>,
 }
 
-/// What a value's op is, for isomorphism: the binary operator or the fused intrinsic.
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-enum Kind {
-    Binary(robovec_ir::BinOp),
-    Fused(Intrinsic),
-}
-
-fn kind(f: &Function, v: Value) -> Option<Kind> {
+/// A value's op as `a·b + c` with one rounding and the same bits (module doc, "Mixed packs"):
+/// its orientations (a sum has two: either addend may be the product's `a`), or none when it
+/// is not a product, sum, difference or fused intrinsic.
+fn fma_forms(f: &Function, v: Value) -> Vec<[Arg; 3]> {
+    let arg = |x: Operand| Arg { x, neg: false };
+    let negated = |x: Operand| Arg { x, neg: true };
+    let one = arg(Operand::Const(1.0));
     match &f.value(v).def {
-        Def::Binary(op, ..) => Some(Kind::Binary(*op)),
-        Def::Call(c, args) => Intrinsic::of(c, args.len()).filter(|i| i.is_fused()).map(Kind::Fused),
-        _ => None,
+        Def::Binary(BinOp::Mul, a, b) => vec![[arg(*a), arg(*b), arg(Operand::Const(-0.0))]],
+        Def::Binary(BinOp::Add, a, b) => vec![[arg(*a), one, arg(*b)], [arg(*b), one, arg(*a)]],
+        Def::Binary(BinOp::Sub, a, b) => vec![[arg(*a), one, negated(*b)], [negated(*b), one, arg(*a)]],
+        Def::Call(c, x) => match Intrinsic::of(c, x.len()) {
+            Some(Intrinsic::Fma) => vec![[arg(x[0]), arg(x[1]), arg(x[2])]],
+            Some(Intrinsic::Fms) => vec![[arg(x[0]), arg(x[1]), negated(x[2])]],
+            Some(Intrinsic::Fnma) => vec![[negated(x[0]), arg(x[1]), arg(x[2])]],
+            _ => Vec::new(),
+        },
+        _ => Vec::new(),
     }
 }
 
-fn operands(f: &Function, v: Value) -> Vec<Operand> {
-    f.value(v).def.operands()
+/// Whether an operand is an op of the family [`fma_forms`] writes (for choosing a sum's
+/// orientation: like with like).
+fn is_arith(f: &Function, x: Operand) -> bool {
+    matches!(x, Operand::Value(v) if !fma_forms(f, v).is_empty())
 }
 
-/// Operand position `k` of four values, lane by lane.
-pub(crate) fn operand_group(f: &Function, lanes: &[Value; LANES], k: usize) -> Vec<Operand> {
-    lanes.iter().map(|&v| operands(f, v)[k]).collect()
+/// The shape of four values as one pack: the same binary operator in every lane, or else each
+/// lane as `a·b + c` (a sum's orientation chosen to match the first lane that has one only,
+/// operand by operand); `None` when a lane is neither.
+pub(crate) fn shape(f: &Function, lanes: &[Value; LANES]) -> Option<Shape> {
+    let binary = |v: Value| match f.value(v).def {
+        Def::Binary(op, ..) => Some(op),
+        _ => None,
+    };
+    if let Some(op) = binary(lanes[0]).filter(|&op| lanes.iter().all(|&v| binary(v) == Some(op))) {
+        let args = (0..2).map(|k| lanes.map(|v| Arg { x: f.value(v).def.operands()[k], neg: false })).collect();
+        return Some(Shape { op: PackOp::Binary(op), args });
+    }
+    let forms: Vec<Vec<[Arg; 3]>> = lanes.iter().map(|&v| fma_forms(f, v)).collect();
+    if forms.iter().any(|x| x.is_empty()) {
+        return None;
+    }
+    let reference = forms.iter().find(|x| x.len() == 1).map_or(forms[0][0], |x| x[0]);
+    let like =
+        |form: &[Arg; 3]| [0, 2].iter().filter(|&&k| is_arith(f, form[k].x) == is_arith(f, reference[k].x)).count();
+    let chosen: Vec<[Arg; 3]> =
+        forms.iter().map(|x| *x.iter().rev().max_by_key(|form| like(form)).expect("at least one form")).collect();
+    let args = (0..3).map(|k| [0, 1, 2, 3].map(|l| chosen[l][k])).collect();
+    Some(Shape { op: PackOp::Fma, args })
 }
 
 /// The output name without its last index (`ddq_dq[3]` for `ddq_dq[3][7]`) and that index,
@@ -90,16 +168,17 @@ impl Packs {
             pos[v.index()] = p;
         }
         let mut claimed: Vec<Option<usize>> = vec![None; n];
-        let group = |lanes: &[Value; LANES], k: usize| operand_group(f, lanes, k);
         let mut packs: Vec<[Value; LANES]> = Vec::new();
-        // A candidate: four distinct ops of one kind, none claimed.
-        let fits = |lanes: &[Value; LANES], claimed: &[Option<usize>]| {
-            let k = kind(f, lanes[0]);
-            k.is_some()
-                && lanes
-                    .iter()
-                    .all(|&v| kind(f, v) == k && claimed[v.index()].is_none() && pos[v.index()] != usize::MAX)
-                && (0..LANES).all(|a| (a + 1..LANES).all(|b| lanes[a] != lanes[b]))
+        let mut shapes: Vec<Shape> = Vec::new();
+        // A candidate: four distinct ops of one shape, none claimed, in the body.
+        let fits = |lanes: &[Value; LANES], claimed: &[Option<usize>]| -> Option<Shape> {
+            let free = lanes.iter().all(|&v| claimed[v.index()].is_none() && pos[v.index()] != usize::MAX)
+                && (0..LANES).all(|a| (a + 1..LANES).all(|b| lanes[a] != lanes[b]));
+            if free {
+                shape(f, lanes)
+            } else {
+                None
+            }
         };
         // Seeds: four outputs in a row of a matrix, consecutive columns.
         let mut seeds: Vec<[Value; LANES]> = Vec::new();
@@ -130,36 +209,39 @@ impl Packs {
         // Build from the seeds, breadth first (no recursion: chains are thousands of ops deep).
         let mut work: std::collections::VecDeque<[Value; LANES]> = seeds.into();
         while let Some(lanes) = work.pop_front() {
-            if !fits(&lanes, &claimed) {
-                continue;
-            }
+            let Some(sh) = fits(&lanes, &claimed) else { continue };
             let id = packs.len();
             for v in lanes {
                 claimed[v.index()] = Some(id);
             }
-            packs.push(lanes);
-            for k in 0..operands(f, lanes[0]).len() {
-                let g = group(&lanes, k);
+            for k in 0..sh.args.len() {
+                let g = sh.operands(k);
                 if g.iter().all(|x| *x == g[0]) {
                     continue;
                 }
-                if let [Operand::Value(a), Operand::Value(b), Operand::Value(c), Operand::Value(d)] = g[..] {
+                if let [Operand::Value(a), Operand::Value(b), Operand::Value(c), Operand::Value(d)] = g {
                     work.push_back([a, b, c, d]);
                 }
             }
+            packs.push(lanes);
+            shapes.push(sh);
         }
         // Drop packs with more than one gathered operand position, children (built later) first.
+        // Four equal operands are one scalar, four constants one vector constant: neither is
+        // gathered.
         let mut live = vec![true; packs.len()];
-        let is_pack_operand = |group: &[Operand], claimed: &[Option<usize>], live: &[bool]| -> bool {
+        let is_pack_operand = |group: &[Operand; LANES], claimed: &[Option<usize>], live: &[bool]| -> bool {
             let Operand::Value(first) = group[0] else { return false };
             let Some(q) = claimed[first.index()] else { return false };
             live[q] && group.iter().enumerate().all(|(l, x)| *x == Operand::Value(packs[q][l]))
         };
         for id in (0..packs.len()).rev() {
-            let gathered = (0..operands(f, packs[id][0]).len())
+            let gathered = (0..shapes[id].args.len())
                 .filter(|&k| {
-                    let g = group(&packs[id], k);
-                    !g.iter().all(|x| *x == g[0]) && !is_pack_operand(&g, &claimed, &live)
+                    let g = shapes[id].operands(k);
+                    !g.iter().all(|x| *x == g[0])
+                        && !g.iter().all(|x| matches!(x, Operand::Const(_)))
+                        && !is_pack_operand(&g, &claimed, &live)
                 })
                 .count();
             if gathered > 1 {
@@ -193,8 +275,9 @@ impl Packs {
                         // Read lane for lane as a whole operand of pack q: ordered by construction.
                         let lane_of_r = packs[q].iter().position(|x| *x == r).expect("a member");
                         let whole = lane_of_r == lane
-                            && operands(f, r).iter().enumerate().any(|(k, x)| {
-                                *x == Operand::Value(*m) && is_pack_operand(&group(&packs[q], k), &claimed, &live)
+                            && (0..shapes[q].args.len()).any(|k| {
+                                shapes[q].args[k][lane].x == Operand::Value(*m)
+                                    && is_pack_operand(&shapes[q].operands(k), &claimed, &live)
                             });
                         if whole {
                             return false;
@@ -215,13 +298,14 @@ impl Packs {
             }
         }
         let mut out = Packs::default();
-        for (id, lanes) in packs.into_iter().enumerate() {
+        for ((id, lanes), sh) in packs.into_iter().enumerate().zip(shapes) {
             if live[id] {
                 let new = out.members.len();
                 for (l, v) in lanes.iter().enumerate() {
                     out.of.insert(v.index(), (new, l));
                 }
                 out.members.push(lanes);
+                out.shapes.push(sh);
             }
         }
         out
@@ -277,6 +361,32 @@ mod tests {
         let sets: Vec<Vec<String>> =
             p.members.iter().map(|m| m.iter().map(|&v| f.value(v).name.clone()).collect()).collect();
         assert_eq!(sets, vec![vec!["y1".to_string(), "y2".into(), "y3".into(), "y4".into()]]);
+    }
+
+    /// Four columns whose ops differ (a fused multiply-add, a product, a sum, a difference) have
+    /// one shape of `a·b + c` forms: the product with `−0`, the sum and the difference through
+    /// `1`, a difference's subtrahend negated; with a division they have none. (Packed only
+    /// where their operands are packs too: `tests/codegen_c.rs` runs such code.)
+    #[test]
+    fn mixed_columns_pack_as_fused_multiply_adds() {
+        let text = "func @f {\n  phase atomised\n  input %a\n  input %c\n  input %x1\n  input %x2\n  \
+                    input %x3\n  input %x4\n  %y1 = call @fma(%a, %x1, %c)\n  %y2 = mul %a, %x2\n  \
+                    %y3 = add %x3, %c\n  %y4 = sub %x4, %c\n  output y[1][1] = %y1\n  output y[1][2] = %y2\n  \
+                    output y[1][3] = %y3\n  output y[1][4] = %y4\n}\n";
+        let f = parse(text);
+        let lanes = |f: &Function| ["y1", "y2", "y3", "y4"].map(|y| f.lookup(y).expect("a value"));
+        let sh = shape(&f, &lanes(&f)).expect("one shape");
+        assert_eq!(sh.op, PackOp::Fma);
+        let v = |name: &str| Operand::Value(f.lookup(name).expect("a value"));
+        let arg = |x: Operand, neg: bool| Arg { x, neg };
+        let k = |c: f64| Operand::Const(c);
+        assert_eq!(sh.args[0], [arg(v("a"), false), arg(v("a"), false), arg(v("x3"), false), arg(v("x4"), false)]);
+        assert_eq!(sh.args[1], [arg(v("x1"), false), arg(v("x2"), false), arg(k(1.0), false), arg(k(1.0), false)]);
+        assert_eq!(sh.args[2][..2], [arg(v("c"), false), arg(k(-0.0), false)]);
+        assert!(matches!(sh.args[2][1].x, Operand::Const(z) if z == 0.0 && z.is_sign_negative()), "−0, not +0");
+        assert_eq!(sh.args[2][2..], [arg(v("c"), false), arg(v("c"), true)]);
+        let f = parse(&text.replace("%y4 = sub %x4, %c", "%y4 = div %x4, %c"));
+        assert!(shape(&f, &lanes(&f)).is_none());
     }
 
     /// Different operators, or fewer than four columns in a row, make no pack.
