@@ -12,7 +12,13 @@
 //! [`Shape`]: the same binary operator in every lane, or else each lane written as `a·b + c`
 //! with one rounding (*mixed packs*, below). Seeds are the outputs in their order, four at a
 //! time among those named `X[…][j]` that differ in the last index only (a row of a matrix, four
-//! consecutive columns). From a pack, each operand position gives four operands: equal ones
+//! consecutive columns), cut at the same columns in every row: the first a multiple of four
+//! columns from the first column of any matrix. (A row's run of non-zero entries starts at
+//! the first column it depends on; cut from there, rows would group the per-column values
+//! they share differently, and a pack of one grouping reads another's lanes only by gathering
+//! them.) The operands of `+`, `×` and `a·b` are put in the order that lines each lane up with
+//! lane 0, by what they are (constant, input, operator) and their names without trailing
+//! indices, as LLVM's SLP vectoriser reorders commutative operands. From a pack, each operand position gives four operands: equal ones
 //! are *broadcast* (a scalar, which the C vector extensions spread over the lanes), four ops
 //! that have a shape become a pack in turn, four constants are one vector constant, and
 //! anything else is *gathered* lane by lane. A pack with more than one gathered operand
@@ -28,8 +34,12 @@
 //! is exact: `x·1` is `x`, negation is exact, and `x·y + (−0)` rounds the exact `x·y` once
 //! with the sign of a zero product kept (`+0 + −0 = +0`, `−0 + −0 = −0`; `+0` would turn a
 //! `−0` product into `+0`). A pack read with some lanes negated is multiplied by a vector of
-//! `±1` first (exact). On Talos' `aba_derivatives` after the bench's `contract` pipeline,
-//! mixed packs take the packs from 5,856 to 6,412.
+//! `±1` first (exact).
+//!
+//! **How many.** Talos on the free flyer after the bench's `atomise,cse,zero-removal,contract,
+//! schedule-cpu`: `aba_derivatives` 5,856 packs before mixed packs, 6,412 with them, 7,264 with
+//! the aligned seeds and the operand order as well; `rnea_derivatives` 494 → 1,038, `minv` 480
+//! → 840 (Solo-12's `aba_derivatives` 465 → 610).
 //!
 //! **Order.** A pack is written where its last member is in the body; its members are read as
 //! scalars from there on. A pack is kept only when every reader of a member that is not a pack
@@ -119,33 +129,67 @@ fn fma_forms(f: &Function, v: Value) -> Vec<[Arg; 3]> {
     }
 }
 
-/// Whether an operand is an op of the family [`fma_forms`] writes (for choosing a sum's
-/// orientation: like with like).
-fn is_arith(f: &Function, x: Operand) -> bool {
-    matches!(x, Operand::Value(v) if !fma_forms(f, v).is_empty())
+/// What an operand is, for lining up the lanes of a pack (never for what it computes): a
+/// constant, an input, a trig variable or an op of one operator or intrinsic, with its name
+/// up to its trailing indices (`Va` for `Va2_24`, the body or column index dropped).
+fn signature(f: &Function, x: Operand) -> (u32, &str) {
+    let Operand::Value(v) = x else { return (0, "") };
+    let data = f.value(v);
+    let kind = match &data.def {
+        Def::Input => 1,
+        Def::Trig(..) => 2,
+        Def::Binary(op, ..) => 3 + *op as u32,
+        Def::Call(c, a) => Intrinsic::of(c, a.len()).map_or(20, |i| 10 + i as u32),
+        Def::Expr(_) => 21,
+    };
+    (kind, data.name.trim_end_matches(|c: char| c.is_ascii_digit() || "_.[]".contains(c)))
+}
+
+/// The orientation of lane `form` that matches `reference` in the most operand positions
+/// (by [`signature`]); the first of equals.
+fn best<'a, const N: usize>(f: &Function, reference: &[Arg; N], forms: &'a [[Arg; N]]) -> &'a [Arg; N] {
+    let like = |form: &[Arg; N]| (0..N).filter(|&k| signature(f, form[k].x) == signature(f, reference[k].x)).count();
+    forms.iter().rev().max_by_key(|form| like(form)).expect("at least one form")
 }
 
 /// The shape of four values as one pack: the same binary operator in every lane, or else each
-/// lane as `a·b + c` (a sum's orientation chosen to match the first lane that has one only,
-/// operand by operand); `None` when a lane is neither.
+/// lane as `a·b + c`; `None` when a lane is neither. Commutative operands (`+`, `×`, `a·b`)
+/// and a sum's addends are put in the order that lines each lane up with lane 0 (as LLVM's
+/// SLP vectoriser reorders the operands of commutative ops), so that their operands make
+/// packs in turn.
 pub(crate) fn shape(f: &Function, lanes: &[Value; LANES]) -> Option<Shape> {
     let binary = |v: Value| match f.value(v).def {
         Def::Binary(op, ..) => Some(op),
         _ => None,
     };
     if let Some(op) = binary(lanes[0]).filter(|&op| lanes.iter().all(|&v| binary(v) == Some(op))) {
-        let args = (0..2).map(|k| lanes.map(|v| Arg { x: f.value(v).def.operands()[k], neg: false })).collect();
+        let arg = |x: Operand| Arg { x, neg: false };
+        let forms: Vec<Vec<[Arg; 2]>> = lanes
+            .iter()
+            .map(|&v| {
+                let o = f.value(v).def.operands();
+                let mut forms = vec![[arg(o[0]), arg(o[1])]];
+                if matches!(op, BinOp::Add | BinOp::Mul) {
+                    forms.push([arg(o[1]), arg(o[0])]);
+                }
+                forms
+            })
+            .collect();
+        let chosen: Vec<[Arg; 2]> = forms.iter().map(|x| *best(f, &forms[0][0], x)).collect();
+        let args = (0..2).map(|k| [0, 1, 2, 3].map(|l| chosen[l][k])).collect();
         return Some(Shape { op: PackOp::Binary(op), args });
     }
-    let forms: Vec<Vec<[Arg; 3]>> = lanes.iter().map(|&v| fma_forms(f, v)).collect();
+    let mut forms: Vec<Vec<[Arg; 3]>> = lanes.iter().map(|&v| fma_forms(f, v)).collect();
     if forms.iter().any(|x| x.is_empty()) {
         return None;
     }
-    let reference = forms.iter().find(|x| x.len() == 1).map_or(forms[0][0], |x| x[0]);
-    let like =
-        |form: &[Arg; 3]| [0, 2].iter().filter(|&&k| is_arith(f, form[k].x) == is_arith(f, reference[k].x)).count();
-    let chosen: Vec<[Arg; 3]> =
-        forms.iter().map(|x| *x.iter().rev().max_by_key(|form| like(form)).expect("at least one form")).collect();
+    // `a·b` commutes; a negation stays with the product: `(−a)·b = (−b)·a`.
+    for x in forms.iter_mut() {
+        let swapped: Vec<[Arg; 3]> =
+            x.iter().map(|[a, b, c]| [Arg { x: b.x, neg: a.neg }, Arg { x: a.x, neg: b.neg }, *c]).collect();
+        x.extend(swapped);
+    }
+    let chosen: Vec<[Arg; 3]> = forms.iter().map(|x| *best(f, &forms[0][0], x)).collect();
     let args = (0..3).map(|k| [0, 1, 2, 3].map(|l| chosen[l][k])).collect();
     Some(Shape { op: PackOp::Fma, args })
 }
@@ -180,13 +224,19 @@ impl Packs {
                 None
             }
         };
-        // Seeds: four outputs in a row of a matrix, consecutive columns.
+        // Seeds: four outputs in a row of a matrix, consecutive columns, the first a multiple of
+        // four columns from the first column of any matrix (every row cut at the same columns,
+        // so that the rows' packs read the same packs of per-column values).
         let mut seeds: Vec<[Value; LANES]> = Vec::new();
         let outs = &f.outputs;
+        let first = outs.iter().filter_map(|o| row_and_column(&o.name)).map(|(_, c)| c).min().unwrap_or(0);
         let mut i = 0;
         while i + LANES <= outs.len() {
             let group: Option<[Value; LANES]> = (|| {
                 let (row, c0) = row_and_column(&outs[i].name)?;
+                if (c0 - first) % LANES as u64 != 0 {
+                    return None;
+                }
                 let mut lanes = [Value::with_number(0); LANES];
                 for (l, lane) in lanes.iter_mut().enumerate() {
                     let (r, c) = row_and_column(&outs[i + l].name)?;
@@ -380,13 +430,54 @@ mod tests {
         let v = |name: &str| Operand::Value(f.lookup(name).expect("a value"));
         let arg = |x: Operand, neg: bool| Arg { x, neg };
         let k = |c: f64| Operand::Const(c);
-        assert_eq!(sh.args[0], [arg(v("a"), false), arg(v("a"), false), arg(v("x3"), false), arg(v("x4"), false)]);
-        assert_eq!(sh.args[1], [arg(v("x1"), false), arg(v("x2"), false), arg(k(1.0), false), arg(k(1.0), false)]);
+        // The sum and the difference as `1·x + …`: their `x` lines up with lane 0's `x1`.
+        assert_eq!(sh.args[0], [arg(v("a"), false), arg(v("a"), false), arg(k(1.0), false), arg(k(1.0), false)]);
+        assert_eq!(sh.args[1], [arg(v("x1"), false), arg(v("x2"), false), arg(v("x3"), false), arg(v("x4"), false)]);
         assert_eq!(sh.args[2][..2], [arg(v("c"), false), arg(k(-0.0), false)]);
         assert!(matches!(sh.args[2][1].x, Operand::Const(z) if z == 0.0 && z.is_sign_negative()), "−0, not +0");
         assert_eq!(sh.args[2][2..], [arg(v("c"), false), arg(v("c"), true)]);
         let f = parse(&text.replace("%y4 = sub %x4, %c", "%y4 = div %x4, %c"));
         assert!(shape(&f, &lanes(&f)).is_none());
+    }
+
+    /// Two rows over the same per-column products `p_j`: row 1 from column 1, row 2 from
+    /// column 2. Seeds are cut at columns 1 and 5 in both rows, so row 2's pack of columns
+    /// 5..8 reads the products' pack of row 1 whole (cut from column 2, it would gather
+    /// `p2..p5`); in row 2 the product's operands are written the other way round in two
+    /// lanes and are lined up with lane 0.
+    #[test]
+    fn rows_are_cut_at_the_same_columns_and_commutative_operands_line_up() {
+        let mut t = String::from("func @f {\n  phase atomised\n  input %a\n  input %b\n");
+        for j in 1..=8 {
+            t += &format!("  input %x{j}\n  %p{j} = mul %x{j}, %a\n  %y{j} = add %p{j}, %a\n");
+        }
+        for j in 2..=8 {
+            let z = if j % 2 == 0 { format!("mul %b, %p{j}") } else { format!("mul %p{j}, %b") };
+            t += &format!("  %z{j} = {z}\n");
+        }
+        for j in 1..=8 {
+            t += &format!("  output y[1][{j}] = %y{j}\n");
+        }
+        for j in 2..=8 {
+            t += &format!("  output y[2][{j}] = %z{j}\n");
+        }
+        t += "}\n";
+        let f = parse(&t);
+        let p = Packs::find(&f);
+        let name = |v: Value| f.value(v).name.clone();
+        let sets: Vec<Vec<String>> = p.members.iter().map(|m| m.iter().map(|&v| name(v)).collect()).collect();
+        let want = |xs: [&str; 4]| xs.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+        for set in [["y1", "y2", "y3", "y4"], ["y5", "y6", "y7", "y8"], ["z5", "z6", "z7", "z8"]] {
+            assert!(sets.contains(&want(set)), "{sets:?}");
+        }
+        assert!(sets.contains(&want(["p5", "p6", "p7", "p8"])), "{sets:?}");
+        let z = sets.iter().position(|s| s[0] == "z5").expect("the pack of z5..z8");
+        let sh = &p.shapes[z];
+        let (products, scalars) =
+            if matches!(sh.args[0][0].x, Operand::Value(v) if name(v) == "p5") { (0, 1) } else { (1, 0) };
+        assert!(p.whole(&sh.operands(products)).is_some(), "{sh:?}");
+        assert!(sh.operands(scalars).iter().all(|x| matches!(x, Operand::Value(v) if name(*v) == "b")), "{sh:?}");
+        assert!(!sets.iter().any(|s| s.contains(&"z2".to_string())), "z2..z4 is three columns");
     }
 
     /// Different operators, or fewer than four columns in a row, make no pack.
