@@ -951,11 +951,23 @@ fn slp_packs_equal_the_interpreter_bit_for_bit() {
     assert!(code.contains("robovec_fma4(&"), "{code}");
     assert!(code.contains("* (robovec_v4){1.0, 1.0, 1.0, -1.0}"), "{code}");
     assert!(code.contains("(-0x0p+0)"), "{code}");
-    let cases = vec![Case { label: "mixed lanes".into(), m }];
+    // Sums and differences only: a vector product by 1 then a vector sum, no FMA, the
+    // subtrahends through a vector of signs.
+    let addsub = t
+        .replace("%y1 = call @fma(%p1, %q1, %r1)", "%y1 = add %p1, %q1")
+        .replace("%y2 = mul %p2, %q2", "%y2 = sub %p2, %q2")
+        .replace("%y3 = call @fms(%p3, %q3, %r3)", "%y3 = add %q3, %p3")
+        .replace("%y4 = call @fnma(%p4, %q4, %r4)", "%y4 = sub %p4, %q4")
+        .replace("func @mixed", "func @addsub");
+    let m2 = robovec_ir::text::parse(&addsub).unwrap_or_else(|e| panic!("{e:?}"));
+    let code2 = o.emit(&m2).unwrap().code.main;
+    assert!(!code2.contains("robovec_fma4(&robovec_p"), "{code2}");
+    assert!(code2.contains("* (robovec_v4){1.0, -1.0, 1.0, -1.0}"), "{code2}");
+    let cases = vec![Case { label: "mixed lanes".into(), m }, Case { label: "sums and differences".into(), m: m2 }];
     let dir = tmp("slp_mixed");
     for extra in [&["-O1"][..], &["-O1", "cc=clang", "-march=native"], &["-O1", "-march=native"]] {
         for seed in 0..3 {
-            assert_eq!(check_plain_with::<f64>(&dir, &cases, &o, seed, extra), 4);
+            assert_eq!(check_plain_with::<f64>(&dir, &cases, &o, seed, extra), 8);
         }
     }
     for bad in ["slp=4;batch=4", "slp=4;precision=f32"] {

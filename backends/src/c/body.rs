@@ -423,14 +423,14 @@ impl<'a> Body<'a> {
                 let expr = format!("{} {op} {}", side(0, &a, true), side(1, &b, !same(&a)));
                 let _ = writeln!(s, "  const robovec_v4 {pack} = {expr};");
             }
-            PackOp::Fma => {
+            PackOp::Fma | PackOp::MulAdd => {
                 let mut args = Vec::with_capacity(3);
                 for k in 0..3 {
                     let g = &shape.args[k];
                     let arg = match earlier(&shape.operands(k)) {
                         Some(name) if g.iter().all(|a| a.neg) => {
                             let _ = writeln!(s, "  const robovec_v4 {pack}_n{k} = -{name};");
-                            format!("&{pack}_n{k}")
+                            format!("{pack}_n{k}")
                         }
                         Some(name) if g.iter().any(|a| a.neg) => {
                             let signs: Vec<&str> = g.iter().map(|a| if a.neg { "-1.0" } else { "1.0" }).collect();
@@ -439,14 +439,19 @@ impl<'a> Body<'a> {
                                 "  const robovec_v4 {pack}_n{k} = {name} * (robovec_v4){{{}}};",
                                 signs.join(", ")
                             );
-                            format!("&{pack}_n{k}")
+                            format!("{pack}_n{k}")
                         }
-                        Some(name) => format!("&{name}"),
-                        None => format!("&{}", lanes(g)),
+                        Some(name) => name,
+                        None => lanes(g),
                     };
                     args.push(arg);
                 }
-                let _ = writeln!(s, "  robovec_v4 {pack};\n  robovec_fma4(&{pack}, {});", args.join(", "));
+                if shape.op == PackOp::Fma {
+                    let args: Vec<String> = args.iter().map(|a| format!("&{a}")).collect();
+                    let _ = writeln!(s, "  robovec_v4 {pack};\n  robovec_fma4(&{pack}, {});", args.join(", "));
+                } else {
+                    let _ = writeln!(s, "  const robovec_v4 {pack} = {} * {} + {};", args[0], args[1], args[2]);
+                }
             }
         }
         for (l, &m) in members.iter().enumerate() {

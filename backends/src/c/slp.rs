@@ -33,17 +33,21 @@
 //! hold a fused op beside a product or a sum. Each lane is then one vector FMA's lane:
 //! `@fma(a, b, c)` as it is, `@fms(a, b, c)` as `a·b + (−c)`, `@fnma(a, b, c)` as `(−a)·b + c`,
 //! `x·y` as `x·y + (−0)`, `x + y` as `x·1 + y` and `x − y` as `x·1 + (−y)` (a sum or a
-//! difference either way round: the one whose addend is like the other lanes' is taken). Each
+//! difference either way round, and `a·b` as `b·a`: the orientation most like lane 0's). Each
 //! is exact: `x·1` is `x`, negation is exact, and `x·y + (−0)` rounds the exact `x·y` once
 //! with the sign of a zero product kept (`+0 + −0 = +0`, `−0 + −0 = −0`; `+0` would turn a
 //! `−0` product into `+0`). A pack read with some lanes negated is multiplied by a vector of
-//! `±1` first (exact).
+//! `±1` first (exact). A mixed pack without a fused lane is written as a vector product then
+//! a vector sum, not an FMA: in each lane one of the two is exact (a factor 1, an addend −0),
+//! so the bits are the same, and a target without FMA does not call C99 `fma` four times
+//! where the scalar code calls it never.
 //!
-//! **How many.** Talos on the free flyer after the bench's `atomise,cse,zero-removal,contract,
-//! schedule-cpu`: `aba_derivatives` 5,856 packs before mixed packs, 6,412 with them, 7,264 with
-//! the aligned seeds and the operand order as well; `rnea_derivatives` 494 → 1,038, `minv` 480
-//! → 840. Solo-12's `rnea_derivatives`: none before, 765 with the isomorphic seeds (its legs),
-//! and one state 1.12–1.15× as fast as without `slp` (paired, two invocations of 41 samples).
+//! **How many** (Talos and Solo-12 on the free flyer after the bench's `atomise,cse,
+//! zero-removal,contract,schedule-cpu`, before → after mixed packs, aligned seeds, operand
+//! order and isomorphic seeds): Talos' `aba_derivatives` 5,856 → 7,264 packs,
+//! `rnea_derivatives` 494 → 1,038, `minv` 480 → 840; Solo-12's `rnea_derivatives` none → 765
+//! (its legs), which makes its one state 1.12–1.15× as fast as without `slp` (paired, two
+//! invocations of 41 samples).
 //!
 //! **Order.** A pack is written where its last member is in the body; its members are read as
 //! scalars from there on. A pack is kept only when every reader of a member that is not a pack
@@ -85,6 +89,10 @@ pub(crate) enum PackOp {
     Binary(BinOp),
     /// `a·b + c`, one rounding, in every lane (module doc, "Mixed packs").
     Fma,
+    /// `a·b + c` as a product then a sum, where in every lane one of the two is exact (`a` or
+    /// `b` is ±1, or `c` is −0): lanes of `+ − ×` only, the same bits with or without FMA
+    /// (module doc, "Mixed packs").
+    MulAdd,
 }
 
 /// A pack's vector op and its operands: `args[k][l]` is operand position `k` of lane `l`.
@@ -158,8 +166,8 @@ fn best<'a, const N: usize>(f: &Function, reference: &[Arg; N], forms: &'a [[Arg
     forms.iter().rev().max_by_key(|form| like(form)).expect("at least one form")
 }
 
-/// The shape of four values as one pack: the same binary operator in every lane, or else each
-/// lane as `a·b + c`; `None` when a lane is neither. Commutative operands (`+`, `×`, `a·b`)
+/// The shape of four values as one pack: the same binary operator in every lane, or else, with
+/// a fused intrinsic in one lane at least, each lane as `a·b + c`; `None` otherwise. Commutative operands (`+`, `×`, `a·b`)
 /// and a sum's addends are put in the order that lines each lane up with lane 0 (as LLVM's
 /// SLP vectoriser reorders the operands of commutative ops), so that their operands make
 /// packs in turn.
@@ -185,6 +193,7 @@ pub(crate) fn shape(f: &Function, lanes: &[Value; LANES]) -> Option<Shape> {
         let args = (0..2).map(|k| [0, 1, 2, 3].map(|l| chosen[l][k])).collect();
         return Some(Shape { op: PackOp::Binary(op), args });
     }
+    let fused = |v: Value| matches!(&f.value(v).def, Def::Call(c, a) if Intrinsic::of(c, a.len()).is_some_and(|i| i.is_fused()));
     let mut forms: Vec<Vec<[Arg; 3]>> = lanes.iter().map(|&v| fma_forms(f, v)).collect();
     if forms.iter().any(|x| x.is_empty()) {
         return None;
@@ -197,7 +206,11 @@ pub(crate) fn shape(f: &Function, lanes: &[Value; LANES]) -> Option<Shape> {
     }
     let chosen: Vec<[Arg; 3]> = forms.iter().map(|x| *best(f, &forms[0][0], x)).collect();
     let args = (0..3).map(|k| [0, 1, 2, 3].map(|l| chosen[l][k])).collect();
-    Some(Shape { op: PackOp::Fma, args })
+    // Without a fused lane, a product then a sum (exact in each lane: `fma_forms` writes a
+    // binary op with a factor 1 or an addend −0): on a target without FMA a vector FMA would
+    // be four calls of C99 `fma`.
+    let op = if lanes.iter().any(|&v| fused(v)) { PackOp::Fma } else { PackOp::MulAdd };
+    Some(Shape { op, args })
 }
 
 /// The output name without its last index (`ddq_dq[3]` for `ddq_dq[3][7]`) and that index,
