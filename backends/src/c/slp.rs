@@ -539,6 +539,11 @@ mod tests {
         m.functions.into_iter().next().expect("one function")
     }
 
+    /// The names of each pack's members, lane 0 first.
+    fn member_names(f: &Function, p: &Packs) -> Vec<Vec<String>> {
+        p.members.iter().map(|m| m.iter().map(|&v| f.value(v).name.clone()).collect()).collect()
+    }
+
     /// Four columns of `y = a·x + b` (shared `a`, `b`): one pack of the sums whose products are
     /// a pack too, `a` and `b` broadcast.
     #[test]
@@ -557,8 +562,7 @@ mod tests {
         let f = parse(&t);
         let p = Packs::find(&f);
         assert_eq!(p.members.len(), 2, "{p:?}");
-        let name = |v: Value| f.value(v).name.clone();
-        let sets: Vec<Vec<String>> = p.members.iter().map(|m| m.iter().map(|&v| name(v)).collect()).collect();
+        let sets = member_names(&f, &p);
         assert!(sets.contains(&vec!["y1".into(), "y2".into(), "y3".into(), "y4".into()]));
         assert!(sets.contains(&vec!["p1".into(), "p2".into(), "p3".into(), "p4".into()]));
         // `p1` read by a scalar op before the products' pack is complete (`p4`): the products are
@@ -568,8 +572,7 @@ mod tests {
             .replace("  output y[1][1]", "  output z = %z\n  output y[1][1]");
         let f = parse(&early);
         let p = Packs::find(&f);
-        let sets: Vec<Vec<String>> =
-            p.members.iter().map(|m| m.iter().map(|&v| f.value(v).name.clone()).collect()).collect();
+        let sets = member_names(&f, &p);
         assert_eq!(sets, vec![vec!["y1".to_string(), "y2".into(), "y3".into(), "y4".into()]]);
     }
 
@@ -625,7 +628,7 @@ mod tests {
         let f = parse(&t);
         let p = Packs::find(&f);
         let name = |v: Value| f.value(v).name.clone();
-        let sets: Vec<Vec<String>> = p.members.iter().map(|m| m.iter().map(|&v| name(v)).collect()).collect();
+        let sets = member_names(&f, &p);
         let want = |xs: [&str; 4]| xs.iter().map(|x| x.to_string()).collect::<Vec<_>>();
         for set in [["y1", "y2", "y3", "y4"], ["y5", "y6", "y7", "y8"], ["z5", "z6", "z7", "z8"]] {
             assert!(sets.contains(&want(set)), "{sets:?}");
@@ -655,8 +658,7 @@ mod tests {
         t += "}\n";
         let f = parse(&t);
         let p = Packs::find(&f);
-        let sets: Vec<Vec<String>> =
-            p.members.iter().map(|m| m.iter().map(|&v| f.value(v).name.clone()).collect()).collect();
+        let sets = member_names(&f, &p);
         assert_eq!(sets.len(), 2, "{sets:?}");
         for set in [["y1", "y3", "y5", "y7"], ["y2", "y4", "y6", "y8"]] {
             assert!(sets.contains(&set.iter().map(|x| x.to_string()).collect()), "{sets:?}");
